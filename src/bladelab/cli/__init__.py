@@ -1,0 +1,78 @@
+"""The ``bladelab`` command line.
+
+Each workflow contributes a sub-command module in this package (``bladelab.cli.trial``,
+``bladelab.cli.blade``, ...) that defines ``register(app)``. Errors derived from
+:class:`~bladelab.errors.BladelabError` are printed as one line and exit with status 2; ``--debug``
+shows the traceback instead.
+"""
+
+from __future__ import annotations
+
+import importlib
+import sys
+
+import typer
+
+from bladelab import __version__
+from bladelab.errors import BladelabError
+
+# Sub-command modules, in help order. Each defines ``register(app: typer.Typer) -> None``.
+_COMMAND_MODULES: tuple[str, ...] = ()
+
+app = typer.Typer(
+    name="bladelab",
+    help="Biomechanics of running-specific prostheses: characterise, predict and design blades.",
+    no_args_is_help=True,
+    pretty_exceptions_enable=False,
+    add_completion=False,
+)
+
+_state = {"debug": False}
+
+
+def _version_callback(value: bool) -> None:
+    if value:
+        typer.echo(f"bladelab {__version__}")
+        raise typer.Exit()
+
+
+@app.callback()
+def _root(
+    debug: bool = typer.Option(False, "--debug", help="Show full tracebacks on errors."),
+    version: bool = typer.Option(
+        False, "--version", callback=_version_callback, is_eager=True, help="Print the version."
+    ),
+) -> None:
+    _state["debug"] = debug
+
+
+for _name in _COMMAND_MODULES:
+    importlib.import_module(f"bladelab.cli.{_name}").register(app)
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Entry point of the ``bladelab`` command; returns the exit status.
+
+    Usage errors exit with 2 (typer's own handling); a :class:`BladelabError` prints one line
+    ``error: ...`` on stderr and exits with 2; ``--debug`` re-raises it with its traceback.
+    """
+    args = sys.argv[1:] if argv is None else list(argv)
+    _state["debug"] = "--debug" in args
+    try:
+        app(args=args, prog_name="bladelab")
+    except SystemExit as exit_:
+        code = exit_.code
+        return code if isinstance(code, int) else (0 if code is None else 1)
+    except BladelabError as err:
+        if _state["debug"]:
+            raise
+        typer.echo(f"error: {err}", err=True)
+        return 2
+    except KeyboardInterrupt:
+        typer.echo("interrupted", err=True)
+        return 130
+    return 0
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())
