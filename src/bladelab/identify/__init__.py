@@ -1,0 +1,49 @@
+"""Identification of K* and D* from sprint stances: costs, optimisers, bounds, identifiability.
+
+See ``docs/identification.md``.
+"""
+
+from bladelab.identify.bounds import (
+    DAMPING_BOUNDS_NMS_PER_DEG,
+    ParameterBounds,
+    instantaneous_stiffness,
+    make_bounds,
+    parameter_bounds,
+    stiffness_bounds,
+)
+from bladelab.identify.cost import CostTerms, StanceCost, contact_window, nrmse
+from bladelab.identify.identifiability import (
+    Identifiability,
+    assess_identifiability,
+    cost_landscape,
+)
+from bladelab.identify.optimizers import (
+    CMAES,
+    OptimizeResult,
+    ParticleSwarm,
+    make_optimizer,
+    minimize,
+    polish,
+)
+
+__all__ = [
+    "CMAES",
+    "DAMPING_BOUNDS_NMS_PER_DEG",
+    "CostTerms",
+    "Identifiability",
+    "OptimizeResult",
+    "ParameterBounds",
+    "ParticleSwarm",
+    "StanceCost",
+    "assess_identifiability",
+    "contact_window",
+    "cost_landscape",
+    "instantaneous_stiffness",
+    "make_bounds",
+    "make_optimizer",
+    "minimize",
+    "nrmse",
+    "parameter_bounds",
+    "polish",
+    "stiffness_bounds",
+]
