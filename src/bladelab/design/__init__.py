@@ -1,0 +1,86 @@
+"""Design studies (seed 002): design space, DOE, response surfaces, performance, constraints.
+
+The pieces, each usable on its own:
+
+- :mod:`~bladelab.design.space`: factors coded to [-1, 1] over user ranges;
+- :mod:`~bladelab.design.doe`: central composite, Box–Behnken, D-optimal, user run lists, and the
+  rank/conditioning report of a design for a model;
+- :mod:`~bladelab.design.surfaces`: second-order response surfaces with R², PRESS, ANOVA and
+  intervals;
+- :mod:`~bladelab.design.optimum`: the constrained optimum over the coded box;
+- :mod:`~bladelab.design.performance`: seed 002's performance functions and the bouncing-ball
+  evaluation parameter;
+- :mod:`~bladelab.design.constraints`: knee buckling and blade clearance;
+- :mod:`~bladelab.design.plots`: main-effect and contour plots;
+- :mod:`~bladelab.design.study`: :func:`run_design` ties them to an evaluator.
+"""
+
+from bladelab.design.constraints import (
+    ClearanceResult,
+    KneeBucklingResult,
+    blade_clearance,
+    knee_buckling,
+    knee_extension_moment,
+)
+from bladelab.design.doe import (
+    Design,
+    EstimabilityReport,
+    box_behnken,
+    central_composite,
+    d_optimal,
+    estimability,
+    make_design,
+    read_runs_csv,
+    require_estimable,
+)
+from bladelab.design.optimum import OptimumResult, SurfaceConstraint, constrained_optimum
+from bladelab.design.performance import (
+    CyclePerformance,
+    StancePerformance,
+    bouncing_ball,
+    cycle_performance,
+    performance_by_leg,
+    performance_by_stance,
+    stance_performance,
+)
+from bladelab.design.space import DesignSpace, Factor, default_design_space
+from bladelab.design.study import DesignStudyResult, run_design
+from bladelab.design.surfaces import ResponseSurface, SurfacePrediction, fit_surface
+from bladelab.design.terms import model_terms, parse_terms
+
+__all__ = [
+    "ClearanceResult",
+    "CyclePerformance",
+    "Design",
+    "DesignSpace",
+    "DesignStudyResult",
+    "EstimabilityReport",
+    "Factor",
+    "KneeBucklingResult",
+    "OptimumResult",
+    "ResponseSurface",
+    "StancePerformance",
+    "SurfaceConstraint",
+    "SurfacePrediction",
+    "blade_clearance",
+    "bouncing_ball",
+    "box_behnken",
+    "central_composite",
+    "constrained_optimum",
+    "cycle_performance",
+    "d_optimal",
+    "default_design_space",
+    "estimability",
+    "fit_surface",
+    "knee_buckling",
+    "knee_extension_moment",
+    "make_design",
+    "model_terms",
+    "parse_terms",
+    "performance_by_leg",
+    "performance_by_stance",
+    "read_runs_csv",
+    "require_estimable",
+    "run_design",
+    "stance_performance",
+]

@@ -1,0 +1,319 @@
+"""A design study: evaluate the runs of a design, fit response surfaces, find the optimum.
+
+:func:`run_design` takes an *evaluator*, any callable ``{factor: value} -> {response: value}``
+(the blade or runner simulation; a cheap analytic function in tests), evaluates every run of the
+design with a progress bar and writes each run's result atomically to
+``out_dir/runs/run_NNNN.json`` as soon as it is known, so an interrupted study resumes where it
+stopped. It then writes, atomically:
+
+- ``study.json``: the design space, design kind, model, seed and options;
+- ``results.csv``: one row per run: ``run``, the factors in their units, ``<factor>_coded``, the
+  responses;
+- ``surfaces.json``, ``coefficients.csv``, ``anova.csv``: the fitted surfaces;
+- ``estimability.json``: the rank/conditioning report of the design for the model;
+- ``optimum.json``: the constrained optimum (if an objective is given).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+from tqdm.auto import tqdm
+
+from bladelab._io import atomic_path, write_json
+from bladelab.design.doe import Design, EstimabilityReport, make_design, require_estimable
+from bladelab.design.optimum import OptimumResult, SurfaceConstraint, constrained_optimum
+from bladelab.design.space import DesignSpace
+from bladelab.design.surfaces import ResponseSurface, fit_surface
+from bladelab.design.terms import parse_terms
+from bladelab.errors import BladelabError, DataError, OptimizationError, SpecError
+
+__all__ = ["DesignStudyResult", "run_design"]
+
+Evaluator = Callable[[dict[str, float]], Mapping[str, float]]
+
+
+@dataclass(frozen=True, eq=False)
+class DesignStudyResult:
+    """The outcome of :func:`run_design`.
+
+    Attributes
+    ----------
+    space, design
+        The design space and the design evaluated.
+    table
+        One row per run: ``run``, factors (their units), ``<factor>_coded``, responses.
+    responses
+        Response names, in the evaluator's order.
+    surfaces
+        Response name -> fitted :class:`ResponseSurface`.
+    estimability
+        The design's report for the model.
+    optimum
+        The constrained optimum, or ``None`` (no objective, or no feasible design: see
+        ``optimum_error``).
+    optimum_error
+        Why there is no optimum, if one was asked for.
+    out_dir
+        Where the files were written.
+    n_evaluated, n_resumed
+        Runs evaluated now and runs read back from an earlier, interrupted study.
+    """
+
+    space: DesignSpace
+    design: Design
+    table: pd.DataFrame = field(repr=False)
+    responses: tuple[str, ...]
+    surfaces: dict[str, ResponseSurface] = field(repr=False)
+    estimability: EstimabilityReport
+    optimum: OptimumResult | None
+    optimum_error: str | None
+    out_dir: Path
+    n_evaluated: int
+    n_resumed: int
+
+    def coefficients(self) -> pd.DataFrame:
+        """Tidy coefficient table of all surfaces."""
+        return pd.concat([s.coefficients() for s in self.surfaces.values()], ignore_index=True)
+
+    def anova(self) -> pd.DataFrame:
+        """Tidy ANOVA table of all surfaces."""
+        return pd.concat([s.anova for s in self.surfaces.values()], ignore_index=True)
+
+    def to_dict(self) -> dict:
+        return {
+            "space": self.space.to_dict(),
+            "design": {"kind": self.design.kind, "n_runs": self.design.n_runs},
+            "responses": list(self.responses),
+            "estimability": self.estimability.to_dict(),
+            "surfaces": {k: s.to_dict() for k, s in self.surfaces.items()},
+            "optimum": None if self.optimum is None else self.optimum.to_dict(),
+            "optimum_error": self.optimum_error,
+            "out_dir": str(self.out_dir),
+            "n_evaluated": self.n_evaluated,
+            "n_resumed": self.n_resumed,
+        }
+
+
+def _run_file(out_dir: Path, i: int) -> Path:
+    return out_dir / "runs" / f"run_{i + 1:04d}.json"
+
+
+def _read_run(path: Path, coded: np.ndarray) -> dict[str, float] | None:
+    """Responses of a finished run, or None if absent; error if it belongs to another study."""
+    if not path.is_file():
+        return None
+    try:
+        data = json.loads(path.read_text(encoding="utf-8"))
+        stored = np.asarray(data["coded"], dtype=float)
+        responses = {str(k): float(v) for k, v in data["responses"].items()}
+    except (OSError, ValueError, KeyError, TypeError):
+        return None  # unreadable: evaluate again (it is rewritten atomically)
+    if stored.shape != coded.shape or not np.allclose(stored, coded, atol=1e-9):
+        raise SpecError(
+            "the output folder holds a run of a different design",
+            file=path,
+            hint="use a new output folder, or delete its runs/ folder to start over",
+        )
+    return responses
+
+
+def _check_responses(
+    raw: object, run: int, expected: Sequence[str] | None
+) -> dict[str, float]:
+    if not isinstance(raw, Mapping) or not raw:
+        raise DataError(
+            f"the evaluator returned {type(raw).__name__}, not a non-empty mapping",
+            where=f"run {run}",
+            hint="an evaluator returns {response_name: value}",
+        )
+    out = {}
+    for k, v in raw.items():
+        try:
+            fv = float(v)
+        except (TypeError, ValueError):
+            raise DataError(f"response {k!r} = {v!r} is not a number", where=f"run {run}") from None
+        if not math.isfinite(fv):
+            raise DataError(
+                f"response {k!r} is not finite ({fv})", where=f"run {run}",
+                hint="the simulation of this design point failed; check the evaluator",
+            )
+        out[str(k)] = fv
+    if expected is not None and list(out) != list(expected):
+        missing = [k for k in expected if k not in out]
+        extra = [k for k in out if k not in expected]
+        if missing or extra:
+            raise DataError(
+                f"responses differ from the first run's (missing {missing}, extra {extra})",
+                where=f"run {run}",
+            )
+        out = {k: out[k] for k in expected}
+    return out
+
+
+def run_design(
+    space: DesignSpace,
+    *,
+    runs: str | Path | Design | np.ndarray = "ccd",
+    evaluator: Evaluator,
+    out_dir: str | Path,
+    seed: int = 0,
+    model: str | Sequence = "quadratic",
+    n_runs: int | None = None,
+    n_center: int = 1,
+    objective: str | None = None,
+    sense: str = "max",
+    constraints: Mapping[str, float] | None = None,
+    units: Mapping[str, str] | None = None,
+    conservative: bool = False,
+    progress: bool = True,
+) -> DesignStudyResult:
+    """Evaluate a design, fit a surface per response and find the constrained optimum.
+
+    Parameters
+    ----------
+    space
+        The design factors and their ranges.
+    runs
+        ``"ccd"`` (face-centred central composite, default), ``"bbd"``, ``"dopt"``, a CSV path
+        of runs (see :func:`~bladelab.design.doe.read_runs_csv`), a Design or coded points.
+    evaluator
+        ``{factor: value in its unit} -> {response: value}``; called once per run.
+    out_dir
+        Output folder (created); a folder of an interrupted study with the same design resumes.
+    seed
+        Seed of the D-optimal design and of the optimiser's starting points.
+    model
+        Response-surface model for every response (checked against the design before any run).
+    n_runs
+        Runs of a D-optimal design (default: model terms + max(3, k)).
+    n_center
+        Centre points of ccd/bbd.
+    objective, sense
+        Response to maximise (``"max"``) or minimise (``"min"``); no optimum if None.
+    constraints
+        Response -> minimum: the optimum must satisfy surface ≥ minimum.
+    units
+        Response -> unit, for tables and plots (e.g. ``{"delta_vx_m_per_s": "m/s"}``).
+    conservative
+        Impose constraints on the lower prediction bound.
+    progress
+        Show a progress bar.
+    """
+    if not callable(evaluator):
+        raise SpecError("evaluator must be callable", where="evaluator")
+    out = Path(out_dir)
+    design = make_design(runs, space, n_runs=n_runs, n_center=n_center, model=model, seed=seed)
+    terms = parse_terms(model, space.names)
+    report = require_estimable(design, terms, space.names)  # refuse before any evaluation
+    constraints = dict(constraints or {})
+    units = dict(units or {})
+
+    meta = {
+        "space": space.to_dict(),
+        "design": design.to_dict(),
+        "model": model if isinstance(model, str) else [str(t) for t in model],
+        "seed": seed,
+        "objective": objective,
+        "sense": sense,
+        "constraints": constraints,
+        "conservative": conservative,
+    }
+    out.mkdir(parents=True, exist_ok=True)
+    write_json(out / "study.json", meta)
+
+    frame = design.to_frame(space)
+    results: list[dict[str, float] | None] = [None] * design.n_runs
+    n_resumed = n_evaluated = 0
+    expected: list[str] | None = None
+    for i in range(design.n_runs):
+        r = _read_run(_run_file(out, i), design.coded[i])
+        if r is not None:
+            results[i] = r
+            n_resumed += 1
+            expected = expected or list(r)
+    todo = [i for i in range(design.n_runs) if results[i] is None]
+    for i in tqdm(todo, desc="design runs", unit="run", disable=not progress):
+        point = space.point(design.coded[i])
+        try:
+            raw = evaluator(dict(point))
+        except BladelabError as err:
+            raise type(err)(
+                f"run {i + 1} ({', '.join(f'{k}={v:g}' for k, v in point.items())}): "
+                f"{err.message}",
+                file=err.file, where=err.where, hint=err.hint,
+            ) from err
+        res = _check_responses(raw, i + 1, expected)
+        expected = expected or list(res)
+        write_json(
+            _run_file(out, i),
+            {"run": i + 1, "coded": design.coded[i].tolist(), "point": point, "responses": res},
+        )
+        results[i] = res
+        n_evaluated += 1
+    responses = tuple(expected or ())
+    for i, r in enumerate(results):
+        if r is None or list(r) != list(responses):
+            raise DataError(
+                "stored responses differ from the other runs'",
+                file=_run_file(out, i),
+                hint="delete that file to evaluate the run again",
+            )
+    for name in responses:
+        frame[name] = [r[name] for r in results]  # type: ignore[index]
+    with atomic_path(out / "results.csv") as tmp:
+        frame.to_csv(tmp, index=False)
+
+    surfaces = {
+        name: fit_surface(
+            design.coded, frame[name].to_numpy(), factor_names=space.names, model=terms,
+            response=name, unit=units.get(name, ""),
+        )
+        for name in responses
+    }
+    write_json(out / "estimability.json", report.to_dict())
+    write_json(out / "surfaces.json", {k: s.to_dict() for k, s in surfaces.items()})
+    coef = pd.concat([s.coefficients() for s in surfaces.values()], ignore_index=True)
+    anova = pd.concat([s.anova for s in surfaces.values()], ignore_index=True)
+    with atomic_path(out / "coefficients.csv") as tmp:
+        coef.to_csv(tmp, index=False)
+    with atomic_path(out / "anova.csv") as tmp:
+        anova.to_csv(tmp, index=False)
+
+    optimum, optimum_error = None, None
+    if objective is not None:
+        unknown = [n for n in [objective, *constraints] if n not in surfaces]
+        if unknown:
+            raise SpecError(
+                f"unknown response(s) {unknown}", where="objective/constraints",
+                hint=f"the evaluator returned {list(responses)}",
+            )
+        cons = [SurfaceConstraint(surfaces[k], float(v)) for k, v in constraints.items()]
+        try:
+            optimum = constrained_optimum(
+                surfaces[objective], sense=sense, constraints=cons, space=space, seed=seed,
+                conservative=conservative,
+            )
+            write_json(out / "optimum.json", optimum.to_dict())
+        except OptimizationError as err:
+            optimum_error = str(err)
+            write_json(out / "optimum.json", {"error": optimum_error})
+    return DesignStudyResult(
+        space=space,
+        design=design,
+        table=frame,
+        responses=responses,
+        surfaces=surfaces,
+        estimability=report,
+        optimum=optimum,
+        optimum_error=optimum_error,
+        out_dir=out,
+        n_evaluated=n_evaluated,
+        n_resumed=n_resumed,
+    )
