@@ -156,6 +156,7 @@ def instantaneous_stiffness(
     tip: Sequence[float],
     contact_point: Sequence[float] | None = None,
     contact_threshold: float = 20.0,
+    reference: str = "touchdown",
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Instantaneous torsional stiffness K(t) = M_y(t)/Δθ(t) of a one-hinge blade (SI).
 
@@ -173,6 +174,9 @@ def instantaneous_stiffness(
         Point of the distal part where the GRF acts (clamp frame, undeformed); default the tip.
     contact_threshold
         Vertical GRF [N] that marks contact; t0 is the first sample above it.
+    reference
+        ``"touchdown"`` (seed 000: Δθ = θ(t) − θ(t0)) or ``"rest"`` (Δθ = q(t), the deflection
+        from the blade's undeformed geometry; exact when the distance agrees with the model).
 
     Returns
     -------
@@ -183,8 +187,11 @@ def instantaneous_stiffness(
     in_contact = np.flatnonzero(grf_z > contact_threshold)
     if in_contact.size == 0:
         raise DataError("the stance has no contact", where="grf_z column")
+    if reference not in ("touchdown", "rest"):
+        raise OptimizationError(f"unknown reference {reference!r}", where="reference",
+                                hint="use 'touchdown' or 'rest'")
     q = hinge_deflection(distance, hinge=hinge, tip=tip)
-    dtheta = q - q[in_contact[0]]
+    dtheta = q - q[in_contact[0]] if reference == "touchdown" else q
     h = np.asarray(hinge, dtype=float)
     p = np.asarray(tip if contact_point is None else contact_point, dtype=float)
     # contact point in the clamp frame after the hinge rotates by q, then in the lab frame
@@ -207,6 +214,7 @@ def stiffness_bounds(
     lower_factor: float = 0.5,
     upper_factor: float = 2.0,
     contact_threshold: float = 20.0,
+    reference: str = "touchdown",
 ) -> tuple[float, float]:
     """K bounds [N·m/rad] from a stance's instantaneous stiffness (see the module docstring).
 
@@ -222,7 +230,7 @@ def stiffness_bounds(
     k, _, dtheta = instantaneous_stiffness(
         clamp_x=stance.clamp_x, clamp_z=stance.clamp_z, clamp_pitch=stance.clamp_pitch,
         grf_x=stance.grf_x, grf_z=stance.grf_z, distance=dist, hinge=hinge, tip=tip,
-        contact_point=contact_point, contact_threshold=contact_threshold,
+        contact_point=contact_point, contact_threshold=contact_threshold, reference=reference,
     )
     grf = np.asarray(stance.grf_z, dtype=float)
     ok = (grf >= load_fraction * np.max(grf)) & (np.abs(dtheta) >= np.deg2rad(min_deflection_deg))

@@ -1,0 +1,97 @@
+"""Identifiability: analytic linear least squares, perfect compensation, landscape."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from scipy import stats
+
+from bladelab.identify.identifiability import (
+    assess_identifiability,
+    cost_landscape,
+    effective_sample_size,
+)
+
+
+def _linear_problem(seed=0, n=80):
+    rng = np.random.default_rng(seed)
+    t = np.linspace(0, 1, n)
+    A = np.column_stack([1 + t, np.sin(3 * t)])  # correlated-ish regressors
+    theta = np.array([2.0, 0.7])
+    y = A @ theta + 0.05 * rng.standard_normal(n)
+    return A, y
+
+
+def test_linear_least_squares_matches_analytic():
+    A, y = _linear_problem()
+    n, p = A.shape
+    theta_hat, *_ = np.linalg.lstsq(A, y, rcond=None)
+    rss = float(np.sum((A @ theta_hat - y) ** 2))
+    s2 = rss / (n - p)
+    cov = s2 * np.linalg.inv(A.T @ A)
+    corr = cov[0, 1] / np.sqrt(cov[0, 0] * cov[1, 1])
+    half = stats.t.ppf(0.975, n - p) * np.sqrt(np.diag(cov))
+
+    res = assess_identifiability(lambda X: X @ A.T - y, theta_hat, [(0, 5), (-3, 3)],
+                                 names=("a", "b"), n_effective=n)
+    assert np.allclose(res.covariance, cov, rtol=1e-6)
+    assert res.correlation[0, 1] == pytest.approx(corr, rel=1e-6)
+    assert np.allclose(res.ci_lower, theta_hat - half, rtol=1e-4)
+    assert np.allclose(res.ci_upper, theta_hat + half, rtol=1e-4)
+    assert res.poorly_determined == (False, False)
+    assert not any(res.ci_open)
+    assert set(res.profiles["parameter"]) == {"a", "b"}
+
+
+def test_effective_sample_size():
+    rng = np.random.default_rng(1)
+    white = rng.standard_normal(2000)
+    assert effective_sample_size(white, 2) == pytest.approx(2000, rel=0.1)
+    ar = np.zeros(2000)
+    for i in range(1, 2000):
+        ar[i] = 0.9 * ar[i - 1] + white[i]
+    # AR(1) with ρ = 0.9: n (1 − ρ)/(1 + ρ) ≈ n / 19
+    assert effective_sample_size(ar, 2) == pytest.approx(2000 / 19, rel=0.3)
+
+
+def test_perfect_compensation_is_flagged():
+    # the model only depends on a + b: a and b compensate each other exactly
+    t = np.linspace(0, 1, 60)
+    y = 1.5 * t + 0.01 * np.random.default_rng(2).standard_normal(60)
+
+    def residuals(X):
+        return (X[:, :1] + X[:, 1:2]) * t[None, :] - y
+
+    res = assess_identifiability(residuals, [0.75, 0.75], [(0, 2), (0, 2)], names=("K", "D"))
+    assert res.correlation[0, 1] < -0.95
+    assert res.poorly_determined == (True, True)
+    assert "compensation" in res.reasons[0]
+    assert all(res.ci_open)  # the profile is flat: the interval reaches the bounds
+
+
+def test_weakly_determined_parameter_flagged_by_width():
+    # b has little influence: wide interval relative to its value
+    t = np.linspace(0, 1, 50)
+    rng = np.random.default_rng(3)
+    y = 2.0 * t + 0.01 * t**2 + 0.05 * rng.standard_normal(50)
+
+    def residuals(X):
+        return X[:, :1] * t + X[:, 1:2] * 1e-3 * np.cos(7 * t) - y
+
+    res = assess_identifiability(residuals, [2.0, 0.5], [(0, 4), (-50, 50)], names=("K", "D"),
+                                 n_effective=50)
+    assert res.poorly_determined[1] and not res.poorly_determined[0]
+
+
+def test_landscape_is_one_batch_and_tidy():
+    calls = []
+
+    def f(X):
+        calls.append(len(X))
+        return (X[:, 0] - 1) ** 2 + (X[:, 1] - 2) ** 2
+
+    df = cost_landscape(f, [1.0, 2.0], [(0, 2), (0, 4)], n=11, rel_span=0.5)
+    assert calls == [121] and list(df.columns) == ["K", "D", "cost"]
+    best = df.loc[df["cost"].idxmin()]
+    assert best["K"] == pytest.approx(1.0) and best["D"] == pytest.approx(2.0)
+    assert df["K"].min() == pytest.approx(0.5) and df["D"].max() == pytest.approx(3.0)
