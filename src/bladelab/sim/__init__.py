@@ -1,0 +1,36 @@
+"""Blade simulation: a blade chain driven by a stance's clamp motion, pressing on the ground.
+
+- :func:`prepare` / :func:`simulate` / :func:`simulate_batch`: the default numba planar-chain
+  kernel (``engine="kernel"``) or the MuJoCo reference (``engine="mujoco"``).
+- :func:`generate_stance`: a physically consistent synthetic stance (a point-mass runner whose
+  leg carries the blade), with the true K, D.
+
+Method notes: ``docs/blade-model.md``.
+"""
+
+from bladelab.sim.api import (
+    BatchResult,
+    Drive,
+    SimProblem,
+    SimResult,
+    prepare,
+    simulate,
+    simulate_batch,
+)
+from bladelab.sim.chain import Chain, build_chain
+from bladelab.sim.kernel import ENERGY_TERMS
+from bladelab.sim.motion import ClampMotion
+
+__all__ = [
+    "ENERGY_TERMS",
+    "BatchResult",
+    "Chain",
+    "ClampMotion",
+    "Drive",
+    "SimProblem",
+    "SimResult",
+    "build_chain",
+    "prepare",
+    "simulate",
+    "simulate_batch",
+]

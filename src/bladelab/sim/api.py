@@ -1,0 +1,433 @@
+"""``prepare`` / ``simulate`` / ``simulate_batch``: a blade driven through one stance.
+
+``prepare`` does everything that does not depend on the joint parameters once (segment merging,
+clamp spline, the clamp's pose at every time step); ``simulate`` and ``simulate_batch`` then run
+the chosen engine for one or many (K, D[, K2]) sets. Identification calls ``simulate_batch``.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import enum
+import math
+from typing import Any, Literal
+
+import numpy as np
+import pandas as pd
+
+from bladelab import units
+from bladelab.blade.model import BladeModel
+from bladelab.errors import DataError, ModelError, SimulationError
+from bladelab.sim import kernel as _k
+from bladelab.sim.chain import Chain, build_chain
+from bladelab.sim.motion import ClampMotion
+from bladelab.trial.stance import Stance
+
+Engine = Literal["kernel", "mujoco"]
+
+
+class Drive(str, enum.Enum):
+    """How the clamp is driven. Only ``prescribed`` exists now; issue 9 adds the others."""
+
+    PRESCRIBED = "prescribed"
+
+
+@dataclasses.dataclass(frozen=True, eq=False)
+class SimProblem:
+    """One (blade, stance) ready to simulate. Build it with :func:`prepare`.
+
+    Attributes
+    ----------
+    blade, stance
+        The inputs.
+    chain
+        The blade merged into rigid bodies between compliant joints.
+    motion
+        The clamp splines (belt speed included).
+    time
+        Output sample times [s] (the stance's own time base).
+    dt
+        Integration step [s] actually used (the stance interval divided by ``n_substeps``).
+    n_substeps
+        Integration steps per stance sample.
+    base
+        (n_steps + 1, 9) clamp pose, velocity and acceleration at every step time.
+    engine, drive, belt_speed
+        As given to :func:`prepare`.
+    """
+
+    blade: BladeModel
+    stance: Stance
+    chain: Chain
+    motion: ClampMotion
+    time: np.ndarray
+    dt: float
+    n_substeps: int
+    base: np.ndarray
+    engine: str
+    drive: Drive
+    belt_speed: float
+
+    @property
+    def n_joints(self) -> int:
+        """Number of compliant joints."""
+        return self.chain.n_joints
+
+    @property
+    def n_samples(self) -> int:
+        """Number of output samples."""
+        return len(self.time)
+
+
+@dataclasses.dataclass(frozen=True, eq=False)
+class SimResult:
+    """Outputs of one simulation on the stance's time base (SI units).
+
+    Attributes
+    ----------
+    time
+        [s], (n,).
+    grf_x, grf_z
+        Ground reaction force on the blade [N], (n,).
+    grf_elements
+        (n, n_soles, 2) force (x, z) on each sole ellipse [N].
+    distance
+        Characteristic distance |tip − clamp origin| [m], (n,).
+    deflection
+        (n, n_joints) joint angle q [rad]: rotation of the distal body relative to the proximal
+        one about +y, 0 at the undeformed posture.
+    torque
+        (n, n_joints) spring-damper torque on the distal body [N·m].
+    contact_state
+        (n, n_soles) 0 no contact, 1 stick (|slip| ≤ critical velocity), 2 slip.
+    energy
+        ``term -> (n,)`` [J]: clamp_work (cumulative), kinetic, potential_gravity, spring,
+        contact_elastic, dissipated_joint / dissipated_contact / dissipated_friction (cumulative).
+    stiffness, damping, stiffness_quadratic
+        Joint parameters used [N·m/rad], [N·m·s/rad], [N·m/rad²].
+    engine
+        ``"kernel"`` or ``"mujoco"``.
+    dt
+        Integration step [s].
+    """
+
+    time: np.ndarray
+    grf_x: np.ndarray
+    grf_z: np.ndarray
+    grf_elements: np.ndarray
+    distance: np.ndarray
+    deflection: np.ndarray
+    torque: np.ndarray
+    contact_state: np.ndarray
+    energy: dict[str, np.ndarray]
+    stiffness: np.ndarray
+    damping: np.ndarray
+    stiffness_quadratic: np.ndarray
+    engine: str
+    dt: float
+
+    @property
+    def grf_total(self) -> np.ndarray:
+        """|GRF| in the x–z plane [N]."""
+        return np.hypot(self.grf_x, self.grf_z)
+
+    def energy_balance_error(self) -> np.ndarray:
+        """Clamp work minus (Δ stored energy + dissipated energy) [J] at every sample."""
+        e = self.energy
+        stored = e["kinetic"] + e["potential_gravity"] + e["spring"] + e["contact_elastic"]
+        dissipated = e["dissipated_joint"] + e["dissipated_contact"] + e["dissipated_friction"]
+        return e["clamp_work"] - (stored - stored[0]) - dissipated
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain-Python summary: parameters (literature units too) and the signals as lists."""
+        return {
+            "engine": self.engine,
+            "dt_s": self.dt,
+            "K_Nm_per_rad": self.stiffness.tolist(),
+            "D_Nms_per_rad": self.damping.tolist(),
+            "K2_Nm_per_rad2": self.stiffness_quadratic.tolist(),
+            "K_Nm_per_deg": np.atleast_1d(units.stiffness_per_rad_to_per_deg(self.stiffness)).tolist(),
+            "D_Nms_per_deg": np.atleast_1d(units.damping_per_rad_to_per_deg(self.damping)).tolist(),
+            "signals": self.to_frame().to_dict(orient="list"),
+        }
+
+    def to_frame(self) -> pd.DataFrame:
+        """One row per sample; units in the column names (deflection in deg, as at the edges)."""
+        cols: dict[str, np.ndarray] = {
+            "time_s": self.time,
+            "grf_x_N": self.grf_x,
+            "grf_z_N": self.grf_z,
+            "grf_total_N": self.grf_total,
+            "distance_m": self.distance,
+        }
+        for j in range(self.deflection.shape[1]):
+            cols[f"deflection_deg_j{j + 1}"] = units.rad2deg(self.deflection[:, j])
+            cols[f"torque_Nm_j{j + 1}"] = self.torque[:, j]
+        for e in range(self.grf_elements.shape[1]):
+            cols[f"grf_x_N_s{e + 1}"] = self.grf_elements[:, e, 0]
+            cols[f"grf_z_N_s{e + 1}"] = self.grf_elements[:, e, 1]
+            cols[f"contact_state_s{e + 1}"] = self.contact_state[:, e].astype(int)
+        for name, values in self.energy.items():
+            cols[f"energy_{name}_J"] = values
+        return pd.DataFrame(cols)
+
+
+@dataclasses.dataclass(frozen=True, eq=False)
+class BatchResult:
+    """Outputs of many parameter sets of one problem (SI units).
+
+    ``grf_x``, ``grf_z``, ``distance``: (n_sets, n_samples); ``deflection``, ``torque``:
+    (n_sets, n_samples, n_joints); ``ok``: (n_sets,) False where the simulation diverged (its
+    rows are NaN); ``time`` (n_samples,) [s].
+    """
+
+    time: np.ndarray
+    grf_x: np.ndarray
+    grf_z: np.ndarray
+    distance: np.ndarray
+    deflection: np.ndarray
+    torque: np.ndarray
+    ok: np.ndarray
+    stiffness: np.ndarray
+    damping: np.ndarray
+    stiffness_quadratic: np.ndarray
+
+    @property
+    def n_sets(self) -> int:
+        """Number of parameter sets."""
+        return self.grf_x.shape[0]
+
+    def to_dict(self) -> dict[str, Any]:
+        """Parameters and a per-set summary (peak GRF [N], minimum distance [m])."""
+        return {
+            "K_Nm_per_rad": self.stiffness.tolist(),
+            "D_Nms_per_rad": self.damping.tolist(),
+            "ok": self.ok.tolist(),
+            "peak_grf_z_N": np.nanmax(self.grf_z, axis=1).tolist(),
+            "min_distance_m": np.nanmin(self.distance, axis=1).tolist(),
+        }
+
+
+def prepare(
+    blade: BladeModel,
+    stance: Stance,
+    *,
+    dt: float = 1e-4,
+    engine: Engine = "kernel",
+    belt_speed: float = 0.0,
+    drive: Drive | str = Drive.PRESCRIBED,
+) -> SimProblem:
+    """Set up the simulation of ``blade`` driven by the clamp motion of ``stance``.
+
+    Parameters
+    ----------
+    blade
+        The built blade (``bladelab.blade.load_blade(name).build()`` or a spec).
+    stance
+        Uniformly sampled stance; its clamp x, z [m] and pitch [rad] drive the blade.
+    dt
+        Largest integration step [s]; the step used divides the stance interval exactly.
+        1e-4 s is the kernel's default accuracy (≈ 0.1–0.3 % GRF error); the MuJoCo engine
+        needs ≤ 5e-6 s with friction (explicit external forces) and picks that itself when
+        ``dt`` is larger.
+    engine
+        ``"kernel"`` (numba, default) or ``"mujoco"`` (reference).
+    belt_speed
+        Treadmill belt speed [m/s], added to the clamp's forward motion.
+    drive
+        Clamp drive; only ``"prescribed"`` (clamp follows the stance exactly).
+
+    Raises
+    ------
+    DataError
+        Non-uniform time or gaps in the clamp channels.
+    ModelError
+        Unknown engine/drive, a non-positive step, or a blade the engines cannot simulate.
+    """
+    try:
+        drive = Drive(drive)
+    except ValueError as err:
+        raise ModelError(f"unknown drive {drive!r}", where="drive",
+                         hint="only 'prescribed' is available") from err
+    if engine not in ("kernel", "mujoco"):
+        raise ModelError(f"unknown engine {engine!r}", where="engine", hint="use kernel or mujoco")
+    if not (dt > 0 and math.isfinite(dt)):
+        raise ModelError(f"dt must be > 0, got {dt}", where="dt")
+    chain = build_chain(blade)
+    time = np.asarray(stance.time, float)
+    if len(time) < 2:
+        raise DataError("a stance needs at least two samples", where="stance.time")
+    steps = np.diff(time)
+    h = float(np.median(steps))
+    if np.any(steps <= 0) or np.ptp(steps) > 1e-3 * h + 1e-12:
+        raise DataError("time is not uniformly sampled", where="stance.time",
+                        hint="resample the stance to one rate")
+    motion = ClampMotion.from_stance(stance, belt_speed=belt_speed)
+    if engine == "mujoco":
+        from bladelab.sim.mujoco_engine import default_mujoco_dt
+
+        dt = min(dt, default_mujoco_dt(chain))
+    nsub = max(1, int(math.ceil(h / dt - 1e-9)))
+    dt_used = h / nsub
+    n_steps = (len(time) - 1) * nsub
+    t_steps = time[0] + dt_used * np.arange(n_steps + 1)
+    t_steps[-1] = time[-1]
+    base = np.ascontiguousarray(motion.evaluate(t_steps))
+    return SimProblem(
+        blade=blade, stance=stance, chain=chain, motion=motion, time=time, dt=dt_used,
+        n_substeps=nsub, base=base, engine=engine, drive=drive, belt_speed=float(belt_speed),
+    )
+
+
+def _params(problem: SimProblem, value, default: np.ndarray, name: str, n_sets: int | None):
+    nj = problem.n_joints
+    if value is None:
+        arr = default[None, :] if n_sets is None else np.broadcast_to(default, (n_sets, nj))
+        return np.ascontiguousarray(arr, dtype=float)
+    arr = np.asarray(value, dtype=float)
+    if n_sets is None:
+        arr = np.broadcast_to(np.atleast_1d(arr), (nj,))[None, :]
+    else:
+        if arr.ndim == 1 and nj == 1 and arr.shape[0] == n_sets:
+            arr = arr[:, None]
+        try:
+            arr = np.broadcast_to(arr, (n_sets, nj))
+        except ValueError as err:
+            raise ModelError(f"shape {np.shape(value)} does not fit ({n_sets}, {nj})",
+                             where=name) from err
+    if not np.all(np.isfinite(arr)) or np.any(arr < 0):
+        raise ModelError(f"must be finite and >= 0, got {np.asarray(value).tolist()}", where=name)
+    return np.ascontiguousarray(arr, dtype=float)
+
+
+def _run_kernel(problem: SimProblem, K, D, K2, *, parallel: bool = False):
+    c = problem.chain
+    n_sets, nj = K.shape
+    ns = problem.n_samples
+    ne = c.n_soles
+    grf = np.zeros((n_sets, ns, ne, 2))
+    dist = np.zeros((n_sets, ns))
+    qout = np.zeros((n_sets, ns, nj))
+    tau = np.zeros((n_sets, ns, nj))
+    state = np.zeros((n_sets, ns, ne), np.int8)
+    energy = np.zeros((n_sets, ns, len(_k.ENERGY_TERMS)))
+    status = np.zeros((n_sets, 2), np.int64)
+    fn = _k._batch_parallel if parallel else _k._batch_serial
+    fn(problem.base, problem.dt, problem.n_substeps, 0.0, c.body_mass, c.body_com,
+       c.body_inertia, c.hinge, c.sole_body, c.sole_geom, c.tip_body, c.tip, c.contact,
+       K, D, K2, np.zeros(nj), np.zeros(nj), grf, dist, qout, tau, state, energy, status)
+    return grf, dist, qout, tau, state, energy, status
+
+
+def simulate(
+    problem: SimProblem,
+    *,
+    stiffness: np.ndarray | float | None = None,
+    damping: np.ndarray | float | None = None,
+    stiffness_quadratic: np.ndarray | float | None = None,
+) -> SimResult:
+    """Simulate one parameter set.
+
+    Parameters
+    ----------
+    problem
+        From :func:`prepare`.
+    stiffness, damping, stiffness_quadratic
+        Per joint K [N·m/rad], D [N·m·s/rad], K2 [N·m/rad²] (scalars broadcast); None = the
+        blade's own values.
+
+    Raises
+    ------
+    SimulationError
+        The integration diverged.
+    """
+    c = problem.chain
+    K = _params(problem, stiffness, c.stiffness, "stiffness", None)
+    D = _params(problem, damping, c.damping, "damping", None)
+    K2 = _params(problem, stiffness_quadratic, c.stiffness_quadratic, "stiffness_quadratic", None)
+    if problem.engine == "mujoco":
+        from bladelab.sim.mujoco_engine import simulate_mujoco
+
+        return simulate_mujoco(problem, K[0], D[0], K2[0])
+    grf, dist, qout, tau, state, energy, status = _run_kernel(problem, K, D, K2)
+    if status[0, 0] != _k.STATUS_OK:
+        t_fail = problem.time[0] + status[0, 1] * problem.dt
+        raise SimulationError(
+            f"the kernel diverged at t = {t_fail:.4g} s", where="simulate",
+            hint="reduce dt or check the stance (clamp far below ground?) and K, D",
+        )
+    return SimResult(
+        time=problem.time.copy(), grf_x=grf[0, :, :, 0].sum(axis=1),
+        grf_z=grf[0, :, :, 1].sum(axis=1), grf_elements=grf[0], distance=dist[0],
+        deflection=qout[0], torque=tau[0], contact_state=state[0],
+        energy={name: energy[0, :, i] for i, name in enumerate(_k.ENERGY_TERMS)},
+        stiffness=K[0].copy(), damping=D[0].copy(), stiffness_quadratic=K2[0].copy(),
+        engine="kernel", dt=problem.dt,
+    )
+
+
+def simulate_batch(
+    problem: SimProblem,
+    stiffness: np.ndarray,
+    damping: np.ndarray,
+    stiffness_quadratic: np.ndarray | None = None,
+    *,
+    parallel: bool = False,
+) -> BatchResult:
+    """Simulate many parameter sets of one problem in one call.
+
+    Parameters
+    ----------
+    problem
+        From :func:`prepare`.
+    stiffness, damping
+        (n_sets, n_joints) K [N·m/rad] and D [N·m·s/rad]; (n_sets,) is accepted for one joint.
+    stiffness_quadratic
+        (n_sets, n_joints) K2 [N·m/rad²]; None = the blade's own values.
+    parallel
+        Spread the sets over numba threads (``prange``). Default False: single thread and
+        deterministic; results are identical either way.
+
+    Returns
+    -------
+    BatchResult
+        Diverged sets are flagged in ``ok`` with NaN outputs (no exception).
+    """
+    stiffness = np.asarray(stiffness, dtype=float)
+    n_sets = stiffness.shape[0] if stiffness.ndim else 1
+    c = problem.chain
+    K = _params(problem, stiffness, c.stiffness, "stiffness", n_sets)
+    D = _params(problem, damping, c.damping, "damping", n_sets)
+    K2 = _params(problem, stiffness_quadratic, c.stiffness_quadratic, "stiffness_quadratic", n_sets)
+    if problem.engine == "mujoco":
+        from bladelab.sim.mujoco_engine import simulate_mujoco
+
+        results = []
+        for s in range(n_sets):
+            try:
+                results.append(simulate_mujoco(problem, K[s], D[s], K2[s]))
+            except SimulationError:
+                results.append(None)
+        ok = np.array([r is not None for r in results])
+        nan = np.full(problem.n_samples, np.nan)
+        nanj = np.full((problem.n_samples, problem.n_joints), np.nan)
+        return BatchResult(
+            time=problem.time.copy(),
+            grf_x=np.array([nan if r is None else r.grf_x for r in results]),
+            grf_z=np.array([nan if r is None else r.grf_z for r in results]),
+            distance=np.array([nan if r is None else r.distance for r in results]),
+            deflection=np.array([nanj if r is None else r.deflection for r in results]),
+            torque=np.array([nanj if r is None else r.torque for r in results]),
+            ok=ok, stiffness=K, damping=D, stiffness_quadratic=K2,
+        )
+    grf, dist, qout, tau, _state, _energy, status = _run_kernel(problem, K, D, K2,
+                                                                parallel=parallel)
+    ok = status[:, 0] == _k.STATUS_OK
+    grf_x = grf[:, :, :, 0].sum(axis=2)
+    grf_z = grf[:, :, :, 1].sum(axis=2)
+    for arr in (grf_x, grf_z, dist, qout, tau):
+        arr[~ok] = np.nan
+    return BatchResult(
+        time=problem.time.copy(), grf_x=grf_x, grf_z=grf_z, distance=dist, deflection=qout,
+        torque=tau, ok=ok, stiffness=K, damping=D, stiffness_quadratic=K2,
+    )

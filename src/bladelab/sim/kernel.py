@@ -1,0 +1,445 @@
+"""The numba planar-chain kernel: a blade chain driven by a prescribed clamp.
+
+Equations (see ``docs/blade-model.md``): generalised coordinates are the compliant-joint angles
+q (rad, rotation of the distal body relative to the proximal one about +y). With the clamp pose
+(x, z, θ) prescribed,
+
+    M(q) q̈ = τ_spring(q, q̇) + Q_gravity(q) + Q_contact(q, q̇, t) − b(q, q̇, t)
+
+where M_jk = Σ_{b > max(j,k)} m_b (r_b − H_j)·(r_b − H_k) + I_b, b is the bias from the clamp's
+acceleration and the centripetal terms (the generalised inertia force at q̈ = 0), and a force F at a
+point P of body b contributes F·perp(P − H_j) to every joint j proximal to b
+(perp(x, z) = (z, −x), the derivative of a point with respect to a rotation about +y).
+
+Integrator: linearly-implicit (Rosenbrock) Euler. Each step linearises the generalised force
+around the predictor (t_{n+1}, q_n + h·q̇_n, q̇_n) with analytic contact and spring Jacobians and
+solves (M − h·∂Q/∂q̇ − h²·∂Q/∂q) Δq̇ = h·(Q − b); then q̇ += Δq̇, q += h·q̇. It is stable with the
+stiff stick-slip friction (≈ 4e4 N·s/m in stick) at h = 1e-4 s, where explicit schemes need
+≈ 1e-5 s.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit, prange
+
+from bladelab.contact import (
+    hunt_crossley_force,
+    smooth_spring_damper_force,
+    smoothstep,
+    stick_slip_friction_coefficient,
+)
+
+GRAVITY = 9.80665
+
+# Columns of the energy output.
+ENERGY_TERMS: tuple[str, ...] = (
+    "clamp_work",
+    "kinetic",
+    "potential_gravity",
+    "spring",
+    "contact_elastic",
+    "dissipated_joint",
+    "dissipated_contact",
+    "dissipated_friction",
+)
+
+STATUS_OK = 0
+STATUS_DIVERGED = 1
+
+
+@njit(cache=True, inline="always")
+def _rot(phi: float, x: float, z: float) -> tuple[float, float]:
+    c = math.cos(phi)
+    s = math.sin(phi)
+    return c * x + s * z, -s * x + c * z
+
+
+@njit(cache=True)
+def _normal_force(contact, depth, rate):
+    """Normal force, ∂F/∂depth, ∂F/∂rate and the elastic part of the force (for energy)."""
+    law = int(contact[0])
+    k = contact[1]
+    if law == 0:
+        c = contact[2]
+        w = contact[3]
+        force = smooth_spring_damper_force(depth, rate, k, c, w)
+        if force <= 0.0:
+            return 0.0, 0.0, 0.0, 0.0
+        if w > 0.0:
+            u = depth / w
+            s = smoothstep(u)
+            ds = 6.0 * u * (1.0 - u) / w if u < 1.0 else 0.0
+        else:
+            s = 1.0
+            ds = 0.0
+        return force, ds * (k * depth + c * rate) + s * k, s * c, s * k * depth
+    n = contact[4]
+    d = contact[5]
+    force = hunt_crossley_force(depth, rate, k, n, d)
+    if force <= 0.0:
+        return 0.0, 0.0, 0.0, 0.0
+    dn = depth**n
+    return force, n * k * depth ** (n - 1.0) * (1.0 + 1.5 * d * rate), 1.5 * d * k * dn, k * dn
+
+
+@njit(cache=True)
+def contact_elastic_energy(contact, depth):
+    """Energy [J] stored by the elastic part of the normal law at penetration ``depth`` [m]."""
+    if depth <= 0.0:
+        return 0.0
+    k = contact[1]
+    if int(contact[0]) == 0:
+        w = contact[3]
+        if w <= 0.0:
+            return 0.5 * k * depth * depth
+        if depth < w:
+            return k * (0.75 * depth**4 / w**2 - 0.4 * depth**5 / w**3)
+        return 0.35 * k * w * w + 0.5 * k * (depth * depth - w * w)
+    n = contact[4]
+    return k * depth ** (n + 1.0) / (n + 1.0)
+
+
+@njit(cache=True)
+def sole_contact(contact, cx, cz, psi, a, b, ox, oz, vox, voz, om, ground_vx):
+    """Force of the ground on one sole ellipse (lab frame, rigid ground at z = 0).
+
+    ``(cx, cz)`` centre [m], ``psi`` absolute angle of the ellipse's x axis about +y [rad],
+    ``a, b`` semi-axes [m]; ``(ox, oz)``, ``(vox, voz)`` a point of the carrying body and its
+    velocity, ``om`` the body's angular velocity [rad/s]; ``ground_vx`` the ground's velocity.
+
+    Returns (px, pz, fx, fz, depth, rate, slip, kn, cn, mu, dmu, f_elastic): the lowest point,
+    the force, penetration [m] and its rate, slip velocity, ∂Fn/∂depth, ∂Fn/∂rate, μ (signed),
+    ∂μ/∂slip and the elastic part of the normal force.
+    """
+    s = math.sin(psi)
+    c = math.cos(psi)
+    nrm = math.sqrt(a * a * s * s + b * b * c * c)
+    px = cx + s * c * (a * a - b * b) / nrm
+    pz = cz - nrm
+    depth = -pz
+    # material velocity of the lowest point
+    vpx = vox + om * (pz - oz)
+    vpz = voz - om * (px - ox)
+    rate = -vpz
+    slip = vpx - ground_vx
+    if depth <= 0.0:
+        return px, pz, 0.0, 0.0, depth, rate, slip, 0.0, 0.0, 0.0, 0.0, 0.0
+    fn, kn, cn, fel = _normal_force(contact, depth, rate)
+    mus = contact[6]
+    mu = 0.0
+    dmu = 0.0
+    if mus > 0.0 and fn > 0.0:
+        muk = contact[7]
+        vc = contact[8]
+        mu = stick_slip_friction_coefficient(slip, mus, muk, vc)
+        h = 1e-3 * vc
+        dmu = (stick_slip_friction_coefficient(slip + h, mus, muk, vc)
+               - stick_slip_friction_coefficient(slip - h, mus, muk, vc)) / (2.0 * h)
+    return px, pz, -mu * fn, fn, depth, rate, slip, kn, cn, mu, dmu, fel
+
+
+@njit(cache=True)
+def _kinematics(bs, q, v, hinge, com0, O, vO, aO, phi, om, al, R, VR, AR):
+    """Body origins (O), angles, COMs (R) with velocities and bias accelerations (q̈ = 0)."""
+    nb = com0.shape[0]
+    O[0, 0] = bs[0]
+    O[0, 1] = bs[1]
+    phi[0] = bs[2]
+    vO[0, 0] = bs[3]
+    vO[0, 1] = bs[4]
+    om[0] = bs[5]
+    aO[0, 0] = bs[6]
+    aO[0, 1] = bs[7]
+    al[0] = bs[8]
+    for b in range(nb):
+        if b > 0:
+            o0x = hinge[b - 2, 0] if b > 1 else 0.0
+            o0z = hinge[b - 2, 1] if b > 1 else 0.0
+            dx, dz = _rot(phi[b - 1], hinge[b - 1, 0] - o0x, hinge[b - 1, 1] - o0z)
+            w = om[b - 1]
+            O[b, 0] = O[b - 1, 0] + dx
+            O[b, 1] = O[b - 1, 1] + dz
+            vO[b, 0] = vO[b - 1, 0] + w * dz
+            vO[b, 1] = vO[b - 1, 1] - w * dx
+            aO[b, 0] = aO[b - 1, 0] + al[b - 1] * dz - w * w * dx
+            aO[b, 1] = aO[b - 1, 1] - al[b - 1] * dx - w * w * dz
+            phi[b] = phi[b - 1] + q[b - 1]
+            om[b] = om[b - 1] + v[b - 1]
+            al[b] = al[b - 1]
+        o0x = hinge[b - 1, 0] if b > 0 else 0.0
+        o0z = hinge[b - 1, 1] if b > 0 else 0.0
+        ex, ez = _rot(phi[b], com0[b, 0] - o0x, com0[b, 1] - o0z)
+        w = om[b]
+        R[b, 0] = O[b, 0] + ex
+        R[b, 1] = O[b, 1] + ez
+        VR[b, 0] = vO[b, 0] + w * ez
+        VR[b, 1] = vO[b, 1] - w * ex
+        AR[b, 0] = aO[b, 0] + al[b] * ez - w * w * ex
+        AR[b, 1] = aO[b, 1] - al[b] * ex - w * w * ez
+
+
+@njit(cache=True)
+def _body_point(b, x0, z0, hinge, O, phi):
+    o0x = hinge[b - 1, 0] if b > 0 else 0.0
+    o0z = hinge[b - 1, 1] if b > 0 else 0.0
+    ex, ez = _rot(phi[b], x0 - o0x, z0 - o0z)
+    return O[b, 0] + ex, O[b, 1] + ez
+
+
+@njit(cache=True)
+def _solve(A, rhs, x):
+    """Solve A x = rhs in place (Gaussian elimination, partial pivoting; A, rhs destroyed)."""
+    n = rhs.shape[0]
+    for k in range(n):
+        p = k
+        big = abs(A[k, k])
+        for i in range(k + 1, n):
+            if abs(A[i, k]) > big:
+                big = abs(A[i, k])
+                p = i
+        if p != k:
+            for j in range(n):
+                tmp = A[k, j]
+                A[k, j] = A[p, j]
+                A[p, j] = tmp
+            tmp = rhs[k]
+            rhs[k] = rhs[p]
+            rhs[p] = tmp
+        for i in range(k + 1, n):
+            f = A[i, k] / A[k, k]
+            if f != 0.0:
+                for j in range(k, n):
+                    A[i, j] -= f * A[k, j]
+                rhs[i] -= f * rhs[k]
+    for i in range(n - 1, -1, -1):
+        acc = rhs[i]
+        for j in range(i + 1, n):
+            acc -= A[i, j] * x[j]
+        x[i] = acc / A[i, i]
+
+
+@njit(cache=True)
+def simulate_prescribed(
+    base, dt, nsub, ground_vx,
+    body_mass, com0, body_inertia, hinge, sole_body, sole_geom, tip_body, tip, contact,
+    stiffness, damping, stiffness_quadratic, q0, v0,
+    grf, dist, qout, tau, state, energy,
+):
+    """Simulate one parameter set with the clamp prescribed.
+
+    ``base`` (n_steps + 1, 9): clamp x, z, θ, ẋ, ż, θ̇, ẍ, z̈, θ̈ at every step time; samples are
+    recorded every ``nsub`` steps into ``grf`` (ns, ne, 2), ``dist`` (ns,), ``qout`` and ``tau``
+    (ns, nj), ``state`` (ns, ne) int8 (0 free, 1 stick, 2 slip) and ``energy`` (ns, 8).
+    Returns (status, step index where it diverged or −1).
+    """
+    nb = com0.shape[0]
+    nj = nb - 1
+    ne = sole_body.shape[0]
+    n_steps = base.shape[0] - 1
+    O = np.zeros((nb, 2))
+    vO = np.zeros((nb, 2))
+    aO = np.zeros((nb, 2))
+    phi = np.zeros(nb)
+    om = np.zeros(nb)
+    al = np.zeros(nb)
+    R = np.zeros((nb, 2))
+    VR = np.zeros((nb, 2))
+    AR = np.zeros((nb, 2))
+    M = np.zeros((nj, nj))
+    Jq = np.zeros((nj, nj))
+    Jv = np.zeros((nj, nj))
+    rhs = np.zeros(nj)
+    dv = np.zeros(nj)
+    q = q0.copy()
+    v = v0.copy()
+    qs = np.zeros(nj)
+    fe = np.zeros((ne, 2))
+    pe = np.zeros((ne, 2))
+    vc = contact[8]
+    w_clamp = 0.0
+    d_joint = 0.0
+    d_contact = 0.0
+    d_friction = 0.0
+
+    for i in range(n_steps + 1):
+        record = i % nsub == 0
+        if i > 0:
+            # ---- one linearly-implicit Euler step from step i-1 to step i ----
+            bs = base[i]
+            for j in range(nj):
+                qs[j] = q[j] + dt * v[j]
+            _kinematics(bs, qs, v, hinge, com0, O, vO, aO, phi, om, al, R, VR, AR)
+            for j in range(nj):
+                hx = O[j + 1, 0]
+                hz = O[j + 1, 1]
+                acc = 0.0
+                for k in range(j, nj):
+                    kx = O[k + 1, 0]
+                    kz = O[k + 1, 1]
+                    mjk = 0.0
+                    for b in range(k + 1, nb):
+                        mjk += (body_mass[b] * ((R[b, 0] - hx) * (R[b, 0] - kx)
+                                                + (R[b, 1] - hz) * (R[b, 1] - kz))
+                                + body_inertia[b])
+                    M[j, k] = mjk
+                    M[k, j] = mjk
+                    Jq[j, k] = 0.0
+                    Jq[k, j] = 0.0
+                    Jv[j, k] = 0.0
+                    Jv[k, j] = 0.0
+                for b in range(j + 1, nb):
+                    rx = R[b, 0] - hx
+                    rz = R[b, 1] - hz
+                    # gravity minus inertia (bias) generalised force
+                    acc += body_mass[b] * (GRAVITY * rx - (AR[b, 0] * rz - AR[b, 1] * rx))
+                    acc -= body_inertia[b] * al[b]
+                qa = qs[j]
+                acc -= stiffness[j] * qa + stiffness_quadratic[j] * qa * abs(qa) + damping[j] * v[j]
+                Jq[j, j] -= stiffness[j] + 2.0 * stiffness_quadratic[j] * abs(qa)
+                Jv[j, j] -= damping[j]
+                rhs[j] = acc
+            p_fric = 0.0
+            p_cdamp = 0.0
+            for e in range(ne):
+                b = sole_body[e]
+                cx, cz = _body_point(b, sole_geom[e, 0], sole_geom[e, 1], hinge, O, phi)
+                (px, pz, fx, fz, depth, rate, slip, kn, cn, mu, dmu, fel) = sole_contact(
+                    contact, cx, cz, phi[b] + sole_geom[e, 4], sole_geom[e, 2], sole_geom[e, 3],
+                    O[b, 0], O[b, 1], vO[b, 0], vO[b, 1], om[b], ground_vx)
+                fe[e, 0] = fx
+                fe[e, 1] = fz
+                pe[e, 0] = px
+                pe[e, 1] = pz
+                if fz == 0.0:
+                    continue
+                p_fric += -fx * slip
+                p_cdamp += (fz - fel) * rate
+                # gradients of (fx, fz) with respect to the point's position and velocity
+                gv00 = -dmu * fz
+                gv01 = mu * cn
+                gv11 = -cn
+                gp01 = mu * kn
+                gp11 = -kn
+                for j in range(b):
+                    jx = pz - O[j + 1, 1]
+                    jz = -(px - O[j + 1, 0])
+                    rhs[j] += fx * jx + fz * jz
+                    for k in range(b):
+                        kx = pz - O[k + 1, 1]
+                        kz = -(px - O[k + 1, 0])
+                        Jv[j, k] += jx * (gv00 * kx + gv01 * kz) + jz * (gv11 * kz)
+                        Jq[j, k] += jx * (gp01 * kz) + jz * (gp11 * kz)
+            for j in range(nj):
+                for k in range(nj):
+                    M[j, k] = M[j, k] - dt * Jv[j, k] - dt * dt * Jq[j, k]
+                rhs[j] *= dt
+            _solve(M, rhs, dv)
+            # clamp power with the step's accelerations
+            fcx = 0.0
+            fcz = 0.0
+            tc = 0.0
+            for b in range(nb):
+                ax = AR[b, 0]
+                az = AR[b, 1]
+                alb = al[b]
+                for j in range(b):
+                    qdd = dv[j] / dt
+                    ax += qdd * (R[b, 1] - O[j + 1, 1])
+                    az -= qdd * (R[b, 0] - O[j + 1, 0])
+                    alb += qdd
+                m = body_mass[b]
+                fcx += m * ax
+                fcz += m * (az + GRAVITY)
+                rx = R[b, 0] - bs[0]
+                rz = R[b, 1] - bs[1]
+                tc += m * (ax * rz - (az + GRAVITY) * rx) + body_inertia[b] * alb
+            for e in range(ne):
+                fcx -= fe[e, 0]
+                fcz -= fe[e, 1]
+                tc -= fe[e, 0] * (pe[e, 1] - bs[1]) - fe[e, 1] * (pe[e, 0] - bs[0])
+            w_clamp += dt * (fcx * bs[3] + fcz * bs[4] + tc * bs[5])
+            diverged = False
+            for j in range(nj):
+                v[j] += dv[j]
+                q[j] = qs[j] + dt * dv[j]
+                d_joint += dt * damping[j] * v[j] * v[j]
+                if not (math.isfinite(q[j]) and abs(q[j]) < 10.0):
+                    diverged = True
+            d_friction += dt * p_fric
+            d_contact += dt * p_cdamp
+            if diverged:
+                return STATUS_DIVERGED, i
+        if record:
+            # ---- outputs at a sample time, from the state itself ----
+            s_idx = i // nsub
+            bs = base[i]
+            _kinematics(bs, q, v, hinge, com0, O, vO, aO, phi, om, al, R, VR, AR)
+            e_contact = 0.0
+            for e in range(ne):
+                b = sole_body[e]
+                cx, cz = _body_point(b, sole_geom[e, 0], sole_geom[e, 1], hinge, O, phi)
+                (px, pz, fx, fz, depth, rate, slip, kn, cn, mu, dmu, fel) = sole_contact(
+                    contact, cx, cz, phi[b] + sole_geom[e, 4], sole_geom[e, 2], sole_geom[e, 3],
+                    O[b, 0], O[b, 1], vO[b, 0], vO[b, 1], om[b], ground_vx)
+                grf[s_idx, e, 0] = fx
+                grf[s_idx, e, 1] = fz
+                if depth <= 0.0:
+                    state[s_idx, e] = 0
+                elif abs(slip) <= vc:
+                    state[s_idx, e] = 1
+                else:
+                    state[s_idx, e] = 2
+                e_contact += contact_elastic_energy(contact, depth)
+            tx, tz = _body_point(tip_body, tip[0], tip[1], hinge, O, phi)
+            dist[s_idx] = math.hypot(tx - bs[0], tz - bs[1])
+            kin = 0.0
+            pot = 0.0
+            for b in range(nb):
+                kin += 0.5 * body_mass[b] * (VR[b, 0] ** 2 + VR[b, 1] ** 2)
+                kin += 0.5 * body_inertia[b] * om[b] ** 2
+                pot += body_mass[b] * GRAVITY * R[b, 1]
+            spring = 0.0
+            for j in range(nj):
+                qa = q[j]
+                qout[s_idx, j] = qa
+                tau[s_idx, j] = -(stiffness[j] * qa + stiffness_quadratic[j] * qa * abs(qa)
+                                  + damping[j] * v[j])
+                spring += 0.5 * stiffness[j] * qa * qa + stiffness_quadratic[j] * abs(qa) ** 3 / 3.0
+            energy[s_idx, 0] = w_clamp
+            energy[s_idx, 1] = kin
+            energy[s_idx, 2] = pot
+            energy[s_idx, 3] = spring
+            energy[s_idx, 4] = e_contact
+            energy[s_idx, 5] = d_joint
+            energy[s_idx, 6] = d_contact
+            energy[s_idx, 7] = d_friction
+    return STATUS_OK, -1
+
+
+@njit(cache=True)
+def _batch_serial(base, dt, nsub, ground_vx, body_mass, com0, body_inertia, hinge, sole_body,
+                  sole_geom, tip_body, tip, contact, K, D, K2, q0, v0,
+                  grf, dist, qout, tau, state, energy, status):
+    for s in range(K.shape[0]):
+        st, at = simulate_prescribed(
+            base, dt, nsub, ground_vx, body_mass, com0, body_inertia, hinge, sole_body, sole_geom,
+            tip_body, tip, contact, K[s], D[s], K2[s], q0, v0,
+            grf[s], dist[s], qout[s], tau[s], state[s], energy[s])
+        status[s, 0] = st
+        status[s, 1] = at
+
+
+@njit(cache=True, parallel=True)
+def _batch_parallel(base, dt, nsub, ground_vx, body_mass, com0, body_inertia, hinge, sole_body,
+                    sole_geom, tip_body, tip, contact, K, D, K2, q0, v0,
+                    grf, dist, qout, tau, state, energy, status):
+    for s in prange(K.shape[0]):
+        st, at = simulate_prescribed(
+            base, dt, nsub, ground_vx, body_mass, com0, body_inertia, hinge, sole_body, sole_geom,
+            tip_body, tip, contact, K[s], D[s], K2[s], q0, v0,
+            grf[s], dist[s], qout[s], tau[s], state[s], energy[s])
+        status[s, 0] = st
+        status[s, 1] = at

@@ -1,0 +1,297 @@
+"""MuJoCo reference engine: the same blade built segment by segment with ``MjSpec``.
+
+Every segment is its own body (rigid segments are welded children, so MuJoCo's own composite
+inertia is used, independent of the kernel's merging); compliant joints are hinges about +y with
+``stiffness`` K and ``damping`` D (implicit in MuJoCo's Euler integrator), the quadratic term
+K2·q·|q| is added through ``qfrc_applied``. Native contact is disabled: the documented contact
+law is applied as external forces (``xfrc_applied``) computed every step from MuJoCo's own
+site frames (ellipse–plane geometry in 3-D) and the point velocities from ``cvel``.
+
+The clamp is driven through slide x, slide z and hinge y joints with a large armature and a
+feed-forward force ``armature × prescribed acceleration``; its position and velocity are reset to
+the prescribed values before every step. So the blade sees the clamp's true velocity and
+acceleration (a mocap clamp would have zero velocity in the dynamics).
+
+The same builder makes the free "runner" of :mod:`bladelab.sim.synthetic`.
+"""
+
+from __future__ import annotations
+
+import math
+
+import mujoco
+import numpy as np
+from numba import njit
+
+from bladelab.blade.model import BladeModel
+from bladelab.errors import SimulationError
+from bladelab.sim import kernel as _k
+from bladelab.sim.chain import Chain
+
+CLAMP_ARMATURE = 1.0e6  # kg (slides) and kg·m² (pitch hinge)
+
+
+def default_mujoco_dt(chain: Chain) -> float:
+    """Step [s] at which MuJoCo's explicit treatment of the contact forces is stable and
+    accurate: 5e-6 s with friction (stick regime ≈ 4e4 N·s/m), 2e-5 s without."""
+    return 5e-6 if chain.contact[6] > 0 else 2e-5
+
+
+def _quat_y(angle: float) -> list[float]:
+    return [math.cos(angle / 2), 0.0, math.sin(angle / 2), 0.0]
+
+
+def build_spec(
+    blade: BladeModel,
+    *,
+    stiffness: np.ndarray,
+    damping: np.ndarray,
+    dt: float,
+    root: str = "prescribed",
+    body_mass: float = 0.0,
+    pylon_length: float = 0.0,
+) -> mujoco.MjSpec:
+    """The blade as an ``MjSpec``.
+
+    ``root = "prescribed"``: world → slide x → slide z → hinge y (clamp, at the clamp origin),
+    each with armature :data:`CLAMP_ARMATURE`. ``root = "runner"``: world → slide x → slide z
+    (a point mass ``body_mass`` [kg] at the hip) → hinge y (pitch of the rigid pylon) → clamp
+    ``pylon_length`` [m] below the hip along the pylon.
+    """
+    spec = mujoco.MjSpec()
+    spec.modelname = "bladelab_blade"
+    spec.option.timestep = dt
+    spec.option.integrator = mujoco.mjtIntegrator.mjINT_EULER
+    spec.option.gravity = [0.0, 0.0, -_k.GRAVITY]
+    spec.option.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_CONTACT)
+    spec.worldbody.add_geom(type=mujoco.mjtGeom.mjGEOM_PLANE, size=[5, 5, 0.1],
+                            contype=0, conaffinity=0)
+
+    def _light(body, mass=1e-6):
+        body.explicitinertial = True
+        body.mass = mass
+        body.inertia = [max(mass, 1e-6) * 1e-3] * 3
+
+    bx = spec.worldbody.add_body(name="root_x")
+    bx.add_joint(name="root_x", type=mujoco.mjtJoint.mjJNT_SLIDE, axis=[1, 0, 0],
+                 armature=CLAMP_ARMATURE if root == "prescribed" else 0.0)
+    bz = bx.add_body(name="root_z")
+    bz.add_joint(name="root_z", type=mujoco.mjtJoint.mjJNT_SLIDE, axis=[0, 0, 1],
+                 armature=CLAMP_ARMATURE if root == "prescribed" else 0.0)
+    if root == "prescribed":
+        _light(bx)
+        _light(bz)
+        parent = bz.add_body(name="clamp")
+        parent.add_joint(name="clamp_pitch", type=mujoco.mjtJoint.mjJNT_HINGE, axis=[0, 1, 0],
+                         armature=CLAMP_ARMATURE)
+        _light(parent)
+    else:
+        _light(bx)
+        _light(bz, body_mass)
+        pylon = bz.add_body(name="pylon")
+        pylon.add_joint(name="pylon_pitch", type=mujoco.mjtJoint.mjJNT_HINGE, axis=[0, 1, 0])
+        _light(pylon)
+        pylon.add_geom(type=mujoco.mjtGeom.mjGEOM_CAPSULE, fromto=[0, 0, 0, 0, 0, -pylon_length],
+                       size=[0.015, 0, 0], contype=0, conaffinity=0, mass=0)
+        parent = pylon.add_body(name="clamp", pos=[0, 0, -pylon_length])
+        _light(parent)
+    parent.add_site(name="clamp", pos=[0, 0, 0])
+    points = np.asarray(blade.points, float)
+    joint_at = {j.point: i for i, j in enumerate(blade.joints)}
+    prev = np.zeros(2)
+    for s in range(blade.n_segments):
+        p = points[s]
+        body = parent.add_body(name=f"seg{s}", pos=[p[0] - prev[0], 0.0, p[1] - prev[1]])
+        if s in joint_at:
+            i = joint_at[s]
+            body.add_joint(name=f"joint{i + 1}", type=mujoco.mjtJoint.mjJNT_HINGE, axis=[0, 1, 0],
+                           stiffness=[float(stiffness[i]), 0, 0], damping=[float(damping[i]), 0, 0])
+        body.explicitinertial = True
+        body.mass = float(blade.segment_mass[s])
+        c = np.asarray(blade.segment_com[s], float) - p
+        body.ipos = [c[0], 0.0, c[1]]
+        inertia = max(float(blade.segment_inertia[s]), 1e-12)
+        body.inertia = [inertia, inertia, inertia]
+        q = points[s + 1] - p
+        body.add_geom(type=mujoco.mjtGeom.mjGEOM_CAPSULE, fromto=[0, 0, 0, q[0], 0, q[1]],
+                      size=[0.006, 0, 0], contype=0, conaffinity=0, mass=0)
+        for e, sole in enumerate(blade.soles):
+            if sole.segment == s:
+                body.add_site(name=f"sole{e}", type=mujoco.mjtGeom.mjGEOM_ELLIPSOID,
+                              pos=[sole.center[0] - p[0], 0.0, sole.center[1] - p[1]],
+                              quat=_quat_y(sole.angle),
+                              size=[sole.semi_axis_x, 0.02, sole.semi_axis_z])
+        if s == blade.tip_segment:
+            body.add_site(name="tip", pos=[blade.tip[0] - p[0], 0.0, blade.tip[1] - p[1]])
+        parent = body
+        prev = p
+    return spec
+
+
+@njit(cache=True)
+def contact_forces_3d(contact, site_pos, site_mat, axes, site_body, cvel, subtree_com, rootid,
+                      xipos, ground_vx, xfrc, out):
+    """Apply the contact law to every sole site; write xfrc_applied and per-sole outputs.
+
+    ``out[e]`` = (fx, fz, depth, slip, elastic normal force, contact-damping power,
+    friction power).
+    """
+    ne = site_pos.shape[0]
+    for e in range(ne):
+        b = site_body[e]
+        a = axes[e, 0]
+        c = axes[e, 1]
+        exz = site_mat[e, 6]  # z component of the site's x axis (row-major 3x3)
+        ezz = site_mat[e, 8]  # z component of the site's z axis
+        nrm = math.sqrt(a * a * exz * exz + c * c * ezz * ezz)
+        ct = -a * exz / nrm
+        st = -c * ezz / nrm
+        px = site_pos[e, 0] + a * ct * site_mat[e, 0] + c * st * site_mat[e, 2]
+        pz = site_pos[e, 2] + a * ct * site_mat[e, 6] + c * st * site_mat[e, 8]
+        r = rootid[b]
+        wx = cvel[b, 0]
+        wy = cvel[b, 1]
+        wz = cvel[b, 2]
+        rx = px - subtree_com[r, 0]
+        ry = 0.0 - subtree_com[r, 1]
+        rz = pz - subtree_com[r, 2]
+        vpx = cvel[b, 3] + wy * rz - wz * ry
+        vpz = cvel[b, 5] + wx * ry - wy * rx
+        depth = -pz
+        out[e, 0] = 0.0
+        out[e, 1] = 0.0
+        out[e, 2] = depth
+        out[e, 3] = vpx - ground_vx
+        out[e, 4] = 0.0
+        out[e, 5] = 0.0
+        out[e, 6] = 0.0
+        if depth <= 0.0:
+            continue
+        rate = -vpz
+        fn, _kn, _cn, fel = _k._normal_force(contact, depth, rate)
+        mu = 0.0
+        if contact[6] > 0.0 and fn > 0.0:
+            mu = _k.stick_slip_friction_coefficient(vpx - ground_vx, contact[6], contact[7],
+                                                    contact[8])
+        fx = -mu * fn
+        out[e, 0] = fx
+        out[e, 1] = fn
+        out[e, 4] = fel
+        out[e, 5] = (fn - fel) * rate
+        out[e, 6] = -fx * (vpx - ground_vx)
+        # force at P -> force + torque about the body's COM
+        dx = px - xipos[b, 0]
+        dy = 0.0 - xipos[b, 1]
+        dz = pz - xipos[b, 2]
+        xfrc[b, 0] += fx
+        xfrc[b, 2] += fn
+        xfrc[b, 3] += dy * fn
+        xfrc[b, 4] += dz * fx - dx * fn
+        xfrc[b, 5] += -dy * fx
+
+
+class MujocoBlade:
+    """A compiled blade model with the indices the simulation loops need."""
+
+    def __init__(self, blade: BladeModel, spec: mujoco.MjSpec) -> None:
+        self.blade = blade
+        self.model = spec.compile()
+        m = self.model
+        self.data = mujoco.MjData(m)
+        self.sole_sites = np.array([m.site(f"sole{e}").id for e in range(len(blade.soles))])
+        self.sole_body = np.ascontiguousarray(m.site_bodyid[self.sole_sites])
+        self.axes = np.array([[s.semi_axis_x, s.semi_axis_z] for s in blade.soles], float)
+        self.joint_dofs = np.array([m.jnt_dofadr[m.joint(f"joint{i + 1}").id]
+                                    for i in range(len(blade.joints))])
+        self.joint_qpos = np.array([m.jnt_qposadr[m.joint(f"joint{i + 1}").id]
+                                    for i in range(len(blade.joints))])
+        self.tip_site = m.site("tip").id
+        self.clamp_site = m.site("clamp").id
+        self.rootid = np.ascontiguousarray(m.body_rootid)
+        self.out = np.zeros((len(blade.soles), 7))
+
+    def apply_contact(self, contact: np.ndarray, ground_vx: float = 0.0) -> None:
+        """Compute the contact forces at the current (step1) state into ``xfrc_applied``."""
+        d = self.data
+        d.xfrc_applied[:] = 0.0
+        contact_forces_3d(contact, d.site_xpos[self.sole_sites], d.site_xmat[self.sole_sites],
+                          self.axes, self.sole_body, d.cvel, d.subtree_com, self.rootid,
+                          d.xipos, ground_vx, d.xfrc_applied, self.out)
+
+
+def simulate_mujoco(problem, K: np.ndarray, D: np.ndarray, K2: np.ndarray):
+    """Run one parameter set of a prescribed-clamp problem on MuJoCo; returns a SimResult."""
+    from bladelab.sim.api import SimResult
+
+    blade = problem.blade
+    chain = problem.chain
+    mj = MujocoBlade(blade, build_spec(blade, stiffness=K, damping=D, dt=problem.dt))
+    m, d = mj.model, mj.data
+    base = problem.base
+    nsub = problem.n_substeps
+    ns = problem.n_samples
+    ne = chain.n_soles
+    nj = chain.n_joints
+    contact = chain.contact
+    vc = contact[8]
+    grf = np.zeros((ns, ne, 2))
+    dist = np.zeros(ns)
+    qout = np.zeros((ns, nj))
+    tau = np.zeros((ns, nj))
+    state = np.zeros((ns, ne), np.int8)
+    energy = np.zeros((ns, len(_k.ENERGY_TERMS)))
+    jd = mj.joint_dofs
+    jq = mj.joint_qpos
+    d_joint = d_contact = d_fric = w_clamp = 0.0
+    dt = problem.dt
+    mass = m.body_mass
+    for i in range(base.shape[0]):
+        bs = base[i]
+        d.qpos[0:3] = bs[0:3]
+        d.qvel[0:3] = bs[3:6]
+        mujoco.mj_step1(m, d)
+        mj.apply_contact(contact)
+        q = d.qpos[jq]
+        v = d.qvel[jd]
+        d.qfrc_applied[:] = 0.0
+        d.qfrc_applied[0:3] = CLAMP_ARMATURE * bs[6:9]
+        d.qfrc_applied[jd] = -K2 * q * np.abs(q)
+        if i % nsub == 0:
+            s = i // nsub
+            grf[s] = mj.out[:, 0:2]
+            state[s] = np.where(mj.out[:, 2] <= 0, 0, np.where(np.abs(mj.out[:, 3]) <= vc, 1, 2))
+            tip = d.site_xpos[mj.tip_site]
+            dist[s] = math.hypot(tip[0] - bs[0], tip[2] - bs[1])
+            qout[s] = q
+            tau[s] = -(K * q + K2 * q * np.abs(q) + D * v)
+            kin = 0.0
+            for b in range(m.nbody):
+                if mass[b] > 1e-5:
+                    w = d.cvel[b, :3]
+                    vcom = d.cvel[b, 3:] + np.cross(w, d.xipos[b] - d.subtree_com[mj.rootid[b]])
+                    kin += 0.5 * mass[b] * vcom @ vcom + 0.5 * float(m.body_inertia[b][1]) * w[1] ** 2
+            pot = float(np.sum(mass[mass > 1e-5] * _k.GRAVITY * d.xipos[mass > 1e-5, 2]))
+            spring = float(np.sum(0.5 * K * q**2 + K2 * np.abs(q) ** 3 / 3.0))
+            e_c = sum(_k.contact_elastic_energy(contact, dep) for dep in mj.out[:, 2])
+            energy[s] = (w_clamp, kin, pot, spring, e_c, d_joint, d_contact, d_fric)
+        if i == base.shape[0] - 1:
+            break
+        mujoco.mj_step2(m, d)
+        # reaction the clamp joints had to supply (power = force × prescribed velocity)
+        f_clamp = d.qfrc_applied[0:3] - CLAMP_ARMATURE * d.qacc[0:3]
+        w_clamp += dt * float(f_clamp @ bs[3:6])
+        d_joint += dt * float(np.sum(D * d.qvel[jd] ** 2))
+        d_contact += dt * float(mj.out[:, 5].sum())
+        d_fric += dt * float(mj.out[:, 6].sum())
+        if not np.all(np.isfinite(d.qpos)) or np.any(np.abs(d.qpos[jq]) > 10.0):
+            raise SimulationError(
+                f"MuJoCo diverged at t = {problem.time[0] + i * dt:.4g} s", where="simulate",
+                hint="reduce dt",
+            )
+    return SimResult(
+        time=problem.time.copy(), grf_x=grf[:, :, 0].sum(axis=1), grf_z=grf[:, :, 1].sum(axis=1),
+        grf_elements=grf, distance=dist, deflection=qout, torque=tau, contact_state=state,
+        energy={name: energy[:, i] for i, name in enumerate(_k.ENERGY_TERMS)},
+        stiffness=np.asarray(K, float).copy(), damping=np.asarray(D, float).copy(),
+        stiffness_quadratic=np.asarray(K2, float).copy(), engine="mujoco", dt=dt,
+    )
