@@ -1,0 +1,134 @@
+"""``bladelab trial ...``: inspect C3D trials, list their stances, extract a stance CSV."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import typer
+
+__all__ = ["register"]
+
+trial_app = typer.Typer(
+    help="Trials: C3D files, force platforms, stance detection, stance CSV export.",
+    no_args_is_help=True,
+)
+
+_FORWARD = typer.Option("auto", "--forward", help="File axis that is forward (+x, -y, ...) or auto.")
+_UP = typer.Option("auto", "--up", help="File axis that is up (+z, +y, ...) or auto.")
+
+
+def _read(path: Path, forward: str, up: str):
+    from bladelab.trial.c3d import read_c3d
+
+    return read_c3d(path, forward=forward, up=up)
+
+
+@trial_app.command("info")
+def _info(
+    file: Path = typer.Argument(..., help="C3D file."),
+    as_json: bool = typer.Option(False, "--json", help="Print JSON instead of text."),
+    forward: str = _FORWARD,
+    up: str = _UP,
+) -> None:
+    """Markers, rates, units and force platforms (type, channels) of a C3D file."""
+    info = _read(file, forward, up).info()
+    if as_json:
+        typer.echo(json.dumps(info, indent=2))
+        return
+    typer.echo(f"file:      {info['source']}")
+    typer.echo(f"duration:  {info['duration_s']:.3f} s")
+    axes = info["axes"] or {}
+    typer.echo(
+        f"lab frame: x forward = file {axes.get('forward')}, y lateral = file {axes.get('lateral')}, "
+        f"z up = file {axes.get('up')}"
+    )
+    typer.echo(
+        f"markers:   {len(info['markers'])} at {info['marker_rate_Hz']:g} Hz, "
+        f"{info['n_frames']} frames, file units {info['point_units']}"
+    )
+    if info["markers"]:
+        typer.echo("           " + ", ".join(info["markers"]))
+    typer.echo(f"analogs:   {len(info['analogs'])} at {info['analog_rate_Hz']:g} Hz")
+    if not info["platforms"]:
+        typer.echo("platforms: none")
+    for p in info["platforms"]:
+        typer.echo(
+            f"platform {p['index']}: type {p['type']}, {p['rate_Hz']:g} Hz, channels "
+            f"{', '.join(p['channels'])}"
+        )
+    for key, value in info["metadata"].items():
+        typer.echo(f"{key}: {value}")
+
+
+@trial_app.command("stances")
+def _stances(
+    file: Path = typer.Argument(..., help="C3D file."),
+    threshold: float = typer.Option(20.0, "--threshold", help="Vertical force threshold [N]."),
+    min_duration: float = typer.Option(0.05, "--min-duration", help="Shortest contact [s]."),
+    tip: str | None = typer.Option(
+        None, "--tip", help="Blade tip marker: mark stances where it is over the COP as prosthetic."
+    ),
+    as_json: bool = typer.Option(False, "--json", help="Print a JSON list instead of a table."),
+    forward: str = _FORWARD,
+    up: str = _UP,
+) -> None:
+    """List the stances: start, end, contact time, peak vertical force, vertical impulse."""
+    from bladelab.trial.events import classify_stances, detect_stances
+
+    trial = _read(file, forward, up)
+    events = detect_stances(trial, threshold=threshold, min_duration=min_duration)
+    if tip:
+        events = classify_stances(trial, events, tip=tip)
+    rows = [e.to_dict() for e in events]
+    if as_json:
+        typer.echo(json.dumps(rows, indent=2))
+        return
+    header = f"{'index':>5} {'plates':>6} {'start_s':>8} {'end_s':>8} {'contact_s':>9} {'peak_fz_N':>9} {'impulse_z_Ns':>12}"
+    if tip:
+        header += f" {'prosthetic':>10}"
+    typer.echo(header)
+    for r in rows:
+        line = (
+            f"{r['index']:>5} {','.join(map(str, r['plates'])):>6} {r['start_s']:>8.3f} "
+            f"{r['end_s']:>8.3f} {r['contact_time_s']:>9.3f} {r['peak_fz_N']:>9.1f} "
+            f"{r['impulse_z_Ns']:>12.2f}"
+        )
+        if tip:
+            line += f" {'yes' if r['prosthetic'] else 'no':>10}"
+        typer.echo(line)
+
+
+@trial_app.command("extract")
+def _extract(
+    file: Path = typer.Argument(..., help="C3D file."),
+    stance: int = typer.Option(..., "--stance", help="Stance index (see `bladelab trial stances`)."),
+    out: Path = typer.Option(..., "--out", help="Output stance CSV."),
+    markers: Path | None = typer.Option(
+        None, "--markers", help="YAML map of roles (clamp_anterior, clamp_posterior, tip) to markers."
+    ),
+    rate: float = typer.Option(1000.0, "--rate", help="Output sampling rate [Hz]."),
+    margin: float = typer.Option(0.02, "--margin", help="Margin before touch-down / after toe-off [s]."),
+    threshold: float = typer.Option(20.0, "--threshold", help="Vertical force threshold [N]."),
+    forward: str = _FORWARD,
+    up: str = _UP,
+) -> None:
+    """Write one stance as a stance CSV (clamp pose, GRF, distance; docs/stance-csv.md)."""
+    from bladelab.trial.kinematics import MarkerMap, extract_stance, load_marker_map
+    from bladelab.trial.stance import write_stance_csv
+
+    marker_map = load_marker_map(markers) if markers else MarkerMap()
+    trial = _read(file, forward, up)
+    result = extract_stance(
+        trial, stance, markers=marker_map, rate=rate, margin=margin, threshold=threshold
+    )
+    write_stance_csv(result, out)
+    typer.echo(
+        f"wrote {out}: stance {stance}, {len(result.time)} samples at {rate:g} Hz, "
+        f"peak GRF {result.grf_z.max():.0f} N"
+    )
+
+
+def register(app: typer.Typer) -> None:
+    """Add ``bladelab trial`` to the root app."""
+    app.add_typer(trial_app, name="trial")
