@@ -1,0 +1,75 @@
+"""Constrained optimum of response surfaces, against hand-derived optima."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from bladelab.design.doe import central_composite
+from bladelab.design.optimum import SurfaceConstraint, constrained_optimum
+from bladelab.design.space import DesignSpace, Factor
+from bladelab.design.surfaces import fit_surface
+from bladelab.errors import OptimizationError
+
+NAMES = ("a", "b")
+D = central_composite(2, n_center=1).coded
+SPACE = DesignSpace((Factor("a", 10.0, 20.0, "kN/m"), Factor("b", 0.05, 0.08, "m")))
+
+
+def _surf(values, name, **kw):
+    return fit_surface(D, values, factor_names=NAMES, response=name, **kw)
+
+
+def test_linear_objective_on_a_circular_constraint():
+    obj = _surf(2 * D[:, 0] + D[:, 1], "speed", unit="m/s")
+    disc = _surf(1.0 - D[:, 0] ** 2 - D[:, 1] ** 2, "margin")
+    res = constrained_optimum(obj, constraints=[SurfaceConstraint(disc, 0.5)], space=SPACE,
+                              seed=1)
+    # maximum of 2a + b on the circle a² + b² = 0.5: along (2, 1)/√5
+    expected = np.sqrt(0.5) * np.array([2.0, 1.0]) / np.sqrt(5.0)
+    np.testing.assert_allclose([res.coded["a"], res.coded["b"]], expected, atol=1e-5)
+    assert res.predicted == pytest.approx(np.sqrt(0.5) * np.sqrt(5.0), abs=1e-5)
+    assert res.constraints["margin"]["slack"] == pytest.approx(0.0, abs=1e-6)
+    assert res.point["a"] == pytest.approx(15.0 + 5.0 * expected[0], abs=1e-4)
+    assert res.n_feasible >= 1 and res.unit == "m/s"
+    # without the constraint, the corner (1, 1)
+    free = constrained_optimum(obj, seed=1)
+    assert free.coded == pytest.approx({"a": 1.0, "b": 1.0})
+    # minimising: the opposite corner
+    low = constrained_optimum(obj, sense="min", seed=1)
+    assert low.coded == pytest.approx({"a": -1.0, "b": -1.0})
+
+
+def test_interior_optimum_and_intervals():
+    rng = np.random.default_rng(2)
+    y = 5.0 - (D[:, 0] - 0.3) ** 2 - 2.0 * (D[:, 1] + 0.2) ** 2
+    obj = _surf(y, "E", unit="m")
+    res = constrained_optimum(obj, seed=0)
+    assert res.coded == pytest.approx({"a": 0.3, "b": -0.2}, abs=1e-6)
+    assert res.predicted == pytest.approx(5.0, abs=1e-9)
+    # with noise: the prediction interval contains the confidence interval
+    d5 = central_composite(2, n_center=5).coded
+    yn = 5.0 - (d5[:, 0] - 0.3) ** 2 - 2.0 * (d5[:, 1] + 0.2) ** 2 + rng.normal(0, 0.05, len(d5))
+    noisy = fit_surface(d5, yn, factor_names=NAMES, response="E")
+    r = constrained_optimum(noisy, seed=0)
+    assert r.pi[0] < r.ci[0] < r.predicted < r.ci[1] < r.pi[1]
+
+
+def test_infeasible_constraints_are_reported():
+    obj = _surf(D[:, 0], "speed")
+    never = _surf(-1.0 - D[:, 0] ** 2, "clearance")
+    with pytest.raises(OptimizationError, match="clearance"):
+        constrained_optimum(obj, constraints=[SurfaceConstraint(never, 0.0)], seed=0)
+
+
+def test_conservative_constraint_moves_inside():
+    rng = np.random.default_rng(4)
+    d5 = central_composite(2, n_center=5).coded
+    obj = fit_surface(d5, d5[:, 0], factor_names=NAMES, model="linear", response="speed")
+    g = 0.5 - d5[:, 0] + rng.normal(0, 0.05, len(d5))
+    con = fit_surface(d5, g, factor_names=NAMES, model="linear", response="knee")
+    mean_opt = constrained_optimum(obj, constraints=[SurfaceConstraint(con, 0.0)], seed=0)
+    safe_opt = constrained_optimum(obj, constraints=[SurfaceConstraint(con, 0.0)], seed=0,
+                                   conservative=True)
+    assert safe_opt.coded["a"] < mean_opt.coded["a"]
+    assert safe_opt.constraints["knee"]["pi_lower"] == pytest.approx(0.0, abs=1e-5)

@@ -1,0 +1,121 @@
+"""run_design with a cheap analytic evaluator: files, surfaces, optimum, resume, refusals."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from bladelab.design.plots import contour_plot, main_effects_plot, save_figure
+from bladelab.design.space import default_design_space
+from bladelab.design.study import run_design
+from bladelab.errors import DataError, SpecError
+
+SPACE = default_design_space()
+
+
+def _evaluator(point):
+    c = SPACE.code([point[n] for n in SPACE.names])
+    k, w, h, t = c
+    return {
+        "delta_vx_m_per_s": 0.2 + 0.08 * k + 0.05 * w + 0.01 * h - 0.02 * k**2 + 0.01 * k * w,
+        "knee_moment_min_Nm": 10.0 + 25.0 * t - 3.0 * k,
+        "clearance_min_m": 0.04 - 0.03 * t - 0.005 * t**2,
+    }
+
+
+class _Crash(Exception):
+    pass
+
+
+def test_run_design_fits_surfaces_and_finds_the_optimum(tmp_path):
+    res = run_design(
+        SPACE, runs="ccd", evaluator=_evaluator, out_dir=tmp_path, seed=3,
+        objective="delta_vx_m_per_s", constraints={"knee_moment_min_Nm": 0.0,
+                                                   "clearance_min_m": 0.02},
+        units={"delta_vx_m_per_s": "m/s"}, progress=False,
+    )
+    assert res.design.n_runs == 25 and res.n_evaluated == 25
+    for f in ("study.json", "results.csv", "surfaces.json", "coefficients.csv", "anova.csv",
+              "optimum.json", "estimability.json"):
+        assert (tmp_path / f).is_file()
+    table = pd.read_csv(tmp_path / "results.csv")
+    assert len(table) == 25 and "width_m_coded" in table
+    s = res.surfaces["delta_vx_m_per_s"]
+    coef = dict(zip(s.term_names, s.coef, strict=True))
+    assert coef["stiffness_kN_per_m"] == pytest.approx(0.08, abs=1e-10)
+    assert coef["stiffness_kN_per_m^2"] == pytest.approx(-0.02, abs=1e-10)
+    # the optimum: k and w high (k² term: d/dk = 0.08 - 0.04k + 0.01w > 0 on the box), toe
+    # length between the knee (t >= (3k - 10)/25) and clearance (t <= ~0.64) limits
+    opt = res.optimum
+    assert opt is not None and res.optimum_error is None
+    assert opt.coded["stiffness_kN_per_m"] == pytest.approx(1.0, abs=1e-6)
+    assert opt.coded["width_m"] == pytest.approx(1.0, abs=1e-6)
+    assert opt.constraints["knee_moment_min_Nm"]["slack"] >= -1e-6
+    assert opt.constraints["clearance_min_m"]["slack"] >= -1e-6
+    assert opt.point["stiffness_kN_per_m"] == pytest.approx(32.0, abs=1e-5)
+    saved = json.loads((tmp_path / "optimum.json").read_text())
+    assert saved["objective"] == "delta_vx_m_per_s"
+    assert res.to_dict()["design"]["n_runs"] == 25
+    assert set(res.coefficients()["response"]) == set(res.responses)
+
+    figs = tmp_path / "figs"
+    fig = main_effects_plot(list(res.surfaces.values()), SPACE)
+    assert fig.axes[0].get_xlabel() == "vertical stiffness [kN/m]"
+    assert fig.axes[0].get_ylabel() == "delta_vx_m_per_s [m/s]"
+    save_figure(fig, figs / "main_effects.png")
+    from bladelab.design.optimum import SurfaceConstraint
+
+    cons = [SurfaceConstraint(res.surfaces["knee_moment_min_Nm"], 0.0),
+            SurfaceConstraint(res.surfaces["clearance_min_m"], 0.02)]
+    fig2 = contour_plot(s, SPACE, x="stiffness_kN_per_m", y="toe_length_m", constraints=cons,
+                        optimum=opt)
+    assert fig2.axes[0].get_ylabel() == "toe length [m]"
+    save_figure(fig2, figs / "contour.png")
+    assert (figs / "main_effects.png").stat().st_size > 1000
+    assert (figs / "contour.png").stat().st_size > 1000
+    assert not list(figs.glob("*.part"))
+
+
+def test_interrupted_study_resumes(tmp_path):
+    calls = {"n": 0}
+
+    def flaky(point):
+        calls["n"] += 1
+        if calls["n"] > 10:
+            raise _Crash("power cut")
+        return _evaluator(point)
+
+    with pytest.raises(_Crash):
+        run_design(SPACE, runs="bbd", evaluator=flaky, out_dir=tmp_path, progress=False)
+    assert len(list((tmp_path / "runs").glob("run_*.json"))) == 10
+    assert not (tmp_path / "results.csv").exists()
+    calls["n"] = -100
+    res = run_design(SPACE, runs="bbd", evaluator=flaky, out_dir=tmp_path, progress=False)
+    assert res.n_resumed == 10 and res.n_evaluated == 15
+    # the same folder with another design is refused
+    with pytest.raises(SpecError, match="different design"):
+        run_design(SPACE, runs="ccd", evaluator=_evaluator, out_dir=tmp_path, progress=False)
+
+
+def test_refusals_before_and_during_evaluation(tmp_path):
+    runs = tmp_path / "nine.csv"
+    rng = np.random.default_rng(0)
+    pts = SPACE.decode(rng.choice([-1.0, 0.0, 1.0], size=(9, 4)))
+    pd.DataFrame(pts, columns=list(SPACE.names)).to_csv(runs, index=False)
+    called = []
+    with pytest.raises(SpecError, match="9 runs cannot estimate the 15-term model"):
+        run_design(SPACE, runs=runs, evaluator=lambda p: called.append(p) or {"y": 1.0},
+                   out_dir=tmp_path / "o", progress=False)
+    assert not called  # refused before any (expensive) evaluation
+
+    def bad(point):
+        return {"y": float("nan")}
+
+    with pytest.raises(DataError, match="run 1"):
+        run_design(SPACE, evaluator=bad, out_dir=tmp_path / "p", progress=False)
+    with pytest.raises(SpecError, match="unknown response"):
+        run_design(SPACE, evaluator=_evaluator, out_dir=tmp_path / "q", objective="speed",
+                   progress=False)
