@@ -259,7 +259,7 @@ def stance_mechanics(
     force: ForceComponent = "vertical",
     d0: float | None = None,
     contact_threshold: float = 20.0,
-    min_compression: float = 2e-3,
+    min_compression: float = 5e-3,
     min_deflection: float = np.deg2rad(1.0),
 ) -> StanceMechanics:
     """Compute Δd, K_c, Δθ, K(t), peaks, loops and energies of one stance.

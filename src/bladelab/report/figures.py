@@ -1,0 +1,296 @@
+"""Report figures from stances, mechanics and parameter tables (seed 000 Figs. 1–3, §3.4–3.5).
+
+Every function returns a :class:`matplotlib.figure.Figure` (object-oriented API, no pyplot
+state), with units on every axis; pass it to :meth:`bladelab.report.Report.add_section`.
+Groups are given as ``{group name: [items...]}`` mappings, in display order.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from typing import Literal
+
+import numpy as np
+import pandas as pd
+from matplotlib.figure import Figure
+
+from bladelab.errors import DataError
+from bladelab.mechanics import StanceMechanics
+from bladelab.trial.stance import Stance
+
+__all__ = [
+    "PALETTE",
+    "resample_percent",
+    "time_series_bands",
+    "hysteresis_loops",
+    "compressive_stiffness_curves",
+    "parameter_bars",
+]
+
+# Colour-blind safe (Okabe–Ito).
+PALETTE = ("#0072B2", "#D55E00", "#009E73", "#CC79A7", "#E69F00", "#56B4E9", "#F0E442")
+MEASURED = "#222222"
+SIMULATED = "#D55E00"
+LOADING = "#0072B2"
+UNLOADING = "#D55E00"
+
+_RC = {
+    "font.size": 9,
+    "axes.titlesize": 10,
+    "axes.titleweight": "bold",
+    "axes.labelsize": 9,
+    "axes.spines.top": False,
+    "axes.spines.right": False,
+    "axes.grid": True,
+    "grid.color": "#e3e3e3",
+    "grid.linewidth": 0.6,
+    "legend.frameon": False,
+    "legend.fontsize": 8,
+}
+
+Signal = Literal["grf", "distance"]
+_SIGNALS = {
+    "grf": ("grf_z", 1.0, "vertical GRF [N]"),
+    "distance": ("distance", 1e3, "clamp–tip distance [mm]"),
+}
+
+
+def _figure(
+    n_panels: int,
+    *,
+    width: float = 3.3,
+    height: float = 2.6,
+    ncols: int | None = None,
+    share: bool = True,
+):
+    import matplotlib as mpl
+
+    ncols = min(n_panels, ncols or 3)
+    nrows = int(np.ceil(n_panels / ncols))
+    with mpl.rc_context(_RC):
+        fig = Figure(figsize=(width * ncols, height * nrows + 0.35), layout="constrained")
+        axes = fig.subplots(nrows, ncols, squeeze=False, sharex=share, sharey=share)
+    for ax in axes.flat[n_panels:]:
+        ax.set_visible(False)
+    return fig, list(axes.flat[:n_panels])
+
+
+def _style(ax) -> None:
+    ax.spines[["top", "right"]].set_visible(False)
+    ax.grid(True, color="#e3e3e3", linewidth=0.6)
+    ax.set_axisbelow(True)
+    ax.tick_params(labelsize=8)
+
+
+def _check_groups(groups: Mapping, what: str) -> None:
+    if not groups or not any(len(v) for v in groups.values()):
+        raise DataError(f"no {what} to plot", where=what, hint="pass {group: [items...]}")
+
+
+def resample_percent(stance: Stance, name: str, *, n_points: int = 101) -> np.ndarray:
+    """Channel ``name`` of ``stance`` resampled to 0–100 % of the window (``n_points`` samples)."""
+    t = stance.time
+    pct = (t - t[0]) / (t[-1] - t[0]) * 100.0
+    return np.interp(np.linspace(0.0, 100.0, n_points), pct, getattr(stance, name))
+
+
+def _mean_sd(stances: Sequence[Stance], name: str, n_points: int) -> tuple[np.ndarray, np.ndarray]:
+    curves = np.array([resample_percent(s, name, n_points=n_points) for s in stances])
+    sd = curves.std(axis=0, ddof=1) if len(curves) > 1 else np.zeros(n_points)
+    return curves.mean(axis=0), sd
+
+
+def time_series_bands(
+    measured: Mapping[str, Sequence[Stance]],
+    simulated: Mapping[str, Sequence[Stance]] | None = None,
+    *,
+    signal: Signal = "grf",
+    n_points: int = 101,
+) -> Figure:
+    """GRF or distance vs stance time, measured vs simulated, group mean ± SD (Figs. 1–2).
+
+    Each stance is normalised to 0–100 % of its window (touch-down to toe-off) before
+    averaging, so stances of different durations share one axis.
+
+    Parameters
+    ----------
+    measured
+        ``{group: [measured Stance, ...]}``, one panel per group.
+    simulated
+        ``{group: [simulated Stance, ...]}`` (same groups), or None.
+    signal
+        ``"grf"`` (vertical GRF [N]) or ``"distance"`` (clamp–tip distance, shown in mm).
+    n_points
+        Samples of the normalised curves.
+    """
+    if signal not in _SIGNALS:
+        raise DataError(f"unknown signal {signal!r}", where="signal", hint="'grf' or 'distance'")
+    _check_groups(measured, "measured stances")
+    name, scale, label = _SIGNALS[signal]
+    pct = np.linspace(0.0, 100.0, n_points)
+    fig, axes = _figure(len(measured))
+    for ax, (group, stances) in zip(axes, measured.items(), strict=True):
+        _style(ax)
+        series = [("measured", MEASURED, "-", stances)]
+        if simulated is not None and simulated.get(group):
+            series.append(("simulated", SIMULATED, "--", simulated[group]))
+        for lab, colour, ls, items in series:
+            mean, sd = _mean_sd(items, name, n_points)
+            ax.fill_between(
+                pct, (mean - sd) * scale, (mean + sd) * scale, color=colour, alpha=0.18, linewidth=0
+            )
+            ax.plot(
+                pct,
+                mean * scale,
+                color=colour,
+                linestyle=ls,
+                linewidth=1.6,
+                label=f"{lab} mean ± SD",
+            )
+        ax.set_title(f"{group} (n = {len(stances)})")
+        ax.set_xlabel("stance [%]")
+        ax.set_ylabel(label)
+        ax.set_xlim(0, 100)
+    axes[0].legend(loc="best")
+    return fig
+
+
+def _loop_panels(
+    mechanics: Mapping[str, Sequence[StanceMechanics]],
+    *,
+    xlabel: str,
+    ylabel: str,
+    get,
+) -> Figure:
+    _check_groups(mechanics, "mechanics")
+    fig, axes = _figure(len(mechanics))
+    for ax, (group, items) in zip(axes, mechanics.items(), strict=True):
+        _style(ax)
+        plotted = 0
+        for m in items:
+            xy = get(m)
+            if xy is None:
+                continue
+            (xl, yl), (xu, yu) = xy
+            ax.plot(
+                xl,
+                yl,
+                color=LOADING,
+                linewidth=1.0,
+                alpha=0.75,
+                label="loading" if plotted == 0 else None,
+            )
+            ax.plot(
+                xu,
+                yu,
+                color=UNLOADING,
+                linewidth=1.0,
+                alpha=0.75,
+                linestyle="--",
+                label="unloading" if plotted == 0 else None,
+            )
+            plotted += 1
+        ax.set_title(f"{group} (n = {plotted})")
+        ax.set_xlabel(xlabel)
+        ax.set_ylabel(ylabel)
+        if plotted == 0:
+            ax.text(0.5, 0.5, "no data", transform=ax.transAxes, ha="center", color="#888888")
+    axes[0].legend(loc="best")
+    return fig
+
+
+def hysteresis_loops(mechanics: Mapping[str, Sequence[StanceMechanics]]) -> Figure:
+    """GRF vs angular deformation Δθ per group, loading and unloading branches (§3.4).
+
+    Stances without a blade angle are left out of their panel.
+    """
+
+    def get(m: StanceMechanics):
+        loop = m.angle_loop
+        if loop is None:
+            return None
+        i0 = m.contact_index
+        (xl, yl), (xu, yu) = loop.loading, loop.unloading
+        return (np.rad2deg(xl[i0:]), yl[i0:]), (np.rad2deg(xu), yu)
+
+    return _loop_panels(mechanics, xlabel="angular deformation Δθ [deg]", ylabel="GRF [N]", get=get)
+
+
+def compressive_stiffness_curves(mechanics: Mapping[str, Sequence[StanceMechanics]]) -> Figure:
+    """Equivalent compressive stiffness K_c vs compression Δd per group (§3.5)."""
+
+    def get(m: StanceMechanics):
+        loop = m.compression_loop
+        kc = m.compressive_stiffness / 1e3
+        i = loop.peak_index
+        dd = m.compression * 1e3
+        return (dd[: i + 1], kc[: i + 1]), (dd[i:], kc[i:])
+
+    return _loop_panels(mechanics, xlabel="compression Δd [mm]", ylabel="K_c [kN/m]", get=get)
+
+
+def parameter_bars(
+    summary: pd.DataFrame,
+    *,
+    parameters: Sequence[tuple[str, str]] = (
+        ("K_Nm_per_deg", "K* [N·m/deg]"),
+        ("D_Nms_per_deg", "D* [N·m·s/deg]"),
+    ),
+    group: str = "group",
+    band: str = "speed_band",
+) -> Figure:
+    """K* and D* per group and speed band with confidence intervals (seed 000 Fig. 3).
+
+    Parameters
+    ----------
+    summary
+        One row per (group, band): the value column (the mean) and ``<value>_ci_low``,
+        ``<value>_ci_high`` (as from :func:`bladelab.stats.summarize`).
+    parameters
+        (column, axis label with unit) pairs, one panel each.
+    group, band
+        Column names of the group and speed band.
+
+    Bars are the means, whiskers the confidence interval given (say so in the caption).
+    """
+    need = [group, band] + [
+        c for col, _ in parameters for c in (col, f"{col}_ci_low", f"{col}_ci_high")
+    ]
+    missing = [c for c in need if c not in summary.columns]
+    if missing:
+        raise DataError(
+            f"missing columns {missing}",
+            where="parameter summary",
+            hint="build it with bladelab.stats.summarize(values=[...], by=[group, speed_band])",
+        )
+    groups = list(dict.fromkeys(summary[group]))
+    bands = list(dict.fromkeys(summary[band]))
+    fig, axes = _figure(len(parameters), width=4.6, height=3.0, share=False)
+    width = 0.8 / max(len(bands), 1)
+    x = np.arange(len(groups))
+    for ax, (col, label) in zip(axes, parameters, strict=True):
+        _style(ax)
+        ax.grid(False, axis="x")
+        for j, b in enumerate(bands):
+            sub = summary[summary[band] == b].set_index(group).reindex(groups)
+            mean = sub[col].to_numpy(float)
+            lo = np.nan_to_num(mean - sub[f"{col}_ci_low"].to_numpy(float))
+            hi = np.nan_to_num(sub[f"{col}_ci_high"].to_numpy(float) - mean)
+            pos = x - 0.4 + width * (j + 0.5)
+            ax.bar(
+                pos,
+                mean,
+                width * 0.92,
+                color=PALETTE[j % len(PALETTE)],
+                label=str(b),
+                edgecolor="white",
+                linewidth=0.5,
+            )
+            ax.errorbar(
+                pos, mean, yerr=[lo, hi], fmt="none", ecolor="#333333", capsize=3, linewidth=1.0
+            )
+        ax.set_xticks(x, groups)
+        ax.set_ylabel(label)
+        ax.set_xlabel("group")
+    axes[0].legend(title="speed band", loc="upper left", title_fontsize=8)
+    return fig
