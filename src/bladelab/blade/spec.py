@@ -401,11 +401,14 @@ def segment_mass_properties(
     inertia : (N,) [kg·m²]
     """
     dense = profile.densified()
-    s = dense.arc_length
+    # Split the dense polyline exactly at the segment breaks, so no piece straddles two segments.
+    s = np.union1d(dense.arc_length, segmentation.breaks)
+    s = s[np.concatenate([[True], np.diff(s) > 1e-12])]
+    pts = profile.at(s)
     length = float(s[-1])
     mid_s = 0.5 * (s[:-1] + s[1:])
-    mid = 0.5 * (dense.points[:-1] + dense.points[1:])
-    ds = np.diff(s)
+    mid = 0.5 * (pts[:-1] + pts[1:])
+    ds = np.hypot(*np.diff(pts, axis=0).T)
     if thickness is None:
         lam = np.ones_like(ds)
     else:
