@@ -53,7 +53,7 @@ def test_kruskal_wallis_and_dunn_with_ties_match_the_hand_computation():
         assert row["z"] == pytest.approx(z, rel=1e-12)
         assert row["p"] == pytest.approx(p, rel=1e-10)
         assert row["p_adjusted"] == pytest.approx(min(1.0, 3 * p), rel=1e-10)
-        assert row["effect_size_r"] == pytest.approx(z / math.sqrt(SIZES[gi] + SIZES[gj]))
+        assert row["effect_size_r"] == pytest.approx(z / math.sqrt(N))  # N of the H test
     assert dunn.loc["A | B", "z"] == pytest.approx(-1.62855, abs=1e-5)  # −4.55 / 2.79388
     # A vs C: z = −8.75/2.79388 = −3.1318, p = 0.00174, Bonferroni 0.0052 -> significant.
     assert bool(dunn.loc["A | C", "significant"])

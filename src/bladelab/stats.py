@@ -22,9 +22,10 @@ Formulas (ranks are mid-ranks over the pooled sample, N values, tie groups of si
 - H = [12/(N(N+1)) Σ Rᵢ²/nᵢ − 3(N+1)] / [1 − Σ(t³−t)/(N³−N)], p = χ²_{k−1} survival.
 - Dunn: zᵢⱼ = (R̄ᵢ − R̄ⱼ)/√{[N(N+1)/12 − Σ(t³−t)/(12(N−1))]·(1/nᵢ + 1/nⱼ)}, p two-sided normal,
   Bonferroni p_adj = min(1, m·p) with m = k(k−1)/2 comparisons.
-- Effect size r = Z/√N with N the number of observations in the comparison (both groups of a
-  pair); |r| ≈ 0.1 small, 0.3 medium, ≥ 0.5 large (Cohen). Positive r: the first group ranks
-  higher. No r for the omnibus H test (NaN).
+- Effect size r = Z/√N: for Mann–Whitney N = n₁ + n₂; for a Dunn pair N is the total of the
+  Kruskal–Wallis test (Dunn's z uses the variance of the pooled ranking, so dividing by the pair
+  size alone can give |r| > 1). |r| ≈ 0.1 small, 0.3 medium, ≥ 0.5 large (Cohen). Positive r:
+  the first group ranks higher. No r for the omnibus H test (NaN).
 """
 
 from __future__ import annotations
@@ -261,7 +262,7 @@ def kruskal_dunn(
                 z=z,
                 p=p,
                 p_adjusted=min(1.0, p * len(pairs)),
-                effect_size_r=z / np.sqrt(sizes[i] + sizes[j]),
+                effect_size_r=z / np.sqrt(n),
                 n=f"{int(sizes[i])} | {int(sizes[j])}",
             )
         )

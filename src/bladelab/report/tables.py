@@ -181,10 +181,20 @@ def _p_text(p: float) -> str:
     return "< 0.001" if p < 1e-3 else f"{p:.3f}"
 
 
+_SHORT_TESTS = {
+    "Mann-Whitney U": "Mann–Whitney U",
+    "Kruskal-Wallis H": "Kruskal–Wallis",
+    "Dunn (Bonferroni)": "Dunn–Bonferroni",
+    "Mann-Whitney U (speed band)": "Speed band (U)",
+}
+_SHORT_PARAMETERS = {"K_Nm_per_deg": "K*", "D_Nms_per_deg": "D*"}
+
+
 def stats_display(results: pd.DataFrame) -> pd.DataFrame:
     """A readable layout of :func:`bladelab.stats.compare_groups` results for the page.
 
-    Columns: Test, Parameter, Subset, Groups, n, Statistic (``"U = 12"``, ``"H = 9.83"``,
+    Columns: Test, Parameter (``K*``/``D*`` for the standard columns), Subset (the category or
+    amputation level, or ``all``), Groups, n, Statistic (``"U = 12"``, ``"H = 9.83"``,
     ``"z = −1.63"``), p, p (Bonferroni) — shown for Dunn rows, r, and ``*`` where significant.
     Write the full numeric table as the CSV (``ReportTable(..., csv=results)``).
     """
@@ -193,9 +203,9 @@ def stats_display(results: pd.DataFrame) -> pd.DataFrame:
         stat = f"{r.statistic_name} = {r.statistic:.3g}" if np.isfinite(r.statistic) else "–"
         rows.append(
             {
-                "Test": r.test,
-                "Parameter": r.parameter,
-                "Subset": r.subset,
+                "Test": _SHORT_TESTS.get(r.test, r.test),
+                "Parameter": _SHORT_PARAMETERS.get(r.parameter, r.parameter),
+                "Subset": r.subset.split("=", 1)[-1],
                 "Groups": r.groups.replace(" | ", " vs "),
                 "n": r.n,
                 "Statistic": stat.replace("-", "−"),
