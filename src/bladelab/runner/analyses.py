@@ -1,0 +1,291 @@
+"""Analyses of a runner simulation (seed 001 §1.1, §2.3, §2.4, Table 3.3).
+
+- :func:`gait_events` and :func:`spatiotemporal`: touch-downs and lift-offs per leg (vertical
+  GRF above a threshold) and stride, step, contact, flight and swing times (§1.1);
+- :func:`leg_grf`: GRF per leg in N and body weights; :func:`joint_angles` in degrees;
+- :func:`joint_powers`: hip, knee, ankle (muscle + ligament torque × angular velocity), socket,
+  and the blade (power the blade contact delivers to the body);
+- :func:`power_balance`: muscle, ligament, contact, gravity and kinetic power (eq. 2.10–2.18),
+  and the residual ``P_external − P_kinetic``;
+- :func:`leg_stiffness`: K_leg = F_peak/ΔL per stance (eq. 2.19–2.21);
+- :func:`leg_energy`: energy stored, generated, hysteresis and recoil per leg (Table 3.3);
+- :func:`summary`: the JSON summary of the CLI.
+
+Powers are positive when delivered to the body segments. All tables are tidy DataFrames.
+"""
+
+from __future__ import annotations
+
+import math
+
+import mujoco
+import numpy as np
+import pandas as pd
+
+from bladelab.runner.model import CP_BLADE, CP_LEG
+from bladelab.runner.params import GRAVITY
+from bladelab.runner.simulate import RC_FX, RC_FZ, RC_VX, RC_VZ, RunnerResult, _leg_names
+
+CONTACT_THRESHOLD_N = 20.0
+
+
+def _forward_pass(result: RunnerResult) -> dict[str, np.ndarray]:
+    """Per sample: kinetic energy [J], COM position/velocity, muscle generalized forces."""
+    cached = getattr(result, "_fwd_cache", None)
+    if cached is not None:
+        return cached
+    m = result.model.mj_model.__copy__()
+    m.opt.enableflags |= int(mujoco.mjtEnableBit.mjENBL_ENERGY)
+    d = mujoco.MjData(m)
+    n = len(result.time)
+    ek = np.zeros(n)
+    com = np.zeros((n, 3))
+    comv = np.zeros((n, 3))
+    qfa = np.zeros((n, m.nv))
+    for i in range(n):
+        d.qpos[:] = result.qpos[i]
+        d.qvel[:] = result.qvel[i]
+        d.ctrl[:] = -result.muscles[i, :, 3]
+        mujoco.mj_forward(m, d)
+        mujoco.mj_subtreeVel(m, d)
+        ek[i] = d.energy[1]
+        com[i] = d.subtree_com[0]
+        comv[i] = d.subtree_linvel[0]
+        qfa[i] = d.qfrc_actuator
+    out = {"ek": ek, "com": com, "comv": comv, "qfrc_muscle": qfa}
+    object.__setattr__(result, "_fwd_cache", out)
+    return out
+
+
+def _leg_fz(result: RunnerResult, leg: int) -> np.ndarray:
+    cols = result.model.contact_params[:, CP_LEG] == leg
+    return result.contacts[:, cols, RC_FZ].sum(axis=1)
+
+
+def leg_grf(result: RunnerResult) -> pd.DataFrame:
+    """GRF per leg (tidy): time [s], leg, Fx, Fz [N], Fx_bw, Fz_bw [body weights]."""
+    return result.leg_grf()
+
+
+def gait_events(result: RunnerResult, *, threshold_n: float = CONTACT_THRESHOLD_N) -> pd.DataFrame:
+    """Touch-downs and lift-offs per leg: columns leg, event (touchdown/liftoff), time [s]."""
+    rows = []
+    names = _leg_names(result.model)
+    for leg in (0, 1):
+        on = _leg_fz(result, leg) > threshold_n
+        change = np.flatnonzero(np.diff(on.astype(np.int8)))
+        for i in change:
+            rows.append({"leg": names[leg], "event": "touchdown" if on[i + 1] else "liftoff",
+                         "time": float(result.time[i + 1])})
+    return pd.DataFrame(rows, columns=["leg", "event", "time"]).sort_values("time", ignore_index=True)
+
+
+def spatiotemporal(result: RunnerResult, *, threshold_n: float = CONTACT_THRESHOLD_N) -> pd.DataFrame:
+    """Mean stride, step, contact, flight and swing times [s] per leg (seed 001 §1.1).
+
+    Tidy: columns leg, variable, value, n (number of complete cycles used). Only stances with
+    both a touch-down and a lift-off inside the simulation count; NaN where there are none.
+    """
+    ev = gait_events(result, threshold_n=threshold_n)
+    names = _leg_names(result.model)
+    rows = []
+    for leg, other in ((names[0], names[1]), (names[1], names[0])):
+        td = ev.time[(ev.leg == leg) & (ev.event == "touchdown")].to_numpy()
+        lo = ev.time[(ev.leg == leg) & (ev.event == "liftoff")].to_numpy()
+        td_other = ev.time[(ev.leg == other) & (ev.event == "touchdown")].to_numpy()
+        contact, flight, step = [], [], []
+        for t in td:
+            after = lo[lo > t]
+            if len(after):
+                contact.append(after[0] - t)
+                nxt = td_other[td_other > after[0]]
+                if len(nxt):
+                    flight.append(nxt[0] - after[0])
+            nxt = td_other[td_other > t]
+            if len(nxt):
+                step.append(nxt[0] - t)
+        stride = np.diff(td)
+        mean_contact = float(np.mean(contact)) if contact else math.nan
+        mean_stride = float(np.mean(stride)) if len(stride) else math.nan
+        values = {
+            "stride_time": (mean_stride, len(stride)),
+            "step_time": (float(np.mean(step)) if step else math.nan, len(step)),
+            "contact_time": (mean_contact, len(contact)),
+            "flight_time": (float(np.mean(flight)) if flight else math.nan, len(flight)),
+            "swing_time": (mean_stride - mean_contact, min(len(stride), len(contact))),
+        }
+        for var, (val, n) in values.items():
+            rows.append({"leg": leg, "variable": var, "value": val, "n": n})
+    return pd.DataFrame(rows)
+
+
+def joint_angles(result: RunnerResult) -> pd.DataFrame:
+    """Joint angles in degrees (tidy): time [s], joint, angle_deg (rotational coordinates)."""
+    model = result.model
+    frames = []
+    for j, name in enumerate(model.dof_names):
+        if name in ("pelvis_tx", "pelvis_tz"):
+            continue
+        frames.append(pd.DataFrame({"time": result.time, "joint": name,
+                                    "angle_deg": np.degrees(result.qpos[:, j])}))
+    return pd.concat(frames, ignore_index=True)
+
+
+def joint_powers(result: RunnerResult) -> pd.DataFrame:
+    """Joint powers [W] (tidy): time, joint, power. Joints: hip/knee/ankle per side (muscle +
+    ligament torque × angular velocity), ``socket_r`` and ``blade_r`` (amputee)."""
+    model = result.model
+    fwd = _forward_pass(result)
+    torque = fwd["qfrc_muscle"] + result.ligament
+    frames = []
+    for j, name in enumerate(model.dof_names):
+        if name.startswith(("hip", "knee", "ankle", "socket")):
+            frames.append(pd.DataFrame({"time": result.time, "joint": name,
+                                        "power": torque[:, j] * result.qvel[:, j]}))
+    blade = model.contact_params[:, CP_BLADE] == 1
+    if blade.any():
+        c = result.contacts[:, blade, :]
+        p = (c[:, :, RC_FX] * c[:, :, RC_VX] + c[:, :, RC_FZ] * c[:, :, RC_VZ]).sum(axis=1)
+        frames.append(pd.DataFrame({"time": result.time, "joint": "blade_r", "power": p}))
+    return pd.concat(frames, ignore_index=True)
+
+
+def power_balance(result: RunnerResult) -> pd.DataFrame:
+    """Power balance (seed 001 eq. 2.10–2.18), wide: time [s], muscle, ligament, contact,
+    gravity, external (their sum), kinetic (dE_kin/dt from the simulated motion), residual [W].
+
+    Muscle power is Σ F_t·(−v_mtu), ligament power Σ τ·q̇, contact power Σ F·v of the body point
+    at each contact, gravity power −M·g·v_com,z; the kinetic power is the time derivative of the
+    kinetic energy computed by MuJoCo from the recorded states, independently of the forces.
+    """
+    fwd = _forward_pass(result)
+    p_m = -(result.muscles[:, :, 3] * result.mtu[:, :, 1]).sum(axis=1)
+    p_l = (result.ligament * result.qvel).sum(axis=1)
+    c = result.contacts
+    p_c = (c[:, :, RC_FX] * c[:, :, RC_VX] + c[:, :, RC_FZ] * c[:, :, RC_VZ]).sum(axis=1)
+    p_g = -result.model.total_mass * GRAVITY * fwd["comv"][:, 2]
+    p_ext = p_m + p_l + p_c + p_g
+    p_k = np.gradient(fwd["ek"], result.time) if len(result.time) > 2 else np.zeros_like(p_ext)
+    return pd.DataFrame({"time": result.time, "muscle": p_m, "ligament": p_l, "contact": p_c,
+                         "gravity": p_g, "external": p_ext, "kinetic": p_k,
+                         "residual": p_ext - p_k})
+
+
+def power_balance_residual_pct(result: RunnerResult) -> float:
+    """RMS of ``P_external − P_kinetic`` in % of the peak |P_kinetic| (first and last samples
+    excluded: one-sided differences)."""
+    pb = power_balance(result).iloc[1:-1]
+    peak = float(np.max(np.abs(pb.kinetic))) if len(pb) else 0.0
+    if peak == 0.0:
+        return 0.0
+    return float(np.sqrt(np.mean(pb.residual**2)) / peak * 100.0)
+
+
+def _stances(result: RunnerResult, leg: int, threshold_n: float) -> list[tuple[int, int]]:
+    on = _leg_fz(result, leg) > threshold_n
+    edges = np.flatnonzero(np.diff(on.astype(np.int8)))
+    out = []
+    for i in edges:
+        if on[i + 1]:
+            after = edges[edges > i]
+            if len(after):
+                out.append((i + 1, after[0] + 1))
+    return out
+
+
+def _leg_length(result: RunnerResult, leg: int) -> float:
+    """Standing leg length L0 [m]: hip joint height in the standing pose (+3 cm prosthetic)."""
+    model = result.model
+    d = mujoco.MjData(model.mj_model)
+    q = model.stand_qpos.copy()
+    q[:] = 0.0
+    d.qpos[:] = q
+    mujoco.mj_kinematics(model.mj_model, d)
+    side = "l" if leg == 0 else "r"
+    hip = d.xanchor[model.mj_model.joint(f"hip_flexion_{side}").id, 2]
+    from bladelab.runner.model import contact_heights
+
+    h = contact_heights(model, q)
+    cols = model.contact_params[:, CP_LEG] == leg
+    return float(hip - h[cols].min())
+
+
+def leg_stiffness(result: RunnerResult, *, threshold_n: float = CONTACT_THRESHOLD_N) -> pd.DataFrame:
+    """Leg stiffness per stance (seed 001 eq. 2.19–2.21): columns leg, touchdown [s],
+    contact_time [s], F_peak [N], delta_y [m], L0 [m], theta_rad, delta_L [m], K_leg [N/m]."""
+    fwd = _forward_pass(result)
+    names = _leg_names(result.model)
+    rows = []
+    for leg in (0, 1):
+        l0 = _leg_length(result, leg)
+        fz = _leg_fz(result, leg)
+        for i0, i1 in _stances(result, leg, threshold_n):
+            tc = result.time[i1] - result.time[i0]
+            v = float(np.mean(fwd["comv"][i0:i1, 0]))
+            dy = float(fwd["com"][i0, 2] - np.min(fwd["com"][i0:i1, 2]))
+            theta = math.asin(min(abs(v) * tc / (2 * l0), 1.0))
+            dl = dy + l0 * (1 - math.cos(theta))
+            fp = float(np.max(fz[i0:i1]))
+            rows.append({"leg": names[leg], "touchdown": float(result.time[i0]), "contact_time": tc,
+                         "F_peak": fp, "delta_y": dy, "L0": l0, "theta_rad": theta, "delta_L": dl,
+                         "K_leg": fp / dl if dl > 0 else math.nan})
+    return pd.DataFrame(rows, columns=["leg", "touchdown", "contact_time", "F_peak", "delta_y",
+                                       "L0", "theta_rad", "delta_L", "K_leg"])
+
+
+def leg_energy(result: RunnerResult, *, threshold_n: float = CONTACT_THRESHOLD_N) -> pd.DataFrame:
+    """Energy per leg and stance from the GRF–vertical COM displacement loop (Table 3.3 layout):
+    columns leg, touchdown [s], E_stored [J] (work absorbed while the COM descends), E_generated
+    [J] (work returned while it rises), hysteresis [J] = |stored − generated|,
+    recoil_pct = 100·min/max."""
+    fwd = _forward_pass(result)
+    names = _leg_names(result.model)
+    rows = []
+    for leg in (0, 1):
+        fz = _leg_fz(result, leg)
+        for i0, i1 in _stances(result, leg, threshold_n):
+            dz = np.diff(fwd["com"][i0:i1 + 1, 2])
+            f = 0.5 * (fz[i0:i1] + fz[i0 + 1:i1 + 1])
+            stored = float(-np.sum(f * np.minimum(dz, 0.0)))
+            generated = float(np.sum(f * np.maximum(dz, 0.0)))
+            big = max(stored, generated)
+            rows.append({"leg": names[leg], "touchdown": float(result.time[i0]),
+                         "E_stored": stored, "E_generated": generated,
+                         "hysteresis": abs(stored - generated),
+                         "recoil_pct": 100.0 * min(stored, generated) / big if big > 0 else math.nan})
+    return pd.DataFrame(rows, columns=["leg", "touchdown", "E_stored", "E_generated", "hysteresis",
+                                       "recoil_pct"])
+
+
+def summary(result: RunnerResult) -> dict:
+    """The JSON summary: fell, duration_s, mean_speed_mps, contact times per leg,
+    power_balance_residual_pct, and the spatiotemporal means."""
+    fwd = _forward_pass(result)
+    names = _leg_names(result.model)
+    st = spatiotemporal(result)
+    dur = result.duration
+    speed = float((fwd["com"][-1, 0] - fwd["com"][0, 0]) / dur) if dur > 0 else 0.0
+
+    def _val(leg: str, var: str) -> float | None:
+        v = st.value[(st.leg == leg) & (st.variable == var)]
+        return None if v.empty or not np.isfinite(v.iloc[0]) else float(v.iloc[0])
+
+    out = {
+        "model": result.model.kind,
+        "blade": result.model.params.blade if result.model.kind == "amputee" else None,
+        "fell": bool(result.fell),
+        "duration_s": dur,
+        "mean_speed_mps": speed,
+        f"contact_time_{names[0]}_s": _val(names[0], "contact_time"),
+        f"contact_time_{names[1]}_s": _val(names[1], "contact_time"),
+        "power_balance_residual_pct": power_balance_residual_pct(result),
+        "peak_grf_bw": {
+            leg: float(np.max(_leg_fz(result, i)) / result.model.body_weight) for i, leg in enumerate(names)
+        },
+        "spatiotemporal_s": {f"{r.leg}.{r.variable}": (None if not np.isfinite(r.value) else float(r.value))
+                             for r in st.itertuples()},
+    }
+    if result.model.kind == "able":
+        out["contact_time_intact_s"] = out[f"contact_time_{names[0]}_s"]
+        out["contact_time_prosthetic_s"] = None
+    return out

@@ -1,0 +1,372 @@
+"""Build the planar runner (able-bodied or transtibial amputee) in MuJoCo with MjSpec.
+
+MuJoCo supplies the multibody dynamics, the tendon (muscle path) lengths, velocities and moment
+arms; muscles, ligaments and ground contact are computed by bladelab's own numba code
+(:mod:`bladelab.runner.simulate`) and applied as forces. MuJoCo's native contact is disabled.
+
+Coordinates (``RunnerModel.dof_names``, OpenSim names and signs): ``pelvis_tx``, ``pelvis_tz`` [m]
+(pelvis centre of mass), ``pelvis_tilt`` (positive tilts the pelvis backward), ``hip_flexion_*``
+(positive flexes), ``knee_angle_*`` (0 straight, negative flexes), ``ankle_angle_*`` (positive
+dorsiflexes) / ``socket_angle_r`` (amputee), ``lumbar_extension`` (positive extends). All hinges
+turn about the lab's −y axis, so that these signs hold with x forward and z up.
+Side ``l`` is the intact leg of the amputee, ``r`` the prosthetic one.
+
+Geometry: SCONE H0918 (Apache-2.0), see :mod:`bladelab.runner.geometry`; masses, inertias and
+muscles: seed 001 Tables 2.1–2.2 via :mod:`bladelab.runner.params`.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import mujoco
+import numpy as np
+
+from bladelab.contact import hertz_sphere_stiffness
+from bladelab.errors import ModelError
+from bladelab.runner import geometry as geo
+from bladelab.runner.params import (
+    BLADE_ALIGNMENT_DEG,
+    BLADE_DISSIPATION_S_PER_M,
+    BLADE_EXTRA_LENGTH_M,
+    BLADE_FRICTION,
+    BLADE_OFFSET_A_M,
+    BLADE_OFFSET_B_M,
+    BLADE_RADIUS_M,
+    FOOT_DISSIPATION_S_PER_M,
+    FOOT_FRICTION,
+    FOOT_PLANE_STRAIN_MODULUS,
+    GRAVITY,
+    RunnerParams,
+    blade_contact_modulus,
+    default_runner_params,
+    muscle_max_force,
+    muscle_names,
+    runner_params_from_dict,
+    scale_ratios,
+)
+
+# Ligaments (joint-limit springs–dampers): (lower, upper) [deg], stiffness [N·m/rad],
+# damping [N·m·s/rad]. Hip and ankle ranges and the knee's stiffness/damping from H0918; the knee
+# range (−90°, 0°) and the soft lumbar limit at 0° from seed 001 §2.1.
+LIGAMENTS: dict[str, tuple[float, float, float, float]] = {
+    "hip_flexion": (-40.0, 120.0, 500.0, 5.0),
+    "knee_angle": (-90.0, 0.0, 114.592, 2.86479),
+    "ankle_angle": (-60.0, 60.0, 500.0, 5.0),
+    "lumbar_extension": (0.0, 0.0, 500.0, 5.0),
+}
+# Socket: stiff nonlinear torsional spring τ = −(K·q + K2·q·|q|) − D·q̇ (seed 001 §2.1).
+SOCKET_STIFFNESS = 1000.0  # N·m/rad
+SOCKET_STIFFNESS_QUADRATIC = 2.0e4  # N·m/rad²
+SOCKET_DAMPING = 10.0  # N·m·s/rad
+# Tangential (friction) bristle spring and damper of every contact [N/m, N·s/m].
+FRICTION_STIFFNESS = 5.0e4
+FRICTION_DAMPING = 200.0
+
+# Columns of RunnerModel.contact_params.
+CP_SITE, CP_BODY, CP_RADIUS, CP_K, CP_C, CP_MU, CP_LEG, CP_BLADE = range(8)
+# Columns of RunnerModel.joint_params (one row per dof).
+JP_LO, JP_HI, JP_K, JP_D, JP_SK, JP_SK2, JP_SD = range(7)
+
+
+@dataclass(frozen=True, eq=False)
+class RunnerModel:
+    """A compiled runner: MuJoCo model plus the parameter arrays of bladelab's force kernels.
+
+    Attributes
+    ----------
+    params
+        The parameter set it was built from.
+    mj_model
+        The MuJoCo model (no native contact; muscles as tendon actuators with ctrl = −force).
+    dof_names, muscle_names, segment_names, contact_names
+        Names in array order.
+    muscle_params
+        (n_muscles, 4): Fmax [N], l_opt [m], l_ts [m], pennation [rad].
+    contact_params
+        (n_contacts, 8): site id, body id, radius [m], Hertz k [N/m^1.5], dissipation [s/m],
+        friction [-], leg (0 = left/intact, 1 = right/prosthetic), is_blade (0/1).
+    joint_params
+        (n_dof, 7): ligament lower, upper [rad], stiffness [N·m/rad], damping [N·m·s/rad], spring
+        K [N·m/rad], K2 [N·m/rad²], D [N·m·s/rad] (the socket's).
+    blade_modulus
+        Plane-strain modulus E [N/m²] of the blade sphere (nan for the able model).
+    stand_qpos
+        A standing pose with every contact just touching the ground.
+    """
+
+    params: RunnerParams
+    mj_model: mujoco.MjModel
+    dof_names: tuple[str, ...]
+    muscle_names: tuple[str, ...]
+    segment_names: tuple[str, ...]
+    contact_names: tuple[str, ...]
+    muscle_params: np.ndarray
+    contact_params: np.ndarray
+    joint_params: np.ndarray
+    blade_modulus: float
+    stand_qpos: np.ndarray = field(repr=False)
+
+    @property
+    def kind(self) -> str:
+        return self.params.kind
+
+    @property
+    def total_mass(self) -> float:
+        """Total mass [kg]."""
+        return float(np.sum(self.mj_model.body_mass))
+
+    @property
+    def body_weight(self) -> float:
+        """Body weight [N]."""
+        return self.total_mass * GRAVITY
+
+    def segment_mass(self, name: str) -> float:
+        """Mass [kg] of one segment."""
+        return float(self.mj_model.body_mass[self.mj_model.body(name).id])
+
+    def dof(self, name: str) -> int:
+        """Index of a coordinate in qpos/qvel."""
+        try:
+            return self.dof_names.index(name)
+        except ValueError:
+            raise ModelError(f"no coordinate {name!r}", hint=f"use one of {self.dof_names}") from None
+
+    def to_dict(self) -> dict:
+        return {
+            "kind": self.kind,
+            "blade": self.params.blade if self.kind == "amputee" else None,
+            "total_mass_kg": self.total_mass,
+            "dof": list(self.dof_names),
+            "muscles": {
+                n: {"Fmax_N": float(p[0]), "l_opt_m": float(p[1]), "l_ts_m": float(p[2])}
+                for n, p in zip(self.muscle_names, self.muscle_params, strict=True)
+            },
+            "blade_modulus_N_per_m2": None if math.isnan(self.blade_modulus) else self.blade_modulus,
+        }
+
+
+def _v(p: tuple[float, float, float], s: float) -> list[float]:
+    return list(geo.to_lab(p, s))
+
+
+def _lab_inertia(ixx: float, iyy: float, izz: float, factor: float) -> list[float]:
+    """Principal inertias in lab axes; the sagittal one (lab y = OpenSim z) is kept exact, the
+    out-of-plane x one is raised if needed to satisfy the triangle inequality (it has no effect
+    in the planar model; the prosthesis of Table 2.1 violates it)."""
+    ix, iy, iz = ixx * factor, izz * factor, iyy * factor
+    if ix + iz < iy:
+        ix = iy - iz + 1e-6
+    return [ix, iy, iz]
+
+
+def _sub(a: tuple[float, float, float], b: tuple[float, float, float]) -> tuple[float, float, float]:
+    return (a[0] - b[0], a[1] - b[1], a[2] - b[2])
+
+
+def build_runner(params: RunnerParams | str = "amputee", *, blade: str | None = None) -> RunnerModel:
+    """Build a runner model from a parameter set (or the name ``"able"`` / ``"amputee"``).
+
+    Parameters
+    ----------
+    params
+        A :class:`RunnerParams` or the name of a built-in parameter set.
+    blade
+        Override the blade category of an amputee parameter set (e.g. ``"Cat5"``).
+    """
+    if isinstance(params, str):
+        params = default_runner_params(params, blade=blade)
+    elif blade is not None:
+        params = runner_params_from_dict({**params.model_dump(), "blade": blade})
+    amputee = params.kind == "amputee"
+    mr, s = scale_ratios(params)
+
+    spec = mujoco.MjSpec()
+    spec.modelname = f"bladelab_runner_{params.kind}"
+    spec.option.timestep = 5e-4
+    spec.option.integrator = mujoco.mjtIntegrator.mjINT_EULER
+    spec.option.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_CONTACT)
+    spec.option.gravity = [0.0, 0.0, -GRAVITY]
+    spec.worldbody.add_geom(
+        name="ground", type=mujoco.mjtGeom.mjGEOM_PLANE, size=[50, 1, 0.1], contype=0, conaffinity=0
+    )
+
+    axis = [0.0, -1.0, 0.0]
+    bodies: dict[str, object] = {}
+    joint_child: dict[str, tuple[float, float, float]] = {}  # COM-relative joint point per body
+
+    def inertial(body, name: str, com: list[float]) -> None:
+        seg = params.segments[name]
+        ixx, iyy, izz = seg.inertia_kg_m2
+        body.explicitinertial = True
+        body.mass = seg.mass_kg * mr
+        body.ipos = com
+        body.inertia = _lab_inertia(ixx, iyy, izz, mr * s * s)
+
+    pelvis = spec.worldbody.add_body(name="pelvis", pos=[0, 0, 0])
+    pelvis.add_joint(name="pelvis_tx", type=mujoco.mjtJoint.mjJNT_SLIDE, axis=[1, 0, 0])
+    pelvis.add_joint(name="pelvis_tz", type=mujoco.mjtJoint.mjJNT_SLIDE, axis=[0, 0, 1])
+    pelvis.add_joint(name="pelvis_tilt", type=mujoco.mjtJoint.mjJNT_HINGE, axis=axis)
+    inertial(pelvis, "pelvis", [0, 0, 0])
+    bodies["pelvis"] = pelvis
+    joint_child["pelvis"] = (0.0, 0.0, 0.0)
+
+    def add(name: str, seg: str, joint: str, dof: str, parent: str, ppos, cpos, com=None):
+        parent_origin = joint_child[parent]
+        pos = _v(_sub(ppos, parent_origin), s)
+        body = bodies[parent].add_body(name=name, pos=pos)
+        body.add_joint(name=dof, type=mujoco.mjtJoint.mjJNT_HINGE, axis=axis)
+        inertial(body, seg, _v(_sub((0, 0, 0), cpos), s) if com is None else com)
+        bodies[name] = body
+        joint_child[name] = cpos
+        return body
+
+    for side in ("l", "r"):
+        par, pp, pc = geo.JOINTS[f"hip_{side}"]
+        add(f"femur_{side}", f"femur_{side}", f"hip_{side}", f"hip_flexion_{side}", "pelvis", pp, pc)
+        par, pp, pc = geo.JOINTS[f"knee_{side}"]
+        if side == "r" and amputee:
+            res_len = geo.RESIDUAL_TIBIA_FRACTION * geo.TIBIA_LENGTH_M
+            com = [0.0, 0.0, -0.5 * res_len * s]
+            add("tibia_res_r", "tibia_res_r", "knee_r", "knee_angle_r", "femur_r", pp, pc, com=com)
+            _add_prosthesis(bodies, joint_child, params, s, mr, res_len, axis)
+        else:
+            add(f"tibia_{side}", f"tibia_{side}", f"knee_{side}", f"knee_angle_{side}",
+                f"femur_{side}", pp, pc)
+            par, pp, pc = geo.JOINTS[f"ankle_{side}"]
+            body = add(f"calcn_{side}", f"calcn_{side}", f"ankle_{side}", f"ankle_angle_{side}",
+                       f"tibia_{side}", pp, pc)
+            for sph, p in geo.FOOT_SPHERES.items():
+                body.add_site(name=f"{sph}_{side}", pos=_v(_sub(p, pc), s),
+                              size=[geo.FOOT_SPHERE_RADIUS_M * s, 0, 0])
+    par, pp, pc = geo.JOINTS["lumbar"]
+    add("torso", "torso", "lumbar", "lumbar_extension", "pelvis", pp, pc)
+
+    # muscles: sites on bodies, spatial tendons, tendon actuators (ctrl = −tendon force)
+    names = muscle_names(params.kind)
+    mp = np.zeros((len(names), 4))
+    for i, mname in enumerate(names):
+        mtype, side = mname.rsplit("_", 1)
+        tendon = spec.add_tendon(name=mname)
+        for k, (body_name, p) in enumerate(geo.muscle_path(mtype, side)):
+            if body_name == "tibia_r" and amputee:
+                body_name, origin = "tibia_res_r", joint_child["tibia_res_r"]
+            else:
+                origin = joint_child[body_name]
+            site = f"{mname}_p{k}"
+            bodies[body_name].add_site(name=site, pos=_v(_sub(p, origin), s))
+            tendon.wrap_site(site)
+        act = spec.add_actuator(name=mname, trntype=mujoco.mjtTrn.mjTRN_TENDON, target=mname)
+        act.ctrllimited = False
+        mt = params.muscle_types[mtype]
+        mp[i] = (muscle_max_force(params, mtype), mt.optimal_fiber_length_m * s,
+                 mt.tendon_slack_length_m * s, mt.pennation_rad)
+
+    model = spec.compile()
+    dof_names = tuple(model.joint(j).name for j in range(model.njnt))
+    segment_names = tuple(model.body(b).name for b in range(1, model.nbody))
+
+    # contacts
+    contacts, rows = [], []
+    k_foot = hertz_sphere_stiffness(geo.FOOT_SPHERE_RADIUS_M * s, FOOT_PLANE_STRAIN_MODULUS)
+    for side, leg in (("l", 0), ("r", 1)):
+        if side == "r" and amputee:
+            continue
+        for sph in geo.FOOT_SPHERES:
+            site = model.site(f"{sph}_{side}")
+            contacts.append(f"{sph}_{side}")
+            rows.append((site.id, model.site_bodyid[site.id], geo.FOOT_SPHERE_RADIUS_M * s,
+                         k_foot, FOOT_DISSIPATION_S_PER_M, FOOT_FRICTION, leg, 0))
+    e_blade = math.nan
+    if amputee:
+        e_blade = blade_contact_modulus(params)
+        site = model.site("blade_r")
+        contacts.append("blade_r")
+        rows.append((site.id, model.site_bodyid[site.id], BLADE_RADIUS_M,
+                     hertz_sphere_stiffness(BLADE_RADIUS_M, e_blade), BLADE_DISSIPATION_S_PER_M,
+                     BLADE_FRICTION, 1, 1))
+    cp = np.array(rows, dtype=np.float64)
+
+    jp = np.zeros((len(dof_names), 7))
+    jp[:, JP_LO], jp[:, JP_HI] = -np.inf, np.inf
+    for i, dn in enumerate(dof_names):
+        base = dn[:-2] if dn.endswith(("_l", "_r")) else dn
+        if base in LIGAMENTS:
+            lo, hi, k, d = LIGAMENTS[base]
+            jp[i, :4] = (math.radians(lo), math.radians(hi), k, d)
+        if dn == "socket_angle_r":
+            jp[i, JP_SK:] = (SOCKET_STIFFNESS, SOCKET_STIFFNESS_QUADRATIC, SOCKET_DAMPING)
+
+    runner = RunnerModel(
+        params=params,
+        mj_model=model,
+        dof_names=dof_names,
+        muscle_names=names,
+        segment_names=segment_names,
+        contact_names=tuple(contacts),
+        muscle_params=mp,
+        contact_params=cp,
+        joint_params=jp,
+        blade_modulus=e_blade,
+        stand_qpos=np.zeros(model.nq),
+    )
+    runner.stand_qpos[:] = _standing_pose(runner)
+    return runner
+
+
+def _add_prosthesis(bodies, joint_child, params, s, mr, res_len, axis) -> None:
+    """Prosthesis (socket + blade mass) on the residual tibia, with the blade contact sphere.
+
+    The sphere centre lies a = 0.069 m in front of and b = 0.0693 m below the prosthesis COM,
+    that offset turned by the 9° alignment (seed 001 Fig. 2.3, our reading), and low enough that
+    the prosthetic leg is 3 cm longer than the intact leg (knee to ground, straight leg).
+    """
+    # knee -> ground of the intact leg: tibia + ankle-to-sphere-bottom
+    intact = geo.TIBIA_LENGTH_M + geo.JOINTS["ankle_l"][2][1] + 0.015 + geo.FOOT_SPHERE_RADIUS_M
+    bottom = (intact + BLADE_EXTRA_LENGTH_M) * s - res_len * s  # below the socket
+    centre = (0.0, -(bottom - BLADE_RADIUS_M))  # (x, z) in the socket frame
+    ox, oz = geo.rotate_pitch(BLADE_OFFSET_A_M * s, -BLADE_OFFSET_B_M * s,
+                              math.radians(BLADE_ALIGNMENT_DEG))
+    com = [centre[0] - ox, 0.0, centre[1] - oz]
+    body = bodies["tibia_res_r"].add_body(name="prosthesis_r", pos=[0.0, 0.0, -res_len * s])
+    body.add_joint(name="socket_angle_r", type=mujoco.mjtJoint.mjJNT_HINGE, axis=axis)
+    seg = params.segments["prosthesis_r"]
+    ixx, iyy, izz = seg.inertia_kg_m2
+    body.explicitinertial = True
+    body.mass = seg.mass_kg * mr
+    body.ipos = com
+    body.inertia = _lab_inertia(ixx, iyy, izz, mr * s * s)
+    body.add_site(name="blade_r", pos=[centre[0], 0.0, centre[1]], size=[BLADE_RADIUS_M, 0, 0])
+    bodies["prosthesis_r"] = body
+    joint_child["prosthesis_r"] = (0.0, 0.0, 0.0)
+
+
+def contact_heights(runner: RunnerModel, qpos: np.ndarray) -> np.ndarray:
+    """Lowest point height [m] of every contact sphere at a pose (negative = penetrating)."""
+    data = mujoco.MjData(runner.mj_model)
+    data.qpos[:] = qpos
+    mujoco.mj_kinematics(runner.mj_model, data)
+    cp = runner.contact_params
+    return np.array([data.site_xpos[int(r[CP_SITE]), 2] - r[CP_RADIUS] for r in cp])
+
+
+def _standing_pose(runner: RunnerModel) -> np.ndarray:
+    """Upright pose with all contacts touching: the longer prosthetic leg's knee is flexed."""
+    q = np.zeros(runner.mj_model.nq)
+    if runner.kind == "amputee":
+        iknee = runner.dof("knee_angle_r")
+        ihip = runner.dof("hip_flexion_r")
+        lo, hi = -0.8, 0.0
+        for _ in range(50):  # bisection: blade bottom level with the intact foot
+            mid = 0.5 * (lo + hi)
+            q[iknee], q[ihip] = mid, -0.5 * mid
+            h = contact_heights(runner, q)
+            if h[-1] < h[:-1].min():
+                hi = mid
+            else:
+                lo = mid
+            q[iknee], q[ihip] = 0.5 * (lo + hi), -0.25 * (lo + hi)
+    h = contact_heights(runner, q)
+    q[runner.dof("pelvis_tz")] -= h.min()
+    return q

@@ -1,0 +1,178 @@
+"""Hill-type muscle–tendon units with activation dynamics and a compliant tendon (numba).
+
+A Geyer & Herr (2010) / Millard (2012, damped equilibrium) class model, normalised by the
+maximum isometric force ``Fmax``, the optimal fibre length ``l_opt`` and the maximum contraction
+velocity ``v_max = 10·l_opt/s``:
+
+- activation ``da/dt = (u − a)·r`` with ``r = 100 /s`` when rising and ``25 /s`` when falling
+  (SCONE's H0918 integrator settings), ``a`` kept in [0.01, 1];
+- active force–length ``f_l(l̃) = exp(ln(0.05)·|(l̃ − 1)/0.56|³)`` (Geyer 2010);
+- force–velocity, ``ṽ = v/v_max`` (> 0 lengthening): ``(1 + ṽ)/(1 − 4ṽ)`` when shortening
+  (Hill, a/F0 = 0.25; 0 at ṽ = −1), ``1.5 − 0.5/(1 + 10ṽ)`` when lengthening (1.5·Fmax eccentric
+  plateau, slope continuous at 0);
+- passive fibre ``f_p = ((l̃ − 1)/0.6)²`` for l̃ > 1; fibre damping ``β·ṽ`` with β = 0.1 (Millard);
+- tendon ``f_t = (ε/0.04)²`` for strain ε > 0 (Geyer 2010: Fmax at 4 % strain);
+- pennation at constant fibre height ``l_ce·sin α = l_opt·sin α₀``.
+
+Equilibrium ``(a·f_l·f_v + f_p + β·ṽ)·cos α = f_t`` is solved for the fibre velocity each step,
+implicitly (backward Euler in the fibre length, Newton), so the fibre stays stable at any
+activation with the explicit multibody step. The tendon force is a function of the state
+(``l_mtu``, ``l_ce``); the muscle power is ``F_t·v_mtu`` (seed 001 eq. 2.12).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+V_MAX_OPT_PER_S = 10.0
+ACTIVATION_RATE = 100.0
+DEACTIVATION_RATE = 25.0
+MIN_ACTIVATION = 0.01
+FIBER_DAMPING = 0.1
+TENDON_REF_STRAIN = 0.04
+PASSIVE_STRAIN = 0.6
+
+# Columns of the muscle parameter array ``mp`` (one row per muscle).
+MP_FMAX, MP_LOPT, MP_LTS, MP_PENN = 0, 1, 2, 3
+# Columns of the muscle state array ``ms``.
+MS_ACT, MS_LCE, MS_VCE, MS_FORCE = 0, 1, 2, 3
+
+
+@njit(cache=True)
+def force_length(l_norm: float) -> float:
+    """Active force–length factor f_l [-] of the normalised fibre length."""
+    x = abs((l_norm - 1.0) / 0.56)
+    return math.exp(math.log(0.05) * x * x * x)
+
+
+@njit(cache=True)
+def force_velocity(v_norm: float) -> float:
+    """Force–velocity factor f_v [-] of the normalised fibre velocity (> 0 lengthening)."""
+    if v_norm <= 0.0:
+        if v_norm <= -1.0:
+            return 0.0
+        return (1.0 + v_norm) / (1.0 - 4.0 * v_norm)
+    return 1.5 - 0.5 / (1.0 + 10.0 * v_norm)
+
+
+@njit(cache=True)
+def _force_velocity_slope(v_norm: float) -> float:
+    if v_norm <= 0.0:
+        if v_norm <= -1.0:
+            return 0.0
+        d = 1.0 - 4.0 * v_norm
+        return 5.0 / (d * d)
+    d = 1.0 + 10.0 * v_norm
+    return 5.0 / (d * d)
+
+
+@njit(cache=True)
+def passive_force(l_norm: float) -> float:
+    """Passive fibre force f_p [-] of the normalised fibre length."""
+    if l_norm <= 1.0:
+        return 0.0
+    x = (l_norm - 1.0) / PASSIVE_STRAIN
+    return x * x
+
+
+@njit(cache=True)
+def tendon_force(strain: float) -> float:
+    """Tendon force f_t [-] of the tendon strain."""
+    if strain <= 0.0:
+        return 0.0
+    x = strain / TENDON_REF_STRAIN
+    return x * x
+
+
+@njit(cache=True)
+def _cos_pennation(l_ce: float, l_opt: float, penn0: float) -> float:
+    h = l_opt * math.sin(penn0)
+    s = h / max(l_ce, 1e-6)
+    if s > 0.99:
+        s = 0.99
+    return math.sqrt(1.0 - s * s)
+
+
+@njit(cache=True)
+def tendon_force_of_state(l_mtu: float, l_ce: float, fmax: float, l_opt: float, l_ts: float,
+                          penn0: float) -> float:
+    """Tendon force [N] given the MTU length [m] and fibre length [m]."""
+    l_t = l_mtu - l_ce * _cos_pennation(l_ce, l_opt, penn0)
+    return fmax * tendon_force((l_t - l_ts) / l_ts)
+
+
+@njit(cache=True)
+def equilibrium_fiber_length(l_mtu: float, act: float, l_opt: float, l_ts: float,
+                             penn0: float) -> float:
+    """Fibre length [m] in static equilibrium (ṽ = 0) at activation ``act`` (bisection)."""
+    lo = 0.3 * l_opt
+    hi = min(2.0 * l_opt, max(l_mtu - 0.5 * l_ts, 0.31 * l_opt))
+    if hi <= lo:
+        return lo
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        c = _cos_pennation(mid, l_opt, penn0)
+        ln = mid / l_opt
+        f_fib = (act * force_length(ln) + passive_force(ln)) * c
+        f_ten = tendon_force((l_mtu - mid * c - l_ts) / l_ts)
+        if f_fib > f_ten:
+            hi = mid
+        else:
+            lo = mid
+    return 0.5 * (lo + hi)
+
+
+@njit(cache=True)
+def muscle_step(mp: np.ndarray, ms: np.ndarray, l_mtu: np.ndarray, u: np.ndarray,
+                dt: float) -> None:
+    """Advance all muscles by one step and store their tendon forces.
+
+    ``mp`` (n, 4): Fmax [N], l_opt [m], l_ts [m], pennation α₀ [rad]. ``ms`` (n, 4) in/out:
+    activation, fibre length [m], fibre velocity [m/s], tendon force [N] (the force to apply
+    during this step, computed from the state at the step's start). ``l_mtu`` [m], ``u`` [-]
+    excitations in [0, 1].
+    """
+    n = mp.shape[0]
+    for i in range(n):
+        fmax = mp[i, MP_FMAX]
+        l_opt = mp[i, MP_LOPT]
+        l_ts = mp[i, MP_LTS]
+        penn0 = mp[i, MP_PENN]
+        act = ms[i, MS_ACT]
+        l_ce = ms[i, MS_LCE]
+        lm = l_mtu[i]
+        ms[i, MS_FORCE] = tendon_force_of_state(lm, l_ce, fmax, l_opt, l_ts, penn0)
+        # fibre: implicit Euler, Newton on the normalised velocity
+        vscale = V_MAX_OPT_PER_S * l_opt
+        v = ms[i, MS_VCE] / vscale
+        for _ in range(6):
+            l_new = l_ce + dt * v * vscale
+            if l_new < 0.2 * l_opt:
+                l_new = 0.2 * l_opt
+            c = _cos_pennation(l_new, l_opt, penn0)
+            ln = l_new / l_opt
+            fl = force_length(ln)
+            strain = (lm - l_new * c - l_ts) / l_ts
+            g = (act * fl * force_velocity(v) + passive_force(ln) + FIBER_DAMPING * v) * c \
+                - tendon_force(strain)
+            dft = 2.0 * strain / (TENDON_REF_STRAIN * TENDON_REF_STRAIN) if strain > 0.0 else 0.0
+            dfp = 2.0 * (ln - 1.0) / (PASSIVE_STRAIN * PASSIVE_STRAIN) if ln > 1.0 else 0.0
+            dg = (act * fl * _force_velocity_slope(v) + FIBER_DAMPING) * c \
+                + dt * vscale * (dfp * c / l_opt + dft * c * c / l_ts)
+            step = g / dg
+            v -= step
+            if abs(step) < 1e-9:
+                break
+        l_new = l_ce + dt * v * vscale
+        if l_new < 0.2 * l_opt:
+            l_new = 0.2 * l_opt
+        ms[i, MS_LCE] = l_new
+        ms[i, MS_VCE] = v * vscale
+        # activation dynamics
+        ui = min(max(u[i], 0.0), 1.0)
+        rate = ACTIVATION_RATE if ui > act else DEACTIVATION_RATE
+        act += dt * rate * (ui - act)
+        ms[i, MS_ACT] = min(max(act, MIN_ACTIVATION), 1.0)

@@ -1,0 +1,292 @@
+"""Parameter sets of the planar runner: athlete, segments, muscles and the blade category.
+
+A parameter set is a YAML file validated by pydantic (:class:`RunnerParams`). The built-in ones,
+``able`` and ``amputee``, hold the tables of seed 001 (Table 2.1 segment masses and inertias,
+Table 2.2 muscle parameters) in ``bladelab/data/runner/``; the blade catalogue
+(``categories.yaml``) holds Table 2.3 and Table 1.1.
+
+Muscle strength follows seed 001 eq. 2.1: ``Fmax = σ·φ·V_total / l_opt`` (σ in N/cm², V in cm³,
+l_opt in cm). Athlete scaling: segment masses and inertias by ``m/m_ref`` (inertias also by
+``(h/h_ref)²``), all lengths by ``h/h_ref``, the total muscle volume by ``m/m_ref``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import lru_cache
+from pathlib import Path
+from typing import Literal
+
+import yaml
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
+
+from bladelab.contact import hertz_sphere_stiffness
+from bladelab.errors import InputFileError, SpecError
+from bladelab.runner.geometry import LEG_MUSCLES, SHANK_MUSCLES, TORSO_MUSCLES
+
+GRAVITY = 9.81
+_DATA = Path(__file__).resolve().parents[1] / "data" / "runner"
+BLADE_RADIUS_M = 0.1464
+BLADE_OFFSET_A_M = 0.069
+BLADE_OFFSET_B_M = 0.0693
+BLADE_ALIGNMENT_DEG = 9.0
+BLADE_EXTRA_LENGTH_M = 0.03
+BLADE_FRICTION = 0.9
+BLADE_DISSIPATION_S_PER_M = 0.2
+FOOT_PLANE_STRAIN_MODULUS = 2.7e6
+FOOT_FRICTION = 0.9
+FOOT_DISSIPATION_S_PER_M = 1.0
+
+
+class _Strict(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+
+class Athlete(_Strict):
+    """Body mass [kg] and height [m] of the athlete (the model is scaled to them)."""
+
+    body_mass_kg: float = Field(gt=0)
+    height_m: float = Field(gt=0.5, lt=2.6)
+
+
+class Segment(_Strict):
+    """Mass [kg] and principal inertia [kg·m²] (OpenSim axes Ixx, Iyy, Izz) of one segment."""
+
+    mass_kg: float
+    inertia_kg_m2: tuple[float, float, float]
+
+    @field_validator("mass_kg")
+    @classmethod
+    def _positive_mass(cls, v: float) -> float:
+        if not v > 0:
+            raise ValueError(f"mass must be positive, got {v} kg")
+        return v
+
+    @field_validator("inertia_kg_m2")
+    @classmethod
+    def _positive_inertia(cls, v: tuple[float, float, float]) -> tuple[float, float, float]:
+        if min(v) <= 0:
+            raise ValueError(f"inertias must be positive, got {v}")
+        return v
+
+
+class MuscleType(_Strict):
+    """Muscle–tendon parameters of seed 001 Table 2.2 (lengths in m, pennation in rad)."""
+
+    volume_fraction: float = Field(gt=0, lt=1)
+    optimal_fiber_length_m: float = Field(gt=0)
+    tendon_slack_length_m: float = Field(gt=0)
+    pennation_rad: float = Field(ge=0, lt=1.2)
+
+
+class RunnerParams(_Strict):
+    """A runner parameter set (one YAML file)."""
+
+    kind: Literal["able", "amputee"]
+    blade: str = "Cat6"
+    athlete: Athlete
+    specific_tension_N_per_cm2: float = Field(gt=0)
+    total_muscle_volume_cm3: float = Field(gt=0)
+    segments: dict[str, Segment]
+    muscle_types: dict[str, MuscleType]
+
+
+@dataclass(frozen=True)
+class BladeCategory:
+    """One stiffness category of the catalogue (seed 001 Table 2.3 / Table 1.1)."""
+
+    name: str
+    stiffness_n_per_m: float
+    e_table: float
+    body_mass_range_kg: tuple[float, float]
+
+    def to_dict(self) -> dict:
+        return {
+            "name": self.name,
+            "stiffness_kN_per_m": self.stiffness_n_per_m / 1e3,
+            "E_table_N_per_m2": self.e_table,
+            "body_mass_kg": list(self.body_mass_range_kg),
+        }
+
+
+def required_segments(kind: str) -> tuple[str, ...]:
+    """Segment names a parameter set of this kind must have."""
+    common = ("torso", "pelvis", "femur_l", "tibia_l", "calcn_l", "femur_r")
+    if kind == "amputee":
+        return common + ("tibia_res_r", "prosthesis_r")
+    return common + ("tibia_r", "calcn_r")
+
+
+def muscle_names(kind: str) -> tuple[str, ...]:
+    """The model's muscle–tendon units in order: intact/left leg, right leg, torso."""
+    left = tuple(f"{m}_l" for m in LEG_MUSCLES)
+    right_types = [m for m in LEG_MUSCLES if kind == "able" or m not in SHANK_MUSCLES]
+    right = tuple(f"{m}_r" for m in right_types)
+    torso = tuple(f"{m}_{s}" for m in TORSO_MUSCLES for s in ("r", "l"))
+    return left + right + torso
+
+
+@lru_cache(maxsize=1)
+def blade_catalogue() -> dict[str, BladeCategory]:
+    """The built-in blade categories, by name (Cat4, Cat5, Cat6, Cat6High, Cat7)."""
+    text = (_DATA / "categories.yaml").read_text()
+    out = {}
+    for name, row in yaml.safe_load(text).items():
+        out[name] = BladeCategory(
+            name=name,
+            stiffness_n_per_m=float(row["stiffness_kN_per_m"]) * 1e3,
+            e_table=float(row["E_table_N_per_m2"]),
+            body_mass_range_kg=(float(row["body_mass_kg"][0]), float(row["body_mass_kg"][1])),
+        )
+    return out
+
+
+def blade_category(name: str) -> BladeCategory:
+    """Look up a category by name (case-insensitive); unknown names raise :class:`SpecError`."""
+    cat = blade_catalogue()
+    for key, value in cat.items():
+        if key.lower() == str(name).lower():
+            return value
+    raise SpecError(
+        f"unknown blade category {name!r}",
+        where="blade",
+        hint=f"use one of {', '.join(cat)}",
+    )
+
+
+def blade_modulus(stiffness_n_per_m: float, load_n: float, *, radius: float = BLADE_RADIUS_M) -> float:
+    """Plane-strain modulus E [N/m²] whose Hertz sphere (eq. 2.3) has the tangent stiffness
+    ``stiffness_n_per_m`` [N/m] at the static load ``load_n`` [N].
+
+    With ``F = k·δ^1.5`` and ``k = 4/3·E·√R``: ``dF/dδ = 1.5·F/δ``, so the compression at the load
+    is ``δ = 1.5·F/K`` and ``E = F / (4/3·√R·δ^1.5)``.
+    """
+    delta = 1.5 * load_n / stiffness_n_per_m
+    return load_n / (hertz_sphere_stiffness(radius, 1.0) * delta**1.5)
+
+
+def muscle_max_force(params: RunnerParams, muscle_type: str) -> float:
+    """Fmax [N] of a muscle type by seed 001 eq. 2.1, for the (scaled) athlete."""
+    mt = params.muscle_types[muscle_type]
+    mass_ratio, length_ratio = scale_ratios(params)
+    volume = params.total_muscle_volume_cm3 * mass_ratio
+    l_opt_cm = mt.optimal_fiber_length_m * length_ratio * 100.0
+    return params.specific_tension_N_per_cm2 * mt.volume_fraction * volume / l_opt_cm
+
+
+def scale_ratios(params: RunnerParams) -> tuple[float, float]:
+    """(mass ratio, length ratio) of the athlete to the parameter set's segment tables."""
+    table_mass = sum(s.mass_kg for s in params.segments.values())
+    return params.athlete.body_mass_kg / table_mass, params.athlete.height_m / 1.80
+
+
+def _check(params: RunnerParams, source: str | None) -> RunnerParams:
+    missing = [s for s in required_segments(params.kind) if s not in params.segments]
+    if missing:
+        raise SpecError(
+            f"missing segment(s) {', '.join(missing)} for a {params.kind} model",
+            file=source,
+            where="segments",
+            hint=f"a {params.kind} model needs {', '.join(required_segments(params.kind))}",
+        )
+    extra = [s for s in params.segments if s not in required_segments(params.kind)]
+    if extra:
+        raise SpecError(
+            f"unknown segment(s) {', '.join(extra)} for a {params.kind} model",
+            file=source,
+            where="segments",
+            hint=f"use {', '.join(required_segments(params.kind))}",
+        )
+    types = set(LEG_MUSCLES) | set(TORSO_MUSCLES)
+    missing = sorted(types - set(params.muscle_types))
+    if missing:
+        raise SpecError(
+            f"missing muscle(s) {', '.join(missing)}",
+            file=source,
+            where="muscle_types",
+            hint=f"the model needs parameters for {', '.join(sorted(types))}",
+        )
+    unknown = sorted(set(params.muscle_types) - types)
+    if unknown:
+        raise SpecError(
+            f"unknown muscle(s) {', '.join(unknown)}",
+            file=source,
+            where="muscle_types",
+            hint=f"known muscles: {', '.join(sorted(types))}",
+        )
+    return params
+
+
+def runner_params_from_dict(data: dict, *, source: str | None = None) -> RunnerParams:
+    """Validate a parameter dictionary; errors name the field and how to fix it."""
+    try:
+        params = RunnerParams.model_validate(data)
+    except ValidationError as err:
+        first = err.errors()[0]
+        where = ".".join(str(p) for p in first["loc"])
+        raise SpecError(
+            first["msg"],
+            file=source,
+            where=where,
+            hint="see bladelab/data/runner/amputee.yaml for a complete parameter set",
+        ) from None
+    if params.kind == "amputee":
+        try:
+            blade_category(params.blade)
+        except SpecError as err:
+            raise SpecError(err.message, file=source, where="blade", hint=err.hint) from None
+    return _check(params, source)
+
+
+def load_runner_params(path: str | Path) -> RunnerParams:
+    """Read and validate a runner parameter YAML file."""
+    path = Path(path)
+    try:
+        data = yaml.safe_load(path.read_text())
+    except FileNotFoundError:
+        raise InputFileError("file not found", file=path) from None
+    except yaml.YAMLError as err:
+        raise InputFileError(f"not valid YAML ({err})", file=path) from None
+    if not isinstance(data, dict):
+        raise InputFileError("expected a mapping of parameters", file=path)
+    return runner_params_from_dict(data, source=str(path))
+
+
+def default_runner_params(kind: str = "amputee", *, blade: str | None = None) -> RunnerParams:
+    """The built-in parameter set ``able`` or ``amputee`` (seed 001), optionally another blade."""
+    if kind not in ("able", "amputee"):
+        raise SpecError(f"unknown model {kind!r}", where="model", hint="use 'able' or 'amputee'")
+    text = (_DATA / f"{kind}.yaml").read_text()
+    data = yaml.safe_load(text)
+    if blade is not None:
+        data["blade"] = blade
+    return runner_params_from_dict(data, source=f"{kind}.yaml")
+
+
+def blade_contact_modulus(params: RunnerParams) -> float:
+    """E [N/m²] of the blade sphere for this athlete: the category's stiffness at body weight."""
+    cat = blade_category(params.blade)
+    return blade_modulus(cat.stiffness_n_per_m, params.athlete.body_mass_kg * GRAVITY)
+
+
+def hertz_compression(force_n: float, modulus: float, radius: float) -> float:
+    """Static compression δ [m] of a Hertz sphere (eq. 2.3) under ``force_n`` [N]."""
+    return (force_n / hertz_sphere_stiffness(radius, modulus)) ** (2.0 / 3.0) if force_n > 0 else 0.0
+
+
+__all__ = [
+    "Athlete",
+    "BladeCategory",
+    "RunnerParams",
+    "blade_catalogue",
+    "blade_category",
+    "blade_contact_modulus",
+    "blade_modulus",
+    "default_runner_params",
+    "hertz_compression",
+    "load_runner_params",
+    "muscle_max_force",
+    "muscle_names",
+    "runner_params_from_dict",
+    "GRAVITY",
+]

@@ -1,0 +1,395 @@
+"""Forward simulation of the runner: MuJoCo multibody step + bladelab's numba force kernel.
+
+Each step: ``mj_step1`` (positions, velocities, tendon lengths/velocities), then one numba call
+that advances the muscles (:mod:`bladelab.runner.muscle`), computes ligament, socket and ground
+contact forces (Hunt–Crossley normal force, elastic–plastic friction capped at μ·Fn) and writes
+them to MuJoCo's ``ctrl`` (muscles, −tendon force), ``qfrc_applied`` (ligaments, socket) and
+``xfrc_applied`` (contacts, at the contact point), then ``mj_step2`` (semi-implicit Euler).
+
+A controller is any callable ``controller(t, state) -> excitations`` (one value in [0, 1] per
+muscle, in ``RunnerModel.muscle_names`` order), called every ``control_interval`` steps with a
+:class:`ControllerState` of live arrays: muscle states (activation, fibre length [m], fibre
+velocity [m/s], tendon force [N]), MTU lengths [m] and velocities [m/s], qpos, qvel, and the
+contact forces (Fx, Fz [N] per contact). Instead of a controller, constant excitations may be
+given.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import mujoco
+import numpy as np
+import pandas as pd
+from numba import njit
+
+from bladelab.contact import hunt_crossley_force
+from bladelab.errors import SimulationError
+from bladelab.runner.model import (
+    CP_BODY,
+    CP_C,
+    CP_K,
+    CP_MU,
+    CP_RADIUS,
+    CP_SITE,
+    FRICTION_DAMPING,
+    FRICTION_STIFFNESS,
+    JP_D,
+    JP_HI,
+    JP_K,
+    JP_LO,
+    JP_SD,
+    JP_SK,
+    JP_SK2,
+    RunnerModel,
+)
+from bladelab.runner.muscle import equilibrium_fiber_length, muscle_step
+
+DEFAULT_DT = 5e-4
+# Record columns per contact: Fx, Fz [N], contact point x, z [m], point velocity vx, vz [m/s],
+# compression δ [m].
+RC_FX, RC_FZ, RC_PX, RC_PZ, RC_VX, RC_VZ, RC_DEPTH = range(7)
+
+
+@dataclass(frozen=True)
+class ControllerState:
+    """Live views handed to a controller (do not keep references between calls)."""
+
+    muscles: np.ndarray  # (n_muscles, 4): activation, l_ce [m], v_ce [m/s], F_t [N]
+    mtu_length: np.ndarray  # [m]
+    mtu_velocity: np.ndarray  # [m/s]
+    qpos: np.ndarray
+    qvel: np.ndarray
+    contacts: np.ndarray  # (n_contacts, 7), columns RC_*
+
+
+@njit(cache=True)
+def _forces(qpos, qvel, l_mtu, site_xpos, cvel, root_com, xipos, ctrl, xfrc, qfrc,
+            mp, ms, u, cp, cstate, jp, crec, lig, dt):
+    """Muscles, ligaments and contacts for one step (see module docstring)."""
+    muscle_step(mp, ms, l_mtu, u, dt)
+    for i in range(mp.shape[0]):
+        ctrl[i] = -ms[i, 3]
+    # ligaments (joint-limit springs-dampers) and the socket's nonlinear spring
+    for j in range(jp.shape[0]):
+        q = qpos[j]
+        qd = qvel[j]
+        tau = 0.0
+        if q > jp[j, JP_HI]:
+            tau = min(-jp[j, JP_K] * (q - jp[j, JP_HI]) - jp[j, JP_D] * qd, 0.0)
+        elif q < jp[j, JP_LO]:
+            tau = max(-jp[j, JP_K] * (q - jp[j, JP_LO]) - jp[j, JP_D] * qd, 0.0)
+        if jp[j, JP_SK] != 0.0 or jp[j, JP_SD] != 0.0:
+            tau -= jp[j, JP_SK] * q + jp[j, JP_SK2] * q * abs(q) + jp[j, JP_SD] * qd
+        qfrc[j] = tau
+        lig[j] = tau
+    xfrc[:, :] = 0.0
+    for c in range(cp.shape[0]):
+        site = int(cp[c, CP_SITE])
+        body = int(cp[c, CP_BODY])
+        r = cp[c, CP_RADIUS]
+        cx = site_xpos[site, 0]
+        cy = site_xpos[site, 1]
+        cz = site_xpos[site, 2]
+        depth = r - cz
+        px, py, pz = cx, cy, cz - r
+        # velocity of the body point at the contact: v + w x (p - root_com)
+        wx, wy, wz = cvel[body, 0], cvel[body, 1], cvel[body, 2]
+        rx, ry, rz = px - root_com[0], py - root_com[1], pz - root_com[2]
+        vx = cvel[body, 3] + wy * rz - wz * ry
+        vz = cvel[body, 5] + wx * ry - wy * rx
+        fn = 0.0
+        ft = 0.0
+        if depth > 0.0:
+            fn = hunt_crossley_force(depth, -vz, cp[c, CP_K], 1.5, cp[c, CP_C])
+            # elastic-plastic friction: bristle spring + damper, capped at mu*Fn
+            s = cstate[c, 0] + vx * dt
+            ft = -FRICTION_STIFFNESS * s - FRICTION_DAMPING * vx
+            lim = cp[c, CP_MU] * fn
+            if ft > lim:
+                ft = lim
+                s = -lim / FRICTION_STIFFNESS
+            elif ft < -lim:
+                ft = -lim
+                s = lim / FRICTION_STIFFNESS
+            cstate[c, 0] = s
+        else:
+            cstate[c, 0] = 0.0
+        xfrc[body, 0] += ft
+        xfrc[body, 2] += fn
+        # torque about the body COM: (p - xipos) x F, F = (ft, 0, fn)
+        dx, dy, dz = px - xipos[body, 0], py - xipos[body, 1], pz - xipos[body, 2]
+        xfrc[body, 3] += dy * fn
+        xfrc[body, 4] += dz * ft - dx * fn
+        xfrc[body, 5] += -dy * ft
+        crec[c, 0] = ft
+        crec[c, 1] = fn
+        crec[c, 2] = px
+        crec[c, 3] = pz
+        crec[c, 4] = vx
+        crec[c, 5] = vz
+        crec[c, 6] = depth if depth > 0.0 else 0.0
+
+
+# SCONE's InitStateGait10.zml (H0918, Apache-2.0): a gait state at 1 m/s, OpenSim names [rad].
+GAIT_INITIAL_STATE = {
+    "pelvis_tilt": (-0.0336387, -0.572135),
+    "hip_flexion_r": (0.165239, -0.576377),
+    "knee_angle_r": (-0.0888009, 0.175894),
+    "ankle_angle_r": (0.0197104, 0.988937),
+    "hip_flexion_l": (0.232604, 4.90666),
+    "knee_angle_l": (-1.22703, -3.59786),
+    "ankle_angle_l": (-0.167279, 0.633253),
+}
+
+
+@dataclass(frozen=True, eq=False)
+class RunnerResult:
+    """A forward simulation, sampled every ``record_every`` steps.
+
+    Arrays have one row per sample: ``time`` [s]; ``qpos``, ``qvel`` (``model.dof_names``);
+    ``muscles`` (n, n_muscles, 4): activation, fibre length [m], fibre velocity [m/s], tendon
+    force [N]; ``mtu`` (n, n_muscles, 2): MTU length [m] and velocity [m/s]; ``excitation``
+    (n, n_muscles); ``contacts`` (n, n_contacts, 7): Fx, Fz [N], contact point x, z [m], its
+    velocity vx, vz [m/s], compression [m]; ``ligament`` (n, n_dof): ligament and socket
+    torques [N·m] (forces [N] for the pelvis translations, always 0).
+    """
+
+    model: RunnerModel
+    time: np.ndarray
+    qpos: np.ndarray
+    qvel: np.ndarray
+    muscles: np.ndarray
+    mtu: np.ndarray
+    excitation: np.ndarray
+    contacts: np.ndarray
+    ligament: np.ndarray
+    dt: float
+    fell: bool
+    requested_duration: float
+
+    @property
+    def duration(self) -> float:
+        """Simulated time [s] (shorter than requested after a fall)."""
+        return float(self.time[-1]) if len(self.time) else 0.0
+
+    def leg_grf(self) -> pd.DataFrame:
+        """Tidy GRF per leg: columns time [s], leg (intact/prosthetic or left/right), Fx, Fz [N],
+        Fx_bw, Fz_bw [body weights]."""
+        bw = self.model.body_weight
+        names = _leg_names(self.model)
+        frames = []
+        for leg in (0, 1):
+            cols = self.model.contact_params[:, 7 - 1] == leg  # CP_LEG
+            fx = self.contacts[:, cols, RC_FX].sum(axis=1)
+            fz = self.contacts[:, cols, RC_FZ].sum(axis=1)
+            frames.append(pd.DataFrame({"time": self.time, "leg": names[leg], "Fx": fx, "Fz": fz,
+                                        "Fx_bw": fx / bw, "Fz_bw": fz / bw}))
+        return pd.concat(frames, ignore_index=True)
+
+    def states(self) -> pd.DataFrame:
+        """Coordinates as a wide table: time [s] and one column per dof (rad or m)."""
+        df = pd.DataFrame(self.qpos, columns=list(self.model.dof_names))
+        df.insert(0, "time", self.time)
+        return df
+
+    def muscle_states(self) -> pd.DataFrame:
+        """Tidy muscle states: time, muscle, excitation, activation, l_ce [m], v_ce [m/s],
+        force [N], l_mtu [m], v_mtu [m/s]."""
+        n, m = self.excitation.shape
+        return pd.DataFrame({
+            "time": np.repeat(self.time, m),
+            "muscle": np.tile(np.array(self.model.muscle_names), n),
+            "excitation": self.excitation.ravel(),
+            "activation": self.muscles[:, :, 0].ravel(),
+            "l_ce": self.muscles[:, :, 1].ravel(),
+            "v_ce": self.muscles[:, :, 2].ravel(),
+            "force": self.muscles[:, :, 3].ravel(),
+            "l_mtu": self.mtu[:, :, 0].ravel(),
+            "v_mtu": self.mtu[:, :, 1].ravel(),
+        })
+
+    def to_dict(self) -> dict:
+        return {
+            "model": self.model.kind,
+            "fell": self.fell,
+            "duration_s": self.duration,
+            "requested_duration_s": self.requested_duration,
+            "dt_s": self.dt,
+            "samples": int(len(self.time)),
+        }
+
+
+def _leg_names(model: RunnerModel) -> tuple[str, str]:
+    return ("intact", "prosthetic") if model.kind == "amputee" else ("left", "right")
+
+
+def initial_qpos(model: RunnerModel, state: str | dict = "stand") -> tuple[np.ndarray, np.ndarray]:
+    """Initial (qpos, qvel): ``"stand"`` (every contact touching, at rest), ``"gait"`` (SCONE's
+    1 m/s gait state, lowest contact touching) or a mapping ``{dof: value}`` on the standing pose.
+    """
+    q = model.stand_qpos.copy()
+    v = np.zeros(model.mj_model.nv)
+    if state == "stand":
+        return q, v
+    if state == "gait":
+        q[:] = 0.0
+        for name, (val, vel) in GAIT_INITIAL_STATE.items():
+            if name in model.dof_names:
+                q[model.dof(name)], v[model.dof(name)] = val, vel
+        v[model.dof("pelvis_tx")] = 1.0
+    elif isinstance(state, dict):
+        for name, val in state.items():
+            q[model.dof(name)] = val
+    else:
+        raise SimulationError(f"unknown initial state {state!r}", hint="use 'stand', 'gait' or a dict")
+    from bladelab.runner.model import contact_heights
+
+    q[model.dof("pelvis_tz")] -= contact_heights(model, q).min()
+    return q, v
+
+
+def simulate_runner(
+    model: RunnerModel,
+    *,
+    controller: Callable[[float, ControllerState], np.ndarray] | None = None,
+    excitations: np.ndarray | float | None = None,
+    duration: float = 10.0,
+    dt: float = DEFAULT_DT,
+    initial_state: str | dict = "stand",
+    initial_speed: float = 0.0,
+    drop_height: float = 0.0,
+    hold_pose: bool = False,
+    control_interval: int = 1,
+    record_every: int = 2,
+    fall_height: float | None = None,
+    initial_activation: float | None = 0.01,
+) -> RunnerResult:
+    """Simulate the runner forward.
+
+    Parameters
+    ----------
+    model
+        A :class:`RunnerModel` (``build_runner``).
+    controller
+        ``controller(t, state) -> excitations`` (n_muscles values in [0, 1]); overrides
+        ``excitations``.
+    excitations
+        Constant excitations: one value for all muscles or one per muscle (default 0.05).
+    duration
+        Requested simulated time [s].
+    dt
+        Time step [s] (default 0.5 ms).
+    initial_state
+        ``"stand"``, ``"gait"`` or ``{dof: value}`` (see :func:`initial_qpos`).
+    initial_speed
+        Forward pelvis speed at t = 0 [m/s] (added to the state's).
+    drop_height
+        Lift the model by this much [m] before release (drop test).
+    hold_pose
+        Hold every joint at its initial angle with stiff springs and the pelvis at its initial
+        x and tilt (MuJoCo joint springs; for drop tests of contact and mass).
+    control_interval
+        Call the controller every this many steps.
+    record_every
+        Store a sample every this many steps.
+    initial_activation
+        Muscle activation at t = 0 (default 0.01, muscles then activate with their dynamics);
+        None starts at the initial excitations.
+    fall_height
+        Stop when the pelvis COM is below this height [m] (default: 60 % of standing height).
+    """
+    if duration <= 0 or dt <= 0 or not math.isfinite(duration) or not math.isfinite(dt):
+        raise SimulationError("duration and dt must be positive", where="duration/dt")
+    m = model.mj_model
+    nm = len(model.muscle_names)
+    if hold_pose:
+        m = _held_copy(model)
+    m.opt.timestep = dt
+    d = mujoco.MjData(m)
+    q0, v0 = initial_qpos(model, initial_state)
+    q0[model.dof("pelvis_tz")] += drop_height
+    v0[model.dof("pelvis_tx")] += initial_speed
+    if hold_pose:
+        m.qpos_spring[:] = q0
+    d.qpos[:] = q0
+    d.qvel[:] = v0
+    u = np.full(nm, 0.05)
+    if excitations is not None:
+        u[:] = np.asarray(excitations, dtype=float)
+    ms = np.zeros((nm, 4))
+    mujoco.mj_forward(m, d)
+    mp = model.muscle_params
+    ms[:, 0] = np.clip(u, 0.01, 1.0) if initial_activation is None else initial_activation
+    for i in range(nm):
+        ms[i, 1] = equilibrium_fiber_length(d.actuator_length[i], ms[i, 0], mp[i, 1], mp[i, 2], mp[i, 3])
+    cp = model.contact_params
+    cstate = np.zeros((cp.shape[0], 1))
+    crec = np.zeros((cp.shape[0], 7))
+    lig = np.zeros(m.nv)
+    jp = model.joint_params
+    n_steps = int(round(duration / dt))
+    n_rec = n_steps // record_every + 1
+    rec_t = np.zeros(n_rec)
+    rec_q = np.zeros((n_rec, m.nq))
+    rec_v = np.zeros((n_rec, m.nv))
+    rec_ms = np.zeros((n_rec, nm, 4))
+    rec_mtu = np.zeros((n_rec, nm, 2))
+    rec_u = np.zeros((n_rec, nm))
+    rec_c = np.zeros((n_rec, cp.shape[0], 7))
+    rec_l = np.zeros((n_rec, m.nv))
+    if fall_height is None:
+        fall_height = 0.6 * model.stand_qpos[model.dof("pelvis_tz")]
+    # live views of MuJoCo's buffers
+    qpos, qvel, alen, avel = d.qpos, d.qvel, d.actuator_length, d.actuator_velocity
+    sxp, cvel, scom, xipos = d.site_xpos, d.cvel, d.subtree_com, d.xipos
+    ctrl, xfrc, qfrc = d.ctrl, d.xfrc_applied, d.qfrc_applied
+    root_com = np.zeros(3)
+    state = ControllerState(ms, alen, avel, qpos, qvel, crec)
+    iz = model.dof("pelvis_tz")
+    fell = False
+    k_rec = 0
+    step1, step2, forces = mujoco.mj_step1, mujoco.mj_step2, _forces
+    for k in range(n_steps + 1):
+        step1(m, d)
+        if controller is not None and k % control_interval == 0:
+            u[:] = controller(k * dt, state)
+        root_com[:] = scom[1]
+        forces(qpos, qvel, alen, sxp, cvel, root_com, xipos, ctrl, xfrc, qfrc,
+               mp, ms, u, cp, cstate, jp, crec, lig, dt)
+        if k % record_every == 0:
+            rec_t[k_rec] = k * dt
+            rec_q[k_rec] = qpos
+            rec_v[k_rec] = qvel
+            rec_ms[k_rec] = ms
+            rec_mtu[k_rec, :, 0] = alen
+            rec_mtu[k_rec, :, 1] = avel
+            rec_u[k_rec] = u
+            rec_c[k_rec] = crec
+            rec_l[k_rec] = lig
+            k_rec += 1
+        if qpos[iz] < fall_height or not math.isfinite(qpos[iz]):
+            fell = True
+            break
+        if k == n_steps:
+            break
+        step2(m, d)
+    sl = slice(0, k_rec)
+    return RunnerResult(
+        model=model, time=rec_t[sl], qpos=rec_q[sl], qvel=rec_v[sl], muscles=rec_ms[sl],
+        mtu=rec_mtu[sl], excitation=rec_u[sl], contacts=rec_c[sl], ligament=rec_l[sl], dt=dt,
+        fell=fell, requested_duration=duration,
+    )
+
+
+def _held_copy(model: RunnerModel) -> mujoco.MjModel:
+    """A copy of the MuJoCo model whose joints (all but pelvis_tz) have stiff springs."""
+    m = model.mj_model.__copy__()
+    for j, name in enumerate(model.dof_names):
+        if name == "pelvis_tz":
+            continue
+        m.jnt_stiffness[j] = 2e5 if name == "pelvis_tx" else 2e4
+        m.dof_damping[j] = 2e3 if name == "pelvis_tx" else 2e2
+    return m
