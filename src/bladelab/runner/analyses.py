@@ -75,12 +75,21 @@ def gait_events(result: RunnerResult, *, threshold_n: float = CONTACT_THRESHOLD_
         on = _leg_fz(result, leg) > threshold_n
         change = np.flatnonzero(np.diff(on.astype(np.int8)))
         for i in change:
-            rows.append({"leg": names[leg], "event": "touchdown" if on[i + 1] else "liftoff",
-                         "time": float(result.time[i + 1])})
-    return pd.DataFrame(rows, columns=["leg", "event", "time"]).sort_values("time", ignore_index=True)
+            rows.append(
+                {
+                    "leg": names[leg],
+                    "event": "touchdown" if on[i + 1] else "liftoff",
+                    "time": float(result.time[i + 1]),
+                }
+            )
+    return pd.DataFrame(rows, columns=["leg", "event", "time"]).sort_values(
+        "time", ignore_index=True
+    )
 
 
-def spatiotemporal(result: RunnerResult, *, threshold_n: float = CONTACT_THRESHOLD_N) -> pd.DataFrame:
+def spatiotemporal(
+    result: RunnerResult, *, threshold_n: float = CONTACT_THRESHOLD_N
+) -> pd.DataFrame:
     """Mean stride, step, contact, flight and swing times [s] per leg (seed 001 §1.1).
 
     Tidy: columns leg, variable, value, n (number of complete cycles used). Only stances with
@@ -126,8 +135,11 @@ def joint_angles(result: RunnerResult) -> pd.DataFrame:
     for j, name in enumerate(model.dof_names):
         if name in ("pelvis_tx", "pelvis_tz"):
             continue
-        frames.append(pd.DataFrame({"time": result.time, "joint": name,
-                                    "angle_deg": np.degrees(result.qpos[:, j])}))
+        frames.append(
+            pd.DataFrame(
+                {"time": result.time, "joint": name, "angle_deg": np.degrees(result.qpos[:, j])}
+            )
+        )
     return pd.concat(frames, ignore_index=True)
 
 
@@ -140,8 +152,11 @@ def joint_powers(result: RunnerResult) -> pd.DataFrame:
     frames = []
     for j, name in enumerate(model.dof_names):
         if name.startswith(("hip", "knee", "ankle", "socket")):
-            frames.append(pd.DataFrame({"time": result.time, "joint": name,
-                                        "power": torque[:, j] * result.qvel[:, j]}))
+            frames.append(
+                pd.DataFrame(
+                    {"time": result.time, "joint": name, "power": torque[:, j] * result.qvel[:, j]}
+                )
+            )
     blade = model.contact_params[:, CP_BLADE] == 1
     if blade.any():
         c = result.contacts[:, blade, :]
@@ -166,9 +181,18 @@ def power_balance(result: RunnerResult) -> pd.DataFrame:
     p_g = -result.model.total_mass * GRAVITY * fwd["comv"][:, 2]
     p_ext = p_m + p_l + p_c + p_g
     p_k = np.gradient(fwd["ek"], result.time) if len(result.time) > 2 else np.zeros_like(p_ext)
-    return pd.DataFrame({"time": result.time, "muscle": p_m, "ligament": p_l, "contact": p_c,
-                         "gravity": p_g, "external": p_ext, "kinetic": p_k,
-                         "residual": p_ext - p_k})
+    return pd.DataFrame(
+        {
+            "time": result.time,
+            "muscle": p_m,
+            "ligament": p_l,
+            "contact": p_c,
+            "gravity": p_g,
+            "external": p_ext,
+            "kinetic": p_k,
+            "residual": p_ext - p_k,
+        }
+    )
 
 
 def power_balance_residual_pct(result: RunnerResult) -> float:
@@ -210,7 +234,9 @@ def _leg_length(result: RunnerResult, leg: int) -> float:
     return float(hip - h[cols].min())
 
 
-def leg_stiffness(result: RunnerResult, *, threshold_n: float = CONTACT_THRESHOLD_N) -> pd.DataFrame:
+def leg_stiffness(
+    result: RunnerResult, *, threshold_n: float = CONTACT_THRESHOLD_N
+) -> pd.DataFrame:
     """Leg stiffness per stance (seed 001 eq. 2.19–2.21): columns leg, touchdown [s],
     contact_time [s], F_peak [N], delta_y [m], L0 [m], theta_rad, delta_L [m], K_leg [N/m]."""
     fwd = _forward_pass(result)
@@ -226,11 +252,33 @@ def leg_stiffness(result: RunnerResult, *, threshold_n: float = CONTACT_THRESHOL
             theta = math.asin(min(abs(v) * tc / (2 * l0), 1.0))
             dl = dy + l0 * (1 - math.cos(theta))
             fp = float(np.max(fz[i0:i1]))
-            rows.append({"leg": names[leg], "touchdown": float(result.time[i0]), "contact_time": tc,
-                         "F_peak": fp, "delta_y": dy, "L0": l0, "theta_rad": theta, "delta_L": dl,
-                         "K_leg": fp / dl if dl > 0 else math.nan})
-    return pd.DataFrame(rows, columns=["leg", "touchdown", "contact_time", "F_peak", "delta_y",
-                                       "L0", "theta_rad", "delta_L", "K_leg"])
+            rows.append(
+                {
+                    "leg": names[leg],
+                    "touchdown": float(result.time[i0]),
+                    "contact_time": tc,
+                    "F_peak": fp,
+                    "delta_y": dy,
+                    "L0": l0,
+                    "theta_rad": theta,
+                    "delta_L": dl,
+                    "K_leg": fp / dl if dl > 0 else math.nan,
+                }
+            )
+    return pd.DataFrame(
+        rows,
+        columns=[
+            "leg",
+            "touchdown",
+            "contact_time",
+            "F_peak",
+            "delta_y",
+            "L0",
+            "theta_rad",
+            "delta_L",
+            "K_leg",
+        ],
+    )
 
 
 def leg_energy(result: RunnerResult, *, threshold_n: float = CONTACT_THRESHOLD_N) -> pd.DataFrame:
@@ -244,17 +292,24 @@ def leg_energy(result: RunnerResult, *, threshold_n: float = CONTACT_THRESHOLD_N
     for leg in (0, 1):
         fz = _leg_fz(result, leg)
         for i0, i1 in _stances(result, leg, threshold_n):
-            dz = np.diff(fwd["com"][i0:i1 + 1, 2])
-            f = 0.5 * (fz[i0:i1] + fz[i0 + 1:i1 + 1])
+            dz = np.diff(fwd["com"][i0 : i1 + 1, 2])
+            f = 0.5 * (fz[i0:i1] + fz[i0 + 1 : i1 + 1])
             stored = float(-np.sum(f * np.minimum(dz, 0.0)))
             generated = float(np.sum(f * np.maximum(dz, 0.0)))
             big = max(stored, generated)
-            rows.append({"leg": names[leg], "touchdown": float(result.time[i0]),
-                         "E_stored": stored, "E_generated": generated,
-                         "hysteresis": abs(stored - generated),
-                         "recoil_pct": 100.0 * min(stored, generated) / big if big > 0 else math.nan})
-    return pd.DataFrame(rows, columns=["leg", "touchdown", "E_stored", "E_generated", "hysteresis",
-                                       "recoil_pct"])
+            rows.append(
+                {
+                    "leg": names[leg],
+                    "touchdown": float(result.time[i0]),
+                    "E_stored": stored,
+                    "E_generated": generated,
+                    "hysteresis": abs(stored - generated),
+                    "recoil_pct": 100.0 * min(stored, generated) / big if big > 0 else math.nan,
+                }
+            )
+    return pd.DataFrame(
+        rows, columns=["leg", "touchdown", "E_stored", "E_generated", "hysteresis", "recoil_pct"]
+    )
 
 
 def summary(result: RunnerResult) -> dict:
@@ -280,10 +335,13 @@ def summary(result: RunnerResult) -> dict:
         f"contact_time_{names[1]}_s": _val(names[1], "contact_time"),
         "power_balance_residual_pct": power_balance_residual_pct(result),
         "peak_grf_bw": {
-            leg: float(np.max(_leg_fz(result, i)) / result.model.body_weight) for i, leg in enumerate(names)
+            leg: float(np.max(_leg_fz(result, i)) / result.model.body_weight)
+            for i, leg in enumerate(names)
         },
-        "spatiotemporal_s": {f"{r.leg}.{r.variable}": (None if not np.isfinite(r.value) else float(r.value))
-                             for r in st.itertuples()},
+        "spatiotemporal_s": {
+            f"{r.leg}.{r.variable}": (None if not np.isfinite(r.value) else float(r.value))
+            for r in st.itertuples()
+        },
     }
     if result.model.kind == "able":
         out["contact_time_intact_s"] = out[f"contact_time_{names[0]}_s"]

@@ -131,7 +131,9 @@ class RunnerModel:
         try:
             return self.dof_names.index(name)
         except ValueError:
-            raise ModelError(f"no coordinate {name!r}", hint=f"use one of {self.dof_names}") from None
+            raise ModelError(
+                f"no coordinate {name!r}", hint=f"use one of {self.dof_names}"
+            ) from None
 
     def to_dict(self) -> dict:
         return {
@@ -143,7 +145,9 @@ class RunnerModel:
                 n: {"Fmax_N": float(p[0]), "l_opt_m": float(p[1]), "l_ts_m": float(p[2])}
                 for n, p in zip(self.muscle_names, self.muscle_params, strict=True)
             },
-            "blade_modulus_N_per_m2": None if math.isnan(self.blade_modulus) else self.blade_modulus,
+            "blade_modulus_N_per_m2": None
+            if math.isnan(self.blade_modulus)
+            else self.blade_modulus,
         }
 
 
@@ -161,11 +165,15 @@ def _lab_inertia(ixx: float, iyy: float, izz: float, factor: float) -> list[floa
     return [ix, iy, iz]
 
 
-def _sub(a: tuple[float, float, float], b: tuple[float, float, float]) -> tuple[float, float, float]:
+def _sub(
+    a: tuple[float, float, float], b: tuple[float, float, float]
+) -> tuple[float, float, float]:
     return (a[0] - b[0], a[1] - b[1], a[2] - b[2])
 
 
-def build_runner(params: RunnerParams | str = "amputee", *, blade: str | None = None) -> RunnerModel:
+def build_runner(
+    params: RunnerParams | str = "amputee", *, blade: str | None = None
+) -> RunnerModel:
     """Build a runner model from a parameter set (or the name ``"able"`` / ``"amputee"``).
 
     Parameters
@@ -224,7 +232,9 @@ def build_runner(params: RunnerParams | str = "amputee", *, blade: str | None = 
 
     for side in ("l", "r"):
         par, pp, pc = geo.JOINTS[f"hip_{side}"]
-        add(f"femur_{side}", f"femur_{side}", f"hip_{side}", f"hip_flexion_{side}", "pelvis", pp, pc)
+        add(
+            f"femur_{side}", f"femur_{side}", f"hip_{side}", f"hip_flexion_{side}", "pelvis", pp, pc
+        )
         par, pp, pc = geo.JOINTS[f"knee_{side}"]
         if side == "r" and amputee:
             res_len = geo.RESIDUAL_TIBIA_FRACTION * geo.TIBIA_LENGTH_M
@@ -232,14 +242,31 @@ def build_runner(params: RunnerParams | str = "amputee", *, blade: str | None = 
             add("tibia_res_r", "tibia_res_r", "knee_r", "knee_angle_r", "femur_r", pp, pc, com=com)
             _add_prosthesis(bodies, joint_child, params, s, mr, res_len, axis)
         else:
-            add(f"tibia_{side}", f"tibia_{side}", f"knee_{side}", f"knee_angle_{side}",
-                f"femur_{side}", pp, pc)
+            add(
+                f"tibia_{side}",
+                f"tibia_{side}",
+                f"knee_{side}",
+                f"knee_angle_{side}",
+                f"femur_{side}",
+                pp,
+                pc,
+            )
             par, pp, pc = geo.JOINTS[f"ankle_{side}"]
-            body = add(f"calcn_{side}", f"calcn_{side}", f"ankle_{side}", f"ankle_angle_{side}",
-                       f"tibia_{side}", pp, pc)
+            body = add(
+                f"calcn_{side}",
+                f"calcn_{side}",
+                f"ankle_{side}",
+                f"ankle_angle_{side}",
+                f"tibia_{side}",
+                pp,
+                pc,
+            )
             for sph, p in geo.FOOT_SPHERES.items():
-                body.add_site(name=f"{sph}_{side}", pos=_v(_sub(p, pc), s),
-                              size=[geo.FOOT_SPHERE_RADIUS_M * s, 0, 0])
+                body.add_site(
+                    name=f"{sph}_{side}",
+                    pos=_v(_sub(p, pc), s),
+                    size=[geo.FOOT_SPHERE_RADIUS_M * s, 0, 0],
+                )
     par, pp, pc = geo.JOINTS["lumbar"]
     add("torso", "torso", "lumbar", "lumbar_extension", "pelvis", pp, pc)
 
@@ -260,8 +287,12 @@ def build_runner(params: RunnerParams | str = "amputee", *, blade: str | None = 
         act = spec.add_actuator(name=mname, trntype=mujoco.mjtTrn.mjTRN_TENDON, target=mname)
         act.ctrllimited = False
         mt = params.muscle_types[mtype]
-        mp[i] = (muscle_max_force(params, mtype), mt.optimal_fiber_length_m * s,
-                 mt.tendon_slack_length_m * s, mt.pennation_rad)
+        mp[i] = (
+            muscle_max_force(params, mtype),
+            mt.optimal_fiber_length_m * s,
+            mt.tendon_slack_length_m * s,
+            mt.pennation_rad,
+        )
 
     model = spec.compile()
     dof_names = tuple(model.joint(j).name for j in range(model.njnt))
@@ -276,16 +307,35 @@ def build_runner(params: RunnerParams | str = "amputee", *, blade: str | None = 
         for sph in geo.FOOT_SPHERES:
             site = model.site(f"{sph}_{side}")
             contacts.append(f"{sph}_{side}")
-            rows.append((site.id, model.site_bodyid[site.id], geo.FOOT_SPHERE_RADIUS_M * s,
-                         k_foot, FOOT_DISSIPATION_S_PER_M, FOOT_FRICTION, leg, 0))
+            rows.append(
+                (
+                    site.id,
+                    model.site_bodyid[site.id],
+                    geo.FOOT_SPHERE_RADIUS_M * s,
+                    k_foot,
+                    FOOT_DISSIPATION_S_PER_M,
+                    FOOT_FRICTION,
+                    leg,
+                    0,
+                )
+            )
     e_blade = math.nan
     if amputee:
         e_blade = blade_contact_modulus(params)
         site = model.site("blade_r")
         contacts.append("blade_r")
-        rows.append((site.id, model.site_bodyid[site.id], BLADE_RADIUS_M,
-                     hertz_sphere_stiffness(BLADE_RADIUS_M, e_blade), BLADE_DISSIPATION_S_PER_M,
-                     BLADE_FRICTION, 1, 1))
+        rows.append(
+            (
+                site.id,
+                model.site_bodyid[site.id],
+                BLADE_RADIUS_M,
+                hertz_sphere_stiffness(BLADE_RADIUS_M, e_blade),
+                BLADE_DISSIPATION_S_PER_M,
+                BLADE_FRICTION,
+                1,
+                1,
+            )
+        )
     cp = np.array(rows, dtype=np.float64)
 
     jp = np.zeros((len(dof_names), 7))
@@ -326,8 +376,9 @@ def _add_prosthesis(bodies, joint_child, params, s, mr, res_len, axis) -> None:
     intact = geo.TIBIA_LENGTH_M + geo.JOINTS["ankle_l"][2][1] + 0.015 + geo.FOOT_SPHERE_RADIUS_M
     bottom = (intact + BLADE_EXTRA_LENGTH_M) * s - res_len * s  # below the socket
     centre = (0.0, -(bottom - BLADE_RADIUS_M))  # (x, z) in the socket frame
-    ox, oz = geo.rotate_pitch(BLADE_OFFSET_A_M * s, -BLADE_OFFSET_B_M * s,
-                              math.radians(BLADE_ALIGNMENT_DEG))
+    ox, oz = geo.rotate_pitch(
+        BLADE_OFFSET_A_M * s, -BLADE_OFFSET_B_M * s, math.radians(BLADE_ALIGNMENT_DEG)
+    )
     com = [centre[0] - ox, 0.0, centre[1] - oz]
     body = bodies["tibia_res_r"].add_body(name="prosthesis_r", pos=[0.0, 0.0, -res_len * s])
     body.add_joint(name="socket_angle_r", type=mujoco.mjtJoint.mjJNT_HINGE, axis=axis)

@@ -97,16 +97,18 @@ def _cos_pennation(l_ce: float, l_opt: float, penn0: float) -> float:
 
 
 @njit(cache=True)
-def tendon_force_of_state(l_mtu: float, l_ce: float, fmax: float, l_opt: float, l_ts: float,
-                          penn0: float) -> float:
+def tendon_force_of_state(
+    l_mtu: float, l_ce: float, fmax: float, l_opt: float, l_ts: float, penn0: float
+) -> float:
     """Tendon force [N] given the MTU length [m] and fibre length [m]."""
     l_t = l_mtu - l_ce * _cos_pennation(l_ce, l_opt, penn0)
     return fmax * tendon_force((l_t - l_ts) / l_ts)
 
 
 @njit(cache=True)
-def equilibrium_fiber_length(l_mtu: float, act: float, l_opt: float, l_ts: float,
-                             penn0: float) -> float:
+def equilibrium_fiber_length(
+    l_mtu: float, act: float, l_opt: float, l_ts: float, penn0: float
+) -> float:
     """Fibre length [m] in static equilibrium (ṽ = 0) at activation ``act`` (bisection)."""
     lo = 0.3 * l_opt
     hi = min(2.0 * l_opt, max(l_mtu - 0.5 * l_ts, 0.31 * l_opt))
@@ -126,8 +128,9 @@ def equilibrium_fiber_length(l_mtu: float, act: float, l_opt: float, l_ts: float
 
 
 @njit(cache=True)
-def muscle_step(mp: np.ndarray, ms: np.ndarray, l_mtu: np.ndarray, u: np.ndarray,
-                dt: float) -> None:
+def muscle_step(
+    mp: np.ndarray, ms: np.ndarray, l_mtu: np.ndarray, u: np.ndarray, dt: float
+) -> None:
     """Advance all muscles by one step and store their tendon forces.
 
     ``mp`` (n, 4): Fmax [N], l_opt [m], l_ts [m], pennation α₀ [rad]. ``ms`` (n, 4) in/out:
@@ -156,12 +159,14 @@ def muscle_step(mp: np.ndarray, ms: np.ndarray, l_mtu: np.ndarray, u: np.ndarray
             ln = l_new / l_opt
             fl = force_length(ln)
             strain = (lm - l_new * c - l_ts) / l_ts
-            g = (act * fl * force_velocity(v) + passive_force(ln) + FIBER_DAMPING * v) * c \
-                - tendon_force(strain)
+            g = (
+                act * fl * force_velocity(v) + passive_force(ln) + FIBER_DAMPING * v
+            ) * c - tendon_force(strain)
             dft = 2.0 * strain / (TENDON_REF_STRAIN * TENDON_REF_STRAIN) if strain > 0.0 else 0.0
             dfp = 2.0 * (ln - 1.0) / (PASSIVE_STRAIN * PASSIVE_STRAIN) if ln > 1.0 else 0.0
-            dg = (act * fl * _force_velocity_slope(v) + FIBER_DAMPING) * c \
-                + dt * vscale * (dfp * c / l_opt + dft * c * c / l_ts)
+            dg = (act * fl * _force_velocity_slope(v) + FIBER_DAMPING) * c + dt * vscale * (
+                dfp * c / l_opt + dft * c * c / l_ts
+            )
             step = g / dg
             v -= step
             if abs(step) < 1e-9:

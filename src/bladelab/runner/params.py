@@ -154,7 +154,9 @@ def blade_category(name: str) -> BladeCategory:
     )
 
 
-def blade_modulus(stiffness_n_per_m: float, load_n: float, *, radius: float = BLADE_RADIUS_M) -> float:
+def blade_modulus(
+    stiffness_n_per_m: float, load_n: float, *, radius: float = BLADE_RADIUS_M
+) -> float:
     """Plane-strain modulus E [N/m²] whose Hertz sphere (eq. 2.3) has the tangent stiffness
     ``stiffness_n_per_m`` [N/m] at the static load ``load_n`` [N].
 
@@ -271,7 +273,9 @@ def blade_contact_modulus(params: RunnerParams) -> float:
 
 def hertz_compression(force_n: float, modulus: float, radius: float) -> float:
     """Static compression δ [m] of a Hertz sphere (eq. 2.3) under ``force_n`` [N]."""
-    return (force_n / hertz_sphere_stiffness(radius, modulus)) ** (2.0 / 3.0) if force_n > 0 else 0.0
+    return (
+        (force_n / hertz_sphere_stiffness(radius, modulus)) ** (2.0 / 3.0) if force_n > 0 else 0.0
+    )
 
 
 __all__ = [

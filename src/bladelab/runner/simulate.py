@@ -66,8 +66,27 @@ class ControllerState:
 
 
 @njit(cache=True)
-def _forces(qpos, qvel, l_mtu, site_xpos, cvel, root_com, xipos, ctrl, xfrc, qfrc,
-            mp, ms, u, cp, cstate, jp, crec, lig, dt):
+def _forces(
+    qpos,
+    qvel,
+    l_mtu,
+    site_xpos,
+    cvel,
+    root_com,
+    xipos,
+    ctrl,
+    xfrc,
+    qfrc,
+    mp,
+    ms,
+    u,
+    cp,
+    cstate,
+    jp,
+    crec,
+    lig,
+    dt,
+):
     """Muscles, ligaments and contacts for one step (see module docstring)."""
     muscle_step(mp, ms, l_mtu, u, dt)
     for i in range(mp.shape[0]):
@@ -185,8 +204,18 @@ class RunnerResult:
             cols = self.model.contact_params[:, 7 - 1] == leg  # CP_LEG
             fx = self.contacts[:, cols, RC_FX].sum(axis=1)
             fz = self.contacts[:, cols, RC_FZ].sum(axis=1)
-            frames.append(pd.DataFrame({"time": self.time, "leg": names[leg], "Fx": fx, "Fz": fz,
-                                        "Fx_bw": fx / bw, "Fz_bw": fz / bw}))
+            frames.append(
+                pd.DataFrame(
+                    {
+                        "time": self.time,
+                        "leg": names[leg],
+                        "Fx": fx,
+                        "Fz": fz,
+                        "Fx_bw": fx / bw,
+                        "Fz_bw": fz / bw,
+                    }
+                )
+            )
         return pd.concat(frames, ignore_index=True)
 
     def states(self) -> pd.DataFrame:
@@ -199,17 +228,19 @@ class RunnerResult:
         """Tidy muscle states: time, muscle, excitation, activation, l_ce [m], v_ce [m/s],
         force [N], l_mtu [m], v_mtu [m/s]."""
         n, m = self.excitation.shape
-        return pd.DataFrame({
-            "time": np.repeat(self.time, m),
-            "muscle": np.tile(np.array(self.model.muscle_names), n),
-            "excitation": self.excitation.ravel(),
-            "activation": self.muscles[:, :, 0].ravel(),
-            "l_ce": self.muscles[:, :, 1].ravel(),
-            "v_ce": self.muscles[:, :, 2].ravel(),
-            "force": self.muscles[:, :, 3].ravel(),
-            "l_mtu": self.mtu[:, :, 0].ravel(),
-            "v_mtu": self.mtu[:, :, 1].ravel(),
-        })
+        return pd.DataFrame(
+            {
+                "time": np.repeat(self.time, m),
+                "muscle": np.tile(np.array(self.model.muscle_names), n),
+                "excitation": self.excitation.ravel(),
+                "activation": self.muscles[:, :, 0].ravel(),
+                "l_ce": self.muscles[:, :, 1].ravel(),
+                "v_ce": self.muscles[:, :, 2].ravel(),
+                "force": self.muscles[:, :, 3].ravel(),
+                "l_mtu": self.mtu[:, :, 0].ravel(),
+                "v_mtu": self.mtu[:, :, 1].ravel(),
+            }
+        )
 
     def to_dict(self) -> dict:
         return {
@@ -244,7 +275,9 @@ def initial_qpos(model: RunnerModel, state: str | dict = "stand") -> tuple[np.nd
         for name, val in state.items():
             q[model.dof(name)] = val
     else:
-        raise SimulationError(f"unknown initial state {state!r}", hint="use 'stand', 'gait' or a dict")
+        raise SimulationError(
+            f"unknown initial state {state!r}", hint="use 'stand', 'gait' or a dict"
+        )
     from bladelab.runner.model import contact_heights
 
     q[model.dof("pelvis_tz")] -= contact_heights(model, q).min()
@@ -324,7 +357,9 @@ def simulate_runner(
     mp = model.muscle_params
     ms[:, 0] = np.clip(u, 0.01, 1.0) if initial_activation is None else initial_activation
     for i in range(nm):
-        ms[i, 1] = equilibrium_fiber_length(d.actuator_length[i], ms[i, 0], mp[i, 1], mp[i, 2], mp[i, 3])
+        ms[i, 1] = equilibrium_fiber_length(
+            d.actuator_length[i], ms[i, 0], mp[i, 1], mp[i, 2], mp[i, 3]
+        )
     cp = model.contact_params
     cstate = np.zeros((cp.shape[0], 1))
     crec = np.zeros((cp.shape[0], 7))
@@ -357,8 +392,27 @@ def simulate_runner(
         if controller is not None and k % control_interval == 0:
             u[:] = controller(k * dt, state)
         root_com[:] = scom[1]
-        forces(qpos, qvel, alen, sxp, cvel, root_com, xipos, ctrl, xfrc, qfrc,
-               mp, ms, u, cp, cstate, jp, crec, lig, dt)
+        forces(
+            qpos,
+            qvel,
+            alen,
+            sxp,
+            cvel,
+            root_com,
+            xipos,
+            ctrl,
+            xfrc,
+            qfrc,
+            mp,
+            ms,
+            u,
+            cp,
+            cstate,
+            jp,
+            crec,
+            lig,
+            dt,
+        )
         if k % record_every == 0:
             rec_t[k_rec] = k * dt
             rec_q[k_rec] = qpos
@@ -378,9 +432,18 @@ def simulate_runner(
         step2(m, d)
     sl = slice(0, k_rec)
     return RunnerResult(
-        model=model, time=rec_t[sl], qpos=rec_q[sl], qvel=rec_v[sl], muscles=rec_ms[sl],
-        mtu=rec_mtu[sl], excitation=rec_u[sl], contacts=rec_c[sl], ligament=rec_l[sl], dt=dt,
-        fell=fell, requested_duration=duration,
+        model=model,
+        time=rec_t[sl],
+        qpos=rec_q[sl],
+        qvel=rec_v[sl],
+        muscles=rec_ms[sl],
+        mtu=rec_mtu[sl],
+        excitation=rec_u[sl],
+        contacts=rec_c[sl],
+        ligament=rec_l[sl],
+        dt=dt,
+        fell=fell,
+        requested_duration=duration,
     )
 
 
