@@ -162,8 +162,14 @@ def multilink_blade(
     points.sort()
     k_nom = units.stiffness_per_rad_to_per_deg(base.joints[0].stiffness) * n_j
     d_nom = units.damping_per_rad_to_per_deg(base.joints[0].damping) * n_j
-    ks = np.broadcast_to(np.asarray(k_nom if K_Nm_per_deg is None else K_Nm_per_deg, float), (n_j,))
-    ds = np.broadcast_to(np.asarray(d_nom if D_Nms_per_deg is None else D_Nms_per_deg, float), (n_j,))
+    try:
+        ks = np.broadcast_to(np.asarray(k_nom if K_Nm_per_deg is None else K_Nm_per_deg, float),
+                             (n_j,))
+        ds = np.broadcast_to(np.asarray(d_nom if D_Nms_per_deg is None else D_Nms_per_deg, float),
+                             (n_j,))
+    except ValueError:
+        raise ModelError(f"give one K and D value for all joints or one per joint ({n_j})",
+                         where="K_Nm_per_deg / D_Nms_per_deg") from None
     if np.any(ks <= 0) or np.any(ds < 0) or not (np.all(np.isfinite(ks)) and np.all(np.isfinite(ds))):
         raise ModelError("joint stiffness must be positive and damping non-negative",
                          where="K_Nm_per_deg / D_Nms_per_deg")
