@@ -1,0 +1,155 @@
+"""``bladelab runner ...``: simulate the planar musculoskeletal runner."""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import typer
+
+from bladelab._io import atomic_open, write_json
+from bladelab.errors import InputFileError, SpecError
+
+runner_app = typer.Typer(help="Planar musculoskeletal runner with a running blade (seed 001).")
+
+
+def _read_controller(path: Path, muscle_names: tuple[str, ...]) -> list[float]:
+    """Constant excitations from a controller JSON file.
+
+    Format: ``{"excitations": {"glut_max_l": 0.3, ...}, "default": 0.05}``; muscles not named
+    get ``default``. (The reflex controller of the predictive-running issue will extend this.)
+    """
+    try:
+        data = json.loads(path.read_text())
+    except FileNotFoundError:
+        raise InputFileError("controller file not found", file=path) from None
+    except json.JSONDecodeError as err:
+        raise InputFileError(f"not valid JSON ({err})", file=path) from None
+    if not isinstance(data, dict):
+        raise InputFileError("expected a JSON object", file=path)
+    unknown_keys = set(data) - {"excitations", "default"}
+    if unknown_keys:
+        raise SpecError(
+            f"unknown key(s) {', '.join(sorted(unknown_keys))}",
+            file=path,
+            hint='use {"excitations": {muscle: value}, "default": value}',
+        )
+    default = data.get("default", 0.05)
+    table = data.get("excitations", {})
+    if not isinstance(table, dict):
+        raise SpecError("must be an object {muscle: value}", file=path, where="excitations")
+    unknown = sorted(set(table) - set(muscle_names))
+    if unknown:
+        raise SpecError(
+            f"unknown muscle(s) {', '.join(unknown)}",
+            file=path,
+            where="excitations",
+            hint=f"muscles of this model: {', '.join(muscle_names)}",
+        )
+    out = []
+    for name in muscle_names:
+        value = table.get(name, default)
+        if not isinstance(value, int | float) or not 0.0 <= float(value) <= 1.0:
+            raise SpecError(
+                f"excitation must be a number in [0, 1], got {value!r}",
+                file=path,
+                where=f"excitations.{name}",
+            )
+        out.append(float(value))
+    return out
+
+
+@runner_app.command("simulate")
+def simulate_cmd(
+    model: str = typer.Option("amputee", "--model", help="able or amputee."),
+    blade: str = typer.Option("Cat6", "--blade", help="Blade category (amputee): Cat4..Cat7."),
+    params: Path | None = typer.Option(None, "--params", help="Runner parameter YAML file."),
+    controller: Path | None = typer.Option(
+        None, "--controller", help="Controller JSON (constant excitations); none: 0.05 for all."
+    ),
+    duration: float = typer.Option(10.0, "--duration", help="Simulated time [s]."),
+    dt: float = typer.Option(5e-4, "--dt", help="Time step [s]."),
+    initial_state: str = typer.Option("stand", "--initial-state", help="stand or gait."),
+    speed: float = typer.Option(0.0, "--speed", help="Initial forward speed [m/s]."),
+    out: Path | None = typer.Option(None, "--out", help="Folder for the CSV/JSON outputs."),
+    as_json: bool = typer.Option(False, "--json", help="Print the summary as JSON."),
+) -> None:
+    """Simulate a runner forward and print its summary (optionally write states, GRF, events,
+    power balance and muscle states as CSV into --out)."""
+    from bladelab.runner import analyses, build_runner, load_runner_params, simulate_runner
+
+    if model not in ("able", "amputee"):
+        raise SpecError(f"unknown model {model!r}", where="--model", hint="use able or amputee")
+    if not (duration > 0 and math.isfinite(duration)):
+        raise SpecError("must be positive", where="--duration")
+    if initial_state not in ("stand", "gait"):
+        raise SpecError(f"unknown initial state {initial_state!r}", where="--initial-state")
+    if params is not None:
+        p = load_runner_params(params)
+        if p.kind != model:
+            raise SpecError(
+                f"parameter file is for a {p.kind} model, not {model}",
+                file=params,
+                where="kind",
+                hint=f"use --model {p.kind}",
+            )
+        runner = build_runner(p, blade=blade if model == "amputee" else None)
+    else:
+        runner = build_runner(model, blade=blade if model == "amputee" else None)
+    excitations = None
+    if controller is not None:
+        excitations = _read_controller(controller, runner.muscle_names)
+    result = simulate_runner(
+        runner,
+        excitations=excitations,
+        duration=duration,
+        dt=dt,
+        initial_state=initial_state,
+        initial_speed=speed,
+    )
+    summary = analyses.summary(result)
+    if out is not None:
+        out.mkdir(parents=True, exist_ok=True)
+        tables = {
+            "states.csv": result.states(),
+            "grf.csv": result.leg_grf(),
+            "events.csv": analyses.gait_events(result),
+            "power_balance.csv": analyses.power_balance(result),
+            "muscles.csv": result.muscle_states(),
+            "joint_powers.csv": analyses.joint_powers(result),
+        }
+        for name, df in tables.items():
+            with atomic_open(out / name, "w", newline="") as fh:
+                df.to_csv(fh, index=False)
+        write_json(out / "summary.json", summary)
+    if as_json:
+        typer.echo(json.dumps(summary, indent=2))
+    else:
+        typer.echo(
+            f"{runner.kind} ({summary['blade'] or 'no blade'}): "
+            f"{'fell' if summary['fell'] else 'ran'} {summary['duration_s']:.3f} s, "
+            f"mean speed {summary['mean_speed_mps']:.2f} m/s, "
+            f"power balance residual {summary['power_balance_residual_pct']:.2f} %"
+        )
+
+
+@runner_app.command("blades")
+def blades_cmd(
+    as_json: bool = typer.Option(False, "--json", help="Print as JSON."),
+) -> None:
+    """List the blade categories (seed 001 Table 2.3)."""
+    from bladelab.runner import blade_catalogue
+
+    rows = [c.to_dict() for c in blade_catalogue().values()]
+    if as_json:
+        typer.echo(json.dumps(rows, indent=2))
+        return
+    for r in rows:
+        lo, hi = r["body_mass_kg"]
+        typer.echo(f"{r['name']:9s} {r['stiffness_kN_per_m']:6.2f} kN/m   body mass {lo}-{hi} kg")
+
+
+def register(app: typer.Typer) -> None:
+    """Add ``bladelab runner`` to the root app."""
+    app.add_typer(runner_app, name="runner")
