@@ -34,7 +34,7 @@ def test_show_reports_K_in_literature_units(capsys):
     code, out, _ = _run(capsys, "show", "xtreme-cat4")
     assert code == 0
     assert "K = 16.00 N·m/deg" in out
-    assert "between segments 8 and 9" in out
+    assert "between segments 7 and 8" in out
     code, out, _ = _run(capsys, "show", "xtreme", "--json")
     data = json.loads(out)
     assert data["joints"][0]["K_Nm_per_deg"] == pytest.approx(18.0)
