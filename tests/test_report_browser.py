@@ -151,10 +151,9 @@ class _DevTools:
         os.close(self._out_r)
 
 
-def test_report_opens_in_headless_chromium(tmp_path: Path):
-    binary = _chromium()
-    index = example_report().write(tmp_path / "report")
-    browser = _DevTools(binary, tmp_path / "profile")
+def _inspect(binary: str, page: Path, screenshot: Path, profile: Path) -> tuple[list, list]:
+    """Load ``page``; return (figure checks, console errors) and save a full-page screenshot."""
+    browser = _DevTools(binary, profile)
     try:
         target = browser.send("Target.createTarget", {"url": "about:blank"})["targetId"]
         session = browser.send("Target.attachToTarget", {"targetId": target, "flatten": True})[
@@ -168,7 +167,7 @@ def test_report_opens_in_headless_chromium(tmp_path: Path):
             session=session,
         )
         browser.events.clear()
-        browser.send("Page.navigate", {"url": index.as_uri()}, session=session)
+        browser.send("Page.navigate", {"url": page.as_uri()}, session=session)
         browser.wait_event("Page.loadEventFired", timeout=60)
         figures = browser.send(
             "Runtime.evaluate",
@@ -190,9 +189,7 @@ def test_report_opens_in_headless_chromium(tmp_path: Path):
             session=session,
             timeout=60,
         )
-        screenshot = tmp_path / "report.png"
         screenshot.write_bytes(base64.b64decode(shot["data"]))
-        print(f"\nreport screenshot: {screenshot}")
         errors = [
             ev["params"]
             for ev in browser.events
@@ -208,9 +205,57 @@ def test_report_opens_in_headless_chromium(tmp_path: Path):
         ]
     finally:
         browser.close()
+    return figures, errors
+
+
+def _figure_ok(fig: dict) -> bool:
+    return (
+        fig["complete"]
+        and fig["naturalWidth"] > 100
+        and fig["naturalHeight"] > 100
+        and fig["visible"]
+        and fig["width"] > 300
+        and fig["height"] > 100
+    )
+
+
+@pytest.fixture(scope="module")
+def report_index(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The example report, written once for both browser tests."""
+    return example_report().write(tmp_path_factory.mktemp("browser") / "report")
+
+
+def test_report_opens_in_headless_chromium(tmp_path: Path, report_index: Path):
+    binary = _chromium()
+    index = report_index
+    screenshot = tmp_path / "report.png"
+    figures, errors = _inspect(binary, index, screenshot, tmp_path / "profile")
+    print(f"\nreport screenshot: {screenshot}")
     assert errors == [], f"console errors: {errors}"
     assert len(figures) == 5
     for fig in figures:
-        assert fig["complete"] and fig["naturalWidth"] > 100 and fig["naturalHeight"] > 100, fig
-        assert fig["visible"] and fig["width"] > 300 and fig["height"] > 100, fig
+        assert _figure_ok(fig), fig
     assert screenshot.stat().st_size > 20_000
+
+
+def test_the_browser_check_catches_errors_and_hidden_or_broken_figures(
+    tmp_path: Path, report_index: Path
+):
+    # A negative control: the same inspection must see a script error, a missing image and a
+    # hidden one, so a passing report check means something.
+    binary = _chromium()
+    html = report_index.read_text(encoding="utf-8")
+    first = html.index('<img src="data:image/png;base64,')
+    html = html[:first] + '<img src="missing.png" alt="broken">' + html[first:]
+    html = html.replace("<figure>", '<figure style="display:none">', 1)
+    html = html.replace(
+        "</body>", "<script>console.error('boom'); undefinedCall();</script></body>"
+    )
+    bad = tmp_path / "bad.html"
+    bad.write_text(html, encoding="utf-8")
+    figures, errors = _inspect(binary, bad, tmp_path / "bad.png", tmp_path / "profile")
+    texts = json.dumps(errors)
+    assert "boom" in texts and "undefinedCall" in texts
+    assert "missing.png" in texts  # the failed load is reported as a console error
+    assert len(figures) == 6
+    assert sum(not _figure_ok(f) for f in figures) == 2  # the broken and the hidden one
