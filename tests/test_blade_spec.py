@@ -178,6 +178,11 @@ def test_uniform_straight_bar_mass_properties():
     np.testing.assert_allclose(m, 0.2)
     np.testing.assert_allclose(com[:, 1], [-0.05, -0.15, -0.25, -0.35], atol=1e-12)
     np.testing.assert_allclose(inertia, 0.2 * 0.1**2 / 12.0, rtol=1e-9)  # rod: m·l²/12
+    # A 20 mm thick bar (constant thickness: same masses): rectangle, m·(l² + t²)/12.
+    m2, _, inertia2 = segment_mass_properties(prof, seg, 0.8,
+                                              thickness=np.array([[0.0, 20.0], [1.0, 20.0]]))
+    np.testing.assert_allclose(m2, m)
+    np.testing.assert_allclose(inertia2, 0.2 * (0.1**2 + 0.02**2) / 12.0, rtol=1e-9)
 
 
 def test_tapered_bar_mass_follows_thickness():

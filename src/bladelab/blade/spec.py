@@ -392,7 +392,9 @@ def segment_mass_properties(
     proportional to the thickness (``thickness``: rows of arc-length fraction [0–1] and thickness,
     linearly interpolated, constant beyond the ends) when given; the total is ``mass_kg``. Each
     segment gets the mass of its piece of the profile, with centre of mass and moment of inertia
-    (about the centre of mass and the y axis) integrated along the curved piece.
+    (about the centre of mass and the y axis) integrated along the curved piece; with a thickness
+    table [mm], each piece also adds its cross-section term dm·t²/12 (the laminate's thickness
+    lies in the x–z plane).
 
     Returns
     -------
@@ -422,6 +424,9 @@ def segment_mass_properties(
     com = np.stack([np.bincount(which, weights=dm * mid[:, k], minlength=n) for k in (0, 1)],
                    axis=1) / mass[:, None]
     r2 = np.sum((mid - com[which]) ** 2, axis=1) + ds**2 / 12.0
+    if thickness is not None:
+        # The laminate's thickness lies in the x-z plane, across the profile: + t²/12 per piece.
+        r2 = r2 + (lam * 1e-3) ** 2 / 12.0
     inertia = np.bincount(which, weights=dm * r2, minlength=n)
     return mass, com, inertia
 
@@ -438,18 +443,23 @@ def _point_segment_distance(p: np.ndarray, a: np.ndarray, b: np.ndarray) -> floa
 
 
 def _format_validation_error(err: pydantic.ValidationError) -> tuple[str, str]:
-    """(where, message) for the first error, with the count of the others."""
-    first = err.errors()[0]
-    loc = ".".join(str(x) for x in first["loc"]) or "(top level)"
-    msg = first["msg"]
-    if first["type"] == "missing":
-        msg = "missing field"
-    elif first["type"] == "extra_forbidden":
-        msg = "unknown field (check the spelling and the unit in the name)"
-    more = err.error_count() - 1
-    if more:
-        msg += f" (and {more} more problem{'s' if more > 1 else ''})"
-    return loc, msg
+    """(where, message): the first error's field, and every error (up to five) in the message."""
+
+    def one(e: dict) -> tuple[str, str]:
+        loc = ".".join(str(x) for x in e["loc"]) or "(top level)"
+        if e["type"] == "missing":
+            return loc, "missing field"
+        if e["type"] == "extra_forbidden":
+            return loc, "unknown field (check the spelling and the unit in the name)"
+        return loc, e["msg"]
+
+    errors = [one(e) for e in err.errors()]
+    where, msg = errors[0]
+    if len(errors) > 1:
+        others = "; ".join(f"{w}: {m}" for w, m in errors[1:5])
+        more = f"; and {len(errors) - 5} more" if len(errors) > 5 else ""
+        msg += f"; also {others}{more}"
+    return where, msg
 
 
 def spec_from_dict(data: Any, *, file: str | Path | None = None,
