@@ -13,11 +13,11 @@ distal part carries the tip marker (``tip``, clamp frame, undeformed posture):
 2. The GRF is applied at the deflected contact point (default: the tip marker; any point of the
    distal part may be given), located in the lab with the measured clamp pose, and its moment
    about the hinge M_y = r_z·F_x − r_x·F_z is taken (r: hinge → contact point, lab frame).
-3. K(t) = M_y / Δθ on the loaded samples (vertical GRF ≥ ``load_fraction`` × peak and
-   |Δθ| ≥ ``min_deflection_deg``); the bounds are
-   [``lower_factor`` × P10, ``upper_factor`` × P90] of those K(t) (defaults 0.5 and 2: the quasi-
-   static estimate ignores damping, inertia and the unknown centre of pressure, which shift it by
-   tens of percent, so the box is generous).
+3. K(t) = M_y / Δθ on the loaded samples (vertical GRF ≥ ``load_fraction`` × peak, default 0.3,
+   and |Δθ| ≥ ``min_deflection_deg``, default 2°); the bounds are
+   [``lower_factor`` × P10, ``upper_factor`` × P90] of those K(t) (defaults 1/3 and 3: the quasi-
+   static estimate ignores damping, inertia, friction and the moving centre of pressure; on
+   simulated stances it was up to about 2× off early in stance, so the box is generous).
 
 D's bounds are [0.01, 1] N·m·s/deg (seed 000: under-damped composite). Internally all bounds are
 SI (N·m/rad, N·m·s/rad).
@@ -209,10 +209,10 @@ def stiffness_bounds(
     hinge: Sequence[float],
     tip: Sequence[float],
     contact_point: Sequence[float] | None = None,
-    load_fraction: float = 0.5,
+    load_fraction: float = 0.3,
     min_deflection_deg: float = 2.0,
-    lower_factor: float = 0.5,
-    upper_factor: float = 2.0,
+    lower_factor: float = 1.0 / 3.0,
+    upper_factor: float = 3.0,
     contact_threshold: float = 20.0,
     reference: str = "touchdown",
 ) -> tuple[float, float]:

@@ -156,13 +156,14 @@ def _profile(
 
 
 def _crossing(grid: np.ndarray, z: np.ndarray, center: int, threshold: float, side: int):
-    """First grid crossing of z(θ) = sqrt(ΔRSS/s²) over ``threshold`` walking from ``center``."""
+    """First grid crossing of z(θ) = sqrt(ΔRSS/s²) over ``threshold`` walking from ``center``
+    (the profile's minimum)."""
     idx = range(center, len(grid)) if side > 0 else range(center, -1, -1)
     prev = None
     for i in idx:
         if prev is not None and z[i] >= threshold:
             z0, z1 = z[prev], z[i]
-            t = (threshold - z0) / (z1 - z0) if z1 > z0 else 1.0
+            t = min(max((threshold - z0) / (z1 - z0), 0.0), 1.0) if z1 > z0 else 1.0
             return float(grid[prev] + t * (grid[i] - grid[prev])), False
         prev = i
     return float(grid[prev]), True
@@ -300,8 +301,9 @@ def assess_identifiability(
         evals += n
         rss_min = min(rss0, float(np.min(rss)))
         z = np.sqrt(np.maximum(rss - rss_min, 0.0) / s2)
-        lo_v, lo_open = _crossing(grid, z, half, threshold, -1)
-        hi_v, hi_open = _crossing(grid, z, half, threshold, +1)
+        centre = int(np.argmin(rss))  # the optimiser's point may sit slightly off the minimum
+        lo_v, lo_open = _crossing(grid, z, centre, threshold, -1)
+        hi_v, hi_open = _crossing(grid, z, centre, threshold, +1)
         lo_open = lo_open and np.isclose(lo_v, b[i, 0])
         hi_open = hi_open and np.isclose(hi_v, b[i, 1])
         lo_ci.append(lo_v)

@@ -1,0 +1,146 @@
+"""Executors that run independent tasks: in-process, a local process pool, or Ray.
+
+Every executor takes a *top-level* (importable, picklable) function ``task(payload) -> dict`` and
+a list of picklable payloads, and yields ``(index, status, value)`` as tasks finish, in any order:
+``status`` is ``"ok"`` (value = the task's dict) or ``"failed"`` (value = an error message). A task
+that raises never stops the others.
+
+- :class:`SerialExecutor`: in this process (``jobs=1``).
+- :class:`LocalExecutor`: ``concurrent.futures.ProcessPoolExecutor`` with the ``forkserver`` start
+  method on Linux (``spawn`` elsewhere); safe with numba's threads and Ray's, unlike ``fork``.
+- :class:`RayExecutor`: Ray (optional extra ``pip install bladelab[ray]``, imported lazily); starts a
+  local instance ``ray.init(num_cpus=jobs, include_dashboard=False)`` unless one is running, and
+  gives the workers the driver's ``sys.path``.
+"""
+
+from __future__ import annotations
+
+import multiprocessing
+import os
+import sys
+import traceback
+from collections.abc import Callable, Iterator, Sequence
+from typing import Any
+
+from bladelab.errors import BladelabError
+
+Task = Callable[[dict], dict]
+
+
+def run_task_safely(task: Task, payload: dict) -> tuple[str, Any]:
+    """Run ``task(payload)``; return ("ok", result) or ("failed", one-line message)."""
+    try:
+        return "ok", task(payload)
+    except BladelabError as err:
+        return "failed", str(err)
+    except Exception as err:  # noqa: BLE001 - a failing trial must not stop the study
+        last = traceback.extract_tb(err.__traceback__)[-1] if err.__traceback__ else None
+        where = f" ({os.path.basename(last.filename)}:{last.lineno})" if last else ""
+        return "failed", f"{type(err).__name__}: {err}{where}"
+
+
+class SerialExecutor:
+    """Run tasks one after the other in this process."""
+
+    name = "serial"
+
+    def __init__(self, jobs: int = 1) -> None:
+        self.jobs = 1
+
+    def run(self, task: Task, payloads: Sequence[dict]) -> Iterator[tuple[int, str, Any]]:
+        for i, payload in enumerate(payloads):
+            status, value = run_task_safely(task, payload)
+            yield i, status, value
+
+
+class LocalExecutor:
+    """A local process pool of ``jobs`` workers."""
+
+    name = "local"
+
+    def __init__(self, jobs: int = 2, *, start_method: str | None = None) -> None:
+        if jobs < 1:
+            raise BladelabError(f"--jobs {jobs}: need at least 1", where="jobs")
+        self.jobs = int(jobs)
+        if start_method is None:
+            start_method = "forkserver" if sys.platform.startswith("linux") else "spawn"
+        self.start_method = start_method
+
+    def run(self, task: Task, payloads: Sequence[dict]) -> Iterator[tuple[int, str, Any]]:
+        from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
+
+        if not payloads:
+            return
+        ctx = multiprocessing.get_context(self.start_method)
+        workers = min(self.jobs, len(payloads))
+        with ProcessPoolExecutor(max_workers=workers, mp_context=ctx) as pool:
+            pending = {pool.submit(run_task_safely, task, p): i for i, p in enumerate(payloads)}
+            try:
+                while pending:
+                    finished, _ = wait(pending, return_when=FIRST_COMPLETED)
+                    for fut in finished:
+                        i = pending.pop(fut)
+                        try:
+                            status, value = fut.result()
+                        except Exception as err:  # noqa: BLE001 - a worker died
+                            status, value = "failed", f"worker failed: {type(err).__name__}: {err}"
+                        yield i, status, value
+            finally:
+                for fut in pending:
+                    fut.cancel()
+
+
+class RayExecutor:
+    """Ray tasks on a local (or already running) Ray instance."""
+
+    name = "ray"
+
+    def __init__(self, jobs: int = 2) -> None:
+        try:
+            import ray  # noqa: F401
+        except ImportError:
+            raise BladelabError(
+                "the Ray executor needs the 'ray' package, which is not installed",
+                where="executor", hint="pip install 'bladelab[ray]', or use --executor local",
+            ) from None
+        self.jobs = int(jobs)
+
+    def run(self, task: Task, payloads: Sequence[dict]) -> Iterator[tuple[int, str, Any]]:
+        import ray
+
+        if not payloads:
+            return
+        started = False
+        if not ray.is_initialized():
+            ray.init(
+                num_cpus=self.jobs, include_dashboard=False, log_to_driver=False,
+                logging_level="ERROR", configure_logging=False,
+                runtime_env={"env_vars": {"PYTHONPATH": os.pathsep.join(p for p in sys.path if p)}},
+            )
+            started = True
+        try:
+            remote = ray.remote(num_cpus=1)(run_task_safely)
+            refs = {remote.remote(task, p): i for i, p in enumerate(payloads)}
+            while refs:
+                ready, _ = ray.wait(list(refs), num_returns=1)
+                for ref in ready:
+                    i = refs.pop(ref)
+                    try:
+                        status, value = ray.get(ref)
+                    except Exception as err:  # noqa: BLE001 - a worker died
+                        status, value = "failed", f"ray task failed: {type(err).__name__}: {err}"
+                    yield i, status, value
+        finally:
+            if started:
+                ray.shutdown()
+
+
+def make_executor(name: str, jobs: int = 1):
+    """``"local"`` (a process pool; in-process when ``jobs == 1``), ``"serial"`` or ``"ray"``."""
+    if name == "local":
+        return SerialExecutor() if jobs <= 1 else LocalExecutor(jobs)
+    if name == "serial":
+        return SerialExecutor()
+    if name == "ray":
+        return RayExecutor(max(1, jobs))
+    raise BladelabError(f"unknown executor {name!r}", where="executor", hint="use 'local' or 'ray'")

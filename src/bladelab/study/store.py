@@ -1,0 +1,145 @@
+"""``results.sqlite``: one row per trial × model variant.
+
+The table ``results`` has the unique key (``trial_id``, ``variant``): two runs never write the same
+row twice (without ``force`` a second insert of a finished row is ignored). The database runs in WAL
+mode and every finished task is committed on its own, so killing a run loses nothing that
+finished. Parameters carry their unit in the column name (N·m/deg, N·m·s/deg).
+"""
+
+from __future__ import annotations
+
+import json
+import sqlite3
+from collections.abc import Iterable
+from datetime import UTC, datetime
+from pathlib import Path
+from typing import Any
+
+import pandas as pd
+
+from bladelab.errors import InputFileError
+
+COLUMNS: dict[str, str] = {
+    "trial_id": "TEXT NOT NULL",
+    "variant": "TEXT NOT NULL",
+    "status": "TEXT NOT NULL",  # "ok" or "failed"
+    "athlete": "TEXT",
+    "blade": "TEXT",
+    "category": "TEXT",
+    "configuration": "TEXT",
+    "speed_pct_pb": "REAL",
+    "K_Nm_per_deg": "REAL",
+    "D_Nms_per_deg": "REAL",
+    "K2_Nm_per_deg2": "REAL",
+    "K_ci_low_Nm_per_deg": "REAL",
+    "K_ci_high_Nm_per_deg": "REAL",
+    "D_ci_low_Nms_per_deg": "REAL",
+    "D_ci_high_Nms_per_deg": "REAL",
+    "KD_correlation": "REAL",
+    "poorly_determined": "TEXT",
+    "nrmse_grf_pct": "REAL",
+    "nrmse_distance_pct": "REAL",
+    "cost": "REAL",
+    "aic": "REAL",
+    "bic": "REAL",
+    "evaluations": "INTEGER",
+    "wall_s": "REAL",
+    "error": "TEXT",
+    "settings_json": "TEXT",
+    "seed": "INTEGER",
+    "package_version": "TEXT",
+    "input_hash": "TEXT",
+    "finished_utc": "TEXT",
+}
+
+
+class ResultsStore:
+    """The results database of a study folder (created on first use).
+
+    Parameters
+    ----------
+    path
+        Path of ``results.sqlite``.
+    """
+
+    def __init__(self, path: str | Path) -> None:
+        self.path = Path(path)
+        self.path.parent.mkdir(parents=True, exist_ok=True)
+        try:
+            self._con = sqlite3.connect(self.path, timeout=30.0)
+            self._con.execute("PRAGMA journal_mode=WAL")
+            self._con.execute("PRAGMA synchronous=NORMAL")
+            cols = ", ".join(f'"{k}" {v}' for k, v in COLUMNS.items())
+            self._con.execute(
+                f"CREATE TABLE IF NOT EXISTS results ({cols}, PRIMARY KEY (trial_id, variant))"
+            )
+            self._con.commit()
+        except sqlite3.DatabaseError as err:
+            raise InputFileError(f"not a results database ({err})", file=self.path,
+                                 hint="move the file away; it will be recreated") from None
+
+    def close(self) -> None:
+        """Close the connection."""
+        self._con.close()
+
+    def __enter__(self) -> ResultsStore:
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+    def done(self, trial_id: str, variant: str, input_hash: str | None = None) -> bool:
+        """True if a successful row exists for (trial, variant) (and the same input hash, if given)."""
+        row = self._con.execute(
+            "SELECT input_hash FROM results WHERE trial_id=? AND variant=? AND status='ok'",
+            (trial_id, variant),
+        ).fetchone()
+        return row is not None and (input_hash is None or row[0] == input_hash)
+
+    def write(self, row: dict[str, Any], *, force: bool = False) -> bool:
+        """Insert one row and commit it; returns False if it already existed and was kept.
+
+        A failed row is replaced by any later result; a successful row only with ``force`` or by a
+        successful result from changed inputs (another input hash).
+        """
+        row = dict(row)
+        row.setdefault("finished_utc", datetime.now(UTC).isoformat(timespec="seconds"))
+        if isinstance(row.get("settings_json"), dict):
+            row["settings_json"] = json.dumps(row["settings_json"], sort_keys=True)
+        unknown = set(row) - set(COLUMNS)
+        if unknown:
+            raise KeyError(f"unknown result column(s): {', '.join(sorted(unknown))}")
+        keys = list(row)
+        sql_cols = ", ".join(f'"{k}"' for k in keys)
+        marks = ", ".join("?" for _ in keys)
+        values = [row[k] for k in keys]
+        with self._con:  # one transaction per finished task
+            if force:
+                cur = self._con.execute(f"INSERT OR REPLACE INTO results ({sql_cols}) VALUES ({marks})", values)
+                return cur.rowcount > 0
+            updates = ", ".join(f'"{k}"=excluded."{k}"' for k in keys if k not in ("trial_id", "variant"))
+            cur = self._con.execute(
+                f"INSERT INTO results ({sql_cols}) VALUES ({marks}) "
+                f"ON CONFLICT(trial_id, variant) DO UPDATE SET {updates} "
+                "WHERE results.status != 'ok' OR (excluded.status = 'ok' "
+                "AND results.input_hash IS NOT excluded.input_hash)",
+                values,
+            )
+            return cur.rowcount > 0
+
+    def table(self, *, status: Iterable[str] | None = None) -> pd.DataFrame:
+        """All rows as a DataFrame (optionally only some statuses), ordered by trial and variant."""
+        df = pd.read_sql_query("SELECT * FROM results ORDER BY trial_id, variant", self._con)
+        if status is not None:
+            df = df[df["status"].isin(list(status))].reset_index(drop=True)
+        return df
+
+
+def open_results(study_dir: str | Path) -> pd.DataFrame:
+    """The results table of a study folder (raises if there is none yet)."""
+    path = Path(study_dir) / "results.sqlite"
+    if not path.is_file():
+        raise InputFileError("no results.sqlite yet", file=path,
+                             hint=f"run `bladelab identify {study_dir} --blade ...` first")
+    with ResultsStore(path) as store:
+        return store.table()
