@@ -1,0 +1,246 @@
+"""Runner model: masses, muscle strengths, blade categories and parameter-file errors.
+
+Expected values are typed from seed 001's tables (Table 2.1, 2.2, 2.3), not from the code's.
+"""
+
+from __future__ import annotations
+
+import math
+
+import mujoco
+import numpy as np
+import pytest
+import yaml
+
+from bladelab.errors import BladelabError, SpecError
+from bladelab.runner import (
+    blade_catalogue,
+    build_runner,
+    contact_heights,
+    default_runner_params,
+    load_runner_params,
+)
+
+G = 9.81
+
+# seed 001 Table 2.1 [kg]
+TABLE_2_1 = {
+    "torso": 35.40,
+    "pelvis": 13.09,
+    "femur": 11.93,
+    "tibia": 4.31,
+    "calcaneus": 1.25,
+    "tibia_amputated": 2.22,
+    "prosthesis": 1.30,
+}
+# seed 001 Table 2.2, Fmax [N]. The soleus row reads 7188 N, but eq. 2.1 with the row's own
+# phi = 0.06 and l0 = 0.05 m gives 60 * 0.06 * 11095 / 5 = 7988 N: the table's digit is
+# transposed (every other row matches eq. 2.1 to within 1 N). We test eq. 2.1's 7988 N.
+TABLE_2_2_FMAX = {
+    "glut_max": 5434,
+    "iliopsoas": 4660,
+    "rect_fem": 2277,
+    "vasti": 13563,
+    "hamstrings": 7023,
+    "bifemsh": 654,
+    "soleus": 7988,
+    "gastroc": 6129,
+    "tib_ant": 2717,
+    "rect_abd": 800,
+    "erect_sp": 3305,
+    "int_obl": 2663,
+}
+# seed 001 Table 2.3 [kN/m]
+TABLE_2_3 = {"Cat4": 21.2, "Cat5": 24.23, "Cat6": 27.3, "Cat6High": 30.3, "Cat7": 33.3}
+
+
+@pytest.fixture(scope="module")
+def amputee():
+    return build_runner("amputee")
+
+
+@pytest.fixture(scope="module")
+def able():
+    return build_runner("able")
+
+
+def test_amputee_structure(amputee):
+    m = amputee.mj_model
+    assert m.nbody - 1 == 8  # 8 segments
+    assert m.nv == 10  # 10 dof
+    assert len(amputee.muscle_names) == 21
+    intact = [
+        n
+        for n in amputee.muscle_names
+        if n.endswith("_l") and "abd" not in n and "obl" not in n and "erect" not in n
+    ]
+    prosth = [
+        n
+        for n in amputee.muscle_names
+        if n.endswith("_r") and "abd" not in n and "obl" not in n and "erect" not in n
+    ]
+    assert len(intact) == 9 and len(prosth) == 6
+    assert not {"gastroc_r", "soleus_r", "tib_ant_r"} & set(amputee.muscle_names)
+    assert amputee.contact_names == ("heel_l", "toe_l", "blade_r")
+
+
+def test_segment_masses_equal_table(amputee, able):
+    t = TABLE_2_1
+    expected_amp = {
+        "torso": t["torso"],
+        "pelvis": t["pelvis"],
+        "femur_l": t["femur"],
+        "femur_r": t["femur"],
+        "tibia_l": t["tibia"],
+        "calcn_l": t["calcaneus"],
+        "tibia_res_r": t["tibia_amputated"],
+        "prosthesis_r": t["prosthesis"],
+    }
+    for name, mass in expected_amp.items():
+        assert amputee.segment_mass(name) == pytest.approx(mass, rel=1e-9), name
+    assert amputee.total_mass == pytest.approx(81.43, abs=1e-6)  # seed §2.1
+    assert able.total_mass == pytest.approx(83.47, abs=1e-6)  # 83.5 kg in seed §2.1
+    assert able.segment_mass("tibia_r") == pytest.approx(t["tibia"])
+    # sagittal inertia (lab y = OpenSim z) of the prosthesis
+    m = amputee.mj_model
+    assert m.body_inertia[m.body("prosthesis_r").id][1] == pytest.approx(0.0370)
+    assert m.body_inertia[m.body("torso").id][1] == pytest.approx(1.4800)
+
+
+def test_muscle_fmax_equals_table(amputee):
+    fmax = dict(zip(amputee.muscle_names, amputee.muscle_params[:, 0], strict=True))
+    for name, value in fmax.items():
+        mtype = name.rsplit("_", 1)[0]
+        assert value == pytest.approx(TABLE_2_2_FMAX[mtype], abs=1.0), name
+
+
+def test_athlete_scaling():
+    data = default_runner_params("amputee").model_dump()
+    data["athlete"] = {"body_mass_kg": 70.0, "height_m": 1.70}
+    from bladelab.runner import runner_params_from_dict
+
+    r = build_runner(runner_params_from_dict(data))
+    assert r.total_mass == pytest.approx(70.0)
+    # eq. 2.1 scaled: volume ∝ mass, l_opt ∝ height
+    ref = build_runner("amputee")
+    ratio = (70.0 / 81.43) / (1.70 / 1.80)
+    np.testing.assert_allclose(r.muscle_params[:, 0], ref.muscle_params[:, 0] * ratio)
+    assert r.stand_qpos[1] == pytest.approx(ref.stand_qpos[1] * 1.70 / 1.80, rel=0.02)
+
+
+def test_prosthetic_leg_three_cm_longer(amputee):
+    q = np.zeros(amputee.mj_model.nq)
+    h = contact_heights(amputee, q)
+    assert h[:2].min() - h[2] == pytest.approx(0.03, abs=1e-9)
+    # standing pose: every contact on the ground
+    np.testing.assert_allclose(contact_heights(amputee, amputee.stand_qpos), 0.0, atol=1e-6)
+
+
+def test_muscle_paths_have_plausible_moment_arms(amputee):
+    """Hip extensors/flexors, knee extensors and the soleus act in the right direction."""
+    m = amputee.mj_model
+    d = mujoco.MjData(m)
+    d.qpos[:] = amputee.stand_qpos
+    mujoco.mj_forward(m, d)
+    moment = np.zeros((m.nu, m.nv))
+    mujoco.mju_sparse2dense(
+        moment, d.actuator_moment, d.moment_rownnz, d.moment_rowadr, d.moment_colind
+    )
+
+    def arm(muscle, dof):  # d l_mtu / d q [m/rad]
+        return moment[m.actuator(muscle).id, amputee.dof(dof)]
+
+    assert arm("glut_max_l", "hip_flexion_l") > 0.02  # lengthens with flexion: extensor
+    assert arm("iliopsoas_l", "hip_flexion_l") < -0.01  # flexor
+    # knee flexion is q < 0: an extensor lengthens as q decreases (dl/dq < 0)
+    assert arm("vasti_l", "knee_angle_l") < -0.02
+    assert arm("bifemsh_l", "knee_angle_l") > 0.01  # knee flexor
+    assert arm("soleus_l", "ankle_angle_l") > 0.02  # lengthens with dorsiflexion: plantarflexor
+    assert arm("tib_ant_l", "ankle_angle_l") < -0.01
+    assert arm("erect_sp_l", "lumbar_extension") < -0.02  # shortens with extension: extensor
+    assert arm("rect_abd_l", "lumbar_extension") > 0.05
+
+
+@pytest.mark.parametrize("category", list(TABLE_2_3))
+def test_blade_sphere_follows_hertz_and_category_stiffness(category):
+    runner = build_runner("amputee", blade=category)
+    row = runner.contact_params[runner.contact_names.index("blade_r")]
+    k = row[3]
+    radius = row[2]
+    assert radius == 0.1464
+    e = runner.blade_modulus
+    bw = 81.43 * G
+    # eq. 2.3: F = 4/3 * sqrt(R) * E * dy^1.5 over a range of compressions
+    from bladelab.contact import hunt_crossley_force
+
+    for dy in (0.005, 0.02, 0.05):
+        f = hunt_crossley_force(dy, 0.0, k, 1.5, row[4])
+        assert f == pytest.approx(4.0 / 3.0 * math.sqrt(0.1464) * e * dy**1.5, rel=1e-12)
+    # linearised stiffness at body-weight load = the category's kN/m (within 5 %)
+    dy_bw = (bw / k) ** (2.0 / 3.0)
+    h = 1e-6
+    k_lin = (
+        hunt_crossley_force(dy_bw + h, 0.0, k, 1.5, 0.0)
+        - hunt_crossley_force(dy_bw - h, 0.0, k, 1.5, 0.0)
+    ) / (2 * h)
+    assert k_lin == pytest.approx(TABLE_2_3[category] * 1e3, rel=0.05)
+
+
+def test_catalogue_has_table_values():
+    cat = blade_catalogue()
+    assert set(cat) == set(TABLE_2_3)
+    for name, knm in TABLE_2_3.items():
+        assert cat[name].stiffness_n_per_m == pytest.approx(knm * 1e3)
+    assert cat["Cat6"].body_mass_range_kg == (78.0, 83.0)
+    assert cat["Cat6"].e_table == pytest.approx(804130.0)
+
+
+def _write(tmp_path, mutate):
+    data = default_runner_params("amputee").model_dump()
+    data["athlete"] = dict(data["athlete"])
+    data["segments"] = {k: dict(v) for k, v in data["segments"].items()}
+    data["muscle_types"] = {k: dict(v) for k, v in data["muscle_types"].items()}
+    mutate(data)
+    path = tmp_path / "params.yaml"
+    path.write_text(yaml.safe_dump(data))
+    return path
+
+
+def test_good_parameter_file_loads(tmp_path):
+    path = _write(tmp_path, lambda d: None)
+    assert load_runner_params(path).kind == "amputee"
+
+
+def test_unknown_category_is_a_clear_error(tmp_path):
+    path = _write(tmp_path, lambda d: d.update(blade="Cat9"))
+    with pytest.raises(SpecError) as err:
+        load_runner_params(path)
+    msg = str(err.value)
+    assert "Cat9" in msg and "blade" in msg and "Cat6High" in msg and str(path) in msg
+
+
+def test_negative_mass_is_a_clear_error(tmp_path):
+    path = _write(tmp_path, lambda d: d["segments"]["pelvis"].update(mass_kg=-13.09))
+    with pytest.raises(SpecError) as err:
+        load_runner_params(path)
+    msg = str(err.value)
+    assert "segments.pelvis.mass_kg" in msg and "positive" in msg
+
+
+def test_missing_muscle_is_a_clear_error(tmp_path):
+    path = _write(tmp_path, lambda d: d["muscle_types"].pop("soleus"))
+    with pytest.raises(SpecError) as err:
+        load_runner_params(path)
+    assert "soleus" in str(err.value) and "muscle_types" in str(err.value)
+
+
+def test_missing_segment_and_bad_yaml(tmp_path):
+    path = _write(tmp_path, lambda d: d["segments"].pop("prosthesis_r"))
+    with pytest.raises(SpecError, match="prosthesis_r"):
+        load_runner_params(path)
+    bad = tmp_path / "bad.yaml"
+    bad.write_text("kind: [able\n")
+    with pytest.raises(BladelabError, match="YAML"):
+        load_runner_params(bad)
+    with pytest.raises(BladelabError, match="not found"):
+        load_runner_params(tmp_path / "nope.yaml")

@@ -1,0 +1,178 @@
+"""Runner simulation: muscle model, drop test, blade statics, power balance, contact kinematics."""
+
+from __future__ import annotations
+
+import math
+
+import mujoco
+import numpy as np
+import pytest
+
+from bladelab.runner import build_runner, power_balance, power_balance_residual_pct, simulate_runner
+from bladelab.runner.muscle import (
+    equilibrium_fiber_length,
+    force_velocity,
+    muscle_step,
+    tendon_force_of_state,
+)
+
+G = 9.81
+
+
+@pytest.fixture(scope="module")
+def amputee():
+    return build_runner("amputee")
+
+
+# ---------------------------------------------------------------- muscle
+
+
+def test_isometric_maximal_force_is_fmax_cos_pennation():
+    """At l_ce = l_opt, a = 1, v = 0 the tendon carries Fmax·cos α0 (hand-derived MTU length)."""
+    fmax, l_opt, l_ts, penn = 3000.0, 0.06, 0.39, 0.3
+    # tendon strain for Fmax·cos α0 with f_t = (ε/0.04)²
+    strain = 0.04 * math.sqrt(math.cos(penn))
+    l_mtu = l_opt * math.cos(penn) + l_ts * (1 + strain)
+    l_ce = equilibrium_fiber_length(l_mtu, 1.0, l_opt, l_ts, penn)
+    assert l_ce == pytest.approx(l_opt, rel=1e-4)
+    assert tendon_force_of_state(l_mtu, l_ce, fmax, l_opt, l_ts, penn) == pytest.approx(
+        fmax * math.cos(penn), rel=1e-3
+    )
+    mp = np.array([[fmax, l_opt, l_ts, penn]])
+    ms = np.array([[1.0, l_ce, 0.0, 0.0]])
+    for _ in range(200):  # held isometric: stays in equilibrium
+        muscle_step(mp, ms, np.array([l_mtu]), np.array([1.0]), 5e-4)
+    assert ms[0, 3] == pytest.approx(fmax * math.cos(penn), rel=1e-3)
+    assert abs(ms[0, 2]) < 1e-6
+
+
+def test_force_velocity_shape():
+    assert force_velocity(0.0) == 1.0
+    assert force_velocity(-1.0) == 0.0
+    assert force_velocity(-0.5) < 0.3  # Hill: (1 - 0.5)/(1 + 2) = 1/6
+    assert force_velocity(-0.5) == pytest.approx(1 / 6)
+    assert force_velocity(10.0) == pytest.approx(1.5, abs=0.01)
+
+
+def test_activation_dynamics_first_order():
+    """u = 1 from a = 0.01: a(t) = 1 − 0.99·exp(−100 t) (rate 100 /s), Euler-discretised."""
+    mp = np.array([[1000.0, 0.1, 0.2, 0.0]])
+    ms = np.array([[0.01, 0.1, 0.0, 0.0]])
+    dt = 1e-4
+    for _ in range(200):
+        muscle_step(mp, ms, np.array([0.3]), np.array([1.0]), dt)
+    assert ms[0, 0] == pytest.approx(1 - 0.99 * math.exp(-100 * 0.02), rel=2e-3)
+
+
+def test_quick_release_shortens_fibre_with_a_compliant_tendon():
+    """A sudden MTU shortening unloads the tendon first; the fibre then shortens (v_ce < 0)."""
+    fmax, l_opt, l_ts, penn = 3000.0, 0.1, 0.2, 0.0
+    l_mtu = l_opt + l_ts * 1.04
+    l_ce = equilibrium_fiber_length(l_mtu, 1.0, l_opt, l_ts, penn)
+    mp = np.array([[fmax, l_opt, l_ts, penn]])
+    ms = np.array([[1.0, l_ce, 0.0, 0.0]])
+    muscle_step(mp, ms, np.array([l_mtu - 0.004]), np.array([1.0]), 5e-4)
+    f_after = tendon_force_of_state(l_mtu - 0.004, ms[0, 1], fmax, l_opt, l_ts, penn)
+    assert f_after < 0.7 * fmax  # tendon unloaded by the release (compliant, not rigid)
+    assert ms[0, 2] < 0  # and the fibre shortens to reload it
+
+
+# ---------------------------------------------------------------- simulation
+
+
+def test_contact_point_velocity_matches_mujoco_jacobian(amputee):
+    """The kernel's contact-point velocity equals J·q̇ from mj_jac at the same point."""
+    rng = np.random.default_rng(3)
+    res = simulate_runner(amputee, duration=0.02, record_every=1, initial_speed=1.0)
+    m = amputee.mj_model
+    d = mujoco.MjData(m)
+    for i in rng.integers(0, len(res.time), 5):
+        d.qpos[:] = res.qpos[i]
+        d.qvel[:] = res.qvel[i]
+        mujoco.mj_forward(m, d)
+        for c, row in enumerate(amputee.contact_params):
+            p = d.site_xpos[int(row[0])] - np.array([0.0, 0.0, row[2]])
+            jac = np.zeros((3, m.nv))
+            mujoco.mj_jac(m, d, jac, None, p, int(row[1]))
+            v = jac @ d.qvel
+            assert res.contacts[i, c, 4] == pytest.approx(v[0], abs=1e-9)
+            assert res.contacts[i, c, 5] == pytest.approx(v[2], abs=1e-9)
+
+
+@pytest.mark.parametrize("kind,mass", [("able", 83.47), ("amputee", 81.43)])
+def test_passive_drop_comes_to_rest_with_body_weight(kind, mass):
+    """Dropped 5 cm with the joints held: static vertical GRF = m·g within 1 %."""
+    runner = build_runner(kind)
+    res = simulate_runner(runner, duration=1.5, hold_pose=True, drop_height=0.05, record_every=5)
+    assert not res.fell
+    fz = res.contacts[:, :, 1].sum(axis=1)
+    assert fz[: len(fz) // 10].max() > 1.5 * mass * G  # the landing impact happened
+    last = res.time > 1.3
+    assert np.mean(fz[last]) == pytest.approx(mass * G, rel=0.01)
+    assert np.ptp(fz[last]) < 0.01 * mass * G  # at rest
+    assert abs(res.qvel[-1, 1]) < 1e-3
+
+
+@pytest.mark.parametrize("category,k_cat", [("Cat4", 21.2e3), ("Cat7", 33.3e3)])
+def test_blade_static_compression_in_simulation(category, k_cat):
+    """Standing on the blade alone (intact hip flexed, joints held): the compression at rest is
+    the Hertz value at body weight, δ = 1.5·m·g/K_cat for a tangent stiffness K_cat."""
+    runner = build_runner("amputee", blade=category)
+    state = {"hip_flexion_l": 0.6, "knee_angle_l": -0.6, "knee_angle_r": 0.0, "hip_flexion_r": 0.0}
+    # the blade's low dissipation (0.2 s/m) lets the bounce ring for a few seconds
+    res = simulate_runner(
+        runner, duration=5.0, hold_pose=True, initial_state=state, drop_height=0.01, record_every=10
+    )
+    blade = runner.contact_names.index("blade_r")
+    assert res.contacts[-50:, :blade, 1].max() == 0.0  # intact foot in the air
+    fz = res.contacts[-50:, blade, 1]
+    assert np.mean(fz) == pytest.approx(81.43 * G, rel=0.01)
+    depth = np.mean(res.contacts[-50:, blade, 6])
+    assert depth == pytest.approx(1.5 * 81.43 * G / k_cat, rel=0.02)
+
+
+@pytest.mark.parametrize("kind,u", [("amputee", 0.05), ("amputee", 0.4), ("able", 0.2)])
+def test_power_balance_with_ground_contact(kind, u):
+    """2 s, constant excitations, feet/blade on the ground throughout: the RMS residual of
+    P_external − P_kinetic is under 2 % of the peak kinetic power. The model collapses (no
+    controller), so the fall stop is switched off to keep the full 2 s."""
+    runner = build_runner(kind)
+    res = simulate_runner(
+        runner, duration=2.0, excitations=u, record_every=1, fall_height=-math.inf
+    )
+    assert res.duration == pytest.approx(2.0)
+    fz = res.contacts[:, :, 1].sum(axis=1)
+    assert (fz > 0).mean() > 0.5  # ground contact during most of the simulation
+    pb = power_balance(res)
+    assert pb.kinetic.abs().max() > 100.0  # something happens
+    assert abs(pb.muscle).max() > 10.0 and abs(pb.contact).max() > 10.0
+    assert power_balance_residual_pct(res) < 2.0
+    # energy: the integral of the external power equals the kinetic energy change; the gap is
+    # the first-order integrator's error (∝ dt: 2.2 % of the kinetic-energy range at 0.5 ms,
+    # 0.5 % at 0.1 ms, measured)
+    from bladelab.runner.analyses import _forward_pass
+
+    ek = _forward_pass(res)["ek"]
+    work = np.trapezoid(pb.external, pb.time)
+    assert work == pytest.approx(ek[-1] - ek[0], abs=0.05 * np.ptp(ek))
+
+
+def test_bad_simulation_inputs(amputee):
+    from bladelab.errors import BladelabError
+
+    with pytest.raises(BladelabError):
+        simulate_runner(amputee, duration=-1.0)
+    with pytest.raises(BladelabError):
+        simulate_runner(amputee, duration=0.1, initial_state="fly")
+
+
+def test_controller_is_called_with_states(amputee):
+    calls = []
+
+    def controller(t, state):
+        calls.append((t, state.muscles.shape, state.contacts.shape))
+        return np.full(len(amputee.muscle_names), 0.2)
+
+    res = simulate_runner(amputee, controller=controller, duration=0.01, control_interval=2)
+    assert len(calls) == 11 and calls[0][1] == (21, 4) and calls[0][2] == (3, 7)
+    assert np.allclose(res.excitation[-1], 0.2)
