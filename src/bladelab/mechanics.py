@@ -1,8 +1,10 @@
 """Blade mechanics of one stance: compression, stiffness, angular deformation and hysteresis.
 
 The quantities of seed 000 §2.3–2.4 and seed 001 eq. (1.2), for a measured stance or a
-simulated one (a simulated result is passed as a :class:`~bladelab.trial.Stance` holding the
-simulated GRF and distance on the same clamp motion).
+simulated one. A simulated result is passed as a :class:`~bladelab.trial.Stance` holding the
+simulated GRF and distance on the same clamp motion, e.g.
+``dataclasses.replace(measured, grf_x=sim_fx, grf_z=sim_fz, distance=sim_d)``, with the
+simulated tip path (``tip_x``, ``tip_z``) or blade angle (``theta``).
 
 Definitions (SI inside; see ``docs/mechanics.md``)
 ---------------------------------------------------
@@ -159,8 +161,13 @@ class StanceMechanics:
         )
 
     def to_dict(self) -> dict[str, Any]:
-        """Scalar results with the unit in each key (K_c in kN/m, angles in deg, K in N·m/deg)."""
+        """Scalar results with the unit in each key (K_c in kN/m, angles in deg, K in N·m/deg).
+
+        Scalar metadata of the stance (group, trial, speed, ...) comes first.
+        """
+        meta = {k: v for k, v in self.metadata.items() if isinstance(v, str | int | float)}
         return {
+            **meta,
             "force_component": self.force_component,
             "d0_m": self.d0,
             "theta0_deg": float(units.rad2deg(self.theta0)),
@@ -175,7 +182,6 @@ class StanceMechanics:
             "energy_returned_J": self.energy_returned,
             "energy_dissipated_J": self.energy_dissipated,
             "efficiency_pct": self.efficiency,
-            **{k: v for k, v in self.metadata.items() if isinstance(v, str | int | float)},
         }
 
     def to_frame(self) -> pd.DataFrame:

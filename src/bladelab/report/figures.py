@@ -7,8 +7,9 @@ Groups are given as ``{group name: [items...]}`` mappings, in display order.
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
-from typing import Literal
+import functools
+from collections.abc import Callable, Mapping, Sequence
+from typing import Literal, TypeVar
 
 import numpy as np
 import pandas as pd
@@ -49,6 +50,22 @@ _RC = {
 }
 
 Signal = Literal["grf", "distance"]
+_F = TypeVar("_F", bound=Callable[..., Figure])
+
+
+def _styled(func: _F) -> _F:
+    """Draw the whole figure under the report's matplotlib style (no global rcParams change)."""
+
+    @functools.wraps(func)
+    def wrapper(*args, **kwargs):
+        import matplotlib as mpl
+
+        with mpl.rc_context(_RC):
+            return func(*args, **kwargs)
+
+    return wrapper  # type: ignore[return-value]
+
+
 _SIGNALS = {
     "grf": ("grf_z", 1.0, "vertical GRF [N]"),
     "distance": ("distance", 1e3, "clamp–tip distance [mm]"),
@@ -63,13 +80,10 @@ def _figure(
     ncols: int | None = None,
     share: bool = True,
 ):
-    import matplotlib as mpl
-
     ncols = min(n_panels, ncols or 3)
     nrows = int(np.ceil(n_panels / ncols))
-    with mpl.rc_context(_RC):
-        fig = Figure(figsize=(width * ncols, height * nrows + 0.35), layout="constrained")
-        axes = fig.subplots(nrows, ncols, squeeze=False, sharex=share, sharey=share)
+    fig = Figure(figsize=(width * ncols, height * nrows + 0.35), layout="constrained")
+    axes = fig.subplots(nrows, ncols, squeeze=False, sharex=share, sharey=share)
     for ax in axes.flat[n_panels:]:
         ax.set_visible(False)
     return fig, list(axes.flat[:n_panels])
@@ -100,6 +114,7 @@ def _mean_sd(stances: Sequence[Stance], name: str, n_points: int) -> tuple[np.nd
     return curves.mean(axis=0), sd
 
 
+@_styled
 def time_series_bands(
     measured: Mapping[str, Sequence[Stance]],
     simulated: Mapping[str, Sequence[Stance]] | None = None,
@@ -199,6 +214,7 @@ def _loop_panels(
     return fig
 
 
+@_styled
 def hysteresis_loops(mechanics: Mapping[str, Sequence[StanceMechanics]]) -> Figure:
     """GRF vs angular deformation Δθ per group, loading and unloading branches (§3.4).
 
@@ -216,6 +232,7 @@ def hysteresis_loops(mechanics: Mapping[str, Sequence[StanceMechanics]]) -> Figu
     return _loop_panels(mechanics, xlabel="angular deformation Δθ [deg]", ylabel="GRF [N]", get=get)
 
 
+@_styled
 def compressive_stiffness_curves(mechanics: Mapping[str, Sequence[StanceMechanics]]) -> Figure:
     """Equivalent compressive stiffness K_c vs compression Δd per group (§3.5)."""
 
@@ -229,6 +246,7 @@ def compressive_stiffness_curves(mechanics: Mapping[str, Sequence[StanceMechanic
     return _loop_panels(mechanics, xlabel="compression Δd [mm]", ylabel="K_c [kN/m]", get=get)
 
 
+@_styled
 def parameter_bars(
     summary: pd.DataFrame,
     *,
