@@ -40,6 +40,7 @@ __all__ = [
     "SoleSpec",
     "read_blade_spec",
     "segment_mass_properties",
+    "spec_from_dict",
 ]
 
 PositiveFloat = Annotated[float, Field(gt=0.0, allow_inf_nan=False)]
