@@ -1,0 +1,145 @@
+"""Runner analyses on synthetic results with hand-derived answers, and on a real simulation."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from bladelab.runner import (
+    build_runner,
+    gait_events,
+    joint_angles,
+    joint_powers,
+    leg_energy,
+    leg_stiffness,
+    simulate_runner,
+    spatiotemporal,
+    summary,
+)
+from bladelab.runner.simulate import RunnerResult
+
+
+@pytest.fixture(scope="module")
+def amputee():
+    return build_runner("amputee")
+
+
+def _synthetic(model, *, stances, duration=2.0, dt=1e-3, speed=3.0, drop=0.0, peak=2000.0):
+    """A result whose pelvis moves forward at ``speed`` (joints fixed at 0) with half-sine
+    vertical GRFs on the given (leg, start, end) stances; the pelvis dips by ``drop`` as a
+    half-sine during each stance."""
+    t = np.arange(0.0, duration + dt / 2, dt)
+    n = len(t)
+    nq = model.mj_model.nq
+    qpos = np.zeros((n, nq))
+    qvel = np.zeros((n, nq))
+    qpos[:, 0] = speed * t
+    qvel[:, 0] = speed
+    qpos[:, 1] = 1.0
+    nc = len(model.contact_names)
+    contacts = np.zeros((n, nc, 7))
+    legs = model.contact_params[:, 6]
+    for leg, t0, t1 in stances:
+        on = (t > t0) & (t < t1)
+        shape = np.sin(math.pi * (t[on] - t0) / (t1 - t0))
+        cols = np.flatnonzero(legs == leg)
+        contacts[np.ix_(on, cols, [1])] = (peak * shape / len(cols))[:, None, None]
+        qpos[on, 1] -= drop * shape
+    nm = len(model.muscle_names)
+    return RunnerResult(
+        model=model,
+        time=t,
+        qpos=qpos,
+        qvel=qvel,
+        muscles=np.zeros((n, nm, 4)),
+        mtu=np.zeros((n, nm, 2)),
+        excitation=np.zeros((n, nm)),
+        contacts=contacts,
+        ligament=np.zeros((n, nq)),
+        dt=dt,
+        fell=False,
+        requested_duration=duration,
+    )
+
+
+# intact stances 0.1-0.3, 0.7-0.9, 1.3-1.5; prosthetic 0.4-0.6, 1.0-1.2
+STANCES = [(0, 0.1, 0.3), (1, 0.4, 0.6), (0, 0.7, 0.9), (1, 1.0, 1.2), (0, 1.3, 1.5)]
+
+
+def test_gait_events_and_spatiotemporal(amputee):
+    res = _synthetic(amputee, stances=STANCES)
+    ev = gait_events(res, threshold_n=1.0)
+    td = ev[(ev.leg == "intact") & (ev.event == "touchdown")].time.to_numpy()
+    np.testing.assert_allclose(td, [0.1, 0.7, 1.3], atol=2e-3)
+    st = spatiotemporal(res, threshold_n=1.0).set_index(["leg", "variable"]).value
+    # hand-derived: stride 0.6, contact 0.2, step 0.3, flight 0.1, swing 0.4
+    for leg in ("intact", "prosthetic"):
+        assert st[(leg, "stride_time")] == pytest.approx(0.6, abs=3e-3)
+        assert st[(leg, "contact_time")] == pytest.approx(0.2, abs=3e-3)
+        assert st[(leg, "step_time")] == pytest.approx(0.3, abs=3e-3)
+        assert st[(leg, "flight_time")] == pytest.approx(0.1, abs=3e-3)
+        assert st[(leg, "swing_time")] == pytest.approx(0.4, abs=3e-3)
+
+
+def test_leg_stiffness_hand_derived(amputee):
+    """K_leg = F_peak / (Δy + L0(1 − cos θ)), θ = asin(v·t_c / 2L0) (seed 001 eq. 2.19–2.21)."""
+    res = _synthetic(amputee, stances=STANCES, drop=0.04, peak=2000.0)
+    ks = leg_stiffness(res, threshold_n=1.0)
+    assert len(ks) == 5
+    row = ks[ks.leg == "intact"].iloc[0]
+    # joints fixed: the COM dips with the pelvis (minus the first 1 ms of the dip, before the
+    # first sample above threshold)
+    assert row.delta_y == pytest.approx(0.04, abs=1e-3)
+    assert row.F_peak == pytest.approx(2000.0, rel=1e-3)
+    l0 = row.L0
+    assert 0.85 < l0 < 1.0  # hip height of a 1.80 m athlete
+    prosth = ks[ks.leg == "prosthetic"].iloc[0].L0
+    assert prosth - l0 == pytest.approx(0.03, abs=1e-6)  # 3 cm longer prosthetic leg
+    tc = row.contact_time
+    theta = math.asin(3.0 * tc / (2 * l0))
+    assert row.K_leg == pytest.approx(2000.0 / (0.04 + l0 * (1 - math.cos(theta))), rel=0.02)
+
+
+def test_leg_energy_of_a_loop(amputee):
+    """COM dips 4 cm and rises back under a half-sine force: stored = generated = ∫F dy."""
+    res = _synthetic(amputee, stances=STANCES, drop=0.04, peak=2000.0)
+    en = leg_energy(res, threshold_n=1.0)
+    row = en.iloc[0]
+    # F = P·sin(s), y = −D·sin(s): ∫ over descent of F·dy = P·D·∫0^{π/2} sin·cos ds = P·D/2
+    assert row.E_stored == pytest.approx(2000.0 * 0.04 / 2, rel=0.01)
+    assert row.E_generated == pytest.approx(2000.0 * 0.04 / 2, rel=0.01)
+    assert row.recoil_pct == pytest.approx(100.0, abs=1.0)
+
+
+def test_analyses_on_a_simulation(amputee):
+    res = simulate_runner(
+        amputee,
+        duration=0.5,
+        excitations=0.1,
+        initial_state="gait",
+        initial_speed=2.0,
+        fall_height=-math.inf,
+    )
+    ang = joint_angles(res)
+    assert set(ang.joint) >= {"hip_flexion_l", "knee_angle_l", "socket_angle_r", "pelvis_tilt"}
+    pw = joint_powers(res)
+    assert set(pw.joint) >= {"hip_flexion_l", "knee_angle_r", "ankle_angle_l", "blade_r"}
+    assert np.isfinite(pw.power).all()
+    s = summary(res)
+    for key in (
+        "fell",
+        "duration_s",
+        "mean_speed_mps",
+        "contact_time_intact_s",
+        "contact_time_prosthetic_s",
+        "power_balance_residual_pct",
+    ):
+        assert key in s
+    assert s["duration_s"] == pytest.approx(0.5)
+    assert s["power_balance_residual_pct"] < 2.0
+    grf = res.leg_grf()
+    assert set(grf.leg) == {"intact", "prosthetic"}
+    bw = amputee.body_weight
+    np.testing.assert_allclose(grf.Fz_bw, grf.Fz / bw)
