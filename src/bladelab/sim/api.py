@@ -67,6 +67,8 @@ class SimProblem:
     engine: str
     drive: Drive
     belt_speed: float
+    order: int = 2
+    iterations: int = 1
 
     @property
     def n_joints(self) -> int:
@@ -216,6 +218,8 @@ def prepare(
     engine: Engine = "kernel",
     belt_speed: float = 0.0,
     drive: Drive | str = Drive.PRESCRIBED,
+    order: int = 2,
+    iterations: int = 1,
 ) -> SimProblem:
     """Set up the simulation of ``blade`` driven by the clamp motion of ``stance``.
 
@@ -276,6 +280,7 @@ def prepare(
     return SimProblem(
         blade=blade, stance=stance, chain=chain, motion=motion, time=time, dt=dt_used,
         n_substeps=nsub, base=base, engine=engine, drive=drive, belt_speed=float(belt_speed),
+        order=int(order), iterations=int(iterations),
     )
 
 
@@ -315,7 +320,7 @@ def _run_kernel(problem: SimProblem, K, D, K2, *, parallel: bool = False):
     fn = _k._batch_parallel if parallel else _k._batch_serial
     fn(problem.base, problem.dt, problem.n_substeps, 0.0, c.body_mass, c.body_com,
        c.body_inertia, c.hinge, c.sole_body, c.sole_geom, c.tip_body, c.tip, c.contact,
-       K, D, K2, np.zeros(nj), np.zeros(nj), grf, dist, qout, tau, state, energy, status)
+       K, D, K2, np.zeros(nj), np.zeros(nj), problem.order, problem.iterations, grf, dist, qout, tau, state, energy, status)
     return grf, dist, qout, tau, state, energy, status
 
 

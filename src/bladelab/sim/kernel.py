@@ -225,7 +225,7 @@ def _solve(A, rhs, x):
 def simulate_prescribed(
     base, dt, nsub, ground_vx,
     body_mass, com0, body_inertia, hinge, sole_body, sole_geom, tip_body, tip, contact,
-    stiffness, damping, stiffness_quadratic, q0, v0,
+    stiffness, damping, stiffness_quadratic, q0, v0, order, n_iter,
     grf, dist, qout, tau, state, energy,
 ):
     """Simulate one parameter set with the clamp prescribed.
@@ -253,6 +253,12 @@ def simulate_prescribed(
     Jv = np.zeros((nj, nj))
     rhs = np.zeros(nj)
     dv = np.zeros(nj)
+    vi = np.zeros(nj)
+    res = np.zeros(nj)
+    qh = np.zeros(nj)
+    vh = np.zeros(nj)
+    qp = np.zeros(nj)
+    vp = np.zeros(nj)
     q = q0.copy()
     v = v0.copy()
     qs = np.zeros(nj)
@@ -267,76 +273,99 @@ def simulate_prescribed(
     for i in range(n_steps + 1):
         record = i % nsub == 0
         if i > 0:
-            # ---- one linearly-implicit Euler step from step i-1 to step i ----
+            # ---- one (linearly-)implicit Euler step from step i-1 to step i ----
             bs = base[i]
+            if order == 2 and i > 1:
+                # BDF2: x_{n+1} = 4/3 x_n - 1/3 x_{n-1} + 2/3 h f(x_{n+1})
+                g = 2.0 * dt / 3.0
+                for j in range(nj):
+                    qh[j] = (4.0 * q[j] - qp[j]) / 3.0
+                    vh[j] = (4.0 * v[j] - vp[j]) / 3.0
+                    vi[j] = 2.0 * v[j] - vp[j]
+            else:
+                # backward Euler (first step of BDF2 too)
+                g = dt
+                for j in range(nj):
+                    qh[j] = q[j]
+                    vh[j] = v[j]
+                    vi[j] = v[j]
+            for _it in range(n_iter):
+                for j in range(nj):
+                    qs[j] = qh[j] + g * vi[j]
+                _kinematics(bs, qs, vi, hinge, com0, O, vO, aO, phi, om, al, R, VR, AR)
+                for j in range(nj):
+                    hx = O[j + 1, 0]
+                    hz = O[j + 1, 1]
+                    acc = 0.0
+                    for k in range(j, nj):
+                        kx = O[k + 1, 0]
+                        kz = O[k + 1, 1]
+                        mjk = 0.0
+                        for b in range(k + 1, nb):
+                            mjk += (body_mass[b] * ((R[b, 0] - hx) * (R[b, 0] - kx)
+                                                    + (R[b, 1] - hz) * (R[b, 1] - kz))
+                                    + body_inertia[b])
+                        M[j, k] = mjk
+                        M[k, j] = mjk
+                        Jq[j, k] = 0.0
+                        Jq[k, j] = 0.0
+                        Jv[j, k] = 0.0
+                        Jv[k, j] = 0.0
+                    for b in range(j + 1, nb):
+                        rx = R[b, 0] - hx
+                        rz = R[b, 1] - hz
+                        # gravity minus inertia (bias) generalised force
+                        acc += body_mass[b] * (GRAVITY * rx - (AR[b, 0] * rz - AR[b, 1] * rx))
+                        acc -= body_inertia[b] * al[b]
+                    qa = qs[j]
+                    acc -= stiffness[j] * qa + stiffness_quadratic[j] * qa * abs(qa) + damping[j] * vi[j]
+                    Jq[j, j] -= stiffness[j] + 2.0 * stiffness_quadratic[j] * abs(qa)
+                    Jv[j, j] -= damping[j]
+                    rhs[j] = acc
+                p_fric = 0.0
+                p_cdamp = 0.0
+                for e in range(ne):
+                    b = sole_body[e]
+                    cx, cz = _body_point(b, sole_geom[e, 0], sole_geom[e, 1], hinge, O, phi)
+                    (px, pz, fx, fz, depth, rate, slip, kn, cn, mu, dmu, fel) = sole_contact(
+                        contact, cx, cz, phi[b] + sole_geom[e, 4], sole_geom[e, 2], sole_geom[e, 3],
+                        O[b, 0], O[b, 1], vO[b, 0], vO[b, 1], om[b], ground_vx)
+                    fe[e, 0] = fx
+                    fe[e, 1] = fz
+                    pe[e, 0] = px
+                    pe[e, 1] = pz
+                    if fz == 0.0:
+                        continue
+                    p_fric += -fx * slip
+                    p_cdamp += (fz - fel) * rate
+                    # gradients of (fx, fz) with respect to the point's position and velocity
+                    gv00 = -dmu * fz
+                    gv01 = mu * cn
+                    gv11 = -cn
+                    gp01 = mu * kn
+                    gp11 = -kn
+                    for j in range(b):
+                        jx = pz - O[j + 1, 1]
+                        jz = -(px - O[j + 1, 0])
+                        rhs[j] += fx * jx + fz * jz
+                        for k in range(b):
+                            kx = pz - O[k + 1, 1]
+                            kz = -(px - O[k + 1, 0])
+                            Jv[j, k] += jx * (gv00 * kx + gv01 * kz) + jz * (gv11 * kz)
+                            Jq[j, k] += jx * (gp01 * kz) + jz * (gp11 * kz)
+                for j in range(nj):
+                    acc = g * rhs[j]
+                    for k in range(nj):
+                        acc -= M[j, k] * (vi[k] - vh[k])
+                    res[j] = acc
+                for j in range(nj):
+                    for k in range(nj):
+                        M[j, k] = M[j, k] - g * Jv[j, k] - g * g * Jq[j, k]
+                _solve(M, res, dv)
+                for j in range(nj):
+                    vi[j] += dv[j]
             for j in range(nj):
-                qs[j] = q[j] + dt * v[j]
-            _kinematics(bs, qs, v, hinge, com0, O, vO, aO, phi, om, al, R, VR, AR)
-            for j in range(nj):
-                hx = O[j + 1, 0]
-                hz = O[j + 1, 1]
-                acc = 0.0
-                for k in range(j, nj):
-                    kx = O[k + 1, 0]
-                    kz = O[k + 1, 1]
-                    mjk = 0.0
-                    for b in range(k + 1, nb):
-                        mjk += (body_mass[b] * ((R[b, 0] - hx) * (R[b, 0] - kx)
-                                                + (R[b, 1] - hz) * (R[b, 1] - kz))
-                                + body_inertia[b])
-                    M[j, k] = mjk
-                    M[k, j] = mjk
-                    Jq[j, k] = 0.0
-                    Jq[k, j] = 0.0
-                    Jv[j, k] = 0.0
-                    Jv[k, j] = 0.0
-                for b in range(j + 1, nb):
-                    rx = R[b, 0] - hx
-                    rz = R[b, 1] - hz
-                    # gravity minus inertia (bias) generalised force
-                    acc += body_mass[b] * (GRAVITY * rx - (AR[b, 0] * rz - AR[b, 1] * rx))
-                    acc -= body_inertia[b] * al[b]
-                qa = qs[j]
-                acc -= stiffness[j] * qa + stiffness_quadratic[j] * qa * abs(qa) + damping[j] * v[j]
-                Jq[j, j] -= stiffness[j] + 2.0 * stiffness_quadratic[j] * abs(qa)
-                Jv[j, j] -= damping[j]
-                rhs[j] = acc
-            p_fric = 0.0
-            p_cdamp = 0.0
-            for e in range(ne):
-                b = sole_body[e]
-                cx, cz = _body_point(b, sole_geom[e, 0], sole_geom[e, 1], hinge, O, phi)
-                (px, pz, fx, fz, depth, rate, slip, kn, cn, mu, dmu, fel) = sole_contact(
-                    contact, cx, cz, phi[b] + sole_geom[e, 4], sole_geom[e, 2], sole_geom[e, 3],
-                    O[b, 0], O[b, 1], vO[b, 0], vO[b, 1], om[b], ground_vx)
-                fe[e, 0] = fx
-                fe[e, 1] = fz
-                pe[e, 0] = px
-                pe[e, 1] = pz
-                if fz == 0.0:
-                    continue
-                p_fric += -fx * slip
-                p_cdamp += (fz - fel) * rate
-                # gradients of (fx, fz) with respect to the point's position and velocity
-                gv00 = -dmu * fz
-                gv01 = mu * cn
-                gv11 = -cn
-                gp01 = mu * kn
-                gp11 = -kn
-                for j in range(b):
-                    jx = pz - O[j + 1, 1]
-                    jz = -(px - O[j + 1, 0])
-                    rhs[j] += fx * jx + fz * jz
-                    for k in range(b):
-                        kx = pz - O[k + 1, 1]
-                        kz = -(px - O[k + 1, 0])
-                        Jv[j, k] += jx * (gv00 * kx + gv01 * kz) + jz * (gv11 * kz)
-                        Jq[j, k] += jx * (gp01 * kz) + jz * (gp11 * kz)
-            for j in range(nj):
-                for k in range(nj):
-                    M[j, k] = M[j, k] - dt * Jv[j, k] - dt * dt * Jq[j, k]
-                rhs[j] *= dt
-            _solve(M, rhs, dv)
+                dv[j] = vi[j] - v[j]
             # clamp power with the step's accelerations
             fcx = 0.0
             fcz = 0.0
@@ -363,8 +392,11 @@ def simulate_prescribed(
             w_clamp += dt * (fcx * bs[3] + fcz * bs[4] + tc * bs[5])
             diverged = False
             for j in range(nj):
-                v[j] += dv[j]
-                q[j] = qs[j] + dt * dv[j]
+                dv[j] = vi[j] - v[j]
+                qp[j] = q[j]
+                vp[j] = v[j]
+                v[j] = vi[j]
+                q[j] = qh[j] + g * vi[j]
                 d_joint += dt * damping[j] * v[j] * v[j]
                 if not (math.isfinite(q[j]) and abs(q[j]) < 10.0):
                     diverged = True
@@ -421,12 +453,12 @@ def simulate_prescribed(
 
 @njit(cache=True)
 def _batch_serial(base, dt, nsub, ground_vx, body_mass, com0, body_inertia, hinge, sole_body,
-                  sole_geom, tip_body, tip, contact, K, D, K2, q0, v0,
+                  sole_geom, tip_body, tip, contact, K, D, K2, q0, v0, order, n_iter,
                   grf, dist, qout, tau, state, energy, status):
     for s in range(K.shape[0]):
         st, at = simulate_prescribed(
             base, dt, nsub, ground_vx, body_mass, com0, body_inertia, hinge, sole_body, sole_geom,
-            tip_body, tip, contact, K[s], D[s], K2[s], q0, v0,
+            tip_body, tip, contact, K[s], D[s], K2[s], q0, v0, order, n_iter,
             grf[s], dist[s], qout[s], tau[s], state[s], energy[s])
         status[s, 0] = st
         status[s, 1] = at
@@ -434,12 +466,12 @@ def _batch_serial(base, dt, nsub, ground_vx, body_mass, com0, body_inertia, hing
 
 @njit(cache=True, parallel=True)
 def _batch_parallel(base, dt, nsub, ground_vx, body_mass, com0, body_inertia, hinge, sole_body,
-                    sole_geom, tip_body, tip, contact, K, D, K2, q0, v0,
+                    sole_geom, tip_body, tip, contact, K, D, K2, q0, v0, order, n_iter,
                     grf, dist, qout, tau, state, energy, status):
     for s in prange(K.shape[0]):
         st, at = simulate_prescribed(
             base, dt, nsub, ground_vx, body_mass, com0, body_inertia, hinge, sole_body, sole_geom,
-            tip_body, tip, contact, K[s], D[s], K2[s], q0, v0,
+            tip_body, tip, contact, K[s], D[s], K2[s], q0, v0, order, n_iter,
             grf[s], dist[s], qout[s], tau[s], state[s], energy[s])
         status[s, 0] = st
         status[s, 1] = at
