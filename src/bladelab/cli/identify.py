@@ -1,0 +1,131 @@
+"""``bladelab identify`` (one stance or a whole study) and ``bladelab results``."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import typer
+
+from bladelab.errors import InputFileError, SpecError
+
+__all__ = ["register"]
+
+
+def _identify(
+    path: Path = typer.Argument(..., help="A stance CSV, or a study folder holding study.yaml."),
+    blade: str | None = typer.Option(
+        None, "--blade", help="Built-in blade name or blade spec file (required for a stance; "
+        "for a study it replaces the study's blades)."),
+    optimizer: str = typer.Option("pso", "--optimizer", help="pso (20 × 30, seed 000) or cmaes."),
+    seed: int | None = typer.Option(None, "--seed", help="Seed (stance: default 0; study: "
+                                    "replaces study.yaml's seed)."),
+    as_json: bool = typer.Option(False, "--json", help="Print the result as JSON."),
+    jobs: int = typer.Option(1, "--jobs", "-j", help="Parallel workers for a study."),
+    executor: str = typer.Option("local", "--executor", help="local (process pool) or ray."),
+    force: bool = typer.Option(False, "--force", help="Re-run trials that are already done."),
+    polish: bool = typer.Option(False, "--polish", help="Refine the optimum with L-BFGS-B."),
+    nonlinear: bool = typer.Option(False, "--nonlinear", help="Also identify K2 (stiffening spring)."),
+    joint: int | None = typer.Option(None, "--joint", help="Hinge position (blade point index)."),
+    grf: str = typer.Option("z", "--grf", help="GRF components in the cost: z or zx."),
+    max_evals: int = typer.Option(600, "--max-evals", help="Evaluation budget of the search."),
+    no_ci: bool = typer.Option(False, "--no-ci", help="Skip confidence intervals."),
+) -> None:
+    """Identify K* [N·m/deg] and D* [N·m·s/deg] of a stance, or of every trial of a study."""
+    if optimizer not in ("pso", "cmaes"):
+        raise SpecError(f"unknown optimizer {optimizer!r}", where="--optimizer", hint="pso or cmaes")
+    if grf not in ("z", "zx", "xz"):
+        raise SpecError(f"unknown GRF components {grf!r}", where="--grf", hint="z or zx")
+    components = ("z",) if grf == "z" else ("z", "x")
+    if path.is_dir():
+        _identify_study(path, blade=blade, seed=seed, as_json=as_json, jobs=jobs, executor=executor,
+                        force=force, settings={
+                            "optimizer": optimizer, "polish": polish, "nonlinear": nonlinear,
+                            "joint": joint, "grf_components": list(components),
+                            "max_evals": max_evals, "identifiability": not no_ci})
+        return
+    if not path.is_file():
+        raise InputFileError("no such stance file or study folder", file=path)
+    if blade is None:
+        raise SpecError("--blade is required to identify a stance", where="--blade",
+                        hint="a built-in name (bladelab blade list) or a blade spec file")
+    from bladelab.identify.identify import identify_stance
+    from bladelab.trial import read_stance_csv
+
+    stance = read_stance_csv(path)
+    ident = identify_stance(stance, blade, optimizer=optimizer, seed=0 if seed is None else seed,
+                            grf_components=components, joint=joint, nonlinear=nonlinear,
+                            polish=polish, max_evals=max_evals, identifiability=not no_ci)
+    d = ident.to_dict()
+    if as_json:
+        typer.echo(json.dumps(d, indent=2))
+        return
+    lines = [f"K* = {d['K_Nm_per_deg']:.3f} N·m/deg", f"D* = {d['D_Nms_per_deg']:.4f} N·m·s/deg"]
+    if "K2_Nm_per_deg2" in d:
+        lines.append(f"K2 = {d['K2_Nm_per_deg2']:.4g} N·m/deg²")
+    if "K_ci_Nm_per_deg" in d:
+        lines.append(f"95 % CI: K [{d['K_ci_Nm_per_deg'][0]:.3f}, {d['K_ci_Nm_per_deg'][1]:.3f}], "
+                     f"D [{d['D_ci_Nms_per_deg'][0]:.4f}, {d['D_ci_Nms_per_deg'][1]:.4f}]; "
+                     f"K–D correlation {d['KD_correlation']:.2f}")
+    lines.append(f"nRMSE GRF {d['nrmse_grf_pct']:.2f} %, distance {d['nrmse_distance_pct']:.2f} %, "
+                 f"cost {d['cost']:.4g}")
+    lines.append(f"{d['evaluations']} simulations ({d['optimizer']}, seed {d['seed']}), "
+                 f"{d['wall_s']:.2f} s")
+    for name, why in d["poorly_determined"].items():
+        lines.append(f"warning: {name} is poorly determined: {why}")
+    typer.echo("\n".join(lines))
+
+
+def _identify_study(path: Path, *, blade, seed, as_json, jobs, executor, force, settings) -> None:
+    from bladelab.study.runner import run_study
+
+    if seed is not None:
+        raise SpecError("--seed applies to a single stance; a study takes its seed from study.yaml",
+                        where="--seed", hint="set 'seed:' in study.yaml")
+    run = run_study(path, blade=blade, settings=settings, jobs=jobs, executor=executor, force=force,
+                    progress=not as_json)
+    if as_json:
+        typer.echo(json.dumps(run.to_dict(), indent=2))
+    else:
+        typer.echo(f"{run.finished} identified, {run.skipped} already done, {len(run.failures)} "
+                   f"failed, of {run.total} ({run.wall_s:.1f} s, {run.executor}, {run.jobs} job(s))")
+        for trial, msg in run.failures:
+            typer.echo(f"failed: {trial}: {msg}", err=True)
+    if run.failures:
+        raise typer.Exit(1)
+
+
+_SHOWN = ["trial_id", "variant", "status", "athlete", "blade", "category", "configuration",
+          "speed_pct_pb", "K_Nm_per_deg", "D_Nms_per_deg", "K_ci_low_Nm_per_deg",
+          "K_ci_high_Nm_per_deg", "nrmse_grf_pct", "nrmse_distance_pct", "error"]
+
+
+def _results(
+    study_dir: Path = typer.Argument(..., help="Study folder (with results.sqlite)."),
+    as_csv: bool = typer.Option(False, "--csv", help="Print all columns as CSV."),
+    output: Path | None = typer.Option(None, "--output", "-o", help="Write the CSV to this file."),
+) -> None:
+    """Print (or export as CSV) the results table of a study."""
+    from bladelab._io import atomic_open
+    from bladelab.study.store import open_results
+
+    df = open_results(study_dir)
+    if output is not None:
+        with atomic_open(output, "w", encoding="utf-8", newline="") as fh:
+            df.to_csv(fh, index=False)
+        typer.echo(f"wrote {output} ({len(df)} rows)", err=True)
+        return
+    if as_csv:
+        typer.echo(df.to_csv(index=False), nl=False)
+        return
+    if df.empty:
+        typer.echo("no results yet")
+        return
+    cols = [c for c in _SHOWN if c in df.columns and df[c].notna().any()]
+    typer.echo(df[cols].to_string(index=False, float_format=lambda v: f"{v:.4g}"))
+
+
+def register(app: typer.Typer) -> None:
+    """Add ``identify`` and ``results`` to the root app."""
+    app.command("identify")(_identify)
+    app.command("results")(_results)

@@ -1,0 +1,211 @@
+"""Study folder: study.yaml validation, results store, executors, skip/force, failures, seeds."""
+
+from __future__ import annotations
+
+import importlib.util
+import sqlite3
+import textwrap
+
+import numpy as np
+import pytest
+
+from bladelab.errors import BladelabError, InputFileError, SpecError
+from bladelab.identify.optimizers import minimize
+from bladelab.study import ResultsStore, load_study, run_study, trial_seed
+from bladelab.study.executors import make_executor
+
+
+def fake_task(payload: dict) -> dict:
+    """A cheap stand-in for the identification: a seeded PSO on a quadratic from the file."""
+    values = np.loadtxt(payload["file"], delimiter=",")
+    target = np.array([values.mean(), values.std()])
+    res = minimize(lambda X: np.sum((X - target) ** 2, axis=1), [(-10, 10), (0, 10)],
+                   seed=payload["seed"], max_evals=60, n_particles=6)
+    return {"K_Nm_per_deg": float(res.x[0]), "D_Nms_per_deg": float(res.x[1]),
+            "cost": float(res.fun), "evaluations": res.evaluations}
+
+
+def failing_task(payload: dict) -> dict:
+    if payload["trial_id"] == "t2":
+        raise ValueError("boom")
+    return fake_task(payload)
+
+
+STUDY = """
+name: test study
+seed: 7
+athletes:
+  - {id: TF1, mass_kg: 65, amputation: transfemoral, height_m: 1.80, side: left}
+  - {id: TT1, mass_kg: 76, amputation: transtibial}
+blades:
+  - {id: xceed, blade: xceed-cat2, category: 2}
+  - {id: xtreme5, blade: xtreme-cat5, category: 5}
+configurations:
+  - {id: A, pylon_height_m: 0.75}
+  - {id: B, pylon_height_m: 0.95}
+trials:
+"""
+
+
+def make_study(tmp_path, n=4, missing=()):
+    lines = [STUDY]
+    for i in range(n):
+        tid = f"t{i}"
+        lines.append(f"  - {{id: {tid}, file: trials/{tid}.csv, athlete: TF1, blade: xceed, "
+                     f"configuration: A, speed_pct_pb: {60 + 10 * i}}}\n")
+        if tid not in missing:
+            (tmp_path / "trials").mkdir(exist_ok=True)
+            np.savetxt(tmp_path / "trials" / f"{tid}.csv", np.arange(5.0) * (i + 1), delimiter=",")
+    (tmp_path / "study.yaml").write_text("".join(lines))
+    return tmp_path
+
+
+def test_load_and_validate(tmp_path):
+    study, folder = load_study(make_study(tmp_path))
+    assert folder == tmp_path and len(study.trials) == 4
+    assert study.athlete("TF1").amputation == "transfemoral"
+    bad = (tmp_path / "study.yaml").read_text().replace("athlete: TF1, blade: xceed, configuration: A, speed_pct_pb: 70",
+                                                        "athlete: TT9, blade: xceed, configuration: A, speed_pct_pb: 70")
+    (tmp_path / "study.yaml").write_text(bad)
+    with pytest.raises(SpecError, match=r"trials\[1\]\.athlete: 'TT9' is not one of the athletes"):
+        load_study(tmp_path)
+
+
+def test_field_paths_in_errors(tmp_path):
+    text = STUDY.replace("mass_kg: 76", "mass_kg: -3") + \
+        "  - {id: a, file: x.csv, athlete: TF1, blade: xceed, speed_pct_pb: 300}\n"
+    (tmp_path / "study.yaml").write_text(text)
+    with pytest.raises(SpecError) as err:
+        load_study(tmp_path)
+    msg = str(err.value)
+    assert "athletes[1].mass_kg" in msg and "trials[0].speed_pct_pb" in msg
+    with pytest.raises(InputFileError, match="no study.yaml"):
+        load_study(tmp_path / "nowhere")
+    (tmp_path / "study.yaml").write_text(STUDY + "  - {id: a, file: x.csv, athlete: TF1, blade: xceed, colour: red}\n")
+    with pytest.raises(SpecError, match=r"trials\[0\]\.colour"):
+        load_study(tmp_path)
+
+
+def test_trial_seeds_are_deterministic_and_distinct():
+    assert trial_seed(7, "t1") == trial_seed(7, "t1")
+    assert len({trial_seed(7, f"t{i}") for i in range(100)}) == 100
+    assert trial_seed(7, "t1") != trial_seed(8, "t1")
+
+
+def test_run_skip_force_and_store(tmp_path):
+    make_study(tmp_path)
+    run = run_study(tmp_path, task=fake_task, progress=False)
+    assert (run.total, run.finished, run.skipped, run.failures) == (4, 4, 0, ())
+    again = run_study(tmp_path, task=fake_task, progress=False)
+    assert (again.finished, again.skipped) == (0, 4)
+    forced = run_study(tmp_path, task=fake_task, progress=False, force=True)
+    assert forced.finished == 4
+    with ResultsStore(tmp_path / "results.sqlite") as store:
+        df = store.table()
+    assert len(df) == 4 and set(df["status"]) == {"ok"}
+    assert list(df["speed_pct_pb"]) == [60, 70, 80, 90] and set(df["category"]) == {"2"}
+    assert df["input_hash"].notna().all() and (df["package_version"] == "0.1.0").all()
+    con = sqlite3.connect(tmp_path / "results.sqlite")
+    assert con.execute("PRAGMA journal_mode").fetchone()[0] == "wal"
+    con.close()
+    # changed input -> re-run that trial only
+    np.savetxt(tmp_path / "trials" / "t0.csv", np.arange(6.0), delimiter=",")
+    changed = run_study(tmp_path, task=fake_task, progress=False)
+    assert (changed.finished, changed.skipped) == (1, 3)
+
+
+def test_missing_file_is_reported_others_run(tmp_path):
+    make_study(tmp_path, missing=("t1",))
+    run = run_study(tmp_path, task=fake_task, progress=False)
+    assert run.finished == 3 and [t for t, _ in run.failures] == ["t1"]
+    assert "file not found" in run.failures[0][1] and "t1.csv" in run.failures[0][1]
+    with ResultsStore(tmp_path / "results.sqlite") as store:
+        df = store.table()
+    assert dict(zip(df["trial_id"], df["status"], strict=True)) == {
+        "t0": "ok", "t1": "failed", "t2": "ok", "t3": "ok"}
+    # the file appears: the failed row is replaced on the next run
+    np.savetxt(tmp_path / "trials" / "t1.csv", np.arange(5.0), delimiter=",")
+    assert run_study(tmp_path, task=fake_task, progress=False).finished == 1
+
+
+def test_task_exception_does_not_stop_others(tmp_path):
+    make_study(tmp_path)
+    run = run_study(tmp_path, task=failing_task, progress=False)
+    assert run.finished == 3 and run.failures[0][0] == "t2" and "ValueError: boom" in run.failures[0][1]
+
+
+def test_store_never_writes_a_row_twice(tmp_path):
+    with ResultsStore(tmp_path / "r.sqlite") as store:
+        row = {"trial_id": "a", "variant": "linear", "status": "ok", "K_Nm_per_deg": 1.0, "input_hash": "h"}
+        assert store.write(row)
+        assert not store.write({**row, "K_Nm_per_deg": 2.0})  # same inputs: kept
+        assert store.table()["K_Nm_per_deg"].tolist() == [1.0]
+        assert store.write({**row, "K_Nm_per_deg": 3.0}, force=True)
+        assert not store.write({**row, "status": "failed", "input_hash": None})  # ok row kept
+        assert store.table()["K_Nm_per_deg"].tolist() == [3.0]
+        with pytest.raises(KeyError, match="unknown result column"):
+            store.write({**row, "colour": "red"})
+
+
+def _k_by_trial(tmp_path):
+    with ResultsStore(tmp_path / "results.sqlite") as store:
+        df = store.table(status=["ok"])
+    return dict(zip(df["trial_id"], zip(df["K_Nm_per_deg"], df["D_Nms_per_deg"], strict=True), strict=True))
+
+
+def test_process_pool_matches_serial(tmp_path):
+    a, b = tmp_path / "a", tmp_path / "b"
+    a.mkdir()
+    b.mkdir()
+    make_study(a)
+    make_study(b)
+    run_study(a, task=fake_task, progress=False, jobs=1)
+    run = run_study(b, task=fake_task, progress=False, jobs=2)
+    assert run.finished == 4
+    assert _k_by_trial(a) == _k_by_trial(b)
+
+
+def test_unknown_executor():
+    with pytest.raises(BladelabError, match="unknown executor"):
+        make_executor("dask", 2)
+
+
+@pytest.mark.skipif(importlib.util.find_spec("ray") is None, reason="ray not installed (pip install bladelab[ray])")
+def test_ray_matches_local(tmp_path):
+    a, b = tmp_path / "a", tmp_path / "b"
+    a.mkdir()
+    b.mkdir()
+    make_study(a, missing=("t3",))
+    make_study(b, missing=("t3",))
+    run_study(a, task=fake_task, progress=False, jobs=2)
+    run = run_study(b, task=fake_task, progress=False, jobs=2, executor="ray")
+    assert run.finished == 3 and [t for t, _ in run.failures] == ["t3"]
+    assert _k_by_trial(a) == _k_by_trial(b)
+
+
+def test_ray_missing_is_a_clear_error(monkeypatch):
+    import builtins
+
+    real_import = builtins.__import__
+
+    def no_ray(name, *args, **kwargs):
+        if name == "ray":
+            raise ImportError("no ray")
+        return real_import(name, *args, **kwargs)
+
+    monkeypatch.setattr(builtins, "__import__", no_ray)
+    with pytest.raises(BladelabError, match=r"bladelab\[ray\]"):
+        make_executor("ray", 2)
+
+
+def test_yaml_example_in_docs_is_valid(tmp_path):
+    # the documented minimal example parses
+    text = textwrap.dedent("""
+        name: minimal
+        athletes: [{id: A1, mass_kg: 70, amputation: transtibial}]
+        blades: [{id: b, blade: xtreme-cat5, category: 5}]
+        trials: [{id: r1, file: r1.csv, athlete: A1, blade: b, speed_pct_pb: 100}]
+    """)
+    (tmp_path / "study.yaml").write_text(text)
+    study, _ = load_study(tmp_path)
+    assert study.identification.optimizer == "pso" and study.trials[0].stance == 1
