@@ -264,14 +264,15 @@ def default_design_space() -> DesignSpace:
     """The four factors of seed 002 with illustrative ranges.
 
     Vertical stiffness target 18-32 kN/m (seed 000 §3.5: peak K_c of category 2-5 blades), width
-    0.05-0.08 m, height 0.30-0.40 m and toe length 0.10-0.16 m. Replace them with the ranges of
-    the blades you can build.
+    0.05-0.08 m, build height 0.40-0.48 m and toe length 0.19-0.25 m (around the built-in
+    ``xtreme`` blade, the blade generator's default base). Replace them with the ranges of the
+    blades you can build.
     """
     return DesignSpace(
         (
             Factor("stiffness_kN_per_m", 18.0, 32.0, "kN/m", "vertical stiffness"),
             Factor("width_m", 0.05, 0.08, "m", "width"),
-            Factor("height_m", 0.30, 0.40, "m", "height"),
-            Factor("toe_length_m", 0.10, 0.16, "m", "toe length"),
+            Factor("height_m", 0.40, 0.48, "m", "height"),
+            Factor("toe_length_m", 0.19, 0.25, "m", "toe length"),
         )
     )
