@@ -114,7 +114,8 @@ def generate_stance(
         ``D_Nms_per_rad`` (lists), ``K_Nm_per_deg``, ``D_Nms_per_deg``, ``contact_time_s``,
         ``peak_grf_z_N``, ``max_compression_m``, ``min_deflection_deg``, ``max_sole_slip_m``,
         ``pitch_touchdown_deg``, ``pitch_toeoff_deg``, ``clamp_mean_speed_mps``, and the clean
-        signals ``deflection`` (n, n_joints) [rad], ``grf_x``, ``grf_z`` [N], ``distance`` [m].
+        signals ``deflection`` (n, n_joints) [rad], ``grf_x``, ``grf_z`` [N], ``distance`` [m],
+        ``tip_x``, ``tip_z`` (blade tip in the lab frame) [m].
 
     Raises
     ------
@@ -197,7 +198,7 @@ def generate_stance(
             rows.append((
                 i * dt, cl[0], cl[2], d.qpos[qp], mj.out[:, 0].sum(), mj.out[:, 1].sum(),
                 math.hypot(tip[0] - cl[0], tip[2] - cl[2]), *q, hx, hz,
-                *mj.out[:, 1], *slip_acc,
+                *mj.out[:, 1], *slip_acc, tip[0], tip[2],
             ))
         if in_contact:
             touched = True
@@ -276,5 +277,7 @@ def generate_stance(
         "grf_x": fx[sl].copy(),
         "grf_z": fz[sl].copy(),
         "distance": dist[sl].copy(),
+        "tip_x": rec[sl, 9 + nj + 2 * ne].copy(),
+        "tip_z": rec[sl, 10 + nj + 2 * ne].copy(),
     }
     return stance, truth
