@@ -12,9 +12,17 @@ The pieces, each usable on its own:
   evaluation parameter;
 - :mod:`~bladelab.design.constraints`: knee buckling and blade clearance;
 - :mod:`~bladelab.design.plots`: main-effect and contour plots;
-- :mod:`~bladelab.design.study`: :func:`run_design` ties them to an evaluator.
+- :mod:`~bladelab.design.study`: :func:`run_design` ties them to an evaluator;
+- :mod:`~bladelab.design.blade_generator`: design point -> multi-link blade spec;
+- :mod:`~bladelab.design.compression`: the virtual compression test of a blade.
 """
 
+from bladelab.design.blade_generator import GeneratedBlade, generate_blade
+from bladelab.design.compression import (
+    CompressionTestResult,
+    compression_test,
+    vertical_stiffness,
+)
 from bladelab.design.constraints import (
     ClearanceResult,
     KneeBucklingResult,
@@ -50,12 +58,14 @@ from bladelab.design.terms import model_terms, parse_terms
 
 __all__ = [
     "ClearanceResult",
+    "CompressionTestResult",
     "CyclePerformance",
     "Design",
     "DesignSpace",
     "DesignStudyResult",
     "EstimabilityReport",
     "Factor",
+    "GeneratedBlade",
     "KneeBucklingResult",
     "OptimumResult",
     "ResponseSurface",
@@ -66,12 +76,14 @@ __all__ = [
     "bouncing_ball",
     "box_behnken",
     "central_composite",
+    "compression_test",
     "constrained_optimum",
     "cycle_performance",
     "d_optimal",
     "default_design_space",
     "estimability",
     "fit_surface",
+    "generate_blade",
     "knee_buckling",
     "knee_extension_moment",
     "make_design",
@@ -83,4 +95,5 @@ __all__ = [
     "require_estimable",
     "run_design",
     "stance_performance",
+    "vertical_stiffness",
 ]

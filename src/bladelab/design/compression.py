@@ -166,6 +166,8 @@ class CompressionTestResult:
         Clamp displacement δ [m] (downward positive), starting at 0.
     force
         Vertical force at the clamp [N] (compressive positive).
+    energy
+        Spring energy stored in the joints [J] (equals ∫F dδ).
     stiffness_linear
         Small-load vertical stiffness [N/m].
     load, displacement_at_load, stiffness_at_load
@@ -177,6 +179,7 @@ class CompressionTestResult:
 
     displacement: np.ndarray
     force: np.ndarray
+    energy: np.ndarray
     stiffness_linear: float
     load: float
     displacement_at_load: float
@@ -186,12 +189,15 @@ class CompressionTestResult:
     support: str
 
     def to_frame(self) -> pd.DataFrame:
-        return pd.DataFrame({"displacement_m": self.displacement, "force_N": self.force})
+        return pd.DataFrame(
+            {"displacement_m": self.displacement, "force_N": self.force, "energy_J": self.energy}
+        )
 
     def to_dict(self) -> dict:
         return {
             "displacement_m": self.displacement.tolist(),
             "force_N": self.force.tolist(),
+            "energy_J": self.energy.tolist(),
             "stiffness_linear_N_per_m": self.stiffness_linear,
             "load_N": self.load,
             "displacement_at_load_m": self.displacement_at_load,
@@ -246,6 +252,7 @@ def compression_test(
 
     deltas = np.linspace(0.0, float(max_displacement), int(n_steps) + 1)
     forces = [0.0]
+    energies = [0.0]
     q = np.zeros(n)
     for d in deltas[1:]:
         target = s0 + np.array([0.0, d])
@@ -273,6 +280,7 @@ def compression_test(
         Jq = _support_jacobian(setup, q)[rows]
         lam = np.linalg.lstsq(Jq.T, grad(q), rcond=None)[0]
         forces.append(float(lam[-1]))  # multiplier of the vertical constraint = dU/dδ
+        energies.append(energy(q))
     force = np.asarray(forces)
     if load is None:
         d_at, k_at, load_v = float("nan"), float("nan"), float("nan")
@@ -288,7 +296,7 @@ def compression_test(
         d_at = float(np.interp(load_v, force[i - 1:i + 1], deltas[i - 1:i + 1]))
         k_at = load_v / d_at
     return CompressionTestResult(
-        displacement=deltas, force=force, stiffness_linear=float(k_lin), load=load_v,
+        displacement=deltas, force=force, energy=np.asarray(energies), stiffness_linear=float(k_lin), load=load_v,
         displacement_at_load=d_at, stiffness_at_load=k_at, alignment_deg=float(alignment_deg),
         tip=tip, support=support,
     )
