@@ -117,3 +117,15 @@ def test_bad_response_values():
         fit_surface(d.coded, y, factor_names=NAMES)
     with pytest.raises(DataError):
         fit_surface(d.coded, y[:5], factor_names=NAMES)
+
+
+def test_degenerate_responses_give_no_spurious_statistics():
+    d = central_composite(4)
+    const = fit_surface(d.coded, np.full(d.n_runs, 2.5), factor_names=NAMES)
+    assert np.isnan(const.r2) and np.isnan(const.r2_pred)
+    assert const.anova["F"].isna().all()
+    assert const.to_dict()["r2"] is None
+    exact = fit_surface(d.coded, 0.1 * d.coded[:, 1], factor_names=NAMES)
+    a = exact.anova.set_index("source")
+    assert a.loc["w", "F"] == np.inf and a.loc["w", "p_value"] == 0.0
+    assert np.isnan(a.loc["k", "F"])  # a zero effect fitted exactly: no test possible

@@ -214,8 +214,8 @@ class ResponseSurface:
             "n_runs": self.n,
             "df_resid": self.df_resid,
             "sigma": self.sigma,
-            "r2": self.r2,
-            "r2_adj": self.r2_adj,
+            "r2": _json_float(self.r2),
+            "r2_adj": _json_float(self.r2_adj),
             "r2_pred": _json_float(self.r2_pred),
             "press": _json_float(self.press),
             "loo_rmse": _json_float(self.loo_rmse),
@@ -229,6 +229,11 @@ class ResponseSurface:
 def _json_float(v: float) -> float | None:
     v = float(v)
     return v if np.isfinite(v) else None
+
+
+def _noise_floor(y: np.ndarray) -> float:
+    """Sums of squares below this are round-off of a response of this size."""
+    return 1e-20 * max(float(y @ y), 1e-300)
 
 
 def _anova(
@@ -247,21 +252,22 @@ def _anova(
     n, p = X.shape
     mse = sse / df_resid
     rows = []
+    floor = _noise_floor(y)  # sums of squares below this are round-off
 
-    def f_p(ms: float, df1: int, ms_err: float, df2: int) -> tuple[float, float]:
-        if ms_err > 0:
-            f = ms / ms_err
+    def f_p(ss: float, df1: int, ss_err: float, df2: int) -> tuple[float, float]:
+        if ss_err > floor:
+            f = (ss / df1) / (ss_err / df2)
             return f, float(stats.f.sf(f, df1, df2))
-        return (float("inf"), 0.0) if ms > 0 else (float("nan"), float("nan"))
+        return (float("inf"), 0.0) if ss > floor else (float("nan"), float("nan"))
 
-    ssr = sst - sse
-    f, pv = f_p(ssr / (p - 1), p - 1, mse, df_resid) if p > 1 else (np.nan, np.nan)
+    ssr = max(sst - sse, 0.0)
+    f, pv = f_p(ssr, p - 1, sse, df_resid) if p > 1 else (np.nan, np.nan)
     rows.append(("model", ssr, p - 1, ssr / (p - 1) if p > 1 else np.nan, f, pv))
     for j, term in enumerate(terms):
         if not term:
             continue
         ss = coef[j] ** 2 / xtx_inv[j, j]
-        f, pv = f_p(ss, 1, mse, df_resid)
+        f, pv = f_p(ss, 1, sse, df_resid)
         rows.append((term_name(term, names), ss, 1, ss, f, pv))
     rows.append(("residual", sse, df_resid, mse, np.nan, np.nan))
     # replicates: pure error and lack of fit
@@ -275,7 +281,7 @@ def _anova(
         means = np.bincount(group, weights=y, minlength=n_groups) / np.bincount(group)
         sspe = float(np.sum((y - means[group]) ** 2))
         sslof = max(sse - sspe, 0.0)
-        f, pv = f_p(sslof / df_lof, df_lof, sspe / df_pe, df_pe)
+        f, pv = f_p(sslof, df_lof, sspe, df_pe)
         rows.append(("lack_of_fit", sslof, df_lof, sslof / df_lof, f, pv))
         rows.append(("pure_error", sspe, df_pe, sspe / df_pe, np.nan, np.nan))
     rows.append(("total", sst, n - 1, np.nan, np.nan, np.nan))
@@ -354,14 +360,14 @@ def fit_surface(
     sst = float(np.sum((y - y.mean()) ** 2))
     sigma2 = sse / df_resid
     se = np.sqrt(np.maximum(np.diag(xtx_inv), 0.0) * sigma2)
-    if sst > 0:
+    if sst > _noise_floor(y):
         r2 = 1.0 - sse / sst
         r2_adj = 1.0 - (sse / df_resid) / (sst / (n - 1))
     else:
         r2 = r2_adj = float("nan")
     if np.all(lev < 1.0 - 1e-10):
         press = float(np.sum((resid / (1.0 - lev)) ** 2))
-        r2_pred = 1.0 - press / sst if sst > 0 else float("nan")
+        r2_pred = 1.0 - press / sst if sst > _noise_floor(y) else float("nan")
         loo_rmse = float(np.sqrt(press / n))
     else:  # a run with leverage 1 is fitted exactly whatever its value: no LOO prediction
         press = r2_pred = loo_rmse = float("nan")
