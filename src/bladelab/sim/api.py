@@ -51,7 +51,8 @@ class SimProblem:
     n_substeps
         Integration steps per stance sample.
     base
-        (n_steps + 1, 9) clamp pose, velocity and acceleration at every step time.
+        (n_steps + 1, 11) clamp pose, velocity, acceleration, cos and sin of the pitch at every
+        step time.
     engine, drive, belt_speed
         As given to :func:`prepare`.
     """

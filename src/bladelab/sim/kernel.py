@@ -50,14 +50,13 @@ STATUS_OK = 0
 STATUS_DIVERGED = 1
 
 
-@njit(cache=True, inline="always")
-def _rot(phi: float, x: float, z: float) -> tuple[float, float]:
-    c = math.cos(phi)
-    s = math.sin(phi)
+@njit(cache=True, inline="always", error_model="numpy")
+def _rot(c: float, s: float, x: float, z: float) -> tuple[float, float]:
+    """Rotate (x, z) by the pitch whose cosine and sine are ``c``, ``s`` (about +y)."""
     return c * x + s * z, -s * x + c * z
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _normal_force(contact, depth, rate):
     """Normal force, ∂F/∂depth, ∂F/∂rate and the elastic part of the force (for energy)."""
     law = int(contact[0])
@@ -85,7 +84,7 @@ def _normal_force(contact, depth, rate):
     return force, n * k * depth ** (n - 1.0) * (1.0 + 1.5 * d * rate), 1.5 * d * k * dn, k * dn
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def contact_elastic_energy(contact, depth):
     """Energy [J] stored by the elastic part of the normal law at penetration ``depth`` [m]."""
     if depth <= 0.0:
@@ -102,11 +101,12 @@ def contact_elastic_energy(contact, depth):
     return k * depth ** (n + 1.0) / (n + 1.0)
 
 
-@njit(cache=True)
-def sole_contact(contact, cx, cz, psi, a, b, ox, oz, vox, voz, om, ground_vx):
+@njit(cache=True, error_model="numpy")
+def sole_contact(contact, cx, cz, s, c, a, b, ox, oz, vox, voz, om, ground_vx):
     """Force of the ground on one sole ellipse (lab frame, rigid ground at z = 0).
 
-    ``(cx, cz)`` centre [m], ``psi`` absolute angle of the ellipse's x axis about +y [rad],
+    ``(cx, cz)`` centre [m], ``s, c`` sine and cosine of the absolute angle ψ of the ellipse's
+    x axis about +y,
     ``a, b`` semi-axes [m]; ``(ox, oz)``, ``(vox, voz)`` a point of the carrying body and its
     velocity, ``om`` the body's angular velocity [rad/s]; ``ground_vx`` the ground's velocity.
 
@@ -114,8 +114,6 @@ def sole_contact(contact, cx, cz, psi, a, b, ox, oz, vox, voz, om, ground_vx):
     the force, penetration [m] and its rate, slip velocity, ∂Fn/∂depth, ∂Fn/∂rate, μ (signed),
     ∂μ/∂slip and the elastic part of the normal force.
     """
-    s = math.sin(psi)
-    c = math.cos(psi)
     nrm = math.sqrt(a * a * s * s + b * b * c * c)
     px = cx + s * c * (a * a - b * b) / nrm
     pz = cz - nrm
@@ -135,19 +133,25 @@ def sole_contact(contact, cx, cz, psi, a, b, ox, oz, vox, voz, om, ground_vx):
         muk = contact[7]
         vc = contact[8]
         mu = stick_slip_friction_coefficient(slip, mus, muk, vc)
-        h = 1e-3 * vc
-        dmu = (stick_slip_friction_coefficient(slip + h, mus, muk, vc)
-               - stick_slip_friction_coefficient(slip - h, mus, muk, vc)) / (2.0 * h)
+        speed = abs(slip)
+        if speed < vc:
+            dmu = mus / vc
+        elif speed < 1.5 * vc:
+            h = 1e-3 * vc
+            dmu = (stick_slip_friction_coefficient(slip + h, mus, muk, vc)
+                   - stick_slip_friction_coefficient(slip - h, mus, muk, vc)) / (2.0 * h)
     return px, pz, -mu * fn, fn, depth, rate, slip, kn, cn, mu, dmu, fel
 
 
-@njit(cache=True)
-def _kinematics(bs, q, v, hinge, com0, O, vO, aO, phi, om, al, R, VR, AR):
+@njit(cache=True, error_model="numpy")
+def _kinematics(bs, q, v, hinge, com0, O, vO, aO, phi, cph, sph, om, al, R, VR, AR):
     """Body origins (O), angles, COMs (R) with velocities and bias accelerations (q̈ = 0)."""
     nb = com0.shape[0]
     O[0, 0] = bs[0]
     O[0, 1] = bs[1]
     phi[0] = bs[2]
+    cph[0] = bs[9]
+    sph[0] = bs[10]
     vO[0, 0] = bs[3]
     vO[0, 1] = bs[4]
     om[0] = bs[5]
@@ -158,7 +162,7 @@ def _kinematics(bs, q, v, hinge, com0, O, vO, aO, phi, om, al, R, VR, AR):
         if b > 0:
             o0x = hinge[b - 2, 0] if b > 1 else 0.0
             o0z = hinge[b - 2, 1] if b > 1 else 0.0
-            dx, dz = _rot(phi[b - 1], hinge[b - 1, 0] - o0x, hinge[b - 1, 1] - o0z)
+            dx, dz = _rot(cph[b - 1], sph[b - 1], hinge[b - 1, 0] - o0x, hinge[b - 1, 1] - o0z)
             w = om[b - 1]
             O[b, 0] = O[b - 1, 0] + dx
             O[b, 1] = O[b - 1, 1] + dz
@@ -167,11 +171,13 @@ def _kinematics(bs, q, v, hinge, com0, O, vO, aO, phi, om, al, R, VR, AR):
             aO[b, 0] = aO[b - 1, 0] + al[b - 1] * dz - w * w * dx
             aO[b, 1] = aO[b - 1, 1] - al[b - 1] * dx - w * w * dz
             phi[b] = phi[b - 1] + q[b - 1]
+            cph[b] = math.cos(phi[b])
+            sph[b] = math.sin(phi[b])
             om[b] = om[b - 1] + v[b - 1]
             al[b] = al[b - 1]
         o0x = hinge[b - 1, 0] if b > 0 else 0.0
         o0z = hinge[b - 1, 1] if b > 0 else 0.0
-        ex, ez = _rot(phi[b], com0[b, 0] - o0x, com0[b, 1] - o0z)
+        ex, ez = _rot(cph[b], sph[b], com0[b, 0] - o0x, com0[b, 1] - o0z)
         w = om[b]
         R[b, 0] = O[b, 0] + ex
         R[b, 1] = O[b, 1] + ez
@@ -181,15 +187,15 @@ def _kinematics(bs, q, v, hinge, com0, O, vO, aO, phi, om, al, R, VR, AR):
         AR[b, 1] = aO[b, 1] - al[b] * ex - w * w * ez
 
 
-@njit(cache=True)
-def _body_point(b, x0, z0, hinge, O, phi):
+@njit(cache=True, error_model="numpy")
+def _body_point(b, x0, z0, hinge, O, cph, sph):
     o0x = hinge[b - 1, 0] if b > 0 else 0.0
     o0z = hinge[b - 1, 1] if b > 0 else 0.0
-    ex, ez = _rot(phi[b], x0 - o0x, z0 - o0z)
+    ex, ez = _rot(cph[b], sph[b], x0 - o0x, z0 - o0z)
     return O[b, 0] + ex, O[b, 1] + ez
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _solve(A, rhs, x):
     """Solve A x = rhs in place (Gaussian elimination, partial pivoting; A, rhs destroyed)."""
     n = rhs.shape[0]
@@ -221,7 +227,7 @@ def _solve(A, rhs, x):
         x[i] = acc / A[i, i]
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def simulate_prescribed(
     base, dt, nsub, ground_vx,
     body_mass, com0, body_inertia, hinge, sole_body, sole_geom, tip_body, tip, contact,
@@ -230,7 +236,8 @@ def simulate_prescribed(
 ):
     """Simulate one parameter set with the clamp prescribed.
 
-    ``base`` (n_steps + 1, 9): clamp x, z, θ, ẋ, ż, θ̇, ẍ, z̈, θ̈ at every step time; samples are
+    ``base`` (n_steps + 1, 11): clamp x, z, θ, ẋ, ż, θ̇, ẍ, z̈, θ̈, cos θ, sin θ at every step time;
+    samples are
     recorded every ``nsub`` steps into ``grf`` (ns, ne, 2), ``dist`` (ns,), ``qout`` and ``tau``
     (ns, nj), ``state`` (ns, ne) int8 (0 free, 1 stick, 2 slip) and ``energy`` (ns, 8).
     Returns (status, step index where it diverged or −1).
@@ -243,6 +250,10 @@ def simulate_prescribed(
     vO = np.zeros((nb, 2))
     aO = np.zeros((nb, 2))
     phi = np.zeros(nb)
+    cph = np.zeros(nb)
+    sph = np.zeros(nb)
+    ce = np.cos(sole_geom[:, 4])
+    se = np.sin(sole_geom[:, 4])
     om = np.zeros(nb)
     al = np.zeros(nb)
     R = np.zeros((nb, 2))
@@ -292,7 +303,7 @@ def simulate_prescribed(
             for _it in range(n_iter):
                 for j in range(nj):
                     qs[j] = qh[j] + g * vi[j]
-                _kinematics(bs, qs, vi, hinge, com0, O, vO, aO, phi, om, al, R, VR, AR)
+                _kinematics(bs, qs, vi, hinge, com0, O, vO, aO, phi, cph, sph, om, al, R, VR, AR)
                 for j in range(nj):
                     hx = O[j + 1, 0]
                     hz = O[j + 1, 1]
@@ -326,9 +337,10 @@ def simulate_prescribed(
                 p_cdamp = 0.0
                 for e in range(ne):
                     b = sole_body[e]
-                    cx, cz = _body_point(b, sole_geom[e, 0], sole_geom[e, 1], hinge, O, phi)
+                    cx, cz = _body_point(b, sole_geom[e, 0], sole_geom[e, 1], hinge, O, cph, sph)
                     (px, pz, fx, fz, depth, rate, slip, kn, cn, mu, dmu, fel) = sole_contact(
-                        contact, cx, cz, phi[b] + sole_geom[e, 4], sole_geom[e, 2], sole_geom[e, 3],
+                        contact, cx, cz, sph[b] * ce[e] + cph[b] * se[e], cph[b] * ce[e] - sph[b] * se[e],
+                    sole_geom[e, 2], sole_geom[e, 3],
                         O[b, 0], O[b, 1], vO[b, 0], vO[b, 1], om[b], ground_vx)
                     fe[e, 0] = fx
                     fe[e, 1] = fz
@@ -408,13 +420,14 @@ def simulate_prescribed(
             # ---- outputs at a sample time, from the state itself ----
             s_idx = i // nsub
             bs = base[i]
-            _kinematics(bs, q, v, hinge, com0, O, vO, aO, phi, om, al, R, VR, AR)
+            _kinematics(bs, q, v, hinge, com0, O, vO, aO, phi, cph, sph, om, al, R, VR, AR)
             e_contact = 0.0
             for e in range(ne):
                 b = sole_body[e]
-                cx, cz = _body_point(b, sole_geom[e, 0], sole_geom[e, 1], hinge, O, phi)
+                cx, cz = _body_point(b, sole_geom[e, 0], sole_geom[e, 1], hinge, O, cph, sph)
                 (px, pz, fx, fz, depth, rate, slip, kn, cn, mu, dmu, fel) = sole_contact(
-                    contact, cx, cz, phi[b] + sole_geom[e, 4], sole_geom[e, 2], sole_geom[e, 3],
+                    contact, cx, cz, sph[b] * ce[e] + cph[b] * se[e], cph[b] * ce[e] - sph[b] * se[e],
+                    sole_geom[e, 2], sole_geom[e, 3],
                     O[b, 0], O[b, 1], vO[b, 0], vO[b, 1], om[b], ground_vx)
                 grf[s_idx, e, 0] = fx
                 grf[s_idx, e, 1] = fz
@@ -425,7 +438,7 @@ def simulate_prescribed(
                 else:
                     state[s_idx, e] = 2
                 e_contact += contact_elastic_energy(contact, depth)
-            tx, tz = _body_point(tip_body, tip[0], tip[1], hinge, O, phi)
+            tx, tz = _body_point(tip_body, tip[0], tip[1], hinge, O, cph, sph)
             dist[s_idx] = math.hypot(tx - bs[0], tz - bs[1])
             kin = 0.0
             pot = 0.0
@@ -451,7 +464,7 @@ def simulate_prescribed(
     return STATUS_OK, -1
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _batch_serial(base, dt, nsub, ground_vx, body_mass, com0, body_inertia, hinge, sole_body,
                   sole_geom, tip_body, tip, contact, K, D, K2, q0, v0, order, n_iter,
                   grf, dist, qout, tau, state, energy, status):

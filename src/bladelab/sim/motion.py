@@ -49,13 +49,15 @@ class ClampMotion:
         return cls(t0=float(t[0]), t1=float(t[-1]), splines=splines, belt_speed=float(belt_speed))
 
     def evaluate(self, t: np.ndarray) -> np.ndarray:
-        """(len(t), 9): x, z, θ, ẋ, ż, θ̇, ẍ, z̈, θ̈ at times ``t`` [s] (SI units)."""
+        """(len(t), 11): x, z, θ, ẋ, ż, θ̇, ẍ, z̈, θ̈, cos θ, sin θ at times ``t`` [s] (SI)."""
         t = np.asarray(t, float)
-        out = np.empty((len(t), 9))
+        out = np.empty((len(t), 11))
         for c, spl in enumerate(self.splines):
             out[:, c] = spl(t)
             out[:, 3 + c] = spl(t, 1)
             out[:, 6 + c] = spl(t, 2)
         out[:, 0] += self.belt_speed * (t - self.t0)
         out[:, 3] += self.belt_speed
+        out[:, 9] = np.cos(out[:, 2])
+        out[:, 10] = np.sin(out[:, 2])
         return out
