@@ -138,7 +138,7 @@ def test_prosthetic_leg_three_cm_longer(amputee):
 
 def test_muscle_paths_have_plausible_moment_arms(amputee):
     """Hip extensors/flexors, knee extensors and the soleus act in the right direction."""
-    m = amputee.mj_model
+    m = amputee.mj_analysis_model
     d = mujoco.MjData(m)
     d.qpos[:] = amputee.stand_qpos
     mujoco.mj_forward(m, d)

@@ -34,7 +34,7 @@ def _forward_pass(result: RunnerResult) -> dict[str, np.ndarray]:
     cached = getattr(result, "_fwd_cache", None)
     if cached is not None:
         return cached
-    m = result.model.mj_model.__copy__()
+    m = result.model.mj_analysis_model.__copy__()
     m.opt.enableflags |= int(mujoco.mjtEnableBit.mjENBL_ENERGY)
     d = mujoco.MjData(m)
     n = len(result.time)

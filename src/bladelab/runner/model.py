@@ -79,11 +79,19 @@ class RunnerModel:
     params
         The parameter set it was built from.
     mj_model
-        The MuJoCo model (no native contact; muscles as tendon actuators with ctrl = −force).
+        The MuJoCo model used for simulation: no native contact, no tendons (muscle forces are
+        applied by bladelab as point forces along each path).
+    mj_analysis_model
+        The same model plus one spatial tendon and one tendon actuator per muscle (ctrl =
+        −tendon force): MuJoCo's own MTU lengths, velocities and moment arms, for analyses and
+        as an independent check of bladelab's path kinematics.
     dof_names, muscle_names, segment_names, contact_names
         Names in array order.
     muscle_params
         (n_muscles, 4): Fmax [N], l_opt [m], l_ts [m], pennation [rad].
+    path_points, path_start
+        Muscle path points as (site id, body id) rows; muscle i uses rows
+        ``path_start[i]:path_start[i+1]`` (origin to insertion).
     contact_params
         (n_contacts, 8): site id, body id, radius [m], Hertz k [N/m^1.5], dissipation [s/m],
         friction [-], leg (0 = left/intact, 1 = right/prosthetic), is_blade (0/1).
@@ -103,6 +111,9 @@ class RunnerModel:
     segment_names: tuple[str, ...]
     contact_names: tuple[str, ...]
     muscle_params: np.ndarray
+    path_points: np.ndarray
+    path_start: np.ndarray
+    mj_analysis_model: mujoco.MjModel
     contact_params: np.ndarray
     joint_params: np.ndarray
     blade_modulus: float
@@ -273,6 +284,9 @@ def build_runner(
     # muscles: sites on bodies, spatial tendons, tendon actuators (ctrl = −tendon force)
     names = muscle_names(params.kind)
     mp = np.zeros((len(names), 4))
+    path_sites: list[str] = []
+    path_start = [0]
+    tendons, actuators = [], []
     for i, mname in enumerate(names):
         mtype, side = mname.rsplit("_", 1)
         tendon = spec.add_tendon(name=mname)
@@ -284,8 +298,12 @@ def build_runner(
             site = f"{mname}_p{k}"
             bodies[body_name].add_site(name=site, pos=_v(_sub(p, origin), s))
             tendon.wrap_site(site)
+            path_sites.append(site)
+        path_start.append(len(path_sites))
         act = spec.add_actuator(name=mname, trntype=mujoco.mjtTrn.mjTRN_TENDON, target=mname)
         act.ctrllimited = False
+        tendons.append(tendon)
+        actuators.append(act)
         mt = params.muscle_types[mtype]
         mp[i] = (
             muscle_max_force(params, mtype),
@@ -294,7 +312,16 @@ def build_runner(
             mt.pennation_rad,
         )
 
+    analysis_model = spec.compile()
+    # the simulation model has no tendons: bladelab computes the (straight-line, via-point) path
+    # lengths and applies the muscle forces itself; MuJoCo's tendon stage cost ~1/3 of a step
+    for element in actuators + tendons:
+        spec.delete(element)
     model = spec.compile()
+    path = np.array(
+        [(model.site(n).id, model.site_bodyid[model.site(n).id]) for n in path_sites],
+        dtype=np.int64,
+    )
     dof_names = tuple(model.joint(j).name for j in range(model.njnt))
     segment_names = tuple(model.body(b).name for b in range(1, model.nbody))
 
@@ -356,6 +383,9 @@ def build_runner(
         segment_names=segment_names,
         contact_names=tuple(contacts),
         muscle_params=mp,
+        path_points=path,
+        path_start=np.array(path_start, dtype=np.int64),
+        mj_analysis_model=analysis_model,
         contact_params=cp,
         joint_params=jp,
         blade_modulus=e_blade,

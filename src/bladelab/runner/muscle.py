@@ -34,6 +34,7 @@ MIN_ACTIVATION = 0.01
 FIBER_DAMPING = 0.1
 TENDON_REF_STRAIN = 0.04
 PASSIVE_STRAIN = 0.6
+_LN_005 = math.log(0.05)
 
 # Columns of the muscle parameter array ``mp`` (one row per muscle).
 MP_FMAX, MP_LOPT, MP_LTS, MP_PENN = 0, 1, 2, 3
@@ -45,7 +46,7 @@ MS_ACT, MS_LCE, MS_VCE, MS_FORCE = 0, 1, 2, 3
 def force_length(l_norm: float) -> float:
     """Active force–length factor f_l [-] of the normalised fibre length."""
     x = abs((l_norm - 1.0) / 0.56)
-    return math.exp(math.log(0.05) * x * x * x)
+    return math.exp(_LN_005 * x * x * x)
 
 
 @njit(cache=True)
@@ -169,7 +170,7 @@ def muscle_step(
             )
             step = g / dg
             v -= step
-            if abs(step) < 1e-9:
+            if abs(step) < 1e-8:
                 break
         l_new = l_ce + dt * v * vscale
         if l_new < 0.2 * l_opt:

@@ -1,10 +1,12 @@
 """Forward simulation of the runner: MuJoCo multibody step + bladelab's numba force kernel.
 
-Each step: ``mj_step1`` (positions, velocities, tendon lengths/velocities), then one numba call
-that advances the muscles (:mod:`bladelab.runner.muscle`), computes ligament, socket and ground
+Each step: ``mj_step1`` (positions, velocities), then one numba call
+(:func:`bladelab.runner.kernel.forces`) that computes the muscle path lengths and velocities,
+advances the muscles (:mod:`bladelab.runner.muscle`), computes ligament, socket and ground
 contact forces (Hunt–Crossley normal force, elastic–plastic friction capped at μ·Fn) and writes
-them to MuJoCo's ``ctrl`` (muscles, −tendon force), ``qfrc_applied`` (ligaments, socket) and
-``xfrc_applied`` (contacts, at the contact point), then ``mj_step2`` (semi-implicit Euler).
+them to MuJoCo's ``xfrc_applied`` (muscle and contact point forces) and ``qfrc_applied``
+(ligaments, socket), then ``mj_step2`` (semi-implicit Euler). With constant excitations the
+whole loop runs in compiled code (:func:`bladelab.runner.kernel.run_loop`).
 
 A controller is any callable ``controller(t, state) -> excitations`` (one value in [0, 1] per
 muscle, in ``RunnerModel.muscle_names`` order), called every ``control_interval`` steps with a
@@ -23,29 +25,11 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 import pandas as pd
-from numba import njit
 
-from bladelab.contact import hunt_crossley_force
 from bladelab.errors import SimulationError
-from bladelab.runner.model import (
-    CP_BODY,
-    CP_C,
-    CP_K,
-    CP_MU,
-    CP_RADIUS,
-    CP_SITE,
-    FRICTION_DAMPING,
-    FRICTION_STIFFNESS,
-    JP_D,
-    JP_HI,
-    JP_K,
-    JP_LO,
-    JP_SD,
-    JP_SK,
-    JP_SK2,
-    RunnerModel,
-)
-from bladelab.runner.muscle import equilibrium_fiber_length, muscle_step
+from bladelab.runner.kernel import _mujoco_step_addresses, forces, path_kinematics, run_loop
+from bladelab.runner.model import RunnerModel, contact_heights
+from bladelab.runner.muscle import equilibrium_fiber_length
 
 DEFAULT_DT = 5e-4
 # Record columns per contact: Fx, Fz [N], contact point x, z [m], point velocity vx, vz [m/s],
@@ -63,93 +47,6 @@ class ControllerState:
     qpos: np.ndarray
     qvel: np.ndarray
     contacts: np.ndarray  # (n_contacts, 7), columns RC_*
-
-
-@njit(cache=True)
-def _forces(
-    qpos,
-    qvel,
-    l_mtu,
-    site_xpos,
-    cvel,
-    root_com,
-    xipos,
-    ctrl,
-    xfrc,
-    qfrc,
-    mp,
-    ms,
-    u,
-    cp,
-    cstate,
-    jp,
-    crec,
-    lig,
-    dt,
-):
-    """Muscles, ligaments and contacts for one step (see module docstring)."""
-    muscle_step(mp, ms, l_mtu, u, dt)
-    for i in range(mp.shape[0]):
-        ctrl[i] = -ms[i, 3]
-    # ligaments (joint-limit springs-dampers) and the socket's nonlinear spring
-    for j in range(jp.shape[0]):
-        q = qpos[j]
-        qd = qvel[j]
-        tau = 0.0
-        if q > jp[j, JP_HI]:
-            tau = min(-jp[j, JP_K] * (q - jp[j, JP_HI]) - jp[j, JP_D] * qd, 0.0)
-        elif q < jp[j, JP_LO]:
-            tau = max(-jp[j, JP_K] * (q - jp[j, JP_LO]) - jp[j, JP_D] * qd, 0.0)
-        if jp[j, JP_SK] != 0.0 or jp[j, JP_SD] != 0.0:
-            tau -= jp[j, JP_SK] * q + jp[j, JP_SK2] * q * abs(q) + jp[j, JP_SD] * qd
-        qfrc[j] = tau
-        lig[j] = tau
-    xfrc[:, :] = 0.0
-    for c in range(cp.shape[0]):
-        site = int(cp[c, CP_SITE])
-        body = int(cp[c, CP_BODY])
-        r = cp[c, CP_RADIUS]
-        cx = site_xpos[site, 0]
-        cy = site_xpos[site, 1]
-        cz = site_xpos[site, 2]
-        depth = r - cz
-        px, py, pz = cx, cy, cz - r
-        # velocity of the body point at the contact: v + w x (p - root_com)
-        wx, wy, wz = cvel[body, 0], cvel[body, 1], cvel[body, 2]
-        rx, ry, rz = px - root_com[0], py - root_com[1], pz - root_com[2]
-        vx = cvel[body, 3] + wy * rz - wz * ry
-        vz = cvel[body, 5] + wx * ry - wy * rx
-        fn = 0.0
-        ft = 0.0
-        if depth > 0.0:
-            fn = hunt_crossley_force(depth, -vz, cp[c, CP_K], 1.5, cp[c, CP_C])
-            # elastic-plastic friction: bristle spring + damper, capped at mu*Fn
-            s = cstate[c, 0] + vx * dt
-            ft = -FRICTION_STIFFNESS * s - FRICTION_DAMPING * vx
-            lim = cp[c, CP_MU] * fn
-            if ft > lim:
-                ft = lim
-                s = -lim / FRICTION_STIFFNESS
-            elif ft < -lim:
-                ft = -lim
-                s = lim / FRICTION_STIFFNESS
-            cstate[c, 0] = s
-        else:
-            cstate[c, 0] = 0.0
-        xfrc[body, 0] += ft
-        xfrc[body, 2] += fn
-        # torque about the body COM: (p - xipos) x F, F = (ft, 0, fn)
-        dx, dy, dz = px - xipos[body, 0], py - xipos[body, 1], pz - xipos[body, 2]
-        xfrc[body, 3] += dy * fn
-        xfrc[body, 4] += dz * ft - dx * fn
-        xfrc[body, 5] += -dy * ft
-        crec[c, 0] = ft
-        crec[c, 1] = fn
-        crec[c, 2] = px
-        crec[c, 3] = pz
-        crec[c, 4] = vx
-        crec[c, 5] = vz
-        crec[c, 6] = depth if depth > 0.0 else 0.0
 
 
 # SCONE's InitStateGait10.zml (H0918, Apache-2.0): a gait state at 1 m/s, OpenSim names [rad].
@@ -278,8 +175,6 @@ def initial_qpos(model: RunnerModel, state: str | dict = "stand") -> tuple[np.nd
         raise SimulationError(
             f"unknown initial state {state!r}", hint="use 'stand', 'gait' or a dict"
         )
-    from bladelab.runner.model import contact_heights
-
     q[model.dof("pelvis_tz")] -= contact_heights(model, q).min()
     return q, v
 
@@ -355,11 +250,13 @@ def simulate_runner(
     ms = np.zeros((nm, 4))
     mujoco.mj_forward(m, d)
     mp = model.muscle_params
+    path, pstart = model.path_points, model.path_start
+    mtu = np.zeros((nm, 2))
+    seg_u = np.zeros((path.shape[0], 3))
+    path_kinematics(d.site_xpos, d.cvel, d.subtree_com[1].copy(), path, pstart, mtu, seg_u)
     ms[:, 0] = np.clip(u, 0.01, 1.0) if initial_activation is None else initial_activation
     for i in range(nm):
-        ms[i, 1] = equilibrium_fiber_length(
-            d.actuator_length[i], ms[i, 0], mp[i, 1], mp[i, 2], mp[i, 3]
-        )
+        ms[i, 1] = equilibrium_fiber_length(mtu[i, 0], ms[i, 0], mp[i, 1], mp[i, 2], mp[i, 3])
     cp = model.contact_params
     cstate = np.zeros((cp.shape[0], 1))
     crec = np.zeros((cp.shape[0], 7))
@@ -377,59 +274,77 @@ def simulate_runner(
     rec_l = np.zeros((n_rec, m.nv))
     if fall_height is None:
         fall_height = 0.6 * model.stand_qpos[model.dof("pelvis_tz")]
-    # live views of MuJoCo's buffers
-    qpos, qvel, alen, avel = d.qpos, d.qvel, d.actuator_length, d.actuator_velocity
-    sxp, cvel, scom, xipos = d.site_xpos, d.cvel, d.subtree_com, d.xipos
-    ctrl, xfrc, qfrc = d.ctrl, d.xfrc_applied, d.qfrc_applied
-    root_com = np.zeros(3)
-    state = ControllerState(ms, alen, avel, qpos, qvel, crec)
     iz = model.dof("pelvis_tz")
-    fell = False
-    k_rec = 0
-    step1, step2, forces = mujoco.mj_step1, mujoco.mj_step2, _forces
-    for k in range(n_steps + 1):
-        step1(m, d)
-        if controller is not None and k % control_interval == 0:
-            u[:] = controller(k * dt, state)
-        root_com[:] = scom[1]
-        forces(
+    # live views of MuJoCo's buffers
+    qpos, qvel = d.qpos, d.qvel
+    sxp, cvel, scom, xipos = d.site_xpos, d.cvel, d.subtree_com, d.xipos
+    xfrc, qfrc = d.xfrc_applied, d.qfrc_applied
+    if controller is None:
+        f1, f2 = _STEP_ADDRESSES
+        k_rec, fell = run_loop(
+            f1,
+            f2,
+            m._address,
+            d._address,
+            n_steps,
+            record_every,
+            dt,
+            iz,
+            float(fall_height),
             qpos,
             qvel,
-            alen,
             sxp,
             cvel,
-            root_com,
+            scom,
             xipos,
-            ctrl,
             xfrc,
             qfrc,
             mp,
             ms,
+            mtu,
+            seg_u,
             u,
+            path,
+            pstart,
             cp,
             cstate,
             jp,
             crec,
             lig,
-            dt,
+            rec_t,
+            rec_q,
+            rec_v,
+            rec_ms,
+            rec_mtu,
+            rec_u,
+            rec_c,
+            rec_l,
         )
-        if k % record_every == 0:
-            rec_t[k_rec] = k * dt
-            rec_q[k_rec] = qpos
-            rec_v[k_rec] = qvel
-            rec_ms[k_rec] = ms
-            rec_mtu[k_rec, :, 0] = alen
-            rec_mtu[k_rec, :, 1] = avel
-            rec_u[k_rec] = u
-            rec_c[k_rec] = crec
-            rec_l[k_rec] = lig
-            k_rec += 1
-        if qpos[iz] < fall_height or not math.isfinite(qpos[iz]):
-            fell = True
-            break
-        if k == n_steps:
-            break
-        step2(m, d)
+    else:
+        k_rec, fell = _python_loop(
+            m,
+            d,
+            controller,
+            control_interval,
+            n_steps,
+            record_every,
+            dt,
+            iz,
+            fall_height,
+            mp,
+            ms,
+            mtu,
+            seg_u,
+            u,
+            path,
+            pstart,
+            cp,
+            cstate,
+            jp,
+            crec,
+            lig,
+            (rec_t, rec_q, rec_v, rec_ms, rec_mtu, rec_u, rec_c, rec_l),
+        )
     sl = slice(0, k_rec)
     return RunnerResult(
         model=model,
@@ -445,6 +360,89 @@ def simulate_runner(
         fell=fell,
         requested_duration=duration,
     )
+
+
+_STEP_ADDRESSES = _mujoco_step_addresses()
+
+
+def _python_loop(
+    m,
+    d,
+    controller,
+    control_interval,
+    n_steps,
+    record_every,
+    dt,
+    iz,
+    fall_height,
+    mp,
+    ms,
+    mtu,
+    seg_u,
+    u,
+    path,
+    pstart,
+    cp,
+    cstate,
+    jp,
+    crec,
+    lig,
+    rec,
+):
+    """The time loop with a Python controller called every ``control_interval`` steps."""
+    rec_t, rec_q, rec_v, rec_ms, rec_mtu, rec_u, rec_c, rec_l = rec
+    qpos, qvel = d.qpos, d.qvel
+    sxp, cvel, scom, xipos = d.site_xpos, d.cvel, d.subtree_com, d.xipos
+    xfrc, qfrc = d.xfrc_applied, d.qfrc_applied
+    root_com = np.zeros(3)
+    state = ControllerState(ms, mtu[:, 0], mtu[:, 1], qpos, qvel, crec)
+    step1, step2 = mujoco.mj_step1, mujoco.mj_step2
+    k_rec = 0
+    for k in range(n_steps + 1):
+        step1(m, d)
+        root_com[:] = scom[1]
+        if k % control_interval == 0:
+            path_kinematics(sxp, cvel, root_com, path, pstart, mtu, seg_u)
+            u[:] = np.clip(controller(k * dt, state), 0.0, 1.0)
+        forces(
+            qpos,
+            qvel,
+            sxp,
+            cvel,
+            root_com,
+            xipos,
+            xfrc,
+            qfrc,
+            mp,
+            ms,
+            mtu,
+            seg_u,
+            u,
+            path,
+            pstart,
+            cp,
+            cstate,
+            jp,
+            crec,
+            lig,
+            dt,
+        )
+        if k % record_every == 0:
+            rec_t[k_rec] = k * dt
+            rec_q[k_rec] = qpos
+            rec_v[k_rec] = qvel
+            rec_ms[k_rec] = ms
+            rec_mtu[k_rec] = mtu
+            rec_u[k_rec] = u
+            rec_c[k_rec] = crec
+            rec_l[k_rec] = lig
+            k_rec += 1
+        if not qpos[iz] >= fall_height:
+            return k_rec, True
+        if k == n_steps:
+            break
+        step2(m, d)
+    return k_rec, False
 
 
 def _held_copy(model: RunnerModel) -> mujoco.MjModel:

@@ -1,0 +1,136 @@
+"""Runner benchmark: 10 s of the amputee model at the default step, and OpenSim 4.6 on SCONE's
+H0918 model for the ratio; plus the accuracy checks behind the tests (power balance, drop test,
+blade compression)."""
+
+from __future__ import annotations
+
+import math
+import time
+from pathlib import Path
+
+import numpy as np
+
+SHARED = Path(__file__).resolve().parents[2] / "shared" / "data" / "models" / "scone-h0918"
+G = 9.81
+
+
+def _best_of(fn, n: int = 3) -> float:
+    best = math.inf
+    for _ in range(n):
+        t0 = time.perf_counter()
+        fn()
+        best = min(best, time.perf_counter() - t0)
+    return best
+
+
+def _opensim_seconds(duration: float) -> tuple[float | None, str]:
+    try:
+        import opensim as osim
+    except ImportError:
+        return None, "opensim not installed (`pip install -e .[bench]`)"
+    model = osim.Model(str(SHARED / "H0918M_osim4.osim"))
+    state = model.initSystem()
+    init = {
+        "pelvis_tilt": -0.0336387,
+        "pelvis_ty": 0.95,
+        "hip_flexion_r": 0.165239,
+        "knee_angle_r": -0.0888009,
+        "ankle_angle_r": 0.0197104,
+        "hip_flexion_l": 0.232604,
+        "knee_angle_l": -1.22703,
+        "ankle_angle_l": -0.167279,
+    }  # SCONE's InitStateGait10.zml
+    cs = model.getCoordinateSet()
+    for name, value in init.items():
+        cs.get(name).setValue(state, value)
+    cs.get("pelvis_tx").setSpeedValue(state, 1.0)
+    model.equilibrateMuscles(state)
+    manager = osim.Manager(model)
+    manager.setIntegratorAccuracy(1e-2)  # SCONE's H0918 setting
+    state.setTime(0.0)
+    manager.initialize(state)
+    t0 = time.perf_counter()
+    manager.integrate(duration)
+    return time.perf_counter() - t0, f"OpenSim {osim.__version__}"
+
+
+def run() -> str:
+    from bladelab.runner import build_runner, power_balance_residual_pct, simulate_runner
+
+    amputee = build_runner("amputee")
+    able = build_runner("able")
+    kw = {"duration": 10.0, "excitations": 0.05, "fall_height": -math.inf}
+    simulate_runner(amputee, duration=0.05)  # compile / load numba cache
+    t_amp = _best_of(lambda: simulate_runner(amputee, **kw))
+    t_able = _best_of(lambda: simulate_runner(able, **kw))
+    t_amp_fine = _best_of(lambda: simulate_runner(amputee, record_every=1, **kw), n=1)
+    t_osim, osim_note = _opensim_seconds(10.0)
+
+    res = simulate_runner(
+        amputee, duration=2.0, excitations=0.05, record_every=1, fall_height=-math.inf
+    )
+    pb = power_balance_residual_pct(res)
+    drop = simulate_runner(amputee, duration=1.5, hold_pose=True, drop_height=0.05, record_every=5)
+    fz = drop.contacts[drop.time > 1.3, :, 1].sum(axis=1).mean()
+    drop_err = (fz / amputee.body_weight - 1) * 100
+
+    lines = [
+        "## Runner model (bladelab.runner)",
+        "",
+        "Planar amputee runner (8 segments, 10 dof, 21 Hill MTUs, 2 foot spheres + blade sphere),",
+        "MuJoCo multibody step + numba muscles/ligaments/contact, one core, default step 0.5 ms,",
+        "constant excitations (the model collapses; the fall stop is off so the full time is run).",
+        "",
+        "| simulation | wall time [s] | per step [µs] |",
+        "|---|---|---|",
+        f"| amputee, 10 s, samples every 2 steps (default) | {t_amp:.3f} | {t_amp / 20000 * 1e6:.1f} |",
+        f"| amputee, 10 s, samples every step | {t_amp_fine:.3f} | {t_amp_fine / 20000 * 1e6:.1f} |",
+        f"| able-bodied, 10 s (default) | {t_able:.3f} | {t_able / 20000 * 1e6:.1f} |",
+    ]
+    if t_osim is not None:
+        lines.append(
+            f"| {osim_note}, SCONE H0918 `.osim`, 10 s, accuracy 1e-2 | {t_osim:.2f} | – |"
+        )
+    lines += [
+        "",
+        f"Target: 10 s of the amputee model in at most 0.5 s: **{'met' if t_amp <= 0.5 else 'NOT met'}** "
+        f"({t_amp:.3f} s).",
+    ]
+    if t_osim is not None:
+        lines.append(
+            f"OpenSim / bladelab ratio (same simulated time, both models collapsing from a gait "
+            f"state): **{t_osim / t_amp:.0f}×** (aim ≥ 20×). OpenSim's H0918 is the able-bodied "
+            f"reference (9 dof, 18 muscles, variable-step integrator)."
+        )
+    else:
+        lines.append(f"OpenSim comparison not run: {osim_note}.")
+    lines += [
+        "",
+        "Accuracy:",
+        f"- power balance, 2 s constant excitations with ground contact: RMS residual "
+        f"{pb:.3f} % of peak kinetic power;",
+        f"- passive drop test (joints held, 5 cm): static GRF − body weight = {drop_err:+.3f} %;",
+    ]
+    for cat, k in (("Cat4", 21.2e3), ("Cat6", 27.3e3), ("Cat7", 33.3e3)):
+        r = build_runner("amputee", blade=cat)
+        state = {
+            "hip_flexion_l": 0.6,
+            "knee_angle_l": -0.6,
+            "knee_angle_r": 0.0,
+            "hip_flexion_r": 0.0,
+        }
+        s = simulate_runner(
+            r, duration=5.0, hold_pose=True, initial_state=state, drop_height=0.01, record_every=10
+        )
+        depth = float(np.mean(s.contacts[-50:, 2, 6]))
+        expect = 1.5 * r.body_weight / k
+        lines.append(
+            f"- {cat} blade alone at body weight: compression {depth * 1e3:.2f} mm vs "
+            f"{expect * 1e3:.2f} mm for a tangent stiffness of {k / 1e3:.1f} kN/m "
+            f"({(depth / expect - 1) * 100:+.2f} %), E = {r.blade_modulus:.4g} N/m²."
+        )
+    return "\n".join(lines) + "\n"
+
+
+if __name__ == "__main__":
+    print(run())

@@ -1,0 +1,319 @@
+"""Numba kernels of the runner: muscle path kinematics, muscle/ligament/contact forces, and the
+whole time loop calling MuJoCo's C ``mj_step1``/``mj_step2`` directly.
+
+Muscle paths are straight lines between via points (H0918 has no wrapping surfaces); length and
+lengthening velocity are summed over the segments, and the tendon force is applied as a pair of
+point forces along every segment (so the generalized force is exactly ``−F·∂l/∂q``, the same as
+a MuJoCo spatial tendon; ``tests/test_runner_simulate.py`` checks both against MuJoCo's tendon).
+Contacts: Hunt–Crossley normal force (:func:`bladelab.contact.hunt_crossley_force`) and an
+elastic–plastic (bristle) friction force capped at ``μ·Fn``, applied at the lowest point of the
+sphere. Ligaments: joint-limit springs–dampers; the socket: ``−(K·q + K2·q·|q|) − D·q̇``.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import math
+import os
+
+import mujoco
+import numpy as np
+from llvmlite import ir
+from numba import njit, types
+from numba.extending import intrinsic
+
+from bladelab.contact import hunt_crossley_force
+from bladelab.runner.model import (
+    CP_BODY,
+    CP_C,
+    CP_K,
+    CP_MU,
+    CP_RADIUS,
+    CP_SITE,
+    FRICTION_DAMPING,
+    FRICTION_STIFFNESS,
+    JP_D,
+    JP_HI,
+    JP_K,
+    JP_LO,
+    JP_SD,
+    JP_SK,
+    JP_SK2,
+)
+from bladelab.runner.muscle import muscle_step
+
+
+def _mujoco_step_addresses() -> tuple[int, int]:
+    """Addresses of ``mj_step1`` and ``mj_step2`` in the libmujoco that the bindings loaded."""
+    folder = os.path.dirname(mujoco.__file__)
+    names = sorted(n for n in os.listdir(folder) if n.startswith("libmujoco.so"))
+    lib = ctypes.CDLL(os.path.join(folder, names[-1]))
+    return (
+        ctypes.cast(lib.mj_step1, ctypes.c_void_p).value,
+        ctypes.cast(lib.mj_step2, ctypes.c_void_p).value,
+    )
+
+
+@intrinsic
+def _call_mj(typingctx, fptr, mptr, dptr):
+    """Call ``void f(const mjModel*, mjData*)`` given the three addresses as integers."""
+    sig = types.void(types.int64, types.int64, types.int64)
+
+    def codegen(context, builder, signature, args):
+        f, m, d = args
+        i8p = ir.IntType(8).as_pointer()
+        fnty = ir.FunctionType(ir.VoidType(), [i8p, i8p])
+        fn = builder.inttoptr(f, fnty.as_pointer())
+        builder.call(fn, [builder.inttoptr(m, i8p), builder.inttoptr(d, i8p)])
+        return context.get_dummy_value()
+
+    return sig, codegen
+
+
+@njit(cache=True)
+def path_kinematics(site_xpos, cvel, root_com, path, pstart, mtu, seg_u):
+    """MTU lengths [m] and lengthening velocities [m/s] into ``mtu`` (n, 2); unit vectors of the
+    path segments into ``seg_u`` (one row per path point, the last of each muscle unused)."""
+    for i in range(pstart.shape[0] - 1):
+        length = 0.0
+        vel = 0.0
+        for k in range(pstart[i], pstart[i + 1] - 1):
+            a = path[k, 0]
+            b = path[k + 1, 0]
+            ba = path[k, 1]
+            bb = path[k + 1, 1]
+            dx = site_xpos[b, 0] - site_xpos[a, 0]
+            dy = site_xpos[b, 1] - site_xpos[a, 1]
+            dz = site_xpos[b, 2] - site_xpos[a, 2]
+            seg = math.sqrt(dx * dx + dy * dy + dz * dz)
+            ux, uy, uz = dx / seg, dy / seg, dz / seg
+            seg_u[k, 0], seg_u[k, 1], seg_u[k, 2] = ux, uy, uz
+            # point velocities v + w x (p - root_com)
+            rx = site_xpos[a, 0] - root_com[0]
+            ry = site_xpos[a, 1] - root_com[1]
+            rz = site_xpos[a, 2] - root_com[2]
+            vax = cvel[ba, 3] + cvel[ba, 1] * rz - cvel[ba, 2] * ry
+            vay = cvel[ba, 4] + cvel[ba, 2] * rx - cvel[ba, 0] * rz
+            vaz = cvel[ba, 5] + cvel[ba, 0] * ry - cvel[ba, 1] * rx
+            rx = site_xpos[b, 0] - root_com[0]
+            ry = site_xpos[b, 1] - root_com[1]
+            rz = site_xpos[b, 2] - root_com[2]
+            vbx = cvel[bb, 3] + cvel[bb, 1] * rz - cvel[bb, 2] * ry
+            vby = cvel[bb, 4] + cvel[bb, 2] * rx - cvel[bb, 0] * rz
+            vbz = cvel[bb, 5] + cvel[bb, 0] * ry - cvel[bb, 1] * rx
+            length += seg
+            vel += ux * (vbx - vax) + uy * (vby - vay) + uz * (vbz - vaz)
+        mtu[i, 0] = length
+        mtu[i, 1] = vel
+
+
+@njit(cache=True)
+def _add_point_force(xfrc, xipos, body, px, py, pz, fx, fy, fz):
+    xfrc[body, 0] += fx
+    xfrc[body, 1] += fy
+    xfrc[body, 2] += fz
+    dx = px - xipos[body, 0]
+    dy = py - xipos[body, 1]
+    dz = pz - xipos[body, 2]
+    xfrc[body, 3] += dy * fz - dz * fy
+    xfrc[body, 4] += dz * fx - dx * fz
+    xfrc[body, 5] += dx * fy - dy * fx
+
+
+@njit(cache=True)
+def forces(
+    qpos,
+    qvel,
+    site_xpos,
+    cvel,
+    root_com,
+    xipos,
+    xfrc,
+    qfrc,
+    mp,
+    ms,
+    mtu,
+    seg_u,
+    u,
+    path,
+    pstart,
+    cp,
+    cstate,
+    jp,
+    crec,
+    lig,
+    dt,
+):
+    """Muscles, ligaments and contacts for one step; writes ``xfrc`` and ``qfrc``."""
+    xfrc[:, :] = 0.0
+    path_kinematics(site_xpos, cvel, root_com, path, pstart, mtu, seg_u)
+    muscle_step(mp, ms, mtu[:, 0], u, dt)
+    for i in range(pstart.shape[0] - 1):
+        f = ms[i, 3]
+        if f == 0.0:
+            continue
+        for k in range(pstart[i], pstart[i + 1] - 1):
+            a = path[k, 0]
+            b = path[k + 1, 0]
+            fx, fy, fz = f * seg_u[k, 0], f * seg_u[k, 1], f * seg_u[k, 2]
+            _add_point_force(
+                xfrc,
+                xipos,
+                path[k, 1],
+                site_xpos[a, 0],
+                site_xpos[a, 1],
+                site_xpos[a, 2],
+                fx,
+                fy,
+                fz,
+            )
+            _add_point_force(
+                xfrc,
+                xipos,
+                path[k + 1, 1],
+                site_xpos[b, 0],
+                site_xpos[b, 1],
+                site_xpos[b, 2],
+                -fx,
+                -fy,
+                -fz,
+            )
+    # ligaments (joint-limit springs-dampers) and the socket's nonlinear spring
+    for j in range(jp.shape[0]):
+        q = qpos[j]
+        qd = qvel[j]
+        tau = 0.0
+        if q > jp[j, JP_HI]:
+            tau = min(-jp[j, JP_K] * (q - jp[j, JP_HI]) - jp[j, JP_D] * qd, 0.0)
+        elif q < jp[j, JP_LO]:
+            tau = max(-jp[j, JP_K] * (q - jp[j, JP_LO]) - jp[j, JP_D] * qd, 0.0)
+        if jp[j, JP_SK] != 0.0 or jp[j, JP_SD] != 0.0:
+            tau -= jp[j, JP_SK] * q + jp[j, JP_SK2] * q * abs(q) + jp[j, JP_SD] * qd
+        qfrc[j] = tau
+        lig[j] = tau
+    # ground contacts
+    for c in range(cp.shape[0]):
+        site = int(cp[c, CP_SITE])
+        body = int(cp[c, CP_BODY])
+        r = cp[c, CP_RADIUS]
+        depth = r - site_xpos[site, 2]
+        px, py, pz = site_xpos[site, 0], site_xpos[site, 1], site_xpos[site, 2] - r
+        rx, ry, rz = px - root_com[0], py - root_com[1], pz - root_com[2]
+        vx = cvel[body, 3] + cvel[body, 1] * rz - cvel[body, 2] * ry
+        vz = cvel[body, 5] + cvel[body, 0] * ry - cvel[body, 1] * rx
+        fn = 0.0
+        ft = 0.0
+        if depth > 0.0:
+            fn = hunt_crossley_force(depth, -vz, cp[c, CP_K], 1.5, cp[c, CP_C])
+            s = cstate[c, 0] + vx * dt
+            ft = -FRICTION_STIFFNESS * s - FRICTION_DAMPING * vx
+            lim = cp[c, CP_MU] * fn
+            if ft > lim:
+                ft = lim
+                s = -lim / FRICTION_STIFFNESS
+            elif ft < -lim:
+                ft = -lim
+                s = lim / FRICTION_STIFFNESS
+            cstate[c, 0] = s
+        else:
+            cstate[c, 0] = 0.0
+        _add_point_force(xfrc, xipos, body, px, py, pz, ft, 0.0, fn)
+        crec[c, 0] = ft
+        crec[c, 1] = fn
+        crec[c, 2] = px
+        crec[c, 3] = pz
+        crec[c, 4] = vx
+        crec[c, 5] = vz
+        crec[c, 6] = depth if depth > 0.0 else 0.0
+
+
+@njit(cache=True)
+def run_loop(
+    f1,
+    f2,
+    mptr,
+    dptr,
+    n_steps,
+    record_every,
+    dt,
+    iz,
+    fall_height,
+    qpos,
+    qvel,
+    site_xpos,
+    cvel,
+    subtree_com,
+    xipos,
+    xfrc,
+    qfrc,
+    mp,
+    ms,
+    mtu,
+    seg_u,
+    u,
+    path,
+    pstart,
+    cp,
+    cstate,
+    jp,
+    crec,
+    lig,
+    rec_t,
+    rec_q,
+    rec_v,
+    rec_ms,
+    rec_mtu,
+    rec_u,
+    rec_c,
+    rec_l,
+):
+    """The time loop with constant excitations, entirely in compiled code.
+
+    Returns (number of samples recorded, fell).
+    """
+    root_com = np.zeros(3)
+    k_rec = 0
+    for k in range(n_steps + 1):
+        _call_mj(f1, mptr, dptr)
+        root_com[0] = subtree_com[1, 0]
+        root_com[1] = subtree_com[1, 1]
+        root_com[2] = subtree_com[1, 2]
+        forces(
+            qpos,
+            qvel,
+            site_xpos,
+            cvel,
+            root_com,
+            xipos,
+            xfrc,
+            qfrc,
+            mp,
+            ms,
+            mtu,
+            seg_u,
+            u,
+            path,
+            pstart,
+            cp,
+            cstate,
+            jp,
+            crec,
+            lig,
+            dt,
+        )
+        if k % record_every == 0:
+            rec_t[k_rec] = k * dt
+            rec_q[k_rec, :] = qpos
+            rec_v[k_rec, :] = qvel
+            rec_ms[k_rec, :, :] = ms
+            rec_mtu[k_rec, :, :] = mtu
+            rec_u[k_rec, :] = u
+            rec_c[k_rec, :, :] = crec
+            rec_l[k_rec, :] = lig
+            k_rec += 1
+        if not qpos[iz] >= fall_height:  # also catches NaN
+            return k_rec, True
+        if k == n_steps:
+            break
+        _call_mj(f2, mptr, dptr)
+    return k_rec, False
