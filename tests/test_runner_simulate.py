@@ -176,3 +176,46 @@ def test_controller_is_called_with_states(amputee):
     res = simulate_runner(amputee, controller=controller, duration=0.01, control_interval=2)
     assert len(calls) == 11 and calls[0][1] == (21, 4) and calls[0][2] == (3, 7)
     assert np.allclose(res.excitation[-1], 0.2)
+
+
+def test_muscle_paths_match_mujoco_spatial_tendons(amputee):
+    """bladelab's path lengths/velocities and muscle generalized forces equal MuJoCo's spatial
+    tendons (the analysis model) at random states."""
+    from bladelab.runner.kernel import path_kinematics
+
+    rng = np.random.default_rng(7)
+    ma = amputee.mj_analysis_model
+    ms_ = amputee.mj_model
+    da, ds = mujoco.MjData(ma), mujoco.MjData(ms_)
+    path, pstart = amputee.path_points, amputee.path_start
+    nm = len(amputee.muscle_names)
+    for _ in range(5):
+        q = amputee.stand_qpos + rng.normal(0, 0.3, ma.nq)
+        v = rng.normal(0, 2.0, ma.nv)
+        force = rng.uniform(0, 2000, nm)
+        for d in (da, ds):
+            d.qpos[:], d.qvel[:] = q, v
+        da.ctrl[:] = -force
+        mujoco.mj_forward(ma, da)
+        mujoco.mj_forward(ms_, ds)
+        mtu = np.zeros((nm, 2))
+        seg_u = np.zeros((path.shape[0], 3))
+        path_kinematics(ds.site_xpos, ds.cvel, ds.subtree_com[1].copy(), path, pstart, mtu, seg_u)
+        np.testing.assert_allclose(mtu[:, 0], da.ten_length, rtol=1e-12)
+        np.testing.assert_allclose(mtu[:, 1], da.ten_velocity, rtol=1e-9, atol=1e-12)
+        # generalized force of the point-force pairs = MuJoCo's tendon actuator force
+        qfrc = np.zeros(ms_.nv)
+        for i in range(nm):
+            for k in range(pstart[i], pstart[i + 1] - 1):
+                f = force[i] * seg_u[k]
+                for row, sign in ((path[k], 1.0), (path[k + 1], -1.0)):
+                    mujoco.mj_applyFT(
+                        ms_,
+                        ds,
+                        sign * f,
+                        np.zeros(3),
+                        ds.site_xpos[row[0]].copy(),
+                        int(row[1]),
+                        qfrc,
+                    )
+        np.testing.assert_allclose(qfrc, da.qfrc_actuator, rtol=1e-9, atol=1e-9)
