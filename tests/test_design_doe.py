@@ -87,13 +87,13 @@ def test_estimability_report_detects_aliasing():
 
 def test_space_coding_round_trip_and_errors():
     s = default_design_space()
-    user = np.array([[18.0, 0.08, 0.35, 0.13], [32.0, 0.05, 0.30, 0.16]])
+    user = np.array([[18.0, 0.08, 0.44, 0.22], [32.0, 0.05, 0.40, 0.25]])
     coded = s.code(user)
     np.testing.assert_allclose(coded, [[-1, 1, 0, 0], [1, -1, -1, 1]], atol=1e-12)
     np.testing.assert_allclose(s.decode(coded), user)
     assert s.point([0, 0, 0, 0])["stiffness_kN_per_m"] == pytest.approx(25.0)
     with pytest.raises(SpecError, match="stiffness_kN_per_m = 40 kN/m lies outside"):
-        s.code([40.0, 0.06, 0.35, 0.13])
+        s.code([40.0, 0.06, 0.44, 0.22])
     with pytest.raises(SpecError, match="low"):
         Factor("a", 2.0, 1.0)
     with pytest.raises(SpecError, match="invalid factor name"):
@@ -110,22 +110,22 @@ def test_user_run_list(tmp_path):
     s = default_design_space()
     f = tmp_path / "blades.csv"
     f.write_text("blade,stiffness_kN_per_m,width_m,height_m,toe_length_m\n"
-                 "A,18,0.05,0.30,0.10\nB,25,0.065,0.35,0.13\nC,32,0.08,0.40,0.16\n")
+                 "A,18,0.05,0.40,0.19\nB,25,0.065,0.44,0.22\nC,32,0.08,0.48,0.25\n")
     d = read_runs_csv(f, s)
     assert d.kind == "user" and d.n_runs == 3
     np.testing.assert_allclose(d.coded[1], 0.0, atol=1e-12)
     assert make_design(str(f), s).n_runs == 3
     bad = tmp_path / "bad.csv"
-    bad.write_text("stiffness_kN_per_m,width_m,height_m\n18,0.05,0.3\n")
+    bad.write_text("stiffness_kN_per_m,width_m,height_m\n18,0.05,0.44\n")
     with pytest.raises(DataError, match="missing factor column"):
         read_runs_csv(bad, s)
     out = tmp_path / "out.csv"
-    out.write_text("stiffness_kN_per_m,width_m,height_m,toe_length_m\n18,0.05,0.3,0.2\n")
+    out.write_text("stiffness_kN_per_m,width_m,height_m,toe_length_m\n18,0.05,0.44,0.3\n")
     with pytest.raises(SpecError, match="toe_length_m") as err:
         read_runs_csv(out, s)
     assert err.value.file == str(out)
     nan = tmp_path / "nan.csv"
-    nan.write_text("stiffness_kN_per_m,width_m,height_m,toe_length_m\n18,x,0.3,0.1\n")
+    nan.write_text("stiffness_kN_per_m,width_m,height_m,toe_length_m\n18,x,0.44,0.22\n")
     with pytest.raises(DataError, match="not a number"):
         read_runs_csv(nan, s)
     with pytest.raises(InputFileError):

@@ -186,7 +186,9 @@ def run_design(
     evaluator
         ``{factor: value in its unit} -> {response: value}``; called once per run.
     out_dir
-        Output folder (created); a folder of an interrupted study with the same design resumes.
+        Output folder (created); a folder of an interrupted study with the same design resumes
+        (finished runs are read back, not re-evaluated: use a new folder after changing the
+        evaluator).
     seed
         Seed of the D-optimal design and of the optimiser's starting points.
     model
