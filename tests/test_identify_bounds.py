@@ -84,10 +84,10 @@ def test_pitch_sign_matters():
 def test_bounds_margins_contain_truth():
     st = quasi_static_stance()
     lo, hi = stiffness_bounds(st, hinge=HINGE, tip=TIP, reference="rest")
-    assert lo == pytest.approx(K_TRUE / 3, rel=1e-6) and hi == pytest.approx(3 * K_TRUE, rel=1e-6)
-    lo, hi = stiffness_bounds(st, hinge=HINGE, tip=TIP, reference="rest", lower_factor=0.5,
-                              upper_factor=2.0)
     assert lo == pytest.approx(0.5 * K_TRUE, rel=1e-6) and hi == pytest.approx(2 * K_TRUE, rel=1e-6)
+    lo, hi = stiffness_bounds(st, hinge=HINGE, tip=TIP, reference="rest", lower_factor=1 / 3,
+                              upper_factor=3.0, percentiles=(5, 95))
+    assert lo == pytest.approx(K_TRUE / 3, rel=1e-6) and hi == pytest.approx(3 * K_TRUE, rel=1e-6)
     b = parameter_bounds(st, hinge=HINGE, tip=TIP)
     assert b.names == ("K", "D") and b.lower[0] < K_TRUE < b.upper[0]
     d = b.to_dict()
