@@ -149,7 +149,7 @@ def contour_plot(
     if optimum is not None:
         ox = fx.mid + optimum.coded[fx.name] * fx.half_range
         oy = fy.mid + optimum.coded[fy.name] * fy.half_range
-        ax.plot([ox], [oy], "*", ms=14, color="r", mec="k",
+        ax.plot([ox], [oy], "*", ms=14, color="r", mec="k", clip_on=False, zorder=5,
                 label=f"optimum: {optimum.predicted:.4g} {optimum.unit}".rstrip())
     ax.set_xlabel(fx.axis_label)
     ax.set_ylabel(fy.axis_label)
