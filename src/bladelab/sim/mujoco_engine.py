@@ -129,25 +129,28 @@ def build_spec(
 
 
 @njit(cache=True)
-def contact_forces_3d(contact, site_pos, site_mat, axes, site_body, cvel, subtree_com, rootid,
-                      xipos, ground_vx, xfrc, out):
+def contact_forces_3d(contact, site_xpos, site_xmat, sites, axes, site_body, cvel, subtree_com,
+                      rootid, xipos, ground_vx, xfrc, out):
     """Apply the contact law to every sole site; write xfrc_applied and per-sole outputs.
 
     ``out[e]`` = (fx, fz, depth, slip, elastic normal force, contact-damping power,
     friction power).
     """
-    ne = site_pos.shape[0]
+    ne = sites.shape[0]
+    xfrc[:, :] = 0.0
     for e in range(ne):
+        site_pos = site_xpos[sites[e]]
+        site_mat = site_xmat[sites[e]]
         b = site_body[e]
         a = axes[e, 0]
         c = axes[e, 1]
-        exz = site_mat[e, 6]  # z component of the site's x axis (row-major 3x3)
-        ezz = site_mat[e, 8]  # z component of the site's z axis
+        exz = site_mat[6]  # z component of the site's x axis (row-major 3x3)
+        ezz = site_mat[8]  # z component of the site's z axis
         nrm = math.sqrt(a * a * exz * exz + c * c * ezz * ezz)
         ct = -a * exz / nrm
         st = -c * ezz / nrm
-        px = site_pos[e, 0] + a * ct * site_mat[e, 0] + c * st * site_mat[e, 2]
-        pz = site_pos[e, 2] + a * ct * site_mat[e, 6] + c * st * site_mat[e, 8]
+        px = site_pos[0] + a * ct * site_mat[0] + c * st * site_mat[2]
+        pz = site_pos[2] + a * ct * site_mat[6] + c * st * site_mat[8]
         r = rootid[b]
         wx = cvel[b, 0]
         wy = cvel[b, 1]
@@ -190,6 +193,61 @@ def contact_forces_3d(contact, site_pos, site_mat, axes, site_body, cvel, subtre
         xfrc[b, 5] += -dy * fx
 
 
+@njit(cache=True)
+def _prescribed_forces(bs, qpos, qfrc, jq, jd, K2):
+    """Clamp feed-forward and the quadratic spring term into ``qfrc_applied``."""
+    qfrc[:] = 0.0
+    qfrc[0] = CLAMP_ARMATURE * bs[6]
+    qfrc[1] = CLAMP_ARMATURE * bs[7]
+    qfrc[2] = CLAMP_ARMATURE * bs[8]
+    for j in range(jd.shape[0]):
+        q = qpos[jq[j]]
+        qfrc[jd[j]] = -K2[j] * q * abs(q)
+
+
+@njit(cache=True)
+def _accumulate(acc, dt, bs, qfrc, qacc, qpos, qvel, jq, jd, D, out):
+    """After a step: clamp work, dissipation; returns False when the state diverged."""
+    w = 0.0
+    for c in range(3):
+        w += (qfrc[c] - CLAMP_ARMATURE * qacc[c]) * bs[3 + c]
+    acc[0] += dt * w
+    for j in range(jd.shape[0]):
+        acc[1] += dt * D[j] * qvel[jd[j]] ** 2
+    for e in range(out.shape[0]):
+        acc[2] += dt * out[e, 5]
+        acc[3] += dt * out[e, 6]
+    for i in range(qpos.shape[0]):
+        if not math.isfinite(qpos[i]):
+            return False
+    for j in range(jq.shape[0]):
+        if abs(qpos[jq[j]]) > 10.0:
+            return False
+    return True
+
+
+@njit(cache=True)
+def _kinetic_potential(body_mass, body_inertia, cvel, xipos, subtree_com, rootid):
+    """Kinetic and gravitational energy [J] of the bodies heavier than 1e-5 kg."""
+    kin = 0.0
+    pot = 0.0
+    for b in range(body_mass.shape[0]):
+        m = body_mass[b]
+        if m <= 1e-5:
+            continue
+        wx, wy, wz = cvel[b, 0], cvel[b, 1], cvel[b, 2]
+        r = rootid[b]
+        rx = xipos[b, 0] - subtree_com[r, 0]
+        ry = xipos[b, 1] - subtree_com[r, 1]
+        rz = xipos[b, 2] - subtree_com[r, 2]
+        vx = cvel[b, 3] + wy * rz - wz * ry
+        vy = cvel[b, 4] + wz * rx - wx * rz
+        vz = cvel[b, 5] + wx * ry - wy * rx
+        kin += 0.5 * m * (vx * vx + vy * vy + vz * vz) + 0.5 * body_inertia[b, 1] * wy * wy
+        pot += m * _k.GRAVITY * xipos[b, 2]
+    return kin, pot
+
+
 class MujocoBlade:
     """A compiled blade model with the indices the simulation loops need."""
 
@@ -213,10 +271,9 @@ class MujocoBlade:
     def apply_contact(self, contact: np.ndarray, ground_vx: float = 0.0) -> None:
         """Compute the contact forces at the current (step1) state into ``xfrc_applied``."""
         d = self.data
-        d.xfrc_applied[:] = 0.0
-        contact_forces_3d(contact, d.site_xpos[self.sole_sites], d.site_xmat[self.sole_sites],
-                          self.axes, self.sole_body, d.cvel, d.subtree_com, self.rootid,
-                          d.xipos, ground_vx, d.xfrc_applied, self.out)
+        contact_forces_3d(contact, d.site_xpos, d.site_xmat, self.sole_sites, self.axes,
+                          self.sole_body, d.cvel, d.subtree_com, self.rootid, d.xipos, ground_vx,
+                          d.xfrc_applied, self.out)
 
 
 def simulate_mujoco(problem, K: np.ndarray, D: np.ndarray, K2: np.ndarray):
@@ -240,50 +297,42 @@ def simulate_mujoco(problem, K: np.ndarray, D: np.ndarray, K2: np.ndarray):
     tau = np.zeros((ns, nj))
     state = np.zeros((ns, ne), np.int8)
     energy = np.zeros((ns, len(_k.ENERGY_TERMS)))
-    jd = mj.joint_dofs
-    jq = mj.joint_qpos
-    d_joint = d_contact = d_fric = w_clamp = 0.0
+    jd = np.ascontiguousarray(mj.joint_dofs)
+    jq = np.ascontiguousarray(mj.joint_qpos)
+    K = np.asarray(K, float)
+    D = np.asarray(D, float)
+    K2 = np.asarray(K2, float)
+    acc = np.zeros(4)  # clamp work, joint, contact, friction dissipation
     dt = problem.dt
-    mass = m.body_mass
+    qpos, qvel, qacc, qfrc = d.qpos, d.qvel, d.qacc, d.qfrc_applied
+    body_inertia = m.body_inertia
+    out = mj.out
+    n_last = base.shape[0] - 1
     for i in range(base.shape[0]):
         bs = base[i]
-        d.qpos[0:3] = bs[0:3]
-        d.qvel[0:3] = bs[3:6]
+        qpos[0:3] = bs[0:3]
+        qvel[0:3] = bs[3:6]
         mujoco.mj_step1(m, d)
         mj.apply_contact(contact)
-        q = d.qpos[jq]
-        v = d.qvel[jd]
-        d.qfrc_applied[:] = 0.0
-        d.qfrc_applied[0:3] = CLAMP_ARMATURE * bs[6:9]
-        d.qfrc_applied[jd] = -K2 * q * np.abs(q)
+        _prescribed_forces(bs, qpos, qfrc, jq, jd, K2)
         if i % nsub == 0:
             s = i // nsub
-            grf[s] = mj.out[:, 0:2]
-            state[s] = np.where(mj.out[:, 2] <= 0, 0, np.where(np.abs(mj.out[:, 3]) <= vc, 1, 2))
+            q = qpos[jq]
+            grf[s] = out[:, 0:2]
+            state[s] = np.where(out[:, 2] <= 0, 0, np.where(np.abs(out[:, 3]) <= vc, 1, 2))
             tip = d.site_xpos[mj.tip_site]
             dist[s] = math.hypot(tip[0] - bs[0], tip[2] - bs[1])
             qout[s] = q
-            tau[s] = -(K * q + K2 * q * np.abs(q) + D * v)
-            kin = 0.0
-            for b in range(m.nbody):
-                if mass[b] > 1e-5:
-                    w = d.cvel[b, :3]
-                    vcom = d.cvel[b, 3:] + np.cross(w, d.xipos[b] - d.subtree_com[mj.rootid[b]])
-                    kin += 0.5 * mass[b] * vcom @ vcom + 0.5 * float(m.body_inertia[b][1]) * w[1] ** 2
-            pot = float(np.sum(mass[mass > 1e-5] * _k.GRAVITY * d.xipos[mass > 1e-5, 2]))
+            tau[s] = -(K * q + K2 * q * np.abs(q) + D * qvel[jd])
+            kin, pot = _kinetic_potential(m.body_mass, body_inertia, d.cvel, d.xipos,
+                                          d.subtree_com, mj.rootid)
             spring = float(np.sum(0.5 * K * q**2 + K2 * np.abs(q) ** 3 / 3.0))
-            e_c = sum(_k.contact_elastic_energy(contact, dep) for dep in mj.out[:, 2])
-            energy[s] = (w_clamp, kin, pot, spring, e_c, d_joint, d_contact, d_fric)
-        if i == base.shape[0] - 1:
+            e_c = sum(_k.contact_elastic_energy(contact, dep) for dep in out[:, 2])
+            energy[s] = (acc[0], kin, pot, spring, e_c, acc[1], acc[2], acc[3])
+        if i == n_last:
             break
         mujoco.mj_step2(m, d)
-        # reaction the clamp joints had to supply (power = force × prescribed velocity)
-        f_clamp = d.qfrc_applied[0:3] - CLAMP_ARMATURE * d.qacc[0:3]
-        w_clamp += dt * float(f_clamp @ bs[3:6])
-        d_joint += dt * float(np.sum(D * d.qvel[jd] ** 2))
-        d_contact += dt * float(mj.out[:, 5].sum())
-        d_fric += dt * float(mj.out[:, 6].sum())
-        if not np.all(np.isfinite(d.qpos)) or np.any(np.abs(d.qpos[jq]) > 10.0):
+        if not _accumulate(acc, dt, bs, qfrc, qacc, qpos, qvel, jq, jd, D, out):
             raise SimulationError(
                 f"MuJoCo diverged at t = {problem.time[0] + i * dt:.4g} s", where="simulate",
                 hint="reduce dt",
