@@ -1,0 +1,115 @@
+"""``bladelab predict`` and ``bladelab sweep``: predictive running (seed 001 §2.2)."""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import typer
+
+from bladelab._io import write_json
+from bladelab.errors import SpecError
+
+
+def _parse_list(text: str, what: str, conv=str) -> list:
+    try:
+        items = [conv(t.strip()) for t in text.split(",") if t.strip()]
+    except ValueError:
+        raise SpecError(
+            f"cannot read {what} {text!r}", where=what, hint="comma-separated"
+        ) from None
+    if not items:
+        raise SpecError(f"no {what} given", where=what)
+    return items
+
+
+def register(app: typer.Typer) -> None:
+    @app.command("predict")
+    def predict(
+        out: Path = typer.Option(..., "--out", help="Output folder (checkpoint, best.json)."),
+        model: str = typer.Option("able", "--model", help="able | amputee"),
+        blade: str = typer.Option("Cat6", "--blade", help="Blade category of the amputee."),
+        speed: float = typer.Option(3.5, "--speed", help="Prescribed speed (m/s)."),
+        init: Path | None = typer.Option(None, "--init", help="Warm start: parameters JSON."),
+        generations: int = typer.Option(100, "--generations", help="CMA-ES generations."),
+        popsize: int = typer.Option(16, "--popsize", help="Candidates per generation."),
+        sigma: float = typer.Option(1.0, "--sigma", help="Initial step (× parameter scale)."),
+        seeds: str = typer.Option("1", "--seeds", help="Comma-separated seeds: one run each."),
+        jobs: int = typer.Option(1, "--jobs", help="Parallel worker processes."),
+        executor: str = typer.Option("local", "--executor", help="local | ray"),
+        resume: bool = typer.Option(False, "--resume", help="Continue from the checkpoint."),
+        duration: float = typer.Option(10.0, "--duration", help="Simulated time (s)."),
+        checkpoint_every: int = typer.Option(5, "--checkpoint-every", help="Generations."),
+    ) -> None:
+        """Optimise the reflex controller of the runner with CMA-ES (seed 001 eq. 2.4)."""
+        from bladelab.runner.controller import read_parameters
+        from bladelab.runner.objective import ObjectiveSettings
+        from bladelab.runner.predict import _model, optimize_controller
+
+        if model not in ("able", "amputee"):
+            raise SpecError(f"unknown model {model!r}", where="--model", hint="able or amputee")
+        if not (math.isfinite(speed) and speed > 0):
+            raise SpecError("speed must be positive", where="--speed")
+        _, layout = _model(model, blade if model == "amputee" else None)
+        x0 = read_parameters(init, layout) if init is not None else None
+        seed_list = _parse_list(seeds, "--seeds", int)
+        results = []
+        for seed in seed_list:
+            folder = out if len(seed_list) == 1 else out / f"seed-{seed}"
+
+            def show(gen: int, best: float, median: float, _s=seed) -> None:
+                typer.echo(f"seed {_s} generation {gen}: best {best:.4g}, median {median:.4g}")
+
+            res = optimize_controller(
+                model,
+                blade=blade,
+                speed=speed,
+                x0=x0,
+                generations=generations,
+                popsize=popsize,
+                sigma=sigma,
+                seed=seed,
+                jobs=jobs,
+                executor=executor,
+                out=folder,
+                resume=resume,
+                checkpoint_every=checkpoint_every,
+                settings=ObjectiveSettings(speed=speed, duration=duration),
+                progress=show,
+            )
+            results.append(res.to_dict())
+        best = min(results, key=lambda r: r["best_cost"])
+        write_json(out / "summary.json", {"runs": results, "best": best})
+        typer.echo(json.dumps(best, indent=2))
+
+    @app.command("sweep")
+    def sweep(
+        out: Path = typer.Option(..., "--out", help="Output folder."),
+        categories: str = typer.Option("Cat4,Cat5,Cat6,Cat6High,Cat7", "--categories"),
+        speeds: str = typer.Option("3.5,4.0,4.5,5.0", "--speeds", help="Speeds (m/s), rising."),
+        init: Path | None = typer.Option(None, "--init", help="Amputee parameters JSON."),
+        generations: int = typer.Option(100, "--generations"),
+        popsize: int = typer.Option(16, "--popsize"),
+        seed: int = typer.Option(1, "--seed"),
+        jobs: int = typer.Option(1, "--jobs"),
+        executor: str = typer.Option("local", "--executor", help="local | ray"),
+        duration: float = typer.Option(10.0, "--duration", help="Simulated time (s)."),
+    ) -> None:
+        """Category × speed grid: warm-started optimisations, maximum speed, cost at 4 m/s,
+        200 m and 400 m times (seed 001 §2.2.2 B–C, Table 3.1)."""
+        from bladelab.runner.sweep import run_sweep
+
+        table = run_sweep(
+            _parse_list(categories, "--categories"),
+            _parse_list(speeds, "--speeds", float),
+            out=out,
+            init=init,
+            generations=generations,
+            popsize=popsize,
+            seed=seed,
+            jobs=jobs,
+            executor=executor,
+            duration=duration,
+        )
+        typer.echo(table.to_string(index=False))

@@ -1,0 +1,464 @@
+"""Reflex controller with a gait-state machine per leg (Geyer & Herr 2010, as in SCONE).
+
+Each leg is in one of five states (SCONE's ``GaitStateController``): ``EarlyStance``,
+``LateStance``, ``Liftoff``, ``Swing``, ``Landing``. Transitions, evaluated every step:
+
+- contact = leg load (vertical GRF of the leg / body weight) above ``stance_load_threshold_<side>``;
+- EarlyStance → LateStance when the leg's contact points are behind the pelvis (sagittal position
+  ``(x_contact − x_pelvis) / leg length`` below ``late_stance_threshold``);
+- LateStance → Liftoff when the other leg is in contact (double support, walking);
+- any stance state → Swing when contact is lost;
+- Swing → Landing when the sagittal position exceeds ``landing_threshold``; Swing/Landing →
+  EarlyStance on contact.
+
+In each state a set of reflexes adds to a muscle's excitation (the sum is clipped to [0, 1]),
+SCONE's ``MuscleReflex`` and ``DofReflex`` with delayed sensors:
+
+- length ``KL·(L(t−d) − L0)`` (L = fibre length / optimal length; negative part dropped where SCONE
+  sets ``allow_neg_L = 0``), force ``KF·F(t−d)`` (F = tendon force / Fmax), constant ``C0``;
+- DOF (pelvis tilt, lumbar extension) ``KP·(P0 − q(t−d)) + KV·(0 − q̇(t−d))`` [rad, rad/s].
+
+The reflex structure is SCONE's ``H0918RS2v3`` controller (Apache-2.0, T. Geijtenbeek) with separate
+parameters per leg (``symmetric = 0``, as ``ControllerGH2010v12Asym``), plus constant offsets
+``C0`` per muscle in stance and in swing (Geyer & Herr's S0 / ΔS terms) and DOF reflexes for the
+torso muscles about the lumbar joint (the seed's model has torso muscles; H0918 has none). The
+prosthetic leg has no shank muscles: reflexes to or from them are left out on that side.
+
+Parameters form a named flat vector (:class:`ControllerLayout`, names like SCONE's ``.par``:
+``S00011.vasti_l.KF`` = vasti of the left leg, states EarlyStance+LateStance, force gain; the state
+mask reads right to left: EarlyStance, LateStance, Liftoff, Swing, Landing). The initial guess is
+ported from SCONE's ``H0918GaitRS2Hfd4.par`` (column ``best``) where the structure matches.
+Everything in the simulation loop is compiled with numba (:func:`control_step`).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+from numba import njit
+
+from bladelab._io import write_json
+from bladelab.errors import InputFileError, SpecError
+
+EARLY_STANCE, LATE_STANCE, LIFTOFF, SWING, LANDING = range(5)
+STATE_NAMES = ("EarlyStance", "LateStance", "Liftoff", "Swing", "Landing")
+# Sensor delays [s] of SCONE's H0918RS2v3.
+HIP_DELAY, HAM_DELAY, KNEE_DELAY, ANKLE_DELAY, VES_DELAY = 0.01, 0.015, 0.02, 0.035, 0.05
+PELVIS_TILT_REF = -0.105  # rad, theta_ref of Geyer & Herr (not optimised)
+LATE_STANCE_THRESHOLD = 0.0
+LANDING_THRESHOLD = 0.0
+
+# Term kinds of the reflex table.
+T_CONST, T_LENGTH, T_LENGTH_POS, T_FORCE, T_DOF_POS, T_DOF_VEL = range(6)
+# Columns of the reflex table (float64): kind, target muscle, leg (−1 = always on), state mask,
+# source (muscle or dof index), delay [steps], gain parameter index, offset parameter index (−1:
+# use the constant), offset constant.
+R_KIND, R_TARGET, R_LEG, R_MASK, R_SOURCE, R_DELAY, R_GAIN, R_OFFSET, R_OFFSET_CONST = range(9)
+
+_ALL = "S11111"
+_STANCE = "S00011"
+_SWING = "S11100"
+
+# (mask, target, source, gain name, offset name or None, kind, delay, SCONE default value(s)).
+# Leg reflexes of H0918RS2v3 (source None = the target itself).
+_LEG_REFLEXES: list[tuple] = [
+    (_ALL, "tib_ant", None, "KL", "L0", T_LENGTH, ANKLE_DELAY, (0.63, 0.55)),
+    (_ALL, "tib_ant", None, "KF", None, T_FORCE, ANKLE_DELAY, (0.5,)),
+    (_ALL, "soleus", None, "KL", "L0", T_LENGTH, ANKLE_DELAY, (0.66, 0.87)),
+    (_ALL, "soleus", None, "KF", None, T_FORCE, ANKLE_DELAY, (1.0,)),
+    (_ALL, "gastroc", None, "KL", "L0", T_LENGTH, ANKLE_DELAY, (0.5, 0.68)),
+    (_ALL, "gastroc", None, "KF", None, T_FORCE, ANKLE_DELAY, (0.76,)),
+    (_ALL, "tib_ant", "soleus", "KL", None, T_LENGTH, ANKLE_DELAY, (-0.08,)),
+    (_ALL, "tib_ant", "soleus", "KF", None, T_FORCE, ANKLE_DELAY, (-1.0,)),
+    (_ALL, "tib_ant", "gastroc", "KL", None, T_LENGTH, ANKLE_DELAY, (-0.05,)),
+    (_ALL, "tib_ant", "gastroc", "KF", None, T_FORCE, ANKLE_DELAY, (-0.7,)),
+    (_ALL, "soleus", "tib_ant", "KF", None, T_FORCE, ANKLE_DELAY, (-0.64,)),
+    (_ALL, "gastroc", "tib_ant", "KF", None, T_FORCE, ANKLE_DELAY, (-0.77,)),
+    (_STANCE, "vasti", None, "KL", "L0", T_LENGTH, KNEE_DELAY, (2.0, 0.6)),
+    (_STANCE, "vasti", None, "KF", None, T_FORCE, KNEE_DELAY, (0.8,)),
+    (_STANCE, "iliopsoas", None, "KL", "L0", T_LENGTH, HIP_DELAY, (2.0, 0.9)),
+    (_STANCE, "rect_fem", None, "KL", "L0", T_LENGTH, HAM_DELAY, (0.2, 0.5)),
+    (_STANCE, "hamstrings", None, "KL", "L0", T_LENGTH, HAM_DELAY, (0.8, 0.7)),
+    (_STANCE, "bifemsh", None, "KF", None, T_FORCE, KNEE_DELAY, (0.2,)),
+    (_STANCE, "glut_max", None, "KL", "L0", T_LENGTH, HIP_DELAY, (0.5, 1.1)),
+    (_STANCE, "hamstrings", "pelvis_tilt", "KP", None, T_DOF_POS, VES_DELAY, (1.3,)),
+    (_STANCE, "hamstrings", "pelvis_tilt", "KV", None, T_DOF_VEL, VES_DELAY, (0.2,)),
+    (_STANCE, "glut_max", "pelvis_tilt", "KP", None, T_DOF_POS, VES_DELAY, (1.0,)),
+    (_STANCE, "rect_fem", "pelvis_tilt", "KP", None, T_DOF_POS, VES_DELAY, (-1.1,)),
+    (_STANCE, "rect_fem", "pelvis_tilt", "KV", None, T_DOF_VEL, VES_DELAY, (-0.02,)),
+    (_SWING, "iliopsoas", None, "KL", "L0", T_LENGTH, HIP_DELAY, (1.0, 0.7)),
+    (_SWING, "rect_fem", None, "KL", "L0", T_LENGTH, HAM_DELAY, (0.5, 1.2)),
+    (_SWING, "iliopsoas", "pelvis_tilt", "KP", None, T_DOF_POS, VES_DELAY, (1.7,)),
+    (_SWING, "iliopsoas", "pelvis_tilt", "KV", None, T_DOF_VEL, VES_DELAY, (0.3,)),
+    (_SWING, "iliopsoas", "hamstrings", "KL", "L0", T_LENGTH, HAM_DELAY, (-3.0, 0.7)),
+    (_SWING, "hamstrings", None, "KL", "L0", T_LENGTH, HAM_DELAY, (0.2, 1.2)),
+    (_SWING, "bifemsh", None, "KF", None, T_FORCE, KNEE_DELAY, (0.2,)),
+    (_SWING, "glut_max", None, "KL", "L0", T_LENGTH, HIP_DELAY, (1.0, 0.85)),
+]
+_LEG_MUSCLES = (
+    "hamstrings",
+    "bifemsh",
+    "glut_max",
+    "iliopsoas",
+    "rect_fem",
+    "vasti",
+    "gastroc",
+    "soleus",
+    "tib_ant",
+)
+# Torso: (muscle, gain name, kind, default); source lumbar_extension, always on, both sides.
+_TORSO_REFLEXES: list[tuple] = [
+    ("erect_sp", "C0", T_CONST, 0.05),
+    ("erect_sp", "KP", T_DOF_POS, 1.0),
+    ("erect_sp", "KV", T_DOF_VEL, 0.1),
+    ("rect_abd", "C0", T_CONST, 0.02),
+    ("rect_abd", "KP", T_DOF_POS, -1.0),
+    ("rect_abd", "KV", T_DOF_VEL, -0.1),
+    ("int_obl", "C0", T_CONST, 0.02),
+]
+INITIAL_DOFS = ("pelvis_tilt", "hip_flexion", "knee_angle", "ankle_angle")
+_SCONE_PAR = "H0918GaitRS2Hfd4.par"
+
+
+@dataclass(frozen=True)
+class ControllerLayout:
+    """Names, initial values, search scales and the compiled reflex table of one runner model.
+
+    Attributes
+    ----------
+    kind
+        ``"able"`` or ``"amputee"`` (the prosthetic right leg has no shank muscles).
+    names
+        Parameter names in vector order.
+    x0
+        Initial guess (SCONE's values where the structure matches).
+    std
+        Initial search scale per parameter (CMA-ES ``CMA_stds``).
+    lower, upper
+        Bounds of each parameter.
+    table
+        (n_terms, 9) reflex table (columns ``R_*``), before delays are converted to steps.
+    delays_s
+        Delay [s] of each table row.
+    """
+
+    kind: str
+    names: tuple[str, ...]
+    x0: np.ndarray = field(repr=False)
+    std: np.ndarray = field(repr=False)
+    lower: np.ndarray = field(repr=False)
+    upper: np.ndarray = field(repr=False)
+    table: np.ndarray = field(repr=False)
+    delays_s: np.ndarray = field(repr=False)
+
+    @property
+    def size(self) -> int:
+        return len(self.names)
+
+    def index(self, name: str) -> int:
+        try:
+            return self.names.index(name)
+        except ValueError:
+            raise SpecError(f"no controller parameter {name!r}", where="parameters") from None
+
+    def vector(self, values: dict[str, float], *, source: str | None = None) -> np.ndarray:
+        """A parameter vector from a ``{name: value}`` mapping (missing names: initial guess)."""
+        unknown = sorted(set(values) - set(self.names))
+        if unknown:
+            raise SpecError(
+                f"unknown controller parameter(s) {', '.join(unknown[:5])}",
+                file=source,
+                where="parameters",
+                hint=f"this is a {self.kind} controller; parameters look like {self.names[0]!r}",
+            )
+        x = self.x0.copy()
+        for k, v in values.items():
+            if not math.isfinite(float(v)):
+                raise SpecError(f"parameter {k} is not finite", file=source, where=k)
+            x[self.names.index(k)] = float(v)
+        return x
+
+    def to_dict(self, x: np.ndarray) -> dict[str, float]:
+        return {n: float(v) for n, v in zip(self.names, x, strict=True)}
+
+    def table_for(self, dt: float) -> np.ndarray:
+        """The reflex table with delays in steps of ``dt`` [s]."""
+        t = self.table.copy()
+        t[:, R_DELAY] = np.round(self.delays_s / dt)
+        return t
+
+
+def _scone_par() -> dict[str, float]:
+    """SCONE's RS2 parameters (column ``best``) by name, or {} if the file is not shipped."""
+    path = Path(__file__).resolve().parents[1] / "data" / "runner" / "solutions" / _SCONE_PAR
+    if not path.exists():
+        return {}
+    out = {}
+    for line in path.read_text().splitlines():
+        parts = line.split()
+        if len(parts) >= 2:
+            out[parts[0]] = float(parts[1])
+    return out
+
+
+def controller_layout(model) -> ControllerLayout:
+    """The controller layout of a :class:`~bladelab.runner.RunnerModel`."""
+    muscles = list(model.muscle_names)
+    dofs = list(model.dof_names)
+    par = _scone_par()
+    names, x0, std, lo, hi, rows, delays = [], [], [], [], [], [], []
+
+    def param(name: str, value: float, low: float, high: float, scale: float | None = None) -> int:
+        names.append(name)
+        x0.append(value)
+        std.append(scale if scale is not None else max(0.05 * abs(value), 0.02))
+        lo.append(low)
+        hi.append(high)
+        return len(names) - 1
+
+    for side, leg in (("l", 0), ("r", 1)):
+        param(f"stance_load_threshold_{side}", par.get("stance_load_threshold", 0.28), 0.01, 1.0)
+    for dof in INITIAL_DOFS:
+        for side in ("l", "r") if dof != "pelvis_tilt" else ("",):
+            dn = f"{dof}_{side}" if side else dof
+            if dn not in dofs:
+                continue
+            param(f"{dn}.offset", par.get(f"{dn}.offset", 0.0), -0.5, 0.5, 0.02)
+    for side, leg in (("l", 0), ("r", 1)):
+        have = {m[: -len(side) - 1] for m in muscles if m.endswith("_" + side)}
+        for mask, target, source, gname, oname, kind, delay, vals in _LEG_REFLEXES:
+            if target not in have or (source in _LEG_MUSCLES and source not in have):
+                continue
+            key = target if source is None else f"{target}-{source}"
+            scone_key = f"{mask}.{key}"
+            tname = f"{target}_{side}"
+            src = muscles.index(tname)
+            if source is not None:
+                src = dofs.index(source) if source in dofs else muscles.index(f"{source}_{side}")
+            gain = param(
+                f"{mask}.{tname if source is None else tname + '-' + source}.{gname}",
+                par.get(f"{scone_key}.{gname}", vals[0]),
+                -10.0,
+                10.0,
+            )
+            off, off_const = -1, 0.0
+            if oname is not None:
+                off = param(
+                    f"{mask}.{tname if source is None else tname + '-' + source}.{oname}",
+                    par.get(f"{scone_key}.{oname}", vals[1]),
+                    0.0,
+                    2.0,
+                )
+            elif kind == T_DOF_POS:
+                off_const = PELVIS_TILT_REF
+            rows.append(
+                (kind, muscles.index(tname), leg, _mask_bits(mask), src, 0, gain, off, off_const)
+            )
+            delays.append(delay)
+        # constant offsets per muscle in stance and swing
+        for mask in (_STANCE, _SWING):
+            for mname in _LEG_MUSCLES:
+                if mname not in have:
+                    continue
+                tname = f"{mname}_{side}"
+                gain = param(f"{mask}.{tname}.C0", 0.0, -1.0, 1.0, 0.02)
+                rows.append(
+                    (T_CONST, muscles.index(tname), leg, _mask_bits(mask), -1, 0, gain, -1, 0.0)
+                )
+                delays.append(0.0)
+    if "lumbar_extension" in dofs:
+        src = dofs.index("lumbar_extension")
+        for mname, gname, kind, val in _TORSO_REFLEXES:
+            gain = param(f"torso.{mname}-lumbar_extension.{gname}", val, -10.0, 10.0)
+            for side in ("r", "l"):
+                tname = f"{mname}_{side}"
+                if tname in muscles:
+                    rows.append((kind, muscles.index(tname), -1, 31, src, 0, gain, -1, 0.0))
+                    delays.append(HIP_DELAY if kind != T_CONST else 0.0)
+    return ControllerLayout(
+        kind=model.kind,
+        names=tuple(names),
+        x0=np.array(x0),
+        std=np.array(std),
+        lower=np.array(lo),
+        upper=np.array(hi),
+        table=np.array(rows, dtype=np.float64),
+        delays_s=np.array(delays),
+    )
+
+
+def _mask_bits(mask: str) -> int:
+    """SCONE's state mask string ("S00011": EarlyStance, LateStance) as bits (bit 0 = EarlyStance)."""
+    bits = mask[1:]
+    return sum(1 << i for i, ch in enumerate(reversed(bits)) if ch == "1")
+
+
+def read_parameters(path: str | Path, layout: ControllerLayout) -> np.ndarray:
+    """Read a parameter JSON file (``{"parameters": {name: value}, ...}``) into a vector."""
+    path = Path(path)
+    try:
+        data = json.loads(path.read_text())
+    except FileNotFoundError:
+        raise InputFileError("file not found", file=path) from None
+    except json.JSONDecodeError as err:
+        raise InputFileError(f"not valid JSON ({err})", file=path) from None
+    params = data.get("parameters") if isinstance(data, dict) else None
+    if not isinstance(params, dict):
+        raise InputFileError(
+            "expected an object with a 'parameters' mapping {name: value}", file=path
+        )
+    if data.get("model") not in (None, layout.kind):
+        raise InputFileError(
+            f"parameters are for the {data.get('model')} model, not {layout.kind}",
+            file=path,
+            hint="use --model matching the file, or another --init file",
+        )
+    return layout.vector(params, source=str(path))
+
+
+def write_parameters(
+    path: str | Path, layout: ControllerLayout, x: np.ndarray, **meta: object
+) -> Path:
+    """Write a parameter vector as JSON (atomically) with optional metadata."""
+    data = {"model": layout.kind, **meta, "parameters": layout.to_dict(np.asarray(x, float))}
+    write_json(path, data)
+    return Path(path)
+
+
+# ----------------------------------------------------------------------------- compiled part
+# Sensor channels in the history buffer: per muscle L, V, F (3 per muscle), then per dof q, qd.
+# Controller state ``cs`` (float64 array): per leg the gait state (cs[0], cs[1]); cs[2] = write
+# position in the history; cs[3] = number of samples written.
+
+
+@njit(cache=True)
+def push_sensors(hist, cs, ms, mp, qpos, qvel):
+    """Append the current sensor values to the ring buffer ``hist`` (n_hist, n_channels)."""
+    nm = ms.shape[0]
+    nh = hist.shape[0]
+    pos = int(cs[2])
+    for i in range(nm):
+        lopt = mp[i, 1]
+        hist[pos, 3 * i] = ms[i, 1] / lopt
+        hist[pos, 3 * i + 1] = ms[i, 2] / lopt
+        hist[pos, 3 * i + 2] = ms[i, 3] / mp[i, 0]
+    nq = qpos.shape[0]
+    for j in range(nq):
+        hist[pos, 3 * nm + j] = qpos[j]
+        hist[pos, 3 * nm + nq + j] = qvel[j]
+    if cs[3] == 0.0:  # first sample: fill the history with it
+        for k in range(nh):
+            if k != pos:
+                hist[k, :] = hist[pos, :]
+    cs[3] += 1.0
+    cs[2] = (pos + 1) % nh
+
+
+@njit(cache=True)
+def delayed(hist, cs, channel, steps):
+    """Sensor channel value ``steps`` samples ago (0 = the newest)."""
+    nh = hist.shape[0]
+    if steps > nh - 1:
+        steps = nh - 1
+    pos = (int(cs[2]) - 1 - steps) % nh
+    return hist[pos, channel]
+
+
+@njit(cache=True)
+def update_gait_states(cs, crec, cp, qpos, ix_pelvis, body_weight, thresholds, leg_length):
+    """Advance each leg's gait state from the contact forces (see module docstring)."""
+    contact = np.zeros(2)
+    sag = np.zeros(2)
+    npts = np.zeros(2)
+    for c in range(cp.shape[0]):
+        leg = int(cp[c, 6])
+        contact[leg] += crec[c, 1]
+        sag[leg] += crec[c, 2]
+        npts[leg] += 1.0
+    for leg in range(2):
+        load = contact[leg] / body_weight
+        on = load > thresholds[leg]
+        other = contact[1 - leg] / body_weight > thresholds[1 - leg]
+        s = (sag[leg] / max(npts[leg], 1.0) - qpos[ix_pelvis]) / leg_length
+        st = int(cs[leg])
+        if st == EARLY_STANCE:
+            if not on:
+                st = SWING
+            elif s < LATE_STANCE_THRESHOLD:
+                st = LATE_STANCE
+        elif st == LATE_STANCE:
+            if not on:
+                st = SWING
+            elif other:
+                st = LIFTOFF
+        elif st == LIFTOFF:
+            if not on:
+                st = SWING
+        elif st == SWING:
+            if on:
+                st = EARLY_STANCE
+            elif s > LANDING_THRESHOLD:
+                st = LANDING
+        else:  # LANDING
+            if on:
+                st = EARLY_STANCE
+        cs[leg] = st
+
+
+@njit(cache=True)
+def compute_excitations(u, table, p, hist, cs, nm, nq):
+    """Excitations ``u`` from the reflex table, parameters ``p`` and the delayed sensors."""
+    u[:] = 0.0
+    for r in range(table.shape[0]):
+        leg = int(table[r, R_LEG])
+        if leg >= 0:
+            st = int(cs[leg])
+            if (int(table[r, R_MASK]) >> st) & 1 == 0:
+                continue
+        kind = int(table[r, R_KIND])
+        tgt = int(table[r, R_TARGET])
+        src = int(table[r, R_SOURCE])
+        d = int(table[r, R_DELAY])
+        g = p[int(table[r, R_GAIN])]
+        oi = int(table[r, R_OFFSET])
+        off = p[oi] if oi >= 0 else table[r, R_OFFSET_CONST]
+        if kind == T_CONST:
+            u[tgt] += g
+        elif kind == T_LENGTH:
+            u[tgt] += g * (delayed(hist, cs, 3 * src, d) - off)
+        elif kind == T_LENGTH_POS:
+            u[tgt] += g * max(delayed(hist, cs, 3 * src, d) - off, 0.0)
+        elif kind == T_FORCE:
+            u[tgt] += g * (delayed(hist, cs, 3 * src + 2, d) - off)
+        elif kind == T_DOF_POS:
+            u[tgt] += g * (off - delayed(hist, cs, 3 * nm + src, d))
+        elif kind == T_DOF_VEL:
+            u[tgt] += -g * delayed(hist, cs, 3 * nm + nq + src, d)
+    for i in range(nm):
+        if u[i] < 0.0:
+            u[i] = 0.0
+        elif u[i] > 1.0:
+            u[i] = 1.0
+
+
+def history_length(layout: ControllerLayout, dt: float) -> int:
+    """Rows of the sensor ring buffer for the longest delay at step ``dt`` [s]."""
+    return int(round(float(layout.delays_s.max(initial=0.0)) / dt)) + 2
+
+
+__all__ = [
+    "ControllerLayout",
+    "STATE_NAMES",
+    "compute_excitations",
+    "controller_layout",
+    "delayed",
+    "history_length",
+    "push_sensors",
+    "read_parameters",
+    "update_gait_states",
+    "write_parameters",
+]

@@ -1,0 +1,142 @@
+"""Muscle metabolic energy rate after Uchida et al. (2016), the Umberger (2003) model as modified
+for running (seed 001 eq. 2.5).
+
+Per muscle, rates per kilogram of muscle [W/kg] (Umberger et al. 2003; Uchida et al. 2016):
+
+- ``A = u`` if the excitation ``u`` exceeds the activation ``a``, else ``(u + a)/2``;
+- activation and maintenance heat ``ḣ_AM = (1.28·FT + 25)·A^0.6·S``, FT = fast-twitch fibres in %;
+  for fibres longer than optimal ``ḣ_AM·(0.4 + 0.6·f_l)``;
+- shortening heat (``ṽ = v_ce/l_opt`` < 0, in optimal lengths per second)
+  ``ḣ_S = (−α_ST·ṽ·(100 − FT)/100 − α_FT·ṽ·FT/100)·A²·S`` with ``α_ST = 100/v_max,ST``,
+  ``α_FT = 153/v_max,FT``, ``v_max,ST = v_max/(1 + 1.5·FT/100)``, ``v_max,FT = 2.5·v_max,ST``
+  (``v_max`` = 10 l_opt/s, the muscle model's); times ``f_l`` for fibres longer than optimal;
+  lengthening heat ``ḣ_L = α_L·ṽ·A·S`` with ``α_L = 4·α_ST``;
+- total heat ``ḣ_AM + ḣ_SL`` not below 1 W/kg (Umberger's floor);
+- mechanical work rate ``ẇ = −F_ce·v_ce / m`` with the active fibre force ``F_ce`` — negative work
+  (lengthening) included (Uchida 2016);
+- ``S = 1.5`` (aerobic), muscle mass ``m = ρ·V`` with ``V = Fmax·l_opt/σ`` (σ = the model's specific
+  tension, so V is the muscle's volume of seed 001 eq. 2.1) and ρ = 1059.7 kg/m³.
+
+Whole body: ``Ė = basal·body mass + Σ_i Ė_i`` with basal 1.51 W/kg (Umberger 2003).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from bladelab.runner.muscle import V_MAX_OPT_PER_S, force_length
+
+MUSCLE_DENSITY = 1059.7  # kg/m^3
+BASAL_RATE_W_PER_KG = 1.51
+AEROBIC_SCALE = 1.5
+MIN_HEAT_RATE_W_PER_KG = 1.0
+# Fast-twitch fibre percentage per muscle type (Johnson et al. 1973, as tabulated in
+# Uchida et al. 2016's supplementary models; rounded; torso muscles 50 %).
+FAST_TWITCH_PERCENT = {
+    "glut_max": 45.0,
+    "iliopsoas": 50.0,
+    "rect_fem": 62.0,
+    "vasti": 50.0,
+    "hamstrings": 35.0,
+    "bifemsh": 35.0,
+    "soleus": 20.0,
+    "gastroc": 50.0,
+    "tib_ant": 30.0,
+}
+# Columns of the metabolic parameter array (one row per muscle).
+MB_MASS, MB_FT = 0, 1
+
+
+def metabolic_params(model, *, specific_tension_pa: float | None = None) -> np.ndarray:
+    """(n_muscles, 2): muscle mass [kg] and fast-twitch percentage of a runner model.
+
+    ``specific_tension_pa`` [Pa] defaults to the model's (``params.specific_tension_N_per_cm2``).
+    """
+    if specific_tension_pa is None:
+        specific_tension_pa = model.params.specific_tension_N_per_cm2 * 1e4
+    mp = model.muscle_params
+    out = np.zeros((mp.shape[0], 2))
+    for i, name in enumerate(model.muscle_names):
+        base = name.rsplit("_", 1)[0]
+        out[i, MB_MASS] = MUSCLE_DENSITY * mp[i, 0] * mp[i, 1] / specific_tension_pa
+        out[i, MB_FT] = FAST_TWITCH_PERCENT.get(base, 50.0)
+    return out
+
+
+@njit(cache=True)
+def muscle_metabolic_rate(
+    u: float,
+    a: float,
+    l_norm: float,
+    v_norm: float,
+    f_ce: float,
+    v_ce: float,
+    mass: float,
+    ft: float,
+) -> float:
+    """Metabolic rate [W] of one muscle (see module docstring).
+
+    ``u`` excitation, ``a`` activation [-]; ``l_norm`` fibre length / l_opt; ``v_norm`` fibre
+    velocity in l_opt/s (< 0 shortening); ``f_ce`` active fibre force [N]; ``v_ce`` fibre velocity
+    [m/s]; ``mass`` muscle mass [kg]; ``ft`` fast-twitch percentage.
+    """
+    big_a = u if u > a else 0.5 * (u + a)
+    if big_a < 0.0:
+        big_a = 0.0
+    f_iso = force_length(l_norm)
+    h_am = (1.28 * ft + 25.0) * big_a**0.6 * AEROBIC_SCALE
+    if l_norm > 1.0:
+        h_am *= 0.4 + 0.6 * f_iso
+    vmax_st = V_MAX_OPT_PER_S / (1.0 + 1.5 * ft / 100.0)
+    vmax_ft = 2.5 * vmax_st
+    alpha_st = 100.0 / vmax_st
+    alpha_ft = 153.0 / vmax_ft
+    if v_norm <= 0.0:
+        h_sl = (
+            (-alpha_st * v_norm * (100.0 - ft) / 100.0 - alpha_ft * v_norm * ft / 100.0)
+            * big_a
+            * big_a
+            * AEROBIC_SCALE
+        )
+        if l_norm > 1.0:
+            h_sl *= f_iso
+    else:
+        h_sl = 4.0 * alpha_st * v_norm * big_a * AEROBIC_SCALE
+    heat = h_am + h_sl
+    if heat < MIN_HEAT_RATE_W_PER_KG:
+        heat = MIN_HEAT_RATE_W_PER_KG
+    w = -f_ce * v_ce / mass
+    return (heat + w) * mass
+
+
+@njit(cache=True)
+def total_metabolic_rate(u, ms, mp, mb, body_mass):
+    """Whole-body metabolic rate [W]: basal + Σ muscles, from excitations ``u``, muscle states
+    ``ms`` (activation, l_ce, v_ce, F_t), muscle parameters ``mp`` and ``mb`` (:func:`metabolic_params`)."""
+    total = BASAL_RATE_W_PER_KG * body_mass
+    for i in range(ms.shape[0]):
+        lopt = mp[i, 1]
+        a = ms[i, 0]
+        ln = ms[i, 1] / lopt
+        # active fibre force along the fibre: tendon force / cos(pennation) less the passive part
+        h = lopt * math.sin(mp[i, 3])
+        s = min(h / max(ms[i, 1], 1e-6), 0.99)
+        cosp = math.sqrt(1.0 - s * s)
+        fp = ((ln - 1.0) / 0.6) ** 2 if ln > 1.0 else 0.0
+        f_ce = max(ms[i, 3] / cosp - fp * mp[i, 0], 0.0)
+        total += muscle_metabolic_rate(
+            u[i], a, ln, ms[i, 2] / lopt, f_ce, ms[i, 2], mb[i, 0], mb[i, 1]
+        )
+    return total
+
+
+__all__ = [
+    "BASAL_RATE_W_PER_KG",
+    "FAST_TWITCH_PERCENT",
+    "metabolic_params",
+    "muscle_metabolic_rate",
+    "total_metabolic_rate",
+]

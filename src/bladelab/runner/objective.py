@@ -1,0 +1,562 @@
+"""Closed-loop simulation with the reflex controller, and the objective of seed 001 eq. 2.4–2.9.
+
+``J = w_cot·J_cot + w_gait·J_gait + w_inj·J_inj + w_lean·J_lean`` (defaults 0.1, 100, 0.1, 0.1):
+
+- ``J_cot = ∫Ė dt / (m·d)`` [J/(kg·m)]: Uchida 2016 gross metabolic energy
+  (:mod:`bladelab.runner.metabolics`) over body mass and distance travelled (pelvis, ≥ 1 m);
+- ``J_gait = 1 − Σ_s t_s·w_s / t_des`` (SCONE's GaitMeasure): steps s run from touch-down to
+  touch-down (the first from t = 0), ``w_s = max(0, 1 − Ψ(v_s, v_min, v_max)/(1 m/s))`` with the
+  linear range penalty Ψ of eq. 2.8 and the step's mean pelvis speed ``v_s``; after a fall no more
+  steps count, so falling early costs up to 1;
+- ``J_inj``: knee load (ligament torque [N·m] of each knee) outside ``knee_load_range``
+  (−100…100), ``J_lean``: pelvis tilt [deg] outside ``pelvis_tilt_range_deg`` (−16…−2); both
+  eq. 2.9, ``abs_penalty·|Err| + squared_penalty·Err²`` averaged over the simulated time.
+
+The simulation stops early once the model has fallen (pelvis below 60 % of standing height).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass
+
+import mujoco
+import numpy as np
+from numba import njit
+
+from bladelab.errors import SimulationError
+from bladelab.runner.controller import (
+    ControllerLayout,
+    compute_excitations,
+    controller_layout,
+    history_length,
+    push_sensors,
+    update_gait_states,
+)
+from bladelab.runner.kernel import _call_mj, _mujoco_step_addresses, forces, path_kinematics
+from bladelab.runner.metabolics import metabolic_params, total_metabolic_rate
+from bladelab.runner.model import RunnerModel
+from bladelab.runner.muscle import equilibrium_fiber_length
+from bladelab.runner.simulate import RunnerResult, initial_qpos
+
+DEFAULT_PREDICT_DT = 5e-4
+MAX_TOUCHDOWNS = 400
+
+
+@dataclass(frozen=True)
+class ObjectiveSettings:
+    """Weights and ranges of the objective (seed 001 §2.2.1). Speeds [m/s], load [N·m], tilt
+    [deg], times [s]."""
+
+    speed: float = 3.5
+    speed_tolerance: float = 0.1
+    duration: float = 10.0
+    dt: float = DEFAULT_PREDICT_DT
+    w_cot: float = 0.1
+    w_gait: float = 100.0
+    w_inj: float = 0.1
+    w_lean: float = 0.1
+    knee_load_range: tuple[float, float] = (-100.0, 100.0)
+    pelvis_tilt_range_deg: tuple[float, float] = (-16.0, -2.0)
+    abs_penalty: float = 1.0
+    squared_penalty: float = 0.0
+
+    def to_dict(self) -> dict:
+        return asdict(self)
+
+
+@dataclass(frozen=True)
+class Evaluation:
+    """One simulation's objective terms."""
+
+    cost: float
+    j_cot: float
+    j_gait: float
+    j_inj: float
+    j_lean: float
+    fell: bool
+    duration: float
+    distance: float
+    mean_speed: float
+    metabolic_energy: float
+    n_steps: int
+
+    def to_dict(self) -> dict:
+        return {k: (float(v) if isinstance(v, float) else v) for k, v in asdict(self).items()}
+
+
+@njit(cache=True)
+def _control_and_measure(
+    k,
+    dt,
+    u,
+    table,
+    p,
+    hist,
+    cs,
+    ms,
+    mp,
+    mb,
+    qpos,
+    qvel,
+    crec,
+    cp,
+    lig,
+    ix,
+    thresholds,
+    body_weight,
+    body_mass,
+    leg_length,
+    acc,
+    td,
+    knee_idx,
+    itilt,
+    ranges,
+    pen,
+):
+    """Controller step plus the objective's running sums (``acc``: energy [J], knee penalty·s,
+    tilt penalty·s, number of touch-downs)."""
+    nm = ms.shape[0]
+    nq = qpos.shape[0]
+    push_sensors(hist, cs, ms, mp, qpos, qvel)
+    s0, s1 = cs[0], cs[1]
+    update_gait_states(cs, crec, cp, qpos, ix, body_weight, thresholds, leg_length)
+    for leg in range(2):
+        old = s0 if leg == 0 else s1
+        if cs[leg] == 0.0 and old >= 3.0:  # swing/landing -> early stance: touch-down
+            n = int(acc[3])
+            if n < td.shape[0]:
+                td[n, 0] = k * dt
+                td[n, 1] = qpos[ix]
+                acc[3] += 1.0
+    compute_excitations(u, table, p, hist, cs, nm, nq)
+    acc[0] += total_metabolic_rate(u, ms, mp, mb, body_mass) * dt
+    for j in range(knee_idx.shape[0]):
+        tau = lig[knee_idx[j]]
+        err = 0.0
+        if tau < ranges[0]:
+            err = ranges[0] - tau
+        elif tau > ranges[1]:
+            err = tau - ranges[1]
+        acc[1] += (pen[0] * err + pen[1] * err * err) * dt
+    tilt = qpos[itilt] * 180.0 / math.pi
+    err = 0.0
+    if tilt < ranges[2]:
+        err = ranges[2] - tilt
+    elif tilt > ranges[3]:
+        err = tilt - ranges[3]
+    acc[2] += (pen[0] * err + pen[1] * err * err) * dt
+
+
+_ADDRESSES: tuple[int, int] | None = None
+
+
+def _step_addresses() -> tuple[int, int]:
+    global _ADDRESSES
+    if _ADDRESSES is None:
+        _ADDRESSES = _mujoco_step_addresses()
+    return _ADDRESSES
+
+
+@njit(cache=True)
+def _run_controlled(
+    f1,
+    f2,
+    mptr,
+    dptr,
+    n_steps,
+    record_every,
+    dt,
+    iz,
+    fall_height,
+    qpos,
+    qvel,
+    site_xpos,
+    cvel,
+    subtree_com,
+    xipos,
+    xfrc,
+    qfrc,
+    mp,
+    ms,
+    mtu,
+    seg_u,
+    u,
+    path,
+    pstart,
+    cp,
+    cstate,
+    jp,
+    crec,
+    lig,
+    table,
+    p,
+    hist,
+    cs,
+    mb,
+    ix,
+    thresholds,
+    body_weight,
+    body_mass,
+    leg_length,
+    acc,
+    td,
+    knee_idx,
+    itilt,
+    ranges,
+    pen,
+    rec_t,
+    rec_q,
+    rec_v,
+    rec_ms,
+    rec_mtu,
+    rec_u,
+    rec_c,
+    rec_l,
+):
+    """The closed-loop time loop, entirely compiled (MuJoCo's C step called directly).
+
+    Returns (last step, samples recorded, fell)."""
+    root_com = np.zeros(3)
+    k_rec = 0
+    k = 0
+    for k in range(n_steps + 1):
+        _call_mj(f1, mptr, dptr)
+        root_com[0] = subtree_com[1, 0]
+        root_com[1] = subtree_com[1, 1]
+        root_com[2] = subtree_com[1, 2]
+        _control_and_measure(
+            k,
+            dt,
+            u,
+            table,
+            p,
+            hist,
+            cs,
+            ms,
+            mp,
+            mb,
+            qpos,
+            qvel,
+            crec,
+            cp,
+            lig,
+            ix,
+            thresholds,
+            body_weight,
+            body_mass,
+            leg_length,
+            acc,
+            td,
+            knee_idx,
+            itilt,
+            ranges,
+            pen,
+        )
+        forces(
+            qpos,
+            qvel,
+            site_xpos,
+            cvel,
+            root_com,
+            xipos,
+            xfrc,
+            qfrc,
+            mp,
+            ms,
+            mtu,
+            seg_u,
+            u,
+            path,
+            pstart,
+            cp,
+            cstate,
+            jp,
+            crec,
+            lig,
+            dt,
+        )
+        if k % record_every == 0:
+            rec_t[k_rec] = k * dt
+            rec_q[k_rec, :] = qpos
+            rec_v[k_rec, :] = qvel
+            rec_ms[k_rec, :, :] = ms
+            rec_mtu[k_rec, :, :] = mtu
+            rec_u[k_rec, :] = u
+            rec_c[k_rec, :, :] = crec
+            rec_l[k_rec, :] = lig
+            k_rec += 1
+        if not qpos[iz] >= fall_height:  # also catches NaN
+            return k, k_rec, True
+        if k == n_steps:
+            break
+        _call_mj(f2, mptr, dptr)
+    return k, k_rec, False
+
+
+def initial_state(
+    model: RunnerModel, layout: ControllerLayout, x: np.ndarray, speed: float
+) -> tuple[np.ndarray, np.ndarray]:
+    """SCONE's gait state with the controller's initial-state offsets, moving at ``speed``."""
+    pose = {}
+    q0, _ = initial_qpos(model, "gait")
+    for i, name in enumerate(layout.names):
+        if name.endswith(".offset"):
+            dof = name[: -len(".offset")]
+            pose[dof] = q0[model.dof(dof)] + x[i]
+    q, v = initial_qpos(model, "gait")
+    for dof, val in pose.items():
+        q[model.dof(dof)] = val
+    from bladelab.runner.model import contact_heights
+
+    q[model.dof("pelvis_tz")] -= contact_heights(model, q).min()
+    v[model.dof("pelvis_tx")] = speed
+    return q, v
+
+
+def simulate_controlled(
+    model: RunnerModel,
+    x: np.ndarray,
+    *,
+    layout: ControllerLayout | None = None,
+    settings: ObjectiveSettings | None = None,
+    record_every: int = 0,
+) -> tuple[Evaluation, RunnerResult | None]:
+    """Simulate the runner under the reflex controller with parameters ``x``.
+
+    Parameters
+    ----------
+    model
+        The runner.
+    x
+        Controller parameter vector (:func:`~bladelab.runner.controller.controller_layout`).
+    settings
+        Speed [m/s], duration [s], time step [s] and objective weights.
+    record_every
+        Record a :class:`RunnerResult` sample every this many steps (0: no recording, faster).
+
+    Returns
+    -------
+    (Evaluation, RunnerResult or None)
+    """
+    settings = settings or ObjectiveSettings()
+    layout = layout or controller_layout(model)
+    x = np.asarray(x, dtype=float)
+    if x.shape != (layout.size,):
+        raise SimulationError(
+            f"expected {layout.size} controller parameters, got {x.shape}", where="parameters"
+        )
+    dt = settings.dt
+    m = model.mj_model
+    m.opt.timestep = dt
+    d = mujoco.MjData(m)
+    q0, v0 = initial_state(model, layout, x, settings.speed)
+    d.qpos[:] = q0
+    d.qvel[:] = v0
+    mujoco.mj_forward(m, d)
+    nm = len(model.muscle_names)
+    mp = model.muscle_params
+    mb = metabolic_params(model)
+    ms = np.zeros((nm, 4))
+    ms[:, 0] = 0.05
+    path, pstart = model.path_points, model.path_start
+    mtu = np.zeros((nm, 2))
+    seg_u = np.zeros((path.shape[0], 3))
+    path_kinematics(d.site_xpos, d.cvel, d.subtree_com[1].copy(), path, pstart, mtu, seg_u)
+    for i in range(nm):
+        ms[i, 1] = equilibrium_fiber_length(mtu[i, 0], ms[i, 0], mp[i, 1], mp[i, 2], mp[i, 3])
+    u = np.zeros(nm)
+    table = layout.table_for(dt)
+    hist = np.zeros((history_length(layout, dt), 3 * nm + 2 * m.nq))
+    cs = np.zeros(4)
+    cs[0] = 3.0  # start in swing; the first contact starts a stance
+    cs[1] = 3.0
+    cp = model.contact_params
+    cstate = np.zeros((cp.shape[0], 1))
+    crec = np.zeros((cp.shape[0], 7))
+    lig = np.zeros(m.nv)
+    jp = model.joint_params
+    ix = model.dof("pelvis_tx")
+    iz = model.dof("pelvis_tz")
+    itilt = model.dof("pelvis_tilt")
+    knee_idx = np.array([model.dof(n) for n in ("knee_angle_l", "knee_angle_r")], dtype=np.int64)
+    thresholds = np.array(
+        [x[layout.index("stance_load_threshold_l")], x[layout.index("stance_load_threshold_r")]]
+    )
+    leg_length = float(model.stand_qpos[iz])
+    fall_height = 0.6 * leg_length
+    ranges = np.array([*settings.knee_load_range, *settings.pelvis_tilt_range_deg], dtype=float)
+    pen = np.array([settings.abs_penalty, settings.squared_penalty])
+    acc = np.zeros(4)
+    td = np.zeros((MAX_TOUCHDOWNS, 2))
+    bw, mass = model.body_weight, model.total_mass
+    n_steps = int(round(settings.duration / dt))
+    every = record_every if record_every > 0 else n_steps + 1
+    rec = _Recorder(model, n_steps, every)
+    f1, f2 = _step_addresses()
+    k, k_rec, fell = _run_controlled(
+        f1,
+        f2,
+        m._address,
+        d._address,
+        n_steps,
+        every,
+        dt,
+        iz,
+        fall_height,
+        d.qpos,
+        d.qvel,
+        d.site_xpos,
+        d.cvel,
+        d.subtree_com,
+        d.xipos,
+        d.xfrc_applied,
+        d.qfrc_applied,
+        mp,
+        ms,
+        mtu,
+        seg_u,
+        u,
+        path,
+        pstart,
+        cp,
+        cstate,
+        jp,
+        crec,
+        lig,
+        table,
+        x,
+        hist,
+        cs,
+        mb,
+        ix,
+        thresholds,
+        bw,
+        mass,
+        leg_length,
+        acc,
+        td,
+        knee_idx,
+        itilt,
+        ranges,
+        pen,
+        rec.t,
+        rec.q,
+        rec.v,
+        rec.ms,
+        rec.mtu,
+        rec.u,
+        rec.c,
+        rec.lig,
+    )
+    rec.k = k_rec
+    qpos = d.qpos
+    t_end = k * dt
+    distance = float(qpos[ix] - q0[ix]) if math.isfinite(qpos[ix]) else 0.0
+    ev = _evaluate(settings, acc, td[: int(acc[3])], t_end, distance, bool(fell), mass, q0[ix])
+    result = rec.result(dt, bool(fell), settings.duration) if record_every > 0 else None
+    return ev, result
+
+
+def _evaluate(settings, acc, td, t_end, distance, fell, mass, x0) -> Evaluation:
+    s = settings
+    v_min, v_max = s.speed - s.speed_tolerance, s.speed + s.speed_tolerance
+    times = np.concatenate([[0.0], td[:, 0]])
+    xs = np.concatenate([[x0], td[:, 1]])
+    credit = 0.0
+    for i in range(1, len(times)):
+        ts = times[i] - times[i - 1]
+        if ts <= 0:
+            continue
+        v = (xs[i] - xs[i - 1]) / ts
+        psi = v_min - v if v < v_min else (v - v_max if v > v_max else 0.0)
+        credit += ts * max(0.0, 1.0 - psi)
+    j_gait = max(0.0, 1.0 - credit / s.duration)
+    t = max(t_end, s.dt)
+    j_cot = acc[0] / (mass * max(distance, 1.0))
+    j_inj = acc[1] / t
+    j_lean = acc[2] / t
+    if not all(math.isfinite(v) for v in (j_cot, j_inj, j_lean)):
+        j_cot, j_inj, j_lean = 1e3, 1e3, 1e3
+    cost = s.w_cot * j_cot + s.w_gait * j_gait + s.w_inj * j_inj + s.w_lean * j_lean
+    return Evaluation(
+        cost=float(cost),
+        j_cot=float(j_cot),
+        j_gait=float(j_gait),
+        j_inj=float(j_inj),
+        j_lean=float(j_lean),
+        fell=bool(fell),
+        duration=float(t_end),
+        distance=float(distance),
+        mean_speed=float(distance / t) if t > 0 else 0.0,
+        metabolic_energy=float(acc[0]),
+        n_steps=int(len(td)),
+    )
+
+
+class _Recorder:
+    def __init__(self, model: RunnerModel, n_steps: int, every: int) -> None:
+        m = model.mj_model
+        nm = len(model.muscle_names)
+        nc = model.contact_params.shape[0]
+        n = n_steps // every + 1
+        self.model = model
+        self.k = 0
+        self.t = np.zeros(n)
+        self.q = np.zeros((n, m.nq))
+        self.v = np.zeros((n, m.nv))
+        self.ms = np.zeros((n, nm, 4))
+        self.mtu = np.zeros((n, nm, 2))
+        self.u = np.zeros((n, nm))
+        self.c = np.zeros((n, nc, 7))
+        self.lig = np.zeros((n, m.nv))
+
+    def add(self, t, q, v, ms, alen, avel, u, crec, lig) -> None:
+        k = self.k
+        self.t[k] = t
+        self.q[k] = q
+        self.v[k] = v
+        self.ms[k] = ms
+        self.mtu[k, :, 0] = alen
+        self.mtu[k, :, 1] = avel
+        self.u[k] = u
+        self.c[k] = crec
+        self.lig[k] = lig
+        self.k += 1
+
+    def result(self, dt: float, fell: bool, duration: float) -> RunnerResult:
+        s = slice(0, self.k)
+        return RunnerResult(
+            model=self.model,
+            time=self.t[s],
+            qpos=self.q[s],
+            qvel=self.v[s],
+            muscles=self.ms[s],
+            mtu=self.mtu[s],
+            excitation=self.u[s],
+            contacts=self.c[s],
+            ligament=self.lig[s],
+            dt=dt,
+            fell=fell,
+            requested_duration=duration,
+        )
+
+
+def evaluate(
+    model: RunnerModel,
+    x: np.ndarray,
+    *,
+    layout: ControllerLayout | None = None,
+    settings: ObjectiveSettings | None = None,
+) -> Evaluation:
+    """The objective of parameters ``x`` (one closed-loop simulation, no recording)."""
+    return simulate_controlled(model, x, layout=layout, settings=settings)[0]
+
+
+__all__ = [
+    "Evaluation",
+    "ObjectiveSettings",
+    "evaluate",
+    "initial_state",
+    "simulate_controlled",
+]

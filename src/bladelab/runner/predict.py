@@ -1,0 +1,414 @@
+"""Predictive simulation: optimise the reflex controller with CMA-ES (seed 001 §2.2).
+
+:func:`optimize_controller` runs ``cma``'s ask/tell loop; the candidates of a generation are
+evaluated in parallel (a persistent local process pool, or Ray), each one a closed-loop
+simulation (:func:`bladelab.runner.objective.simulate_controlled`) stopped early once the model
+has fallen. Sampling uses a seeded ``numpy.random.Generator`` (never NumPy's global one) and
+``cma`` writes no log files.
+
+Output folder (``out``):
+
+- ``checkpoint.pkl``: the full optimiser state (pickled ``cma.CMAEvolutionStrategy`` including its
+  random generator, generation, history, best), written atomically every ``checkpoint_every``
+  generations and at the end; ``resume=True`` continues from it to the same result as an
+  uninterrupted run (same settings, same seed);
+- ``best.json``: the best parameters so far (``--init`` file of a warm start), with the run's
+  settings and the best evaluation;
+- ``history.csv``: generation, evaluations, best, median and sigma per generation.
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+import os
+import pickle
+import sys
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from bladelab._io import atomic_open, atomic_path
+from bladelab.errors import InputFileError, OptimizationError
+from bladelab.runner.controller import ControllerLayout, controller_layout, write_parameters
+from bladelab.runner.objective import Evaluation, ObjectiveSettings, simulate_controlled
+
+CHECKPOINT_FORMAT = 1
+CHECKPOINT_NAME = "checkpoint.pkl"
+
+# per-process cache of built models: (kind, blade) -> (model, layout)
+_MODELS: dict[tuple[str, str | None], tuple[object, ControllerLayout]] = {}
+
+
+def _model(kind: str, blade: str | None):
+    key = (kind, blade if kind == "amputee" else None)
+    if key not in _MODELS:
+        from bladelab.runner.model import build_runner
+
+        model = build_runner(kind, blade=key[1])
+        _MODELS[key] = (model, controller_layout(model))
+    return _MODELS[key]
+
+
+def evaluate_candidates(payload: dict) -> list[dict]:
+    """Evaluate a batch of parameter vectors (a top-level function for worker processes).
+
+    ``payload``: ``model``, ``blade``, ``settings`` (ObjectiveSettings as a dict), ``xs`` (list
+    of vectors). Returns one :meth:`Evaluation.to_dict` per vector.
+    """
+    model, layout = _model(payload["model"], payload.get("blade"))
+    settings = _settings_from_dict(payload["settings"])
+    out = []
+    for x in payload["xs"]:
+        ev, _ = simulate_controlled(model, np.asarray(x, float), layout=layout, settings=settings)
+        out.append(ev.to_dict())
+    return out
+
+
+def _settings_from_dict(d: dict) -> ObjectiveSettings:
+    d = dict(d)
+    for key in ("knee_load_range", "pelvis_tilt_range_deg"):
+        if key in d:
+            d[key] = tuple(d[key])
+    return ObjectiveSettings(**d)
+
+
+class _Randn:
+    """``randn(*shape)`` for ``cma`` drawn from a seeded Generator (picklable)."""
+
+    def __init__(self, seed: int) -> None:
+        self.rng = np.random.default_rng(seed)
+
+    def __call__(self, *shape: int) -> np.ndarray:
+        return self.rng.standard_normal(shape)
+
+
+class _Evaluator:
+    """Evaluates a list of vectors: in-process, a persistent process pool, or Ray."""
+
+    def __init__(self, executor: str, jobs: int, base: dict) -> None:
+        self.executor, self.jobs, self.base = executor, max(1, int(jobs)), base
+        self._pool = None
+        self._ray = None
+        if executor not in ("local", "ray"):
+            raise OptimizationError(
+                f"unknown executor {executor!r}", where="executor", hint="use 'local' or 'ray'"
+            )
+        if executor == "ray":
+            from bladelab.study.executors import RayExecutor
+
+            self._ray = RayExecutor(self.jobs)
+        elif self.jobs > 1:
+            import multiprocessing
+            from concurrent.futures import ProcessPoolExecutor
+
+            method = "forkserver" if sys.platform.startswith("linux") else "spawn"
+            self._pool = ProcessPoolExecutor(
+                max_workers=self.jobs, mp_context=multiprocessing.get_context(method)
+            )
+
+    def __call__(self, xs: Sequence[np.ndarray]) -> list[dict]:
+        xs = [np.asarray(x, float).tolist() for x in xs]
+        if self._pool is None and self._ray is None:
+            return evaluate_candidates({**self.base, "xs": xs})
+        n = self.jobs
+        chunks = [xs[i::n] for i in range(n)]
+        payloads = [{**self.base, "xs": c} for c in chunks if c]
+        if self._pool is not None:
+            results = list(self._pool.map(evaluate_candidates, payloads))
+        else:
+            results = [None] * len(payloads)
+            for i, status, value in self._ray.run(evaluate_candidates, payloads):
+                if status != "ok":
+                    raise OptimizationError(f"evaluation failed on Ray: {value}")
+                results[i] = value
+        out: list[dict] = [{}] * len(xs)
+        for i, res in enumerate(results):
+            for j, ev in enumerate(res):
+                out[i + j * n] = ev
+        return out
+
+    def close(self) -> None:
+        if self._pool is not None:
+            self._pool.shutdown()
+            self._pool = None
+
+
+@dataclass(frozen=True)
+class OptimizationResult:
+    """Outcome of :func:`optimize_controller`."""
+
+    model: str
+    blade: str | None
+    speed: float
+    seed: int
+    generations: int
+    evaluations: int
+    best_cost: float
+    best: Evaluation
+    x: np.ndarray = field(repr=False)
+    history: tuple[tuple[int, int, float, float, float], ...] = field(repr=False)
+    out: str | None = None
+
+    def to_dict(self) -> dict:
+        return {
+            "model": self.model,
+            "blade": self.blade,
+            "speed_m_per_s": self.speed,
+            "seed": self.seed,
+            "generations": self.generations,
+            "evaluations": self.evaluations,
+            "best_cost": self.best_cost,
+            "best": self.best.to_dict(),
+            "out": self.out,
+        }
+
+
+def optimize_controller(
+    model: str = "able",
+    *,
+    blade: str | None = "Cat6",
+    speed: float = 3.5,
+    x0: np.ndarray | None = None,
+    generations: int = 100,
+    popsize: int = 16,
+    sigma: float = 1.0,
+    seed: int = 1,
+    jobs: int = 1,
+    executor: str = "local",
+    out: str | Path | None = None,
+    resume: bool = False,
+    checkpoint_every: int = 5,
+    settings: ObjectiveSettings | None = None,
+    progress: Callable[[int, float, float], None] | None = None,
+) -> OptimizationResult:
+    """Optimise the reflex controller of a runner with CMA-ES.
+
+    Parameters
+    ----------
+    model
+        ``"able"`` or ``"amputee"``.
+    blade
+        Blade category of the amputee (ignored for ``able``).
+    speed
+        Prescribed running speed [m/s] (initial speed and the centre of the step-speed band).
+    x0
+        Initial parameters (warm start); default SCONE's (:func:`controller_layout`).
+    generations
+        Number of CMA-ES generations in total (a resumed run continues up to this number).
+    popsize
+        Candidates per generation (λ).
+    sigma
+        Initial step size, in units of each parameter's initial scale (``layout.std``).
+    seed
+        Seed of the sampling generator.
+    jobs, executor
+        Parallel workers and ``"local"`` (process pool) or ``"ray"``.
+    out
+        Output folder (checkpoint, best.json, history.csv); None writes nothing.
+    resume
+        Continue from ``out/checkpoint.pkl``.
+    checkpoint_every
+        Write the checkpoint every this many generations.
+    settings
+        Objective settings (speed is taken from ``speed``).
+    progress
+        Called after each generation with (generation, best cost, generation median).
+    """
+    import cma
+
+    base_settings = settings or ObjectiveSettings()
+    settings = _settings_from_dict({**base_settings.to_dict(), "speed": float(speed)})
+    blade = blade if model == "amputee" else None
+    runner, layout = _model(model, blade)
+    del runner
+    out_dir = Path(out) if out is not None else None
+    if generations < 1 or popsize < 2:
+        raise OptimizationError("need generations >= 1 and popsize >= 2", where="generations")
+    ckpt = out_dir / CHECKPOINT_NAME if out_dir is not None else None
+    state = None
+    if resume:
+        if ckpt is None or not ckpt.exists():
+            raise InputFileError(
+                "no checkpoint to resume from",
+                file=ckpt,
+                hint="run without --resume first, with the same --out",
+            )
+        state = load_checkpoint(ckpt)
+        if (state["model"], state["blade"], state["speed"]) != (model, blade, float(speed)):
+            raise InputFileError(
+                f"checkpoint is for {state['model']} {state['blade']} at {state['speed']} m/s",
+                file=ckpt,
+                hint="resume with the same --model, --blade and --speed",
+            )
+        es = state["es"]
+        gen, evals = state["generation"], state["evaluations"]
+        history = list(state["history"])
+        best_x, best_f, best_ev = state["best_x"], state["best_f"], state["best_eval"]
+        seed = state["seed"]
+    else:
+        start = layout.x0 if x0 is None else np.asarray(x0, float)
+        if start.shape != (layout.size,):
+            raise OptimizationError(
+                f"initial guess has {start.size} values, the {model} controller {layout.size}",
+                where="init",
+            )
+        start = np.clip(start, layout.lower, layout.upper)
+        opts = {
+            "popsize": int(popsize),
+            "CMA_stds": layout.std.tolist(),
+            "bounds": [layout.lower.tolist(), layout.upper.tolist()],
+            "randn": _Randn(seed),
+            "seed": math.nan,
+            "verbose": -9,
+            "verb_log": 0,
+            "verb_disp": 0,
+            "verb_filenameprefix": os.devnull + "/",
+            "maxiter": math.inf,
+            "tolfun": 0.0,
+            "tolfunhist": 0.0,
+            "tolx": 0.0,
+            "tolstagnation": 10**9,
+            "tolflatfitness": 10**9,
+        }
+        es = cma.CMAEvolutionStrategy(start.tolist(), float(sigma), opts)
+        gen, evals, history = 0, 0, []
+        best_x, best_f, best_ev = start.copy(), math.inf, None
+    evaluator = _Evaluator(
+        executor, jobs, {"model": model, "blade": blade, "settings": settings.to_dict()}
+    )
+    try:
+        while gen < generations:
+            xs = es.ask()
+            evs = evaluator(xs)
+            fs = [e["cost"] for e in evs]
+            es.tell(xs, fs)
+            gen += 1
+            evals += len(xs)
+            i = int(np.argmin(fs))
+            if fs[i] < best_f:
+                best_f, best_x, best_ev = float(fs[i]), np.asarray(xs[i], float), evs[i]
+            history.append((gen, evals, best_f, float(np.median(fs)), float(es.sigma)))
+            if progress is not None:
+                progress(gen, best_f, float(np.median(fs)))
+            if out_dir is not None and (gen % checkpoint_every == 0 or gen == generations):
+                _save(
+                    out_dir,
+                    es,
+                    gen,
+                    evals,
+                    history,
+                    best_x,
+                    best_f,
+                    best_ev,
+                    layout,
+                    model,
+                    blade,
+                    float(speed),
+                    seed,
+                    settings,
+                )
+    finally:
+        evaluator.close()
+    best = Evaluation(**best_ev) if best_ev is not None else None
+    return OptimizationResult(
+        model=model,
+        blade=blade,
+        speed=float(speed),
+        seed=int(seed),
+        generations=gen,
+        evaluations=evals,
+        best_cost=best_f,
+        best=best,
+        x=best_x,
+        history=tuple(history),
+        out=str(out_dir) if out_dir is not None else None,
+    )
+
+
+def _save(
+    out_dir,
+    es,
+    gen,
+    evals,
+    history,
+    best_x,
+    best_f,
+    best_ev,
+    layout,
+    model,
+    blade,
+    speed,
+    seed,
+    settings,
+) -> None:
+    import cma
+
+    out_dir.mkdir(parents=True, exist_ok=True)
+    state = {
+        "format": CHECKPOINT_FORMAT,
+        "cma_version": cma.__version__,
+        "model": model,
+        "blade": blade,
+        "speed": speed,
+        "seed": seed,
+        "settings": settings.to_dict(),
+        "parameter_names": list(layout.names),
+        "es": es,
+        "generation": gen,
+        "evaluations": evals,
+        "history": history,
+        "best_x": best_x,
+        "best_f": best_f,
+        "best_eval": best_ev,
+    }
+    with atomic_path(out_dir / CHECKPOINT_NAME) as tmp:
+        tmp.write_bytes(pickle.dumps(state, protocol=4))
+    write_parameters(
+        out_dir / "best.json",
+        layout,
+        best_x,
+        blade=blade,
+        speed_m_per_s=speed,
+        generation=gen,
+        evaluations=evals,
+        seed=seed,
+        settings=settings.to_dict(),
+        evaluation=best_ev,
+    )
+    with atomic_open(out_dir / "history.csv", "w", newline="") as fh:
+        w = csv.writer(fh)
+        w.writerow(["generation", "evaluations", "best", "median", "sigma"])
+        w.writerows(history)
+
+
+def load_checkpoint(path: str | Path) -> dict:
+    """Read a checkpoint written by :func:`optimize_controller`."""
+    path = Path(path)
+    try:
+        state = pickle.loads(path.read_bytes())
+    except FileNotFoundError:
+        raise InputFileError("file not found", file=path) from None
+    except Exception as err:  # noqa: BLE001 - corrupt or incompatible pickle
+        raise InputFileError(
+            f"cannot read checkpoint ({type(err).__name__}: {err})",
+            file=path,
+            hint="warm-start a new run from best.json with --init instead",
+        ) from None
+    if not isinstance(state, dict) or state.get("format") != CHECKPOINT_FORMAT:
+        raise InputFileError(
+            "not a bladelab checkpoint of this format",
+            file=path,
+            hint="warm-start a new run from best.json with --init instead",
+        )
+    return state
+
+
+__all__ = [
+    "OptimizationResult",
+    "evaluate_candidates",
+    "load_checkpoint",
+    "optimize_controller",
+]
