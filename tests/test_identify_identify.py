@@ -14,7 +14,11 @@ from bladelab.blade import load_blade
 from bladelab.cli import main
 from bladelab.errors import DataError, OptimizationError
 from bladelab.identify.bounds import make_bounds
-from bladelab.identify.identify import compare_spring_locations, compare_spring_models, identify_stance
+from bladelab.identify.identify import (
+    compare_spring_locations,
+    compare_spring_models,
+    identify_stance,
+)
 from bladelab.sim.synthetic import generate_stance
 from bladelab.trial import write_stance_csv
 

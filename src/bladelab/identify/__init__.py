@@ -17,6 +17,12 @@ from bladelab.identify.identifiability import (
     assess_identifiability,
     cost_landscape,
 )
+from bladelab.identify.identify import (
+    Identification,
+    compare_spring_locations,
+    compare_spring_models,
+    identify_stance,
+)
 from bladelab.identify.optimizers import (
     CMAES,
     OptimizeResult,
@@ -31,13 +37,17 @@ __all__ = [
     "DAMPING_BOUNDS_NMS_PER_DEG",
     "CostTerms",
     "Identifiability",
+    "Identification",
     "OptimizeResult",
     "ParameterBounds",
     "ParticleSwarm",
     "StanceCost",
     "assess_identifiability",
+    "compare_spring_locations",
+    "compare_spring_models",
     "contact_window",
     "cost_landscape",
+    "identify_stance",
     "instantaneous_stiffness",
     "make_bounds",
     "make_optimizer",

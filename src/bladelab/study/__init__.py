@@ -5,7 +5,15 @@ See ``docs/study-yaml.md``.
 
 from bladelab.study.executors import LocalExecutor, RayExecutor, SerialExecutor, make_executor
 from bladelab.study.runner import StudyRun, run_study, trial_seed, variant_name
-from bladelab.study.spec import Athlete, BladeEntry, Configuration, Study, Trial, load_study, parse_study
+from bladelab.study.spec import (
+    Athlete,
+    BladeEntry,
+    Configuration,
+    Study,
+    Trial,
+    load_study,
+    parse_study,
+)
 from bladelab.study.store import ResultsStore, open_results
 
 __all__ = [
