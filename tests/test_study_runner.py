@@ -100,6 +100,9 @@ def test_run_skip_force_and_store(tmp_path):
     assert (again.finished, again.skipped) == (0, 4)
     forced = run_study(tmp_path, task=fake_task, progress=False, force=True)
     assert forced.finished == 4
+    # another seed changes the input hash: everything re-runs
+    assert run_study(tmp_path, task=fake_task, progress=False, seed=99).finished == 4
+    assert run_study(tmp_path, task=fake_task, progress=False, force=True).finished == 4
     with ResultsStore(tmp_path / "results.sqlite") as store:
         df = store.table()
     assert len(df) == 4 and set(df["status"]) == {"ok"}
@@ -209,3 +212,19 @@ def test_yaml_example_in_docs_is_valid(tmp_path):
     (tmp_path / "study.yaml").write_text(text)
     study, _ = load_study(tmp_path)
     assert study.identification.optimizer == "pso" and study.trials[0].stance == 1
+
+
+def interrupted_task(payload: dict) -> dict:
+    if payload["trial_id"] == "t2":
+        raise KeyboardInterrupt  # the user kills the run half-way
+    return fake_task(payload)
+
+
+def test_killed_run_keeps_finished_rows(tmp_path):
+    make_study(tmp_path)
+    with pytest.raises(KeyboardInterrupt):
+        run_study(tmp_path, task=interrupted_task, progress=False)
+    with ResultsStore(tmp_path / "results.sqlite") as store:
+        assert store.table()["trial_id"].tolist() == ["t0", "t1"]
+    resumed = run_study(tmp_path, task=fake_task, progress=False)
+    assert (resumed.finished, resumed.skipped) == (2, 2)

@@ -79,11 +79,8 @@ def _identify(
 def _identify_study(path: Path, *, blade, seed, as_json, jobs, executor, force, settings) -> None:
     from bladelab.study.runner import run_study
 
-    if seed is not None:
-        raise SpecError("--seed applies to a single stance; a study takes its seed from study.yaml",
-                        where="--seed", hint="set 'seed:' in study.yaml")
     run = run_study(path, blade=blade, settings=settings, jobs=jobs, executor=executor, force=force,
-                    progress=not as_json)
+                    progress=not as_json, seed=seed)
     if as_json:
         typer.echo(json.dumps(run.to_dict(), indent=2))
     else:

@@ -151,6 +151,7 @@ def run_study(
     force: bool = False,
     progress: bool = True,
     task: Callable[[dict], dict] | str = DEFAULT_TASK,
+    seed: int | None = None,
 ) -> StudyRun:
     """Run every trial of a study folder and store the results in its ``results.sqlite``.
 
@@ -174,11 +175,15 @@ def run_study(
     task
         ``task(payload) -> dict`` of result columns, top-level importable (or ``"module:function"``).
         The default identifies K and D (:func:`bladelab.study.tasks.identify_trial`).
+    seed
+        Replaces the study's seed (per-trial seeds are derived from it and the trial ids).
     """
     from tqdm import tqdm
 
     t0 = time.perf_counter()
     study, folder = load_study(study_dir)
+    if seed is not None:
+        study = study.model_copy(update={"seed": int(seed)})
     merged = study.identification.model_dump(mode="json")
     if settings:
         from bladelab.study.spec import IdentificationSettings
