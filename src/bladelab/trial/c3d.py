@@ -23,6 +23,7 @@ The lab frame
 
 from __future__ import annotations
 
+import os
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
@@ -106,7 +107,12 @@ def read_c3d(
     analog_labels = (analog_labels + [f"ANALOG{i + 1}" for i in range(n_analog)])[:n_analog]
     analog_rate = float(c3d["header"]["analogs"]["frame_rate"])
 
-    plates_file = _read_platforms(path, params, analogs_arr, analog_labels, analog_units, analog_rate)
+    # a file without analog data (e.g. a static trial) recorded no platform signals
+    plates_file = (
+        _read_platforms(path, params, analogs_arr, analog_labels, analog_units, analog_rate)
+        if n_analog and analogs_arr.shape[1]
+        else []
+    )
 
     # file axes -> lab axes
     up_vec = _choose_up(up, plates_file, path)
@@ -155,6 +161,17 @@ def _open_c3d(path: Path):
             "not a C3D file (no C3D header)", file=path,
             hint="export the trial as C3D from the motion-capture software",
         )
+    # ezc3d can hang on a file cut inside its parameter section: check that the file reaches
+    # the data block announced by the header (word 9) before handing it over.
+    data_start = int.from_bytes(head[16:18], "little")
+    param_start = head[0]
+    size = path.stat().st_size
+    if data_start < 2 or param_start < 1 or size < (data_start - 1) * 512:
+        raise InputFileError(
+            f"truncated: {size} bytes, but the header puts the data block at byte "
+            f"{max(data_start - 1, 0) * 512}", file=path,
+            hint="re-export it from the motion-capture software",
+        )
     try:
         c3d = ezc3d.c3d(str(path))
     except Exception as err:  # ezc3d raises RuntimeError/IOError on corrupt files
@@ -162,39 +179,29 @@ def _open_c3d(path: Path):
             f"cannot be read as C3D ({err}); the file looks truncated or corrupt", file=path,
             hint="re-export it from the motion-capture software",
         ) from err
-    # ezc3d may read a truncated data block without complaint: check the size.
-    header = c3d["header"]
-    n_frames = header["points"]["last_frame"] - header["points"]["first_frame"] + 1
+    # ezc3d reads a truncated data block without complaint (it shortens last_frame): compare
+    # the frames it got with the count the raw header announces.
     got = np.asarray(c3d["data"]["points"]).shape[-1]
-    expected_bytes = _expected_size(path, c3d)
-    if got < n_frames or (expected_bytes is not None and path.stat().st_size < expected_bytes):
+    announced = _announced_frames(head)
+    if announced is not None and got < announced:
         raise InputFileError(
-            f"truncated: the header announces {n_frames} frames but the data block is shorter",
+            f"truncated: the file announces {announced} frames but holds only {got}",
             file=path, hint="re-export it from the motion-capture software",
         )
     return c3d
 
 
-def _expected_size(path: Path, c3d) -> int | None:
-    """Minimum file size [bytes] implied by the header (data start + frames × frame size)."""
-    try:
-        with open(path, "rb") as fh:
-            head = fh.read(512)
-        data_start_block = int.from_bytes(head[16:18], "little")
-        scale = float(np.frombuffer(head[12:16], dtype="<f4")[0])
-    except (OSError, ValueError):
+def _announced_frames(head: bytes) -> int | None:
+    """Number of frames the raw header announces (words 4–5), None when saturated.
+
+    ezc3d silently shortens ``last_frame`` and ``POINT:FRAMES`` of a truncated file, so the
+    count is taken from the header bytes themselves.
+    """
+    first = int.from_bytes(head[6:8], "little")
+    last = int.from_bytes(head[8:10], "little")
+    if last >= 65535 or last < first:
         return None
-    header = c3d["header"]
-    n_frames = header["points"]["last_frame"] - header["points"]["first_frame"] + 1
-    n_points = header["points"]["size"]
-    n_analog_per_frame = int(round(header["analogs"]["size"] * header["analogs"]["frame_rate"]
-                                   / max(header["points"]["frame_rate"], 1e-9)))
-    word = 4 if scale < 0 else 2
-    frame_bytes = (4 * n_points + n_analog_per_frame) * word
-    if data_start_block < 1:
-        return None
-    # the last frame need not fill its block: require all frames except a partial last one
-    return (data_start_block - 1) * 512 + max(n_frames - 1, 0) * frame_bytes
+    return last - first + 1
 
 
 def _param(params, group: str, name: str, default):
@@ -607,5 +614,13 @@ def write_c3d(
                 [float(value)] if isinstance(value, (int, float)) else [str(value)],
             )
     with atomic_path(path) as tmp:
-        c3d.write(str(tmp))
+        # ezc3d appends ".c3d" to a name without it: write there, then move onto the temp name
+        written = tmp if tmp.suffix.lower() == ".c3d" else tmp.with_name(tmp.name + ".c3d")
+        try:
+            c3d.write(str(written))
+            if written != tmp:
+                os.replace(written, tmp)
+        finally:
+            if written != tmp and written.exists():
+                written.unlink()
     return path
