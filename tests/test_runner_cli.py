@@ -104,3 +104,25 @@ def test_blades_listing(capsys):
     assert main(["runner", "blades", "--json"]) == 0
     rows = json.loads(capsys.readouterr().out)
     assert [r["name"] for r in rows] == ["Cat4", "Cat5", "Cat6", "Cat6High", "Cat7"]
+
+
+def test_simulate_wearing_a_multilink_blade(capsys):
+    code = main(
+        [
+            "runner",
+            "simulate",
+            "--wear",
+            "xtreme-cat5",
+            "--K",
+            "16",
+            "--D",
+            "0.25",
+            "--duration",
+            "0.05",
+            "--json",
+        ]
+    )
+    assert code == 0
+    assert json.loads(capsys.readouterr().out)["blade"] == "xtreme-cat5"
+    assert main(["runner", "simulate", "--wear", "nope", "--duration", "0.05"]) == 2
+    assert "nope" in capsys.readouterr().err

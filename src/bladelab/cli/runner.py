@@ -60,16 +60,56 @@ def _read_controller(path: Path, muscle_names: tuple[str, ...]) -> list[float]:
     return out
 
 
+def _wear(name: str, links: int | None, k_deg: float | None, d_deg: float | None):
+    """A BladeModel from the blade module, with optional link count and K*, D*."""
+    import numpy as np
+
+    from bladelab.blade import load_blade, multilink_blade
+    from bladelab.units import damping_per_deg_to_per_rad, stiffness_per_deg_to_per_rad
+
+    if links is not None:
+        return multilink_blade(name, n_links=links, K_Nm_per_deg=k_deg, D_Nms_per_deg=d_deg)
+    blade = load_blade(name).build()
+    if k_deg is not None or d_deg is not None:
+        n = len(blade.joints)
+        k = (
+            [j.stiffness for j in blade.joints]
+            if k_deg is None
+            else [stiffness_per_deg_to_per_rad(k_deg)] * n
+        )
+        d = (
+            [j.damping for j in blade.joints]
+            if d_deg is None
+            else [damping_per_deg_to_per_rad(d_deg)] * n
+        )
+        blade = blade.with_joint_parameters(np.array(k, float), np.array(d, float))
+    return blade
+
+
 @runner_app.command("simulate")
 def simulate_cmd(
     model: str = typer.Option("amputee", "--model", help="able or amputee."),
     blade: str = typer.Option("Cat6", "--blade", help="Blade category (amputee): Cat4..Cat7."),
     params: Path | None = typer.Option(None, "--params", help="Runner parameter YAML file."),
+    wear: str | None = typer.Option(
+        None,
+        "--wear",
+        help="Wear a multi-link blade (built-in name or blade spec YAML) instead of the sphere.",
+    ),
+    links: int | None = typer.Option(
+        None, "--links", help="With --wear: regroup into this many links (seed 002)."
+    ),
+    k_deg: float | None = typer.Option(
+        None, "--K", help="With --wear: joint stiffness K* [N·m/deg] (identified)."
+    ),
+    d_deg: float | None = typer.Option(
+        None, "--D", help="With --wear: joint damping D* [N·m·s/deg] (identified)."
+    ),
     controller: Path | None = typer.Option(
         None, "--controller", help="Controller JSON (constant excitations); none: 0.05 for all."
     ),
     duration: float = typer.Option(10.0, "--duration", help="Simulated time [s]."),
-    dt: float = typer.Option(5e-4, "--dt", help="Time step [s]."),
+    dt: float = typer.Option(5e-4, "--dt", help="Time step [s] (1e-4 with --wear)."),
     initial_state: str = typer.Option("stand", "--initial-state", help="stand or gait."),
     speed: float = typer.Option(0.0, "--speed", help="Initial forward speed [m/s]."),
     out: Path | None = typer.Option(None, "--out", help="Folder for the CSV/JSON outputs."),
@@ -85,6 +125,13 @@ def simulate_cmd(
         raise SpecError("must be positive", where="--duration")
     if initial_state not in ("stand", "gait"):
         raise SpecError(f"unknown initial state {initial_state!r}", where="--initial-state")
+    blade_model = None
+    if wear is not None:
+        if model != "amputee":
+            raise SpecError("only the amputee model wears a blade", where="--wear")
+        blade_model = _wear(wear, links, k_deg, d_deg)
+        if dt == 5e-4:
+            dt = 1e-4  # the blade's sole contact needs a finer step
     if params is not None:
         p = load_runner_params(params)
         if p.kind != model:
@@ -94,9 +141,13 @@ def simulate_cmd(
                 where="kind",
                 hint=f"use --model {p.kind}",
             )
-        runner = build_runner(p, blade=blade if model == "amputee" else None)
+        runner = build_runner(
+            p, blade=blade if model == "amputee" else None, blade_model=blade_model
+        )
     else:
-        runner = build_runner(model, blade=blade if model == "amputee" else None)
+        runner = build_runner(
+            model, blade=blade if model == "amputee" else None, blade_model=blade_model
+        )
     excitations = None
     if controller is not None:
         excitations = _read_controller(controller, runner.muscle_names)

@@ -312,6 +312,12 @@ def leg_energy(result: RunnerResult, *, threshold_n: float = CONTACT_THRESHOLD_N
     )
 
 
+def _blade_name(model) -> str | None:
+    if model.kind != "amputee":
+        return None
+    return model.blade_model.name if model.blade_model is not None else model.params.blade
+
+
 def summary(result: RunnerResult) -> dict:
     """The JSON summary: fell, duration_s, mean_speed_mps, contact times per leg,
     power_balance_residual_pct, and the spatiotemporal means."""
@@ -327,7 +333,7 @@ def summary(result: RunnerResult) -> dict:
 
     out = {
         "model": result.model.kind,
-        "blade": result.model.params.blade if result.model.kind == "amputee" else None,
+        "blade": _blade_name(result.model),
         "fell": bool(result.fell),
         "duration_s": dur,
         "mean_speed_mps": speed,

@@ -22,14 +22,19 @@ from llvmlite import ir
 from numba import njit, types
 from numba.extending import intrinsic
 
-from bladelab.contact import hunt_crossley_force
+from bladelab.contact import hunt_crossley_force, smooth_spring_damper_force
 from bladelab.runner.model import (
+    CP_AZ,
     CP_BODY,
     CP_C,
+    CP_DAMP,
+    CP_EXP,
     CP_K,
+    CP_LAW,
     CP_MU,
     CP_RADIUS,
     CP_SITE,
+    CP_WIDTH,
     FRICTION_DAMPING,
     FRICTION_STIFFNESS,
     JP_D,
@@ -125,6 +130,7 @@ def forces(
     qpos,
     qvel,
     site_xpos,
+    site_xmat,
     cvel,
     root_com,
     xipos,
@@ -191,20 +197,33 @@ def forces(
             tau -= jp[j, JP_SK] * q + jp[j, JP_SK2] * q * abs(q) + jp[j, JP_SD] * qd
         qfrc[j] = tau
         lig[j] = tau
-    # ground contacts
+    # ground contacts: sphere or ellipse (semi-axes ax, az in the site's x-z plane)
     for c in range(cp.shape[0]):
         site = int(cp[c, CP_SITE])
         body = int(cp[c, CP_BODY])
-        r = cp[c, CP_RADIUS]
-        depth = r - site_xpos[site, 2]
-        px, py, pz = site_xpos[site, 0], site_xpos[site, 1], site_xpos[site, 2] - r
+        ax = cp[c, CP_RADIUS]
+        az = cp[c, CP_AZ]
+        exx, exz = site_xmat[site, 0], site_xmat[site, 6]  # site x axis (world x, z)
+        ezx, ezz = site_xmat[site, 2], site_xmat[site, 8]  # site z axis
+        h = math.sqrt((ax * exz) ** 2 + (az * ezz) ** 2)
+        ct = -ax * exz / h
+        st = -az * ezz / h
+        px = site_xpos[site, 0] + ax * ct * exx + az * st * ezx
+        py = site_xpos[site, 1]
+        pz = site_xpos[site, 2] - h
+        depth = h - site_xpos[site, 2]
         rx, ry, rz = px - root_com[0], py - root_com[1], pz - root_com[2]
         vx = cvel[body, 3] + cvel[body, 1] * rz - cvel[body, 2] * ry
         vz = cvel[body, 5] + cvel[body, 0] * ry - cvel[body, 1] * rx
         fn = 0.0
         ft = 0.0
         if depth > 0.0:
-            fn = hunt_crossley_force(depth, -vz, cp[c, CP_K], 1.5, cp[c, CP_C])
+            if cp[c, CP_LAW] == 0.0:
+                fn = hunt_crossley_force(depth, -vz, cp[c, CP_K], cp[c, CP_EXP], cp[c, CP_C])
+            else:
+                fn = smooth_spring_damper_force(
+                    depth, -vz, cp[c, CP_K], cp[c, CP_DAMP], cp[c, CP_WIDTH]
+                )
             s = cstate[c, 0] + vx * dt
             ft = -FRICTION_STIFFNESS * s - FRICTION_DAMPING * vx
             lim = cp[c, CP_MU] * fn
@@ -241,6 +260,7 @@ def run_loop(
     qpos,
     qvel,
     site_xpos,
+    site_xmat,
     cvel,
     subtree_com,
     xipos,
@@ -282,6 +302,7 @@ def run_loop(
             qpos,
             qvel,
             site_xpos,
+            site_xmat,
             cvel,
             root_com,
             xipos,

@@ -23,9 +23,11 @@ from dataclasses import dataclass, field
 import mujoco
 import numpy as np
 
+from bladelab.blade.model import BladeModel
 from bladelab.contact import hertz_sphere_stiffness
 from bladelab.errors import ModelError
 from bladelab.runner import geometry as geo
+from bladelab.runner.multilink import add_multilink_blade, multilink_contact_rows
 from bladelab.runner.params import (
     BLADE_ALIGNMENT_DEG,
     BLADE_DISSIPATION_S_PER_M,
@@ -66,6 +68,8 @@ FRICTION_DAMPING = 200.0
 
 # Columns of RunnerModel.contact_params.
 CP_SITE, CP_BODY, CP_RADIUS, CP_K, CP_C, CP_MU, CP_LEG, CP_BLADE = range(8)
+CP_AZ, CP_LAW, CP_EXP, CP_DAMP, CP_WIDTH = range(8, 13)
+LAW_HUNT_CROSSLEY, LAW_SPRING_DAMPER = 0, 1
 # Columns of RunnerModel.joint_params (one row per dof).
 JP_LO, JP_HI, JP_K, JP_D, JP_SK, JP_SK2, JP_SD = range(7)
 
@@ -93,8 +97,11 @@ class RunnerModel:
         Muscle path points as (site id, body id) rows; muscle i uses rows
         ``path_start[i]:path_start[i+1]`` (origin to insertion).
     contact_params
-        (n_contacts, 8): site id, body id, radius [m], Hertz k [N/m^1.5], dissipation [s/m],
-        friction [-], leg (0 = left/intact, 1 = right/prosthetic), is_blade (0/1).
+        (n_contacts, 13): site id, body id, radius or x semi-axis [m], stiffness k [N/m^n],
+        dissipation [s/m], friction [-], leg (0 = left/intact, 1 = right/prosthetic), is_blade
+        (0/1), z semi-axis [m], law (0 Hunt–Crossley, 1 smooth spring–damper), exponent n,
+        damping [N·s/m] and transition width [m] (spring–damper). Spheres have equal semi-axes;
+        the multi-link blade's soles are ellipses in the site's x–z plane.
     joint_params
         (n_dof, 7): ligament lower, upper [rad], stiffness [N·m/rad], damping [N·m·s/rad], spring
         K [N·m/rad], K2 [N·m/rad²], D [N·m·s/rad] (the socket's).
@@ -118,6 +125,7 @@ class RunnerModel:
     joint_params: np.ndarray
     blade_modulus: float
     stand_qpos: np.ndarray = field(repr=False)
+    blade_model: BladeModel | None = None
 
     @property
     def kind(self) -> str:
@@ -149,7 +157,9 @@ class RunnerModel:
     def to_dict(self) -> dict:
         return {
             "kind": self.kind,
-            "blade": self.params.blade if self.kind == "amputee" else None,
+            "blade": None
+            if self.kind != "amputee"
+            else (self.blade_model.name if self.blade_model is not None else self.params.blade),
             "total_mass_kg": self.total_mass,
             "dof": list(self.dof_names),
             "muscles": {
@@ -183,7 +193,10 @@ def _sub(
 
 
 def build_runner(
-    params: RunnerParams | str = "amputee", *, blade: str | None = None
+    params: RunnerParams | str = "amputee",
+    *,
+    blade: str | None = None,
+    blade_model: BladeModel | None = None,
 ) -> RunnerModel:
     """Build a runner model from a parameter set (or the name ``"able"`` / ``"amputee"``).
 
@@ -193,12 +206,18 @@ def build_runner(
         A :class:`RunnerParams` or the name of a built-in parameter set.
     blade
         Override the blade category of an amputee parameter set (e.g. ``"Cat5"``).
+    blade_model
+        Wear this multi-link blade (:class:`bladelab.blade.BladeModel`, e.g. with identified K*
+        and D*) instead of the category's contact sphere (amputee only; see
+        :mod:`bladelab.runner.multilink`; needs a step of about 1e-4 s).
     """
     if isinstance(params, str):
         params = default_runner_params(params, blade=blade)
     elif blade is not None:
         params = runner_params_from_dict({**params.model_dump(), "blade": blade})
     amputee = params.kind == "amputee"
+    if blade_model is not None and not amputee:
+        raise ModelError("only the amputee model wears a blade", where="blade_model")
     mr, s = scale_ratios(params)
 
     spec = mujoco.MjSpec()
@@ -251,7 +270,20 @@ def build_runner(
             res_len = geo.RESIDUAL_TIBIA_FRACTION * geo.TIBIA_LENGTH_M
             com = [0.0, 0.0, -0.5 * res_len * s]
             add("tibia_res_r", "tibia_res_r", "knee_r", "knee_angle_r", "femur_r", pp, pc, com=com)
-            _add_prosthesis(bodies, joint_child, params, s, mr, res_len, axis)
+            if blade_model is None:
+                _add_prosthesis(bodies, joint_child, params, s, mr, res_len, axis)
+            else:
+                add_multilink_blade(
+                    bodies,
+                    joint_child,
+                    params,
+                    s,
+                    mr,
+                    res_len,
+                    axis,
+                    blade_model,
+                    _prosthetic_bottom(s, res_len),
+                )
         else:
             add(
                 f"tibia_{side}",
@@ -344,10 +376,19 @@ def build_runner(
                     FOOT_FRICTION,
                     leg,
                     0,
+                    geo.FOOT_SPHERE_RADIUS_M * s,
+                    LAW_HUNT_CROSSLEY,
+                    1.5,
+                    0.0,
+                    0.0,
                 )
             )
     e_blade = math.nan
-    if amputee:
+    if amputee and blade_model is not None:
+        for i, row in enumerate(multilink_contact_rows(model, blade_model)):
+            contacts.append(f"blade_sole{i}")
+            rows.append(row)
+    elif amputee:
         e_blade = blade_contact_modulus(params)
         site = model.site("blade_r")
         contacts.append("blade_r")
@@ -361,6 +402,11 @@ def build_runner(
                 BLADE_FRICTION,
                 1,
                 1,
+                BLADE_RADIUS_M,
+                LAW_HUNT_CROSSLEY,
+                1.5,
+                0.0,
+                0.0,
             )
         )
     cp = np.array(rows, dtype=np.float64)
@@ -374,6 +420,9 @@ def build_runner(
             jp[i, :4] = (math.radians(lo), math.radians(hi), k, d)
         if dn == "socket_angle_r":
             jp[i, JP_SK:] = (SOCKET_STIFFNESS, SOCKET_STIFFNESS_QUADRATIC, SOCKET_DAMPING)
+        if dn.startswith("blade_joint") and blade_model is not None:
+            j = blade_model.joints[int(dn.removeprefix("blade_joint"))]
+            jp[i, JP_SK:] = (j.stiffness, j.stiffness_quadratic, j.damping)
 
     runner = RunnerModel(
         params=params,
@@ -390,9 +439,17 @@ def build_runner(
         joint_params=jp,
         blade_modulus=e_blade,
         stand_qpos=np.zeros(model.nq),
+        blade_model=blade_model,
     )
     runner.stand_qpos[:] = _standing_pose(runner)
     return runner
+
+
+def _prosthetic_bottom(s: float, res_len: float) -> float:
+    """Depth [m] below the socket of the prosthetic leg's lowest point: the straight prosthetic
+    leg is 3 cm longer (knee to ground) than the intact one."""
+    intact = geo.TIBIA_LENGTH_M + geo.JOINTS["ankle_l"][2][1] + 0.015 + geo.FOOT_SPHERE_RADIUS_M
+    return (intact + BLADE_EXTRA_LENGTH_M) * s - res_len * s
 
 
 def _add_prosthesis(bodies, joint_child, params, s, mr, res_len, axis) -> None:
@@ -402,9 +459,7 @@ def _add_prosthesis(bodies, joint_child, params, s, mr, res_len, axis) -> None:
     that offset turned by the 9° alignment (seed 001 Fig. 2.3, our reading), and low enough that
     the prosthetic leg is 3 cm longer than the intact leg (knee to ground, straight leg).
     """
-    # knee -> ground of the intact leg: tibia + ankle-to-sphere-bottom
-    intact = geo.TIBIA_LENGTH_M + geo.JOINTS["ankle_l"][2][1] + 0.015 + geo.FOOT_SPHERE_RADIUS_M
-    bottom = (intact + BLADE_EXTRA_LENGTH_M) * s - res_len * s  # below the socket
+    bottom = _prosthetic_bottom(s, res_len)
     centre = (0.0, -(bottom - BLADE_RADIUS_M))  # (x, z) in the socket frame
     ox, oz = geo.rotate_pitch(
         BLADE_OFFSET_A_M * s, -BLADE_OFFSET_B_M * s, math.radians(BLADE_ALIGNMENT_DEG)
@@ -428,8 +483,13 @@ def contact_heights(runner: RunnerModel, qpos: np.ndarray) -> np.ndarray:
     data = mujoco.MjData(runner.mj_model)
     data.qpos[:] = qpos
     mujoco.mj_kinematics(runner.mj_model, data)
-    cp = runner.contact_params
-    return np.array([data.site_xpos[int(r[CP_SITE]), 2] - r[CP_RADIUS] for r in cp])
+    out = []
+    for r in runner.contact_params:
+        site = int(r[CP_SITE])
+        xm = data.site_xmat[site]
+        h = math.hypot(r[CP_RADIUS] * xm[6], r[CP_AZ] * xm[8])
+        out.append(data.site_xpos[site, 2] - h)
+    return np.array(out)
 
 
 def _standing_pose(runner: RunnerModel) -> np.ndarray:
@@ -438,12 +498,13 @@ def _standing_pose(runner: RunnerModel) -> np.ndarray:
     if runner.kind == "amputee":
         iknee = runner.dof("knee_angle_r")
         ihip = runner.dof("hip_flexion_r")
-        lo, hi = -0.8, 0.0
+        lo, hi = -1.5, 0.0
         for _ in range(50):  # bisection: blade bottom level with the intact foot
             mid = 0.5 * (lo + hi)
             q[iknee], q[ihip] = mid, -0.5 * mid
             h = contact_heights(runner, q)
-            if h[-1] < h[:-1].min():
+            blade = runner.contact_params[:, CP_BLADE] == 1
+            if h[blade].min() < h[~blade].min():
                 hi = mid
             else:
                 lo = mid

@@ -1,0 +1,141 @@
+"""Wear a multi-link blade (:class:`bladelab.blade.BladeModel`) on the amputee runner.
+
+This links the characterise and predict workflows: a blade whose compliant joints carry
+identified K* and D* (``BladeModel.with_joint_parameters``) replaces seed 001's massless contact
+sphere. Placement (our choice, see docs/runner-model.md): the blade's clamp frame (x forward,
+z up along the pylon) is aligned with the socket frame, its origin 3 cm behind the socket axis
+and at the height that puts the lowest sole point of the undeformed blade 3 cm below the intact
+foot (straight legs), like the sphere model. Runs of rigidly joined segments become one MuJoCo
+body each (composite mass, COM and sagittal inertia); every compliant joint is a hinge about +y
+(the blade module's sign) with ``τ = −(K·q + K2·q·|q|) − D·q̇``. The socket body keeps Table
+2.1's prosthesis mass minus the blade's mass. The soles are ellipse contacts with the blade's
+own contact law (smooth spring–damper or Hunt–Crossley) and friction cap ``friction_kinetic``.
+
+The blade's contact stiffness (about 1e6 N/m on links of a few hundred grams) needs a time step
+of about 1e-4 s; the sphere model runs at 5e-4 s.
+"""
+
+from __future__ import annotations
+
+import math
+
+import mujoco
+import numpy as np
+
+from bladelab.blade.model import BladeModel
+from bladelab.errors import ModelError
+
+CLAMP_OFFSET_X_M = -0.03
+
+
+def _links(blade: BladeModel) -> list[list[int]]:
+    """Segments of each rigid link (split at the compliant joints' points)."""
+    cuts = sorted(j.point for j in blade.joints)
+    links, start = [], 0
+    for c in cuts + [blade.n_segments]:
+        links.append(list(range(start, c)))
+        start = c
+    return links
+
+
+def _sole_lowest_z(blade: BladeModel) -> float:
+    """Lowest sole point z [m] in the clamp frame, undeformed."""
+    low = math.inf
+    for sole in blade.soles:
+        # ellipse x axis at angle a about +y: ex = (cos a, −sin a) in (x, z); ez = (sin a, cos a)
+        h = math.hypot(
+            sole.semi_axis_x * math.sin(sole.angle), sole.semi_axis_z * math.cos(sole.angle)
+        )
+        low = min(low, sole.center[1] - h)
+    return low
+
+
+def add_multilink_blade(bodies, joint_child, params, s, mr, res_len, axis, blade, bottom) -> None:
+    """Add the socket body and the blade's links under the residual tibia (MjSpec)."""
+    if not blade.soles or not blade.joints:
+        raise ModelError(
+            "the blade needs at least one sole and one compliant joint", where="blade_model"
+        )
+    seg = params.segments["prosthesis_r"]
+    socket_mass = seg.mass_kg * mr - blade.mass
+    if socket_mass <= 0:
+        raise ModelError(
+            f"blade mass {blade.mass:.2f} kg exceeds the prosthesis mass {seg.mass_kg * mr:.2f} kg",
+            where="blade_model",
+            hint="the Table 2.1 prosthesis mass includes socket and blade",
+        )
+    body = bodies["tibia_res_r"].add_body(name="prosthesis_r", pos=[0.0, 0.0, -res_len * s])
+    body.add_joint(name="socket_angle_r", type=mujoco.mjtJoint.mjJNT_HINGE, axis=axis)
+    ixx, iyy, izz = seg.inertia_kg_m2
+    f = socket_mass / seg.mass_kg * s * s
+    body.explicitinertial = True
+    body.mass = socket_mass
+    body.ipos = [0.0, 0.0, 0.05 * s]
+    body.inertia = [max(ixx * f, izz * f - iyy * f + 1e-6), izz * f, iyy * f]
+    bodies["prosthesis_r"] = body
+    joint_child["prosthesis_r"] = (0.0, 0.0, 0.0)
+    clamp = np.array([CLAMP_OFFSET_X_M, -bottom - _sole_lowest_z(blade)])
+    parent, prev = body, None
+    pts = np.asarray(blade.points, float)
+    links = _links(blade)
+    joint_points = [0] + sorted(j.point for j in blade.joints)
+    for n, (segs, jp_idx) in enumerate(zip(links, joint_points, strict=True)):
+        m = float(np.sum(blade.segment_mass[segs]))
+        com = np.sum(blade.segment_com[segs] * blade.segment_mass[segs, None], axis=0) / m
+        iy = float(
+            np.sum(
+                blade.segment_inertia[segs]
+                + blade.segment_mass[segs] * np.sum((blade.segment_com[segs] - com) ** 2, axis=1)
+            )
+        )
+        rel = clamp if prev is None else pts[jp_idx] - pts[prev]  # in the parent's frame
+        pos = [rel[0], 0.0, rel[1]]
+        link = parent.add_body(name=f"blade_link{n}", pos=pos)
+        if n:
+            link.add_joint(
+                name=f"blade_joint{n - 1}", type=mujoco.mjtJoint.mjJNT_HINGE, axis=[0.0, 1.0, 0.0]
+            )
+        link.explicitinertial = True
+        link.mass = m
+        c = com - pts[jp_idx]
+        link.ipos = [c[0], 0.0, c[1]]
+        link.inertia = [iy, iy, iy]
+        for k, sole in enumerate(blade.soles):
+            if sole.segment in segs:
+                p = np.asarray(sole.center) - pts[jp_idx]
+                link.add_site(
+                    name=f"blade_sole{k}",
+                    pos=[p[0], 0.0, p[1]],
+                    quat=[math.cos(sole.angle / 2), 0.0, math.sin(sole.angle / 2), 0.0],
+                    size=[sole.semi_axis_x, sole.semi_axis_z, sole.semi_axis_z],
+                )
+        parent, prev = link, jp_idx
+
+
+def multilink_contact_rows(model: mujoco.MjModel, blade: BladeModel) -> list[tuple]:
+    """Contact parameter rows (``RunnerModel.contact_params`` layout) of the blade's soles."""
+    from bladelab.runner.model import LAW_HUNT_CROSSLEY, LAW_SPRING_DAMPER
+
+    c = blade.contact
+    law = LAW_HUNT_CROSSLEY if c.law == "hunt_crossley" else LAW_SPRING_DAMPER
+    rows = []
+    for k, sole in enumerate(blade.soles):
+        site = model.site(f"blade_sole{k}").id
+        rows.append(
+            (
+                site,
+                model.site_bodyid[site],
+                sole.semi_axis_x,
+                c.stiffness,
+                c.dissipation,
+                c.friction_kinetic,
+                1,
+                1,
+                sole.semi_axis_z,
+                law,
+                c.exponent,
+                c.damping,
+                c.transition_width,
+            )
+        )
+    return rows
