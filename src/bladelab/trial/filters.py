@@ -1,7 +1,7 @@
 """Zero-lag Butterworth low-pass filtering that respects gaps (fill, filter, restore).
 
 Marker trajectories have gaps (NaN). As in kineticstoolkit, short interior gaps are filled
-(shape-preserving cubic interpolation), the signal is filtered forward and backward, and the
+(cubic spline through the valid samples), the signal is filtered forward and backward, and the
 gaps are restored to NaN afterwards so that filtering never invents data. An interior gap longer
 than ``max_gap`` [s] is an error (it cannot be filled reliably); leading and trailing gaps are
 left as they are and only the valid span is filtered.
@@ -31,7 +31,7 @@ def fill_gaps(
     where: str = "signal",
     file: str | Path | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Fill interior NaN gaps of at most ``max_gap`` seconds by PCHIP interpolation.
+    """Fill interior NaN gaps of at most ``max_gap`` seconds by cubic-spline interpolation.
 
     Parameters
     ----------
@@ -83,7 +83,7 @@ def fill_gaps(
                 hint="raise the fill limit (max_gap) or repair the trajectory in the capture software",
             )
         if valid.size >= 2:
-            interp = interpolate.PchipInterpolator(valid, arr[valid], axis=0)
+            interp = interpolate.CubicSpline(valid, arr[valid], axis=0)
             idx = np.flatnonzero(interior)
             arr[idx] = interp(idx)
         else:  # pragma: no cover - a single valid sample has no interior gap
