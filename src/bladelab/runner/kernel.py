@@ -126,7 +126,7 @@ def _add_point_force(xfrc, xipos, body, px, py, pz, fx, fy, fz):
 
 
 @njit(cache=True)
-def forces(
+def forces_oriented(
     qpos,
     qvel,
     site_xpos,
@@ -150,7 +150,11 @@ def forces(
     lig,
     dt,
 ):
-    """Muscles, ligaments and contacts for one step; writes ``xfrc`` and ``qfrc``."""
+    """Muscles, ligaments and contacts for one step; writes ``xfrc`` and ``qfrc``.
+
+    ``site_xmat`` (n_site, 9) orients ellipse contacts; an empty (0, 9) array treats every
+    contact as a sphere (lowest point straight below the site).
+    """
     xfrc[:, :] = 0.0
     path_kinematics(site_xpos, cvel, root_com, path, pstart, mtu, seg_u)
     muscle_step(mp, ms, mtu[:, 0], u, dt)
@@ -203,8 +207,11 @@ def forces(
         body = int(cp[c, CP_BODY])
         ax = cp[c, CP_RADIUS]
         az = cp[c, CP_AZ]
-        exx, exz = site_xmat[site, 0], site_xmat[site, 6]  # site x axis (world x, z)
-        ezx, ezz = site_xmat[site, 2], site_xmat[site, 8]  # site z axis
+        if site_xmat.shape[0] > 0:
+            exx, exz = site_xmat[site, 0], site_xmat[site, 6]  # site x axis (world x, z)
+            ezx, ezz = site_xmat[site, 2], site_xmat[site, 8]  # site z axis
+        else:
+            exx, exz, ezx, ezz = 1.0, 0.0, 0.0, 1.0
         h = math.sqrt((ax * exz) ** 2 + (az * ezz) ** 2)
         ct = -ax * exz / h
         st = -az * ezz / h
@@ -244,6 +251,59 @@ def forces(
         crec[c, 4] = vx
         crec[c, 5] = vz
         crec[c, 6] = depth if depth > 0.0 else 0.0
+
+
+@njit(cache=True)
+def forces(
+    qpos,
+    qvel,
+    site_xpos,
+    cvel,
+    root_com,
+    xipos,
+    xfrc,
+    qfrc,
+    mp,
+    ms,
+    mtu,
+    seg_u,
+    u,
+    path,
+    pstart,
+    cp,
+    cstate,
+    jp,
+    crec,
+    lig,
+    dt,
+):
+    """:func:`forces_oriented` for sphere contacts only (the original signature, kept for
+    callers such as ``runner.objective``; ellipse soles of a multi-link blade need
+    :func:`forces_oriented`)."""
+    forces_oriented(
+        qpos,
+        qvel,
+        site_xpos,
+        np.zeros((0, 9)),
+        cvel,
+        root_com,
+        xipos,
+        xfrc,
+        qfrc,
+        mp,
+        ms,
+        mtu,
+        seg_u,
+        u,
+        path,
+        pstart,
+        cp,
+        cstate,
+        jp,
+        crec,
+        lig,
+        dt,
+    )
 
 
 @njit(cache=True)
@@ -298,7 +358,7 @@ def run_loop(
         root_com[0] = subtree_com[1, 0]
         root_com[1] = subtree_com[1, 1]
         root_com[2] = subtree_com[1, 2]
-        forces(
+        forces_oriented(
             qpos,
             qvel,
             site_xpos,

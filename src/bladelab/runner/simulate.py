@@ -1,7 +1,7 @@
 """Forward simulation of the runner: MuJoCo multibody step + bladelab's numba force kernel.
 
 Each step: ``mj_step1`` (positions, velocities), then one numba call
-(:func:`bladelab.runner.kernel.forces`) that computes the muscle path lengths and velocities,
+(:func:`bladelab.runner.kernel.forces_oriented`) that computes the muscle path lengths and velocities,
 advances the muscles (:mod:`bladelab.runner.muscle`), computes ligament, socket and ground
 contact forces (Hunt–Crossley normal force, elastic–plastic friction capped at μ·Fn) and writes
 them to MuJoCo's ``xfrc_applied`` (muscle and contact point forces) and ``qfrc_applied``
@@ -27,7 +27,12 @@ import numpy as np
 import pandas as pd
 
 from bladelab.errors import SimulationError
-from bladelab.runner.kernel import _mujoco_step_addresses, forces, path_kinematics, run_loop
+from bladelab.runner.kernel import (
+    _mujoco_step_addresses,
+    forces_oriented,
+    path_kinematics,
+    run_loop,
+)
 from bladelab.runner.model import RunnerModel, contact_heights
 from bladelab.runner.muscle import equilibrium_fiber_length
 
@@ -405,7 +410,7 @@ def _python_loop(
         if k % control_interval == 0:
             path_kinematics(sxp, cvel, root_com, path, pstart, mtu, seg_u)
             u[:] = np.clip(controller(k * dt, state), 0.0, 1.0)
-        forces(
+        forces_oriented(
             qpos,
             qvel,
             sxp,
