@@ -30,6 +30,7 @@ def fill_gaps(
     max_gap: float,
     where: str = "signal",
     file: str | Path | None = None,
+    first_frame: int = 0,
 ) -> tuple[np.ndarray, np.ndarray]:
     """Fill interior NaN gaps of at most ``max_gap`` seconds by cubic-spline interpolation.
 
@@ -44,6 +45,8 @@ def fill_gaps(
         Longest interior gap [s] that may be filled.
     where, file
         Names used in error messages (channel/marker, file).
+    first_frame
+        Frame number of ``data[0]`` in the trial (for error messages).
 
     Returns
     -------
@@ -74,7 +77,7 @@ def fill_gaps(
         lengths = ends - starts
         longest = int(np.argmax(lengths))
         if lengths[longest] / rate > max_gap + 1e-12:
-            s, e = int(starts[longest]), int(ends[longest])
+            s, e = int(starts[longest]) + first_frame, int(ends[longest]) + first_frame
             raise DataError(
                 f"gap of {lengths[longest]} frames ({lengths[longest] / rate:.3f} s) at frames "
                 f"{s}–{e - 1} (t = {s / rate:.3f}–{(e - 1) / rate:.3f} s) is longer than the fill "
@@ -100,6 +103,7 @@ def lowpass(
     max_gap: float = 0.1,
     where: str = "signal",
     file: str | Path | None = None,
+    first_frame: int = 0,
 ) -> np.ndarray:
     """Zero-lag Butterworth low-pass along axis 0, gap-aware (fill, filter, restore).
 
@@ -115,8 +119,8 @@ def lowpass(
         Order of the designed filter (doubled by forward-backward filtering).
     max_gap
         Longest interior gap [s] that is filled before filtering.
-    where, file
-        Names used in error messages.
+    where, file, first_frame
+        Names and frame offset used in error messages.
 
     Returns
     -------
@@ -133,7 +137,9 @@ def lowpass(
             f"cut-off {cutoff:g} Hz must be between 0 and the Nyquist frequency {rate / 2.0:g} Hz",
             file=file, where=where, hint="lower the cut-off",
         )
-    filled, gap = fill_gaps(data, rate=rate, max_gap=max_gap, where=where, file=file)
+    filled, gap = fill_gaps(
+        data, rate=rate, max_gap=max_gap, where=where, file=file, first_frame=first_frame
+    )
     arr = filled[:, None] if filled.ndim == 1 else filled
     out = np.full_like(arr, np.nan)
     finite = np.all(np.isfinite(arr), axis=1)

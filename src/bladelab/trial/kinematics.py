@@ -163,7 +163,9 @@ def blade_kinematics(
         label = getattr(markers, role)
         raw = trial.marker(label)[a:b]
         where = f"marker {label} ({role})"
-        filled, gap = fill_gaps(raw, rate=rate, max_gap=max_gap, where=where, file=trial.source)
+        filled, _ = fill_gaps(
+            raw, rate=rate, max_gap=max_gap, where=where, file=trial.source, first_frame=a
+        )
         if np.any(~np.isfinite(filled)):
             bad = np.flatnonzero(~np.all(np.isfinite(filled), axis=1))
             raise DataError(
@@ -173,10 +175,8 @@ def blade_kinematics(
                 hint="choose another stance or repair the trajectory",
             )
         if cutoff is not None:
-            filled = lowpass(filled, rate, cutoff, order=order, max_gap=max_gap, where=where,
-                             file=trial.source)
-            # gaps were restored to NaN by lowpass: fill them again from the filtered signal
-            filled, _ = fill_gaps(filled, rate=rate, max_gap=max_gap, where=where, file=trial.source)
+            # filter the filled signal (its gaps are short and already interpolated)
+            filled = lowpass(filled, rate, cutoff, order=order, where=where, file=trial.source)
         xyz[role] = filled
     ant, post, tip = xyz["clamp_anterior"], xyz["clamp_posterior"], xyz["tip"]
     origin = 0.5 * (ant + post)
