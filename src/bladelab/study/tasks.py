@@ -5,21 +5,36 @@ from __future__ import annotations
 from bladelab.errors import DataError
 
 
+def read_trial_stance(file: str, stance: int = 1):
+    """The stance of a study trial file: a stance CSV (holds one stance) or a C3D trial.
+
+    A C3D trial goes through :func:`bladelab.trial.extract_stance` with its defaults (stance
+    ``stance`` counted from 1 among the detected stances, markers 20 Hz, forces 75 Hz, 1000 Hz).
+    """
+    from pathlib import Path
+
+    from bladelab.trial import extract_stance, read_c3d, read_stance_csv
+
+    if Path(file).suffix.lower() == ".c3d":
+        stance_obj = extract_stance(read_c3d(file), int(stance) - 1)
+        return stance_obj
+    if stance != 1:
+        raise DataError(f"stance {stance} requested, a stance CSV holds one stance",
+                        file=file, where="stance",
+                        hint="export each stance to its own CSV, or use stance: 1")
+    return read_stance_csv(file)
+
+
 def identify_trial(payload: dict) -> dict:
     """Identify K and D of one trial; returns the result columns of ``results.sqlite``.
 
-    ``payload`` (built by :func:`bladelab.study.runner.plan`): ``file`` (stance CSV), ``stance``
-    (1-based stance number; a stance CSV holds one), ``blade`` (name or spec path), ``settings``
-    (identification settings), ``seed``.
+    ``payload`` (built by :func:`bladelab.study.runner.plan`): ``file`` (stance CSV or C3D trial),
+    ``stance`` (1-based stance number; a stance CSV holds one), ``blade`` (name or spec path),
+    ``settings`` (identification settings), ``seed``.
     """
     from bladelab.identify.identify import identify_stance
-    from bladelab.trial import read_stance_csv
 
-    if payload.get("stance", 1) != 1:
-        raise DataError(f"stance {payload['stance']} requested, a stance CSV holds one stance",
-                        file=payload["file"], where="stance",
-                        hint="export each stance to its own CSV, or use stance: 1")
-    stance = read_stance_csv(payload["file"])
+    stance = read_trial_stance(payload["file"], payload.get("stance", 1))
     s = payload["settings"]
     ident = identify_stance(
         stance, payload["blade"], optimizer=s["optimizer"], seed=int(payload["seed"]),
