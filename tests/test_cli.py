@@ -1,0 +1,109 @@
+"""The command line: trial commands, and the generic error path (exit 2, no traceback)."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+import trial_synth as synth
+
+from bladelab.cli import main
+from bladelab.trial.stance import read_stance_csv
+
+FUKUCHI = "real/fukuchi2017/RBDS001runT35.c3d"
+
+
+@pytest.fixture(scope="module")
+def synthetic(tmp_path_factory):
+    path = tmp_path_factory.mktemp("cli") / "s.c3d"
+    synth.write_single_plate(path)
+    return path
+
+
+def test_info(shared_data, capsys):
+    assert main(["trial", "info", str(shared_data / FUKUCHI)]) == 0
+    out = capsys.readouterr().out
+    assert "platform 1: type 4, 300 Hz" in out and "R.Heel.Bottom" in out and "units mm" in out
+    assert main(["trial", "info", str(shared_data / FUKUCHI), "--json"]) == 0
+    info = json.loads(capsys.readouterr().out)
+    assert info["marker_rate_Hz"] == 150.0 and info["platforms"][0]["type"] == 4
+    assert info["platforms"][0]["channels"] == ["F1X", "F1Y", "F1Z", "M1X", "M1Y", "M1Z"]
+
+
+def test_stances_json(synthetic, capsys):
+    assert main(["trial", "stances", str(synthetic), "--json"]) == 0
+    rows = json.loads(capsys.readouterr().out)
+    assert len(rows) == 1
+    row = rows[0]
+    for key in ("index", "plates", "start_s", "end_s", "contact_time_s", "peak_fz_N", "impulse_z_Ns"):
+        assert key in row
+    assert row["plates"] == [1]
+    assert row["start_s"] == pytest.approx(synth.TD, abs=2e-3)
+    assert row["peak_fz_N"] == pytest.approx(synth.PEAK, rel=5e-3)
+
+
+def test_stances_table_and_threshold(synthetic, capsys):
+    assert main(["trial", "stances", str(synthetic), "--tip", "BLADE_TIP"]) == 0
+    out = capsys.readouterr().out.splitlines()
+    assert out[0].split()[:3] == ["index", "plates", "start_s"] and out[1].split()[-1] == "yes"
+    assert main(["trial", "stances", str(synthetic), "--threshold", "5000"]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("error:") and "no stance found" in err and "Traceback" not in err
+
+
+def test_extract(synthetic, tmp_path, capsys):
+    out = tmp_path / "stance.csv"
+    assert main(["trial", "extract", str(synthetic), "--stance", "0", "--out", str(out)]) == 0
+    st = read_stance_csv(out)
+    assert st.sample_rate == pytest.approx(1000.0)
+    assert st.grf_z.max() == pytest.approx(synth.PEAK, rel=0.02)
+    t = st.time + st.metadata["window_start_s"]
+    np.testing.assert_allclose(st.clamp_pitch, synth.clamp_pitch(t), atol=np.deg2rad(0.3))
+
+
+def test_extract_with_marker_map_and_errors_leave_no_file(synthetic, tmp_path, capsys):
+    mapping = tmp_path / "map.yaml"
+    mapping.write_text("clamp_anterior: CLAMP_ANT\nclamp_posterior: CLAMP_POST\ntip: TOE\n")
+    out = tmp_path / "stance.csv"
+    code = main(["trial", "extract", str(synthetic), "--stance", "0", "--out", str(out),
+                 "--markers", str(mapping)])
+    assert code == 2
+    err = capsys.readouterr().err
+    assert "no marker named 'TOE'" in err and "BLADE_TIP" in err
+    assert list(tmp_path.iterdir()) == [mapping]  # no output, no temporary file
+    code = main(["trial", "extract", str(synthetic), "--stance", "7", "--out", str(out)])
+    assert code == 2 and not out.exists()
+
+
+def test_bad_file_exit_2(tmp_path, capsys):
+    bad = tmp_path / "x.c3d"
+    bad.write_text("hello" * 200)
+    for cmd in ("info", "stances"):
+        assert main(["trial", cmd, str(bad)]) == 2
+        err = capsys.readouterr().err
+        assert err.startswith(f"error: {bad}: not a C3D file")
+
+
+def _run(*args):
+    return subprocess.run([sys.executable, "-m", "bladelab", *args], capture_output=True, text=True,
+                          timeout=120)
+
+
+def test_error_path_in_a_real_process(tmp_path):
+    """Exit status 2, one line on stderr, no traceback; --debug shows the traceback."""
+    bad = tmp_path / "x.c3d"
+    bad.write_text("hello" * 200)
+    proc = _run("trial", "info", str(bad))
+    assert proc.returncode == 2
+    assert proc.stderr.startswith("error:") and "Traceback" not in proc.stderr
+    assert len(proc.stderr.strip().splitlines()) == 1
+    proc = _run("--debug", "trial", "info", str(bad))
+    assert proc.returncode != 0
+    assert "Traceback" in proc.stderr and "InputFileError" in proc.stderr
+
+
+def test_usage_error_exit_2(capsys):
+    assert main(["trial", "extract"]) == 2
