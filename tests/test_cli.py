@@ -8,8 +8,8 @@ import sys
 
 import numpy as np
 import pytest
-import trial_synth as synth
 
+import trial_synth as synth
 from bladelab.cli import main
 from bladelab.trial.stance import read_stance_csv
 

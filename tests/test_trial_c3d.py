@@ -8,8 +8,8 @@ import ezc3d
 import numpy as np
 import pandas as pd
 import pytest
-import trial_synth as synth
 
+import trial_synth as synth
 from bladelab.errors import BladelabError, DataError, InputFileError, SpecError
 from bladelab.trial.c3d import plate_corners, read_c3d, write_c3d
 from bladelab.units import body_weight

@@ -6,8 +6,8 @@ import ezc3d
 import numpy as np
 import pandas as pd
 import pytest
-import trial_synth as synth
 
+import trial_synth as synth
 from bladelab.errors import DataError
 from bladelab.trial.c3d import plate_corners, read_c3d, write_c3d
 from bladelab.trial.events import classify_stances, detect_stances

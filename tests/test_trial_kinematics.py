@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-import trial_synth as synth
 
+import trial_synth as synth
 from bladelab.errors import DataError, InputFileError, SpecError
 from bladelab.trial.c3d import read_c3d, write_c3d
 from bladelab.trial.events import detect_stances
