@@ -1,0 +1,48 @@
+"""Trial pipeline speed: read a real ~2.5 MB C3D, find its stances, extract one stance."""
+
+from __future__ import annotations
+
+import statistics
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+FILE = ROOT.parent / "shared" / "data" / "real" / "fukuchi2017" / "RBDS001runT35.c3d"
+REPEATS = 7
+
+
+def _median_time(fn, repeats: int = REPEATS) -> tuple[float, object]:
+    times, result = [], None
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        result = fn()
+        times.append(time.perf_counter() - t0)
+    return statistics.median(times), result
+
+
+def run() -> str:
+    from bladelab.trial import MarkerMap, detect_stances, extract_stance, read_c3d
+
+    size_mb = FILE.stat().st_size / 1e6
+    read_c3d(FILE)  # warm-up (imports, ezc3d)
+    t_read, trial = _median_time(lambda: read_c3d(FILE))
+    t_detect, stances = _median_time(lambda: detect_stances(trial))
+    t_both, _ = _median_time(lambda: detect_stances(read_c3d(FILE)))
+    markers = MarkerMap(clamp_anterior="R.MT1", clamp_posterior="R.Heel.Bottom", tip="R.Shank.Top.Lateral")
+    t_extract, stance = _median_time(lambda: extract_stance(trial, 0, markers=markers, stances=stances))
+    return "\n".join(
+        [
+            "## trial: C3D reading and stance detection",
+            "",
+            f"File: `{FILE.name}` ({size_mb:.1f} MB; 32 markers × 4500 frames at 150 Hz, one type-4 "
+            f"platform, 6 channels × 9000 samples at 300 Hz). Median of {REPEATS} runs.",
+            "",
+            "| step | median time |",
+            "|---|---|",
+            f"| `read_c3d` (ezc3d + calibration, COP, lab frame) | {t_read * 1e3:.0f} ms |",
+            f"| `detect_stances` ({len(stances)} stances, 75 Hz filter) | {t_detect * 1e3:.0f} ms |",
+            f"| read + detect | {t_both * 1e3:.0f} ms |",
+            f"| `extract_stance` (one stance, {len(stance.time)} samples at 1 kHz, filtered) | "
+            f"{t_extract * 1e3:.0f} ms |",
+        ]
+    )
