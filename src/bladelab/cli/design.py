@@ -1,0 +1,260 @@
+"""``bladelab design``: a response-surface design study; ``bladelab blade test``: compression test.
+
+``bladelab blade test`` is added to the ``blade`` group of :mod:`bladelab.cli.blade` from here
+(this module is registered after it).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from pathlib import Path
+
+import typer
+
+from bladelab.errors import SpecError
+
+__all__ = ["register", "figure_pairs", "write_design_figures"]
+
+
+def _parse_floats(text: str, what: str) -> list[float]:
+    try:
+        vals = [float(v) for v in text.split(",") if v.strip()]
+    except ValueError:
+        raise SpecError(f"cannot read {text!r} as comma-separated numbers", where=what,
+                        hint="e.g. --alignment 0,-8,8") from None
+    if not vals or not all(math.isfinite(v) for v in vals):
+        raise SpecError(f"no finite numbers in {text!r}", where=what)
+    return vals
+
+
+def _blade_test(
+    blade: str = typer.Argument(..., help="Built-in blade name or blade spec file."),
+    category: str | None = typer.Option(None, "--category", help="Stiffness category, e.g. cat5."),
+    alignment: str = typer.Option("0,-8,8", "--alignment",
+                                  help="Alignment angles [deg], comma-separated."),
+    body_mass: float = typer.Option(76.0, "--body-mass", help="Body mass [kg] (load = m·g)."),
+    max_displacement: float = typer.Option(0.08, "--max-displacement",
+                                           help="Largest clamp displacement [m]."),
+    tip: str = typer.Option("held", "--tip", help="held (seed 002's fixture) or free."),
+    plot: Path | None = typer.Option(None, "--plot", help="Draw the force–displacement curves."),
+    as_json: bool = typer.Option(False, "--json", help="Print JSON (curves included)."),
+) -> None:
+    """Virtual compression test: force–displacement curve and stiffness at body-weight load."""
+    from bladelab.blade import load_blade
+    from bladelab.design.compression import compression_test
+
+    if not (body_mass > 0 and math.isfinite(body_mass)):
+        raise SpecError(f"body mass must be > 0 kg, got {body_mass}", where="--body-mass")
+    angles = _parse_floats(alignment, "--alignment")
+    spec = load_blade(blade, category=category)
+    model = spec.build()
+    load = body_mass * 9.80665
+    results = []
+    from bladelab.design.compression import vertical_stiffness
+    from bladelab.errors import ModelError
+
+    if tip == "held":
+        try:
+            vertical_stiffness(model, alignment_deg=angles[0], tip="held")
+        except ModelError:
+            tip = "free"
+            typer.echo("note: this blade cannot compress with its support held (fewer than two "
+                       "compliant joints between clamp and support); testing with tip free",
+                       err=True)
+    for a in angles:
+        try:
+            r = compression_test(model, max_displacement=max_displacement, n_steps=40, load=load,
+                                 alignment_deg=a, tip=tip)
+        except SpecError as err:
+            if err.where != "load":
+                raise
+            r = compression_test(model, max_displacement=max_displacement, n_steps=40,
+                                 alignment_deg=a, tip=tip)
+        results.append(r)
+    if as_json:
+        typer.echo(json.dumps({"blade": model.name, "body_mass_kg": body_mass, "load_N": load,
+                               "tests": [r.to_dict() for r in results]}, indent=2,
+                              allow_nan=False, default=str).replace("NaN", "null"))
+    else:
+        typer.echo(f"{model.name}: virtual compression test (tip {tip}), load m·g = {load:.0f} N")
+        typer.echo(" alignment_deg  k_linear_kN_per_m  k_at_bw_kN_per_m  displacement_at_bw_mm")
+        for r in results:
+            at = ("not reached" if math.isnan(r.stiffness_at_load) else
+                  f"{r.stiffness_at_load / 1e3:16.2f}  {r.displacement_at_load * 1e3:21.1f}")
+            typer.echo(f"{r.alignment_deg:14.1f}  {r.stiffness_linear / 1e3:17.2f}  {at}")
+    if plot is not None:
+        _plot_compression(results, model.name, load, plot)
+        typer.echo(f"wrote {plot}", err=True)
+
+
+def _plot_compression(results, name: str, load: float, path: Path) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from bladelab.design.plots import save_figure
+
+    fig, ax = plt.subplots(figsize=(5, 4))
+    for r in results:
+        ax.plot(r.displacement * 1e3, r.force, label=f"{r.alignment_deg:+g}°")
+    ax.axhline(load, color="0.5", ls="--", lw=0.8, label="body weight")
+    ax.set_xlabel("clamp displacement [mm]")
+    ax.set_ylabel("vertical force [N]")
+    ax.set_title(f"{name}: virtual compression test")
+    ax.legend(title="alignment")
+    fig.tight_layout()
+    save_figure(fig, path)
+    plt.close(fig)
+
+
+def figure_pairs(names: tuple[str, ...]) -> list[tuple[str, str]]:
+    """Factor pairs drawn as contour plots: (stiffness, width) and (height, toe length) when
+    present (seed 002's figures), else consecutive pairs."""
+    pairs = [(a, b) for a, b in (("stiffness_kN_per_m", "width_m"), ("height_m", "toe_length_m"))
+             if a in names and b in names]
+    if not pairs and len(names) >= 2:
+        pairs = [(names[i], names[i + 1]) for i in range(0, len(names) - 1, 2)]
+    return pairs
+
+
+def write_design_figures(result, out_dir: Path, *, objective: str,
+                         constraints: dict[str, float]) -> list[Path]:
+    """Main-effect and contour figures of a finished study into ``out_dir/figures``."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from bladelab.design.optimum import SurfaceConstraint
+    from bladelab.design.plots import contour_plot, main_effects_plot, save_figure
+
+    fig_dir = Path(out_dir) / "figures"
+    written = []
+    names = [objective, *[c for c in constraints if c != objective]]
+    surfs = [result.surfaces[n] for n in names if n in result.surfaces]
+    fig = main_effects_plot(surfs, result.space)
+    written.append(save_figure(fig, fig_dir / "main_effects.png"))
+    plt.close(fig)
+    cons = [SurfaceConstraint(result.surfaces[k], float(v)) for k, v in constraints.items()]
+    for x, y in figure_pairs(result.space.names):
+        fig = contour_plot(result.surfaces[objective], result.space, x=x, y=y, constraints=cons,
+                           optimum=result.optimum)
+        written.append(save_figure(fig, fig_dir / f"contour_{objective}_{x}_{y}.png"))
+        plt.close(fig)
+    return written
+
+
+def _evaluate_one(evaluator, i: int, coded: list[float], point: dict[str, float]):
+    return i, coded, point, dict(evaluator(point))
+
+
+def _evaluate_parallel(evaluator, space, design, out: Path, jobs: int) -> None:
+    """Evaluate the runs not yet stored with ``jobs`` processes, in run_design's run-file format
+    (``runs/run_NNNN.json``), so that :func:`run_design` then only reads them back."""
+    from tqdm.auto import tqdm
+
+    from bladelab._io import write_json
+
+    todo = []
+    for i in range(design.n_runs):
+        path = out / "runs" / f"run_{i + 1:04d}.json"
+        if not path.is_file():
+            todo.append((i, design.coded[i].tolist(), space.point(design.coded[i])))
+    if not todo:
+        return
+    with ProcessPoolExecutor(max_workers=jobs) as pool:
+        futures = [pool.submit(_evaluate_one, evaluator, *args) for args in todo]
+        for fut in tqdm(as_completed(futures), total=len(futures), desc="design runs",
+                        unit="run"):
+            i, coded, point, res = fut.result()
+            write_json(out / "runs" / f"run_{i + 1:04d}.json",
+                       {"run": i + 1, "coded": coded, "point": point,
+                        "responses": {k: float(v) for k, v in res.items()}})
+
+
+def _design(
+    factors: str | None = typer.Option(
+        None, "--factors",
+        help="name=low:high,... (default: stiffness_kN_per_m=18:32,width_m=0.05:0.08,"
+             "height_m=0.40:0.48,toe_length_m=0.19:0.25)."),
+    runs: str = typer.Option("ccd", "--runs", help="ccd, bbd, dopt or a CSV file of runs."),
+    evaluator: str = typer.Option("blade", "--evaluator", help="blade or runner."),
+    out: Path = typer.Option(..., "--out", help="Output folder (resumes an interrupted study)."),
+    seed: int = typer.Option(0, "--seed", help="Seed (D-optimal design, optimiser starts)."),
+    jobs: int = typer.Option(1, "--jobs", help="Worker processes for the runs."),
+    n_runs: int | None = typer.Option(None, "--n-runs", help="Runs of a D-optimal design."),
+    model: str = typer.Option("quadratic", "--model",
+                              help="Surface model: quadratic, linear, interaction, or terms."),
+    objective: str = typer.Option("delta_vx_m_per_s", "--objective", help="Response to maximise."),
+    sense: str = typer.Option("max", "--sense", help="max or min."),
+    constraint: list[str] = typer.Option(
+        [], "--constraint",
+        help="response=minimum (repeatable), e.g. knee_moment_min_Nm=0 swing_clearance_m=0.02."),
+    speed: float = typer.Option(8.0, "--speed", help="Running speed [m/s] (blade evaluator)."),
+    body_mass: float = typer.Option(76.0, "--body-mass", help="Body mass [kg]."),
+    base: str = typer.Option("xtreme", "--base", help="Base blade of the generator."),
+    gait: Path | None = typer.Option(None, "--gait",
+                                     help="Gait-cycle CSV (runner evaluator; default built-in)."),
+    figures: bool = typer.Option(True, "--figures/--no-figures", help="Write figures."),
+) -> None:
+    """Run a design study: DOE -> evaluator per run -> surfaces, ANOVA, optimum, figures."""
+    from bladelab.design import DesignSpace, default_design_space, make_design, run_design
+    from bladelab.design.evaluators import make_evaluator
+    from bladelab.design.terms import parse_terms
+
+    space = DesignSpace.parse(factors) if factors else default_design_space()
+    if jobs < 1:
+        raise SpecError(f"--jobs must be >= 1, got {jobs}", where="--jobs")
+    cons: dict[str, float] = {}
+    for c in constraint:
+        name, sep, value = c.partition("=")
+        try:
+            cons[name.strip()] = float(value)
+        except ValueError:
+            sep = ""
+        if not sep or not name.strip():
+            raise SpecError(f"cannot read constraint {c!r}", where="--constraint",
+                            hint="write response=minimum, e.g. knee_moment_min_Nm=0")
+    options: dict = {"body_mass_kg": body_mass, "generator": {"base": base}}
+    if evaluator == "blade":
+        options["speed_mps"] = speed
+    elif evaluator == "runner" and gait is not None:
+        options["gait"] = str(gait)
+    ev = make_evaluator(evaluator, **options)
+    design = make_design(runs, space, n_runs=n_runs, model=model, seed=seed)
+    from bladelab.design.doe import require_estimable
+
+    require_estimable(design, parse_terms(model, space.names), space.names)
+    out.mkdir(parents=True, exist_ok=True)
+    if jobs > 1:
+        _evaluate_parallel(ev, space, design, out, jobs)
+    result = run_design(space, runs=design, evaluator=ev, out_dir=out, seed=seed, model=model,
+                        objective=objective, sense=sense, constraints=cons, units=ev.units)
+    from bladelab._io import write_json
+
+    write_json(out / "evaluator.json", ev.to_dict())
+    typer.echo(f"{design.n_runs} runs ({result.n_evaluated} evaluated, {result.n_resumed} "
+               f"resumed) -> {out}")
+    for name, s in result.surfaces.items():
+        typer.echo(f"  {name:22s} R² {s.r2:6.3f}  R²adj {s.r2_adj:6.3f}  R²pred {s.r2_pred:6.3f}")
+    if result.optimum is not None:
+        o = result.optimum
+        pt = ", ".join(f"{k}={v:.4g}" for k, v in (o.point or o.coded).items())
+        typer.echo(f"optimum ({o.sense} {objective}): {pt}; predicted {o.predicted:.4g} "
+                   f"(PI {o.pi[0]:.4g} .. {o.pi[1]:.4g})")
+    elif result.optimum_error:
+        typer.echo(f"no optimum: {result.optimum_error}")
+    if figures:
+        for p in write_design_figures(result, out, objective=objective, constraints=cons):
+            typer.echo(f"wrote {p}", err=True)
+
+
+def register(app: typer.Typer) -> None:
+    """Add ``bladelab design`` and ``bladelab blade test``."""
+    from bladelab.cli.blade import blade_app
+
+    blade_app.command("test")(_blade_test)
+    app.command("design")(_design)
