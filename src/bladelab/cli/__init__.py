@@ -17,7 +17,7 @@ from bladelab import __version__
 from bladelab.errors import BladelabError
 
 # Sub-command modules, in help order. Each defines ``register(app: typer.Typer) -> None``.
-_COMMAND_MODULES: tuple[str, ...] = ("trial", "blade", "runner", "identify", "predict", "example", "report",
+_COMMAND_MODULES: tuple[str, ...] = ("trial", "blade", "runner", "identify", "predict", "example",
                                      "design")
 
 app = typer.Typer(
