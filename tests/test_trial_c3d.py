@@ -261,3 +261,72 @@ def test_axis_options(shared_data, tmp_path):
         read_c3d(path, forward="+z", up="+z")
     with pytest.raises(SpecError):
         read_c3d(path, up="+w")
+
+
+def _write_raw_platform(path, ptype, channels, units, corners_m, origin):
+    """A C3D with one platform of the given type and hand-made analog channels (ezc3d only)."""
+    n = channels.shape[1]
+    c = ezc3d.c3d()
+    c["parameters"]["POINT"]["RATE"]["value"] = [100.0]
+    c["parameters"]["POINT"]["LABELS"]["value"] = ("A",)
+    c["parameters"]["POINT"]["UNITS"]["value"] = ["mm"]
+    pts = np.zeros((4, 1, n // 10))
+    pts[3] = 1.0
+    c["data"]["points"] = pts
+    c["parameters"]["ANALOG"]["RATE"]["value"] = [1000.0]
+    c["parameters"]["ANALOG"]["LABELS"]["value"] = tuple(f"CH{i + 1}" for i in range(len(channels)))
+    c["parameters"]["ANALOG"]["UNITS"]["value"] = units
+    c["data"]["analogs"] = channels[None]
+    c.add_parameter("FORCE_PLATFORM", "USED", [1])
+    c.add_parameter("FORCE_PLATFORM", "TYPE", [ptype])
+    c.add_parameter("FORCE_PLATFORM", "CHANNEL",
+                    np.arange(1, len(channels) + 1, dtype=float).reshape(-1, 1))
+    c.add_parameter("FORCE_PLATFORM", "CORNERS", (np.asarray(corners_m).T * 1000.0)[:, :, None])
+    c.add_parameter("FORCE_PLATFORM", "ORIGIN", np.asarray(origin, dtype=float).reshape(3, 1))
+    c.write(str(path))
+
+
+def _known_load(n=500):
+    t = np.arange(n) / 1000.0
+    # GRF on the subject in plate axes (z down into the plate): a load pushes the subject up, Fz < 0
+    fz = -(800.0 + 400.0 * np.sin(2 * np.pi * 2 * t))
+    fx, fy = 0.1 * fz, -0.05 * fz
+    ax, ay = 0.10 * np.cos(2 * np.pi * t), -0.05 + 0.02 * t  # COP rel. plate centre, plate axes [m]
+    tz = 2.0 * np.sin(2 * np.pi * 3 * t)  # free moment about plate z [N·m]
+    return fx, fy, fz, ax, ay, tz
+
+
+def test_type3_kistler_against_the_manufacturer_formula(tmp_path):
+    """Channels built from Kistler's formulas: ax = (Fx·az0 − My)/Fz, ay = (Fy·az0 + Mx)/Fz."""
+    fx, fy, fz, ax, ay, tz = _known_load()
+    a, b, az0 = 0.12, 0.20, -0.045  # sensor offsets [m]; az0 < 0 as Kistler specifies
+    my = fx * az0 - ax * fz
+    mx = ay * fz - fy * az0
+    mz = tz + (ax * fy - ay * fx)
+    # fz1..fz4 from sum, Mx = b(fz1+fz2−fz3−fz4), My = a(−fz1+fz2+fz3−fz4), and fz1−fz2+fz3−fz4 = 0
+    A = np.array([[1, 1, 1, 1], [1, 1, -1, -1], [-1, 1, 1, -1], [1, -1, 1, -1]], dtype=float)
+    fzs = np.linalg.solve(A, np.vstack([fz, mx / b, my / a, np.zeros_like(fz)]))
+    fx12, fx34 = fx / 2 - mz / (2 * b), fx / 2 + mz / (2 * b)
+    fy14, fy23 = fy / 2, fy / 2
+    channels = np.vstack([fx12, fx34, fy14, fy23, *fzs])
+    corners = plate_corners((1.0, 0.5, 0.0), 0.6, 0.4)  # plate x = lab +x, plate y = lab −y
+    path = tmp_path / "kistler.c3d"
+    _write_raw_platform(path, 3, channels, ["N"] * 8, corners, [a * 1000, b * 1000, az0 * 1000])
+    plate = read_c3d(path, forward="+x", up="+z").platforms[0]
+    assert plate.type == 3
+    np.testing.assert_allclose(plate.force, np.column_stack([fx, -fy, -fz]), atol=1e-3)
+    np.testing.assert_allclose(plate.cop[:, 0], 1.0 + ax, atol=1e-5)
+    np.testing.assert_allclose(plate.cop[:, 1], 0.5 - ay, atol=1e-5)
+    np.testing.assert_allclose(plate.free_moment, -tz, atol=1e-3)  # about lab +z = −z_plate
+
+
+def test_type1_cop_channels(tmp_path):
+    fx, fy, fz, ax, ay, tz = _known_load()
+    channels = np.vstack([fx, fy, fz, ax * 1000, ay * 1000, tz * 1000])
+    corners = plate_corners((1.0, 0.5, 0.0), 0.6, 0.4)
+    path = tmp_path / "type1.c3d"
+    _write_raw_platform(path, 1, channels, ["N", "N", "N", "mm", "mm", "Nmm"], corners, [0, 0, 0])
+    plate = read_c3d(path, forward="+x", up="+z").platforms[0]
+    np.testing.assert_allclose(plate.force, np.column_stack([fx, -fy, -fz]), atol=1e-3)
+    np.testing.assert_allclose(plate.cop[:, :2], np.column_stack([1.0 + ax, 0.5 - ay]), atol=1e-6)
+    np.testing.assert_allclose(plate.free_moment, -tz, atol=1e-4)
