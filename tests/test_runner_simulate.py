@@ -164,6 +164,12 @@ def test_bad_simulation_inputs(amputee):
         simulate_runner(amputee, duration=-1.0)
     with pytest.raises(BladelabError):
         simulate_runner(amputee, duration=0.1, initial_state="fly")
+    with pytest.raises(BladelabError, match="21"):
+        simulate_runner(amputee, duration=0.1, excitations=[0.1, 0.2])
+    with pytest.raises(BladelabError, match=r"\[0, 1\]"):
+        simulate_runner(amputee, duration=0.1, excitations=1.5)
+    with pytest.raises(BladelabError, match="dt"):
+        simulate_runner(amputee, duration=0.1, dt=0.01)
 
 
 def test_controller_is_called_with_states(amputee):

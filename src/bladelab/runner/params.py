@@ -262,7 +262,7 @@ def default_runner_params(kind: str = "amputee", *, blade: str | None = None) ->
     data = yaml.safe_load(text)
     if blade is not None:
         data["blade"] = blade
-    return runner_params_from_dict(data, source=f"{kind}.yaml")
+    return runner_params_from_dict(data, source=f"built-in {kind} parameters")
 
 
 def blade_contact_modulus(params: RunnerParams) -> float:

@@ -234,8 +234,16 @@ def simulate_runner(
     fall_height
         Stop when the pelvis COM is below this height [m] (default: 60 % of standing height).
     """
-    if duration <= 0 or dt <= 0 or not math.isfinite(duration) or not math.isfinite(dt):
+    if not (duration > 0 and dt > 0 and math.isfinite(duration) and math.isfinite(dt)):
         raise SimulationError("duration and dt must be positive", where="duration/dt")
+    if dt > 2e-3:
+        raise SimulationError(
+            f"time step {dt} s is too large for the contact and muscle laws",
+            where="dt",
+            hint="use at most 1e-3 s (default 5e-4 s)",
+        )
+    if int(record_every) < 1 or int(control_interval) < 1:
+        raise SimulationError("must be at least 1", where="record_every/control_interval")
     m = model.mj_model
     nm = len(model.muscle_names)
     if hold_pose:
@@ -251,7 +259,16 @@ def simulate_runner(
     d.qvel[:] = v0
     u = np.full(nm, 0.05)
     if excitations is not None:
-        u[:] = np.asarray(excitations, dtype=float)
+        exc = np.asarray(excitations, dtype=float)
+        if exc.ndim > 1 or (exc.ndim == 1 and exc.shape[0] != nm):
+            raise SimulationError(
+                f"expected one excitation or {nm} (one per muscle), got shape {exc.shape}",
+                where="excitations",
+                hint=f"muscles: {', '.join(model.muscle_names)}",
+            )
+        if not np.all((exc >= 0) & (exc <= 1)):
+            raise SimulationError("excitations must be in [0, 1]", where="excitations")
+        u[:] = exc
     ms = np.zeros((nm, 4))
     mujoco.mj_forward(m, d)
     mp = model.muscle_params
