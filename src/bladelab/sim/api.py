@@ -70,6 +70,7 @@ class SimProblem:
     belt_speed: float
     order: int = 2
     iterations: int = 1
+    refine: int = 10
 
     @property
     def n_joints(self) -> int:
@@ -221,6 +222,7 @@ def prepare(
     drive: Drive | str = Drive.PRESCRIBED,
     order: int = 2,
     iterations: int = 1,
+    refine: int = 10,
 ) -> SimProblem:
     """Set up the simulation of ``blade`` driven by the clamp motion of ``stance``.
 
@@ -281,7 +283,7 @@ def prepare(
     return SimProblem(
         blade=blade, stance=stance, chain=chain, motion=motion, time=time, dt=dt_used,
         n_substeps=nsub, base=base, engine=engine, drive=drive, belt_speed=float(belt_speed),
-        order=int(order), iterations=int(iterations),
+        order=int(order), iterations=int(iterations), refine=int(refine),
     )
 
 
@@ -321,7 +323,8 @@ def _run_kernel(problem: SimProblem, K, D, K2, *, parallel: bool = False):
     fn = _k._batch_parallel if parallel else _k._batch_serial
     fn(problem.base, problem.dt, problem.n_substeps, 0.0, c.body_mass, c.body_com,
        c.body_inertia, c.hinge, c.sole_body, c.sole_geom, c.tip_body, c.tip, c.contact,
-       K, D, K2, np.zeros(nj), np.zeros(nj), problem.order, problem.iterations, grf, dist, qout, tau, state, energy, status)
+       K, D, K2, np.zeros(nj), np.zeros(nj), problem.order, problem.iterations,
+       problem.refine, grf, dist, qout, tau, state, energy, status)
     return grf, dist, qout, tau, state, energy, status
 
 

@@ -231,16 +231,18 @@ def _solve(A, rhs, x):
 def simulate_prescribed(
     base, dt, nsub, ground_vx,
     body_mass, com0, body_inertia, hinge, sole_body, sole_geom, tip_body, tip, contact,
-    stiffness, damping, stiffness_quadratic, q0, v0, order, n_iter,
+    stiffness, damping, stiffness_quadratic, q0, v0, order, n_iter, refine,
     grf, dist, qout, tau, state, energy,
 ):
     """Simulate one parameter set with the clamp prescribed.
 
-    ``base`` (n_steps + 1, 11): clamp x, z, θ, ẋ, ż, θ̇, ẍ, z̈, θ̈, cos θ, sin θ at every step time;
-    samples are
-    recorded every ``nsub`` steps into ``grf`` (ns, ne, 2), ``dist`` (ns,), ``qout`` and ``tau``
-    (ns, nj), ``state`` (ns, ne) int8 (0 free, 1 stick, 2 slip) and ``energy`` (ns, 8).
-    Returns (status, step index where it diverged or −1).
+    ``base`` (n_steps + 1, 11): clamp x, z, θ, ẋ, ż, θ̇, ẍ, z̈, θ̈, cos θ, sin θ at every step time.
+    ``order`` 2 (BDF2) or 1 (backward Euler); ``n_iter`` Newton iterations per step (1 =
+    linearly implicit); ``refine``: a step in which any sole element changes regime (touch-down,
+    stick ↔ slip, lift-off) is redone as ``refine`` sub-steps with the clamp row interpolated
+    linearly (1 = never). Samples are recorded every ``nsub`` steps into ``grf`` (ns, ne, 2),
+    ``dist`` (ns,), ``qout`` and ``tau`` (ns, nj), ``state`` (ns, ne) int8 (0 free, 1 stick,
+    2 slip) and ``energy`` (ns, 8). Returns (status, step index where it diverged or −1).
     """
     nb = com0.shape[0]
     nj = nb - 1
@@ -273,150 +275,204 @@ def simulate_prescribed(
     q = q0.copy()
     v = v0.copy()
     qs = np.zeros(nj)
+    q_save = np.zeros(nj)
+    v_save = np.zeros(nj)
+    qp_save = np.zeros(nj)
+    vp_save = np.zeros(nj)
     fe = np.zeros((ne, 2))
     pe = np.zeros((ne, 2))
+    regime = np.zeros(ne, np.int64)
+    regime_old = np.zeros(ne, np.int64)
+    bsub = np.zeros(base.shape[1])
     vc = contact[8]
     w_clamp = 0.0
     d_joint = 0.0
     d_contact = 0.0
     d_friction = 0.0
+    have_history = False
 
     for i in range(n_steps + 1):
-        record = i % nsub == 0
         if i > 0:
-            # ---- one (linearly-)implicit Euler step from step i-1 to step i ----
-            bs = base[i]
-            if order == 2 and i > 1:
-                # BDF2: x_{n+1} = 4/3 x_n - 1/3 x_{n-1} + 2/3 h f(x_{n+1})
-                g = 2.0 * dt / 3.0
-                for j in range(nj):
-                    qh[j] = (4.0 * q[j] - qp[j]) / 3.0
-                    vh[j] = (4.0 * v[j] - vp[j]) / 3.0
-                    vi[j] = 2.0 * v[j] - vp[j]
-            else:
-                # backward Euler (first step of BDF2 too)
-                g = dt
-                for j in range(nj):
-                    qh[j] = q[j]
-                    vh[j] = v[j]
-                    vi[j] = v[j]
-            for _it in range(n_iter):
-                for j in range(nj):
-                    qs[j] = qh[j] + g * vi[j]
-                _kinematics(bs, qs, vi, hinge, com0, O, vO, aO, phi, cph, sph, om, al, R, VR, AR)
-                for j in range(nj):
-                    hx = O[j + 1, 0]
-                    hz = O[j + 1, 1]
-                    acc = 0.0
-                    for k in range(j, nj):
-                        kx = O[k + 1, 0]
-                        kz = O[k + 1, 1]
-                        mjk = 0.0
-                        for b in range(k + 1, nb):
-                            mjk += (body_mass[b] * ((R[b, 0] - hx) * (R[b, 0] - kx)
-                                                    + (R[b, 1] - hz) * (R[b, 1] - kz))
-                                    + body_inertia[b])
-                        M[j, k] = mjk
-                        M[k, j] = mjk
-                        Jq[j, k] = 0.0
-                        Jq[k, j] = 0.0
-                        Jv[j, k] = 0.0
-                        Jv[k, j] = 0.0
-                    for b in range(j + 1, nb):
-                        rx = R[b, 0] - hx
-                        rz = R[b, 1] - hz
-                        # gravity minus inertia (bias) generalised force
-                        acc += body_mass[b] * (GRAVITY * rx - (AR[b, 0] * rz - AR[b, 1] * rx))
-                        acc -= body_inertia[b] * al[b]
-                    qa = qs[j]
-                    acc -= stiffness[j] * qa + stiffness_quadratic[j] * qa * abs(qa) + damping[j] * vi[j]
-                    Jq[j, j] -= stiffness[j] + 2.0 * stiffness_quadratic[j] * abs(qa)
-                    Jv[j, j] -= damping[j]
-                    rhs[j] = acc
-                p_fric = 0.0
-                p_cdamp = 0.0
-                for e in range(ne):
-                    b = sole_body[e]
-                    cx, cz = _body_point(b, sole_geom[e, 0], sole_geom[e, 1], hinge, O, cph, sph)
-                    (px, pz, fx, fz, depth, rate, slip, kn, cn, mu, dmu, fel) = sole_contact(
-                        contact, cx, cz, sph[b] * ce[e] + cph[b] * se[e], cph[b] * ce[e] - sph[b] * se[e],
-                    sole_geom[e, 2], sole_geom[e, 3],
-                        O[b, 0], O[b, 1], vO[b, 0], vO[b, 1], om[b], ground_vx)
-                    fe[e, 0] = fx
-                    fe[e, 1] = fz
-                    pe[e, 0] = px
-                    pe[e, 1] = pz
-                    if fz == 0.0:
-                        continue
-                    p_fric += -fx * slip
-                    p_cdamp += (fz - fel) * rate
-                    # gradients of (fx, fz) with respect to the point's position and velocity
-                    gv00 = -dmu * fz
-                    gv01 = mu * cn
-                    gv11 = -cn
-                    gp01 = mu * kn
-                    gp11 = -kn
-                    for j in range(b):
-                        jx = pz - O[j + 1, 1]
-                        jz = -(px - O[j + 1, 0])
-                        rhs[j] += fx * jx + fz * jz
-                        for k in range(b):
-                            kx = pz - O[k + 1, 1]
-                            kz = -(px - O[k + 1, 0])
-                            Jv[j, k] += jx * (gv00 * kx + gv01 * kz) + jz * (gv11 * kz)
-                            Jq[j, k] += jx * (gp01 * kz) + jz * (gp11 * kz)
-                for j in range(nj):
-                    acc = g * rhs[j]
-                    for k in range(nj):
-                        acc -= M[j, k] * (vi[k] - vh[k])
-                    res[j] = acc
-                for j in range(nj):
-                    for k in range(nj):
-                        M[j, k] = M[j, k] - g * Jv[j, k] - g * g * Jq[j, k]
-                _solve(M, res, dv)
-                for j in range(nj):
-                    vi[j] += dv[j]
+            bs_row = base[i]
+            b0 = base[i - 1]
             for j in range(nj):
-                dv[j] = vi[j] - v[j]
-            # clamp power with the step's accelerations
-            fcx = 0.0
-            fcz = 0.0
-            tc = 0.0
-            for b in range(nb):
-                ax = AR[b, 0]
-                az = AR[b, 1]
-                alb = al[b]
-                for j in range(b):
-                    qdd = dv[j] / dt
-                    ax += qdd * (R[b, 1] - O[j + 1, 1])
-                    az -= qdd * (R[b, 0] - O[j + 1, 0])
-                    alb += qdd
-                m = body_mass[b]
-                fcx += m * ax
-                fcz += m * (az + GRAVITY)
-                rx = R[b, 0] - bs[0]
-                rz = R[b, 1] - bs[1]
-                tc += m * (ax * rz - (az + GRAVITY) * rx) + body_inertia[b] * alb
+                q_save[j] = q[j]
+                v_save[j] = v[j]
+                qp_save[j] = qp[j]
+                vp_save[j] = vp[j]
+            n_here = 1
+            for attempt in range(2):
+                wc = 0.0
+                dj = 0.0
+                dc = 0.0
+                df = 0.0
+                h = dt / n_here
+                changed = False
+                for k in range(1, n_here + 1):
+                    if n_here == 1:
+                        for c in range(bsub.shape[0]):
+                            bsub[c] = bs_row[c]
+                        use_bdf2 = (order == 2) & have_history
+                    else:
+                        f = k / n_here
+                        for c in range(bsub.shape[0]):
+                            bsub[c] = b0[c] + f * (bs_row[c] - b0[c])
+                        use_bdf2 = (order == 2) & (k > 1)
+                    bs = bsub
+                    if use_bdf2:
+                        # BDF2: x_{n+1} = 4/3 x_n - 1/3 x_{n-1} + 2/3 h f(x_{n+1})
+                        g = 2.0 * h / 3.0
+                        for j in range(nj):
+                            qh[j] = (4.0 * q[j] - qp[j]) / 3.0
+                            vh[j] = (4.0 * v[j] - vp[j]) / 3.0
+                            vi[j] = 2.0 * v[j] - vp[j]
+                    else:
+                        g = h
+                        for j in range(nj):
+                            qh[j] = q[j]
+                            vh[j] = v[j]
+                            vi[j] = v[j]
+                    p_fric = 0.0
+                    p_cdamp = 0.0
+                    for _it in range(n_iter):
+                        for j in range(nj):
+                            qs[j] = qh[j] + g * vi[j]
+                        _kinematics(bs, qs, vi, hinge, com0, O, vO, aO, phi, cph, sph, om, al, R, VR, AR)
+                        for j in range(nj):
+                            hx = O[j + 1, 0]
+                            hz = O[j + 1, 1]
+                            acc = 0.0
+                            for k in range(j, nj):
+                                kx = O[k + 1, 0]
+                                kz = O[k + 1, 1]
+                                mjk = 0.0
+                                for b in range(k + 1, nb):
+                                    mjk += (body_mass[b] * ((R[b, 0] - hx) * (R[b, 0] - kx)
+                                                            + (R[b, 1] - hz) * (R[b, 1] - kz))
+                                            + body_inertia[b])
+                                M[j, k] = mjk
+                                M[k, j] = mjk
+                                Jq[j, k] = 0.0
+                                Jq[k, j] = 0.0
+                                Jv[j, k] = 0.0
+                                Jv[k, j] = 0.0
+                            for b in range(j + 1, nb):
+                                rx = R[b, 0] - hx
+                                rz = R[b, 1] - hz
+                                # gravity minus inertia (bias) generalised force
+                                acc += body_mass[b] * (GRAVITY * rx - (AR[b, 0] * rz - AR[b, 1] * rx))
+                                acc -= body_inertia[b] * al[b]
+                            qa = qs[j]
+                            acc -= stiffness[j] * qa + stiffness_quadratic[j] * qa * abs(qa) + damping[j] * vi[j]
+                            Jq[j, j] -= stiffness[j] + 2.0 * stiffness_quadratic[j] * abs(qa)
+                            Jv[j, j] -= damping[j]
+                            rhs[j] = acc
+                        p_fric = 0.0
+                        p_cdamp = 0.0
+                        for e in range(ne):
+                            b = sole_body[e]
+                            cx, cz = _body_point(b, sole_geom[e, 0], sole_geom[e, 1], hinge, O, cph, sph)
+                            (px, pz, fx, fz, depth, rate, slip, kn, cn, mu, dmu, fel) = sole_contact(
+                                contact, cx, cz, sph[b] * ce[e] + cph[b] * se[e], cph[b] * ce[e] - sph[b] * se[e],
+                                sole_geom[e, 2], sole_geom[e, 3],
+                                O[b, 0], O[b, 1], vO[b, 0], vO[b, 1], om[b], ground_vx)
+                            fe[e, 0] = fx
+                            fe[e, 1] = fz
+                            pe[e, 0] = px
+                            pe[e, 1] = pz
+                            if fz == 0.0:
+                                regime[e] = 0
+                                continue
+                            speed = abs(slip)
+                            regime[e] = 1 if speed <= vc else (2 if speed < 1.5 * vc else 3)
+                            p_fric += -fx * slip
+                            p_cdamp += (fz - fel) * rate
+                            # gradients of (fx, fz) with respect to the point's position and velocity
+                            gv00 = -dmu * fz
+                            gv01 = mu * cn
+                            gv11 = -cn
+                            gp01 = mu * kn
+                            gp11 = -kn
+                            for j in range(b):
+                                jx = pz - O[j + 1, 1]
+                                jz = -(px - O[j + 1, 0])
+                                rhs[j] += fx * jx + fz * jz
+                                for k in range(b):
+                                    kx = pz - O[k + 1, 1]
+                                    kz = -(px - O[k + 1, 0])
+                                    Jv[j, k] += jx * (gv00 * kx + gv01 * kz) + jz * (gv11 * kz)
+                                    Jq[j, k] += jx * (gp01 * kz) + jz * (gp11 * kz)
+                        for j in range(nj):
+                            acc = g * rhs[j]
+                            for k in range(nj):
+                                acc -= M[j, k] * (vi[k] - vh[k])
+                            res[j] = acc
+                        for j in range(nj):
+                            for k in range(nj):
+                                M[j, k] = M[j, k] - g * Jv[j, k] - g * g * Jq[j, k]
+                        _solve(M, res, dv)
+                        for j in range(nj):
+                            vi[j] += dv[j]
+                    # clamp power with the step's accelerations (v_{n+1} - v_n) / h
+                    fcx = 0.0
+                    fcz = 0.0
+                    tc = 0.0
+                    for b in range(nb):
+                        ax = AR[b, 0]
+                        az = AR[b, 1]
+                        alb = al[b]
+                        for j in range(b):
+                            qdd = (vi[j] - v[j]) / h
+                            ax += qdd * (R[b, 1] - O[j + 1, 1])
+                            az -= qdd * (R[b, 0] - O[j + 1, 0])
+                            alb += qdd
+                        m = body_mass[b]
+                        fcx += m * ax
+                        fcz += m * (az + GRAVITY)
+                        rx = R[b, 0] - bs[0]
+                        rz = R[b, 1] - bs[1]
+                        tc += m * (ax * rz - (az + GRAVITY) * rx) + body_inertia[b] * alb
+                    for e in range(ne):
+                        fcx -= fe[e, 0]
+                        fcz -= fe[e, 1]
+                        tc -= fe[e, 0] * (pe[e, 1] - bs[1]) - fe[e, 1] * (pe[e, 0] - bs[0])
+                    wc += h * (fcx * bs[3] + fcz * bs[4] + tc * bs[5])
+                    for j in range(nj):
+                        qp[j] = q[j]
+                        vp[j] = v[j]
+                        v[j] = vi[j]
+                        q[j] = qh[j] + g * vi[j]
+                        dj += h * damping[j] * v[j] * v[j]
+                    dc += h * p_cdamp
+                    df += h * p_fric
+                    for e in range(ne):
+                        if regime[e] != regime_old[e] or regime[e] >= 2:
+                            changed = True
+                if attempt == 0 and changed and refine > 1 and i > 1:
+                    # the contact law changes regime or slides in this step: redo it in sub-steps
+                    for j in range(nj):
+                        q[j] = q_save[j]
+                        v[j] = v_save[j]
+                        qp[j] = qp_save[j]
+                        vp[j] = vp_save[j]
+                    n_here = refine
+                    continue
+                break
+            if n_here > 1:
+                for j in range(nj):
+                    qp[j] = q_save[j]
+                    vp[j] = v_save[j]
+            have_history = True
             for e in range(ne):
-                fcx -= fe[e, 0]
-                fcz -= fe[e, 1]
-                tc -= fe[e, 0] * (pe[e, 1] - bs[1]) - fe[e, 1] * (pe[e, 0] - bs[0])
-            w_clamp += dt * (fcx * bs[3] + fcz * bs[4] + tc * bs[5])
-            diverged = False
+                regime_old[e] = regime[e]
+            w_clamp += wc
+            d_joint += dj
+            d_contact += dc
+            d_friction += df
             for j in range(nj):
-                dv[j] = vi[j] - v[j]
-                qp[j] = q[j]
-                vp[j] = v[j]
-                v[j] = vi[j]
-                q[j] = qh[j] + g * vi[j]
-                d_joint += dt * damping[j] * v[j] * v[j]
                 if not (math.isfinite(q[j]) and abs(q[j]) < 10.0):
-                    diverged = True
-            d_friction += dt * p_fric
-            d_contact += dt * p_cdamp
-            if diverged:
-                return STATUS_DIVERGED, i
-        if record:
+                    return STATUS_DIVERGED, i
+        if i % nsub == 0:
             # ---- outputs at a sample time, from the state itself ----
             s_idx = i // nsub
             bs = base[i]
@@ -426,8 +482,8 @@ def simulate_prescribed(
                 b = sole_body[e]
                 cx, cz = _body_point(b, sole_geom[e, 0], sole_geom[e, 1], hinge, O, cph, sph)
                 (px, pz, fx, fz, depth, rate, slip, kn, cn, mu, dmu, fel) = sole_contact(
-                    contact, cx, cz, sph[b] * ce[e] + cph[b] * se[e], cph[b] * ce[e] - sph[b] * se[e],
-                    sole_geom[e, 2], sole_geom[e, 3],
+                    contact, cx, cz, sph[b] * ce[e] + cph[b] * se[e],
+                    cph[b] * ce[e] - sph[b] * se[e], sole_geom[e, 2], sole_geom[e, 3],
                     O[b, 0], O[b, 1], vO[b, 0], vO[b, 1], om[b], ground_vx)
                 grf[s_idx, e, 0] = fx
                 grf[s_idx, e, 1] = fz
@@ -466,12 +522,12 @@ def simulate_prescribed(
 
 @njit(cache=True, error_model="numpy")
 def _batch_serial(base, dt, nsub, ground_vx, body_mass, com0, body_inertia, hinge, sole_body,
-                  sole_geom, tip_body, tip, contact, K, D, K2, q0, v0, order, n_iter,
+                  sole_geom, tip_body, tip, contact, K, D, K2, q0, v0, order, n_iter, refine,
                   grf, dist, qout, tau, state, energy, status):
     for s in range(K.shape[0]):
         st, at = simulate_prescribed(
             base, dt, nsub, ground_vx, body_mass, com0, body_inertia, hinge, sole_body, sole_geom,
-            tip_body, tip, contact, K[s], D[s], K2[s], q0, v0, order, n_iter,
+            tip_body, tip, contact, K[s], D[s], K2[s], q0, v0, order, n_iter, refine,
             grf[s], dist[s], qout[s], tau[s], state[s], energy[s])
         status[s, 0] = st
         status[s, 1] = at
@@ -479,12 +535,12 @@ def _batch_serial(base, dt, nsub, ground_vx, body_mass, com0, body_inertia, hing
 
 @njit(cache=True, parallel=True)
 def _batch_parallel(base, dt, nsub, ground_vx, body_mass, com0, body_inertia, hinge, sole_body,
-                    sole_geom, tip_body, tip, contact, K, D, K2, q0, v0, order, n_iter,
+                    sole_geom, tip_body, tip, contact, K, D, K2, q0, v0, order, n_iter, refine,
                     grf, dist, qout, tau, state, energy, status):
     for s in prange(K.shape[0]):
         st, at = simulate_prescribed(
             base, dt, nsub, ground_vx, body_mass, com0, body_inertia, hinge, sole_body, sole_geom,
-            tip_body, tip, contact, K[s], D[s], K2[s], q0, v0, order, n_iter,
+            tip_body, tip, contact, K[s], D[s], K2[s], q0, v0, order, n_iter, refine,
             grf[s], dist[s], qout[s], tau[s], state[s], energy[s])
         status[s, 0] = st
         status[s, 1] = at
