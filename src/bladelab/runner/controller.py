@@ -220,7 +220,7 @@ def controller_layout(model) -> ControllerLayout:
         hi.append(high)
         return len(names) - 1
 
-    for side, leg in (("l", 0), ("r", 1)):
+    for side in ("l", "r"):
         param(f"stance_load_threshold_{side}", par.get("stance_load_threshold", 0.28), 0.01, 1.0)
     for dof in INITIAL_DOFS:
         for side in ("l", "r") if dof != "pelvis_tilt" else ("",):

@@ -243,6 +243,12 @@ def optimize_controller(
                 file=ckpt,
                 hint="resume with the same --model, --blade and --speed",
             )
+        if list(state["parameter_names"]) != list(layout.names):
+            raise InputFileError(
+                "checkpoint was written for another controller layout",
+                file=ckpt,
+                hint="warm-start a new run from its best.json with --init instead",
+            )
         es = state["es"]
         gen, evals = state["generation"], state["evaluations"]
         history = list(state["history"])

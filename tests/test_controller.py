@@ -1,0 +1,168 @@
+"""Reflex controller: sensor delays, gait-state transitions, reflex laws, layout, JSON I/O."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from bladelab.errors import InputFileError, SpecError
+from bladelab.runner import build_runner
+from bladelab.runner.controller import (
+    EARLY_STANCE,
+    LANDING,
+    LATE_STANCE,
+    LIFTOFF,
+    R_DELAY,
+    SWING,
+    T_DOF_POS,
+    T_DOF_VEL,
+    T_FORCE,
+    T_LENGTH,
+    compute_excitations,
+    controller_layout,
+    delayed,
+    push_sensors,
+    read_parameters,
+    update_gait_states,
+    write_parameters,
+)
+
+
+@pytest.fixture(scope="module")
+def able():
+    return build_runner("able")
+
+
+@pytest.fixture(scope="module")
+def amputee():
+    return build_runner("amputee", blade="Cat6")
+
+
+def test_delay_returns_the_value_from_d_steps_ago():
+    nm, nq = 1, 2
+    mp = np.array([[1000.0, 0.1, 0.2, 0.0]])
+    hist = np.zeros((6, 3 * nm + 2 * nq))
+    cs = np.zeros(4)
+    for k in range(10):
+        ms = np.array([[0.1, 0.1 * (1 + k), 0.0, 10.0 * k]])  # L = 1 + k, F = k/100
+        push_sensors(hist, cs, ms, mp, np.array([k, -k], float), np.zeros(2))
+        for d in range(0, min(k, 4) + 1):
+            assert delayed(hist, cs, 0, d) == pytest.approx(1 + k - d)
+            assert delayed(hist, cs, 2, d) == pytest.approx((k - d) / 100)
+            assert delayed(hist, cs, 3 * nm + 1, d) == pytest.approx(-(k - d))
+
+
+def test_delay_before_history_is_filled_gives_the_first_sample():
+    mp = np.array([[1000.0, 0.1, 0.2, 0.0]])
+    hist = np.zeros((5, 3 + 2))
+    cs = np.zeros(4)
+    push_sensors(hist, cs, np.array([[0.1, 0.07, 0.0, 0.0]]), mp, np.array([0.3]), np.zeros(1))
+    assert delayed(hist, cs, 0, 3) == pytest.approx(0.7)
+    assert delayed(hist, cs, 3, 3) == pytest.approx(0.3)
+
+
+def _crec(fz_left, fz_right, x_left, x_right):
+    # two contacts: leg 0 and leg 1; columns Fx, Fz, px, pz, vx, vz, depth
+    crec = np.zeros((2, 7))
+    crec[0, 1], crec[1, 1] = fz_left, fz_right
+    crec[0, 2], crec[1, 2] = x_left, x_right
+    cp = np.zeros((2, 8))
+    cp[0, 6], cp[1, 6] = 0, 1
+    return crec, cp
+
+
+def test_gait_state_machine_walks_through_the_cycle():
+    bw, thr, leg_len = 800.0, np.array([0.2, 0.2]), 1.0
+    qpos = np.zeros(3)  # pelvis x = 0
+    cs = np.array([SWING, SWING, 0, 0], float)
+
+    def step(fl, fr, xl, xr):
+        return update_gait_states(cs, *_crec(fl, fr, xl, xr), qpos, 0, bw, thr, leg_len)
+
+    step(0, 0, 0.3, -0.3)  # left foot ahead, no contact: landing
+    assert cs[0] == LANDING and cs[1] == SWING
+    step(400, 0, 0.3, -0.3)  # load 0.5 BW > 0.2: early stance
+    assert cs[0] == EARLY_STANCE
+    step(100, 0, 0.1, -0.3)  # load 0.125 BW < 0.2: contact lost -> swing
+    assert cs[0] == SWING
+    step(400, 0, 0.2, -0.2)
+    assert cs[0] == EARLY_STANCE
+    step(400, 0, -0.05, 0.1)  # foot behind the pelvis: late stance
+    assert cs[0] == LATE_STANCE
+    step(400, 400, -0.2, 0.3)  # other leg lands: liftoff (double support)
+    assert cs[0] == LIFTOFF and cs[1] == EARLY_STANCE
+    step(0, 400, -0.3, 0.2)
+    assert cs[0] == SWING
+
+
+def test_reflex_laws_by_hand():
+    # one muscle, one dof: every kind of term, with delays
+    table = np.array(
+        [
+            # kind, target, leg, mask, source, delay, gain idx, offset idx, offset const
+            [T_LENGTH, 0, 0, 0b00011, 0, 2, 0, 1, 0.0],
+            [T_FORCE, 0, 0, 0b00011, 0, 1, 2, -1, 0.0],
+            [T_DOF_POS, 0, 0, 0b11100, 0, 0, 3, -1, -0.105],
+            [T_DOF_VEL, 0, 0, 0b11100, 0, 0, 4, -1, 0.0],
+        ]
+    )
+    p = np.array([2.0, 0.9, 0.5, 1.5, 0.3])
+    mp = np.array([[1000.0, 0.1, 0.2, 0.0]])
+    hist = np.zeros((4, 3 + 2))
+    cs = np.array([EARLY_STANCE, SWING, 0, 0], float)
+    lengths = [0.10, 0.11, 0.12]
+    forces = [100.0, 200.0, 300.0]
+    for ln, f in zip(lengths, forces, strict=True):
+        push_sensors(hist, cs, np.array([[0.1, ln, 0.0, f]]), mp, np.array([-0.2]), np.array([0.4]))
+    u = np.zeros(1)
+    compute_excitations(u, table, p, hist, cs, 1, 1)
+    # stance: KL*(L(t-2) - L0) + KF*F(t-1) = 2*(1.0 - 0.9) + 0.5*0.2
+    assert u[0] == pytest.approx(2 * 0.1 + 0.5 * 0.2)
+    cs[0] = SWING
+    compute_excitations(u, table, p, hist, cs, 1, 1)
+    # swing: KP*(P0 - q) - KV*qd = 1.5*(-0.105 + 0.2) - 0.3*0.4, clipped at 0
+    assert u[0] == pytest.approx(max(1.5 * 0.095 - 0.12, 0.0))
+    p[3] = 10.0
+    compute_excitations(u, table, p, hist, cs, 1, 1)
+    assert u[0] == pytest.approx(10 * 0.095 - 0.12)
+    p[3] = 100.0
+    compute_excitations(u, table, p, hist, cs, 1, 1)
+    assert u[0] == 1.0  # clipped
+
+
+def test_layout_ports_scone_values_and_is_asymmetric(able, amputee):
+    la, lp = controller_layout(able), controller_layout(amputee)
+    assert len(set(la.names)) == la.size
+    # SCONE H0918GaitRS2Hfd4.par, column best
+    assert la.x0[la.index("S00011.vasti_l.KF")] == pytest.approx(0.82139952)
+    assert la.x0[la.index("S00011.vasti_r.KF")] == pytest.approx(0.82139952)
+    assert la.x0[la.index("S11100.iliopsoas_l-hamstrings.KL")] == pytest.approx(-2.8426204)
+    assert la.x0[la.index("stance_load_threshold_l")] == pytest.approx(0.28168695)
+    # the prosthetic leg has no shank muscles, so no reflex to or from them
+    assert not [
+        n for n in lp.names if "_r" in n and any(m in n for m in ("soleus", "gastroc", "tib_ant"))
+    ]
+    assert "S11111.soleus_l.KF" in lp.names and "S11111.soleus_r.KF" in la.names
+    assert la.size > lp.size
+    # delays: ankle reflexes 35 ms -> 70 steps of 0.5 ms
+    t = la.table_for(5e-4)
+    assert set(np.unique(t[:, R_DELAY])) <= {0, 20, 30, 40, 70, 100}
+
+
+def test_parameter_json_roundtrip_and_errors(tmp_path, able, amputee):
+    la = controller_layout(able)
+    x = la.x0 + 0.01
+    path = write_parameters(tmp_path / "p.json", la, x, speed_m_per_s=3.5)
+    np.testing.assert_allclose(read_parameters(path, la), x)
+    with pytest.raises(InputFileError, match="able model"):
+        read_parameters(path, controller_layout(amputee))
+    (tmp_path / "bad.json").write_text(json.dumps({"parameters": {"nope.KL": 1.0}}))
+    with pytest.raises(SpecError, match="nope.KL"):
+        read_parameters(tmp_path / "bad.json", la)
+    (tmp_path / "broken.json").write_text("{")
+    with pytest.raises(InputFileError, match="JSON"):
+        read_parameters(tmp_path / "broken.json", la)
+    with pytest.raises(InputFileError, match="not found"):
+        read_parameters(tmp_path / "missing.json", la)

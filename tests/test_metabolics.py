@@ -1,0 +1,74 @@
+"""Uchida 2016 / Umberger 2003 metabolic model against hand-computed cases."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from bladelab.runner import build_runner
+from bladelab.runner.metabolics import (
+    BASAL_RATE_W_PER_KG,
+    metabolic_params,
+    muscle_metabolic_rate,
+    total_metabolic_rate,
+)
+
+
+def test_isometric_activation_maintenance_only():
+    # A = u = 0.5 (u > a); h_AM = (1.28*50 + 25) * 0.5**0.6 * 1.5; no shortening heat, no work
+    expected = 89.0 * 0.5**0.6 * 1.5
+    assert muscle_metabolic_rate(0.5, 0.3, 1.0, 0.0, 800.0, 0.0, 1.0, 50.0) == pytest.approx(
+        expected
+    )
+
+
+def test_shortening_with_deactivation_average():
+    # u < a: A = (0.2 + 0.6)/2 = 0.4; FT 20 %: v_max,ST = 10/1.3, v_max,FT = 2.5 v_max,ST
+    a_st = 100.0 / (10.0 / 1.3)  # 13.0
+    a_ft = 153.0 / (2.5 * 10.0 / 1.3)  # 7.956
+    h_am = (1.28 * 20 + 25) * 0.4**0.6 * 1.5
+    h_s = (a_st * 2.0 * 0.8 + a_ft * 2.0 * 0.2) * 0.4**2 * 1.5
+    work = 500.0 * 0.2 / 0.5  # shortening at 0.2 m/s against 500 N, per kg of a 0.5 kg muscle
+    expected = (h_am + h_s + work) * 0.5
+    got = muscle_metabolic_rate(0.2, 0.6, 0.9, -2.0, 500.0, -0.2, 0.5, 20.0)
+    assert got == pytest.approx(expected)
+    assert a_st == pytest.approx(13.0)
+
+
+def test_lengthening_counts_negative_work():
+    # A = 1, FT 50 %: alpha_L = 4 * 100 / (10/1.75) = 70; h_L = 70 * 1 * 1 * 1.5 = 105
+    # h_AM = 89 * 1.5 = 133.5; negative work -1000*0.1/1 = -100 (Uchida: included)
+    assert muscle_metabolic_rate(1.0, 1.0, 1.0, 1.0, 1000.0, 0.1, 1.0, 50.0) == pytest.approx(
+        133.5 + 105.0 - 100.0
+    )
+
+
+def test_heat_floor_of_one_watt_per_kg():
+    assert muscle_metabolic_rate(0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 2.0, 50.0) == pytest.approx(2.0)
+
+
+def test_long_fibres_scale_by_isometric_force():
+    f_iso = math.exp(math.log(0.05) * (0.2 / 0.56) ** 3)
+    h_am = 89.0 * 1.5 * (0.4 + 0.6 * f_iso)
+    assert muscle_metabolic_rate(1.0, 1.0, 1.2, 0.0, 0.0, 0.0, 1.0, 50.0) == pytest.approx(h_am)
+
+
+def test_muscle_masses_are_the_seed_volumes():
+    model = build_runner("able")
+    mb = metabolic_params(model)
+    i = model.muscle_names.index("glut_max_l")
+    # seed 001 eq. 2.1: V = phi * V_total = 0.12 * 11095 cm^3; rho = 1059.7 kg/m^3
+    assert mb[i, 0] == pytest.approx(1059.7 * 0.12 * 11095e-6, rel=1e-9)
+    assert mb[i, 1] == 45.0
+
+
+def test_total_rate_is_basal_plus_muscles():
+    mp = np.array([[1000.0, 0.1, 0.2, 0.0]])
+    mb = np.array([[1.0, 50.0]])
+    ms = np.array([[0.5, 0.1, 0.0, 300.0]])  # isometric at optimal length
+    u = np.array([0.5])
+    expected = BASAL_RATE_W_PER_KG * 70.0 + 89.0 * 0.5**0.6 * 1.5
+    assert total_metabolic_rate(u, ms, mp, mb, 70.0) == pytest.approx(expected)
+    assert total_metabolic_rate(u[:0], ms[:0], mp[:0], mb[:0], 70.0) == pytest.approx(1.51 * 70)

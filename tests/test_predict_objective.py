@@ -1,0 +1,85 @@
+"""Objective of seed 001 eq. 2.4–2.9 and the closed-loop simulation."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from bladelab.runner import build_runner
+from bladelab.runner.controller import controller_layout
+from bladelab.runner.objective import ObjectiveSettings, _evaluate, simulate_controlled
+
+
+@pytest.fixture(scope="module")
+def able():
+    model = build_runner("able")
+    return model, controller_layout(model)
+
+
+def _td(times, speed):
+    return np.array([[t, speed * t] for t in times])
+
+
+def test_gait_measure_by_hand():
+    s = ObjectiveSettings(speed=3.5, speed_tolerance=0.1, duration=10.0)
+    acc = np.zeros(4)
+    # steps every 0.35 s at exactly 3.5 m/s up to 9.8 s: every step counts fully
+    ev = _evaluate(s, acc, _td(np.arange(1, 29) * 0.35, 3.5), 10.0, 35.0, False, 80.0, 0.0)
+    assert ev.j_gait == pytest.approx(1.0 - 9.8 / 10.0)
+    # steps at 3.0 m/s: Psi = 3.4 - 3.0 = 0.4, each step weighs 0.6
+    ev = _evaluate(s, acc, _td(np.arange(1, 29) * 0.35, 3.0), 10.0, 30.0, False, 80.0, 0.0)
+    assert ev.j_gait == pytest.approx(1.0 - 0.6 * 9.8 / 10.0)
+    # too fast by more than 1 m/s: no credit
+    ev = _evaluate(s, acc, _td([0.5, 1.0], 5.0), 1.0, 5.0, True, 80.0, 0.0)
+    assert ev.j_gait == pytest.approx(1.0)
+    assert ev.cost == pytest.approx(100.0 * 1.0)
+
+
+def test_cost_terms_and_weights_by_hand():
+    s = ObjectiveSettings(speed=3.5, duration=2.0)
+    # energy 1600 J, 80 kg, 7 m: J_cot = 1600/(80*7); penalties accumulated as integral * s
+    acc = np.array([1600.0, 30.0, 4.0, 0.0])
+    ev = _evaluate(s, acc, np.zeros((0, 2)), 2.0, 7.0, False, 80.0, 0.0)
+    assert ev.j_cot == pytest.approx(1600 / 560)
+    assert ev.j_inj == pytest.approx(15.0)
+    assert ev.j_lean == pytest.approx(2.0)
+    assert ev.j_gait == pytest.approx(1.0)
+    assert ev.cost == pytest.approx(0.1 * 1600 / 560 + 100.0 + 0.1 * 15 + 0.1 * 2)
+
+
+def test_simulation_is_deterministic_and_stops_when_fallen(able):
+    model, layout = able
+    s = ObjectiveSettings(duration=3.0)
+    e1, res = simulate_controlled(model, layout.x0, layout=layout, settings=s, record_every=1)
+    e2, _ = simulate_controlled(model, layout.x0, layout=layout, settings=s)
+    assert e1 == e2
+    # SCONE's walking parameters do not run at 3.5 m/s: the model falls, the run stops early
+    assert e1.fell and e1.duration < 3.0 and res.fell
+    assert res.time[-1] == pytest.approx(e1.duration)
+    assert res.qpos[-1, model.dof("pelvis_tz")] < 0.6 * model.stand_qpos[model.dof("pelvis_tz")]
+    assert e1.j_gait > 1.0 - e1.duration / 3.0 - 1e-9
+
+
+def test_lean_penalty_recomputed_from_recorded_states(able):
+    model, layout = able
+    s = ObjectiveSettings(duration=0.5, squared_penalty=0.5)
+    ev, res = simulate_controlled(model, layout.x0, layout=layout, settings=s, record_every=1)
+    tilt = np.degrees(res.qpos[:, model.dof("pelvis_tilt")])
+    err = np.where(tilt < -16.0, -16.0 - tilt, np.where(tilt > -2.0, tilt + 2.0, 0.0))
+    expected = np.sum(err + 0.5 * err**2) * s.dt / ev.duration
+    assert expected > 0
+    assert ev.j_lean == pytest.approx(expected, rel=1e-9)
+    # distance and speed from the recorded pelvis
+    x = res.qpos[:, model.dof("pelvis_tx")]
+    assert ev.distance == pytest.approx(x[-1] - x[0])
+    assert math.isfinite(ev.j_cot) and ev.j_cot > 0
+
+
+def test_wrong_parameter_count_is_an_error(able):
+    from bladelab.errors import SimulationError
+
+    model, layout = able
+    with pytest.raises(SimulationError, match="controller parameters"):
+        simulate_controlled(model, layout.x0[:-1], layout=layout)
