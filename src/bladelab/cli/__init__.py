@@ -18,7 +18,7 @@ from bladelab.errors import BladelabError
 
 # Sub-command modules, in help order. Each defines ``register(app: typer.Typer) -> None``.
 _COMMAND_MODULES: tuple[str, ...] = ("trial", "blade", "runner", "identify", "predict", "example",
-                                     "design")
+                                     "report", "design")
 
 app = typer.Typer(
     name="bladelab",
