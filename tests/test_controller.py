@@ -156,8 +156,13 @@ def test_parameter_json_roundtrip_and_errors(tmp_path, able, amputee):
     x = la.x0 + 0.01
     path = write_parameters(tmp_path / "p.json", la, x, speed_m_per_s=3.5)
     np.testing.assert_allclose(read_parameters(path, la), x)
+    lp = controller_layout(amputee)
     with pytest.raises(InputFileError, match="able model"):
-        read_parameters(path, controller_layout(amputee))
+        read_parameters(path, lp)
+    # warm start of the amputee from the able-bodied solution: shared names carried over
+    xt = read_parameters(path, lp, transfer=True)
+    assert xt[lp.index("S00011.vasti_r.KF")] == pytest.approx(x[la.index("S00011.vasti_r.KF")])
+    assert xt[lp.index("S11111.soleus_l.KF")] == pytest.approx(x[la.index("S11111.soleus_l.KF")])
     (tmp_path / "bad.json").write_text(json.dumps({"parameters": {"nope.KL": 1.0}}))
     with pytest.raises(SpecError, match="nope.KL"):
         read_parameters(tmp_path / "bad.json", la)

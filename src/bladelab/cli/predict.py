@@ -52,7 +52,7 @@ def register(app: typer.Typer) -> None:
         if not (math.isfinite(speed) and speed > 0):
             raise SpecError("speed must be positive", where="--speed")
         _, layout = _model(model, blade if model == "amputee" else None)
-        x0 = read_parameters(init, layout) if init is not None else None
+        x0 = read_parameters(init, layout, transfer=True) if init is not None else None
         seed_list = _parse_list(seeds, "--seeds", int)
         results = []
         for seed in seed_list:

@@ -297,8 +297,15 @@ def _mask_bits(mask: str) -> int:
     return sum(1 << i for i, ch in enumerate(reversed(bits)) if ch == "1")
 
 
-def read_parameters(path: str | Path, layout: ControllerLayout) -> np.ndarray:
-    """Read a parameter JSON file (``{"parameters": {name: value}, ...}``) into a vector."""
+def read_parameters(
+    path: str | Path, layout: ControllerLayout, *, transfer: bool = False
+) -> np.ndarray:
+    """Read a parameter JSON file (``{"parameters": {name: value}, ...}``) into a vector.
+
+    With ``transfer=True`` a file of the other model kind is accepted (warm start of the amputee
+    from an able-bodied solution, as seed 001 does): parameters the layout lacks (the prosthetic
+    side's shank reflexes) are dropped, those it has and the file lacks keep the initial guess.
+    """
     path = Path(path)
     try:
         data = json.loads(path.read_text())
@@ -311,7 +318,9 @@ def read_parameters(path: str | Path, layout: ControllerLayout) -> np.ndarray:
         raise InputFileError(
             "expected an object with a 'parameters' mapping {name: value}", file=path
         )
-    if data.get("model") not in (None, layout.kind):
+    if transfer and data.get("model") not in (None, layout.kind):
+        params = {k: v for k, v in params.items() if k in layout.names}
+    elif data.get("model") not in (None, layout.kind):
         raise InputFileError(
             f"parameters are for the {data.get('model')} model, not {layout.kind}",
             file=path,

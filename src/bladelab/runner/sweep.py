@@ -37,7 +37,7 @@ def category_task(payload: dict) -> dict:
 
     cat = payload["category"]
     _, layout = _model("amputee", cat)
-    x = read_parameters(payload["init"], layout) if payload.get("init") else None
+    x = read_parameters(payload["init"], layout, transfer=True) if payload.get("init") else None
     rows = []
     for speed in payload["speeds"]:
         res = optimize_controller(
