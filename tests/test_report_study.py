@@ -1,0 +1,102 @@
+"""A reduced example study end to end: generate C3D trials -> identify -> ``bladelab report``.
+
+Also the report's clear errors, and a headless-Chromium check of the study page with the harness
+of ``test_report_browser.py``.
+"""
+
+from __future__ import annotations
+
+import re
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from bladelab.cli import main
+from bladelab.errors import DataError, InputFileError
+from bladelab.example.study import make_example_study, read_ground_truth
+from bladelab.report.study import build_study_report
+from bladelab.study import run_study
+
+N_TRIALS = 4
+FIGURES = 8  # GRF, distance, K*/D* bars, 3 mechanics panels, cost landscape, recovered vs true
+
+
+@pytest.fixture(scope="module")
+def study(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("e2e") / "sprint"
+    make_example_study(folder, seed=1, n_trials=N_TRIALS, jobs=1, progress=False)
+    run = run_study(folder, settings={"max_evals": 200}, jobs=1, executor="serial",
+                    progress=False)
+    assert run.finished + len(run.failures) == N_TRIALS
+    return folder
+
+
+@pytest.fixture(scope="module")
+def report(study):
+    return build_study_report(study, landscape_points=7, progress=False)
+
+
+def test_the_report_has_every_section_and_its_tables(study, report):
+    html = report.index.read_text(encoding="utf-8")
+    for heading in ("nRMSE of the GRF (Table 1)", "nRMSE of the characteristic distance (Table 2)",
+                    "GRF and distance vs time", "K* and D* per group and speed band",
+                    "Blade mechanics", "Statistics", "Identifiability",
+                    "Recovered vs true parameters", "Settings, versions and seed"):
+        assert heading in html, heading
+    assert "SYNTHETIC" in html
+    assert len(re.findall(r'<img src="data:image/png;base64,', html)) == FIGURES
+    assert report.n_trials + report.n_failed == N_TRIALS and report.n_trials >= 3
+    tables = report.index.parent / "tables"
+    grf = pd.read_csv(tables / "nrmse-grf.csv")
+    # both amputation levels and every category group of the reduced study are rows
+    assert {"TF", "TT"} <= set(grf["group"])
+    # a richer generating model: the fit is good but not exact (seed 000: 10–17 % for GRF)
+    assert (grf["nrmse_trials_mean_pct"] > 1.0).all() and (grf["nrmse_trials_mean_pct"] < 60).all()
+    dist = pd.read_csv(tables / "nrmse-distance.csv")
+    assert (dist["nrmse_trials_mean_pct"] < 30).all()
+
+
+def test_recovered_parameters_are_compared_with_the_generators_truth(study, report):
+    per_trial = pd.read_csv(report.index.parent / "tables"
+                            / "recovered-vs-true-parameters-per-trial.csv")
+    truth = read_ground_truth(study).set_index("trial_id")
+    assert len(per_trial) == report.n_trials
+    for row in per_trial.itertuples():
+        assert row.K_true == pytest.approx(truth.loc[row.trial_id, "K_Nm_per_deg"])
+        assert row.K_error_pct == pytest.approx(100 * (row.K_Nm_per_deg / row.K_true - 1))
+    # the seed's formulation on degraded data is biased, but lands in the right region
+    assert np.all(np.abs(per_trial["K_error_pct"]) < 50)
+
+
+def test_no_results_yet_is_a_clear_error(tmp_path, study, capsys):
+    empty = tmp_path / "fresh"
+    make_example_study(empty, seed=1, n_trials=2, jobs=1, progress=False)
+    with pytest.raises(InputFileError, match="no identification results"):
+        build_study_report(empty, progress=False)
+    assert main(["report", str(empty)]) == 2
+    err = capsys.readouterr().err
+    assert "run `bladelab identify" in err and "Traceback" not in err
+    assert not (empty / "report").exists()
+    with pytest.raises(DataError, match="no identification result"):
+        build_study_report(study, trial="nope", progress=False)
+
+
+def test_the_cli_writes_the_report_with_a_chosen_landscape_trial(study, tmp_path, capsys):
+    trial_id = sorted(p.stem for p in (study / "trials").glob("*.c3d"))[-1]
+    out = tmp_path / "rep"
+    assert main(["report", str(study), "--trial", trial_id, "--out", str(out), "--json"]) == 0
+    assert f'"landscape_trial": "{trial_id}"' in capsys.readouterr().out
+    assert (out / "index.html").is_file()
+
+
+def test_the_study_report_opens_in_headless_chromium(tmp_path, report):
+    from test_report_browser import _chromium, _figure_ok, _inspect
+
+    binary = _chromium()
+    figures, errors = _inspect(binary, report.index, tmp_path / "study.png", tmp_path / "profile")
+    print(f"\nstudy report screenshot: {tmp_path / 'study.png'}")
+    assert errors == [], f"console errors: {errors}"
+    assert len(figures) == FIGURES
+    for fig in figures:
+        assert _figure_ok(fig), fig
