@@ -412,8 +412,72 @@ def load_checkpoint(path: str | Path) -> dict:
     return state
 
 
+def verify_solution(
+    path: str | Path,
+    *,
+    model: str | None = None,
+    blade: str | None = None,
+    speed: float | None = None,
+    duration: float = 10.0,
+    speed_tolerance: float = 0.1,
+    max_power_residual_pct: float = 2.0,
+) -> dict:
+    """Re-simulate a parameter file and check the shipped-solution criteria.
+
+    Criteria (all recomputed from the file, nothing trusted from it): ``duration`` [s] without a
+    fall; mean speed within ``speed_tolerance`` [m/s] of ``speed`` (default: the file's
+    ``speed_m_per_s``); a flight phase (no leg loaded above 20 N) between every two successive
+    touch-downs; power-balance residual below ``max_power_residual_pct`` % (runner analyses).
+    Returns the measured values and ``ok``.
+    """
+    import json
+
+    from bladelab.runner.analyses import (
+        CONTACT_THRESHOLD_N,
+        gait_events,
+        power_balance_residual_pct,
+    )
+    from bladelab.runner.controller import read_parameters
+
+    data = json.loads(Path(path).read_text())
+    model = model or data.get("model", "able")
+    blade = blade or data.get("blade")
+    speed = float(speed if speed is not None else data.get("speed_m_per_s", 3.5))
+    runner, layout = _model(model, blade)
+    x = read_parameters(path, layout)
+    settings = ObjectiveSettings(speed=speed, duration=duration)
+    ev, res = simulate_controlled(runner, x, layout=layout, settings=settings, record_every=2)
+    fz = res.contacts[:, :, 1].sum(axis=1)
+    td = gait_events(res)
+    td = td.time[td.event == "touchdown"].to_numpy()
+    flights = []
+    for a, b in zip(td[:-1], td[1:], strict=True):
+        sel = (res.time > a) & (res.time < b)
+        flights.append(bool(np.any(fz[sel] < CONTACT_THRESHOLD_N)))
+    residual = power_balance_residual_pct(res)
+    out = {
+        "fell": ev.fell,
+        "duration_s": ev.duration,
+        "mean_speed_m_per_s": ev.mean_speed,
+        "strides": len(flights),
+        "strides_with_flight": int(sum(flights)),
+        "power_balance_residual_pct": residual,
+        "cost": ev.cost,
+    }
+    out["ok"] = bool(
+        not ev.fell
+        and ev.duration >= duration - 1e-9
+        and abs(ev.mean_speed - speed) <= speed_tolerance
+        and len(flights) >= 2
+        and all(flights)
+        and residual <= max_power_residual_pct
+    )
+    return out
+
+
 __all__ = [
     "OptimizationResult",
+    "verify_solution",
     "evaluate_candidates",
     "load_checkpoint",
     "optimize_controller",
