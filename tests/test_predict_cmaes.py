@@ -177,3 +177,11 @@ def test_sweep_on_ray_matches_local(tmp_path):
     a = pd.read_csv(tmp_path / "local" / "results.csv")
     b = pd.read_csv(tmp_path / "ray" / "results.csv")
     pd.testing.assert_frame_equal(a, b)
+
+
+def test_resume_keeps_the_runs_settings(tmp_path):
+    full = _run(out=tmp_path / "full", generations=3)
+    _run(out=tmp_path / "part", generations=1)
+    other = ObjectiveSettings(duration=0.3)
+    resumed = _run(out=tmp_path / "part", generations=3, resume=True, settings=other, seed=99)
+    assert resumed.history == full.history

@@ -209,7 +209,8 @@ def optimize_controller(
     out
         Output folder (checkpoint, best.json, history.csv); None writes nothing.
     resume
-        Continue from ``out/checkpoint.pkl``.
+        Continue from ``out/checkpoint.pkl`` (with the checkpoint's seed and objective settings;
+        ``x0``, ``popsize``, ``sigma`` and ``settings`` are then ignored).
     checkpoint_every
         Write the checkpoint every this many generations.
     settings
@@ -254,6 +255,7 @@ def optimize_controller(
         history = list(state["history"])
         best_x, best_f, best_ev = state["best_x"], state["best_f"], state["best_eval"]
         seed = state["seed"]
+        settings = _settings_from_dict(state["settings"])  # the run's own objective settings
     else:
         start = layout.x0 if x0 is None else np.asarray(x0, float)
         if start.shape != (layout.size,):
