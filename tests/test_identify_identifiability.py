@@ -75,12 +75,20 @@ def test_weakly_determined_parameter_flagged_by_width():
     rng = np.random.default_rng(3)
     y = 2.0 * t + 0.01 * t**2 + 0.05 * rng.standard_normal(50)
 
-    def residuals(X):
-        return X[:, :1] * t + X[:, 1:2] * 1e-3 * np.cos(7 * t) - y
+    A = np.column_stack([t, 1e-3 * np.cos(7 * t)])
 
-    res = assess_identifiability(residuals, [2.0, 0.5], [(0, 4), (-50, 50)], names=("K", "D"),
+    def residuals(X):
+        return X @ A.T - y
+
+    x_hat, *_ = np.linalg.lstsq(A, y, rcond=None)
+    res = assess_identifiability(residuals, x_hat, [(0, 4), (-50, 50)], names=("K", "D"),
                                  n_effective=50)
     assert res.poorly_determined[1] and not res.poorly_determined[0]
+    assert "half-width" in res.reasons[1]
+    # started away from the optimum: flagged as not converged
+    off = assess_identifiability(residuals, x_hat + [0.3, 0.0], [(0, 4), (-50, 50)],
+                                 names=("K", "D"), n_effective=50)
+    assert "did not converge" in off.reasons[0]
 
 
 def test_landscape_is_one_batch_and_tidy():

@@ -16,8 +16,9 @@ squares RSS(θ) = ‖r(θ)‖² is the least-squares analogue of the identificat
   n·(1 − ρ₁)/(1 + ρ₁) with ρ₁ the lag-1 autocorrelation of the residuals at the optimum (AR(1)),
   so intervals are not over-confident because of a high sampling rate.
 - **Flags**: a parameter is poorly determined when its interval reaches a search bound (open), its
-  half-width exceeds ``max_rel_halfwidth`` of the estimate, or it correlates with another parameter
-  with |ρ| > ``max_abs_corr`` (K–D compensation).
+  half-width exceeds ``max_rel_halfwidth`` of the estimate, it correlates with another parameter
+  with |ρ| > ``max_abs_corr`` (K–D compensation), or the optimiser did not converge (a profile
+  found an RSS lower than at ``x_opt`` by more than a tenth of the interval threshold).
 """
 
 from __future__ import annotations
@@ -290,6 +291,7 @@ def assess_identifiability(
     sd = np.sqrt(np.diag(cov))
     half = max(1, n_profile // 2)
     lo_ci, hi_ci, opened, frames = [], [], [], []
+    profile_min = rss0
     for i in range(d):
         width = b[i, 1] - b[i, 0]
         span = min(max(3.0 * threshold * sd[i], 1e-3 * width), width)
@@ -300,6 +302,7 @@ def assess_identifiability(
                           rel_step=rel_step)
         evals += n
         rss_min = min(rss0, float(np.min(rss)))
+        profile_min = min(profile_min, float(np.min(rss)))
         z = np.sqrt(np.maximum(rss - rss_min, 0.0) / s2)
         centre = int(np.argmin(rss))  # the optimiser's point may sit slightly off the minimum
         lo_v, lo_open = _crossing(grid, z, centre, threshold, -1)
@@ -311,9 +314,14 @@ def assess_identifiability(
         opened.append(bool(lo_open or hi_open))
         frames.append(pd.DataFrame({"parameter": names[i], "value": grid, "rss": rss}))
     lo_ci, hi_ci = np.asarray(lo_ci), np.asarray(hi_ci)
+    # the optimum should be the lowest point the profiles saw; a clearly lower RSS elsewhere means
+    # the optimiser stopped early (more evaluations, polish=True or CMA-ES)
+    not_converged = (rss0 - profile_min) / s2 > 0.1 * threshold**2
     flags, reasons = [], []
     for i in range(d):
         why = []
+        if not_converged:
+            why.append("the optimiser did not converge (the profiles found a lower cost)")
         if opened[i]:
             why.append("confidence interval reaches a search bound")
         rel = 0.5 * (hi_ci[i] - lo_ci[i]) / max(abs(x[i]), 1e-300)
