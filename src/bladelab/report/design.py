@@ -1,0 +1,144 @@
+"""The design-study section of the HTML report (a folder written by ``run_design``).
+
+:func:`design_report_sections` reads a design folder (``study.json``, ``results.csv``,
+``anova.csv``) and returns the keyword arguments of :meth:`Report.add_section` for: the fitted
+surfaces (R², adjusted and predicted R², leave-one-out error), main effects, contours with the
+constraint boundaries and the optimum, the ANOVA of the objective and the optimum with its
+prediction interval. :func:`build_design_report` writes them as ``<out_dir>/index.html``.
+The surfaces are refitted from ``results.csv`` (same model), the optimum recomputed with the
+study's seed (deterministic: the same as ``optimum.json``).
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+import pandas as pd
+
+from bladelab.errors import InputFileError
+
+__all__ = ["build_design_report", "design_report_sections", "is_design_folder"]
+
+
+def is_design_folder(path: str | Path) -> bool:
+    """True when ``path`` holds a design study (``study.json`` and ``results.csv``)."""
+    p = Path(path)
+    return (p / "study.json").is_file() and (p / "results.csv").is_file()
+
+
+def _load(design_dir: Path):
+    from bladelab.design.space import DesignSpace
+    from bladelab.design.surfaces import fit_surface
+    from bladelab.design.terms import parse_terms
+
+    if not is_design_folder(design_dir):
+        raise InputFileError("not a design-study folder (no study.json / results.csv)",
+                             file=design_dir, hint="run 'bladelab design --out DIR' first")
+    try:
+        meta = json.loads((design_dir / "study.json").read_text(encoding="utf-8"))
+        space = DesignSpace.from_dict(meta["space"])
+        table = pd.read_csv(design_dir / "results.csv")
+    except (OSError, ValueError, KeyError) as err:
+        raise InputFileError(f"cannot read the design study: {err}", file=design_dir) from None
+    units = {}
+    ev = design_dir / "evaluator.json"
+    if ev.is_file():
+        from bladelab.design.evaluators import BLADE_RESPONSE_UNITS
+        from bladelab.runner.transfemoral import RUNNER_RESPONSE_UNITS
+
+        kind = json.loads(ev.read_text(encoding="utf-8")).get("evaluator")
+        units = RUNNER_RESPONSE_UNITS if kind == "runner" else BLADE_RESPONSE_UNITS
+    coded_cols = [f"{n}_coded" for n in space.names]
+    skip = {"run", *space.names, *coded_cols}
+    responses = [c for c in table.columns if c not in skip]
+    terms = parse_terms(meta.get("model", "quadratic"), space.names)
+    coded = table[coded_cols].to_numpy(float)
+    surfaces = {r: fit_surface(coded, table[r].to_numpy(float), factor_names=space.names,
+                               model=terms, response=r, unit=units.get(r, ""))
+                for r in responses}
+    return meta, space, table, surfaces
+
+
+def design_report_sections(design_dir: str | Path) -> list[dict[str, Any]]:
+    """Keyword arguments of :meth:`bladelab.report.Report.add_section`, one dict per section."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from bladelab.cli.design import figure_pairs
+    from bladelab.design.optimum import SurfaceConstraint, constrained_optimum
+    from bladelab.design.plots import contour_plot, main_effects_plot
+    from bladelab.errors import OptimizationError
+
+    design_dir = Path(design_dir)
+    meta, space, table, surfaces = _load(design_dir)
+    objective = meta.get("objective") or next(iter(surfaces))
+    constraints = {k: float(v) for k, v in (meta.get("constraints") or {}).items()
+                   if k in surfaces}
+    fit = pd.DataFrame([
+        {"response": r, "unit": s.unit, "R2": s.r2, "R2_adj": s.r2_adj, "R2_pred": s.r2_pred,
+         "loo_rmse": s.loo_rmse} for r, s in surfaces.items()])
+    design_text = (f"{len(table)} runs ({meta.get('design', {}).get('kind', '?')} design), "
+                   f"model {meta.get('model')}, factors: "
+                   + ", ".join(f"{f.name} {f.low:g}–{f.high:g} {f.unit}".strip()
+                               for f in space.factors) + ".")
+    sections: list[dict[str, Any]] = [{
+        "title": "Design study: response surfaces",
+        "text": design_text + "\n\nPredicted R² comes from PRESS (leave-one-out).",
+        "tables": [("Surface fits", fit), ("Runs", table)],
+    }]
+    shown = [objective, *[c for c in constraints if c != objective]]
+    sections.append({
+        "title": "Design study: main effects",
+        "figures": [("Main effects (others at the centre; band: 95 % CI of the mean)",
+                     main_effects_plot([surfaces[r] for r in shown], space))],
+    })
+    cons = [SurfaceConstraint(surfaces[k], v) for k, v in constraints.items()]
+    optimum, why = None, ""
+    try:
+        optimum = constrained_optimum(surfaces[objective], sense=meta.get("sense", "max"),
+                                      constraints=cons, space=space, seed=int(meta.get("seed", 0)),
+                                      conservative=bool(meta.get("conservative", False)))
+    except OptimizationError as err:
+        why = str(err)
+    figs = [(f"{objective} over {x} and {y}; constraints hatched on their infeasible side",
+             contour_plot(surfaces[objective], space, x=x, y=y, constraints=cons,
+                          optimum=optimum)) for x, y in figure_pairs(space.names)]
+    sections.append({"title": "Design study: contours and constraints", "figures": figs})
+    anova = surfaces[objective].anova
+    sections.append({"title": f"Design study: ANOVA of {objective}",
+                     "tables": [(f"ANOVA of {objective}", anova),
+                                (f"Coefficients of {objective}",
+                                 surfaces[objective].coefficients())]})
+    if optimum is None:
+        sections.append({"title": "Design study: optimum",
+                         "text": f"No feasible optimum: {why}"})
+    else:
+        rows = [{"factor": k, "value": optimum.point[k], "unit": space.factor(k).unit,
+                 "coded": optimum.coded[k]} for k in space.names]
+        cons_rows = [{"constraint": k, **v} for k, v in optimum.constraints.items()]
+        text = (f"{optimum.sense} {objective}: predicted {optimum.predicted:.4g} "
+                f"{optimum.unit}, 95 % prediction interval {optimum.pi[0]:.4g} to "
+                f"{optimum.pi[1]:.4g}.")
+        tabs = [("Optimum design", pd.DataFrame(rows))]
+        if cons_rows:
+            tabs.append(("Constraints at the optimum", pd.DataFrame(cons_rows)))
+        sections.append({"title": "Design study: optimum", "text": text, "tables": tabs})
+    return sections
+
+
+def build_design_report(design_dir: str | Path, out_dir: str | Path | None = None) -> Path:
+    """Write the design report to ``out_dir`` (default ``design_dir/report``); returns index."""
+    from bladelab.report.builder import Report
+
+    design_dir = Path(design_dir)
+    meta = {}
+    if (design_dir / "study.json").is_file():
+        meta = json.loads((design_dir / "study.json").read_text(encoding="utf-8"))
+    sections = design_report_sections(design_dir)
+    rep = Report("Blade design study", subtitle=str(design_dir), settings=meta,
+                 seed=meta.get("seed"))
+    for s in sections:
+        rep.add_section(**s)
+    return Path(rep.write(Path(out_dir) if out_dir else design_dir / "report"))

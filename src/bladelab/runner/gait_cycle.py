@@ -1,0 +1,262 @@
+"""Gait cycles for the kinematics-driven transfemoral runner, and seed 002's motion adaptation.
+
+A :class:`GaitCycle` is one period of sagittal joint angles, starting at touch-down of the
+prosthetic leg. Angles [rad] inside, flexion positive:
+
+=====================  ==============================================================
+``hip_sound``          thigh relative to pelvis, flexion +
+``knee_sound``         flexion +
+``ankle_sound``        dorsiflexion +
+``hip_prosthetic``     thigh relative to pelvis, flexion +
+``knee_prosthetic``    prosthetic knee flexion + (the knee is passive: only its value at the
+                       start is used, as initial condition; kept for motion adaptation)
+``trunk_pitch``        pelvis/trunk forward lean + (tracked by a residual servo)
+=====================  ==============================================================
+
+Gait-cycle CSV (:func:`read_gait_csv`): a column ``time_s`` (one period, starting at 0 at
+prosthetic touch-down; the last row may repeat the first at t = T) and the angle columns with the
+suffix ``_deg`` (``hip_sound_deg`` ...); ``trunk_pitch_deg`` is optional (default 10°). The period
+is the time span (last − first + one sample, or the last time if its row equals the first).
+
+Motion adaptation (seed 002): :func:`fit_motion_model` fits period and every joint angle at
+``n_nodes`` normalised times as second-order response surfaces of the coded design factors,
+from cycles measured (or predicted) with several blades; :meth:`MotionModel.predict` gives the
+cycle for a new design.
+
+The default cycle (:func:`default_gait_cycle`) is a **smooth template, not a measurement**: a
+periodic cubic spline through literature-typical sagittal joint angles of sprinting at about
+7 m/s (touch-down hip flexion ~40°, toe-off hip extension ~10°, stance knee flexion ~40°, swing
+knee flexion ~115°; stride 0.52 s, contact ~23 % of the cycle), mirrored half a period for the
+other leg; the prosthetic knee lands nearly straight (5°), as transfemoral runners do. Use your
+own measured cycles for real studies.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+from scipy.interpolate import CubicSpline
+
+from bladelab.design.terms import model_matrix, parse_terms
+from bladelab.errors import DataError, InputFileError, SpecError
+
+__all__ = [
+    "ANGLE_NAMES",
+    "GaitCycle",
+    "MotionModel",
+    "default_gait_cycle",
+    "fit_motion_model",
+    "read_gait_csv",
+]
+
+ANGLE_NAMES: tuple[str, ...] = ("hip_sound", "knee_sound", "ankle_sound", "hip_prosthetic",
+                                "knee_prosthetic", "trunk_pitch")
+_REQUIRED = ANGLE_NAMES[:5]
+
+
+@dataclass(frozen=True, eq=False)
+class GaitCycle:
+    """One period of joint angles.
+
+    Attributes
+    ----------
+    period
+        Cycle duration T [s].
+    phase
+        Normalised times in [0, 1) of the samples (increasing).
+    angles
+        Name -> angles [rad] at ``phase`` (see the module table).
+    source
+        Where the cycle came from.
+    """
+
+    period: float
+    phase: np.ndarray
+    angles: Mapping[str, np.ndarray]
+    source: str = ""
+
+    def __post_init__(self) -> None:
+        if not (self.period > 0 and math.isfinite(self.period)):
+            raise DataError(f"the period must be > 0 s, got {self.period}", where=self.source)
+        ph = np.asarray(self.phase, float)
+        if ph.ndim != 1 or ph.size < 4 or np.any(np.diff(ph) <= 0) or ph[0] < 0 or ph[-1] >= 1:
+            raise DataError("phase must increase within [0, 1) with at least 4 samples",
+                            where=self.source)
+        missing = [n for n in _REQUIRED if n not in self.angles]
+        if missing:
+            raise DataError(f"missing joint angles {missing}", where=self.source,
+                            hint=f"a gait cycle needs {list(_REQUIRED)}")
+        ang = {n: np.asarray(self.angles.get(n, np.full(ph.size, math.radians(10.0))), float)
+               for n in ANGLE_NAMES}
+        for n, a in ang.items():
+            if a.shape != ph.shape or not np.all(np.isfinite(a)):
+                raise DataError(f"{n}: needs {ph.size} finite values", where=self.source)
+        object.__setattr__(self, "phase", ph)
+        object.__setattr__(self, "angles", ang)
+
+    def _splines(self) -> dict[str, CubicSpline]:
+        ph = np.append(self.phase, self.phase[0] + 1.0)
+        return {n: CubicSpline(ph, np.append(a, a[0]), bc_type="periodic")
+                for n, a in self.angles.items()}
+
+    def at(self, t: np.ndarray | float, *, derivative: int = 0) -> dict[str, np.ndarray]:
+        """Angles [rad] (or their time derivatives [rad/s^k]) at times ``t`` [s] (periodic)."""
+        s = self._splines()
+        ph = np.mod(np.asarray(t, float) / self.period, 1.0)
+        return {n: sp(ph, derivative) / self.period**derivative for n, sp in s.items()}
+
+    def resampled(self, n: int) -> GaitCycle:
+        """The cycle at ``n`` equally spaced phases."""
+        ph = np.arange(n) / n
+        vals = self.at(ph * self.period)
+        return GaitCycle(self.period, ph, vals, self.source)
+
+    def to_frame(self) -> pd.DataFrame:
+        """Tidy CSV layout: ``time_s`` and ``<angle>_deg``."""
+        df = pd.DataFrame({"time_s": self.phase * self.period})
+        for n, a in self.angles.items():
+            df[f"{n}_deg"] = np.degrees(a)
+        return df
+
+    def to_dict(self) -> dict:
+        return {"period_s": self.period, "n_samples": int(self.phase.size), "source": self.source}
+
+
+def _template(keys: Sequence[tuple[float, float]], shift: float = 0.0):
+    ph = np.array([k[0] for k in keys]) / 100.0
+    val = np.radians([k[1] for k in keys])
+    sp = CubicSpline(np.append(ph, ph[0] + 1.0), np.append(val, val[0]), bc_type="periodic")
+    return lambda p: sp(np.mod(p - shift, 1.0))
+
+
+# (phase % from that leg's touch-down, angle deg): literature-typical sprint values (template)
+_HIP = [(0, 30), (12, 12), (23, -12), (35, 0), (55, 45), (75, 62), (90, 42)]
+_KNEE = [(0, 25), (10, 40), (23, 22), (45, 115), (65, 90), (82, 35), (92, 20)]
+_ANKLE = [(0, 0), (10, 18), (23, -25), (40, -12), (60, 5), (85, 5)]
+_PROS_KNEE = [(0, 5), (23, 5), (45, 90), (68, 60), (85, 12)]
+
+
+def default_gait_cycle(*, period_s: float = 0.52, trunk_pitch_deg: float = 10.0,
+                       n: int = 104) -> GaitCycle:
+    """The built-in template cycle (see the module notes: a template, not a measurement)."""
+    ph = np.arange(n) / n
+    angles = {
+        "hip_sound": _template(_HIP, 0.5)(ph),
+        "knee_sound": _template(_KNEE, 0.5)(ph),
+        "ankle_sound": _template(_ANKLE, 0.5)(ph),
+        "hip_prosthetic": _template(_HIP)(ph),
+        "knee_prosthetic": _template(_PROS_KNEE)(ph),
+        "trunk_pitch": np.full(n, math.radians(trunk_pitch_deg)),
+    }
+    return GaitCycle(period_s, ph, angles, "bladelab template (literature-typical sprint angles)")
+
+
+def read_gait_csv(path: str | Path) -> GaitCycle:
+    """Read a gait-cycle CSV (see the module notes)."""
+    path = Path(path)
+    try:
+        df = pd.read_csv(path)
+    except (OSError, ValueError) as err:
+        raise InputFileError(f"cannot read the gait cycle: {err}", file=path) from None
+    cols = ["time_s", *(f"{n}_deg" for n in _REQUIRED)]
+    missing = [c for c in cols if c not in df.columns]
+    if missing:
+        raise InputFileError(f"missing columns {missing}", file=path,
+                             hint=f"a gait-cycle CSV needs {cols} (trunk_pitch_deg optional)")
+    try:
+        t = df["time_s"].to_numpy(float)
+    except ValueError:
+        raise InputFileError("time_s must be numeric", file=path) from None
+    if t.size < 5 or np.any(np.diff(t) <= 0) or not np.all(np.isfinite(t)):
+        raise InputFileError("time_s must increase (at least 5 rows)", file=path)
+    names = [n for n in ANGLE_NAMES if f"{n}_deg" in df.columns]
+    vals = {n: np.radians(df[f"{n}_deg"].to_numpy(float)) for n in names}
+    closes = all(abs(v[-1] - v[0]) < 1e-9 for v in vals.values())
+    if closes:
+        period = float(t[-1] - t[0])
+        t, vals = t[:-1], {n: v[:-1] for n, v in vals.items()}
+    else:
+        period = float(t[-1] - t[0] + np.median(np.diff(t)))
+    try:
+        return GaitCycle(period, (t - t[0]) / period, vals, str(path))
+    except DataError as err:
+        raise InputFileError(err.message, file=path, hint=err.hint) from None
+
+
+@dataclass(frozen=True, eq=False)
+class MotionModel:
+    """Period and time-normalised joint angles as response surfaces of coded design factors.
+
+    Attributes
+    ----------
+    factor_names, terms
+        The factors and surface terms.
+    phase
+        The normalised times of the angle surfaces.
+    period_coef
+        Coefficients of the period surface [s].
+    angle_coef
+        Name -> (n_terms, n_phase) coefficients [rad].
+    r2_period
+        R² of the period fit (NaN without residual degrees of freedom).
+    """
+
+    factor_names: tuple[str, ...]
+    terms: tuple
+    phase: np.ndarray
+    period_coef: np.ndarray
+    angle_coef: Mapping[str, np.ndarray]
+    r2_period: float
+
+    def predict(self, coded: Sequence[float]) -> GaitCycle:
+        """The predicted gait cycle at a coded design point."""
+        c = np.asarray(coded, float).reshape(1, -1)
+        if c.shape[1] != len(self.factor_names):
+            raise SpecError(f"expected {len(self.factor_names)} coded factors", where="motion")
+        X = model_matrix(c, self.terms)[0]
+        return GaitCycle(float(X @ self.period_coef), self.phase,
+                         {n: X @ a for n, a in self.angle_coef.items()},
+                         "motion model (response surfaces)")
+
+
+def fit_motion_model(
+    coded: np.ndarray,
+    cycles: Sequence[GaitCycle],
+    *,
+    factor_names: Sequence[str],
+    model: str | Sequence = "quadratic",
+    n_nodes: int = 51,
+) -> MotionModel:
+    """Fit seed 002's motion response surfaces from cycles observed at coded design points.
+
+    Several cycles may share a design point (trials with the same blade). Least squares per
+    surface; refuses a model the points cannot estimate (rank-deficient model matrix).
+    """
+    coded = np.atleast_2d(np.asarray(coded, float))
+    if coded.shape[0] != len(cycles):
+        raise DataError(f"{coded.shape[0]} design points but {len(cycles)} cycles",
+                        where="motion model")
+    terms = parse_terms(model, list(factor_names))
+    X = model_matrix(coded, terms)
+    if np.linalg.matrix_rank(X) < X.shape[1]:
+        raise SpecError(
+            f"{len(cycles)} cycles at these design points cannot estimate the {len(terms)}-term "
+            f"{model} motion model", where="motion model",
+            hint="use a smaller model, e.g. model='linear', or more blades")
+    phase = np.arange(n_nodes) / n_nodes
+    T = np.array([c.period for c in cycles])
+    sampled = [c.at(phase * c.period) for c in cycles]
+    period_coef = np.linalg.lstsq(X, T, rcond=None)[0]
+    angle_coef = {}
+    for n in ANGLE_NAMES:
+        Y = np.array([s[n] for s in sampled])
+        angle_coef[n] = np.linalg.lstsq(X, Y, rcond=None)[0]
+    resid = T - X @ period_coef
+    ss = float(np.sum((T - T.mean()) ** 2))
+    r2 = 1.0 - float(resid @ resid) / ss if ss > 0 and X.shape[0] > X.shape[1] else float("nan")
+    return MotionModel(tuple(factor_names), tuple(terms), phase, period_coef, angle_coef, r2)
