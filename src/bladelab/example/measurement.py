@@ -59,6 +59,7 @@ import numpy as np
 from scipy import interpolate
 
 from bladelab.errors import DataError
+from bladelab.trial.c3d import plate_corners
 from bladelab.trial.stance import Stance
 
 __all__ = [
@@ -172,7 +173,8 @@ def clamp_cluster_positions(
     c, s = np.cos(clamp_pitch), np.sin(clamp_pitch)
     out = {}
     for name, (a, b, h) in cluster.items():
-        out[name] = np.column_stack([clamp_x + c * a + s * h, clamp_y + b + 0 * c, clamp_z - s * a + c * h])
+        y = np.broadcast_to(np.asarray(clamp_y, float) + b, np.shape(c))
+        out[name] = np.column_stack([clamp_x + c * a + s * h, y, clamp_z - s * a + c * h])
     return out
 
 
@@ -232,10 +234,9 @@ def extend_flight(
         s = h * np.arange(1, n + 1)  # time away from the stance end
         v = {k: (cols[k][idx1] - cols[k][idx0]) / ((idx1 - idx0) * h) for k in
              ("clamp_x", "clamp_y", "clamp_z", "clamp_pitch")}
-        e = cols["clamp_x"][idx0 if sign < 0 else idx1]
         base = {k: cols[k][idx0 if sign < 0 else idx1] for k in cols}
         out = {
-            "clamp_x": base["clamp_x"] + sign * v["clamp_x"] * s + 0 * e,
+            "clamp_x": base["clamp_x"] + sign * v["clamp_x"] * s,
             "clamp_y": base["clamp_y"] + sign * v["clamp_y"] * s,
             "clamp_z": base["clamp_z"] + sign * v["clamp_z"] * s - 0.5 * _G * s**2,
             "clamp_pitch": base["clamp_pitch"]
@@ -391,8 +392,6 @@ def measure_stance(
         noise = rng.normal(0.0, 1.0, f.shape) * sd[:, None]
         pc = cop_a.copy()
         pc[:, 0] = np.clip(pc[:, 0], lo + 1e-3, hi - 1e-3)
-        from bladelab.trial.c3d import plate_corners
-
         plates.append({
             "force": f + noise, "cop": pc, "free_moment": np.zeros(len(ta)),
             "corners": plate_corners((cx, float(cop[:, 1].mean()), 0.0), _PLATE_LENGTH_M,

@@ -40,6 +40,11 @@ _AMPUTATION_ABBR = {
 }
 
 
+_MECH_COLUMNS = ("trial", "group", "source", "speed_pct_pb", "peak_force_N", "peak_compression_m",
+                 "peak_Kc_kN_per_m", "peak_angular_deformation_deg", "energy_stored_J",
+                 "energy_returned_J", "efficiency_pct")
+
+
 @dataclasses.dataclass(frozen=True)
 class StudyReport:
     """What :func:`build_study_report` wrote.
@@ -351,7 +356,10 @@ def build_study_report(
                   "docs/example-study.md). The recovered-vs-true section compares the two.")
     if problems:
         intro += "\n\nNot reported: " + "; ".join(f"{t} ({m})" for t, m in problems[:10])
-    rep.add_section("Overview", text=intro, tables=[("Trials", per_trial)])
+    overview = per_trial[["trial_id", "group", "configuration", "speed_pct_pb", "K_Nm_per_deg",
+                          "D_Nms_per_deg", "nrmse_grf_pct", "nrmse_distance_pct"]]
+    rep.add_section("Overview", text=intro,
+                    tables=[ReportTable("Trials", overview, "trials", csv=per_trial)])
 
     # nRMSE tables (seed 000 Tables 1-2): amputation levels, then category groups
     for signal, title in (("grf", "nRMSE of the GRF (Table 1)"),
@@ -393,7 +401,8 @@ def build_study_report(
         figures=[("GRF vs angular deformation, measured", figures.hysteresis_loops(mech_m)),
                  ("K_c vs compression, measured", figures.compressive_stiffness_curves(mech_m)),
                  ("GRF vs angular deformation, simulated", figures.hysteresis_loops(mech_s))],
-        tables=[("Peak mechanics per stance", mt)],
+        tables=[ReportTable("Peak mechanics per stance", mt[[c for c in _MECH_COLUMNS if c in mt]],
+                            "mechanics", csv=mt)],
     )
     st = compare_groups(per_trial, amputation="amputation", category="group",
                         speed="speed_pct_pb")
