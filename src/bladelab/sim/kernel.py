@@ -144,11 +144,11 @@ def sole_contact(contact, cx, cz, s, c, a, b, ox, oz, vox, voz, om, ground_vx):
 
 
 @njit(cache=True, error_model="numpy")
-def _kinematics(bs, q, v, hinge, com0, O, vO, aO, phi, cph, sph, om, al, R, VR, AR):
-    """Body origins (O), angles, COMs (R) with velocities and bias accelerations (q̈ = 0)."""
+def _kinematics(bs, q, v, hinge, com0, Ob, vO, aO, phi, cph, sph, om, al, R, VR, AR):
+    """Body origins (Ob), angles, COMs (R) with velocities and bias accelerations (q̈ = 0)."""
     nb = com0.shape[0]
-    O[0, 0] = bs[0]
-    O[0, 1] = bs[1]
+    Ob[0, 0] = bs[0]
+    Ob[0, 1] = bs[1]
     phi[0] = bs[2]
     cph[0] = bs[9]
     sph[0] = bs[10]
@@ -164,8 +164,8 @@ def _kinematics(bs, q, v, hinge, com0, O, vO, aO, phi, cph, sph, om, al, R, VR, 
             o0z = hinge[b - 2, 1] if b > 1 else 0.0
             dx, dz = _rot(cph[b - 1], sph[b - 1], hinge[b - 1, 0] - o0x, hinge[b - 1, 1] - o0z)
             w = om[b - 1]
-            O[b, 0] = O[b - 1, 0] + dx
-            O[b, 1] = O[b - 1, 1] + dz
+            Ob[b, 0] = Ob[b - 1, 0] + dx
+            Ob[b, 1] = Ob[b - 1, 1] + dz
             vO[b, 0] = vO[b - 1, 0] + w * dz
             vO[b, 1] = vO[b - 1, 1] - w * dx
             aO[b, 0] = aO[b - 1, 0] + al[b - 1] * dz - w * w * dx
@@ -179,8 +179,8 @@ def _kinematics(bs, q, v, hinge, com0, O, vO, aO, phi, cph, sph, om, al, R, VR, 
         o0z = hinge[b - 1, 1] if b > 0 else 0.0
         ex, ez = _rot(cph[b], sph[b], com0[b, 0] - o0x, com0[b, 1] - o0z)
         w = om[b]
-        R[b, 0] = O[b, 0] + ex
-        R[b, 1] = O[b, 1] + ez
+        R[b, 0] = Ob[b, 0] + ex
+        R[b, 1] = Ob[b, 1] + ez
         VR[b, 0] = vO[b, 0] + w * ez
         VR[b, 1] = vO[b, 1] - w * ex
         AR[b, 0] = aO[b, 0] + al[b] * ez - w * w * ex
@@ -188,11 +188,11 @@ def _kinematics(bs, q, v, hinge, com0, O, vO, aO, phi, cph, sph, om, al, R, VR, 
 
 
 @njit(cache=True, error_model="numpy")
-def _body_point(b, x0, z0, hinge, O, cph, sph):
+def _body_point(b, x0, z0, hinge, Ob, cph, sph):
     o0x = hinge[b - 1, 0] if b > 0 else 0.0
     o0z = hinge[b - 1, 1] if b > 0 else 0.0
     ex, ez = _rot(cph[b], sph[b], x0 - o0x, z0 - o0z)
-    return O[b, 0] + ex, O[b, 1] + ez
+    return Ob[b, 0] + ex, Ob[b, 1] + ez
 
 
 @njit(cache=True, error_model="numpy")
@@ -248,7 +248,7 @@ def simulate_prescribed(
     nj = nb - 1
     ne = sole_body.shape[0]
     n_steps = base.shape[0] - 1
-    O = np.zeros((nb, 2))
+    Ob = np.zeros((nb, 2))
     vO = np.zeros((nb, 2))
     aO = np.zeros((nb, 2))
     phi = np.zeros(nb)
@@ -337,14 +337,14 @@ def simulate_prescribed(
                     for _it in range(n_iter):
                         for j in range(nj):
                             qs[j] = qh[j] + g * vi[j]
-                        _kinematics(bs, qs, vi, hinge, com0, O, vO, aO, phi, cph, sph, om, al, R, VR, AR)
+                        _kinematics(bs, qs, vi, hinge, com0, Ob, vO, aO, phi, cph, sph, om, al, R, VR, AR)
                         for j in range(nj):
-                            hx = O[j + 1, 0]
-                            hz = O[j + 1, 1]
+                            hx = Ob[j + 1, 0]
+                            hz = Ob[j + 1, 1]
                             acc = 0.0
                             for k in range(j, nj):
-                                kx = O[k + 1, 0]
-                                kz = O[k + 1, 1]
+                                kx = Ob[k + 1, 0]
+                                kz = Ob[k + 1, 1]
                                 mjk = 0.0
                                 for b in range(k + 1, nb):
                                     mjk += (body_mass[b] * ((R[b, 0] - hx) * (R[b, 0] - kx)
@@ -371,11 +371,11 @@ def simulate_prescribed(
                         p_cdamp = 0.0
                         for e in range(ne):
                             b = sole_body[e]
-                            cx, cz = _body_point(b, sole_geom[e, 0], sole_geom[e, 1], hinge, O, cph, sph)
+                            cx, cz = _body_point(b, sole_geom[e, 0], sole_geom[e, 1], hinge, Ob, cph, sph)
                             (px, pz, fx, fz, depth, rate, slip, kn, cn, mu, dmu, fel) = sole_contact(
                                 contact, cx, cz, sph[b] * ce[e] + cph[b] * se[e], cph[b] * ce[e] - sph[b] * se[e],
                                 sole_geom[e, 2], sole_geom[e, 3],
-                                O[b, 0], O[b, 1], vO[b, 0], vO[b, 1], om[b], ground_vx)
+                                Ob[b, 0], Ob[b, 1], vO[b, 0], vO[b, 1], om[b], ground_vx)
                             fe[e, 0] = fx
                             fe[e, 1] = fz
                             pe[e, 0] = px
@@ -394,12 +394,12 @@ def simulate_prescribed(
                             gp01 = mu * kn
                             gp11 = -kn
                             for j in range(b):
-                                jx = pz - O[j + 1, 1]
-                                jz = -(px - O[j + 1, 0])
+                                jx = pz - Ob[j + 1, 1]
+                                jz = -(px - Ob[j + 1, 0])
                                 rhs[j] += fx * jx + fz * jz
                                 for k in range(b):
-                                    kx = pz - O[k + 1, 1]
-                                    kz = -(px - O[k + 1, 0])
+                                    kx = pz - Ob[k + 1, 1]
+                                    kz = -(px - Ob[k + 1, 0])
                                     Jv[j, k] += jx * (gv00 * kx + gv01 * kz) + jz * (gv11 * kz)
                                     Jq[j, k] += jx * (gp01 * kz) + jz * (gp11 * kz)
                         for j in range(nj):
@@ -423,8 +423,8 @@ def simulate_prescribed(
                         alb = al[b]
                         for j in range(b):
                             qdd = (vi[j] - v[j]) / h
-                            ax += qdd * (R[b, 1] - O[j + 1, 1])
-                            az -= qdd * (R[b, 0] - O[j + 1, 0])
+                            ax += qdd * (R[b, 1] - Ob[j + 1, 1])
+                            az -= qdd * (R[b, 0] - Ob[j + 1, 0])
                             alb += qdd
                         m = body_mass[b]
                         fcx += m * ax
@@ -476,15 +476,15 @@ def simulate_prescribed(
             # ---- outputs at a sample time, from the state itself ----
             s_idx = i // nsub
             bs = base[i]
-            _kinematics(bs, q, v, hinge, com0, O, vO, aO, phi, cph, sph, om, al, R, VR, AR)
+            _kinematics(bs, q, v, hinge, com0, Ob, vO, aO, phi, cph, sph, om, al, R, VR, AR)
             e_contact = 0.0
             for e in range(ne):
                 b = sole_body[e]
-                cx, cz = _body_point(b, sole_geom[e, 0], sole_geom[e, 1], hinge, O, cph, sph)
+                cx, cz = _body_point(b, sole_geom[e, 0], sole_geom[e, 1], hinge, Ob, cph, sph)
                 (px, pz, fx, fz, depth, rate, slip, kn, cn, mu, dmu, fel) = sole_contact(
                     contact, cx, cz, sph[b] * ce[e] + cph[b] * se[e],
                     cph[b] * ce[e] - sph[b] * se[e], sole_geom[e, 2], sole_geom[e, 3],
-                    O[b, 0], O[b, 1], vO[b, 0], vO[b, 1], om[b], ground_vx)
+                    Ob[b, 0], Ob[b, 1], vO[b, 0], vO[b, 1], om[b], ground_vx)
                 grf[s_idx, e, 0] = fx
                 grf[s_idx, e, 1] = fz
                 if depth <= 0.0:
@@ -494,7 +494,7 @@ def simulate_prescribed(
                 else:
                     state[s_idx, e] = 2
                 e_contact += contact_elastic_energy(contact, depth)
-            tx, tz = _body_point(tip_body, tip[0], tip[1], hinge, O, cph, sph)
+            tx, tz = _body_point(tip_body, tip[0], tip[1], hinge, Ob, cph, sph)
             dist[s_idx] = math.hypot(tx - bs[0], tz - bs[1])
             kin = 0.0
             pot = 0.0
