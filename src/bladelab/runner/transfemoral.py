@@ -3,8 +3,9 @@
 Model (MuJoCo, built with ``MjSpec``; x forward, z up, pitch about +y):
 
 - root: slide x, slide z (free) and the trunk pitch hinge at the hips; the pelvis carries the
-  head-arms-trunk mass (``torso`` + ``pelvis`` of the runner parameters, scaled to the body
-  mass); a stiff *residual* servo holds the trunk pitch on the cycle's ``trunk_pitch`` (as the
+  head-arms-trunk mass (``torso`` + ``pelvis`` of the runner parameters); the biological segment
+  masses are scaled so that the whole model (with socket, knee and blade) weighs
+  ``body_mass_kg``; a stiff *residual* servo holds the trunk pitch on the cycle's ``trunk_pitch`` (as the
   residual actuators of inverse-dynamics tools);
 - sound leg: thigh, shank, foot (segment masses of :mod:`bladelab.runner.params`); hip, knee
   and ankle follow the gait cycle by stiff PD servos; two contact circles (heel, toe, radius
@@ -55,6 +56,7 @@ __all__ = ["RUNNER_RESPONSE_UNITS", "RunnerEvaluator", "TransfemoralResult",
 
 GRAVITY = 9.80665
 FOOT_RADIUS_M = 0.03
+_SOCKET_KG = 1.0
 _FOOT_CIRCLES = ((-0.05, -0.06), (0.15, -0.06))  # heel, toe centres below the ankle [m]
 _SERVOS = ("trunk", "hip_s", "knee_s", "ankle_s", "hip_p")
 
@@ -120,10 +122,15 @@ class _Built:
 def _build(blade: BladeModel, body_mass: float, height: float, knee: ProstheticKnee,
            extra_leg: float, dt: float) -> _Built:
     params = default_runner_params("able")
-    m_ref = params.athlete.body_mass_kg
     s = height / params.athlete.height_m
-    mr = body_mass / m_ref
     seg = params.segments
+    bio = (seg["torso"].mass_kg + seg["pelvis"].mass_kg + seg["femur_l"].mass_kg
+           + seg["tibia_l"].mass_kg + seg["calcn_l"].mass_kg + 0.6 * seg["femur_r"].mass_kg)
+    prosthesis = _SOCKET_KG + knee.mass + blade.mass
+    if body_mass <= prosthesis + 10.0:
+        raise ModelError(f"body mass {body_mass} kg is too small for the prosthesis "
+                         f"({prosthesis:.1f} kg)", where="body_mass_kg")
+    mr = (body_mass - prosthesis) / bio  # the model's total mass equals body_mass
     thigh = (0.226 + 0.17) * s
     shank = geo.TIBIA_LENGTH_M * s
     ankle_h = 0.06 + FOOT_RADIUS_M
@@ -154,7 +161,7 @@ def _build(blade: BladeModel, body_mass: float, height: float, knee: ProstheticK
         ft.add_site(name=f"foot{i}", type=mujoco.mjtGeom.mjGEOM_ELLIPSOID, pos=[x, 0, z],
                     size=[FOOT_RADIUS_M, 0.02, FOOT_RADIUS_M])
     # prosthetic leg
-    m_th = 0.6 * seg["femur_r"].mass_kg * mr + 1.0
+    m_th = 0.6 * seg["femur_r"].mass_kg * mr + _SOCKET_KG
     th_p = _body(pelvis, "thigh_p", (0, 0, 0), m_th, (0, 0, -0.15 * s),
                  0.6 * seg["femur_r"].inertia_kg_m2[2] * mr * s * s)
     _hinge(th_p, "hip_p")
