@@ -17,8 +17,8 @@ from bladelab import __version__
 from bladelab.errors import BladelabError
 
 # Sub-command modules, in help order. Each defines ``register(app: typer.Typer) -> None``.
-_COMMAND_MODULES: tuple[str, ...] = ("trial", "blade", "runner", "identify", "predict", "example",
-                                     "report", "design")
+_COMMAND_MODULES: tuple[str, ...] = ("trial", "blade", "simulate", "runner", "identify", "predict", "example", "report",
+                                     "design")
 
 app = typer.Typer(
     name="bladelab",
