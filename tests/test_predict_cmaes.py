@@ -185,3 +185,26 @@ def test_resume_keeps_the_runs_settings(tmp_path):
     other = ObjectiveSettings(duration=0.3)
     resumed = _run(out=tmp_path / "part", generations=3, resume=True, settings=other, seed=99)
     assert resumed.history == full.history
+
+
+def test_sweep_chain_warm_starts_neighbours(tmp_path):
+    from bladelab.runner.controller import read_parameters
+    from bladelab.runner.predict import load_checkpoint
+
+    run_sweep(
+        ["Cat4", "Cat5", "Cat6"],
+        [3.5],
+        out=tmp_path,
+        generations=1,
+        popsize=4,
+        duration=0.3,
+        progress=False,
+        chain_from="Cat6",
+    )
+    for child, parent in (("Cat5", "Cat6"), ("Cat4", "Cat5")):
+        _, layout = _model("amputee", child)
+        x_parent = read_parameters(tmp_path / parent / "3.5" / "best.json", layout)
+        es = load_checkpoint(tmp_path / child / "3.5" / "checkpoint.pkl")["es"]
+        np.testing.assert_allclose(es.x0, x_parent)
+    with pytest.raises(Exception, match="chain-from"):
+        run_sweep(["Cat4"], [3.5], out=tmp_path / "x", chain_from="Cat7", progress=False)

@@ -95,6 +95,9 @@ def register(app: typer.Typer) -> None:
         jobs: int = typer.Option(1, "--jobs"),
         executor: str = typer.Option("local", "--executor", help="local | ray"),
         duration: float = typer.Option(10.0, "--duration", help="Simulated time (s)."),
+        chain_from: str | None = typer.Option(
+            None, "--chain-from", help="Warm-start categories outwards from this one (e.g. Cat6)."
+        ),
     ) -> None:
         """Category × speed grid: warm-started optimisations, maximum speed, cost at 4 m/s,
         200 m and 400 m times (seed 001 §2.2.2 B–C, Table 3.1)."""
@@ -111,5 +114,6 @@ def register(app: typer.Typer) -> None:
             jobs=jobs,
             executor=executor,
             duration=duration,
+            chain_from=chain_from,
         )
         typer.echo(table.to_string(index=False))

@@ -60,6 +60,57 @@ def category_task(payload: dict) -> dict:
     return {"category": cat, "rows": rows}
 
 
+def _run_wave(ex, payloads: list[dict], bar) -> list[dict]:
+    rows, failed = [], []
+    for i, status, value in ex.run(category_task, payloads):
+        if status != "ok":
+            failed.append(f"{payloads[i]['category']}: {value}")
+            continue
+        bar.update(len(value["rows"]))
+        rows.extend(value["rows"])
+    if failed:
+        raise OptimizationError("sweep task(s) failed: " + "; ".join(failed))
+    return rows
+
+
+def _chain(ex, base, categories, speeds, init, chain_from, bar) -> list[dict]:
+    """Waves of first-speed optimisations outwards from ``chain_from``, then speed chains."""
+    from bladelab.runner.params import blade_catalogue
+
+    stiff = {name: c.stiffness_n_per_m for name, c in blade_catalogue().items()}
+    ordered = sorted(categories, key=lambda c: stiff[blade_category(c).name])
+    names = [blade_category(c).name for c in ordered]
+    start = blade_category(chain_from).name
+    if start not in names:
+        raise OptimizationError(
+            f"--chain-from {chain_from} is not among the categories", where="chain_from"
+        )
+    i0 = names.index(start)
+    first = speeds[0]
+
+    def best(cat: str) -> str:
+        return str(Path(base["out"]) / cat / f"{first:g}" / "best.json")
+
+    rows: list[dict] = []
+    for dist in range(max(i0, len(ordered) - 1 - i0) + 1):
+        wave = []
+        for i in {i0 - dist, i0 + dist}:
+            if 0 <= i < len(ordered):
+                parent = None if dist == 0 else (i + 1 if i < i0 else i - 1)
+                src = (str(init) if init else None) if parent is None else best(ordered[parent])
+                wave.append({**base, "category": ordered[i], "speeds": [first], "init": src})
+        rows.extend(_run_wave(ex, wave, bar))
+    ran = {r["category"] for r in rows if not r["fell"]}
+    rest = [
+        {**base, "category": c, "speeds": speeds[1:], "init": best(c)}
+        for c in ordered
+        if c in ran and len(speeds) > 1
+    ]
+    if rest:
+        rows.extend(_run_wave(ex, rest, bar))
+    return rows
+
+
 def summarise(results: pd.DataFrame) -> pd.DataFrame:
     """One row per category: max_speed [m/s], cot_4 [J/(kg·m)], t200 and t400 [s]."""
     out = []
@@ -91,6 +142,7 @@ def run_sweep(
     jobs: int = 1,
     executor: str = "local",
     duration: float = 10.0,
+    chain_from: str | None = None,
     progress: bool = True,
 ) -> pd.DataFrame:
     """Run the category × speed sweep; returns the per-category summary (see module docstring).
@@ -111,6 +163,11 @@ def run_sweep(
         Categories run in parallel on ``executor`` (``local``/``ray``) with ``jobs`` workers.
     duration
         Simulated time [s] of each evaluation.
+    chain_from
+        Warm-start categories from each other at the first speed, as seed 001 §2.2.2 B does:
+        this category starts from ``init``, its softer and stiffer neighbours (catalogue order)
+        from its solution, and so on outwards (each wave in parallel); then every category
+        raises its speed independently. None: every category starts from ``init``.
     """
     from bladelab.study.executors import make_executor
 
@@ -119,33 +176,26 @@ def run_sweep(
     if not speeds or any(not (s > 0) for s in speeds):
         raise OptimizationError("speeds must be positive", where="speeds")
     out = Path(out)
-    settings = ObjectiveSettings(duration=duration).to_dict()
-    payloads = [
-        {
-            "category": c,
-            "speeds": sorted(float(s) for s in speeds),
-            "init": str(init) if init else None,
-            "generations": generations,
-            "popsize": popsize,
-            "seed": seed,
-            "out": str(out),
-            "settings": settings,
-        }
-        for c in categories
-    ]
-    rows: list[dict] = []
-    failed = []
+    speeds = sorted(float(s) for s in speeds)
+    base = {
+        "generations": generations,
+        "popsize": popsize,
+        "seed": seed,
+        "out": str(out),
+        "settings": ObjectiveSettings(duration=duration).to_dict(),
+    }
     ex = make_executor(executor, jobs)
-    bar = tqdm(total=len(payloads), desc="categories", disable=not progress)
-    for i, status, value in ex.run(category_task, payloads):
-        bar.update(1)
-        if status != "ok":
-            failed.append(f"{categories[i]}: {value}")
-            continue
-        rows.extend(value["rows"])
+    bar = tqdm(total=len(categories) * len(speeds), desc="optimisations", disable=not progress)
+    rows: list[dict] = []
+    if chain_from is None:
+        payloads = [
+            {**base, "category": c, "speeds": speeds, "init": str(init) if init else None}
+            for c in categories
+        ]
+        rows.extend(_run_wave(ex, payloads, bar))
+    else:
+        rows.extend(_chain(ex, base, categories, speeds, init, chain_from, bar))
     bar.close()
-    if failed:
-        raise OptimizationError("sweep task(s) failed: " + "; ".join(failed))
     order = {c: i for i, c in enumerate(categories)}
     results = pd.DataFrame(rows)
     results = results.sort_values(
