@@ -1,0 +1,99 @@
+"""``bladelab design``, ``bladelab blade test`` and the design report section."""
+
+from __future__ import annotations
+
+import json
+
+import pandas as pd
+import pytest
+
+from bladelab.cli import main
+from bladelab.design import generate_blade
+
+
+@pytest.fixture(scope="module")
+def blade_yaml(tmp_path_factory):
+    path = tmp_path_factory.mktemp("blade") / "gen.yaml"
+    path.write_text(generate_blade({"stiffness_kN_per_m": 25.0}).spec.to_yaml())
+    return path
+
+
+def test_blade_test_hits_target_stiffness(blade_yaml, capsys, tmp_path):
+    """The generated blade was scaled to 25 kN/m at 0°: the command reports that at 0°."""
+    fig = tmp_path / "ct.png"
+    assert main(["blade", "test", str(blade_yaml), "--alignment", "0,-8,8", "--json",
+                 "--plot", str(fig)]) == 0
+    data = json.loads(capsys.readouterr().out)
+    tests = {t["alignment_deg"]: t for t in data["tests"]}
+    assert tests[0.0]["stiffness_linear_N_per_m"] == pytest.approx(25e3, rel=1e-6)
+    assert data["load_N"] == pytest.approx(76 * 9.80665)
+    # secant stiffness at body weight: load / displacement there
+    t0 = tests[0.0]
+    assert t0["stiffness_at_load_N_per_m"] == pytest.approx(t0["load_N"] / t0["displacement_at_load_m"])
+    assert fig.stat().st_size > 0
+
+
+def test_blade_test_single_joint_falls_back_to_free(capsys):
+    assert main(["blade", "test", "xtreme", "--alignment", "0"]) == 0
+    out = capsys.readouterr()
+    assert "tip free" in out.out and "cannot compress" in out.err
+
+
+def test_blade_test_bad_input(blade_yaml, capsys):
+    assert main(["blade", "test", str(blade_yaml), "--alignment", "0,x"]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("error:") and "--alignment" in err and "Traceback" not in err
+    assert main(["blade", "test", "no-such-blade"]) == 2
+
+
+@pytest.fixture(scope="module")
+def study(tmp_path_factory):
+    out = tmp_path_factory.mktemp("study") / "ds"
+    args = ["design", "--factors", "stiffness_kN_per_m=18:32,toe_length_m=0.19:0.25",
+            "--runs", "ccd", "--evaluator", "blade", "--out", str(out),
+            "--constraint", "swing_clearance_m=0.07", "--no-figures"]
+    assert main(args) == 0
+    return out, args
+
+
+def test_design_writes_study(study):
+    out, _ = study
+    for name in ("study.json", "results.csv", "surfaces.json", "anova.csv", "optimum.json",
+                 "evaluator.json"):
+        assert (out / name).is_file(), name
+    table = pd.read_csv(out / "results.csv")
+    assert len(table) == 9  # 2-factor face-centred CCD: 4 + 4 + 1
+    # the clearance proxy is pure geometry of the toe: the surface fits it almost exactly
+    surf = json.loads((out / "surfaces.json").read_text())
+    assert surf["swing_clearance_m"]["r2"] > 0.999
+    opt = json.loads((out / "optimum.json").read_text())
+    assert opt["constraints"]["swing_clearance_m"]["slack"] >= -1e-6
+
+
+def test_design_resumes_and_draws(study, capsys):
+    out, args = study
+    args = [a for a in args if a != "--no-figures"]
+    assert main(args) == 0
+    assert "(0 evaluated, 9 resumed)" in capsys.readouterr().out
+    assert (out / "figures" / "main_effects.png").is_file()
+    assert any((out / "figures").glob("contour_*.png"))
+
+
+def test_design_report(study, tmp_path):
+    from bladelab.report.design import build_design_report, design_report_sections
+
+    out, _ = study
+    sections = design_report_sections(out)
+    titles = [s["title"] for s in sections]
+    assert any("ANOVA" in t for t in titles) and any("optimum" in t for t in titles)
+    index = build_design_report(out, tmp_path / "rep")
+    html = index.read_text()
+    assert "ANOVA of delta_vx_m_per_s" in html and "<img" in html
+
+
+def test_design_bad_input(tmp_path, capsys):
+    assert main(["design", "--out", str(tmp_path / "x"), "--constraint", "nonsense"]) == 2
+    assert "--constraint" in capsys.readouterr().err
+    assert main(["design", "--out", str(tmp_path / "y"), "--evaluator", "fem"]) == 2
+    assert main(["design", "--out", str(tmp_path / "z"), "--runs", "bbd", "--factors",
+                 "stiffness_kN_per_m=18:32,width_m=0.05:0.08"]) == 2  # BBD needs k >= 3
