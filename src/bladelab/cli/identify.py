@@ -24,7 +24,8 @@ def _identify(
     jobs: int = typer.Option(1, "--jobs", "-j", help="Parallel workers for a study."),
     executor: str = typer.Option("local", "--executor", help="local (process pool) or ray."),
     force: bool = typer.Option(False, "--force", help="Re-run trials that are already done."),
-    polish: bool = typer.Option(False, "--polish", help="Refine the optimum with L-BFGS-B."),
+    polish: bool = typer.Option(False, "--polish", help="Refine the optimum with L-BFGS-B "
+                                "(always on with --nonlinear)."),
     nonlinear: bool = typer.Option(False, "--nonlinear", help="Also identify K2 (stiffening spring)."),
     joint: int | None = typer.Option(None, "--joint", help="Hinge position (blade point index)."),
     grf: str = typer.Option("z", "--grf", help="GRF components in the cost: z or zx."),
@@ -40,7 +41,8 @@ def _identify(
     if path.is_dir():
         _identify_study(path, blade=blade, seed=seed, as_json=as_json, jobs=jobs, executor=executor,
                         force=force, settings={
-                            "optimizer": optimizer, "polish": polish, "nonlinear": nonlinear,
+                            "optimizer": optimizer, "polish": True if polish else None,
+                            "nonlinear": nonlinear,
                             "joint": joint, "grf_components": list(components),
                             "max_evals": max_evals, "identifiability": not no_ci})
         return
@@ -55,7 +57,8 @@ def _identify(
     stance = read_stance_csv(path)
     ident = identify_stance(stance, blade, optimizer=optimizer, seed=0 if seed is None else seed,
                             grf_components=components, joint=joint, nonlinear=nonlinear,
-                            polish=polish, max_evals=max_evals, identifiability=not no_ci)
+                            polish=True if polish else None, max_evals=max_evals,
+                            identifiability=not no_ci)
     d = ident.to_dict()
     if as_json:
         typer.echo(json.dumps(d, indent=2))

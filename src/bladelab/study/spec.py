@@ -75,7 +75,7 @@ class IdentificationSettings(_Model):
 
     optimizer: Literal["pso", "cmaes"] = "pso"
     max_evals: int = Field(default=600, ge=10)
-    polish: bool = False
+    polish: bool | None = None  # None: on for the nonlinear spring, off for the linear one
     weights: tuple[float, float] = (0.5, 0.5)
     grf_components: tuple[Literal["z", "x"], ...] = ("z",)
     nonlinear: bool = False

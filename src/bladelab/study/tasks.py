@@ -39,7 +39,7 @@ def identify_trial(payload: dict) -> dict:
     ident = identify_stance(
         stance, payload["blade"], optimizer=s["optimizer"], seed=int(payload["seed"]),
         weights=tuple(s["weights"]), grf_components=tuple(s["grf_components"]),
-        joint=s.get("joint"), nonlinear=bool(s["nonlinear"]), polish=bool(s["polish"]),
+        joint=s.get("joint"), nonlinear=bool(s["nonlinear"]), polish=s.get("polish"),
         max_evals=int(s["max_evals"]), identifiability=bool(s.get("identifiability", True)),
     )
     return ident.to_row()
