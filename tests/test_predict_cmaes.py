@@ -125,6 +125,27 @@ def test_cli_predict_and_errors(tmp_path, capsys):
     assert "not found" in capsys.readouterr().err
     assert main(["sweep", "--categories", "Cat9", "--out", str(tmp_path / "s")]) == 2
     assert "Cat9" in capsys.readouterr().err
+    code = main(
+        [
+            "sweep",
+            "--categories",
+            "Cat6",
+            "--speeds",
+            "3.5",
+            "--generations",
+            "1",
+            "--popsize",
+            "2",
+            "--duration",
+            "0.3",
+            "--out",
+            str(tmp_path / "sw"),
+        ]
+    )
+    assert code == 0
+    summary = pd.read_csv(tmp_path / "sw" / "summary.csv")
+    assert summary.category.tolist() == ["Cat6"]
+    assert (tmp_path / "sw" / "Cat6" / "3.5" / "best.json").exists()
 
 
 def _sweep(tmp_path, name, speeds=(3.5, 4.0), **kw):
