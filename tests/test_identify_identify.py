@@ -17,6 +17,7 @@ from bladelab.identify.bounds import make_bounds
 from bladelab.identify.identify import (
     compare_spring_locations,
     compare_spring_models,
+    identification_landscape,
     identify_stance,
 )
 from bladelab.sim.synthetic import generate_stance
@@ -68,6 +69,12 @@ def test_recovery_cmaes_and_ci(stances):
                 "evaluations", "wall_s", "seed", "K_ci_Nm_per_deg", "D_ci_Nms_per_deg"):
         assert key in d
     json.dumps(d)
+    grid = identification_landscape(stance, blade, ident, n=9, rel_span=0.2)
+    assert len(grid) == 81 and list(grid.columns) == ["K_Nm_per_deg", "D_Nms_per_deg", "cost"]
+    best = grid.loc[grid["cost"].idxmin()]
+    # the identified point is the centre of the grid and the grid's lowest cost is next to it
+    assert abs(best["K_Nm_per_deg"] / ident.K_Nm_per_deg - 1) <= 0.05 + 1e-9
+    assert grid["cost"].min() >= ident.cost - 1e-3
 
 
 def test_same_seed_same_result(stances):

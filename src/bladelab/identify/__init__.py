@@ -21,6 +21,7 @@ from bladelab.identify.identify import (
     Identification,
     compare_spring_locations,
     compare_spring_models,
+    identification_landscape,
     identify_stance,
 )
 from bladelab.identify.optimizers import (
@@ -47,6 +48,7 @@ __all__ = [
     "compare_spring_models",
     "contact_window",
     "cost_landscape",
+    "identification_landscape",
     "identify_stance",
     "instantaneous_stiffness",
     "make_bounds",

@@ -310,6 +310,46 @@ def identify_stance(
     )
 
 
+def identification_landscape(
+    stance,
+    blade: BladeModel | str,
+    ident: Identification,
+    *,
+    n: int = 21,
+    rel_span: float = 0.3,
+    weights: tuple[float, float] = (0.5, 0.5),
+    grf_components: Sequence[str] = ("z",),
+    dt: float = 1e-4,
+    belt_speed: float = 0.0,
+    contact_threshold: float = 20.0,
+) -> pd.DataFrame:
+    """The cost on an n × n K × D grid (± ``rel_span``) around an identification, one batch.
+
+    Use the same cost options as the identification. Returns a tidy DataFrame with columns
+    ``K_Nm_per_deg``, ``D_Nms_per_deg``, ``cost`` (K2, if any, held at its identified value).
+    """
+    from bladelab import sim
+    from bladelab.identify.identifiability import cost_landscape
+
+    model = _with_joint(_as_model(blade), ident.joint_point)
+    cost = StanceCost.from_stance(stance, weights=weights, grf_components=grf_components,
+                                  contact_threshold=contact_threshold)
+    problem = sim.prepare(model, stance, dt=dt, belt_speed=belt_speed)
+    k2 = 0.0 if ident.K2_Nm_per_deg2 is None else ident.K2_Nm_per_deg2 * units.DEG_PER_RAD**2
+
+    def fun_batch(X: np.ndarray) -> np.ndarray:
+        res = sim.simulate_batch(problem, X[:, 0:1], X[:, 1:2], np.full((len(X), 1), k2))
+        return cost.evaluate(grf_z=res.grf_z, grf_x=res.grf_x, distance=res.distance).cost
+
+    centre = [units.stiffness_per_deg_to_per_rad(ident.K_Nm_per_deg),
+              units.damping_per_deg_to_per_rad(ident.D_Nms_per_deg)]
+    box = [[c * (1 - rel_span), c * (1 + rel_span)] for c in centre]
+    df = cost_landscape(fun_batch, centre, box, names=("K", "D"), n=n, rel_span=rel_span)
+    return pd.DataFrame({"K_Nm_per_deg": units.stiffness_per_rad_to_per_deg(df["K"].to_numpy()),
+                         "D_Nms_per_deg": units.damping_per_rad_to_per_deg(df["D"].to_numpy()),
+                         "cost": df["cost"].to_numpy()})
+
+
 def compare_spring_locations(
     stances: Sequence,
     blade: BladeModel | str,
