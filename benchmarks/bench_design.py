@@ -60,6 +60,23 @@ def run() -> str:
         t_study = _t(lambda: run_design(space, evaluator=evaluator, out_dir=tmp, progress=False,
                                         objective="stiffness_at_bw_N_per_m"), repeat=1)
     rows.append(("25-run study, generator + compression-test evaluator (no simulation)", t_study))
+
+    # the simulation evaluators (issue 8, part B)
+    from bladelab.design.evaluators import BladeEvaluator
+    from bladelab.runner.transfemoral import RunnerEvaluator
+
+    blade_ev = BladeEvaluator()
+    blade_ev(space.point(d.coded[-1]))  # compile the numba helpers once
+    with tempfile.TemporaryDirectory() as tmp:
+        t_blade = _t(lambda: run_design(space, evaluator=blade_ev, out_dir=tmp, progress=False,
+                                        objective="delta_vx_m_per_s"), repeat=1)
+    rows.append(("25-run CCD study, blade evaluator (generated blade + simulated stance, "
+                 "dt 1e-5 s)", t_blade))
+    runner_ev = RunnerEvaluator()
+    runner_ev(space.point(d.coded[-1]))
+    t_runner = _t(lambda: runner_ev(space.point(d.coded[0])), repeat=2)
+    rows.append(("runner evaluator, one run (blade + one 0.52 s transfemoral gait cycle, "
+                 "dt 2e-5 s)", t_runner))
     lines = ["## Design studies (`bladelab.design`)", "",
              "| operation | time |", "|---|---|"]
     lines += [f"| {name} | {t * 1e3:.1f} ms |" if t < 1 else f"| {name} | {t:.2f} s |"
