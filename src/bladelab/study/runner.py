@@ -190,6 +190,8 @@ def run_study(
 
         merged = IdentificationSettings.model_validate({**merged, **settings}).model_dump(mode="json")
     fn = _resolve_task(task)
+    if blade is not None and Path(blade).is_file():
+        blade = str(Path(blade).resolve())  # a spec file given on the command line: relative to cwd
     payloads = plan(study, folder, settings=merged, blade=blade)
     store = ResultsStore(folder / RESULTS_FILE)
     failures: list[tuple[str, str]] = []
