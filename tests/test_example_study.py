@@ -107,3 +107,19 @@ def test_a_complete_study_is_reused_and_force_regenerates_identically(small_stud
     assert forced.generated
     for name, tip in before.items():
         np.testing.assert_array_equal(read_c3d(folder / "trials" / name).markers["BLADE_TIP"], tip)
+
+
+def test_cli_example_make_and_its_errors(small_study, tmp_path, capsys):
+    from bladelab.cli import main
+
+    # a complete study is reused (no simulation) and reported as such
+    folder = small_study.folder
+    assert main(["example", "make", str(folder), "--trials", "2", "--json"]) == 0
+    assert '"generated": false' in capsys.readouterr().out
+    assert main(["example", "make", str(tmp_path / "x"), "--jobs", "0"]) == 2
+    err = capsys.readouterr().err
+    assert "--jobs" in err and "Traceback" not in err
+    blocker = tmp_path / "file"
+    blocker.write_text("not a folder")
+    assert main(["example", "make", str(blocker), "--trials", "1", "--jobs", "1"]) == 2
+    assert "not a folder" in capsys.readouterr().err
