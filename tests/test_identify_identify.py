@@ -135,6 +135,11 @@ def test_cli_stance_and_study(stances, tmp_path, capsys):
     assert abs(out["K_Nm_per_deg"] / 18 - 1) < 0.03 and out["seed"] == 2
     assert main(["identify", str(csv)]) == 2
     assert "--blade is required" in capsys.readouterr().err
+    flat = write_stance_csv(dataclasses.replace(stance, distance=np.full_like(stance.distance, 0.45)),
+                            tmp_path / "flat.csv")
+    assert main(["identify", str(flat), "--blade", "xtreme-cat5"]) == 2
+    err = capsys.readouterr().err
+    assert "distance column is constant" in err and "Traceback" not in err
     # a study of two trials, one of them missing
     (tmp_path / "study.yaml").write_text(
         "name: cli\nathletes: [{id: A, mass_kg: 70, amputation: transtibial}]\n"
