@@ -120,7 +120,7 @@ class _Built:
 
 
 def _build(blade: BladeModel, body_mass: float, height: float, knee: ProstheticKnee,
-           extra_leg: float, dt: float) -> _Built:
+           extra_leg: float, dt: float, knee_offset: float = 0.0) -> _Built:
     params = default_runner_params("able")
     s = height / params.athlete.height_m
     seg = params.segments
@@ -174,7 +174,7 @@ def _build(blade: BladeModel, body_mass: float, height: float, knee: ProstheticK
     kb = _body(th_p, "knee_p", (0, 0, -thigh), knee.mass, (0, 0, -0.03),
                knee.mass * 0.05**2)
     _hinge(kb, "knee_p")
-    parent = _body(kb, "clamp", (0, 0, -adapter), 1e-6, (0, 0, 0), 1e-9)
+    parent = _body(kb, "clamp", (knee_offset, 0, -adapter), 1e-6, (0, 0, 0), 1e-9)
     parent.add_site(name="clamp", pos=[0, 0, 0])
     points = np.asarray(blade.points, float)
     joint_at = {j.point: i for i, j in enumerate(blade.joints)}
@@ -339,6 +339,7 @@ def simulate_transfemoral(
     height_m: float = 1.75,
     knee: ProstheticKnee | None = None,
     extra_leg_length_m: float = 0.02,
+    knee_offset_m: float = 0.0,
     servo_stiffness: float = 2.0e4,
     servo_damping: float = 200.0,
     dt: float = 2e-5,
@@ -361,6 +362,9 @@ def simulate_transfemoral(
         Prosthetic knee parameters.
     extra_leg_length_m
         Standing prosthetic leg minus sound leg (knee to ground) [m].
+    knee_offset_m
+        Forward offset of the clamp relative to the knee axis [m] (alignment: a positive value
+        puts the knee axis behind the blade's load line).
     servo_stiffness, servo_damping
         PD gains of the joint servos [N·m/rad], [N·m·s/rad] (the ankle and trunk use 1/10 and
         5× of them).
@@ -373,7 +377,7 @@ def simulate_transfemoral(
     cycle = cycle or default_gait_cycle()
     knee = knee or ProstheticKnee()
     chain = build_chain(blade)
-    b = _build(blade, body_mass_kg, height_m, knee, extra_leg_length_m, dt)
+    b = _build(blade, body_mass_kg, height_m, knee, extra_leg_length_m, dt, knee_offset_m)
     m = b.model
     d = mujoco.MjData(m)
     nsub = max(1, int(round(1.0 / (sample_rate * dt))))
