@@ -91,6 +91,13 @@ def test_design_report(study, tmp_path):
     assert "ANOVA of delta_vx_m_per_s" in html and "<img" in html
 
 
+def test_bladelab_report_dispatches_design_folder(study, tmp_path, capsys):
+    out, _ = study
+    assert main(["report", str(out), "--out", str(tmp_path / "r")]) == 0
+    assert "report written" in capsys.readouterr().out
+    assert (tmp_path / "r" / "index.html").is_file()
+
+
 def test_design_bad_input(tmp_path, capsys):
     assert main(["design", "--out", str(tmp_path / "x"), "--constraint", "nonsense"]) == 2
     assert "--constraint" in capsys.readouterr().err

@@ -26,6 +26,12 @@ def _report(
     if not study_dir.is_dir():
         raise InputFileError("no such study folder", file=study_dir,
                              hint="give the folder that holds study.yaml")
+    from bladelab.report.design import build_design_report, is_design_folder
+
+    if is_design_folder(study_dir):  # a 'bladelab design' folder (study.json from run_design)
+        index = build_design_report(study_dir, out)
+        typer.echo(json.dumps({"index": str(index)}) if as_json else f"report written: {index}")
+        return
     res = build_study_report(study_dir, trial=trial, variant=variant, out_dir=out,
                              progress=not as_json)
     if as_json:
