@@ -14,7 +14,8 @@ The pieces, each usable on its own:
 - :mod:`~bladelab.design.plots`: main-effect and contour plots;
 - :mod:`~bladelab.design.study`: :func:`run_design` ties them to an evaluator;
 - :mod:`~bladelab.design.blade_generator`: design point -> multi-link blade spec;
-- :mod:`~bladelab.design.compression`: the virtual compression test of a blade.
+- :mod:`~bladelab.design.compression`: the virtual compression test of a blade;
+- :mod:`~bladelab.design.evaluators`: design point -> blade -> simulation -> responses.
 """
 
 from bladelab.design.blade_generator import GeneratedBlade, generate_blade
@@ -41,6 +42,7 @@ from bladelab.design.doe import (
     read_runs_csv,
     require_estimable,
 )
+from bladelab.design.evaluators import BladeEvaluator, make_evaluator, swing_clearance
 from bladelab.design.optimum import OptimumResult, SurfaceConstraint, constrained_optimum
 from bladelab.design.performance import (
     CyclePerformance,
@@ -57,6 +59,7 @@ from bladelab.design.surfaces import ResponseSurface, SurfacePrediction, fit_sur
 from bladelab.design.terms import model_terms, parse_terms
 
 __all__ = [
+    "BladeEvaluator",
     "ClearanceResult",
     "CompressionTestResult",
     "CyclePerformance",
@@ -87,6 +90,7 @@ __all__ = [
     "knee_buckling",
     "knee_extension_moment",
     "make_design",
+    "make_evaluator",
     "model_terms",
     "parse_terms",
     "performance_by_leg",
@@ -95,5 +99,6 @@ __all__ = [
     "require_estimable",
     "run_design",
     "stance_performance",
+    "swing_clearance",
     "vertical_stiffness",
 ]
