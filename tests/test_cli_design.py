@@ -91,6 +91,16 @@ def test_design_report(study, tmp_path):
     assert "ANOVA of delta_vx_m_per_s" in html and "<img" in html
 
 
+def test_design_jobs_match_serial(study, tmp_path):
+    """Runs evaluated by 2 worker processes give the serial study's results exactly."""
+    out, args = study
+    par = tmp_path / "par"
+    i = args.index("--out")
+    assert main([*args[:i], "--out", str(par), *args[i + 2:], "--jobs", "2"]) == 0
+    pd.testing.assert_frame_equal(pd.read_csv(par / "results.csv"),
+                                  pd.read_csv(out / "results.csv"))
+
+
 def test_bladelab_report_dispatches_design_folder(study, tmp_path, capsys):
     out, _ = study
     assert main(["report", str(out), "--out", str(tmp_path / "r")]) == 0
