@@ -46,6 +46,10 @@ ENERGY_TERMS: tuple[str, ...] = (
     "dissipated_friction",
 )
 
+# Normal force [N] below which a touching sole element does not count as loaded when the kernel
+# decides to sub-step (an element hovering at the surface must not trigger sub-steps every step).
+REGIME_MIN_FORCE = 50.0
+
 STATUS_OK = 0
 STATUS_DIVERGED = 1
 
@@ -384,7 +388,12 @@ def simulate_prescribed(
                                 regime[e] = 0
                                 continue
                             speed = abs(slip)
-                            regime[e] = 1 if speed <= vc else (2 if speed < 1.5 * vc else 3)
+                            if fz < REGIME_MIN_FORCE:
+                                regime[e] = 0  # a barely touching element: no refinement
+                            elif speed <= vc:
+                                regime[e] = 1
+                            else:
+                                regime[e] = 2 if speed < 1.5 * vc else 3
                             p_fric += -fx * slip
                             p_cdamp += (fz - fel) * rate
                             # gradients of (fx, fz) with respect to the point's position and velocity
@@ -518,19 +527,6 @@ def simulate_prescribed(
             energy[s_idx, 6] = d_contact
             energy[s_idx, 7] = d_friction
     return STATUS_OK, -1
-
-
-@njit(cache=True, error_model="numpy")
-def _batch_serial(base, dt, nsub, ground_vx, body_mass, com0, body_inertia, hinge, sole_body,
-                  sole_geom, tip_body, tip, contact, K, D, K2, q0, v0, order, n_iter, refine,
-                  grf, dist, qout, tau, state, energy, status):
-    for s in range(K.shape[0]):
-        st, at = simulate_prescribed(
-            base, dt, nsub, ground_vx, body_mass, com0, body_inertia, hinge, sole_body, sole_geom,
-            tip_body, tip, contact, K[s], D[s], K2[s], q0, v0, order, n_iter, refine,
-            grf[s], dist[s], qout[s], tau[s], state[s], energy[s])
-        status[s, 0] = st
-        status[s, 1] = at
 
 
 @njit(cache=True, parallel=True)

@@ -181,7 +181,7 @@ def generate_stance(
     p_low = np.array([c * p[0] + s * p[1], -s * p[0] + c * p[1]])  # lab offset clamp -> sole
     clamp_td = -p_low + np.array([0.0, 0.0])  # sole lowest point at the pivot (0, 0)
     hip_td = clamp_td + np.array([s * pylon_length_m, c * pylon_length_m])
-    lead = 0.010
+    lead = max(0.010, margin_s + 0.002)  # start in flight, before the kept margin
     g = _k.GRAVITY
     v_td = np.array([speed_mps, touchdown_vertical_speed_mps])
     hip0 = hip_td - v_td * lead - np.array([0.0, 0.5 * g * lead**2])
