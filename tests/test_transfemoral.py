@@ -14,6 +14,7 @@ from bladelab.runner.gait_cycle import (
     GaitCycle,
     default_gait_cycle,
     fit_motion_model,
+    gait_cycle_from_runner,
     read_gait_csv,
 )
 from bladelab.runner.prosthetic_knee import ProstheticKnee
@@ -99,6 +100,48 @@ def test_motion_model_recovers_quadratic_motion():
         np.testing.assert_allclose(pred.angles[n], truth.angles[n], atol=1e-10)
     with pytest.raises(SpecError, match="cannot estimate"):
         fit_motion_model(coded[:9], [cycle_at(c) for c in coded[:9]], factor_names=space.names)
+
+
+class _FakeRunnerResult:
+    """Duck-typed RunnerResult: right-leg contact at 0.1-0.2 s and 0.6-0.7 s and 1.1-1.2 s."""
+
+    def __init__(self):
+        import pandas as pd
+
+        self.t = np.arange(0, 1.3, 0.001)
+        w = 2 * np.pi / 0.5
+        self.st = pd.DataFrame({
+            "time": self.t, "pelvis_tilt": -0.2 + 0 * self.t,
+            "hip_flexion_l": 0.5 * np.sin(w * self.t), "knee_angle_l": -0.8 - 0.5 * np.cos(w * self.t),
+            "ankle_angle_l": 0.1 * np.sin(w * self.t), "hip_flexion_r": 0.5 * np.cos(w * self.t),
+            "knee_angle_r": -0.3 + 0 * self.t,
+        })
+        k = np.arange(self.t.size) % 500
+        on = (k >= 100) & (k < 200)
+        self.g = pd.concat([pd.DataFrame({"time": self.t, "leg": "intact", "Fz": 0.0 * self.t}),
+                            pd.DataFrame({"time": self.t, "leg": "prosthetic",
+                                          "Fz": np.where(on, 1500.0, 0.0)})])
+
+    def states(self):
+        return self.st
+
+    def leg_grf(self):
+        return self.g
+
+
+def test_gait_cycle_from_runner_result():
+    c = gait_cycle_from_runner(_FakeRunnerResult())
+    assert c.period == pytest.approx(0.5)
+    # the last complete cycle starts at t = 0.6 s: hip_r = 0.5 cos(w t), flexion-positive knee
+    t0 = 0.6
+    a = c.at(np.array([0.0, 0.125]))
+    w = 2 * np.pi / 0.5
+    np.testing.assert_allclose(a["hip_prosthetic"], 0.5 * np.cos(w * (t0 + np.array([0, 0.125]))),
+                               atol=1e-6)
+    assert a["knee_prosthetic"][0] == pytest.approx(0.3)
+    assert a["trunk_pitch"][0] == pytest.approx(0.2)
+    with pytest.raises(DataError, match="cycle 5"):
+        gait_cycle_from_runner(_FakeRunnerResult(), cycle=5)
 
 
 # -- simulated cycle -------------------------------------------------------------------------------

@@ -51,6 +51,7 @@ __all__ = [
     "MotionModel",
     "default_gait_cycle",
     "fit_motion_model",
+    "gait_cycle_from_runner",
     "read_gait_csv",
 ]
 
@@ -186,6 +187,64 @@ def read_gait_csv(path: str | Path) -> GaitCycle:
         return GaitCycle(period, (t - t[0]) / period, vals, str(path))
     except DataError as err:
         raise InputFileError(err.message, file=path, hint=err.hint) from None
+
+
+def gait_cycle_from_runner(result, *, cycle: int = -1, threshold_N: float = 50.0) -> GaitCycle:
+    """One gait cycle from a runner simulation (e.g. a predictive run's ``RunnerResult``).
+
+    The cycle runs from a touch-down of the right (prosthetic) leg to its next one (``cycle``
+    picks which complete cycle; default the last). Angles map from the runner's coordinates
+    (``bladelab.runner.model`` conventions): ``hip_flexion_r/l`` -> ``hip_prosthetic/sound``,
+    −``knee_angle_r/l`` -> ``knee_prosthetic/sound`` (flexion positive), ``ankle_angle_l`` ->
+    ``ankle_sound``, −``pelvis_tilt`` -> ``trunk_pitch``. A transtibial runner's biological
+    right knee becomes the prosthetic knee's starting angle (the transfemoral knee is passive).
+
+    Parameters
+    ----------
+    result
+        An object with ``states()`` (time + coordinates, rad) and ``leg_grf()`` (tidy: time,
+        leg, Fz), such as :class:`bladelab.runner.simulate.RunnerResult`.
+    cycle
+        Index of the complete cycle (Python indexing).
+    threshold_N
+        Vertical force that counts as contact [N].
+    """
+    states = result.states()
+    grf = result.leg_grf()
+    legs = [str(v) for v in pd.unique(grf["leg"])]
+    right = "prosthetic" if "prosthetic" in legs else "right"
+    if right not in legs:
+        raise DataError(f"no right/prosthetic leg in the GRF table (legs: {legs})",
+                        where="runner result")
+    fz = grf.loc[grf["leg"] == right, "Fz"].to_numpy(float)
+    t = states["time"].to_numpy(float)
+    on = fz > threshold_N
+    td = np.flatnonzero(on[1:] & ~on[:-1]) + 1
+    if td.size < 2:
+        raise DataError("fewer than two touch-downs of the right leg: no complete cycle",
+                        where="runner result", hint="simulate longer, or check that it runs")
+    starts = list(zip(td[:-1], td[1:], strict=True))
+    try:
+        a, b = starts[cycle]
+    except IndexError:
+        raise DataError(f"cycle {cycle} does not exist ({len(starts)} complete cycles)",
+                        where="runner result") from None
+    need = ["hip_flexion_l", "knee_angle_l", "ankle_angle_l", "hip_flexion_r", "knee_angle_r",
+            "pelvis_tilt"]
+    missing = [c for c in need if c not in states.columns]
+    if missing:
+        raise DataError(f"missing coordinates {missing}", where="runner result")
+    sl = slice(a, b)
+    period = float(t[b] - t[a])
+    angles = {
+        "hip_sound": states["hip_flexion_l"].to_numpy(float)[sl],
+        "knee_sound": -states["knee_angle_l"].to_numpy(float)[sl],
+        "ankle_sound": states["ankle_angle_l"].to_numpy(float)[sl],
+        "hip_prosthetic": states["hip_flexion_r"].to_numpy(float)[sl],
+        "knee_prosthetic": -states["knee_angle_r"].to_numpy(float)[sl],
+        "trunk_pitch": -states["pelvis_tilt"].to_numpy(float)[sl],
+    }
+    return GaitCycle(period, (t[sl] - t[a]) / period, angles, "runner simulation")
 
 
 @dataclass(frozen=True, eq=False)
