@@ -20,6 +20,7 @@ from bladelab.sim.api import (
 from bladelab.sim.chain import Chain, build_chain
 from bladelab.sim.kernel import ENERGY_TERMS
 from bladelab.sim.motion import ClampMotion
+from bladelab.sim.synthetic import generate_stance
 
 __all__ = [
     "ENERGY_TERMS",
@@ -30,6 +31,7 @@ __all__ = [
     "SimProblem",
     "SimResult",
     "build_chain",
+    "generate_stance",
     "prepare",
     "simulate",
     "simulate_batch",
