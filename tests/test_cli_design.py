@@ -112,5 +112,8 @@ def test_design_bad_input(tmp_path, capsys):
     assert main(["design", "--out", str(tmp_path / "x"), "--constraint", "nonsense"]) == 2
     assert "--constraint" in capsys.readouterr().err
     assert main(["design", "--out", str(tmp_path / "y"), "--evaluator", "fem"]) == 2
+    assert main(["design", "--out", str(tmp_path / "w"), "--evaluator", "runner", "--gait",
+                 str(tmp_path / "missing.csv")]) == 2
+    assert "no such gait-cycle file" in capsys.readouterr().err
     assert main(["design", "--out", str(tmp_path / "z"), "--runs", "bbd", "--factors",
                  "stiffness_kN_per_m=18:32,width_m=0.05:0.08"]) == 2  # BBD needs k >= 3

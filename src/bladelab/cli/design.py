@@ -193,7 +193,8 @@ def _design(
     constraint: list[str] = typer.Option(
         [], "--constraint",
         help="response=minimum (repeatable), e.g. knee_moment_min_Nm=0 swing_clearance_m=0.02."),
-    speed: float = typer.Option(8.0, "--speed", help="Running speed [m/s] (blade evaluator)."),
+    speed: float | None = typer.Option(
+        None, "--speed", help="Touch-down speed [m/s] (default 8 blade, 7 runner)."),
     body_mass: float = typer.Option(76.0, "--body-mass", help="Body mass [kg]."),
     base: str = typer.Option("xtreme", "--base", help="Base blade of the generator."),
     gait: Path | None = typer.Option(None, "--gait",
@@ -219,9 +220,14 @@ def _design(
             raise SpecError(f"cannot read constraint {c!r}", where="--constraint",
                             hint="write response=minimum, e.g. knee_moment_min_Nm=0")
     options: dict = {"body_mass_kg": body_mass, "generator": {"base": base}}
-    if evaluator == "blade":
+    if speed is not None:
         options["speed_mps"] = speed
-    elif evaluator == "runner" and gait is not None:
+    if evaluator == "runner" and gait is not None:
+        if not gait.is_file():
+            from bladelab.errors import InputFileError
+
+            raise InputFileError("no such gait-cycle file", file=gait,
+                                 hint="a CSV with time_s and the joint angles (docs/design.md)")
         options["gait"] = str(gait)
     ev = make_evaluator(evaluator, **options)
     design = make_design(runs, space, n_runs=n_runs, model=model, seed=seed)
