@@ -305,10 +305,23 @@ class TransfemoralResult:
 
     def responses(self, *, knee_margin: float = 0.0, clearance_threshold: float = 0.0,
                   swing_window: tuple[float, float] = (0.25, 0.75)) -> dict[str, float]:
-        """Performance functions and constraints of the cycle (units: RUNNER_RESPONSE_UNITS)."""
+        """Performance functions and constraints of the cycle (units: RUNNER_RESPONSE_UNITS).
+
+        Δv_x, mean v_x and the impulses span the whole cycle; E, the knee moment, contact time,
+        peak force and stance knee flexion refer to the prosthetic stance that starts the cycle.
+        """
         fx = self.grf_prosthetic[:, 0] + self.grf_sound[:, 0]
         fz = self.grf_prosthetic[:, 1] + self.grf_sound[:, 1]
-        st = self.prosthetic_stance
+        on = self.prosthetic_stance
+        if not on.any():
+            raise SimulationError("the blade never touched the ground in this cycle",
+                                  where="transfemoral runner",
+                                  hint="check the gait cycle and the speed")
+        # the stance that starts the cycle (a next touch-down may begin before T)
+        st = np.zeros_like(on)
+        i0 = int(np.argmax(on))
+        i1 = i0 + int(np.argmin(on[i0:])) if not on[i0:].all() else on.size
+        st[i0:i1] = True
         perf = cycle_performance(
             self.time, fx, fz, self.mass, stance_masks={"prosthetic": st},
             com_x=self.com[:, 0])
@@ -322,7 +335,7 @@ class TransfemoralResult:
             "impulse_x_Ns": float(perf.impulse_x),
             "impulse_z_Ns": float(perf.impulse_z),
             "evaluation_E_m": float(perf.per_leg["prosthetic"]["evaluation"]),
-            "peak_grf_z_prosthetic_N": float(self.grf_prosthetic[:, 1].max()),
+            "peak_grf_z_prosthetic_N": float(self.grf_prosthetic[st, 1].max()),
             "contact_time_prosthetic_s": float(st.sum() * dt),
             "knee_moment_min_Nm": kb.min_moment,
             "swing_clearance_m": cl.min_clearance,
