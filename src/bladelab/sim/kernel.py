@@ -49,6 +49,9 @@ ENERGY_TERMS: tuple[str, ...] = (
 # Normal force [N] below which a touching sole element does not count as loaded when the kernel
 # decides to sub-step (an element hovering at the surface must not trigger sub-steps every step).
 REGIME_MIN_FORCE = 50.0
+# Time [s] after an element becomes loaded during which its sliding is sub-stepped (the landing
+# slide decides where the sole sticks; later steady sliding is smooth and needs no sub-steps).
+SLIDE_WINDOW = 0.005
 
 STATUS_OK = 0
 STATUS_DIVERGED = 1
@@ -287,6 +290,8 @@ def simulate_prescribed(
     pe = np.zeros((ne, 2))
     regime = np.zeros(ne, np.int64)
     regime_old = np.zeros(ne, np.int64)
+    onset = np.full(ne, -(10**9), np.int64)  # step at which each element became loaded
+    window = int(SLIDE_WINDOW / dt + 0.5)
     bsub = np.zeros(base.shape[1])
     vc = contact[8]
     w_clamp = 0.0
@@ -455,7 +460,8 @@ def simulate_prescribed(
                     dc += h * p_cdamp
                     df += h * p_fric
                     for e in range(ne):
-                        if regime[e] != regime_old[e] or regime[e] >= 2:
+                        if regime[e] != regime_old[e] or (regime[e] >= 2
+                                                          and i - onset[e] <= window):
                             changed = True
                 if attempt == 0 and changed and refine > 1 and i > 1:
                     # the contact law changes regime or slides in this step: redo it in sub-steps
@@ -473,6 +479,8 @@ def simulate_prescribed(
                     vp[j] = v_save[j]
             have_history = True
             for e in range(ne):
+                if regime_old[e] == 0 and regime[e] > 0:
+                    onset[e] = i
                 regime_old[e] = regime[e]
             w_clamp += wc
             d_joint += dj
