@@ -39,6 +39,13 @@ def test_blade_test_single_joint_falls_back_to_free(capsys):
     assert "tip free" in out.out and "cannot compress" in out.err
 
 
+def test_blade_test_load_not_reached_is_null(capsys):
+    assert main(["blade", "test", "xtreme", "--alignment", "0", "--max-displacement", "0.01",
+                 "--json"]) == 0
+    t = json.loads(capsys.readouterr().out)["tests"][0]
+    assert t["stiffness_at_load_N_per_m"] is None and t["stiffness_linear_N_per_m"] > 0
+
+
 def test_blade_test_bad_input(blade_yaml, capsys):
     assert main(["blade", "test", str(blade_yaml), "--alignment", "0,x"]) == 2
     err = capsys.readouterr().err

@@ -74,9 +74,18 @@ def _blade_test(
                                  alignment_deg=a, tip=tip)
         results.append(r)
     if as_json:
-        typer.echo(json.dumps({"blade": model.name, "body_mass_kg": body_mass, "load_N": load,
-                               "tests": [r.to_dict() for r in results]}, indent=2,
-                              allow_nan=False, default=str).replace("NaN", "null"))
+        def _clean(v):
+            if isinstance(v, float) and not math.isfinite(v):
+                return None
+            if isinstance(v, dict):
+                return {k: _clean(x) for k, x in v.items()}
+            if isinstance(v, list):
+                return [_clean(x) for x in v]
+            return v
+
+        typer.echo(json.dumps(_clean({"blade": model.name, "body_mass_kg": body_mass,
+                                      "load_N": load, "tests": [r.to_dict() for r in results]}),
+                              indent=2))
     else:
         typer.echo(f"{model.name}: virtual compression test (tip {tip}), load m·g = {load:.0f} N")
         typer.echo(" alignment_deg  k_linear_kN_per_m  k_at_bw_kN_per_m  displacement_at_bw_mm")
