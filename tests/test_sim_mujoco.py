@@ -48,6 +48,20 @@ def test_kernel_agrees_with_mujoco(blade_and_stance, friction):
             assert np.all(ker.grf_x == 0.0) and np.all(ref.grf_x == 0.0)
 
 
+def test_nonlinear_spring_agrees_with_mujoco(blade_and_stance):
+    """K2·q·|q| (the nonlinear option) is applied the same way by both engines."""
+    blade, stance = blade_and_stance
+    K = units.stiffness_per_deg_to_per_rad(13.0)
+    K2 = 3.0 * K  # the spring stiffens by 30 % per 0.1 rad of deflection
+    ker = simulate(prepare(blade, stance), stiffness=K, stiffness_quadratic=K2)
+    lin = simulate(prepare(blade, stance), stiffness=K)
+    ref = simulate(prepare(blade, stance, engine="mujoco"), stiffness=K, stiffness_quadratic=K2)
+    assert nrmse(lin.grf_z, ref.grf_z) > 0.03  # K2 matters here
+    assert nrmse(ker.grf_z, ref.grf_z) < 0.01
+    assert nrmse(ker.distance, ref.distance) < 0.01
+    assert nrmse(ker.torque[:, 0], ref.torque[:, 0]) < 0.01
+
+
 def test_six_link_blade_agrees_with_mujoco():
     blade = multilink_blade("xtreme", n_links=6)
     assert len(blade.joints) == 5

@@ -311,7 +311,8 @@ def _params(problem: SimProblem, value, default: np.ndarray, name: str, n_sets: 
     return np.ascontiguousarray(arr, dtype=float)
 
 
-def _run_kernel(problem: SimProblem, K, D, K2, *, parallel: bool = False):
+def _run_kernel(problem: SimProblem, K, D, K2, *, parallel: bool = False,
+                with_energy: bool = True):
     c = problem.chain
     n_sets, nj = K.shape
     ns = problem.n_samples
@@ -326,7 +327,7 @@ def _run_kernel(problem: SimProblem, K, D, K2, *, parallel: bool = False):
     args = (problem.base, problem.dt, problem.n_substeps, 0.0, c.body_mass, c.body_com,
             c.body_inertia, c.hinge, c.sole_body, c.sole_geom, c.tip_body, c.tip, c.contact)
     q0 = np.zeros(nj)
-    opts = (problem.order, problem.iterations, problem.refine)
+    opts = (problem.order, problem.iterations, problem.refine, with_energy)
     if parallel:
         _k._batch_parallel(*args, K, D, K2, q0, q0, *opts, grf, dist, qout, tau, state, energy,
                            status)
@@ -440,7 +441,8 @@ def simulate_batch(
             ok=ok, stiffness=K, damping=D, stiffness_quadratic=K2,
         )
     grf, dist, qout, tau, _state, _energy, status = _run_kernel(problem, K, D, K2,
-                                                                parallel=parallel)
+                                                                parallel=parallel,
+                                                                with_energy=False)
     ok = status[:, 0] == _k.STATUS_OK
     grf_x = grf[:, :, :, 0].sum(axis=2)
     grf_z = grf[:, :, :, 1].sum(axis=2)

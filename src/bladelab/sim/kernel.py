@@ -238,14 +238,15 @@ def _solve(A, rhs, x):
 def simulate_prescribed(
     base, dt, nsub, ground_vx,
     body_mass, com0, body_inertia, hinge, sole_body, sole_geom, tip_body, tip, contact,
-    stiffness, damping, stiffness_quadratic, q0, v0, order, n_iter, refine,
+    stiffness, damping, stiffness_quadratic, q0, v0, order, n_iter, refine, with_energy,
     grf, dist, qout, tau, state, energy,
 ):
     """Simulate one parameter set with the clamp prescribed.
 
     ``base`` (n_steps + 1, 11): clamp x, z, θ, ẋ, ż, θ̇, ẍ, z̈, θ̈, cos θ, sin θ at every step time.
     ``order`` 2 (BDF2) or 1 (backward Euler); ``n_iter`` Newton iterations per step (1 =
-    linearly implicit); ``refine``: a step in which any sole element changes regime (touch-down,
+    linearly implicit); ``with_energy``: keep the energy bookkeeping (clamp work, dissipation,
+    stored energies; off for identification batches); ``refine``: a step in which any sole element changes regime (touch-down,
     stick ↔ slip, lift-off) is redone as ``refine`` sub-steps with the clamp row interpolated
     linearly (1 = never). Samples are recorded every ``nsub`` steps into ``grf`` (ns, ne, 2),
     ``dist`` (ns,), ``qout`` and ``tau`` (ns, nj), ``state`` (ns, ne) int8 (0 free, 1 stick,
@@ -427,30 +428,31 @@ def simulate_prescribed(
                         _solve(M, res, dv)
                         for j in range(nj):
                             vi[j] += dv[j]
-                    # clamp power with the step's accelerations (v_{n+1} - v_n) / h
-                    fcx = 0.0
-                    fcz = 0.0
-                    tc = 0.0
-                    for b in range(nb):
-                        ax = AR[b, 0]
-                        az = AR[b, 1]
-                        alb = al[b]
-                        for j in range(b):
-                            qdd = (vi[j] - v[j]) / h
-                            ax += qdd * (R[b, 1] - Ob[j + 1, 1])
-                            az -= qdd * (R[b, 0] - Ob[j + 1, 0])
-                            alb += qdd
-                        m = body_mass[b]
-                        fcx += m * ax
-                        fcz += m * (az + GRAVITY)
-                        rx = R[b, 0] - bs[0]
-                        rz = R[b, 1] - bs[1]
-                        tc += m * (ax * rz - (az + GRAVITY) * rx) + body_inertia[b] * alb
-                    for e in range(ne):
-                        fcx -= fe[e, 0]
-                        fcz -= fe[e, 1]
-                        tc -= fe[e, 0] * (pe[e, 1] - bs[1]) - fe[e, 1] * (pe[e, 0] - bs[0])
-                    wc += h * (fcx * bs[3] + fcz * bs[4] + tc * bs[5])
+                    if with_energy:
+                        # clamp power with the step's accelerations (v_{n+1} - v_n) / h
+                        fcx = 0.0
+                        fcz = 0.0
+                        tc = 0.0
+                        for b in range(nb):
+                            ax = AR[b, 0]
+                            az = AR[b, 1]
+                            alb = al[b]
+                            for j in range(b):
+                                qdd = (vi[j] - v[j]) / h
+                                ax += qdd * (R[b, 1] - Ob[j + 1, 1])
+                                az -= qdd * (R[b, 0] - Ob[j + 1, 0])
+                                alb += qdd
+                            m = body_mass[b]
+                            fcx += m * ax
+                            fcz += m * (az + GRAVITY)
+                            rx = R[b, 0] - bs[0]
+                            rz = R[b, 1] - bs[1]
+                            tc += m * (ax * rz - (az + GRAVITY) * rx) + body_inertia[b] * alb
+                        for e in range(ne):
+                            fcx -= fe[e, 0]
+                            fcz -= fe[e, 1]
+                            tc -= fe[e, 0] * (pe[e, 1] - bs[1]) - fe[e, 1] * (pe[e, 0] - bs[0])
+                        wc += h * (fcx * bs[3] + fcz * bs[4] + tc * bs[5])
                     for j in range(nj):
                         qp[j] = q[j]
                         vp[j] = v[j]
@@ -510,15 +512,10 @@ def simulate_prescribed(
                     state[s_idx, e] = 1
                 else:
                     state[s_idx, e] = 2
-                e_contact += contact_elastic_energy(contact, depth)
+                if with_energy:
+                    e_contact += contact_elastic_energy(contact, depth)
             tx, tz = _body_point(tip_body, tip[0], tip[1], hinge, Ob, cph, sph)
             dist[s_idx] = math.hypot(tx - bs[0], tz - bs[1])
-            kin = 0.0
-            pot = 0.0
-            for b in range(nb):
-                kin += 0.5 * body_mass[b] * (VR[b, 0] ** 2 + VR[b, 1] ** 2)
-                kin += 0.5 * body_inertia[b] * om[b] ** 2
-                pot += body_mass[b] * GRAVITY * R[b, 1]
             spring = 0.0
             for j in range(nj):
                 qa = q[j]
@@ -526,25 +523,34 @@ def simulate_prescribed(
                 tau[s_idx, j] = -(stiffness[j] * qa + stiffness_quadratic[j] * qa * abs(qa)
                                   + damping[j] * v[j])
                 spring += 0.5 * stiffness[j] * qa * qa + stiffness_quadratic[j] * abs(qa) ** 3 / 3.0
-            energy[s_idx, 0] = w_clamp
-            energy[s_idx, 1] = kin
-            energy[s_idx, 2] = pot
-            energy[s_idx, 3] = spring
-            energy[s_idx, 4] = e_contact
-            energy[s_idx, 5] = d_joint
-            energy[s_idx, 6] = d_contact
-            energy[s_idx, 7] = d_friction
+            if with_energy:
+                kin = 0.0
+                pot = 0.0
+                for b in range(nb):
+                    kin += 0.5 * body_mass[b] * (VR[b, 0] ** 2 + VR[b, 1] ** 2)
+                    kin += 0.5 * body_inertia[b] * om[b] ** 2
+                    pot += body_mass[b] * GRAVITY * R[b, 1]
+                energy[s_idx, 0] = w_clamp
+                energy[s_idx, 1] = kin
+                energy[s_idx, 2] = pot
+                energy[s_idx, 3] = spring
+                energy[s_idx, 4] = e_contact
+                energy[s_idx, 5] = d_joint
+                energy[s_idx, 6] = d_contact
+                energy[s_idx, 7] = d_friction
     return STATUS_OK, -1
 
 
 @njit(cache=True, parallel=True)
 def _batch_parallel(base, dt, nsub, ground_vx, body_mass, com0, body_inertia, hinge, sole_body,
                     sole_geom, tip_body, tip, contact, K, D, K2, q0, v0, order, n_iter, refine,
+                    with_energy,
                     grf, dist, qout, tau, state, energy, status):
     for s in prange(K.shape[0]):
         st, at = simulate_prescribed(
             base, dt, nsub, ground_vx, body_mass, com0, body_inertia, hinge, sole_body, sole_geom,
             tip_body, tip, contact, K[s], D[s], K2[s], q0, v0, order, n_iter, refine,
+            with_energy,
             grf[s], dist[s], qout[s], tau[s], state[s], energy[s])
         status[s, 0] = st
         status[s, 1] = at
