@@ -416,6 +416,9 @@ def build_study_report(
     )
     if landscape is not None:
         df, k_opt, d_opt = landscape
+        grid = df.assign(K_Nm_per_deg=units.stiffness_per_rad_to_per_deg(df["K"]),
+                         D_Nms_per_deg=units.damping_per_rad_to_per_deg(df["D"]))[
+                             ["K_Nm_per_deg", "D_Nms_per_deg", "cost"]]
         rep.add_section(
             "Identifiability",
             text=f"Cost J(K, D) on a {landscape_points} × {landscape_points} grid around the "
@@ -423,10 +426,11 @@ def build_study_report(
                  "valley means K and D compensate each other.",
             figures=[(f"Cost landscape of {landscape_id}",
                       _landscape_figure(df, k_opt, d_opt, f"cost landscape: {landscape_id}"))],
-            tables=[(f"Landscape {landscape_id}", df.assign(
-                K_Nm_per_deg=units.stiffness_per_rad_to_per_deg(df["K"]),
-                D_Nms_per_deg=units.damping_per_rad_to_per_deg(df["D"]))[
-                    ["K_Nm_per_deg", "D_Nms_per_deg", "cost"]])],
+            tables=[ReportTable(
+                f"Cost landscape of {landscape_id} (grid minimum; the whole grid in the CSV)",
+                grid.nsmallest(1, "cost").assign(K_identified_Nm_per_deg=k_opt,
+                                                 D_identified_Nms_per_deg=d_opt),
+                "landscape", csv=grid)],
         )
     if synthetic:
         gt = pd.read_csv(gt_path, comment="#")
