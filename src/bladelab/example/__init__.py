@@ -17,14 +17,31 @@ from bladelab.example.measurement import (
     extend_flight,
     measure_stance,
 )
+from bladelab.example.pipeline import PipelineResult, run_example_pipeline
+from bladelab.example.study import (
+    ExampleStudy,
+    GeneratorSettings,
+    TrialPlan,
+    make_example_study,
+    plan_trials,
+    read_ground_truth,
+)
 
 __all__ = [
     "CLAMP_CLUSTER",
     "TIP_MARKER",
+    "ExampleStudy",
+    "GeneratorSettings",
     "MeasuredTrial",
+    "PipelineResult",
+    "TrialPlan",
     "clamp_cluster_positions",
     "default_tip",
     "degrade_stance",
     "extend_flight",
+    "make_example_study",
     "measure_stance",
+    "plan_trials",
+    "read_ground_truth",
+    "run_example_pipeline",
 ]

@@ -53,6 +53,7 @@ __all__ = [
     "is_complete",
     "make_example_study",
     "plan_trials",
+    "read_ground_truth",
 ]
 
 GENERATOR_VERSION = 1
