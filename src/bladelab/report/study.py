@@ -171,6 +171,8 @@ def _truth_figure(merged: pd.DataFrame):
         pad = 0.05 * (hi - lo if hi > lo else 1.0)
         ax.plot([lo - pad, hi + pad], [lo - pad, hi + pad], color="#333333", linewidth=1.0,
                 linestyle="--", label="identity")
+        # long whiskers (poorly determined trials) must not squash the points
+        ax.set_ylim(lo - 4 * pad, hi + 4 * pad)
         ax.set_xlabel(f"true {label}")
         ax.set_ylabel(f"identified {label}")
         ax.set_title(f"{label.split(' ')[0]}: identified vs true")
