@@ -62,6 +62,17 @@ def test_nonlinear_spring_agrees_with_mujoco(blade_and_stance):
     assert nrmse(ker.torque[:, 0], ref.torque[:, 0]) < 0.01
 
 
+def test_hunt_crossley_contact_agrees_with_mujoco(blade_and_stance):
+    blade, stance = blade_and_stance
+    hc = blade.with_contact(law="hunt_crossley", stiffness=6e7, exponent=1.5, dissipation=1.0)
+    ker = simulate(prepare(hc, stance))
+    ref = simulate(prepare(hc, stance, engine="mujoco"))
+    assert ref.grf_z.max() > 1000.0
+    assert nrmse(ker.grf_z, ref.grf_z) < 0.01
+    assert nrmse(ker.grf_x, ref.grf_x) < 0.01
+    assert nrmse(ker.distance, ref.distance) < 0.01
+
+
 def test_six_link_blade_agrees_with_mujoco():
     blade = multilink_blade("xtreme", n_links=6)
     assert len(blade.joints) == 5

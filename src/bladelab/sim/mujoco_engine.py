@@ -60,9 +60,14 @@ def default_mujoco_dt(chain: Chain, *, peak_force: float = 3000.0) -> float:
         m_z = 1.0 / max(jz @ Minv @ jz, 1e-12)
         if mu_s > 0:
             dt = min(dt, m_x / (mu_s * peak_force / v_c))
-        if law == 0 and c_c > 0:
-            dt = min(dt, m_z / c_c)
-        dt = min(dt, 0.2 * math.sqrt(m_z / k_c))
+        if law == 0:
+            k_eff, c_eff = k_c, c_c
+        else:  # Hunt-Crossley: linearise at 2 mm of penetration
+            n, diss, ref = chain.contact[4], chain.contact[5], 0.002
+            k_eff, c_eff = n * k_c * ref ** (n - 1.0), 1.5 * diss * k_c * ref**n
+        if c_eff > 0:
+            dt = min(dt, m_z / c_eff)
+        dt = min(dt, 0.2 * math.sqrt(m_z / k_eff))
     return float(dt)
 
 
