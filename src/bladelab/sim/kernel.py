@@ -264,6 +264,8 @@ def simulate_prescribed(
     sph = np.zeros(nb)
     ce = np.cos(sole_geom[:, 4])
     se = np.sin(sole_geom[:, 4])
+    # an ellipse whose centre is higher than its larger semi-axis cannot touch z = 0
+    reach = np.maximum(sole_geom[:, 2], sole_geom[:, 3]) * 1.000001
     om = np.zeros(nb)
     al = np.zeros(nb)
     R = np.zeros((nb, 2))
@@ -382,6 +384,11 @@ def simulate_prescribed(
                         for e in range(ne):
                             b = sole_body[e]
                             cx, cz = _body_point(b, sole_geom[e, 0], sole_geom[e, 1], hinge, Ob, cph, sph)
+                            if cz > reach[e]:  # far above the ground: no force
+                                fe[e, 0] = 0.0
+                                fe[e, 1] = 0.0
+                                regime[e] = 0
+                                continue
                             (px, pz, fx, fz, depth, rate, slip, kn, cn, mu, dmu, fel) = sole_contact(
                                 contact, cx, cz, sph[b] * ce[e] + cph[b] * se[e], cph[b] * ce[e] - sph[b] * se[e],
                                 sole_geom[e, 2], sole_geom[e, 3],
@@ -500,6 +507,11 @@ def simulate_prescribed(
             for e in range(ne):
                 b = sole_body[e]
                 cx, cz = _body_point(b, sole_geom[e, 0], sole_geom[e, 1], hinge, Ob, cph, sph)
+                if cz > reach[e]:  # far above the ground
+                    grf[s_idx, e, 0] = 0.0
+                    grf[s_idx, e, 1] = 0.0
+                    state[s_idx, e] = 0
+                    continue
                 (px, pz, fx, fz, depth, rate, slip, kn, cn, mu, dmu, fel) = sole_contact(
                     contact, cx, cz, sph[b] * ce[e] + cph[b] * se[e],
                     cph[b] * ce[e] - sph[b] * se[e], sole_geom[e, 2], sole_geom[e, 3],
