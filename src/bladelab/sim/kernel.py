@@ -322,15 +322,14 @@ def simulate_prescribed(
                 changed = False
                 for k in range(1, n_here + 1):
                     if n_here == 1:
-                        for c in range(bsub.shape[0]):
-                            bsub[c] = bs_row[c]
+                        bs = bs_row
                         use_bdf2 = (order == 2) & have_history
                     else:
                         f = k / n_here
                         for c in range(bsub.shape[0]):
                             bsub[c] = b0[c] + f * (bs_row[c] - b0[c])
+                        bs = bsub
                         use_bdf2 = (order == 2) & (k > 1)
-                    bs = bsub
                     if use_bdf2:
                         # BDF2: x_{n+1} = 4/3 x_n - 1/3 x_{n-1} + 2/3 h f(x_{n+1})
                         g = 2.0 * h / 3.0
