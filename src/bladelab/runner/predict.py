@@ -423,20 +423,21 @@ def verify_solution(
     duration: float = 10.0,
     speed_tolerance: float = 0.1,
     max_power_residual_pct: float = 2.0,
+    min_gap_s: float = 0.05,
 ) -> dict:
     """Re-simulate a parameter file and check the shipped-solution criteria.
 
     Criteria (all recomputed from the file, nothing trusted from it): ``duration`` [s] without a
     fall; mean speed within ``speed_tolerance`` [m/s] of ``speed`` (default: the file's
-    ``speed_m_per_s``); a flight phase (no leg loaded above 20 N) between every two successive
-    touch-downs; power-balance residual below ``max_power_residual_pct`` % (runner analyses).
+    ``speed_m_per_s``); a flight phase (no leg loaded above 20 N) in every stride of each leg
+    (touch-down to touch-down of that leg; unloaded gaps shorter than ``min_gap_s`` [s] inside a
+    stance, i.e. contact bounces, do not end it); power-balance residual below ``max_power_residual_pct`` % (runner analyses).
     Returns the measured values and ``ok``.
     """
     import json
 
     from bladelab.runner.analyses import (
         CONTACT_THRESHOLD_N,
-        gait_events,
         power_balance_residual_pct,
     )
     from bladelab.runner.controller import read_parameters
@@ -449,13 +450,13 @@ def verify_solution(
     x = read_parameters(path, layout)
     settings = ObjectiveSettings(speed=speed, duration=duration)
     ev, res = simulate_controlled(runner, x, layout=layout, settings=settings, record_every=2)
-    fz = res.contacts[:, :, 1].sum(axis=1)
-    td = gait_events(res)
-    td = td.time[td.event == "touchdown"].to_numpy()
+    leg = res.model.contact_params[:, 6]
+    loaded = [res.contacts[:, leg == i, 1].sum(axis=1) > CONTACT_THRESHOLD_N for i in (0, 1)]
+    airborne = ~(loaded[0] | loaded[1])
     flights = []
-    for a, b in zip(td[:-1], td[1:], strict=True):
-        sel = (res.time > a) & (res.time < b)
-        flights.append(bool(np.any(fz[sel] < CONTACT_THRESHOLD_N)))
+    for on in loaded:
+        for a, b in _strides(res.time, on, min_gap_s):
+            flights.append(bool(np.any(airborne[a:b])))
     residual = power_balance_residual_pct(res)
     out = {
         "fell": ev.fell,
@@ -475,6 +476,19 @@ def verify_solution(
         and residual <= max_power_residual_pct
     )
     return out
+
+
+def _strides(time: np.ndarray, on: np.ndarray, min_gap_s: float) -> list[tuple[int, int]]:
+    """Sample ranges from one touch-down to the next of a leg, bounces shorter than
+    ``min_gap_s`` merged into the stance."""
+    on = on.copy()
+    edges = np.flatnonzero(np.diff(on.astype(np.int8)))
+    # fill short unloaded gaps (liftoff followed by touch-down within min_gap_s)
+    for e0, e1 in zip(edges[:-1], edges[1:], strict=True):
+        if on[e0] and not on[e0 + 1] and time[e1 + 1] - time[e0 + 1] < min_gap_s:
+            on[e0 + 1 : e1 + 1] = True
+    td = np.flatnonzero(~on[:-1] & on[1:]) + 1
+    return list(zip(td[:-1], td[1:], strict=True))
 
 
 __all__ = [
