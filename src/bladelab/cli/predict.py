@@ -41,6 +41,7 @@ def register(app: typer.Typer) -> None:
         resume: bool = typer.Option(False, "--resume", help="Continue from the checkpoint."),
         duration: float = typer.Option(10.0, "--duration", help="Simulated time (s)."),
         checkpoint_every: int = typer.Option(5, "--checkpoint-every", help="Generations."),
+        dt: float = typer.Option(5e-4, "--dt", help="Time step (s); 2.5e-4 for final solutions."),
     ) -> None:
         """Optimise the reflex controller of the runner with CMA-ES (seed 001 eq. 2.4)."""
         from bladelab.runner.controller import read_parameters
@@ -51,6 +52,8 @@ def register(app: typer.Typer) -> None:
             raise SpecError(f"unknown model {model!r}", where="--model", hint="able or amputee")
         if not (math.isfinite(speed) and speed > 0):
             raise SpecError("speed must be positive", where="--speed")
+        if not (math.isfinite(dt) and 0 < dt <= 2e-3):
+            raise SpecError("time step must be in (0, 2e-3] s", where="--dt")
         _, layout = _model(model, blade if model == "amputee" else None)
         x0 = read_parameters(init, layout, transfer=True) if init is not None else None
         seed_list = _parse_list(seeds, "--seeds", int)
@@ -75,7 +78,7 @@ def register(app: typer.Typer) -> None:
                 out=folder,
                 resume=resume,
                 checkpoint_every=checkpoint_every,
-                settings=ObjectiveSettings(speed=speed, duration=duration),
+                settings=ObjectiveSettings(speed=speed, duration=duration, dt=dt),
                 progress=show,
             )
             results.append(res.to_dict())

@@ -427,6 +427,9 @@ def verify_solution(
 ) -> dict:
     """Re-simulate a parameter file and check the shipped-solution criteria.
 
+    The simulation uses the time step the file was optimised with (``settings.dt``, default
+    0.5 ms).
+
     Criteria (all recomputed from the file, nothing trusted from it): ``duration`` [s] without a
     fall; mean speed within ``speed_tolerance`` [m/s] of ``speed`` (default: the file's
     ``speed_m_per_s``); a flight phase (no leg loaded above 20 N) in every stride of each leg
@@ -448,7 +451,8 @@ def verify_solution(
     speed = float(speed if speed is not None else data.get("speed_m_per_s", 3.5))
     runner, layout = _model(model, blade)
     x = read_parameters(path, layout)
-    settings = ObjectiveSettings(speed=speed, duration=duration)
+    dt = float(data.get("settings", {}).get("dt", ObjectiveSettings().dt))
+    settings = ObjectiveSettings(speed=speed, duration=duration, dt=dt)
     ev, res = simulate_controlled(runner, x, layout=layout, settings=settings, record_every=2)
     leg = res.model.contact_params[:, 6]
     loaded = [res.contacts[:, leg == i, 1].sum(axis=1) > CONTACT_THRESHOLD_N for i in (0, 1)]
