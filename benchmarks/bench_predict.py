@@ -54,18 +54,21 @@ def _generation(jobs: int) -> tuple[float, float, int, float]:
 
 
 def _long_run() -> str:
-    hist = ROOT / "runs" / "able-3.5" / "history.csv"
-    if not hist.exists():
-        return "No long optimisation found under `runs/able-3.5/`."
     import pandas as pd
 
-    h = pd.read_csv(hist)
-    last = h.iloc[-1]
-    return (
-        f"Long optimisation `runs/able-3.5` (able, 3.5 m/s, λ = 16, 1 worker, niced, on the "
-        f"shared machine): {int(last.generation)} generations, {int(last.evaluations)} "
-        f"evaluations, best cost {last.best:.4g} (first checkpoint {h.best.iloc[0]:.4g})."
-    )
+    out = []
+    for name, step in (("able-3.5-dt0.5", "0.5 ms"), ("able-3.5", "0.25 ms")):
+        hist = ROOT / "runs" / name / "history.csv"
+        if not hist.exists():
+            continue
+        h = pd.read_csv(hist)
+        last = h.iloc[-1]
+        out.append(
+            f"Long optimisation `runs/{name}` (able, 3.5 m/s, {step} step, λ = 16, 1 worker, niced, on the "
+            f"shared machine): {int(last.generation)} generations, {int(last.evaluations)} "
+            f"evaluations, best cost {last.best:.4g} (first checkpoint {h.best.iloc[0]:.4g})."
+        )
+    return "\n\n".join(out) or "No long optimisation found under `runs/`."
 
 
 def run() -> str:
@@ -88,6 +91,8 @@ def run() -> str:
         f"| same, 2nd generation | {g2:.2f} s ({evals} evaluations; best cost {best:.4g}) |",
         f"| extrapolated generation of 16 full 10 s simulations on 2 workers | {gen_full:.1f} s |",
         f"| extrapolated 1000 such generations | {gen_full * 1000 / 3600:.2f} h |",
+        f"| same at the 0.25 ms step that running needs for the power balance "
+        f"(docs/predictive.md) | {2 * gen_full * 1000 / 3600:.2f} h |",
         "",
         "The initial guess (SCONE's walking parameters) falls within about half a second at "
         "3.5 m/s, so early generations are cheap; once candidates run the full 10 s a generation "
