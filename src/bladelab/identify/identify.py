@@ -29,6 +29,7 @@ from bladelab.identify.bounds import (
     parameter_bounds,
 )
 from bladelab.identify.cost import StanceCost
+from bladelab.identify.formulations import DEFAULT_FORMULATION, formulation_drive
 from bladelab.identify.identifiability import assess_identifiability, effective_sample_size
 from bladelab.identify.optimizers import minimize
 
@@ -183,6 +184,7 @@ def identify_stance(
     engine: str = "kernel",
     belt_speed: float = 0.0,
     contact_threshold: float = 20.0,
+    formulation: str = DEFAULT_FORMULATION,
 ) -> Identification:
     """Identify K* [N·m/deg] and D* [N·m·s/deg] (and K2 if ``nonlinear``) of one stance.
 
@@ -254,7 +256,8 @@ def identify_stance(
     expected = ("K", "D", "K2") if nonlinear else ("K", "D")
     if tuple(bounds.names) != expected:
         raise ModelError(f"bounds are for {bounds.names}, the model needs {expected}", where="bounds")
-    problem = sim.prepare(model, stance, dt=dt, engine=engine, belt_speed=belt_speed)
+    problem = sim.prepare(model, stance, dt=dt, engine=engine, belt_speed=belt_speed,
+                          drive=formulation_drive(formulation))
 
     def run(X: np.ndarray):
         X = np.atleast_2d(X)

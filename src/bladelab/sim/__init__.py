@@ -16,6 +16,7 @@ from bladelab.sim.api import (
     prepare,
     simulate,
     simulate_batch,
+    utilised_friction_ratio,
 )
 from bladelab.sim.chain import Chain, build_chain
 from bladelab.sim.kernel import ENERGY_TERMS
@@ -35,4 +36,5 @@ __all__ = [
     "prepare",
     "simulate",
     "simulate_batch",
+    "utilised_friction_ratio",
 ]

@@ -27,9 +27,47 @@ Engine = Literal["kernel", "mujoco"]
 
 
 class Drive(enum.StrEnum):
-    """How the clamp is driven. Only ``prescribed`` exists now; issue 9 adds the others."""
+    """How the model is driven by the stance.
+
+    ``prescribed``: the clamp follows the measured pose; contact with stick-slip friction (seed 000).
+    ``utilised-friction``: the clamp follows the measured pose; the friction force of every
+    loaded sole element is r(t)·Fn with r = measured Fx/Fz (:func:`utilised_friction_ratio`)
+    instead of the stick-slip law, so clamp-path errors no longer become horizontal forces.
+    """
 
     PRESCRIBED = "prescribed"
+    UTILISED_FRICTION = "utilised-friction"
+
+
+# The utilised ratio r = Fx·Fz/(Fz² + F0²) with F0 this fraction of the peak
+UTILISED_FLOOR_FRAC = 0.05
+# |r| is limited to this value (a static friction coefficient larger than any measured one)
+UTILISED_LIMIT = 1.0
+
+
+def utilised_friction_ratio(
+    stance: Stance, *, floor_frac: float = UTILISED_FLOOR_FRAC, limit: float = UTILISED_LIMIT
+) -> np.ndarray:
+    """Utilised friction r(t) = Fx/Fz of the measured GRF, regularised where Fz is small.
+
+    r = Fx·Fz / (Fz² + F0²) with F0 = ``floor_frac`` × peak vertical GRF (so r → 0 in flight and
+    r ≈ Fx/Fz when loaded), clipped to ±``limit``. Dimensionless, on the stance's time base.
+
+    Raises
+    ------
+    DataError
+        The stance has no finite horizontal or vertical GRF inside contact.
+    """
+    fx = np.asarray(stance.grf_x, float)
+    fz = np.asarray(stance.grf_z, float)
+    ok = np.isfinite(fx) & np.isfinite(fz)
+    if not np.any(ok & (fz > 0)):
+        raise DataError("no finite vertical GRF: the utilised friction needs GRF x and z",
+                        where="stance.grf_x / grf_z", hint="use drive='prescribed'")
+    peak = float(np.max(np.abs(fz[ok])))
+    f0 = max(floor_frac * peak, 1e-9)
+    r = np.where(ok, fx * fz / (fz * fz + f0 * f0), 0.0)
+    return np.clip(r, -limit, limit)
 
 
 @dataclasses.dataclass(frozen=True, eq=False)
@@ -52,7 +90,8 @@ class SimProblem:
         Integration steps per stance sample.
     base
         (n_steps + 1, 11) clamp pose, velocity, acceleration, cos and sin of the pitch at every
-        step time.
+        step time; a 12th column holds the utilised friction ratio r(t) with
+        ``drive="utilised-friction"``.
     engine, drive, belt_speed
         As given to :func:`prepare`.
     """
@@ -244,7 +283,9 @@ def prepare(
     belt_speed
         Treadmill belt speed [m/s], added to the clamp's forward motion.
     drive
-        Clamp drive; only ``"prescribed"`` (clamp follows the stance exactly).
+        ``"prescribed"`` (clamp follows the stance exactly; stick-slip friction, seed 000) or
+        ``"utilised-friction"`` (clamp follows the stance; friction r(t)·Fn with r the measured
+        Fx/Fz, see :class:`Drive`; needs the stance's GRF x and z).
 
     Raises
     ------
@@ -257,7 +298,7 @@ def prepare(
         drive = Drive(drive)
     except ValueError as err:
         raise ModelError(f"unknown drive {drive!r}", where="drive",
-                         hint="only 'prescribed' is available") from err
+                         hint="one of " + ", ".join(d.value for d in Drive)) from err
     if engine not in ("kernel", "mujoco"):
         raise ModelError(f"unknown engine {engine!r}", where="engine", hint="use kernel or mujoco")
     if not (dt > 0 and math.isfinite(dt)):
@@ -282,7 +323,11 @@ def prepare(
     n_steps = (len(time) - 1) * nsub
     t_steps = time[0] + dt_used * np.arange(n_steps + 1)
     t_steps[-1] = time[-1]
-    base = np.ascontiguousarray(motion.evaluate(t_steps))
+    base = motion.evaluate(t_steps)
+    if drive == Drive.UTILISED_FRICTION:
+        ratio = np.interp(t_steps, time, utilised_friction_ratio(stance))
+        base = np.column_stack([base, ratio])
+    base = np.ascontiguousarray(base)
     return SimProblem(
         blade=blade, stance=stance, chain=chain, motion=motion, time=time, dt=dt_used,
         n_substeps=nsub, base=base, engine=engine, drive=drive, belt_speed=float(belt_speed),

@@ -53,6 +53,11 @@ REGIME_MIN_FORCE = 50.0
 # slide decides where the sole sticks; later steady sliding is smooth and needs no sub-steps).
 SLIDE_WINDOW = 0.005
 
+# Column of ``base`` that holds the utilised friction ratio r(t) = measured Fx/Fz when the clamp
+# drive is "utilised-friction" (``base`` then has 12 columns): the friction of every loaded sole
+# element is r(t)·Fn instead of the stick-slip law (see docs/identification.md).
+UTILISED_COLUMN = 11
+
 STATUS_OK = 0
 STATUS_DIVERGED = 1
 
@@ -243,7 +248,9 @@ def simulate_prescribed(
 ):
     """Simulate one parameter set with the clamp prescribed.
 
-    ``base`` (n_steps + 1, 11): clamp x, z, θ, ẋ, ż, θ̇, ẍ, z̈, θ̈, cos θ, sin θ at every step time.
+    ``base`` (n_steps + 1, 11): clamp x, z, θ, ẋ, ż, θ̇, ẍ, z̈, θ̈, cos θ, sin θ at every step time;
+    with a 12th column r(t) (drive "utilised-friction") the friction of each sole element is
+    r·Fn (no stick-slip law).
     ``order`` 2 (BDF2) or 1 (backward Euler); ``n_iter`` Newton iterations per step (1 =
     linearly implicit); ``with_energy``: keep the energy bookkeeping (clamp work, dissipation,
     stored energies; off for identification batches); ``refine``: a step in which any sole element changes regime (touch-down,
@@ -297,6 +304,8 @@ def simulate_prescribed(
     window = int(SLIDE_WINDOW / dt + 0.5)
     bsub = np.zeros(base.shape[1])
     vc = contact[8]
+    # a 12th column of ``base`` holds the utilised friction ratio r(t) (drive "utilised-friction")
+    utilised = base.shape[1] > UTILISED_COLUMN
     w_clamp = 0.0
     d_joint = 0.0
     d_contact = 0.0
@@ -392,6 +401,11 @@ def simulate_prescribed(
                                 contact, cx, cz, sph[b] * ce[e] + cph[b] * se[e], cph[b] * ce[e] - sph[b] * se[e],
                                 sole_geom[e, 2], sole_geom[e, 3],
                                 Ob[b, 0], Ob[b, 1], vO[b, 0], vO[b, 1], om[b], ground_vx)
+                            if utilised:
+                                # utilised friction: Fx = r(t)·Fn with the measured r = Fx/Fz
+                                mu = -bs[UTILISED_COLUMN]
+                                dmu = 0.0
+                                fx = -mu * fz
                             fe[e, 0] = fx
                             fe[e, 1] = fz
                             pe[e, 0] = px
@@ -402,6 +416,8 @@ def simulate_prescribed(
                             speed = abs(slip)
                             if fz < REGIME_MIN_FORCE:
                                 regime[e] = 0  # a barely touching element: no refinement
+                            elif utilised:
+                                regime[e] = 1  # no stick/slip regimes: refine only at touch-down
                             elif speed <= vc:
                                 regime[e] = 1
                             else:
@@ -515,6 +531,8 @@ def simulate_prescribed(
                     contact, cx, cz, sph[b] * ce[e] + cph[b] * se[e],
                     cph[b] * ce[e] - sph[b] * se[e], sole_geom[e, 2], sole_geom[e, 3],
                     Ob[b, 0], Ob[b, 1], vO[b, 0], vO[b, 1], om[b], ground_vx)
+                if utilised:
+                    fx = bs[UTILISED_COLUMN] * fz
                 grf[s_idx, e, 0] = fx
                 grf[s_idx, e, 1] = fz
                 if depth <= 0.0:

@@ -168,7 +168,8 @@ def contact_forces_3d(contact, site_xpos, site_xmat, sites, axes, site_body, cve
     """Apply the contact law to every sole site; write xfrc_applied and per-sole outputs.
 
     ``out[e]`` = (fx, fz, depth, slip, elastic normal force, contact-damping power,
-    friction power).
+    friction power). A 12th entry of ``contact``, if present, is the utilised friction ratio r:
+    the friction force is then r·Fn instead of the stick-slip law.
     """
     ne = sites.shape[0]
     xfrc[:, :] = 0.0
@@ -207,7 +208,9 @@ def contact_forces_3d(contact, site_xpos, site_xmat, sites, axes, site_body, cve
         rate = -vpz
         fn, _kn, _cn, fel = _k._normal_force(contact, depth, rate)
         mu = 0.0
-        if contact[6] > 0.0 and fn > 0.0:
+        if contact.shape[0] > 11:
+            mu = -contact[11]  # utilised friction: Fx = r·Fn (drive "utilised-friction")
+        elif contact[6] > 0.0 and fn > 0.0:
             mu = _k.stick_slip_friction_coefficient(vpx - ground_vx, contact[6], contact[7],
                                                     contact[8])
         fx = -mu * fn
@@ -342,12 +345,16 @@ def simulate_mujoco(problem, K: np.ndarray, D: np.ndarray, K2: np.ndarray):
     body_inertia = m.body_inertia
     out = mj.out
     n_last = base.shape[0] - 1
+    utilised = base.shape[1] > _k.UTILISED_COLUMN
+    contact_u = np.append(contact, 0.0) if utilised else contact
     for i in range(base.shape[0]):
         bs = base[i]
         qpos[0:3] = bs[0:3]
         qvel[0:3] = bs[3:6]
         mujoco.mj_step1(m, d)
-        mj.apply_contact(contact)
+        if utilised:
+            contact_u[11] = bs[_k.UTILISED_COLUMN]
+        mj.apply_contact(contact_u)
         _prescribed_forces(bs, qpos, qfrc, jq, jd, K2)
         if i % nsub == 0:
             s = i // nsub
