@@ -97,7 +97,10 @@ def test_recovery_nonlinear_and_model_choice(k2_ratio, speed, seed):
 
 def test_linear_truth_prefers_linear_model(stances):
     blade, stance = stances[CASES[1]]
-    table = compare_spring_models(stance, blade, seed=1, identifiability=False)
+    # the seed formulation: its contact law is the generator's, so a linear truth is exactly
+    # representable (utilised friction approximates the per-element friction, and on clean data
+    # BIC can then favour a tiny K2: see docs/robust-identification.md)
+    table = compare_spring_models(stance, blade, seed=1, identifiability=False, formulation="seed")
     assert table.set_index("model").loc["linear", "preferred"]
 
 

@@ -31,6 +31,11 @@ def _identify(
     grf: str = typer.Option("z", "--grf", help="GRF components in the cost: z or zx."),
     max_evals: int = typer.Option(600, "--max-evals", help="Evaluation budget of the search."),
     no_ci: bool = typer.Option(False, "--no-ci", help="Skip confidence intervals."),
+    formulation: str | None = typer.Option(
+        None, "--formulation", help="How the stance drives the model: utilised-friction (default; "
+        "friction = measured Fx/Fz × normal force, robust to motion-capture noise) or seed "
+        "(seed 000 exactly: prescribed clamp, stick-slip friction). For a study: replaces "
+        "study.yaml's setting."),
 ) -> None:
     """Identify K* [N·m/deg] and D* [N·m·s/deg] of a stance, or of every trial of a study."""
     if optimizer not in ("pso", "cmaes"):
@@ -38,13 +43,19 @@ def _identify(
     if grf not in ("z", "zx", "xz"):
         raise SpecError(f"unknown GRF components {grf!r}", where="--grf", hint="z or zx")
     components = ("z",) if grf == "z" else ("z", "x")
+    from bladelab.identify.formulations import DEFAULT_FORMULATION, FORMULATIONS
+
+    if formulation is not None and formulation not in FORMULATIONS:
+        raise SpecError(f"unknown formulation {formulation!r}", where="--formulation",
+                        hint="one of " + ", ".join(FORMULATIONS))
     if path.is_dir():
         _identify_study(path, blade=blade, seed=seed, as_json=as_json, jobs=jobs, executor=executor,
                         force=force, settings={
                             "optimizer": optimizer, "polish": True if polish else None,
                             "nonlinear": nonlinear,
                             "joint": joint, "grf_components": list(components),
-                            "max_evals": max_evals, "identifiability": not no_ci})
+                            "max_evals": max_evals, "identifiability": not no_ci,
+                            **({} if formulation is None else {"formulation": formulation})})
         return
     if not path.is_file():
         raise InputFileError("no such stance file or study folder", file=path)
@@ -58,7 +69,8 @@ def _identify(
     ident = identify_stance(stance, blade, optimizer=optimizer, seed=0 if seed is None else seed,
                             grf_components=components, joint=joint, nonlinear=nonlinear,
                             polish=True if polish else None, max_evals=max_evals,
-                            identifiability=not no_ci)
+                            identifiability=not no_ci,
+                            formulation=DEFAULT_FORMULATION if formulation is None else formulation)
     d = ident.to_dict()
     if as_json:
         typer.echo(json.dumps(d, indent=2))
@@ -72,7 +84,8 @@ def _identify(
                      f"K–D correlation {d['KD_correlation']:.2f}")
     lines.append(f"nRMSE GRF {d['nrmse_grf_pct']:.2f} %, distance {d['nrmse_distance_pct']:.2f} %, "
                  f"cost {d['cost']:.4g}")
-    lines.append(f"{d['evaluations']} simulations ({d['optimizer']}, seed {d['seed']}), "
+    lines.append(f"{d['evaluations']} simulations ({d['optimizer']}, seed {d['seed']}, "
+                 f"formulation {d['formulation']}), "
                  f"{d['wall_s']:.2f} s")
     for name, why in d["poorly_determined"].items():
         lines.append(f"warning: {name} is poorly determined: {why}")

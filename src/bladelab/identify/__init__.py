@@ -12,6 +12,7 @@ from bladelab.identify.bounds import (
     stiffness_bounds,
 )
 from bladelab.identify.cost import CostTerms, StanceCost, contact_window, nrmse
+from bladelab.identify.formulations import DEFAULT_FORMULATION, FORMULATIONS, formulation_drive
 from bladelab.identify.identifiability import (
     Identifiability,
     assess_identifiability,
@@ -36,6 +37,8 @@ from bladelab.identify.optimizers import (
 __all__ = [
     "CMAES",
     "DAMPING_BOUNDS_NMS_PER_DEG",
+    "DEFAULT_FORMULATION",
+    "FORMULATIONS",
     "CostTerms",
     "Identifiability",
     "Identification",
@@ -48,6 +51,7 @@ __all__ = [
     "compare_spring_models",
     "contact_window",
     "cost_landscape",
+    "formulation_drive",
     "identification_landscape",
     "identify_stance",
     "instantaneous_stiffness",

@@ -72,6 +72,8 @@ class Identification:
         The search bounds (edge units, with their source).
     ci_evaluations
         Simulations used by the identifiability analysis.
+    formulation
+        How the stance drove the model (:mod:`bladelab.identify.formulations`).
     """
 
     K_Nm_per_deg: float
@@ -93,6 +95,7 @@ class Identification:
     bic: float
     bounds: dict
     ci_evaluations: int
+    formulation: str = "seed"
 
     def to_dict(self) -> dict:
         """JSON-ready dictionary with the keys of the CLI's ``--json`` output."""
@@ -117,6 +120,7 @@ class Identification:
             "KD_correlation": None if math.isnan(self.KD_correlation) else self.KD_correlation,
             "poorly_determined": dict(self.poorly_determined),
             "optimizer": self.optimizer,
+            "formulation": self.formulation,
             "joint_point": self.joint_point,
             "aic": self.aic,
             "bic": self.bic,
@@ -222,6 +226,11 @@ def identify_stance(
         Passed to ``bladelab.sim.prepare``.
     contact_threshold
         Vertical GRF [N] defining the contact window of the cost.
+    formulation
+        How the stance drives the model (:mod:`bladelab.identify.formulations`):
+        ``"utilised-friction"`` (default: friction of each sole element = measured Fx/Fz × its
+        normal force; robust to motion-capture noise and 100 Hz kinematics) or ``"seed"`` (seed
+        000 exactly: prescribed clamp, stick-slip friction). See docs/robust-identification.md.
 
     Raises
     ------
@@ -309,7 +318,7 @@ def identify_stance(
         evaluations=opt.evaluations, wall_s=time.perf_counter() - t0, seed=int(seed),
         optimizer=opt.optimizer, joint_point=point, ci=ci, ci_level=0.95, KD_correlation=corr,
         poorly_determined=flagged, aic=float(aic), bic=float(bic), bounds=bounds.to_dict(),
-        ci_evaluations=ci_evals,
+        ci_evaluations=ci_evals, formulation=str(formulation),
     )
 
 
@@ -325,10 +334,12 @@ def identification_landscape(
     dt: float = 1e-4,
     belt_speed: float = 0.0,
     contact_threshold: float = 20.0,
+    formulation: str | None = None,
 ) -> pd.DataFrame:
     """The cost on an n × n K × D grid (± ``rel_span``) around an identification, one batch.
 
-    Use the same cost options as the identification. Returns a tidy DataFrame with columns
+    Use the same cost options as the identification (``formulation`` None: the
+    identification's own). Returns a tidy DataFrame with columns
     ``K_Nm_per_deg``, ``D_Nms_per_deg``, ``cost`` (K2, if any, held at its identified value).
     """
     from bladelab import sim
@@ -337,7 +348,8 @@ def identification_landscape(
     model = _with_joint(_as_model(blade), ident.joint_point)
     cost = StanceCost.from_stance(stance, weights=weights, grf_components=grf_components,
                                   contact_threshold=contact_threshold)
-    problem = sim.prepare(model, stance, dt=dt, belt_speed=belt_speed)
+    problem = sim.prepare(model, stance, dt=dt, belt_speed=belt_speed, drive=formulation_drive(
+        ident.formulation if formulation is None else formulation))
     k2 = 0.0 if ident.K2_Nm_per_deg2 is None else ident.K2_Nm_per_deg2 * units.DEG_PER_RAD**2
 
     def fun_batch(X: np.ndarray) -> np.ndarray:

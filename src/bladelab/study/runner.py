@@ -36,10 +36,16 @@ def trial_seed(study_seed: int, trial_id: str) -> int:
 
 
 def variant_name(settings: dict) -> str:
-    """The model variant of a settings dict: ``linear`` or ``nonlinear``, ``@j<point>`` if a joint is forced."""
+    """The model variant of a settings dict: ``linear`` or ``nonlinear``, ``@j<point>`` if a joint
+    is forced, ``+<formulation>`` for a formulation other than the default (e.g. ``linear+seed``)."""
+    from bladelab.identify.formulations import DEFAULT_FORMULATION
+
     name = "nonlinear" if settings.get("nonlinear") else "linear"
     if settings.get("joint") is not None:
         name += f"@j{settings['joint']}"
+    formulation = settings.get("formulation", DEFAULT_FORMULATION)
+    if formulation != DEFAULT_FORMULATION:
+        name += f"+{formulation}"
     return name
 
 

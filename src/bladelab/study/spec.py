@@ -81,6 +81,8 @@ class IdentificationSettings(_Model):
     nonlinear: bool = False
     joint: int | None = None
     identifiability: bool = True
+    # how the stance drives the model (bladelab.identify.formulations); "seed" = seed 000 exactly
+    formulation: Literal["utilised-friction", "seed"] = "utilised-friction"
 
 
 class Study(_Model):

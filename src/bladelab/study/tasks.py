@@ -32,6 +32,7 @@ def identify_trial(payload: dict) -> dict:
     ``stance`` (1-based stance number; a stance CSV holds one), ``blade`` (name or spec path),
     ``settings`` (identification settings), ``seed``.
     """
+    from bladelab.identify.formulations import DEFAULT_FORMULATION
     from bladelab.identify.identify import identify_stance
 
     stance = read_trial_stance(payload["file"], payload.get("stance", 1))
@@ -41,5 +42,6 @@ def identify_trial(payload: dict) -> dict:
         weights=tuple(s["weights"]), grf_components=tuple(s["grf_components"]),
         joint=s.get("joint"), nonlinear=bool(s["nonlinear"]), polish=s.get("polish"),
         max_evals=int(s["max_evals"]), identifiability=bool(s.get("identifiability", True)),
+        formulation=s.get("formulation", DEFAULT_FORMULATION),
     )
     return ident.to_row()
