@@ -219,6 +219,7 @@ def build_study_report(
 
     from bladelab import sim
     from bladelab.identify.cost import StanceCost
+    from bladelab.identify.formulations import DEFAULT_FORMULATION, formulation_drive
     from bladelab.identify.identifiability import cost_landscape
     from bladelab.mechanics import mechanics_table, stance_mechanics
     from bladelab.report import figures, tables
@@ -265,6 +266,7 @@ def build_study_report(
     rows = []
     problems: list[tuple[str, str]] = [(str(r.trial_id), str(r.error)) for r in failed.itertuples()]
     landscape = None
+    formulations: set[str] = set()
     for tid, t in tqdm(trials.items(), desc="simulating", unit="trial", disable=not progress,
                        leave=False):
         r = ok.loc[tid]
@@ -284,7 +286,9 @@ def build_study_report(
             D = units.damping_per_deg_to_per_rad(float(r["D_Nms_per_deg"]))
             k2 = r.get("K2_Nm_per_deg2")
             K2 = 0.0 if k2 is None or not np.isfinite(k2) else float(k2) / units.RAD_PER_DEG**2
-            problem = sim.prepare(model, stance)
+            formulation = settings.get("formulation", DEFAULT_FORMULATION)
+            problem = sim.prepare(model, stance, drive=formulation_drive(formulation))
+            formulations.add(formulation)
             res = sim.simulate(problem, stiffness=K, damping=D, stiffness_quadratic=K2)
         except Exception as err:  # noqa: BLE001 - one bad trial must not stop the report
             problems.append((tid, f"re-simulation failed: {err}"))
@@ -343,15 +347,17 @@ def build_study_report(
         "Blade characterisation: study report", subtitle=f"{study.name} — {folder}",
         settings={"study": str(folder), "variant": variant,
                   "identification": study.identification.model_dump(mode="json"),
-                  "simulation": {"engine": "kernel", "dt_s": 1e-4},
+                  "simulation": {"engine": "kernel", "dt_s": 1e-4,
+                                 "formulation": ", ".join(sorted(formulations))},
                   "landscape_trial": landscape_id, "trials_reported": len(per_trial),
                   "trials_failed": len(problems)},
         seed=study.seed,
     )
     gt_path = folder / "ground_truth.csv"
     synthetic = gt_path.is_file()
-    intro = (f"{len(per_trial)} trials identified ({variant} spring model) and re-simulated at "
-             f"their K*, D* with the blade kernel; groups are amputation level and blade category.")
+    intro = (f"{len(per_trial)} trials identified ({variant} spring model, formulation "
+             f"{', '.join(sorted(formulations))}) and re-simulated the same way at their K*, D* with "
+             f"the blade kernel; groups are amputation level and blade category.")
     if synthetic:
         intro += ("\n\nThis study folder holds ground_truth.csv: its trials are SYNTHETIC, made by "
                   "`bladelab example make` with a richer model than the one identified (see "
