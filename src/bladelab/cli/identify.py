@@ -34,7 +34,8 @@ def _identify(
     formulation: str | None = typer.Option(
         None, "--formulation", help="How the stance drives the model: utilised-friction (default; "
         "friction = measured Fx/Fz × normal force, robust to motion-capture noise) or seed "
-        "(seed 000 exactly: prescribed clamp, stick-slip friction). For a study: replaces "
+        "(seed 000 exactly: prescribed clamp, stick-slip friction) or grf-driven (measured GRF "
+        "drives the model, distance-only cost). For a study: replaces "
         "study.yaml's setting."),
 ) -> None:
     """Identify K* [N·m/deg] and D* [N·m·s/deg] of a stance, or of every trial of a study."""

@@ -11,6 +11,10 @@ formulation                 model
 ``"utilised-friction"``     the clamp follows the measured pose; the friction force of each loaded
                             sole element is r(t)·Fn,e with r = measured Fx/Fz (the utilised
                             friction), instead of the stick-slip law.
+``"grf-driven"``            the clamp follows the measured pose and the measured GRF is applied to
+                            the sole (split over the elements by the model's normal forces); the
+                            cost is the distance only (the simulated GRF is the measured one).
+                            Kernel only.
 ==========================  =====================================================================
 
 Why (``docs/robust-identification.md``): in its stick regime the stick-slip law acts as a damper
@@ -28,10 +32,13 @@ from bladelab.sim.api import Drive
 FORMULATIONS: dict[str, Drive] = {
     "seed": Drive.PRESCRIBED,
     "utilised-friction": Drive.UTILISED_FRICTION,
+    "grf-driven": Drive.GRF_DRIVEN,
 }
+# formulations whose cost is the distance only (their simulated GRF is the measured one)
+DISTANCE_ONLY = frozenset({"grf-driven"})
 DEFAULT_FORMULATION = "utilised-friction"
 
-__all__ = ["DEFAULT_FORMULATION", "FORMULATIONS", "formulation_drive"]
+__all__ = ["DEFAULT_FORMULATION", "DISTANCE_ONLY", "FORMULATIONS", "formulation_drive"]
 
 
 def formulation_drive(formulation: str) -> Drive:

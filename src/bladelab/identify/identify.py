@@ -29,7 +29,7 @@ from bladelab.identify.bounds import (
     parameter_bounds,
 )
 from bladelab.identify.cost import StanceCost
-from bladelab.identify.formulations import DEFAULT_FORMULATION, formulation_drive
+from bladelab.identify.formulations import DEFAULT_FORMULATION, DISTANCE_ONLY, formulation_drive
 from bladelab.identify.identifiability import assess_identifiability, effective_sample_size
 from bladelab.identify.optimizers import minimize
 
@@ -230,7 +230,9 @@ def identify_stance(
         How the stance drives the model (:mod:`bladelab.identify.formulations`):
         ``"utilised-friction"`` (default: friction of each sole element = measured Fx/Fz × its
         normal force; robust to motion-capture noise and 100 Hz kinematics) or ``"seed"`` (seed
-        000 exactly: prescribed clamp, stick-slip friction). See docs/robust-identification.md.
+        000 exactly: prescribed clamp, stick-slip friction) or ``"grf-driven"`` (the measured GRF
+        drives the model, distance-only cost: ``weights`` is then (0, 1)). See
+        docs/robust-identification.md.
 
     Raises
     ------
@@ -242,6 +244,9 @@ def identify_stance(
     from bladelab import sim
 
     t0 = time.perf_counter()
+    drive = formulation_drive(formulation)
+    if formulation in DISTANCE_ONLY:
+        weights = (0.0, 1.0)  # its simulated GRF is the measured one
     model = _with_joint(_as_model(blade), joint)
     point = model.joints[0].point
     cost = StanceCost.from_stance(stance, weights=weights, grf_components=grf_components,
@@ -266,7 +271,7 @@ def identify_stance(
     if tuple(bounds.names) != expected:
         raise ModelError(f"bounds are for {bounds.names}, the model needs {expected}", where="bounds")
     problem = sim.prepare(model, stance, dt=dt, engine=engine, belt_speed=belt_speed,
-                          drive=formulation_drive(formulation))
+                          drive=drive)
 
     def run(X: np.ndarray):
         X = np.atleast_2d(X)
@@ -346,6 +351,8 @@ def identification_landscape(
     from bladelab.identify.identifiability import cost_landscape
 
     model = _with_joint(_as_model(blade), ident.joint_point)
+    if (ident.formulation if formulation is None else formulation) in DISTANCE_ONLY:
+        weights = (0.0, 1.0)
     cost = StanceCost.from_stance(stance, weights=weights, grf_components=grf_components,
                                   contact_threshold=contact_threshold)
     problem = sim.prepare(model, stance, dt=dt, belt_speed=belt_speed, drive=formulation_drive(

@@ -33,10 +33,14 @@ class Drive(enum.StrEnum):
     ``utilised-friction``: the clamp follows the measured pose; the friction force of every
     loaded sole element is r(t)·Fn with r = measured Fx/Fz (:func:`utilised_friction_ratio`)
     instead of the stick-slip law, so clamp-path errors no longer become horizontal forces.
+    ``grf-driven``: the clamp follows the measured pose and the measured GRF (x, z) is applied
+    to the sole, split over the sole elements by the model's normal forces (kernel only); the
+    simulated GRF is the measured one, so only the distance carries information.
     """
 
     PRESCRIBED = "prescribed"
     UTILISED_FRICTION = "utilised-friction"
+    GRF_DRIVEN = "grf-driven"
 
 
 # The utilised ratio r = Fx·Fz/(Fz² + F0²) with F0 this fraction of the peak
@@ -91,7 +95,8 @@ class SimProblem:
     base
         (n_steps + 1, 11) clamp pose, velocity, acceleration, cos and sin of the pitch at every
         step time; a 12th column holds the utilised friction ratio r(t) with
-        ``drive="utilised-friction"``.
+        ``drive="utilised-friction"``, 12th and 13th the measured GRF x, z [N] with
+        ``drive="grf-driven"``.
     engine, drive, belt_speed
         As given to :func:`prepare`.
     """
@@ -285,7 +290,8 @@ def prepare(
     drive
         ``"prescribed"`` (clamp follows the stance exactly; stick-slip friction, seed 000) or
         ``"utilised-friction"`` (clamp follows the stance; friction r(t)·Fn with r the measured
-        Fx/Fz, see :class:`Drive`; needs the stance's GRF x and z).
+        Fx/Fz, see :class:`Drive`; needs the stance's GRF x and z) or ``"grf-driven"`` (the
+        measured GRF applied to the sole; kernel only).
 
     Raises
     ------
@@ -301,6 +307,9 @@ def prepare(
                          hint="one of " + ", ".join(d.value for d in Drive)) from err
     if engine not in ("kernel", "mujoco"):
         raise ModelError(f"unknown engine {engine!r}", where="engine", hint="use kernel or mujoco")
+    if engine == "mujoco" and drive == Drive.GRF_DRIVEN:
+        raise ModelError("the grf-driven drive exists in the kernel only", where="drive",
+                         hint="use engine='kernel', or drive 'prescribed' / 'utilised-friction'")
     if not (dt > 0 and math.isfinite(dt)):
         raise ModelError(f"dt must be > 0, got {dt}", where="dt")
     chain = build_chain(blade)
@@ -327,6 +336,14 @@ def prepare(
     if drive == Drive.UTILISED_FRICTION:
         ratio = np.interp(t_steps, time, utilised_friction_ratio(stance))
         base = np.column_stack([base, ratio])
+    elif drive == Drive.GRF_DRIVEN:
+        gx = np.asarray(stance.grf_x, float)
+        gz = np.asarray(stance.grf_z, float)
+        if not (np.all(np.isfinite(gx)) and np.all(np.isfinite(gz))):
+            raise DataError("missing or non-finite GRF samples: the grf-driven drive needs GRF x "
+                            "and z at every sample", where="stance.grf_x / grf_z",
+                            hint="fill the gaps or use drive='prescribed'")
+        base = np.column_stack([base, np.interp(t_steps, time, gx), np.interp(t_steps, time, gz)])
     base = np.ascontiguousarray(base)
     return SimProblem(
         blade=blade, stance=stance, chain=chain, motion=motion, time=time, dt=dt_used,

@@ -57,6 +57,11 @@ SLIDE_WINDOW = 0.005
 # drive is "utilised-friction" (``base`` then has 12 columns): the friction of every loaded sole
 # element is r(t)·Fn instead of the stick-slip law (see docs/identification.md).
 UTILISED_COLUMN = 11
+# Columns of ``base`` that hold the measured GRF x, z [N] when the drive is "grf-driven" (``base``
+# then has 13 columns): the measured force is applied to the sole, split over the elements in
+# proportion to the model's normal forces of the previous step; the contact law only sets the split.
+GRF_X_COLUMN = 11
+GRF_Z_COLUMN = 12
 
 STATUS_OK = 0
 STATUS_DIVERGED = 1
@@ -250,7 +255,9 @@ def simulate_prescribed(
 
     ``base`` (n_steps + 1, 11): clamp x, z, θ, ẋ, ż, θ̇, ẍ, z̈, θ̈, cos θ, sin θ at every step time;
     with a 12th column r(t) (drive "utilised-friction") the friction of each sole element is
-    r·Fn (no stick-slip law).
+    r·Fn (no stick-slip law); with 13 columns (measured GRF x, z: drive "grf-driven") the
+    measured GRF is applied to the sole elements (split by the model's normal forces of the
+    previous step) and the contact law only decides the split (energy terms are then not balanced).
     ``order`` 2 (BDF2) or 1 (backward Euler); ``n_iter`` Newton iterations per step (1 =
     linearly implicit); ``with_energy``: keep the energy bookkeeping (clamp work, dissipation,
     stored energies; off for identification batches); ``refine``: a step in which any sole element changes regime (touch-down,
@@ -305,7 +312,11 @@ def simulate_prescribed(
     bsub = np.zeros(base.shape[1])
     vc = contact[8]
     # a 12th column of ``base`` holds the utilised friction ratio r(t) (drive "utilised-friction")
-    utilised = base.shape[1] > UTILISED_COLUMN
+    utilised = base.shape[1] == UTILISED_COLUMN + 1
+    grf_driven = base.shape[1] == GRF_Z_COLUMN + 1
+    wgt = np.zeros(ne)  # grf-driven: share of the measured GRF carried by each sole element
+    fn_model = np.zeros(ne)
+    dep_model = np.full(ne, -1e300)
     w_clamp = 0.0
     d_joint = 0.0
     d_contact = 0.0
@@ -392,7 +403,7 @@ def simulate_prescribed(
                         for e in range(ne):
                             b = sole_body[e]
                             cx, cz = _body_point(b, sole_geom[e, 0], sole_geom[e, 1], hinge, Ob, cph, sph)
-                            if cz > reach[e]:  # far above the ground: no force
+                            if cz > reach[e] and not grf_driven:  # far above the ground: no force
                                 fe[e, 0] = 0.0
                                 fe[e, 1] = 0.0
                                 regime[e] = 0
@@ -401,7 +412,17 @@ def simulate_prescribed(
                                 contact, cx, cz, sph[b] * ce[e] + cph[b] * se[e], cph[b] * ce[e] - sph[b] * se[e],
                                 sole_geom[e, 2], sole_geom[e, 3],
                                 Ob[b, 0], Ob[b, 1], vO[b, 0], vO[b, 1], om[b], ground_vx)
-                            if utilised:
+                            if grf_driven:
+                                # measured GRF applied at the element's lowest point, share wgt[e]
+                                fn_model[e] = fz
+                                dep_model[e] = depth
+                                fx = bs[GRF_X_COLUMN] * wgt[e]
+                                fz = bs[GRF_Z_COLUMN] * wgt[e]
+                                kn = 0.0
+                                cn = 0.0
+                                mu = 0.0
+                                dmu = 0.0
+                            elif utilised:
                                 # utilised friction: Fx = r(t)·Fn with the measured r = Fx/Fz
                                 mu = -bs[UTILISED_COLUMN]
                                 dmu = 0.0
@@ -414,7 +435,7 @@ def simulate_prescribed(
                                 regime[e] = 0
                                 continue
                             speed = abs(slip)
-                            if fz < REGIME_MIN_FORCE:
+                            if fz < REGIME_MIN_FORCE or grf_driven:
                                 regime[e] = 0  # a barely touching element: no refinement
                             elif utilised:
                                 regime[e] = 1  # no stick/slip regimes: refine only at touch-down
@@ -502,6 +523,17 @@ def simulate_prescribed(
                     qp[j] = q_save[j]
                     vp[j] = v_save[j]
             have_history = True
+            if grf_driven:
+                # the split of the measured GRF for the next step: the model's normal forces;
+                # none (sole off the model ground): keep the last split, or the lowest element
+                tot = 0.0
+                for e in range(ne):
+                    tot += max(fn_model[e], 0.0)
+                if tot > 0.0:
+                    for e in range(ne):
+                        wgt[e] = max(fn_model[e], 0.0) / tot
+                elif np.sum(wgt) == 0.0:
+                    wgt[np.argmax(dep_model)] = 1.0
             for e in range(ne):
                 if regime_old[e] == 0 and regime[e] > 0:
                     onset[e] = i
@@ -522,7 +554,7 @@ def simulate_prescribed(
             for e in range(ne):
                 b = sole_body[e]
                 cx, cz = _body_point(b, sole_geom[e, 0], sole_geom[e, 1], hinge, Ob, cph, sph)
-                if cz > reach[e]:  # far above the ground
+                if cz > reach[e] and not grf_driven:  # far above the ground
                     grf[s_idx, e, 0] = 0.0
                     grf[s_idx, e, 1] = 0.0
                     state[s_idx, e] = 0
@@ -531,7 +563,10 @@ def simulate_prescribed(
                     contact, cx, cz, sph[b] * ce[e] + cph[b] * se[e],
                     cph[b] * ce[e] - sph[b] * se[e], sole_geom[e, 2], sole_geom[e, 3],
                     Ob[b, 0], Ob[b, 1], vO[b, 0], vO[b, 1], om[b], ground_vx)
-                if utilised:
+                if grf_driven:
+                    fx = bs[GRF_X_COLUMN] * wgt[e]
+                    fz = bs[GRF_Z_COLUMN] * wgt[e]
+                elif utilised:
                     fx = bs[UTILISED_COLUMN] * fz
                 grf[s_idx, e, 0] = fx
                 grf[s_idx, e, 1] = fz

@@ -345,7 +345,7 @@ def simulate_mujoco(problem, K: np.ndarray, D: np.ndarray, K2: np.ndarray):
     body_inertia = m.body_inertia
     out = mj.out
     n_last = base.shape[0] - 1
-    utilised = base.shape[1] > _k.UTILISED_COLUMN
+    utilised = base.shape[1] == _k.UTILISED_COLUMN + 1
     contact_u = np.append(contact, 0.0) if utilised else contact
     for i in range(base.shape[0]):
         bs = base[i]

@@ -82,7 +82,7 @@ class IdentificationSettings(_Model):
     joint: int | None = None
     identifiability: bool = True
     # how the stance drives the model (bladelab.identify.formulations); "seed" = seed 000 exactly
-    formulation: Literal["utilised-friction", "seed"] = "utilised-friction"
+    formulation: Literal["utilised-friction", "seed", "grf-driven"] = "utilised-friction"
 
 
 class Study(_Model):
