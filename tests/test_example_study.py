@@ -73,6 +73,10 @@ def test_a_small_study_is_written_completely(small_study):
     raw = yaml.safe_load((folder / "study.yaml").read_text())
     assert all(t["file"].endswith(".c3d") for t in raw["trials"])
     assert (folder / GROUND_TRUTH).read_text().startswith("# bladelab example study")
+    # the stiffening hinge: τ/q = K (1 + 0.15 |q| / 20°) at the peak deflection
+    expect = gt["K_Nm_per_deg"] * (1 + 0.15 * gt["min_deflection_deg"].abs() / 20.0)
+    np.testing.assert_allclose(gt["K_secant_peak_Nm_per_deg"], expect, rtol=1e-3)
+    assert (gt["K_secant_peak_Nm_per_deg"] > gt["K_Nm_per_deg"] * 1.05).all()
 
 
 def test_trials_read_back_through_the_trial_pipeline_like_their_truth(small_study):

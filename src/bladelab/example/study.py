@@ -56,7 +56,7 @@ __all__ = [
     "read_ground_truth",
 ]
 
-GENERATOR_VERSION = 1
+GENERATOR_VERSION = 2
 MANIFEST = "generator.json"
 GROUND_TRUTH = "ground_truth.csv"
 
@@ -305,6 +305,9 @@ def generate_trial(payload: dict) -> dict:
                                 "configuration", "speed_pct_pb", "speed_mps")},
         "K_Nm_per_deg": plan["K_Nm_per_deg"], "D_Nms_per_deg": plan["D_Nms_per_deg"],
         "K2_Nm_per_deg2": round(k2, 5),
+        # secant stiffness τ/q of the stiffening hinge at its peak deflection [N·m/deg]
+        "K_secant_peak_Nm_per_deg": round(plan["K_Nm_per_deg"] * (
+            1.0 + s["k2_rise"] * abs(truth["min_deflection_deg"]) / 20.0), 3),
         "n_links": s["n_links"],
         "contact_stiffness_factor": s["contact_stiffness_factor"],
         "contact_damping_factor": s["contact_damping_factor"],
