@@ -41,6 +41,7 @@ def test_stances_json(synthetic, capsys):
     for key in ("index", "plates", "start_s", "end_s", "contact_time_s", "peak_fz_N", "impulse_z_Ns"):
         assert key in row
     assert row["plates"] == [1]
+    assert row["index"] == 1  # stance numbers count from 1 at the command line
     assert row["start_s"] == pytest.approx(synth.TD, abs=2e-3)
     assert row["peak_fz_N"] == pytest.approx(synth.PEAK, rel=5e-3)
 
@@ -56,7 +57,7 @@ def test_stances_table_and_threshold(synthetic, capsys):
 
 def test_extract(synthetic, tmp_path, capsys):
     out = tmp_path / "stance.csv"
-    assert main(["trial", "extract", str(synthetic), "--stance", "0", "--out", str(out)]) == 0
+    assert main(["trial", "extract", str(synthetic), "--stance", "1", "--out", str(out)]) == 0
     st = read_stance_csv(out)
     assert st.sample_rate == pytest.approx(1000.0)
     assert st.grf_z.max() == pytest.approx(synth.PEAK, rel=0.02)
@@ -68,7 +69,7 @@ def test_extract_with_marker_map_and_errors_leave_no_file(synthetic, tmp_path, c
     mapping = tmp_path / "map.yaml"
     mapping.write_text("clamp_anterior: CLAMP_ANT\nclamp_posterior: CLAMP_POST\ntip: TOE\n")
     out = tmp_path / "stance.csv"
-    code = main(["trial", "extract", str(synthetic), "--stance", "0", "--out", str(out),
+    code = main(["trial", "extract", str(synthetic), "--stance", "1", "--out", str(out),
                  "--markers", str(mapping)])
     assert code == 2
     err = capsys.readouterr().err
@@ -76,6 +77,8 @@ def test_extract_with_marker_map_and_errors_leave_no_file(synthetic, tmp_path, c
     assert list(tmp_path.iterdir()) == [mapping]  # no output, no temporary file
     code = main(["trial", "extract", str(synthetic), "--stance", "7", "--out", str(out)])
     assert code == 2 and not out.exists()
+    code = main(["trial", "extract", str(synthetic), "--stance", "0", "--out", str(out)])
+    assert code == 2 and not out.exists()  # stance numbers start at 1
 
 
 def test_bad_file_exit_2(tmp_path, capsys):

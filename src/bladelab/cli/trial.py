@@ -80,7 +80,9 @@ def _stances(
     events = detect_stances(trial, threshold=threshold, min_duration=min_duration)
     if tip:
         events = classify_stances(trial, events, tip=tip)
-    rows = [e.to_dict() for e in events]
+    # Stances are numbered from 1 at the command line and in study.yaml (``stance:``); the
+    # Python API (``StanceEvent.index``, ``extract_stance``) counts from 0.
+    rows = [{**e.to_dict(), "index": e.index + 1} for e in events]
     if as_json:
         typer.echo(json.dumps(rows, indent=2))
         return
@@ -102,7 +104,9 @@ def _stances(
 @trial_app.command("extract")
 def _extract(
     file: Path = typer.Argument(..., help="C3D file."),
-    stance: int = typer.Option(..., "--stance", help="Stance index (see `bladelab trial stances`)."),
+    stance: int = typer.Option(
+        ..., "--stance", min=1, help="Stance number, from 1 (see `bladelab trial stances`)."
+    ),
     out: Path = typer.Option(..., "--out", help="Output stance CSV."),
     markers: Path | None = typer.Option(
         None, "--markers", help="YAML map of roles (clamp_anterior, clamp_posterior, tip) to markers."
@@ -120,7 +124,7 @@ def _extract(
     marker_map = load_marker_map(markers) if markers else MarkerMap()
     trial = _read(file, forward, up)
     result = extract_stance(
-        trial, stance, markers=marker_map, rate=rate, margin=margin, threshold=threshold
+        trial, stance - 1, markers=marker_map, rate=rate, margin=margin, threshold=threshold
     )
     write_stance_csv(result, out)
     typer.echo(
