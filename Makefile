@@ -1,8 +1,9 @@
 # bladelab: two commands do all the set-up on a fresh machine (Python 3.11, pip, gcc, make).
+#   make demo   installs bladelab into .venv and runs the main job on the embedded example study
+#   make test   installs the test dependencies (pytest, statsmodels, ruff, ray) and runs the tests
 PYTHON ?= python3
 VENV   := .venv
 PY     := $(VENV)/bin/python
-STAMP  := $(VENV)/.installed
 
 .PHONY: demo test bench lint clean
 
@@ -10,20 +11,24 @@ $(VENV)/bin/python:
 	$(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet --upgrade pip
 
-$(STAMP): pyproject.toml | $(VENV)/bin/python
-	$(PY) -m pip install --quiet -e ".[test]"
-	touch $(STAMP)
+$(VENV)/.installed-base: pyproject.toml | $(VENV)/bin/python
+	$(PY) -m pip install --quiet -e .
+	touch $@
 
-demo: $(STAMP)
+$(VENV)/.installed-test: pyproject.toml | $(VENV)/bin/python
+	$(PY) -m pip install --quiet -e ".[test,ray]"
+	touch $@ $(VENV)/.installed-base
+
+demo: $(VENV)/.installed-base
 	$(PY) -m bladelab.demo
 
-test: $(STAMP)
+test: $(VENV)/.installed-test
 	$(PY) -m pytest -q
 
-bench: $(STAMP)
+bench: $(VENV)/.installed-test
 	$(PY) benchmarks/run.py
 
-lint: $(STAMP)
+lint: $(VENV)/.installed-test
 	$(VENV)/bin/ruff check src tests benchmarks
 
 clean:
