@@ -150,7 +150,8 @@ class SimResult:
         (n, n_soles) 0 no contact, 1 stick (|slip| ≤ critical velocity), 2 slip.
     energy
         ``term -> (n,)`` [J]: clamp_work (cumulative), kinetic, potential_gravity, spring,
-        contact_elastic, dissipated_joint / dissipated_contact / dissipated_friction (cumulative).
+        contact_elastic (contact law and track spring), dissipated_joint / dissipated_contact /
+        dissipated_friction / dissipated_track (cumulative; the track damper, 0 on rigid ground).
     stiffness, damping, stiffness_quadratic
         Joint parameters used [N·m/rad], [N·m·s/rad], [N·m/rad²].
     engine
@@ -183,7 +184,7 @@ class SimResult:
         """Clamp work minus (Δ stored energy + dissipated energy) [J] at every sample."""
         e = self.energy
         stored = e["kinetic"] + e["potential_gravity"] + e["spring"] + e["contact_elastic"]
-        dissipated = e["dissipated_joint"] + e["dissipated_contact"] + e["dissipated_friction"]
+        dissipated = sum(v for k, v in e.items() if k.startswith("dissipated_"))
         return e["clamp_work"] - (stored - stored[0]) - dissipated
 
     def to_dict(self) -> dict[str, Any]:

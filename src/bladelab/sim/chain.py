@@ -42,7 +42,7 @@ class Chain:
         Body carrying the tip marker and its position (x, z) [m].
     contact
         (11,) law code, k, c, transition width, exponent, dissipation, μ_s, μ_k, v_c,
-        track stiffness (0 = rigid), track damping.
+        track stiffness k_t [N/m] (0 = rigid ground), track damping c_t [N·s/m].
     stiffness, damping, stiffness_quadratic
         (nj,) the blade's own K [N·m/rad], D [N·m·s/rad], K2 [N·m/rad²].
     """
@@ -129,14 +129,19 @@ def build_chain(blade: BladeModel) -> Chain:
     if law is None:
         raise ModelError(f"unknown contact law {c.law!r}", where="contact.law",
                          hint="use 'spring_damper' or 'hunt_crossley'")
-    if c.track_stiffness is not None:
-        raise ModelError(
-            "a compliant track layer is not supported by the simulation engines yet",
-            where="contact.track_stiffness", hint="leave it empty (rigid ground)",
-        )
+    if c.track_stiffness is not None and not (c.track_stiffness > 0
+                                              and np.isfinite(c.track_stiffness)):
+        raise ModelError(f"track stiffness must be > 0 [N/m], got {c.track_stiffness}",
+                         where="contact.track_stiffness",
+                         hint="leave it empty for rigid ground")
+    if not (c.track_damping >= 0 and np.isfinite(c.track_damping)):
+        raise ModelError(f"track damping must be >= 0 [N·s/m], got {c.track_damping}",
+                         where="contact.track_damping")
+    track_k = 0.0 if c.track_stiffness is None else float(c.track_stiffness)
     contact = np.array([
         law, c.stiffness, c.damping, c.transition_width, c.exponent, c.dissipation,
-        c.friction_static, c.friction_kinetic, c.critical_velocity, 0.0, c.track_damping,
+        c.friction_static, c.friction_kinetic, c.critical_velocity, track_k,
+        c.track_damping if track_k > 0 else 0.0,
     ], float)
     if c.friction_static > 0 and not c.critical_velocity > 0:
         raise ModelError("critical_velocity must be > 0 when friction is on",

@@ -44,6 +44,7 @@ ENERGY_TERMS: tuple[str, ...] = (
     "dissipated_joint",
     "dissipated_contact",
     "dissipated_friction",
+    "dissipated_track",
 )
 
 # Normal force [N] below which a touching sole element does not count as loaded when the kernel
@@ -119,6 +120,137 @@ def contact_elastic_energy(contact, depth):
 
 
 @njit(cache=True, error_model="numpy")
+def _law_affine(contact, dc):
+    """The normal law at contact penetration ``dc`` written as F = E + B·rate (before the
+    no-adhesion clip): returns (E, B, ∂E/∂dc, ∂B/∂dc)."""
+    if dc <= 0.0:
+        return 0.0, 0.0, 0.0, 0.0
+    k = contact[1]
+    if int(contact[0]) == 0:
+        c = contact[2]
+        w = contact[3]
+        if w > 0.0:
+            u = dc / w
+            s = smoothstep(u)
+            ds = 6.0 * u * (1.0 - u) / w if u < 1.0 else 0.0
+        else:
+            s = 1.0
+            ds = 0.0
+        return s * k * dc, s * c, ds * k * dc + s * k, ds * c
+    n = contact[4]
+    d = contact[5]
+    dn = dc**n
+    ddn = n * dc ** (n - 1.0)
+    return k * dn, 1.5 * d * k * dn, k * ddn, 1.5 * d * k * ddn
+
+
+@njit(cache=True, error_model="numpy")
+def track_contact(contact, depth, rate, uh, g):
+    """Normal force through a massless track layer in series with the contact law.
+
+    The track surface is pressed down by u ≥ 0 [m] (a spring k_t = ``contact[9]`` [N/m] and
+    damper c_t = ``contact[10]`` [N·s/m]); the sole penetrates the deflected surface by
+    δ_c = ``depth`` − u at the rate ``rate`` − u̇. The force is the same in both:
+    F = F_c(δ − u, δ̇ − u̇) = k_t u + c_t u̇. ``u`` is integrated implicitly,
+    u = ``uh`` + ``g``·u̇ (BDF2: uh = (4u_n − u_{n−1})/3, g = 2h/3; Euler: uh = u_n, g = h), so
+    the step solves one monotone scalar equation (safeguarded Newton).
+
+    Returns (F, ∂F/∂δ, ∂F/∂δ̇, E, u, u̇, du/dδ̇) where ∂F/∂δ and ∂F/∂δ̇ are the series
+    (effective) derivatives, E the elastic part of the contact law at δ_c (for the energy terms)
+    and du/dδ̇ the change of u per change of the penetration rate along the step
+    (δ = δ̂ + g·δ̇).
+    """
+    kt = contact[9]
+    ct = contact[10]
+    a = kt + ct / g  # d(track force)/du along the step
+    b0 = ct * uh / g  # track force = a·u − b0
+    lo = b0 / a  # the track relaxes on its own: zero force
+    hi = max(depth, lo)
+    u = min(max(uh, lo), hi)
+    fc = 0.0
+    kc = 0.0
+    cc = 0.0
+    e_el = 0.0
+    for _it in range(60):
+        w = (u - uh) / g
+        e_el, bb, de, db = _law_affine(contact, depth - u)
+        fc = e_el + bb * (rate - w)
+        if fc > 0.0:
+            kc = de + db * (rate - w)
+            cc = bb
+        else:
+            fc = 0.0
+            kc = 0.0
+            cc = 0.0
+        r = fc - (a * u - b0)
+        if r > 0.0:
+            lo = u
+        else:
+            hi = u
+        slope = kc + cc / g + a
+        un = u + r / slope
+        if not (lo <= un <= hi):
+            un = 0.5 * (lo + hi)
+        if abs(un - u) <= 1e-14 + 1e-11 * abs(u):
+            break
+        u = un
+    w = (u - uh) / g
+    e_el, bb, de, db = _law_affine(contact, depth - u)
+    fc = e_el + bb * (rate - w)
+    if fc > 0.0:
+        kc = de + db * (rate - w)
+        cc = bb
+    else:
+        kc = 0.0
+        cc = 0.0
+    slope = kc + cc / g + a
+    force = a * u - b0
+    if force < 0.0:
+        force = 0.0
+    return force, a * kc / slope, a * cc / slope, e_el, u, w, (g * kc + cc) / slope
+
+
+@njit(cache=True, error_model="numpy")
+def track_state_force(contact, depth, rate, u):
+    """Force [N], elastic part E of the contact law and track rate u̇ [m/s] at a state (δ, δ̇, u).
+
+    From F_c(δ − u, δ̇ − u̇) = k_t u + c_t u̇ (affine in u̇); without any damping (c = c_t = 0)
+    the force is the contact law's elastic force at δ − u.
+    """
+    kt = contact[9]
+    ct = contact[10]
+    e_el, bb, _de, _db = _law_affine(contact, depth - u)
+    if bb + ct > 0.0:
+        w = (e_el + bb * rate - kt * u) / (bb + ct)
+        fc = e_el + bb * (rate - w)
+        if fc <= 0.0:
+            w = -kt * u / ct if ct > 0.0 else 0.0
+            fc = 0.0
+        return fc, e_el, w
+    return e_el, e_el, 0.0
+
+
+@njit(cache=True, error_model="numpy")
+def _friction(contact, slip):
+    """Signed μ of the stick-slip law at ``slip`` and ∂μ/∂slip (0 where friction is off)."""
+    mus = contact[6]
+    if mus <= 0.0:
+        return 0.0, 0.0
+    muk = contact[7]
+    vc = contact[8]
+    mu = stick_slip_friction_coefficient(slip, mus, muk, vc)
+    dmu = 0.0
+    speed = abs(slip)
+    if speed < vc:
+        dmu = mus / vc
+    elif speed < 1.5 * vc:
+        h = 1e-3 * vc
+        dmu = (stick_slip_friction_coefficient(slip + h, mus, muk, vc)
+               - stick_slip_friction_coefficient(slip - h, mus, muk, vc)) / (2.0 * h)
+    return mu, dmu
+
+
+@njit(cache=True, error_model="numpy")
 def sole_contact(contact, cx, cz, s, c, a, b, ox, oz, vox, voz, om, ground_vx):
     """Force of the ground on one sole ellipse (lab frame, rigid ground at z = 0).
 
@@ -143,20 +275,10 @@ def sole_contact(contact, cx, cz, s, c, a, b, ox, oz, vox, voz, om, ground_vx):
     if depth <= 0.0:
         return px, pz, 0.0, 0.0, depth, rate, slip, 0.0, 0.0, 0.0, 0.0, 0.0
     fn, kn, cn, fel = _normal_force(contact, depth, rate)
-    mus = contact[6]
     mu = 0.0
     dmu = 0.0
-    if mus > 0.0 and fn > 0.0:
-        muk = contact[7]
-        vc = contact[8]
-        mu = stick_slip_friction_coefficient(slip, mus, muk, vc)
-        speed = abs(slip)
-        if speed < vc:
-            dmu = mus / vc
-        elif speed < 1.5 * vc:
-            h = 1e-3 * vc
-            dmu = (stick_slip_friction_coefficient(slip + h, mus, muk, vc)
-                   - stick_slip_friction_coefficient(slip - h, mus, muk, vc)) / (2.0 * h)
+    if fn > 0.0:
+        mu, dmu = _friction(contact, slip)
     return px, pz, -mu * fn, fn, depth, rate, slip, kn, cn, mu, dmu, fel
 
 
@@ -264,7 +386,9 @@ def simulate_prescribed(
     stick ↔ slip, lift-off) is redone as ``refine`` sub-steps with the clamp row interpolated
     linearly (1 = never). Samples are recorded every ``nsub`` steps into ``grf`` (ns, ne, 2),
     ``dist`` (ns,), ``qout`` and ``tau`` (ns, nj), ``state`` (ns, ne) int8 (0 free, 1 stick,
-    2 slip) and ``energy`` (ns, 8). Returns (status, step index where it diverged or −1).
+    2 slip) and ``energy`` (ns, 9), columns :data:`ENERGY_TERMS`. ``contact[9]`` > 0 adds a
+    compliant track layer in series with every sole element (:func:`track_contact`; its
+    deflection is a state integrated with the same BDF2/Euler formula). Returns (status, step index where it diverged or −1).
     """
     nb = com0.shape[0]
     nj = nb - 1
@@ -322,6 +446,18 @@ def simulate_prescribed(
     d_contact = 0.0
     d_friction = 0.0
     have_history = False
+    # compliant track layer in series with the contact: its deflection per element is a state
+    kt = contact[9]
+    ct = contact[10]
+    track = kt > 0.0
+    ut = np.zeros(ne)
+    utp = np.zeros(ne)
+    ut_new = np.zeros(ne)
+    wt = np.zeros(ne)
+    dud = np.zeros(ne)
+    ut_save = np.zeros(ne)
+    utp_save = np.zeros(ne)
+    d_track = 0.0
 
     for i in range(n_steps + 1):
         if i > 0:
@@ -332,12 +468,16 @@ def simulate_prescribed(
                 v_save[j] = v[j]
                 qp_save[j] = qp[j]
                 vp_save[j] = vp[j]
+            for e in range(ne):
+                ut_save[e] = ut[e]
+                utp_save[e] = utp[e]
             n_here = 1
             for attempt in range(2):
                 wc = 0.0
                 dj = 0.0
                 dc = 0.0
                 df = 0.0
+                dtk = 0.0
                 h = dt / n_here
                 changed = False
                 for k in range(1, n_here + 1):
@@ -365,6 +505,7 @@ def simulate_prescribed(
                             vi[j] = v[j]
                     p_fric = 0.0
                     p_cdamp = 0.0
+                    p_track = 0.0
                     for _it in range(n_iter):
                         for j in range(nj):
                             qs[j] = qh[j] + g * vi[j]
@@ -400,6 +541,7 @@ def simulate_prescribed(
                             rhs[j] = acc
                         p_fric = 0.0
                         p_cdamp = 0.0
+                        p_track = 0.0
                         for e in range(ne):
                             b = sole_body[e]
                             cx, cz = _body_point(b, sole_geom[e, 0], sole_geom[e, 1], hinge, Ob, cph, sph)
@@ -407,11 +549,32 @@ def simulate_prescribed(
                                 fe[e, 0] = 0.0
                                 fe[e, 1] = 0.0
                                 regime[e] = 0
+                                if track:  # the track relaxes on its own
+                                    uhe = (4.0 * ut[e] - utp[e]) / 3.0 if use_bdf2 else ut[e]
+                                    ut_new[e] = ct * uhe / g / (kt + ct / g)
+                                    wt[e] = (ut_new[e] - uhe) / g
+                                    dud[e] = 0.0
+                                    p_track += ct * wt[e] * wt[e]
                                 continue
                             (px, pz, fx, fz, depth, rate, slip, kn, cn, mu, dmu, fel) = sole_contact(
                                 contact, cx, cz, sph[b] * ce[e] + cph[b] * se[e], cph[b] * ce[e] - sph[b] * se[e],
                                 sole_geom[e, 2], sole_geom[e, 3],
                                 Ob[b, 0], Ob[b, 1], vO[b, 0], vO[b, 1], om[b], ground_vx)
+                            rc = rate
+                            if track:
+                                uhe = (4.0 * ut[e] - utp[e]) / 3.0 if use_bdf2 else ut[e]
+                                (fz, kn, cn, fel, u_e, w_e, dud_e) = track_contact(
+                                    contact, depth, rate, uhe, g)
+                                ut_new[e] = u_e
+                                wt[e] = w_e
+                                dud[e] = dud_e
+                                rc = rate - w_e
+                                p_track += ct * w_e * w_e
+                                mu = 0.0
+                                dmu = 0.0
+                                if fz > 0.0:
+                                    mu, dmu = _friction(contact, slip)
+                                fx = -mu * fz
                             if grf_driven:
                                 # measured GRF applied at the element's lowest point, share wgt[e]
                                 fn_model[e] = fz
@@ -444,7 +607,7 @@ def simulate_prescribed(
                             else:
                                 regime[e] = 2 if speed < 1.5 * vc else 3
                             p_fric += -fx * slip
-                            p_cdamp += (fz - fel) * rate
+                            p_cdamp += (fz - fel) * rc
                             # gradients of (fx, fz) with respect to the point's position and velocity
                             gv00 = -dmu * fz
                             gv01 = mu * cn
@@ -471,6 +634,14 @@ def simulate_prescribed(
                         _solve(M, res, dv)
                         for j in range(nj):
                             vi[j] += dv[j]
+                        if track:
+                            # the track deflection follows the final velocity (linearised)
+                            for e in range(ne):
+                                if dud[e] != 0.0:
+                                    dr = 0.0
+                                    for j in range(sole_body[e]):
+                                        dr += (pe[e, 0] - Ob[j + 1, 0]) * dv[j]
+                                    ut_new[e] += dud[e] * dr
                     if with_energy:
                         # clamp power with the step's accelerations (v_{n+1} - v_n) / h
                         fcx = 0.0
@@ -504,6 +675,11 @@ def simulate_prescribed(
                         dj += h * damping[j] * v[j] * v[j]
                     dc += h * p_cdamp
                     df += h * p_fric
+                    dtk += h * p_track
+                    if track:
+                        for e in range(ne):
+                            utp[e] = ut[e]
+                            ut[e] = ut_new[e]
                     for e in range(ne):
                         if regime[e] != regime_old[e] or (regime[e] >= 2
                                                           and i - onset[e] <= window):
@@ -515,6 +691,9 @@ def simulate_prescribed(
                         v[j] = v_save[j]
                         qp[j] = qp_save[j]
                         vp[j] = vp_save[j]
+                    for e in range(ne):
+                        ut[e] = ut_save[e]
+                        utp[e] = utp_save[e]
                     n_here = refine
                     continue
                 break
@@ -522,6 +701,8 @@ def simulate_prescribed(
                 for j in range(nj):
                     qp[j] = q_save[j]
                     vp[j] = v_save[j]
+                for e in range(ne):
+                    utp[e] = ut_save[e]
             have_history = True
             if grf_driven:
                 # the split of the measured GRF for the next step: the model's normal forces;
@@ -542,6 +723,7 @@ def simulate_prescribed(
             d_joint += dj
             d_contact += dc
             d_friction += df
+            d_track += dtk
             for j in range(nj):
                 if not (math.isfinite(q[j]) and abs(q[j]) < 10.0):
                     return STATUS_DIVERGED, i
@@ -558,11 +740,21 @@ def simulate_prescribed(
                     grf[s_idx, e, 0] = 0.0
                     grf[s_idx, e, 1] = 0.0
                     state[s_idx, e] = 0
+                    if track and with_energy:
+                        e_contact += 0.5 * kt * ut[e] * ut[e]
                     continue
                 (px, pz, fx, fz, depth, rate, slip, kn, cn, mu, dmu, fel) = sole_contact(
                     contact, cx, cz, sph[b] * ce[e] + cph[b] * se[e],
                     cph[b] * ce[e] - sph[b] * se[e], sole_geom[e, 2], sole_geom[e, 3],
                     Ob[b, 0], Ob[b, 1], vO[b, 0], vO[b, 1], om[b], ground_vx)
+                depth_c = depth
+                if track:
+                    fz, _fel, _w = track_state_force(contact, depth, rate, ut[e])
+                    mu = 0.0
+                    if fz > 0.0:
+                        mu, _dmu = _friction(contact, slip)
+                    fx = -mu * fz
+                    depth_c = depth - ut[e]
                 if grf_driven:
                     fx = bs[GRF_X_COLUMN] * wgt[e]
                     fz = bs[GRF_Z_COLUMN] * wgt[e]
@@ -570,14 +762,16 @@ def simulate_prescribed(
                     fx = bs[UTILISED_COLUMN] * fz
                 grf[s_idx, e, 0] = fx
                 grf[s_idx, e, 1] = fz
-                if depth <= 0.0:
+                if depth_c <= 0.0:
                     state[s_idx, e] = 0
                 elif abs(slip) <= vc:
                     state[s_idx, e] = 1
                 else:
                     state[s_idx, e] = 2
                 if with_energy:
-                    e_contact += contact_elastic_energy(contact, depth)
+                    e_contact += contact_elastic_energy(contact, depth_c)
+                    if track:
+                        e_contact += 0.5 * kt * ut[e] * ut[e]
             tx, tz = _body_point(tip_body, tip[0], tip[1], hinge, Ob, cph, sph)
             dist[s_idx] = math.hypot(tx - bs[0], tz - bs[1])
             spring = 0.0
@@ -602,6 +796,7 @@ def simulate_prescribed(
                 energy[s_idx, 5] = d_joint
                 energy[s_idx, 6] = d_contact
                 energy[s_idx, 7] = d_friction
+                energy[s_idx, 8] = d_track
     return STATUS_OK, -1
 
 

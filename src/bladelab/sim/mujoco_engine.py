@@ -231,6 +231,75 @@ def contact_forces_3d(contact, site_xpos, site_xmat, sites, axes, site_body, cve
 
 
 @njit(cache=True)
+def contact_forces_track(contact, site_xpos, site_xmat, sites, axes, site_body, cvel, subtree_com,
+                         rootid, xipos, ground_vx, track_u, dt, xfrc, out):
+    """:func:`contact_forces_3d` through a compliant track layer (``contact[9]`` > 0).
+
+    The track deflection ``track_u[e]`` [m] of each sole element advances by one backward-Euler
+    step of ``dt`` from the penetration and its rate at the current state
+    (:func:`bladelab.sim.kernel.track_contact` with uh = u_n, g = dt). ``out[e]`` = (fx, fz,
+    depth, slip, elastic contact force, contact-damping power, friction power, track-damping
+    power, track deflection).
+    """
+    ne = sites.shape[0]
+    xfrc[:, :] = 0.0
+    ct = contact[10]
+    for e in range(ne):
+        site_pos = site_xpos[sites[e]]
+        site_mat = site_xmat[sites[e]]
+        b = site_body[e]
+        a = axes[e, 0]
+        c = axes[e, 1]
+        exz = site_mat[6]
+        ezz = site_mat[8]
+        nrm = math.sqrt(a * a * exz * exz + c * c * ezz * ezz)
+        ct_ = -a * exz / nrm
+        st = -c * ezz / nrm
+        px = site_pos[0] + a * ct_ * site_mat[0] + c * st * site_mat[2]
+        pz = site_pos[2] + a * ct_ * site_mat[6] + c * st * site_mat[8]
+        r = rootid[b]
+        wx = cvel[b, 0]
+        wy = cvel[b, 1]
+        wz = cvel[b, 2]
+        rx = px - subtree_com[r, 0]
+        ry = 0.0 - subtree_com[r, 1]
+        rz = pz - subtree_com[r, 2]
+        vpx = cvel[b, 3] + wy * rz - wz * ry
+        vpz = cvel[b, 5] + wx * ry - wy * rx
+        depth = -pz
+        rate = -vpz
+        slip = vpx - ground_vx
+        fn, _kn, _cn, fel, u, w, _dud = _k.track_contact(contact, depth, rate, track_u[e], dt)
+        track_u[e] = u
+        mu = 0.0
+        if fn > 0.0:
+            if contact.shape[0] > 11:
+                mu = -contact[11]
+            elif contact[6] > 0.0:
+                mu = _k.stick_slip_friction_coefficient(slip, contact[6], contact[7], contact[8])
+        fx = -mu * fn
+        out[e, 0] = fx
+        out[e, 1] = fn
+        out[e, 2] = depth
+        out[e, 3] = slip
+        out[e, 4] = fel
+        out[e, 5] = (fn - fel) * (rate - w) if fn > 0.0 else 0.0
+        out[e, 6] = -fx * slip
+        out[e, 7] = ct * w * w
+        out[e, 8] = u
+        if fn == 0.0:
+            continue
+        dx = px - xipos[b, 0]
+        dy = 0.0 - xipos[b, 1]
+        dz = pz - xipos[b, 2]
+        xfrc[b, 0] += fx
+        xfrc[b, 2] += fn
+        xfrc[b, 3] += dy * fn
+        xfrc[b, 4] += dz * fx - dx * fn
+        xfrc[b, 5] += -dy * fx
+
+
+@njit(cache=True)
 def _prescribed_forces(bs, qpos, qfrc, jq, jd, K2):
     """Clamp feed-forward and the quadratic spring term into ``qfrc_applied``."""
     qfrc[:] = 0.0
@@ -254,6 +323,8 @@ def _accumulate(acc, dt, bs, qfrc, qacc, qpos, qvel, jq, jd, D, out):
     for e in range(out.shape[0]):
         acc[2] += dt * out[e, 5]
         acc[3] += dt * out[e, 6]
+        if out.shape[1] > 7:
+            acc[4] += dt * out[e, 7]
     for i in range(qpos.shape[0]):
         if not math.isfinite(qpos[i]):
             return False
@@ -339,11 +410,16 @@ def simulate_mujoco(problem, K: np.ndarray, D: np.ndarray, K2: np.ndarray):
     K = np.asarray(K, float)
     D = np.asarray(D, float)
     K2 = np.asarray(K2, float)
-    acc = np.zeros(4)  # clamp work, joint, contact, friction dissipation
+    acc = np.zeros(5)  # clamp work, joint, contact, friction, track dissipation
+    track = contact[9] > 0.0
+    track_u = np.zeros(ne)
+    if track:
+        out = np.zeros((ne, 9))
     dt = problem.dt
     qpos, qvel, qacc, qfrc = d.qpos, d.qvel, d.qacc, d.qfrc_applied
     body_inertia = m.body_inertia
-    out = mj.out
+    if not track:
+        out = mj.out
     n_last = base.shape[0] - 1
     utilised = base.shape[1] == _k.UTILISED_COLUMN + 1
     contact_u = np.append(contact, 0.0) if utilised else contact
@@ -354,13 +430,19 @@ def simulate_mujoco(problem, K: np.ndarray, D: np.ndarray, K2: np.ndarray):
         mujoco.mj_step1(m, d)
         if utilised:
             contact_u[11] = bs[_k.UTILISED_COLUMN]
-        mj.apply_contact(contact_u)
+        if track:
+            contact_forces_track(contact_u, d.site_xpos, d.site_xmat, mj.sole_sites, mj.axes,
+                                 mj.sole_body, d.cvel, d.subtree_com, mj.rootid, d.xipos, 0.0,
+                                 track_u, dt, d.xfrc_applied, out)
+        else:
+            mj.apply_contact(contact_u)
         _prescribed_forces(bs, qpos, qfrc, jq, jd, K2)
         if i % nsub == 0:
             s = i // nsub
             q = qpos[jq]
             grf[s] = out[:, 0:2]
-            state[s] = np.where(out[:, 2] <= 0, 0, np.where(np.abs(out[:, 3]) <= vc, 1, 2))
+            depth_c = out[:, 2] - track_u if track else out[:, 2]
+            state[s] = np.where(depth_c <= 0, 0, np.where(np.abs(out[:, 3]) <= vc, 1, 2))
             tip = d.site_xpos[mj.tip_site]
             dist[s] = math.hypot(tip[0] - bs[0], tip[2] - bs[1])
             qout[s] = q
@@ -368,8 +450,10 @@ def simulate_mujoco(problem, K: np.ndarray, D: np.ndarray, K2: np.ndarray):
             kin, pot = _kinetic_potential(m.body_mass, body_inertia, d.cvel, d.xipos,
                                           d.subtree_com, mj.rootid)
             spring = float(np.sum(0.5 * K * q**2 + K2 * np.abs(q) ** 3 / 3.0))
-            e_c = sum(_k.contact_elastic_energy(contact, dep) for dep in out[:, 2])
-            energy[s] = (acc[0], kin, pot, spring, e_c, acc[1], acc[2], acc[3])
+            e_c = sum(_k.contact_elastic_energy(contact, dep) for dep in depth_c)
+            if track:
+                e_c += float(np.sum(0.5 * contact[9] * track_u**2))
+            energy[s] = (acc[0], kin, pot, spring, e_c, acc[1], acc[2], acc[3], acc[4])
         if i == n_last:
             break
         mujoco.mj_step2(m, d)
