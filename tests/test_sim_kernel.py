@@ -121,8 +121,8 @@ def test_energy_terms_with_dissipation_are_positive(xtreme_stance):
 
 def test_halving_dt_changes_grf_little(xtreme_stance):
     blade, stance, _ = xtreme_stance
-    a = simulate(prepare(blade, stance, dt=1e-4))
-    b = simulate(prepare(blade, stance, dt=5e-5))
+    a = simulate(prepare(blade, stance))  # the default step
+    b = simulate(prepare(blade, stance, dt=0.5 * a.dt))
     assert nrmse(a.grf_z, b.grf_z) < 0.005
     assert nrmse(a.grf_total, b.grf_total) < 0.005
     assert nrmse(a.grf_x, b.grf_x) < 0.01
@@ -155,6 +155,19 @@ def test_batch_equals_single_runs(xtreme_stance):
         np.testing.assert_array_equal(batch.distance[s], single.distance)
     # stiffer blade, less compression
     assert batch.distance[2].min() > batch.distance[0].min()
+
+
+def test_parallel_batch_equals_serial_bit_for_bit(xtreme_stance):
+    blade, stance, _ = xtreme_stance
+    problem = prepare(blade, stance)
+    rng = np.random.default_rng(3)
+    K = units.stiffness_per_deg_to_per_rad(rng.uniform(13, 22, (6, 1)))
+    D = units.damping_per_deg_to_per_rad(rng.uniform(0.15, 0.5, (6, 1)))
+    serial = simulate_batch(problem, K, D)
+    parallel = simulate_batch(problem, K, D, parallel=True)
+    assert serial.ok.all() and parallel.ok.all()
+    for name in ("grf_x", "grf_z", "distance", "deflection", "torque"):
+        np.testing.assert_array_equal(getattr(parallel, name), getattr(serial, name), err_msg=name)
 
 
 def test_belt_speed_equals_moving_the_clamp(xtreme_stance):

@@ -14,7 +14,6 @@ from bladelab.blade import load_blade
 from bladelab.blade.spec import read_blade_spec
 from bladelab.errors import ModelError
 from bladelab.sim import prepare, simulate
-
 from test_sim_kernel import arc_blade, still_stance
 
 TRACK_K = 5.0e5  # N/m

@@ -39,7 +39,8 @@ def _simulate(
                                  "per joint (comma-separated). Default: the blade's own."),
     D: str | None = typer.Option(None, "--D", help="Joint damping [N·m·s/deg]; as --K."),
     engine: str = typer.Option("kernel", "--engine", help="kernel (numba, default) or mujoco."),
-    dt: float = typer.Option(1e-4, "--dt", help="Largest integration step [s]."),
+    dt: float = typer.Option(2e-4, "--dt", help="Largest integration step [s] (kernel default "
+                             "2e-4; MuJoCo uses a smaller stable step itself)."),
     belt_speed: float = typer.Option(0.0, "--belt-speed", help="Treadmill belt speed [m/s]."),
 ) -> None:
     """Simulate a blade driven by the clamp motion of a stance; write GRF, distance, deflection."""

@@ -74,7 +74,7 @@ def _rot(c: float, s: float, x: float, z: float) -> tuple[float, float]:
     return c * x + s * z, -s * x + c * z
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, inline="always", error_model="numpy")
 def _normal_force(contact, depth, rate):
     """Normal force, ∂F/∂depth, ∂F/∂rate and the elastic part of the force (for energy)."""
     law = int(contact[0])
@@ -102,7 +102,7 @@ def _normal_force(contact, depth, rate):
     return force, n * k * depth ** (n - 1.0) * (1.0 + 1.5 * d * rate), 1.5 * d * k * dn, k * dn
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, inline="always", error_model="numpy")
 def contact_elastic_energy(contact, depth):
     """Energy [J] stored by the elastic part of the normal law at penetration ``depth`` [m]."""
     if depth <= 0.0:
@@ -119,7 +119,7 @@ def contact_elastic_energy(contact, depth):
     return k * depth ** (n + 1.0) / (n + 1.0)
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, inline="always", error_model="numpy")
 def _law_affine(contact, dc):
     """The normal law at contact penetration ``dc`` written as F = E + B·rate (before the
     no-adhesion clip): returns (E, B, ∂E/∂dc, ∂B/∂dc)."""
@@ -144,7 +144,7 @@ def _law_affine(contact, dc):
     return k * dn, 1.5 * d * k * dn, k * ddn, 1.5 * d * k * ddn
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, inline="always", error_model="numpy")
 def track_contact(contact, depth, rate, uh, g):
     """Normal force through a massless track layer in series with the contact law.
 
@@ -210,7 +210,7 @@ def track_contact(contact, depth, rate, uh, g):
     return force, a * kc / slope, a * cc / slope, e_el, u, w, (g * kc + cc) / slope
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, inline="always", error_model="numpy")
 def track_state_force(contact, depth, rate, u):
     """Force [N], elastic part E of the contact law and track rate u̇ [m/s] at a state (δ, δ̇, u).
 
@@ -230,7 +230,7 @@ def track_state_force(contact, depth, rate, u):
     return e_el, e_el, 0.0
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, inline="always", error_model="numpy")
 def _friction(contact, slip):
     """Signed μ of the stick-slip law at ``slip`` and ∂μ/∂slip (0 where friction is off)."""
     mus = contact[6]
@@ -250,7 +250,7 @@ def _friction(contact, slip):
     return mu, dmu
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, inline="always", error_model="numpy")
 def sole_contact(contact, cx, cz, s, c, a, b, ox, oz, vox, voz, om, ground_vx):
     """Force of the ground on one sole ellipse (lab frame, rigid ground at z = 0).
 
@@ -282,7 +282,7 @@ def sole_contact(contact, cx, cz, s, c, a, b, ox, oz, vox, voz, om, ground_vx):
     return px, pz, -mu * fn, fn, depth, rate, slip, kn, cn, mu, dmu, fel
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, inline="always", error_model="numpy")
 def _kinematics(bs, q, v, hinge, com0, Ob, vO, aO, phi, cph, sph, om, al, R, VR, AR):
     """Body origins (Ob), angles, COMs (R) with velocities and bias accelerations (q̈ = 0)."""
     nb = com0.shape[0]
@@ -326,7 +326,7 @@ def _kinematics(bs, q, v, hinge, com0, Ob, vO, aO, phi, cph, sph, om, al, R, VR,
         AR[b, 1] = aO[b, 1] - al[b] * ex - w * w * ez
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, inline="always", error_model="numpy")
 def _body_point(b, x0, z0, hinge, Ob, cph, sph):
     o0x = hinge[b - 1, 0] if b > 0 else 0.0
     o0z = hinge[b - 1, 1] if b > 0 else 0.0
@@ -334,10 +334,13 @@ def _body_point(b, x0, z0, hinge, Ob, cph, sph):
     return Ob[b, 0] + ex, Ob[b, 1] + ez
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, inline="always", error_model="numpy")
 def _solve(A, rhs, x):
     """Solve A x = rhs in place (Gaussian elimination, partial pivoting; A, rhs destroyed)."""
     n = rhs.shape[0]
+    if n == 1:
+        x[0] = rhs[0] / A[0, 0]
+        return
     for k in range(n):
         p = k
         big = abs(A[k, k])
@@ -433,7 +436,9 @@ def simulate_prescribed(
     regime_old = np.zeros(ne, np.int64)
     onset = np.full(ne, -(10**9), np.int64)  # step at which each element became loaded
     window = int(SLIDE_WINDOW / dt + 0.5)
-    bsub = np.zeros(base.shape[1])
+    # the clamp row of the current (sub-)step, copied so that no array view is made per step
+    ncol = base.shape[1]
+    bs = np.zeros(ncol)
     vc = contact[8]
     # a 12th column of ``base`` holds the utilised friction ratio r(t) (drive "utilised-friction")
     utilised = base.shape[1] == UTILISED_COLUMN + 1
@@ -461,8 +466,6 @@ def simulate_prescribed(
 
     for i in range(n_steps + 1):
         if i > 0:
-            bs_row = base[i]
-            b0 = base[i - 1]
             for j in range(nj):
                 q_save[j] = q[j]
                 v_save[j] = v[j]
@@ -482,13 +485,13 @@ def simulate_prescribed(
                 changed = False
                 for k in range(1, n_here + 1):
                     if n_here == 1:
-                        bs = bs_row
+                        for c in range(ncol):
+                            bs[c] = base[i, c]
                         use_bdf2 = (order == 2) & have_history
                     else:
                         f = k / n_here
-                        for c in range(bsub.shape[0]):
-                            bsub[c] = b0[c] + f * (bs_row[c] - b0[c])
-                        bs = bsub
+                        for c in range(ncol):
+                            bs[c] = base[i - 1, c] + f * (base[i, c] - base[i - 1, c])
                         use_bdf2 = (order == 2) & (k > 1)
                     if use_bdf2:
                         # BDF2: x_{n+1} = 4/3 x_n - 1/3 x_{n-1} + 2/3 h f(x_{n+1})
@@ -730,7 +733,8 @@ def simulate_prescribed(
         if i % nsub == 0:
             # ---- outputs at a sample time, from the state itself ----
             s_idx = i // nsub
-            bs = base[i]
+            for c in range(ncol):
+                bs[c] = base[i, c]
             _kinematics(bs, q, v, hinge, com0, Ob, vO, aO, phi, cph, sph, om, al, R, VR, AR)
             e_contact = 0.0
             for e in range(ne):
@@ -806,6 +810,22 @@ def _batch_parallel(base, dt, nsub, ground_vx, body_mass, com0, body_inertia, hi
                     with_energy,
                     grf, dist, qout, tau, state, energy, status):
     for s in prange(K.shape[0]):
+        st, at = simulate_prescribed(
+            base, dt, nsub, ground_vx, body_mass, com0, body_inertia, hinge, sole_body, sole_geom,
+            tip_body, tip, contact, K[s], D[s], K2[s], q0, v0, order, n_iter, refine,
+            with_energy,
+            grf[s], dist[s], qout[s], tau[s], state[s], energy[s])
+        status[s, 0] = st
+        status[s, 1] = at
+
+
+@njit(cache=True)
+def _batch_serial(base, dt, nsub, ground_vx, body_mass, com0, body_inertia, hinge, sole_body,
+                  sole_geom, tip_body, tip, contact, K, D, K2, q0, v0, order, n_iter, refine,
+                  with_energy,
+                  grf, dist, qout, tau, state, energy, status):
+    """The sets one after the other in one compiled call (no per-set dispatch cost)."""
+    for s in range(K.shape[0]):
         st, at = simulate_prescribed(
             base, dt, nsub, ground_vx, body_mass, com0, body_inertia, hinge, sole_body, sole_geom,
             tip_body, tip, contact, K[s], D[s], K2[s], q0, v0, order, n_iter, refine,
