@@ -63,7 +63,7 @@ def run() -> str:
     rows = []
     for label, p in ((f"default dt {problem.dt:.2g} s", problem), (f"dt {fine.dt:.2g} s", fine)):
         res = simulate(p)
-        t = _best(lambda p=p: simulate(p), 50)
+        t = _best(lambda p=p: simulate(p), 200)
         rows.append((f"kernel, one stance, {label}", t, _errors(res, ref)))
     t_single = rows[0][1]
 
@@ -81,7 +81,7 @@ def run() -> str:
     split_rows = []
     for label, p, energy in split:
         _run_kernel(p, K1, D1, K21, with_energy=energy)
-        t = _best(lambda p=p, energy=energy: _run_kernel(p, K1, D1, K21, with_energy=energy), 50)
+        t = _best(lambda p=p, energy=energy: _run_kernel(p, K1, D1, K21, with_energy=energy), 200)
         split_rows.append((label, t))
 
     rng = np.random.default_rng(0)
@@ -90,7 +90,7 @@ def run() -> str:
     batch_rows = []
     for par in (False, True):
         simulate_batch(problem, K, D, parallel=par)
-        t = _best(lambda par=par: simulate_batch(problem, K, D, parallel=par), 15,
+        t = _best(lambda par=par: simulate_batch(problem, K, D, parallel=par), 40,
                   clock=time.process_time)
         batch_rows.append(("2 threads (`parallel=True`)" if par else "one thread", t))
 
@@ -119,15 +119,15 @@ def run() -> str:
         "|---|---|---|---|---|---|",
     ]
     for label, (wmin, wmed, cmin), (ez, ex, ed) in rows:
-        lines.append(f"| {label} (`simulate`, of 50) | {_ms(wmin)} / {_ms(wmed)} | {_ms(cmin)} | "
+        lines.append(f"| {label} (`simulate`, of 200) | {_ms(wmin)} / {_ms(wmed)} | {_ms(cmin)} | "
                      f"{ez:.3%} | {ex:.3%} | {ed:.4%} |")
     for label, (wmin, wmed, cmin) in batch_rows:
         lines.append(f"| kernel, batch of 20 (K 13–22 N·m/deg, D 0.15–0.5 N·m·s/deg), {label}, "
-                     f"of 15 | {wmin * 1e3:.2f} / {wmed * 1e3:.2f} | {cmin * 1e3:.2f} | | | |")
+                     f"of 40 | {wmin * 1e3:.2f} / {wmed * 1e3:.2f} | {cmin * 1e3:.2f} | | | |")
     for dt, wall, cpu, (ez, ex, ed) in mj_rows:
         lines.append(f"| MuJoCo, dt {dt:.2g} s (one run) | {wall * 1e3:.0f} | {cpu * 1e3:.0f} | "
                      f"{ez:.3%} | {ex:.3%} | {ed:.4%} |")
-    lines += ["", "Where the time goes (default step, one stance, CPU min of 50):", "",
+    lines += ["", "Where the time goes (default step, one stance, CPU min of 200):", "",
               "| kernel call | CPU min [ms] |", "|---|---|"]
     for label, (_w, _m, cmin) in split_rows:
         lines.append(f"| {label} | {_ms(cmin)} |")
