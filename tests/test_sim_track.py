@@ -145,3 +145,20 @@ def test_bad_track_parameters_are_refused(xtreme_stance):
         prepare(blade.with_contact(track_stiffness=-1.0), stance)
     with pytest.raises(ModelError, match="track"):
         prepare(blade.with_contact(track_stiffness=1e5, track_damping=-3.0), stance)
+
+
+def test_track_with_utilised_friction_and_six_links_agrees_with_mujoco(xtreme_stance):
+    from bladelab.blade import multilink_blade
+
+    blade, stance = xtreme_stance
+    tb = blade.with_contact(track_stiffness=TRACK_K, track_damping=TRACK_D)
+    ker = simulate(prepare(tb, stance, drive="utilised-friction"))
+    ref = simulate(prepare(tb, stance, drive="utilised-friction", engine="mujoco"))
+    for name in ("grf_z", "grf_x", "distance"):
+        assert nrmse(getattr(ker, name), getattr(ref, name)) < 0.01, name
+    six = multilink_blade("xtreme", n_links=6).with_contact(track_stiffness=TRACK_K,
+                                                             track_damping=TRACK_D)
+    ker = simulate(prepare(six, stance))
+    ref = simulate(prepare(six, stance, engine="mujoco", dt=2e-6))
+    for name in ("grf_z", "grf_x", "distance"):
+        assert nrmse(getattr(ker, name), getattr(ref, name)) < 0.01, name
