@@ -81,6 +81,7 @@ def _opensim_seconds(duration: float) -> tuple[float | None, str]:
 
 def run() -> str:
     from bladelab.runner import build_runner, power_balance_residual_pct, simulate_runner
+    from bladelab.runner.model import DEFAULT_DT
 
     amputee = build_runner("amputee")
     able = build_runner("able")
@@ -106,7 +107,7 @@ def run() -> str:
         "## Runner model (bladelab.runner)",
         "",
         "Planar amputee runner (8 segments, 10 dof, 21 Hill MTUs, 2 foot spheres + blade sphere),",
-        "MuJoCo multibody step + numba muscles/ligaments/contact, one core, default step 0.5 ms,",
+        f"MuJoCo multibody step + numba muscles/ligaments/contact, one core, default step {DEFAULT_DT * 1e3:g} ms,",
         "constant excitations (the model collapses; the fall stop is off so the full time is run).",
         "",
         f"Machine load average during the run: {load:.1f} (2 cores shared with other work);",

@@ -179,7 +179,8 @@ def test_controller_is_called_with_states(amputee):
         calls.append((t, state.muscles.shape, state.contacts.shape))
         return np.full(len(amputee.muscle_names), 0.2)
 
-    res = simulate_runner(amputee, controller=controller, duration=0.01, control_interval=2)
+    res = simulate_runner(amputee, controller=controller, duration=0.01, dt=5e-4, control_interval=2)
+    # 20 steps of 0.5 ms, a call every 2 steps, plus the call at t = 0
     assert len(calls) == 11 and calls[0][1] == (21, 4) and calls[0][2] == (3, 7)
     assert np.allclose(res.excitation[-1], 0.2)
 

@@ -10,6 +10,7 @@ import typer
 
 from bladelab._io import write_json
 from bladelab.errors import SpecError
+from bladelab.runner.model import DEFAULT_DT
 
 
 def _parse_list(text: str, what: str, conv=str) -> list:
@@ -41,7 +42,9 @@ def register(app: typer.Typer) -> None:
         resume: bool = typer.Option(False, "--resume", help="Continue from the checkpoint."),
         duration: float = typer.Option(10.0, "--duration", help="Simulated time (s)."),
         checkpoint_every: int = typer.Option(5, "--checkpoint-every", help="Generations."),
-        dt: float = typer.Option(5e-4, "--dt", help="Time step (s); 2.5e-4 for final solutions."),
+        dt: float = typer.Option(
+            DEFAULT_DT, "--dt", help="Time step (s); 5e-4 only for quick exploratory runs."
+        ),
     ) -> None:
         """Optimise the reflex controller of the runner with CMA-ES (seed 001 eq. 2.4)."""
         from bladelab.runner.controller import read_parameters

@@ -10,6 +10,7 @@ import typer
 
 from bladelab._io import atomic_open, write_json
 from bladelab.errors import InputFileError, SpecError
+from bladelab.runner.model import DEFAULT_DT
 
 runner_app = typer.Typer(help="Planar musculoskeletal runner with a running blade (seed 001).")
 
@@ -109,7 +110,7 @@ def simulate_cmd(
         None, "--controller", help="Controller JSON (constant excitations); none: 0.05 for all."
     ),
     duration: float = typer.Option(10.0, "--duration", help="Simulated time [s]."),
-    dt: float = typer.Option(5e-4, "--dt", help="Time step [s] (1e-4 with --wear)."),
+    dt: float = typer.Option(DEFAULT_DT, "--dt", help="Time step [s] (1e-4 with --wear)."),
     initial_state: str = typer.Option("stand", "--initial-state", help="stand or gait."),
     speed: float = typer.Option(0.0, "--speed", help="Initial forward speed [m/s]."),
     out: Path | None = typer.Option(None, "--out", help="Folder for the CSV/JSON outputs."),
@@ -130,7 +131,7 @@ def simulate_cmd(
         if model != "amputee":
             raise SpecError("only the amputee model wears a blade", where="--wear")
         blade_model = _wear(wear, links, k_deg, d_deg)
-        if dt == 5e-4:
+        if dt == DEFAULT_DT:
             dt = 1e-4  # the blade's sole contact needs a finer step
     if params is not None:
         p = load_runner_params(params)

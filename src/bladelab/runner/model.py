@@ -74,6 +74,11 @@ LAW_HUNT_CROSSLEY, LAW_SPRING_DAMPER = 0, 1
 JP_LO, JP_HI, JP_K, JP_D, JP_SK, JP_SK2, JP_SD = range(7)
 
 
+# Default time step [s]. Under running loads 0.5 ms leaves a 2 ms stance oscillation and a 4.8 %
+# power-balance residual; 0.25 ms gives 0.4 % (docs/predictive.md), so 0.25 ms is the default.
+DEFAULT_DT = 2.5e-4
+
+
 @dataclass(frozen=True, eq=False)
 class RunnerModel:
     """A compiled runner: MuJoCo model plus the parameter arrays of bladelab's force kernels.
@@ -222,7 +227,7 @@ def build_runner(
 
     spec = mujoco.MjSpec()
     spec.modelname = f"bladelab_runner_{params.kind}"
-    spec.option.timestep = 5e-4
+    spec.option.timestep = DEFAULT_DT
     spec.option.integrator = mujoco.mjtIntegrator.mjINT_EULER
     spec.option.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_CONTACT)
     spec.option.gravity = [0.0, 0.0, -GRAVITY]

@@ -12,7 +12,7 @@ body each (composite mass, COM and sagittal inertia); every compliant joint is a
 own contact law (smooth spring–damper or Hunt–Crossley) and friction cap ``friction_kinetic``.
 
 The blade's contact stiffness (about 1e6 N/m on links of a few hundred grams) needs a time step
-of about 1e-4 s; the sphere model runs at 5e-4 s.
+of about 1e-4 s; the sphere model runs at 2.5e-4 s.
 """
 
 from __future__ import annotations

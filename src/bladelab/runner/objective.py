@@ -35,11 +35,11 @@ from bladelab.runner.controller import (
 )
 from bladelab.runner.kernel import _call_mj, _mujoco_step_addresses, forces, path_kinematics
 from bladelab.runner.metabolics import metabolic_params, total_metabolic_rate
-from bladelab.runner.model import RunnerModel
+from bladelab.runner.model import DEFAULT_DT, RunnerModel
 from bladelab.runner.muscle import equilibrium_fiber_length
 from bladelab.runner.simulate import RunnerResult, initial_qpos
 
-DEFAULT_PREDICT_DT = 5e-4
+DEFAULT_PREDICT_DT = DEFAULT_DT
 MAX_TOUCHDOWNS = 400
 
 
