@@ -24,8 +24,10 @@ import numpy as np
 from numba import njit
 
 from bladelab.blade.model import BladeModel
+from bladelab.contact import stick_slip_friction_coefficient
 from bladelab.errors import SimulationError
 from bladelab.sim import kernel as _k
+from bladelab.sim import sole as _sole
 from bladelab.sim.chain import Chain
 
 CLAMP_ARMATURE = 1.0e6  # kg (slides) and kg·m² (pitch hinge)
@@ -206,12 +208,12 @@ def contact_forces_3d(contact, site_xpos, site_xmat, sites, axes, site_body, cve
         if depth <= 0.0:
             continue
         rate = -vpz
-        fn, _kn, _cn, fel = _k._normal_force(contact, depth, rate)
+        fn, _kn, _cn, fel = _sole.normal_force(contact, depth, rate)
         mu = 0.0
         if contact.shape[0] > 11:
             mu = -contact[11]  # utilised friction: Fx = r·Fn (drive "utilised-friction")
         elif contact[6] > 0.0 and fn > 0.0:
-            mu = _k.stick_slip_friction_coefficient(vpx - ground_vx, contact[6], contact[7],
+            mu = stick_slip_friction_coefficient(vpx - ground_vx, contact[6], contact[7],
                                                     contact[8])
         fx = -mu * fn
         out[e, 0] = fx
@@ -269,14 +271,14 @@ def contact_forces_track(contact, site_xpos, site_xmat, sites, axes, site_body, 
         depth = -pz
         rate = -vpz
         slip = vpx - ground_vx
-        fn, _kn, _cn, fel, u, w, _dud = _k.track_contact(contact, depth, rate, track_u[e], dt)
+        fn, _kn, _cn, fel, u, w, _dud = _sole.track_contact(contact, depth, rate, track_u[e], dt)
         track_u[e] = u
         mu = 0.0
         if fn > 0.0:
             if contact.shape[0] > 11:
                 mu = -contact[11]
             elif contact[6] > 0.0:
-                mu = _k.stick_slip_friction_coefficient(slip, contact[6], contact[7], contact[8])
+                mu = stick_slip_friction_coefficient(slip, contact[6], contact[7], contact[8])
         fx = -mu * fn
         out[e, 0] = fx
         out[e, 1] = fn
@@ -450,7 +452,7 @@ def simulate_mujoco(problem, K: np.ndarray, D: np.ndarray, K2: np.ndarray):
             kin, pot = _kinetic_potential(m.body_mass, body_inertia, d.cvel, d.xipos,
                                           d.subtree_com, mj.rootid)
             spring = float(np.sum(0.5 * K * q**2 + K2 * np.abs(q) ** 3 / 3.0))
-            e_c = sum(_k.contact_elastic_energy(contact, dep) for dep in depth_c)
+            e_c = sum(_sole.contact_elastic_energy(contact, dep) for dep in depth_c)
             if track:
                 e_c += float(np.sum(0.5 * contact[9] * track_u**2))
             energy[s] = (acc[0], kin, pot, spring, e_c, acc[1], acc[2], acc[3], acc[4])
