@@ -11,11 +11,15 @@ acceleration and the centripetal terms (the generalised inertia force at q̈ = 0
 point P of body b contributes F·perp(P − H_j) to every joint j proximal to b
 (perp(x, z) = (z, −x), the derivative of a point with respect to a rotation about +y).
 
-Integrator: linearly-implicit (Rosenbrock) Euler. Each step linearises the generalised force
-around the predictor (t_{n+1}, q_n + h·q̇_n, q̇_n) with analytic contact and spring Jacobians and
-solves (M − h·∂Q/∂q̇ − h²·∂Q/∂q) Δq̇ = h·(Q − b); then q̇ += Δq̇, q += h·q̇. It is stable with the
-stiff stick-slip friction (≈ 4e4 N·s/m in stick) at h = 1e-4 s, where explicit schemes need
-≈ 1e-5 s.
+Integrator: linearly-implicit BDF2 (backward Euler on the first step and after a restart). Each
+step linearises the generalised force around the predictor with analytic contact and spring
+Jacobians and solves (M − γ·∂Q/∂q̇ − γ²·∂Q/∂q) Δq̇ = γ·(Q − b) − M(q̇* − q̇̂), γ = 2h/3; steps
+where a loaded sole element lands or slides are redone as sub-steps. It is stable with the stiff
+stick-slip friction (≈ 4e4 N·s/m in stick) at h = 2e-4 s, where explicit schemes need ≈ 1e-5 s.
+The sole contact (geometry, laws, friction, compliant track) is in :mod:`bladelab.sim.sole`; its
+functions and the helpers here are inlined at numba-IR level (``inline="always"``). Caveat of
+numba's cache: editing :mod:`bladelab.sim.sole` or :mod:`bladelab.contact` does not invalidate
+the cached kernel; touch this file (or clear ``__pycache__``) after such an edit.
 """
 
 from __future__ import annotations
