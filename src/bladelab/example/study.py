@@ -14,7 +14,8 @@ Each trial is simulated by a model RICHER than the one identified
 - optionally the compliance spread over ``n_links − 1`` hinges (multi-link blade, equal springs
   n_j·K in series);
 - a softer ground (contact stiffness × ``contact_stiffness_factor``), standing in for a
-  compliant track layer, which the engines do not model separately;
+  compliant track (the synthetic runner, ``bladelab.sim.generate_stance``, does not take the
+  series track layer that ``prepare`` supports, so the surface compliance goes into the contact);
 - touch-down conditions that vary from trial to trial (leg angle ±1°, vertical speed ±0.05 m/s);
 - the measurement of :mod:`bladelab.example.measurement`: clamp cluster and tip markers at
   100 Hz with 1 mm noise, two force plates at 1000 Hz with 1 % noise, random touch-down phase,
