@@ -32,6 +32,7 @@ from bladelab.identify.cost import StanceCost
 from bladelab.identify.formulations import DEFAULT_FORMULATION, DISTANCE_ONLY, formulation_drive
 from bladelab.identify.identifiability import assess_identifiability, effective_sample_size
 from bladelab.identify.optimizers import minimize
+from bladelab.sim.api import DEFAULT_DT
 
 _CI_KEYS = {"K": ("K_ci_Nm_per_deg", 1), "D": ("D_ci_Nms_per_deg", 1), "K2": ("K2_ci_Nm_per_deg2", 2)}
 
@@ -184,7 +185,7 @@ def identify_stance(
     bounds: ParameterBounds | None = None,
     max_evals: int = 600,
     identifiability: bool = True,
-    dt: float = 1e-4,
+    dt: float = DEFAULT_DT,
     engine: str = "kernel",
     belt_speed: float = 0.0,
     contact_threshold: float = 20.0,
@@ -223,7 +224,7 @@ def identify_stance(
     identifiability
         Compute the K–D correlation and confidence intervals.
     dt, engine, belt_speed
-        Passed to ``bladelab.sim.prepare``.
+        Passed to ``bladelab.sim.prepare`` (``dt`` [s], default the kernel's default accuracy).
     contact_threshold
         Vertical GRF [N] defining the contact window of the cost.
     formulation
@@ -336,7 +337,7 @@ def identification_landscape(
     rel_span: float = 0.3,
     weights: tuple[float, float] = (0.5, 0.5),
     grf_components: Sequence[str] = ("z",),
-    dt: float = 1e-4,
+    dt: float = DEFAULT_DT,
     belt_speed: float = 0.0,
     contact_threshold: float = 20.0,
     formulation: str | None = None,

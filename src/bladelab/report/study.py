@@ -73,6 +73,13 @@ class StudyReport:
                 "landscape_trial": self.landscape_trial}
 
 
+
+def _sim_default_dt() -> float:
+    """The kernel's default time step [s], used for every re-simulation in the report."""
+    from bladelab.sim import DEFAULT_DT
+
+    return DEFAULT_DT
+
 def _blade_model(ref: str, folder: Path):
     from bladelab.blade import load_blade
 
@@ -347,7 +354,7 @@ def build_study_report(
         "Blade characterisation: study report", subtitle=f"{study.name} — {folder}",
         settings={"study": str(folder), "variant": variant,
                   "identification": study.identification.model_dump(mode="json"),
-                  "simulation": {"engine": "kernel", "dt_s": 1e-4,
+                  "simulation": {"engine": "kernel", "dt_s": _sim_default_dt(),
                                  "formulation": ", ".join(sorted(formulations))},
                   "landscape_trial": landscape_id, "trials_reported": len(per_trial),
                   "trials_failed": len(problems)},

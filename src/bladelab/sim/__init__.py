@@ -9,6 +9,7 @@ Method notes: ``docs/blade-model.md``.
 """
 
 from bladelab.sim.api import (
+    DEFAULT_DT,
     BatchResult,
     Drive,
     SimProblem,
@@ -24,6 +25,7 @@ from bladelab.sim.motion import ClampMotion
 from bladelab.sim.synthetic import generate_stance
 
 __all__ = [
+    "DEFAULT_DT",
     "ENERGY_TERMS",
     "BatchResult",
     "Chain",
