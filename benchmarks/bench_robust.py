@@ -161,35 +161,12 @@ def sensitivity_study(cases: list[dict]) -> pd.DataFrame:
 
 
 def _figure(sens: pd.DataFrame, path: Path) -> None:
-    import matplotlib
+    """Save the report's sensitivity figure (bladelab.report.sensitivity) as a PNG, atomically."""
+    from bladelab._io import atomic_path
+    from bladelab.report.sensitivity import sensitivity_figure
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    fig, axes = plt.subplots(1, 2, figsize=(10, 4), sharex=True)
-    styles = {("seed", 100.0): ("tab:red", "--"), ("seed", 250.0): ("tab:red", "-"),
-              ("utilised-friction", 100.0): ("tab:blue", "--"),
-              ("utilised-friction", 250.0): ("tab:blue", "-")}
-    for ax, col, lim in ((axes[0], "K_err_pct", 5), (axes[1], "D_err_pct", 20)):
-        for (form, rate), g in sens.groupby(["formulation", "marker_rate_Hz"]):
-            agg = g.assign(a=g[col].abs()).groupby("marker_noise_mm")["a"]
-            med, p90 = agg.median(), agg.quantile(0.9)
-            color, ls = styles[(form, rate)]
-            ax.plot(med.index, med.values, color=color, ls=ls, marker="o",
-                    label=f"{form}, {rate:.0f} Hz (median)")
-            ax.plot(p90.index, p90.values, color=color, ls=ls, alpha=0.35)
-        ax.axhline(lim, color="k", lw=0.8, ls=":")
-        ax.set_xlabel("marker noise per coordinate [mm]")
-        ax.set_ylabel(f"|{col.split('_')[0]} error| [%] (faint: 90th pct)")
-        ax.set_yscale("symlog", linthresh=1)
-    axes[0].legend(fontsize=7)
-    fig.suptitle("Sensitivity of K* and D* to marker noise and rate (forces 1 kHz, 1 %)")
-    fig.tight_layout()
-    tmp = path.with_suffix(".part.png")
-    fig.savefig(tmp, dpi=110)
-    plt.close(fig)
-    tmp.replace(path)
-
+    with atomic_path(path) as tmp:
+        sensitivity_figure(sens).savefig(tmp, dpi=110, format="png")
 
 def speed(case: dict) -> dict:
     """Wall and CPU time of one robust identification (set-up included), best of 5."""
@@ -217,6 +194,12 @@ def run() -> str:
     summary = _summary(df)
     sens = sensitivity_study(cases[:4])
     sens.to_csv(HERE / "results" / "robust-sensitivity.csv", index=False)
+    # The study report's "How far to trust K* and D*" section reads the packaged copy.
+    from bladelab.report.sensitivity import packaged_sensitivity_path
+
+    packaged = packaged_sensitivity_path()
+    packaged.parent.mkdir(parents=True, exist_ok=True)
+    sens.to_csv(packaged, index=False)
     df.to_csv(HERE / "results" / "robust-stances.csv", index=False)
     _figure(sens, HERE / "results" / "robust-sensitivity.png")
     sp = speed(cases[0])

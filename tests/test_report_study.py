@@ -19,7 +19,9 @@ from bladelab.report.study import build_study_report
 from bladelab.study import run_study
 
 N_TRIALS = 4
-FIGURES = 8  # GRF, distance, K*/D* bars, 3 mechanics panels, cost landscape, recovered vs true
+# GRF, distance, K*/D* bars, 3 mechanics panels, cost landscape, sensitivity to noise and
+# marker rate, recovered vs true
+FIGURES = 9
 
 
 @pytest.fixture(scope="module")
@@ -42,7 +44,7 @@ def test_the_report_has_every_section_and_its_tables(study, report):
     for heading in ("nRMSE of the GRF (Table 1)", "nRMSE of the characteristic distance (Table 2)",
                     "GRF and distance vs time", "K* and D* per group and speed band",
                     "Blade mechanics", "Statistics", "Identifiability",
-                    "Recovered vs true parameters", "Settings, versions and seed"):
+                    "How far to trust K* and D*", "Recovered vs true parameters", "Settings, versions and seed"):
         assert heading in html, heading
     assert "SYNTHETIC" in html
     assert len(re.findall(r'<img src="data:image/png;base64,', html)) == FIGURES
