@@ -165,6 +165,42 @@ def build_spec(
 
 
 @njit(cache=True)
+def _sole_point(site_pos, site_mat, a, c, cvel, subtree_com, root, body):
+    """Lowest point (x, z) [m] of a sole ellipse site (semi-axes ``a`` along its x, ``c`` along
+    its z) and that point's velocity (vx, vz) [m/s] from the body's ``cvel`` about the subtree
+    COM of its ``root``."""
+    exz = site_mat[6]  # z component of the site's x axis (row-major 3x3)
+    ezz = site_mat[8]  # z component of the site's z axis
+    nrm = math.sqrt(a * a * exz * exz + c * c * ezz * ezz)
+    ct = -a * exz / nrm
+    st = -c * ezz / nrm
+    px = site_pos[0] + a * ct * site_mat[0] + c * st * site_mat[2]
+    pz = site_pos[2] + a * ct * site_mat[6] + c * st * site_mat[8]
+    wx = cvel[body, 0]
+    wy = cvel[body, 1]
+    wz = cvel[body, 2]
+    rx = px - subtree_com[root, 0]
+    ry = 0.0 - subtree_com[root, 1]
+    rz = pz - subtree_com[root, 2]
+    vpx = cvel[body, 3] + wy * rz - wz * ry
+    vpz = cvel[body, 5] + wx * ry - wy * rx
+    return px, pz, vpx, vpz
+
+
+@njit(cache=True)
+def _friction_coefficient(contact, fn, slip):
+    """Signed μ: the utilised ratio −r when ``contact`` has a 12th entry r, else the stick-slip
+    law (0 when friction is off or the element is unloaded)."""
+    if fn <= 0.0:
+        return 0.0
+    if contact.shape[0] > 11:
+        return -contact[11]  # utilised friction: Fx = r·Fn (drive "utilised-friction")
+    if contact[6] > 0.0:
+        return stick_slip_friction_coefficient(slip, contact[6], contact[7], contact[8])
+    return 0.0
+
+
+@njit(cache=True)
 def contact_forces_3d(contact, site_xpos, site_xmat, sites, axes, site_body, cvel, subtree_com,
                       rootid, xipos, ground_vx, xfrc, out):
     """Apply the contact law to every sole site; write xfrc_applied and per-sole outputs.
@@ -176,27 +212,9 @@ def contact_forces_3d(contact, site_xpos, site_xmat, sites, axes, site_body, cve
     ne = sites.shape[0]
     xfrc[:, :] = 0.0
     for e in range(ne):
-        site_pos = site_xpos[sites[e]]
-        site_mat = site_xmat[sites[e]]
         b = site_body[e]
-        a = axes[e, 0]
-        c = axes[e, 1]
-        exz = site_mat[6]  # z component of the site's x axis (row-major 3x3)
-        ezz = site_mat[8]  # z component of the site's z axis
-        nrm = math.sqrt(a * a * exz * exz + c * c * ezz * ezz)
-        ct = -a * exz / nrm
-        st = -c * ezz / nrm
-        px = site_pos[0] + a * ct * site_mat[0] + c * st * site_mat[2]
-        pz = site_pos[2] + a * ct * site_mat[6] + c * st * site_mat[8]
-        r = rootid[b]
-        wx = cvel[b, 0]
-        wy = cvel[b, 1]
-        wz = cvel[b, 2]
-        rx = px - subtree_com[r, 0]
-        ry = 0.0 - subtree_com[r, 1]
-        rz = pz - subtree_com[r, 2]
-        vpx = cvel[b, 3] + wy * rz - wz * ry
-        vpz = cvel[b, 5] + wx * ry - wy * rx
+        px, pz, vpx, vpz = _sole_point(site_xpos[sites[e]], site_xmat[sites[e]], axes[e, 0],
+                                       axes[e, 1], cvel, subtree_com, rootid[b], b)
         depth = -pz
         out[e, 0] = 0.0
         out[e, 1] = 0.0
@@ -209,13 +227,7 @@ def contact_forces_3d(contact, site_xpos, site_xmat, sites, axes, site_body, cve
             continue
         rate = -vpz
         fn, _kn, _cn, fel = _sole.normal_force(contact, depth, rate)
-        mu = 0.0
-        if contact.shape[0] > 11:
-            mu = -contact[11]  # utilised friction: Fx = r·Fn (drive "utilised-friction")
-        elif contact[6] > 0.0 and fn > 0.0:
-            mu = stick_slip_friction_coefficient(vpx - ground_vx, contact[6], contact[7],
-                                                    contact[8])
-        fx = -mu * fn
+        fx = -_friction_coefficient(contact, fn, vpx - ground_vx) * fn
         out[e, 0] = fx
         out[e, 1] = fn
         out[e, 4] = fel
@@ -247,39 +259,15 @@ def contact_forces_track(contact, site_xpos, site_xmat, sites, axes, site_body, 
     xfrc[:, :] = 0.0
     ct = contact[10]
     for e in range(ne):
-        site_pos = site_xpos[sites[e]]
-        site_mat = site_xmat[sites[e]]
         b = site_body[e]
-        a = axes[e, 0]
-        c = axes[e, 1]
-        exz = site_mat[6]
-        ezz = site_mat[8]
-        nrm = math.sqrt(a * a * exz * exz + c * c * ezz * ezz)
-        ct_ = -a * exz / nrm
-        st = -c * ezz / nrm
-        px = site_pos[0] + a * ct_ * site_mat[0] + c * st * site_mat[2]
-        pz = site_pos[2] + a * ct_ * site_mat[6] + c * st * site_mat[8]
-        r = rootid[b]
-        wx = cvel[b, 0]
-        wy = cvel[b, 1]
-        wz = cvel[b, 2]
-        rx = px - subtree_com[r, 0]
-        ry = 0.0 - subtree_com[r, 1]
-        rz = pz - subtree_com[r, 2]
-        vpx = cvel[b, 3] + wy * rz - wz * ry
-        vpz = cvel[b, 5] + wx * ry - wy * rx
+        px, pz, vpx, vpz = _sole_point(site_xpos[sites[e]], site_xmat[sites[e]], axes[e, 0],
+                                       axes[e, 1], cvel, subtree_com, rootid[b], b)
         depth = -pz
         rate = -vpz
         slip = vpx - ground_vx
         fn, _kn, _cn, fel, u, w, _dud = _sole.track_contact(contact, depth, rate, track_u[e], dt)
         track_u[e] = u
-        mu = 0.0
-        if fn > 0.0:
-            if contact.shape[0] > 11:
-                mu = -contact[11]
-            elif contact[6] > 0.0:
-                mu = stick_slip_friction_coefficient(slip, contact[6], contact[7], contact[8])
-        fx = -mu * fn
+        fx = -_friction_coefficient(contact, fn, slip) * fn
         out[e, 0] = fx
         out[e, 1] = fn
         out[e, 2] = depth
