@@ -253,6 +253,11 @@ def forces_oriented(
         crec[c, 6] = depth if depth > 0.0 else 0.0
 
 
+# An empty site-orientation array: every contact is a sphere. A global, so numba freezes it as
+# a constant instead of allocating it on every step of the hot loop.
+_SPHERES_ONLY = np.zeros((0, 9))
+
+
 @njit(cache=True)
 def forces(
     qpos,
@@ -284,7 +289,7 @@ def forces(
         qpos,
         qvel,
         site_xpos,
-        np.zeros((0, 9)),
+        _SPHERES_ONLY,
         cvel,
         root_com,
         xipos,
