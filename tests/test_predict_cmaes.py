@@ -229,3 +229,22 @@ def test_sweep_chain_warm_starts_neighbours(tmp_path):
         np.testing.assert_allclose(es.x0, x_parent)
     with pytest.raises(Exception, match="chain-from"):
         run_sweep(["Cat4"], [3.5], out=tmp_path / "x", chain_from="Cat7", progress=False)
+
+
+def test_robust_evaluation_is_the_mean_over_jittered_copies():
+    from bladelab.runner.objective import simulate_controlled
+    from bladelab.runner.predict import jittered_parameters
+
+    model, layout = _model("able", None)
+    robust = ObjectiveSettings(duration=1.0, robust_samples=3, robust_jitter=1e-4)
+    x = layout.x0
+    copies = jittered_parameters(x, 2, 1e-4)
+    # the copies move every parameter, by about the requested relative amount
+    for xj in copies:
+        rel = np.abs(xj - x) / (np.abs(x) + 1e-3)
+        assert 0 < np.median(rel) < 1e-3
+    assert not np.array_equal(copies[0], copies[1])
+    costs = [simulate_controlled(model, xi, layout=layout, settings=SHORT)[0].cost
+             for xi in [x, *copies]]
+    got = evaluate_candidates({"model": "able", "settings": robust.to_dict(), "xs": [x.tolist()]})
+    assert got[0]["cost"] == pytest.approx(np.mean(costs), rel=1e-12)

@@ -45,6 +45,12 @@ def register(app: typer.Typer) -> None:
         dt: float = typer.Option(
             DEFAULT_DT, "--dt", help="Time step (s); 5e-4 only for quick exploratory runs."
         ),
+        robust_samples: int = typer.Option(
+            1, "--robust-samples", help="Simulations per candidate (nominal + jittered copies)."
+        ),
+        robust_jitter: float = typer.Option(
+            1e-6, "--robust-jitter", help="Relative parameter jitter of the copies."
+        ),
     ) -> None:
         """Optimise the reflex controller of the runner with CMA-ES (seed 001 eq. 2.4)."""
         from bladelab.runner.controller import read_parameters
@@ -57,6 +63,10 @@ def register(app: typer.Typer) -> None:
             raise SpecError("speed must be positive", where="--speed")
         if not (math.isfinite(dt) and 0 < dt <= 2e-3):
             raise SpecError("time step must be in (0, 2e-3] s", where="--dt")
+        if robust_samples < 1:
+            raise SpecError("must be at least 1", where="--robust-samples")
+        if not (math.isfinite(robust_jitter) and 0 < robust_jitter < 0.1):
+            raise SpecError("must be in (0, 0.1)", where="--robust-jitter")
         _, layout = _model(model, blade if model == "amputee" else None)
         x0 = read_parameters(init, layout, transfer=True) if init is not None else None
         seed_list = _parse_list(seeds, "--seeds", int)
@@ -81,7 +91,13 @@ def register(app: typer.Typer) -> None:
                 out=folder,
                 resume=resume,
                 checkpoint_every=checkpoint_every,
-                settings=ObjectiveSettings(speed=speed, duration=duration, dt=dt),
+                settings=ObjectiveSettings(
+                    speed=speed,
+                    duration=duration,
+                    dt=dt,
+                    robust_samples=robust_samples,
+                    robust_jitter=robust_jitter,
+                ),
                 progress=show,
             )
             results.append(res.to_dict())

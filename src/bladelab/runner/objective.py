@@ -13,6 +13,12 @@
   eq. 2.9, ``abs_penalty·|Err| + squared_penalty·Err²`` averaged over the simulated time.
 
 The simulation stops early once the model has fallen (pelvis below 60 % of standing height).
+
+Robust evaluation (``robust_samples`` = n > 1, :func:`bladelab.runner.predict.evaluate_candidates`):
+a candidate's cost is the mean over the nominal simulation and n − 1 copies with the
+parameters jittered by ``robust_jitter`` (relative, fixed seeded directions), and it counts as
+fallen if any copy falls. A reflex gait is chaotic: without this, CMA-ES finds controllers that
+survive only on the exact floating-point path and fall after a 1e-9 change (docs/predictive.md).
 """
 
 from __future__ import annotations
@@ -60,6 +66,8 @@ class ObjectiveSettings:
     pelvis_tilt_range_deg: tuple[float, float] = (-16.0, -2.0)
     abs_penalty: float = 1.0
     squared_penalty: float = 0.0
+    robust_samples: int = 1
+    robust_jitter: float = 1e-6
 
     def to_dict(self) -> dict:
         return asdict(self)

@@ -25,7 +25,7 @@ import os
 import pickle
 import sys
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
@@ -62,9 +62,30 @@ def evaluate_candidates(payload: dict) -> list[dict]:
     settings = _settings_from_dict(payload["settings"])
     out = []
     for x in payload["xs"]:
-        ev, _ = simulate_controlled(model, np.asarray(x, float), layout=layout, settings=settings)
+        x = np.asarray(x, float)
+        ev, _ = simulate_controlled(model, x, layout=layout, settings=settings)
+        if settings.robust_samples > 1:
+            ev = _robust(ev, model, x, layout, settings)
         out.append(ev.to_dict())
     return out
+
+
+def jittered_parameters(x: np.ndarray, n: int, jitter: float) -> list[np.ndarray]:
+    """``n`` copies of ``x`` moved by ``jitter`` (relative; absolute 1e-3·jitter near zero)
+    along fixed directions (seeded, the same for every candidate and run)."""
+    rng = np.random.default_rng(20261121)
+    scale = jitter * (np.abs(x) + 1e-3)
+    return [x + scale * rng.standard_normal(x.shape) for _ in range(n)]
+
+
+def _robust(nominal: Evaluation, model, x, layout, settings: ObjectiveSettings) -> Evaluation:
+    """The nominal evaluation with the cost averaged over jittered copies (any fall counts)."""
+    costs, fell = [nominal.cost], nominal.fell
+    for xj in jittered_parameters(x, settings.robust_samples - 1, settings.robust_jitter):
+        ev, _ = simulate_controlled(model, xj, layout=layout, settings=settings)
+        costs.append(ev.cost)
+        fell = fell or ev.fell
+    return replace(nominal, cost=float(np.mean(costs)), fell=fell)
 
 
 def _settings_from_dict(d: dict) -> ObjectiveSettings:
