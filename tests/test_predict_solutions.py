@@ -1,6 +1,6 @@
 """Shipped controller solutions: each re-simulated from its parameter file for 10 s must run
 (no fall), at 3.5 ± 0.1 m/s, with a flight phase in every stride and the power balance within
-2 %. None is shipped until an optimisation meets these criteria (docs/predictive.md)."""
+2 %, and so must two copies with the parameters moved by 1e-9. None is shipped until an optimisation meets these criteria (docs/predictive.md)."""
 
 from __future__ import annotations
 
@@ -27,11 +27,14 @@ def test_verification_rejects_a_falling_controller(tmp_path):
 @pytest.mark.skipif(not SHIPPED, reason="no shipped solution yet (optimisation in progress)")
 @pytest.mark.parametrize("path", SHIPPED, ids=[p.stem for p in SHIPPED])
 def test_shipped_solution_runs(path):
-    out = verify_solution(path)
-    assert not out["fell"]
-    assert out["mean_speed_m_per_s"] == pytest.approx(3.5, abs=0.1)
-    assert out["strides"] >= 2 and out["strides_with_flight"] == out["strides"]
-    assert out["power_balance_residual_pct"] <= 2.0
+    # two copies moved by 1e-9 (relative) stand in for another CPU's or library's rounding
+    out = verify_solution(path, jittered_copies=2)
+    for run in (out, *out["jittered"]):
+        assert not run["fell"]
+        assert run["duration_s"] == pytest.approx(10.0)
+        assert run["mean_speed_m_per_s"] == pytest.approx(3.5, abs=0.1)
+        assert run["strides"] >= 2 and run["strides_with_flight"] == run["strides"]
+        assert run["power_balance_residual_pct"] <= 2.0
     assert out["ok"]
 
 

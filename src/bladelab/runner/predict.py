@@ -445,25 +445,26 @@ def verify_solution(
     speed_tolerance: float = 0.1,
     max_power_residual_pct: float = 2.0,
     min_gap_s: float = 0.05,
+    jittered_copies: int = 0,
+    jitter: float = 1e-9,
 ) -> dict:
     """Re-simulate a parameter file and check the shipped-solution criteria.
 
-    The simulation uses the time step the file was optimised with (``settings.dt``, default
-    0.5 ms).
+    The simulation uses the time step the file was optimised with (``settings.dt``).
 
     Criteria (all recomputed from the file, nothing trusted from it): ``duration`` [s] without a
     fall; mean speed within ``speed_tolerance`` [m/s] of ``speed`` (default: the file's
     ``speed_m_per_s``); a flight phase (no leg loaded above 20 N) in every stride of each leg
     (touch-down to touch-down of that leg; unloaded gaps shorter than ``min_gap_s`` [s] inside a
-    stance, i.e. contact bounces, do not end it); power-balance residual below ``max_power_residual_pct`` % (runner analyses).
-    Returns the measured values and ``ok``.
+    stance, i.e. contact bounces, do not end it); power-balance residual below
+    ``max_power_residual_pct`` % (runner analyses). With ``jittered_copies`` = n > 0 the same
+    criteria must also hold for n copies of the parameters moved by ``jitter`` (relative,
+    :func:`jittered_parameters`): a gait that survives only on one floating-point path (another
+    CPU, compiler or library version) is not a solution. Returns the measured values (the
+    copies' under ``"jittered"``) and ``ok``.
     """
     import json
 
-    from bladelab.runner.analyses import (
-        CONTACT_THRESHOLD_N,
-        power_balance_residual_pct,
-    )
     from bladelab.runner.controller import read_parameters
 
     data = json.loads(Path(path).read_text())
@@ -474,6 +475,22 @@ def verify_solution(
     x = read_parameters(path, layout)
     dt = float(data.get("settings", {}).get("dt", ObjectiveSettings().dt))
     settings = ObjectiveSettings(speed=speed, duration=duration, dt=dt)
+    limits = (duration, speed, speed_tolerance, max_power_residual_pct, min_gap_s)
+    out = _check_gait(runner, layout, x, settings, limits)
+    if jittered_copies > 0:
+        out["jittered"] = [
+            _check_gait(runner, layout, xj, settings, limits)
+            for xj in jittered_parameters(x, jittered_copies, jitter)
+        ]
+        out["ok"] = bool(out["ok"] and all(c["ok"] for c in out["jittered"]))
+    return out
+
+
+def _check_gait(runner, layout, x, settings: ObjectiveSettings, limits: tuple) -> dict:
+    """Simulate ``x`` and measure the shipped-solution criteria (:func:`verify_solution`)."""
+    from bladelab.runner.analyses import CONTACT_THRESHOLD_N, power_balance_residual_pct
+
+    duration, speed, tolerance, max_residual, min_gap_s = limits
     ev, res = simulate_controlled(runner, x, layout=layout, settings=settings, record_every=2)
     leg = res.model.contact_params[:, 6]
     loaded = [res.contacts[:, leg == i, 1].sum(axis=1) > CONTACT_THRESHOLD_N for i in (0, 1)]
@@ -495,10 +512,10 @@ def verify_solution(
     out["ok"] = bool(
         not ev.fell
         and ev.duration >= duration - 1e-9
-        and abs(ev.mean_speed - speed) <= speed_tolerance
+        and abs(ev.mean_speed - speed) <= tolerance
         and len(flights) >= 2
         and all(flights)
-        and residual <= max_power_residual_pct
+        and residual <= max_residual
     )
     return out
 
