@@ -1,7 +1,7 @@
 """A reduced example study end to end: generate C3D trials -> identify -> ``bladelab report``.
 
 Also the report's clear errors, and a headless-Chromium check of the study page with the harness
-of ``test_report_browser.py``.
+of ``browser.py``.
 """
 
 from __future__ import annotations
@@ -92,13 +92,13 @@ def test_the_cli_writes_the_report_with_a_chosen_landscape_trial(study, tmp_path
     assert (out / "index.html").is_file()
 
 
-def test_the_study_report_opens_in_headless_chromium(tmp_path, report):
-    from test_report_browser import _chromium, _figure_ok, _inspect
+def test_the_study_report_opens_in_headlesschromium(tmp_path, report):
+    from browser import chromium, figure_ok, inspect_page
 
-    binary = _chromium()
-    figures, errors = _inspect(binary, report.index, tmp_path / "study.png", tmp_path / "profile")
+    binary = chromium()
+    figures, errors = inspect_page(binary, report.index, tmp_path / "study.png", tmp_path / "profile")
     print(f"\nstudy report screenshot: {tmp_path / 'study.png'}")
     assert errors == [], f"console errors: {errors}"
     assert len(figures) == FIGURES
     for fig in figures:
-        assert _figure_ok(fig), fig
+        assert figure_ok(fig), fig
