@@ -1,19 +1,18 @@
-"""CMA-ES optimisation of the controller: improves, reproducible, resumable; sweep; CLI."""
+"""CMA-ES optimisation of the controller: improves, reproducible, resumable; CLI.
+
+Sweeps: tests/test_predict_sweep.py."""
 
 from __future__ import annotations
 
-import importlib.util
 import json
 
 import numpy as np
-import pandas as pd
 import pytest
 
 from bladelab.cli import main
 from bladelab.errors import InputFileError
 from bladelab.runner.objective import ObjectiveSettings
 from bladelab.runner.predict import _model, evaluate_candidates, optimize_controller
-from bladelab.runner.sweep import run_sweep
 
 SHORT = ObjectiveSettings(duration=1.0)
 
@@ -123,81 +122,6 @@ def test_cli_predict_and_errors(tmp_path, capsys):
     assert "robot" in capsys.readouterr().err
     assert main(["predict", "--init", str(tmp_path / "missing.json"), "--out", str(tmp_path)]) == 2
     assert "not found" in capsys.readouterr().err
-    assert main(["sweep", "--categories", "Cat9", "--out", str(tmp_path / "s")]) == 2
-    assert "Cat9" in capsys.readouterr().err
-    code = main(
-        [
-            "sweep",
-            "--categories",
-            "Cat6",
-            "--speeds",
-            "3.5",
-            "--generations",
-            "1",
-            "--popsize",
-            "2",
-            "--duration",
-            "0.3",
-            "--out",
-            str(tmp_path / "sw"),
-        ]
-    )
-    assert code == 0
-    summary = pd.read_csv(tmp_path / "sw" / "summary.csv")
-    assert summary.category.tolist() == ["Cat6"]
-    assert (tmp_path / "sw" / "Cat6" / "3.5" / "best.json").exists()
-
-
-def _sweep(tmp_path, name, speeds=(3.5, 4.0), **kw):
-    return run_sweep(
-        ["Cat4", "Cat6"],
-        list(speeds),
-        out=tmp_path / name,
-        generations=2,
-        popsize=4,
-        duration=0.5,
-        progress=False,
-        **kw,
-    )
-
-
-def test_sweep_tables(tmp_path):
-    serial = _sweep(tmp_path, "serial")
-    res = pd.read_csv(tmp_path / "serial" / "results.csv")
-    assert set(res.category) == {"Cat4", "Cat6"}
-    assert list(serial.columns) == ["category", "max_speed", "cot_4", "t200", "t400"]
-    # 0.5 s runs cannot finish a stride: the models fall at 3.5 m/s, the chain stops there
-    for _cat, df in res.groupby("category"):
-        assert df.speed.tolist()[0] == 3.5
-        if df.fell.iloc[0]:
-            assert len(df) == 1
-
-
-def test_summary_by_hand():
-    from bladelab.runner.sweep import summarise
-
-    res = pd.DataFrame(
-        {
-            "category": ["Cat6"] * 3,
-            "speed": [3.5, 4.0, 4.5],
-            "fell": [False, False, True],
-            "mean_speed": [3.52, 4.05, 2.0],
-            "j_cot": [5.0, 6.9, 9.0],
-        }
-    )
-    s = summarise(res).iloc[0]
-    assert s.max_speed == pytest.approx(4.05) and s.cot_4 == pytest.approx(6.9)
-    assert s.t200 == pytest.approx(200 / 4.05) and s.t400 == pytest.approx(400 / 4.05)
-
-
-@pytest.mark.skipif(importlib.util.find_spec("ray") is None, reason="ray not installed")
-def test_sweep_on_ray_matches_local(tmp_path):
-    local = _sweep(tmp_path, "local", speeds=(3.5,))
-    ray = _sweep(tmp_path, "ray", speeds=(3.5,), jobs=2, executor="ray")
-    pd.testing.assert_frame_equal(local, ray)
-    a = pd.read_csv(tmp_path / "local" / "results.csv")
-    b = pd.read_csv(tmp_path / "ray" / "results.csv")
-    pd.testing.assert_frame_equal(a, b)
 
 
 def test_resume_keeps_the_runs_settings(tmp_path):
@@ -206,29 +130,6 @@ def test_resume_keeps_the_runs_settings(tmp_path):
     other = ObjectiveSettings(duration=0.3)
     resumed = _run(out=tmp_path / "part", generations=3, resume=True, settings=other, seed=99)
     assert resumed.history == full.history
-
-
-def test_sweep_chain_warm_starts_neighbours(tmp_path):
-    from bladelab.runner.controller import read_parameters
-    from bladelab.runner.predict import load_checkpoint
-
-    run_sweep(
-        ["Cat4", "Cat5", "Cat6"],
-        [3.5],
-        out=tmp_path,
-        generations=1,
-        popsize=4,
-        duration=0.3,
-        progress=False,
-        chain_from="Cat6",
-    )
-    for child, parent in (("Cat5", "Cat6"), ("Cat4", "Cat5")):
-        _, layout = _model("amputee", child)
-        x_parent = read_parameters(tmp_path / parent / "3.5" / "best.json", layout)
-        es = load_checkpoint(tmp_path / child / "3.5" / "checkpoint.pkl")["es"]
-        np.testing.assert_allclose(es.x0, x_parent)
-    with pytest.raises(Exception, match="chain-from"):
-        run_sweep(["Cat4"], [3.5], out=tmp_path / "x", chain_from="Cat7", progress=False)
 
 
 def test_robust_evaluation_is_the_mean_over_jittered_copies():

@@ -107,7 +107,7 @@ def register(app: typer.Typer) -> None:
 
     @app.command("sweep")
     def sweep(
-        out: Path = typer.Option(..., "--out", help="Output folder."),
+        out: Path = typer.Option(..., "--out", help="Output folder (re-run to continue)."),
         categories: str = typer.Option("Cat4,Cat5,Cat6,Cat6High,Cat7", "--categories"),
         speeds: str = typer.Option("3.5,4.0,4.5,5.0", "--speeds", help="Speeds (m/s), rising."),
         init: Path | None = typer.Option(None, "--init", help="Amputee parameters JSON."),
@@ -117,14 +117,33 @@ def register(app: typer.Typer) -> None:
         jobs: int = typer.Option(1, "--jobs"),
         executor: str = typer.Option("local", "--executor", help="local | ray"),
         duration: float = typer.Option(10.0, "--duration", help="Simulated time (s)."),
+        dt: float = typer.Option(DEFAULT_DT, "--dt", help="Time step (s)."),
+        robust_samples: int = typer.Option(
+            1, "--robust-samples", help="Simulations per candidate (nominal + jittered copies)."
+        ),
+        robust_jitter: float = typer.Option(
+            1e-6, "--robust-jitter", help="Relative parameter jitter of the copies."
+        ),
+        checkpoint_every: int = typer.Option(5, "--checkpoint-every", help="Generations."),
         chain_from: str | None = typer.Option(
             None, "--chain-from", help="Warm-start categories outwards from this one (e.g. Cat6)."
         ),
     ) -> None:
         """Category × speed grid: warm-started optimisations, maximum speed, cost at 4 m/s,
-        200 m and 400 m times (seed 001 §2.2.2 B–C, Table 3.1)."""
+        200 m and 400 m times, contact times (seed 001 §2.2.2 B–C, Table 3.1). Running it again
+        with the same --out continues: finished cells are read back, interrupted ones resumed."""
         from bladelab.runner.sweep import run_sweep
 
+        if not (math.isfinite(duration) and duration > 0):
+            raise SpecError("must be positive", where="--duration")
+        if not (math.isfinite(dt) and 0 < dt <= 2e-3):
+            raise SpecError("time step must be in (0, 2e-3] s", where="--dt")
+        if robust_samples < 1:
+            raise SpecError("must be at least 1", where="--robust-samples")
+        if not (math.isfinite(robust_jitter) and 0 < robust_jitter < 0.1):
+            raise SpecError("must be in (0, 0.1)", where="--robust-jitter")
+        if init is not None and not init.is_file():
+            raise SpecError("file not found", file=init, where="--init")
         table = run_sweep(
             _parse_list(categories, "--categories"),
             _parse_list(speeds, "--speeds", float),
@@ -136,6 +155,10 @@ def register(app: typer.Typer) -> None:
             jobs=jobs,
             executor=executor,
             duration=duration,
+            dt=dt,
+            robust_samples=robust_samples,
+            robust_jitter=robust_jitter,
+            checkpoint_every=checkpoint_every,
             chain_from=chain_from,
         )
         typer.echo(table.to_string(index=False))

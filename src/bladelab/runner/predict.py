@@ -14,7 +14,13 @@ Output folder (``out``):
   uninterrupted run (same settings, same seed);
 - ``best.json``: the best parameters so far (``--init`` file of a warm start), with the run's
   settings and the best evaluation;
-- ``history.csv``: generation, evaluations, best, median and sigma per generation.
+- ``history.csv``: generation, evaluations, best, median, sigma and ``elapsed_s`` (wall time
+  [s] since the run started, accumulated across resumes) per generation.
+
+``best.json`` also holds ``wall_time_s``: the wall time [s] the run has taken so far, summed over
+resumes (the checkpoint stores the elapsed time; generations recomputed after an interruption
+count once, the lost ones not at all). Wall time is kept apart from
+:attr:`OptimizationResult.history`, which depends only on the seed and settings.
 """
 
 from __future__ import annotations
@@ -24,6 +30,7 @@ import math
 import os
 import pickle
 import sys
+import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -172,6 +179,7 @@ class OptimizationResult:
     x: np.ndarray = field(repr=False)
     history: tuple[tuple[int, int, float, float, float], ...] = field(repr=False)
     out: str | None = None
+    wall_time_s: float = math.nan
 
     def to_dict(self) -> dict:
         return {
@@ -184,6 +192,7 @@ class OptimizationResult:
             "best_cost": self.best_cost,
             "best": self.best.to_dict(),
             "out": self.out,
+            "wall_time_s": self.wall_time_s,
         }
 
 
@@ -275,6 +284,9 @@ def optimize_controller(
         gen, evals = state["generation"], state["evaluations"]
         history = list(state["history"])
         best_x, best_f, best_ev = state["best_x"], state["best_f"], state["best_eval"]
+        # wall time before this call (NaN for a checkpoint written before it was recorded)
+        elapsed0 = float(state.get("elapsed_s", math.nan))
+        elapsed = list(state.get("elapsed", [math.nan] * len(history)))
         seed = state["seed"]
         settings = _settings_from_dict(state["settings"])  # the run's own objective settings
     else:
@@ -305,6 +317,8 @@ def optimize_controller(
         es = cma.CMAEvolutionStrategy(start.tolist(), float(sigma), opts)
         gen, evals, history = 0, 0, []
         best_x, best_f, best_ev = start.copy(), math.inf, None
+        elapsed0, elapsed = 0.0, []
+    t_start = time.perf_counter()
     evaluator = _Evaluator(
         executor, jobs, {"model": model, "blade": blade, "settings": settings.to_dict()}
     )
@@ -320,6 +334,7 @@ def optimize_controller(
             if fs[i] < best_f:
                 best_f, best_x, best_ev = float(fs[i]), np.asarray(xs[i], float), evs[i]
             history.append((gen, evals, best_f, float(np.median(fs)), float(es.sigma)))
+            elapsed.append(elapsed0 + time.perf_counter() - t_start)
             if progress is not None:
                 progress(gen, best_f, float(np.median(fs)))
             if out_dir is not None and (gen % checkpoint_every == 0 or gen == generations):
@@ -338,6 +353,8 @@ def optimize_controller(
                     float(speed),
                     seed,
                     settings,
+                    elapsed,
+                    elapsed0 if not elapsed else elapsed[-1],
                 )
     finally:
         evaluator.close()
@@ -354,6 +371,7 @@ def optimize_controller(
         x=best_x,
         history=tuple(history),
         out=str(out_dir) if out_dir is not None else None,
+        wall_time_s=elapsed[-1] if elapsed else elapsed0,
     )
 
 
@@ -372,6 +390,8 @@ def _save(
     speed,
     seed,
     settings,
+    elapsed,
+    wall_time_s,
 ) -> None:
     import cma
 
@@ -392,6 +412,8 @@ def _save(
         "best_x": best_x,
         "best_f": best_f,
         "best_eval": best_ev,
+        "elapsed": list(elapsed),
+        "elapsed_s": wall_time_s,
     }
     with atomic_path(out_dir / CHECKPOINT_NAME) as tmp:
         tmp.write_bytes(pickle.dumps(state, protocol=4))
@@ -406,11 +428,12 @@ def _save(
         seed=seed,
         settings=settings.to_dict(),
         evaluation=best_ev,
+        wall_time_s=wall_time_s if math.isfinite(wall_time_s) else None,
     )
     with atomic_open(out_dir / "history.csv", "w", newline="") as fh:
         w = csv.writer(fh)
-        w.writerow(["generation", "evaluations", "best", "median", "sigma"])
-        w.writerows(history)
+        w.writerow(["generation", "evaluations", "best", "median", "sigma", "elapsed_s"])
+        w.writerows((*row, t) for row, t in zip(history, elapsed, strict=True))
 
 
 def load_checkpoint(path: str | Path) -> dict:

@@ -4,19 +4,31 @@ Each category is one independent task (run on an executor of :mod:`bladelab.stud
 in-process, local process pool or Ray): the amputee with that blade is optimised at the first
 prescribed speed, warm-started from ``init`` (or the controller's initial guess), then at each
 higher speed warm-started from the previous speed's best, until the model falls (it "can no
-longer run"). Per category:
+longer run"). Per category (``summary.csv``):
 
 - ``max_speed``: the highest mean speed [m/s] of a solution that ran the whole simulation;
 - ``cot_4``: metabolic cost of transport [J/(kg·m)] of the 4 m/s solution (if it ran);
-- ``t200``, ``t400``: 200 m and 400 m times [s] at the maximum speed (distance / speed).
+- ``t200``, ``t400``: 200 m and 400 m times [s] at the maximum speed (distance / speed);
+- ``contact_time_intact``, ``contact_time_prosthetic``: mean contact time [s] of each leg in the
+  maximum-speed solution (re-simulated when its cell finished; :func:`spatiotemporal`).
 
-Results: ``out/results.csv`` (tidy: category, speed, cost, fell, mean_speed, j_cot, ...) and
-``out/summary.csv`` (one row per category), each task's optimisation under
-``out/<category>/<speed>/``.
+Results: ``out/results.csv`` (tidy: category, speed, cost, fell, mean_speed, j_cot, ...,
+generations, evaluations, wall_time_s, contact times) and ``out/summary.csv``, both rewritten
+(atomically) after every finished cell; each cell's optimisation under
+``out/<category>/<speed>/`` with a ``cell.json`` (its settings, then its result).
+
+Resuming: running the same sweep again with the same ``out`` continues it. A cell whose
+optimisation finished is read back from its ``cell.json`` and ``best.json`` (no evaluation); an
+interrupted cell continues from its ``checkpoint.pkl`` (``optimize_controller(resume=True)``,
+the same result as not stopping). A cell run with other settings (generations, popsize, seed,
+duration, time step, robust sampling, objective) or from another initial guess is an error that
+names the cell and the setting.
 """
 
 from __future__ import annotations
 
+import hashlib
+import json
 import math
 from pathlib import Path
 
@@ -24,39 +36,236 @@ import numpy as np
 import pandas as pd
 from tqdm import tqdm
 
-from bladelab._io import atomic_open
-from bladelab.errors import OptimizationError
+from bladelab._io import atomic_open, write_json
+from bladelab.errors import InputFileError, OptimizationError, SpecError
 from bladelab.runner.objective import ObjectiveSettings
 from bladelab.runner.params import blade_category
 
+CELL_NAME = "cell.json"
+CELL_FORMAT = 1
+
+# CLI option of each checked setting (for the error message)
+_OPTION = {
+    "generations": "--generations",
+    "popsize": "--popsize",
+    "seed": "--seed",
+    "duration": "--duration",
+    "dt": "--dt",
+    "robust_samples": "--robust-samples",
+    "robust_jitter": "--robust-jitter",
+}
+
+
+def cell_dir(out: str | Path, category: str, speed: float) -> Path:
+    """The folder of one (category, speed) optimisation: ``out/<category>/<speed:g>``."""
+    return Path(out) / category / f"{float(speed):g}"
+
+
+def _plain(obj):
+    """JSON round trip (tuples become lists) so stored and wanted settings compare equal."""
+    return json.loads(json.dumps(obj))
+
+
+def _wanted(payload: dict) -> dict:
+    """The settings a cell must have been run with (the objective's speed is the cell's)."""
+    obj = {k: v for k, v in payload["settings"].items() if k != "speed"}
+    return _plain(
+        {
+            "generations": payload["generations"],
+            "popsize": payload["popsize"],
+            "seed": payload["seed"],
+            **obj,
+        }
+    )
+
+
+def _digest(x: np.ndarray) -> str:
+    return hashlib.sha256(np.ascontiguousarray(x, dtype="<f8").tobytes()).hexdigest()
+
+
+def _read_cell(folder: Path, category: str, speed: float, wanted: dict) -> dict | None:
+    """The cell's ``cell.json`` (None if it has none); an error if its settings differ."""
+    from bladelab.runner.predict import CHECKPOINT_NAME
+
+    path = folder / CELL_NAME
+    where = f"{category} at {speed:g} m/s"
+    if not path.is_file():
+        if (folder / CHECKPOINT_NAME).exists():
+            raise InputFileError(
+                f"sweep cell {where} holds a checkpoint but no {CELL_NAME} "
+                "(not written by this version of 'bladelab sweep')",
+                file=folder,
+                hint="use another --out, or remove that folder to recompute the cell",
+            )
+        return None
+    try:
+        data = json.loads(path.read_text(encoding="utf-8"))
+        stored = data["settings"]
+    except (OSError, ValueError, KeyError, TypeError) as err:
+        raise InputFileError(
+            f"cannot read sweep cell {where} ({type(err).__name__}: {err})",
+            file=path,
+            hint="remove that folder to recompute the cell",
+        ) from None
+    if data.get("format") != CELL_FORMAT:
+        raise InputFileError(f"sweep cell {where}: unknown format", file=path)
+    diff = [k for k in sorted(set(wanted) | set(stored)) if stored.get(k) != wanted.get(k)]
+    if diff:
+        parts = [
+            f"{_OPTION.get(k, k)} {stored.get(k)!r} there, {wanted.get(k)!r} now" for k in diff
+        ]
+        raise SpecError(
+            f"sweep cell {where} was run with other settings: " + "; ".join(parts),
+            file=path,
+            where=_OPTION.get(diff[0], diff[0]),
+            hint="re-run with the settings of the first run, or use another --out",
+        )
+    return data
+
+
+def _contact_times(category: str, x: np.ndarray, settings: ObjectiveSettings) -> dict:
+    """Mean contact time [s] per leg of the solution ``x``, re-simulated with ``settings``."""
+    from bladelab.runner.analyses import spatiotemporal
+    from bladelab.runner.objective import simulate_controlled
+    from bladelab.runner.predict import _model
+
+    model, layout = _model("amputee", category)
+    _, res = simulate_controlled(model, x, layout=layout, settings=settings, record_every=2)
+    st = spatiotemporal(res)
+    out = {}
+    for leg in ("intact", "prosthetic"):
+        v = st.value[(st.leg == leg) & (st.variable == "contact_time")]
+        out[f"contact_time_{leg}"] = float(v.iloc[0]) if len(v) else math.nan
+    return out
+
+
+def _cells_done(out: Path, categories: list[str], speeds: list[float]) -> list[dict]:
+    rows = []
+    for cat in categories:
+        for speed in speeds:
+            path = cell_dir(out, cat, speed) / CELL_NAME
+            if not path.is_file():
+                continue
+            try:
+                data = json.loads(path.read_text(encoding="utf-8"))
+            except (OSError, ValueError):
+                continue
+            if data.get("status") == "done":
+                rows.append(data["result"])
+    return rows
+
+
+def _write_tables(out: Path, rows: list[dict], categories: list[str]) -> pd.DataFrame:
+    """Write results.csv and summary.csv (atomically); return the summary."""
+    order = {c: i for i, c in enumerate(categories)}
+    results = pd.DataFrame(rows)
+    if len(results):
+        results = results.sort_values(
+            ["category", "speed"], key=lambda s: s.map(order) if s.name == "category" else s
+        ).reset_index(drop=True)
+    summary = summarise(results)
+    out.mkdir(parents=True, exist_ok=True)
+    with atomic_open(out / "results.csv", "w", newline="") as fh:
+        results.to_csv(fh, index=False)
+    with atomic_open(out / "summary.csv", "w", newline="") as fh:
+        summary.to_csv(fh, index=False)
+    return summary
+
 
 def category_task(payload: dict) -> dict:
-    """Run one category's speed chain (a top-level function for executors)."""
+    """Run one category's speed chain (a top-level function for executors).
+
+    Finished cells are read back, interrupted ones resumed from their checkpoint; after each
+    newly finished cell, ``results.csv`` and ``summary.csv`` are rewritten from every finished
+    cell of the sweep on disk.
+    """
     from bladelab.runner.controller import read_parameters
-    from bladelab.runner.predict import _model, optimize_controller
+    from bladelab.runner.predict import (
+        CHECKPOINT_NAME,
+        _model,
+        _settings_from_dict,
+        optimize_controller,
+    )
 
     cat = payload["category"]
+    out = Path(payload["out"])
     _, layout = _model("amputee", cat)
-    x = read_parameters(payload["init"], layout, transfer=True) if payload.get("init") else None
+    if payload.get("init"):
+        x = read_parameters(payload["init"], layout, transfer=True)
+    else:
+        x = layout.x0.copy()
+    wanted = _wanted(payload)
     rows = []
     for speed in payload["speeds"]:
-        res = optimize_controller(
-            "amputee",
-            blade=cat,
-            speed=speed,
-            x0=x,
-            generations=payload["generations"],
-            popsize=payload["popsize"],
-            seed=payload["seed"],
-            jobs=1,
-            out=Path(payload["out"]) / cat / f"{speed:g}",
-            settings=ObjectiveSettings(**payload["settings"]),
-        )
-        ev = res.best.to_dict()
-        rows.append({"category": cat, "speed": speed, **ev, "generations": res.generations})
-        if ev["fell"]:
+        folder = cell_dir(out, cat, speed)
+        data = _read_cell(folder, cat, speed, wanted)
+        digest = _digest(x)
+        if data is not None and data.get("x0_sha256") != digest:
+            raise SpecError(
+                f"sweep cell {cat} at {speed:g} m/s was started from another initial guess",
+                file=folder / CELL_NAME,
+                where="--init",
+                hint="use the --init (and --chain-from) of the first run, or another --out",
+            )
+        if data is not None and data.get("status") == "done":
+            row = data["result"]
+            x = read_parameters(folder / "best.json", layout)
+        else:
+            resume = data is not None and (folder / CHECKPOINT_NAME).is_file()
+            if data is None:
+                write_json(
+                    folder / CELL_NAME,
+                    {
+                        "format": CELL_FORMAT,
+                        "category": cat,
+                        "speed_m_per_s": speed,
+                        "status": "running",
+                        "settings": wanted,
+                        "x0_sha256": digest,
+                    },
+                )
+            settings = _settings_from_dict({**payload["settings"], "speed": float(speed)})
+            res = optimize_controller(
+                "amputee",
+                blade=cat,
+                speed=speed,
+                x0=x,
+                generations=payload["generations"],
+                popsize=payload["popsize"],
+                seed=payload["seed"],
+                jobs=1,
+                out=folder,
+                resume=resume,
+                checkpoint_every=payload.get("checkpoint_every", 5),
+                settings=settings,
+            )
+            row = {
+                "category": cat,
+                "speed": float(speed),
+                **res.best.to_dict(),
+                "generations": res.generations,
+                "evaluations": res.evaluations,
+                "wall_time_s": res.wall_time_s,
+                **_contact_times(cat, res.x, settings),
+            }
+            write_json(
+                folder / CELL_NAME,
+                {
+                    "format": CELL_FORMAT,
+                    "category": cat,
+                    "speed_m_per_s": speed,
+                    "status": "done",
+                    "settings": wanted,
+                    "x0_sha256": digest,
+                    "result": row,
+                },
+            )
+            x = res.x
+            done = _cells_done(out, payload["categories"], payload["all_speeds"])
+            _write_tables(out, done, payload["categories"])
+        rows.append(row)
+        if row["fell"]:
             break
-        x = res.x
     return {"category": cat, "rows": rows}
 
 
@@ -89,7 +298,7 @@ def _chain(ex, base, categories, speeds, init, chain_from, bar) -> list[dict]:
     first = speeds[0]
 
     def best(cat: str) -> str:
-        return str(Path(base["out"]) / cat / f"{first:g}" / "best.json")
+        return str(cell_dir(base["out"], cat, first) / "best.json")
 
     rows: list[dict] = []
     for dist in range(max(i0, len(ordered) - 1 - i0) + 1):
@@ -112,12 +321,30 @@ def _chain(ex, base, categories, speeds, init, chain_from, bar) -> list[dict]:
 
 
 def summarise(results: pd.DataFrame) -> pd.DataFrame:
-    """One row per category: max_speed [m/s], cot_4 [J/(kg·m)], t200 and t400 [s]."""
+    """One row per category: max_speed [m/s], cot_4 [J/(kg·m)], t200 and t400 [s], and the
+    mean contact times [s] of the intact and prosthetic leg at the maximum speed."""
+    cols = [
+        "category",
+        "max_speed",
+        "cot_4",
+        "t200",
+        "t400",
+        "contact_time_intact",
+        "contact_time_prosthetic",
+    ]
     out = []
+    if not len(results):
+        return pd.DataFrame(columns=cols)
     for cat, df in results.groupby("category", sort=False):
         ran = df[~df.fell.astype(bool)]
         vmax = float(ran.mean_speed.max()) if len(ran) else math.nan
         at4 = ran[np.isclose(ran.speed, 4.0)]
+        contact = {"contact_time_intact": math.nan, "contact_time_prosthetic": math.nan}
+        if len(ran):
+            top = ran.loc[ran.mean_speed.idxmax()]
+            for key in contact:
+                if key in top.index:
+                    contact[key] = float(top[key])
         out.append(
             {
                 "category": cat,
@@ -125,9 +352,10 @@ def summarise(results: pd.DataFrame) -> pd.DataFrame:
                 "cot_4": float(at4.j_cot.iloc[0]) if len(at4) else math.nan,
                 "t200": 200.0 / vmax if vmax > 0 else math.nan,
                 "t400": 400.0 / vmax if vmax > 0 else math.nan,
+                **contact,
             }
         )
-    return pd.DataFrame(out)
+    return pd.DataFrame(out, columns=cols)
 
 
 def run_sweep(
@@ -142,10 +370,15 @@ def run_sweep(
     jobs: int = 1,
     executor: str = "local",
     duration: float = 10.0,
+    dt: float | None = None,
+    robust_samples: int = 1,
+    robust_jitter: float = 1e-6,
+    checkpoint_every: int = 5,
     chain_from: str | None = None,
     progress: bool = True,
 ) -> pd.DataFrame:
-    """Run the category × speed sweep; returns the per-category summary (see module docstring).
+    """Run (or continue) the category × speed sweep; returns the per-category summary (see
+    the module docstring).
 
     Parameters
     ----------
@@ -154,15 +387,23 @@ def run_sweep(
     speeds
         Prescribed speeds [m/s], raised in this order.
     out
-        Output folder.
+        Output folder. Running again with the same folder continues the sweep: finished cells
+        are read back, interrupted ones resumed from their checkpoint.
     init
         Warm start for the first speed of every category (parameters JSON).
     generations, popsize, seed
-        CMA-ES settings of every task.
+        CMA-ES settings of every cell.
     jobs, executor
         Categories run in parallel on ``executor`` (``local``/``ray``) with ``jobs`` workers.
     duration
         Simulated time [s] of each evaluation.
+    dt
+        Time step [s] (default the objective's, :data:`bladelab.runner.model.DEFAULT_DT`).
+    robust_samples, robust_jitter
+        Robust evaluation: simulations per candidate (nominal + jittered copies) and their
+        relative parameter jitter (:class:`ObjectiveSettings`).
+    checkpoint_every
+        Checkpoint every this many generations in each cell.
     chain_from
         Warm-start categories from each other at the first speed, as seed 001 §2.2.2 B does:
         this category starts from ``init``, its softer and stiffer neighbours (catalogue order)
@@ -175,39 +416,48 @@ def run_sweep(
         blade_category(c)
     if not speeds or any(not (s > 0) for s in speeds):
         raise OptimizationError("speeds must be positive", where="speeds")
+    if generations < 1 or popsize < 2 or checkpoint_every < 1:
+        raise OptimizationError(
+            "need generations >= 1, popsize >= 2 and checkpoint_every >= 1", where="generations"
+        )
     out = Path(out)
     speeds = sorted(float(s) for s in speeds)
+    objective = ObjectiveSettings(
+        duration=duration,
+        robust_samples=int(robust_samples),
+        robust_jitter=float(robust_jitter),
+        **({"dt": float(dt)} if dt is not None else {}),
+    )
     base = {
-        "generations": generations,
-        "popsize": popsize,
-        "seed": seed,
+        "generations": int(generations),
+        "popsize": int(popsize),
+        "seed": int(seed),
         "out": str(out),
-        "settings": ObjectiveSettings(duration=duration).to_dict(),
+        "settings": objective.to_dict(),
+        "checkpoint_every": int(checkpoint_every),
+        "categories": list(categories),
+        "all_speeds": speeds,
     }
+    # settings of cells already there: checked before anything runs
+    wanted = _wanted(base)
+    for c in categories:
+        for s in speeds:
+            _read_cell(cell_dir(out, c, s), c, s, wanted)
     ex = make_executor(executor, jobs)
     bar = tqdm(total=len(categories) * len(speeds), desc="optimisations", disable=not progress)
     rows: list[dict] = []
-    if chain_from is None:
-        payloads = [
-            {**base, "category": c, "speeds": speeds, "init": str(init) if init else None}
-            for c in categories
-        ]
-        rows.extend(_run_wave(ex, payloads, bar))
-    else:
-        rows.extend(_chain(ex, base, categories, speeds, init, chain_from, bar))
-    bar.close()
-    order = {c: i for i, c in enumerate(categories)}
-    results = pd.DataFrame(rows)
-    results = results.sort_values(
-        ["category", "speed"], key=lambda s: s.map(order) if s.name == "category" else s
-    ).reset_index(drop=True)
-    summary = summarise(results)
-    out.mkdir(parents=True, exist_ok=True)
-    with atomic_open(out / "results.csv", "w", newline="") as fh:
-        results.to_csv(fh, index=False)
-    with atomic_open(out / "summary.csv", "w", newline="") as fh:
-        summary.to_csv(fh, index=False)
-    return summary
+    try:
+        if chain_from is None:
+            payloads = [
+                {**base, "category": c, "speeds": speeds, "init": str(init) if init else None}
+                for c in categories
+            ]
+            rows.extend(_run_wave(ex, payloads, bar))
+        else:
+            rows.extend(_chain(ex, base, categories, speeds, init, chain_from, bar))
+    finally:
+        bar.close()
+    return _write_tables(out, rows, categories)
 
 
-__all__ = ["category_task", "run_sweep", "summarise"]
+__all__ = ["CELL_NAME", "category_task", "cell_dir", "run_sweep", "summarise"]

@@ -1,0 +1,214 @@
+"""Category sweeps: tables, warm-start chain, resuming (read back / checkpoint), settings
+checks, wall time of an optimisation, CLI, Ray = local."""
+
+from __future__ import annotations
+
+import importlib.util
+import json
+
+import numpy as np
+import pandas as pd
+import pytest
+
+import bladelab.runner.predict as predict
+from bladelab.cli import main
+from bladelab.errors import SpecError
+from bladelab.runner.analyses import spatiotemporal
+from bladelab.runner.controller import read_parameters
+from bladelab.runner.objective import ObjectiveSettings, simulate_controlled
+from bladelab.runner.predict import _model, load_checkpoint, optimize_controller
+from bladelab.runner.sweep import run_sweep, summarise
+
+TINY = {"generations": 3, "popsize": 4, "duration": 0.3, "checkpoint_every": 1}
+
+
+def _sweep(out, categories=("Cat6",), speeds=(3.5, 4.0), **kw):
+    args = {**TINY, **kw}
+    return run_sweep(list(categories), list(speeds), out=out, progress=False, **args)
+
+
+class _Interrupt(BaseException):
+    """Stands for Ctrl-C / a killed job (not an Exception: executors do not catch it)."""
+
+
+def _counting(monkeypatch, stop_at: int | None = None) -> list[int]:
+    """Count calls of the candidate evaluation (one per generation with one job); raise
+    _Interrupt on call ``stop_at``."""
+    calls = [0]
+    real = predict.evaluate_candidates
+
+    def wrapped(payload):
+        calls[0] += 1
+        if stop_at is not None and calls[0] == stop_at:
+            raise _Interrupt
+        return real(payload)
+
+    monkeypatch.setattr(predict, "evaluate_candidates", wrapped)
+    return calls
+
+
+def _without_time(df: pd.DataFrame) -> pd.DataFrame:
+    return df.drop(columns=[c for c in df.columns if c in ("wall_time_s", "elapsed_s")])
+
+
+def test_resume_equals_not_stopping_and_finished_cells_are_read_back(tmp_path, monkeypatch):
+    full = _sweep(tmp_path / "full")
+    full_res = pd.read_csv(tmp_path / "full" / "results.csv")
+    assert full_res.speed.tolist() == [3.5, 4.0]  # 0.3 s: both cells run, the chain goes on
+    # interrupted in the 4 m/s cell's 2nd generation (3 generations of 3.5 m/s before it)
+    calls = _counting(monkeypatch, stop_at=5)
+    with pytest.raises(_Interrupt):
+        _sweep(tmp_path / "part")
+    # the finished 3.5 m/s cell is already in the tables
+    part = pd.read_csv(tmp_path / "part" / "results.csv")
+    assert part.speed.tolist() == [3.5]
+    assert json.loads((tmp_path / "part" / "Cat6" / "4" / "cell.json").read_text())[
+        "status"
+    ] == "running"
+    calls = _counting(monkeypatch)
+    resumed = _sweep(tmp_path / "part")
+    # 3.5 m/s read back (0 generations), 4 m/s resumed from its generation-1 checkpoint (2)
+    assert calls[0] == 2
+    pd.testing.assert_frame_equal(resumed, full)
+    got = pd.read_csv(tmp_path / "part" / "results.csv")
+    pd.testing.assert_frame_equal(_without_time(got), _without_time(full_res))
+    for speed in ("3.5", "4"):
+        a = tmp_path / "full" / "Cat6" / speed
+        b = tmp_path / "part" / "Cat6" / speed
+        pa = json.loads((a / "best.json").read_text())["parameters"]
+        pb = json.loads((b / "best.json").read_text())["parameters"]
+        assert pa == pb
+        ha = pd.read_csv(a / "history.csv")
+        hb = pd.read_csv(b / "history.csv")
+        pd.testing.assert_frame_equal(_without_time(ha), _without_time(hb))
+    # a finished sweep run again evaluates nothing and gives the same tables
+    calls = _counting(monkeypatch)
+    again = _sweep(tmp_path / "part")
+    assert calls[0] == 0
+    pd.testing.assert_frame_equal(again, full)
+    # the summary's contact times are those of the maximum-speed solution, re-simulated
+    top = full_res.loc[full_res.mean_speed.idxmax()]
+    cell = tmp_path / "full" / "Cat6" / f"{top.speed:g}"
+    model, layout = _model("amputee", "Cat6")
+    x = read_parameters(cell / "best.json", layout)
+    settings = ObjectiveSettings(speed=top.speed, duration=0.3)
+    _, res = simulate_controlled(model, x, layout=layout, settings=settings, record_every=2)
+    st = spatiotemporal(res)
+    want = st.value[(st.leg == "prosthetic") & (st.variable == "contact_time")].iloc[0]
+    assert full.contact_time_prosthetic.iloc[0] == pytest.approx(want, rel=1e-12)
+    assert 0.05 < want < 0.4
+
+
+def test_changed_settings_are_refused_naming_cell_and_setting(tmp_path, capsys):
+    _sweep(tmp_path / "s", speeds=(3.5,), generations=1)
+    for kw, option in (
+        ({"generations": 2}, "--generations"),
+        ({"generations": 1, "popsize": 6}, "--popsize"),
+        ({"generations": 1, "seed": 2}, "--seed"),
+        ({"generations": 1, "duration": 0.4}, "--duration"),
+        ({"generations": 1, "robust_samples": 2}, "--robust-samples"),
+    ):
+        with pytest.raises(SpecError, match=f"Cat6 at 3.5 m/s.*{option}"):
+            _sweep(tmp_path / "s", speeds=(3.5,), **kw)
+    # another initial guess
+    _, layout = _model("amputee", "Cat6")
+    init = tmp_path / "init.json"
+    init.write_text(json.dumps({"model": "amputee", "parameters": {layout.names[0]: 0.3}}))
+    code = main(
+        ["sweep", "--categories", "Cat6", "--speeds", "3.5", "--generations", "1",
+         "--popsize", "4", "--duration", "0.3", "--checkpoint-every", "1",
+         "--init", str(init), "--out", str(tmp_path / "s")]
+    )
+    assert code == 2
+    err = capsys.readouterr().err
+    assert "Cat6 at 3.5 m/s" in err and "initial guess" in err
+    assert err.count("error:") == 1 and "Traceback" not in err
+    code = main(["sweep", "--categories", "Cat6", "--generations", "5", "--out",
+                 str(tmp_path / "s")])
+    assert code == 2
+    assert "--generations 1 there, 5 now" in capsys.readouterr().err
+
+
+def test_wall_time_is_recorded_and_accumulates_across_resume(tmp_path):
+    settings = ObjectiveSettings(duration=0.3)
+    args = {"popsize": 4, "seed": 3, "settings": settings, "checkpoint_every": 1}
+    part = optimize_controller("able", generations=1, out=tmp_path, **args)
+    first = json.loads((tmp_path / "best.json").read_text())["wall_time_s"]
+    assert first > 0 and first == pytest.approx(part.wall_time_s)
+    resumed = optimize_controller("able", generations=3, out=tmp_path, resume=True, **args)
+    hist = pd.read_csv(tmp_path / "history.csv")
+    assert list(hist.columns) == ["generation", "evaluations", "best", "median", "sigma",
+                                  "elapsed_s"]
+    assert hist.elapsed_s.iloc[0] == pytest.approx(first)
+    assert np.all(np.diff(hist.elapsed_s) > 0)
+    best = json.loads((tmp_path / "best.json").read_text())
+    assert best["wall_time_s"] == pytest.approx(hist.elapsed_s.iloc[-1])
+    assert resumed.wall_time_s == pytest.approx(best["wall_time_s"]) and resumed.wall_time_s > first
+    ckpt = load_checkpoint(tmp_path / "checkpoint.pkl")
+    assert ckpt["elapsed_s"] == pytest.approx(best["wall_time_s"])
+    assert len(resumed.history[0]) == 5  # history tuples hold no time
+
+
+def test_summary_by_hand():
+    res = pd.DataFrame(
+        {
+            "category": ["Cat6"] * 3 + ["Cat4"],
+            "speed": [3.5, 4.0, 4.5, 3.5],
+            "fell": [False, False, True, True],
+            "mean_speed": [3.52, 4.05, 2.0, 1.0],
+            "j_cot": [5.0, 6.9, 9.0, 9.0],
+            "contact_time_intact": [0.2, 0.17, 0.1, 0.3],
+            "contact_time_prosthetic": [0.19, 0.15, 0.1, 0.3],
+        }
+    )
+    s = summarise(res)
+    six = s[s.category == "Cat6"].iloc[0]
+    assert six.max_speed == pytest.approx(4.05) and six.cot_4 == pytest.approx(6.9)
+    assert six.t200 == pytest.approx(200 / 4.05) and six.t400 == pytest.approx(400 / 4.05)
+    assert six.contact_time_intact == 0.17 and six.contact_time_prosthetic == 0.15
+    four = s[s.category == "Cat4"].iloc[0]  # nothing ran
+    assert np.isnan(four.max_speed) and np.isnan(four.t200) and np.isnan(four.cot_4)
+
+
+def test_chain_warm_starts_neighbours(tmp_path):
+    _sweep(tmp_path, categories=("Cat4", "Cat5", "Cat6"), speeds=(3.5,), generations=1,
+           chain_from="Cat6")
+    for child, parent in (("Cat5", "Cat6"), ("Cat4", "Cat5")):
+        _, layout = _model("amputee", child)
+        x_parent = read_parameters(tmp_path / parent / "3.5" / "best.json", layout)
+        es = load_checkpoint(tmp_path / child / "3.5" / "checkpoint.pkl")["es"]
+        np.testing.assert_allclose(es.x0, x_parent)
+    with pytest.raises(Exception, match="chain-from"):
+        _sweep(tmp_path / "x", categories=("Cat4",), chain_from="Cat7")
+
+
+def test_cli_sweep(tmp_path, capsys):
+    assert main(["sweep", "--categories", "Cat9", "--out", str(tmp_path / "s")]) == 2
+    assert "Cat9" in capsys.readouterr().err
+    assert main(["sweep", "--robust-samples", "0", "--out", str(tmp_path / "s")]) == 2
+    assert "--robust-samples" in capsys.readouterr().err
+    assert not (tmp_path / "s").exists()
+    code = main(
+        ["sweep", "--categories", "Cat6", "--speeds", "3.5", "--generations", "1",
+         "--popsize", "2", "--duration", "0.3", "--robust-samples", "2",
+         "--robust-jitter", "1e-5", "--out", str(tmp_path / "sw")]
+    )
+    assert code == 0
+    summary = pd.read_csv(tmp_path / "sw" / "summary.csv")
+    assert summary.category.tolist() == ["Cat6"]
+    assert "contact_time_prosthetic" in summary.columns
+    cell = json.loads((tmp_path / "sw" / "Cat6" / "3.5" / "cell.json").read_text())
+    assert cell["settings"]["robust_samples"] == 2
+    assert cell["settings"]["robust_jitter"] == 1e-5
+    assert cell["result"]["evaluations"] == 2
+
+
+@pytest.mark.skipif(importlib.util.find_spec("ray") is None, reason="ray not installed")
+def test_sweep_on_ray_matches_local(tmp_path):
+    kw = {"categories": ("Cat4", "Cat6"), "speeds": (3.5,), "generations": 2}
+    local = _sweep(tmp_path / "local", **kw)
+    ray = _sweep(tmp_path / "ray", jobs=2, executor="ray", **kw)
+    pd.testing.assert_frame_equal(local, ray)
+    a = pd.read_csv(tmp_path / "local" / "results.csv")
+    b = pd.read_csv(tmp_path / "ray" / "results.csv")
+    pd.testing.assert_frame_equal(_without_time(a), _without_time(b))
