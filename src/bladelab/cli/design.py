@@ -1,4 +1,5 @@
-"""``bladelab design``: a response-surface design study; ``bladelab blade test``: compression test.
+"""``bladelab design``: a response-surface design study; ``bladelab design gait-cycle``: the mean
+gait cycle of a measured trial; ``bladelab blade test``: compression test.
 
 ``bladelab blade test`` is added to the ``blade`` group of :mod:`bladelab.cli.blade` from here
 (this module is registered after it).
@@ -185,13 +186,15 @@ def _evaluate_parallel(evaluator, space, design, out: Path, jobs: int) -> None:
 
 
 def _design(
+    ctx: typer.Context,
     factors: str | None = typer.Option(
         None, "--factors",
         help="name=low:high,... (default: stiffness_kN_per_m=18:32,width_m=0.05:0.08,"
              "height_m=0.40:0.48,toe_length_m=0.19:0.25)."),
     runs: str = typer.Option("ccd", "--runs", help="ccd, bbd, dopt or a CSV file of runs."),
     evaluator: str = typer.Option("blade", "--evaluator", help="blade or runner."),
-    out: Path = typer.Option(..., "--out", help="Output folder (resumes an interrupted study)."),
+    out: Path | None = typer.Option(None, "--out",
+                                    help="Output folder (resumes an interrupted study); required."),
     seed: int = typer.Option(0, "--seed", help="Seed (D-optimal design, optimiser starts)."),
     jobs: int = typer.Option(1, "--jobs", help="Worker processes for the runs."),
     n_runs: int | None = typer.Option(None, "--n-runs", help="Runs of a D-optimal design."),
@@ -210,7 +213,15 @@ def _design(
                                      help="Gait-cycle CSV (runner evaluator; default built-in)."),
     figures: bool = typer.Option(True, "--figures/--no-figures", help="Write figures."),
 ) -> None:
-    """Run a design study: DOE -> evaluator per run -> surfaces, ANOVA, optimum, figures."""
+    """Run a design study: DOE -> evaluator per run -> surfaces, ANOVA, optimum, figures.
+
+    ``bladelab design gait-cycle TRIAL.c3d ...`` makes a gait-cycle CSV for ``--gait``.
+    """
+    if ctx.invoked_subcommand is not None:
+        return
+    if out is None:
+        raise typer.BadParameter("missing option '--out' (the study's output folder)",
+                                 param_hint="--out")
     from bladelab.design import DesignSpace, default_design_space, make_design, run_design
     from bladelab.design.evaluators import make_evaluator
     from bladelab.design.terms import parse_terms
@@ -267,9 +278,68 @@ def _design(
             typer.echo(f"wrote {p}", err=True)
 
 
+def _gait_cycle(
+    trial_file: Path = typer.Argument(..., help="C3D trial with markers and force platforms."),
+    out: Path = typer.Option(..., "--out", help="Gait-cycle CSV to write (for --gait)."),
+    leg: str = typer.Option("right", "--leg",
+                            help="left or right: the leg whose touch-down starts the cycle "
+                                 "(the prosthetic leg)."),
+    static: Path | None = typer.Option(None, "--static",
+                                       help="Standing trial: its angles become zero."),
+    markers: Path | None = typer.Option(None, "--markers",
+                                        help="YAML joint marker map (default: Fukuchi set)."),
+    samples: int = typer.Option(100, "--samples", help="Samples per cycle."),
+    cutoff: float = typer.Option(20.0, "--cutoff", help="Marker low-pass [Hz] (0: none)."),
+    forward: str = typer.Option("auto", "--forward", help="File axis that is forward (+x, -y...)."),
+    up: str = typer.Option("auto", "--up", help="File axis that is up."),
+) -> None:
+    """Mean gait cycle of a measured trial (joint angles from markers) as a gait-cycle CSV."""
+    import numpy as np
+
+    from bladelab._io import atomic_path
+    from bladelab.errors import InputFileError
+    from bladelab.runner.gait_cycle import average_gait_cycle, gait_cycles_from_trial
+    from bladelab.trial import read_c3d
+    from bladelab.trial.joint_angles import load_joint_marker_map
+
+    if samples < 8:
+        raise SpecError(f"--samples must be >= 8, got {samples}", where="--samples")
+    for f in (trial_file, static):
+        if f is not None and not f.is_file():
+            raise InputFileError("no such file", file=f)
+    mmap = load_joint_marker_map(markers) if markers is not None else None
+    trial = read_c3d(trial_file, forward=forward, up=up)
+    ax = trial.metadata.get("axes", {})
+    st = None
+    if static is not None:
+        st = read_c3d(static, forward=ax.get("forward", forward), up=ax.get("up", up))
+    else:
+        typer.echo("note: no --static trial: angles are those of the marker axes, not zero at "
+                   "standing", err=True)
+    cycles = gait_cycles_from_trial(trial, leg=leg, markers=mmap, static=st,
+                                    cutoff_hz=cutoff if cutoff > 0 else None, n=samples)
+    mean = average_gait_cycle(cycles, source=f"{trial_file}: mean of {len(cycles)} {leg}-leg "
+                                             "cycles")
+    with atomic_path(out) as tmp:
+        mean.to_frame().to_csv(tmp, index=False, float_format="%.6g")
+    periods = np.array([c.period for c in cycles])
+    a = {k: np.degrees(v) for k, v in mean.angles.items()}
+    sd = {k: float(np.mean(np.degrees(np.std([c.angles[k] for c in cycles], axis=0))))
+          for k in mean.angles}
+    typer.echo(f"{len(cycles)} cycles of the {leg} leg: period {periods.mean():.4f} ± "
+               f"{periods.std():.4f} s")
+    for k in a:
+        typer.echo(f"  {k:16s} {a[k].min():7.1f} .. {a[k].max():7.1f} deg  "
+                   f"(between-cycle SD {sd[k]:.1f} deg)")
+    typer.echo(f"wrote {out}")
+
+
 def register(app: typer.Typer) -> None:
-    """Add ``bladelab design`` and ``bladelab blade test``."""
+    """Add ``bladelab design`` (with ``design gait-cycle``) and ``bladelab blade test``."""
     from bladelab.cli.blade import blade_app
 
     blade_app.command("test")(_blade_test)
-    app.command("design")(_design)
+    design_app = typer.Typer()
+    design_app.callback(invoke_without_command=True)(_design)
+    design_app.command("gait-cycle")(_gait_cycle)
+    app.add_typer(design_app, name="design")

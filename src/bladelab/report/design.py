@@ -3,8 +3,8 @@
 :func:`design_report_sections` reads a design folder (``study.json``, ``results.csv``,
 ``anova.csv``) and returns the keyword arguments of :meth:`Report.add_section` for: the fitted
 surfaces (R², adjusted and predicted R², leave-one-out error), main effects, contours with the
-constraint boundaries and the optimum, the ANOVA of the objective and the optimum with its
-prediction interval. :func:`build_design_report` writes them as ``<out_dir>/index.html``.
+constraint boundaries and the optimum, the ANOVA of the objective, seed 002's trends checked on
+the study's surfaces (:func:`trends_section`) and the optimum with its prediction interval. :func:`build_design_report` writes them as ``<out_dir>/index.html``.
 The surfaces are refitted from ``results.csv`` (same model), the optimum recomputed with the
 study's seed (deterministic: the same as ``optimum.json``).
 """
@@ -19,7 +19,7 @@ import pandas as pd
 
 from bladelab.errors import InputFileError
 
-__all__ = ["build_design_report", "design_report_sections", "is_design_folder"]
+__all__ = ["build_design_report", "design_report_sections", "is_design_folder", "trends_section"]
 
 
 def is_design_folder(path: str | Path) -> bool:
@@ -44,12 +44,18 @@ def _load(design_dir: Path):
         raise InputFileError(f"cannot read the design study: {err}", file=design_dir) from None
     units = {}
     ev = design_dir / "evaluator.json"
+    evaluator: dict = {}
     if ev.is_file():
         from bladelab.design.evaluators import BLADE_RESPONSE_UNITS
         from bladelab.runner.transfemoral import RUNNER_RESPONSE_UNITS
 
-        kind = json.loads(ev.read_text(encoding="utf-8")).get("evaluator")
+        try:
+            evaluator = json.loads(ev.read_text(encoding="utf-8"))
+        except ValueError as err:
+            raise InputFileError(f"cannot read the evaluator settings: {err}", file=ev) from None
+        kind = evaluator.get("evaluator")
         units = RUNNER_RESPONSE_UNITS if kind == "runner" else BLADE_RESPONSE_UNITS
+    meta = {**meta, "_evaluator": evaluator}
     coded_cols = [f"{n}_coded" for n in space.names]
     skip = {"run", *space.names, *coded_cols}
     responses = [c for c in table.columns if c not in skip]
@@ -111,6 +117,7 @@ def design_report_sections(design_dir: str | Path) -> list[dict[str, Any]]:
                      "tables": [(f"ANOVA of {objective}", anova),
                                 (f"Coefficients of {objective}",
                                  surfaces[objective].coefficients())]})
+    sections.append(trends_section(surfaces, meta.get("_evaluator") or {}))
     if optimum is None:
         sections.append({"title": "Design study: optimum",
                          "text": f"No feasible optimum: {why}"})
@@ -126,6 +133,30 @@ def design_report_sections(design_dir: str | Path) -> list[dict[str, Any]]:
             tabs.append(("Constraints at the optimum", pd.DataFrame(cons_rows)))
         sections.append({"title": "Design study: optimum", "text": text, "tables": tabs})
     return sections
+
+
+def trends_section(surfaces, evaluator: dict | None = None) -> dict[str, Any]:
+    """The "Seed 002 trends" section: each trend's verdict on the study's own surfaces
+    (:func:`bladelab.design.trends.evaluate_trends`), with the test used and, for a trend that
+    does not hold, the reason. ``evaluator`` is the study's ``evaluator.json`` (its kind selects
+    the reasons; its generator ``roles`` map factors to stiffness/width/height/toe length)."""
+    from bladelab.design.trends import evaluate_trends, trends_frame
+
+    evaluator = evaluator or {}
+    kind = evaluator.get("evaluator")
+    roles = (evaluator.get("generator") or {}).get("roles")
+    verdicts = evaluate_trends(surfaces, evaluator=kind, roles=roles)
+    counts = {v: sum(1 for x in verdicts if x.verdict == v)
+              for v in ("holds", "does not hold", "not estimable")}
+    text = (f"The trends seed 002 reports, checked on this study's fitted surfaces "
+            f"(evaluator: {kind or 'unknown'}): {counts['holds']} hold, "
+            f"{counts['does not hold']} do not hold, {counts['not estimable']} not estimable. "
+            "Sign trends use a two-sided t-test of the linear coefficient per coded unit "
+            "(α = 0.05); 'matter less' compares the ranges of the main-effect curves over the "
+            "coded interval. A trend that does not hold gives the reason known for this "
+            "evaluator (docs/design.md), or says it is not explained.")
+    return {"title": "Seed 002 trends", "text": text,
+            "tables": [("Seed 002 trends on this study", trends_frame(verdicts))]}
 
 
 def build_design_report(design_dir: str | Path, out_dir: str | Path | None = None) -> Path:

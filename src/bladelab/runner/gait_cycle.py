@@ -18,6 +18,12 @@ prosthetic touch-down; the last row may repeat the first at t = T) and the angle
 suffix ``_deg`` (``hip_sound_deg`` ...); ``trunk_pitch_deg`` is optional (default 10°). The period
 is the time span (last − first + one sample, or the last time if its row equals the first).
 
+From a measured trial (:func:`gait_cycle_from_trial`): sagittal angles from markers
+(:mod:`bladelab.trial.joint_angles`), one cycle from each touch-down of the chosen (prosthetic)
+leg to its next one (force-platform stances, each assigned to the leg whose foot is over the
+centre of pressure), time-normalised and averaged over the trial's cycles; the other leg is the
+sound leg.
+
 Motion adaptation (seed 002): :func:`fit_motion_model` fits period and every joint angle at
 ``n_nodes`` normalised times as second-order response surfaces of the coded design factors,
 from cycles measured (or predicted) with several blades; :meth:`MotionModel.predict` gives the
@@ -49,9 +55,12 @@ __all__ = [
     "ANGLE_NAMES",
     "GaitCycle",
     "MotionModel",
+    "average_gait_cycle",
     "default_gait_cycle",
     "fit_motion_model",
     "gait_cycle_from_runner",
+    "gait_cycle_from_trial",
+    "gait_cycles_from_trial",
     "read_gait_csv",
 ]
 
@@ -245,6 +254,135 @@ def gait_cycle_from_runner(result, *, cycle: int = -1, threshold_N: float = 50.0
         "trunk_pitch": -states["pelvis_tilt"].to_numpy(float)[sl],
     }
     return GaitCycle(period, (t[sl] - t[a]) / period, angles, "runner simulation")
+
+
+_OTHER = {"left": "right", "right": "left"}
+
+
+def gait_cycles_from_trial(
+    trial,
+    *,
+    leg: str = "right",
+    markers=None,
+    static=None,
+    cutoff_hz: float | None = 20.0,
+    n: int = 100,
+    stances=None,
+    max_period_s: float = 2.0,
+) -> list[GaitCycle]:
+    """Every complete gait cycle of a measured trial, each time-normalised to ``n`` samples.
+
+    A cycle runs from a touch-down of ``leg`` (the prosthetic leg of the cycle) to its next
+    touch-down: consecutive stances of that leg, at most ``max_period_s`` apart, with at most
+    one stance of the other leg between them. Angles: :func:`bladelab.trial.joint_angles.
+    sagittal_angles` (``hip/knee_<leg>`` -> prosthetic, ``hip/knee/ankle_<other>`` -> sound,
+    the pelvis lean -> ``trunk_pitch``). Cycles with a marker gap are left out.
+
+    Parameters
+    ----------
+    trial
+        A :class:`~bladelab.trial.Trial` with markers and force platforms.
+    leg
+        ``"left"`` or ``"right"``: the leg whose touch-down starts the cycle.
+    markers
+        :class:`~bladelab.trial.joint_angles.JointMarkerMap` (default: the Fukuchi marker set).
+    static
+        Standing trial for the neutral offsets (same lab frame).
+    cutoff_hz
+        Marker low-pass [Hz].
+    n
+        Samples per cycle.
+    stances
+        Stance events (default :func:`~bladelab.trial.detect_stances` of the trial).
+    max_period_s
+        Longest accepted cycle [s].
+
+    Raises
+    ------
+    SpecError
+        ``leg`` is not left/right.
+    DataError
+        Missing markers or platforms, or no complete cycle of ``leg``.
+    """
+    from scipy.interpolate import CubicSpline
+
+    from bladelab.trial.events import detect_stances
+    from bladelab.trial.joint_angles import sagittal_angles, stance_legs
+
+    if leg not in _OTHER:
+        raise SpecError(f"leg must be 'left' or 'right', got {leg!r}", where="--leg")
+    sound = _OTHER[leg]
+    src = trial.source or "trial"
+    events = detect_stances(trial) if stances is None else list(stances)
+    legs = stance_legs(trial, events, markers=markers)
+    ja = sagittal_angles(trial, markers=markers, static=static, cutoff_hz=cutoff_hz)
+    names = {"hip_sound": f"hip_{sound}", "knee_sound": f"knee_{sound}",
+             "ankle_sound": f"ankle_{sound}", "hip_prosthetic": f"hip_{leg}",
+             "knee_prosthetic": f"knee_{leg}", "trunk_pitch": "trunk_pitch"}
+    if names["ankle_sound"] not in ja.angles:
+        raise DataError(f"the {sound} (sound) leg has no foot markers, so no ankle angle",
+                        file=src, where=f"{sound} foot",
+                        hint="map foot_anterior / foot_posterior of the sound side")
+    t = ja.time
+    series = {}
+    for k, v in names.items():
+        a = ja.angles[v]
+        series[k] = CubicSpline(t, a) if np.all(np.isfinite(a)) else (
+            lambda x, a=a: np.interp(x, t, a, left=np.nan, right=np.nan))
+    mine = [i for i, s in enumerate(legs) if s == leg]
+    phase = np.arange(n) / n
+    cycles = []
+    for i, j in zip(mine[:-1], mine[1:], strict=True):
+        a, b = events[i].start_s, events[j].start_s
+        between = sum(1 for s in legs[i + 1:j] if s == sound)
+        if b - a > max_period_s or between > 1 or j - i - 1 != between:
+            continue
+        tt = a + phase * (b - a)
+        if tt[0] < t[0] or b > t[-1]:
+            continue
+        vals = {k: np.asarray(f(tt), float) for k, f in series.items()}
+        if not all(np.all(np.isfinite(v)) for v in vals.values()):
+            continue
+        cycles.append(GaitCycle(float(b - a), phase, vals,
+                                f"{src}: {leg} touch-down at {a:.3f} s"))
+    if not cycles:
+        n_leg = len(mine)
+        raise DataError(
+            f"no complete gait cycle of the {leg} leg ({n_leg} {leg} stance(s) among "
+            f"{len(events)})", file=src, where=f"{leg} leg",
+            hint="a cycle needs two consecutive touch-downs of the leg on force platforms")
+    return cycles
+
+
+def average_gait_cycle(cycles: Sequence[GaitCycle], *, n: int | None = None,
+                       source: str | None = None) -> GaitCycle:
+    """Mean of time-normalised cycles: mean period, mean angle at each normalised time.
+
+    ``n`` samples (default: those of the first cycle, whose phases are used).
+    """
+    if not cycles:
+        raise DataError("no cycles to average", where="gait cycles")
+    phase = cycles[0].phase if n is None else np.arange(n) / n
+    period = float(np.mean([c.period for c in cycles]))
+    sampled = [c.angles if (n is None and c.phase.shape == phase.shape
+                            and np.allclose(c.phase, phase)) else c.at(phase * c.period)
+               for c in cycles]
+    mean = {k: np.mean([s[k] for s in sampled], axis=0) for k in ANGLE_NAMES}
+    return GaitCycle(period, phase, mean, source or f"mean of {len(cycles)} cycles")
+
+
+def gait_cycle_from_trial(trial, *, leg: str = "right", markers=None, static=None,
+                          cutoff_hz: float | None = 20.0, n: int = 100,
+                          max_period_s: float = 2.0) -> GaitCycle:
+    """The mean gait cycle of a measured trial (:func:`gait_cycles_from_trial`, averaged).
+
+    Returns a :class:`GaitCycle` whose period is the mean stride time [s] from the force
+    platform and whose angles are the time-normalised means over the trial's cycles.
+    """
+    cycles = gait_cycles_from_trial(trial, leg=leg, markers=markers, static=static,
+                                    cutoff_hz=cutoff_hz, n=n, max_period_s=max_period_s)
+    src = trial.source or "trial"
+    return average_gait_cycle(cycles, source=f"{src}: mean of {len(cycles)} {leg}-leg cycles")
 
 
 @dataclass(frozen=True, eq=False)

@@ -1,0 +1,286 @@
+"""Seed 002's reported trends, checked on a study's own response surfaces.
+
+Seed 002 reports five trends (fig. 7, 9, 10 and the conclusion):
+
+====================================  ==================  ===================================
+trend                                 response            test
+====================================  ==================  ===================================
+stiffer blades increase Δv_x          delta_vx_m_per_s    linear coefficient of stiffness > 0
+wider blades increase Δv_x            delta_vx_m_per_s    linear coefficient of width > 0
+height and toe length matter less     delta_vx_m_per_s    main-effect ranges (see below)
+shorter toe lowers the knee margin    knee_moment_min_Nm  linear coefficient of toe length > 0
+longer toe lowers swing clearance     swing_clearance_m   linear coefficient of toe length < 0
+====================================  ==================  ===================================
+
+Sign tests: the linear coefficient per coded unit of the fitted surface, two-sided t-test
+(α = 0.05 by default, the surface's residual degrees of freedom): **holds** when it is
+significant with the stated sign; **does not hold** when it is significant with the opposite
+sign ("reversed") or not significant ("no significant effect"). Effect-size test ("matter
+less"): the range of each factor's main-effect curve over [−1, 1] (others at the centre) on the
+fitted surface; holds when the height and toe-length ranges are both smaller than the stiffness
+and width ranges. **not estimable**: the response or a factor is not in the study, the term is
+not in the model, or the surface has no residual degree of freedom.
+
+A trend that does not hold gets a reason: the known mechanism of the evaluator that produced the
+study (:data:`TREND_REASONS`, keyed by evaluator and trend; measured and explained in
+docs/design.md), else :data:`NOT_EXPLAINED`. A surface whose predicted R² is below 0.5 is
+flagged in the evidence.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Mapping
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from bladelab.design.blade_generator import DEFAULT_FACTOR_ROLES
+from bladelab.design.surfaces import ResponseSurface
+from bladelab.errors import SpecError
+
+__all__ = [
+    "NOT_EXPLAINED",
+    "SEED002_TRENDS",
+    "TREND_REASONS",
+    "Trend",
+    "TrendVerdict",
+    "evaluate_trends",
+    "trends_frame",
+]
+
+
+@dataclasses.dataclass(frozen=True)
+class Trend:
+    """One reported trend.
+
+    Attributes
+    ----------
+    key
+        Identifier (used in :data:`TREND_REASONS`).
+    statement
+        The trend in words.
+    response
+        Response column it concerns.
+    roles
+        Factor role(s) (``stiffness``, ``width``, ``height``, ``toe_length``).
+    sign
+        +1 / −1: expected sign of the linear coefficient; 0: effect-size comparison
+        (``roles`` smaller than ``versus``).
+    versus
+        Roles that must have the larger effects (comparison trends).
+    """
+
+    key: str
+    statement: str
+    response: str
+    roles: tuple[str, ...]
+    sign: int
+    versus: tuple[str, ...] = ()
+
+
+SEED002_TRENDS: tuple[Trend, ...] = (
+    Trend("stiffness_increases_dvx", "stiffer blades increase Δv_x (performance)",
+          "delta_vx_m_per_s", ("stiffness",), +1),
+    Trend("width_increases_dvx", "wider blades increase Δv_x (performance)",
+          "delta_vx_m_per_s", ("width",), +1),
+    Trend("height_toe_matter_less", "height and toe length matter less than stiffness and width",
+          "delta_vx_m_per_s", ("height", "toe_length"), 0, ("stiffness", "width")),
+    Trend("shorter_toe_lowers_knee_margin", "shorter toe lowers the knee extension margin",
+          "knee_moment_min_Nm", ("toe_length",), +1),
+    Trend("longer_toe_lowers_clearance", "longer toe lowers swing clearance",
+          "swing_clearance_m", ("toe_length",), -1),
+)
+
+#: Why a trend does not hold, by (evaluator, trend key): see docs/design.md for the measurements.
+TREND_REASONS: dict[tuple[str, str], str] = {
+    ("blade", "stiffness_increases_dvx"): (
+        "The blade evaluator's runner is passive (a point mass on a spring leg at a fixed "
+        "touch-down angle): it cannot push off, so Δv_x < 0 in every run, and a stiffer blade "
+        "gives a larger vertical impulse and more braking. Seed 002's runner follows measured "
+        "joint angles whose hip extension supplies the propulsion and adapts to the blade; a "
+        "passive stance has no such mechanism."),
+    ("blade", "width_increases_dvx"): (
+        "At a fixed target stiffness the blade generator lets width change only the blade's mass "
+        "and contact stiffness, which barely affect the stance; in seed 002 width also changed "
+        "the bending-stiffness distribution and the contact area."),
+    ("blade", "height_toe_matter_less"): (
+        "Toe length moves the contact point forward of the clamp (the leg rolls over a longer "
+        "lever and brakes less) and height lengthens the leg (the pylon is fixed): both change "
+        "Δv_x of the passive stance about as much as stiffness, while width barely changes it "
+        "(see the width trend)."),
+    ("blade", "shorter_toe_lowers_knee_margin"): (
+        "The blade evaluator's knee moment is a proxy (a virtual knee 0.08 m above the clamp, "
+        "the GRF line through the hip); its minimum falls in the touch-down transient, where "
+        "braking tilts the GRF line behind the knee and width and height move it more than the "
+        "toe's lever does."),
+    ("runner", "stiffness_increases_dvx"): (
+        "With open-loop (template or measured) kinematics the transfemoral runner is not "
+        "periodic: Δv_x over the cycle depends on when the next contact happens and its surface "
+        "is not predictive (predicted R² < 0 on the template); the passive knee yields and the "
+        "blade lands sliding. Average v_x does rise with stiffness on the template "
+        "(docs/design.md)."),
+    ("runner", "width_increases_dvx"): (
+        "At a fixed target stiffness the blade generator lets width change only the blade's mass "
+        "and contact stiffness, which barely affect the cycle; in seed 002 width also changed "
+        "the bending-stiffness distribution and the contact area."),
+    ("runner", "height_toe_matter_less"): (
+        "Δv_x over an open-loop cycle is not predictive (see the stiffness trend), so effect "
+        "sizes on it are noise; toe length dominates the knee moment and the contact time "
+        "instead."),
+    ("runner", "shorter_toe_lowers_knee_margin"): (
+        "The passive knee (no stance lock) yields: after the sliding touch-down the GRF line "
+        "settles through the knee axis, so the minimum moment is set by the touch-down "
+        "transient more than by the toe's lever."),
+    ("runner", "longer_toe_lowers_clearance"): (
+        "The kinematics-driven runner's swing clearance is erratic between neighbouring designs "
+        "(predicted R² < 0 on the template): the passive knee's swing depends on the stance "
+        "before it. The blade evaluator's geometric proxy shows the trend."),
+}
+
+#: Reason given when no known mechanism of the evaluator explains a trend that does not hold.
+NOT_EXPLAINED = ("not explained: no known mechanism of this evaluator accounts for it; check the "
+                 "surface fit (predicted R²), the factor ranges and the runs")
+
+
+@dataclasses.dataclass(frozen=True)
+class TrendVerdict:
+    """The verdict on one trend.
+
+    Attributes
+    ----------
+    key, statement, response
+        The trend (see :class:`Trend`).
+    test
+        The test used, in words.
+    verdict
+        ``"holds"``, ``"does not hold"`` or ``"not estimable"``.
+    evidence
+        The numbers behind it (coefficients per coded unit with p-values, or effect ranges).
+    reason
+        Why it does not hold (empty otherwise).
+    estimate, p_value
+        Linear coefficient per coded unit and its p-value (sign tests; NaN otherwise).
+    """
+
+    key: str
+    statement: str
+    response: str
+    test: str
+    verdict: str
+    evidence: str
+    reason: str = ""
+    estimate: float = math.nan
+    p_value: float = math.nan
+
+    def to_dict(self) -> dict[str, Any]:
+        return dataclasses.asdict(self)
+
+
+def _coef(surface: ResponseSurface, factor: str) -> tuple[float, float] | None:
+    tab = surface.coefficients()
+    row = tab[tab["term"] == factor]
+    if row.empty:
+        return None
+    return float(row["estimate"].iloc[0]), float(row["p_value"].iloc[0])
+
+
+def _effect_range(surface: ResponseSurface, factor: str) -> float:
+    k = list(surface.factor_names).index(factor)
+    pts = np.zeros((41, len(surface.factor_names)))
+    pts[:, k] = np.linspace(-1.0, 1.0, 41)
+    y = np.asarray(surface.predict_mean(pts), float)
+    return float(y.max() - y.min())
+
+
+def _fmt(v: float) -> str:
+    return f"{v:.3g}"
+
+
+def evaluate_trends(
+    surfaces: Mapping[str, ResponseSurface],
+    *,
+    evaluator: str | None = None,
+    roles: Mapping[str, str] | None = None,
+    alpha: float = 0.05,
+    trends: tuple[Trend, ...] = SEED002_TRENDS,
+) -> list[TrendVerdict]:
+    """Check seed 002's trends on fitted response surfaces (see the module docstring).
+
+    Parameters
+    ----------
+    surfaces
+        Response name -> fitted surface over coded factors (all over the same factors).
+    evaluator
+        ``"blade"`` or ``"runner"`` (selects the reasons), or None (generic reasons).
+    roles
+        Role -> factor name (default the generator's: ``stiffness_kN_per_m``, ``width_m``,
+        ``height_m``, ``toe_length_m``).
+    alpha
+        Significance level of the coefficient t-tests.
+
+    Returns
+    -------
+    list of TrendVerdict
+    """
+    if not 0 < alpha < 1:
+        raise SpecError(f"alpha must lie in (0, 1), got {alpha}", where="alpha")
+    roles = {**DEFAULT_FACTOR_ROLES, **(roles or {})}
+    out = []
+    for tr in trends:
+        sign_test = (f"t-test of the linear coefficient per coded unit (two-sided, α = {alpha:g}),"
+                     f" expected sign {'+' if tr.sign > 0 else '−'}")
+        size_test = ("range of the main-effect curve over the coded interval (others at the "
+                     "centre): " + " and ".join(tr.roles) + " both below " + " and ".join(tr.versus))
+        test = sign_test if tr.sign else size_test
+        base = {"key": tr.key, "statement": tr.statement, "response": tr.response, "test": test}
+        surf = surfaces.get(tr.response)
+        if surf is None:
+            out.append(TrendVerdict(**base, verdict="not estimable",
+                                    evidence=f"the study has no response {tr.response}"))
+            continue
+        needed = [*tr.roles, *tr.versus]
+        missing = [r for r in needed if roles.get(r) not in surf.factor_names]
+        if missing:
+            out.append(TrendVerdict(**base, verdict="not estimable",
+                                    evidence=f"no factor for {', '.join(missing)} in the study"))
+            continue
+        note = ""
+        if not (surf.r2_pred >= 0.5):
+            note = f"; caution: the surface is not predictive (R²pred {surf.r2_pred:.2f})"
+        unit = f" {surf.unit}" if surf.unit else ""
+        if tr.sign:
+            fac = roles[tr.roles[0]]
+            c = _coef(surf, fac)
+            if c is None or surf.df_resid < 1:
+                why = ("the model has no linear term of " + fac if c is None
+                       else "no residual degree of freedom")
+                out.append(TrendVerdict(**base, verdict="not estimable", evidence=why))
+                continue
+            b, p = c
+            ev = f"{fac}: {b:+.3g}{unit} per coded unit, p = {p:.2g}{note}"
+            if p < alpha and np.sign(b) == tr.sign:
+                verdict, reason = "holds", ""
+            else:
+                verdict = "does not hold"
+                ev += "; reversed" if p < alpha else "; no significant effect"
+                reason = TREND_REASONS.get((str(evaluator), tr.key), NOT_EXPLAINED)
+            out.append(TrendVerdict(**base, verdict=verdict, evidence=ev, reason=reason,
+                                    estimate=b, p_value=p))
+        else:
+            rng = {r: _effect_range(surf, roles[r]) for r in needed}
+            ev = ", ".join(f"{r} {_fmt(v)}" for r, v in rng.items()) + f"{unit}{note}"
+            holds = max(rng[r] for r in tr.roles) < min(rng[r] for r in tr.versus)
+            reason = "" if holds else TREND_REASONS.get((str(evaluator), tr.key), NOT_EXPLAINED)
+            out.append(TrendVerdict(**base, verdict="holds" if holds else "does not hold",
+                                    evidence="main-effect ranges: " + ev, reason=reason))
+    return out
+
+
+def trends_frame(verdicts: list[TrendVerdict]) -> pd.DataFrame:
+    """Tidy table: trend, response, verdict, evidence, test, reason."""
+    return pd.DataFrame([{"trend": v.statement, "response": v.response, "verdict": v.verdict,
+                          "evidence": v.evidence, "test": v.test, "reason": v.reason}
+                         for v in verdicts])
