@@ -3,11 +3,16 @@
 :func:`add_predictive_sections` appends to a :class:`bladelab.report.Report`: joint angles per
 leg, GRF in body weights, spatiotemporal bars, joint power curves, the P+/P− table (Table 3.2
 layout: mean positive and negative power per stride in W/kg), the energy table (Table 3.3), and,
-given a sweep summary, maximum speed, metabolic cost at 4 m/s and 200/400 m times per category.
-:func:`power_table` and :func:`energy_table` are the tables alone.
+given a sweep summary, maximum speed, metabolic cost at 4 m/s, 200/400 m times and contact times
+per category set beside seed 001's values (:func:`seed001_results`, a packaged table citing the
+seed's table, figure or text for every number). :func:`power_table`, :func:`energy_table` and
+:func:`seed_comparison` are the tables alone.
 """
 
 from __future__ import annotations
+
+import math
+from importlib import resources
 
 import numpy as np
 import pandas as pd
@@ -75,14 +80,183 @@ def energy_table(result: RunnerResult) -> pd.DataFrame:
     )
 
 
+_JOINT_LABEL = {"hip_flexion": "hip", "knee_angle": "knee", "ankle_angle": "ankle",
+                "socket_angle": "socket", "blade": "RSP"}
+
+
+def _joint_label(joint: str) -> str:
+    base = joint.rsplit("_", 1)[0]
+    return _JOINT_LABEL.get(base, base)
+
+
+def power_table_wide(result: RunnerResult) -> pd.DataFrame:
+    """:func:`power_table` as one row in seed 001's Table 3.2 layout: ``<leg> <joint> P+ (W/kg)``
+    and ``P− (W/kg)`` per leg and joint (P− negative), then each leg's and the TOTAL sums."""
+    tab = power_table(result)
+    row: dict[str, float] = {}
+    for r in tab.itertuples():
+        name = "total" if r.joint == "total" else _joint_label(r.joint)
+        row[f"{r.leg} {name} P+ (W/kg)"] = r.P_pos
+        row[f"{r.leg} {name} P− (W/kg)"] = r.P_neg
+    tot = tab[tab.joint == "total"]
+    row["TOTAL P+ (W/kg)"] = float(tot.P_pos.sum()) if len(tot) else math.nan
+    row["TOTAL P− (W/kg)"] = float(tot.P_neg.sum()) if len(tot) else math.nan
+    return pd.DataFrame([row])
+
+
+def energy_table_wide(result: RunnerResult) -> pd.DataFrame:
+    """:func:`energy_table` as one row in seed 001's Table 3.3 layout: per leg E stored,
+    E generated, hysteresis [J] and recoil [%], and the total E generated [J]."""
+    e = energy_table(result)
+    row: dict[str, float] = {}
+    for r in e.itertuples():
+        row[f"{r.leg} E stored (J)"] = r.E_stored
+        row[f"{r.leg} E generated (J)"] = r.E_generated
+        row[f"{r.leg} hysteresis (J)"] = r.hysteresis
+        row[f"{r.leg} recoil (%)"] = r.recoil_pct
+    row["total E generated (J)"] = float(e.E_generated.sum()) if len(e) else math.nan
+    return pd.DataFrame([row])
+
+
+_ENERGY_LABELS = {"E_stored": "E stored (J)", "E_generated": "E generated (J)",
+                  "hysteresis": "hysteresis (J)", "recoil_pct": "recoil (%)"}
+
+
+def _solution_first(frames: list[pd.DataFrame]) -> pd.DataFrame:
+    df = pd.concat(frames, ignore_index=True)
+    return df[["solution", *[c for c in df.columns if c != "solution"]]]
+
+
+def _power_display(result: RunnerResult) -> pd.DataFrame:
+    tab = power_table(result)
+    tab["joint"] = [j if j == "total" else _joint_label(j) for j in tab.joint]
+    return tab.rename(columns={"P_pos": "P+ (W/kg)", "P_neg": "P− (W/kg)"})
+
+
+# Sweep summary columns and their display names (with units)
+SUMMARY_LABELS = {
+    "category": "category",
+    "max_speed": "maximum speed (m/s)",
+    "cot_4": "metabolic cost at 4 m/s (J/(kg·m))",
+    "t200": "200 m time (s)",
+    "t400": "400 m time (s)",
+    "contact_time_intact": "intact contact time at maximum speed (s)",
+    "contact_time_prosthetic": "prosthetic contact time at maximum speed (s)",
+}
+# quantities whose seed range across categories is a meaningful yardstick (the 200/400 m times
+# follow from the maximum speed, so they get no verdict of their own)
+_RANGE_VERDICT = ("max_speed", "cot_4", "contact_time_intact", "contact_time_prosthetic")
+
+
+def seed001_results() -> pd.DataFrame:
+    """Seed 001's per-category results (packaged ``data/runner/seed001_results.csv``).
+
+    Tidy: category, quantity (a :func:`bladelab.runner.sweep.summarise` column name, or
+    stride/flight times), value, unit, source (the seed's table, figure or text section), note.
+    """
+    ref = resources.files("bladelab") / "data" / "runner" / "seed001_results.csv"
+    with resources.as_file(ref) as path:
+        return pd.read_csv(path)
+
+
+def seed_comparison(summary: pd.DataFrame) -> pd.DataFrame:
+    """Our sweep summary beside seed 001's values, one row per category and quantity.
+
+    Columns: category, quantity (with unit), bladelab, seed 001, difference (%) (ours relative to
+    the seed's), seed 001 range (over its five categories), within seed range (only for maximum
+    speed, cost at 4 m/s and contact times; blank for the 200/400 m times, which follow from
+    the maximum speed), source (where in seed 001 the number is).
+    """
+    seed = seed001_results()
+    rows = []
+    for r in summary.itertuples(index=False):
+        ours = r._asdict()
+        for q in SUMMARY_LABELS:
+            if q == "category":
+                continue
+            ref = seed[(seed.category == r.category) & (seed.quantity == q)]
+            if ref.empty:
+                continue
+            all_cats = seed[seed.quantity == q].value
+            lo, hi = float(all_cats.min()), float(all_cats.max())
+            v = float(ours.get(q, math.nan))
+            s = float(ref.value.iloc[0])
+            verdict = ""
+            if q in _RANGE_VERDICT and math.isfinite(v):
+                verdict = "yes" if lo <= v <= hi else "no"
+            rows.append(
+                {
+                    "category": r.category,
+                    "quantity": SUMMARY_LABELS[q],
+                    "bladelab": v,
+                    "seed 001": s,
+                    "difference (%)": 100.0 * (v - s) / s if math.isfinite(v) else math.nan,
+                    "seed 001 range": f"{lo:g}–{hi:g}",
+                    "within seed range": verdict,
+                    "source": ref.source.iloc[0],
+                }
+            )
+    return pd.DataFrame(
+        rows,
+        columns=["category", "quantity", "bladelab", "seed 001", "difference (%)",
+                 "seed 001 range", "within seed range", "source"],
+    )
+
+
+def _sweep_section(report, summary: pd.DataFrame, compare_seed: bool) -> None:
+    import matplotlib.pyplot as plt
+
+    summary = summary.copy()
+    for col in SUMMARY_LABELS:
+        if col not in summary.columns:
+            summary[col] = math.nan
+    summary = summary[list(SUMMARY_LABELS)]
+    seed = seed001_results() if compare_seed else None
+    fig, axes = plt.subplots(1, 2, figsize=(10, 3.5))
+    cats = summary.category.astype(str).tolist()
+    xs = np.arange(len(cats))
+    for ax, q in zip(axes, ("cot_4", "max_speed"), strict=True):
+        ax.bar(xs, summary[q].to_numpy(float), width=0.6, label="bladelab")
+        if seed is not None:
+            ref = [seed[(seed.category == c) & (seed.quantity == q)].value for c in cats]
+            vals = [float(v.iloc[0]) if len(v) else np.nan for v in ref]
+            ax.plot(xs, vals, "k_", markersize=22, mew=2, label="seed 001")
+        ax.set_xticks(xs, cats)
+        ax.set_ylabel(SUMMARY_LABELS[q])
+        ax.legend(fontsize=7)
+    tables = [(
+        "Per category: maximum speed, metabolic cost at 4 m/s, 200 m and 400 m times "
+        "(Table 3.1) and contact times at maximum speed",
+        summary.rename(columns=SUMMARY_LABELS),
+    )]
+    text = None
+    if seed is not None:
+        tables.append(("bladelab beside seed 001 (Fig. 3.7, Table 3.1, Fig. 3.9)",
+                       seed_comparison(summary)))
+        text = ("Seed 001's values come from its §3.2 text and Table 3.1 (every number is stated "
+                "there; the source column names the table or figure that shows it). 'within seed "
+                "range' asks whether our value lies within the seed's spread over its five "
+                "categories.")
+    report.add_section(
+        "Blade categories: maximum speed and metabolic cost",
+        figures=[("Metabolic cost at 4 m/s and maximum speed per category "
+                  "(bars: bladelab; black lines: seed 001)", fig)],
+        tables=tables,
+        text=text,
+    )
+
+
 def add_predictive_sections(
     report,
     results: dict[str, RunnerResult],
     *,
     sweep_summary: pd.DataFrame | None = None,
+    compare_seed: bool = True,
 ) -> None:
     """Append the predictive sections for the labelled simulations ``results`` (e.g.
-    ``{"able 3.5 m/s": r1, "amputee Cat6 3.5 m/s": r2}``) to ``report``."""
+    ``{"able 3.5 m/s": r1, "amputee Cat6 3.5 m/s": r2}``) to ``report``; with a sweep summary
+    (:func:`bladelab.runner.sweep.summarise`) also the category section, and with
+    ``compare_seed`` seed 001's values beside ours."""
     import matplotlib.pyplot as plt
 
     for label, res in results.items():
@@ -126,27 +300,45 @@ def add_predictive_sections(
                 ("Joint powers", fig4),
             ],
             tables=[
-                ("Spatiotemporal variables (s)", st),
                 (
-                    "Mean positive/negative power per stride (W/kg), Table 3.2 layout",
-                    power_table(res),
+                    "Spatiotemporal variables (means over complete cycles)",
+                    st.rename(columns={"value": "value (s)", "n": "cycles (count)"}),
                 ),
-                ("Energy per leg and stance (J), Table 3.3 layout", energy_table(res)),
+                (
+                    "Mean positive/negative power per stride (W/kg), Table 3.2 quantities",
+                    _power_display(res),
+                ),
+                (
+                    "Energy per leg, mean over stances, Table 3.3 quantities",
+                    energy_table(res).rename(columns=_ENERGY_LABELS),
+                ),
+            ],
+        )
+    if len(results) > 1:
+        rows_p, rows_e = [], []
+        for label, res in results.items():
+            rows_p.append(power_table_wide(res).assign(solution=label))
+            rows_e.append(energy_table_wide(res).assign(solution=label))
+        report.add_section(
+            "Joint power and leg energy of every solution",
+            tables=[
+                ("Mean positive (P+) and negative (P−) power per stride, seed 001 Table 3.2 "
+                 "layout", _solution_first(rows_p)),
+                ("Energy stored, generated, hysteresis and recoil per leg, seed 001 Table 3.3 "
+                 "layout", _solution_first(rows_e)),
             ],
         )
     if sweep_summary is not None and len(sweep_summary):
-        fig, axes = plt.subplots(1, 2, figsize=(9, 3))
-        axes[0].bar(sweep_summary.category, sweep_summary.cot_4)
-        axes[0].set_ylabel("metabolic cost at 4 m/s (J/kg/m)")
-        axes[1].bar(sweep_summary.category, sweep_summary.max_speed)
-        axes[1].set_ylabel("maximum speed (m/s)")
-        report.add_section(
-            "Blade categories: maximum speed and metabolic cost",
-            figures=[("Metabolic cost at 4 m/s and maximum speed per category", fig)],
-            tables=[
-                ("Maximum speed, cost at 4 m/s, 200 m and 400 m times (Table 3.1)", sweep_summary)
-            ],
-        )
+        _sweep_section(report, sweep_summary, compare_seed)
 
 
-__all__ = ["add_predictive_sections", "energy_table", "power_table"]
+__all__ = [
+    "SUMMARY_LABELS",
+    "add_predictive_sections",
+    "energy_table",
+    "energy_table_wide",
+    "power_table",
+    "power_table_wide",
+    "seed001_results",
+    "seed_comparison",
+]
