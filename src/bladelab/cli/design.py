@@ -313,9 +313,6 @@ def _gait_cycle(
     st = None
     if static is not None:
         st = read_c3d(static, forward=ax.get("forward", forward), up=ax.get("up", up))
-    else:
-        typer.echo("note: no --static trial: angles are those of the marker axes, not zero at "
-                   "standing", err=True)
     cycles = gait_cycles_from_trial(trial, leg=leg, markers=mmap, static=st,
                                     cutoff_hz=cutoff if cutoff > 0 else None, n=samples)
     mean = average_gait_cycle(cycles, source=f"{trial_file}: mean of {len(cycles)} {leg}-leg "
@@ -332,6 +329,9 @@ def _gait_cycle(
         typer.echo(f"  {k:16s} {a[k].min():7.1f} .. {a[k].max():7.1f} deg  "
                    f"(between-cycle SD {sd[k]:.1f} deg)")
     typer.echo(f"wrote {out}")
+    if st is None:
+        typer.echo("note: no --static trial: the angles are those of the marker axes, not zero "
+                   "at standing", err=True)
 
 
 def register(app: typer.Typer) -> None:

@@ -1,0 +1,136 @@
+"""Seed 002's trends checked on a study's surfaces, and the trends section of the report."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from bladelab.design import central_composite, default_design_space, fit_surface, run_design
+from bladelab.design.trends import (
+    NOT_EXPLAINED,
+    SEED002_TRENDS,
+    TREND_REASONS,
+    evaluate_trends,
+    trends_frame,
+)
+from bladelab.errors import SpecError
+
+NAMES = ("stiffness_kN_per_m", "width_m", "height_m", "toe_length_m")
+
+
+def _surfaces(coef: dict[str, tuple[float, float, float, float]], *, seed=0, noise=1e-3,
+              names=NAMES):
+    """Surfaces of synthetic responses y = Σ b_i·c_i + small noise on a 25-run CCD."""
+    coded = central_composite(len(names)).coded
+    rng = np.random.default_rng(seed)
+    out = {}
+    for resp, b in coef.items():
+        y = coded @ np.asarray(b[:len(names)]) + noise * rng.standard_normal(len(coded))
+        out[resp] = fit_surface(coded, y, factor_names=list(names), response=resp)
+    return out
+
+
+def _by_key(verdicts):
+    return {v.key: v for v in verdicts}
+
+
+HOLD = {  # each trend holds: k, w > 0 and larger than h, toe; toe raises knee, lowers clearance
+    "delta_vx_m_per_s": (0.10, 0.08, 0.02, 0.01),
+    "knee_moment_min_Nm": (0.0, 0.0, 0.0, 0.05),
+    "swing_clearance_m": (0.0, 0.0, -0.01, -0.02),
+}
+REVERSED = {  # each trend reversed
+    "delta_vx_m_per_s": (-0.10, -0.08, 0.02, 0.30),
+    "knee_moment_min_Nm": (0.0, 0.0, 0.0, -0.05),
+    "swing_clearance_m": (0.0, 0.0, -0.01, 0.02),
+}
+
+
+def test_all_trends_hold_on_a_table_built_to_hold():
+    v = evaluate_trends(_surfaces(HOLD), evaluator="blade")
+    assert [x.verdict for x in v] == ["holds"] * len(SEED002_TRENDS)
+    assert all(x.reason == "" for x in v)
+    k = _by_key(v)
+    assert k["stiffness_increases_dvx"].estimate == pytest.approx(0.10, abs=2e-3)
+    assert k["stiffness_increases_dvx"].p_value < 1e-6
+
+
+@pytest.mark.parametrize("evaluator", ["blade", "runner", None])
+def test_reversed_trends_do_not_hold_with_the_reason(evaluator):
+    v = _by_key(evaluate_trends(_surfaces(REVERSED), evaluator=evaluator))
+    for t in SEED002_TRENDS:
+        assert v[t.key].verdict == "does not hold", t.key
+        assert v[t.key].reason == TREND_REASONS.get((str(evaluator), t.key), NOT_EXPLAINED)
+    assert "reversed" in v["stiffness_increases_dvx"].evidence
+    # the blade evaluator explains the Δv_x trends; its clearance proxy has no known reason
+    if evaluator == "blade":
+        assert "passive" in v["stiffness_increases_dvx"].reason
+        assert v["longer_toe_lowers_clearance"].reason == NOT_EXPLAINED
+    if evaluator is None:
+        assert all(x.reason == NOT_EXPLAINED for x in v.values())
+
+
+def test_no_significant_effect_does_not_hold():
+    coef = dict(HOLD, delta_vx_m_per_s=(0.10, 0.0, 0.02, 0.01))
+    v = _by_key(evaluate_trends(_surfaces(coef, noise=0.01), evaluator="blade"))
+    w = v["width_increases_dvx"]
+    assert w.verdict == "does not hold" and "no significant effect" in w.evidence
+    assert w.p_value > 0.05
+    # width now has the smallest effect: height/toe no longer matter less than both
+    assert v["height_toe_matter_less"].verdict == "does not hold"
+
+
+def test_not_estimable():
+    # no clearance response, and a study without a toe-length factor
+    surf = _surfaces({"delta_vx_m_per_s": (0.1, 0.08, 0.02)}, names=NAMES[:3])
+    v = _by_key(evaluate_trends(surf))
+    assert v["longer_toe_lowers_clearance"].verdict == "not estimable"
+    assert v["height_toe_matter_less"].verdict == "not estimable"
+    assert v["stiffness_increases_dvx"].verdict == "holds"
+    # a model without the linear term
+    coded = central_composite(4).coded
+    s = fit_surface(coded, coded[:, 1] * 0.1, factor_names=list(NAMES), model="width_m",
+                    response="delta_vx_m_per_s")
+    v = _by_key(evaluate_trends({"delta_vx_m_per_s": s}))
+    assert v["stiffness_increases_dvx"].verdict == "not estimable"
+    with pytest.raises(SpecError):
+        evaluate_trends(surf, alpha=1.5)
+
+
+def test_roles_map_other_factor_names():
+    names = ("k", "w", "h", "toe")
+    surf = _surfaces(HOLD, names=names)
+    v = evaluate_trends(surf, roles={"stiffness": "k", "width": "w", "height": "h",
+                                     "toe_length": "toe"})
+    assert all(x.verdict == "holds" for x in v)
+    frame = trends_frame(v)
+    assert list(frame.columns) == ["trend", "response", "verdict", "evidence", "test", "reason"]
+
+
+def test_report_has_the_trends_section(tmp_path):
+    from bladelab.report.design import build_design_report, design_report_sections
+
+    space = default_design_space()
+    mid = {n: 0.5 * (space.factor(n).low + space.factor(n).high) for n in NAMES}
+    half = {n: 0.5 * (space.factor(n).high - space.factor(n).low) for n in NAMES}
+
+    def evaluator(point):
+        c = np.array([(point[n] - mid[n]) / half[n] for n in NAMES])
+        return {r: float(np.dot(b, c) + 1e-3 * np.sin(7 * c.sum() + i + c[0]))
+                for i, (r, b) in enumerate(REVERSED.items())}
+
+    out = tmp_path / "ds"
+    run_design(space, runs="ccd", evaluator=evaluator, out_dir=out, objective="delta_vx_m_per_s",
+               progress=False)
+    (out / "evaluator.json").write_text(json.dumps({"evaluator": "blade"}))
+    sections = design_report_sections(out)
+    trend = [s for s in sections if s["title"] == "Seed 002 trends"]
+    assert len(trend) == 1
+    table = trend[0]["tables"][0][1]
+    assert set(table["verdict"]) == {"does not hold"}
+    index = build_design_report(out)
+    html = index.read_text(encoding="utf-8")
+    assert "Seed 002 trends" in html and "does not hold" in html
+    assert "a point mass on a spring leg" in html  # the blade evaluator's stiffness reason
