@@ -1,16 +1,27 @@
-"""Predictive report sections and the Table 3.2 power table."""
+"""Predictive report: sections and tables, `bladelab report` on predict/sweep folders and
+parameter files (everything re-simulated), seed 001's packaged values, bad paths."""
 
 from __future__ import annotations
+
+import json
+import re
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
 import pytest
 
 import bladelab.runner.predictive_report as pr
+from bladelab.cli import main
 from bladelab.report import Report
+from bladelab.report.predictive import build_predictive_report, predictive_kind
 from bladelab.runner import build_runner
 from bladelab.runner.controller import controller_layout
 from bladelab.runner.objective import ObjectiveSettings, simulate_controlled
+from bladelab.runner.predict import optimize_controller
+from bladelab.runner.sweep import run_sweep
+
+SOLUTIONS = Path(pr.__file__).resolve().parents[1] / "data" / "runner" / "solutions"
 
 
 class _FakeModel:
@@ -37,6 +48,9 @@ def test_power_table_by_hand(monkeypatch):
     assert row.P_neg == pytest.approx(-0.5, rel=2e-3)
     tot = tab[(tab.leg == "left") & (tab.joint == "total")].iloc[0]
     assert tot.P_pos == pytest.approx(row.P_pos)
+    wide = pr.power_table_wide(_FakeResult())
+    assert wide["left hip P+ (W/kg)"].iloc[0] == pytest.approx(1.0, rel=2e-3)
+    assert wide["TOTAL P− (W/kg)"].iloc[0] == pytest.approx(-0.5, rel=2e-3)
 
 
 def test_report_sections_are_written(tmp_path):
@@ -60,3 +74,175 @@ def test_report_sections_are_written(tmp_path):
     html = index.read_text()
     assert "Predictive simulation: amputee Cat6" in html
     assert "Table 3.1" in html and "Joint powers" in html
+
+
+def test_seed001_values_are_those_of_the_seed():
+    seed = pr.seed001_results()
+    assert set(seed.category) == {"Cat4", "Cat5", "Cat6", "Cat6High", "Cat7"}
+    assert seed.source.str.len().min() > 5  # every row cites where it comes from
+
+    def v(cat, q):
+        return float(seed[(seed.category == cat) & (seed.quantity == q)].value.iloc[0])
+
+    # seed 001 §3.2 A and Table 3.1 (typed again here from the seed's text)
+    assert v("Cat6High", "max_speed") == 4.675 and v("Cat4", "max_speed") == 4.27
+    assert v("Cat6", "cot_4") == 6.91 and v("Cat5", "cot_4") == 7.29
+    assert v("Cat6High", "t200") == 42.8 and v("Cat4", "t400") == 93.7
+    assert v("Cat7", "contact_time_prosthetic") == 0.138
+    # Table 3.1's times are distance / maximum speed of the text, to its rounding
+    for cat in set(seed.category):
+        vmax = v(cat, "max_speed")
+        assert abs(v(cat, "t200") - 200 / vmax) < 0.1
+        assert abs(v(cat, "t400") - 400 / vmax) < 0.2
+    # the comparison: differences relative to the seed, verdicts only where meaningful
+    ours = pd.DataFrame({"category": ["Cat6"], "max_speed": [4.62 * 1.1], "cot_4": [6.95],
+                         "t200": [200 / (4.62 * 1.1)], "t400": [400 / (4.62 * 1.1)],
+                         "contact_time_intact": [0.2], "contact_time_prosthetic": [0.15]})
+    cmp = pr.seed_comparison(ours).set_index("quantity")
+    assert cmp.loc["maximum speed (m/s)", "difference (%)"] == pytest.approx(10.0)
+    assert cmp.loc["maximum speed (m/s)", "within seed range"] == "no"
+    assert cmp.loc["metabolic cost at 4 m/s (J/(kg·m))", "within seed range"] == "yes"
+    assert cmp.loc["intact contact time at maximum speed (s)", "within seed range"] == "no"
+    assert cmp.loc["200 m time (s)", "within seed range"] == ""
+
+
+def _tables(index: Path) -> dict[str, pd.DataFrame]:
+    return {p.stem: pd.read_csv(p) for p in (index.parent / "tables").glob("*.csv")}
+
+
+def _table(tables: dict, part: str) -> pd.DataFrame:
+    hits = [k for k in tables if part in k]
+    assert len(hits) >= 1, (part, sorted(tables))
+    return tables[hits[0]]
+
+
+def _units_everywhere(df: pd.DataFrame, unitless=("run", "solution", "category", "leg",
+                                                   "variable", "joint", "quantity")) -> None:
+    for col in df.columns:
+        assert col in unitless or re.search(r"\(.+\)$", col), col
+
+
+def test_report_of_predict_folders(tmp_path, capsys):
+    # one run (API) and a two-seed run (CLI), 3 generations of 1 s simulations
+    run = tmp_path / "run"
+    optimize_controller("able", generations=3, popsize=4, seed=2,
+                        settings=ObjectiveSettings(duration=1.0), out=run)
+    assert predictive_kind(run) == "run"
+    assert main(["report", str(run)]) == 0
+    index = run / "report" / "index.html"
+    html = index.read_text(encoding="utf-8")
+    for title in ("Optimisation: convergence and run summary", "Joint angles per leg",
+                  "Ground reaction force in body weights", "Spatiotemporal variables",
+                  "Joint powers", "Table 3.2", "Table 3.3", "Re-simulation of the solutions"):
+        assert title in html, title
+    tables = _tables(index)
+    summary = _table(tables, "run-summary")
+    _units_everywhere(summary)
+    row = summary.iloc[0]
+    assert row["generations (count)"] == 3 and row["evaluations (count)"] == 12
+    assert row["wall time (s)"] > 0
+    # the stored best cost is reproduced by an independent re-simulation of best.json
+    assert bool(row["stored cost reproduced (yes/no)"])
+    hist = pd.read_csv(run / "history.csv")
+    assert row["recomputed cost (–)"] == pytest.approx(hist.best.iloc[-1], rel=1e-9)
+    resim = _table(tables, "re-simulations")
+    _units_everywhere(resim)
+    assert 0 < resim["simulated (s)"].iloc[0] <= 10.0 + 1e-9
+    assert resim["time step (s)"].iloc[0] == ObjectiveSettings().dt
+    for part in ("table-3-2", "table-3-3", "spatiotemporal"):
+        _units_everywhere(_table(tables, part))
+    capsys.readouterr()
+    seeds = tmp_path / "seeds"
+    assert main(["predict", "--generations", "2", "--popsize", "4", "--duration", "0.5",
+                 "--seeds", "1,2", "--out", str(seeds)]) == 0
+    assert predictive_kind(seeds) == "runs"
+    capsys.readouterr()
+    assert main(["report", str(seeds), "--out", str(tmp_path / "r2"), "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["kind"] == "runs" and len(out["solutions"]) == 1
+    assert "best of seed-" in out["solutions"][0]
+    runs = _table(_tables(Path(out["index"])), "run-summary")
+    assert sorted(runs.run) == ["seed-1", "seed-2"]
+
+
+@pytest.fixture(scope="module")
+def sweep_dir(tmp_path_factory) -> Path:
+    out = tmp_path_factory.mktemp("sweep")
+    run_sweep(["Cat4", "Cat6"], [3.5, 4.0], out=out, generations=2, popsize=4, duration=0.3,
+              progress=False)
+    return out
+
+
+def test_report_of_a_sweep(sweep_dir, tmp_path):
+    assert predictive_kind(sweep_dir) == "sweep"
+    assert main(["report", str(sweep_dir), "--out", str(tmp_path / "r")]) == 0
+    index = tmp_path / "r" / "index.html"
+    html = index.read_text(encoding="utf-8")
+    results = pd.read_csv(sweep_dir / "results.csv")
+    for cat in ("Cat4", "Cat6"):
+        assert f"Predictive simulation: {cat} 3.5 m/s" in html
+        ran = results[(results.category == cat) & ~results.fell]
+        if len(ran):
+            top = ran.loc[ran.mean_speed.idxmax()]
+            assert f"{cat} {top.speed:g} m/s (highest speed that ran)" in html
+    assert "Blade categories: maximum speed and metabolic cost" in html
+    tables = _tables(index)
+    check = _table(tables, "recomputed-summary")
+    assert check["as in summary.csv (yes/no)"].all()  # re-simulation reproduces the sweep
+    cats = _table(tables, "per-category")
+    _units_everywhere(cats)
+    stored = pd.read_csv(sweep_dir / "summary.csv")
+    np.testing.assert_allclose(cats["maximum speed (m/s)"], stored.max_speed, rtol=1e-9)
+    cmp = _table(tables, "beside-seed-001")
+    six = cmp[(cmp.category == "Cat6") & (cmp.quantity == "maximum speed (m/s)")].iloc[0]
+    assert six["seed 001"] == 4.62 and six["source"].startswith("§3.2 A")
+    assert six["difference (%)"] == pytest.approx(
+        100 * (stored.set_index("category").max_speed["Cat6"] - 4.62) / 4.62)
+
+
+def test_sweep_report_opens_in_a_browser(sweep_dir, tmp_path):
+    from browser import chromium, figure_ok, inspect_page
+
+    binary = chromium()
+    rep = build_predictive_report(sweep_dir, tmp_path / "r", duration=0.5, progress=False)
+    figures, errors = inspect_page(binary, Path(rep.index), tmp_path / "shot.png",
+                                   tmp_path / "profile")
+    assert errors == []
+    assert len(figures) == 4 * len(rep.solutions) + 1
+    assert all(figure_ok(f) for f in figures)
+
+
+@pytest.mark.skipif(not (SOLUTIONS / "in_progress" / "able-3.5.json").is_file(),
+                    reason="no packaged able 3.5 m/s parameter file")
+def test_report_of_a_parameter_file(tmp_path):
+    src = SOLUTIONS / "in_progress" / "able-3.5.json"
+    rep = build_predictive_report(src, tmp_path / "r", duration=2.0, progress=False)
+    assert rep.kind == "parameters" and rep.simulations == 1
+    tables = _tables(Path(rep.index))
+    resim = _table(tables, "re-simulations").iloc[0]
+    # a running solution: 2 s without a fall near its 3.5 m/s, energy conserved (power balance)
+    assert not resim["fell (yes/no)"] and resim["simulated (s)"] == pytest.approx(2.0)
+    assert abs(resim["mean speed (m/s)"] - 3.5) < 0.3
+    assert resim["power-balance residual (%)"] < 2.0
+    st = _table(tables, "spatiotemporal")
+    contact = st[st.variable == "contact_time"]["value (s)"]
+    assert ((contact > 0.1) & (contact < 0.35)).all()  # running contact times (seed 001 §3.1)
+
+
+def test_bad_paths_exit_2_and_write_nothing(tmp_path, capsys):
+    (tmp_path / "notes.txt").write_text("hello")
+    (tmp_path / "other.json").write_text(json.dumps({"model": "able"}))
+    (tmp_path / "broken.json").write_text("{not json")
+    (tmp_path / "empty").mkdir()
+    before = sorted(p.relative_to(tmp_path) for p in tmp_path.rglob("*"))
+    for name in ("missing", "notes.txt", "other.json", "broken.json", "empty"):
+        capsys.readouterr()
+        assert main(["report", str(tmp_path / name)]) == 2, name
+        err = capsys.readouterr().err.strip().splitlines()
+        assert len(err) == 1 and err[0].startswith("error:"), err
+        assert name in err[0]
+    assert sorted(p.relative_to(tmp_path) for p in tmp_path.rglob("*")) == before
+    from bladelab.errors import InputFileError
+
+    with pytest.raises(InputFileError, match="not a predictive result"):
+        build_predictive_report(tmp_path / "empty")

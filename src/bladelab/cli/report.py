@@ -1,4 +1,4 @@
-"""``bladelab report STUDY_DIR``: the HTML study report."""
+"""``bladelab report PATH``: the HTML report of a study, design study or predictive result."""
 
 from __future__ import annotations
 
@@ -11,7 +11,9 @@ __all__ = ["register"]
 
 
 def _report(
-    study_dir: Path = typer.Argument(..., help="Study folder (study.yaml + results.sqlite)."),
+    study_dir: Path = typer.Argument(..., help="Study folder (study.yaml + results.sqlite), "
+                                     "design folder, 'bladelab predict' or 'bladelab sweep' "
+                                     "folder, or a runner parameter JSON file."),
     trial: str | None = typer.Option(None, "--trial", help="Trial of the cost landscape "
                                      "(default: the first identified trial)."),
     variant: str | None = typer.Option(None, "--variant", help="Model variant to report "
@@ -19,13 +21,26 @@ def _report(
     out: Path | None = typer.Option(None, "--out", help="Report folder (default STUDY_DIR/report)."),
     as_json: bool = typer.Option(False, "--json", help="Print the result as JSON."),
 ) -> None:
-    """Write STUDY_DIR/report/index.html: fits, K*/D*, mechanics, statistics, identifiability."""
+    """Write PATH/report/index.html: fits, K*/D*, mechanics, statistics, identifiability (a
+    study); surfaces and optimum (a design study); or the re-simulated predictive solutions."""
     from bladelab.errors import InputFileError
+    from bladelab.report.predictive import build_predictive_report, predictive_kind
     from bladelab.report.study import build_study_report
 
+    if study_dir.is_file() or (study_dir.is_dir() and predictive_kind(study_dir) is not None
+                               and not (study_dir / "study.yaml").is_file()):
+        if predictive_kind(study_dir) is None:
+            raise InputFileError("not a runner parameter file (no 'parameters' mapping)",
+                                 file=study_dir, hint="a file must be a parameter JSON file; "
+                                 "otherwise give a study, design, predict or sweep folder")
+        pres = build_predictive_report(study_dir, out, progress=not as_json)
+        typer.echo(json.dumps(pres.to_dict(), indent=2) if as_json
+                   else f"report written: {pres.index} ({len(pres.solutions)} solutions)")
+        return
     if not study_dir.is_dir():
-        raise InputFileError("no such study folder", file=study_dir,
-                             hint="give the folder that holds study.yaml")
+        raise InputFileError("no such study folder, predictive result or parameter file",
+                             file=study_dir, hint="give the folder that holds study.yaml, a "
+                             "'bladelab predict'/'sweep' folder or a parameter JSON file")
     from bladelab.report.design import build_design_report, is_design_folder
 
     if is_design_folder(study_dir):  # a 'bladelab design' folder (study.json from run_design)

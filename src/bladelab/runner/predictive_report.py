@@ -244,6 +244,7 @@ def _sweep_section(report, summary: pd.DataFrame, compare_seed: bool) -> None:
         tables=tables,
         text=text,
     )
+    plt.close(fig)
 
 
 def add_predictive_sections(
@@ -314,6 +315,8 @@ def add_predictive_sections(
                 ),
             ],
         )
+        for f in (fig, fig2, fig3, fig4):
+            plt.close(f)
     if len(results) > 1:
         rows_p, rows_e = [], []
         for label, res in results.items():

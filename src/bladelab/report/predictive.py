@@ -1,0 +1,456 @@
+"""The HTML report of predictive-running results (``bladelab report PATH``).
+
+``PATH`` is one of (:func:`predictive_kind`):
+
+- ``"run"``: a ``bladelab predict`` folder (``best.json`` and ``history.csv``);
+- ``"runs"``: a ``bladelab predict --seeds ...`` folder (``summary.json`` and ``seed-<n>/``);
+- ``"sweep"``: a ``bladelab sweep`` folder (``results.csv``, ``summary.csv``,
+  ``<category>/<speed>/best.json``);
+- ``"parameters"``: one parameter JSON file (keys ``model``, ``blade``, ``speed_m_per_s``,
+  ``settings`` {``dt``, ...}, ``parameters``).
+
+Nothing is taken from a stored evaluation: every solution is simulated again from its parameters
+(:func:`bladelab.runner.objective.simulate_controlled` with the file's time step). The sections
+shown (:func:`bladelab.runner.predictive_report.add_predictive_sections`) come from a
+``duration`` (10 s) re-simulation recorded every 2nd step. A run's cost terms are recomputed with
+the run's own objective settings (its duration, robust sampling) and set beside the stored best
+cost; a sweep's category summary is recomputed from every cell the same way.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+from tqdm import tqdm
+
+from bladelab.errors import InputFileError
+
+__all__ = ["PredictiveReport", "build_predictive_report", "predictive_kind"]
+
+_KINDS_HINT = (
+    "give a 'bladelab predict' folder (best.json + history.csv, or summary.json + seed-N/), "
+    "a 'bladelab sweep' folder (results.csv + summary.csv) or a parameter JSON file"
+)
+
+
+@dataclasses.dataclass(frozen=True)
+class PredictiveReport:
+    """What :func:`build_predictive_report` wrote."""
+
+    index: str
+    kind: str
+    solutions: tuple[str, ...]
+    simulations: int
+
+    def to_dict(self) -> dict:
+        return dataclasses.asdict(self) | {"solutions": list(self.solutions)}
+
+
+def predictive_kind(path: str | Path) -> str | None:
+    """``"run"``, ``"runs"``, ``"sweep"``, ``"parameters"`` or None (see module docstring)."""
+    p = Path(path)
+    if p.is_file():
+        if p.suffix.lower() != ".json":
+            return None
+        try:
+            data = json.loads(p.read_text(encoding="utf-8"))
+        except (OSError, ValueError):
+            return None
+        ok = isinstance(data, dict) and isinstance(data.get("parameters"), dict)
+        return "parameters" if ok else None
+    if not p.is_dir():
+        return None
+    if (p / "results.csv").is_file() and (p / "summary.csv").is_file():
+        if any(p.glob("*/*/best.json")):
+            return "sweep"
+    if (p / "best.json").is_file() and (p / "history.csv").is_file():
+        return "run"
+    if (p / "summary.json").is_file() and any(p.glob("seed-*/best.json")):
+        return "runs"
+    return None
+
+
+def _read_json(path: Path) -> dict:
+    try:
+        data = json.loads(path.read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        raise InputFileError("file not found", file=path) from None
+    except (OSError, ValueError) as err:
+        raise InputFileError(f"cannot read JSON ({err})", file=path) from None
+    if not isinstance(data, dict) or not isinstance(data.get("parameters"), dict):
+        raise InputFileError("expected a parameter file with a 'parameters' mapping", file=path)
+    return data
+
+
+@dataclasses.dataclass
+class _Solution:
+    """A parameter file, its model and settings, and its simulations (cached)."""
+
+    path: Path
+    data: dict
+    model: object = None
+    layout: object = None
+    x: np.ndarray | None = None
+
+    def __post_init__(self) -> None:
+        from bladelab.runner.controller import read_parameters
+        from bladelab.runner.predict import _model
+
+        kind = self.data.get("model", "able")
+        if kind not in ("able", "amputee"):
+            raise InputFileError(f"unknown model {kind!r}", file=self.path, where="model")
+        blade = self.data.get("blade") or ("Cat6" if kind == "amputee" else None)
+        self.model, self.layout = _model(kind, blade)
+        self.x = read_parameters(self.path, self.layout)
+
+    @property
+    def kind(self) -> str:
+        return self.data.get("model", "able")
+
+    @property
+    def blade(self) -> str | None:
+        return self.data.get("blade") if self.kind == "amputee" else None
+
+    @property
+    def speed(self) -> float:
+        s = self.data.get("speed_m_per_s", self.data.get("settings", {}).get("speed", 3.5))
+        return float(s)
+
+    def settings(self, duration: float | None = None, *, nominal: bool = False):
+        """The run's objective settings (unknown keys dropped), optionally another duration."""
+        from bladelab.runner.objective import ObjectiveSettings
+        from bladelab.runner.predict import _settings_from_dict
+
+        known = {f.name for f in dataclasses.fields(ObjectiveSettings)}
+        d = {k: v for k, v in (self.data.get("settings") or {}).items() if k in known}
+        d["speed"] = self.speed
+        if duration is not None:
+            d["duration"] = float(duration)
+        if nominal:
+            d["robust_samples"] = 1
+        return _settings_from_dict(d)
+
+    def simulate(self, duration: float | None = None):
+        """(Evaluation, RunnerResult) of a nominal simulation recorded every 2nd step."""
+        from bladelab.runner.objective import simulate_controlled
+
+        s = self.settings(duration, nominal=True)
+        return simulate_controlled(self.model, self.x, layout=self.layout, settings=s,
+                                   record_every=2)
+
+    def evaluate(self, nominal_ev):
+        """The evaluation as the optimiser computed it (robust mean where the run used it)."""
+        from bladelab.runner.predict import _robust
+
+        s = self.settings()
+        if s.robust_samples > 1:
+            return _robust(nominal_ev, self.model, self.x, self.layout, s)
+        return nominal_ev
+
+    def label(self) -> str:
+        who = "able-bodied" if self.kind == "able" else f"amputee {self.blade}"
+        return f"{who} {self.speed:g} m/s"
+
+
+class _Counter:
+    """A progress bar that also counts (a disabled tqdm does not)."""
+
+    def __init__(self, bar) -> None:
+        self.bar, self.count = bar, 0
+
+    def update(self) -> None:
+        self.count += 1
+        self.bar.update()
+
+    def __enter__(self) -> _Counter:
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.bar.close()
+
+
+def _close(a: float, b: float) -> bool:
+    if not (math.isfinite(a) and math.isfinite(b)):
+        return math.isnan(a) and math.isnan(b)
+    return bool(np.isclose(a, b, rtol=1e-9, atol=1e-12))
+
+
+def _resim_row(label: str, sol: _Solution, ev, res) -> dict:
+    from bladelab.runner.analyses import power_balance_residual_pct
+
+    return {
+        "solution": label,
+        "time step (s)": sol.settings().dt,
+        "simulated (s)": ev.duration,
+        "fell (yes/no)": bool(ev.fell),
+        "prescribed speed (m/s)": sol.speed,
+        "mean speed (m/s)": ev.mean_speed,
+        "cost (–)": ev.cost,
+        "J_cot (J/(kg·m))": ev.j_cot,
+        "power-balance residual (%)": power_balance_residual_pct(res),
+    }
+
+
+def _convergence_figure(histories: dict[str, pd.DataFrame]):
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(8, 3.5))
+    positive = True
+    for name, h in histories.items():
+        tag = f"{name}: " if len(histories) > 1 else ""
+        ax.plot(h.generation, h.best, label=f"{tag}best")
+        ax.plot(h.generation, h["median"], "--", alpha=0.7, label=f"{tag}generation median")
+        positive = positive and bool((h[["best", "median"]].to_numpy() > 0).all())
+    if positive:
+        ax.set_yscale("log")
+    else:
+        ax.set_yscale("symlog")
+    ax.set_xlabel("generation")
+    ax.set_ylabel("cost J (–)")
+    ax.legend(fontsize=7)
+    return fig
+
+
+def _read_history(folder: Path) -> pd.DataFrame:
+    path = folder / "history.csv"
+    try:
+        h = pd.read_csv(path)
+    except (OSError, ValueError) as err:
+        raise InputFileError(f"cannot read the history ({err})", file=path) from None
+    missing = {"generation", "evaluations", "best", "median"} - set(h.columns)
+    if missing:
+        raise InputFileError(f"history lacks column(s) {', '.join(sorted(missing))}", file=path)
+    return h
+
+
+def _run_sections(report, folders: dict[str, Path], duration: float, bar) -> tuple[dict, list]:
+    """Convergence + run summary sections; returns ({label: result}, re-simulation rows)."""
+    histories, rows, sols = {}, [], {}
+    for name, folder in folders.items():
+        histories[name] = _read_history(folder)
+        sol = _Solution(folder / "best.json", _read_json(folder / "best.json"))
+        ev0, _ = sol.simulate()  # the run's own settings (duration, dt)
+        bar.update()
+        ev = sol.evaluate(ev0)
+        stored = (sol.data.get("evaluation") or {}).get("cost", math.nan)
+        wall = sol.data.get("wall_time_s")
+        rows.append({
+            "run": name,
+            "seed (–)": sol.data.get("seed"),
+            "generations (count)": sol.data.get("generation"),
+            "evaluations (count)": sol.data.get("evaluations"),
+            "wall time (s)": math.nan if wall is None else float(wall),
+            "stored best cost (–)": float(stored),
+            "recomputed cost (–)": ev.cost,
+            "stored cost reproduced (yes/no)": _close(ev.cost, float(stored)),
+            "J_cot (J/(kg·m))": ev.j_cot,
+            "J_gait (–)": ev.j_gait,
+            "J_inj (N·m)": ev.j_inj,
+            "J_lean (deg)": ev.j_lean,
+            "fell (yes/no)": bool(ev.fell),
+            "simulated (s)": ev.duration,
+            "mean speed (m/s)": ev.mean_speed,
+        })
+        sols[name] = (sol, ev.cost)
+    table = pd.DataFrame(rows)
+    import matplotlib.pyplot as plt
+
+    fig = _convergence_figure(histories)
+    report.add_section(
+        "Optimisation: convergence and run summary",
+        figures=[("Best and generation-median cost per generation (log scale)", fig)],
+        tables=[("Run summary: the best solution re-evaluated with the run's own settings",
+                 table)],
+        text=("Every cost term is recomputed from best.json's parameters with the run's objective "
+              "settings (simulated time, time step, robust sampling) and set beside the cost the "
+              "optimiser stored. Wall time: elapsed time of the optimisation summed over resumes "
+              "(blank for runs written before it was recorded)."),
+    )
+    plt.close(fig)
+    name = min(sols, key=lambda n: sols[n][1])
+    sol = sols[name][0]
+    ev, res = sol.simulate(duration)
+    bar.update()
+    label = f"{sol.label()} (best of {name})" if len(folders) > 1 else sol.label()
+    return {label: res}, [_resim_row(label, sol, ev, res)]
+
+
+def _sweep_cells(folder: Path) -> list[tuple[str, float, Path]]:
+    try:
+        res = pd.read_csv(folder / "results.csv")
+        order = list(dict.fromkeys(res.category.astype(str)))
+    except (OSError, ValueError, AttributeError) as err:
+        raise InputFileError(f"cannot read the sweep results ({err})",
+                             file=folder / "results.csv") from None
+    cells = []
+    for cat_dir in sorted(p for p in folder.iterdir() if p.is_dir()):
+        for cell in cat_dir.iterdir():
+            if (cell / "best.json").is_file():
+                try:
+                    speed = float(cell.name)
+                except ValueError:
+                    continue
+                cells.append((cat_dir.name, speed, cell))
+    rank = {c: i for i, c in enumerate(order)}
+    cells.sort(key=lambda c: (rank.get(c[0], len(rank)), c[0], c[1]))
+    return cells
+
+
+def _sweep_sections(report, folder: Path, duration: float, bar) -> tuple[dict, list, pd.DataFrame]:
+    from bladelab.runner.analyses import spatiotemporal
+    from bladelab.runner.sweep import summarise
+
+    cells = _sweep_cells(folder)
+    rows, sims = [], {}
+    for cat, speed, cell in cells:
+        sol = _Solution(cell / "best.json", _read_json(cell / "best.json"))
+        ev0, res = sol.simulate()
+        bar.update()
+        ev = sol.evaluate(ev0)
+        st = spatiotemporal(res)
+        ct = {f"contact_time_{leg}": st.value[(st.leg == leg)
+                                             & (st.variable == "contact_time")].iloc[0]
+              for leg in ("intact", "prosthetic")}
+        rows.append({"category": cat, "speed": speed, **ev.to_dict(), **ct})
+        sims[(cat, speed)] = (sol, ev0, res)
+    results = pd.DataFrame(rows)
+    summary = summarise(results)
+    try:
+        stored = pd.read_csv(folder / "summary.csv").set_index("category")
+    except (OSError, ValueError, KeyError):
+        stored = pd.DataFrame()
+    same = []
+    for r in summary.itertuples(index=False):
+        ok = r.category in stored.index and all(
+            _close(float(getattr(r, q)), float(stored.loc[r.category, q]))
+            for q in ("max_speed", "cot_4", "contact_time_intact", "contact_time_prosthetic")
+            if q in stored.columns)
+        same.append(bool(ok))
+    check = summary[["category"]].assign(**{"as in summary.csv (yes/no)": same})
+    report.add_section(
+        "Sweep: recomputed cells",
+        text=("Every cell's best.json is simulated again with the cell's own settings; the "
+              "category summary below comes from these simulations, not from results.csv. "
+              "'as in summary.csv' checks its maximum speed, cost at 4 m/s and contact times "
+              "against the sweep's own table."),
+        tables=[("Cells re-evaluated with their own settings",
+                 results.rename(columns={
+                     "speed": "prescribed speed (m/s)", "cost": "cost (–)",
+                     "j_cot": "J_cot (J/(kg·m))", "j_gait": "J_gait (–)", "j_inj": "J_inj (N·m)",
+                     "j_lean": "J_lean (deg)", "fell": "fell (yes/no)",
+                     "duration": "simulated (s)", "distance": "distance (m)",
+                     "mean_speed": "mean speed (m/s)", "metabolic_energy": "metabolic energy (J)",
+                     "n_steps": "steps (count)",
+                     "contact_time_intact": "intact contact time (s)",
+                     "contact_time_prosthetic": "prosthetic contact time (s)"})),
+                ("Recomputed summary against the stored one", check)],
+    )
+    shown, resim = {}, []
+    for cat in dict.fromkeys(c for c, _, _ in cells):
+        mine = results[results.category == cat]
+        ran = mine[~mine.fell.astype(bool)]
+        picks = []
+        if len(ran):
+            top = ran.loc[ran.mean_speed.idxmax()]
+            picks.append((float(top.speed), "highest speed that ran"))
+        at35 = mine[np.isclose(mine.speed, 3.5)]
+        if len(at35) and not any(np.isclose(p[0], 3.5) for p in picks):
+            picks.append((3.5, ""))
+        for speed, note in picks:
+            sol, ev0, res0 = sims[(cat, speed)]
+            if math.isclose(sol.settings().duration, duration):
+                ev, res = ev0, res0
+            else:
+                ev, res = sol.simulate(duration)
+                bar.update()
+            label = f"{cat} {speed:g} m/s" + (f" ({note})" if note else "")
+            shown[label] = res
+            resim.append(_resim_row(label, sol, ev, res))
+    return shown, resim, summary
+
+
+def build_predictive_report(
+    path: str | Path,
+    out_dir: str | Path | None = None,
+    *,
+    duration: float = 10.0,
+    progress: bool = True,
+) -> PredictiveReport:
+    """Write the HTML report of a predictive result (see the module docstring).
+
+    Parameters
+    ----------
+    path
+        A ``bladelab predict`` or ``bladelab sweep`` folder, or a parameter JSON file.
+    out_dir
+        Report folder; default ``path/report`` (a file: ``<stem>-report`` beside it).
+    duration
+        Simulated time [s] of the re-simulations shown in the sections.
+    progress
+        Show a progress bar while simulating.
+
+    Raises
+    ------
+    InputFileError
+        ``path`` is none of the kinds above, or one of its files cannot be read. Nothing is
+        written then.
+    """
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from bladelab.report.builder import Report
+    from bladelab.runner.predictive_report import add_predictive_sections
+
+    path = Path(path)
+    kind = predictive_kind(path)
+    if kind is None:
+        raise InputFileError("not a predictive result", file=path, hint=_KINDS_HINT)
+    if out_dir is None:
+        out_dir = path.parent / f"{path.stem}-report" if kind == "parameters" else path / "report"
+    titles = {"run": "Predictive running: optimisation", "runs": "Predictive running: runs",
+              "sweep": "Predictive running: blade-category sweep",
+              "parameters": "Predictive running: solution"}
+    rep = Report(titles[kind], subtitle=str(path))
+    sweep_summary = None
+    with _Counter(tqdm(desc="re-simulating", unit="sim", disable=not progress)) as bar:
+        if kind == "parameters":
+            sol = _Solution(path, _read_json(path))
+            ev, res = sol.simulate(duration)
+            bar.update()
+            results = {sol.label(): res}
+            resim = [_resim_row(sol.label(), sol, ev, res)]
+            settings = sol.data.get("settings") or {}
+            seed = sol.data.get("seed")
+        elif kind in ("run", "runs"):
+            if kind == "run":
+                folders = {path.name: path}
+            else:
+                folders = {p.name: p for p in sorted(path.glob("seed-*"))
+                           if (p / "best.json").is_file()}
+            results, resim = _run_sections(rep, folders, duration, bar)
+            first = _read_json(next(iter(folders.values())) / "best.json")
+            settings, seed = first.get("settings") or {}, first.get("seed")
+        else:
+            results, resim, sweep_summary = _sweep_sections(rep, path, duration, bar)
+            cells = _sweep_cells(path)
+            first = _read_json(cells[0][2] / "best.json") if cells else {}
+            settings, seed = first.get("settings") or {}, first.get("seed")
+    rep.add_section(
+        "Re-simulation of the solutions shown",
+        text=(f"Each solution below is simulated again from its parameters for {duration:g} s "
+              "with the time step it was optimised with; nothing is taken from a stored "
+              "evaluation. Power-balance residual: RMS of external minus kinetic power in % of "
+              "the peak kinetic power."),
+        tables=[("Re-simulations", pd.DataFrame(resim))],
+    )
+    add_predictive_sections(rep, results, sweep_summary=sweep_summary)
+    rep.settings = {"source": str(path), "kind": kind, "resimulated_s": duration,
+                    "objective": settings}
+    rep.seed = seed
+    index = rep.write(Path(out_dir))
+    return PredictiveReport(str(index), kind, tuple(results), bar.count)
