@@ -134,3 +134,26 @@ def test_report_has_the_trends_section(tmp_path):
     html = index.read_text(encoding="utf-8")
     assert "Seed 002 trends" in html and "does not hold" in html
     assert "a point mass on a spring leg" in html  # the blade evaluator's stiffness reason
+
+
+def test_shipped_example_trends_hold_or_are_explained(tmp_path):
+    """The demo's design example (25-run CCD, blade evaluator): every seed 002 trend holds or
+    the report gives the blade evaluator's known reason (never 'not explained')."""
+    from bladelab.demo import design_example
+    from bladelab.report.design import design_report_sections
+
+    report, lines = design_example(tmp_path / "design-study")
+    assert report.is_file() and "Seed 002 trends" in report.read_text(encoding="utf-8")
+    assert any("seed 002 trends" in line for line in lines)
+    section = next(s for s in design_report_sections(tmp_path / "design-study")
+                   if s["title"] == "Seed 002 trends")
+    table = section["tables"][0][1]
+    assert len(table) == len(SEED002_TRENDS)
+    for _, row in table.iterrows():
+        assert row["verdict"] in ("holds", "does not hold"), row["trend"]
+        if row["verdict"] == "does not hold":
+            assert row["reason"] and row["reason"] != NOT_EXPLAINED, row["trend"]
+    # the geometric toe trends of the blade evaluator hold
+    verdicts = dict(zip(table["trend"], table["verdict"], strict=True))
+    assert verdicts["longer toe lowers swing clearance"] == "holds"
+    assert verdicts["shorter toe lowers the knee extension margin"] == "holds"

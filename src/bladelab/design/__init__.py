@@ -57,6 +57,7 @@ from bladelab.design.space import DesignSpace, Factor, default_design_space
 from bladelab.design.study import DesignStudyResult, run_design
 from bladelab.design.surfaces import ResponseSurface, SurfacePrediction, fit_surface
 from bladelab.design.terms import model_terms, parse_terms
+from bladelab.design.trends import SEED002_TRENDS, TrendVerdict, evaluate_trends, trends_frame
 
 __all__ = [
     "BladeEvaluator",
@@ -72,9 +73,11 @@ __all__ = [
     "KneeBucklingResult",
     "OptimumResult",
     "ResponseSurface",
+    "SEED002_TRENDS",
     "StancePerformance",
     "SurfaceConstraint",
     "SurfacePrediction",
+    "TrendVerdict",
     "blade_clearance",
     "bouncing_ball",
     "box_behnken",
@@ -85,6 +88,7 @@ __all__ = [
     "d_optimal",
     "default_design_space",
     "estimability",
+    "evaluate_trends",
     "fit_surface",
     "generate_blade",
     "knee_buckling",
@@ -100,5 +104,6 @@ __all__ = [
     "run_design",
     "stance_performance",
     "swing_clearance",
+    "trends_frame",
     "vertical_stiffness",
 ]

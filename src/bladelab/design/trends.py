@@ -127,9 +127,10 @@ TREND_REASONS: dict[tuple[str, str], str] = {
         "and contact stiffness, which barely affect the cycle; in seed 002 width also changed "
         "the bending-stiffness distribution and the contact area."),
     ("runner", "height_toe_matter_less"): (
-        "Δv_x over an open-loop cycle is not predictive (see the stiffness trend), so effect "
-        "sizes on it are noise; toe length dominates the knee moment and the contact time "
-        "instead."),
+        "Under fixed (open-loop) joint angles toe length moves the contact point and the timing "
+        "of touch-down, so it changes Δv_x about as much as stiffness, while at a fixed target "
+        "stiffness width barely matters (see the width trend); on the template cycle Δv_x is "
+        "not even predictive. Toe length also dominates the knee moment and contact time."),
     ("runner", "shorter_toe_lowers_knee_margin"): (
         "The passive knee (no stance lock) yields: after the sliding touch-down the GRF line "
         "settles through the knee axis, so the minimum moment is set by the touch-down "
