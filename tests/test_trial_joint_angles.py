@@ -132,3 +132,14 @@ def test_marker_map_yaml(tmp_path):
         load_joint_marker_map(path)
     with pytest.raises(InputFileError):
         load_joint_marker_map(tmp_path / "none.yaml")
+
+
+def test_side_without_foot_markers_has_no_ankle(trials):
+    """An amputee's prosthetic side: no foot roles, contact from other markers."""
+    run, static = trials
+    m = JointMarkerMap(right={"foot_anterior": (), "foot_posterior": (),
+                              "contact": ("R.Shank.Bottom.Lateral",)})
+    ja = sagittal_angles(run, markers=m, static=static)
+    assert "ankle_right" not in ja.angles and "ankle_left" in ja.angles
+    full = sagittal_angles(run, static=static)
+    np.testing.assert_allclose(ja.angles["knee_right"], full.angles["knee_right"])
