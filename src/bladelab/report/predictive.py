@@ -213,6 +213,7 @@ def _convergence_figure(histories: dict[str, pd.DataFrame]):
     ax.set_xlabel("generation")
     ax.set_ylabel("cost J (–)")
     ax.legend(fontsize=7)
+    fig.tight_layout()
     return fig
 
 

@@ -223,7 +223,10 @@ def _sweep_section(report, summary: pd.DataFrame, compare_seed: bool) -> None:
             ax.plot(xs, vals, "k_", markersize=22, mew=2, label="seed 001")
         ax.set_xticks(xs, cats)
         ax.set_ylabel(SUMMARY_LABELS[q])
-        ax.legend(fontsize=7)
+        top = ax.get_ylim()[1]
+        ax.set_ylim(0, top * 1.25 if np.isfinite(top) and top > 0 else 1.0)
+        ax.legend(fontsize=7, loc="upper center", ncol=2)
+    fig.tight_layout()
     tables = [(
         "Per category: maximum speed, metabolic cost at 4 m/s, 200 m and 400 m times "
         "(Table 3.1) and contact times at maximum speed",
@@ -283,8 +286,11 @@ def add_predictive_sections(
         st = spatiotemporal(res)
         fig3, ax3 = plt.subplots(figsize=(7, 3))
         piv = st.pivot(index="variable", columns="leg", values="value")
-        piv.plot.bar(ax=ax3)
-        ax3.set_ylabel("time (s)")
+        piv = piv.reindex([v for v in st.variable.unique() if v in piv.index])[list(names)]
+        piv.index = [v.replace("_time", "") for v in piv.index]
+        piv.plot.bar(ax=ax3, rot=0)
+        ax3.set_xlabel("")
+        ax3.set_ylabel("mean time (s)")
         pw = joint_powers(res)
         fig4, ax4 = plt.subplots(figsize=(8, 3))
         for joint, df in pw.groupby("joint", sort=False):
@@ -292,6 +298,8 @@ def add_predictive_sections(
         ax4.set_xlabel("time (s)")
         ax4.set_ylabel("power (W/kg)")
         ax4.legend(fontsize=7, ncol=2)
+        for f in (fig, fig2, fig3, fig4):
+            f.tight_layout()
         report.add_section(
             f"Predictive simulation: {label}",
             figures=[
