@@ -23,6 +23,7 @@ from numba import njit, types
 from numba.extending import intrinsic
 
 from bladelab.contact import hunt_crossley_force, smooth_spring_damper_force
+from bladelab.runner.closed_loop import control_step
 from bladelab.runner.model import (
     CP_AZ,
     CP_BODY,
@@ -126,35 +127,18 @@ def _add_point_force(xfrc, xipos, body, px, py, pz, fx, fy, fz):
 
 
 @njit(cache=True)
-def forces_oriented(
-    qpos,
-    qvel,
-    site_xpos,
-    site_xmat,
-    cvel,
-    root_com,
-    xipos,
-    xfrc,
-    qfrc,
-    mp,
-    ms,
-    mtu,
-    seg_u,
-    u,
-    path,
-    pstart,
-    cp,
-    cstate,
-    jp,
-    crec,
-    lig,
-    dt,
-):
+def forces(mj, arrays, root_com, dt):
     """Muscles, ligaments and contacts for one step; writes ``xfrc`` and ``qfrc``.
 
+    ``mj`` = (qpos, qvel, site_xpos, site_xmat, cvel, subtree_com, xipos, xfrc, qfrc): live
+    views of MuJoCo's buffers (:func:`mujoco_views`); ``arrays`` = (mp, ms, mtu, seg_u, u, path,
+    pstart, cp, cstate, jp, crec, lig): the model's parameters and the force state
+    (:func:`force_arrays`); ``root_com`` the root subtree's COM [m] (MuJoCo's ``cvel`` origin).
     ``site_xmat`` (n_site, 9) orients ellipse contacts; an empty (0, 9) array treats every
     contact as a sphere (lowest point straight below the site).
     """
+    qpos, qvel, site_xpos, site_xmat, cvel, _, xipos, xfrc, qfrc = mj
+    mp, ms, mtu, seg_u, u, path, pstart, cp, cstate, jp, crec, lig = arrays
     xfrc[:, :] = 0.0
     path_kinematics(site_xpos, cvel, root_com, path, pstart, mtu, seg_u)
     muscle_step(mp, ms, mtu[:, 0], u, dt)
@@ -253,153 +237,69 @@ def forces_oriented(
         crec[c, 6] = depth if depth > 0.0 else 0.0
 
 
-# An empty site-orientation array: every contact is a sphere. A global, so numba freezes it as
-# a constant instead of allocating it on every step of the hot loop.
-_SPHERES_ONLY = np.zeros((0, 9))
-
-
 @njit(cache=True)
-def forces(
-    qpos,
-    qvel,
-    site_xpos,
-    cvel,
-    root_com,
-    xipos,
-    xfrc,
-    qfrc,
-    mp,
-    ms,
-    mtu,
-    seg_u,
-    u,
-    path,
-    pstart,
-    cp,
-    cstate,
-    jp,
-    crec,
-    lig,
-    dt,
-):
-    """:func:`forces_oriented` for sphere contacts only (the original signature, kept for
-    callers such as ``runner.objective``; ellipse soles of a multi-link blade need
-    :func:`forces_oriented`)."""
-    forces_oriented(
-        qpos,
-        qvel,
-        site_xpos,
-        _SPHERES_ONLY,
-        cvel,
-        root_com,
-        xipos,
-        xfrc,
-        qfrc,
-        mp,
-        ms,
-        mtu,
-        seg_u,
-        u,
-        path,
-        pstart,
-        cp,
-        cstate,
-        jp,
-        crec,
-        lig,
-        dt,
-    )
+def record_sample(rec, i, t, mj, arrays):
+    """Store sample ``i`` at time ``t`` [s] in ``rec`` = (t, qpos, qvel, muscles, mtu,
+    excitation, contacts, ligament) arrays (:class:`bladelab.runner.simulate.Recording`)."""
+    rec_t, rec_q, rec_v, rec_ms, rec_mtu, rec_u, rec_c, rec_l = rec
+    _, ms, mtu, _, u, _, _, _, _, _, crec, lig = arrays
+    rec_t[i] = t
+    rec_q[i, :] = mj[0]
+    rec_v[i, :] = mj[1]
+    rec_ms[i, :, :] = ms
+    rec_mtu[i, :, :] = mtu
+    rec_u[i, :] = u
+    rec_c[i, :, :] = crec
+    rec_l[i, :] = lig
 
 
 @njit(cache=True)
 def run_loop(
-    f1,
-    f2,
-    mptr,
-    dptr,
-    n_steps,
-    record_every,
-    dt,
-    iz,
-    fall_height,
-    qpos,
-    qvel,
-    site_xpos,
-    site_xmat,
-    cvel,
-    subtree_com,
-    xipos,
-    xfrc,
-    qfrc,
-    mp,
-    ms,
-    mtu,
-    seg_u,
-    u,
-    path,
-    pstart,
-    cp,
-    cstate,
-    jp,
-    crec,
-    lig,
-    rec_t,
-    rec_q,
-    rec_v,
-    rec_ms,
-    rec_mtu,
-    rec_u,
-    rec_c,
-    rec_l,
+    f1, f2, mptr, dptr, n_steps, record_every, dt, iz, fall_height, mj, arrays, rec, control
 ):
-    """The time loop with constant excitations, entirely in compiled code.
+    """The whole time loop in compiled code, MuJoCo's C ``mj_step1``/``mj_step2`` called directly.
 
-    Returns (number of samples recorded, fell).
+    ``control``: None for constant excitations, or the reflex controller's arrays
+    (:func:`bladelab.runner.closed_loop.control_step`, called before the forces of every step).
+    Stops after ``n_steps`` or once the pelvis height ``qpos[iz]`` is below ``fall_height`` [m]
+    (or NaN). Returns (last step, samples recorded, fell).
     """
+    qpos = mj[0]
+    subtree_com = mj[5]
     root_com = np.zeros(3)
     k_rec = 0
+    k = 0
     for k in range(n_steps + 1):
         _call_mj(f1, mptr, dptr)
         root_com[0] = subtree_com[1, 0]
         root_com[1] = subtree_com[1, 1]
         root_com[2] = subtree_com[1, 2]
-        forces_oriented(
-            qpos,
-            qvel,
-            site_xpos,
-            site_xmat,
-            cvel,
-            root_com,
-            xipos,
-            xfrc,
-            qfrc,
-            mp,
-            ms,
-            mtu,
-            seg_u,
-            u,
-            path,
-            pstart,
-            cp,
-            cstate,
-            jp,
-            crec,
-            lig,
-            dt,
-        )
+        if control is not None:
+            control_step(k, dt, mj, arrays, control)
+        forces(mj, arrays, root_com, dt)
         if k % record_every == 0:
-            rec_t[k_rec] = k * dt
-            rec_q[k_rec, :] = qpos
-            rec_v[k_rec, :] = qvel
-            rec_ms[k_rec, :, :] = ms
-            rec_mtu[k_rec, :, :] = mtu
-            rec_u[k_rec, :] = u
-            rec_c[k_rec, :, :] = crec
-            rec_l[k_rec, :] = lig
+            record_sample(rec, k_rec, k * dt, mj, arrays)
             k_rec += 1
         if not qpos[iz] >= fall_height:  # also catches NaN
-            return k_rec, True
+            return k, k_rec, True
         if k == n_steps:
             break
         _call_mj(f2, mptr, dptr)
-    return k_rec, False
+    return k, k_rec, False
+
+
+def mujoco_views(d: mujoco.MjData, *, oriented: bool = True) -> tuple:
+    """The live MuJoCo buffers :func:`forces` reads and writes, as its ``mj`` tuple
+    (``oriented=False``: every contact a sphere)."""
+    xmat = d.site_xmat if oriented else np.zeros((0, 9))
+    return (
+        d.qpos,
+        d.qvel,
+        d.site_xpos,
+        xmat,
+        d.cvel,
+        d.subtree_com,
+        d.xipos,
+        d.xfrc_applied,
+        d.qfrc_applied,
+    )

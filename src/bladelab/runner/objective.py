@@ -28,22 +28,18 @@ from dataclasses import asdict, dataclass
 
 import mujoco
 import numpy as np
-from numba import njit
 
 from bladelab.errors import SimulationError
 from bladelab.runner.controller import (
     ControllerLayout,
-    compute_excitations,
     controller_layout,
     history_length,
-    push_sensors,
-    update_gait_states,
 )
-from bladelab.runner.kernel import _call_mj, _mujoco_step_addresses, forces, path_kinematics
-from bladelab.runner.metabolics import metabolic_params, total_metabolic_rate
+from bladelab.runner.kernel import _mujoco_step_addresses, mujoco_views, path_kinematics, run_loop
+from bladelab.runner.metabolics import metabolic_params
 from bladelab.runner.model import DEFAULT_DT, RunnerModel
 from bladelab.runner.muscle import equilibrium_fiber_length
-from bladelab.runner.simulate import RunnerResult, initial_qpos
+from bladelab.runner.simulate import Recording, RunnerResult, initial_qpos
 
 DEFAULT_PREDICT_DT = DEFAULT_DT
 MAX_TOUCHDOWNS = 400
@@ -93,69 +89,6 @@ class Evaluation:
         return {k: (float(v) if isinstance(v, float) else v) for k, v in asdict(self).items()}
 
 
-@njit(cache=True)
-def _control_and_measure(
-    k,
-    dt,
-    u,
-    table,
-    p,
-    hist,
-    cs,
-    ms,
-    mp,
-    mb,
-    qpos,
-    qvel,
-    crec,
-    cp,
-    lig,
-    ix,
-    thresholds,
-    body_weight,
-    body_mass,
-    leg_length,
-    acc,
-    td,
-    knee_idx,
-    itilt,
-    ranges,
-    pen,
-):
-    """Controller step plus the objective's running sums (``acc``: energy [J], knee penalty·s,
-    tilt penalty·s, number of touch-downs)."""
-    nm = ms.shape[0]
-    nq = qpos.shape[0]
-    push_sensors(hist, cs, ms, mp, qpos, qvel)
-    s0, s1 = cs[0], cs[1]
-    update_gait_states(cs, crec, cp, qpos, ix, body_weight, thresholds, leg_length)
-    for leg in range(2):
-        old = s0 if leg == 0 else s1
-        if cs[leg] == 0.0 and old >= 3.0:  # swing/landing -> early stance: touch-down
-            n = int(acc[3])
-            if n < td.shape[0]:
-                td[n, 0] = k * dt
-                td[n, 1] = qpos[ix]
-                acc[3] += 1.0
-    compute_excitations(u, table, p, hist, cs, nm, nq)
-    acc[0] += total_metabolic_rate(u, ms, mp, mb, body_mass) * dt
-    for j in range(knee_idx.shape[0]):
-        tau = lig[knee_idx[j]]
-        err = 0.0
-        if tau < ranges[0]:
-            err = ranges[0] - tau
-        elif tau > ranges[1]:
-            err = tau - ranges[1]
-        acc[1] += (pen[0] * err + pen[1] * err * err) * dt
-    tilt = qpos[itilt] * 180.0 / math.pi
-    err = 0.0
-    if tilt < ranges[2]:
-        err = ranges[2] - tilt
-    elif tilt > ranges[3]:
-        err = tilt - ranges[3]
-    acc[2] += (pen[0] * err + pen[1] * err * err) * dt
-
-
 _ADDRESSES: tuple[int, int] | None = None
 
 
@@ -164,142 +97,6 @@ def _step_addresses() -> tuple[int, int]:
     if _ADDRESSES is None:
         _ADDRESSES = _mujoco_step_addresses()
     return _ADDRESSES
-
-
-@njit(cache=True)
-def _run_controlled(
-    f1,
-    f2,
-    mptr,
-    dptr,
-    n_steps,
-    record_every,
-    dt,
-    iz,
-    fall_height,
-    qpos,
-    qvel,
-    site_xpos,
-    cvel,
-    subtree_com,
-    xipos,
-    xfrc,
-    qfrc,
-    mp,
-    ms,
-    mtu,
-    seg_u,
-    u,
-    path,
-    pstart,
-    cp,
-    cstate,
-    jp,
-    crec,
-    lig,
-    table,
-    p,
-    hist,
-    cs,
-    mb,
-    ix,
-    thresholds,
-    body_weight,
-    body_mass,
-    leg_length,
-    acc,
-    td,
-    knee_idx,
-    itilt,
-    ranges,
-    pen,
-    rec_t,
-    rec_q,
-    rec_v,
-    rec_ms,
-    rec_mtu,
-    rec_u,
-    rec_c,
-    rec_l,
-):
-    """The closed-loop time loop, entirely compiled (MuJoCo's C step called directly).
-
-    Returns (last step, samples recorded, fell)."""
-    root_com = np.zeros(3)
-    k_rec = 0
-    k = 0
-    for k in range(n_steps + 1):
-        _call_mj(f1, mptr, dptr)
-        root_com[0] = subtree_com[1, 0]
-        root_com[1] = subtree_com[1, 1]
-        root_com[2] = subtree_com[1, 2]
-        _control_and_measure(
-            k,
-            dt,
-            u,
-            table,
-            p,
-            hist,
-            cs,
-            ms,
-            mp,
-            mb,
-            qpos,
-            qvel,
-            crec,
-            cp,
-            lig,
-            ix,
-            thresholds,
-            body_weight,
-            body_mass,
-            leg_length,
-            acc,
-            td,
-            knee_idx,
-            itilt,
-            ranges,
-            pen,
-        )
-        forces(
-            qpos,
-            qvel,
-            site_xpos,
-            cvel,
-            root_com,
-            xipos,
-            xfrc,
-            qfrc,
-            mp,
-            ms,
-            mtu,
-            seg_u,
-            u,
-            path,
-            pstart,
-            cp,
-            cstate,
-            jp,
-            crec,
-            lig,
-            dt,
-        )
-        if k % record_every == 0:
-            rec_t[k_rec] = k * dt
-            rec_q[k_rec, :] = qpos
-            rec_v[k_rec, :] = qvel
-            rec_ms[k_rec, :, :] = ms
-            rec_mtu[k_rec, :, :] = mtu
-            rec_u[k_rec, :] = u
-            rec_c[k_rec, :, :] = crec
-            rec_l[k_rec, :] = lig
-            k_rec += 1
-        if not qpos[iz] >= fall_height:  # also catches NaN
-            return k, k_rec, True
-        if k == n_steps:
-            break
-        _call_mj(f2, mptr, dptr)
-    return k, k_rec, False
 
 
 def initial_state(
@@ -400,38 +197,10 @@ def simulate_controlled(
     bw, mass = model.body_weight, model.total_mass
     n_steps = int(round(settings.duration / dt))
     every = record_every if record_every > 0 else n_steps + 1
-    rec = _Recorder(model, n_steps, every)
+    rec = Recording(model, n_steps, every)
     f1, f2 = _step_addresses()
-    k, k_rec, fell = _run_controlled(
-        f1,
-        f2,
-        m._address,
-        d._address,
-        n_steps,
-        every,
-        dt,
-        iz,
-        fall_height,
-        d.qpos,
-        d.qvel,
-        d.site_xpos,
-        d.cvel,
-        d.subtree_com,
-        d.xipos,
-        d.xfrc_applied,
-        d.qfrc_applied,
-        mp,
-        ms,
-        mtu,
-        seg_u,
-        u,
-        path,
-        pstart,
-        cp,
-        cstate,
-        jp,
-        crec,
-        lig,
+    arrays = (mp, ms, mtu, seg_u, u, path, pstart, cp, cstate, jp, crec, lig)
+    control = (
         table,
         x,
         hist,
@@ -448,21 +217,27 @@ def simulate_controlled(
         itilt,
         ranges,
         pen,
-        rec.t,
-        rec.q,
-        rec.v,
-        rec.ms,
-        rec.mtu,
-        rec.u,
-        rec.c,
-        rec.lig,
     )
-    rec.k = k_rec
+    k, k_rec, fell = run_loop(
+        f1,
+        f2,
+        m._address,
+        d._address,
+        n_steps,
+        every,
+        dt,
+        iz,
+        fall_height,
+        mujoco_views(d, oriented=False),
+        arrays,
+        rec.arrays,
+        control,
+    )
     qpos = d.qpos
     t_end = k * dt
     distance = float(qpos[ix] - q0[ix]) if math.isfinite(qpos[ix]) else 0.0
     ev = _evaluate(settings, acc, td[: int(acc[3])], t_end, distance, bool(fell), mass, q0[ix])
-    result = rec.result(dt, bool(fell), settings.duration) if record_every > 0 else None
+    result = rec.result(k_rec, dt, bool(fell), settings.duration) if record_every > 0 else None
     return ev, result
 
 
@@ -500,54 +275,6 @@ def _evaluate(settings, acc, td, t_end, distance, fell, mass, x0) -> Evaluation:
         metabolic_energy=float(acc[0]),
         n_steps=int(len(td)),
     )
-
-
-class _Recorder:
-    def __init__(self, model: RunnerModel, n_steps: int, every: int) -> None:
-        m = model.mj_model
-        nm = len(model.muscle_names)
-        nc = model.contact_params.shape[0]
-        n = n_steps // every + 1
-        self.model = model
-        self.k = 0
-        self.t = np.zeros(n)
-        self.q = np.zeros((n, m.nq))
-        self.v = np.zeros((n, m.nv))
-        self.ms = np.zeros((n, nm, 4))
-        self.mtu = np.zeros((n, nm, 2))
-        self.u = np.zeros((n, nm))
-        self.c = np.zeros((n, nc, 7))
-        self.lig = np.zeros((n, m.nv))
-
-    def add(self, t, q, v, ms, alen, avel, u, crec, lig) -> None:
-        k = self.k
-        self.t[k] = t
-        self.q[k] = q
-        self.v[k] = v
-        self.ms[k] = ms
-        self.mtu[k, :, 0] = alen
-        self.mtu[k, :, 1] = avel
-        self.u[k] = u
-        self.c[k] = crec
-        self.lig[k] = lig
-        self.k += 1
-
-    def result(self, dt: float, fell: bool, duration: float) -> RunnerResult:
-        s = slice(0, self.k)
-        return RunnerResult(
-            model=self.model,
-            time=self.t[s],
-            qpos=self.q[s],
-            qvel=self.v[s],
-            muscles=self.ms[s],
-            mtu=self.mtu[s],
-            excitation=self.u[s],
-            contacts=self.c[s],
-            ligament=self.lig[s],
-            dt=dt,
-            fell=fell,
-            requested_duration=duration,
-        )
 
 
 def evaluate(

@@ -1,7 +1,7 @@
 """Forward simulation of the runner: MuJoCo multibody step + bladelab's numba force kernel.
 
 Each step: ``mj_step1`` (positions, velocities), then one numba call
-(:func:`bladelab.runner.kernel.forces_oriented`) that computes the muscle path lengths and velocities,
+(:func:`bladelab.runner.kernel.forces`) that computes the muscle path lengths and velocities,
 advances the muscles (:mod:`bladelab.runner.muscle`), computes ligament, socket and ground
 contact forces (Hunt–Crossley normal force, elastic–plastic friction capped at μ·Fn) and writes
 them to MuJoCo's ``xfrc_applied`` (muscle and contact point forces) and ``qfrc_applied``
@@ -29,8 +29,10 @@ import pandas as pd
 from bladelab.errors import SimulationError
 from bladelab.runner.kernel import (
     _mujoco_step_addresses,
-    forces_oriented,
+    forces,
+    mujoco_views,
     path_kinematics,
+    record_sample,
     run_loop,
 )
 from bladelab.runner.model import DEFAULT_DT, RunnerModel, contact_heights
@@ -284,25 +286,15 @@ def simulate_runner(
     lig = np.zeros(m.nv)
     jp = model.joint_params
     n_steps = int(round(duration / dt))
-    n_rec = n_steps // record_every + 1
-    rec_t = np.zeros(n_rec)
-    rec_q = np.zeros((n_rec, m.nq))
-    rec_v = np.zeros((n_rec, m.nv))
-    rec_ms = np.zeros((n_rec, nm, 4))
-    rec_mtu = np.zeros((n_rec, nm, 2))
-    rec_u = np.zeros((n_rec, nm))
-    rec_c = np.zeros((n_rec, cp.shape[0], 7))
-    rec_l = np.zeros((n_rec, m.nv))
+    rec = Recording(model, n_steps, record_every)
     if fall_height is None:
         fall_height = 0.6 * model.stand_qpos[model.dof("pelvis_tz")]
     iz = model.dof("pelvis_tz")
-    # live views of MuJoCo's buffers
-    qpos, qvel = d.qpos, d.qvel
-    sxp, cvel, scom, xipos = d.site_xpos, d.cvel, d.subtree_com, d.xipos
-    xfrc, qfrc = d.xfrc_applied, d.qfrc_applied
+    mj = mujoco_views(d)
+    arrays = (mp, ms, mtu, seg_u, u, path, pstart, cp, cstate, jp, crec, lig)
     if controller is None:
         f1, f2 = _STEP_ADDRESSES
-        k_rec, fell = run_loop(
+        _, k_rec, fell = run_loop(
             f1,
             f2,
             m._address,
@@ -312,35 +304,10 @@ def simulate_runner(
             dt,
             iz,
             float(fall_height),
-            qpos,
-            qvel,
-            sxp,
-            d.site_xmat,
-            cvel,
-            scom,
-            xipos,
-            xfrc,
-            qfrc,
-            mp,
-            ms,
-            mtu,
-            seg_u,
-            u,
-            path,
-            pstart,
-            cp,
-            cstate,
-            jp,
-            crec,
-            lig,
-            rec_t,
-            rec_q,
-            rec_v,
-            rec_ms,
-            rec_mtu,
-            rec_u,
-            rec_c,
-            rec_l,
+            mj,
+            arrays,
+            rec.arrays,
+            None,
         )
     else:
         k_rec, fell = _python_loop(
@@ -353,35 +320,11 @@ def simulate_runner(
             dt,
             iz,
             fall_height,
-            mp,
-            ms,
-            mtu,
-            seg_u,
-            u,
-            path,
-            pstart,
-            cp,
-            cstate,
-            jp,
-            crec,
-            lig,
-            (rec_t, rec_q, rec_v, rec_ms, rec_mtu, rec_u, rec_c, rec_l),
+            mj,
+            arrays,
+            rec.arrays,
         )
-    sl = slice(0, k_rec)
-    return RunnerResult(
-        model=model,
-        time=rec_t[sl],
-        qpos=rec_q[sl],
-        qvel=rec_v[sl],
-        muscles=rec_ms[sl],
-        mtu=rec_mtu[sl],
-        excitation=rec_u[sl],
-        contacts=rec_c[sl],
-        ligament=rec_l[sl],
-        dt=dt,
-        fell=fell,
-        requested_duration=duration,
-    )
+    return rec.result(k_rec, dt, fell, duration)
 
 
 _STEP_ADDRESSES = _mujoco_step_addresses()
@@ -397,25 +340,13 @@ def _python_loop(
     dt,
     iz,
     fall_height,
-    mp,
-    ms,
-    mtu,
-    seg_u,
-    u,
-    path,
-    pstart,
-    cp,
-    cstate,
-    jp,
-    crec,
-    lig,
+    mj,
+    arrays,
     rec,
 ):
     """The time loop with a Python controller called every ``control_interval`` steps."""
-    rec_t, rec_q, rec_v, rec_ms, rec_mtu, rec_u, rec_c, rec_l = rec
-    qpos, qvel = d.qpos, d.qvel
-    sxp, cvel, scom, xipos = d.site_xpos, d.cvel, d.subtree_com, d.xipos
-    xfrc, qfrc = d.xfrc_applied, d.qfrc_applied
+    qpos, qvel, sxp, _, cvel, scom = mj[:6]
+    _, ms, mtu, seg_u, u, path, pstart, _, _, _, crec, _ = arrays
     root_com = np.zeros(3)
     state = ControllerState(ms, mtu[:, 0], mtu[:, 1], qpos, qvel, crec)
     step1, step2 = mujoco.mj_step1, mujoco.mj_step2
@@ -426,39 +357,9 @@ def _python_loop(
         if k % control_interval == 0:
             path_kinematics(sxp, cvel, root_com, path, pstart, mtu, seg_u)
             u[:] = np.clip(controller(k * dt, state), 0.0, 1.0)
-        forces_oriented(
-            qpos,
-            qvel,
-            sxp,
-            d.site_xmat,
-            cvel,
-            root_com,
-            xipos,
-            xfrc,
-            qfrc,
-            mp,
-            ms,
-            mtu,
-            seg_u,
-            u,
-            path,
-            pstart,
-            cp,
-            cstate,
-            jp,
-            crec,
-            lig,
-            dt,
-        )
+        forces(mj, arrays, root_com, dt)
         if k % record_every == 0:
-            rec_t[k_rec] = k * dt
-            rec_q[k_rec] = qpos
-            rec_v[k_rec] = qvel
-            rec_ms[k_rec] = ms
-            rec_mtu[k_rec] = mtu
-            rec_u[k_rec] = u
-            rec_c[k_rec] = crec
-            rec_l[k_rec] = lig
+            record_sample(rec, k_rec, k * dt, mj, arrays)
             k_rec += 1
         if not qpos[iz] >= fall_height:
             return k_rec, True
@@ -466,6 +367,46 @@ def _python_loop(
             break
         step2(m, d)
     return k_rec, False
+
+
+class Recording:
+    """Preallocated arrays of a simulation's samples (``arrays``: the tuple the compiled loops
+    fill, :func:`bladelab.runner.kernel.record_sample`)."""
+
+    def __init__(self, model: RunnerModel, n_steps: int, every: int) -> None:
+        m = model.mj_model
+        nm = len(model.muscle_names)
+        nc = model.contact_params.shape[0]
+        n = n_steps // every + 1
+        self.model = model
+        self.arrays = (
+            np.zeros(n),  # time [s]
+            np.zeros((n, m.nq)),
+            np.zeros((n, m.nv)),
+            np.zeros((n, nm, 4)),
+            np.zeros((n, nm, 2)),
+            np.zeros((n, nm)),
+            np.zeros((n, nc, 7)),
+            np.zeros((n, m.nv)),
+        )
+
+    def result(self, n: int, dt: float, fell: bool, duration: float) -> RunnerResult:
+        """The first ``n`` samples as a :class:`RunnerResult`."""
+        t, q, v, ms, mtu, u, c, lig = (a[:n] for a in self.arrays)
+        return RunnerResult(
+            model=self.model,
+            time=t,
+            qpos=q,
+            qvel=v,
+            muscles=ms,
+            mtu=mtu,
+            excitation=u,
+            contacts=c,
+            ligament=lig,
+            dt=dt,
+            fell=fell,
+            requested_duration=duration,
+        )
 
 
 def _held_copy(model: RunnerModel) -> mujoco.MjModel:
