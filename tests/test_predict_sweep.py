@@ -147,6 +147,15 @@ def test_wall_time_is_recorded_and_accumulates_across_resume(tmp_path):
     ckpt = load_checkpoint(tmp_path / "checkpoint.pkl")
     assert ckpt["elapsed_s"] == pytest.approx(best["wall_time_s"])
     assert len(resumed.history[0]) == 5  # history tuples hold no time
+    # a checkpoint written before wall time was recorded resumes with unknown (NaN) times
+    import pickle
+
+    del ckpt["elapsed"], ckpt["elapsed_s"]
+    (tmp_path / "checkpoint.pkl").write_bytes(pickle.dumps(ckpt, protocol=4))
+    old = optimize_controller("able", generations=4, out=tmp_path, resume=True, **args)
+    assert old.history[:3] == resumed.history and np.isnan(old.wall_time_s)
+    assert pd.read_csv(tmp_path / "history.csv").elapsed_s.isna().all()
+    assert json.loads((tmp_path / "best.json").read_text())["wall_time_s"] is None
 
 
 def test_summary_by_hand():
