@@ -11,14 +11,14 @@ __all__ = ["register"]
 
 
 def _report(
-    study_dir: Path = typer.Argument(..., help="Study folder (study.yaml + results.sqlite), "
+    study_dir: Path = typer.Argument(..., metavar="PATH", help="Study folder (study.yaml + results.sqlite), "
                                      "design folder, 'bladelab predict' or 'bladelab sweep' "
                                      "folder, or a runner parameter JSON file."),
     trial: str | None = typer.Option(None, "--trial", help="Trial of the cost landscape "
                                      "(default: the first identified trial)."),
     variant: str | None = typer.Option(None, "--variant", help="Model variant to report "
                                        "(default: linear)."),
-    out: Path | None = typer.Option(None, "--out", help="Report folder (default STUDY_DIR/report)."),
+    out: Path | None = typer.Option(None, "--out", help="Report folder (default PATH/report)."),
     as_json: bool = typer.Option(False, "--json", help="Print the result as JSON."),
 ) -> None:
     """Write PATH/report/index.html: fits, K*/D*, mechanics, statistics, identifiability (a
