@@ -269,14 +269,52 @@ def category_task(payload: dict) -> dict:
     return {"category": cat, "rows": rows}
 
 
+class _CellProgress:
+    """A progress bar of finished cells, counted from their ``cell.json`` on disk (the cells
+    finish inside worker processes); a background thread refreshes it every ``every`` s."""
+
+    def __init__(self, out: Path, categories: list[str], speeds: list[float], *,
+                 enabled: bool, every: float = 2.0) -> None:
+        import threading
+
+        self.out, self.categories, self.speeds = out, categories, speeds
+        self.bar = tqdm(total=len(categories) * len(speeds), desc="sweep cells",
+                        unit="cell", disable=not enabled)
+        self._stop = threading.Event()
+        self._thread = None
+        if enabled:
+            self.refresh_count()
+            self._thread = threading.Thread(target=self._loop, args=(every,), daemon=True)
+            self._thread.start()
+
+    def _loop(self, every: float) -> None:
+        while not self._stop.wait(every):
+            self.refresh_count()
+
+    def refresh_count(self) -> None:
+        if self.bar.disable:
+            return
+        n = len(_cells_done(self.out, self.categories, self.speeds))
+        if n != self.bar.n:
+            self.bar.n = n
+            self.bar.refresh()
+
+    def close(self) -> None:
+        self._stop.set()
+        if self._thread is not None:
+            self._thread.join()
+        self.refresh_count()
+        self.bar.close()
+
+
 def _run_wave(ex, payloads: list[dict], bar) -> list[dict]:
     rows, failed = [], []
     for i, status, value in ex.run(category_task, payloads):
         if status != "ok":
             failed.append(f"{payloads[i]['category']}: {value}")
             continue
-        bar.update(len(value["rows"]))
         rows.extend(value["rows"])
+        bar.refresh_count()
     if failed:
         raise OptimizationError("sweep task(s) failed: " + "; ".join(failed))
     return rows
@@ -409,6 +447,8 @@ def run_sweep(
         this category starts from ``init``, its softer and stiffer neighbours (catalogue order)
         from its solution, and so on outwards (each wave in parallel); then every category
         raises its speed independently. None: every category starts from ``init``.
+    progress
+        Show a progress bar of finished cells (read back ones included).
     """
     from bladelab.study.executors import make_executor
 
@@ -444,7 +484,7 @@ def run_sweep(
         for s in speeds:
             _read_cell(cell_dir(out, c, s), c, s, wanted)
     ex = make_executor(executor, jobs)
-    bar = tqdm(total=len(categories) * len(speeds), desc="optimisations", disable=not progress)
+    bar = _CellProgress(out, list(categories), speeds, enabled=progress)
     rows: list[dict] = []
     try:
         if chain_from is None:
