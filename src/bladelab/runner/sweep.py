@@ -461,6 +461,7 @@ def run_sweep(
             "need generations >= 1, popsize >= 2 and checkpoint_every >= 1", where="generations"
         )
     out = Path(out)
+    init = Path(init).resolve() if init else None
     speeds = sorted(float(s) for s in speeds)
     objective = ObjectiveSettings(
         duration=duration,
@@ -472,7 +473,7 @@ def run_sweep(
         "generations": int(generations),
         "popsize": int(popsize),
         "seed": int(seed),
-        "out": str(out),
+        "out": str(out.resolve()),  # workers (Ray) may run in another folder
         "settings": objective.to_dict(),
         "checkpoint_every": int(checkpoint_every),
         "categories": list(categories),
