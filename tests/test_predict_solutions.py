@@ -52,3 +52,17 @@ def test_strides_merge_contact_bounces():
     assert strides == [(0.1, 0.5), (0.5, 0.9)]
     # with no merging the bounce starts a stride of its own
     assert len(_strides(t, on, 0.0)) == 3
+
+
+def test_brief_touches_do_not_start_a_stride():
+    import numpy as np
+
+    from bladelab.runner.predict import _strides
+
+    t = np.arange(0.0, 1.0, 0.001)
+    on = np.zeros_like(t, dtype=bool)
+    for a, b in ((0.1, 0.3), (0.5, 0.7), (0.9, 0.99)):
+        on[(t >= a - 1e-9) & (t < b - 1e-9)] = True
+    on[(t >= 0.4 - 1e-9) & (t < 0.41 - 1e-9)] = True  # a 10 ms touch of the swinging foot
+    strides = [(round(t[a], 3), round(t[b], 3)) for a, b in _strides(t, on, 0.05)]
+    assert strides == [(0.1, 0.5), (0.5, 0.9)]

@@ -83,6 +83,26 @@ def test_gait_events_and_spatiotemporal(amputee):
         assert st[(leg, "swing_time")] == pytest.approx(0.4, abs=3e-3)
 
 
+def test_bounces_and_brief_touches_do_not_change_the_gait_events(amputee):
+    # a 10 ms bounce inside the first intact stance and a 10 ms touch of the swinging intact
+    # foot at 0.5 s: the same strides and contact times as without them
+    stances = [*STANCES, (0, 0.5, 0.51)]
+    res = _synthetic(amputee, stances=stances)
+    fz = res.contacts[:, :, 1]
+    legs = amputee.contact_params[:, 6]
+    gap = (res.time > 0.18) & (res.time < 0.19)
+    fz[np.ix_(gap, np.flatnonzero(legs == 0))] = 0.0
+    ev = gait_events(res, threshold_n=1.0)
+    td = ev[(ev.leg == "intact") & (ev.event == "touchdown")].time.to_numpy()
+    np.testing.assert_allclose(td, [0.1, 0.7, 1.3], atol=2e-3)
+    st = spatiotemporal(res, threshold_n=1.0).set_index(["leg", "variable"]).value
+    assert st[("intact", "contact_time")] == pytest.approx(0.2, abs=3e-3)
+    assert st[("intact", "stride_time")] == pytest.approx(0.6, abs=3e-3)
+    # without the cleaning the bounce and the touch are events of their own
+    raw = gait_events(res, threshold_n=1.0, min_gap_s=0.0, min_contact_s=0.0)
+    assert len(raw[raw.leg == "intact"]) == len(ev[ev.leg == "intact"]) + 4
+
+
 def test_leg_stiffness_hand_derived(amputee):
     """K_leg = F_peak / (Δy + L0(1 − cos θ)), θ = asin(v·t_c / 2L0) (seed 001 eq. 2.19–2.21)."""
     res = _synthetic(amputee, stances=STANCES, drop=0.04, peak=2000.0)

@@ -27,6 +27,8 @@ from bladelab.runner.params import GRAVITY
 from bladelab.runner.simulate import RC_FX, RC_FZ, RC_VX, RC_VZ, RunnerResult, _leg_names
 
 CONTACT_THRESHOLD_N = 20.0
+MIN_GAP_S = 0.05  # unloaded gaps shorter than this inside a stance are contact bounces [s]
+MIN_CONTACT_S = 0.03  # loaded stretches shorter than this are brief touches, not stances [s]
 
 
 def _forward_pass(result: RunnerResult) -> dict[str, np.ndarray]:
@@ -67,12 +69,53 @@ def leg_grf(result: RunnerResult) -> pd.DataFrame:
     return result.leg_grf()
 
 
-def gait_events(result: RunnerResult, *, threshold_n: float = CONTACT_THRESHOLD_N) -> pd.DataFrame:
-    """Touch-downs and lift-offs per leg: columns leg, event (touchdown/liftoff), time [s]."""
+def contact_mask(
+    time: np.ndarray,
+    loaded: np.ndarray,
+    *,
+    min_gap_s: float = MIN_GAP_S,
+    min_contact_s: float = MIN_CONTACT_S,
+) -> np.ndarray:
+    """Stance mask of one leg from its loaded samples (vertical GRF above the threshold).
+
+    Unloaded gaps shorter than ``min_gap_s`` [s] between two loaded stretches (contact
+    bounces) are filled, then loaded stretches shorter than ``min_contact_s`` [s] (a brief
+    touch of the swinging foot) are dropped; a stretch touching either end of the record is
+    kept. ``time`` [s] and ``loaded`` (bool) are per sample.
+    """
+    on = np.asarray(loaded, dtype=bool).copy()
+    time = np.asarray(time, dtype=float)
+    for value, shortest in ((False, min_gap_s), (True, min_contact_s)):
+        edges = np.flatnonzero(np.diff(on.astype(np.int8))) + 1
+        bounds = np.concatenate([[0], edges, [len(on)]])
+        for a, b in zip(bounds[:-1], bounds[1:], strict=True):
+            inner = a > 0 and b < len(on)
+            if inner and on[a] == value and time[b] - time[a] < shortest:
+                on[a:b] = not value
+    return on
+
+
+def gait_events(
+    result: RunnerResult,
+    *,
+    threshold_n: float = CONTACT_THRESHOLD_N,
+    min_gap_s: float = MIN_GAP_S,
+    min_contact_s: float = MIN_CONTACT_S,
+) -> pd.DataFrame:
+    """Touch-downs and lift-offs per leg: columns leg, event (touchdown/liftoff), time [s].
+
+    A leg is in contact while its vertical GRF exceeds ``threshold_n`` [N], with bounces and
+    brief touches cleaned by :func:`contact_mask`.
+    """
     rows = []
     names = _leg_names(result.model)
     for leg in (0, 1):
-        on = _leg_fz(result, leg) > threshold_n
+        on = contact_mask(
+            result.time,
+            _leg_fz(result, leg) > threshold_n,
+            min_gap_s=min_gap_s,
+            min_contact_s=min_contact_s,
+        )
         change = np.flatnonzero(np.diff(on.astype(np.int8)))
         for i in change:
             rows.append(

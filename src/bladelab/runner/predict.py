@@ -479,7 +479,8 @@ def verify_solution(
     fall; mean speed within ``speed_tolerance`` [m/s] of ``speed`` (default: the file's
     ``speed_m_per_s``); a flight phase (no leg loaded above 20 N) in every stride of each leg
     (touch-down to touch-down of that leg; unloaded gaps shorter than ``min_gap_s`` [s] inside a
-    stance, i.e. contact bounces, do not end it); power-balance residual below
+    stance, i.e. contact bounces, do not end it, and touches shorter than 30 ms do not start
+    one); power-balance residual below
     ``max_power_residual_pct`` % (runner analyses). With ``jittered_copies`` = n > 0 the same
     criteria must also hold for n copies of the parameters moved by ``jitter`` (relative,
     :func:`jittered_parameters`): a gait that survives only on one floating-point path (another
@@ -544,14 +545,12 @@ def _check_gait(runner, layout, x, settings: ObjectiveSettings, limits: tuple) -
 
 
 def _strides(time: np.ndarray, on: np.ndarray, min_gap_s: float) -> list[tuple[int, int]]:
-    """Sample ranges from one touch-down to the next of a leg, bounces shorter than
-    ``min_gap_s`` merged into the stance."""
-    on = on.copy()
-    edges = np.flatnonzero(np.diff(on.astype(np.int8)))
-    # fill short unloaded gaps (liftoff followed by touch-down within min_gap_s)
-    for e0, e1 in zip(edges[:-1], edges[1:], strict=True):
-        if on[e0] and not on[e0 + 1] and time[e1 + 1] - time[e0 + 1] < min_gap_s:
-            on[e0 + 1 : e1 + 1] = True
+    """Sample ranges from one touch-down to the next of a leg, with contact bounces shorter
+    than ``min_gap_s`` [s] merged into the stance and brief touches dropped
+    (:func:`bladelab.runner.analyses.contact_mask`)."""
+    from bladelab.runner.analyses import contact_mask
+
+    on = contact_mask(time, on, min_gap_s=min_gap_s)
     td = np.flatnonzero(~on[:-1] & on[1:]) + 1
     return list(zip(td[:-1], td[1:], strict=True))
 
