@@ -25,6 +25,16 @@ def _parse_list(text: str, what: str, conv=str) -> list:
     return items
 
 
+def _check_simulation_options(dt: float, robust_samples: int, robust_jitter: float) -> None:
+    """The time step [s] and the robust-evaluation options shared by predict and sweep."""
+    if not (math.isfinite(dt) and 0 < dt <= 2e-3):
+        raise SpecError("time step must be in (0, 2e-3] s", where="--dt")
+    if robust_samples < 1:
+        raise SpecError("must be at least 1", where="--robust-samples")
+    if not (math.isfinite(robust_jitter) and 0 < robust_jitter < 0.1):
+        raise SpecError("must be in (0, 0.1)", where="--robust-jitter")
+
+
 def register(app: typer.Typer) -> None:
     @app.command("predict")
     def predict(
@@ -61,12 +71,7 @@ def register(app: typer.Typer) -> None:
             raise SpecError(f"unknown model {model!r}", where="--model", hint="able or amputee")
         if not (math.isfinite(speed) and speed > 0):
             raise SpecError("speed must be positive", where="--speed")
-        if not (math.isfinite(dt) and 0 < dt <= 2e-3):
-            raise SpecError("time step must be in (0, 2e-3] s", where="--dt")
-        if robust_samples < 1:
-            raise SpecError("must be at least 1", where="--robust-samples")
-        if not (math.isfinite(robust_jitter) and 0 < robust_jitter < 0.1):
-            raise SpecError("must be in (0, 0.1)", where="--robust-jitter")
+        _check_simulation_options(dt, robust_samples, robust_jitter)
         _, layout = _model(model, blade if model == "amputee" else None)
         x0 = read_parameters(init, layout, transfer=True) if init is not None else None
         seed_list = _parse_list(seeds, "--seeds", int)
@@ -136,12 +141,7 @@ def register(app: typer.Typer) -> None:
 
         if not (math.isfinite(duration) and duration > 0):
             raise SpecError("must be positive", where="--duration")
-        if not (math.isfinite(dt) and 0 < dt <= 2e-3):
-            raise SpecError("time step must be in (0, 2e-3] s", where="--dt")
-        if robust_samples < 1:
-            raise SpecError("must be at least 1", where="--robust-samples")
-        if not (math.isfinite(robust_jitter) and 0 < robust_jitter < 0.1):
-            raise SpecError("must be in (0, 0.1)", where="--robust-jitter")
+        _check_simulation_options(dt, robust_samples, robust_jitter)
         if init is not None and not init.is_file():
             raise SpecError("file not found", file=init, where="--init")
         table = run_sweep(

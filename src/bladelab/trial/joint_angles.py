@@ -55,12 +55,12 @@ from typing import Any
 
 import numpy as np
 import pandas as pd
-import yaml
-from pydantic import BaseModel, ConfigDict, ValidationError
+from pydantic import BaseModel, ConfigDict
 
-from bladelab.errors import DataError, InputFileError, SpecError
+from bladelab.errors import DataError, SpecError
 from bladelab.trial.events import StanceEvent, combined_grf
 from bladelab.trial.filters import lowpass
+from bladelab.trial.kinematics import read_marker_yaml, validated_marker_map
 from bladelab.trial.trial import Trial
 
 __all__ = [
@@ -73,8 +73,15 @@ __all__ = [
 ]
 
 JOINT_ROLES: tuple[str, ...] = (
-    "pelvis_anterior", "pelvis_posterior", "thigh_proximal", "thigh_distal", "shank_proximal",
-    "shank_distal", "foot_posterior", "foot_anterior", "contact",
+    "pelvis_anterior",
+    "pelvis_posterior",
+    "thigh_proximal",
+    "thigh_distal",
+    "shank_proximal",
+    "shank_distal",
+    "foot_posterior",
+    "foot_anterior",
+    "contact",
 )
 SIDES: tuple[str, ...] = ("left", "right")
 _PELVIS = ("pelvis_anterior", "pelvis_posterior")
@@ -93,8 +100,7 @@ class JointMarkerMap(BaseModel):
     shank_distal: tuple[str, ...] = ("{side}.Shank.Bottom.Lateral", "{side}.Shank.Bottom.Medial")
     foot_posterior: tuple[str, ...] = ("{side}.Heel.Top",)
     foot_anterior: tuple[str, ...] = ("{side}.MT1", "{side}.MT5")
-    contact: tuple[str, ...] = ("{side}.Heel.Top", "{side}.Heel.Bottom", "{side}.MT1",
-                                "{side}.MT5")
+    contact: tuple[str, ...] = ("{side}.Heel.Top", "{side}.Heel.Bottom", "{side}.MT1", "{side}.MT5")
     side_prefix: dict[str, str] = {"left": "L", "right": "R"}
     left: dict[str, tuple[str, ...]] = {}
     right: dict[str, tuple[str, ...]] = {}
@@ -102,8 +108,11 @@ class JointMarkerMap(BaseModel):
     def names(self, role: str, side: str | None = None) -> tuple[str, ...]:
         """Marker names of ``role`` (on ``side`` for a leg role), ``{side}`` substituted."""
         if role not in JOINT_ROLES:
-            raise SpecError(f"unknown marker role {role!r}", where="marker map",
-                            hint=f"roles: {', '.join(JOINT_ROLES)}")
+            raise SpecError(
+                f"unknown marker role {role!r}",
+                where="marker map",
+                hint=f"roles: {', '.join(JOINT_ROLES)}",
+            )
         over = getattr(self, side) if side in SIDES else {}
         names = over.get(role, getattr(self, role))
         prefix = self.side_prefix.get(side, "") if side else ""
@@ -121,30 +130,25 @@ def load_joint_marker_map(path: str | Path) -> JointMarkerMap:
         Unknown keys or wrong types.
     """
     path = Path(path)
-    if not path.is_file():
-        raise InputFileError("marker map not found", file=path, hint="check the --markers path")
-    try:
-        data = yaml.safe_load(path.read_text(encoding="utf-8")) or {}
-    except yaml.YAMLError as err:
-        raise InputFileError(f"not valid YAML ({err})", file=path) from err
-    if not isinstance(data, dict):
-        raise SpecError("a marker map is a mapping role: [marker names]", file=path)
+    data = read_marker_yaml(path, "a marker map is a mapping role: [marker names]")
     data = {k: ([v] if isinstance(v, str) else v) for k, v in data.items()}
     for side in SIDES:
         if isinstance(data.get(side), dict):
             bad = [k for k in data[side] if k not in JOINT_ROLES]
             if bad:
-                raise SpecError(f"unknown roles {bad}", file=path, where=side,
-                                hint=f"roles: {', '.join(JOINT_ROLES)}")
+                raise SpecError(
+                    f"unknown roles {bad}",
+                    file=path,
+                    where=side,
+                    hint=f"roles: {', '.join(JOINT_ROLES)}",
+                )
             data[side] = {k: ([v] if isinstance(v, str) else v) for k, v in data[side].items()}
-    try:
-        return JointMarkerMap(**data)
-    except ValidationError as err:
-        first = err.errors()[0]
-        raise SpecError(
-            first["msg"], file=path, where=".".join(str(x) for x in first["loc"]),
-            hint=f"keys: {', '.join(JOINT_ROLES)}, side_prefix, left, right",
-        ) from err
+    return validated_marker_map(
+        JointMarkerMap,
+        data,
+        path,
+        f"keys: {', '.join(JOINT_ROLES)}, side_prefix, left, right",
+    )
 
 
 @dataclasses.dataclass(frozen=True, eq=False)
@@ -178,9 +182,12 @@ class JointAngles:
 
     def to_dict(self) -> dict[str, Any]:
         """Summary: source, samples, angle names, offsets in degrees."""
-        return {"source": self.source, "n_samples": int(self.time.size),
-                "angles": list(self.angles),
-                "offsets_deg": {k: float(np.degrees(v)) for k, v in self.offsets.items()}}
+        return {
+            "source": self.source,
+            "n_samples": int(self.time.size),
+            "angles": list(self.angles),
+            "offsets_deg": {k: float(np.degrees(v)) for k, v in self.offsets.items()},
+        }
 
 
 def _mean_marker(trial: Trial, names: Sequence[str], role: str, side: str | None) -> np.ndarray:
@@ -190,7 +197,8 @@ def _mean_marker(trial: Trial, names: Sequence[str], role: str, side: str | None
         raise DataError(
             f"marker {missing[0] if missing else '(none)'} for {what} is not in the trial; it has: "
             f"{', '.join(trial.markers) or '(none)'}",
-            file=trial.source, where=f"marker {missing[0] if missing else role}",
+            file=trial.source,
+            where=f"marker {missing[0] if missing else role}",
             hint="map the role to existing markers with --markers MAP.yaml (docs/design.md)",
         )
     return np.mean([trial.markers[n] for n in names], axis=0)
@@ -201,8 +209,9 @@ def _segment(d: np.ndarray) -> np.ndarray:
     return np.arctan2(d[:, 0], -d[:, 2])
 
 
-def _raw_angles(trial: Trial, markers: JointMarkerMap, cutoff_hz: float | None,
-                sides: Sequence[str]) -> dict[str, np.ndarray]:
+def _raw_angles(
+    trial: Trial, markers: JointMarkerMap, cutoff_hz: float | None, sides: Sequence[str]
+) -> dict[str, np.ndarray]:
     cache: dict[tuple, np.ndarray] = {}
 
     def pos(role: str, side: str | None) -> np.ndarray:
@@ -211,8 +220,13 @@ def _raw_angles(trial: Trial, markers: JointMarkerMap, cutoff_hz: float | None,
         if key not in cache:
             xyz = _mean_marker(trial, names, role, side)
             if cutoff_hz is not None and cutoff_hz < trial.marker_rate / 2:
-                xyz = lowpass(xyz, trial.marker_rate, cutoff_hz, where=f"{role} ({'+'.join(names)})",
-                              file=trial.source)
+                xyz = lowpass(
+                    xyz,
+                    trial.marker_rate,
+                    cutoff_hz,
+                    where=f"{role} ({'+'.join(names)})",
+                    file=trial.source,
+                )
             cache[key] = xyz
         return cache[key]
 
@@ -225,8 +239,10 @@ def _raw_angles(trial: Trial, markers: JointMarkerMap, cutoff_hz: float | None,
         out[f"hip_{side}"] = thigh + lean
         out[f"knee_{side}"] = thigh - shank
         over = getattr(markers, side)
-        has_foot = not (("foot_anterior" in over and not over["foot_anterior"])
-                        or ("foot_posterior" in over and not over["foot_posterior"]))
+        has_foot = not (
+            ("foot_anterior" in over and not over["foot_anterior"])
+            or ("foot_posterior" in over and not over["foot_posterior"])
+        )
         if has_foot:
             f = pos("foot_anterior", side) - pos("foot_posterior", side)
             out[f"ankle_{side}"] = np.arctan2(f[:, 2], f[:, 0]) - shank
@@ -279,9 +295,12 @@ def sagittal_angles(
         for k in raw:
             v = st[k][np.isfinite(st[k])]
             if v.size == 0:
-                raise DataError(f"no frame of the static trial has the markers of {k}",
-                                file=static.source, where=k,
-                                hint="use a static trial in which these markers are visible")
+                raise DataError(
+                    f"no frame of the static trial has the markers of {k}",
+                    file=static.source,
+                    where=k,
+                    hint="use a static trial in which these markers are visible",
+                )
             offsets[k] = float(np.mean(v))
             raw[k] = raw[k] - offsets[k]
     return JointAngles(trial.marker_time, raw, offsets, trial.source)
@@ -318,8 +337,11 @@ def stance_legs(
             d = d[np.isfinite(d)]
             dist[s] = float(np.median(d)) if d.size else np.inf
         if not np.isfinite(min(dist.values())):
-            raise DataError(f"stance {ev.index + 1} ({ev.start_s:.3f} s): no centre of pressure "
-                            "or contact markers to tell the leg", file=trial.source,
-                            where=f"platforms {ev.plates}")
+            raise DataError(
+                f"stance {ev.index + 1} ({ev.start_s:.3f} s): no centre of pressure "
+                "or contact markers to tell the leg",
+                file=trial.source,
+                where=f"platforms {ev.plates}",
+            )
         legs.append(min(dist, key=dist.get))
     return legs

@@ -74,6 +74,18 @@ def load_marker_map(path: str | Path) -> MarkerMap:
         Unknown keys or non-string values.
     """
     path = Path(path)
+    data = read_marker_yaml(path, "a marker map is a mapping role: marker name")
+    return validated_marker_map(
+        MarkerMap,
+        data,
+        path,
+        "keys: clamp_anterior, clamp_posterior, tip (marker names as strings)",
+    )
+
+
+def read_marker_yaml(path: Path, shape_hint: str) -> dict:
+    """The mapping in a YAML marker-map file (errors name the file; ``shape_hint`` says what
+    the mapping should look like)."""
     if not path.is_file():
         raise InputFileError("marker map not found", file=path, hint="check the --markers path")
     try:
@@ -81,14 +93,19 @@ def load_marker_map(path: str | Path) -> MarkerMap:
     except yaml.YAMLError as err:
         raise InputFileError(f"not valid YAML ({err})", file=path) from err
     if not isinstance(data, dict):
-        raise SpecError("a marker map is a mapping role: marker name", file=path)
+        raise SpecError(shape_hint, file=path)
+    return data
+
+
+def validated_marker_map(model: type, data: dict, path: Path, hint: str):
+    """``model(**data)`` (a pydantic marker map), its first validation error as a SpecError
+    naming the file and the field."""
     try:
-        return MarkerMap(**data)
+        return model(**data)
     except ValidationError as err:
         first = err.errors()[0]
         raise SpecError(
-            first["msg"], file=path, where=".".join(str(x) for x in first["loc"]),
-            hint="keys: clamp_anterior, clamp_posterior, tip (marker names as strings)",
+            first["msg"], file=path, where=".".join(str(x) for x in first["loc"]), hint=hint
         ) from err
 
 
@@ -171,7 +188,8 @@ def blade_kinematics(
             raise DataError(
                 f"missing at frames {a + bad[0]}–{a + bad[-1]} (t = {(a + bad[0]) / rate:.3f}–"
                 f"{(a + bad[-1]) / rate:.3f} s), at the edge of the span where it cannot be filled",
-                file=trial.source, where=where,
+                file=trial.source,
+                where=where,
                 hint="choose another stance or repair the trajectory",
             )
         if cutoff is not None:
@@ -184,18 +202,25 @@ def blade_kinematics(
     pitch = np.arctan2(-d[:, 2], d[:, 0])
     distance = np.linalg.norm(tip - origin, axis=1)
     return BladeKinematics(
-        time=np.arange(a, b) / rate, clamp_origin=origin, clamp_pitch=pitch, tip=tip,
+        time=np.arange(a, b) / rate,
+        clamp_origin=origin,
+        clamp_pitch=pitch,
+        tip=tip,
         distance=distance,
     )
 
 
-def compression(distance: np.ndarray, time: np.ndarray, touchdown_s: float) -> tuple[np.ndarray, float]:
+def compression(
+    distance: np.ndarray, time: np.ndarray, touchdown_s: float
+) -> tuple[np.ndarray, float]:
     """Δd(t) = d0 − d(t) [m] with d0 = d at touch-down (linear interpolation); returns (Δd, d0)."""
     d0 = float(np.interp(touchdown_s, time, distance))
     return d0 - np.asarray(distance, dtype=float), d0
 
 
-def stance_window(event: StanceEvent, *, margin: float = 0.02, duration: float | None = None) -> tuple[float, float]:
+def stance_window(
+    event: StanceEvent, *, margin: float = 0.02, duration: float | None = None
+) -> tuple[float, float]:
     """Window [s] centred on the GRF peak, covering touch-down and toe-off plus ``margin``.
 
     ``duration`` (the recording length [s]) clips the window when given.
@@ -264,21 +289,30 @@ def extract_stance(
     if not 0 <= index < len(events):
         raise DataError(
             f"no stance {index}: the trial has {len(events)} stance(s), numbered 0–{len(events) - 1}",
-            file=trial.source, where="--stance", hint="list them with `bladelab trial stances`",
+            file=trial.source,
+            where="--stance",
+            hint="list them with `bladelab trial stances`",
         )
     ev = events[index]
     t0, t1 = stance_window(ev, margin=margin, duration=min(trial.duration, _force_duration(trial)))
     pad = 0.1 + (2.0 / marker_cutoff if marker_cutoff else 0.0)
     kin = blade_kinematics(
-        trial, markers=markers, cutoff=marker_cutoff, order=order, max_gap=max_gap,
+        trial,
+        markers=markers,
+        cutoff=marker_cutoff,
+        order=order,
+        max_gap=max_gap,
         span=(max(t0 - pad, 0.0), t1 + pad),
     )
     n_out = int(np.floor((t1 - t0) * rate + 1e-9)) + 1
     t = t0 + np.arange(n_out) / rate
     t = t[t <= min(kin.time[-1], _force_duration(trial)) + 1e-12]
     if t.size < 3:
-        raise DataError("the stance window holds fewer than 3 samples", file=trial.source,
-                        where=f"stance {index}")
+        raise DataError(
+            "the stance window holds fewer than 3 samples",
+            file=trial.source,
+            where=f"stance {index}",
+        )
 
     def spline(values: np.ndarray) -> np.ndarray:
         return interpolate.CubicSpline(kin.time, values, axis=0)(t)
@@ -316,8 +350,15 @@ def extract_stance(
         }
     )
     return Stance(
-        time=t - t[0], clamp_x=origin[:, 0], clamp_y=origin[:, 1], clamp_z=origin[:, 2],
-        clamp_pitch=pitch, grf_x=grf[:, 0], grf_y=grf[:, 1], grf_z=grf[:, 2], distance=distance,
+        time=t - t[0],
+        clamp_x=origin[:, 0],
+        clamp_y=origin[:, 1],
+        clamp_z=origin[:, 2],
+        clamp_pitch=pitch,
+        grf_x=grf[:, 0],
+        grf_y=grf[:, 1],
+        grf_z=grf[:, 2],
+        distance=distance,
         metadata=meta,
     )
 
