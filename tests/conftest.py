@@ -16,3 +16,17 @@ def shared_data() -> Path:
     if not SHARED_DATA.is_dir():
         pytest.fail(f"{SHARED_DATA} not found: clone bladelab beside the shared/ folder")
     return SHARED_DATA
+
+
+FUKUCHI_RUN = "real/fukuchi2017/RBDS001runT35.c3d"
+FUKUCHI_STATIC = "real/fukuchi2017/RBDS001static.c3d"
+
+
+@pytest.fixture(scope="session")
+def fukuchi_trials(shared_data):
+    """The Fukuchi 3.5 m/s running trial and its static trial, in the same lab axes."""
+    from bladelab.trial import read_c3d
+
+    run = read_c3d(shared_data / FUKUCHI_RUN)
+    ax = run.metadata["axes"]
+    return run, read_c3d(shared_data / FUKUCHI_STATIC, forward=ax["forward"], up=ax["up"])

@@ -16,16 +16,13 @@ from bladelab.runner.gait_cycle import (
     read_gait_csv,
 )
 from bladelab.trial import detect_stances, read_c3d
-
-RUN = "real/fukuchi2017/RBDS001runT35.c3d"
-STATIC = "real/fukuchi2017/RBDS001static.c3d"
+from conftest import FUKUCHI_RUN as RUN
+from conftest import FUKUCHI_STATIC as STATIC
 
 
 @pytest.fixture(scope="module")
-def trials(shared_data):
-    run = read_c3d(shared_data / RUN)
-    ax = run.metadata["axes"]
-    return run, read_c3d(shared_data / STATIC, forward=ax["forward"], up=ax["up"])
+def trials(fukuchi_trials):
+    return fukuchi_trials
 
 
 @pytest.fixture(scope="module")

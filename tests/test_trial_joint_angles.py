@@ -9,24 +9,20 @@ import numpy as np
 import pytest
 
 from bladelab.errors import DataError, InputFileError, SpecError
-from bladelab.trial import combined_grf, detect_stances, read_c3d
+from bladelab.trial import combined_grf, detect_stances
 from bladelab.trial.joint_angles import (
     JointMarkerMap,
     load_joint_marker_map,
     sagittal_angles,
     stance_legs,
 )
-
-RUN = "real/fukuchi2017/RBDS001runT35.c3d"
-STATIC = "real/fukuchi2017/RBDS001static.c3d"
+from conftest import FUKUCHI_RUN as RUN
+from conftest import FUKUCHI_STATIC as STATIC
 
 
 @pytest.fixture(scope="module")
-def trials(shared_data):
-    run = read_c3d(shared_data / RUN)
-    ax = run.metadata["axes"]
-    static = read_c3d(shared_data / STATIC, forward=ax["forward"], up=ax["up"])
-    return run, static
+def trials(fukuchi_trials):
+    return fukuchi_trials
 
 
 def _raw_sagittal(path, names):
