@@ -211,11 +211,21 @@ def _design(
     base: str = typer.Option("xtreme", "--base", help="Base blade of the generator."),
     gait: Path | None = typer.Option(None, "--gait",
                                      help="Gait-cycle CSV (runner evaluator; default built-in)."),
+    motion: Path | None = typer.Option(
+        None, "--motion",
+        help="Motion file (YAML/CSV: gait cycles with their blades): each design runs the "
+             "cycle predicted by seed 002's motion model (runner evaluator; not with --gait)."),
+    motion_model: str | None = typer.Option(
+        None, "--motion-model",
+        help="Motion model: auto (quadratic if the cycles can estimate it, else linear), "
+             "quadratic, linear, or terms (default: the file's model:, else auto)."),
+    dt: float | None = typer.Option(None, "--dt", help="Simulation step [s] of the evaluator."),
     figures: bool = typer.Option(True, "--figures/--no-figures", help="Write figures."),
 ) -> None:
     """Run a design study: DOE -> evaluator per run -> surfaces, ANOVA, optimum, figures.
 
-    ``bladelab design gait-cycle TRIAL.c3d ...`` makes a gait-cycle CSV for ``--gait``.
+    ``bladelab design gait-cycle TRIAL.c3d ...`` makes a gait-cycle CSV for ``--gait``; a motion
+    file of several such cycles (one per blade or trial) adapts the motion per design.
     """
     if ctx.invoked_subcommand is not None:
         return
@@ -242,18 +252,37 @@ def _design(
     options: dict = {"body_mass_kg": body_mass, "generator": {"base": base}}
     if speed is not None:
         options["speed_mps"] = speed
-    if evaluator == "runner" and gait is not None:
-        if not gait.is_file():
-            from bladelab.errors import InputFileError
+    if dt is not None:
+        if not (dt > 0 and math.isfinite(dt)):
+            raise SpecError(f"--dt must be > 0 s, got {dt}", where="--dt")
+        options["dt"] = dt
+    if gait is not None and motion is not None:
+        raise SpecError("--gait (one cycle for every design) and --motion (a predicted cycle per "
+                        "design) exclude each other", where="--gait/--motion",
+                        hint="give one of them")
+    if evaluator != "runner" and (gait is not None or motion is not None):
+        raise SpecError(f"--{'gait' if gait is not None else 'motion'} needs --evaluator runner",
+                        where="--evaluator")
+    if motion_model is not None and motion is None:
+        raise SpecError("--motion-model needs --motion", where="--motion-model")
+    from bladelab.errors import InputFileError
 
+    if gait is not None:
+        if not gait.is_file():
             raise InputFileError("no such gait-cycle file", file=gait,
                                  hint="a CSV with time_s and the joint angles (docs/design.md)")
         options["gait"] = str(gait)
-    ev = make_evaluator(evaluator, **options)
     design = make_design(runs, space, n_runs=n_runs, model=model, seed=seed)
     from bladelab.design.doe import require_estimable
 
     require_estimable(design, parse_terms(model, space.names), space.names)
+    if motion is not None:
+        from bladelab.design.motion import load_motion_model
+
+        options["motion"] = load_motion_model(motion, space=space, model=motion_model,
+                                              progress=True)
+        _echo_motion(options["motion"])
+    ev = make_evaluator(evaluator, **options)
     out.mkdir(parents=True, exist_ok=True)
     if jobs > 1:
         _evaluate_parallel(ev, space, design, out, jobs)
@@ -276,6 +305,17 @@ def _design(
     if figures:
         for p in write_design_figures(result, out, objective=objective, constraints=cons):
             typer.echo(f"wrote {p}", err=True)
+
+
+def _echo_motion(mm) -> None:
+    """One summary line of the motion model, and its leave-one-blade-out errors."""
+    def fmt(v: float, scale: float = 1.0, digits: int = 2) -> str:
+        return "n/a" if not math.isfinite(v) else f"{v * scale:.{digits}f}"
+
+    typer.echo(f"motion model: {mm.model} ({len(mm.terms)} terms: {', '.join(mm.term_names)}) "
+               f"from {mm.n_cycles} cycles at {mm.n_blades} blades")
+    typer.echo(f"  leave-one-blade-out error: period {fmt(mm.loo_period_s, 1e3, 1)} ms; "
+               + ", ".join(f"{k} {fmt(v)}°" for k, v in mm.loo_angles_deg.items()))
 
 
 def _gait_cycle(

@@ -11,7 +11,11 @@ stopped. It then writes, atomically:
   responses;
 - ``surfaces.json``, ``coefficients.csv``, ``anova.csv``: the fitted surfaces;
 - ``estimability.json``: the rank/conditioning report of the design for the model;
-- ``optimum.json``: the constrained optimum (if an objective is given).
+- ``optimum.json``: the constrained optimum (if an objective is given);
+- ``motion.json``: with an evaluator that adapts the motion to the design (its ``motion``
+  attribute, a :class:`~bladelab.runner.gait_cycle.MotionModel`): the motion model, its terms,
+  coding and leave-one-blade-out errors. Its factors must be the design's (checked before any
+  run).
 """
 
 from __future__ import annotations
@@ -214,6 +218,13 @@ def run_design(
     design = make_design(runs, space, n_runs=n_runs, n_center=n_center, model=model, seed=seed)
     terms = parse_terms(model, space.names)
     report = require_estimable(design, terms, space.names)  # refuse before any evaluation
+    motion = getattr(evaluator, "motion", None)
+    if motion is not None and hasattr(motion, "predict_point"):
+        from bladelab.design.motion import check_motion_factors
+
+        check_motion_factors(motion, space.names)
+    else:
+        motion = None
     constraints = dict(constraints or {})
     units = dict(units or {})
 
@@ -226,9 +237,12 @@ def run_design(
         "sense": sense,
         "constraints": constraints,
         "conservative": conservative,
+        "motion": None if motion is None else "motion.json",
     }
     out.mkdir(parents=True, exist_ok=True)
     write_json(out / "study.json", meta)
+    if motion is not None:
+        write_json(out / "motion.json", motion.to_dict())
 
     frame = design.to_frame(space)
     results: list[dict[str, float] | None] = [None] * design.n_runs

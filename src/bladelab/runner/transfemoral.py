@@ -32,7 +32,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -512,6 +512,11 @@ class RunnerEvaluator:
         Simulation step [s].
     generator
         Options of :func:`~bladelab.design.blade_generator.generate_blade`.
+    motion
+        Motion adaptation (seed 002): a :class:`~bladelab.runner.gait_cycle.MotionModel` or a
+        motion file (:func:`bladelab.design.motion.load_motion_model`, fitted once here); each
+        design then runs its predicted cycle and gets the response ``predicted_period_s``.
+        Exclusive with ``gait``.
     """
 
     gait: str | None = None
@@ -522,24 +527,44 @@ class RunnerEvaluator:
     clearance_threshold_m: float = 0.0
     dt: float = 2e-5
     generator: Mapping[str, Any] = field(default_factory=dict)
+    motion: Any = None
+
+    def __post_init__(self) -> None:
+        if self.motion is not None:
+            from bladelab.design.motion import as_motion_model
+
+            if self.gait is not None:
+                raise SpecError("give either gait (one cycle for every design) or motion (a "
+                                "predicted cycle per design), not both", where="runner evaluator")
+            object.__setattr__(self, "motion", as_motion_model(self.motion))
 
     @property
     def units(self) -> dict[str, str]:
-        return dict(RUNNER_RESPONSE_UNITS)
+        u = dict(RUNNER_RESPONSE_UNITS)
+        if self.motion is not None:
+            u["predicted_period_s"] = "s"
+        return u
 
     def to_dict(self) -> dict:
-        d = asdict(self)
+        d = asdict(replace(self, motion=None))
         d["generator"] = {k: str(v) if isinstance(v, Path) else v
                           for k, v in dict(self.generator).items()}
+        d["motion"] = None if self.motion is None else self.motion.to_dict()
         return {"evaluator": "runner", **d}
 
     def __call__(self, point: Mapping[str, float]) -> dict[str, float]:
         from bladelab.design.blade_generator import generate_blade
 
         blade = generate_blade(point, **dict(self.generator)).model
-        cycle = read_gait_csv(self.gait) if self.gait else default_gait_cycle()
+        if self.motion is not None:
+            cycle = self.motion.predict_point(point)
+        else:
+            cycle = read_gait_csv(self.gait) if self.gait else default_gait_cycle()
         res = simulate_transfemoral(blade, cycle=cycle, speed_mps=self.speed_mps,
                                     body_mass_kg=self.body_mass_kg, height_m=self.height_m,
                                     dt=self.dt)
-        return res.responses(knee_margin=self.knee_margin_Nm,
-                             clearance_threshold=self.clearance_threshold_m)
+        out = res.responses(knee_margin=self.knee_margin_Nm,
+                            clearance_threshold=self.clearance_threshold_m)
+        if self.motion is not None:
+            out["predicted_period_s"] = float(cycle.period)
+        return out
