@@ -25,9 +25,11 @@ centre of pressure), time-normalised and averaged over the trial's cycles; the o
 sound leg.
 
 Motion adaptation (seed 002): :func:`fit_motion_model` fits period and every joint angle at
-``n_nodes`` normalised times as second-order response surfaces of the coded design factors,
-from cycles measured (or predicted) with several blades; :meth:`MotionModel.predict` gives the
-cycle for a new design.
+``n_nodes`` normalised times as response surfaces of the coded design factors (quadratic, or
+``model="auto"``: quadratic if the cycles can estimate it, else linear), from cycles measured
+(or predicted) with several blades, with leave-one-blade-out errors;
+:meth:`MotionModel.predict` / :meth:`MotionModel.predict_point` give the cycle of a new design.
+Motion files (cycles with their blades) are read by :mod:`bladelab.design.motion`.
 
 The default cycle (:func:`default_gait_cycle`) is a **smooth template, not a measurement**: a
 periodic cubic spline through literature-typical sagittal joint angles of sprinting at about
