@@ -18,8 +18,10 @@ def able():
     return model, controller_layout(model)
 
 
-def _td(times, speed):
-    return np.array([[t, speed * t] for t in times])
+def _td(times, speed, legs=None):
+    """Touch-downs (time [s], pelvis x [m], leg) at a constant speed, legs alternating."""
+    legs = [i % 2 for i in range(len(times))] if legs is None else legs
+    return np.array([[t, speed * t, leg] for t, leg in zip(times, legs, strict=True)])
 
 
 def test_gait_measure_by_hand():
@@ -37,11 +39,25 @@ def test_gait_measure_by_hand():
     assert ev.cost == pytest.approx(100.0 * 1.0)
 
 
+def test_gait_measure_gives_no_credit_to_a_gallop():
+    s = ObjectiveSettings(speed=3.5, speed_tolerance=0.1, duration=10.0)
+    acc = np.zeros(4)
+    times = np.arange(1, 29) * 0.35  # 28 steps at 3.5 m/s
+    gallop = [(0, 1, 1)[i % 3] for i in range(28)]  # left, right, right, left, right, right...
+    # hand count: steps 3, 6, ..., 27 (1-based) repeat the leg before them: 9 steps of 0.35 s
+    ev = _evaluate(s, acc, _td(times, 3.5, gallop), 10.0, 35.0, False, 80.0, 0.0)
+    assert ev.j_gait == pytest.approx(1.0 - (9.8 - 9 * 0.35) / 10.0)
+    # the seed's measure counts every step
+    seed = ObjectiveSettings(speed=3.5, duration=10.0, alternating_steps=False)
+    ev = _evaluate(seed, acc, _td(times, 3.5, gallop), 10.0, 35.0, False, 80.0, 0.0)
+    assert ev.j_gait == pytest.approx(1.0 - 9.8 / 10.0)
+
+
 def test_cost_terms_and_weights_by_hand():
     s = ObjectiveSettings(speed=3.5, duration=2.0)
     # energy 1600 J, 80 kg, 7 m: J_cot = 1600/(80*7); penalties accumulated as integral * s
     acc = np.array([1600.0, 30.0, 4.0, 0.0])
-    ev = _evaluate(s, acc, np.zeros((0, 2)), 2.0, 7.0, False, 80.0, 0.0)
+    ev = _evaluate(s, acc, np.zeros((0, 3)), 2.0, 7.0, False, 80.0, 0.0)
     assert ev.j_cot == pytest.approx(1600 / 560)
     assert ev.j_inj == pytest.approx(15.0)
     assert ev.j_lean == pytest.approx(2.0)
@@ -83,3 +99,39 @@ def test_wrong_parameter_count_is_an_error(able):
     model, layout = able
     with pytest.raises(SimulationError, match="controller parameters"):
         simulate_controlled(model, layout.x0[:-1], layout=layout)
+
+
+def test_online_touchdowns_match_the_offline_contact_mask():
+    # the objective's online step detection and runner.analyses.contact_mask (offline) agree on
+    # a force record with a bounce, a brief touch and alternating stances
+    from bladelab.runner.analyses import contact_mask
+    from bladelab.runner.closed_loop import LEGLOAD_COLUMNS, _count_touchdowns
+
+    dt = 2.5e-4
+    t = np.arange(0.0, 2.0, dt)
+    force = np.zeros((len(t), 2))
+    for leg, a, b in ((0, 0.10, 0.30), (1, 0.45, 0.62), (0, 0.80, 1.0), (1, 1.15, 1.35),
+                      (1, 1.50, 1.52), (0, 1.60, 1.80)):
+        force[(t >= a) & (t < b), leg] = 900.0
+    force[(t >= 0.20) & (t < 0.23), 0] = 0.0  # a 30 ms bounce inside the first stance
+    cp = np.zeros((2, 13))
+    cp[1, 6] = 1.0  # contact 0 on the left leg, contact 1 on the right
+    crec = np.zeros((2, 7))
+    legload = np.zeros((2, LEGLOAD_COLUMNS))
+    legload[:, 1] = -1e9
+    acc, td = np.zeros(4), np.zeros((50, 3))
+    for k in range(len(t)):
+        crec[:, 1] = force[k - 1] if k else 0.0  # the previous step's forces, as in the loop
+        _count_touchdowns(t[k], 3.5 * t[k], crec, cp, legload, acc, td)
+    online = td[: int(acc[3])]
+    offline = []
+    for leg in (0, 1):
+        on = contact_mask(t, force[:, leg] > 20.0)
+        # the loop sees a force one step late
+        offline += [(t[i] + dt, leg) for i in np.flatnonzero(~on[:-1] & on[1:]) + 1]
+    offline = np.array(sorted(offline))
+    np.testing.assert_allclose(online[:, 0], offline[:, 0], atol=dt / 2)
+    np.testing.assert_array_equal(online[:, 2], offline[:, 1])
+    # by hand: the bounce and the 20 ms touch at 1.50 s are not steps
+    assert online[:, 2].tolist() == [0, 1, 0, 1, 0]
+    np.testing.assert_allclose(td[: int(acc[3]), 1], 3.5 * td[: int(acc[3]), 0])

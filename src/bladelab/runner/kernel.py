@@ -48,6 +48,11 @@ from bladelab.runner.model import (
 )
 from bladelab.runner.muscle import muscle_step
 
+# numba's cache is keyed on the content of the file that defines a function, not on the files of
+# the functions it calls: after editing a compiled function in closed_loop.py, controller.py,
+# metabolics.py, muscle.py or contact.py, bump this number so the loop below is compiled again.
+_CACHE_GENERATION = 4
+
 
 def _mujoco_step_addresses() -> tuple[int, int]:
     """Addresses of ``mj_step1`` and ``mj_step2`` in the libmujoco that the bindings loaded."""

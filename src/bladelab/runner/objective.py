@@ -5,9 +5,12 @@
 - ``J_cot = ∫Ė dt / (m·d)`` [J/(kg·m)]: Uchida 2016 gross metabolic energy
   (:mod:`bladelab.runner.metabolics`) over body mass and distance travelled (pelvis, ≥ 1 m);
 - ``J_gait = 1 − Σ_s t_s·w_s / t_des`` (SCONE's GaitMeasure): steps s run from touch-down to
-  touch-down (the first from t = 0), ``w_s = max(0, 1 − Ψ(v_s, v_min, v_max)/(1 m/s))`` with the
+  touch-down (the first from t = 0; a touch-down starts a contact of at least 30 ms, the
+  leg's vertical GRF above 20 N after at least 50 ms unloaded: runner.closed_loop), ``w_s = max(0, 1 − Ψ(v_s, v_min, v_max)/(1 m/s))`` with the
   linear range penalty Ψ of eq. 2.8 and the step's mean pelvis speed ``v_s``; after a fall no more
-  steps count, so falling early costs up to 1;
+  steps count, so falling early costs up to 1; with ``alternating_steps`` (default) a step by
+  the same leg as the step before earns nothing (a hop or gallop is not running; our addition,
+  docs/predictive.md);
 - ``J_inj``: knee load (ligament torque [N·m] of each knee) outside ``knee_load_range``
   (−100…100), ``J_lean``: pelvis tilt [deg] outside ``pelvis_tilt_range_deg`` (−16…−2); both
   eq. 2.9, ``abs_penalty·|Err| + squared_penalty·Err²`` averaged over the simulated time.
@@ -30,6 +33,7 @@ import mujoco
 import numpy as np
 
 from bladelab.errors import SimulationError
+from bladelab.runner.closed_loop import LEGLOAD_COLUMNS
 from bladelab.runner.controller import (
     ControllerLayout,
     controller_layout,
@@ -64,6 +68,7 @@ class ObjectiveSettings:
     squared_penalty: float = 0.0
     robust_samples: int = 1
     robust_jitter: float = 1e-6
+    alternating_steps: bool = True
 
     def to_dict(self) -> dict:
         return asdict(self)
@@ -193,7 +198,9 @@ def simulate_controlled(
     ranges = np.array([*settings.knee_load_range, *settings.pelvis_tilt_range_deg], dtype=float)
     pen = np.array([settings.abs_penalty, settings.squared_penalty])
     acc = np.zeros(4)
-    td = np.zeros((MAX_TOUCHDOWNS, 2))
+    td = np.zeros((MAX_TOUCHDOWNS, 3))
+    legload = np.zeros((2, LEGLOAD_COLUMNS))
+    legload[:, 1] = -1e9  # unloaded since long before t = 0
     bw, mass = model.body_weight, model.total_mass
     n_steps = int(round(settings.duration / dt))
     every = record_every if record_every > 0 else n_steps + 1
@@ -213,6 +220,7 @@ def simulate_controlled(
         leg_length,
         acc,
         td,
+        legload,
         knee_idx,
         itilt,
         ranges,
@@ -246,11 +254,14 @@ def _evaluate(settings, acc, td, t_end, distance, fell, mass, x0) -> Evaluation:
     v_min, v_max = s.speed - s.speed_tolerance, s.speed + s.speed_tolerance
     times = np.concatenate([[0.0], td[:, 0]])
     xs = np.concatenate([[x0], td[:, 1]])
+    legs = np.concatenate([[-1.0], td[:, 2]])
     credit = 0.0
     for i in range(1, len(times)):
         ts = times[i] - times[i - 1]
         if ts <= 0:
             continue
+        if s.alternating_steps and i > 1 and legs[i] == legs[i - 1]:
+            continue  # the same leg again: a hop or gallop, not a running step
         v = (xs[i] - xs[i - 1]) / ts
         psi = v_min - v if v < v_min else (v - v_max if v > v_max else 0.0)
         credit += ts * max(0.0, 1.0 - psi)

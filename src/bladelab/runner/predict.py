@@ -480,7 +480,8 @@ def verify_solution(
     ``speed_m_per_s``); a flight phase (no leg loaded above 20 N) in every stride of each leg
     (touch-down to touch-down of that leg; unloaded gaps shorter than ``min_gap_s`` [s] inside a
     stance, i.e. contact bounces, do not end it, and touches shorter than 30 ms do not start
-    one); power-balance residual below
+    one); touch-downs alternating between the legs after the first step (``same_leg_steps`` 0:
+    no hop or gallop); power-balance residual below
     ``max_power_residual_pct`` % (runner analyses). With ``jittered_copies`` = n > 0 the same
     criteria must also hold for n copies of the parameters moved by ``jitter`` (relative,
     :func:`jittered_parameters`): a gait that survives only on one floating-point path (another
@@ -523,6 +524,7 @@ def _check_gait(runner, layout, x, settings: ObjectiveSettings, limits: tuple) -
     for on in loaded:
         for a, b in _strides(res.time, on, min_gap_s):
             flights.append(bool(np.any(airborne[a:b])))
+    same_leg = _same_leg_steps(res.time, loaded, min_gap_s)
     residual = power_balance_residual_pct(res)
     out = {
         "fell": ev.fell,
@@ -530,6 +532,7 @@ def _check_gait(runner, layout, x, settings: ObjectiveSettings, limits: tuple) -
         "mean_speed_m_per_s": ev.mean_speed,
         "strides": len(flights),
         "strides_with_flight": int(sum(flights)),
+        "same_leg_steps": same_leg,
         "power_balance_residual_pct": residual,
         "cost": ev.cost,
     }
@@ -539,9 +542,23 @@ def _check_gait(runner, layout, x, settings: ObjectiveSettings, limits: tuple) -
         and abs(ev.mean_speed - speed) <= tolerance
         and len(flights) >= 2
         and all(flights)
+        and same_leg == 0
         and residual <= max_residual
     )
     return out
+
+
+def _same_leg_steps(time: np.ndarray, loaded: list[np.ndarray], min_gap_s: float) -> int:
+    """Touch-downs after the second that repeat the leg of the touch-down before (hops and
+    gallops); ``loaded`` holds each leg's loaded samples."""
+    from bladelab.runner.analyses import contact_mask
+
+    touchdowns = []
+    for side, on in enumerate(loaded):
+        on = contact_mask(time, on, min_gap_s=min_gap_s)
+        touchdowns += [(i, side) for i in np.flatnonzero(~on[:-1] & on[1:]) + 1]
+    order = [side for _, side in sorted(touchdowns)]
+    return sum(1 for i in range(2, len(order)) if order[i] == order[i - 1])
 
 
 def _strides(time: np.ndarray, on: np.ndarray, min_gap_s: float) -> list[tuple[int, int]]:
