@@ -236,6 +236,14 @@ def test_run_design_records_the_motion_model(tmp_path):
     saved = json.loads((tmp_path / "o" / "motion.json").read_text())
     assert saved["model"] == "quadratic" and saved["n_cycles"] == 9
     assert json.loads((tmp_path / "o" / "study.json").read_text())["motion"] == "motion.json"
+    # the design report shows the motion model and its leave-one-blade-out errors
+    from bladelab.report.design import design_report_sections
+
+    section = next(s for s in design_report_sections(tmp_path / "o")
+                   if s["title"] == "Design study: motion adaptation")
+    errors = dict(section["tables"][0][1].to_numpy()[:, :2])
+    assert errors["period"] == pytest.approx(saved["loo_period_s"], nan_ok=True)
+    assert len(section["tables"][2][1]) == 9
     # the design's factors must be the motion model's: refused before any run
     space3 = DesignSpace.parse("stiffness_kN_per_m=18:32,width_m=0.05:0.08,height_m=0.4:0.48")
     with pytest.raises(SpecError, match=r"missing factor\(s\) \['height_m'\]"):

@@ -117,6 +117,9 @@ def design_report_sections(design_dir: str | Path) -> list[dict[str, Any]]:
                      "tables": [(f"ANOVA of {objective}", anova),
                                 (f"Coefficients of {objective}",
                                  surfaces[objective].coefficients())]})
+    motion = _motion_section(design_dir, meta)
+    if motion is not None:
+        sections.append(motion)
     sections.append(trends_section(surfaces, meta.get("_evaluator") or {}))
     if optimum is None:
         sections.append({"title": "Design study: optimum",
@@ -133,6 +136,37 @@ def design_report_sections(design_dir: str | Path) -> list[dict[str, Any]]:
             tabs.append(("Constraints at the optimum", pd.DataFrame(cons_rows)))
         sections.append({"title": "Design study: optimum", "text": text, "tables": tabs})
     return sections
+
+
+def _motion_section(design_dir: Path, meta: dict) -> dict[str, Any] | None:
+    """The motion model of a study whose runner adapted its motion to each design (seed 002):
+    model, terms, and the leave-one-blade-out errors of the period and the joint angles."""
+    name = meta.get("motion")
+    if not name:
+        return None
+    path = design_dir / name
+    try:
+        motion = json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, ValueError) as err:
+        raise InputFileError(f"cannot read the motion model: {err}", file=path) from None
+    loo = motion.get("loo_angles_deg") or {}
+    errors = pd.DataFrame(
+        [{"quantity": "period", "leave-one-blade-out error": motion.get("loo_period_s"),
+          "unit": "s"}]
+        + [{"quantity": f"{k} angle", "leave-one-blade-out error": v, "unit": "deg"}
+           for k, v in loo.items()])
+    coef = pd.DataFrame([{"term": k, "period coefficient (s)": v}
+                         for k, v in (motion.get("period_coefficients_s") or {}).items()])
+    text = (f"Each design run follows the gait cycle predicted for its blade by a "
+            f"{motion.get('model')} motion model in the coded factors "
+            f"({', '.join(motion.get('factors', []))}), fitted to {motion.get('n_cycles')} "
+            f"cycles of {motion.get('n_blades')} blades (period and joint angles at "
+            f"{motion.get('n_phase_nodes')} normalised times; seed 002's motion adaptation). "
+            "Leave-one-blade-out errors: RMS error of a blade's cycles predicted from the "
+            "other blades (blank where the others cannot fit the model).")
+    return {"title": "Design study: motion adaptation", "text": text,
+            "tables": [("Motion model errors", errors), ("Period model", coef),
+                       ("Cycles used", pd.DataFrame({"source": motion.get("sources", [])}))]}
 
 
 def trends_section(surfaces, evaluator: dict | None = None) -> dict[str, Any]:
