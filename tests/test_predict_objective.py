@@ -101,37 +101,36 @@ def test_wrong_parameter_count_is_an_error(able):
         simulate_controlled(model, layout.x0[:-1], layout=layout)
 
 
-def test_online_touchdowns_match_the_offline_contact_mask():
-    # the objective's online step detection and runner.analyses.contact_mask (offline) agree on
-    # a force record with a bounce, a brief touch and alternating stances
-    from bladelab.runner.analyses import contact_mask
-    from bladelab.runner.closed_loop import LEGLOAD_COLUMNS, _count_touchdowns
+def test_online_steps_match_the_offline_count_and_scone_rules():
+    # the objective's online step count (runner.closed_loop) and runner.analyses.step_touchdowns
+    # (offline) agree on a force record with a bounce, a scuff and alternating stances
+    from bladelab.runner.analyses import step_touchdowns
+    from bladelab.runner.closed_loop import STEP_STATE_SIZE, _count_touchdowns
 
-    dt = 2.5e-4
+    dt, bw = 2.5e-4, 700.0
     t = np.arange(0.0, 2.0, dt)
     force = np.zeros((len(t), 2))
-    for leg, a, b in ((0, 0.10, 0.30), (1, 0.45, 0.62), (0, 0.80, 1.0), (1, 1.15, 1.35),
-                      (1, 1.50, 1.52), (0, 1.60, 1.80)):
-        force[(t >= a) & (t < b), leg] = 900.0
-    force[(t >= 0.20) & (t < 0.23), 0] = 0.0  # a 30 ms bounce inside the first stance
+    for leg, a, b, f in ((0, 0.10, 0.30, 1800.0), (1, 0.45, 0.62, 1800.0),
+                         (0, 0.80, 1.0, 1800.0), (1, 1.15, 1.35, 1800.0),
+                         (1, 1.42, 1.45, 300.0),  # a scuff 0.27 s after the last step
+                         (0, 1.50, 1.52, 50.0),  # a touch below 0.1 BW (70 N)
+                         (0, 1.60, 1.80, 1800.0)):
+        force[(t >= a) & (t < b), leg] = f
+    force[(t >= 0.15) & (t < 0.17), 0] = 0.0  # a bounce: back 70 ms after the step
     cp = np.zeros((2, 13))
     cp[1, 6] = 1.0  # contact 0 on the left leg, contact 1 on the right
     crec = np.zeros((2, 7))
-    legload = np.zeros((2, LEGLOAD_COLUMNS))
-    legload[:, 1] = -1e9
+    steps = np.zeros(STEP_STATE_SIZE)
+    steps[2] = -1e9
     acc, td = np.zeros(4), np.zeros((50, 3))
     for k in range(len(t)):
         crec[:, 1] = force[k - 1] if k else 0.0  # the previous step's forces, as in the loop
-        _count_touchdowns(t[k], 3.5 * t[k], crec, cp, legload, acc, td)
+        _count_touchdowns(t[k], 3.5 * t[k], crec, cp, bw, steps, acc, td)
     online = td[: int(acc[3])]
-    offline = []
-    for leg in (0, 1):
-        on = contact_mask(t, force[:, leg] > 20.0)
-        # the loop sees a force one step late
-        offline += [(t[i] + dt, leg) for i in np.flatnonzero(~on[:-1] & on[1:]) + 1]
-    offline = np.array(sorted(offline))
-    np.testing.assert_allclose(online[:, 0], offline[:, 0], atol=dt / 2)
+    offline = np.array(step_touchdowns(t, force, bw))
+    np.testing.assert_allclose(online[:, 0], offline[:, 0], atol=1e-12)
     np.testing.assert_array_equal(online[:, 2], offline[:, 1])
-    # by hand: the bounce and the 20 ms touch at 1.50 s are not steps
-    assert online[:, 2].tolist() == [0, 1, 0, 1, 0]
-    np.testing.assert_allclose(td[: int(acc[3]), 1], 3.5 * td[: int(acc[3]), 0])
+    # by hand: the bounce (back within 0.1 s) and the 50 N touch are not steps, the scuff is
+    assert online[:, 2].tolist() == [0, 1, 0, 1, 1, 0]
+    np.testing.assert_allclose(online[:, 0], [0.1, 0.45, 0.8, 1.15, 1.42, 1.6], atol=2 * dt)
+    np.testing.assert_allclose(online[:, 1], 3.5 * online[:, 0])

@@ -76,12 +76,12 @@ def test_same_leg_steps_count_hops_and_gallops():
 
     t = np.arange(0.0, 3.0, 0.001)
 
-    def legs(pattern):
-        on = [np.zeros_like(t, dtype=bool), np.zeros_like(t, dtype=bool)]
+    def forces(pattern):
+        f = np.zeros((len(t), 2))
         for i, side in enumerate(pattern):  # a 0.12 s stance every 0.3 s
-            on[side][(t >= 0.1 + 0.3 * i - 1e-9) & (t < 0.22 + 0.3 * i - 1e-9)] = True
-        return on
+            f[(t >= 0.1 + 0.3 * i - 1e-9) & (t < 0.22 + 0.3 * i - 1e-9), side] = 1500.0
+        return f
 
-    assert _same_leg_steps(t, legs([0, 1] * 4), 0.05) == 0
+    assert _same_leg_steps(t, forces([0, 1] * 4), 700.0) == 0
     # left, right, right, left, right, right, ...: every third step repeats (2 of 8 here)
-    assert _same_leg_steps(t, legs([0, 1, 1, 0, 1, 1, 0, 1]), 0.05) == 2
+    assert _same_leg_steps(t, forces([0, 1, 1, 0, 1, 1, 0, 1]), 700.0) == 2

@@ -22,6 +22,7 @@ import mujoco
 import numpy as np
 import pandas as pd
 
+from bladelab.runner.closed_loop import MIN_STEP_S, STEP_LOAD_BW
 from bladelab.runner.model import CP_BLADE, CP_LEG
 from bladelab.runner.params import GRAVITY
 from bladelab.runner.simulate import RC_FX, RC_FZ, RC_VX, RC_VZ, RunnerResult, _leg_names
@@ -75,13 +76,16 @@ def contact_mask(
     *,
     min_gap_s: float = MIN_GAP_S,
     min_contact_s: float = MIN_CONTACT_S,
+    force: np.ndarray | None = None,
+    min_peak_n: float = 0.0,
 ) -> np.ndarray:
     """Stance mask of one leg from its loaded samples (vertical GRF above the threshold).
 
     Unloaded gaps shorter than ``min_gap_s`` [s] between two loaded stretches (contact
     bounces) are filled, then loaded stretches shorter than ``min_contact_s`` [s] (a brief
-    touch of the swinging foot) are dropped; a stretch touching either end of the record is
-    kept. ``time`` [s] and ``loaded`` (bool) are per sample.
+    touch of the swinging foot) or, given the leg's vertical ``force`` [N] per sample, never
+    reaching ``min_peak_n`` [N] (a scuff) are dropped; a stretch touching either end of the
+    record is kept. ``time`` [s] and ``loaded`` (bool) are per sample.
     """
     on = np.asarray(loaded, dtype=bool).copy()
     time = np.asarray(time, dtype=float)
@@ -89,10 +93,37 @@ def contact_mask(
         edges = np.flatnonzero(np.diff(on.astype(np.int8))) + 1
         bounds = np.concatenate([[0], edges, [len(on)]])
         for a, b in zip(bounds[:-1], bounds[1:], strict=True):
-            inner = a > 0 and b < len(on)
-            if inner and on[a] == value and time[b] - time[a] < shortest:
+            if not (a > 0 and b < len(on)) or on[a] != value:
+                continue
+            weak = value and force is not None and np.max(force[a:b]) < min_peak_n
+            if time[b] - time[a] < shortest or weak:
                 on[a:b] = not value
     return on
+
+
+def step_touchdowns(
+    time: np.ndarray,
+    leg_force: np.ndarray,
+    body_weight: float,
+    *,
+    load_bw: float = STEP_LOAD_BW,
+    min_step_s: float = MIN_STEP_S,
+) -> list[tuple[float, int]]:
+    """Steps as SCONE's GaitMeasure (and the objective, online) counts them: a new contact of a
+    leg (vertical GRF ``leg_force`` (n, 2) [N] rising to ``load_bw`` body weights) more than
+    ``min_step_s`` [s] after the previous step. The force of sample i is seen at sample i + 1,
+    as in the compiled loop. Returns (time [s], leg index) per step."""
+    loaded_prev = np.zeros(2, dtype=bool)
+    last = -np.inf
+    out = []
+    for k in range(1, len(time)):
+        for leg in (0, 1):
+            loaded = leg_force[k - 1, leg] >= load_bw * body_weight
+            if loaded and not loaded_prev[leg] and time[k] - last > min_step_s:
+                out.append((float(time[k]), leg))
+                last = time[k]
+            loaded_prev[leg] = loaded
+    return out
 
 
 def gait_events(
@@ -104,17 +135,21 @@ def gait_events(
 ) -> pd.DataFrame:
     """Touch-downs and lift-offs per leg: columns leg, event (touchdown/liftoff), time [s].
 
-    A leg is in contact while its vertical GRF exceeds ``threshold_n`` [N], with bounces and
-    brief touches cleaned by :func:`contact_mask`.
+    A leg is in contact while its vertical GRF exceeds ``threshold_n`` [N], with bounces, brief
+    touches and scuffs (contacts never reaching 0.1 body weight, SCONE's step load) cleaned by
+    :func:`contact_mask` (``min_contact_s=0`` keeps every contact).
     """
     rows = []
     names = _leg_names(result.model)
     for leg in (0, 1):
+        fz = _leg_fz(result, leg)
         on = contact_mask(
             result.time,
-            _leg_fz(result, leg) > threshold_n,
+            fz > threshold_n,
             min_gap_s=min_gap_s,
             min_contact_s=min_contact_s,
+            force=fz,
+            min_peak_n=STEP_LOAD_BW * result.model.body_weight if min_contact_s > 0 else 0.0,
         )
         change = np.flatnonzero(np.diff(on.astype(np.int8)))
         for i in change:

@@ -17,47 +17,34 @@ from bladelab.runner.controller import compute_excitations, push_sensors, update
 from bladelab.runner.metabolics import total_metabolic_rate
 from bladelab.runner.model import CP_LEG
 
-TOUCHDOWN_LOAD_N = 20.0  # a leg is loaded above this vertical GRF [N] (runner.analyses)
-TOUCHDOWN_MIN_GAP_S = 0.05  # a new contact after a shorter unloaded gap is a bounce [s]
-TOUCHDOWN_MIN_CONTACT_S = 0.03  # a shorter contact is a brief touch, not a step [s]
-LEGLOAD_COLUMNS = 5  # per leg: loaded now, unloaded since [s], contact start [s], its x, pending
+STEP_LOAD_BW = 0.1  # a leg is loaded at or above this vertical GRF [body weights] (SCONE)
+MIN_STEP_S = 0.1  # a new contact sooner than this after the last step is not a step [s] (SCONE)
+STEP_STATE_SIZE = 3  # left loaded, right loaded, time of the last step [s]
 
 
 @njit(cache=True)
-def _count_touchdowns(t, x_pelvis, crec, cp, legload, acc, td):
-    """Record the touch-downs of the objective's steps from the legs' vertical GRF, online, as
-    :func:`bladelab.runner.analyses.contact_mask` does offline (SCONE's GaitMeasure also counts
-    steps from foot contacts): a contact starts when the leg's force rises above
-    ``TOUCHDOWN_LOAD_N`` after at least ``TOUCHDOWN_MIN_GAP_S`` unloaded (a shorter gap is a
-    bounce of the same contact) and is a step once it has lasted ``TOUCHDOWN_MIN_CONTACT_S``
-    (a shorter one is a brief touch, ignored). ``legload`` (2, LEGLOAD_COLUMNS) keeps each
-    leg's state; ``crec`` holds the previous step's contact forces. The touch-down's time [s],
-    pelvis x [m] and leg go to ``td``, their number to ``acc[3]``."""
+def _count_touchdowns(t, x_pelvis, crec, cp, body_weight, steps, acc, td):
+    """Record the objective's steps as SCONE's GaitMeasure counts them, online: a step is a
+    new contact of a leg (its vertical GRF rising to ``STEP_LOAD_BW`` body weights) more than
+    ``MIN_STEP_S`` after the previous step (sooner contacts, e.g. a bounce or a scuff, are not
+    steps). ``steps`` = (left loaded, right loaded, time of the last step [s]); ``crec`` holds
+    the previous step's contact forces. The step's time [s], pelvis x [m] and leg (0 left, 1
+    right) go to ``td``, their number to ``acc[3]``
+    (:func:`bladelab.runner.analyses.step_touchdowns` does the same offline)."""
     force = np.zeros(2)
     for c in range(cp.shape[0]):
         force[int(cp[c, CP_LEG])] += crec[c, 1]
     for leg in range(2):
-        loaded = force[leg] > TOUCHDOWN_LOAD_N
-        if loaded and legload[leg, 0] == 0.0:  # rising edge
-            legload[leg, 0] = 1.0
-            if t - legload[leg, 1] >= TOUCHDOWN_MIN_GAP_S:
-                legload[leg, 2] = t
-                legload[leg, 3] = x_pelvis
-                legload[leg, 4] = 1.0
-        elif not loaded and legload[leg, 0] == 1.0:  # falling edge
-            legload[leg, 0] = 0.0
-            if legload[leg, 4] == 1.0:
-                legload[leg, 4] = 0.0  # a brief touch: the leg stays unloaded since before it
-            else:
-                legload[leg, 1] = t
-        if legload[leg, 4] == 1.0 and loaded and t - legload[leg, 2] >= TOUCHDOWN_MIN_CONTACT_S:
-            legload[leg, 4] = 0.0
+        loaded = force[leg] >= STEP_LOAD_BW * body_weight
+        if loaded and steps[leg] == 0.0 and t - steps[2] > MIN_STEP_S:
             n = int(acc[3])
             if n < td.shape[0]:
-                td[n, 0] = legload[leg, 2]
-                td[n, 1] = legload[leg, 3]
+                td[n, 0] = t
+                td[n, 1] = x_pelvis
                 td[n, 2] = leg
                 acc[3] += 1.0
+            steps[2] = t
+        steps[leg] = 1.0 if loaded else 0.0
 
 
 @njit(cache=True)
@@ -65,7 +52,7 @@ def control_step(k, dt, mj, arrays, control):
     """One controller step at step ``k`` (time ``k·dt`` [s]); writes the excitations ``u``.
 
     ``control`` = (table, p, hist, cs, mb, ix, thresholds, body_weight, body_mass, leg_length,
-    acc, td, legload, knee_idx, itilt, ranges, pen) (built by ``runner.objective``); running
+    acc, td, steps, knee_idx, itilt, ranges, pen) (built by ``runner.objective``); running
     sums go to ``acc``: metabolic energy [J], knee penalty·s, tilt penalty·s, number of
     touch-downs, and the touch-downs' time [s], pelvis x [m] and leg (0 left, 1 right) to ``td``
     (:func:`_count_touchdowns`).
@@ -85,7 +72,7 @@ def control_step(k, dt, mj, arrays, control):
         leg_length,
         acc,
         td,
-        legload,
+        steps,
         knee_idx,
         itilt,
         ranges,
@@ -95,7 +82,7 @@ def control_step(k, dt, mj, arrays, control):
     nq = qpos.shape[0]
     push_sensors(hist, cs, ms, mp, qpos, qvel)
     update_gait_states(cs, crec, cp, qpos, ix, body_weight, thresholds, leg_length)
-    _count_touchdowns(k * dt, qpos[ix], crec, cp, legload, acc, td)
+    _count_touchdowns(k * dt, qpos[ix], crec, cp, body_weight, steps, acc, td)
     compute_excitations(u, table, p, hist, cs, nm, nq)
     acc[0] += total_metabolic_rate(u, ms, mp, mb, body_mass) * dt
     for j in range(knee_idx.shape[0]):

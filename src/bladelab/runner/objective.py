@@ -5,8 +5,8 @@
 - ``J_cot = ∫Ė dt / (m·d)`` [J/(kg·m)]: Uchida 2016 gross metabolic energy
   (:mod:`bladelab.runner.metabolics`) over body mass and distance travelled (pelvis, ≥ 1 m);
 - ``J_gait = 1 − Σ_s t_s·w_s / t_des`` (SCONE's GaitMeasure): steps s run from touch-down to
-  touch-down (the first from t = 0; a touch-down starts a contact of at least 30 ms, the
-  leg's vertical GRF above 20 N after at least 50 ms unloaded: runner.closed_loop), ``w_s = max(0, 1 − Ψ(v_s, v_min, v_max)/(1 m/s))`` with the
+  touch-down (the first from t = 0; a touch-down: a leg's new contact at 0.1 body weight,
+  more than 0.1 s after the last one, as SCONE's GaitMeasure: runner.closed_loop), ``w_s = max(0, 1 − Ψ(v_s, v_min, v_max)/(1 m/s))`` with the
   linear range penalty Ψ of eq. 2.8 and the step's mean pelvis speed ``v_s``; after a fall no more
   steps count, so falling early costs up to 1; with ``alternating_steps`` (default) a step by
   the same leg as the step before earns nothing (a hop or gallop is not running; our addition,
@@ -33,7 +33,7 @@ import mujoco
 import numpy as np
 
 from bladelab.errors import SimulationError
-from bladelab.runner.closed_loop import LEGLOAD_COLUMNS
+from bladelab.runner.closed_loop import STEP_STATE_SIZE
 from bladelab.runner.controller import (
     ControllerLayout,
     controller_layout,
@@ -199,8 +199,8 @@ def simulate_controlled(
     pen = np.array([settings.abs_penalty, settings.squared_penalty])
     acc = np.zeros(4)
     td = np.zeros((MAX_TOUCHDOWNS, 3))
-    legload = np.zeros((2, LEGLOAD_COLUMNS))
-    legload[:, 1] = -1e9  # unloaded since long before t = 0
+    steps = np.zeros(STEP_STATE_SIZE)
+    steps[2] = -1e9  # no step yet
     bw, mass = model.body_weight, model.total_mass
     n_steps = int(round(settings.duration / dt))
     every = record_every if record_every > 0 else n_steps + 1
@@ -220,7 +220,7 @@ def simulate_controlled(
         leg_length,
         acc,
         td,
-        legload,
+        steps,
         knee_idx,
         itilt,
         ranges,

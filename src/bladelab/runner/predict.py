@@ -479,9 +479,9 @@ def verify_solution(
     fall; mean speed within ``speed_tolerance`` [m/s] of ``speed`` (default: the file's
     ``speed_m_per_s``); a flight phase (no leg loaded above 20 N) in every stride of each leg
     (touch-down to touch-down of that leg; unloaded gaps shorter than ``min_gap_s`` [s] inside a
-    stance, i.e. contact bounces, do not end it, and touches shorter than 30 ms do not start
-    one); touch-downs alternating between the legs after the first step (``same_leg_steps`` 0:
-    no hop or gallop); power-balance residual below
+    stance, i.e. contact bounces, do not end it, and touches shorter than 30 ms or never
+    reaching 0.1 body weight do not start one); steps (SCONE's definition, :func:`bladelab.runner.analyses.step_touchdowns`)
+    alternating between the legs after the first (``same_leg_steps`` 0: no hop or gallop); power-balance residual below
     ``max_power_residual_pct`` % (runner analyses). With ``jittered_copies`` = n > 0 the same
     criteria must also hold for n copies of the parameters moved by ``jitter`` (relative,
     :func:`jittered_parameters`): a gait that survives only on one floating-point path (another
@@ -518,13 +518,15 @@ def _check_gait(runner, layout, x, settings: ObjectiveSettings, limits: tuple) -
     duration, speed, tolerance, max_residual, min_gap_s = limits
     ev, res = simulate_controlled(runner, x, layout=layout, settings=settings, record_every=2)
     leg = res.model.contact_params[:, 6]
-    loaded = [res.contacts[:, leg == i, 1].sum(axis=1) > CONTACT_THRESHOLD_N for i in (0, 1)]
-    airborne = ~(loaded[0] | loaded[1])
+    forces = np.stack([res.contacts[:, leg == i, 1].sum(axis=1) for i in (0, 1)], axis=1)
+    loaded = forces > CONTACT_THRESHOLD_N
+    airborne = ~(loaded[:, 0] | loaded[:, 1])
     flights = []
-    for on in loaded:
-        for a, b in _strides(res.time, on, min_gap_s):
+    for i in (0, 1):
+        strides = _strides(res.time, loaded[:, i], min_gap_s, forces[:, i], runner.body_weight)
+        for a, b in strides:
             flights.append(bool(np.any(airborne[a:b])))
-    same_leg = _same_leg_steps(res.time, loaded, min_gap_s)
+    same_leg = _same_leg_steps(res.time, forces, runner.body_weight)
     residual = power_balance_residual_pct(res)
     out = {
         "fell": ev.fell,
@@ -548,26 +550,32 @@ def _check_gait(runner, layout, x, settings: ObjectiveSettings, limits: tuple) -
     return out
 
 
-def _same_leg_steps(time: np.ndarray, loaded: list[np.ndarray], min_gap_s: float) -> int:
-    """Touch-downs after the second that repeat the leg of the touch-down before (hops and
-    gallops); ``loaded`` holds each leg's loaded samples."""
-    from bladelab.runner.analyses import contact_mask
+def _same_leg_steps(time: np.ndarray, leg_force: np.ndarray, body_weight: float) -> int:
+    """Steps after the second by the same leg as the step before (hops, gallops, a scuff
+    counted as a step): :func:`bladelab.runner.analyses.step_touchdowns` of the legs'
+    vertical GRF ``leg_force`` (n, 2) [N]."""
+    from bladelab.runner.analyses import step_touchdowns
 
-    touchdowns = []
-    for side, on in enumerate(loaded):
-        on = contact_mask(time, on, min_gap_s=min_gap_s)
-        touchdowns += [(i, side) for i in np.flatnonzero(~on[:-1] & on[1:]) + 1]
-    order = [side for _, side in sorted(touchdowns)]
+    order = [leg for _, leg in step_touchdowns(time, leg_force, body_weight)]
     return sum(1 for i in range(2, len(order)) if order[i] == order[i - 1])
 
 
-def _strides(time: np.ndarray, on: np.ndarray, min_gap_s: float) -> list[tuple[int, int]]:
+def _strides(
+    time: np.ndarray,
+    on: np.ndarray,
+    min_gap_s: float,
+    force: np.ndarray | None = None,
+    body_weight: float = 0.0,
+) -> list[tuple[int, int]]:
     """Sample ranges from one touch-down to the next of a leg, with contact bounces shorter
-    than ``min_gap_s`` [s] merged into the stance and brief touches dropped
+    than ``min_gap_s`` [s] merged into the stance, brief touches dropped and, given the leg's
+    vertical ``force`` [N], scuffs below 0.1 ``body_weight`` [N] dropped
     (:func:`bladelab.runner.analyses.contact_mask`)."""
-    from bladelab.runner.analyses import contact_mask
+    from bladelab.runner.analyses import STEP_LOAD_BW, contact_mask
 
-    on = contact_mask(time, on, min_gap_s=min_gap_s)
+    on = contact_mask(
+        time, on, min_gap_s=min_gap_s, force=force, min_peak_n=STEP_LOAD_BW * body_weight
+    )
     td = np.flatnonzero(~on[:-1] & on[1:]) + 1
     return list(zip(td[:-1], td[1:], strict=True))
 
