@@ -30,3 +30,23 @@ def fukuchi_trials(shared_data):
     run = read_c3d(shared_data / FUKUCHI_RUN)
     ax = run.metadata["axes"]
     return run, read_c3d(shared_data / FUKUCHI_STATIC, forward=ax["forward"], up=ax["up"])
+
+
+@pytest.fixture(scope="session")
+def ray_instance():
+    """One local Ray instance (2 CPUs) for every Ray test of the session (started once: Ray's
+    start-up is most of a Ray test's time); bladelab's Ray executor uses a running instance."""
+    ray = pytest.importorskip("ray", reason="ray not installed (pip install bladelab[ray])")
+    import os
+    import sys
+
+    started = not ray.is_initialized()
+    if started:
+        ray.init(
+            num_cpus=2, include_dashboard=False, log_to_driver=False, logging_level="ERROR",
+            configure_logging=False,
+            runtime_env={"env_vars": {"PYTHONPATH": os.pathsep.join(p for p in sys.path if p)}},
+        )
+    yield ray
+    if started:
+        ray.shutdown()

@@ -3,7 +3,6 @@ checks, wall time of an optimisation, CLI, Ray = local."""
 
 from __future__ import annotations
 
-import importlib.util
 import json
 
 import numpy as np
@@ -212,8 +211,7 @@ def test_cli_sweep(tmp_path, capsys):
     assert cell["result"]["evaluations"] == 2
 
 
-@pytest.mark.skipif(importlib.util.find_spec("ray") is None, reason="ray not installed")
-def test_sweep_on_ray_matches_local(tmp_path):
+def test_sweep_on_ray_matches_local(tmp_path, ray_instance):
     kw = {"categories": ("Cat4", "Cat6"), "speeds": (3.5,), "generations": 2}
     local = _sweep(tmp_path / "local", **kw)
     ray = _sweep(tmp_path / "ray", jobs=2, executor="ray", **kw)

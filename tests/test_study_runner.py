@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import importlib.util
 import sqlite3
 import textwrap
 
@@ -173,8 +172,7 @@ def test_unknown_executor():
         make_executor("dask", 2)
 
 
-@pytest.mark.skipif(importlib.util.find_spec("ray") is None, reason="ray not installed (pip install bladelab[ray])")
-def test_ray_matches_local(tmp_path):
+def test_ray_matches_local(tmp_path, ray_instance):
     a, b = tmp_path / "a", tmp_path / "b"
     a.mkdir()
     b.mkdir()
