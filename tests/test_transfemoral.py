@@ -8,12 +8,12 @@ import numpy as np
 import pytest
 
 from bladelab.design import central_composite, default_design_space, generate_blade
+from bladelab.design.motion_model import fit_motion_model
 from bladelab.errors import DataError, InputFileError, SpecError
 from bladelab.runner.gait_cycle import (
     ANGLE_NAMES,
     GaitCycle,
     default_gait_cycle,
-    fit_motion_model,
     gait_cycle_from_runner,
     read_gait_csv,
 )

@@ -4,7 +4,7 @@ Seed 002 measured its runner with 9 blades (4 trials each) and fitted the period
 time-normalised joint angles as second-order response surfaces of the design factors, so that a
 new design gets a predicted motion. Here the cycles and their blades come from a motion file
 (YAML or CSV), :func:`load_motion_model` fits
-:func:`~bladelab.runner.gait_cycle.fit_motion_model` to them and
+:func:`~bladelab.design.motion_model.fit_motion_model` to them and
 :class:`~bladelab.runner.transfemoral.RunnerEvaluator` (``motion=``) predicts each design's
 cycle from it.
 
@@ -371,7 +371,7 @@ def load_motion_model(
         With its coding, so that ``predict_point({factor: value})`` works; ``to_dict()`` gives
         the model, its terms and the leave-one-blade-out errors (period [s], angles [deg]).
     """
-    from bladelab.runner.gait_cycle import fit_motion_model
+    from bladelab.design.motion_model import fit_motion_model
 
     motion = read_motion_file(path, space=space)
     cycles = load_motion_cycles(motion, progress=progress)
@@ -411,9 +411,9 @@ def check_motion_factors(motion, names: Sequence[str]) -> None:
 
 
 def as_motion_model(motion):
-    """A :class:`~bladelab.runner.gait_cycle.MotionModel` as it is, or one fitted from a motion
+    """A :class:`~bladelab.design.motion_model.MotionModel` as it is, or one fitted from a motion
     file path (:func:`load_motion_model`, coded over the cycles' own blades)."""
-    from bladelab.runner.gait_cycle import MotionModel
+    from bladelab.design.motion_model import MotionModel
 
     if isinstance(motion, MotionModel):
         return motion

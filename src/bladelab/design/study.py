@@ -13,7 +13,7 @@ stopped. It then writes, atomically:
 - ``estimability.json``: the rank/conditioning report of the design for the model;
 - ``optimum.json``: the constrained optimum (if an objective is given);
 - ``motion.json``: with an evaluator that adapts the motion to the design (its ``motion``
-  attribute, a :class:`~bladelab.runner.gait_cycle.MotionModel`): the motion model, its terms,
+  attribute, a :class:`~bladelab.design.motion_model.MotionModel`): the motion model, its terms,
   coding and leave-one-blade-out errors. Its factors must be the design's (checked before any
   run).
 """

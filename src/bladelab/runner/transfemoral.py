@@ -513,7 +513,7 @@ class RunnerEvaluator:
     generator
         Options of :func:`~bladelab.design.blade_generator.generate_blade`.
     motion
-        Motion adaptation (seed 002): a :class:`~bladelab.runner.gait_cycle.MotionModel` or a
+        Motion adaptation (seed 002): a :class:`~bladelab.design.motion_model.MotionModel` or a
         motion file (:func:`bladelab.design.motion.load_motion_model`, fitted once here); each
         design then runs its predicted cycle and gets the response ``predicted_period_s``.
         Exclusive with ``gait``.
