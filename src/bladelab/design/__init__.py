@@ -43,6 +43,8 @@ from bladelab.design.doe import (
     require_estimable,
 )
 from bladelab.design.evaluators import BladeEvaluator, make_evaluator, swing_clearance
+from bladelab.design.motion import load_motion_model, read_motion_file
+from bladelab.design.motion_model import MotionModel, fit_motion_model
 from bladelab.design.optimum import OptimumResult, SurfaceConstraint, constrained_optimum
 from bladelab.design.performance import (
     CyclePerformance,
@@ -71,6 +73,7 @@ __all__ = [
     "Factor",
     "GeneratedBlade",
     "KneeBucklingResult",
+    "MotionModel",
     "OptimumResult",
     "ResponseSurface",
     "SEED002_TRENDS",
@@ -89,16 +92,19 @@ __all__ = [
     "default_design_space",
     "estimability",
     "evaluate_trends",
+    "fit_motion_model",
     "fit_surface",
     "generate_blade",
     "knee_buckling",
     "knee_extension_moment",
+    "load_motion_model",
     "make_design",
     "make_evaluator",
     "model_terms",
     "parse_terms",
     "performance_by_leg",
     "performance_by_stance",
+    "read_motion_file",
     "read_runs_csv",
     "require_estimable",
     "run_design",
