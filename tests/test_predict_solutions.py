@@ -39,34 +39,43 @@ def test_shipped_solution_runs(path):
     assert out["ok"]
 
 
+def _three_stances():
+    """Time [s] and a leg's contact mask with stances 0.1-0.3, 0.5-0.7 and 0.9-0.99 s."""
+    import numpy as np
+
+    t = np.arange(0.0, 1.0, 0.001)
+    on = np.zeros_like(t, dtype=bool)
+    for a, b in ((0.1, 0.3), (0.5, 0.7), (0.9, 0.99)):
+        on[(t >= a - 1e-9) & (t < b - 1e-9)] = True
+    return t, on
+
+
+def _stride_times(t, on, min_gap_s, **kw):
+    from bladelab.runner.predict import _strides
+
+    return [(round(t[a], 3), round(t[b], 3)) for a, b in _strides(t, on, min_gap_s, **kw)]
+
+
 def test_strides_merge_contact_bounces():
-    import numpy as np
-
-    from bladelab.runner.predict import _strides
-
-    t = np.arange(0.0, 1.0, 0.001)
-    on = np.zeros_like(t, dtype=bool)
-    for a, b in ((0.1, 0.3), (0.5, 0.7), (0.9, 0.99)):
-        on[(t >= a - 1e-9) & (t < b - 1e-9)] = True
+    t, on = _three_stances()
     on[(t >= 0.2 - 1e-9) & (t < 0.22 - 1e-9)] = False  # a 20 ms bounce inside the first stance
-    strides = [(round(t[a], 3), round(t[b], 3)) for a, b in _strides(t, on, 0.05)]
-    assert strides == [(0.1, 0.5), (0.5, 0.9)]
+    assert _stride_times(t, on, 0.05) == [(0.1, 0.5), (0.5, 0.9)]
     # with no merging the bounce starts a stride of its own
-    assert len(_strides(t, on, 0.0)) == 3
+    assert len(_stride_times(t, on, 0.0)) == 3
 
 
-def test_brief_touches_do_not_start_a_stride():
+def test_brief_touches_and_scuffs_do_not_start_a_stride():
     import numpy as np
 
-    from bladelab.runner.predict import _strides
-
-    t = np.arange(0.0, 1.0, 0.001)
-    on = np.zeros_like(t, dtype=bool)
-    for a, b in ((0.1, 0.3), (0.5, 0.7), (0.9, 0.99)):
-        on[(t >= a - 1e-9) & (t < b - 1e-9)] = True
+    t, on = _three_stances()
     on[(t >= 0.4 - 1e-9) & (t < 0.41 - 1e-9)] = True  # a 10 ms touch of the swinging foot
-    strides = [(round(t[a], 3), round(t[b], 3)) for a, b in _strides(t, on, 0.05)]
-    assert strides == [(0.1, 0.5), (0.5, 0.9)]
+    assert _stride_times(t, on, 0.05) == [(0.1, 0.5), (0.5, 0.9)]
+    t, on = _three_stances()
+    on[(t >= 0.4 - 1e-9) & (t < 0.45 - 1e-9)] = True  # a 50 ms scuff at 50 N
+    force = np.where(on, 1500.0, 0.0)
+    force[(t >= 0.4 - 1e-9) & (t < 0.45 - 1e-9)] = 50.0
+    assert len(_stride_times(t, on, 0.05)) == 3  # without the force it is a stance
+    assert _stride_times(t, on, 0.05, force=force, body_weight=700.0) == [(0.1, 0.5), (0.5, 0.9)]
 
 
 def test_same_leg_steps_count_hops_and_gallops():
