@@ -71,9 +71,9 @@ def test_brief_touches_and_scuffs_do_not_start_a_stride():
     on[(t >= 0.4 - 1e-9) & (t < 0.41 - 1e-9)] = True  # a 10 ms touch of the swinging foot
     assert _stride_times(t, on, 0.05) == [(0.1, 0.5), (0.5, 0.9)]
     t, on = _three_stances()
-    on[(t >= 0.4 - 1e-9) & (t < 0.45 - 1e-9)] = True  # a 50 ms scuff at 50 N
+    on[(t >= 0.36 - 1e-9) & (t < 0.41 - 1e-9)] = True  # a 50 ms scuff at 50 N
     force = np.where(on, 1500.0, 0.0)
-    force[(t >= 0.4 - 1e-9) & (t < 0.45 - 1e-9)] = 50.0
+    force[(t >= 0.36 - 1e-9) & (t < 0.41 - 1e-9)] = 50.0
     assert len(_stride_times(t, on, 0.05)) == 3  # without the force it is a stance
     assert _stride_times(t, on, 0.05, force=force, body_weight=700.0) == [(0.1, 0.5), (0.5, 0.9)]
 
