@@ -18,10 +18,11 @@ def able():
     return model, controller_layout(model)
 
 
-def _td(times, speed, legs=None):
-    """Touch-downs (time [s], pelvis x [m], leg) at a constant speed, legs alternating."""
+def _td(times, speed, legs=None, struck=()):
+    """Steps (time [s], pelvis x [m], leg, struck) at a constant speed, legs alternating."""
     legs = [i % 2 for i in range(len(times))] if legs is None else legs
-    return np.array([[t, speed * t, leg] for t, leg in zip(times, legs, strict=True)])
+    return np.array([[t, speed * t, leg, float(i in struck)]
+                     for i, (t, leg) in enumerate(zip(times, legs, strict=True))])
 
 
 def test_gait_measure_by_hand():
@@ -47,6 +48,9 @@ def test_gait_measure_gives_no_credit_to_a_gallop():
     # hand count: steps 3, 6, ..., 27 (1-based) repeat the leg before them: 9 steps of 0.35 s
     ev = _evaluate(s, acc, _td(times, 3.5, gallop), 10.0, 35.0, False, 80.0, 0.0)
     assert ev.j_gait == pytest.approx(1.0 - (9.8 - 9 * 0.35) / 10.0)
+    # a step during which the other foot struck the ground earns nothing either (2 of 28)
+    ev = _evaluate(s, acc, _td(times, 3.5, struck=(4, 10)), 10.0, 35.0, False, 80.0, 0.0)
+    assert ev.j_gait == pytest.approx(1.0 - (9.8 - 2 * 0.35) / 10.0)
     # the seed's measure counts every step
     seed = ObjectiveSettings(speed=3.5, duration=10.0, alternating_steps=False)
     ev = _evaluate(seed, acc, _td(times, 3.5, gallop), 10.0, 35.0, False, 80.0, 0.0)
@@ -57,7 +61,7 @@ def test_cost_terms_and_weights_by_hand():
     s = ObjectiveSettings(speed=3.5, duration=2.0)
     # energy 1600 J, 80 kg, 7 m: J_cot = 1600/(80*7); penalties accumulated as integral * s
     acc = np.array([1600.0, 30.0, 4.0, 0.0])
-    ev = _evaluate(s, acc, np.zeros((0, 3)), 2.0, 7.0, False, 80.0, 0.0)
+    ev = _evaluate(s, acc, np.zeros((0, 4)), 2.0, 7.0, False, 80.0, 0.0)
     assert ev.j_cot == pytest.approx(1600 / 560)
     assert ev.j_inj == pytest.approx(15.0)
     assert ev.j_lean == pytest.approx(2.0)
@@ -117,20 +121,23 @@ def test_online_steps_match_the_offline_count_and_scone_rules():
                          (0, 1.60, 1.80, 1800.0)):
         force[(t >= a) & (t < b), leg] = f
     force[(t >= 0.15) & (t < 0.17), 0] = 0.0  # a bounce: back 70 ms after the step
+    force[(t >= 0.86) & (t < 0.90), 1] = 900.0  # the swinging right foot strikes at 0.86 s
     cp = np.zeros((2, 13))
     cp[1, 6] = 1.0  # contact 0 on the left leg, contact 1 on the right
     crec = np.zeros((2, 7))
     steps = np.zeros(STEP_STATE_SIZE)
-    steps[2] = -1e9
-    acc, td = np.zeros(4), np.zeros((50, 3))
+    steps[2], steps[3] = -1e9, -1.0
+    acc, td = np.zeros(4), np.zeros((50, 4))
     for k in range(len(t)):
         crec[:, 1] = force[k - 1] if k else 0.0  # the previous step's forces, as in the loop
         _count_touchdowns(t[k], 3.5 * t[k], crec, cp, bw, steps, acc, td)
     online = td[: int(acc[3])]
-    offline = np.array(step_touchdowns(t, force, bw))
+    offline = np.array(step_touchdowns(t, force, bw), dtype=float)
     np.testing.assert_allclose(online[:, 0], offline[:, 0], atol=1e-12)
-    np.testing.assert_array_equal(online[:, 2], offline[:, 1])
-    # by hand: the bounce (back within 0.1 s) and the 50 N touch are not steps, the scuff is
+    np.testing.assert_array_equal(online[:, 2:4], offline[:, 1:3])
+    # by hand: the bounce (back within 0.1 s) and the 50 N touch are not steps, the scuff is;
+    # the strike 60 ms after the left step at 0.8 s marks that step
     assert online[:, 2].tolist() == [0, 1, 0, 1, 1, 0]
+    assert online[:, 3].tolist() == [0, 0, 1, 0, 0, 0]
     np.testing.assert_allclose(online[:, 0], [0.1, 0.45, 0.8, 1.15, 1.42, 1.6], atol=2 * dt)
     np.testing.assert_allclose(online[:, 1], 3.5 * online[:, 0])

@@ -17,6 +17,7 @@ from bladelab.runner import (
     simulate_runner,
     spatiotemporal,
     summary,
+    swing_contacts,
 )
 from bladelab.runner.simulate import RunnerResult
 
@@ -99,8 +100,24 @@ def test_bounces_and_brief_touches_do_not_change_the_gait_events(amputee):
     assert st[("intact", "contact_time")] == pytest.approx(0.2, abs=3e-3)
     assert st[("intact", "stride_time")] == pytest.approx(0.6, abs=3e-3)
     # without the cleaning the bounce and the touch are events of their own
-    raw = gait_events(res, threshold_n=1.0, min_gap_s=0.0, min_contact_s=0.0)
+    raw = gait_events(res, threshold_n=1.0, min_gap_s=0.0, min_contact_s=0.0, steps_only=False)
     assert len(raw[raw.leg == "intact"]) == len(ev[ev.leg == "intact"]) + 4
+
+
+def test_a_swinging_foot_striking_the_ground_is_not_a_stance(amputee):
+    # the intact foot strikes the ground (40 ms, 1 kN) 20 ms after each prosthetic touch-down:
+    # not a step (SCONE: within 0.1 s of the last step), so not a stance but a swing contact
+    strikes = [(0, 0.42, 0.46), (0, 1.02, 1.06)]
+    res = _synthetic(amputee, stances=[*STANCES, *strikes], peak=2000.0)
+    ev = gait_events(res, threshold_n=1.0)
+    td = ev[(ev.leg == "intact") & (ev.event == "touchdown")].time.to_numpy()
+    np.testing.assert_allclose(td, [0.1, 0.7, 1.3], atol=2e-3)
+    st = spatiotemporal(res, threshold_n=1.0).set_index(["leg", "variable"]).value
+    assert st[("intact", "stride_time")] == pytest.approx(0.6, abs=3e-3)
+    sc = swing_contacts(res, threshold_n=1.0)
+    np.testing.assert_allclose(sc.start, [0.42, 1.02], atol=2e-3)
+    assert (sc.leg == "intact").all() and sc.peak_N.min() > 900.0
+    assert len(gait_events(res, threshold_n=1.0, steps_only=False)) == len(ev) + 4
 
 
 def test_leg_stiffness_hand_derived(amputee):

@@ -18,6 +18,7 @@ from bladelab.runner.analyses import (
     power_balance_residual_pct,
     spatiotemporal,
     summary,
+    swing_contacts,
 )
 from bladelab.runner.model import RunnerModel, build_runner, contact_heights
 from bladelab.runner.params import (
@@ -60,4 +61,5 @@ __all__ = [
     "simulate_runner",
     "spatiotemporal",
     "summary",
+    "swing_contacts",
 ]

@@ -108,21 +108,66 @@ def step_touchdowns(
     *,
     load_bw: float = STEP_LOAD_BW,
     min_step_s: float = MIN_STEP_S,
-) -> list[tuple[float, int]]:
+) -> list[tuple[float, int, bool]]:
     """Steps as SCONE's GaitMeasure (and the objective, online) counts them: a new contact of a
     leg (vertical GRF ``leg_force`` (n, 2) [N] rising to ``load_bw`` body weights) more than
-    ``min_step_s`` [s] after the previous step. The force of sample i is seen at sample i + 1,
-    as in the compiled loop. Returns (time [s], leg index) per step."""
+    ``min_step_s`` [s] after the previous step; a sooner new contact of the other leg marks the
+    step as struck (the swinging foot hit the ground). The force of sample i is seen at sample
+    i + 1, as in the compiled loop. Returns (time [s], leg index, struck) per step."""
     loaded_prev = np.zeros(2, dtype=bool)
-    last = -np.inf
-    out = []
+    last, last_leg = -np.inf, -1
+    out: list[tuple[float, int, bool]] = []
     for k in range(1, len(time)):
         for leg in (0, 1):
             loaded = leg_force[k - 1, leg] >= load_bw * body_weight
-            if loaded and not loaded_prev[leg] and time[k] - last > min_step_s:
-                out.append((float(time[k]), leg))
-                last = time[k]
+            if loaded and not loaded_prev[leg]:
+                if time[k] - last > min_step_s:
+                    out.append((float(time[k]), leg, False))
+                    last, last_leg = time[k], leg
+                elif leg != last_leg and out:
+                    out[-1] = (out[-1][0], out[-1][1], True)
             loaded_prev[leg] = loaded
+    return out
+
+
+def _contacts(
+    result: RunnerResult, threshold_n: float, min_gap_s: float, min_contact_s: float
+) -> list[dict]:
+    """Every cleaned contact of both legs (:func:`contact_mask`), each marked as a stance (a
+    step of :func:`step_touchdowns` starts in it) or not (a swing contact)."""
+    names = _leg_names(result.model)
+    bw = result.model.body_weight
+    forces = np.stack([_leg_fz(result, leg) for leg in (0, 1)], axis=1)
+    steps = step_touchdowns(result.time, forces, bw)
+    dt = float(result.time[1] - result.time[0]) if len(result.time) > 1 else 0.0
+    out = []
+    for leg in (0, 1):
+        fz = forces[:, leg]
+        on = contact_mask(
+            result.time,
+            fz > threshold_n,
+            min_gap_s=min_gap_s,
+            min_contact_s=min_contact_s,
+            force=fz,
+            min_peak_n=STEP_LOAD_BW * bw if min_contact_s > 0 else 0.0,
+        )
+        edges = np.flatnonzero(np.diff(on.astype(np.int8))) + 1
+        bounds = np.concatenate([[0], edges, [len(on)]])
+        for a, b in zip(bounds[:-1], bounds[1:], strict=True):
+            if not on[a]:
+                continue
+            t0, t1 = float(result.time[a]), float(result.time[b - 1])
+            stance = any(side == leg and t0 - 1e-12 <= t <= t1 + dt + 1e-12 for t, side, _ in steps)
+            out.append(
+                {
+                    "leg": names[leg],
+                    "start": t0,
+                    "end": float(result.time[min(b, len(on) - 1)]),
+                    "peak_N": float(fz[a:b].max()),
+                    "stance": stance,
+                    "open": b == len(on),
+                }
+            )
     return out
 
 
@@ -132,37 +177,49 @@ def gait_events(
     threshold_n: float = CONTACT_THRESHOLD_N,
     min_gap_s: float = MIN_GAP_S,
     min_contact_s: float = MIN_CONTACT_S,
+    steps_only: bool = True,
 ) -> pd.DataFrame:
     """Touch-downs and lift-offs per leg: columns leg, event (touchdown/liftoff), time [s].
 
     A leg is in contact while its vertical GRF exceeds ``threshold_n`` [N], with bounces, brief
     touches and scuffs (contacts never reaching 0.1 body weight, SCONE's step load) cleaned by
-    :func:`contact_mask` (``min_contact_s=0`` keeps every contact).
+    :func:`contact_mask` (``min_contact_s=0`` keeps every contact). With ``steps_only``, only
+    stances count: contacts in which a step (:func:`step_touchdowns`, SCONE's definition)
+    starts; the others, a swinging foot striking the ground, are :func:`swing_contacts`.
     """
     rows = []
-    names = _leg_names(result.model)
-    for leg in (0, 1):
-        fz = _leg_fz(result, leg)
-        on = contact_mask(
-            result.time,
-            fz > threshold_n,
-            min_gap_s=min_gap_s,
-            min_contact_s=min_contact_s,
-            force=fz,
-            min_peak_n=STEP_LOAD_BW * result.model.body_weight if min_contact_s > 0 else 0.0,
-        )
-        change = np.flatnonzero(np.diff(on.astype(np.int8)))
-        for i in change:
-            rows.append(
-                {
-                    "leg": names[leg],
-                    "event": "touchdown" if on[i + 1] else "liftoff",
-                    "time": float(result.time[i + 1]),
-                }
-            )
+    for c in _contacts(result, threshold_n, min_gap_s, min_contact_s):
+        if steps_only and not c["stance"]:
+            continue
+        if c["start"] > result.time[0]:
+            rows.append({"leg": c["leg"], "event": "touchdown", "time": c["start"]})
+        if not c["open"]:
+            rows.append({"leg": c["leg"], "event": "liftoff", "time": c["end"]})
     return pd.DataFrame(rows, columns=["leg", "event", "time"]).sort_values(
         "time", ignore_index=True
     )
+
+
+def swing_contacts(
+    result: RunnerResult,
+    *,
+    threshold_n: float = CONTACT_THRESHOLD_N,
+    min_gap_s: float = MIN_GAP_S,
+    min_contact_s: float = MIN_CONTACT_S,
+) -> pd.DataFrame:
+    """Contacts that are not stances (no step starts in them: a swinging foot striking or
+    scuffing the ground): leg, start [s], duration [s], peak vertical force [N]."""
+    rows = [
+        {
+            "leg": c["leg"],
+            "start": c["start"],
+            "duration": c["end"] - c["start"],
+            "peak_N": c["peak_N"],
+        }
+        for c in _contacts(result, threshold_n, min_gap_s, min_contact_s)
+        if not c["stance"]
+    ]
+    return pd.DataFrame(rows, columns=["leg", "start", "duration", "peak_N"])
 
 
 def spatiotemporal(

@@ -19,31 +19,37 @@ from bladelab.runner.model import CP_LEG
 
 STEP_LOAD_BW = 0.1  # a leg is loaded at or above this vertical GRF [body weights] (SCONE)
 MIN_STEP_S = 0.1  # a new contact sooner than this after the last step is not a step [s] (SCONE)
-STEP_STATE_SIZE = 3  # left loaded, right loaded, time of the last step [s]
+STEP_STATE_SIZE = 4  # left loaded, right loaded, time [s] and leg of the last step
 
 
 @njit(cache=True)
 def _count_touchdowns(t, x_pelvis, crec, cp, body_weight, steps, acc, td):
     """Record the objective's steps as SCONE's GaitMeasure counts them, online: a step is a
     new contact of a leg (its vertical GRF rising to ``STEP_LOAD_BW`` body weights) more than
-    ``MIN_STEP_S`` after the previous step (sooner contacts, e.g. a bounce or a scuff, are not
-    steps). ``steps`` = (left loaded, right loaded, time of the last step [s]); ``crec`` holds
-    the previous step's contact forces. The step's time [s], pelvis x [m] and leg (0 left, 1
-    right) go to ``td``, their number to ``acc[3]``
-    (:func:`bladelab.runner.analyses.step_touchdowns` does the same offline)."""
+    ``MIN_STEP_S`` after the previous step (sooner contacts, e.g. a bounce, are not steps).
+    A sooner new contact of the *other* leg (the swinging foot striking the ground just after
+    the step) marks that step as struck. ``steps`` = (left loaded, right loaded, time [s] and
+    leg of the last step); ``crec`` holds the previous step's contact forces. Per step, ``td``
+    gets time [s], pelvis x [m], leg (0 left, 1 right) and struck (0/1); ``acc[3]`` counts the
+    steps (:func:`bladelab.runner.analyses.step_touchdowns` does the same offline)."""
     force = np.zeros(2)
     for c in range(cp.shape[0]):
         force[int(cp[c, CP_LEG])] += crec[c, 1]
     for leg in range(2):
         loaded = force[leg] >= STEP_LOAD_BW * body_weight
-        if loaded and steps[leg] == 0.0 and t - steps[2] > MIN_STEP_S:
+        if loaded and steps[leg] == 0.0:
             n = int(acc[3])
-            if n < td.shape[0]:
-                td[n, 0] = t
-                td[n, 1] = x_pelvis
-                td[n, 2] = leg
-                acc[3] += 1.0
-            steps[2] = t
+            if t - steps[2] > MIN_STEP_S:
+                if n < td.shape[0]:
+                    td[n, 0] = t
+                    td[n, 1] = x_pelvis
+                    td[n, 2] = leg
+                    td[n, 3] = 0.0
+                    acc[3] += 1.0
+                steps[2] = t
+                steps[3] = leg
+            elif leg != steps[3] and 0 < n <= td.shape[0]:
+                td[n - 1, 3] = 1.0
         steps[leg] = 1.0 if loaded else 0.0
 
 
@@ -54,8 +60,7 @@ def control_step(k, dt, mj, arrays, control):
     ``control`` = (table, p, hist, cs, mb, ix, thresholds, body_weight, body_mass, leg_length,
     acc, td, steps, knee_idx, itilt, ranges, pen) (built by ``runner.objective``); running
     sums go to ``acc``: metabolic energy [J], knee penalty·s, tilt penalty·s, number of
-    touch-downs, and the touch-downs' time [s], pelvis x [m] and leg (0 left, 1 right) to ``td``
-    (:func:`_count_touchdowns`).
+    steps, and the steps to ``td`` (:func:`_count_touchdowns`).
     """
     qpos, qvel = mj[0], mj[1]
     mp, ms, _, _, u, _, _, cp, _, _, crec, lig = arrays

@@ -51,7 +51,7 @@ from bladelab.runner.muscle import muscle_step
 # numba's cache is keyed on the content of the file that defines a function, not on the files of
 # the functions it calls: after editing a compiled function in closed_loop.py, controller.py,
 # metabolics.py, muscle.py or contact.py, bump this number so the loop below is compiled again.
-_CACHE_GENERATION = 5
+_CACHE_GENERATION = 6
 
 
 def _mujoco_step_addresses() -> tuple[int, int]:

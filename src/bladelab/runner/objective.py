@@ -9,8 +9,9 @@
   more than 0.1 s after the last one, as SCONE's GaitMeasure: runner.closed_loop), ``w_s = max(0, 1 − Ψ(v_s, v_min, v_max)/(1 m/s))`` with the
   linear range penalty Ψ of eq. 2.8 and the step's mean pelvis speed ``v_s``; after a fall no more
   steps count, so falling early costs up to 1; with ``alternating_steps`` (default) a step by
-  the same leg as the step before earns nothing (a hop or gallop is not running; our addition,
-  docs/predictive.md);
+  the same leg as the step before, or one during which the other (swinging) foot strikes the
+  ground within 0.1 s, earns nothing (hops, gallops and stumbles are not running; our
+  addition, docs/predictive.md);
 - ``J_inj``: knee load (ligament torque [N·m] of each knee) outside ``knee_load_range``
   (−100…100), ``J_lean``: pelvis tilt [deg] outside ``pelvis_tilt_range_deg`` (−16…−2); both
   eq. 2.9, ``abs_penalty·|Err| + squared_penalty·Err²`` averaged over the simulated time.
@@ -198,9 +199,10 @@ def simulate_controlled(
     ranges = np.array([*settings.knee_load_range, *settings.pelvis_tilt_range_deg], dtype=float)
     pen = np.array([settings.abs_penalty, settings.squared_penalty])
     acc = np.zeros(4)
-    td = np.zeros((MAX_TOUCHDOWNS, 3))
+    td = np.zeros((MAX_TOUCHDOWNS, 4))
     steps = np.zeros(STEP_STATE_SIZE)
     steps[2] = -1e9  # no step yet
+    steps[3] = -1.0
     bw, mass = model.body_weight, model.total_mass
     n_steps = int(round(settings.duration / dt))
     every = record_every if record_every > 0 else n_steps + 1
@@ -255,13 +257,14 @@ def _evaluate(settings, acc, td, t_end, distance, fell, mass, x0) -> Evaluation:
     times = np.concatenate([[0.0], td[:, 0]])
     xs = np.concatenate([[x0], td[:, 1]])
     legs = np.concatenate([[-1.0], td[:, 2]])
+    struck = np.concatenate([[False], td[:, 3] > 0.0])
     credit = 0.0
     for i in range(1, len(times)):
         ts = times[i] - times[i - 1]
         if ts <= 0:
             continue
-        if s.alternating_steps and i > 1 and legs[i] == legs[i - 1]:
-            continue  # the same leg again: a hop or gallop, not a running step
+        if s.alternating_steps and (struck[i] or (i > 1 and legs[i] == legs[i - 1])):
+            continue  # the same leg again (a hop or gallop) or the other foot struck the ground
         v = (xs[i] - xs[i - 1]) / ts
         psi = v_min - v if v < v_min else (v - v_max if v > v_max else 0.0)
         credit += ts * max(0.0, 1.0 - psi)

@@ -481,7 +481,9 @@ def verify_solution(
     (touch-down to touch-down of that leg; unloaded gaps shorter than ``min_gap_s`` [s] inside a
     stance, i.e. contact bounces, do not end it, and touches shorter than 30 ms or never
     reaching 0.1 body weight do not start one); steps (SCONE's definition, :func:`bladelab.runner.analyses.step_touchdowns`)
-    alternating between the legs after the first (``same_leg_steps`` 0: no hop or gallop); power-balance residual below
+    alternating between the legs after the first (``same_leg_steps`` 0: no hop or gallop);
+    reported, not a criterion: ``swing_contacts`` (a swinging foot striking the ground,
+    :func:`bladelab.runner.analyses.swing_contacts`) and the largest one's peak force [N]; power-balance residual below
     ``max_power_residual_pct`` % (runner analyses). With ``jittered_copies`` = n > 0 the same
     criteria must also hold for n copies of the parameters moved by ``jitter`` (relative,
     :func:`jittered_parameters`): a gait that survives only on one floating-point path (another
@@ -513,7 +515,11 @@ def verify_solution(
 
 def _check_gait(runner, layout, x, settings: ObjectiveSettings, limits: tuple) -> dict:
     """Simulate ``x`` and measure the shipped-solution criteria (:func:`verify_solution`)."""
-    from bladelab.runner.analyses import CONTACT_THRESHOLD_N, power_balance_residual_pct
+    from bladelab.runner.analyses import (
+        CONTACT_THRESHOLD_N,
+        power_balance_residual_pct,
+        swing_contacts,
+    )
 
     duration, speed, tolerance, max_residual, min_gap_s = limits
     ev, res = simulate_controlled(runner, x, layout=layout, settings=settings, record_every=2)
@@ -535,6 +541,8 @@ def _check_gait(runner, layout, x, settings: ObjectiveSettings, limits: tuple) -
         "strides": len(flights),
         "strides_with_flight": int(sum(flights)),
         "same_leg_steps": same_leg,
+        "swing_contacts": int(len(swings := swing_contacts(res))),
+        "swing_contact_peak_N": float(swings.peak_N.max()) if len(swings) else 0.0,
         "power_balance_residual_pct": residual,
         "cost": ev.cost,
     }
@@ -556,7 +564,7 @@ def _same_leg_steps(time: np.ndarray, leg_force: np.ndarray, body_weight: float)
     vertical GRF ``leg_force`` (n, 2) [N]."""
     from bladelab.runner.analyses import step_touchdowns
 
-    order = [leg for _, leg in step_touchdowns(time, leg_force, body_weight)]
+    order = [leg for _, leg, _ in step_touchdowns(time, leg_force, body_weight)]
     return sum(1 for i in range(2, len(order)) if order[i] == order[i - 1])
 
 
