@@ -181,8 +181,9 @@ def _close(a: float, b: float) -> bool:
 
 
 def _resim_row(label: str, sol: _Solution, ev, res) -> dict:
-    from bladelab.runner.analyses import power_balance_residual_pct
+    from bladelab.runner.analyses import power_balance_residual_pct, swing_contacts
 
+    swings = swing_contacts(res)
     return {
         "solution": label,
         "time step (s)": sol.settings().dt,
@@ -193,6 +194,8 @@ def _resim_row(label: str, sol: _Solution, ev, res) -> dict:
         "cost (–)": ev.cost,
         "J_cot (J/(kg·m))": ev.j_cot,
         "power-balance residual (%)": power_balance_residual_pct(res),
+        "swing contacts (count)": len(swings),
+        "largest swing contact (N)": float(swings.peak_N.max()) if len(swings) else 0.0,
     }
 
 
@@ -446,7 +449,9 @@ def build_predictive_report(
         text=(f"Each solution below is simulated again from its parameters for {duration:g} s "
               "with the time step it was optimised with; nothing is taken from a stored "
               "evaluation. Power-balance residual: RMS of external minus kinetic power in % of "
-              "the peak kinetic power."),
+              "the peak kinetic power. Swing contacts: a swinging foot striking the ground "
+              "(contacts in which no step starts; left out of the gait events and "
+              "spatiotemporal variables below)."),
         tables=[("Re-simulations", pd.DataFrame(resim))],
     )
     add_predictive_sections(rep, results, sweep_summary=sweep_summary)
