@@ -212,10 +212,8 @@ def test_sweep_report_opens_in_a_browser(sweep_dir, tmp_path):
     assert all(figure_ok(f) for f in figures)
 
 
-@pytest.mark.skipif(not (SOLUTIONS / "in_progress" / "able-3.5.json").is_file(),
-                    reason="no packaged able 3.5 m/s parameter file")
 def test_report_of_a_parameter_file(tmp_path):
-    src = SOLUTIONS / "in_progress" / "able-3.5.json"
+    src = SOLUTIONS / "able-3.5.json"  # the shipped solution
     rep = build_predictive_report(src, tmp_path / "r", duration=2.0, progress=False)
     assert rep.kind == "parameters" and rep.simulations == 1
     tables = _tables(Path(rep.index))
