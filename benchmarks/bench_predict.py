@@ -8,11 +8,13 @@ import math
 import time
 from pathlib import Path
 
+from bladelab.runner.objective import DEFAULT_PREDICT_DT
+
 ROOT = Path(__file__).resolve().parents[1]
 
 
 def _closed_loop_rate() -> tuple[float, float, int]:
-    """Best wall and CPU seconds per simulated second of the closed loop (amputee, 0.5 ms)."""
+    """Best wall and CPU seconds per simulated second of the closed loop (amputee, default step)."""
     from bladelab.runner import build_runner
     from bladelab.runner.controller import controller_layout
     from bladelab.runner.objective import ObjectiveSettings, simulate_controlled
@@ -62,10 +64,12 @@ LONG_RUNS = (
     ("able-3.5", "able, warm start from the run above, 0.25 ms, 1 niced worker",
      "≈ 35 min (not recorded)"),
     ("able-r", "able, warm start from the run above; alternating steps, 2 robust samples, "
-     "11 s, 0.25 ms, 2 workers", None),
+     "11 s, 0.25 ms, 2 workers: **the shipped `able-3.5.json`**", None),
+    ("able-n", "able, from the shipped solution via 44 generations of `able-s`; with the "
+     "stumble rule, 1 worker (stopped, `in_progress/able-3.5-no-strikes.json`)", None),
     ("amp-cat6-3.5", "amputee Cat6, warm start from able-3.5, 0.25 ms, 2 workers", "≈ 16 min"),
-    ("amp-r", "amputee Cat6, warm start from the run above (generation 245); alternating steps, "
-     "2 robust samples, 11 s, 0.25 ms, 2 workers", None),
+    ("amp-n", "amputee Cat6, from the `amp-a`/`amp-s` chain; all step rules, 1–2 workers "
+     "(stopped, `in_progress/amputee-Cat6-3.5.json`)", None),
 )
 
 
@@ -135,9 +139,10 @@ def run() -> str:
         "",
         "| quantity | value |",
         "|---|---|",
-        f"| closed-loop simulation (amputee Cat6, 0.5 ms step), wall per simulated s | "
+        f"| closed-loop simulation (amputee Cat6, {DEFAULT_PREDICT_DT * 1e3:g} ms step), wall per "
+        f"simulated s | "
         f"{per_s_wall * 1e3:.1f} ms |",
-        f"| same, CPU per simulated s | {per_s_cpu * 1e3:.1f} ms ({per_s_cpu / 2000 * 1e6:.1f} µs "
+        f"| same, CPU per simulated s | {per_s_cpu * 1e3:.1f} ms ({per_s_cpu * DEFAULT_PREDICT_DT * 1e6:.1f} µs "
         f"per step) |",
         f"| → one 10 s simulation (CPU) | {t10:.2f} s |",
         f"| one generation from the initial guess, 2 workers, 1st (incl. worker start) | "
@@ -145,8 +150,8 @@ def run() -> str:
         f"| same, 2nd generation | {g2:.2f} s ({evals} evaluations; best cost {best:.4g}) |",
         f"| extrapolated generation of 16 full 10 s simulations on 2 workers | {gen_full:.1f} s |",
         f"| extrapolated 1000 such generations | {gen_full * 1000 / 3600:.2f} h |",
-        f"| same at the 0.25 ms step that running needs for the power balance "
-        f"(docs/predictive.md) | {2 * gen_full * 1000 / 3600:.2f} h |",
+        f"| same with 2 robust samples (the shipped solutions' setting) | "
+        f"{2 * gen_full * 1000 / 3600:.2f} h |",
         "",
         "The initial guess (SCONE's walking parameters) falls within about half a second at "
         "3.5 m/s, so early generations are cheap; once candidates run the full 10 s a generation "
