@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import math
 
-import numpy as np
 from numba import njit
 
 from bladelab.runner.controller import compute_excitations, push_sensors, update_gait_states
@@ -32,11 +31,15 @@ def _count_touchdowns(t, x_pelvis, crec, cp, body_weight, steps, acc, td):
     leg of the last step); ``crec`` holds the previous step's contact forces. Per step, ``td``
     gets time [s], pelvis x [m], leg (0 left, 1 right) and struck (0/1); ``acc[3]`` counts the
     steps (:func:`bladelab.runner.analyses.step_touchdowns` does the same offline)."""
-    force = np.zeros(2)
+    left = 0.0  # no array allocated in the hot loop
+    right = 0.0
     for c in range(cp.shape[0]):
-        force[int(cp[c, CP_LEG])] += crec[c, 1]
+        if cp[c, CP_LEG] == 0.0:
+            left += crec[c, 1]
+        else:
+            right += crec[c, 1]
     for leg in range(2):
-        loaded = force[leg] >= STEP_LOAD_BW * body_weight
+        loaded = (left if leg == 0 else right) >= STEP_LOAD_BW * body_weight
         if loaded and steps[leg] == 0.0:
             n = int(acc[3])
             if t - steps[2] > MIN_STEP_S:

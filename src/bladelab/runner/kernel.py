@@ -47,11 +47,13 @@ from bladelab.runner.model import (
     JP_SK2,
 )
 from bladelab.runner.muscle import muscle_step
+from bladelab.sim.mujoco_engine import add_point_force
 
 # numba's cache is keyed on the content of the file that defines a function, not on the files of
 # the functions it calls: after editing a compiled function in closed_loop.py, controller.py,
-# metabolics.py, muscle.py or contact.py, bump this number so the loop below is compiled again.
-_CACHE_GENERATION = 6
+# metabolics.py, muscle.py, contact.py or sim/mujoco_engine.py, bump this number so the loop
+# below is compiled again.
+_CACHE_GENERATION = 7
 
 
 def _mujoco_step_addresses() -> tuple[int, int]:
@@ -119,19 +121,6 @@ def path_kinematics(site_xpos, cvel, root_com, path, pstart, mtu, seg_u):
 
 
 @njit(cache=True)
-def _add_point_force(xfrc, xipos, body, px, py, pz, fx, fy, fz):
-    xfrc[body, 0] += fx
-    xfrc[body, 1] += fy
-    xfrc[body, 2] += fz
-    dx = px - xipos[body, 0]
-    dy = py - xipos[body, 1]
-    dz = pz - xipos[body, 2]
-    xfrc[body, 3] += dy * fz - dz * fy
-    xfrc[body, 4] += dz * fx - dx * fz
-    xfrc[body, 5] += dx * fy - dy * fx
-
-
-@njit(cache=True)
 def forces(mj, arrays, root_com, dt):
     """Muscles, ligaments and contacts for one step; writes ``xfrc`` and ``qfrc``.
 
@@ -155,7 +144,7 @@ def forces(mj, arrays, root_com, dt):
             a = path[k, 0]
             b = path[k + 1, 0]
             fx, fy, fz = f * seg_u[k, 0], f * seg_u[k, 1], f * seg_u[k, 2]
-            _add_point_force(
+            add_point_force(
                 xfrc,
                 xipos,
                 path[k, 1],
@@ -166,7 +155,7 @@ def forces(mj, arrays, root_com, dt):
                 fy,
                 fz,
             )
-            _add_point_force(
+            add_point_force(
                 xfrc,
                 xipos,
                 path[k + 1, 1],
@@ -232,7 +221,7 @@ def forces(mj, arrays, root_com, dt):
             cstate[c, 0] = s
         else:
             cstate[c, 0] = 0.0
-        _add_point_force(xfrc, xipos, body, px, py, pz, ft, 0.0, fn)
+        add_point_force(xfrc, xipos, body, px, py, pz, ft, 0.0, fn)
         crec[c, 0] = ft
         crec[c, 1] = fn
         crec[c, 2] = px

@@ -201,6 +201,22 @@ def _friction_coefficient(contact, fn, slip):
 
 
 @njit(cache=True)
+def add_point_force(xfrc, xipos, body, px, py, pz, fx, fy, fz):
+    """Add the force (``fx``, ``fy``, ``fz``) [N] acting at (``px``, ``py``, ``pz``) [m] to
+    ``body``'s row of MuJoCo's ``xfrc_applied``: the force and its torque about the body's COM
+    (``xipos``). Used by the blade engine and the runner."""
+    xfrc[body, 0] += fx
+    xfrc[body, 1] += fy
+    xfrc[body, 2] += fz
+    dx = px - xipos[body, 0]
+    dy = py - xipos[body, 1]
+    dz = pz - xipos[body, 2]
+    xfrc[body, 3] += dy * fz - dz * fy
+    xfrc[body, 4] += dz * fx - dx * fz
+    xfrc[body, 5] += dx * fy - dy * fx
+
+
+@njit(cache=True)
 def contact_forces_3d(contact, site_xpos, site_xmat, sites, axes, site_body, cvel, subtree_com,
                       rootid, xipos, ground_vx, xfrc, out):
     """Apply the contact law to every sole site; write xfrc_applied and per-sole outputs.
@@ -233,15 +249,7 @@ def contact_forces_3d(contact, site_xpos, site_xmat, sites, axes, site_body, cve
         out[e, 4] = fel
         out[e, 5] = (fn - fel) * rate
         out[e, 6] = -fx * (vpx - ground_vx)
-        # force at P -> force + torque about the body's COM
-        dx = px - xipos[b, 0]
-        dy = 0.0 - xipos[b, 1]
-        dz = pz - xipos[b, 2]
-        xfrc[b, 0] += fx
-        xfrc[b, 2] += fn
-        xfrc[b, 3] += dy * fn
-        xfrc[b, 4] += dz * fx - dx * fn
-        xfrc[b, 5] += -dy * fx
+        add_point_force(xfrc, xipos, b, px, 0.0, pz, fx, 0.0, fn)
 
 
 @njit(cache=True)
@@ -279,14 +287,7 @@ def contact_forces_track(contact, site_xpos, site_xmat, sites, axes, site_body, 
         out[e, 8] = u
         if fn == 0.0:
             continue
-        dx = px - xipos[b, 0]
-        dy = 0.0 - xipos[b, 1]
-        dz = pz - xipos[b, 2]
-        xfrc[b, 0] += fx
-        xfrc[b, 2] += fn
-        xfrc[b, 3] += dy * fn
-        xfrc[b, 4] += dz * fx - dx * fn
-        xfrc[b, 5] += -dy * fx
+        add_point_force(xfrc, xipos, b, px, 0.0, pz, fx, 0.0, fn)
 
 
 @njit(cache=True)

@@ -94,6 +94,19 @@ def law_affine(contact, dc):
 
 
 @njit(cache=True, inline="always", error_model="numpy")
+def _series_contact(contact, depth, rate, u, uh, g):
+    """The contact law on the track deflected by ``u`` [m] (u̇ = (u − ``uh``)/``g``): force
+    [N] (0 when the law pulls), its derivatives by the contact's penetration and rate (0 then),
+    the law's elastic part and u̇ [m/s]."""
+    w = (u - uh) / g
+    e_el, bb, de, db = law_affine(contact, depth - u)
+    fc = e_el + bb * (rate - w)
+    if fc > 0.0:
+        return fc, de + db * (rate - w), bb, e_el, w
+    return 0.0, 0.0, 0.0, e_el, w
+
+
+@njit(cache=True, inline="always", error_model="numpy")
 def track_contact(contact, depth, rate, uh, g):
     """Normal force through a massless track layer in series with the contact law.
 
@@ -116,21 +129,8 @@ def track_contact(contact, depth, rate, uh, g):
     lo = b0 / a  # the track relaxes on its own: zero force
     hi = max(depth, lo)
     u = min(max(uh, lo), hi)
-    fc = 0.0
-    kc = 0.0
-    cc = 0.0
-    e_el = 0.0
     for _it in range(60):
-        w = (u - uh) / g
-        e_el, bb, de, db = law_affine(contact, depth - u)
-        fc = e_el + bb * (rate - w)
-        if fc > 0.0:
-            kc = de + db * (rate - w)
-            cc = bb
-        else:
-            fc = 0.0
-            kc = 0.0
-            cc = 0.0
+        fc, kc, cc, _, _ = _series_contact(contact, depth, rate, u, uh, g)
         r = fc - (a * u - b0)
         if r > 0.0:
             lo = u
@@ -143,15 +143,7 @@ def track_contact(contact, depth, rate, uh, g):
         if abs(un - u) <= 1e-14 + 1e-11 * abs(u):
             break
         u = un
-    w = (u - uh) / g
-    e_el, bb, de, db = law_affine(contact, depth - u)
-    fc = e_el + bb * (rate - w)
-    if fc > 0.0:
-        kc = de + db * (rate - w)
-        cc = bb
-    else:
-        kc = 0.0
-        cc = 0.0
+    _, kc, cc, e_el, w = _series_contact(contact, depth, rate, u, uh, g)
     slope = kc + cc / g + a
     force = a * u - b0
     if force < 0.0:
