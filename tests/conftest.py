@@ -37,16 +37,9 @@ def ray_instance():
     """One local Ray instance (2 CPUs) for every Ray test of the session (started once: Ray's
     start-up is most of a Ray test's time); bladelab's Ray executor uses a running instance."""
     ray = pytest.importorskip("ray", reason="ray not installed (pip install bladelab[ray])")
-    import os
-    import sys
+    from bladelab.study.executors import start_local_ray
 
-    started = not ray.is_initialized()
-    if started:
-        ray.init(
-            num_cpus=2, include_dashboard=False, log_to_driver=False, logging_level="ERROR",
-            configure_logging=False,
-            runtime_env={"env_vars": {"PYTHONPATH": os.pathsep.join(p for p in sys.path if p)}},
-        )
+    started = start_local_ray(2)
     yield ray
     if started:
         ray.shutdown()

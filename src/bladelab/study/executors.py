@@ -110,14 +110,7 @@ class RayExecutor:
 
         if not payloads:
             return
-        started = False
-        if not ray.is_initialized():
-            ray.init(
-                num_cpus=self.jobs, include_dashboard=False, log_to_driver=False,
-                logging_level="ERROR", configure_logging=False,
-                runtime_env={"env_vars": {"PYTHONPATH": os.pathsep.join(p for p in sys.path if p)}},
-            )
-            started = True
+        started = start_local_ray(self.jobs)
         try:
             remote = ray.remote(num_cpus=1)(run_task_safely)
             refs = {remote.remote(task, p): i for i, p in enumerate(payloads)}
@@ -133,6 +126,21 @@ class RayExecutor:
         finally:
             if started:
                 ray.shutdown()
+
+
+def start_local_ray(num_cpus: int) -> bool:
+    """Start a quiet local Ray instance with ``num_cpus`` CPUs, its workers on this process's
+    ``sys.path``, unless one is running; True when this call started it."""
+    import ray
+
+    if ray.is_initialized():
+        return False
+    ray.init(
+        num_cpus=num_cpus, include_dashboard=False, log_to_driver=False,
+        logging_level="ERROR", configure_logging=False,
+        runtime_env={"env_vars": {"PYTHONPATH": os.pathsep.join(p for p in sys.path if p)}},
+    )
+    return True
 
 
 def make_executor(name: str, jobs: int = 1):
