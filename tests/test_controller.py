@@ -23,6 +23,7 @@ from bladelab.runner.controller import (
     compute_excitations,
     controller_layout,
     delayed,
+    history_length,
     push_sensors,
     read_parameters,
     update_gait_states,
@@ -149,6 +150,27 @@ def test_layout_ports_scone_values_and_is_asymmetric(able, amputee):
     # delays: ankle reflexes 35 ms -> 70 steps of 0.5 ms
     t = la.table_for(5e-4)
     assert set(np.unique(t[:, R_DELAY])) <= {0, 20, 30, 40, 70, 100}
+
+
+def test_early_swing_knee_flexion_offset_acts_in_swing_only(amputee):
+    # S01000.bifemsh_<side>.C0 (our addition): on in Swing, off in every other state; the
+    # prosthetic side has it too (bifemsh is a thigh muscle)
+    layout = controller_layout(amputee)
+    table = layout.table_for(5e-4)
+    muscles = list(amputee.muscle_names)
+    nm, nq = len(muscles), len(amputee.dof_names)
+    hist = np.zeros((history_length(layout, 5e-4), 3 * nm + 2 * nq))
+    for side, leg in (("l", 0), ("r", 1)):
+        p = np.zeros(layout.size)
+        p[layout.index(f"S01000.bifemsh_{side}.C0")] = 0.37
+        target = muscles.index(f"bifemsh_{side}")
+        for state in (EARLY_STANCE, LATE_STANCE, LIFTOFF, SWING, LANDING):
+            cs = np.array([EARLY_STANCE, EARLY_STANCE, 0, 1], float)
+            cs[leg] = state
+            u = np.zeros(nm)
+            compute_excitations(u, table, p, hist, cs, nm, nq)
+            assert u[target] == (0.37 if state == SWING else 0.0), (side, state)
+            assert np.count_nonzero(u) == (1 if state == SWING else 0)
 
 
 def test_parameter_json_roundtrip_and_errors(tmp_path, able, amputee):

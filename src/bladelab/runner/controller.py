@@ -20,8 +20,9 @@ SCONE's ``MuscleReflex`` and ``DofReflex`` with delayed sensors:
 
 The reflex structure is SCONE's ``H0918RS2v3`` controller (Apache-2.0, T. Geijtenbeek) with separate
 parameters per leg (``symmetric = 0``, as ``ControllerGH2010v12Asym``), plus constant offsets
-``C0`` per muscle in stance and in swing (Geyer & Herr's S0 / ΔS terms) and DOF reflexes for the
-torso muscles about the lumbar joint (the seed's model has torso muscles; H0918 has none). The
+``C0`` per muscle in stance and in swing (Geyer & Herr's S0 / ΔS terms), a Swing-only ``C0`` of
+the short head of biceps femoris (early-swing knee flexion so the trailing foot clears the
+ground in running; docs/predictive.md) and DOF reflexes for the torso muscles about the lumbar joint (the seed's model has torso muscles; H0918 has none). The
 prosthetic leg has no shank muscles: reflexes to or from them are left out on that side.
 
 Parameters form a named flat vector (:class:`ControllerLayout`, names like SCONE's ``.par``:
@@ -62,6 +63,8 @@ R_KIND, R_TARGET, R_LEG, R_MASK, R_SOURCE, R_DELAY, R_GAIN, R_OFFSET, R_OFFSET_C
 _ALL = "S11111"
 _STANCE = "S00011"
 _SWING = "S11100"
+_EARLY_SWING = "S01000"
+_EARLY_SWING_C0 = ("bifemsh",)
 
 # (mask, target, source, gain name, offset name or None, kind, delay, SCONE default value(s)).
 # Leg reflexes of H0918RS2v3 (source None = the target itself).
@@ -269,6 +272,15 @@ def controller_layout(model) -> ControllerLayout:
                 rows.append(
                     (T_CONST, muscles.index(tname), leg, _mask_bits(mask), -1, 0, gain, -1, 0.0)
                 )
+                delays.append(0.0)
+        # early-swing knee flexion (our addition, docs/predictive.md): a constant offset of the
+        # short head of biceps femoris in Swing only, so the trailing foot clears the ground
+        for mname in _EARLY_SWING_C0:
+            if mname in have:
+                tname = f"{mname}_{side}"
+                gain = param(f"{_EARLY_SWING}.{tname}.C0", 0.0, -1.0, 1.0, 0.05)
+                bits = _mask_bits(_EARLY_SWING)
+                rows.append((T_CONST, muscles.index(tname), leg, bits, -1, 0, gain, -1, 0.0))
                 delays.append(0.0)
     if "lumbar_extension" in dofs:
         src = dofs.index("lumbar_extension")
