@@ -18,10 +18,11 @@ def able():
     return model, controller_layout(model)
 
 
-def _td(times, speed, legs=None, struck=()):
-    """Steps (time [s], pelvis x [m], leg, struck) at a constant speed, legs alternating."""
+def _td(times, speed, legs=None, struck=(), strike_bw=1.0):
+    """Steps (time [s], pelvis x [m], leg, strike peak [BW]) at a constant speed, legs
+    alternating; the steps in ``struck`` are struck with a peak of ``strike_bw``."""
     legs = [i % 2 for i in range(len(times))] if legs is None else legs
-    return np.array([[t, speed * t, leg, float(i in struck)]
+    return np.array([[t, speed * t, leg, strike_bw if i in struck else 0.0]
                      for i, (t, leg) in enumerate(zip(times, legs, strict=True))])
 
 
@@ -48,8 +49,21 @@ def test_gait_measure_gives_no_credit_to_a_gallop():
     # hand count: steps 3, 6, ..., 27 (1-based) repeat the leg before them: 9 steps of 0.35 s
     ev = _evaluate(s, acc, _td(times, 3.5, gallop), 10.0, 35.0, False, 80.0, 0.0)
     assert ev.j_gait == pytest.approx(1.0 - (9.8 - 9 * 0.35) / 10.0)
-    # a step during which the other foot struck the ground earns nothing either (2 of 28)
+    # a step during which the other foot struck the ground with 1 BW (strike_limit_bw) or
+    # more earns nothing either (2 of 28)
     ev = _evaluate(s, acc, _td(times, 3.5, struck=(4, 10)), 10.0, 35.0, False, 80.0, 0.0)
+    assert ev.j_gait == pytest.approx(1.0 - (9.8 - 2 * 0.35) / 10.0)
+    ev = _evaluate(s, acc, _td(times, 3.5, struck=(4, 10), strike_bw=1.7), 10.0, 35.0, False,
+                   80.0, 0.0)
+    assert ev.j_gait == pytest.approx(1.0 - (9.8 - 2 * 0.35) / 10.0)
+    # a lighter strike (0.25 BW) costs a quarter of the step's credit
+    ev = _evaluate(s, acc, _td(times, 3.5, struck=(4, 10), strike_bw=0.25), 10.0, 35.0, False,
+                   80.0, 0.0)
+    assert ev.j_gait == pytest.approx(1.0 - (9.8 - 2 * 0.25 * 0.35) / 10.0)
+    # strike_limit_bw = 0: any strike cancels the step's credit
+    strict = ObjectiveSettings(speed=3.5, duration=10.0, strike_limit_bw=0.0)
+    ev = _evaluate(strict, acc, _td(times, 3.5, struck=(4, 10), strike_bw=0.25), 10.0, 35.0,
+                   False, 80.0, 0.0)
     assert ev.j_gait == pytest.approx(1.0 - (9.8 - 2 * 0.35) / 10.0)
     # the seed's measure counts every step
     seed = ObjectiveSettings(speed=3.5, duration=10.0, alternating_steps=False)
@@ -121,7 +135,10 @@ def test_online_steps_match_the_offline_count_and_scone_rules():
                          (0, 1.60, 1.80, 1800.0)):
         force[(t >= a) & (t < b), leg] = f
     force[(t >= 0.15) & (t < 0.17), 0] = 0.0  # a bounce: back 70 ms after the step
-    force[(t >= 0.86) & (t < 0.90), 1] = 900.0  # the swinging right foot strikes at 0.86 s
+    # the swinging right foot strikes at 0.86 s, its force rising to 1200 N at 0.93 s, after
+    # the 0.1 s window: the peak counts to the end of the strike
+    strike = (t >= 0.86) & (t < 0.94)
+    force[strike, 1] = np.minimum(500.0 + 1e4 * (t[strike] - 0.86), 1200.0)
     cp = np.zeros((2, 13))
     cp[1, 6] = 1.0  # contact 0 on the left leg, contact 1 on the right
     crec = np.zeros((2, 7))
@@ -134,10 +151,13 @@ def test_online_steps_match_the_offline_count_and_scone_rules():
     online = td[: int(acc[3])]
     offline = np.array(step_touchdowns(t, force, bw), dtype=float)
     np.testing.assert_allclose(online[:, 0], offline[:, 0], atol=1e-12)
-    np.testing.assert_array_equal(online[:, 2:4], offline[:, 1:3])
+    np.testing.assert_array_equal(online[:, 2], offline[:, 1])
+    np.testing.assert_allclose(online[:, 3], offline[:, 2], rtol=1e-12)
     # by hand: the bounce (back within 0.1 s) and the 50 N touch are not steps, the scuff is;
-    # the strike 60 ms after the left step at 0.8 s marks that step
+    # the strike 60 ms after the left step at 0.8 s marks that step with its peak
     assert online[:, 2].tolist() == [0, 1, 0, 1, 1, 0]
-    assert online[:, 3].tolist() == [0, 0, 1, 0, 0, 0]
+    peak = force[strike, 1].max()
+    assert peak > 1150.0
+    np.testing.assert_allclose(online[:, 3], [0, 0, peak / bw, 0, 0, 0], rtol=1e-12)
     np.testing.assert_allclose(online[:, 0], [0.1, 0.45, 0.8, 1.15, 1.42, 1.6], atol=2 * dt)
     np.testing.assert_allclose(online[:, 1], 3.5 * online[:, 0])

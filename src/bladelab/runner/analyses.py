@@ -108,24 +108,31 @@ def step_touchdowns(
     *,
     load_bw: float = STEP_LOAD_BW,
     min_step_s: float = MIN_STEP_S,
-) -> list[tuple[float, int, bool]]:
+) -> list[tuple[float, int, float]]:
     """Steps as SCONE's GaitMeasure (and the objective, online) counts them: a new contact of a
     leg (vertical GRF ``leg_force`` (n, 2) [N] rising to ``load_bw`` body weights) more than
     ``min_step_s`` [s] after the previous step; a sooner new contact of the other leg marks the
-    step as struck (the swinging foot hit the ground). The force of sample i is seen at sample
-    i + 1, as in the compiled loop. Returns (time [s], leg index, struck) per step."""
+    step as struck (the swinging foot hit the ground), with that contact's peak force. The
+    force of sample i is seen at sample i + 1, as in the compiled loop. Returns (time [s], leg
+    index, strike peak [body weights], 0 if not struck) per step."""
     loaded_prev = np.zeros(2, dtype=bool)
-    last, last_leg = -np.inf, -1
-    out: list[tuple[float, int, bool]] = []
+    last, last_leg, striking = -np.inf, -1, -1
+    out: list[tuple[float, int, float]] = []
     for k in range(1, len(time)):
         for leg in (0, 1):
             loaded = leg_force[k - 1, leg] >= load_bw * body_weight
             if loaded and not loaded_prev[leg]:
                 if time[k] - last > min_step_s:
-                    out.append((float(time[k]), leg, False))
-                    last, last_leg = time[k], leg
+                    out.append((float(time[k]), leg, 0.0))
+                    last, last_leg, striking = time[k], leg, -1
                 elif leg != last_leg and out:
-                    out[-1] = (out[-1][0], out[-1][1], True)
+                    striking = leg
+            if striking == leg:
+                if loaded:
+                    peak = max(out[-1][2], float(leg_force[k - 1, leg] / body_weight))
+                    out[-1] = (out[-1][0], out[-1][1], peak)
+                else:
+                    striking = -1
             loaded_prev[leg] = loaded
     return out
 

@@ -18,7 +18,7 @@ from bladelab.runner.model import CP_LEG
 
 STEP_LOAD_BW = 0.1  # a leg is loaded at or above this vertical GRF [body weights] (SCONE)
 MIN_STEP_S = 0.1  # a new contact sooner than this after the last step is not a step [s] (SCONE)
-STEP_STATE_SIZE = 4  # left loaded, right loaded, time [s] and leg of the last step
+STEP_STATE_SIZE = 5  # left loaded, right loaded, time [s] and leg of the last step, striking leg + 1
 
 
 @njit(cache=True)
@@ -27,10 +27,12 @@ def _count_touchdowns(t, x_pelvis, crec, cp, body_weight, steps, acc, td):
     new contact of a leg (its vertical GRF rising to ``STEP_LOAD_BW`` body weights) more than
     ``MIN_STEP_S`` after the previous step (sooner contacts, e.g. a bounce, are not steps).
     A sooner new contact of the *other* leg (the swinging foot striking the ground just after
-    the step) marks that step as struck. ``steps`` = (left loaded, right loaded, time [s] and
-    leg of the last step); ``crec`` holds the previous step's contact forces. Per step, ``td``
-    gets time [s], pelvis x [m], leg (0 left, 1 right) and struck (0/1); ``acc[3]`` counts the
-    steps (:func:`bladelab.runner.analyses.step_touchdowns` does the same offline)."""
+    the step) marks that step as struck, with the strike's peak vertical force (until that
+    contact ends). ``steps`` = (left loaded, right loaded, time [s] and leg of the last step,
+    striking leg + 1 while a strike lasts, else 0); ``crec`` holds the previous step's contact
+    forces. Per step, ``td`` gets time [s], pelvis x [m], leg (0 left, 1 right) and the strike's
+    peak [body weights] (0: not struck); ``acc[3]`` counts the steps
+    (:func:`bladelab.runner.analyses.step_touchdowns` does the same offline)."""
     left = 0.0  # no array allocated in the hot loop
     right = 0.0
     for c in range(cp.shape[0]):
@@ -39,9 +41,10 @@ def _count_touchdowns(t, x_pelvis, crec, cp, body_weight, steps, acc, td):
         else:
             right += crec[c, 1]
     for leg in range(2):
-        loaded = (left if leg == 0 else right) >= STEP_LOAD_BW * body_weight
+        force = left if leg == 0 else right
+        loaded = force >= STEP_LOAD_BW * body_weight
+        n = int(acc[3])
         if loaded and steps[leg] == 0.0:
-            n = int(acc[3])
             if t - steps[2] > MIN_STEP_S:
                 if n < td.shape[0]:
                     td[n, 0] = t
@@ -51,8 +54,14 @@ def _count_touchdowns(t, x_pelvis, crec, cp, body_weight, steps, acc, td):
                     acc[3] += 1.0
                 steps[2] = t
                 steps[3] = leg
+                steps[4] = 0.0
             elif leg != steps[3] and 0 < n <= td.shape[0]:
-                td[n - 1, 3] = 1.0
+                steps[4] = leg + 1.0
+        if steps[4] == leg + 1.0:
+            if loaded and 0 < n <= td.shape[0]:
+                td[n - 1, 3] = max(td[n - 1, 3], force / body_weight)
+            elif not loaded:
+                steps[4] = 0.0
         steps[leg] = 1.0 if loaded else 0.0
 
 

@@ -53,7 +53,7 @@ from bladelab.sim.mujoco_engine import add_point_force
 # the functions it calls: after editing a compiled function in closed_loop.py, controller.py,
 # metabolics.py, muscle.py, contact.py or sim/mujoco_engine.py, bump this number so the loop
 # below is compiled again.
-_CACHE_GENERATION = 7
+_CACHE_GENERATION = 8
 
 
 def _mujoco_step_addresses() -> tuple[int, int]:

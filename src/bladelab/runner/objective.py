@@ -9,9 +9,11 @@
   more than 0.1 s after the last one, as SCONE's GaitMeasure: runner.closed_loop), ``w_s = max(0, 1 − Ψ(v_s, v_min, v_max)/(1 m/s))`` with the
   linear range penalty Ψ of eq. 2.8 and the step's mean pelvis speed ``v_s``; after a fall no more
   steps count, so falling early costs up to 1; with ``alternating_steps`` (default) a step by
-  the same leg as the step before, or one during which the other (swinging) foot strikes the
-  ground within 0.1 s, earns nothing (hops, gallops and stumbles are not running; our
-  addition, docs/predictive.md);
+  the same leg as the step before earns nothing (hops and gallops are not running), and one
+  during which the other (swinging) foot strikes the ground within 0.1 s earns
+  ``max(0, 1 − peak/strike_limit_bw)`` of its credit, ``peak`` the strike's vertical force
+  [body weights] (a stumble; graded so the optimiser sees a lighter strike as better; our
+  additions, docs/predictive.md);
 - ``J_inj``: knee load (ligament torque [N·m] of each knee) outside ``knee_load_range``
   (−100…100), ``J_lean``: pelvis tilt [deg] outside ``pelvis_tilt_range_deg`` (−16…−2); both
   eq. 2.9, ``abs_penalty·|Err| + squared_penalty·Err²`` averaged over the simulated time.
@@ -70,6 +72,7 @@ class ObjectiveSettings:
     robust_samples: int = 1
     robust_jitter: float = 1e-6
     alternating_steps: bool = True
+    strike_limit_bw: float = 1.0
 
     def to_dict(self) -> dict:
         return asdict(self)
@@ -257,17 +260,21 @@ def _evaluate(settings, acc, td, t_end, distance, fell, mass, x0) -> Evaluation:
     times = np.concatenate([[0.0], td[:, 0]])
     xs = np.concatenate([[x0], td[:, 1]])
     legs = np.concatenate([[-1.0], td[:, 2]])
-    struck = np.concatenate([[False], td[:, 3] > 0.0])
+    strike = np.concatenate([[0.0], td[:, 3]])
     credit = 0.0
     for i in range(1, len(times)):
         ts = times[i] - times[i - 1]
         if ts <= 0:
             continue
-        if s.alternating_steps and (struck[i] or (i > 1 and legs[i] == legs[i - 1])):
-            continue  # the same leg again (a hop or gallop) or the other foot struck the ground
+        weight = 1.0
+        if s.alternating_steps:
+            if i > 1 and legs[i] == legs[i - 1]:
+                continue  # the same leg again: a hop or gallop
+            if strike[i] > 0.0:  # the other foot struck the ground
+                weight = max(0.0, 1.0 - strike[i] / s.strike_limit_bw) if s.strike_limit_bw > 0 else 0.0
         v = (xs[i] - xs[i - 1]) / ts
         psi = v_min - v if v < v_min else (v - v_max if v > v_max else 0.0)
-        credit += ts * max(0.0, 1.0 - psi)
+        credit += ts * weight * max(0.0, 1.0 - psi)
     j_gait = max(0.0, 1.0 - credit / s.duration)
     t = max(t_end, s.dt)
     j_cot = acc[0] / (mass * max(distance, 1.0))
