@@ -5,7 +5,7 @@ PYTHON ?= python3
 VENV   := .venv
 PY     := $(VENV)/bin/python
 
-.PHONY: demo test bench lint clean
+.PHONY: demo test bench lint clean clean-cache
 
 $(VENV)/bin/python:
 	$(PYTHON) -m venv $(VENV)
@@ -31,5 +31,10 @@ bench: $(VENV)/.installed-test
 lint: $(VENV)/.installed-test
 	$(VENV)/bin/ruff check src tests benchmarks
 
-clean:
+clean: clean-cache
 	rm -rf $(VENV) build *.egg-info src/*.egg-info .pytest_cache
+
+# numba's on-disk cache of compiled functions (keyed on each function's own file: after editing
+# a compiled function that others call, their cached machine code can be stale)
+clean-cache:
+	find src -name '*.nbi' -delete -o -name '*.nbc' -delete

@@ -52,7 +52,8 @@ from bladelab.sim.mujoco_engine import add_point_force
 # numba's cache is keyed on the content of the file that defines a function, not on the files of
 # the functions it calls: after editing a compiled function in closed_loop.py, controller.py,
 # metabolics.py, muscle.py, contact.py or sim/mujoco_engine.py, bump this number so the loop
-# below is compiled again.
+# below is compiled again. This is not always enough (a session saw a controller edit have no
+# effect until the caches were deleted): when in doubt, `make clean-cache`.
 _CACHE_GENERATION = 8
 
 
