@@ -104,11 +104,17 @@ def test_changed_settings_are_refused_naming_cell_and_setting(tmp_path, capsys):
         ({"generations": 2}, "--generations"),
         ({"generations": 1, "popsize": 6}, "--popsize"),
         ({"generations": 1, "seed": 2}, "--seed"),
+        ({"generations": 1, "sigma": 0.2}, "--sigma"),
         ({"generations": 1, "duration": 0.4}, "--duration"),
         ({"generations": 1, "robust_samples": 2}, "--robust-samples"),
     ):
         with pytest.raises(SpecError, match=f"Cat6 at 3.5 m/s.*{option}"):
             _sweep(tmp_path / "s", speeds=(3.5,), **kw)
+    # --sigma reaches the cell's CMA-ES (its step after the first generation stays near it)
+    _sweep(tmp_path / "small", speeds=(3.5,), generations=1, sigma=0.05)
+    steps = [pd.read_csv(tmp_path / f / "Cat6" / "3.5" / "history.csv").sigma.iloc[0]
+             for f in ("s", "small")]
+    assert 0.5 < steps[0] < 2.0 and 0.025 < steps[1] < 0.1
     # another initial guess
     _, layout = _model("amputee", "Cat6")
     init = tmp_path / "init.json"

@@ -118,6 +118,9 @@ def register(app: typer.Typer) -> None:
         init: Path | None = typer.Option(None, "--init", help="Amputee parameters JSON."),
         generations: int = typer.Option(100, "--generations"),
         popsize: int = typer.Option(16, "--popsize"),
+        sigma: float = typer.Option(
+            1.0, "--sigma", help="Initial step (× parameter scale); 0.05–0.2 from a solution."
+        ),
         seed: int = typer.Option(1, "--seed"),
         jobs: int = typer.Option(1, "--jobs"),
         executor: str = typer.Option("local", "--executor", help="local | ray"),
@@ -151,6 +154,7 @@ def register(app: typer.Typer) -> None:
             init=init,
             generations=generations,
             popsize=popsize,
+            sigma=sigma,
             seed=seed,
             jobs=jobs,
             executor=executor,

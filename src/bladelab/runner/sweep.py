@@ -48,6 +48,7 @@ CELL_FORMAT = 1
 _OPTION = {
     "generations": "--generations",
     "popsize": "--popsize",
+    "sigma": "--sigma",
     "seed": "--seed",
     "duration": "--duration",
     "dt": "--dt",
@@ -73,6 +74,7 @@ def _wanted(payload: dict) -> dict:
         {
             "generations": payload["generations"],
             "popsize": payload["popsize"],
+            "sigma": payload["sigma"],
             "seed": payload["seed"],
             **obj,
         }
@@ -100,7 +102,7 @@ def _read_cell(folder: Path, category: str, speed: float, wanted: dict) -> dict 
         return None
     try:
         data = json.loads(path.read_text(encoding="utf-8"))
-        stored = data["settings"]
+        stored = {"sigma": 1.0, **data["settings"]}  # cells written before --sigma existed
     except (OSError, ValueError, KeyError, TypeError) as err:
         raise InputFileError(
             f"cannot read sweep cell {where} ({type(err).__name__}: {err})",
@@ -232,6 +234,7 @@ def category_task(payload: dict) -> dict:
                 x0=x,
                 generations=payload["generations"],
                 popsize=payload["popsize"],
+                sigma=payload["sigma"],
                 seed=payload["seed"],
                 jobs=1,
                 out=folder,
@@ -404,6 +407,7 @@ def run_sweep(
     init: str | Path | None = None,
     generations: int = 100,
     popsize: int = 16,
+    sigma: float = 1.0,
     seed: int = 1,
     jobs: int = 1,
     executor: str = "local",
@@ -429,8 +433,10 @@ def run_sweep(
         are read back, interrupted ones resumed from their checkpoint.
     init
         Warm start for the first speed of every category (parameters JSON).
-    generations, popsize, seed
-        CMA-ES settings of every cell.
+    generations, popsize, sigma, seed
+        CMA-ES settings of every cell (``sigma``: initial step × parameter scale; from a warm
+        start a small one, 0.05–0.2, keeps the gait: 1 scatters the first candidates so far
+        that nearly all fall).
     jobs, executor
         Categories run in parallel on ``executor`` (``local``/``ray``) with ``jobs`` workers.
     duration
@@ -456,9 +462,10 @@ def run_sweep(
         blade_category(c)
     if not speeds or any(not (s > 0) for s in speeds):
         raise OptimizationError("speeds must be positive", where="speeds")
-    if generations < 1 or popsize < 2 or checkpoint_every < 1:
+    if generations < 1 or popsize < 2 or checkpoint_every < 1 or not sigma > 0:
         raise OptimizationError(
-            "need generations >= 1, popsize >= 2 and checkpoint_every >= 1", where="generations"
+            "need generations >= 1, popsize >= 2, sigma > 0 and checkpoint_every >= 1",
+            where="generations",
         )
     out = Path(out)
     init = Path(init).resolve() if init else None
@@ -472,6 +479,7 @@ def run_sweep(
     base = {
         "generations": int(generations),
         "popsize": int(popsize),
+        "sigma": float(sigma),
         "seed": int(seed),
         "out": str(out.resolve()),  # workers (Ray) may run in another folder
         "settings": objective.to_dict(),
