@@ -68,8 +68,16 @@ LONG_RUNS = (
     ("able-n", "able, from the shipped solution via 44 generations of `able-s`; with the "
      "stumble rule, 1 worker (stopped, `in_progress/able-3.5-no-strikes.json`)", None),
     ("amp-cat6-3.5", "amputee Cat6, warm start from able-3.5, 0.25 ms, 2 workers", "≈ 16 min"),
-    ("amp-n", "amputee Cat6, from the `amp-a`/`amp-s` chain; all step rules, 1–2 workers "
-     "(stopped, `in_progress/amputee-Cat6-3.5.json`)", None),
+    ("amp-n", "amputee Cat6, from the `amp-a`/`amp-s` chain; all step rules (all-or-nothing "
+     "stumble rule), 1–2 workers (stopped: 12 same-leg steps, blade strikes)", None),
+    ("amp-g2", "amputee Cat6, from `amp-n`'s best; graded stumble rule, Swing-only bifemsh "
+     "offset, σ 0.3, seed 6, 1–2 workers", None),
+    ("amp-g4", "amputee Cat6, from `amp-g2`'s generation-783 best; 12 s horizon, σ 0.1, seed 9, "
+     "1 worker: **the shipped `amputee-Cat6-3.5.json` is its generation 69** (1120 "
+     "evaluations, 386 s)", None),
+    ("amp-g6", "amputee Cat6, from the shipped solution; 2 robust samples, 11 s, σ 0.05, "
+     "seed 12, 1 worker (stopped: its best survives 1e-9 copies but runs 3.37 m/s, below "
+     "3.4)", None),
 )
 
 
@@ -92,7 +100,7 @@ def _long_run() -> str:
     if not rows:
         return "No long optimisation found under `runs/`."
     return "\n".join([
-        "Long optimisations at 3.5 m/s (λ = 16, seed 1, on the shared 2-core machine with other "
+        "Long optimisations at 3.5 m/s (λ = 16, seed 1 unless given, on the shared 2-core machine with other "
         "work running; costs are each run's own objective, so they are comparable only within "
         "a run):",
         "",
@@ -102,26 +110,43 @@ def _long_run() -> str:
     ])
 
 
-def _sweep_table() -> str:
+def _sweep_table(folder: Path | None = None) -> str:
+    """Our sweep (``runs/sweep``: summary.csv, results.csv) beside seed 001's values. A category
+    whose speed chain has not ended (no fall, speeds left) shows its maximum speed as a lower
+    bound."""
     import pandas as pd
 
     from bladelab.runner.predictive_report import seed001_results
 
+    folder = folder or ROOT / "runs" / "sweep"
     seed = seed001_results().pivot(index="category", columns="quantity", values="value")
-    summary = ROOT / "runs" / "sweep" / "summary.csv"
+    summary, results = folder / "summary.csv", folder / "results.csv"
     ours = pd.read_csv(summary).set_index("category") if summary.exists() else None
+    cells = pd.read_csv(results) if results.exists() else None
     lines = [
         "Category sweep beside seed 001 (§3.2 A, Fig. 3.7, Table 3.1):",
         "",
-        "| category | seed: max speed (m/s) | ours | seed: cost at 4 m/s (J/(kg·m)) | ours |",
-        "|---|---|---|---|---|",
+        "| category | seed: max speed (m/s) | ours | seed: cost at 4 m/s (J/(kg·m)) | ours "
+        "| our cells (prescribed m/s: ran / fell, mean m/s) |",
+        "|---|---|---|---|---|---|",
     ]
     for cat in ("Cat4", "Cat5", "Cat6", "Cat6High", "Cat7"):
         o = ours.loc[cat] if ours is not None and cat in ours.index else None
+        mine = cells[cells.category == cat].sort_values("speed") if cells is not None else None
+        done = "–"
+        open_chain = False
+        if mine is not None and len(mine):
+            done = ", ".join(
+                f"{r.speed:g}: {'fell' if r.fell else 'ran'} {r.mean_speed:.2f}"
+                for r in mine.itertuples()
+            )
+            open_chain = not bool(mine.fell.any())
         ms = f"{o.max_speed:.2f}" if o is not None and pd.notna(o.max_speed) else "–"
+        if open_chain and ms != "–":
+            ms = f"≥ {ms} (chain unfinished)"
         cot = f"{o.cot_4:.2f}" if o is not None and pd.notna(o.cot_4) else "–"
         lines.append(f"| {cat} | {seed.loc[cat, 'max_speed']:g} | {ms} | "
-                     f"{seed.loc[cat, 'cot_4']:g} | {cot} |")
+                     f"{seed.loc[cat, 'cot_4']:g} | {cot} | {done} |")
     lines += ["", "The seed's contact times at maximum speed were 0.14–0.17 s."]
     if ours is None:
         lines += ["", "Ours: not yet measured (no `runs/sweep/summary.csv`): the sweep "
