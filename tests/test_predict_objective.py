@@ -161,3 +161,17 @@ def test_online_steps_match_the_offline_count_and_scone_rules():
     np.testing.assert_allclose(online[:, 3], [0, 0, peak / bw, 0, 0, 0], rtol=1e-12)
     np.testing.assert_allclose(online[:, 0], [0.1, 0.45, 0.8, 1.15, 1.42, 1.6], atol=2 * dt)
     np.testing.assert_allclose(online[:, 1], 3.5 * online[:, 0])
+
+
+def test_initial_speed_sets_the_starting_state_not_the_target(able):
+    # the run starts moving at initial_speed (default: the prescribed speed); the gait measure
+    # still judges the steps against the prescribed speed
+    model, layout = able
+    ix = model.dof("pelvis_tx")
+    firsts = {}
+    for v0 in (None, 3.0):
+        s = ObjectiveSettings(speed=4.0, duration=0.05, initial_speed=v0)
+        ev, res = simulate_controlled(model, layout.x0, layout=layout, settings=s, record_every=1)
+        firsts[v0] = res.qvel[0, ix]
+    assert firsts[None] == pytest.approx(4.0, abs=0.02)
+    assert firsts[3.0] == pytest.approx(3.0, abs=0.02)

@@ -90,7 +90,8 @@ def test_resume_equals_not_stopping_and_finished_cells_are_read_back(tmp_path, m
     cell = tmp_path / "full" / "Cat6" / f"{top.speed:g}"
     model, layout = _model("amputee", "Cat6")
     x = read_parameters(cell / "best.json", layout)
-    settings = ObjectiveSettings(speed=top.speed, duration=0.3)
+    # every cell starts from the first speed's state (seed 001 §2.2.2)
+    settings = ObjectiveSettings(speed=top.speed, duration=0.3, initial_speed=3.5)
     _, res = simulate_controlled(model, x, layout=layout, settings=settings, record_every=2)
     st = spatiotemporal(res)
     want = st.value[(st.leg == "prosthetic") & (st.variable == "contact_time")].iloc[0]
@@ -105,6 +106,7 @@ def test_changed_settings_are_refused_naming_cell_and_setting(tmp_path, capsys):
         ({"generations": 1, "popsize": 6}, "--popsize"),
         ({"generations": 1, "seed": 2}, "--seed"),
         ({"generations": 1, "sigma": 0.2}, "--sigma"),
+        ({"generations": 1, "initial_speed": 4.0}, "--initial-speed"),
         ({"generations": 1, "duration": 0.4}, "--duration"),
         ({"generations": 1, "robust_samples": 2}, "--robust-samples"),
     ):

@@ -61,6 +61,9 @@ def register(app: typer.Typer) -> None:
         robust_jitter: float = typer.Option(
             1e-6, "--robust-jitter", help="Relative parameter jitter of the copies."
         ),
+        initial_speed: float | None = typer.Option(
+            None, "--initial-speed", help="Forward speed of the initial state (m/s); default --speed."
+        ),
     ) -> None:
         """Optimise the reflex controller of the runner with CMA-ES (seed 001 eq. 2.4)."""
         from bladelab.runner.controller import read_parameters
@@ -102,6 +105,7 @@ def register(app: typer.Typer) -> None:
                     dt=dt,
                     robust_samples=robust_samples,
                     robust_jitter=robust_jitter,
+                    initial_speed=initial_speed,
                 ),
                 progress=show,
             )
@@ -131,6 +135,11 @@ def register(app: typer.Typer) -> None:
         ),
         robust_jitter: float = typer.Option(
             1e-6, "--robust-jitter", help="Relative parameter jitter of the copies."
+        ),
+        initial_speed: float | None = typer.Option(
+            None,
+            "--initial-speed",
+            help="Forward speed of every cell's initial state (m/s); default the first speed.",
         ),
         checkpoint_every: int = typer.Option(5, "--checkpoint-every", help="Generations."),
         chain_from: str | None = typer.Option(
@@ -162,6 +171,7 @@ def register(app: typer.Typer) -> None:
             dt=dt,
             robust_samples=robust_samples,
             robust_jitter=robust_jitter,
+            initial_speed=initial_speed,
             checkpoint_every=checkpoint_every,
             chain_from=chain_from,
         )

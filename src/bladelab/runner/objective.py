@@ -18,6 +18,11 @@
   (−100…100), ``J_lean``: pelvis tilt [deg] outside ``pelvis_tilt_range_deg`` (−16…−2); both
   eq. 2.9, ``abs_penalty·|Err| + squared_penalty·Err²`` averaged over the simulated time.
 
+The simulation starts from SCONE's gait state moving forward at ``initial_speed`` [m/s] (None:
+the prescribed ``speed``). Seed 001 started every simulation from the same state (§2.2.2);
+sweeps start every speed from the first speed's, so a solution warm-started at a higher speed
+keeps running and its steps' speed penalty, not a fall, tells the optimiser to go faster.
+
 The simulation stops early once the model has fallen (pelvis below 60 % of standing height).
 
 Robust evaluation (``robust_samples`` = n > 1, :func:`bladelab.runner.predict.evaluate_candidates`):
@@ -73,6 +78,7 @@ class ObjectiveSettings:
     robust_jitter: float = 1e-6
     alternating_steps: bool = True
     strike_limit_bw: float = 1.0
+    initial_speed: float | None = None
 
     def to_dict(self) -> dict:
         return asdict(self)
@@ -164,7 +170,8 @@ def simulate_controlled(
     m = model.mj_model
     m.opt.timestep = dt
     d = mujoco.MjData(m)
-    q0, v0 = initial_state(model, layout, x, settings.speed)
+    v_start = settings.speed if settings.initial_speed is None else settings.initial_speed
+    q0, v0 = initial_state(model, layout, x, v_start)
     d.qpos[:] = q0
     d.qvel[:] = v0
     mujoco.mj_forward(m, d)

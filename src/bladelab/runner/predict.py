@@ -473,7 +473,8 @@ def verify_solution(
 ) -> dict:
     """Re-simulate a parameter file and check the shipped-solution criteria.
 
-    The simulation uses the time step the file was optimised with (``settings.dt``).
+    The simulation uses the time step and initial speed the file was optimised with
+    (``settings.dt``, ``settings.initial_speed``).
 
     Criteria (all recomputed from the file, nothing trusted from it): ``duration`` [s] without a
     fall; mean speed within ``speed_tolerance`` [m/s] of ``speed`` (default: the file's
@@ -500,8 +501,12 @@ def verify_solution(
     speed = float(speed if speed is not None else data.get("speed_m_per_s", 3.5))
     runner, layout = _model(model, blade)
     x = read_parameters(path, layout)
-    dt = float(data.get("settings", {}).get("dt", ObjectiveSettings().dt))
-    settings = ObjectiveSettings(speed=speed, duration=duration, dt=dt)
+    stored = data.get("settings", {})
+    dt = float(stored.get("dt", ObjectiveSettings().dt))
+    v0 = stored.get("initial_speed")
+    settings = ObjectiveSettings(
+        speed=speed, duration=duration, dt=dt, initial_speed=None if v0 is None else float(v0)
+    )
     limits = (duration, speed, speed_tolerance, max_power_residual_pct, min_gap_s)
     out = _check_gait(runner, layout, x, settings, limits)
     if jittered_copies > 0:

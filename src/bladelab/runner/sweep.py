@@ -54,6 +54,7 @@ _OPTION = {
     "dt": "--dt",
     "robust_samples": "--robust-samples",
     "robust_jitter": "--robust-jitter",
+    "initial_speed": "--initial-speed",
 }
 
 
@@ -415,6 +416,7 @@ def run_sweep(
     dt: float | None = None,
     robust_samples: int = 1,
     robust_jitter: float = 1e-6,
+    initial_speed: float | None = None,
     checkpoint_every: int = 5,
     chain_from: str | None = None,
     progress: bool = True,
@@ -446,6 +448,11 @@ def run_sweep(
     robust_samples, robust_jitter
         Robust evaluation: simulations per candidate (nominal + jittered copies) and their
         relative parameter jitter (:class:`ObjectiveSettings`).
+    initial_speed
+        Forward speed [m/s] of every cell's initial state; None: the first (lowest) speed. One
+        initial state for all, as seed 001 §2.2.2: a solution warm-started at the next speed
+        keeps running (starting at the new speed, the previous controller falls within a second)
+        and the step-speed penalty guides it faster.
     checkpoint_every
         Checkpoint every this many generations in each cell.
     chain_from
@@ -474,6 +481,7 @@ def run_sweep(
         duration=duration,
         robust_samples=int(robust_samples),
         robust_jitter=float(robust_jitter),
+        initial_speed=float(speeds[0] if initial_speed is None else initial_speed),
         **({"dt": float(dt)} if dt is not None else {}),
     )
     base = {
