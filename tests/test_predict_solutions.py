@@ -39,48 +39,50 @@ def test_shipped_solution_runs(path):
     assert out["ok"]
 
 
-def _three_stances():
-    """Time [s] and a leg's contact mask with stances 0.1-0.3, 0.5-0.7 and 0.9-0.99 s."""
+def _stride_times(force, bw=700.0, dt=0.001):
+    """Strides (start, end) [s] of :func:`_strides` on a (n, 2) vertical GRF record [N]."""
     import numpy as np
 
-    t = np.arange(0.0, 1.0, 0.001)
-    on = np.zeros_like(t, dtype=bool)
-    for a, b in ((0.1, 0.3), (0.5, 0.7), (0.9, 0.99)):
-        on[(t >= a - 1e-9) & (t < b - 1e-9)] = True
-    return t, on
-
-
-def _stride_times(t, on, min_gap_s, **kw):
+    from bladelab.runner.analyses import step_touchdowns
     from bladelab.runner.predict import _strides
 
-    return [(round(t[a], 3), round(t[b], 3)) for a, b in _strides(t, on, min_gap_s, **kw)]
+    t = np.arange(len(force)) * dt
+    steps = step_touchdowns(t, force, bw)
+    return sorted((round(t[a], 3), round(t[b], 3)) for a, b in _strides(t, steps))
 
 
-def test_strides_merge_contact_bounces():
-    t, on = _three_stances()
-    on[(t >= 0.2 - 1e-9) & (t < 0.22 - 1e-9)] = False  # a 20 ms bounce inside the first stance
-    assert _stride_times(t, on, 0.05) == [(0.1, 0.5), (0.5, 0.9)]
-    # with no merging the bounce starts a stride of its own
-    assert len(_stride_times(t, on, 0.0)) == 3
-
-
-def test_brief_touches_and_scuffs_do_not_start_a_stride():
+def _running(n=4):
+    """Left stances at 0.1, 0.7, 1.3 ... s and right ones at 0.4, 1.0 ... (0.2 s long, 1500 N)."""
     import numpy as np
 
-    t, on = _three_stances()
-    on[(t >= 0.4 - 1e-9) & (t < 0.41 - 1e-9)] = True  # a 10 ms touch of the swinging foot
-    assert _stride_times(t, on, 0.05) == [(0.1, 0.5), (0.5, 0.9)]
-    t, on = _three_stances()
-    on[(t >= 0.36 - 1e-9) & (t < 0.41 - 1e-9)] = True  # a 50 ms scuff at 50 N
-    force = np.where(on, 1500.0, 0.0)
-    force[(t >= 0.36 - 1e-9) & (t < 0.41 - 1e-9)] = 50.0
-    assert len(_stride_times(t, on, 0.05)) == 3  # without the force it is a stance
-    assert _stride_times(t, on, 0.05, force=force, body_weight=700.0) == [(0.1, 0.5), (0.5, 0.9)]
+    t = np.arange(0.0, 0.3 + 0.6 * n, 0.001)
+    f = np.zeros((len(t), 2))
+    for i in range(n):
+        for leg, t0 in ((0, 0.1 + 0.6 * i), (1, 0.4 + 0.6 * i)):
+            f[(t >= t0 - 1e-9) & (t < t0 + 0.2 - 1e-9), leg] = 1500.0
+    return t, f
+
+
+def test_strides_run_from_step_to_step_of_each_leg():
+    t, f = _running(3)
+    # left 0.1 -> 0.7 -> 1.3, right 0.4 -> 1.0 -> 1.6 (the force is seen one sample later)
+    assert _stride_times(f) == [(0.101, 0.701), (0.401, 1.001), (0.701, 1.301), (1.001, 1.601)]
+    # a 20 ms bounce inside a stance, a 50 N scuff and the swinging right foot striking the
+    # ground 30 ms after the left touch-down (a swing contact) start no stride
+    f[(t >= 0.15 - 1e-9) & (t < 0.17 - 1e-9), 0] = 0.0
+    f[(t >= 0.55 - 1e-9) & (t < 0.6 - 1e-9), 0] = 50.0
+    f[(t >= 0.73 - 1e-9) & (t < 0.77 - 1e-9), 1] = 400.0
+    assert _stride_times(f) == [(0.101, 0.701), (0.401, 1.001), (0.701, 1.301), (1.001, 1.601)]
+    # a 300 N touch of the swinging left foot 0.15 s into the right stance is a step (SCONE's
+    # rule: more than 0.1 s after the last): it splits the left stride
+    f[(t >= 0.55 - 1e-9) & (t < 0.6 - 1e-9), 0] = 300.0
+    assert (0.551, 0.701) in _stride_times(f)
 
 
 def test_same_leg_steps_count_hops_and_gallops():
     import numpy as np
 
+    from bladelab.runner.analyses import step_touchdowns
     from bladelab.runner.predict import _same_leg_steps
 
     t = np.arange(0.0, 3.0, 0.001)
@@ -91,6 +93,6 @@ def test_same_leg_steps_count_hops_and_gallops():
             f[(t >= 0.1 + 0.3 * i - 1e-9) & (t < 0.22 + 0.3 * i - 1e-9), side] = 1500.0
         return f
 
-    assert _same_leg_steps(t, forces([0, 1] * 4), 700.0) == 0
+    assert _same_leg_steps(step_touchdowns(t, forces([0, 1] * 4), 700.0)) == 0
     # left, right, right, left, right, right, ...: every third step repeats (2 of 8 here)
-    assert _same_leg_steps(t, forces([0, 1, 1, 0, 1, 1, 0, 1]), 700.0) == 2
+    assert _same_leg_steps(step_touchdowns(t, forces([0, 1, 1, 0, 1, 1, 0, 1]), 700.0)) == 2

@@ -467,7 +467,6 @@ def verify_solution(
     duration: float = 10.0,
     speed_tolerance: float = 0.1,
     max_power_residual_pct: float = 2.0,
-    min_gap_s: float = 0.05,
     jittered_copies: int = 0,
     jitter: float = 1e-9,
 ) -> dict:
@@ -478,13 +477,13 @@ def verify_solution(
 
     Criteria (all recomputed from the file, nothing trusted from it): ``duration`` [s] without a
     fall; mean speed within ``speed_tolerance`` [m/s] of ``speed`` (default: the file's
-    ``speed_m_per_s``); a flight phase (no leg loaded above 20 N) in every stride of each leg
-    (touch-down to touch-down of that leg; unloaded gaps shorter than ``min_gap_s`` [s] inside a
-    stance, i.e. contact bounces, do not end it, and touches shorter than 30 ms or never
-    reaching 0.1 body weight do not start one); steps (SCONE's definition, :func:`bladelab.runner.analyses.step_touchdowns`)
-    alternating between the legs after the first (``same_leg_steps`` 0: no hop or gallop);
+    ``speed_m_per_s``); steps (SCONE's definition, :func:`bladelab.runner.analyses.step_touchdowns`:
+    bounces, scuffs below 0.1 body weight and strikes of the swinging foot are not steps)
+    alternating between the legs after the first (``same_leg_steps`` 0: no hop or gallop); a
+    flight phase (no leg loaded above 20 N) in every stride (one step of a leg to its next);
     reported, not a criterion: ``swing_contacts`` (a swinging foot striking the ground,
-    :func:`bladelab.runner.analyses.swing_contacts`) and the largest one's peak force [N]; power-balance residual below
+    :func:`bladelab.runner.analyses.swing_contacts`) and the largest one's peak force [N];
+    power-balance residual below
     ``max_power_residual_pct`` % (runner analyses). With ``jittered_copies`` = n > 0 the same
     criteria must also hold for n copies of the parameters moved by ``jitter`` (relative,
     :func:`jittered_parameters`): a gait that survives only on one floating-point path (another
@@ -507,7 +506,7 @@ def verify_solution(
     settings = ObjectiveSettings(
         speed=speed, duration=duration, dt=dt, initial_speed=None if v0 is None else float(v0)
     )
-    limits = (duration, speed, speed_tolerance, max_power_residual_pct, min_gap_s)
+    limits = (duration, speed, speed_tolerance, max_power_residual_pct)
     out = _check_gait(runner, layout, x, settings, limits)
     if jittered_copies > 0:
         out["jittered"] = [
@@ -523,21 +522,19 @@ def _check_gait(runner, layout, x, settings: ObjectiveSettings, limits: tuple) -
     from bladelab.runner.analyses import (
         CONTACT_THRESHOLD_N,
         power_balance_residual_pct,
+        step_touchdowns,
         swing_contacts,
     )
 
-    duration, speed, tolerance, max_residual, min_gap_s = limits
+    duration, speed, tolerance, max_residual = limits
     ev, res = simulate_controlled(runner, x, layout=layout, settings=settings, record_every=2)
     leg = res.model.contact_params[:, 6]
     forces = np.stack([res.contacts[:, leg == i, 1].sum(axis=1) for i in (0, 1)], axis=1)
     loaded = forces > CONTACT_THRESHOLD_N
     airborne = ~(loaded[:, 0] | loaded[:, 1])
-    flights = []
-    for i in (0, 1):
-        strides = _strides(res.time, loaded[:, i], min_gap_s, forces[:, i], runner.body_weight)
-        for a, b in strides:
-            flights.append(bool(np.any(airborne[a:b])))
-    same_leg = _same_leg_steps(res.time, forces, runner.body_weight)
+    steps = step_touchdowns(res.time, forces, runner.body_weight)
+    flights = [bool(np.any(airborne[a:b])) for a, b in _strides(res.time, steps)]
+    same_leg = _same_leg_steps(steps)
     residual = power_balance_residual_pct(res)
     out = {
         "fell": ev.fell,
@@ -563,34 +560,22 @@ def _check_gait(runner, layout, x, settings: ObjectiveSettings, limits: tuple) -
     return out
 
 
-def _same_leg_steps(time: np.ndarray, leg_force: np.ndarray, body_weight: float) -> int:
+def _same_leg_steps(steps: list[tuple[float, int, float]]) -> int:
     """Steps after the second by the same leg as the step before (hops, gallops, a scuff
-    counted as a step): :func:`bladelab.runner.analyses.step_touchdowns` of the legs'
-    vertical GRF ``leg_force`` (n, 2) [N]."""
-    from bladelab.runner.analyses import step_touchdowns
-
-    order = [leg for _, leg, _ in step_touchdowns(time, leg_force, body_weight)]
+    counted as a step), of :func:`bladelab.runner.analyses.step_touchdowns`' ``steps``."""
+    order = [leg for _, leg, _ in steps]
     return sum(1 for i in range(2, len(order)) if order[i] == order[i - 1])
 
 
-def _strides(
-    time: np.ndarray,
-    on: np.ndarray,
-    min_gap_s: float,
-    force: np.ndarray | None = None,
-    body_weight: float = 0.0,
-) -> list[tuple[int, int]]:
-    """Sample ranges from one touch-down to the next of a leg, with contact bounces shorter
-    than ``min_gap_s`` [s] merged into the stance, brief touches dropped and, given the leg's
-    vertical ``force`` [N], scuffs below 0.1 ``body_weight`` [N] dropped
-    (:func:`bladelab.runner.analyses.contact_mask`)."""
-    from bladelab.runner.analyses import STEP_LOAD_BW, contact_mask
-
-    on = contact_mask(
-        time, on, min_gap_s=min_gap_s, force=force, min_peak_n=STEP_LOAD_BW * body_weight
-    )
-    td = np.flatnonzero(~on[:-1] & on[1:]) + 1
-    return list(zip(td[:-1], td[1:], strict=True))
+def _strides(time: np.ndarray, steps: list[tuple[float, int, float]]) -> list[tuple[int, int]]:
+    """Sample ranges of every stride of both legs: from one step of a leg (``steps`` of
+    :func:`bladelab.runner.analyses.step_touchdowns`, time [s] and leg) to its next step."""
+    out = []
+    for leg in (0, 1):
+        t = [ts for ts, side, _ in steps if side == leg]
+        idx = np.searchsorted(time, t)
+        out += list(zip(idx[:-1].tolist(), idx[1:].tolist(), strict=True))
+    return out
 
 
 __all__ = [
