@@ -15,6 +15,7 @@ from bladelab.runner.objective import ObjectiveSettings
 from bladelab.runner.predict import _model, evaluate_candidates, optimize_controller
 
 SHORT = ObjectiveSettings(duration=1.0)
+THREE_S = ObjectiveSettings(duration=3.0)
 
 
 def _run(**kw):
@@ -149,3 +150,24 @@ def test_robust_evaluation_is_the_mean_over_jittered_copies():
              for xi in [x, *copies]]
     got = evaluate_candidates({"model": "able", "settings": robust.to_dict(), "xs": [x.tolist()]})
     assert got[0]["cost"] == pytest.approx(np.mean(costs), rel=1e-12)
+
+
+def test_a_warm_start_is_never_lost():
+    # from the shipped able solution a wide first step (sigma 3) scatters every candidate to a
+    # worse cost; the best stays the start itself, evaluated once before the first generation
+    from pathlib import Path
+
+    import bladelab
+    from bladelab.runner.controller import read_parameters
+
+    _, layout = _model("able", None)
+    shipped = Path(bladelab.__file__).parent / "data" / "runner" / "solutions" / "able-3.5.json"
+    x0 = read_parameters(shipped, layout)
+    start = evaluate_candidates(
+        {"model": "able", "settings": THREE_S.to_dict(), "xs": [x0.tolist()]}
+    )
+    res = _run(x0=x0, sigma=3.0, generations=1, settings=THREE_S)
+    assert res.evaluations == 1 + 6
+    assert res.best_cost == start[0]["cost"]  # every candidate was worse (seeded)
+    assert np.array_equal(res.x, x0)
+    assert res.history[0][2] == start[0]["cost"]

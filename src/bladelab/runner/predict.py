@@ -225,7 +225,8 @@ def optimize_controller(
     speed
         Prescribed running speed [m/s] (initial speed and the centre of the step-speed band).
     x0
-        Initial parameters (warm start); default SCONE's (:func:`controller_layout`).
+        Initial parameters (warm start; evaluated once before the first generation, so the
+        best is never worse than it); default SCONE's (:func:`controller_layout`).
     generations
         Number of CMA-ES generations in total (a resumed run continues up to this number).
     popsize
@@ -323,6 +324,12 @@ def optimize_controller(
         executor, jobs, {"model": model, "blade": blade, "settings": settings.to_dict()}
     )
     try:
+        if state is None and x0 is not None:
+            # a warm start is evaluated first: the best is never worse than the start (CMA-ES
+            # samples around it and, from a fragile gait, may not find as good a point soon)
+            ev0 = evaluator([best_x])[0]
+            best_f, best_ev = float(ev0["cost"]), ev0
+            evals += 1
         while gen < generations:
             xs = es.ask()
             evs = evaluator(xs)
