@@ -4,6 +4,11 @@ checks, wall time of an optimisation, CLI, Ray = local."""
 from __future__ import annotations
 
 import json
+import os
+import signal
+import subprocess
+import sys
+import time
 
 import numpy as np
 import pandas as pd
@@ -228,3 +233,65 @@ def test_sweep_on_ray_matches_local(tmp_path, ray_instance):
     a = pd.read_csv(tmp_path / "local" / "results.csv")
     b = pd.read_csv(tmp_path / "ray" / "results.csv")
     pd.testing.assert_frame_equal(_without_time(a), _without_time(b))
+
+
+
+def _alive(pid: int) -> bool:
+    """Whether process ``pid`` runs (exists and is not a zombie; Linux /proc)."""
+    from pathlib import Path
+
+    try:
+        return Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0] != "Z"
+    except OSError:
+        return False
+
+
+def _descendants(pid: int) -> set[int]:
+    """Running descendant process ids of ``pid`` (Linux /proc)."""
+    from pathlib import Path
+
+    parent = {}
+    for stat in Path("/proc").glob("[0-9]*/stat"):
+        try:
+            fields = stat.read_text().rsplit(")", 1)[1].split()
+        except OSError:
+            continue
+        if fields[0] != "Z":
+            parent[int(stat.parent.name)] = int(fields[1])
+    out, frontier = set(), {pid}
+    while frontier:
+        frontier = {p for p, pp in parent.items() if pp in frontier} - out
+        out |= frontier
+    return out
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc")
+def test_sigterm_stops_the_sweep_and_its_workers(tmp_path):
+    # a killed sweep (SIGTERM, as `kill` or a job scheduler sends) exits 143 and leaves no
+    # worker running: orphaned workers used to go on writing into the output folder
+    out = tmp_path / "sw"
+    cmd = [sys.executable, "-c", "import sys; from bladelab.cli import main; sys.exit(main())",
+           "sweep", "--categories", "Cat5,Cat6", "--speeds", "3.5", "--generations", "500",
+           "--popsize", "4", "--duration", "3", "--checkpoint-every", "1", "--jobs", "2",
+           "--out", str(out)]
+    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    workers: set[int] = set()
+    try:
+        deadline = time.monotonic() + 180
+        while time.monotonic() < deadline and proc.poll() is None:
+            if len(list(out.glob("*/3.5/checkpoint.pkl"))) == 2:
+                break  # both category tasks are optimising in their workers
+            time.sleep(0.2)
+        assert proc.poll() is None, proc.communicate()
+        workers = _descendants(proc.pid)
+        assert len(workers) >= 2
+        proc.send_signal(signal.SIGTERM)
+        _, err = proc.communicate(timeout=60)
+        assert proc.returncode == 143 and "terminated" in err
+        time.sleep(1.0)
+        assert not [p for p in workers if _alive(p)]
+    finally:  # never leave a process behind, even when the test fails
+        for pid in [proc.pid, *workers]:
+            if _alive(pid):
+                os.kill(pid, signal.SIGKILL)
+        proc.communicate()

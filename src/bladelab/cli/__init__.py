@@ -9,7 +9,9 @@ shows the traceback instead.
 from __future__ import annotations
 
 import importlib
+import signal
 import sys
+import threading
 
 import typer
 
@@ -59,9 +61,14 @@ def main(argv: list[str] | None = None) -> int:
     """
     args = sys.argv[1:] if argv is None else list(argv)
     _state["debug"] = "--debug" in args
+    _state["terminated"] = False
+    previous = _catch_sigterm()
     try:
         app(args=args, prog_name="bladelab")
     except SystemExit as exit_:
+        if _state.get("terminated"):  # click turned the interrupt into an exit
+            typer.echo("terminated", err=True)
+            return 143
         code = exit_.code
         return code if isinstance(code, int) else (0 if code is None else 1)
     except BladelabError as err:
@@ -70,9 +77,29 @@ def main(argv: list[str] | None = None) -> int:
         typer.echo(f"error: {err}", err=True)
         return 2
     except KeyboardInterrupt:
+        if _state.get("terminated"):
+            typer.echo("terminated", err=True)
+            return 143
         typer.echo("interrupted", err=True)
         return 130
+    finally:
+        if previous is not None:
+            signal.signal(signal.SIGTERM, previous)
     return 0
+
+
+def _raise_terminated(signum, frame) -> None:
+    """SIGTERM (``kill``, a job scheduler) raised as an interrupt, so the same clean-up runs as
+    for Ctrl-C: worker processes are stopped and written checkpoints stay valid."""
+    _state["terminated"] = True
+    raise KeyboardInterrupt
+
+
+def _catch_sigterm():
+    """Install the SIGTERM handler (main thread only); returns the previous handler or None."""
+    if threading.current_thread() is not threading.main_thread():
+        return None
+    return signal.signal(signal.SIGTERM, _raise_terminated)
 
 
 if __name__ == "__main__":  # pragma: no cover

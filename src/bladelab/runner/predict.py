@@ -158,9 +158,15 @@ class _Evaluator:
                 out[i + j * n] = ev
         return out
 
-    def close(self) -> None:
+    def close(self, *, abort: bool = False) -> None:
+        """Shut the pool down; ``abort`` stops busy workers at once (an interrupted run)."""
         if self._pool is not None:
-            self._pool.shutdown()
+            if abort:
+                from bladelab.study.executors import terminate_pool
+
+                terminate_pool(self._pool)
+            else:
+                self._pool.shutdown()
             self._pool = None
 
 
@@ -363,8 +369,10 @@ def optimize_controller(
                     elapsed,
                     elapsed0 if not elapsed else elapsed[-1],
                 )
-    finally:
-        evaluator.close()
+    except BaseException:
+        evaluator.close(abort=True)
+        raise
+    evaluator.close()
     best = Evaluation(**best_ev) if best_ev is not None else None
     return OptimizationResult(
         model=model,

@@ -53,6 +53,15 @@ class SerialExecutor:
             yield i, status, value
 
 
+def terminate_pool(pool) -> None:
+    """Stop a ``ProcessPoolExecutor``'s workers now (an interrupted run): without this, workers
+    busy with long tasks outlive a killed parent and go on writing to its output folder."""
+    for proc in list((getattr(pool, "_processes", None) or {}).values()):
+        if proc.is_alive():
+            proc.terminate()
+    pool.shutdown(wait=True, cancel_futures=True)
+
+
 class LocalExecutor:
     """A local process pool of ``jobs`` workers."""
 
@@ -88,6 +97,8 @@ class LocalExecutor:
             finally:
                 for fut in pending:
                     fut.cancel()
+                if pending:  # interrupted (Ctrl-C, SIGTERM via the CLI, an error)
+                    terminate_pool(pool)
 
 
 class RayExecutor:
