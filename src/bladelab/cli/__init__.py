@@ -66,9 +66,8 @@ def main(argv: list[str] | None = None) -> int:
     try:
         app(args=args, prog_name="bladelab")
     except SystemExit as exit_:
-        if _state.get("terminated"):  # click turned the interrupt into an exit
-            typer.echo("terminated", err=True)
-            return 143
+        if _state["terminated"]:  # click turned the interrupt into an exit
+            return _interrupted()
         code = exit_.code
         return code if isinstance(code, int) else (0 if code is None else 1)
     except BladelabError as err:
@@ -77,15 +76,20 @@ def main(argv: list[str] | None = None) -> int:
         typer.echo(f"error: {err}", err=True)
         return 2
     except KeyboardInterrupt:
-        if _state.get("terminated"):
-            typer.echo("terminated", err=True)
-            return 143
-        typer.echo("interrupted", err=True)
-        return 130
+        return _interrupted()
     finally:
         if previous is not None:
             signal.signal(signal.SIGTERM, previous)
     return 0
+
+
+def _interrupted() -> int:
+    """Say how the run was stopped; the exit status of SIGTERM (143) or Ctrl-C (130)."""
+    if _state["terminated"]:
+        typer.echo("terminated", err=True)
+        return 143
+    typer.echo("interrupted", err=True)
+    return 130
 
 
 def _raise_terminated(signum, frame) -> None:

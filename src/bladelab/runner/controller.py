@@ -22,8 +22,8 @@ The reflex structure is SCONE's ``H0918RS2v3`` controller (Apache-2.0, T. Geijte
 parameters per leg (``symmetric = 0``, as ``ControllerGH2010v12Asym``), plus constant offsets
 ``C0`` per muscle in stance and in swing (Geyer & Herr's S0 / ΔS terms), a Swing-only ``C0`` of
 the short head of biceps femoris (early-swing knee flexion so the trailing foot clears the
-ground in running; docs/predictive.md) and DOF reflexes for the torso muscles about the lumbar joint (the seed's model has torso muscles; H0918 has none). The
-prosthetic leg has no shank muscles: reflexes to or from them are left out on that side.
+ground in running; docs/predictive.md) and DOF reflexes for the torso muscles about the lumbar
+joint (the seed's model has torso muscles; H0918 has none). The prosthetic leg has no shank muscles: reflexes to or from them are left out on that side.
 
 Parameters form a named flat vector (:class:`ControllerLayout`, names like SCONE's ``.par``:
 ``S00011.vasti_l.KF`` = vasti of the left leg, states EarlyStance+LateStance, force gain; the state
@@ -64,7 +64,6 @@ _ALL = "S11111"
 _STANCE = "S00011"
 _SWING = "S11100"
 _EARLY_SWING = "S01000"
-_EARLY_SWING_C0 = ("bifemsh",)
 
 # (mask, target, source, gain name, offset name or None, kind, delay, SCONE default value(s)).
 # Leg reflexes of H0918RS2v3 (source None = the target itself).
@@ -112,6 +111,12 @@ _LEG_MUSCLES = (
     "gastroc",
     "soleus",
     "tib_ant",
+)
+# Constant offsets C0: (state mask, muscles, search scale), per leg in this order.
+_CONSTANT_OFFSETS = (
+    (_STANCE, _LEG_MUSCLES, 0.02),
+    (_SWING, _LEG_MUSCLES, 0.02),
+    (_EARLY_SWING, ("bifemsh",), 0.05),
 )
 # Torso: (muscle, gain name, kind, default); source lumbar_extension, always on, both sides.
 _TORSO_REFLEXES: list[tuple] = [
@@ -262,25 +267,18 @@ def controller_layout(model) -> ControllerLayout:
                 (kind, muscles.index(tname), leg, _mask_bits(mask), src, 0, gain, off, off_const)
             )
             delays.append(delay)
-        # constant offsets per muscle in stance and swing
-        for mask in (_STANCE, _SWING):
-            for mname in _LEG_MUSCLES:
+        # constant offsets per muscle in stance and swing, then (our addition,
+        # docs/predictive.md) bifemsh in Swing only: early-swing knee flexion so the trailing
+        # foot clears the ground
+        for mask, offset_muscles, scale in _CONSTANT_OFFSETS:
+            for mname in offset_muscles:
                 if mname not in have:
                     continue
                 tname = f"{mname}_{side}"
-                gain = param(f"{mask}.{tname}.C0", 0.0, -1.0, 1.0, 0.02)
+                gain = param(f"{mask}.{tname}.C0", 0.0, -1.0, 1.0, scale)
                 rows.append(
                     (T_CONST, muscles.index(tname), leg, _mask_bits(mask), -1, 0, gain, -1, 0.0)
                 )
-                delays.append(0.0)
-        # early-swing knee flexion (our addition, docs/predictive.md): a constant offset of the
-        # short head of biceps femoris in Swing only, so the trailing foot clears the ground
-        for mname in _EARLY_SWING_C0:
-            if mname in have:
-                tname = f"{mname}_{side}"
-                gain = param(f"{_EARLY_SWING}.{tname}.C0", 0.0, -1.0, 1.0, 0.05)
-                bits = _mask_bits(_EARLY_SWING)
-                rows.append((T_CONST, muscles.index(tname), leg, bits, -1, 0, gain, -1, 0.0))
                 delays.append(0.0)
     if "lumbar_extension" in dofs:
         src = dofs.index("lumbar_extension")
