@@ -24,6 +24,26 @@ def test_verification_rejects_a_falling_controller(tmp_path):
     assert out["fell"] and not out["ok"]
 
 
+def test_verification_uses_the_files_own_objective_settings(tmp_path):
+    # a file optimised with other weights, another time step and robust sampling: the check
+    # re-simulates it with those weights and that time step, once (no robust sampling)
+    from bladelab.runner.controller import write_parameters
+    from bladelab.runner.objective import ObjectiveSettings, simulate_controlled
+
+    runner, layout = _model("able", None)
+    stored = {"w_cot": 2.0, "w_lean": 1.0, "dt": 0.0004, "robust_samples": 4, "gone": 1}
+    path = write_parameters(
+        tmp_path / "x0.json", layout, layout.x0, speed_m_per_s=3.5, settings=stored
+    )
+    out = verify_solution(path, duration=0.6)
+    own = ObjectiveSettings(speed=3.5, duration=0.6, w_cot=2.0, w_lean=1.0, dt=0.0004)
+    default = ObjectiveSettings(speed=3.5, duration=0.6)
+    want = simulate_controlled(runner, layout.x0, layout=layout, settings=own)[0].cost
+    other = simulate_controlled(runner, layout.x0, layout=layout, settings=default)[0].cost
+    assert out["cost"] == pytest.approx(want, rel=1e-12)
+    assert abs(want - other) > 1e-6 * abs(want)  # the settings do change the cost
+
+
 @pytest.mark.skipif(not SHIPPED, reason="no shipped solution yet (optimisation in progress)")
 @pytest.mark.parametrize("path", SHIPPED, ids=[p.stem for p in SHIPPED])
 def test_shipped_solution_runs(path):

@@ -123,17 +123,9 @@ class _Solution:
 
     def settings(self, duration: float | None = None, *, nominal: bool = False):
         """The run's objective settings (unknown keys dropped), optionally another duration."""
-        from bladelab.runner.objective import ObjectiveSettings
-        from bladelab.runner.predict import _settings_from_dict
+        from bladelab.runner.predict import _stored_settings
 
-        known = {f.name for f in dataclasses.fields(ObjectiveSettings)}
-        d = {k: v for k, v in (self.data.get("settings") or {}).items() if k in known}
-        d["speed"] = self.speed
-        if duration is not None:
-            d["duration"] = float(duration)
-        if nominal:
-            d["robust_samples"] = 1
-        return _settings_from_dict(d)
+        return _stored_settings(self.data, speed=self.speed, duration=duration, nominal=nominal)
 
     def simulate(self, duration: float | None = None):
         """(Evaluation, RunnerResult) of a nominal simulation recorded every 2nd step."""

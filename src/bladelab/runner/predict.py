@@ -32,7 +32,7 @@ import pickle
 import sys
 import time
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field, fields, replace
 from pathlib import Path
 
 import numpy as np
@@ -101,6 +101,22 @@ def _settings_from_dict(d: dict) -> ObjectiveSettings:
         if key in d:
             d[key] = tuple(d[key])
     return ObjectiveSettings(**d)
+
+
+def _stored_settings(
+    data: dict, *, speed: float, duration: float | None = None, nominal: bool = False
+) -> ObjectiveSettings:
+    """The objective settings a parameter file was optimised with (its ``settings``; keys this
+    version does not know are dropped), at ``speed`` [m/s], optionally another ``duration`` [s];
+    ``nominal`` drops robust sampling (one simulation of the parameters as they are)."""
+    known = {f.name for f in fields(ObjectiveSettings)}
+    d = {k: v for k, v in (data.get("settings") or {}).items() if k in known}
+    d["speed"] = float(speed)
+    if duration is not None:
+        d["duration"] = float(duration)
+    if nominal:
+        d["robust_samples"] = 1
+    return _settings_from_dict(d)
 
 
 class _Randn:
@@ -487,8 +503,8 @@ def verify_solution(
 ) -> dict:
     """Re-simulate a parameter file and check the shipped-solution criteria.
 
-    The simulation uses the time step and initial speed the file was optimised with
-    (``settings.dt``, ``settings.initial_speed``).
+    The simulation uses the objective settings the file was optimised with (its ``settings``:
+    time step, initial speed, weights; without robust sampling), at ``speed`` for ``duration``.
 
     Criteria (all recomputed from the file, nothing trusted from it): ``duration`` [s] without a
     fall; mean speed within ``speed_tolerance`` [m/s] of ``speed`` (default: the file's
@@ -515,12 +531,7 @@ def verify_solution(
     speed = float(speed if speed is not None else data.get("speed_m_per_s", 3.5))
     runner, layout = _model(model, blade)
     x = read_parameters(path, layout)
-    stored = data.get("settings", {})
-    dt = float(stored.get("dt", ObjectiveSettings().dt))
-    v0 = stored.get("initial_speed")
-    settings = ObjectiveSettings(
-        speed=speed, duration=duration, dt=dt, initial_speed=None if v0 is None else float(v0)
-    )
+    settings = _stored_settings(data, speed=speed, duration=duration, nominal=True)
     limits = (duration, speed, speed_tolerance, max_power_residual_pct)
     out = _check_gait(runner, layout, x, settings, limits)
     if jittered_copies > 0:
