@@ -192,6 +192,20 @@ def test_summary_by_hand():
     assert np.isnan(four.max_speed) and np.isnan(four.t200) and np.isnan(four.cot_4)
 
 
+def test_progress_counts_the_cells_a_fall_makes_unneeded():
+    from bladelab.runner.sweep import _cells_settled
+
+    speeds = [3.5, 4.0, 4.5, 5.0]
+    done = [
+        {"category": "Cat7", "speed": 3.5, "fell": True},  # its chain ends: 3 cells unneeded
+        {"category": "Cat6", "speed": 3.5, "fell": False},
+        {"category": "Cat6", "speed": 4.0, "fell": True},  # 2 unneeded
+        {"category": "Cat5", "speed": 3.5, "fell": False},
+    ]
+    assert _cells_settled(done, speeds) == 4 + 3 + 2
+    assert _cells_settled([], speeds) == 0
+
+
 def test_chain_warm_starts_neighbours(tmp_path):
     _sweep(tmp_path, categories=("Cat4", "Cat5", "Cat6"), speeds=(3.5,), generations=1,
            chain_from="Cat6")

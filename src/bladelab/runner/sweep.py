@@ -158,6 +158,17 @@ def _cells_done(out: Path, categories: list[str], speeds: list[float]) -> list[d
     return rows
 
 
+def _cells_settled(done: list[dict], speeds: list[float]) -> int:
+    """Cells finished or no longer needed: the finished ``done`` rows, plus each category's
+    speeds above its first fall (its chain ends there)."""
+    n = len(done)
+    for cat in {r["category"] for r in done}:
+        fell = [r["speed"] for r in done if r["category"] == cat and r["fell"]]
+        if fell:
+            n += sum(1 for v in speeds if v > min(fell))
+    return n
+
+
 def _write_tables(out: Path, rows: list[dict], categories: list[str]) -> pd.DataFrame:
     """Write results.csv and summary.csv (atomically); return the summary."""
     order = {c: i for i, c in enumerate(categories)}
@@ -298,7 +309,7 @@ class _CellProgress:
     def refresh_count(self) -> None:
         if self.bar.disable:
             return
-        n = len(_cells_done(self.out, self.categories, self.speeds))
+        n = _cells_settled(_cells_done(self.out, self.categories, self.speeds), self.speeds)
         if n != self.bar.n:
             self.bar.n = n
             self.bar.refresh()
