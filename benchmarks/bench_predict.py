@@ -8,6 +8,8 @@ import math
 import time
 from pathlib import Path
 
+import numpy as np
+
 from bladelab.runner.objective import DEFAULT_PREDICT_DT
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -116,6 +118,23 @@ def _fmt(v, spec: str = ".2f") -> str:
     return "–" if v is None or (isinstance(v, float) and math.isnan(v)) else format(v, spec)
 
 
+def _best_before_end(folder: Path, category: str, speed: float, generations: int) -> float:
+    """A sweep cell's best cost ``generations`` before its last generation (NaN if unknown):
+    how much the cell was still improving when its budget ended."""
+    import math
+
+    import pandas as pd
+
+    from bladelab.runner.sweep import cell_dir
+
+    hist = cell_dir(folder, category, speed) / "history.csv"
+    if not hist.is_file():
+        return math.nan
+    h = pd.read_csv(hist)
+    earlier = h[h.generation <= h.generation.max() - generations]
+    return float(earlier.best.iloc[-1]) if len(earlier) else math.nan
+
+
 def _sweep_table(folder: Path | None = None) -> str:
     """Our sweep (``runs/sweep``: summary.csv, results.csv) beside seed 001's values: one row per
     category (maximum speed, cost at 4 m/s, 200/400 m times, contact times), then one row per
@@ -146,13 +165,18 @@ def _sweep_table(folder: Path | None = None) -> str:
     for cat in cats:
         o = ours.loc[cat] if cat in ours.index else None
         mine = cells[cells.category == cat]
-        get = (lambda q: None if o is None else float(o[q]))  # noqa: E731
+        vals = {} if o is None else {q: float(o[q]) for q in o.index}
+        get = vals.get
         ms = _fmt(get("max_speed"))
         if len(mine) and not mine.fell.any() and ms != "–":
             ms = f"≥ {ms} (chain unfinished)"
         sd = seed.loc[cat]
+        cot = _fmt(get("cot_4"))
+        at4 = mine[np.isclose(mine.speed, 4.0) & ~mine.fell.astype(bool)]
+        if cot != "–" and len(at4):
+            cot += f" (ran {at4.mean_speed.iloc[0]:.2f} m/s)"
         lines.append(
-            f"| {cat} | {sd.max_speed:g} / {ms} | {sd.cot_4:g} / {_fmt(get('cot_4'))} | "
+            f"| {cat} | {sd.max_speed:g} / {ms} | {sd.cot_4:g} / {cot} | "
             f"{sd.t200:g} / {_fmt(get('t200'), '.1f')} | {sd.t400:g} / {_fmt(get('t400'), '.1f')} | "
             f"{sd.contact_time_intact:g} / {_fmt(get('contact_time_intact'), '.3f')} | "
             f"{sd.contact_time_prosthetic:g} / {_fmt(get('contact_time_prosthetic'), '.3f')} |"
@@ -163,15 +187,16 @@ def _sweep_table(folder: Path | None = None) -> str:
         "machine; the 3.5 m/s Cat6 cell starts from the shipped solution, the others as "
         "docs/predictive.md describes):",
         "",
-        "| category | prescribed (m/s) | outcome | mean speed (m/s) | cost (–) | J_cot (J/(kg·m)) "
-        "| J_gait (–) | evaluations | wall time (min) |",
-        "|---|---|---|---|---|---|---|---|---|",
+        "| category | prescribed (m/s) | outcome | mean speed (m/s) | cost (–) | cost 50 "
+        "generations earlier (–) | J_cot (J/(kg·m)) | J_gait (–) | evaluations | wall time (min) |",
+        "|---|---|---|---|---|---|---|---|---|---|",
     ]
     order = {c: i for i, c in enumerate(cats)}
     for r in sorted(cells.itertuples(), key=lambda r: (order.get(r.category, 9), r.speed)):
         outcome = f"fell at {r.duration:.2f} s" if r.fell else f"ran {r.duration:g} s"
         lines.append(
             f"| {r.category} | {r.speed:g} | {outcome} | {r.mean_speed:.2f} | {r.cost:.2f} | "
+            f"{_fmt(_best_before_end(folder, r.category, r.speed, 50))} | "
             f"{r.j_cot:.2f} | {r.j_gait:.3f} | {int(r.evaluations)} | {r.wall_time_s / 60:.1f} |"
         )
     return "\n".join(lines)
