@@ -200,6 +200,24 @@ def test_report_of_a_sweep(sweep_dir, tmp_path):
         100 * (stored.set_index("category").max_speed["Cat6"] - 4.62) / 4.62)
 
 
+def test_sweep_report_leaves_out_unfinished_cells(sweep_dir, tmp_path):
+    # a cell still optimising (status "running") holds an interim best.json: not a result
+    import shutil
+
+    copy = tmp_path / "sweep"
+    shutil.copytree(sweep_dir, copy)
+    cell = copy / "Cat6" / "4" / "cell.json"
+    data = json.loads(cell.read_text())
+    data["status"] = "running"
+    cell.write_text(json.dumps(data))
+    rep = build_predictive_report(copy, tmp_path / "r", duration=0.3, progress=False)
+    html = Path(rep.index).read_text(encoding="utf-8")
+    assert "Unfinished cells, left out (their best is an interim one): Cat6 at 4 m/s." in html
+    cells = _table(_tables(Path(rep.index)), "re-evaluated-with-their-own-settings")
+    shown = set(zip(cells.category, cells["prescribed speed (m/s)"], strict=True))
+    assert ("Cat6", 4.0) not in shown and ("Cat6", 3.5) in shown and ("Cat4", 4.0) in shown
+
+
 def test_sweep_report_opens_in_a_browser(sweep_dir, tmp_path):
     from browser import chromium, figure_ok, inspect_page
 

@@ -276,32 +276,45 @@ def _run_sections(report, folders: dict[str, Path], duration: float, bar) -> tup
     return {label: res}, [_resim_row(label, sol, ev, res)]
 
 
-def _sweep_cells(folder: Path) -> list[tuple[str, float, Path]]:
+def _sweep_cells(folder: Path) -> tuple[list[tuple[str, float, Path]], list[str]]:
+    """The sweep's finished cells (category, prescribed speed [m/s], folder), in results.csv's
+    category order, and the names of the unfinished ones (still optimising or stopped: their
+    best.json is an interim best, so they are left out)."""
+    from bladelab.runner.sweep import CELL_NAME
+
     try:
         res = pd.read_csv(folder / "results.csv")
         order = list(dict.fromkeys(res.category.astype(str)))
     except (OSError, ValueError, AttributeError) as err:
         raise InputFileError(f"cannot read the sweep results ({err})",
                              file=folder / "results.csv") from None
-    cells = []
+    cells, unfinished = [], []
     for cat_dir in sorted(p for p in folder.iterdir() if p.is_dir()):
         for cell in cat_dir.iterdir():
-            if (cell / "best.json").is_file():
-                try:
-                    speed = float(cell.name)
-                except ValueError:
-                    continue
+            if not (cell / "best.json").is_file():
+                continue
+            try:
+                speed = float(cell.name)
+            except ValueError:
+                continue
+            try:
+                status = json.loads((cell / CELL_NAME).read_text(encoding="utf-8")).get("status")
+            except (OSError, ValueError, AttributeError):
+                status = None
+            if status == "done":
                 cells.append((cat_dir.name, speed, cell))
+            else:
+                unfinished.append(f"{cat_dir.name} at {speed:g} m/s")
     rank = {c: i for i, c in enumerate(order)}
     cells.sort(key=lambda c: (rank.get(c[0], len(rank)), c[0], c[1]))
-    return cells
+    return cells, sorted(unfinished)
 
 
 def _sweep_sections(report, folder: Path, duration: float, bar) -> tuple[dict, list, pd.DataFrame]:
     from bladelab.runner.analyses import spatiotemporal
     from bladelab.runner.sweep import summarise
 
-    cells = _sweep_cells(folder)
+    cells, unfinished = _sweep_cells(folder)
     rows, sims = [], {}
     for cat, speed, cell in cells:
         sol = _Solution(cell / "best.json", _read_json(cell / "best.json"))
@@ -333,7 +346,9 @@ def _sweep_sections(report, folder: Path, duration: float, bar) -> tuple[dict, l
         text=("Every cell's best.json is simulated again with the cell's own settings; the "
               "category summary below comes from these simulations, not from results.csv. "
               "'as in summary.csv' checks its maximum speed, cost at 4 m/s and contact times "
-              "against the sweep's own table."),
+              "against the sweep's own table."
+              + (" Unfinished cells, left out (their best is an interim one): "
+                 + ", ".join(unfinished) + "." if unfinished else "")),
         tables=[("Cells re-evaluated with their own settings",
                  results.rename(columns={
                      "speed": "prescribed speed (m/s)", "cost": "cost (–)",
@@ -433,7 +448,7 @@ def build_predictive_report(
             settings, seed = first.get("settings") or {}, first.get("seed")
         else:
             results, resim, sweep_summary = _sweep_sections(rep, path, duration, bar)
-            cells = _sweep_cells(path)
+            cells, _ = _sweep_cells(path)
             first = _read_json(cells[0][2] / "best.json") if cells else {}
             settings, seed = first.get("settings") or {}, first.get("seed")
     rep.add_section(
