@@ -135,14 +135,36 @@ def _best_before_end(folder: Path, category: str, speed: float, generations: int
     return float(earlier.best.iloc[-1]) if len(earlier) else math.nan
 
 
+def _stage2(folder: Path):
+    """Cells of second-budget sweeps (``<folder>-stage2-*``: a sweep warm-started from a
+    first-stage cell's best), with a ``folder`` column; None if there are none."""
+    import pandas as pd
+
+    frames = []
+    for f in sorted(folder.parent.glob(f"{folder.name}-stage2-*")):
+        if (f / "results.csv").is_file():
+            frames.append(pd.read_csv(f / "results.csv").assign(folder=str(f)))
+    return pd.concat(frames, ignore_index=True) if frames else None
+
+
+def _ran_at_4(cells, category: str) -> float:
+    """Mean speed [m/s] of the category's 4 m/s cell if it ran the whole time (else NaN)."""
+    at4 = cells[(cells.category == category) & np.isclose(cells.speed, 4.0)
+                & ~cells.fell.astype(bool)]
+    return float(at4.mean_speed.iloc[0]) if len(at4) else math.nan
+
+
 def _sweep_table(folder: Path | None = None) -> str:
     """Our sweep (``runs/sweep``: summary.csv, results.csv) beside seed 001's values: one row per
     category (maximum speed, cost at 4 m/s, 200/400 m times, contact times), then one row per
     cell (prescribed speed, outcome, generations, evaluations, wall time). A category whose speed
-    chain has not ended (no fall, speeds left) shows its maximum speed as a lower bound."""
+    chain has not ended (no fall, speeds left) shows its maximum speed as a lower bound. Where
+    second-budget sweeps exist (``runs/sweep-stage2-*``), a value they change is shown as
+    ``first → with the second budget``."""
     import pandas as pd
 
     from bladelab.runner.predictive_report import seed001_results
+    from bladelab.runner.sweep import summarise
 
     folder = folder or ROOT / "runs" / "sweep"
     seed = seed001_results().pivot(index="category", columns="quantity", values="value")
@@ -151,53 +173,74 @@ def _sweep_table(folder: Path | None = None) -> str:
         return ("Category sweep: not yet measured (no `runs/sweep/summary.csv`): the sweep "
                 "warm-starts from the shipped amputee Cat6 solution (docs/predictive.md).")
     ours = pd.read_csv(summary).set_index("category")
-    cells = pd.read_csv(results)
+    cells = pd.read_csv(results).assign(folder=str(folder))
+    extra = _stage2(folder)
+    both, combined = ours, cells
+    if extra is not None:
+        key = set(zip(extra.category, extra.speed, strict=True))
+        kept = cells[[(c, v) not in key for c, v in zip(cells.category, cells.speed, strict=True)]]
+        combined = pd.concat([kept, extra], ignore_index=True)
+        both = summarise(combined).set_index("category")
     cats = ("Cat4", "Cat5", "Cat6", "Cat6High", "Cat7")
     lines = [
         "Category sweep beside seed 001 (§3.2 A and C, Fig. 3.7, Table 3.1); seed's value / "
         "ours. Maximum speed: the highest mean speed of a cell that ran the whole 12 s; contact "
-        "times: mean per leg in that solution.",
+        "times: mean per leg in that solution"
+        + ("; first → after a second 200-generation budget where one was run" if extra is not None
+           else "") + ".",
         "",
         "| category | max speed (m/s) | cost of transport at 4 m/s (J/(kg·m)) | 200 m (s) | "
         "400 m (s) | intact contact (s) | prosthetic contact (s) |",
         "|---|---|---|---|---|---|---|",
     ]
+
+    def value(table, cat: str, q: str, spec: str) -> str:
+        v = float(table.loc[cat, q]) if cat in table.index else math.nan
+        return _fmt(v, spec)
+
     for cat in cats:
-        o = ours.loc[cat] if cat in ours.index else None
         mine = cells[cells.category == cat]
-        vals = {} if o is None else {q: float(o[q]) for q in o.index}
-        get = vals.get
-        ms = _fmt(get("max_speed"))
-        if len(mine) and not mine.fell.any() and ms != "–":
-            ms = f"≥ {ms} (chain unfinished)"
         sd = seed.loc[cat]
-        cot = _fmt(get("cot_4"))
-        at4 = mine[np.isclose(mine.speed, 4.0) & ~mine.fell.astype(bool)]
-        if cot != "–" and len(at4):
-            cot += f" (ran {at4.mean_speed.iloc[0]:.2f} m/s)"
+        shown = {}
+        for q, spec in (("max_speed", ".2f"), ("cot_4", ".2f"), ("t200", ".1f"), ("t400", ".1f"),
+                        ("contact_time_intact", ".3f"), ("contact_time_prosthetic", ".3f")):
+            first, second = value(ours, cat, q, spec), value(both, cat, q, spec)
+            if q == "cot_4":
+                first, second = (
+                    v if v == "–" else f"{v} (ran {at4:.2f} m/s)"
+                    for v, at4 in ((first, _ran_at_4(cells, cat)),
+                                   (second, _ran_at_4(combined, cat)))
+                )
+            shown[q] = first if second == first else f"{first} → {second}"
+        if len(mine) and not mine.fell.any() and shown["max_speed"] != "–":
+            shown["max_speed"] = f"≥ {shown['max_speed']} (chain unfinished)"
         lines.append(
-            f"| {cat} | {sd.max_speed:g} / {ms} | {sd.cot_4:g} / {cot} | "
-            f"{sd.t200:g} / {_fmt(get('t200'), '.1f')} | {sd.t400:g} / {_fmt(get('t400'), '.1f')} | "
-            f"{sd.contact_time_intact:g} / {_fmt(get('contact_time_intact'), '.3f')} | "
-            f"{sd.contact_time_prosthetic:g} / {_fmt(get('contact_time_prosthetic'), '.3f')} |"
+            f"| {cat} | {sd.max_speed:g} / {shown['max_speed']} | {sd.cot_4:g} / {shown['cot_4']} "
+            f"| {sd.t200:g} / {shown['t200']} | {sd.t400:g} / {shown['t400']} | "
+            f"{sd.contact_time_intact:g} / {shown['contact_time_intact']} | "
+            f"{sd.contact_time_prosthetic:g} / {shown['contact_time_prosthetic']} |"
         )
     lines += [
         "",
-        "Every cell (200 generations of λ = 16 on one worker, two cells at a time on the 2-core "
-        "machine; the 3.5 m/s Cat6 cell starts from the shipped solution, the others as "
+        "Every cell (200 generations of λ = 16 on one worker, two or three cells at a time on the "
+        "2-core machine; budget 2nd: a second sweep of 200 generations from the first's best "
+        "cell; the 3.5 m/s Cat6 cell starts from the shipped solution, the others as "
         "docs/predictive.md describes):",
         "",
-        "| category | prescribed (m/s) | outcome | mean speed (m/s) | cost (–) | cost 50 "
+        "| category | prescribed (m/s) | budget | outcome | mean speed (m/s) | cost (–) | cost 50 "
         "generations earlier (–) | J_cot (J/(kg·m)) | J_gait (–) | evaluations | wall time (min) |",
-        "|---|---|---|---|---|---|---|---|---|---|",
+        "|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     order = {c: i for i, c in enumerate(cats)}
-    for r in sorted(cells.itertuples(), key=lambda r: (order.get(r.category, 9), r.speed)):
+    rows = cells if extra is None else pd.concat([cells, extra], ignore_index=True)
+    rows = rows.assign(stage=[1 if f == str(folder) else 2 for f in rows.folder])
+    for r in sorted(rows.itertuples(), key=lambda r: (order.get(r.category, 9), r.speed, r.stage)):
         outcome = f"fell at {r.duration:.2f} s" if r.fell else f"ran {r.duration:g} s"
+        earlier = _best_before_end(Path(r.folder), r.category, r.speed, 50)
         lines.append(
-            f"| {r.category} | {r.speed:g} | {outcome} | {r.mean_speed:.2f} | {r.cost:.2f} | "
-            f"{_fmt(_best_before_end(folder, r.category, r.speed, 50))} | "
-            f"{r.j_cot:.2f} | {r.j_gait:.3f} | {int(r.evaluations)} | {r.wall_time_s / 60:.1f} |"
+            f"| {r.category} | {r.speed:g} | {'1st' if r.stage == 1 else '2nd'} | {outcome} | "
+            f"{r.mean_speed:.2f} | {r.cost:.2f} | {_fmt(earlier)} | {r.j_cot:.2f} | "
+            f"{r.j_gait:.3f} | {int(r.evaluations)} | {r.wall_time_s / 60:.1f} |"
         )
     return "\n".join(lines)
 
