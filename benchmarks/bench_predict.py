@@ -148,7 +148,8 @@ SWEEP_NOTES = """Where ours differ from seed 001, and why (sweep of 2026-11-21):
   Cat6's 4 m/s cell from a fall at 11.5 s into a 12 s run and raised Cat6's maximum speed from
   3.42 to 3.60 m/s. The others sat at their warm start the whole time: nearly every candidate
   around a gait this fragile falls (the generation's median candidate scores 80–100, a fall's
-  cost), and Cat7's 3.5 m/s cell did not move in a second budget either. The seed ran 6
+  cost); Cat7's 3.5 m/s cell did not move in a second budget either, nor did Cat6's 3.60 m/s
+  gait prescribed a finer step (3.85 and 4.1 m/s). The seed ran 6
   optimisations in parallel per cell until the solution stopped changing. The 0.5 m/s grid adds
   to this: once the prescribed speed is more than 1 m/s above what the gait runs, every step's
   speed credit `max(0, 1 − Ψ/(1 m/s))` is zero and J_gait stops ranking candidates by speed
@@ -163,7 +164,7 @@ SWEEP_NOTES = """Where ours differ from seed 001, and why (sweep of 2026-11-21):
   stiffer about as much as Cat6 (Cat6High 4.06, Cat7 4.05), as in the seed's 4 m/s values.
 - **Contact times: ours 0.16–0.20 s, the seed's 0.14–0.17 s**, each at its model's maximum
   speed: contact shortens with speed (Cat5: 0.195 / 0.191 s intact / prosthetic at 3.34 m/s,
-  0.185 / 0.183 s at 3.52 m/s) and ours are 0.7–1.1 m/s slower. As in the seed, the prosthetic
+  0.185 / 0.183 s at 3.52 m/s) and ours are 0.8–1.1 m/s slower. As in the seed, the prosthetic
   contact is the shorter and shortens with stiffness (3.5 m/s cells: 0.196, 0.191, 0.174, 0.169,
   0.153 s from Cat4 to Cat7).
 - **Cat7 has no maximum speed**: its 3.5 m/s cell fell at 11.85 s of 12 s (which the seed's
