@@ -61,6 +61,10 @@ def _generation(jobs: int) -> tuple[float, float, int, float]:
 # read from each run's history.csv when it is there). Wall time from history.csv's elapsed_s
 # (recorded from 2026-11-21 on); the earlier runs' wall times are the session notes' estimates.
 LONG_RUNS = (
+    ("able-bench-2cores", "able, from the shipped initial guess (SCONE's walking parameters), "
+     "10 s, 2 workers with nothing else running: the first 150 generations, in which candidates "
+     "still fall within about a second (the later, full-length generations: the extrapolation "
+     "above)", None),
     ("able-3.5-dt0.5", "able, from SCONE's parameters (the shipped initial guess), 0.5 ms, "
      "1 niced worker", "≈ 35 min (not recorded)"),
     ("able-3.5", "able, warm start from the run above, 0.25 ms, 1 niced worker",
@@ -94,7 +98,7 @@ def _long_run() -> str:
         h = pd.read_csv(hist)
         last = h.iloc[-1]
         if wall is None and "elapsed_s" in h and pd.notna(last.elapsed_s):
-            wall = f"{last.elapsed_s / 60:.0f} min"
+            wall = f"{last.elapsed_s / 60:.1f} min"
         rows.append(
             f"| `{name}` | {what} | {int(last.generation)} | {int(last.evaluations)} | "
             f"{h.best.iloc[0]:.4g} → {last.best:.4g} | {wall or '–'} |"
