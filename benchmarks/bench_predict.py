@@ -60,6 +60,9 @@ def _generation(jobs: int) -> tuple[float, float, int, float]:
 # The optimisations behind the shipped solutions, in order (runs/ is not in git: the numbers are
 # read from each run's history.csv when it is there). Wall time from history.csv's elapsed_s
 # (recorded from 2026-11-21 on); the earlier runs' wall times are the session notes' estimates.
+# history.csv of each long run (copied from runs/<name>/, which git ignores)
+HISTORIES = ROOT / "benchmarks" / "runs"
+
 LONG_RUNS = (
     ("able-bench-2cores", "able, from the shipped initial guess (SCONE's walking parameters), "
      "10 s, 2 workers with nothing else running: the first 150 generations, in which candidates "
@@ -92,7 +95,7 @@ def _long_run() -> str:
 
     rows = []
     for name, what, wall in LONG_RUNS:
-        hist = ROOT / "runs" / name / "history.csv"
+        hist = HISTORIES / name / "history.csv"
         if not hist.exists():
             continue
         h = pd.read_csv(hist)
@@ -104,7 +107,7 @@ def _long_run() -> str:
             f"{h.best.iloc[0]:.4g} → {last.best:.4g} | {wall or '–'} |"
         )
     if not rows:
-        return "No long optimisation found under `runs/`."
+        return f"No long optimisation found under `{HISTORIES}`."
     return "\n".join([
         "Long optimisations at 3.5 m/s (λ = 16, seed 1 unless given, on the shared 2-core machine with other "
         "work running; costs are each run's own objective, so they are comparable only within "
@@ -138,6 +141,11 @@ def _best_before_end(folder: Path, category: str, speed: float, generations: int
     earlier = h[h.generation <= h.generation.max() - generations]
     return float(earlier.best.iloc[-1]) if len(earlier) else math.nan
 
+
+# The sweep shown (copied from runs/: results.csv, summary.csv, and each finished cell's
+# cell.json, best.json and history.csv; `bladelab report` re-simulates it), with its second
+# budgets beside it as sweep-stage2-*
+SWEEP_ARCHIVE = ROOT / "benchmarks" / "sweeps" / "2026-11-21" / "sweep"
 
 # Why our sweep differs from seed 001: measured on the sweep of 2026-11-21 (runs/sweep and its
 # second budgets); the long form, with the follow-up, is docs/predictive.md § "The category
@@ -210,11 +218,11 @@ def _sweep_table(folder: Path | None = None) -> str:
     from bladelab.runner.predictive_report import seed001_results
     from bladelab.runner.sweep import summarise
 
-    folder = folder or ROOT / "runs" / "sweep"
+    folder = folder or SWEEP_ARCHIVE
     seed = seed001_results().pivot(index="category", columns="quantity", values="value")
     summary, results = folder / "summary.csv", folder / "results.csv"
     if not summary.exists() or not results.exists():
-        return ("Category sweep: not yet measured (no `runs/sweep/summary.csv`): the sweep "
+        return (f"Category sweep: not found ({folder}/summary.csv): the sweep "
                 "warm-starts from the shipped amputee Cat6 solution (docs/predictive.md).")
     ours = pd.read_csv(summary).set_index("category")
     cells = pd.read_csv(results).assign(folder=str(folder))
