@@ -257,12 +257,11 @@ def _sweep_table(folder: Path | None = None) -> str:
         for q, spec in (("max_speed", ".2f"), ("cot_4", ".2f"), ("t200", ".1f"), ("t400", ".1f"),
                         ("contact_time_intact", ".3f"), ("contact_time_prosthetic", ".3f")):
             first, second = value(ours, cat, q, spec), value(both, cat, q, spec)
-            if q == "cot_4":
-                first, second = (
-                    v if v == "–" else f"{v} (ran {at4:.2f} m/s)"
-                    for v, at4 in ((first, _ran_at_4(cells, cat)),
-                                   (second, _ran_at_4(combined, cat)))
-                )
+            if q == "cot_4":  # beside it, the speed that 4 m/s cell actually ran
+                if first != "–":
+                    first += f" (ran {_ran_at_4(cells, cat):.2f} m/s)"
+                if second != "–":
+                    second += f" (ran {_ran_at_4(combined, cat):.2f} m/s)"
             shown[q] = first if second == first else f"{first} → {second}"
         if len(mine) and not mine.fell.any() and shown["max_speed"] != "–":
             shown["max_speed"] = f"≥ {shown['max_speed']} (chain unfinished)"

@@ -280,7 +280,7 @@ def _sweep_cells(folder: Path) -> tuple[list[tuple[str, float, Path]], list[str]
     """The sweep's finished cells (category, prescribed speed [m/s], folder), in results.csv's
     category order, and the names of the unfinished ones (still optimising or stopped: their
     best.json is an interim best, so they are left out)."""
-    from bladelab.runner.sweep import CELL_NAME
+    from bladelab.runner.sweep import finished_cell
 
     try:
         res = pd.read_csv(folder / "results.csv")
@@ -297,11 +297,7 @@ def _sweep_cells(folder: Path) -> tuple[list[tuple[str, float, Path]], list[str]
                 speed = float(cell.name)
             except ValueError:
                 continue
-            try:
-                status = json.loads((cell / CELL_NAME).read_text(encoding="utf-8")).get("status")
-            except (OSError, ValueError, AttributeError):
-                status = None
-            if status == "done":
+            if finished_cell(cell) is not None:
                 cells.append((cat_dir.name, speed, cell))
             else:
                 unfinished.append(f"{cat_dir.name} at {speed:g} m/s")
@@ -310,7 +306,11 @@ def _sweep_cells(folder: Path) -> tuple[list[tuple[str, float, Path]], list[str]
     return cells, sorted(unfinished)
 
 
-def _sweep_sections(report, folder: Path, duration: float, bar) -> tuple[dict, list, pd.DataFrame]:
+def _sweep_sections(
+    report, folder: Path, duration: float, bar
+) -> tuple[dict, list, pd.DataFrame, list[tuple[str, float, Path]]]:
+    """Add the sweep's sections; return the solutions shown, their re-simulation rows, the
+    recomputed category summary and the finished cells (:func:`_sweep_cells`)."""
     from bladelab.runner.analyses import spatiotemporal
     from bladelab.runner.sweep import summarise
 
@@ -382,7 +382,7 @@ def _sweep_sections(report, folder: Path, duration: float, bar) -> tuple[dict, l
             label = f"{cat} {speed:g} m/s" + (f" ({note})" if note else "")
             shown[label] = res
             resim.append(_resim_row(label, sol, ev, res))
-    return shown, resim, summary
+    return shown, resim, summary, cells
 
 
 def build_predictive_report(
@@ -447,8 +447,7 @@ def build_predictive_report(
             first = _read_json(next(iter(folders.values())) / "best.json")
             settings, seed = first.get("settings") or {}, first.get("seed")
         else:
-            results, resim, sweep_summary = _sweep_sections(rep, path, duration, bar)
-            cells, _ = _sweep_cells(path)
+            results, resim, sweep_summary, cells = _sweep_sections(rep, path, duration, bar)
             first = _read_json(cells[0][2] / "best.json") if cells else {}
             settings, seed = first.get("settings") or {}, first.get("seed")
     rep.add_section(

@@ -142,18 +142,22 @@ def _contact_times(category: str, x: np.ndarray, settings: ObjectiveSettings) ->
     return out
 
 
+def finished_cell(folder: Path) -> dict | None:
+    """The ``cell.json`` of a finished sweep cell in ``folder``; None while it has none, cannot
+    be read, or is not done (its ``best.json`` is then an interim best)."""
+    try:
+        data = json.loads((Path(folder) / CELL_NAME).read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return None
+    return data if isinstance(data, dict) and data.get("status") == "done" else None
+
+
 def _cells_done(out: Path, categories: list[str], speeds: list[float]) -> list[dict]:
     rows = []
     for cat in categories:
         for speed in speeds:
-            path = cell_dir(out, cat, speed) / CELL_NAME
-            if not path.is_file():
-                continue
-            try:
-                data = json.loads(path.read_text(encoding="utf-8"))
-            except (OSError, ValueError):
-                continue
-            if data.get("status") == "done":
+            data = finished_cell(cell_dir(out, cat, speed))
+            if data is not None:
                 rows.append(data["result"])
     return rows
 
@@ -528,4 +532,4 @@ def run_sweep(
     return _write_tables(out, rows, categories)
 
 
-__all__ = ["CELL_NAME", "category_task", "cell_dir", "run_sweep", "summarise"]
+__all__ = ["CELL_NAME", "category_task", "cell_dir", "finished_cell", "run_sweep", "summarise"]
