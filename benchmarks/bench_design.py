@@ -63,7 +63,7 @@ def run() -> str:
 
     # the simulation evaluators (issue 8, part B)
     from bladelab.design.evaluators import BladeEvaluator
-    from bladelab.runner.transfemoral import RunnerEvaluator
+    from bladelab.design.transfemoral import RunnerEvaluator
 
     blade_ev = BladeEvaluator()
     blade_ev(space.point(d.coded[-1]))  # compile the numba helpers once

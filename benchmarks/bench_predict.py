@@ -10,16 +10,16 @@ from pathlib import Path
 
 import numpy as np
 
-from bladelab.runner.objective import DEFAULT_PREDICT_DT
+from bladelab.predict.reflex.objective import DEFAULT_PREDICT_DT
 
 ROOT = Path(__file__).resolve().parents[1]
 
 
 def _closed_loop_rate() -> tuple[float, float, int]:
     """Best wall and CPU seconds per simulated second of the closed loop (amputee, default step)."""
+    from bladelab.predict.reflex.controller import controller_layout
+    from bladelab.predict.reflex.objective import ObjectiveSettings, simulate_controlled
     from bladelab.runner import build_runner
-    from bladelab.runner.controller import controller_layout
-    from bladelab.runner.objective import ObjectiveSettings, simulate_controlled
 
     model = build_runner("amputee", blade="Cat6")
     layout = controller_layout(model)
@@ -40,7 +40,7 @@ def _closed_loop_rate() -> tuple[float, float, int]:
 def _generation(jobs: int) -> tuple[float, float, int, float]:
     """Wall time of the 1st generation (includes worker start) and the 2nd, evaluations per
     generation and the best cost, for 16 candidates at 3.5 m/s from the initial guess."""
-    from bladelab.runner.predict import optimize_controller
+    from bladelab.predict.reflex.optimize import optimize_controller
 
     times = []
     res = None
@@ -132,7 +132,7 @@ def _best_before_end(folder: Path, category: str, speed: float, generations: int
 
     import pandas as pd
 
-    from bladelab.runner.sweep import cell_dir
+    from bladelab.predict.reflex.sweep import cell_dir
 
     hist = cell_dir(folder, category, speed) / "history.csv"
     if not hist.is_file():
@@ -215,8 +215,8 @@ def _sweep_table(folder: Path | None = None) -> str:
     ``first → with the second budget``."""
     import pandas as pd
 
-    from bladelab.runner.predictive_report import seed001_results
-    from bladelab.runner.sweep import summarise
+    from bladelab.predict.reflex.sweep import summarise
+    from bladelab.report.predictive_sections import seed001_results
 
     folder = folder or SWEEP_ARCHIVE
     seed = seed001_results().pivot(index="category", columns="quantity", values="value")

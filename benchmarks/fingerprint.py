@@ -65,18 +65,13 @@ def _fields(obj):
 
 def runner() -> dict[str, str]:
     from bladelab.blade import load_blade
+    from bladelab.predict.reflex import (
+        ObjectiveSettings,
+        controller_layout,
+        read_parameters,
+        simulate_controlled,
+    )
     from bladelab.runner import build_runner, simulate_runner
-
-    try:
-        from bladelab.predict.reflex import read_parameters, simulate_controlled
-    except ImportError:
-        from bladelab.runner.controller import read_parameters
-        from bladelab.runner.objective import simulate_controlled
-    try:
-        from bladelab.predict.reflex import ObjectiveSettings, controller_layout
-    except ImportError:
-        from bladelab.runner.controller import controller_layout
-        from bladelab.runner.objective import ObjectiveSettings
 
     out = {}
     m = build_runner("amputee", blade="Cat6")
@@ -104,11 +99,7 @@ def runner() -> dict[str, str]:
 
 def design() -> dict[str, str]:
     from bladelab.design import BladeEvaluator, DesignSpace, Factor, run_design
-
-    try:
-        from bladelab.design import RunnerEvaluator
-    except ImportError:
-        from bladelab.runner.transfemoral import RunnerEvaluator
+    from bladelab.design.transfemoral import RunnerEvaluator
     space = DesignSpace((Factor("stiffness_kN_per_m", 18.0, 32.0, "kN/m"),
                          Factor("toe_length_m", 0.19, 0.25, "m")))
     with tempfile.TemporaryDirectory() as tmp:

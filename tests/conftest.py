@@ -37,7 +37,7 @@ def ray_instance():
     """One local Ray instance (2 CPUs) for every Ray test of the session (started once: Ray's
     start-up is most of a Ray test's time); bladelab's Ray executor uses a running instance."""
     ray = pytest.importorskip("ray", reason="ray not installed (pip install bladelab[ray])")
-    from bladelab.study.executors import start_local_ray
+    from bladelab.executors import start_local_ray
 
     started = start_local_ray(2)
     yield ray

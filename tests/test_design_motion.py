@@ -13,6 +13,7 @@ import yaml
 
 from bladelab.cli import main
 from bladelab.design import DesignSpace, run_design
+from bladelab.design.gait_cycle import ANGLE_NAMES, GaitCycle, default_gait_cycle
 from bladelab.design.motion import (
     check_motion_factors,
     load_motion_cycles,
@@ -20,7 +21,6 @@ from bladelab.design.motion import (
     read_motion_file,
 )
 from bladelab.errors import InputFileError, SpecError
-from bladelab.runner.gait_cycle import ANGLE_NAMES, GaitCycle, default_gait_cycle
 
 SPACE2 = DesignSpace.parse("stiffness_kN_per_m=18:32,width_m=0.05:0.08")
 SPACE1 = DesignSpace.parse("stiffness_kN_per_m=18:32")
@@ -255,7 +255,7 @@ def test_run_design_records_the_motion_model(tmp_path):
 
 
 def test_runner_evaluator_motion_and_gait_exclude_each_other(tmp_path):
-    from bladelab.runner.transfemoral import RunnerEvaluator
+    from bladelab.design.transfemoral import RunnerEvaluator
 
     path = _write_motion(tmp_path, [(18.0,), (21.5,), (25.0,), (32.0,)])
     with pytest.raises(SpecError, match="not both"):
@@ -273,7 +273,7 @@ def test_design_command_with_motion(tmp_path, capsys):
     """A 3-run study on the runner: each run's predicted period is the known one, and the run
     simulated the predicted cycle (the same responses as simulating it directly)."""
     from bladelab.design import generate_blade
-    from bladelab.runner.transfemoral import simulate_transfemoral
+    from bladelab.design.transfemoral import simulate_transfemoral
 
     motion = _write_motion(tmp_path / "m", [(18.0,), (21.5,), (25.0,), (28.5,), (32.0,)])
     runs = tmp_path / "runs.csv"

@@ -11,15 +11,15 @@ import numpy as np
 import pandas as pd
 import pytest
 
-import bladelab.runner.predictive_report as pr
+import bladelab.report.predictive_sections as pr
 from bladelab.cli import main
+from bladelab.predict.reflex.controller import controller_layout
+from bladelab.predict.reflex.objective import ObjectiveSettings, simulate_controlled
+from bladelab.predict.reflex.optimize import optimize_controller
+from bladelab.predict.reflex.sweep import run_sweep
 from bladelab.report import Report
 from bladelab.report.predictive import build_predictive_report, predictive_kind
 from bladelab.runner import build_runner
-from bladelab.runner.controller import controller_layout
-from bladelab.runner.objective import ObjectiveSettings, simulate_controlled
-from bladelab.runner.predict import optimize_controller
-from bladelab.runner.sweep import run_sweep
 
 SOLUTIONS = Path(pr.__file__).resolve().parents[1] / "data" / "runner" / "solutions"
 

@@ -9,9 +9,9 @@ import numpy as np
 import pytest
 
 from bladelab.errors import BladelabError, InputFileError, SpecError
+from bladelab.executors import make_executor
 from bladelab.identify.optimizers import minimize
 from bladelab.study import ResultsStore, load_study, run_study, trial_seed
-from bladelab.study.executors import make_executor
 
 
 def fake_task(payload: dict) -> dict:

@@ -10,9 +10,10 @@ import math
 
 import numpy as np
 
+from bladelab.constants import STANDARD_GRAVITY
+
 DEG_PER_RAD = 180.0 / math.pi
 RAD_PER_DEG = math.pi / 180.0
-STANDARD_GRAVITY = 9.80665  # m/s²
 
 
 def _scale(value, factor: float):

@@ -9,14 +9,13 @@ from __future__ import annotations
 
 import json
 import math
-from concurrent.futures import ProcessPoolExecutor, as_completed
 from pathlib import Path
 
 import typer
 
 from bladelab.errors import SpecError
 
-__all__ = ["register", "figure_pairs", "write_design_figures"]
+__all__ = ["register"]
 
 
 def _parse_floats(text: str, what: str) -> list[float]:
@@ -45,13 +44,14 @@ def _blade_test(
     """Virtual compression test: force–displacement curve and stiffness at body-weight load."""
     from bladelab.blade import load_blade
     from bladelab.design.compression import compression_test
+    from bladelab.units import body_weight
 
     if not (body_mass > 0 and math.isfinite(body_mass)):
         raise SpecError(f"body mass must be > 0 kg, got {body_mass}", where="--body-mass")
     angles = _parse_floats(alignment, "--alignment")
     spec = load_blade(blade, category=category)
     model = spec.build()
-    load = body_mass * 9.80665
+    load = body_weight(body_mass)
     results = []
     from bladelab.design.compression import vertical_stiffness
     from bladelab.errors import ModelError
@@ -118,71 +118,6 @@ def _plot_compression(results, name: str, load: float, path: Path) -> None:
     fig.tight_layout()
     save_figure(fig, path)
     plt.close(fig)
-
-
-def figure_pairs(names: tuple[str, ...]) -> list[tuple[str, str]]:
-    """Factor pairs drawn as contour plots: (stiffness, width) and (height, toe length) when
-    present (seed 002's figures), else consecutive pairs."""
-    pairs = [(a, b) for a, b in (("stiffness_kN_per_m", "width_m"), ("height_m", "toe_length_m"))
-             if a in names and b in names]
-    if not pairs and len(names) >= 2:
-        pairs = [(names[i], names[i + 1]) for i in range(0, len(names) - 1, 2)]
-    return pairs
-
-
-def write_design_figures(result, out_dir: Path, *, objective: str,
-                         constraints: dict[str, float]) -> list[Path]:
-    """Main-effect and contour figures of a finished study into ``out_dir/figures``."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    from bladelab.design.optimum import SurfaceConstraint
-    from bladelab.design.plots import contour_plot, main_effects_plot, save_figure
-
-    fig_dir = Path(out_dir) / "figures"
-    written = []
-    names = [objective, *[c for c in constraints if c != objective]]
-    surfs = [result.surfaces[n] for n in names if n in result.surfaces]
-    fig = main_effects_plot(surfs, result.space)
-    written.append(save_figure(fig, fig_dir / "main_effects.png"))
-    plt.close(fig)
-    cons = [SurfaceConstraint(result.surfaces[k], float(v)) for k, v in constraints.items()]
-    for x, y in figure_pairs(result.space.names):
-        fig = contour_plot(result.surfaces[objective], result.space, x=x, y=y, constraints=cons,
-                           optimum=result.optimum)
-        written.append(save_figure(fig, fig_dir / f"contour_{objective}_{x}_{y}.png"))
-        plt.close(fig)
-    return written
-
-
-def _evaluate_one(evaluator, i: int, coded: list[float], point: dict[str, float]):
-    return i, coded, point, dict(evaluator(point))
-
-
-def _evaluate_parallel(evaluator, space, design, out: Path, jobs: int) -> None:
-    """Evaluate the runs not yet stored with ``jobs`` processes, in run_design's run-file format
-    (``runs/run_NNNN.json``), so that :func:`run_design` then only reads them back."""
-    from tqdm.auto import tqdm
-
-    from bladelab._io import write_json
-
-    todo = []
-    for i in range(design.n_runs):
-        path = out / "runs" / f"run_{i + 1:04d}.json"
-        if not path.is_file():
-            todo.append((i, design.coded[i].tolist(), space.point(design.coded[i])))
-    if not todo:
-        return
-    with ProcessPoolExecutor(max_workers=jobs) as pool:
-        futures = [pool.submit(_evaluate_one, evaluator, *args) for args in todo]
-        for fut in tqdm(as_completed(futures), total=len(futures), desc="design runs",
-                        unit="run"):
-            i, coded, point, res = fut.result()
-            write_json(out / "runs" / f"run_{i + 1:04d}.json",
-                       {"run": i + 1, "coded": coded, "point": point,
-                        "responses": {k: float(v) for k, v in res.items()}})
 
 
 def _design(
@@ -283,14 +218,9 @@ def _design(
                                               progress=True)
         _echo_motion(options["motion"])
     ev = make_evaluator(evaluator, **options)
-    out.mkdir(parents=True, exist_ok=True)
-    if jobs > 1:
-        _evaluate_parallel(ev, space, design, out, jobs)
     result = run_design(space, runs=design, evaluator=ev, out_dir=out, seed=seed, model=model,
-                        objective=objective, sense=sense, constraints=cons, units=ev.units)
-    from bladelab._io import write_json
-
-    write_json(out / "evaluator.json", ev.to_dict())
+                        objective=objective, sense=sense, constraints=cons, units=ev.units,
+                        jobs=jobs)
     typer.echo(f"{design.n_runs} runs ({result.n_evaluated} evaluated, {result.n_resumed} "
                f"resumed) -> {out}")
     for name, s in result.surfaces.items():
@@ -303,6 +233,8 @@ def _design(
     elif result.optimum_error:
         typer.echo(f"no optimum: {result.optimum_error}")
     if figures:
+        from bladelab.design.plots import write_design_figures
+
         for p in write_design_figures(result, out, objective=objective, constraints=cons):
             typer.echo(f"wrote {p}", err=True)
 
@@ -337,8 +269,8 @@ def _gait_cycle(
     import numpy as np
 
     from bladelab._io import atomic_path
+    from bladelab.design.gait_cycle import average_gait_cycle, gait_cycles_from_trial
     from bladelab.errors import InputFileError
-    from bladelab.runner.gait_cycle import average_gait_cycle, gait_cycles_from_trial
     from bladelab.trial import read_c3d
     from bladelab.trial.joint_angles import load_joint_marker_map
 

@@ -8,7 +8,6 @@ from pathlib import Path
 
 import typer
 
-from bladelab._io import write_json
 from bladelab.errors import SpecError
 from bladelab.runner.model import DEFAULT_DT
 
@@ -66,53 +65,48 @@ def register(app: typer.Typer) -> None:
         ),
     ) -> None:
         """Optimise the reflex controller of the runner with CMA-ES (seed 001 eq. 2.4)."""
-        from bladelab.runner.controller import read_parameters
-        from bladelab.runner.objective import ObjectiveSettings
-        from bladelab.runner.predict import _model, optimize_controller
+        from bladelab.predict.reflex.controller import read_parameters
+        from bladelab.predict.reflex.objective import ObjectiveSettings
+        from bladelab.predict.reflex.optimize import optimize_seeds, runner_and_layout
 
         if model not in ("able", "amputee"):
             raise SpecError(f"unknown model {model!r}", where="--model", hint="able or amputee")
         if not (math.isfinite(speed) and speed > 0):
             raise SpecError("speed must be positive", where="--speed")
         _check_simulation_options(dt, robust_samples, robust_jitter)
-        _, layout = _model(model, blade if model == "amputee" else None)
+        _, layout = runner_and_layout(model, blade if model == "amputee" else None)
         x0 = read_parameters(init, layout, transfer=True) if init is not None else None
         seed_list = _parse_list(seeds, "--seeds", int)
-        results = []
-        for seed in seed_list:
-            folder = out if len(seed_list) == 1 else out / f"seed-{seed}"
 
-            def show(gen: int, best: float, median: float, _s=seed) -> None:
-                typer.echo(f"seed {_s} generation {gen}: best {best:.4g}, median {median:.4g}")
+        def show(seed: int, gen: int, best: float, median: float) -> None:
+            typer.echo(f"seed {seed} generation {gen}: best {best:.4g}, median {median:.4g}")
 
-            res = optimize_controller(
-                model,
-                blade=blade,
+        results = optimize_seeds(
+            model,
+            seeds=seed_list,
+            out=out,
+            progress=show,
+            blade=blade,
+            speed=speed,
+            x0=x0,
+            generations=generations,
+            popsize=popsize,
+            sigma=sigma,
+            jobs=jobs,
+            executor=executor,
+            resume=resume,
+            checkpoint_every=checkpoint_every,
+            settings=ObjectiveSettings(
                 speed=speed,
-                x0=x0,
-                generations=generations,
-                popsize=popsize,
-                sigma=sigma,
-                seed=seed,
-                jobs=jobs,
-                executor=executor,
-                out=folder,
-                resume=resume,
-                checkpoint_every=checkpoint_every,
-                settings=ObjectiveSettings(
-                    speed=speed,
-                    duration=duration,
-                    dt=dt,
-                    robust_samples=robust_samples,
-                    robust_jitter=robust_jitter,
-                    initial_speed=initial_speed,
-                ),
-                progress=show,
-            )
-            results.append(res.to_dict())
-        best = min(results, key=lambda r: r["best_cost"])
-        write_json(out / "summary.json", {"runs": results, "best": best})
-        typer.echo(json.dumps(best, indent=2))
+                duration=duration,
+                dt=dt,
+                robust_samples=robust_samples,
+                robust_jitter=robust_jitter,
+                initial_speed=initial_speed,
+            ),
+        )
+        best = min(results, key=lambda r: r.best_cost)
+        typer.echo(json.dumps(best.to_dict(), indent=2))
 
     @app.command("sweep")
     def sweep(
@@ -149,7 +143,7 @@ def register(app: typer.Typer) -> None:
         """Category × speed grid: warm-started optimisations, maximum speed, cost at 4 m/s,
         200 m and 400 m times, contact times (seed 001 §2.2.2 B–C, Table 3.1). Running it again
         with the same --out continues: finished cells are read back, interrupted ones resumed."""
-        from bladelab.runner.sweep import run_sweep
+        from bladelab.predict.reflex.sweep import run_sweep
 
         if not (math.isfinite(duration) and duration > 0):
             raise SpecError("must be positive", where="--duration")

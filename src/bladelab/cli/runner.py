@@ -8,7 +8,6 @@ from pathlib import Path
 
 import typer
 
-from bladelab._io import atomic_open, write_json
 from bladelab.errors import InputFileError, SpecError
 from bladelab.runner.model import DEFAULT_DT
 
@@ -119,6 +118,7 @@ def simulate_cmd(
     """Simulate a runner forward and print its summary (optionally write states, GRF, events,
     power balance and muscle states as CSV into --out)."""
     from bladelab.runner import analyses, build_runner, load_runner_params, simulate_runner
+    from bladelab.runner.export import write_simulation
 
     if model not in ("able", "amputee"):
         raise SpecError(f"unknown model {model!r}", where="--model", hint="use able or amputee")
@@ -160,21 +160,10 @@ def simulate_cmd(
         initial_state=initial_state,
         initial_speed=speed,
     )
-    summary = analyses.summary(result)
     if out is not None:
-        out.mkdir(parents=True, exist_ok=True)
-        tables = {
-            "states.csv": result.states(),
-            "grf.csv": result.leg_grf(),
-            "events.csv": analyses.gait_events(result),
-            "power_balance.csv": analyses.power_balance(result),
-            "muscles.csv": result.muscle_states(),
-            "joint_powers.csv": analyses.joint_powers(result),
-        }
-        for name, df in tables.items():
-            with atomic_open(out / name, "w", newline="") as fh:
-                df.to_csv(fh, index=False)
-        write_json(out / "summary.json", summary)
+        summary = write_simulation(result, out)
+    else:
+        summary = analyses.summary(result)
     if as_json:
         typer.echo(json.dumps(summary, indent=2))
     else:

@@ -57,6 +57,7 @@ from typing import Any
 import numpy as np
 
 from bladelab.blade.model import BladeModel
+from bladelab.constants import STANDARD_GRAVITY
 from bladelab.design.blade_generator import generate_blade
 from bladelab.design.constraints import knee_extension_moment
 from bladelab.design.performance import bouncing_ball
@@ -68,8 +69,6 @@ __all__ = [
     "make_evaluator",
     "swing_clearance",
 ]
-
-STANDARD_GRAVITY = 9.80665
 
 #: Units of the blade evaluator's responses (for tables and plots).
 BLADE_RESPONSE_UNITS: dict[str, str] = {
@@ -242,11 +241,11 @@ class BladeEvaluator:
 
 def make_evaluator(kind: str, **options: Any):
     """An evaluator by name: ``"blade"`` (:class:`BladeEvaluator`) or ``"runner"``
-    (:class:`bladelab.runner.transfemoral.RunnerEvaluator`), with its options as keywords."""
+    (:class:`bladelab.design.transfemoral.RunnerEvaluator`), with its options as keywords."""
     if kind == "blade":
         return BladeEvaluator(**options)
     if kind == "runner":
-        from bladelab.runner.transfemoral import RunnerEvaluator
+        from bladelab.design.transfemoral import RunnerEvaluator
 
         return RunnerEvaluator(**options)
     raise SpecError(f"unknown evaluator {kind!r}", where="evaluator", hint="use 'blade' or 'runner'")

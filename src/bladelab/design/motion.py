@@ -5,7 +5,7 @@ time-normalised joint angles as second-order response surfaces of the design fac
 new design gets a predicted motion. Here the cycles and their blades come from a motion file
 (YAML or CSV), :func:`load_motion_model` fits
 :func:`~bladelab.design.motion_model.fit_motion_model` to them and
-:class:`~bladelab.runner.transfemoral.RunnerEvaluator` (``motion=``) predicts each design's
+:class:`~bladelab.design.transfemoral.RunnerEvaluator` (``motion=``) predicts each design's
 cycle from it.
 
 Motion file
@@ -15,9 +15,9 @@ One entry (row) per gait cycle. Keys (YAML) or columns (CSV):
 - every design factor, by the design space's name and in its unit (e.g.
   ``stiffness_kN_per_m``, ``width_m``, ``height_m``, ``toe_length_m``): the blade the cycle was
   run with; a blade outside the design space's ranges is allowed (it is coded beyond ±1);
-- ``gait``: a gait-cycle CSV (:func:`~bladelab.runner.gait_cycle.read_gait_csv`), **or**
+- ``gait``: a gait-cycle CSV (:func:`~bladelab.design.gait_cycle.read_gait_csv`), **or**
   ``trial``: a C3D trial with markers and force platforms whose mean cycle
-  :func:`~bladelab.runner.gait_cycle.gait_cycle_from_trial` extracts, with optional ``leg``
+  :func:`~bladelab.design.gait_cycle.gait_cycle_from_trial` extracts, with optional ``leg``
   (``right``/``left``: the prosthetic side, default ``right``), ``static`` (standing C3D
   trial), ``markers`` (YAML joint marker map), ``cutoff_hz`` (marker low-pass, default 20; 0:
   none), ``forward`` / ``up`` (file axes, default ``auto``);
@@ -299,14 +299,14 @@ def _with_row(err: BladelabError, motion: MotionFile, row: int) -> BladelabError
 
 
 def load_motion_cycles(motion: MotionFile, *, n: int = 100, progress: bool = False) -> list:
-    """The gait cycle of every entry (:class:`~bladelab.runner.gait_cycle.GaitCycle`).
+    """The gait cycle of every entry (:class:`~bladelab.design.gait_cycle.GaitCycle`).
 
     ``gait`` entries are read; ``trial`` entries give their mean cycle of ``n`` samples (a C3D
     file named by several entries is read once). Each cycle's ``source`` starts with its row.
     """
     from tqdm.auto import tqdm
 
-    from bladelab.runner.gait_cycle import gait_cycle_from_trial, read_gait_csv
+    from bladelab.design.gait_cycle import gait_cycle_from_trial, read_gait_csv
     from bladelab.trial import read_c3d
     from bladelab.trial.joint_angles import load_joint_marker_map
 

@@ -3,7 +3,7 @@
 :func:`fit_motion_model` fits the period [s] and every joint angle at ``n_nodes`` normalised
 times as response surfaces of the coded design factors (quadratic, or ``model="auto"``:
 quadratic if the cycles can estimate it, else linear), from gait cycles
-(:class:`bladelab.runner.gait_cycle.GaitCycle`) measured or predicted with several blades, with
+(:class:`bladelab.design.gait_cycle.GaitCycle`) measured or predicted with several blades, with
 leave-one-blade-out errors; :meth:`MotionModel.predict` / :meth:`MotionModel.predict_point` give
 the cycle of a new design. Motion files (cycles with their blades) are read by
 :mod:`bladelab.design.motion`.
@@ -17,9 +17,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from bladelab.design.gait_cycle import ANGLE_NAMES, GaitCycle
 from bladelab.design.terms import model_matrix, parse_terms, term_name
 from bladelab.errors import DataError, SpecError
-from bladelab.runner.gait_cycle import ANGLE_NAMES, GaitCycle
 
 __all__ = ["MotionModel", "fit_motion_model"]
 

@@ -36,10 +36,10 @@ from dataclasses import asdict, dataclass
 import numpy as np
 import pandas as pd
 
+from bladelab.constants import STANDARD_GRAVITY
 from bladelab.errors import DataError
 
 __all__ = [
-    "STANDARD_GRAVITY",
     "StancePerformance",
     "CyclePerformance",
     "stance_windows",
@@ -53,7 +53,6 @@ __all__ = [
     "cycle_performance",
 ]
 
-STANDARD_GRAVITY = 9.80665
 
 
 def _trapz(y: np.ndarray, x: np.ndarray) -> float:

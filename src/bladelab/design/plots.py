@@ -18,7 +18,7 @@ from bladelab.design.space import DesignSpace
 from bladelab.design.surfaces import ResponseSurface
 from bladelab.errors import SpecError
 
-__all__ = ["main_effects_plot", "contour_plot", "save_figure"]
+__all__ = ["contour_plot", "figure_pairs", "main_effects_plot", "save_figure", "write_design_figures"]
 
 
 def _levels(space: DesignSpace, at: Mapping[str, float] | None) -> np.ndarray:
@@ -168,3 +168,30 @@ def save_figure(fig: Figure, path: str | Path, *, dpi: int = 150) -> Path:
     with atomic_path(path) as tmp:
         fig.savefig(tmp, format=fmt, dpi=dpi)
     return path
+
+
+def figure_pairs(names: Sequence[str]) -> list[tuple[str, str]]:
+    """Factor pairs drawn as contour plots: (stiffness, width) and (height, toe length) when
+    present (seed 002's figures), else consecutive pairs."""
+    pairs = [(a, b) for a, b in (("stiffness_kN_per_m", "width_m"), ("height_m", "toe_length_m"))
+             if a in names and b in names]
+    if not pairs and len(names) >= 2:
+        pairs = [(names[i], names[i + 1]) for i in range(0, len(names) - 1, 2)]
+    return pairs
+
+
+def write_design_figures(result, out_dir: str | Path, *, objective: str,
+                         constraints: Mapping[str, float]) -> list[Path]:
+    """Main-effect and contour figures of a finished study
+    (:class:`~bladelab.design.study.DesignStudyResult`) into ``out_dir/figures``; returns the
+    paths written."""
+    fig_dir = Path(out_dir) / "figures"
+    names = [objective, *[c for c in constraints if c != objective]]
+    surfs = [result.surfaces[n] for n in names if n in result.surfaces]
+    written = [save_figure(main_effects_plot(surfs, result.space), fig_dir / "main_effects.png")]
+    cons = [SurfaceConstraint(result.surfaces[k], float(v)) for k, v in constraints.items()]
+    for x, y in figure_pairs(result.space.names):
+        fig = contour_plot(result.surfaces[objective], result.space, x=x, y=y, constraints=cons,
+                           optimum=result.optimum)
+        written.append(save_figure(fig, fig_dir / f"contour_{objective}_{x}_{y}.png"))
+    return written

@@ -22,7 +22,7 @@ from __future__ import annotations
 
 import json
 import math
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -128,6 +128,51 @@ def _read_run(path: Path, coded: np.ndarray) -> dict[str, float] | None:
     return responses
 
 
+def evaluate_design_run(payload: dict) -> dict:
+    """One run in a worker process: ``payload`` = {"evaluator", "point"} -> responses."""
+    return dict(payload["evaluator"](dict(payload["point"])))
+
+
+def _evaluate_runs(evaluator, space: DesignSpace, design: Design, todo: list[int], *, jobs: int,
+                   executor: str, progress: bool) -> Iterator[tuple[int, object]]:
+    """Yield (run index, raw responses) of the runs ``todo`` as they finish: in this process
+    (``jobs`` 1; an evaluator's error propagates, naming the run) or on an executor (errors
+    are collected and raised, naming the runs, after the other runs have finished)."""
+    bar = tqdm(total=len(todo), desc="design runs", unit="run", disable=not progress)
+    if jobs <= 1:
+        for i in todo:
+            point = space.point(design.coded[i])
+            try:
+                raw = evaluator(dict(point))
+            except BladelabError as err:
+                raise type(err)(
+                    f"run {i + 1} ({', '.join(f'{k}={v:g}' for k, v in point.items())}): "
+                    f"{err.message}",
+                    file=err.file, where=err.where, hint=err.hint,
+                ) from err
+            bar.update()
+            yield i, raw
+        bar.close()
+        return
+    from bladelab.executors import make_executor
+
+    payloads = [{"evaluator": evaluator, "point": space.point(design.coded[i])} for i in todo]
+    failed = []
+    for k, status, value in make_executor(executor, jobs).run(evaluate_design_run, payloads):
+        bar.update()
+        if status == "ok":
+            yield todo[k], value
+        else:
+            failed.append(f"run {todo[k] + 1}: {value}")
+    bar.close()
+    if failed:
+        raise BladelabError(
+            f"{len(failed)} of {len(todo)} runs failed ({'; '.join(failed[:3])})",
+            where="design runs", hint="the finished runs are stored; fix the cause and run "
+                                      "again with the same output folder to resume",
+        )
+
+
 def _check_responses(
     raw: object, run: int, expected: Sequence[str] | None
 ) -> dict[str, float]:
@@ -177,6 +222,8 @@ def run_design(
     units: Mapping[str, str] | None = None,
     conservative: bool = False,
     progress: bool = True,
+    jobs: int = 1,
+    executor: str = "local",
 ) -> DesignStudyResult:
     """Evaluate a design, fit a surface per response and find the constrained optimum.
 
@@ -211,6 +258,10 @@ def run_design(
         Impose constraints on the lower prediction bound.
     progress
         Show a progress bar.
+    jobs, executor
+        Worker processes and ``"local"`` (a process pool) or ``"ray"``
+        (:mod:`bladelab.executors`); with ``jobs`` > 1 the evaluator must be picklable. Every
+        finished run is stored before a failed one is reported.
     """
     if not callable(evaluator):
         raise SpecError("evaluator must be callable", where="evaluator")
@@ -241,6 +292,8 @@ def run_design(
     }
     out.mkdir(parents=True, exist_ok=True)
     write_json(out / "study.json", meta)
+    if hasattr(evaluator, "to_dict"):
+        write_json(out / "evaluator.json", evaluator.to_dict())
     if motion is not None:
         write_json(out / "motion.json", motion.to_dict())
 
@@ -255,18 +308,12 @@ def run_design(
             n_resumed += 1
             expected = expected or list(r)
     todo = [i for i in range(design.n_runs) if results[i] is None]
-    for i in tqdm(todo, desc="design runs", unit="run", disable=not progress):
-        point = space.point(design.coded[i])
-        try:
-            raw = evaluator(dict(point))
-        except BladelabError as err:
-            raise type(err)(
-                f"run {i + 1} ({', '.join(f'{k}={v:g}' for k, v in point.items())}): "
-                f"{err.message}",
-                file=err.file, where=err.where, hint=err.hint,
-            ) from err
+    finished = _evaluate_runs(evaluator, space, design, todo, jobs=jobs, executor=executor,
+                              progress=progress)
+    for i, raw in finished:
         res = _check_responses(raw, i + 1, expected)
         expected = expected or list(res)
+        point = space.point(design.coded[i])
         write_json(
             _run_file(out, i),
             {"run": i + 1, "coded": design.coded[i].tolist(), "point": point, "responses": res},

@@ -17,7 +17,6 @@ from bladelab.example.measurement import (
     extend_flight,
     measure_stance,
 )
-from bladelab.example.pipeline import PipelineResult, run_example_pipeline
 from bladelab.example.study import (
     ExampleStudy,
     GeneratorSettings,
@@ -33,7 +32,6 @@ __all__ = [
     "ExampleStudy",
     "GeneratorSettings",
     "MeasuredTrial",
-    "PipelineResult",
     "TrialPlan",
     "clamp_cluster_positions",
     "default_tip",
@@ -43,5 +41,4 @@ __all__ = [
     "measure_stance",
     "plan_trials",
     "read_ground_truth",
-    "run_example_pipeline",
 ]

@@ -58,6 +58,7 @@ from typing import Any
 import numpy as np
 from scipy import interpolate
 
+from bladelab.constants import STANDARD_GRAVITY
 from bladelab.errors import DataError
 from bladelab.trial.c3d import plate_corners
 from bladelab.trial.stance import Stance
@@ -83,7 +84,6 @@ CLAMP_CLUSTER: dict[str, tuple[float, float, float]] = {
 #: Name of the tip marker.
 TIP_MARKER = "BLADE_TIP"
 
-_G = 9.81
 _PLATE_LENGTH_M = 0.6
 _PLATE_WIDTH_M = 0.4
 
@@ -202,7 +202,7 @@ def extend_flight(
     """Add flight before and after a stance so that a recording has room for filters and margins.
 
     In flight the clamp follows a ballistic path (velocity estimated from the first/last three
-    samples, gravity 9.81 m/s²), its pitch rate decays exponentially with time constant
+    samples, standard gravity), its pitch rate decays exponentially with time constant
     ``pitch_decay_s`` [s], the tip moves rigidly with the clamp and the GRF is zero.
 
     Parameters
@@ -238,7 +238,7 @@ def extend_flight(
         out = {
             "clamp_x": base["clamp_x"] + sign * v["clamp_x"] * s,
             "clamp_y": base["clamp_y"] + sign * v["clamp_y"] * s,
-            "clamp_z": base["clamp_z"] + sign * v["clamp_z"] * s - 0.5 * _G * s**2,
+            "clamp_z": base["clamp_z"] + sign * v["clamp_z"] * s - 0.5 * STANDARD_GRAVITY * s**2,
             "clamp_pitch": base["clamp_pitch"]
             + sign * v["clamp_pitch"] * pitch_decay_s * (1.0 - np.exp(-s / pitch_decay_s)),
             "distance": np.full(n, base["distance"]),

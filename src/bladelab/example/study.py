@@ -417,7 +417,7 @@ def make_example_study(
     """
     from tqdm import tqdm
 
-    from bladelab.study.executors import make_executor
+    from bladelab.executors import make_executor
 
     t0 = time.perf_counter()
     folder = Path(out_dir) if out_dir is not None else default_example_dir()

@@ -47,7 +47,7 @@ def _load(design_dir: Path):
     evaluator: dict = {}
     if ev.is_file():
         from bladelab.design.evaluators import BLADE_RESPONSE_UNITS
-        from bladelab.runner.transfemoral import RUNNER_RESPONSE_UNITS
+        from bladelab.design.transfemoral import RUNNER_RESPONSE_UNITS
 
         try:
             evaluator = json.loads(ev.read_text(encoding="utf-8"))
@@ -72,9 +72,8 @@ def design_report_sections(design_dir: str | Path) -> list[dict[str, Any]]:
     import matplotlib
 
     matplotlib.use("Agg")
-    from bladelab.cli.design import figure_pairs
     from bladelab.design.optimum import SurfaceConstraint, constrained_optimum
-    from bladelab.design.plots import contour_plot, main_effects_plot
+    from bladelab.design.plots import contour_plot, figure_pairs, main_effects_plot
     from bladelab.errors import OptimizationError
 
     design_dir = Path(design_dir)

@@ -66,7 +66,7 @@ def _styled(func: _F) -> _F:
     return wrapper  # type: ignore[return-value]
 
 
-_SIGNALS = {
+SIGNALS = {
     "grf": ("grf_z", 1.0, "vertical GRF [N]"),
     "distance": ("distance", 1e3, "clamp–tip distance [mm]"),
 }
@@ -138,10 +138,10 @@ def time_series_bands(
     n_points
         Samples of the normalised curves.
     """
-    if signal not in _SIGNALS:
+    if signal not in SIGNALS:
         raise DataError(f"unknown signal {signal!r}", where="signal", hint="'grf' or 'distance'")
     _check_groups(measured, "measured stances")
-    name, scale, label = _SIGNALS[signal]
+    name, scale, label = SIGNALS[signal]
     pct = np.linspace(0.0, 100.0, n_points)
     fig, axes = _figure(len(measured))
     for ax, (group, stances) in zip(axes, measured.items(), strict=True):

@@ -10,8 +10,8 @@
   ``settings`` {``dt``, ...}, ``parameters``).
 
 Nothing is taken from a stored evaluation: every solution is simulated again from its parameters
-(:func:`bladelab.runner.objective.simulate_controlled` with the file's time step). The sections
-shown (:func:`bladelab.runner.predictive_report.add_predictive_sections`) come from a
+(:func:`bladelab.predict.reflex.objective.simulate_controlled` with the file's time step). The sections
+shown (:func:`bladelab.report.predictive_sections.add_predictive_sections`) come from a
 ``duration`` (10 s) re-simulation recorded every 2nd step. A run's cost terms are recomputed with
 the run's own objective settings (its duration, robust sampling) and set beside the stored best
 cost; a sweep's category summary is recomputed from every cell the same way.
@@ -98,14 +98,14 @@ class _Solution:
     x: np.ndarray | None = None
 
     def __post_init__(self) -> None:
-        from bladelab.runner.controller import read_parameters
-        from bladelab.runner.predict import _model
+        from bladelab.predict.reflex.controller import read_parameters
+        from bladelab.predict.reflex.optimize import runner_and_layout
 
         kind = self.data.get("model", "able")
         if kind not in ("able", "amputee"):
             raise InputFileError(f"unknown model {kind!r}", file=self.path, where="model")
         blade = self.data.get("blade") or ("Cat6" if kind == "amputee" else None)
-        self.model, self.layout = _model(kind, blade)
+        self.model, self.layout = runner_and_layout(kind, blade)
         self.x = read_parameters(self.path, self.layout)
 
     @property
@@ -123,13 +123,13 @@ class _Solution:
 
     def settings(self, duration: float | None = None, *, nominal: bool = False):
         """The run's objective settings (unknown keys dropped), optionally another duration."""
-        from bladelab.runner.predict import _stored_settings
+        from bladelab.predict.reflex.optimize import stored_settings
 
-        return _stored_settings(self.data, speed=self.speed, duration=duration, nominal=nominal)
+        return stored_settings(self.data, speed=self.speed, duration=duration, nominal=nominal)
 
     def simulate(self, duration: float | None = None):
         """(Evaluation, RunnerResult) of a nominal simulation recorded every 2nd step."""
-        from bladelab.runner.objective import simulate_controlled
+        from bladelab.predict.reflex.objective import simulate_controlled
 
         s = self.settings(duration, nominal=True)
         return simulate_controlled(self.model, self.x, layout=self.layout, settings=s,
@@ -137,11 +137,11 @@ class _Solution:
 
     def evaluate(self, nominal_ev):
         """The evaluation as the optimiser computed it (robust mean where the run used it)."""
-        from bladelab.runner.predict import _robust
+        from bladelab.predict.reflex.optimize import robust_evaluation
 
         s = self.settings()
         if s.robust_samples > 1:
-            return _robust(nominal_ev, self.model, self.x, self.layout, s)
+            return robust_evaluation(nominal_ev, self.model, self.x, self.layout, s)
         return nominal_ev
 
     def label(self) -> str:
@@ -280,7 +280,7 @@ def _sweep_cells(folder: Path) -> tuple[list[tuple[str, float, Path]], list[str]
     """The sweep's finished cells (category, prescribed speed [m/s], folder), in results.csv's
     category order, and the names of the unfinished ones (still optimising or stopped: their
     best.json is an interim best, so they are left out)."""
-    from bladelab.runner.sweep import finished_cell
+    from bladelab.predict.reflex.sweep import finished_cell
 
     try:
         res = pd.read_csv(folder / "results.csv")
@@ -311,8 +311,8 @@ def _sweep_sections(
 ) -> tuple[dict, list, pd.DataFrame, list[tuple[str, float, Path]]]:
     """Add the sweep's sections; return the solutions shown, their re-simulation rows, the
     recomputed category summary and the finished cells (:func:`_sweep_cells`)."""
+    from bladelab.predict.reflex.sweep import summarise
     from bladelab.runner.analyses import spatiotemporal
-    from bladelab.runner.sweep import summarise
 
     cells, unfinished = _sweep_cells(folder)
     rows, sims = [], {}
@@ -415,7 +415,7 @@ def build_predictive_report(
 
     matplotlib.use("Agg")
     from bladelab.report.builder import Report
-    from bladelab.runner.predictive_report import add_predictive_sections
+    from bladelab.report.predictive_sections import add_predictive_sections
 
     path = Path(path)
     kind = predictive_kind(path)

@@ -13,7 +13,7 @@ import numpy as np
 import pandas as pd
 
 from bladelab.errors import DataError
-from bladelab.report.figures import _SIGNALS, Signal, resample_percent
+from bladelab.report.figures import SIGNALS, Signal, resample_percent
 from bladelab.trial.stance import Stance
 
 __all__ = [
@@ -53,7 +53,7 @@ def trial_nrmse(
     Returns a tidy table with columns ``group``, ``trial`` (index in the group, or the
     ``trial`` metadata), ``signal`` and ``nrmse_pct``.
     """
-    name = _SIGNALS[signal][0]
+    name = SIGNALS[signal][0]
     rows = []
     for group, stances in measured.items():
         sims = simulated.get(group, [])
@@ -86,7 +86,7 @@ def mean_curve_nrmse(
 
     Returns columns ``group``, ``signal``, ``nrmse_pct``.
     """
-    name = _SIGNALS[signal][0]
+    name = SIGNALS[signal][0]
     rows = []
     for group, stances in measured.items():
         sims = simulated.get(group, [])

@@ -22,12 +22,12 @@ import mujoco
 import numpy as np
 import pandas as pd
 
-from bladelab.runner.closed_loop import MIN_STEP_S, STEP_LOAD_BW
 from bladelab.runner.model import CP_BLADE, CP_LEG
-from bladelab.runner.params import GRAVITY
-from bladelab.runner.simulate import RC_FX, RC_FZ, RC_VX, RC_VZ, RunnerResult, _leg_names
+from bladelab.runner.simulate import RC_FX, RC_FZ, RC_VX, RC_VZ, RunnerResult, leg_names
 
 CONTACT_THRESHOLD_N = 20.0
+STEP_LOAD_BW = 0.1  # a leg is loaded at or above this vertical GRF [body weights] (SCONE)
+MIN_STEP_S = 0.1  # a new contact sooner than this after the last step is not a step [s] (SCONE)
 MIN_GAP_S = 0.05  # unloaded gaps shorter than this inside a stance are contact bounces [s]
 MIN_CONTACT_S = 0.03  # loaded stretches shorter than this are brief touches, not stances [s]
 
@@ -142,7 +142,7 @@ def _contacts(
 ) -> list[dict]:
     """Every cleaned contact of both legs (:func:`contact_mask`), each marked as a stance (a
     step of :func:`step_touchdowns` starts in it) or not (a swing contact)."""
-    names = _leg_names(result.model)
+    names = leg_names(result.model)
     bw = result.model.body_weight
     forces = np.stack([_leg_fz(result, leg) for leg in (0, 1)], axis=1)
     steps = step_touchdowns(result.time, forces, bw)
@@ -238,7 +238,7 @@ def spatiotemporal(
     both a touch-down and a lift-off inside the simulation count; NaN where there are none.
     """
     ev = gait_events(result, threshold_n=threshold_n)
-    names = _leg_names(result.model)
+    names = leg_names(result.model)
     rows = []
     for leg, other in ((names[0], names[1]), (names[1], names[0])):
         td = ev.time[(ev.leg == leg) & (ev.event == "touchdown")].to_numpy()
@@ -320,7 +320,7 @@ def power_balance(result: RunnerResult) -> pd.DataFrame:
     p_l = (result.ligament * result.qvel).sum(axis=1)
     c = result.contacts
     p_c = (c[:, :, RC_FX] * c[:, :, RC_VX] + c[:, :, RC_FZ] * c[:, :, RC_VZ]).sum(axis=1)
-    p_g = -result.model.total_mass * GRAVITY * fwd["comv"][:, 2]
+    p_g = -result.model.total_mass * result.model.gravity * fwd["comv"][:, 2]
     p_ext = p_m + p_l + p_c + p_g
     p_k = np.gradient(fwd["ek"], result.time) if len(result.time) > 2 else np.zeros_like(p_ext)
     return pd.DataFrame(
@@ -382,7 +382,7 @@ def leg_stiffness(
     """Leg stiffness per stance (seed 001 eq. 2.19–2.21): columns leg, touchdown [s],
     contact_time [s], F_peak [N], delta_y [m], L0 [m], theta_rad, delta_L [m], K_leg [N/m]."""
     fwd = _forward_pass(result)
-    names = _leg_names(result.model)
+    names = leg_names(result.model)
     rows = []
     for leg in (0, 1):
         l0 = _leg_length(result, leg)
@@ -429,7 +429,7 @@ def leg_energy(result: RunnerResult, *, threshold_n: float = CONTACT_THRESHOLD_N
     [J] (work returned while it rises), hysteresis [J] = |stored − generated|,
     recoil_pct = 100·min/max."""
     fwd = _forward_pass(result)
-    names = _leg_names(result.model)
+    names = leg_names(result.model)
     rows = []
     for leg in (0, 1):
         fz = _leg_fz(result, leg)
@@ -464,7 +464,7 @@ def summary(result: RunnerResult) -> dict:
     """The JSON summary: fell, duration_s, mean_speed_mps, contact times per leg,
     power_balance_residual_pct, and the spatiotemporal means."""
     fwd = _forward_pass(result)
-    names = _leg_names(result.model)
+    names = leg_names(result.model)
     st = spatiotemporal(result)
     dur = result.duration
     speed = float((fwd["com"][-1, 0] - fwd["com"][0, 0]) / dur) if dur > 0 else 0.0

@@ -13,6 +13,7 @@ sphere. Ligaments: joint-limit springs–dampers; the socket: ``−(K·q + K2·q
 from __future__ import annotations
 
 import ctypes
+import functools
 import math
 import os
 
@@ -23,7 +24,6 @@ from numba import njit, types
 from numba.extending import intrinsic
 
 from bladelab.contact import hunt_crossley_force, smooth_spring_damper_force
-from bladelab.runner.closed_loop import control_step
 from bladelab.runner.model import (
     CP_AZ,
     CP_BODY,
@@ -50,14 +50,15 @@ from bladelab.runner.muscle import muscle_step
 from bladelab.sim.mujoco_engine import add_point_force
 
 # numba's cache is keyed on the content of the file that defines a function, not on the files of
-# the functions it calls: after editing a compiled function in closed_loop.py, controller.py,
+# the functions it calls: after editing a compiled function in muscle.py,
 # metabolics.py, muscle.py, contact.py or sim/mujoco_engine.py, bump this number so the loop
 # below is compiled again. This is not always enough (a session saw a controller edit have no
 # effect until the caches were deleted): when in doubt, `make clean-cache`.
 _CACHE_GENERATION = 8
 
 
-def _mujoco_step_addresses() -> tuple[int, int]:
+@functools.cache
+def mujoco_step_addresses() -> tuple[int, int]:
     """Addresses of ``mj_step1`` and ``mj_step2`` in the libmujoco that the bindings loaded."""
     folder = os.path.dirname(mujoco.__file__)
     names = sorted(n for n in os.listdir(folder) if n.startswith("libmujoco.so"))
@@ -69,7 +70,7 @@ def _mujoco_step_addresses() -> tuple[int, int]:
 
 
 @intrinsic
-def _call_mj(typingctx, fptr, mptr, dptr):
+def call_mujoco(typingctx, fptr, mptr, dptr):
     """Call ``void f(const mjModel*, mjData*)`` given the three addresses as integers."""
     sig = types.void(types.int64, types.int64, types.int64)
 
@@ -249,37 +250,48 @@ def record_sample(rec, i, t, mj, arrays):
 
 
 @njit(cache=True)
-def run_loop(
-    f1, f2, mptr, dptr, n_steps, record_every, dt, iz, fall_height, mj, arrays, rec, control
-):
-    """The whole time loop in compiled code, MuJoCo's C ``mj_step1``/``mj_step2`` called directly.
-
-    ``control``: None for constant excitations, or the reflex controller's arrays
-    (:func:`bladelab.runner.closed_loop.control_step`, called before the forces of every step).
-    Stops after ``n_steps`` or once the pelvis height ``qpos[iz]`` is below ``fall_height`` [m]
-    (or NaN). Returns (last step, samples recorded, fell).
-    """
-    qpos = mj[0]
+def step_begin(f1, mptr, dptr, mj, root_com):
+    """First half of a step: MuJoCo's ``mj_step1`` (positions, velocities, forces of the
+    current state), then ``root_com`` [m] = the root subtree's COM (MuJoCo's ``cvel`` origin)."""
+    call_mujoco(f1, mptr, dptr)
     subtree_com = mj[5]
+    root_com[0] = subtree_com[1, 0]
+    root_com[1] = subtree_com[1, 1]
+    root_com[2] = subtree_com[1, 2]
+
+
+@njit(cache=True)
+def step_end(k, k_rec, record_every, dt, iz, fall_height, mj, arrays, rec, root_com):
+    """Second half of step ``k`` (after any controller): muscle, ligament and contact forces,
+    a sample every ``record_every`` steps. Returns (samples recorded, fell): the pelvis height
+    ``qpos[iz]`` below ``fall_height`` [m] or NaN is a fall."""
+    forces(mj, arrays, root_com, dt)
+    if k % record_every == 0:
+        record_sample(rec, k_rec, k * dt, mj, arrays)
+        k_rec += 1
+    return k_rec, not mj[0][iz] >= fall_height  # also catches NaN
+
+
+@njit(cache=True)
+def run_loop(f1, f2, mptr, dptr, n_steps, record_every, dt, iz, fall_height, mj, arrays, rec):
+    """The whole open-loop time loop (constant excitations ``u`` in ``arrays``) in compiled
+    code, MuJoCo's C ``mj_step1``/``mj_step2`` called directly (:func:`step_begin`,
+    :func:`step_end`; a controller runs between the two, as in
+    :func:`bladelab.predict.reflex.closed_loop.run_closed_loop`). Stops after ``n_steps`` or at
+    a fall. Returns (last step, samples recorded, fell).
+    """
     root_com = np.zeros(3)
     k_rec = 0
     k = 0
     for k in range(n_steps + 1):
-        _call_mj(f1, mptr, dptr)
-        root_com[0] = subtree_com[1, 0]
-        root_com[1] = subtree_com[1, 1]
-        root_com[2] = subtree_com[1, 2]
-        if control is not None:
-            control_step(k, dt, mj, arrays, control)
-        forces(mj, arrays, root_com, dt)
-        if k % record_every == 0:
-            record_sample(rec, k_rec, k * dt, mj, arrays)
-            k_rec += 1
-        if not qpos[iz] >= fall_height:  # also catches NaN
+        step_begin(f1, mptr, dptr, mj, root_com)
+        k_rec, fell = step_end(k, k_rec, record_every, dt, iz, fall_height, mj, arrays, rec,
+                               root_com)
+        if fell:
             return k, k_rec, True
         if k == n_steps:
             break
-        _call_mj(f2, mptr, dptr)
+        call_mujoco(f2, mptr, dptr)
     return k, k_rec, False
 
 

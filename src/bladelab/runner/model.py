@@ -39,7 +39,6 @@ from bladelab.runner.params import (
     FOOT_DISSIPATION_S_PER_M,
     FOOT_FRICTION,
     FOOT_PLANE_STRAIN_MODULUS,
-    GRAVITY,
     RunnerParams,
     blade_contact_modulus,
     default_runner_params,
@@ -142,9 +141,14 @@ class RunnerModel:
         return float(np.sum(self.mj_model.body_mass))
 
     @property
+    def gravity(self) -> float:
+        """Gravity of the model [m/s²] (its parameter set's)."""
+        return self.params.gravity_m_per_s2
+
+    @property
     def body_weight(self) -> float:
         """Body weight [N]."""
-        return self.total_mass * GRAVITY
+        return self.total_mass * self.gravity
 
     def segment_mass(self, name: str) -> float:
         """Mass [kg] of one segment."""
@@ -230,7 +234,7 @@ def build_runner(
     spec.option.timestep = DEFAULT_DT
     spec.option.integrator = mujoco.mjtIntegrator.mjINT_EULER
     spec.option.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_CONTACT)
-    spec.option.gravity = [0.0, 0.0, -GRAVITY]
+    spec.option.gravity = [0.0, 0.0, -params.gravity_m_per_s2]
     spec.worldbody.add_geom(
         name="ground", type=mujoco.mjtGeom.mjGEOM_PLANE, size=[50, 1, 0.1], contype=0, conaffinity=0
     )

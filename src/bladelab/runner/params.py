@@ -24,8 +24,8 @@ from bladelab.contact import hertz_sphere_stiffness
 from bladelab.errors import InputFileError, SpecError
 from bladelab.runner.geometry import LEG_MUSCLES, SHANK_MUSCLES, TORSO_MUSCLES
 
-GRAVITY = 9.81
-_DATA = Path(__file__).resolve().parents[1] / "data" / "runner"
+#: Folder of the runner models' data files (parameter sets, categories, shipped solutions).
+RUNNER_DATA_DIR = Path(__file__).resolve().parents[1] / "data" / "runner"
 BLADE_RADIUS_M = 0.1464
 BLADE_OFFSET_A_M = 0.069
 BLADE_OFFSET_B_M = 0.0693
@@ -89,6 +89,10 @@ class RunnerParams(_Strict):
     total_muscle_volume_cm3: float = Field(gt=0)
     segments: dict[str, Segment]
     muscle_types: dict[str, MuscleType]
+    #: Gravity of this model [m/s²]: 9.81, the value the seed-001 runner and its shipped reflex
+    #: solutions were built with (not bladelab.constants.STANDARD_GRAVITY; a change would make
+    #: those fragile solutions fall).
+    gravity_m_per_s2: float = Field(default=9.81, gt=0)
 
 
 @dataclass(frozen=True)
@@ -129,7 +133,7 @@ def muscle_names(kind: str) -> tuple[str, ...]:
 @lru_cache(maxsize=1)
 def blade_catalogue() -> dict[str, BladeCategory]:
     """The built-in blade categories, by name (Cat4, Cat5, Cat6, Cat6High, Cat7)."""
-    text = (_DATA / "categories.yaml").read_text()
+    text = (RUNNER_DATA_DIR / "categories.yaml").read_text()
     out = {}
     for name, row in yaml.safe_load(text).items():
         out[name] = BladeCategory(
@@ -258,7 +262,7 @@ def default_runner_params(kind: str = "amputee", *, blade: str | None = None) ->
     """The built-in parameter set ``able`` or ``amputee`` (seed 001), optionally another blade."""
     if kind not in ("able", "amputee"):
         raise SpecError(f"unknown model {kind!r}", where="model", hint="use 'able' or 'amputee'")
-    text = (_DATA / f"{kind}.yaml").read_text()
+    text = (RUNNER_DATA_DIR / f"{kind}.yaml").read_text()
     data = yaml.safe_load(text)
     if blade is not None:
         data["blade"] = blade
@@ -268,7 +272,7 @@ def default_runner_params(kind: str = "amputee", *, blade: str | None = None) ->
 def blade_contact_modulus(params: RunnerParams) -> float:
     """E [N/m²] of the blade sphere for this athlete: the category's stiffness at body weight."""
     cat = blade_category(params.blade)
-    return blade_modulus(cat.stiffness_n_per_m, params.athlete.body_mass_kg * GRAVITY)
+    return blade_modulus(cat.stiffness_n_per_m, params.athlete.body_mass_kg * params.gravity_m_per_s2)
 
 
 def hertz_compression(force_n: float, modulus: float, radius: float) -> float:
@@ -279,6 +283,7 @@ def hertz_compression(force_n: float, modulus: float, radius: float) -> float:
 
 
 __all__ = [
+    "RUNNER_DATA_DIR",
     "Athlete",
     "BladeCategory",
     "RunnerParams",
@@ -292,5 +297,4 @@ __all__ = [
     "muscle_max_force",
     "muscle_names",
     "runner_params_from_dict",
-    "GRAVITY",
 ]

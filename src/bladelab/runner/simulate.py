@@ -28,8 +28,8 @@ import pandas as pd
 
 from bladelab.errors import SimulationError
 from bladelab.runner.kernel import (
-    _mujoco_step_addresses,
     forces,
+    mujoco_step_addresses,
     mujoco_views,
     path_kinematics,
     record_sample,
@@ -101,7 +101,7 @@ class RunnerResult:
         """Tidy GRF per leg: columns time [s], leg (intact/prosthetic or left/right), Fx, Fz [N],
         Fx_bw, Fz_bw [body weights]."""
         bw = self.model.body_weight
-        names = _leg_names(self.model)
+        names = leg_names(self.model)
         frames = []
         for leg in (0, 1):
             cols = self.model.contact_params[:, 7 - 1] == leg  # CP_LEG
@@ -156,7 +156,8 @@ class RunnerResult:
         }
 
 
-def _leg_names(model: RunnerModel) -> tuple[str, str]:
+def leg_names(model: RunnerModel) -> tuple[str, str]:
+    """Names of the left and right legs in tables: (intact, prosthetic) or (left, right)."""
     return ("intact", "prosthetic") if model.kind == "amputee" else ("left", "right")
 
 
@@ -293,7 +294,7 @@ def simulate_runner(
     mj = mujoco_views(d)
     arrays = (mp, ms, mtu, seg_u, u, path, pstart, cp, cstate, jp, crec, lig)
     if controller is None:
-        f1, f2 = _STEP_ADDRESSES
+        f1, f2 = mujoco_step_addresses()
         _, k_rec, fell = run_loop(
             f1,
             f2,
@@ -307,7 +308,6 @@ def simulate_runner(
             mj,
             arrays,
             rec.arrays,
-            None,
         )
     else:
         k_rec, fell = _python_loop(
@@ -325,9 +325,6 @@ def simulate_runner(
             rec.arrays,
         )
     return rec.result(k_rec, dt, fell, duration)
-
-
-_STEP_ADDRESSES = _mujoco_step_addresses()
 
 
 def _python_loop(

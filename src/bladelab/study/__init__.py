@@ -1,9 +1,9 @@
-"""Whole studies: ``study.yaml``, the ``results.sqlite`` store, executors and the batch runner.
+"""Whole studies: ``study.yaml``, the ``results.sqlite`` store and the batch runner (its tasks run
+on :mod:`bladelab.executors`).
 
 See ``docs/study-yaml.md``.
 """
 
-from bladelab.study.executors import LocalExecutor, RayExecutor, SerialExecutor, make_executor
 from bladelab.study.runner import StudyRun, run_study, trial_seed, variant_name
 from bladelab.study.spec import (
     Athlete,
@@ -20,15 +20,11 @@ __all__ = [
     "Athlete",
     "BladeEntry",
     "Configuration",
-    "LocalExecutor",
-    "RayExecutor",
     "ResultsStore",
-    "SerialExecutor",
     "Study",
     "StudyRun",
     "Trial",
     "load_study",
-    "make_executor",
     "open_results",
     "parse_study",
     "run_study",

@@ -22,7 +22,7 @@ from typing import Any
 import numpy as np
 
 from bladelab import __version__
-from bladelab.study.executors import make_executor, run_task_safely
+from bladelab.executors import make_executor, run_task_safely
 from bladelab.study.spec import RESULTS_FILE, Study, load_study
 from bladelab.study.store import ResultsStore
 

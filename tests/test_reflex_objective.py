@@ -7,9 +7,9 @@ import math
 import numpy as np
 import pytest
 
+from bladelab.predict.reflex.controller import controller_layout
+from bladelab.predict.reflex.objective import ObjectiveSettings, _evaluate, simulate_controlled
 from bladelab.runner import build_runner
-from bladelab.runner.controller import controller_layout
-from bladelab.runner.objective import ObjectiveSettings, _evaluate, simulate_controlled
 
 
 @pytest.fixture(scope="module")
@@ -122,8 +122,8 @@ def test_wrong_parameter_count_is_an_error(able):
 def test_online_steps_match_the_offline_count_and_scone_rules():
     # the objective's online step count (runner.closed_loop) and runner.analyses.step_touchdowns
     # (offline) agree on a force record with a bounce, a scuff and alternating stances
+    from bladelab.predict.reflex.closed_loop import STEP_STATE_SIZE, _count_touchdowns
     from bladelab.runner.analyses import step_touchdowns
-    from bladelab.runner.closed_loop import STEP_STATE_SIZE, _count_touchdowns
 
     dt, bw = 2.5e-4, 700.0
     t = np.arange(0.0, 2.0, dt)

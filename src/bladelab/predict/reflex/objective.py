@@ -25,7 +25,7 @@ keeps running and its steps' speed penalty, not a fall, tells the optimiser to g
 
 The simulation stops early once the model has fallen (pelvis below 60 % of standing height).
 
-Robust evaluation (``robust_samples`` = n > 1, :func:`bladelab.runner.predict.evaluate_candidates`):
+Robust evaluation (``robust_samples`` = n > 1, :func:`bladelab.predict.reflex.optimize.evaluate_candidates`):
 a candidate's cost is the mean over the nominal simulation and n − 1 copies with the
 parameters jittered by ``robust_jitter`` (relative, fixed seeded directions), and it counts as
 fallen if any copy falls. A reflex gait is chaotic: without this, CMA-ES finds controllers that
@@ -41,13 +41,13 @@ import mujoco
 import numpy as np
 
 from bladelab.errors import SimulationError
-from bladelab.runner.closed_loop import STEP_STATE_SIZE
-from bladelab.runner.controller import (
+from bladelab.predict.reflex.closed_loop import STEP_STATE_SIZE, run_closed_loop
+from bladelab.predict.reflex.controller import (
     ControllerLayout,
     controller_layout,
     history_length,
 )
-from bladelab.runner.kernel import _mujoco_step_addresses, mujoco_views, path_kinematics, run_loop
+from bladelab.runner.kernel import mujoco_step_addresses, mujoco_views, path_kinematics
 from bladelab.runner.metabolics import metabolic_params
 from bladelab.runner.model import DEFAULT_DT, RunnerModel
 from bladelab.runner.muscle import equilibrium_fiber_length
@@ -80,6 +80,15 @@ class ObjectiveSettings:
     strike_limit_bw: float = 1.0
     initial_speed: float | None = None
 
+    @classmethod
+    def from_dict(cls, d: dict) -> ObjectiveSettings:
+        """Settings from :meth:`to_dict`'s output (JSON lists back to tuples)."""
+        d = dict(d)
+        for key in ("knee_load_range", "pelvis_tilt_range_deg"):
+            if key in d:
+                d[key] = tuple(d[key])
+        return cls(**d)
+
     def to_dict(self) -> dict:
         return asdict(self)
 
@@ -102,16 +111,6 @@ class Evaluation:
 
     def to_dict(self) -> dict:
         return {k: (float(v) if isinstance(v, float) else v) for k, v in asdict(self).items()}
-
-
-_ADDRESSES: tuple[int, int] | None = None
-
-
-def _step_addresses() -> tuple[int, int]:
-    global _ADDRESSES
-    if _ADDRESSES is None:
-        _ADDRESSES = _mujoco_step_addresses()
-    return _ADDRESSES
 
 
 def initial_state(
@@ -149,7 +148,7 @@ def simulate_controlled(
     model
         The runner.
     x
-        Controller parameter vector (:func:`~bladelab.runner.controller.controller_layout`).
+        Controller parameter vector (:func:`~bladelab.predict.reflex.controller.controller_layout`).
     settings
         Speed [m/s], duration [s], time step [s] and objective weights.
     record_every
@@ -217,7 +216,7 @@ def simulate_controlled(
     n_steps = int(round(settings.duration / dt))
     every = record_every if record_every > 0 else n_steps + 1
     rec = Recording(model, n_steps, every)
-    f1, f2 = _step_addresses()
+    f1, f2 = mujoco_step_addresses()
     arrays = (mp, ms, mtu, seg_u, u, path, pstart, cp, cstate, jp, crec, lig)
     control = (
         table,
@@ -238,7 +237,7 @@ def simulate_controlled(
         ranges,
         pen,
     )
-    k, k_rec, fell = run_loop(
+    k, k_rec, fell = run_closed_loop(
         f1,
         f2,
         m._address,

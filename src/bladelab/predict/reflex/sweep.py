@@ -1,6 +1,6 @@
 """Blade-category sweeps (seed 001 §2.2.2 B–C, Fig. 3.7, Table 3.1).
 
-Each category is one independent task (run on an executor of :mod:`bladelab.study.executors`:
+Each category is one independent task (run on an executor of :mod:`bladelab.executors`:
 in-process, local process pool or Ray): the amputee with that blade is optimised at the first
 prescribed speed, warm-started from ``init`` (or the controller's initial guess), then at each
 higher speed warm-started from the previous speed's best, until the model falls (it "can no
@@ -38,7 +38,7 @@ from tqdm import tqdm
 
 from bladelab._io import atomic_open, write_json
 from bladelab.errors import InputFileError, OptimizationError, SpecError
-from bladelab.runner.objective import ObjectiveSettings
+from bladelab.predict.reflex.objective import ObjectiveSettings
 from bladelab.runner.params import blade_category
 
 CELL_NAME = "cell.json"
@@ -88,7 +88,7 @@ def _digest(x: np.ndarray) -> str:
 
 def _read_cell(folder: Path, category: str, speed: float, wanted: dict) -> dict | None:
     """The cell's ``cell.json`` (None if it has none); an error if its settings differ."""
-    from bladelab.runner.predict import CHECKPOINT_NAME
+    from bladelab.predict.reflex.optimize import CHECKPOINT_NAME
 
     path = folder / CELL_NAME
     where = f"{category} at {speed:g} m/s"
@@ -128,11 +128,11 @@ def _read_cell(folder: Path, category: str, speed: float, wanted: dict) -> dict 
 
 def _contact_times(category: str, x: np.ndarray, settings: ObjectiveSettings) -> dict:
     """Mean contact time [s] per leg of the solution ``x``, re-simulated with ``settings``."""
+    from bladelab.predict.reflex.objective import simulate_controlled
+    from bladelab.predict.reflex.optimize import runner_and_layout
     from bladelab.runner.analyses import spatiotemporal
-    from bladelab.runner.objective import simulate_controlled
-    from bladelab.runner.predict import _model
 
-    model, layout = _model("amputee", category)
+    model, layout = runner_and_layout("amputee", category)
     _, res = simulate_controlled(model, x, layout=layout, settings=settings, record_every=2)
     st = spatiotemporal(res)
     out = {}
@@ -197,17 +197,16 @@ def category_task(payload: dict) -> dict:
     newly finished cell, ``results.csv`` and ``summary.csv`` are rewritten from every finished
     cell of the sweep on disk.
     """
-    from bladelab.runner.controller import read_parameters
-    from bladelab.runner.predict import (
+    from bladelab.predict.reflex.controller import read_parameters
+    from bladelab.predict.reflex.optimize import (
         CHECKPOINT_NAME,
-        _model,
-        _settings_from_dict,
         optimize_controller,
+        runner_and_layout,
     )
 
     cat = payload["category"]
     out = Path(payload["out"])
-    _, layout = _model("amputee", cat)
+    _, layout = runner_and_layout("amputee", cat)
     if payload.get("init"):
         x = read_parameters(payload["init"], layout, transfer=True)
     else:
@@ -242,7 +241,7 @@ def category_task(payload: dict) -> dict:
                         "x0_sha256": digest,
                     },
                 )
-            settings = _settings_from_dict({**payload["settings"], "speed": float(speed)})
+            settings = ObjectiveSettings.from_dict({**payload["settings"], "speed": float(speed)})
             res = optimize_controller(
                 "amputee",
                 blade=cat,
@@ -478,7 +477,7 @@ def run_sweep(
     progress
         Show a progress bar of finished cells (read back ones included).
     """
-    from bladelab.study.executors import make_executor
+    from bladelab.executors import make_executor
 
     for c in categories:
         blade_category(c)

@@ -24,7 +24,7 @@ from bladelab.runner.analyses import (
     leg_energy,
     spatiotemporal,
 )
-from bladelab.runner.simulate import RunnerResult, _leg_names
+from bladelab.runner.simulate import RunnerResult, leg_names
 
 
 def _leg_of(joint: str, names: tuple[str, str]) -> str | None:
@@ -42,7 +42,7 @@ def power_table(result: RunnerResult) -> pd.DataFrame:
     complete strides (first to last touch-down of that leg) and divided by that time and the
     body mass. Tidy: leg, joint, P_pos, P_neg [W/kg]; rows ``total`` per leg sum the joints.
     """
-    names = _leg_names(result.model)
+    names = leg_names(result.model)
     pw = joint_powers(result)
     ev = gait_events(result)
     mass = result.model.total_mass
@@ -151,7 +151,7 @@ _RANGE_VERDICT = ("max_speed", "cot_4", "contact_time_intact", "contact_time_pro
 def seed001_results() -> pd.DataFrame:
     """Seed 001's per-category results (packaged ``data/runner/seed001_results.csv``).
 
-    Tidy: category, quantity (a :func:`bladelab.runner.sweep.summarise` column name, or
+    Tidy: category, quantity (a :func:`bladelab.predict.reflex.sweep.summarise` column name, or
     stride/flight times), value, unit, source (the seed's table, figure or text section), note.
     """
     ref = resources.files("bladelab") / "data" / "runner" / "seed001_results.csv"
@@ -259,12 +259,12 @@ def add_predictive_sections(
 ) -> None:
     """Append the predictive sections for the labelled simulations ``results`` (e.g.
     ``{"able 3.5 m/s": r1, "amputee Cat6 3.5 m/s": r2}``) to ``report``; with a sweep summary
-    (:func:`bladelab.runner.sweep.summarise`) also the category section, and with
+    (:func:`bladelab.predict.reflex.sweep.summarise`) also the category section, and with
     ``compare_seed`` seed 001's values beside ours."""
     import matplotlib.pyplot as plt
 
     for label, res in results.items():
-        names = _leg_names(res.model)
+        names = leg_names(res.model)
         ang = joint_angles(res)
         fig, axes = plt.subplots(1, 2, figsize=(10, 3.5), sharey=True)
         for ax, leg in zip(axes, names, strict=True):

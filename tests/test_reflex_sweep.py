@@ -14,14 +14,14 @@ import numpy as np
 import pandas as pd
 import pytest
 
-import bladelab.runner.predict as predict
+import bladelab.predict.reflex.optimize as predict
 from bladelab.cli import main
 from bladelab.errors import SpecError
+from bladelab.predict.reflex.controller import read_parameters
+from bladelab.predict.reflex.objective import ObjectiveSettings, simulate_controlled
+from bladelab.predict.reflex.optimize import load_checkpoint, optimize_controller, runner_and_layout
+from bladelab.predict.reflex.sweep import run_sweep, summarise
 from bladelab.runner.analyses import spatiotemporal
-from bladelab.runner.controller import read_parameters
-from bladelab.runner.objective import ObjectiveSettings, simulate_controlled
-from bladelab.runner.predict import _model, load_checkpoint, optimize_controller
-from bladelab.runner.sweep import run_sweep, summarise
 
 TINY = {"generations": 3, "popsize": 4, "duration": 0.3, "checkpoint_every": 1}
 
@@ -94,7 +94,7 @@ def test_resume_equals_not_stopping_and_finished_cells_are_read_back(tmp_path, m
     # the summary's contact times are those of the maximum-speed solution, re-simulated
     top = full_res.loc[full_res.mean_speed.idxmax()]
     cell = tmp_path / "full" / "Cat6" / f"{top.speed:g}"
-    model, layout = _model("amputee", "Cat6")
+    model, layout = runner_and_layout("amputee", "Cat6")
     x = read_parameters(cell / "best.json", layout)
     # every cell starts from the first speed's state (seed 001 §2.2.2)
     settings = ObjectiveSettings(speed=top.speed, duration=0.3, initial_speed=3.5)
@@ -124,7 +124,7 @@ def test_changed_settings_are_refused_naming_cell_and_setting(tmp_path, capsys):
              for f in ("s", "small")]
     assert 0.5 < steps[0] < 2.0 and 0.025 < steps[1] < 0.1
     # another initial guess
-    _, layout = _model("amputee", "Cat6")
+    _, layout = runner_and_layout("amputee", "Cat6")
     init = tmp_path / "init.json"
     init.write_text(json.dumps({"model": "amputee", "parameters": {layout.names[0]: 0.3}}))
     code = main(
@@ -193,7 +193,7 @@ def test_summary_by_hand():
 
 
 def test_progress_counts_the_cells_a_fall_makes_unneeded():
-    from bladelab.runner.sweep import _cells_settled
+    from bladelab.predict.reflex.sweep import _cells_settled
 
     speeds = [3.5, 4.0, 4.5, 5.0]
     done = [
@@ -210,7 +210,7 @@ def test_chain_warm_starts_neighbours(tmp_path):
     _sweep(tmp_path, categories=("Cat4", "Cat5", "Cat6"), speeds=(3.5,), generations=1,
            chain_from="Cat6")
     for child, parent in (("Cat5", "Cat6"), ("Cat4", "Cat5")):
-        _, layout = _model("amputee", child)
+        _, layout = runner_and_layout("amputee", child)
         x_parent = read_parameters(tmp_path / parent / "3.5" / "best.json", layout)
         es = load_checkpoint(tmp_path / child / "3.5" / "checkpoint.pkl")["es"]
         np.testing.assert_allclose(es.x0, x_parent)

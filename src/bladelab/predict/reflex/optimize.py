@@ -2,7 +2,7 @@
 
 :func:`optimize_controller` runs ``cma``'s ask/tell loop; the candidates of a generation are
 evaluated in parallel (a persistent local process pool, or Ray), each one a closed-loop
-simulation (:func:`bladelab.runner.objective.simulate_controlled`) stopped early once the model
+simulation (:func:`bladelab.predict.reflex.objective.simulate_controlled`) stopped early once the model
 has fallen. Sampling uses a seeded ``numpy.random.Generator`` (never NumPy's global one) and
 ``cma`` writes no log files.
 
@@ -29,7 +29,6 @@ import csv
 import math
 import os
 import pickle
-import sys
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field, fields, replace
@@ -37,23 +36,25 @@ from pathlib import Path
 
 import numpy as np
 
-from bladelab._io import atomic_open, atomic_path
+from bladelab._io import atomic_open, atomic_path, write_json
 from bladelab.errors import InputFileError, OptimizationError
-from bladelab.runner.controller import ControllerLayout, controller_layout, write_parameters
-from bladelab.runner.objective import Evaluation, ObjectiveSettings, simulate_controlled
+from bladelab.executors import ProcessPool, RayExecutor
+from bladelab.predict.reflex.controller import ControllerLayout, controller_layout, write_parameters
+from bladelab.predict.reflex.objective import Evaluation, ObjectiveSettings, simulate_controlled
+from bladelab.runner.model import RunnerModel, build_runner
 
 CHECKPOINT_FORMAT = 1
 CHECKPOINT_NAME = "checkpoint.pkl"
 
 # per-process cache of built models: (kind, blade) -> (model, layout)
-_MODELS: dict[tuple[str, str | None], tuple[object, ControllerLayout]] = {}
+_MODELS: dict[tuple[str, str | None], tuple[RunnerModel, ControllerLayout]] = {}
 
 
-def _model(kind: str, blade: str | None):
+def runner_and_layout(kind: str, blade: str | None) -> tuple[RunnerModel, ControllerLayout]:
+    """The runner ``kind`` (``"able"``/``"amputee"``; ``blade`` category of the amputee) and its
+    controller layout, built once per process (workers evaluate many candidates of one model)."""
     key = (kind, blade if kind == "amputee" else None)
     if key not in _MODELS:
-        from bladelab.runner.model import build_runner
-
         model = build_runner(kind, blade=key[1])
         _MODELS[key] = (model, controller_layout(model))
     return _MODELS[key]
@@ -65,14 +66,14 @@ def evaluate_candidates(payload: dict) -> list[dict]:
     ``payload``: ``model``, ``blade``, ``settings`` (ObjectiveSettings as a dict), ``xs`` (list
     of vectors). Returns one :meth:`Evaluation.to_dict` per vector.
     """
-    model, layout = _model(payload["model"], payload.get("blade"))
-    settings = _settings_from_dict(payload["settings"])
+    model, layout = runner_and_layout(payload["model"], payload.get("blade"))
+    settings = ObjectiveSettings.from_dict(payload["settings"])
     out = []
     for x in payload["xs"]:
         x = np.asarray(x, float)
         ev, _ = simulate_controlled(model, x, layout=layout, settings=settings)
         if settings.robust_samples > 1:
-            ev = _robust(ev, model, x, layout, settings)
+            ev = robust_evaluation(ev, model, x, layout, settings)
         out.append(ev.to_dict())
     return out
 
@@ -85,8 +86,12 @@ def jittered_parameters(x: np.ndarray, n: int, jitter: float) -> list[np.ndarray
     return [x + scale * rng.standard_normal(x.shape) for _ in range(n)]
 
 
-def _robust(nominal: Evaluation, model, x, layout, settings: ObjectiveSettings) -> Evaluation:
-    """The nominal evaluation with the cost averaged over jittered copies (any fall counts)."""
+def robust_evaluation(
+    nominal: Evaluation, model: RunnerModel, x: np.ndarray, layout: ControllerLayout,
+    settings: ObjectiveSettings,
+) -> Evaluation:
+    """The nominal evaluation of ``x`` with the cost averaged over ``settings.robust_samples``
+    − 1 jittered copies (:func:`jittered_parameters`; any fall counts)."""
     costs, fell = [nominal.cost], nominal.fell
     for xj in jittered_parameters(x, settings.robust_samples - 1, settings.robust_jitter):
         ev, _ = simulate_controlled(model, xj, layout=layout, settings=settings)
@@ -95,15 +100,7 @@ def _robust(nominal: Evaluation, model, x, layout, settings: ObjectiveSettings) 
     return replace(nominal, cost=float(np.mean(costs)), fell=fell)
 
 
-def _settings_from_dict(d: dict) -> ObjectiveSettings:
-    d = dict(d)
-    for key in ("knee_load_range", "pelvis_tilt_range_deg"):
-        if key in d:
-            d[key] = tuple(d[key])
-    return ObjectiveSettings(**d)
-
-
-def _stored_settings(
+def stored_settings(
     data: dict, *, speed: float, duration: float | None = None, nominal: bool = False
 ) -> ObjectiveSettings:
     """The objective settings a parameter file was optimised with (its ``settings``; keys this
@@ -116,7 +113,7 @@ def _stored_settings(
         d["duration"] = float(duration)
     if nominal:
         d["robust_samples"] = 1
-    return _settings_from_dict(d)
+    return ObjectiveSettings.from_dict(d)
 
 
 class _Randn:
@@ -130,7 +127,8 @@ class _Randn:
 
 
 class _Evaluator:
-    """Evaluates a list of vectors: in-process, a persistent process pool, or Ray."""
+    """Evaluates a list of vectors: in-process, on a persistent local process pool, or Ray
+    (:mod:`bladelab.executors`)."""
 
     def __init__(self, executor: str, jobs: int, base: dict) -> None:
         self.executor, self.jobs, self.base = executor, max(1, int(jobs)), base
@@ -141,17 +139,9 @@ class _Evaluator:
                 f"unknown executor {executor!r}", where="executor", hint="use 'local' or 'ray'"
             )
         if executor == "ray":
-            from bladelab.study.executors import RayExecutor
-
             self._ray = RayExecutor(self.jobs)
         elif self.jobs > 1:
-            import multiprocessing
-            from concurrent.futures import ProcessPoolExecutor
-
-            method = "forkserver" if sys.platform.startswith("linux") else "spawn"
-            self._pool = ProcessPoolExecutor(
-                max_workers=self.jobs, mp_context=multiprocessing.get_context(method)
-            )
+            self._pool = ProcessPool(self.jobs)
 
     def __call__(self, xs: Sequence[np.ndarray]) -> list[dict]:
         xs = [np.asarray(x, float).tolist() for x in xs]
@@ -161,7 +151,7 @@ class _Evaluator:
         chunks = [xs[i::n] for i in range(n)]
         payloads = [{**self.base, "xs": c} for c in chunks if c]
         if self._pool is not None:
-            results = list(self._pool.map(evaluate_candidates, payloads))
+            results = self._pool.map(evaluate_candidates, payloads)
         else:
             results = [None] * len(payloads)
             for i, status, value in self._ray.run(evaluate_candidates, payloads):
@@ -177,12 +167,7 @@ class _Evaluator:
     def close(self, *, abort: bool = False) -> None:
         """Shut the pool down; ``abort`` stops busy workers at once (an interrupted run)."""
         if self._pool is not None:
-            if abort:
-                from bladelab.study.executors import terminate_pool
-
-                terminate_pool(self._pool)
-            else:
-                self._pool.shutdown()
+            self._pool.close(abort=abort)
             self._pool = None
 
 
@@ -274,9 +259,9 @@ def optimize_controller(
     import cma
 
     base_settings = settings or ObjectiveSettings()
-    settings = _settings_from_dict({**base_settings.to_dict(), "speed": float(speed)})
+    settings = ObjectiveSettings.from_dict({**base_settings.to_dict(), "speed": float(speed)})
     blade = blade if model == "amputee" else None
-    runner, layout = _model(model, blade)
+    runner, layout = runner_and_layout(model, blade)
     del runner
     out_dir = Path(out) if out is not None else None
     if generations < 1 or popsize < 2:
@@ -311,7 +296,7 @@ def optimize_controller(
         elapsed0 = float(state.get("elapsed_s", math.nan))
         elapsed = list(state.get("elapsed", [math.nan] * len(history)))
         seed = state["seed"]
-        settings = _settings_from_dict(state["settings"])  # the run's own objective settings
+        settings = ObjectiveSettings.from_dict(state["settings"])  # the run's own objective settings
     else:
         start = layout.x0 if x0 is None else np.asarray(x0, float)
         if start.shape != (layout.size,):
@@ -404,6 +389,31 @@ def optimize_controller(
         out=str(out_dir) if out_dir is not None else None,
         wall_time_s=elapsed[-1] if elapsed else elapsed0,
     )
+
+
+def optimize_seeds(
+    model: str = "able",
+    *,
+    seeds: Sequence[int] = (1,),
+    out: str | Path,
+    progress: Callable[[int, int, float, float], None] | None = None,
+    **options,
+) -> list[OptimizationResult]:
+    """:func:`optimize_controller` once per seed: into ``out`` (one seed) or ``out/seed-N``
+    (several), then ``out/summary.json`` with every run and the best (lowest cost).
+
+    ``progress`` is called with (seed, generation, best cost, generation median); ``options``
+    are :func:`optimize_controller`'s keywords.
+    """
+    out = Path(out)
+    results = []
+    for seed in seeds:
+        folder = out if len(seeds) == 1 else out / f"seed-{seed}"
+        show = None if progress is None else (lambda g, b, m, _s=seed: progress(_s, g, b, m))
+        results.append(optimize_controller(model, seed=seed, out=folder, progress=show, **options))
+    runs = [r.to_dict() for r in results]
+    write_json(out / "summary.json", {"runs": runs, "best": min(runs, key=lambda r: r["best_cost"])})
+    return results
 
 
 def _save(
@@ -523,15 +533,15 @@ def verify_solution(
     """
     import json
 
-    from bladelab.runner.controller import read_parameters
+    from bladelab.predict.reflex.controller import read_parameters
 
     data = json.loads(Path(path).read_text())
     model = model or data.get("model", "able")
     blade = blade or data.get("blade")
     speed = float(speed if speed is not None else data.get("speed_m_per_s", 3.5))
-    runner, layout = _model(model, blade)
+    runner, layout = runner_and_layout(model, blade)
     x = read_parameters(path, layout)
-    settings = _stored_settings(data, speed=speed, duration=duration, nominal=True)
+    settings = stored_settings(data, speed=speed, duration=duration, nominal=True)
     limits = (duration, speed, speed_tolerance, max_power_residual_pct)
     out = _check_gait(runner, layout, x, settings, limits)
     if jittered_copies > 0:
@@ -606,8 +616,13 @@ def _strides(time: np.ndarray, steps: list[tuple[float, int, float]]) -> list[tu
 
 __all__ = [
     "OptimizationResult",
+    "jittered_parameters",
+    "robust_evaluation",
+    "runner_and_layout",
+    "stored_settings",
     "verify_solution",
     "evaluate_candidates",
     "load_checkpoint",
     "optimize_controller",
+    "optimize_seeds",
 ]

@@ -6,8 +6,7 @@ import numpy as np
 import pytest
 
 from bladelab.cli import main
-from bladelab.errors import DataError, SpecError
-from bladelab.runner.gait_cycle import (
+from bladelab.design.gait_cycle import (
     ANGLE_NAMES,
     GaitCycle,
     average_gait_cycle,
@@ -15,6 +14,7 @@ from bladelab.runner.gait_cycle import (
     gait_cycles_from_trial,
     read_gait_csv,
 )
+from bladelab.errors import DataError, SpecError
 from bladelab.trial import detect_stances, read_c3d
 from conftest import FUKUCHI_RUN as RUN
 from conftest import FUKUCHI_STATIC as STATIC

@@ -1,8 +1,9 @@
 """The reflex controller's step inside the compiled time loop, with the objective's running sums.
 
-:func:`control_step` is called by :func:`bladelab.runner.kernel.run_loop` before the forces of
-every step when the loop is closed (``runner.objective.simulate_controlled``): delayed sensors,
-gait states per leg, excitations (:mod:`bladelab.runner.controller`), and the sums the objective
+:func:`run_closed_loop` is the runner's time loop (:mod:`bladelab.runner.kernel`) with
+:func:`control_step` called before the forces of every step
+(:func:`bladelab.predict.reflex.objective.simulate_controlled`): delayed sensors,
+gait states per leg, excitations (:mod:`bladelab.predict.reflex.controller`), and the sums the objective
 needs (metabolic energy, knee-load and pelvis-tilt penalties, touch-downs).
 """
 
@@ -10,14 +11,15 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 from numba import njit
 
-from bladelab.runner.controller import compute_excitations, push_sensors, update_gait_states
+from bladelab.predict.reflex.controller import compute_excitations, push_sensors, update_gait_states
+from bladelab.runner.analyses import MIN_STEP_S, STEP_LOAD_BW
+from bladelab.runner.kernel import call_mujoco, step_begin, step_end
 from bladelab.runner.metabolics import total_metabolic_rate
 from bladelab.runner.model import CP_LEG
 
-STEP_LOAD_BW = 0.1  # a leg is loaded at or above this vertical GRF [body weights] (SCONE)
-MIN_STEP_S = 0.1  # a new contact sooner than this after the last step is not a step [s] (SCONE)
 STEP_STATE_SIZE = 5  # left loaded, right loaded, time [s] and leg of the last step, striking leg + 1
 
 
@@ -70,7 +72,7 @@ def control_step(k, dt, mj, arrays, control):
     """One controller step at step ``k`` (time ``k·dt`` [s]); writes the excitations ``u``.
 
     ``control`` = (table, p, hist, cs, mb, ix, thresholds, body_weight, body_mass, leg_length,
-    acc, td, steps, knee_idx, itilt, ranges, pen) (built by ``runner.objective``); running
+    acc, td, steps, knee_idx, itilt, ranges, pen) (built by :mod:`bladelab.predict.reflex.objective`); running
     sums go to ``acc``: metabolic energy [J], knee penalty·s, tilt penalty·s, number of
     steps, and the steps to ``td`` (:func:`_count_touchdowns`).
     """
@@ -117,3 +119,26 @@ def control_step(k, dt, mj, arrays, control):
     elif tilt > ranges[3]:
         err = tilt - ranges[3]
     acc[2] += (pen[0] * err + pen[1] * err * err) * dt
+
+
+@njit(cache=True)
+def run_closed_loop(
+    f1, f2, mptr, dptr, n_steps, record_every, dt, iz, fall_height, mj, arrays, rec, control
+):
+    """The runner's compiled time loop (:func:`bladelab.runner.kernel.run_loop`) with the reflex
+    controller: :func:`control_step` between MuJoCo's ``mj_step1`` and the forces of every step.
+    Stops after ``n_steps`` or at a fall; returns (last step, samples recorded, fell)."""
+    root_com = np.zeros(3)
+    k_rec = 0
+    k = 0
+    for k in range(n_steps + 1):
+        step_begin(f1, mptr, dptr, mj, root_com)
+        control_step(k, dt, mj, arrays, control)
+        k_rec, fell = step_end(k, k_rec, record_every, dt, iz, fall_height, mj, arrays, rec,
+                               root_com)
+        if fell:
+            return k, k_rec, True
+        if k == n_steps:
+            break
+        call_mujoco(f2, mptr, dptr)
+    return k, k_rec, False

@@ -11,7 +11,7 @@ Model (MuJoCo, built with ``MjSpec``; x forward, z up, pitch about +y):
   and ankle follow the gait cycle by stiff PD servos; two contact circles (heel, toe, radius
   3 cm) under the foot;
 - prosthetic leg: residual thigh + socket (60 % of the thigh mass, + 1 kg socket), hip servo;
-  the passive monocentric knee (:class:`~bladelab.runner.prosthetic_knee.ProstheticKnee`) at
+  the passive monocentric knee (:class:`~bladelab.design.prosthetic_knee.ProstheticKnee`) at
   the sound knee's height; below it a short adapter to the blade clamp, sized so that the
   standing prosthetic leg (knee to the ground, blade undeformed) is ``extra_leg_length_m``
   longer than the sound one; the multi-link blade from its :class:`BladeModel` (passive joints
@@ -41,20 +41,20 @@ import numpy as np
 from numba import njit
 
 from bladelab.blade.model import BladeModel
+from bladelab.constants import STANDARD_GRAVITY
 from bladelab.design.constraints import blade_clearance, knee_buckling, knee_extension_moment
+from bladelab.design.gait_cycle import GaitCycle, default_gait_cycle, read_gait_csv
 from bladelab.design.performance import cycle_performance
+from bladelab.design.prosthetic_knee import ProstheticKnee, knee_torque
 from bladelab.errors import ModelError, SimulationError, SpecError
 from bladelab.runner import geometry as geo
-from bladelab.runner.gait_cycle import GaitCycle, default_gait_cycle, read_gait_csv
 from bladelab.runner.params import default_runner_params
-from bladelab.runner.prosthetic_knee import ProstheticKnee, knee_torque
 from bladelab.sim.chain import build_chain
 from bladelab.sim.mujoco_engine import contact_forces_3d
 
 __all__ = ["RUNNER_RESPONSE_UNITS", "RunnerEvaluator", "TransfemoralResult",
            "simulate_transfemoral"]
 
-GRAVITY = 9.80665
 FOOT_RADIUS_M = 0.03
 _SOCKET_KG = 1.0
 _FOOT_CIRCLES = ((-0.05, -0.06), (0.15, -0.06))  # heel, toe centres below the ankle [m]
@@ -138,7 +138,7 @@ def _build(blade: BladeModel, body_mass: float, height: float, knee: ProstheticK
     spec.modelname = "bladelab_transfemoral"
     spec.option.timestep = dt
     spec.option.integrator = mujoco.mjtIntegrator.mjINT_EULER
-    spec.option.gravity = [0.0, 0.0, -GRAVITY]
+    spec.option.gravity = [0.0, 0.0, -STANDARD_GRAVITY]
     spec.option.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_CONTACT)
     bx = _body(spec.worldbody, "root_x", (0, 0, 0), 1e-6, (0, 0, 0), 1e-9)
     bx.add_joint(name="root_x", type=mujoco.mjtJoint.mjJNT_SLIDE, axis=[1, 0, 0])
@@ -366,7 +366,7 @@ def simulate_transfemoral(
     blade
         The multi-link blade (K, D, K2 and contact from the model).
     cycle
-        Joint angles; default :func:`~bladelab.runner.gait_cycle.default_gait_cycle`.
+        Joint angles; default :func:`~bladelab.design.gait_cycle.default_gait_cycle`.
     speed_mps
         Forward speed at prosthetic touch-down [m/s].
     body_mass_kg, height_m
@@ -412,7 +412,7 @@ def simulate_transfemoral(
     contact_guess = 0.23 * cycle.period
     t_flight = max(0.5 * cycle.period - contact_guess, 0.0)
     d.qvel[m.jnt_dofadr[m.joint("root_x").id]] = speed_mps
-    d.qvel[m.jnt_dofadr[m.joint("root_z").id]] = -0.5 * GRAVITY * t_flight
+    d.qvel[m.jnt_dofadr[m.joint("root_z").id]] = -0.5 * STANDARD_GRAVITY * t_flight
     contact = chain.contact
     ns = len(b.sites)
     out = np.zeros((ns, 7))

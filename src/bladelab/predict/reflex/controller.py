@@ -44,6 +44,7 @@ from numba import njit
 
 from bladelab._io import write_json
 from bladelab.errors import InputFileError, SpecError
+from bladelab.runner.params import RUNNER_DATA_DIR
 
 EARLY_STANCE, LATE_STANCE, LIFTOFF, SWING, LANDING = range(5)
 STATE_NAMES = ("EarlyStance", "LateStance", "Liftoff", "Swing", "Landing")
@@ -201,10 +202,11 @@ class ControllerLayout:
 
 
 def _scone_par() -> dict[str, float]:
-    """SCONE's RS2 parameters (column ``best``) by name, or {} if the file is not shipped."""
-    path = Path(__file__).resolve().parents[1] / "data" / "runner" / "solutions" / _SCONE_PAR
+    """SCONE's RS2 parameters (column ``best``) by name (shipped with bladelab)."""
+    path = RUNNER_DATA_DIR / "solutions" / _SCONE_PAR
     if not path.exists():
-        return {}
+        raise InputFileError("SCONE's reflex parameter file is missing from the installation",
+                             file=path, hint="reinstall bladelab (pip install --force-reinstall)")
     out = {}
     for line in path.read_text().splitlines():
         parts = line.split()

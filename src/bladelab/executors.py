@@ -11,6 +11,10 @@ that raises never stops the others.
 - :class:`RayExecutor`: Ray (optional extra ``pip install bladelab[ray]``, imported lazily); starts a
   local instance ``ray.init(num_cpus=jobs, include_dashboard=False)`` unless one is running, and
   gives the workers the driver's ``sys.path``.
+
+:class:`ProcessPool` is the persistent local pool underneath, for callers that submit many
+rounds of work to the same workers (CMA-ES generations, :mod:`bladelab.predict.reflex.optimize`).
+Used by :mod:`bladelab.study`, :mod:`bladelab.predict` and :mod:`bladelab.design`.
 """
 
 from __future__ import annotations
@@ -53,6 +57,12 @@ class SerialExecutor:
             yield i, status, value
 
 
+def default_start_method() -> str:
+    """``forkserver`` on Linux (safe with numba's and Ray's threads, unlike ``fork``), else
+    ``spawn``."""
+    return "forkserver" if sys.platform.startswith("linux") else "spawn"
+
+
 def terminate_pool(pool) -> None:
     """Stop a ``ProcessPoolExecutor``'s workers now (an interrupted run): without this, workers
     busy with long tasks outlive a killed parent and go on writing to its output folder."""
@@ -60,6 +70,39 @@ def terminate_pool(pool) -> None:
         if proc.is_alive():
             proc.terminate()
     pool.shutdown(wait=True, cancel_futures=True)
+
+
+class ProcessPool:
+    """A persistent pool of ``jobs`` local worker processes; a context manager that stops busy
+    workers at once when its block raises (Ctrl-C, SIGTERM via the CLI, an error)."""
+
+    def __init__(self, jobs: int, *, start_method: str | None = None) -> None:
+        from concurrent.futures import ProcessPoolExecutor
+
+        ctx = multiprocessing.get_context(start_method or default_start_method())
+        self.jobs = int(jobs)
+        self._pool = ProcessPoolExecutor(max_workers=self.jobs, mp_context=ctx)
+
+    def submit(self, fn: Callable, *args: Any):
+        """Run ``fn(*args)`` in a worker; returns its ``concurrent.futures.Future``."""
+        return self._pool.submit(fn, *args)
+
+    def map(self, fn: Callable, items: Sequence) -> list:
+        """``[fn(item) for item in items]`` on the workers, in order (a worker's error raises)."""
+        return list(self._pool.map(fn, items))
+
+    def close(self, *, abort: bool = False) -> None:
+        """Shut the pool down; ``abort`` stops busy workers at once."""
+        if abort:
+            terminate_pool(self._pool)
+        else:
+            self._pool.shutdown()
+
+    def __enter__(self) -> ProcessPool:
+        return self
+
+    def __exit__(self, exc_type, exc, tb) -> None:
+        self.close(abort=exc_type is not None)
 
 
 class LocalExecutor:
@@ -71,18 +114,14 @@ class LocalExecutor:
         if jobs < 1:
             raise BladelabError(f"--jobs {jobs}: need at least 1", where="jobs")
         self.jobs = int(jobs)
-        if start_method is None:
-            start_method = "forkserver" if sys.platform.startswith("linux") else "spawn"
-        self.start_method = start_method
+        self.start_method = start_method or default_start_method()
 
     def run(self, task: Task, payloads: Sequence[dict]) -> Iterator[tuple[int, str, Any]]:
-        from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
+        from concurrent.futures import FIRST_COMPLETED, wait
 
         if not payloads:
             return
-        ctx = multiprocessing.get_context(self.start_method)
-        workers = min(self.jobs, len(payloads))
-        with ProcessPoolExecutor(max_workers=workers, mp_context=ctx) as pool:
+        with ProcessPool(min(self.jobs, len(payloads)), start_method=self.start_method) as pool:
             pending = {pool.submit(run_task_safely, task, p): i for i, p in enumerate(payloads)}
             try:
                 while pending:
@@ -98,7 +137,7 @@ class LocalExecutor:
                 for fut in pending:
                     fut.cancel()
                 if pending:  # interrupted (Ctrl-C, SIGTERM via the CLI, an error)
-                    terminate_pool(pool)
+                    pool.close(abort=True)
 
 
 class RayExecutor:
@@ -163,3 +202,16 @@ def make_executor(name: str, jobs: int = 1):
     if name == "ray":
         return RayExecutor(max(1, jobs))
     raise BladelabError(f"unknown executor {name!r}", where="executor", hint="use 'local' or 'ray'")
+
+
+__all__ = [
+    "LocalExecutor",
+    "ProcessPool",
+    "RayExecutor",
+    "SerialExecutor",
+    "default_start_method",
+    "make_executor",
+    "run_task_safely",
+    "start_local_ray",
+    "terminate_pool",
+]

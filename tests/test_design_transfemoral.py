@@ -8,21 +8,21 @@ import numpy as np
 import pytest
 
 from bladelab.design import central_composite, default_design_space, generate_blade
-from bladelab.design.motion_model import fit_motion_model
-from bladelab.errors import DataError, InputFileError, SpecError
-from bladelab.runner.gait_cycle import (
+from bladelab.design.gait_cycle import (
     ANGLE_NAMES,
     GaitCycle,
     default_gait_cycle,
     gait_cycle_from_runner,
     read_gait_csv,
 )
-from bladelab.runner.prosthetic_knee import ProstheticKnee
-from bladelab.runner.transfemoral import (
+from bladelab.design.motion_model import fit_motion_model
+from bladelab.design.prosthetic_knee import ProstheticKnee
+from bladelab.design.transfemoral import (
     RUNNER_RESPONSE_UNITS,
     RunnerEvaluator,
     simulate_transfemoral,
 )
+from bladelab.errors import DataError, InputFileError, SpecError
 
 G = 9.80665
 

@@ -11,8 +11,12 @@ import pytest
 
 from bladelab.cli import main
 from bladelab.errors import InputFileError
-from bladelab.runner.objective import ObjectiveSettings
-from bladelab.runner.predict import _model, evaluate_candidates, optimize_controller
+from bladelab.predict.reflex.objective import ObjectiveSettings
+from bladelab.predict.reflex.optimize import (
+    evaluate_candidates,
+    optimize_controller,
+    runner_and_layout,
+)
 
 SHORT = ObjectiveSettings(duration=1.0)
 THREE_S = ObjectiveSettings(duration=3.0)
@@ -25,7 +29,7 @@ def _run(**kw):
 
 
 def test_short_optimisation_improves_and_is_reproducible(tmp_path):
-    _, layout = _model("able", None)
+    _, layout = runner_and_layout("able", None)
     start = evaluate_candidates(
         {"model": "able", "settings": SHORT.to_dict(), "xs": [layout.x0.tolist()]}
     )[0]["cost"]
@@ -134,10 +138,10 @@ def test_resume_keeps_the_runs_settings(tmp_path):
 
 
 def test_robust_evaluation_is_the_mean_over_jittered_copies():
-    from bladelab.runner.objective import simulate_controlled
-    from bladelab.runner.predict import jittered_parameters
+    from bladelab.predict.reflex.objective import simulate_controlled
+    from bladelab.predict.reflex.optimize import jittered_parameters
 
-    model, layout = _model("able", None)
+    model, layout = runner_and_layout("able", None)
     robust = ObjectiveSettings(duration=1.0, robust_samples=3, robust_jitter=1e-4)
     x = layout.x0
     copies = jittered_parameters(x, 2, 1e-4)
@@ -158,9 +162,9 @@ def test_a_warm_start_is_never_lost():
     from pathlib import Path
 
     import bladelab
-    from bladelab.runner.controller import read_parameters
+    from bladelab.predict.reflex.controller import read_parameters
 
-    _, layout = _model("able", None)
+    _, layout = runner_and_layout("able", None)
     shipped = Path(bladelab.__file__).parent / "data" / "runner" / "solutions" / "able-3.5.json"
     x0 = read_parameters(shipped, layout)
     start = evaluate_candidates(

@@ -9,16 +9,16 @@ from pathlib import Path
 import pytest
 
 import bladelab
-from bladelab.runner.predict import _model, verify_solution
+from bladelab.predict.reflex.optimize import runner_and_layout, verify_solution
 
 SOLUTIONS = Path(bladelab.__file__).parent / "data" / "runner" / "solutions"
 SHIPPED = sorted(SOLUTIONS.glob("*.json"))  # in_progress/ is not searched
 
 
 def test_verification_rejects_a_falling_controller(tmp_path):
-    from bladelab.runner.controller import write_parameters
+    from bladelab.predict.reflex.controller import write_parameters
 
-    _, layout = _model("able", None)
+    _, layout = runner_and_layout("able", None)
     path = write_parameters(tmp_path / "x0.json", layout, layout.x0, speed_m_per_s=3.5)
     out = verify_solution(path, duration=2.0)
     assert out["fell"] and not out["ok"]
@@ -27,10 +27,10 @@ def test_verification_rejects_a_falling_controller(tmp_path):
 def test_verification_uses_the_files_own_objective_settings(tmp_path):
     # a file optimised with other weights, another time step and robust sampling: the check
     # re-simulates it with those weights and that time step, once (no robust sampling)
-    from bladelab.runner.controller import write_parameters
-    from bladelab.runner.objective import ObjectiveSettings, simulate_controlled
+    from bladelab.predict.reflex.controller import write_parameters
+    from bladelab.predict.reflex.objective import ObjectiveSettings, simulate_controlled
 
-    runner, layout = _model("able", None)
+    runner, layout = runner_and_layout("able", None)
     stored = {"w_cot": 2.0, "w_lean": 1.0, "dt": 0.0004, "robust_samples": 4, "gone": 1}
     path = write_parameters(
         tmp_path / "x0.json", layout, layout.x0, speed_m_per_s=3.5, settings=stored
@@ -63,8 +63,8 @@ def _stride_times(force, bw=700.0, dt=0.001):
     """Strides (start, end) [s] of :func:`_strides` on a (n, 2) vertical GRF record [N]."""
     import numpy as np
 
+    from bladelab.predict.reflex.optimize import _strides
     from bladelab.runner.analyses import step_touchdowns
-    from bladelab.runner.predict import _strides
 
     t = np.arange(len(force)) * dt
     steps = step_touchdowns(t, force, bw)
@@ -102,8 +102,8 @@ def test_strides_run_from_step_to_step_of_each_leg():
 def test_same_leg_steps_count_hops_and_gallops():
     import numpy as np
 
+    from bladelab.predict.reflex.optimize import _same_leg_steps
     from bladelab.runner.analyses import step_touchdowns
-    from bladelab.runner.predict import _same_leg_steps
 
     t = np.arange(0.0, 3.0, 0.001)
 

@@ -8,8 +8,7 @@ import numpy as np
 import pytest
 
 from bladelab.errors import InputFileError, SpecError
-from bladelab.runner import build_runner
-from bladelab.runner.controller import (
+from bladelab.predict.reflex.controller import (
     EARLY_STANCE,
     LANDING,
     LATE_STANCE,
@@ -29,6 +28,7 @@ from bladelab.runner.controller import (
     update_gait_states,
     write_parameters,
 )
+from bladelab.runner import build_runner
 
 
 @pytest.fixture(scope="module")
