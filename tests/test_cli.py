@@ -103,9 +103,15 @@ def test_error_path_in_a_real_process(tmp_path):
     assert proc.returncode == 2
     assert proc.stderr.startswith("error:") and "Traceback" not in proc.stderr
     assert len(proc.stderr.strip().splitlines()) == 1
-    proc = _run("--debug", "trial", "info", str(bad))
-    assert proc.returncode != 0
-    assert "Traceback" in proc.stderr and "InputFileError" in proc.stderr
+    for args in (("--debug", "trial", "info", str(bad)), ("trial", "info", str(bad), "--debug")):
+        proc = _run(*args)  # --debug before or after the sub-command
+        assert proc.returncode != 0
+        assert "Traceback" in proc.stderr and "InputFileError" in proc.stderr
+
+
+def test_units_in_brackets_stay_visible_in_help(capsys):
+    assert main(["blade", "segment", "--help"]) == 0
+    assert "[mm²/mm]" in capsys.readouterr().out
 
 
 def test_usage_error_exit_2(capsys):

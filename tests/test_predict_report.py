@@ -245,6 +245,17 @@ def test_report_of_a_parameter_file(tmp_path):
     assert ((contact > 0.1) & (contact < 0.35)).all()  # running contact times (seed 001 §3.1)
 
 
+def test_a_shipped_file_reports_into_the_current_folder(tmp_path, monkeypatch):
+    from bladelab.report.predictive import default_report_dir
+
+    monkeypatch.chdir(tmp_path)
+    shipped = SOLUTIONS / "able-3.5.json"
+    assert default_report_dir(shipped, "parameters") == tmp_path / "able-3.5-report"
+    mine = tmp_path / "sub" / "mine.json"
+    assert default_report_dir(mine, "parameters") == tmp_path / "sub" / "mine-report"
+    assert default_report_dir(tmp_path / "run", "run") == tmp_path / "run" / "report"
+
+
 def test_bad_paths_exit_2_and_write_nothing(tmp_path, capsys):
     (tmp_path / "notes.txt").write_text("hello")
     (tmp_path / "other.json").write_text(json.dumps({"model": "able"}))

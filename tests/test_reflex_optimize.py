@@ -175,3 +175,21 @@ def test_a_warm_start_is_never_lost():
     assert res.best_cost == start[0]["cost"]  # every candidate was worse (seeded)
     assert np.array_equal(res.x, x0)
     assert res.history[0][2] == start[0]["cost"]
+
+
+def test_a_folder_holding_a_run_is_refused_unless_resumed_or_forced(tmp_path, capsys):
+    from bladelab.cli import main
+    from bladelab.errors import InputFileError
+
+    args = {"generations": 1, "popsize": 4, "seed": 3, "settings": ObjectiveSettings(duration=0.2)}
+    optimize_controller("able", out=tmp_path, **args)
+    history = (tmp_path / "history.csv").read_text()
+    with pytest.raises(InputFileError, match="holds a run"):
+        optimize_controller("able", out=tmp_path, **args)
+    assert (tmp_path / "history.csv").read_text() == history  # nothing erased
+    code = main(["predict", "--model", "able", "--generations", "1", "--popsize", "4",
+                 "--duration", "0.2", "--out", str(tmp_path)])
+    assert code == 2 and "--resume continues it" in capsys.readouterr().err
+    assert (tmp_path / "history.csv").read_text() == history
+    optimize_controller("able", out=tmp_path, force=True, **{**args, "seed": 4})
+    assert (tmp_path / "history.csv").read_text() != history

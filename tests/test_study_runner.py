@@ -226,3 +226,35 @@ def test_killed_run_keeps_finished_rows(tmp_path):
         assert store.table()["trial_id"].tolist() == ["t0", "t1"]
     resumed = run_study(tmp_path, task=fake_task, progress=False)
     assert (resumed.finished, resumed.skipped) == (2, 2)
+
+
+def test_concurrent_runs_split_the_trials_by_claims(tmp_path):
+    import subprocess
+    import sys
+
+    store = ResultsStore(tmp_path / "results.sqlite")
+    keys = [("T1", "linear"), ("T2", "linear")]
+    assert store.claim(keys[:1], "run-a") == keys[:1]
+    assert store.claim(keys, "run-b") == keys[1:]  # T1 is run-a's while its process lives
+    store.release("run-a")
+    assert store.claim(keys, "run-c") == keys[:1]  # released; T2 still run-b's
+    # a claim left by a process that died is taken over
+    dead = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"],
+                          capture_output=True, text=True, check=True)
+    with store._con:
+        store._con.execute("UPDATE claims SET pid=? WHERE owner='run-b'", (int(dead.stdout),))
+    assert store.claim(keys, "run-d") == keys[1:]
+    store.close()
+
+
+def test_a_run_leaves_trials_claimed_by_another_live_run(tmp_path):
+    make_study(tmp_path)
+    trials = [t.id for t in load_study(tmp_path)[0].trials]
+    with ResultsStore(tmp_path / "results.sqlite") as store:  # another run holds two trials
+        store.claim([(t, "linear") for t in trials[:2]], "other-run")
+    run = run_study(tmp_path, task=fake_task, progress=False)
+    assert (run.finished, run.claimed) == (len(trials) - 2, 2)
+    with ResultsStore(tmp_path / "results.sqlite") as store:
+        assert sorted(store.table().trial_id) == sorted(trials[2:])
+        store.release("other-run")
+    assert run_study(tmp_path, task=fake_task, progress=False).finished == 2

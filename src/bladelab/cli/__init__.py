@@ -28,6 +28,7 @@ app = typer.Typer(
     no_args_is_help=True,
     pretty_exceptions_enable=False,
     add_completion=False,
+    rich_markup_mode=None,  # help text is plain: units in brackets such as [mm²/mm] stay visible
 )
 
 _state = {"debug": False}
@@ -46,7 +47,7 @@ def _root(
         False, "--version", callback=_version_callback, is_eager=True, help="Print the version."
     ),
 ) -> None:
-    _state["debug"] = debug
+    _state["debug"] = _state["debug"] or debug
 
 
 for _name in _COMMAND_MODULES:
@@ -60,7 +61,9 @@ def main(argv: list[str] | None = None) -> int:
     ``error: ...`` on stderr and exits with 2; ``--debug`` re-raises it with its traceback.
     """
     args = sys.argv[1:] if argv is None else list(argv)
+    # --debug is accepted anywhere on the line (before or after the sub-command)
     _state["debug"] = "--debug" in args
+    args = [a for a in args if a != "--debug"]
     _state["terminated"] = False
     previous = _catch_sigterm()
     try:

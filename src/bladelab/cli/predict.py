@@ -49,6 +49,9 @@ def register(app: typer.Typer) -> None:
         jobs: int = typer.Option(1, "--jobs", help="Parallel worker processes."),
         executor: str = typer.Option("local", "--executor", help="local | ray"),
         resume: bool = typer.Option(False, "--resume", help="Continue from the checkpoint."),
+        force: bool = typer.Option(
+            False, "--force", help="Start over in an --out that holds a run (replacing it)."
+        ),
         duration: float = typer.Option(10.0, "--duration", help="Simulated time (s)."),
         checkpoint_every: int = typer.Option(5, "--checkpoint-every", help="Generations."),
         dt: float = typer.Option(
@@ -95,6 +98,7 @@ def register(app: typer.Typer) -> None:
             jobs=jobs,
             executor=executor,
             resume=resume,
+            force=force,
             checkpoint_every=checkpoint_every,
             settings=ObjectiveSettings(
                 speed=speed,

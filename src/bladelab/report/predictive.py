@@ -30,7 +30,7 @@ from tqdm import tqdm
 
 from bladelab.errors import InputFileError
 
-__all__ = ["PredictiveReport", "build_predictive_report", "predictive_kind"]
+__all__ = ["PredictiveReport", "build_predictive_report", "default_report_dir", "predictive_kind"]
 
 _KINDS_HINT = (
     "give a 'bladelab predict' folder (best.json + history.csv, or summary.json + seed-N/), "
@@ -385,6 +385,17 @@ def _sweep_sections(
     return shown, resim, summary, cells
 
 
+def default_report_dir(path: Path, kind: str) -> Path:
+    """Where a report goes without ``out_dir``: ``path/report`` for a folder; ``<stem>-report``
+    beside a parameter file, or in the current folder for a file shipped inside bladelab (never
+    into the installed package)."""
+    if kind != "parameters":
+        return path / "report"
+    package = Path(__file__).resolve().parents[1]
+    folder = Path.cwd() if path.resolve().is_relative_to(package) else path.parent
+    return folder / f"{path.stem}-report"
+
+
 def build_predictive_report(
     path: str | Path,
     out_dir: str | Path | None = None,
@@ -399,7 +410,7 @@ def build_predictive_report(
     path
         A ``bladelab predict`` or ``bladelab sweep`` folder, or a parameter JSON file.
     out_dir
-        Report folder; default ``path/report`` (a file: ``<stem>-report`` beside it).
+        Report folder; default :func:`default_report_dir`.
     duration
         Simulated time [s] of the re-simulations shown in the sections.
     progress
@@ -422,7 +433,7 @@ def build_predictive_report(
     if kind is None:
         raise InputFileError("not a predictive result", file=path, hint=_KINDS_HINT)
     if out_dir is None:
-        out_dir = path.parent / f"{path.stem}-report" if kind == "parameters" else path / "report"
+        out_dir = default_report_dir(path, kind)
     titles = {"run": "Predictive running: optimisation", "runs": "Predictive running: runs",
               "sweep": "Predictive running: blade-category sweep",
               "parameters": "Predictive running: solution"}

@@ -15,6 +15,7 @@ import hashlib
 import importlib
 import json
 import time
+import uuid
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -77,6 +78,8 @@ class StudyRun:
         Tasks run and written successfully now.
     skipped
         Already done (same input) and not forced.
+    claimed
+        Left to another run on the same study that had claimed them (running concurrently).
     failures
         (trial id, message) of every failed trial.
     wall_s
@@ -92,6 +95,7 @@ class StudyRun:
     wall_s: float
     executor: str
     jobs: int
+    claimed: int = 0
 
     def to_dict(self) -> dict:
         """JSON-ready dictionary."""
@@ -200,6 +204,8 @@ def run_study(
         blade = str(Path(blade).resolve())  # a spec file given on the command line: relative to cwd
     payloads = plan(study, folder, settings=merged, blade=blade)
     store = ResultsStore(folder / RESULTS_FILE)
+    owner = uuid.uuid4().hex
+    others = 0
     failures: list[tuple[str, str]] = []
     finished = skipped = 0
     try:
@@ -212,6 +218,13 @@ def run_study(
                 skipped += 1
             else:
                 todo.append(p)
+        # claim the tasks, so that a second run on the same study does the others
+        mine = set(store.claim([(p["trial_id"], p["variant"]) for p in todo], owner))
+        others = len(todo) - len(mine)
+        todo = [p for p in todo if (p["trial_id"], p["variant"]) in mine]
+        if others and progress:
+            print(f"{others} trial(s) are being identified by another run on this study; "
+                  "leaving them to it", flush=True)
         ex = make_executor(executor, jobs)
         bar = tqdm(total=len(todo), desc="trials", unit="trial", disable=not progress, leave=False)
         try:
@@ -227,8 +240,9 @@ def run_study(
         finally:
             bar.close()
     finally:
+        store.release(owner)
         store.close()
-    return StudyRun(total=len(payloads), finished=finished, skipped=skipped,
+    return StudyRun(total=len(payloads), finished=finished, skipped=skipped, claimed=others,
                     failures=tuple(sorted(failures)), wall_s=time.perf_counter() - t0,
                     executor=executor, jobs=jobs)
 

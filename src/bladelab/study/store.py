@@ -9,6 +9,8 @@ finished. Parameters carry their unit in the column name (N·m/deg, N·m·s/deg)
 from __future__ import annotations
 
 import json
+import os
+import socket
 import sqlite3
 from collections.abc import Iterable
 from datetime import UTC, datetime
@@ -73,6 +75,10 @@ class ResultsStore:
             self._con.execute(
                 f"CREATE TABLE IF NOT EXISTS results ({cols}, PRIMARY KEY (trial_id, variant))"
             )
+            self._con.execute(
+                "CREATE TABLE IF NOT EXISTS claims (trial_id TEXT, variant TEXT, owner TEXT, "
+                "host TEXT, pid INTEGER, claimed_utc TEXT, PRIMARY KEY (trial_id, variant))"
+            )
             self._con.commit()
         except sqlite3.DatabaseError as err:
             raise InputFileError(f"not a results database ({err})", file=self.path,
@@ -127,12 +133,53 @@ class ResultsStore:
             )
             return cur.rowcount > 0
 
+    def claim(self, keys: Iterable[tuple[str, str]], owner: str) -> list[tuple[str, str]]:
+        """Claim (trial, variant) tasks for the run ``owner``, in one transaction; returns the
+        ones claimed. A task claimed by another run whose process is still alive (same host) or
+        that is not on this host is left to it; a claim of a dead process is taken over."""
+        host, pid = socket.gethostname(), os.getpid()
+        now = datetime.now(UTC).isoformat(timespec="seconds")
+        got = []
+        with self._con:
+            self._con.execute("BEGIN IMMEDIATE")
+            for trial_id, variant in keys:
+                row = self._con.execute(
+                    "SELECT owner, host, pid FROM claims WHERE trial_id=? AND variant=?",
+                    (trial_id, variant),
+                ).fetchone()
+                if row is not None and row[0] != owner and not _dead(row[1], row[2]):
+                    continue
+                self._con.execute(
+                    "INSERT OR REPLACE INTO claims VALUES (?, ?, ?, ?, ?, ?)",
+                    (trial_id, variant, owner, host, pid, now),
+                )
+                got.append((trial_id, variant))
+        return got
+
+    def release(self, owner: str) -> None:
+        """Drop every claim of the run ``owner`` (its tasks are finished or abandoned)."""
+        with self._con:
+            self._con.execute("DELETE FROM claims WHERE owner=?", (owner,))
+
     def table(self, *, status: Iterable[str] | None = None) -> pd.DataFrame:
         """All rows as a DataFrame (optionally only some statuses), ordered by trial and variant."""
         df = pd.read_sql_query("SELECT * FROM results ORDER BY trial_id, variant", self._con)
         if status is not None:
             df = df[df["status"].isin(list(status))].reset_index(drop=True)
         return df
+
+
+def _dead(host: str, pid: int) -> bool:
+    """True when the claiming process ran on this host and is gone."""
+    if host != socket.gethostname():
+        return False
+    try:
+        os.kill(int(pid), 0)
+    except ProcessLookupError:
+        return True
+    except OSError:  # exists, owned by someone else
+        return False
+    return False
 
 
 def open_results(study_dir: str | Path) -> pd.DataFrame:

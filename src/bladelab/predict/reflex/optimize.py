@@ -45,6 +45,8 @@ from bladelab.runner.model import RunnerModel, build_runner
 
 CHECKPOINT_FORMAT = 1
 CHECKPOINT_NAME = "checkpoint.pkl"
+#: Files of a run folder (an ``out`` holding any of them holds a run).
+RUN_FILES = (CHECKPOINT_NAME, "best.json", "history.csv")
 
 # per-process cache of built models: (kind, blade) -> (model, layout)
 _MODELS: dict[tuple[str, str | None], tuple[RunnerModel, ControllerLayout]] = {}
@@ -217,6 +219,7 @@ def optimize_controller(
     executor: str = "local",
     out: str | Path | None = None,
     resume: bool = False,
+    force: bool = False,
     checkpoint_every: int = 5,
     settings: ObjectiveSettings | None = None,
     progress: Callable[[int, float, float], None] | None = None,
@@ -249,6 +252,9 @@ def optimize_controller(
     resume
         Continue from ``out/checkpoint.pkl`` (with the checkpoint's seed and objective settings;
         ``x0``, ``popsize``, ``sigma`` and ``settings`` are then ignored).
+    force
+        Start a new run in an ``out`` that holds one (its files are replaced as the new run
+        writes them); without ``force`` or ``resume`` such a folder is refused.
     checkpoint_every
         Write the checkpoint every this many generations.
     settings
@@ -268,6 +274,14 @@ def optimize_controller(
         raise OptimizationError("need generations >= 1 and popsize >= 2", where="generations")
     ckpt = out_dir / CHECKPOINT_NAME if out_dir is not None else None
     state = None
+    if out_dir is not None and not (resume or force):
+        held = [n for n in RUN_FILES if (out_dir / n).exists()]
+        if held:
+            raise InputFileError(
+                f"the output folder holds a run ({', '.join(held)})",
+                file=out_dir,
+                hint="--resume continues it, --force starts over in it, or choose another --out",
+            )
     if resume:
         if ckpt is None or not ckpt.exists():
             raise InputFileError(

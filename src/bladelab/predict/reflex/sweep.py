@@ -254,6 +254,7 @@ def category_task(payload: dict) -> dict:
                 jobs=1,
                 out=folder,
                 resume=resume,
+                force=not resume,  # the cell's folder is the sweep's own
                 checkpoint_every=payload.get("checkpoint_every", 5),
                 settings=settings,
             )
