@@ -50,6 +50,7 @@ from bladelab.errors import ModelError, SimulationError, SpecError
 from bladelab.runner import geometry as geo
 from bladelab.runner.params import default_runner_params
 from bladelab.sim.chain import build_chain
+from bladelab.sim.mujoco_blade import add_blade_bodies, lowest_sole_z
 from bladelab.sim.mujoco_engine import contact_forces_3d
 
 __all__ = ["RUNNER_RESPONSE_UNITS", "RunnerEvaluator", "TransfemoralResult",
@@ -74,10 +75,6 @@ RUNNER_RESPONSE_UNITS: dict[str, str] = {
 }
 
 
-def _quat_y(angle: float) -> list[float]:
-    return [math.cos(angle / 2), 0.0, math.sin(angle / 2), 0.0]
-
-
 def _body(parent, name, pos, mass, com, inertia):
     b = parent.add_body(name=name, pos=list(pos))
     b.explicitinertial = True
@@ -93,10 +90,7 @@ def _hinge(body, name):
 
 def _standing_depth(blade: BladeModel) -> float:
     """Depth [m] of the lowest undeformed sole point below the clamp at pitch 0."""
-    low = 0.0
-    for e in blade.soles:
-        half = math.hypot(e.semi_axis_x * math.sin(e.angle), e.semi_axis_z * math.cos(e.angle))
-        low = min(low, e.center[1] - half)
+    low = min(0.0, lowest_sole_z(blade))
     return -min(low, float(np.min(np.asarray(blade.points)[:, 1])))
 
 
@@ -176,29 +170,8 @@ def _build(blade: BladeModel, body_mass: float, height: float, knee: ProstheticK
     _hinge(kb, "knee_p")
     parent = _body(kb, "clamp", (knee_offset, 0, -adapter), 1e-6, (0, 0, 0), 1e-9)
     parent.add_site(name="clamp", pos=[0, 0, 0])
-    points = np.asarray(blade.points, float)
-    joint_at = {j.point: i for i, j in enumerate(blade.joints)}
-    prev = np.zeros(2)
-    for k in range(blade.n_segments):
-        p = points[k]
-        c = np.asarray(blade.segment_com[k], float) - p
-        body = _body(parent, f"seg{k}", (p[0] - prev[0], 0, p[1] - prev[1]),
-                     blade.segment_mass[k], (c[0], 0, c[1]), blade.segment_inertia[k])
-        if k in joint_at:
-            j = blade.joints[joint_at[k]]
-            body.add_joint(name=f"joint{joint_at[k] + 1}", type=mujoco.mjtJoint.mjJNT_HINGE,
-                           axis=[0, 1, 0], stiffness=[float(j.stiffness), 0, 0],
-                           damping=[float(j.damping), 0, 0])
-        for e, sole in enumerate(blade.soles):
-            if sole.segment == k:
-                body.add_site(name=f"sole{e}", type=mujoco.mjtGeom.mjGEOM_ELLIPSOID,
-                              pos=[sole.center[0] - p[0], 0, sole.center[1] - p[1]],
-                              quat=_quat_y(sole.angle),
-                              size=[sole.semi_axis_x, 0.02, sole.semi_axis_z])
-        if k == blade.tip_segment:
-            body.add_site(name="tip", pos=[blade.tip[0] - p[0], 0, blade.tip[1] - p[1]])
-        parent = body
-        prev = p
+    add_blade_bodies(parent, blade, stiffness=[j.stiffness for j in blade.joints],
+                     damping=[j.damping for j in blade.joints], min_inertia=1e-8)
     m = spec.compile()
     ne = len(blade.soles)
     names = [f"sole{e}" for e in range(ne)] + ["foot0", "foot1"]

@@ -17,37 +17,16 @@ of about 1e-4 s; the sphere model runs at 2.5e-4 s.
 
 from __future__ import annotations
 
-import math
-
 import mujoco
-import numpy as np
 
 from bladelab.blade.model import BladeModel
 from bladelab.errors import ModelError
+from bladelab.sim.mujoco_blade import BladeNames, add_blade_bodies, lowest_sole_z
 
 CLAMP_OFFSET_X_M = -0.03
-
-
-def _links(blade: BladeModel) -> list[list[int]]:
-    """Segments of each rigid link (split at the compliant joints' points)."""
-    cuts = sorted(j.point for j in blade.joints)
-    links, start = [], 0
-    for c in cuts + [blade.n_segments]:
-        links.append(list(range(start, c)))
-        start = c
-    return links
-
-
-def _sole_lowest_z(blade: BladeModel) -> float:
-    """Lowest sole point z [m] in the clamp frame, undeformed."""
-    low = math.inf
-    for sole in blade.soles:
-        # ellipse x axis at angle a about +y: ex = (cos a, −sin a) in (x, z); ez = (sin a, cos a)
-        h = math.hypot(
-            sole.semi_axis_x * math.sin(sole.angle), sole.semi_axis_z * math.cos(sole.angle)
-        )
-        low = min(low, sole.center[1] - h)
-    return low
+# MuJoCo names of the blade's links, hinges (index in ``blade.joints``) and sole sites; no tip.
+BLADE_NAMES = BladeNames(body="blade_link{index}", joint="blade_joint{index}",
+                         sole="blade_sole{index}", tip=None)
 
 
 def add_multilink_blade(bodies, joint_child, params, s, mr, res_len, axis, blade, bottom) -> None:
@@ -74,42 +53,8 @@ def add_multilink_blade(bodies, joint_child, params, s, mr, res_len, axis, blade
     body.inertia = [max(ixx * f, izz * f - iyy * f + 1e-6), izz * f, iyy * f]
     bodies["prosthesis_r"] = body
     joint_child["prosthesis_r"] = (0.0, 0.0, 0.0)
-    clamp = np.array([CLAMP_OFFSET_X_M, -bottom - _sole_lowest_z(blade)])
-    parent, prev = body, None
-    pts = np.asarray(blade.points, float)
-    links = _links(blade)
-    joint_points = [0] + sorted(j.point for j in blade.joints)
-    for n, (segs, jp_idx) in enumerate(zip(links, joint_points, strict=True)):
-        m = float(np.sum(blade.segment_mass[segs]))
-        com = np.sum(blade.segment_com[segs] * blade.segment_mass[segs, None], axis=0) / m
-        iy = float(
-            np.sum(
-                blade.segment_inertia[segs]
-                + blade.segment_mass[segs] * np.sum((blade.segment_com[segs] - com) ** 2, axis=1)
-            )
-        )
-        rel = clamp if prev is None else pts[jp_idx] - pts[prev]  # in the parent's frame
-        pos = [rel[0], 0.0, rel[1]]
-        link = parent.add_body(name=f"blade_link{n}", pos=pos)
-        if n:
-            link.add_joint(
-                name=f"blade_joint{n - 1}", type=mujoco.mjtJoint.mjJNT_HINGE, axis=[0.0, 1.0, 0.0]
-            )
-        link.explicitinertial = True
-        link.mass = m
-        c = com - pts[jp_idx]
-        link.ipos = [c[0], 0.0, c[1]]
-        link.inertia = [iy, iy, iy]
-        for k, sole in enumerate(blade.soles):
-            if sole.segment in segs:
-                p = np.asarray(sole.center) - pts[jp_idx]
-                link.add_site(
-                    name=f"blade_sole{k}",
-                    pos=[p[0], 0.0, p[1]],
-                    quat=[math.cos(sole.angle / 2), 0.0, math.sin(sole.angle / 2), 0.0],
-                    size=[sole.semi_axis_x, sole.semi_axis_z, sole.semi_axis_z],
-                )
-        parent, prev = link, jp_idx
+    clamp = (CLAMP_OFFSET_X_M, -bottom - lowest_sole_z(blade))
+    add_blade_bodies(body, blade, origin=clamp, merge_rigid_links=True, names=BLADE_NAMES)
 
 
 def multilink_contact_rows(model: mujoco.MjModel, blade: BladeModel) -> list[tuple]:

@@ -12,7 +12,9 @@ feed-forward force ``armature × prescribed acceleration``; its position and vel
 the prescribed values before every step. So the blade sees the clamp's true velocity and
 acceleration (a mocap clamp would have zero velocity in the dynamics).
 
-The same builder makes the free "runner" of :mod:`bladelab.sim.synthetic`.
+The same builder makes the free "runner" of :mod:`bladelab.sim.synthetic`; the blade's bodies,
+hinges and sites come from :func:`bladelab.sim.mujoco_blade.add_blade_bodies` (per-segment bodies,
+K and D in MuJoCo's joints, segment capsules).
 """
 
 from __future__ import annotations
@@ -29,6 +31,7 @@ from bladelab.errors import SimulationError
 from bladelab.sim import kernel as _k
 from bladelab.sim import sole as _sole
 from bladelab.sim.chain import Chain
+from bladelab.sim.mujoco_blade import add_blade_bodies
 
 CLAMP_ARMATURE = 1.0e6  # kg (slides) and kg·m² (pitch hinge)
 
@@ -71,10 +74,6 @@ def default_mujoco_dt(chain: Chain, *, peak_force: float = 3000.0) -> float:
             dt = min(dt, m_z / c_eff)
         dt = min(dt, 0.2 * math.sqrt(m_z / k_eff))
     return float(dt)
-
-
-def _quat_y(angle: float) -> list[float]:
-    return [math.cos(angle / 2), 0.0, math.sin(angle / 2), 0.0]
 
 
 def build_spec(
@@ -132,35 +131,8 @@ def build_spec(
         parent = pylon.add_body(name="clamp", pos=[0, 0, -pylon_length])
         _light(parent)
     parent.add_site(name="clamp", pos=[0, 0, 0])
-    points = np.asarray(blade.points, float)
-    joint_at = {j.point: i for i, j in enumerate(blade.joints)}
-    prev = np.zeros(2)
-    for s in range(blade.n_segments):
-        p = points[s]
-        body = parent.add_body(name=f"seg{s}", pos=[p[0] - prev[0], 0.0, p[1] - prev[1]])
-        if s in joint_at:
-            i = joint_at[s]
-            body.add_joint(name=f"joint{i + 1}", type=mujoco.mjtJoint.mjJNT_HINGE, axis=[0, 1, 0],
-                           stiffness=[float(stiffness[i]), 0, 0], damping=[float(damping[i]), 0, 0])
-        body.explicitinertial = True
-        body.mass = float(blade.segment_mass[s])
-        c = np.asarray(blade.segment_com[s], float) - p
-        body.ipos = [c[0], 0.0, c[1]]
-        inertia = max(float(blade.segment_inertia[s]), 1e-12)
-        body.inertia = [inertia, inertia, inertia]
-        q = points[s + 1] - p
-        body.add_geom(type=mujoco.mjtGeom.mjGEOM_CAPSULE, fromto=[0, 0, 0, q[0], 0, q[1]],
-                      size=[0.006, 0, 0], contype=0, conaffinity=0, mass=0)
-        for e, sole in enumerate(blade.soles):
-            if sole.segment == s:
-                body.add_site(name=f"sole{e}", type=mujoco.mjtGeom.mjGEOM_ELLIPSOID,
-                              pos=[sole.center[0] - p[0], 0.0, sole.center[1] - p[1]],
-                              quat=_quat_y(sole.angle),
-                              size=[sole.semi_axis_x, 0.02, sole.semi_axis_z])
-        if s == blade.tip_segment:
-            body.add_site(name="tip", pos=[blade.tip[0] - p[0], 0.0, blade.tip[1] - p[1]])
-        parent = body
-        prev = p
+    add_blade_bodies(parent, blade, stiffness=stiffness, damping=damping, min_inertia=1e-12,
+                     capsule_radius=0.006)
     return spec
 
 
