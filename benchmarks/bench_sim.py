@@ -20,7 +20,7 @@ import numpy as np
 from bladelab import units
 from bladelab.blade import load_blade
 from bladelab.sim import prepare, simulate, simulate_batch
-from bladelab.sim.api import _run_kernel
+from bladelab.sim.api import run_kernel
 from bladelab.sim.synthetic import generate_stance
 
 
@@ -80,8 +80,8 @@ def run() -> str:
     ]
     split_rows = []
     for label, p, energy in split:
-        _run_kernel(p, K1, D1, K21, with_energy=energy)
-        t = _best(lambda p=p, energy=energy: _run_kernel(p, K1, D1, K21, with_energy=energy), 200)
+        run_kernel(p, K1, D1, K21, with_energy=energy)
+        t = _best(lambda p=p, energy=energy: run_kernel(p, K1, D1, K21, with_energy=energy), 200)
         split_rows.append((label, t))
 
     rng = np.random.default_rng(0)

@@ -379,31 +379,23 @@ def _params(problem: SimProblem, value, default: np.ndarray, name: str, n_sets: 
     return np.ascontiguousarray(arr, dtype=float)
 
 
-def _run_kernel(problem: SimProblem, K, D, K2, *, parallel: bool = False,
+def run_kernel(problem: SimProblem, K, D, K2, *, parallel: bool = False,
                 with_energy: bool = True):
-    c = problem.chain
-    n_sets, nj = K.shape
-    ns = problem.n_samples
-    ne = c.n_soles
-    grf = np.zeros((n_sets, ns, ne, 2))
-    dist = np.zeros((n_sets, ns))
-    qout = np.zeros((n_sets, ns, nj))
-    tau = np.zeros((n_sets, ns, nj))
-    state = np.zeros((n_sets, ns, ne), np.int8)
-    energy = np.zeros((n_sets, ns, len(_k.ENERGY_TERMS)))
-    status = np.zeros((n_sets, 2), np.int64)
-    args = (problem.base, problem.dt, problem.n_substeps, 0.0, c.body_mass, c.body_com,
-            c.body_inertia, c.hinge, c.sole_body, c.sole_geom, c.tip_body, c.tip, c.contact)
+    """Run the kernel for the (n_sets, nj) parameter arrays; the buffers and (n_sets, 2) status."""
+    nj = K.shape[1]
     q0 = np.zeros(nj)
-    opts = (problem.order, problem.iterations, problem.refine, with_energy)
+    model = _k.ChainModel.from_chain(problem.chain)
+    stance_drive = _k.StanceDrive(problem.base, problem.dt, problem.n_substeps, 0.0, q0, q0)
+    params = _k.JointParams(K, D, K2)
+    solver = _k.SolverSettings(problem.order, problem.iterations, problem.refine, with_energy)
+    out = _k.KernelOutputs.zeros(K.shape[0], problem.n_samples, problem.chain.n_soles, nj)
+    status = np.zeros((K.shape[0], 2), np.int64)
     if parallel:
-        _k._batch_parallel(*args, K, D, K2, q0, q0, *opts, grf, dist, qout, tau, state, energy,
-                           status)
+        _k.simulate_batch_parallel(model, stance_drive, params, solver, out, status)
     else:
         # all sets in one compiled call (a Python loop costs ~10 µs of dispatch per set)
-        _k._batch_serial(*args, K, D, K2, q0, q0, *opts, grf, dist, qout, tau, state, energy,
-                         status)
-    return grf, dist, qout, tau, state, energy, status
+        _k.simulate_batch_serial(model, stance_drive, params, solver, out, status)
+    return (*out, status)
 
 
 def simulate(
@@ -436,7 +428,7 @@ def simulate(
         from bladelab.sim.mujoco_engine import simulate_mujoco
 
         return simulate_mujoco(problem, K[0], D[0], K2[0])
-    grf, dist, qout, tau, state, energy, status = _run_kernel(problem, K, D, K2)
+    grf, dist, qout, tau, state, energy, status = run_kernel(problem, K, D, K2)
     if status[0, 0] != _k.STATUS_OK:
         t_fail = problem.time[0] + status[0, 1] * problem.dt
         raise SimulationError(
@@ -507,7 +499,7 @@ def simulate_batch(
             torque=np.array([nanj if r is None else r.torque for r in results]),
             ok=ok, stiffness=K, damping=D, stiffness_quadratic=K2,
         )
-    grf, dist, qout, tau, _state, _energy, status = _run_kernel(problem, K, D, K2,
+    grf, dist, qout, tau, _state, _energy, status = run_kernel(problem, K, D, K2,
                                                                 parallel=parallel,
                                                                 with_energy=False)
     ok = status[:, 0] == _k.STATUS_OK

@@ -25,10 +25,13 @@ the cached kernel; touch this file (or clear ``__pycache__``) after such an edit
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numpy as np
 from numba import njit, prange
 
+from bladelab.constants import STANDARD_GRAVITY
+from bladelab.sim.chain import Chain
 from bladelab.sim.sole import (
     contact_elastic_energy,
     friction,
@@ -36,8 +39,6 @@ from bladelab.sim.sole import (
     track_contact,
     track_state_force,
 )
-
-GRAVITY = 9.80665
 
 # Columns of the energy output.
 ENERGY_TERMS: tuple[str, ...] = (
@@ -71,6 +72,107 @@ GRF_Z_COLUMN = 12
 
 STATUS_OK = 0
 STATUS_DIVERGED = 1
+
+
+class ChainModel(NamedTuple):
+    """The fixed blade description the kernel simulates (SI, clamp frame, undeformed posture).
+
+    Fields: ``body_mass`` (nb,) [kg]; ``body_com`` (nb, 2) centre of mass x, z [m];
+    ``body_inertia`` (nb,) about the centre of mass and +y [kg·m²]; ``hinge`` (nj, 2) hinge
+    points x, z [m] (hinge j joins body j and body j + 1); ``sole_body`` (ne,) int64 body of each
+    sole ellipse; ``sole_geom`` (ne, 5) ellipse centre x, z [m], semi-axes x, z [m], angle [rad];
+    ``tip_body`` (int) body of the tip marker; ``tip`` (2,) its position x, z [m]; ``contact``
+    (11,) the contact vector of :class:`~bladelab.sim.chain.Chain` (law code, k, c, transition
+    width [m], exponent, dissipation [s/m], μ_s, μ_k, v_c [m/s], k_t [N/m], c_t [N·s/m]).
+    """
+
+    body_mass: np.ndarray
+    body_com: np.ndarray
+    body_inertia: np.ndarray
+    hinge: np.ndarray
+    sole_body: np.ndarray
+    sole_geom: np.ndarray
+    tip_body: int
+    tip: np.ndarray
+    contact: np.ndarray
+
+    @classmethod
+    def from_chain(cls, chain: Chain) -> ChainModel:
+        """The kernel's view of ``chain`` (the arrays themselves, not copies)."""
+        return cls(chain.body_mass, chain.body_com, chain.body_inertia, chain.hinge,
+                   chain.sole_body, chain.sole_geom, int(chain.tip_body), chain.tip, chain.contact)
+
+
+class StanceDrive(NamedTuple):
+    """The prescribed clamp motion, its time base and the joints' initial state.
+
+    Fields: ``base`` (n_steps + 1, 11–13) clamp row at every step time (columns in
+    :func:`simulate_prescribed`); ``dt`` integration step [s]; ``nsub`` (int) steps per output
+    sample; ``ground_vx`` ground (belt) velocity along x [m/s]; ``q0``, ``v0`` (nj,) initial
+    joint angles [rad] and rates [rad/s].
+    """
+
+    base: np.ndarray
+    dt: float
+    nsub: int
+    ground_vx: float
+    q0: np.ndarray
+    v0: np.ndarray
+
+
+class JointParams(NamedTuple):
+    """The joint parameters being identified: (nj,) for one set, (n_sets, nj) for a batch.
+
+    Fields: ``stiffness`` K [N·m/rad]; ``damping`` D [N·m·s/rad]; ``stiffness_quadratic``
+    K2 [N·m/rad²] (spring torque −K·q − K2·q·|q| − D·q̇).
+    """
+
+    stiffness: np.ndarray
+    damping: np.ndarray
+    stiffness_quadratic: np.ndarray
+
+
+class SolverSettings(NamedTuple):
+    """Integrator settings.
+
+    Fields: ``order`` (int) 2 = BDF2, 1 = backward Euler; ``n_iter`` (int) Newton iterations per
+    step (1 = linearly implicit); ``refine`` (int) sub-steps of a step in which a sole element
+    changes regime (1 = never); ``with_energy`` (bool) keep the energy bookkeeping.
+    """
+
+    order: int
+    n_iter: int
+    refine: int
+    with_energy: bool
+
+
+class KernelOutputs(NamedTuple):
+    """Buffers the kernel writes into, one row per output sample (a leading set axis in a batch).
+
+    Fields: ``grf`` (ns, ne, 2) force x, z on each sole element [N]; ``dist`` (ns,) tip–clamp
+    distance [m]; ``qout`` (ns, nj) joint angles [rad]; ``tau`` (ns, nj) spring-damper torques
+    [N·m]; ``state`` (ns, ne) int8 contact state (0 free, 1 stick, 2 slip); ``energy`` (ns, 9)
+    [J], columns :data:`ENERGY_TERMS`.
+    """
+
+    grf: np.ndarray
+    dist: np.ndarray
+    qout: np.ndarray
+    tau: np.ndarray
+    state: np.ndarray
+    energy: np.ndarray
+
+    @classmethod
+    def zeros(cls, n_sets: int, n_samples: int, n_soles: int, n_joints: int) -> KernelOutputs:
+        """Zeroed buffers for a batch of ``n_sets`` parameter sets."""
+        return cls(
+            grf=np.zeros((n_sets, n_samples, n_soles, 2)),
+            dist=np.zeros((n_sets, n_samples)),
+            qout=np.zeros((n_sets, n_samples, n_joints)),
+            tau=np.zeros((n_sets, n_samples, n_joints)),
+            state=np.zeros((n_sets, n_samples, n_soles), np.int8),
+            energy=np.zeros((n_sets, n_samples, len(ENERGY_TERMS))),
+        )
 
 
 @njit(cache=True, inline="always", error_model="numpy")
@@ -167,29 +269,29 @@ def _solve(A, rhs, x):
 
 
 @njit(cache=True, error_model="numpy")
-def simulate_prescribed(
-    base, dt, nsub, ground_vx,
-    body_mass, com0, body_inertia, hinge, sole_body, sole_geom, tip_body, tip, contact,
-    stiffness, damping, stiffness_quadratic, q0, v0, order, n_iter, refine, with_energy,
-    grf, dist, qout, tau, state, energy,
-):
+def simulate_prescribed(model, drive, params, solver, out):
     """Simulate one parameter set with the clamp prescribed.
 
-    ``base`` (n_steps + 1, 11): clamp x, z, θ, ẋ, ż, θ̇, ẍ, z̈, θ̈, cos θ, sin θ at every step time;
-    with a 12th column r(t) (drive "utilised-friction") the friction of each sole element is
-    r·Fn (no stick-slip law); with 13 columns (measured GRF x, z: drive "grf-driven") the
-    measured GRF is applied to the sole elements (split by the model's normal forces of the
-    previous step) and the contact law only decides the split (energy terms are then not balanced).
-    ``order`` 2 (BDF2) or 1 (backward Euler); ``n_iter`` Newton iterations per step (1 =
-    linearly implicit); ``with_energy``: keep the energy bookkeeping (clamp work, dissipation,
-    stored energies; off for identification batches); ``refine``: a step in which any sole element changes regime (touch-down,
-    stick ↔ slip, lift-off) is redone as ``refine`` sub-steps with the clamp row interpolated
-    linearly (1 = never). Samples are recorded every ``nsub`` steps into ``grf`` (ns, ne, 2),
-    ``dist`` (ns,), ``qout`` and ``tau`` (ns, nj), ``state`` (ns, ne) int8 (0 free, 1 stick,
-    2 slip) and ``energy`` (ns, 9), columns :data:`ENERGY_TERMS`. ``contact[9]`` > 0 adds a
-    compliant track layer in series with every sole element (:func:`track_contact`; its
-    deflection is a state integrated with the same BDF2/Euler formula). Returns (status, step index where it diverged or −1).
+    ``model`` :class:`ChainModel`; ``drive`` :class:`StanceDrive`; ``params`` :class:`JointParams`
+    of one set, (nj,) each; ``solver`` :class:`SolverSettings`; ``out`` :class:`KernelOutputs` of
+    one set, written in place. Returns (status, step index where it diverged or −1).
+
+    ``drive.base`` (n_steps + 1, 11): clamp x, z [m], θ [rad], ẋ, ż, θ̇, ẍ, z̈, θ̈, cos θ, sin θ at
+    every step time; with a 12th column r(t) (drive "utilised-friction") the friction of each
+    sole element is r·Fn (no stick-slip law); with 13 columns (measured GRF x, z [N]: drive
+    "grf-driven") the measured GRF is applied to the sole elements (split by the model's normal
+    forces of the previous step) and the contact law only decides the split (energy terms are
+    then not balanced). ``solver.refine``: a step in which any sole element changes regime
+    (touch-down, stick ↔ slip, lift-off) is redone as ``refine`` sub-steps with the clamp row
+    interpolated linearly. Samples are recorded every ``drive.nsub`` steps. ``model.contact[9]``
+    > 0 adds a compliant track layer in series with every sole element (:func:`track_contact`;
+    its deflection is a state integrated with the same BDF2/Euler formula).
     """
+    body_mass, com0, body_inertia, hinge, sole_body, sole_geom, tip_body, tip, contact = model
+    base, dt, nsub, ground_vx, q0, v0 = drive
+    stiffness, damping, stiffness_quadratic = params
+    order, n_iter, refine, with_energy = solver
+    grf, dist, qout, tau, state, energy = out
     nb = com0.shape[0]
     nj = nb - 1
     ne = sole_body.shape[0]
@@ -332,7 +434,7 @@ def simulate_prescribed(
                                 rx = R[b, 0] - hx
                                 rz = R[b, 1] - hz
                                 # gravity minus inertia (bias) generalised force
-                                acc += body_mass[b] * (GRAVITY * rx - (AR[b, 0] * rz - AR[b, 1] * rx))
+                                acc += body_mass[b] * (STANDARD_GRAVITY * rx - (AR[b, 0] * rz - AR[b, 1] * rx))
                                 acc -= body_inertia[b] * al[b]
                             qa = qs[j]
                             acc -= stiffness[j] * qa + stiffness_quadratic[j] * qa * abs(qa) + damping[j] * vi[j]
@@ -458,10 +560,10 @@ def simulate_prescribed(
                                 alb += qdd
                             m = body_mass[b]
                             fcx += m * ax
-                            fcz += m * (az + GRAVITY)
+                            fcz += m * (az + STANDARD_GRAVITY)
                             rx = R[b, 0] - bs[0]
                             rz = R[b, 1] - bs[1]
-                            tc += m * (ax * rz - (az + GRAVITY) * rx) + body_inertia[b] * alb
+                            tc += m * (ax * rz - (az + STANDARD_GRAVITY) * rx) + body_inertia[b] * alb
                         for e in range(ne):
                             fcx -= fe[e, 0]
                             fcz -= fe[e, 1]
@@ -588,7 +690,7 @@ def simulate_prescribed(
                 for b in range(nb):
                     kin += 0.5 * body_mass[b] * (VR[b, 0] ** 2 + VR[b, 1] ** 2)
                     kin += 0.5 * body_inertia[b] * om[b] ** 2
-                    pot += body_mass[b] * GRAVITY * R[b, 1]
+                    pot += body_mass[b] * STANDARD_GRAVITY * R[b, 1]
                 energy[s_idx, 0] = w_clamp
                 energy[s_idx, 1] = kin
                 energy[s_idx, 2] = pot
@@ -602,31 +704,36 @@ def simulate_prescribed(
 
 
 @njit(cache=True, parallel=True)
-def _batch_parallel(base, dt, nsub, ground_vx, body_mass, com0, body_inertia, hinge, sole_body,
-                    sole_geom, tip_body, tip, contact, K, D, K2, q0, v0, order, n_iter, refine,
-                    with_energy,
-                    grf, dist, qout, tau, state, energy, status):
-    for s in prange(K.shape[0]):
+def simulate_batch_parallel(model, drive, params, solver, out, status):
+    """Many parameter sets over numba threads (``prange``); results identical to the serial one.
+
+    ``params`` :class:`JointParams` of (n_sets, nj) arrays; ``out`` :class:`KernelOutputs` with a
+    leading n_sets axis; ``status`` (n_sets, 2) int64 receives :func:`simulate_prescribed`'s
+    return value per set.
+    """
+    for s in prange(params.stiffness.shape[0]):
         st, at = simulate_prescribed(
-            base, dt, nsub, ground_vx, body_mass, com0, body_inertia, hinge, sole_body, sole_geom,
-            tip_body, tip, contact, K[s], D[s], K2[s], q0, v0, order, n_iter, refine,
-            with_energy,
-            grf[s], dist[s], qout[s], tau[s], state[s], energy[s])
+            model, drive,
+            JointParams(params.stiffness[s], params.damping[s], params.stiffness_quadratic[s]),
+            solver,
+            KernelOutputs(out.grf[s], out.dist[s], out.qout[s], out.tau[s], out.state[s],
+                          out.energy[s]))
         status[s, 0] = st
         status[s, 1] = at
 
 
 @njit(cache=True)
-def _batch_serial(base, dt, nsub, ground_vx, body_mass, com0, body_inertia, hinge, sole_body,
-                  sole_geom, tip_body, tip, contact, K, D, K2, q0, v0, order, n_iter, refine,
-                  with_energy,
-                  grf, dist, qout, tau, state, energy, status):
-    """The sets one after the other in one compiled call (no per-set dispatch cost)."""
-    for s in range(K.shape[0]):
+def simulate_batch_serial(model, drive, params, solver, out, status):
+    """The sets one after the other in one compiled call (no per-set dispatch cost).
+
+    Arguments as :func:`simulate_batch_parallel`.
+    """
+    for s in range(params.stiffness.shape[0]):
         st, at = simulate_prescribed(
-            base, dt, nsub, ground_vx, body_mass, com0, body_inertia, hinge, sole_body, sole_geom,
-            tip_body, tip, contact, K[s], D[s], K2[s], q0, v0, order, n_iter, refine,
-            with_energy,
-            grf[s], dist[s], qout[s], tau[s], state[s], energy[s])
+            model, drive,
+            JointParams(params.stiffness[s], params.damping[s], params.stiffness_quadratic[s]),
+            solver,
+            KernelOutputs(out.grf[s], out.dist[s], out.qout[s], out.tau[s], out.state[s],
+                          out.energy[s]))
         status[s, 0] = st
         status[s, 1] = at

@@ -26,6 +26,7 @@ import numpy as np
 from numba import njit
 
 from bladelab.blade.model import BladeModel
+from bladelab.constants import STANDARD_GRAVITY
 from bladelab.contact import stick_slip_friction_coefficient
 from bladelab.errors import SimulationError
 from bladelab.sim import kernel as _k
@@ -97,7 +98,7 @@ def build_spec(
     spec.modelname = "bladelab_blade"
     spec.option.timestep = dt
     spec.option.integrator = mujoco.mjtIntegrator.mjINT_EULER
-    spec.option.gravity = [0.0, 0.0, -_k.GRAVITY]
+    spec.option.gravity = [0.0, 0.0, -STANDARD_GRAVITY]
     spec.option.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_CONTACT)
     spec.worldbody.add_geom(type=mujoco.mjtGeom.mjGEOM_PLANE, size=[5, 5, 0.1],
                             contype=0, conaffinity=0)
@@ -231,7 +232,7 @@ def contact_forces_track(contact, site_xpos, site_xmat, sites, axes, site_body, 
 
     The track deflection ``track_u[e]`` [m] of each sole element advances by one backward-Euler
     step of ``dt`` from the penetration and its rate at the current state
-    (:func:`bladelab.sim.kernel.track_contact` with uh = u_n, g = dt). ``out[e]`` = (fx, fz,
+    (:func:`bladelab.sim.sole.track_contact` with uh = u_n, g = dt). ``out[e]`` = (fx, fz,
     depth, slip, elastic contact force, contact-damping power, friction power, track-damping
     power, track deflection).
     """
@@ -315,7 +316,7 @@ def _kinetic_potential(body_mass, body_inertia, cvel, xipos, subtree_com, rootid
         vy = cvel[b, 4] + wz * rx - wx * rz
         vz = cvel[b, 5] + wx * ry - wy * rx
         kin += 0.5 * m * (vx * vx + vy * vy + vz * vz) + 0.5 * body_inertia[b, 1] * wy * wy
-        pot += m * _k.GRAVITY * xipos[b, 2]
+        pot += m * STANDARD_GRAVITY * xipos[b, 2]
     return kin, pot
 
 

@@ -25,8 +25,8 @@ from numba import njit
 
 from bladelab import units
 from bladelab.blade.model import BladeModel
+from bladelab.constants import STANDARD_GRAVITY
 from bladelab.errors import ModelError, SimulationError
-from bladelab.sim import kernel as _k
 from bladelab.sim.chain import build_chain
 from bladelab.sim.mujoco_engine import MujocoBlade, build_spec
 from bladelab.trial.stance import Stance
@@ -182,7 +182,7 @@ def generate_stance(
     clamp_td = -p_low + np.array([0.0, 0.0])  # sole lowest point at the pivot (0, 0)
     hip_td = clamp_td + np.array([s * pylon_length_m, c * pylon_length_m])
     lead = max(0.010, margin_s + 0.002)  # start in flight, before the kept margin
-    g = _k.GRAVITY
+    g = STANDARD_GRAVITY
     v_td = np.array([speed_mps, touchdown_vertical_speed_mps])
     hip0 = hip_td - v_td * lead - np.array([0.0, 0.5 * g * lead**2])
     hip0[1] += 0.001  # 1 mm clearance
