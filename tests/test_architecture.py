@@ -23,7 +23,7 @@ ALLOWED: dict[str, set[str]] = {
     "stats": FOUNDATION,
     "study": FOUNDATION | {"trial", "blade", "sim", "identify"},
     "runner": FOUNDATION | {"blade", "sim"},
-    "predict": FOUNDATION | {"blade", "sim", "runner"},
+    "predict": FOUNDATION | {"trial", "blade", "sim", "runner"},
     "design": FOUNDATION | {"trial", "blade", "sim", "runner", "predict"},
     "example": FOUNDATION | {"trial", "blade", "sim", "identify", "study"},
     "report": FOUNDATION | {"trial", "blade", "sim", "identify", "mechanics", "stats", "study",

@@ -299,53 +299,30 @@ def gait_cycles_from_trial(
     DataError
         Missing markers or platforms, or no complete cycle of ``leg``.
     """
-    from scipy.interpolate import CubicSpline
-
-    from bladelab.trial.events import detect_stances
-    from bladelab.trial.joint_angles import sagittal_angles, stance_legs
+    from bladelab.trial.cycles import joint_angle_cycles
 
     if leg not in _OTHER:
         raise SpecError(f"leg must be 'left' or 'right', got {leg!r}", where="--leg")
     sound = _OTHER[leg]
-    src = trial.source or "trial"
-    events = detect_stances(trial) if stances is None else list(stances)
-    legs = stance_legs(trial, events, markers=markers)
-    ja = sagittal_angles(trial, markers=markers, static=static, cutoff_hz=cutoff_hz)
     names = {"hip_sound": f"hip_{sound}", "knee_sound": f"knee_{sound}",
              "ankle_sound": f"ankle_{sound}", "hip_prosthetic": f"hip_{leg}",
              "knee_prosthetic": f"knee_{leg}", "trunk_pitch": "trunk_pitch"}
-    if names["ankle_sound"] not in ja.angles:
+    measured = joint_angle_cycles(trial, leg=leg, markers=markers, static=static,
+                                  cutoff_hz=cutoff_hz, n=n, stances=stances,
+                                  max_period_s=max_period_s)
+    if names["ankle_sound"] not in measured[0].angles:
         raise DataError(f"the {sound} (sound) leg has no foot markers, so no ankle angle",
-                        file=src, where=f"{sound} foot",
+                        file=trial.source or "trial", where=f"{sound} foot",
                         hint="map foot_anterior / foot_posterior of the sound side")
-    t = ja.time
-    series = {}
-    for k, v in names.items():
-        a = ja.angles[v]
-        series[k] = CubicSpline(t, a) if np.all(np.isfinite(a)) else (
-            lambda x, a=a: np.interp(x, t, a, left=np.nan, right=np.nan))
-    mine = [i for i, s in enumerate(legs) if s == leg]
-    phase = np.arange(n) / n
     cycles = []
-    for i, j in zip(mine[:-1], mine[1:], strict=True):
-        a, b = events[i].start_s, events[j].start_s
-        between = sum(1 for s in legs[i + 1:j] if s == sound)
-        if b - a > max_period_s or between > 1 or j - i - 1 != between:
-            continue
-        tt = a + phase * (b - a)
-        if tt[0] < t[0] or b > t[-1]:
-            continue
-        vals = {k: np.asarray(f(tt), float) for k, f in series.items()}
-        if not all(np.all(np.isfinite(v)) for v in vals.values()):
-            continue
-        cycles.append(GaitCycle(float(b - a), phase, vals,
-                                f"{src}: {leg} touch-down at {a:.3f} s"))
+    for c in measured:
+        vals = {k: c.angles[v] for k, v in names.items()}
+        if all(np.all(np.isfinite(v)) for v in vals.values()):
+            cycles.append(GaitCycle(c.period, c.phase, vals, c.source))
     if not cycles:
-        n_leg = len(mine)
-        raise DataError(
-            f"no complete gait cycle of the {leg} leg ({n_leg} {leg} stance(s) among "
-            f"{len(events)})", file=src, where=f"{leg} leg",
-            hint="a cycle needs two consecutive touch-downs of the leg on force platforms")
+        raise DataError(f"every cycle of the {leg} leg has a marker gap",
+                        file=trial.source or "trial", where=f"{leg} leg",
+                        hint="fill the gaps, or use a trial with complete marker data")
     return cycles
 
 

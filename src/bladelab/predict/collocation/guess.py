@@ -1,0 +1,273 @@
+"""Initial guesses of one periodic stride for the collocation problems.
+
+A stride starts at a touch-down of the left leg (the intact leg of the amputee) and ends at its
+next one; a guess gives the runner's coordinates and speeds at ``n + 1`` equally spaced times
+(the last node one period after the first, pelvis_tx advanced by the stride length) and, when
+known, muscle activations and normalised tendon forces. Three sources:
+
+- :func:`template_guess`: a smooth template of running kinematics (sinusoidal hip, knee and
+  ankle angles with literature-typical ranges at 3–5 m/s, the other leg half a period later),
+  the pelvis lowered at every node until its lowest contact point touches the ground (a guess
+  that starts near the ground converges far better than a constant-height one, DESIGN.md);
+- :func:`guess_from_trial`: measured running (e.g. the Fukuchi et al. 2017 treadmill trial at
+  3.5 m/s): sagittal angles from markers (:mod:`bladelab.trial.cycles`), averaged over the
+  trial's left-leg cycles, the pelvis placed the same way; the amputee's socket held at 0;
+- :func:`guess_from_result`: a forward simulation (a reflex-controller solution re-simulated,
+  :func:`guess_from_reflex`): the last complete left-leg stride with its muscle states.
+
+Sign conventions are the runner model's (:mod:`bladelab.runner.model`): hip flexion +, knee
+0 straight and negative flexed, ankle dorsiflexion +, pelvis tilt + backward.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+from pathlib import Path
+
+import numpy as np
+
+from bladelab.errors import DataError, SpecError
+from bladelab.runner.model import RunnerModel, contact_heights
+
+__all__ = [
+    "StrideGuess",
+    "guess_from_reflex",
+    "guess_from_result",
+    "guess_from_trial",
+    "template_guess",
+]
+
+
+@dataclass(frozen=True)
+class StrideGuess:
+    """Coordinates and speeds of one stride at ``n + 1`` equally spaced nodes.
+
+    Attributes
+    ----------
+    source
+        Where the guess comes from (for reports).
+    period
+        Stride time [s].
+    q, qd
+        (n + 1, n_dof) coordinates [m, rad] and speeds [m/s, rad/s] in ``model.dof_names``
+        order; the last row is one period after the first.
+    activation, tendon_force
+        (n + 1, n_muscles) activations [-] and tendon forces normalised by Fmax [-], or None.
+    """
+
+    source: str
+    period: float
+    q: np.ndarray
+    qd: np.ndarray
+    activation: np.ndarray | None = None
+    tendon_force: np.ndarray | None = None
+
+    @property
+    def n_intervals(self) -> int:
+        """Mesh intervals n (nodes − 1)."""
+        return self.q.shape[0] - 1
+
+    @property
+    def speed(self) -> float:
+        """Mean forward speed [m/s] (pelvis travel over the period)."""
+        return float((self.q[-1, 0] - self.q[0, 0]) / self.period)
+
+    def resample(self, n: int) -> StrideGuess:
+        """The same stride on ``n`` intervals (periodic cubic interpolation of each column)."""
+        if n < 4:
+            raise SpecError(f"need at least 4 mesh intervals, got {n}", where="mesh intervals")
+        if n == self.n_intervals:
+            return self
+        old = np.linspace(0.0, 1.0, self.n_intervals + 1)
+        new = np.linspace(0.0, 1.0, n + 1)
+        return replace(
+            self,
+            q=_resample(self.q, old, new, advance=self.q[-1] - self.q[0]),
+            qd=_resample(self.qd, old, new),
+            activation=None if self.activation is None else _resample(self.activation, old, new),
+            tendon_force=None if self.tendon_force is None
+            else _resample(self.tendon_force, old, new),
+        )
+
+    def with_speed(self, speed: float) -> StrideGuess:
+        """The same stride at another mean speed [m/s]: the stride length scales with the
+        speed (same period), pelvis forward positions and speed accordingly."""
+        if not (speed > 0 and math.isfinite(speed)):
+            raise SpecError(f"speed must be > 0 m/s, got {speed}", where="speed")
+        q, qd = self.q.copy(), self.qd.copy()
+        scale = speed / self.speed
+        q[:, 0] = q[0, 0] + (q[:, 0] - q[0, 0]) * scale
+        qd[:, 0] *= scale
+        return replace(self, q=q, qd=qd, source=f"{self.source}, scaled to {speed:g} m/s")
+
+
+def _resample(y: np.ndarray, old: np.ndarray, new: np.ndarray,
+              advance: np.ndarray | None = None) -> np.ndarray:
+    """Periodic cubic interpolation of columns ``y`` (rows at ``old``) at ``new``; columns with
+    a net ``advance`` over the period (pelvis_tx) are interpolated after removing it."""
+    from scipy.interpolate import CubicSpline
+
+    drift = np.zeros(y.shape[1]) if advance is None else np.asarray(advance, float)
+    base = y - np.outer(old, drift)
+    base[-1] = base[0]  # exactly periodic once the advance is removed
+    return CubicSpline(old, base, bc_type="periodic")(new) + np.outer(new, drift)
+
+
+def _periodic_derivative(q: np.ndarray, period: float) -> np.ndarray:
+    """Time derivative of node values (last row = first + advance) by periodic central
+    differences [unit/s]."""
+    n = q.shape[0] - 1
+    h = period / n
+    body = q[:-1]
+    advance = q[-1] - q[0]
+    nxt = np.vstack([body[1:], body[:1] + advance])
+    prv = np.vstack([body[-1:] - advance, body[:-1]])
+    d = (nxt - prv) / (2 * h)
+    return np.vstack([d, d[:1]])
+
+
+def _grounded(model: RunnerModel, q: np.ndarray) -> np.ndarray:
+    """``q`` with pelvis_tz lowered (or raised) at every node until the lowest contact point is
+    on the ground."""
+    q = q.copy()
+    iz = model.dof("pelvis_tz")
+    for k in range(q.shape[0]):
+        q[k, iz] -= contact_heights(model, q[k]).min()
+    return q
+
+
+def _angles_to_q(model: RunnerModel, time_frac: np.ndarray, period: float, speed: float,
+                 angles: dict[str, np.ndarray]) -> np.ndarray:
+    """Model coordinates from sagittal angles [rad] (trial names: hip_left, knee_left (flexion
+    +), ankle_left, ..., trunk_pitch (forward lean +)) at fractions of the stride."""
+    q = np.zeros((time_frac.size, len(model.dof_names)))
+    q[:, model.dof("pelvis_tx")] = speed * period * time_frac
+    q[:, model.dof("pelvis_tilt")] = -angles.get("trunk_pitch", np.zeros(time_frac.size))
+    for side, s in (("left", "l"), ("right", "r")):
+        q[:, model.dof(f"hip_flexion_{s}")] = angles[f"hip_{side}"]
+        q[:, model.dof(f"knee_angle_{s}")] = -angles[f"knee_{side}"]
+        if f"ankle_angle_{s}" in model.dof_names:
+            q[:, model.dof(f"ankle_angle_{s}")] = angles[f"ankle_{side}"]
+    return _grounded(model, q)
+
+
+def template_guess(model: RunnerModel, *, speed: float = 3.5, n: int = 50,
+                   period: float | None = None) -> StrideGuess:
+    """A smooth template stride at ``speed`` [m/s] on ``n`` intervals (module docstring).
+
+    The period defaults to a typical stride time, 0.75 s at 3.5 m/s, shorter when faster
+    (stride frequency rising ~5 %/(m/s)).
+    """
+    if not (speed > 0 and math.isfinite(speed)):
+        raise SpecError(f"speed must be > 0 m/s, got {speed}", where="speed")
+    period = float(period) if period is not None else 0.75 / (1.0 + 0.05 * (speed - 3.5))
+    frac = np.linspace(0.0, 1.0, n + 1)
+    deg = math.pi / 180.0
+
+    def leg(phase: np.ndarray) -> dict[str, np.ndarray]:
+        w = 2 * math.pi * phase
+        # phase 0 = touch-down: hip flexed ~30°, knee ~15° flexed; swing knee flexion peaks
+        # ~100° at 70 % of the cycle; ankle dorsiflexed in stance, plantarflexed at toe-off
+        return {
+            "hip": deg * (10.0 + 25.0 * np.cos(w - 0.15)),
+            "knee": deg * (45.0 - 35.0 * np.cos(w - 4.3) + 15.0 * np.cos(2 * w - 1.2)),
+            "ankle": deg * (-5.0 + 15.0 * np.cos(w - 0.9)),
+        }
+
+    left, right = leg(frac), leg(frac + 0.5)
+    angles = {"trunk_pitch": np.full(frac.size, 5.0 * deg)}
+    for side, a in (("left", left), ("right", right)):
+        angles.update({f"hip_{side}": a["hip"], f"knee_{side}": a["knee"],
+                       f"ankle_{side}": a["ankle"]})
+    q = _angles_to_q(model, frac, period, speed, angles)
+    return StrideGuess(f"template at {speed:g} m/s", period, q, _periodic_derivative(q, period))
+
+
+def guess_from_trial(model: RunnerModel, path: str | Path, *, static: str | Path | None = None,
+                     n: int = 50, speed: float | None = None, markers=None) -> StrideGuess:
+    """The mean left-leg stride of a measured running trial (C3D with markers and force
+    platforms) on ``n`` intervals.
+
+    ``speed`` [m/s] is the treadmill's (or the runner's) mean speed: required, since a
+    treadmill trial's markers do not travel. ``static``: a standing trial, so that standing is
+    the model's zero posture.
+    """
+    from bladelab.trial import read_c3d
+    from bladelab.trial.cycles import joint_angle_cycles
+
+    if speed is None or not (speed > 0 and math.isfinite(speed)):
+        raise SpecError("a trial guess needs the running speed", where="speed",
+                        hint="give the treadmill speed in m/s (3.5 for RBDS001runT35)")
+    trial = read_c3d(path)
+    axes = trial.metadata.get("axes", {})
+    st = None
+    if static is not None:
+        st = read_c3d(static, forward=axes.get("forward", "auto"), up=axes.get("up", "auto"))
+    cycles = joint_angle_cycles(trial, leg="left", markers=markers, static=st, n=n)
+    names = [k for k in cycles[0].angles if k.split("_")[0] in ("hip", "knee", "ankle", "trunk")]
+    good = [c for c in cycles if all(np.all(np.isfinite(c.angles[k])) for k in names)]
+    if not good:
+        raise DataError("every left-leg cycle has a marker gap", file=path, where="left leg")
+    period = float(np.mean([c.period for c in good]))
+    mean = {k: np.mean([c.angles[k] for c in good], axis=0) for k in names}
+    closed = {k: np.append(v, v[0]) for k, v in mean.items()}  # node n = node 0 (periodic)
+    frac = np.linspace(0.0, 1.0, n + 1)
+    q = _angles_to_q(model, frac, period, speed, closed)
+    return StrideGuess(f"{Path(path).name}: mean of {len(good)} left-leg cycles at {speed:g} m/s",
+                       period, q, _periodic_derivative(q, period))
+
+
+def guess_from_result(result, *, n: int = 50) -> StrideGuess:
+    """The last complete left-leg stride of a forward simulation (a
+    :class:`~bladelab.runner.RunnerResult`) on ``n`` intervals, with its activations and
+    tendon forces (steps as :func:`bladelab.runner.analyses.step_touchdowns` counts them)."""
+    from bladelab.runner.analyses import step_touchdowns
+    from bladelab.runner.model import CP_LEG
+    from bladelab.runner.simulate import RC_FZ
+
+    model = result.model
+    cp = model.contact_params
+    forces = np.stack([result.contacts[:, cp[:, CP_LEG] == leg, RC_FZ].sum(axis=1)
+                       for leg in (0, 1)], axis=1)
+    left = [t for t, leg, _ in step_touchdowns(result.time, forces, model.body_weight)
+            if leg == 0]
+    if len(left) < 2:
+        raise DataError(f"the simulation has {len(left)} left-leg step(s); a stride needs two",
+                        where="guess from a simulation",
+                        hint="simulate longer, or use a solution that runs")
+    t0, t1 = left[-2], left[-1]
+    tt = np.linspace(t0, t1, n + 1)
+
+    def at(y: np.ndarray) -> np.ndarray:
+        return np.stack([np.interp(tt, result.time, y[:, j]) for j in range(y.shape[1])], axis=1)
+
+    fmax = model.muscle_params[:, 0]
+    return StrideGuess(
+        f"forward simulation, stride {t0:.3f}–{t1:.3f} s", float(t1 - t0),
+        at(result.qpos), at(result.qvel),
+        activation=at(result.muscles[:, :, 0]),
+        tendon_force=at(result.muscles[:, :, 3] / fmax),
+    )
+
+
+def guess_from_reflex(path: str | Path, *, n: int = 50, duration: float = 5.0) -> StrideGuess:
+    """Re-simulate a reflex-controller parameter file (its own model, blade, speed and settings)
+    for ``duration`` [s] and take :func:`guess_from_result` of it."""
+    import json
+
+    from bladelab.predict.reflex import (
+        read_parameters,
+        runner_and_layout,
+        simulate_controlled,
+        stored_settings,
+    )
+
+    data = json.loads(Path(path).read_text(encoding="utf-8"))
+    model, layout = runner_and_layout(data.get("model", "able"), data.get("blade"))
+    settings = stored_settings(data, speed=float(data.get("speed_m_per_s", 3.5)),
+                               duration=duration, nominal=True)
+    _, result = simulate_controlled(model, read_parameters(path, layout), layout=layout,
+                                    settings=settings, record_every=4)
+    guess = guess_from_result(result, n=n)
+    return replace(guess, source=f"{Path(path).name} re-simulated: {guess.source}")

@@ -1,0 +1,81 @@
+"""Initial guesses of a periodic stride (template, measured trial, forward simulation)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from bladelab.errors import SpecError
+from bladelab.predict.collocation.guess import (
+    guess_from_reflex,
+    guess_from_trial,
+    template_guess,
+)
+from bladelab.runner import build_runner
+from bladelab.runner.model import contact_heights
+
+FUKUCHI = Path(__file__).resolve().parents[1].parent / "shared/data/real/fukuchi2017"
+SOLUTIONS = Path(__file__).resolve().parents[1] / "src/bladelab/data/runner/solutions"
+
+
+@pytest.fixture(scope="module")
+def able():
+    return build_runner("able")
+
+
+def _check_stride(model, g, speed):
+    assert g.speed == pytest.approx(speed, rel=1e-9)
+    # periodic: the last node is the first one period later (pelvis advanced by the stride)
+    advance = np.zeros(g.q.shape[1])
+    advance[model.dof("pelvis_tx")] = speed * g.period
+    np.testing.assert_allclose(g.q[-1], g.q[0] + advance, atol=1e-9)
+    np.testing.assert_allclose(g.qd[-1], g.qd[0], atol=1e-9)
+    # the pelvis is placed so that the lowest contact point touches the ground at every node
+    lowest = np.array([contact_heights(model, q).min() for q in g.q])
+    np.testing.assert_allclose(lowest, 0.0, atol=1e-9)
+
+
+def test_template_is_a_periodic_grounded_stride(able):
+    g = template_guess(able, speed=4.0, n=40)
+    _check_stride(able, g, 4.0)
+    assert g.q.shape == (41, 10) and 0.6 < g.period < 0.8
+    # swing knee flexion of running (> 80°) and the legs half a period apart
+    knee = -np.degrees(g.q[:, able.dof("knee_angle_l")])
+    assert knee.max() > 80 and knee.min() < 25
+    right = -np.degrees(g.q[:, able.dof("knee_angle_r")])
+    np.testing.assert_allclose(np.roll(right[:-1], -20), knee[:-1], atol=1e-9)
+    with pytest.raises(SpecError, match="speed"):
+        template_guess(able, speed=0.0)
+
+
+def test_resampling_keeps_the_stride(able):
+    g = template_guess(able, speed=3.5, n=50)
+    back = g.resample(100).resample(50)
+    assert np.abs(back.q - g.q).max() < 1e-3
+    assert back.speed == pytest.approx(3.5)
+    faster = g.with_speed(4.5)
+    assert faster.speed == pytest.approx(4.5) and faster.period == g.period
+
+
+@pytest.mark.skipif(not (FUKUCHI / "RBDS001runT35.c3d").is_file(), reason="shared data absent")
+def test_guess_from_the_fukuchi_trial(able):
+    g = guess_from_trial(able, FUKUCHI / "RBDS001runT35.c3d",
+                         static=FUKUCHI / "RBDS001static.c3d", speed=3.5, n=50)
+    _check_stride(able, g, 3.5)
+    # 3.5 m/s treadmill running: stride ~0.70 s (the force platforms' touch-downs); knee
+    # nearly straight at touch-down, flexed > 90° in swing
+    assert 0.65 < g.period < 0.75 and "41 left-leg cycles" in g.source
+    knee = -np.degrees(g.q[:, able.dof("knee_angle_l")])
+    assert knee[0] < 25 and knee.max() > 90
+    with pytest.raises(SpecError, match="running speed"):
+        guess_from_trial(able, FUKUCHI / "RBDS001runT35.c3d")
+
+
+def test_guess_from_the_shipped_reflex_solution():
+    g = guess_from_reflex(SOLUTIONS / "able-3.5.json", n=30, duration=3.0)
+    assert g.q.shape == (31, 10) and g.activation.shape == (31, 24)
+    assert abs(g.speed - 3.5) < 0.2 and 0.6 < g.period < 0.85
+    assert g.activation.min() >= 0.01 - 1e-12 and g.activation.max() <= 1.0
+    assert g.tendon_force.min() >= 0.0 and g.tendon_force.max() < 2.0
