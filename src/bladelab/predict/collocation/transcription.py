@@ -1,0 +1,397 @@
+"""Trapezoidal direct collocation of one periodic stride (the NLP, CasADi MX + IPOPT).
+
+The stride (left touch-down to the next; both legs move, so an asymmetric amputee is
+represented whole) is cut into ``n`` equal intervals of the free period ``T``. At every node
+k = 0..n the NLP holds the states x = (q, q̇, a, F̃ₜ) — coordinates, speeds, muscle
+activations, tendon forces normalised by F_max — and the controls u = (q̈, e, dF̃ₜ/dt) —
+accelerations (implicit multibody dynamics), excitations, tendon-force rates (De Groote et al.
+2016). Constraints:
+
+- trapezoidal defects ``x_{k+1} − x_k − h/2·(ẋ_k + ẋ_{k+1})`` with ``h = T/n`` and
+  ``ẋ = (q̇, q̈, ȧ(e, a), dF̃ₜ/dt)``;
+- path residuals at k = 0..n−1 (node n repeats node 0): the multibody dynamics
+  ``M(q)·q̈ + C(q, q̇) − τ(q, q̇, F̃ₜ) = 0`` for every dof (the pelvis's three unactuated) and
+  the Hill equilibrium of every muscle, both from :class:`StrideDynamics`;
+- periodicity: node n equals node 0 except pelvis_tx, advanced by the stride length ``d``;
+  pelvis_tx = 0 at node 0;
+- the speed: ``d = v·T`` (prescribed speed) or ``d`` free (maximum speed).
+
+Objective (a setting, :class:`StrideWeights`): prescribed speed — metabolic energy per
+distance and body mass (cost of transport [J/(kg·m)]) plus time-averaged mean cubed activation
+and mean squared acceleration [(rad/s²)²] terms with small weights; maximum speed — the negative
+mean speed [m/s] plus the same effort terms. Every integral is the trapezoidal rule on the mesh.
+
+Variables are scaled (:class:`VariableScales`) so that IPOPT sees numbers of order one.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import asdict, dataclass, field
+
+import casadi as ca
+import numpy as np
+
+from bladelab.errors import SpecError
+
+__all__ = [
+    "NLPSolution",
+    "StrideDynamics",
+    "StrideNLP",
+    "StrideWeights",
+    "VariableScales",
+]
+
+
+@dataclass(frozen=True)
+class StrideDynamics:
+    """What the transcription needs of a model: sizes, names, bounds and node functions.
+
+    Attributes
+    ----------
+    dof_names, muscle_names
+        Names in array order (``model.dof_names``, ``model.muscle_names``).
+    mass, gravity
+        Total mass [kg] and gravity [m/s²].
+    residuals
+        CasADi Function (q, q̇, q̈, a, F̃ₜ, dF̃ₜ/dt) -> (multibody residual (n_dof,) [N or N·m],
+        Hill residual (n_muscles,) [-]).
+    activation_rate
+        CasADi Function (e, a) -> ȧ (n_muscles,) [1/s].
+    metabolic_rate
+        CasADi Function (q, q̇, a, F̃ₜ, dF̃ₜ/dt, e) -> whole-body metabolic rate [W].
+    q_bounds, qd_bounds
+        (n_dof, 2) bounds of coordinates [m, rad] and speeds [m/s, rad/s]; pelvis_tx's are
+        set by the transcription.
+    residual_scale
+        (n_dof,) typical size of each multibody residual [N or N·m] (constraint scaling).
+    """
+
+    dof_names: tuple[str, ...]
+    muscle_names: tuple[str, ...]
+    mass: float
+    gravity: float
+    residuals: ca.Function
+    activation_rate: ca.Function
+    metabolic_rate: ca.Function
+    q_bounds: np.ndarray
+    qd_bounds: np.ndarray
+    residual_scale: np.ndarray
+
+    @property
+    def nq(self) -> int:
+        return len(self.dof_names)
+
+    @property
+    def nm(self) -> int:
+        return len(self.muscle_names)
+
+
+@dataclass(frozen=True)
+class StrideWeights:
+    """Weights of the objective's terms (dimensionless multipliers of the stated terms).
+
+    Attributes
+    ----------
+    metabolic
+        Cost of transport [J/(kg·m)] (prescribed speed; 0 in a maximum-speed problem unless
+        set).
+    activation
+        Time-averaged mean cubed activation [-].
+    acceleration
+        Time-averaged mean squared joint acceleration, in (rad/s²)² / 1e4.
+    speed
+        Negative mean speed [m/s] (maximum-speed problem).
+    """
+
+    metabolic: float = 1.0
+    activation: float = 1.0
+    acceleration: float = 0.1
+    speed: float = 1.0
+
+    def to_dict(self) -> dict[str, float]:
+        return asdict(self)
+
+
+@dataclass(frozen=True)
+class VariableScales:
+    """Typical magnitudes: the NLP variables are the physical ones divided by these."""
+
+    q: float = 1.0  # m, rad
+    qd: float = 5.0  # m/s, rad/s
+    qdd: float = 100.0  # m/s², rad/s²
+    tendon_force_rate: float = 10.0  # 1/s
+    period: float = 1.0  # s
+
+
+@dataclass(frozen=True)
+class NLPSolution:
+    """The solution (or the last iterate) of a stride NLP.
+
+    Arrays have n + 1 rows (nodes at ``time``); ``tendon_force`` is normalised by F_max.
+    """
+
+    time: np.ndarray
+    q: np.ndarray
+    qd: np.ndarray
+    activation: np.ndarray
+    tendon_force: np.ndarray
+    qdd: np.ndarray
+    excitation: np.ndarray
+    tendon_force_rate: np.ndarray
+    period: float
+    objective: float
+    objective_terms: dict[str, float]
+    success: bool
+    status: str
+    iterations: int
+    wall_s: float
+    timings: dict[str, float] = field(default_factory=dict)
+    max_violation: float = math.nan
+    worst_constraints: tuple[tuple[str, float], ...] = ()
+
+    @property
+    def speed(self) -> float:
+        """Mean forward speed [m/s]."""
+        return float((self.q[-1, 0] - self.q[0, 0]) / self.period)
+
+
+class StrideNLP:
+    """The collocation NLP of one periodic stride.
+
+    Parameters
+    ----------
+    dynamics
+        The model's node functions (:class:`StrideDynamics`).
+    n
+        Mesh intervals.
+    speed
+        Prescribed mean speed [m/s], or None for the maximum-speed problem.
+    weights
+        Objective weights.
+    period_bounds
+        Bounds of the stride time [s].
+    scales
+        Variable scaling.
+    min_activation
+        Lower bound of activations and excitations [-] (the forward model's 0.01).
+    """
+
+    def __init__(
+        self,
+        dynamics: StrideDynamics,
+        *,
+        n: int = 50,
+        speed: float | None = 3.5,
+        weights: StrideWeights | None = None,
+        period_bounds: tuple[float, float] = (0.4, 1.2),
+        scales: VariableScales | None = None,
+        min_activation: float = 0.01,
+        max_tendon_force: float = 3.0,
+    ) -> None:
+        if n < 4:
+            raise SpecError(f"need at least 4 mesh intervals, got {n}", where="mesh intervals")
+        if speed is not None and not (speed > 0 and math.isfinite(speed)):
+            raise SpecError(f"speed must be > 0 m/s, got {speed}", where="speed")
+        self.dyn = dynamics
+        self.n = int(n)
+        self.speed = None if speed is None else float(speed)
+        self.weights = weights or StrideWeights(metabolic=0.0 if speed is None else 1.0)
+        self.scales = scales or VariableScales()
+        self.period_bounds = tuple(float(b) for b in period_bounds)
+        self.min_activation = float(min_activation)
+        self.max_tendon_force = float(max_tendon_force)
+        self._build()
+
+    # -- layout -------------------------------------------------------------------------
+    def _build(self) -> None:
+        d, n, s = self.dyn, self.n, self.scales
+        nq, nm = d.nq, d.nm
+        self.nx = 2 * nq + 2 * nm
+        self.nu = nq + 2 * nm
+        sx = np.concatenate([np.full(nq, s.q), np.full(nq, s.qd), np.ones(nm), np.ones(nm)])
+        su = np.concatenate([np.full(nq, s.qdd), np.ones(nm), np.full(nm, s.tendon_force_rate)])
+        self.sx, self.su = sx, su
+
+        xs = ca.SX.sym("x", self.nx)
+        us = ca.SX.sym("u", self.nu)
+        x, u = xs * sx, us * su
+        q, qd = x[:nq], x[nq:2 * nq]
+        a, fnt = x[2 * nq:2 * nq + nm], x[2 * nq + nm:]
+        qdd, e, dfnt = u[:nq], u[nq:nq + nm], u[nq + nm:]
+        r_mb, r_hill = d.residuals(q, qd, qdd, a, fnt, dfnt)
+        adot = d.activation_rate(e, a)
+        xdot_scaled = ca.vertcat(qd, qdd, adot, dfnt) / sx
+        path = ca.vertcat(r_mb / d.residual_scale, r_hill)
+        w = self.weights
+        effort = (w.activation * ca.sum1(a**3) / max(nm, 1)
+                  + w.acceleration * ca.sumsqr(qdd[3:]) / max(nq - 3, 1) / 1e4)
+        met = d.metabolic_rate(q, qd, a, fnt, dfnt, e)
+        node = ca.Function("node", [xs, us], [xdot_scaled, path, effort, met])
+        fmap = node.map(n + 1)
+
+        X = ca.MX.sym("X", self.nx, n + 1)
+        U = ca.MX.sym("U", self.nu, n + 1)
+        T = ca.MX.sym("T")
+        period = T * s.period
+        h = period / n
+        xdot, pth, eff, mets = fmap(X, U)
+        defects = X[:, 1:] - X[:, :-1] - h / 2 * (xdot[:, 1:] + xdot[:, :-1])
+        itx = d.dof_names.index("pelvis_tx")
+        shift = ca.MX.zeros(self.nx)
+        distance = (X[itx, n] - X[itx, 0]) * sx[itx]
+        shift[itx] = distance / sx[itx]
+        periodic = X[:, n] - X[:, 0] - shift
+        g = [ca.vec(defects), ca.vec(pth[:, :n]), periodic]
+        self._g_names = (
+            [f"defect {nm_}@{k}" for k in range(n) for nm_ in self._state_names()]
+            + [f"path {nm_}@{k}" for k in range(n) for nm_ in self._path_names()]
+            + [f"periodicity {nm_}" for nm_ in self._state_names()]
+        )
+        trap = (ca.sum2(eff[:, :-1]) + ca.sum2(eff[:, 1:])) / 2 * h  # ∫ effort dt
+        energy = (ca.sum2(mets[:, :-1]) + ca.sum2(mets[:, 1:])) / 2 * h  # ∫ Ė dt [J]
+        terms = {"effort": trap / period}
+        if self.speed is not None:
+            g.append(distance - self.speed * period)
+            self._g_names.append("speed")
+            terms["metabolic"] = w.metabolic * energy / (d.mass * self.speed * period)
+        else:
+            terms["speed"] = -w.speed * distance / period
+            if w.metabolic:
+                terms["metabolic"] = w.metabolic * energy / (d.mass * ca.fmax(distance, 1e-3))
+        J = sum(terms.values())
+        self._terms = ca.Function("terms", [X, U, T], list(terms.values()))
+        self._term_names = tuple(terms)
+        self._energy = ca.Function("energy", [X, U, T], [energy, distance])
+        w_all = ca.veccat(X, U, T)
+        self.nlp = {"x": w_all, "f": J, "g": ca.vertcat(*g)}
+        self.n_vars = int(w_all.numel())
+        self.n_cons = int(self.nlp["g"].numel())
+
+    def _state_names(self) -> list[str]:
+        d = self.dyn
+        return ([f"q {n}" for n in d.dof_names] + [f"qd {n}" for n in d.dof_names]
+                + [f"a {n}" for n in d.muscle_names] + [f"Ft {n}" for n in d.muscle_names])
+
+    def _path_names(self) -> list[str]:
+        d = self.dyn
+        return [f"dynamics {n}" for n in d.dof_names] + [f"hill {n}" for n in d.muscle_names]
+
+    # -- bounds and guess ---------------------------------------------------------------
+    def bounds(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """(lbx, ubx, lbg, ubg) of the scaled NLP."""
+        d, n = self.dyn, self.n
+        nq, nm = d.nq, d.nm
+        itx = d.dof_names.index("pelvis_tx")
+        lx = np.concatenate([d.q_bounds[:, 0], d.qd_bounds[:, 0], np.full(nm, self.min_activation),
+                             np.zeros(nm)])
+        ux = np.concatenate([d.q_bounds[:, 1], d.qd_bounds[:, 1], np.ones(nm),
+                             np.full(nm, self.max_tendon_force)])
+        lX = np.tile((lx / self.sx)[:, None], (1, n + 1))
+        uX = np.tile((ux / self.sx)[:, None], (1, n + 1))
+        lX[itx, :], uX[itx, :] = -np.inf, np.inf
+        lX[itx, 0] = uX[itx, 0] = 0.0
+        qdd_max = 1e4
+        lu = np.concatenate([np.full(nq, -qdd_max), np.full(nm, self.min_activation),
+                             np.full(nm, -1e3)]) / self.su
+        uu = np.concatenate([np.full(nq, qdd_max), np.ones(nm), np.full(nm, 1e3)]) / self.su
+        lU = np.tile(lu[:, None], (1, n + 1))
+        uU = np.tile(uu[:, None], (1, n + 1))
+        lT = self.period_bounds[0] / self.scales.period
+        uT = self.period_bounds[1] / self.scales.period
+        lbx = np.concatenate([lX.ravel(order="F"), lU.ravel(order="F"), [lT]])
+        ubx = np.concatenate([uX.ravel(order="F"), uU.ravel(order="F"), [uT]])
+        zeros = np.zeros(self.n_cons)
+        return lbx, ubx, zeros, zeros.copy()
+
+    def initial_vector(self, guess) -> np.ndarray:
+        """The scaled NLP vector of a :class:`~bladelab.predict.collocation.guess.StrideGuess`
+        (resampled to the mesh; activations 0.05 and tendon forces from a static estimate of
+        0.05 where the guess has none; accelerations by differentiating the speeds)."""
+        from bladelab.predict.collocation.guess import _periodic_derivative
+
+        d, n = self.dyn, self.n
+        g = guess.resample(n)
+        act = g.activation if g.activation is not None else np.full((n + 1, d.nm), 0.05)
+        ften = g.tendon_force if g.tendon_force is not None else np.full((n + 1, d.nm), 0.05)
+        act = np.clip(act, self.min_activation, 1.0)
+        ften = np.clip(ften, 0.0, self.max_tendon_force)
+        qdd = _periodic_derivative(np.vstack([g.qd[:-1], g.qd[:1]]), g.period)
+        dft = _periodic_derivative(np.vstack([ften[:-1], ften[:1]]), g.period)
+        X = np.hstack([g.q, g.qd, act, ften]).T / self.sx[:, None]
+        U = np.hstack([qdd, act, dft]).T / self.su[:, None]
+        return np.concatenate([X.ravel(order="F"), U.ravel(order="F"),
+                               [g.period / self.scales.period]])
+
+    # -- solve --------------------------------------------------------------------------
+    def solve(self, x0: np.ndarray, *, max_iter: int = 3000, tol: float = 1e-6,
+              print_level: int = 0, options: dict | None = None) -> NLPSolution:
+        """Solve with IPOPT (exact Hessian, MUMPS with METIS ordering, monotone barrier)."""
+        opts = {
+            "ipopt.max_iter": int(max_iter),
+            "ipopt.tol": float(tol),
+            "ipopt.constr_viol_tol": 1e-6,
+            "ipopt.print_level": int(print_level),
+            "ipopt.mu_strategy": "monotone",
+            "ipopt.linear_solver": "mumps",
+            "ipopt.mumps_pivot_order": 5,  # METIS
+            "ipopt.nlp_scaling_method": "gradient-based",
+            "ipopt.sb": "yes",  # no banner
+            "print_time": False,
+        }
+        opts.update(options or {})
+        t0 = time.perf_counter()
+        solver = ca.nlpsol("stride", "ipopt", self.nlp, opts)
+        t_build = time.perf_counter() - t0
+        lbx, ubx, lbg, ubg = self.bounds()
+        res = solver(x0=x0, lbx=lbx, ubx=ubx, lbg=lbg, ubg=ubg)
+        wall = time.perf_counter() - t0
+        stats = solver.stats()
+        return self.unpack(np.asarray(res["x"]).ravel(), stats, wall, t_build, lbg, ubg,
+                           np.asarray(res["g"]).ravel())
+
+    def unpack(self, w: np.ndarray, stats: dict, wall: float, t_build: float,
+               lbg: np.ndarray, ubg: np.ndarray, gval: np.ndarray) -> NLPSolution:
+        """An :class:`NLPSolution` from the scaled vector and IPOPT's statistics."""
+        d, n = self.dyn, self.n
+        nq, nm = d.nq, d.nm
+        nX, nU = self.nx * (n + 1), self.nu * (n + 1)
+        X = w[:nX].reshape((self.nx, n + 1), order="F") * self.sx[:, None]
+        U = w[nX:nX + nU].reshape((self.nu, n + 1), order="F") * self.su[:, None]
+        T = float(w[-1]) * self.scales.period
+        Xs = w[:nX].reshape((self.nx, n + 1), order="F")
+        Us = w[nX:nX + nU].reshape((self.nu, n + 1), order="F")
+        terms = [float(v) for v in self._terms(Xs, Us, w[-1])]
+        viol = np.maximum(lbg - gval, gval - ubg)
+        order = np.argsort(viol)[::-1][:5]
+        timings = {"build_s": t_build}
+        for key in ("t_wall_nlp_f", "t_wall_nlp_g", "t_wall_nlp_grad_f", "t_wall_nlp_jac_g",
+                    "t_wall_nlp_hess_l"):
+            if key in stats:
+                timings[key.replace("t_wall_", "") + "_s"] = float(stats[key])
+        for key in ("n_call_nlp_f", "n_call_nlp_g", "n_call_nlp_jac_g", "n_call_nlp_hess_l"):
+            if key in stats:
+                timings[key.replace("n_call_", "calls_")] = float(stats[key])
+        return NLPSolution(
+            time=np.linspace(0.0, T, n + 1),
+            q=X[:nq].T, qd=X[nq:2 * nq].T,
+            activation=X[2 * nq:2 * nq + nm].T, tendon_force=X[2 * nq + nm:].T,
+            qdd=U[:nq].T, excitation=U[nq:nq + nm].T, tendon_force_rate=U[nq + nm:].T,
+            period=T, objective=float(sum(terms)),
+            objective_terms=dict(zip(self._term_names, terms, strict=True)),
+            success=bool(stats.get("success", False)),
+            status=str(stats.get("return_status", "unknown")),
+            iterations=int(stats.get("iter_count", -1)),
+            wall_s=float(wall), timings=timings,
+            max_violation=float(viol.max()) if viol.size else 0.0,
+            worst_constraints=tuple((self._g_names[i], float(viol[i])) for i in order
+                                    if viol[i] > 0),
+        )
+
+    def energy_and_distance(self, sol: NLPSolution) -> tuple[float, float]:
+        """Metabolic energy [J] over the stride and the stride length [m]."""
+        Xs = np.hstack([sol.q, sol.qd, sol.activation, sol.tendon_force]).T / self.sx[:, None]
+        Us = np.hstack([sol.qdd, sol.excitation, sol.tendon_force_rate]).T / self.su[:, None]
+        e, dist = self._energy(Xs, Us, sol.period / self.scales.period)
+        return float(e), float(dist)

@@ -1,0 +1,65 @@
+"""The trapezoidal stride NLP on a toy model whose optimum is known."""
+
+from __future__ import annotations
+
+import casadi as ca
+import numpy as np
+import pytest
+
+from bladelab.errors import SpecError
+from bladelab.predict.collocation.guess import StrideGuess
+from bladelab.predict.collocation.transcription import StrideDynamics, StrideNLP
+
+M, G, K = 80.0, 9.81, 2.0e4  # kg, m/s², N/m
+
+
+def _toy() -> StrideDynamics:
+    """A mass on a smooth ground spring, carried forward at constant speed, with one 'muscle'
+    (force 500·F̃ₜ [N] upward, rigid: F̃ₜ = a) that costs 100·a² [W]."""
+    q, qd, qdd = (ca.SX.sym(n, 3) for n in ("q", "qd", "qdd"))
+    a, f, df, e = (ca.SX.sym(n, 1) for n in ("a", "f", "df", "e"))
+    grf = K * 0.5 * (-q[1] + ca.sqrt(q[1] ** 2 + 1e-8))
+    r_mb = ca.vertcat(M * qdd[0], M * qdd[1] + M * G - grf - 500 * f, qdd[2])
+    return StrideDynamics(
+        dof_names=("pelvis_tx", "pelvis_tz", "pelvis_tilt"), muscle_names=("push",), mass=M,
+        gravity=G,
+        residuals=ca.Function("r", [q, qd, qdd, a, f, df], [r_mb, f - a]),
+        activation_rate=ca.Function("ad", [e, a], [(e - a) * 50]),
+        metabolic_rate=ca.Function("met", [q, qd, a, f, df, e], [100 * a[0] ** 2]),
+        q_bounds=np.array([[-1, 1], [-0.5, 0.5], [-1, 1]]),
+        qd_bounds=np.array([[-10.0, 10.0]] * 3), residual_scale=np.full(3, M * G))
+
+
+def _bouncing_guess(n: int, speed: float) -> StrideGuess:
+    t = np.linspace(0, 0.6, n + 1)
+    w = 2 * np.pi / 0.6
+    q = np.stack([speed * t, 0.05 * np.sin(w * t), 0 * t], 1)
+    qd = np.stack([speed + 0 * t, 0.05 * w * np.cos(w * t), 0 * t], 1)
+    return StrideGuess("toy", 0.6, q, qd)
+
+
+def test_the_toy_settles_on_its_spring_at_the_prescribed_speed():
+    nlp = StrideNLP(_toy(), n=40, speed=2.0)
+    sol = nlp.solve(nlp.initial_vector(_bouncing_guess(40, 2.0)))
+    assert sol.success, sol.status
+    assert sol.speed == pytest.approx(2.0, rel=1e-8)
+    assert sol.max_violation < 1e-6
+    # the cheapest periodic motion: resting on the spring (static deflection m·g/k, the 0.01
+    # minimum activation's 5 N pushing up a little), muscle at its minimum
+    assert sol.q[:, 1] == pytest.approx(-(M * G - 5.0) / K, abs=2e-3)
+    assert sol.activation.max() < 0.02
+    # the objective is the cost of transport: ∫100·a² dt / (m·v·T)
+    energy, distance = nlp.energy_and_distance(sol)
+    assert distance == pytest.approx(2.0 * sol.period)
+    assert sol.objective_terms["metabolic"] == pytest.approx(energy / (M * distance))
+    # trapezoidal defects hold: q̇ integrates to q
+    dq = np.diff(sol.q, axis=0)
+    h = sol.period / 40
+    np.testing.assert_allclose(dq, h / 2 * (sol.qd[1:] + sol.qd[:-1]), atol=1e-7)
+
+
+def test_bad_settings_are_refused():
+    with pytest.raises(SpecError, match="mesh intervals"):
+        StrideNLP(_toy(), n=2)
+    with pytest.raises(SpecError, match="speed"):
+        StrideNLP(_toy(), speed=-1.0)
