@@ -34,6 +34,10 @@ MIN_ACTIVATION = 0.01
 FIBER_DAMPING = 0.1
 TENDON_REF_STRAIN = 0.04
 PASSIVE_STRAIN = 0.6
+FL_WIDTH = 0.56  # Geyer's force–length width [optimal lengths]
+FV_SHORTENING = 4.0  # Hill's shortening branch (1 + ṽ)/(1 − 4ṽ), a/F0 = 0.25
+FV_LENGTHENING = 10.0  # lengthening branch 1.5 − 0.5/(1 + 10ṽ)
+FV_ECCENTRIC = 1.5  # eccentric force plateau [Fmax]
 _LN_005 = math.log(0.05)
 
 # Columns of the muscle parameter array ``mp`` (one row per muscle).
@@ -45,7 +49,7 @@ MS_ACT, MS_LCE, MS_VCE, MS_FORCE = 0, 1, 2, 3
 @njit(cache=True)
 def force_length(l_norm: float) -> float:
     """Active force–length factor f_l [-] of the normalised fibre length."""
-    x = abs((l_norm - 1.0) / 0.56)
+    x = abs((l_norm - 1.0) / FL_WIDTH)
     return math.exp(_LN_005 * x * x * x)
 
 
@@ -55,8 +59,8 @@ def force_velocity(v_norm: float) -> float:
     if v_norm <= 0.0:
         if v_norm <= -1.0:
             return 0.0
-        return (1.0 + v_norm) / (1.0 - 4.0 * v_norm)
-    return 1.5 - 0.5 / (1.0 + 10.0 * v_norm)
+        return (1.0 + v_norm) / (1.0 - FV_SHORTENING * v_norm)
+    return FV_ECCENTRIC - (FV_ECCENTRIC - 1.0) / (1.0 + FV_LENGTHENING * v_norm)
 
 
 @njit(cache=True)

@@ -32,6 +32,7 @@ from bladelab.runner.model import RunnerModel, contact_heights
 
 __all__ = [
     "StrideGuess",
+    "periodic_derivative",
     "guess_from_reflex",
     "guess_from_result",
     "guess_from_trial",
@@ -114,7 +115,7 @@ def _resample(y: np.ndarray, old: np.ndarray, new: np.ndarray,
     return CubicSpline(old, base, bc_type="periodic")(new) + np.outer(new, drift)
 
 
-def _periodic_derivative(q: np.ndarray, period: float) -> np.ndarray:
+def periodic_derivative(q: np.ndarray, period: float) -> np.ndarray:
     """Time derivative of node values (last row = first + advance) by periodic central
     differences [unit/s]."""
     n = q.shape[0] - 1
@@ -181,7 +182,7 @@ def template_guess(model: RunnerModel, *, speed: float = 3.5, n: int = 50,
         angles.update({f"hip_{side}": a["hip"], f"knee_{side}": a["knee"],
                        f"ankle_{side}": a["ankle"]})
     q = _angles_to_q(model, frac, period, speed, angles)
-    return StrideGuess(f"template at {speed:g} m/s", period, q, _periodic_derivative(q, period))
+    return StrideGuess(f"template at {speed:g} m/s", period, q, periodic_derivative(q, period))
 
 
 def guess_from_trial(model: RunnerModel, path: str | Path, *, static: str | Path | None = None,
@@ -215,7 +216,7 @@ def guess_from_trial(model: RunnerModel, path: str | Path, *, static: str | Path
     frac = np.linspace(0.0, 1.0, n + 1)
     q = _angles_to_q(model, frac, period, speed, closed)
     return StrideGuess(f"{Path(path).name}: mean of {len(good)} left-leg cycles at {speed:g} m/s",
-                       period, q, _periodic_derivative(q, period))
+                       period, q, periodic_derivative(q, period))
 
 
 def guess_from_result(result, *, n: int = 50) -> StrideGuess:

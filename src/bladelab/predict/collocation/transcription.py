@@ -66,6 +66,10 @@ class StrideDynamics:
         set by the transcription.
     residual_scale
         (n_dof,) typical size of each multibody residual [N or N·m] (constraint scaling).
+    inequalities, inequality_bounds
+        Optional path inequalities: a CasADi Function (q, q̇, a, F̃ₜ, dF̃ₜ/dt) -> (n_ineq,) and
+        their (n_ineq, 2) lower and upper bounds, imposed at every node (e.g. the normalised
+        fibre velocities within [−1, 1], the domain of the force–velocity curve).
     """
 
     dof_names: tuple[str, ...]
@@ -78,6 +82,8 @@ class StrideDynamics:
     q_bounds: np.ndarray
     qd_bounds: np.ndarray
     residual_scale: np.ndarray
+    inequalities: ca.Function | None = None
+    inequality_bounds: np.ndarray | None = None
 
     @property
     def nq(self) -> int:
@@ -176,6 +182,14 @@ class StrideNLP:
         Variable scaling.
     min_activation
         Lower bound of activations and excitations [-] (the forward model's 0.01).
+    min_tendon_force, max_tendon_force
+        Bounds of the normalised tendon forces [-] (> 0: the inverse tendon curve of the
+        De Groote formulation diverges at 0).
+    tracking
+        ``(q_ref, weight)``: add ``weight`` × the time-averaged mean squared deviation [rad²]
+        of the joint angles (pelvis tilt and the joints, not the pelvis translations) from
+        ``q_ref`` ((n + 1, n_dof), nodes of the mesh) — a tracking problem that makes a guess
+        dynamically consistent before the predictive solve.
     """
 
     def __init__(
@@ -188,7 +202,9 @@ class StrideNLP:
         period_bounds: tuple[float, float] = (0.4, 1.2),
         scales: VariableScales | None = None,
         min_activation: float = 0.01,
+        min_tendon_force: float = 1e-3,
         max_tendon_force: float = 3.0,
+        tracking: tuple[np.ndarray, float] | None = None,
     ) -> None:
         if n < 4:
             raise SpecError(f"need at least 4 mesh intervals, got {n}", where="mesh intervals")
@@ -201,7 +217,9 @@ class StrideNLP:
         self.scales = scales or VariableScales()
         self.period_bounds = tuple(float(b) for b in period_bounds)
         self.min_activation = float(min_activation)
+        self.min_tendon_force = float(min_tendon_force)
         self.max_tendon_force = float(max_tendon_force)
+        self.tracking = tracking
         self._build()
 
     # -- layout -------------------------------------------------------------------------
@@ -228,7 +246,10 @@ class StrideNLP:
         effort = (w.activation * ca.sum1(a**3) / max(nm, 1)
                   + w.acceleration * ca.sumsqr(qdd[3:]) / max(nq - 3, 1) / 1e4)
         met = d.metabolic_rate(q, qd, a, fnt, dfnt, e)
-        node = ca.Function("node", [xs, us], [xdot_scaled, path, effort, met])
+        ineq = (d.inequalities(q, qd, a, fnt, dfnt) if d.inequalities is not None
+                else ca.SX.zeros(0, 1))
+        self.n_ineq = int(ineq.numel())
+        node = ca.Function("node", [xs, us], [xdot_scaled, path, effort, met, ineq])
         fmap = node.map(n + 1)
 
         X = ca.MX.sym("X", self.nx, n + 1)
@@ -236,18 +257,19 @@ class StrideNLP:
         T = ca.MX.sym("T")
         period = T * s.period
         h = period / n
-        xdot, pth, eff, mets = fmap(X, U)
+        xdot, pth, eff, mets, ineqs = fmap(X, U)
         defects = X[:, 1:] - X[:, :-1] - h / 2 * (xdot[:, 1:] + xdot[:, :-1])
         itx = d.dof_names.index("pelvis_tx")
-        shift = ca.MX.zeros(self.nx)
         distance = (X[itx, n] - X[itx, 0]) * sx[itx]
-        shift[itx] = distance / sx[itx]
-        periodic = X[:, n] - X[:, 0] - shift
+        # periodic: every state but pelvis_tx, which advances by the stride length `distance`
+        keep = [i for i in range(self.nx) if i != itx]
+        periodic = X[keep, n] - X[keep, 0]
         g = [ca.vec(defects), ca.vec(pth[:, :n]), periodic]
+        state_names = self._state_names()
         self._g_names = (
-            [f"defect {nm_}@{k}" for k in range(n) for nm_ in self._state_names()]
+            [f"defect {nm_}@{k}" for k in range(n) for nm_ in state_names]
             + [f"path {nm_}@{k}" for k in range(n) for nm_ in self._path_names()]
-            + [f"periodicity {nm_}" for nm_ in self._state_names()]
+            + [f"periodicity {state_names[i]}" for i in keep]
         )
         trap = (ca.sum2(eff[:, :-1]) + ca.sum2(eff[:, 1:])) / 2 * h  # ∫ effort dt
         energy = (ca.sum2(mets[:, :-1]) + ca.sum2(mets[:, 1:])) / 2 * h  # ∫ Ė dt [J]
@@ -260,6 +282,19 @@ class StrideNLP:
             terms["speed"] = -w.speed * distance / period
             if w.metabolic:
                 terms["metabolic"] = w.metabolic * energy / (d.mass * ca.fmax(distance, 1e-3))
+        if self.tracking is not None:
+            q_ref, weight = self.tracking
+            q_ref = np.asarray(q_ref, float)
+            if q_ref.shape != (n + 1, nq):
+                raise SpecError(f"tracking reference has shape {q_ref.shape}, the mesh needs "
+                                f"{(n + 1, nq)}", where="tracking")
+            dev = (X[2:nq, :] * sx[2:nq, None] - q_ref[:, 2:].T) ** 2
+            per_node = ca.sum1(dev) / (nq - 2)
+            terms["tracking"] = float(weight) * (ca.sum2(per_node[:, :-1])
+                                                 + ca.sum2(per_node[:, 1:])) / (2 * n)
+        if self.n_ineq:
+            g.append(ca.vec(ineqs[:, :n]))
+            self._g_names += [f"inequality {i}@{k}" for k in range(n) for i in range(self.n_ineq)]
         J = sum(terms.values())
         self._terms = ca.Function("terms", [X, U, T], list(terms.values()))
         self._term_names = tuple(terms)
@@ -285,7 +320,7 @@ class StrideNLP:
         nq, nm = d.nq, d.nm
         itx = d.dof_names.index("pelvis_tx")
         lx = np.concatenate([d.q_bounds[:, 0], d.qd_bounds[:, 0], np.full(nm, self.min_activation),
-                             np.zeros(nm)])
+                             np.full(nm, self.min_tendon_force)])
         ux = np.concatenate([d.q_bounds[:, 1], d.qd_bounds[:, 1], np.ones(nm),
                              np.full(nm, self.max_tendon_force)])
         lX = np.tile((lx / self.sx)[:, None], (1, n + 1))
@@ -302,23 +337,27 @@ class StrideNLP:
         uT = self.period_bounds[1] / self.scales.period
         lbx = np.concatenate([lX.ravel(order="F"), lU.ravel(order="F"), [lT]])
         ubx = np.concatenate([uX.ravel(order="F"), uU.ravel(order="F"), [uT]])
-        zeros = np.zeros(self.n_cons)
-        return lbx, ubx, zeros, zeros.copy()
+        lbg, ubg = np.zeros(self.n_cons), np.zeros(self.n_cons)
+        if self.n_ineq:
+            b = np.asarray(d.inequality_bounds, float)
+            lbg[-self.n_ineq * n:] = np.tile(b[:, 0], n)
+            ubg[-self.n_ineq * n:] = np.tile(b[:, 1], n)
+        return lbx, ubx, lbg, ubg
 
     def initial_vector(self, guess) -> np.ndarray:
         """The scaled NLP vector of a :class:`~bladelab.predict.collocation.guess.StrideGuess`
         (resampled to the mesh; activations 0.05 and tendon forces from a static estimate of
         0.05 where the guess has none; accelerations by differentiating the speeds)."""
-        from bladelab.predict.collocation.guess import _periodic_derivative
+        from bladelab.predict.collocation.guess import periodic_derivative
 
         d, n = self.dyn, self.n
         g = guess.resample(n)
         act = g.activation if g.activation is not None else np.full((n + 1, d.nm), 0.05)
         ften = g.tendon_force if g.tendon_force is not None else np.full((n + 1, d.nm), 0.05)
         act = np.clip(act, self.min_activation, 1.0)
-        ften = np.clip(ften, 0.0, self.max_tendon_force)
-        qdd = _periodic_derivative(np.vstack([g.qd[:-1], g.qd[:1]]), g.period)
-        dft = _periodic_derivative(np.vstack([ften[:-1], ften[:1]]), g.period)
+        ften = np.clip(ften, self.min_tendon_force, self.max_tendon_force)
+        qdd = periodic_derivative(np.vstack([g.qd[:-1], g.qd[:1]]), g.period)
+        dft = periodic_derivative(np.vstack([ften[:-1], ften[:1]]), g.period)
         X = np.hstack([g.q, g.qd, act, ften]).T / self.sx[:, None]
         U = np.hstack([qdd, act, dft]).T / self.su[:, None]
         return np.concatenate([X.ravel(order="F"), U.ravel(order="F"),
@@ -338,6 +377,7 @@ class StrideNLP:
             "ipopt.mumps_pivot_order": 5,  # METIS
             "ipopt.nlp_scaling_method": "gradient-based",
             "ipopt.sb": "yes",  # no banner
+            "expand": True,  # SX graph: about 10x faster iterations than MX (measured)
             "print_time": False,
         }
         opts.update(options or {})

@@ -1,0 +1,25 @@
+"""Predictive running by direct collocation: the CasADi side of the runner model.
+
+The model layer (issue 15, "same model on both sides"): :func:`build_collocation_model` derives,
+from the very :class:`bladelab.runner.RunnerModel` that the forward simulation runs, CasADi
+Functions of the planar multibody dynamics (implicit inverse dynamics, exact against MuJoCo's
+``mj_inverse``), the muscle paths (lengths, velocities, moment arms, exact against
+:func:`bladelab.runner.kernel.path_kinematics`), smooth Hunt–Crossley contact with smooth
+friction, smooth ligaments and socket, and De Groote et al. (2016) muscle–tendon dynamics with
+the forward Hill model's curves. Numeric code (:mod:`.planar`, reading the MuJoCo model) and
+symbolic code (:mod:`.multibody`, :mod:`.paths`, :mod:`.contact`, :mod:`.muscles`) are kept
+apart. What is exact and what is smoothed, by how much: ``docs/collocation.md``.
+"""
+
+from bladelab.predict.collocation.model import CollocationModel, build_collocation_model
+from bladelab.predict.collocation.planar import PlanarJoint, PlanarTree, planar_tree
+from bladelab.predict.collocation.smooth import Smoothing
+
+__all__ = [
+    "CollocationModel",
+    "PlanarJoint",
+    "PlanarTree",
+    "Smoothing",
+    "build_collocation_model",
+    "planar_tree",
+]

@@ -1,0 +1,83 @@
+"""The node functions of the stride NLP, assembled from a :class:`CollocationModel`.
+
+:func:`stride_dynamics` turns the model layer into the :class:`StrideDynamics` that the
+transcription needs: the multibody residual ``M·q̈ + C − τ_muscle − τ_passive − τ_contact``,
+the fibre–tendon equilibrium of every muscle, the normalised fibre velocities kept within
+[−1, 1] (the force–velocity curve's domain), the activation rate, the smooth metabolic rate
+and the bounds of coordinates and speeds (the model's ligament ranges widened, so that the
+ligaments, not the bounds, limit the joints).
+"""
+
+from __future__ import annotations
+
+import math
+
+import casadi as ca
+import numpy as np
+
+from bladelab.predict.collocation.metabolics import MetabolicSmoothing, metabolic_rate
+from bladelab.predict.collocation.model import CollocationModel
+from bladelab.predict.collocation.transcription import StrideDynamics
+from bladelab.runner.muscle import MP_LOPT, V_MAX_OPT_PER_S
+
+__all__ = ["COORDINATE_BOUNDS_DEG", "stride_dynamics"]
+
+#: Bounds of the rotational coordinates [deg] (pelvis translations: :data:`PELVIS_BOUNDS_M`).
+COORDINATE_BOUNDS_DEG: dict[str, tuple[float, float]] = {
+    "pelvis_tilt": (-60.0, 30.0),
+    "hip_flexion": (-60.0, 130.0),
+    "knee_angle": (-150.0, 5.0),
+    "ankle_angle": (-70.0, 70.0),
+    "socket_angle": (-30.0, 30.0),
+    "lumbar_extension": (-30.0, 30.0),
+}
+PELVIS_BOUNDS_M = {"pelvis_tx": (-math.inf, math.inf), "pelvis_tz": (0.4, 1.4)}
+SPEED_BOUNDS = {"pelvis_tx": (0.0, 12.0), "pelvis_tz": (-4.0, 4.0)}  # m/s
+MAX_ANGULAR_SPEED = 40.0  # rad/s
+
+
+def _bounds(dof_names) -> tuple[np.ndarray, np.ndarray]:
+    q, qd = [], []
+    for name in dof_names:
+        if name in PELVIS_BOUNDS_M:
+            q.append(PELVIS_BOUNDS_M[name])
+            qd.append(SPEED_BOUNDS[name])
+            continue
+        base = name[:-2] if name.endswith(("_l", "_r")) else name
+        lo, hi = COORDINATE_BOUNDS_DEG.get(base, (-90.0, 90.0))
+        q.append((math.radians(lo), math.radians(hi)))
+        qd.append((-MAX_ANGULAR_SPEED, MAX_ANGULAR_SPEED))
+    return np.array(q), np.array(qd)
+
+
+def stride_dynamics(cm: CollocationModel, *,
+                    metabolic: MetabolicSmoothing | None = None) -> StrideDynamics:
+    """The :class:`StrideDynamics` of a collocation model (see the module docstring)."""
+    runner = cm.runner
+    nv, nm = cm.nv, cm.n_muscles
+    q, qd, qdd = ca.SX.sym("q", nv), ca.SX.sym("qd", nv), ca.SX.sym("qdd", nv)
+    a, ft, dft, u = (ca.SX.sym(n, nm) for n in ("a", "ft", "dft", "u"))
+    l_mt, v_mt = cm.mtu(q, qd)
+    r_mb = cm.dynamics_residual(q, qd, qdd, ft)
+    r_hill = cm.muscle_residual(a, ft, dft, l_mt, v_mt)
+    met = metabolic_rate(runner, u, a, ft, dft, l_mt, v_mt, cm.smoothing, metabolic)
+    _, v_m, _ = cm.fiber(l_mt, v_mt, ft, dft)
+    v_norm = v_m / (V_MAX_OPT_PER_S * ca.DM(runner.muscle_params[:, MP_LOPT]))
+    q_b, qd_b = _bounds(runner.dof_names)
+    weight = runner.total_mass * runner.gravity
+    scale = np.array([weight if n.startswith("pelvis_t") and n != "pelvis_tilt" else 100.0
+                      for n in runner.dof_names])
+    return StrideDynamics(
+        dof_names=tuple(runner.dof_names),
+        muscle_names=tuple(runner.muscle_names),
+        mass=float(runner.total_mass),
+        gravity=float(runner.gravity),
+        residuals=ca.Function("residuals", [q, qd, qdd, a, ft, dft], [r_mb, r_hill]),
+        activation_rate=cm.activation_rate,
+        metabolic_rate=ca.Function("metabolic_rate", [q, qd, a, ft, dft, u], [met]),
+        q_bounds=q_b,
+        qd_bounds=qd_b,
+        residual_scale=scale,
+        inequalities=ca.Function("fibre_velocity", [q, qd, a, ft, dft], [v_norm]),
+        inequality_bounds=np.tile([-1.0, 1.0], (nm, 1)),
+    )

@@ -1,0 +1,106 @@
+"""Smooth whole-body metabolic rate for collocation: the forward model's Uchida et al. (2016) /
+Umberger (2003) model (:mod:`bladelab.runner.metabolics`) with its switches made smooth.
+
+The same equations and constants as the forward model; every ``if`` becomes a sigmoid of width
+``w`` in the switching variable and every ``max`` a softplus:
+
+- ``A = u`` when ``u > a``, else ``(u + a)/2``: blended by ``sigmoid(u − a, w_a)``;
+- ``l̃ > 1`` factors (``0.4 + 0.6·f_l`` on the activation–maintenance heat, ``f_l`` on the
+  shortening heat): blended by ``sigmoid(l̃ − 1, w_l)``;
+- shortening (ṽ ≤ 0) and lengthening heat: blended by ``sigmoid(ṽ, w_v)``;
+- the 1 W/kg floor of the heat rate: ``1 + softplus(heat − 1, w_h)``;
+- ``A^0.6`` is smooth on the NLP's domain (A ≥ 0.01, the minimum activation).
+
+Mechanical work rate ``−F_ce·v_ce`` with the active fibre force ``F_ce = F_T/cos α − f_p·F_max``
+(negative work included, as Uchida 2016), fibre state from
+:func:`bladelab.predict.collocation.muscles.fiber_kinematics`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import casadi as ca
+import numpy as np
+
+from bladelab.predict.collocation import muscles
+from bladelab.predict.collocation.smooth import Smoothing, sigmoid, softplus
+from bladelab.runner.metabolics import (
+    AEROBIC_SCALE,
+    BASAL_RATE_W_PER_KG,
+    MB_FT,
+    MB_MASS,
+    MIN_HEAT_RATE_W_PER_KG,
+    metabolic_params,
+)
+from bladelab.runner.muscle import MP_FMAX, MP_LOPT, V_MAX_OPT_PER_S
+
+__all__ = ["MetabolicSmoothing", "metabolic_rate"]
+
+
+@dataclass(frozen=True)
+class MetabolicSmoothing:
+    """Widths of the metabolic model's smooth switches.
+
+    Attributes
+    ----------
+    excitation
+        In ``u − a`` [-].
+    length
+        In ``l̃ − 1`` [-] (optimal lengths).
+    velocity
+        In ``ṽ`` [l_opt/s].
+    heat_w_per_kg
+        Of the heat-rate floor [W/kg].
+    """
+
+    excitation: float = 0.01
+    length: float = 0.01
+    velocity: float = 0.05
+    heat_w_per_kg: float = 0.1
+
+
+def metabolic_rate(runner, u, a, ft, dft, l_mt, v_mt, smoothing: Smoothing,
+                   widths: MetabolicSmoothing | None = None):
+    """Whole-body metabolic rate [W] (basal + Σ muscles) as a CasADi expression.
+
+    Parameters
+    ----------
+    runner
+        The :class:`~bladelab.runner.RunnerModel` (muscle and metabolic parameters).
+    u, a, ft, dft
+        Excitations, activations, normalised tendon forces and their rates (n_muscles,).
+    l_mt, v_mt
+        MTU lengths [m] and lengthening velocities [m/s] (n_muscles,).
+    smoothing
+        The model's smoothing (fibre kinematics, passive curve).
+    widths
+        Widths of the metabolic switches (default :class:`MetabolicSmoothing`).
+    """
+    w = widths or MetabolicSmoothing()
+    mp = runner.muscle_params
+    mb = metabolic_params(runner)
+    mass, ftp = ca.DM(mb[:, MB_MASS]), ca.DM(mb[:, MB_FT])
+    l_opt, fmax = ca.DM(mp[:, MP_LOPT]), ca.DM(mp[:, MP_FMAX])
+    l_m, v_m, cos_a = muscles.fiber_kinematics(mp, l_mt, v_mt, ft, dft, smoothing)
+    ln = l_m / l_opt
+    vn = v_m / l_opt  # optimal lengths per second (< 0 shortening)
+    big_a = a + (u - a) * (0.5 + 0.5 * sigmoid(u - a, w.excitation))  # u if u > a else (u+a)/2
+    f_iso = muscles.force_length(ln)
+    long = sigmoid(ln - 1.0, w.length)
+    h_am = (1.28 * ftp + 25.0) * big_a**0.6 * AEROBIC_SCALE
+    h_am = h_am * (1.0 + long * (0.4 + 0.6 * f_iso - 1.0))
+    vmax_st = V_MAX_OPT_PER_S / (1.0 + 1.5 * ftp / 100.0)
+    alpha_st = 100.0 / vmax_st
+    alpha_ft = 153.0 / (2.5 * vmax_st)
+    h_short = (-alpha_st * vn * (100.0 - ftp) / 100.0 - alpha_ft * vn * ftp / 100.0) \
+        * big_a**2 * AEROBIC_SCALE
+    h_short = h_short * (1.0 + long * (f_iso - 1.0))
+    h_long = 4.0 * alpha_st * vn * big_a * AEROBIC_SCALE
+    lengthening = sigmoid(vn, w.velocity)
+    heat = h_am + (1.0 - lengthening) * h_short + lengthening * h_long
+    heat = MIN_HEAT_RATE_W_PER_KG + softplus(heat - MIN_HEAT_RATE_W_PER_KG, w.heat_w_per_kg)
+    f_ce = fmax * ft / cos_a - muscles.passive_force(ln, smoothing) * fmax
+    work = -f_ce * v_m / mass
+    body_mass = float(np.sum(runner.mj_model.body_mass))
+    return BASAL_RATE_W_PER_KG * body_mass + ca.sum1((heat + work) * mass)

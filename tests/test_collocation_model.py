@@ -1,0 +1,386 @@
+"""Issue 15, "same model on both sides": the CasADi collocation model equals the forward model
+(MuJoCo + bladelab's numba kernels) at random states, exactly or within the stated bounds of
+its smooth approximations (bladelab.predict.collocation.bounds, docs/collocation.md)."""
+
+from __future__ import annotations
+
+import casadi as ca
+import mujoco
+import numpy as np
+import pytest
+
+from bladelab.blade import load_blade
+from bladelab.contact import hunt_crossley_force, smooth_spring_damper_force
+from bladelab.predict.collocation import Smoothing, build_collocation_model
+from bladelab.predict.collocation.bounds import (
+    hunt_crossley_bound,
+    ligament_bound,
+    sliding_friction_bound,
+    socket_bound,
+    spring_damper_bound,
+)
+from bladelab.runner.kernel import forces, mujoco_views, path_kinematics
+from bladelab.runner.model import (
+    CP_BLADE,
+    CP_BODY,
+    CP_C,
+    CP_DAMP,
+    CP_EXP,
+    CP_K,
+    CP_LAW,
+    CP_MU,
+    CP_WIDTH,
+    JP_D,
+    JP_HI,
+    JP_K,
+    JP_LO,
+    JP_SK2,
+    build_runner,
+    contact_heights,
+)
+from bladelab.runner.muscle import (
+    FIBER_DAMPING,
+    TENDON_REF_STRAIN,
+    equilibrium_fiber_length,
+    force_length,
+    force_velocity,
+    muscle_step,
+    passive_force,
+    tendon_force,
+    tendon_force_of_state,
+)
+
+N_STATES = 20
+KINDS = ("able", "amputee-Cat6")
+SM = Smoothing()
+
+
+@pytest.fixture(scope="module")
+def models():
+    """The forward runners and their collocation models, built once."""
+    out = {}
+    for kind in KINDS:
+        runner = build_runner("able") if kind == "able" else build_runner("amputee", blade="Cat6")
+        out[kind] = (runner, build_collocation_model(runner))
+    return out
+
+
+def _states(runner, seed: int):
+    """20 random poses, velocities and accelerations around the standing pose."""
+    rng = np.random.default_rng(seed)
+    nv = runner.mj_model.nv
+    for _ in range(N_STATES):
+        q = runner.stand_qpos + rng.normal(0.0, 0.4, nv)
+        yield q, rng.normal(0.0, 2.0, nv), rng.normal(0.0, 20.0, nv)
+
+
+def _np(x) -> np.ndarray:
+    return np.array(x, dtype=np.float64)
+
+
+# ---------------------------------------------------------------- (a) multibody dynamics
+
+
+@pytest.mark.parametrize("kind", KINDS)
+def test_inverse_dynamics_equals_mj_inverse(models, kind):
+    runner, cm = models[kind]
+    m = runner.mj_model
+    assert not (m.dof_armature.any() or m.dof_damping.any() or m.dof_frictionloss.any())
+    assert cm.tree.gravity[1] == pytest.approx(-runner.gravity)
+    d = mujoco.MjData(m)
+    worst = 0.0
+    for q, qd, qdd in _states(runner, 1):
+        d.qpos[:], d.qvel[:], d.qacc[:] = q, qd, qdd
+        mujoco.mj_inverse(m, d)
+        tau = _np(cm.inverse_dynamics(q, qd, qdd)).ravel()
+        worst = max(worst, np.abs(tau - d.qfrc_inverse).max() / np.abs(d.qfrc_inverse).max())
+        full = np.zeros((m.nv, m.nv))
+        mujoco.mj_fullM(m, d, full)
+        np.testing.assert_allclose(_np(cm.mass_matrix(q)), full, rtol=0, atol=1e-9)
+    assert worst < 1e-6, worst
+
+
+# ---------------------------------------------------------------- (b) muscle paths
+
+
+@pytest.mark.parametrize("kind", KINDS)
+def test_mtu_lengths_velocities_moment_arms(models, kind):
+    runner, cm = models[kind]
+    m, ma = runner.mj_model, runner.mj_analysis_model
+    assert np.all(ma.actuator_gear[:, 0] == 1.0)
+    d, da = mujoco.MjData(m), mujoco.MjData(ma)
+    nm = len(runner.muscle_names)
+    mtu = np.zeros((nm, 2))
+    seg_u = np.zeros((runner.path_points.shape[0], 3))
+    for q, qd, _ in _states(runner, 2):
+        for data, model in ((d, m), (da, ma)):
+            data.qpos[:], data.qvel[:] = q, qd
+            mujoco.mj_forward(model, data)
+        path_kinematics(d.site_xpos, d.cvel, d.subtree_com[1].copy(), runner.path_points,
+                        runner.path_start, mtu, seg_u)
+        length, vel = (_np(x).ravel() for x in cm.mtu(q, qd))
+        arms = _np(cm.moment_arms(q))
+        np.testing.assert_allclose(length, mtu[:, 0], rtol=1e-6)
+        np.testing.assert_allclose(length, da.ten_length, rtol=1e-6)
+        scale = np.abs(mtu[:, 1]).max()
+        np.testing.assert_allclose(vel, mtu[:, 1], rtol=0, atol=1e-6 * scale)
+        np.testing.assert_allclose(vel, da.ten_velocity, rtol=0, atol=1e-6 * scale)
+        jac = np.zeros((ma.nu, ma.nv))
+        mujoco.mju_sparse2dense(jac, da.actuator_moment, da.moment_rownnz, da.moment_rowadr,
+                                da.moment_colind)
+        np.testing.assert_allclose(arms, -jac, rtol=0, atol=1e-6 * np.abs(jac).max())
+
+
+# ---------------------------------------------------------------- (c) contact and passive
+
+
+def _penetrating_states(runner, seed: int):
+    """Random poses lowered so that the lowest contact is 3–40 mm deep, random velocities."""
+    rng = np.random.default_rng(seed)
+    iz = runner.dof("pelvis_tz")
+    for q, qd, _ in _states(runner, seed):
+        qd = 0.5 * qd
+        q[iz] -= contact_heights(runner, q).min() + rng.uniform(0.003, 0.04)
+        yield q, qd
+
+
+def _forward_forces(runner, d):
+    """One call of the forward kernel: contact rows (ft, fn, px, pz, vx, vz, depth) with the
+    friction bristle in its sliding state, and the ligament + socket torques."""
+    mp, cp = runner.muscle_params, runner.contact_params
+    nm, nc = mp.shape[0], cp.shape[0]
+    ms = np.zeros((nm, 4))
+    ms[:, 0], ms[:, 1] = 0.01, mp[:, 1]
+    crec, lig = np.zeros((nc, 7)), np.zeros(runner.mj_model.nv)
+    cstate = np.zeros((nc, 1))
+    arrays = (mp, ms, np.zeros((nm, 2)), np.zeros((runner.path_points.shape[0], 3)),
+              np.zeros(nm), runner.path_points, runner.path_start, cp, cstate,
+              runner.joint_params, crec, lig)
+    root = d.subtree_com[1].copy()
+    forces(mujoco_views(d), arrays, root, 2.5e-4)
+    cstate[:, 0] = np.sign(crec[:, 4])  # anchor 1 m behind: the bristle slides
+    forces(mujoco_views(d), arrays, root, 2.5e-4)
+    return crec.copy(), lig.copy()
+
+
+@pytest.mark.parametrize("kind", KINDS)
+def test_contact_forces_match_forward_hunt_crossley(models, kind):
+    runner, cm = models[kind]
+    m = runner.mj_model
+    d = mujoco.MjData(m)
+    n_in_contact = 0
+    for q, qd in _penetrating_states(runner, 3):
+        d.qpos[:], d.qvel[:] = q, qd
+        mujoco.mj_forward(m, d)
+        crec, _ = _forward_forces(runner, d)
+        f, p, tau = (_np(x) for x in cm.contacts(q, qd))
+        np.testing.assert_allclose(p, crec[:, 2:4], rtol=0, atol=1e-12)
+        qfrc = np.zeros(m.nv)
+        for c, row in enumerate(runner.contact_params):
+            depth, vx, vz = crec[c, 6], crec[c, 4], crec[c, 5]
+            k, n, diss, mu = row[CP_K], row[CP_EXP], row[CP_C], row[CP_MU]
+            fn = hunt_crossley_force(depth, -vz, k, n, diss)
+            assert crec[c, 1] == pytest.approx(fn, rel=1e-12, abs=1e-12)
+            bound_n = hunt_crossley_bound(depth, -vz, k, n, diss, SM)
+            assert abs(f[c, 1] - fn) <= bound_n + 1e-9, (c, f[c, 1], fn, bound_n)
+            if abs(vx) >= 0.1:  # the forward bristle slides: −μ·Fn·sign(v)
+                assert crec[c, 0] == pytest.approx(-mu * fn * np.sign(vx), rel=1e-12, abs=1e-12)
+                bound_t = mu * bound_n + sliding_friction_bound(vx, f[c, 1], mu, SM)
+                assert abs(f[c, 0] - crec[c, 0]) <= bound_t + 1e-9
+            assert abs(f[c, 0]) <= mu * f[c, 1] + 1e-12
+            n_in_contact += depth > 0.003
+            mujoco.mj_applyFT(m, d, np.array([f[c, 0], 0.0, f[c, 1]]), np.zeros(3),
+                              np.array([p[c, 0], 0.0, p[c, 1]]), int(row[CP_BODY]), qfrc)
+        np.testing.assert_allclose(tau.ravel(), qfrc, rtol=0, atol=1e-9 * np.abs(qfrc).max())
+    assert n_in_contact >= N_STATES
+
+
+@pytest.mark.parametrize("kind", KINDS)
+def test_ligament_and_socket_torques_match_forward(models, kind):
+    runner, cm = models[kind]
+    m = runner.mj_model
+    d = mujoco.MjData(m)
+    jp = runner.joint_params
+    checked = 0
+    for q, qd, _ in _states(runner, 4):
+        d.qpos[:], d.qvel[:] = q, qd
+        mujoco.mj_forward(m, d)
+        _, lig = _forward_forces(runner, d)
+        tau = _np(cm.passive(q, qd)).ravel()
+        for j, row in enumerate(jp):
+            if row[JP_SK2] != 0.0:
+                assert abs(tau[j] - lig[j]) <= socket_bound(row[JP_SK2], SM) + 1e-9
+                checked += 1
+            elif row[JP_K] != 0.0:
+                margin = min(abs(q[j] - row[JP_LO]), abs(q[j] - row[JP_HI]))
+                if margin >= 0.1:
+                    bound = ligament_bound(margin, qd[j], row[JP_K], row[JP_D], SM)
+                    assert abs(tau[j] - lig[j]) <= bound + 1e-9, (j, tau[j], lig[j])
+                    checked += 1
+            else:
+                assert tau[j] == 0.0 and lig[j] == 0.0
+    assert checked >= 3 * N_STATES
+
+
+def test_multilink_blade_model_matches_forward():
+    """The amputee wearing a multi-link blade (extra hinge about +y, ellipse soles turned in
+    their bodies, spring–damper law): inverse dynamics, contact geometry, sole normal forces
+    (within the stated bound) and the blade joint's spring."""
+    runner = build_runner("amputee", blade_model=load_blade("xtreme-cat5").build())
+    cm = build_collocation_model(runner)
+    m = runner.mj_model
+    d = mujoco.MjData(m)
+    for q, qd, qdd in _states(runner, 8):
+        d.qpos[:], d.qvel[:], d.qacc[:] = q, qd, qdd
+        mujoco.mj_inverse(m, d)
+        tau = _np(cm.inverse_dynamics(q, qd, qdd)).ravel()
+        assert np.abs(tau - d.qfrc_inverse).max() < 1e-6 * np.abs(d.qfrc_inverse).max()
+    rng = np.random.default_rng(9)
+    iz, blade = runner.dof("pelvis_tz"), runner.contact_params[:, CP_BLADE] == 1
+    jb = runner.dof("blade_joint0")
+    checked = 0
+    for q, qd, _ in _states(runner, 9):
+        qd = 0.5 * qd
+        q[iz] -= contact_heights(runner, q)[blade].min() + rng.uniform(0.0005, 0.004)
+        d.qpos[:], d.qvel[:] = q, qd
+        mujoco.mj_forward(m, d)
+        crec, lig = _forward_forces(runner, d)
+        f, p, _ = (_np(x) for x in cm.contacts(q, qd))
+        np.testing.assert_allclose(p, crec[:, 2:4], rtol=0, atol=1e-12)
+        for c, row in enumerate(runner.contact_params):
+            depth, rate = crec[c, 6], -crec[c, 5]
+            if row[CP_LAW] != 1 or depth < max(row[CP_WIDTH], SM.spring_damper_depth_m):
+                continue
+            fn = smooth_spring_damper_force(depth, rate, row[CP_K], row[CP_DAMP], row[CP_WIDTH])
+            assert crec[c, 1] == pytest.approx(fn, rel=1e-12)
+            bound = spring_damper_bound(depth, rate, row[CP_K], row[CP_DAMP], row[CP_WIDTH], SM)
+            assert abs(f[c, 1] - fn) <= bound + 1e-9
+            checked += 1
+        tau = _np(cm.passive(q, qd)).ravel()
+        assert abs(tau[jb] - lig[jb]) <= socket_bound(runner.joint_params[jb, JP_SK2], SM) + 1e-9
+    assert checked >= N_STATES
+
+
+# ---------------------------------------------------------------- (d) muscles
+
+# Stated fit errors of the smooth curves at the default Smoothing (docs/collocation.md).
+FV_ERROR = 1.0e-3  # force–velocity, on −1 ≤ ṽ ≤ 1
+FP_ERROR = 3.0e-4  # passive force, absolute [-]
+FT_ERROR = 6.0e-4  # tendon force, absolute [-]
+ADOT_ERROR = 0.14  # activation rate [1/s]: 75/s · w/e
+EQ_ERROR = (1.0e-3, FP_ERROR)  # equilibrium tendon force: relative, absolute [-]
+
+
+def _curve(f):
+    x = ca.SX.sym("x")
+    fun = ca.Function("curve", [x], [f(x)])
+    return lambda v: _np(fun(v)).ravel()
+
+
+def test_muscle_curves_match_forward_hill():
+    from bladelab.predict.collocation import muscles as dg
+
+    v = np.linspace(-1.0, 1.0, 4001)
+    fv = _curve(lambda x: dg.force_velocity(x, SM))(v)
+    assert np.abs(fv - [force_velocity(x) for x in v]).max() <= FV_ERROR
+    ln = np.linspace(0.2, 2.0, 4001)
+    fl = _curve(dg.force_length)(ln)
+    np.testing.assert_allclose(fl, [force_length(x) for x in ln], rtol=1e-12, atol=1e-15)
+    fp = _curve(lambda x: dg.passive_force(x, SM))(ln)
+    assert np.abs(fp - [passive_force(x) for x in ln]).max() <= FP_ERROR
+    eps = np.linspace(-0.05, 0.12, 4001)
+    ft = _curve(lambda x: dg.tendon_force_curve(x, SM))(eps)
+    assert np.abs(ft - [tendon_force(x) for x in eps]).max() <= FT_ERROR
+    # the inverse tendon curve is the inverse
+    f = np.linspace(0.01, 2.0, 200)
+    back = _curve(lambda x: dg.tendon_force_curve(dg.tendon_strain(x, SM), SM))(f)
+    np.testing.assert_allclose(back, f, rtol=1e-10)
+
+
+def test_activation_rate_matches_forward(models):
+    runner, cm = models["able"]
+    rng = np.random.default_rng(5)
+    mp = runner.muscle_params
+    nm, dt = mp.shape[0], 1e-6
+    for _ in range(N_STATES):
+        a = rng.uniform(0.02, 0.98, nm)
+        u = rng.uniform(0.0, 1.0, nm)
+        ms = np.zeros((nm, 4))
+        ms[:, 0], ms[:, 1] = a, mp[:, 1]
+        muscle_step(mp, ms, np.full(nm, 0.5), u, dt)
+        forward = (ms[:, 0] - a) / dt
+        smooth = _np(cm.activation_rate(u, a)).ravel()
+        np.testing.assert_allclose(smooth, forward, rtol=0, atol=ADOT_ERROR + 1e-6)
+
+
+def _fibre_force(a, ln, vn, cos_a):
+    """The forward model's normalised fibre force along the tendon."""
+    return (a * force_length(ln) * force_velocity(vn) + passive_force(ln)
+            + FIBER_DAMPING * vn) * cos_a
+
+
+def test_static_equilibrium_tendon_force_matches_forward(models):
+    """Isometric equilibrium (ṽ = 0) at random activations and fibre lengths: the forward
+    model's equilibrium fibre length and tendon force against the De Groote residual's root."""
+    runner, cm = models["able"]
+    mp = runner.muscle_params
+    nm = mp.shape[0]
+    rng = np.random.default_rng(6)
+    ft, p = ca.SX.sym("ft", nm), ca.SX.sym("p", 2 * nm)
+    res = cm.muscle_residual(p[:nm], ft, 0.0, p[nm:], 0.0)
+    solve = ca.rootfinder("eq", "newton", ca.Function("g", [ft, p], [res]),
+                          {"abstol": 1e-13, "max_iter": 50})
+    worst = 0.0
+    for _ in range(N_STATES):
+        a, ln = rng.uniform(0.1, 1.0, nm), rng.uniform(0.6, 1.5, nm)
+        l_mt = np.zeros(nm)
+        for i, (_, l_opt, l_ts, penn) in enumerate(mp):
+            cos_a = np.sqrt(1.0 - (np.sin(penn) / ln[i]) ** 2)
+            f = _fibre_force(a[i], ln[i], 0.0, cos_a)
+            l_mt[i] = ln[i] * l_opt * cos_a + l_ts * (1.0 + TENDON_REF_STRAIN * np.sqrt(f))
+        forward = np.array([
+            tendon_force_of_state(l_mt[i], equilibrium_fiber_length(l_mt[i], a[i], *mp[i, 1:]),
+                                  *mp[i]) / mp[i, 0] for i in range(nm)])
+        dg = _np(solve(forward, np.concatenate([a, l_mt]))).ravel()
+        assert np.abs(_np(cm.muscle_residual(a, dg, 0.0, l_mt, 0.0))).max() < 1e-10
+        excess = np.abs(dg - forward) - (EQ_ERROR[0] * forward + EQ_ERROR[1])
+        worst = max(worst, excess.max())
+    assert worst <= 0.0, worst
+
+
+def test_fibre_state_and_residual_match_forward_in_motion(models):
+    """At forward states with fibre and MTU velocities, the De Groote fibre length and velocity
+    (from F̃_T and dF̃_T/dt) equal the forward fibre's, and the equilibrium residual is within
+    the force–velocity fit error."""
+    runner, cm = models["able"]
+    mp = runner.muscle_params
+    nm = mp.shape[0]
+    rng = np.random.default_rng(7)
+    for _ in range(N_STATES):
+        a, ln = rng.uniform(0.1, 1.0, nm), rng.uniform(0.6, 1.4, nm)
+        vn = rng.uniform(-0.9, 0.9, nm)
+        v_mt = rng.uniform(-0.5, 0.5, nm)
+        l_ce, v_ce, l_mt, ft, dft, cos_a = (np.zeros(nm) for _ in range(6))
+        for i, (fmax, l_opt, l_ts, penn) in enumerate(mp):
+            cos_a[i] = np.sqrt(1.0 - (np.sin(penn) / ln[i]) ** 2)
+            f = max(_fibre_force(a[i], ln[i], vn[i], cos_a[i]), 0.05)  # a taut tendon
+            l_ce[i], v_ce[i] = ln[i] * l_opt, vn[i] * 10.0 * l_opt
+            l_mt[i] = l_ce[i] * cos_a[i] + l_ts * (1.0 + TENDON_REF_STRAIN * np.sqrt(f))
+            ft[i] = tendon_force_of_state(l_mt[i], l_ce[i], *mp[i]) / fmax
+            h = 1e-6
+            hi = tendon_force_of_state(l_mt[i] + h * v_mt[i], l_ce[i] + h * v_ce[i], *mp[i])
+            lo = tendon_force_of_state(l_mt[i] - h * v_mt[i], l_ce[i] - h * v_ce[i], *mp[i])
+            dft[i] = (hi - lo) / (2 * h * fmax)
+        l_m, v_m, cos_m = (_np(x).ravel() for x in cm.fiber(l_mt, v_mt, ft, dft))
+        np.testing.assert_allclose(l_m, l_ce, rtol=1e-5)
+        np.testing.assert_allclose(cos_m, cos_a, rtol=1e-5)
+        # the tendon curve's softplus changes the tendon compliance by e^{−s/w}/(1 − e^{−s/w})
+        v_t = v_mt - v_ce / cos_a
+        r = np.exp(-TENDON_REF_STRAIN * np.sqrt(ft) / SM.tendon_strain)
+        np.testing.assert_array_less(np.abs(v_m - v_ce), 1.01 * r / (1 - r) * np.abs(v_t) + 1e-9)
+        # residual of the forward state: forward fibre force minus F̃_T, up to the fits
+        forward = np.array([_fibre_force(a[i], ln[i], vn[i], cos_a[i]) for i in range(nm)])
+        expected = forward - ft
+        res = _np(cm.muscle_residual(a, ft, dft, l_mt, v_mt)).ravel()
+        bound = a * FV_ERROR + FP_ERROR + 1e-4
+        assert np.all(np.abs(res - expected) <= bound), np.abs(res - expected).max()
