@@ -34,6 +34,9 @@ COORDINATE_BOUNDS_DEG: dict[str, tuple[float, float]] = {
 PELVIS_BOUNDS_M = {"pelvis_tx": (-math.inf, math.inf), "pelvis_tz": (0.4, 1.4)}
 SPEED_BOUNDS = {"pelvis_tx": (0.0, 12.0), "pelvis_tz": (-4.0, 4.0)}  # m/s
 MAX_ANGULAR_SPEED = 40.0  # rad/s
+# Fibre length along the tendon line [optimal lengths]: positive (cos α > 0) and within the
+# forward model's clamp at 0.2 (bladelab.runner.muscle) and a generous stretch.
+MIN_FIBER_ALONG, MAX_FIBER_ALONG = 0.2, 2.0
 
 
 def _bounds(dof_names) -> tuple[np.ndarray, np.ndarray]:
@@ -61,8 +64,10 @@ def stride_dynamics(cm: CollocationModel, *,
     r_mb = cm.dynamics_residual(q, qd, qdd, ft)
     r_hill = cm.muscle_residual(a, ft, dft, l_mt, v_mt)
     met = metabolic_rate(runner, u, a, ft, dft, l_mt, v_mt, cm.smoothing, metabolic)
-    _, v_m, _ = cm.fiber(l_mt, v_mt, ft, dft)
-    v_norm = v_m / (V_MAX_OPT_PER_S * ca.DM(runner.muscle_params[:, MP_LOPT]))
+    l_m, v_m, cos_a = cm.fiber(l_mt, v_mt, ft, dft)
+    l_opt = ca.DM(runner.muscle_params[:, MP_LOPT])
+    v_norm = v_m / (V_MAX_OPT_PER_S * l_opt)
+    along = l_m * cos_a / l_opt  # fibre length along the tendon line [optimal lengths]
     q_b, qd_b = _bounds(runner.dof_names)
     weight = runner.total_mass * runner.gravity
     scale = np.array([weight if n.startswith("pelvis_t") and n != "pelvis_tilt" else 100.0
@@ -78,6 +83,30 @@ def stride_dynamics(cm: CollocationModel, *,
         q_bounds=q_b,
         qd_bounds=qd_b,
         residual_scale=scale,
-        inequalities=ca.Function("fibre_velocity", [q, qd, a, ft, dft], [v_norm]),
-        inequality_bounds=np.tile([-1.0, 1.0], (nm, 1)),
+        inequalities=ca.Function("fibre_domain", [q, qd, a, ft, dft],
+                                 [ca.vertcat(v_norm, along)]),
+        inequality_bounds=np.vstack([np.tile([-1.0, 1.0], (nm, 1)),
+                                     np.tile([MIN_FIBER_ALONG, MAX_FIBER_ALONG], (nm, 1))]),
+        static_tendon_force=lambda q_nodes, a_nodes: static_tendon_forces(cm, q_nodes, a_nodes),
     )
+
+
+def static_tendon_forces(cm: CollocationModel, q_nodes: np.ndarray, a_nodes: np.ndarray,
+                         *, grid: int = 400) -> np.ndarray:
+    """Normalised tendon forces (n_nodes, n_muscles) in static equilibrium (ṽ = 0, the
+    fibre–tendon residual's root in F̃ₜ, found on a log grid from 1e-3 to 3) at poses
+    ``q_nodes`` and activations ``a_nodes``: a consistent initial guess of the muscle states."""
+    nm = cm.n_muscles
+    levels = np.logspace(-3, math.log10(3.0), grid)
+    out = np.empty((q_nodes.shape[0], nm))
+    zeros_v = np.zeros(cm.nv)
+    for k, (qk, ak) in enumerate(zip(q_nodes, a_nodes, strict=True)):
+        l_mt, _ = cm.mtu(qk, zeros_v)
+        l_mt = np.tile(np.asarray(l_mt).ravel()[:, None], (1, grid))
+        r = np.asarray(cm.muscle_residual(np.tile(ak[:, None], (1, grid)),
+                                          np.tile(levels, (nm, 1)), np.zeros((nm, grid)),
+                                          l_mt, np.zeros((nm, grid))))
+        for i in range(nm):
+            change = np.flatnonzero(np.sign(r[i, :-1]) != np.sign(r[i, 1:]))
+            out[k, i] = levels[change[0]] if change.size else levels[np.argmin(np.abs(r[i]))]
+    return out

@@ -12,8 +12,8 @@ accelerations (implicit multibody dynamics), excitations, tendon-force rates (De
 - path residuals at k = 0..n−1 (node n repeats node 0): the multibody dynamics
   ``M(q)·q̈ + C(q, q̇) − τ(q, q̇, F̃ₜ) = 0`` for every dof (the pelvis's three unactuated) and
   the Hill equilibrium of every muscle, both from :class:`StrideDynamics`;
-- periodicity: node n equals node 0 except pelvis_tx, advanced by the stride length ``d``;
-  pelvis_tx = 0 at node 0;
+- periodicity: node n equals node 0 (states and controls) except pelvis_tx, advanced by the
+  stride length ``d``; pelvis_tx = 0 at node 0;
 - the speed: ``d = v·T`` (prescribed speed) or ``d`` free (maximum speed).
 
 Objective (a setting, :class:`StrideWeights`): prescribed speed — metabolic energy per
@@ -28,6 +28,7 @@ from __future__ import annotations
 
 import math
 import time
+from collections.abc import Callable
 from dataclasses import asdict, dataclass, field
 
 import casadi as ca
@@ -70,6 +71,9 @@ class StrideDynamics:
         Optional path inequalities: a CasADi Function (q, q̇, a, F̃ₜ, dF̃ₜ/dt) -> (n_ineq,) and
         their (n_ineq, 2) lower and upper bounds, imposed at every node (e.g. the normalised
         fibre velocities within [−1, 1], the domain of the force–velocity curve).
+    static_tendon_force
+        Optional ``(q (n+1, n_dof), a (n+1, n_muscles)) -> F̃ₜ`` in static equilibrium, used
+        for initial guesses without muscle states.
     """
 
     dof_names: tuple[str, ...]
@@ -84,6 +88,7 @@ class StrideDynamics:
     residual_scale: np.ndarray
     inequalities: ca.Function | None = None
     inequality_bounds: np.ndarray | None = None
+    static_tendon_force: Callable[[np.ndarray, np.ndarray], np.ndarray] | None = None
 
     @property
     def nq(self) -> int:
@@ -263,13 +268,18 @@ class StrideNLP:
         distance = (X[itx, n] - X[itx, 0]) * sx[itx]
         # periodic: every state but pelvis_tx, which advances by the stride length `distance`
         keep = [i for i in range(self.nx) if i != itx]
-        periodic = X[keep, n] - X[keep, 0]
+        # the controls too: node n is node 0 one period later, and its controls enter the last
+        # interval's defect, so free controls there would act as an impulse (measured: a
+        # torque-driven 'gait' that never touched the ground, one flight phase closed by an
+        # acceleration spike at the last node)
+        periodic = ca.vertcat(X[keep, n] - X[keep, 0], U[:, n] - U[:, 0])
         g = [ca.vec(defects), ca.vec(pth[:, :n]), periodic]
         state_names = self._state_names()
         self._g_names = (
             [f"defect {nm_}@{k}" for k in range(n) for nm_ in state_names]
             + [f"path {nm_}@{k}" for k in range(n) for nm_ in self._path_names()]
             + [f"periodicity {state_names[i]}" for i in keep]
+            + [f"periodicity {nm_}" for nm_ in self._control_names()]
         )
         trap = (ca.sum2(eff[:, :-1]) + ca.sum2(eff[:, 1:])) / 2 * h  # ∫ effort dt
         energy = (ca.sum2(mets[:, :-1]) + ca.sum2(mets[:, 1:])) / 2 * h  # ∫ Ė dt [J]
@@ -309,6 +319,11 @@ class StrideNLP:
         return ([f"q {n}" for n in d.dof_names] + [f"qd {n}" for n in d.dof_names]
                 + [f"a {n}" for n in d.muscle_names] + [f"Ft {n}" for n in d.muscle_names])
 
+    def _control_names(self) -> list[str]:
+        d = self.dyn
+        return ([f"qdd {n}" for n in d.dof_names] + [f"e {n}" for n in d.muscle_names]
+                + [f"dFt {n}" for n in d.muscle_names])
+
     def _path_names(self) -> list[str]:
         d = self.dyn
         return [f"dynamics {n}" for n in d.dof_names] + [f"hill {n}" for n in d.muscle_names]
@@ -346,14 +361,20 @@ class StrideNLP:
 
     def initial_vector(self, guess) -> np.ndarray:
         """The scaled NLP vector of a :class:`~bladelab.predict.collocation.guess.StrideGuess`
-        (resampled to the mesh; activations 0.05 and tendon forces from a static estimate of
-        0.05 where the guess has none; accelerations by differentiating the speeds)."""
+        (resampled to the mesh; where the guess has no muscle states, activations 0.05 and the
+        tendon forces of static equilibrium, else 0.05; accelerations by differentiating the
+        speeds)."""
         from bladelab.predict.collocation.guess import periodic_derivative
 
         d, n = self.dyn, self.n
         g = guess.resample(n)
         act = g.activation if g.activation is not None else np.full((n + 1, d.nm), 0.05)
-        ften = g.tendon_force if g.tendon_force is not None else np.full((n + 1, d.nm), 0.05)
+        if g.tendon_force is not None:
+            ften = g.tendon_force
+        elif d.static_tendon_force is not None:
+            ften = d.static_tendon_force(g.q, act)
+        else:
+            ften = np.full((n + 1, d.nm), 0.05)
         act = np.clip(act, self.min_activation, 1.0)
         ften = np.clip(ften, self.min_tendon_force, self.max_tendon_force)
         qdd = periodic_derivative(np.vstack([g.qd[:-1], g.qd[:1]]), g.period)
