@@ -287,7 +287,8 @@ class StrideNLP:
         if self.speed is not None:
             g.append(distance - self.speed * period)
             self._g_names.append("speed")
-            terms["metabolic"] = w.metabolic * energy / (d.mass * self.speed * period)
+            if w.metabolic:  # a zero weight drops the term (0·H would spread any inf/NaN)
+                terms["metabolic"] = w.metabolic * energy / (d.mass * self.speed * period)
         else:
             terms["speed"] = -w.speed * distance / period
             if w.metabolic:
