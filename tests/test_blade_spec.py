@@ -308,7 +308,7 @@ def test_unreadable_files(tmp_path):
         read_blade_spec(tmp_path / "none.yaml")
     f = tmp_path / "broken.yaml"
     f.write_text("name: [unclosed\n")
-    with pytest.raises(InputFileError, match="invalid YAML"):
+    with pytest.raises(InputFileError, match=r"not valid YAML: .* line 2"):
         read_blade_spec(f)
     f.write_text("- just a list\n")
     with pytest.raises(SpecError, match="mapping"):

@@ -1,6 +1,9 @@
-"""Atomic output: write to a temporary name beside the target, then rename.
+"""File input and output shared by every wing.
 
-A crash never leaves a half-written file that looks complete.
+Output is atomic: written to a temporary name beside the target, then renamed, so a crash never
+leaves a half-written file that looks complete. Input of JSON and YAML goes through
+:func:`read_json` / :func:`read_yaml`, whose errors name the file (and the line and column of a
+syntax error) as :class:`~bladelab.errors.InputFileError`.
 """
 
 from __future__ import annotations
@@ -55,3 +58,46 @@ def write_json(target: str | Path, obj: Any) -> None:
     with atomic_open(target, "w", encoding="utf-8") as fh:
         json.dump(obj, fh, indent=2, sort_keys=False)
         fh.write("\n")
+
+
+def _read_text(path: Path, what: str, hint: str | None) -> str:
+    from bladelab.errors import InputFileError
+
+    if not path.is_file():
+        raise InputFileError(f"{what} not found", file=path, hint=hint)
+    try:
+        return path.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as err:
+        raise InputFileError(f"cannot read the {what} ({type(err).__name__}: {err})",
+                             file=path, hint=hint) from None
+
+
+def read_json(path: str | Path, *, what: str = "JSON file", hint: str | None = None) -> Any:
+    """The content of a JSON file; a missing, unreadable or invalid file raises
+    :class:`~bladelab.errors.InputFileError` naming it (``what`` says what the file is)."""
+    from bladelab.errors import InputFileError
+
+    path = Path(path)
+    text = _read_text(path, what, hint)
+    try:
+        return json.loads(text)
+    except json.JSONDecodeError as err:
+        raise InputFileError(f"not valid JSON: {err.msg} at line {err.lineno}, column {err.colno}",
+                             file=path, hint=hint) from None
+
+
+def read_yaml(path: str | Path, *, what: str = "YAML file", hint: str | None = None) -> Any:
+    """The content of a YAML file (``safe_load``); errors as :func:`read_json`."""
+    import yaml
+
+    from bladelab.errors import InputFileError
+
+    path = Path(path)
+    text = _read_text(path, what, hint)
+    try:
+        return yaml.safe_load(text)
+    except yaml.YAMLError as err:
+        mark = getattr(err, "problem_mark", None)
+        where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark is not None else ""
+        problem = getattr(err, "problem", None) or str(err).splitlines()[0]
+        raise InputFileError(f"not valid YAML: {problem}{where}", file=path, hint=hint) from None

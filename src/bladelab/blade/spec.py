@@ -21,6 +21,7 @@ import yaml
 from pydantic import BaseModel, ConfigDict, Field
 
 from bladelab import units
+from bladelab._io import read_yaml
 from bladelab.blade.model import BladeModel, CompliantJoint, ContactModel, SoleEllipse
 from bladelab.blade.profile import (
     Profile,
@@ -29,7 +30,8 @@ from bladelab.blade.profile import (
     read_profile_csv,
 )
 from bladelab.blade.segmentation import Segmentation, segment_profile
-from bladelab.errors import BladelabError, InputFileError, ModelError, SpecError
+from bladelab.errors import BladelabError, ModelError, SpecError
+from bladelab.parameters import JOINT_PARAMETERS
 
 __all__ = [
     "BladeSpec",
@@ -286,8 +288,7 @@ class BladeSpec(_Strict):
                 stiffness=float(units.stiffness_per_deg_to_per_rad(k)),
                 damping=float(units.damping_per_deg_to_per_rad(j.D_Nms_per_deg)),
                 # N·m/deg² -> N·m/rad²: one factor 180/π per degree.
-                stiffness_quadratic=float(units.stiffness_per_deg_to_per_rad(
-                    units.stiffness_per_deg_to_per_rad(j.K2_Nm_per_deg2))),
+                stiffness_quadratic=JOINT_PARAMETERS["K2"].from_edge(j.K2_Nm_per_deg2),
             ))
         joints.sort(key=lambda jt: jt.point)
         soles = tuple(self._sole(i, s, seg, prof) for i, s in enumerate(self.soles))
@@ -368,8 +369,7 @@ class BladeSpec(_Strict):
                 {"between_segments": [j.point, j.point + 1],
                  "K_Nm_per_deg": float(units.stiffness_per_rad_to_per_deg(j.stiffness)),
                  "D_Nms_per_deg": float(units.damping_per_rad_to_per_deg(j.damping)),
-                 "K2_Nm_per_deg2": float(units.stiffness_per_rad_to_per_deg(
-                     units.stiffness_per_rad_to_per_deg(j.stiffness_quadratic)))}
+                 "K2_Nm_per_deg2": JOINT_PARAMETERS["K2"].to_edge(j.stiffness_quadratic)}
                 for j in model.joints],
             "soles": [{"segment": s.segment + 1, "center_x_m": s.center[0],
                        "center_z_m": s.center[1], "semi_axis_x_m": s.semi_axis_x,
@@ -503,12 +503,7 @@ def read_blade_spec(path: str | Path, *, category: str | None = None,
         Invalid content; the message names the field.
     """
     path = Path(path)
-    if not path.is_file():
-        raise InputFileError("blade spec not found", file=path)
-    try:
-        data = yaml.safe_load(path.read_text(encoding="utf-8"))
-    except (yaml.YAMLError, UnicodeDecodeError) as err:
-        raise InputFileError(f"invalid YAML ({err})".replace("\n", " "), file=path) from None
+    data = read_yaml(path, what="blade spec")
     spec = spec_from_dict(data, file=path, base_dir=path.parent)
     if category is not None:
         spec = spec.with_category(category)

@@ -44,8 +44,8 @@ def _simulate(
     belt_speed: float = typer.Option(0.0, "--belt-speed", help="Treadmill belt speed [m/s]."),
 ) -> None:
     """Simulate a blade driven by the clamp motion of a stance; write GRF, distance, deflection."""
-    from bladelab import units
     from bladelab.blade import load_blade
+    from bladelab.parameters import JOINT_PARAMETERS
     from bladelab.sim import prepare, simulate
     from bladelab.trial.stance import read_stance_csv
 
@@ -59,18 +59,19 @@ def _simulate(
     problem = prepare(model, st, dt=dt, engine=engine, belt_speed=belt_speed)
     result = simulate(
         problem,
-        stiffness=None if k_deg is None else units.stiffness_per_deg_to_per_rad(k_deg),
-        damping=None if d_deg is None else units.damping_per_deg_to_per_rad(d_deg),
+        stiffness=None if k_deg is None else JOINT_PARAMETERS["K"].from_edge(k_deg),
+        damping=None if d_deg is None else JOINT_PARAMETERS["D"].from_edge(d_deg),
     )
     frame = result.to_frame()
     with atomic_open(out, "w", encoding="utf-8", newline="\n") as fh:
-        k_used = np.atleast_1d(units.stiffness_per_rad_to_per_deg(result.stiffness))
-        d_used = np.atleast_1d(units.damping_per_rad_to_per_deg(result.damping))
+        k_used = np.atleast_1d(JOINT_PARAMETERS["K"].to_edge(result.stiffness))
+        d_used = np.atleast_1d(JOINT_PARAMETERS["D"].to_edge(result.damping))
         fh.write("# bladelab simulation\n")
         fh.write(f"# blade: {model.name}\n# stance: {stance}\n# engine: {result.engine}\n")
         fh.write(f"# dt_s: {result.dt:.6g}\n")
-        fh.write("# K_Nm_per_deg: " + ",".join(f"{v:.6g}" for v in k_used) + "\n")
-        fh.write("# D_Nms_per_deg: " + ",".join(f"{v:.6g}" for v in d_used) + "\n")
+        for key, used in ((JOINT_PARAMETERS["K"].edge_key, k_used),
+                          (JOINT_PARAMETERS["D"].edge_key, d_used)):
+            fh.write(f"# {key}: " + ",".join(f"{v:.6g}" for v in used) + "\n")
         frame.to_csv(fh, index=False, float_format="%.9g")
     typer.echo(
         f"wrote {out}: {len(frame)} samples, peak GRF z {result.grf_z.max():.1f} N, "

@@ -41,6 +41,7 @@ from typing import Any
 
 import numpy as np
 
+from bladelab._io import read_yaml
 from bladelab.errors import BladelabError, InputFileError, SpecError
 
 __all__ = [
@@ -149,12 +150,7 @@ def _raw_rows(path: Path) -> tuple[list[Any], str | None]:
     if suffix not in (".yaml", ".yml"):
         raise InputFileError("a motion file is YAML (.yaml, .yml) or CSV (.csv)", file=path,
                              hint="docs/design.md, 'Motion adaptation'")
-    import yaml
-
-    try:
-        data = yaml.safe_load(path.read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError, yaml.YAMLError) as err:
-        raise InputFileError(f"cannot read the motion file: {err}", file=path) from None
+    data = read_yaml(path, what="motion file", hint="docs/design.md, 'Motion adaptation'")
     model = None
     if isinstance(data, Mapping):
         unknown = [str(k) for k in data if k not in _TOP_KEYS]

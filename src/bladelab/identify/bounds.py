@@ -33,6 +33,7 @@ import numpy as np
 
 from bladelab import units
 from bladelab.errors import DataError, OptimizationError
+from bladelab.parameters import JOINT_PARAMETERS
 
 DAMPING_BOUNDS_NMS_PER_DEG: tuple[float, float] = (0.01, 1.0)
 """Seed 000's damping search range [N·m·s/deg]."""
@@ -41,7 +42,6 @@ FALLBACK_STIFFNESS_BOUNDS_NM_PER_DEG: tuple[float, float] = (3.0, 60.0)
 """Used only when the stance has no distance channel to estimate K(t) from [N·m/deg]
 (seed 000 found 13–22 N·m/deg)."""
 
-_EDGE_UNITS = {"K": ("K_Nm_per_deg", 1.0), "D": ("D_Nms_per_deg", 1.0), "K2": ("K2_Nm_per_deg2", 2.0)}
 
 
 @dataclasses.dataclass(frozen=True)
@@ -71,10 +71,10 @@ class ParameterBounds:
             if not (np.isfinite(lo) and np.isfinite(hi)):
                 raise OptimizationError(f"bounds of {name} must be finite", where=f"bounds.{name}")
             if lo >= hi:
-                unit, power = _EDGE_UNITS.get(name, (name, 1.0))
-                f = units.RAD_PER_DEG**power
+                p = JOINT_PARAMETERS.get(name)
+                lo_e, hi_e = (p.to_edge(lo), p.to_edge(hi)) if p else (lo, hi)
                 raise OptimizationError(
-                    f"min {lo * f:.6g} is not below max {hi * f:.6g} ({unit})",
+                    f"min {lo_e:.6g} is not below max {hi_e:.6g} ({p.edge_key if p else name})",
                     where=f"bounds.{name}", hint="give the bounds as (min, max) with min < max",
                 )
 
@@ -86,9 +86,8 @@ class ParameterBounds:
         """Edge units: ``{"K_Nm_per_deg": [min, max], "D_Nms_per_deg": [min, max], ...}``."""
         out: dict = {}
         for name, lo, hi in zip(self.names, self.lower, self.upper, strict=True):
-            key, power = _EDGE_UNITS.get(name, (name, 0.0))
-            f = units.RAD_PER_DEG**power
-            out[key] = [lo * f, hi * f]
+            p = JOINT_PARAMETERS.get(name)
+            out[p.edge_key if p else name] = [p.to_edge(lo), p.to_edge(hi)] if p else [lo, hi]
         out["source"] = self.source
         return out
 
@@ -107,15 +106,12 @@ def make_bounds(
     OptimizationError
         A minimum is not below its maximum, or a bound is not finite.
     """
-    names = ["K", "D"]
-    lo = [units.stiffness_per_deg_to_per_rad(float(k_nm_per_deg[0])),
-          units.damping_per_deg_to_per_rad(float(d_nms_per_deg[0]))]
-    hi = [units.stiffness_per_deg_to_per_rad(float(k_nm_per_deg[1])),
-          units.damping_per_deg_to_per_rad(float(d_nms_per_deg[1]))]
+    edge = {"K": k_nm_per_deg, "D": d_nms_per_deg}
     if k2_nm_per_deg2 is not None:
-        names.append("K2")
-        lo.append(float(k2_nm_per_deg2[0]) * units.DEG_PER_RAD**2)
-        hi.append(float(k2_nm_per_deg2[1]) * units.DEG_PER_RAD**2)
+        edge["K2"] = k2_nm_per_deg2
+    names = list(edge)
+    lo = [JOINT_PARAMETERS[n].from_edge(v[0]) for n, v in edge.items()]
+    hi = [JOINT_PARAMETERS[n].from_edge(v[1]) for n, v in edge.items()]
     return ParameterBounds(tuple(names), tuple(lo), tuple(hi), source=source)
 
 

@@ -32,9 +32,8 @@ from bladelab.identify.cost import StanceCost
 from bladelab.identify.formulations import DEFAULT_FORMULATION, DISTANCE_ONLY, formulation_drive
 from bladelab.identify.identifiability import assess_identifiability, effective_sample_size
 from bladelab.identify.optimizers import minimize
+from bladelab.parameters import JOINT_PARAMETERS
 from bladelab.sim.api import DEFAULT_DT
-
-_CI_KEYS = {"K": ("K_ci_Nm_per_deg", 1), "D": ("D_ci_Nms_per_deg", 1), "K2": ("K2_ci_Nm_per_deg2", 2)}
 
 
 @dataclasses.dataclass(frozen=True)
@@ -112,7 +111,7 @@ class Identification:
         }
         if self.K2_Nm_per_deg2 is not None:
             out["K2_Nm_per_deg2"] = self.K2_Nm_per_deg2
-        for name, (key, _) in _CI_KEYS.items():
+        for name, key in ((n, p.ci_key) for n, p in JOINT_PARAMETERS.items()):
             if name in self.ci:
                 out[key] = list(self.ci[name])
         out.update({
@@ -167,8 +166,7 @@ def _with_joint(blade: BladeModel, joint: int | None) -> BladeModel:
 
 
 def _to_edge(name: str, value: float) -> float:
-    power = _CI_KEYS[name][1]
-    return float(value) * units.RAD_PER_DEG**power
+    return JOINT_PARAMETERS[name].to_edge(value)
 
 
 def identify_stance(
@@ -358,7 +356,7 @@ def identification_landscape(
                                   contact_threshold=contact_threshold)
     problem = sim.prepare(model, stance, dt=dt, belt_speed=belt_speed, drive=formulation_drive(
         ident.formulation if formulation is None else formulation))
-    k2 = 0.0 if ident.K2_Nm_per_deg2 is None else ident.K2_Nm_per_deg2 * units.DEG_PER_RAD**2
+    k2 = 0.0 if ident.K2_Nm_per_deg2 is None else JOINT_PARAMETERS["K2"].from_edge(ident.K2_Nm_per_deg2)
 
     def fun_batch(X: np.ndarray) -> np.ndarray:
         res = sim.simulate_batch(problem, X[:, 0:1], X[:, 1:2], np.full((len(X), 1), k2))

@@ -11,12 +11,12 @@ study's seed (deterministic: the same as ``optimum.json``).
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 from typing import Any
 
 import pandas as pd
 
+from bladelab._io import read_json
 from bladelab.errors import InputFileError
 
 __all__ = ["build_design_report", "design_report_sections", "is_design_folder", "trends_section"]
@@ -36,8 +36,8 @@ def _load(design_dir: Path):
     if not is_design_folder(design_dir):
         raise InputFileError("not a design-study folder (no study.json / results.csv)",
                              file=design_dir, hint="run 'bladelab design --out DIR' first")
+    meta = read_json(design_dir / "study.json", what="design study file")
     try:
-        meta = json.loads((design_dir / "study.json").read_text(encoding="utf-8"))
         space = DesignSpace.from_dict(meta["space"])
         table = pd.read_csv(design_dir / "results.csv")
     except (OSError, ValueError, KeyError) as err:
@@ -49,10 +49,7 @@ def _load(design_dir: Path):
         from bladelab.design.evaluators import BLADE_RESPONSE_UNITS
         from bladelab.design.transfemoral import RUNNER_RESPONSE_UNITS
 
-        try:
-            evaluator = json.loads(ev.read_text(encoding="utf-8"))
-        except ValueError as err:
-            raise InputFileError(f"cannot read the evaluator settings: {err}", file=ev) from None
+        evaluator = read_json(ev, what="evaluator settings")
         kind = evaluator.get("evaluator")
         units = RUNNER_RESPONSE_UNITS if kind == "runner" else BLADE_RESPONSE_UNITS
     meta = {**meta, "_evaluator": evaluator}
@@ -144,10 +141,7 @@ def _motion_section(design_dir: Path, meta: dict) -> dict[str, Any] | None:
     if not name:
         return None
     path = design_dir / name
-    try:
-        motion = json.loads(path.read_text(encoding="utf-8"))
-    except (OSError, ValueError) as err:
-        raise InputFileError(f"cannot read the motion model: {err}", file=path) from None
+    motion = read_json(path, what="motion model")
     loo = motion.get("loo_angles_deg") or {}
     errors = pd.DataFrame(
         [{"quantity": "period", "leave-one-blade-out error": motion.get("loo_period_s"),
@@ -199,7 +193,7 @@ def build_design_report(design_dir: str | Path, out_dir: str | Path | None = Non
     design_dir = Path(design_dir)
     meta = {}
     if (design_dir / "study.json").is_file():
-        meta = json.loads((design_dir / "study.json").read_text(encoding="utf-8"))
+        meta = read_json(design_dir / "study.json", what="design study file")
     sections = design_report_sections(design_dir)
     rep = Report("Blade design study", subtitle=str(design_dir), settings=meta,
                  seed=meta.get("seed"))

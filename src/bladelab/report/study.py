@@ -31,6 +31,7 @@ import pandas as pd
 
 from bladelab import units
 from bladelab.errors import DataError, InputFileError
+from bladelab.parameters import JOINT_PARAMETERS
 
 __all__ = ["StudyReport", "build_study_report"]
 
@@ -292,7 +293,7 @@ def build_study_report(
             K = units.stiffness_per_deg_to_per_rad(float(r["K_Nm_per_deg"]))
             D = units.damping_per_deg_to_per_rad(float(r["D_Nms_per_deg"]))
             k2 = r.get("K2_Nm_per_deg2")
-            K2 = 0.0 if k2 is None or not np.isfinite(k2) else float(k2) / units.RAD_PER_DEG**2
+            K2 = 0.0 if k2 is None or not np.isfinite(k2) else JOINT_PARAMETERS["K2"].from_edge(k2)
             formulation = settings.get("formulation", DEFAULT_FORMULATION)
             problem = sim.prepare(model, stance, drive=formulation_drive(formulation))
             formulations.add(formulation)

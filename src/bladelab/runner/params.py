@@ -20,6 +20,7 @@ from typing import Literal
 import yaml
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
 
+from bladelab._io import read_yaml
 from bladelab.contact import hertz_sphere_stiffness
 from bladelab.errors import InputFileError, SpecError
 from bladelab.runner.geometry import LEG_MUSCLES, SHANK_MUSCLES, TORSO_MUSCLES
@@ -247,12 +248,7 @@ def runner_params_from_dict(data: dict, *, source: str | None = None) -> RunnerP
 def load_runner_params(path: str | Path) -> RunnerParams:
     """Read and validate a runner parameter YAML file."""
     path = Path(path)
-    try:
-        data = yaml.safe_load(path.read_text())
-    except FileNotFoundError:
-        raise InputFileError("file not found", file=path) from None
-    except yaml.YAMLError as err:
-        raise InputFileError(f"not valid YAML ({err})", file=path) from None
+    data = read_yaml(path, what="runner parameter file")
     if not isinstance(data, dict):
         raise InputFileError("expected a mapping of parameters", file=path)
     return runner_params_from_dict(data, source=str(path))

@@ -10,9 +10,9 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Literal
 
-import yaml
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
 
+from bladelab._io import read_yaml
 from bladelab.errors import InputFileError, SpecError
 
 STUDY_FILE = "study.yaml"
@@ -173,8 +173,5 @@ def load_study(path: str | Path) -> tuple[Study, Path]:
     if not file.is_file():
         raise InputFileError(f"no {STUDY_FILE} found", file=file,
                              hint="a study folder holds study.yaml, the trial files and results.sqlite")
-    try:
-        data = yaml.safe_load(file.read_text(encoding="utf-8"))
-    except yaml.YAMLError as err:
-        raise InputFileError(f"not valid YAML ({err})", file=file) from None
+    data = read_yaml(file, what=STUDY_FILE)
     return parse_study(data, file=file), file.parent

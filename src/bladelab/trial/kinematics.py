@@ -32,11 +32,11 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-import yaml
 from pydantic import BaseModel, ConfigDict, ValidationError
 from scipy import interpolate
 
-from bladelab.errors import DataError, InputFileError, SpecError
+from bladelab._io import read_yaml
+from bladelab.errors import DataError, SpecError
 from bladelab.trial.events import StanceEvent, combined_grf, detect_stances
 from bladelab.trial.filters import fill_gaps, lowpass
 from bladelab.trial.stance import Stance
@@ -86,12 +86,7 @@ def load_marker_map(path: str | Path) -> MarkerMap:
 def read_marker_yaml(path: Path, shape_hint: str) -> dict:
     """The mapping in a YAML marker-map file (errors name the file; ``shape_hint`` says what
     the mapping should look like)."""
-    if not path.is_file():
-        raise InputFileError("marker map not found", file=path, hint="check the --markers path")
-    try:
-        data = yaml.safe_load(path.read_text(encoding="utf-8")) or {}
-    except yaml.YAMLError as err:
-        raise InputFileError(f"not valid YAML ({err})", file=path) from err
+    data = read_yaml(path, what="marker map", hint="check the --markers path") or {}
     if not isinstance(data, dict):
         raise SpecError(shape_hint, file=path)
     return data

@@ -255,8 +255,7 @@ def guess_from_result(result, *, n: int = 50) -> StrideGuess:
 def guess_from_reflex(path: str | Path, *, n: int = 50, duration: float = 5.0) -> StrideGuess:
     """Re-simulate a reflex-controller parameter file (its own model, blade, speed and settings)
     for ``duration`` [s] and take :func:`guess_from_result` of it."""
-    import json
-
+    from bladelab._io import read_json
     from bladelab.predict.reflex import (
         read_parameters,
         runner_and_layout,
@@ -264,7 +263,7 @@ def guess_from_reflex(path: str | Path, *, n: int = 50, duration: float = 5.0) -
         stored_settings,
     )
 
-    data = json.loads(Path(path).read_text(encoding="utf-8"))
+    data = read_json(path, what="parameter file")
     model, layout = runner_and_layout(data.get("model", "able"), data.get("blade"))
     settings = stored_settings(data, speed=float(data.get("speed_m_per_s", 3.5)),
                                duration=duration, nominal=True)

@@ -34,7 +34,6 @@ Everything in the simulation loop is compiled with numba (:func:`control_step`).
 
 from __future__ import annotations
 
-import json
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -42,7 +41,7 @@ from pathlib import Path
 import numpy as np
 from numba import njit
 
-from bladelab._io import write_json
+from bladelab._io import read_json, write_json
 from bladelab.errors import InputFileError, SpecError
 from bladelab.runner.params import RUNNER_DATA_DIR
 
@@ -319,12 +318,7 @@ def read_parameters(
     side's shank reflexes) are dropped, those it has and the file lacks keep the initial guess.
     """
     path = Path(path)
-    try:
-        data = json.loads(path.read_text())
-    except FileNotFoundError:
-        raise InputFileError("file not found", file=path) from None
-    except json.JSONDecodeError as err:
-        raise InputFileError(f"not valid JSON ({err})", file=path) from None
+    data = read_json(path, what="parameter file")
     params = data.get("parameters") if isinstance(data, dict) else None
     if not isinstance(params, dict):
         raise InputFileError(

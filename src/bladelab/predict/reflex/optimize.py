@@ -36,7 +36,7 @@ from pathlib import Path
 
 import numpy as np
 
-from bladelab._io import atomic_open, atomic_path, write_json
+from bladelab._io import atomic_open, atomic_path, read_json, write_json
 from bladelab.errors import InputFileError, OptimizationError
 from bladelab.executors import ProcessPool, RayExecutor
 from bladelab.predict.reflex.controller import ControllerLayout, controller_layout, write_parameters
@@ -545,11 +545,10 @@ def verify_solution(
     CPU, compiler or library version) is not a solution. Returns the measured values (the
     copies' under ``"jittered"``) and ``ok``.
     """
-    import json
 
     from bladelab.predict.reflex.controller import read_parameters
 
-    data = json.loads(Path(path).read_text())
+    data = read_json(path, what="parameter file")
     model = model or data.get("model", "able")
     blade = blade or data.get("blade")
     speed = float(speed if speed is not None else data.get("speed_m_per_s", 3.5))
