@@ -265,39 +265,20 @@ def gait_cycles_from_trial(
     stances=None,
     max_period_s: float = 2.0,
 ) -> list[GaitCycle]:
-    """Every complete gait cycle of a measured trial, each time-normalised to ``n`` samples.
+    """Every complete gait cycle of a measured trial as :class:`GaitCycle` s of the
+    transfemoral runner, ``leg`` being the prosthetic one.
 
-    A cycle runs from a touch-down of ``leg`` (the prosthetic leg of the cycle) to its next
-    touch-down: consecutive stances of that leg, at most ``max_period_s`` apart, with at most
-    one stance of the other leg between them. Angles: :func:`bladelab.trial.joint_angles.
-    sagittal_angles` (``hip/knee_<leg>`` -> prosthetic, ``hip/knee/ankle_<other>`` -> sound,
-    the pelvis lean -> ``trunk_pitch``). Cycles with a marker gap are left out.
-
-    Parameters
-    ----------
-    trial
-        A :class:`~bladelab.trial.Trial` with markers and force platforms.
-    leg
-        ``"left"`` or ``"right"``: the leg whose touch-down starts the cycle.
-    markers
-        :class:`~bladelab.trial.joint_angles.JointMarkerMap` (default: the Fukuchi marker set).
-    static
-        Standing trial for the neutral offsets (same lab frame).
-    cutoff_hz
-        Marker low-pass [Hz].
-    n
-        Samples per cycle.
-    stances
-        Stance events (default :func:`~bladelab.trial.detect_stances` of the trial).
-    max_period_s
-        Longest accepted cycle [s].
+    The cycles and every parameter are those of :func:`bladelab.trial.cycles.joint_angle_cycles`
+    (a touch-down of ``leg`` to its next, ``n`` samples); the angles are renamed
+    ``hip/knee_<leg>`` -> prosthetic, ``hip/knee/ankle_<other>`` -> sound, the pelvis lean ->
+    ``trunk_pitch``. Cycles with a marker gap are left out.
 
     Raises
     ------
     SpecError
         ``leg`` is not left/right.
     DataError
-        Missing markers or platforms, or no complete cycle of ``leg``.
+        Missing markers or platforms, the sound leg has no foot markers, or no complete cycle.
     """
     from bladelab.trial.cycles import joint_angle_cycles
 
