@@ -11,7 +11,7 @@ import pytest
 
 import trial_synth as synth
 from bladelab.errors import BladelabError, DataError, InputFileError, SpecError
-from bladelab.trial.c3d import plate_corners, read_c3d, write_c3d
+from bladelab.trial.c3d import C3DWarning, plate_corners, read_c3d, write_c3d
 from bladelab.units import body_weight
 
 FUKUCHI = "real/fukuchi2017/RBDS001runT35.c3d"
@@ -72,8 +72,11 @@ def test_fukuchi_axes_and_units(fukuchi):
 
 @pytest.mark.parametrize("name", [FUKUCHI, *WALKING])
 def test_cop_and_free_moment_match_ezc3d_module(shared_data, name):
-    """ezc3d's own force-platform module is an independent implementation of COP and Tz."""
-    trial = read_c3d(shared_data / name)
+    """ezc3d's own force-platform module is an independent implementation of COP and Tz.
+
+    ezc3d keeps the file's zero offsets, so the comparison reads the file as it is.
+    """
+    trial = read_c3d(shared_data / name, zero_offset=False)
     c = ezc3d.c3d(str(shared_data / name), extract_forceplat_data=True)
     axes = trial.metadata["axes"]
     perm = np.zeros((3, 3))
@@ -138,6 +141,30 @@ def test_forces_txt_export_agrees_on_matching_quantities(shared_data, fukuchi):
     ty = np.percentile(np.abs(txt["Ty"]), 95) / 1000.0
     ours = np.nanpercentile(np.abs(plate.free_moment), 95)
     assert 0.2 < ours / ty < 5.0
+
+
+@pytest.mark.parametrize("name", WALKING)
+def test_walking_plates_zero_offset(shared_data, name):
+    """The OpenSim walking plates read −14 to −20 N unloaded: removed as a constant offset."""
+    raw = read_c3d(shared_data / name, zero_offset=False)
+    zeroed = read_c3d(shared_data / name)
+    for p0, p1 in zip(raw.platforms, zeroed.platforms, strict=True):
+        fz = p0.force[:, 2]
+        by_hand = np.median(fz)  # the plates are unloaded most of the time
+        assert -25.0 < by_hand < -10.0
+        assert p1.zero_offset_N == pytest.approx(by_hand, abs=1.0)
+        diff = p1.force - p0.force
+        np.testing.assert_allclose(diff, np.broadcast_to(diff[0], diff.shape), atol=1e-9)  # constant
+        assert diff[0, 2] == pytest.approx(-p1.zero_offset_N, abs=1e-3)
+        assert abs(np.median(p1.force[:, 2])) < 1.0
+    assert "warnings" not in zeroed.metadata
+
+
+def test_fukuchi_zeroed_plate_is_left_alone(shared_data, fukuchi):
+    """A zeroed plate (unloaded level within 5 N) reads exactly as the file gives it."""
+    raw = read_c3d(shared_data / FUKUCHI, zero_offset=False)
+    assert fukuchi.platforms[0].zero_offset_N == 0.0
+    np.testing.assert_array_equal(fukuchi.platforms[0].force, raw.platforms[0].force)
 
 
 def test_walking_two_type2_platforms(shared_data):
@@ -312,7 +339,8 @@ def test_type3_kistler_against_the_manufacturer_formula(tmp_path):
     corners = plate_corners((1.0, 0.5, 0.0), 0.6, 0.4)  # plate x = lab +x, plate y = lab −y
     path = tmp_path / "kistler.c3d"
     _write_raw_platform(path, 3, channels, ["N"] * 8, corners, [a * 1000, b * 1000, az0 * 1000])
-    plate = read_c3d(path, forward="+x", up="+z").platforms[0]
+    with pytest.warns(C3DWarning, match="platform 1: never unloads"):  # loaded all along
+        plate = read_c3d(path, forward="+x", up="+z").platforms[0]
     assert plate.type == 3
     np.testing.assert_allclose(plate.force, np.column_stack([fx, -fy, -fz]), atol=1e-3)
     np.testing.assert_allclose(plate.cop[:, 0], 1.0 + ax, atol=1e-5)
@@ -326,7 +354,8 @@ def test_type1_cop_channels(tmp_path):
     corners = plate_corners((1.0, 0.5, 0.0), 0.6, 0.4)
     path = tmp_path / "type1.c3d"
     _write_raw_platform(path, 1, channels, ["N", "N", "N", "mm", "mm", "Nmm"], corners, [0, 0, 0])
-    plate = read_c3d(path, forward="+x", up="+z").platforms[0]
+    with pytest.warns(C3DWarning, match="platform 1: never unloads"):
+        plate = read_c3d(path, forward="+x", up="+z").platforms[0]
     np.testing.assert_allclose(plate.force, np.column_stack([fx, -fy, -fz]), atol=1e-3)
     np.testing.assert_allclose(plate.cop[:, :2], np.column_stack([1.0 + ax, 0.5 - ay]), atol=1e-6)
     np.testing.assert_allclose(plate.free_moment, -tz, atol=1e-4)

@@ -16,12 +16,23 @@ trial_app = typer.Typer(
 
 _FORWARD = typer.Option("auto", "--forward", help="File axis that is forward (+x, -y, ...) or auto.")
 _UP = typer.Option("auto", "--up", help="File axis that is up (+z, +y, ...) or auto.")
+_ZERO = typer.Option(True, "--zero-offset/--no-zero-offset",
+                     help="Remove each plate's offset measured in its unloaded periods "
+                          "(docs/trial.md).")
 
 
-def _read(path: Path, forward: str, up: str):
+def _read(path: Path, forward: str, up: str, zero_offset: bool = True):
+    import warnings
+
+    from bladelab.trial import C3DWarning
     from bladelab.trial.c3d import read_c3d
 
-    return read_c3d(path, forward=forward, up=up)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", C3DWarning)
+        trial = read_c3d(path, forward=forward, up=up, zero_offset=zero_offset)
+    for w in caught:  # one plain line each, like the CLI's errors
+        typer.echo(f"warning: {w.message}", err=True)
+    return trial
 
 
 @trial_app.command("info")
@@ -30,9 +41,10 @@ def _info(
     as_json: bool = typer.Option(False, "--json", help="Print JSON instead of text."),
     forward: str = _FORWARD,
     up: str = _UP,
+    zero_offset: bool = _ZERO,
 ) -> None:
     """Markers, rates, units and force platforms (type, channels) of a C3D file."""
-    info = _read(file, forward, up).info()
+    info = _read(file, forward, up, zero_offset).info()
     if as_json:
         typer.echo(json.dumps(info, indent=2))
         return
@@ -72,11 +84,12 @@ def _stances(
     as_json: bool = typer.Option(False, "--json", help="Print a JSON list instead of a table."),
     forward: str = _FORWARD,
     up: str = _UP,
+    zero_offset: bool = _ZERO,
 ) -> None:
     """List the stances: start, end, contact time, peak vertical force, vertical impulse."""
     from bladelab.trial.events import classify_stances, detect_stances
 
-    trial = _read(file, forward, up)
+    trial = _read(file, forward, up, zero_offset)
     events = detect_stances(trial, threshold=threshold, min_duration=min_duration)
     if tip:
         events = classify_stances(trial, events, tip=tip)
@@ -116,13 +129,14 @@ def _extract(
     threshold: float = typer.Option(20.0, "--threshold", help="Vertical force threshold [N]."),
     forward: str = _FORWARD,
     up: str = _UP,
+    zero_offset: bool = _ZERO,
 ) -> None:
     """Write one stance as a stance CSV (clamp pose, GRF, distance; docs/stance-csv.md)."""
     from bladelab.trial.kinematics import MarkerMap, extract_stance, load_marker_map
     from bladelab.trial.stance import write_stance_csv
 
     marker_map = load_marker_map(markers) if markers else MarkerMap()
-    trial = _read(file, forward, up)
+    trial = _read(file, forward, up, zero_offset)
     result = extract_stance(
         trial, stance - 1, markers=marker_map, rate=rate, margin=margin, threshold=threshold
     )

@@ -4,7 +4,7 @@
 ``extract_stance`` -> :class:`Stance` (written/read as a stance CSV).
 """
 
-from bladelab.trial.c3d import plate_corners, read_c3d, write_c3d
+from bladelab.trial.c3d import C3DWarning, plate_corners, read_c3d, write_c3d
 from bladelab.trial.events import StanceEvent, classify_stances, combined_grf, detect_stances
 from bladelab.trial.filters import fill_gaps, lowpass
 from bladelab.trial.kinematics import (
@@ -22,6 +22,7 @@ from bladelab.trial.trial import ForcePlatform, Trial
 __all__ = [
     "STANCE_COLUMNS",
     "BladeKinematics",
+    "C3DWarning",
     "ForcePlatform",
     "MarkerMap",
     "Stance",

@@ -1,24 +1,28 @@
 """C3D files: read a trial into the lab frame, write synthetic trials (both via ezc3d).
 
 Reading
-    Marker units come from ``POINT:UNITS`` (mm, cm or m); samples with a negative residual or
-    NaN are gaps (NaN). Force platforms of types 1–4 are supported (type 4 applies
-    ``FORCE_PLATFORM:CAL_MATRIX`` to its 6 analog channels; type 3 is the 8-channel Kistler
-    layout). Each platform's axes come from its ``CORNERS``. ``ORIGIN`` (plate axes): its x and y
-    give the centre of the top surface relative to the sensor origin, and the surface lies
-    ``|ORIGIN_z|`` above the sensor origin (files disagree on the sign of ``ORIGIN_z``; this reading
-    puts the COP under the foot markers on the Fukuchi treadmill file and agrees with ezc3d's own
-    force-platform module on all the real files). Forces are the ground reaction force on the
-    subject; the centre of pressure is computed on the plate surface and expressed in the lab
-    frame, with the free moment about the vertical.
+    The file is checked first (:mod:`bladelab.trial.c3d_format`: processor type, truncation,
+    stale frame counts). Marker units come from ``POINT:UNITS`` (m, cm, mm, read leniently:
+    'mete', 'meters', 'millimetres' ...); samples with a negative residual or NaN are gaps
+    (NaN). Force platforms of types 1–4 (:mod:`bladelab.trial.platforms`): each platform's axes
+    come from its ``CORNERS``; ``ORIGIN`` (plate axes): its x and y give the centre of the top
+    surface relative to the sensor origin, and the surface lies ``|ORIGIN_z|`` above the sensor
+    origin (files disagree on the sign of ``ORIGIN_z``; this reading puts the COP under the foot
+    markers on the Fukuchi treadmill file and agrees with ezc3d's own force-platform module on all
+    the real files). Each plate's zero offset is estimated over its unloaded periods and removed
+    when larger than 5 N (``zero_offset=False`` keeps the file's values). Forces are the ground
+    reaction force on the subject; the centre of pressure is computed on the plate surface and
+    expressed in the lab frame, with the free moment about the vertical.
 
 The lab frame
     bladelab's lab frame is x forward, y lateral, z up. Files differ (the Fukuchi treadmill files
     have y up), so the reader maps the file's axes onto the lab frame with a signed permutation:
-    ``up`` defaults to the normal of the first force platform (else the file's +z), ``forward`` to
-    the direction of overground progression of the markers, or on a treadmill to the direction
-    in which the horizontal force changes from braking to propulsion during contact. Both can be
-    given explicitly ("+x", "-y", ...). The mapping used is stored in ``trial.metadata["axes"]``.
+    ``up`` defaults to the normal of the first force platform (else the file's +z), its sense
+    taken from the data (the ground reaction force on a loaded plate points up; a warning says
+    when the corners say otherwise); ``forward`` to the direction of overground progression of
+    the markers, or on a treadmill to the direction in which the horizontal force changes from
+    braking to propulsion during contact. Both can be given explicitly ("+x", "-y", ...). The
+    mapping used is stored in ``trial.metadata["axes"]``.
 """
 
 from __future__ import annotations
@@ -31,16 +35,19 @@ from typing import Any
 import numpy as np
 
 from bladelab._io import atomic_path
-from bladelab.errors import DataError, InputFileError, SpecError
+from bladelab.errors import SpecError
+from bladelab.trial.c3d_format import C3DWarning, WarningLog, length_scale, open_c3d
+from bladelab.trial.platforms import (
+    SUPPORTED_PLATFORM_TYPES,
+    FilePlate,
+    plate_rotation,
+    read_platforms,
+)
 from bladelab.trial.trial import METADATA_KEYS, ForcePlatform, Trial
 
-__all__ = ["SUPPORTED_PLATFORM_TYPES", "plate_corners", "read_c3d", "write_c3d"]
+__all__ = ["SUPPORTED_PLATFORM_TYPES", "C3DWarning", "plate_corners", "read_c3d", "write_c3d"]
 
-SUPPORTED_PLATFORM_TYPES: tuple[int, ...] = (1, 2, 3, 4)
-_LENGTH_UNITS = {"mm": 1e-3, "cm": 1e-2, "m": 1.0, "meters": 1.0, "millimeters": 1e-3}
-_MOMENT_UNITS = {"nmm": 1e-3, "n.mm": 1e-3, "nm": 1.0, "n.m": 1.0, "nmm ": 1e-3}
 _AXES = {"x": 0, "y": 1, "z": 2}
-_C3D_PARAMETER_BLOCK_KEY = 0x50  # byte 2 of every C3D file
 
 
 # --------------------------------------------------------------------------------------------
@@ -54,8 +61,9 @@ def read_c3d(
     forward: str = "auto",
     up: str = "auto",
     cop_threshold: float = 20.0,
+    zero_offset: bool = True,
 ) -> Trial:
-    """Read a C3D file into a :class:`~bladelab.trial.trial.Trial` (lab frame, SI).
+    r"""Read a C3D file into a :class:`~bladelab.trial.trial.Trial` (lab frame, SI).
 
     Parameters
     ----------
@@ -66,29 +74,33 @@ def read_c3d(
         the vertical; "auto" detects them (see the module docstring).
     cop_threshold
         Vertical force [N] under which a platform's COP and free moment are NaN.
+    zero_offset
+        Remove each platform's zero offset, estimated over its unloaded periods, when it is
+        larger than 5 N (see :mod:`bladelab.trial.platforms`).
+
+    Odd but readable files (a stale frame count, a plate that never unloads or is stuck, a
+    vertical force whose sign contradicts the plate's corners) give :class:`C3DWarning`\ s, also
+    kept in ``trial.metadata["warnings"]``.
 
     Raises
     ------
     InputFileError
-        The file is missing, is not a C3D file, or is truncated/corrupt.
+        The file is missing, is not a C3D file, is truncated/corrupt, or comes from an
+        unsupported (big-endian) processor type.
     DataError
         A platform has an unsupported type, references missing analog channels, or has
         degenerate corners; marker units are unknown.
     """
     path = Path(path)
-    c3d = _open_c3d(path)
+    log = WarningLog()
+    c3d, raw = open_c3d(path, log)
     params = c3d["parameters"]
     data = c3d["data"]
 
     # markers, in file axes [m]
-    point_units = _param(params, "POINT", "UNITS", ["mm"])
-    point_units = (point_units[0] if point_units else "mm").strip().lower() or "mm"
-    if point_units not in _LENGTH_UNITS:
-        raise DataError(
-            f"unknown marker units {point_units!r}", file=path, where="POINT:UNITS",
-            hint="expected mm, cm or m",
-        )
-    scale = _LENGTH_UNITS[point_units]
+    units_value = _param(params, "POINT", "UNITS", [])
+    point_units = (str(units_value[0]) if len(units_value) else "").strip() or "mm"
+    scale = length_scale(point_units, file=path, where="POINT:UNITS")
     labels = [str(s).strip() for s in _param(params, "POINT", "LABELS", [])]
     points = np.asarray(data["points"], dtype=float)[:3] * scale  # (3, n_points, n_frames)
     residuals = np.asarray(data["meta_points"]["residuals"], dtype=float)[0]
@@ -109,13 +121,17 @@ def read_c3d(
 
     # a file without analog data (e.g. a static trial) recorded no platform signals
     plates_file = (
-        _read_platforms(path, params, analogs_arr, analog_labels, analog_units, analog_rate)
+        read_platforms(
+            path, params, analogs_arr, analog_labels, analog_units, analog_rate,
+            point_scale=scale, zero_offset=zero_offset,
+            used_in_file=raw.platforms_used is not None, log=log,
+        )
         if n_analog and analogs_arr.shape[1]
         else []
     )
 
     # file axes -> lab axes
-    up_vec = _choose_up(up, plates_file, path)
+    up_vec = _choose_up(up, plates_file, path, log)
     fwd_vec = _choose_forward(forward, up_vec, points, plates_file, analog_rate, path)
     lat_vec = np.cross(up_vec, fwd_vec)
     rot = np.vstack([fwd_vec, lat_vec, up_vec])  # lab = rot @ file
@@ -129,6 +145,8 @@ def read_c3d(
     metadata["axes"] = {
         "forward": _axis_name(fwd_vec), "lateral": _axis_name(lat_vec), "up": _axis_name(up_vec)
     }
+    if log:
+        metadata["warnings"] = list(log)
     names = _param(params, "SUBJECTS", "NAMES", [])
     if names and str(names[0]).strip():
         metadata["athlete"] = str(names[0]).strip()
@@ -149,61 +167,6 @@ def read_c3d(
     )
 
 
-def _open_c3d(path: Path):
-    import ezc3d
-
-    if not path.is_file():
-        raise InputFileError("file not found", file=path, hint="check the path")
-    with open(path, "rb") as fh:
-        head = fh.read(512)
-    if len(head) < 512 or head[1] != _C3D_PARAMETER_BLOCK_KEY:
-        raise InputFileError(
-            "not a C3D file (no C3D header)", file=path,
-            hint="export the trial as C3D from the motion-capture software",
-        )
-    # ezc3d can hang on a file cut inside its parameter section: check that the file reaches
-    # the data block announced by the header (word 9) before handing it over.
-    data_start = int.from_bytes(head[16:18], "little")
-    param_start = head[0]
-    size = path.stat().st_size
-    if data_start < 2 or param_start < 1 or size < (data_start - 1) * 512:
-        raise InputFileError(
-            f"truncated: {size} bytes, but the header puts the data block at byte "
-            f"{max(data_start - 1, 0) * 512}", file=path,
-            hint="re-export it from the motion-capture software",
-        )
-    try:
-        c3d = ezc3d.c3d(str(path))
-    except Exception as err:  # ezc3d raises RuntimeError/IOError on corrupt files
-        raise InputFileError(
-            f"cannot be read as C3D ({err}); the file looks truncated or corrupt", file=path,
-            hint="re-export it from the motion-capture software",
-        ) from err
-    # ezc3d reads a truncated data block without complaint (it shortens last_frame): compare
-    # the frames it got with the count the raw header announces.
-    got = np.asarray(c3d["data"]["points"]).shape[-1]
-    announced = _announced_frames(head)
-    if announced is not None and got < announced:
-        raise InputFileError(
-            f"truncated: the file announces {announced} frames but holds only {got}",
-            file=path, hint="re-export it from the motion-capture software",
-        )
-    return c3d
-
-
-def _announced_frames(head: bytes) -> int | None:
-    """Number of frames the raw header announces (words 4–5), None when saturated.
-
-    ezc3d silently shortens ``last_frame`` and ``POINT:FRAMES`` of a truncated file, so the
-    count is taken from the header bytes themselves.
-    """
-    first = int.from_bytes(head[6:8], "little")
-    last = int.from_bytes(head[8:10], "little")
-    if last >= 65535 or last < first:
-        return None
-    return last - first + 1
-
-
 def _param(params, group: str, name: str, default):
     try:
         return params[group][name]["value"]
@@ -214,141 +177,6 @@ def _param(params, group: str, name: str, default):
 def _num(value) -> Any:
     f = float(value)
     return int(f) if f.is_integer() else f
-
-
-# A platform in the file's axes, before the lab mapping (all SI).
-class _FilePlate:
-    def __init__(self, index, type_, force, cop, free_moment, corners, rot, channels, rate):
-        self.index, self.type, self.force, self.cop = index, type_, force, cop
-        self.free_moment, self.corners, self.rot, self.channels = free_moment, corners, rot, channels
-        self.rate = rate
-
-
-def _read_platforms(path, params, analogs, labels, units, rate) -> list[_FilePlate]:
-    if "FORCE_PLATFORM" not in params:
-        return []
-    used = int(np.asarray(_param(params, "FORCE_PLATFORM", "USED", [0])).ravel()[0])
-    if used == 0:
-        return []
-    types = np.asarray(_param(params, "FORCE_PLATFORM", "TYPE", []), dtype=float).ravel()
-    channel = np.asarray(_param(params, "FORCE_PLATFORM", "CHANNEL", []), dtype=float)
-    corners = np.asarray(_param(params, "FORCE_PLATFORM", "CORNERS", []), dtype=float)
-    origin = np.asarray(_param(params, "FORCE_PLATFORM", "ORIGIN", []), dtype=float)
-    cal = np.asarray(_param(params, "FORCE_PLATFORM", "CAL_MATRIX", []), dtype=float)
-    point_units = _param(params, "POINT", "UNITS", ["mm"])
-    length_scale = _LENGTH_UNITS.get((point_units[0] if point_units else "mm").strip().lower(), 1e-3)
-    if types.size < used or corners.size < 12 * used:
-        raise DataError(
-            f"FORCE_PLATFORM:USED is {used} but TYPE/CORNERS describe fewer platforms",
-            file=path, where="FORCE_PLATFORM", hint="fix the platform set-up in the export",
-        )
-    channel = channel.reshape(channel.shape[0], -1) if channel.ndim >= 1 and channel.size else channel
-    corners = corners.reshape(3, 4, -1)
-    origin = origin.reshape(3, -1) if origin.size else np.zeros((3, used))
-    plates = []
-    for k in range(used):
-        index = k + 1
-        where = f"platform {index}"
-        ptype = int(types[k])
-        if ptype not in SUPPORTED_PLATFORM_TYPES:
-            raise DataError(
-                f"force platform type {ptype} is not supported (supported: 1, 2, 3, 4)",
-                file=path, where=where, hint="export the platform as type 2 (Fx..Mz) from the capture software",
-            )
-        n_ch = 8 if ptype == 3 else 6
-        if channel.ndim != 2 or channel.shape[0] < n_ch or channel.shape[1] <= k:
-            raise DataError(
-                f"type {ptype} needs {n_ch} channels in FORCE_PLATFORM:CHANNEL", file=path, where=where,
-            )
-        chans = channel[:n_ch, k].astype(int) - 1
-        if np.any(chans < 0) or np.any(chans >= analogs.shape[0]):
-            raise DataError(
-                f"references analog channel(s) {sorted(set((chans + 1).tolist()))} but the file has "
-                f"{analogs.shape[0]}", file=path, where=where,
-            )
-        raw = analogs[chans]  # (n_ch, n)
-        ch_labels = tuple(labels[c] for c in chans)
-        ch_units = [units[c].lower() if c < len(units) else "" for c in chans]
-        cnr = corners[:, :, k].T * length_scale  # (4, 3) file axes [m]
-        rot = _plate_rotation(cnr, path, where)
-        org = origin[:, k] * length_scale if origin.shape[1] > k else np.zeros(3)
-        if ptype == 4:
-            if cal.size < 36 * (k + 1):
-                raise DataError(
-                    "type 4 platform without FORCE_PLATFORM:CAL_MATRIX", file=path, where=where,
-                    hint="a type-4 platform's analog channels must be calibrated by CAL_MATRIX",
-                )
-            raw = cal.reshape(6, 6, -1)[:, :, k] @ raw
-        force_p, cop_p, tz = _plate_kinetics(ptype, raw, ch_units, org, length_scale)
-        force = (rot @ force_p).T
-        with np.errstate(invalid="ignore"):
-            cop = cnr.mean(axis=0) + (rot @ cop_p).T
-        plates.append(_FilePlate(index, ptype, force, cop, tz, cnr, rot, ch_labels, rate))
-    return plates
-
-
-def _plate_kinetics(ptype, raw, ch_units, org, length_scale):
-    """Force (3, n) [N], COP relative to the surface centre (3, n) [m], Tz (n,) [N·m], plate axes.
-
-    ``org`` is FORCE_PLATFORM:ORIGIN [m]: its x, y give the surface centre relative to the sensor
-    origin; the surface lies ``|org_z|`` above the sensor origin (files disagree on the sign of
-    ``org_z``; the surface is never below the sensors).
-    """
-
-    def mscale(u):
-        return _MOMENT_UNITS.get(u.replace(" ", ""), 1e-3 if "mm" in u else 1.0)
-
-    n = raw.shape[1]
-    h = abs(float(org[2]))
-    centre_xy = np.array([org[0], org[1]])
-    if ptype == 3:  # Kistler: fx12, fx34, fy14, fy23, fz1..fz4; ORIGIN = (a, b, az0)
-        a, b = org[0], org[1]
-        fx12, fx34, fy14, fy23, fz1, fz2, fz3, fz4 = raw
-        force = np.vstack([fx12 + fx34, fy14 + fy23, fz1 + fz2 + fz3 + fz4])
-        mx = b * (fz1 + fz2 - fz3 - fz4)
-        my = a * (-fz1 + fz2 + fz3 - fz4)
-        mz = b * (-fx12 + fx34) + a * (fy14 - fy23)
-        moment = np.vstack([mx, my, mz])
-        centre_xy = np.zeros(2)  # a, b locate the sensors; the moments are about the centre
-    elif ptype == 1:  # Fx, Fy, Fz, Px, Py, Tz
-        force = raw[:3]
-        px = raw[3] * _length_scale_of(ch_units[3], length_scale)
-        py = raw[4] * _length_scale_of(ch_units[4], length_scale)
-        tz = raw[5] * mscale(ch_units[5])
-        cop = np.vstack([px - centre_xy[0], py - centre_xy[1], np.zeros(n)])
-        return force, cop, tz
-    else:  # 2 and 4 (after calibration): Fx, Fy, Fz, Mx, My, Mz about the sensor origin
-        force = raw[:3]
-        moment = np.vstack([raw[3 + i] * mscale(ch_units[3 + i]) for i in range(3)])
-    fx, fy, fz = force
-    with np.errstate(divide="ignore", invalid="ignore"):
-        # force F applied at p = (px, py, -h) (plate z points down): M = p × F + (0, 0, Tz)
-        px = (-moment[1] - h * fx) / fz
-        py = (moment[0] - h * fy) / fz
-        tz = moment[2] - (px * fy - py * fx)
-    cop = np.vstack([px - centre_xy[0], py - centre_xy[1], np.zeros(n)])
-    return force, cop, tz
-
-
-def _length_scale_of(unit: str, default: float) -> float:
-    return _LENGTH_UNITS.get(unit.strip().lower(), default)
-
-
-def _plate_rotation(corners: np.ndarray, path, where) -> np.ndarray:
-    """Plate axes in file axes (columns x_p, y_p, z_p) from the 4 corners (C3D order)."""
-    c1, c2, c3, c4 = corners
-    xp = (c1 - c2) + (c4 - c3)
-    yp = (c1 - c4) + (c2 - c3)
-    if np.linalg.norm(xp) < 1e-9 or np.linalg.norm(yp) < 1e-9:
-        raise DataError(
-            "degenerate FORCE_PLATFORM:CORNERS (zero-size plate)", file=path, where=where,
-            hint="the plate's corners are needed to place it in the lab",
-        )
-    xp = xp / np.linalg.norm(xp)
-    zp = np.cross(xp, yp)
-    zp = zp / np.linalg.norm(zp)
-    yp = np.cross(zp, xp)
-    return np.column_stack([xp, yp, zp])
 
 
 def _axis_vec(spec: str, what: str, path) -> np.ndarray:
@@ -374,12 +202,51 @@ def _snap(v: np.ndarray) -> np.ndarray:
     return out
 
 
-def _choose_up(up: str, plates: list[_FilePlate], path) -> np.ndarray:
+def _choose_up(up: str, plates: list[FilePlate], path, log: WarningLog) -> np.ndarray:
+    """The lab's up in file axes; plates whose loaded force points down are inverted.
+
+    Auto: the axis is the first plate's normal (else the file's +z); its sense comes from the
+    data: the ground reaction force on a loaded plate points up (a foot pushes a plate down).
+    The plates with unloaded periods vote (those that never unload when none has any); a tie
+    keeps the corners' sense.
+    """
     if up != "auto":
-        return _axis_vec(up, "up", path)
-    if plates:
-        return _snap(-plates[0].rot[:, 2])  # plate z points down into the plate
-    return np.array([0.0, 0.0, 1.0])
+        up_vec = _axis_vec(up, "up", path)
+    elif plates:
+        up_vec = _snap(-plates[0].rot[:, 2])  # plate z points down into the plate
+        voters = [p for p in plates if p.loading.status == "unloads"] or [
+            p for p in plates if p.loading.sense != 0
+        ]
+        against = [p for p in voters if _sense_along(p, up_vec) < 0]
+        if 2 * len(against) > len(voters):
+            p = against[0]
+            log.warn(
+                f"its CORNERS make file {_axis_name(_snap(p.rot[:, 2]))} the plate's z axis (into "
+                f"the plate, i.e. down), but under load its ground reaction force points along "
+                f"file {_axis_name(-up_vec)} (peak {abs(p.loading.peak):.0f} N): taking file "
+                f"{_axis_name(-up_vec)} as up, as the data say (the ground pushes a foot up)",
+                file=path, where=p.name,
+                hint="check the corner order (C3D: z into the plate), or give the up axis (--up)",
+            )
+            up_vec = -up_vec
+    else:
+        return np.array([0.0, 0.0, 1.0])
+    for p in plates:
+        if p.loading.sense != 0 and _sense_along(p, up_vec) < 0:
+            log.warn(
+                f"loaded, its vertical force points down (peak {-abs(p.loading.peak):.0f} N along "
+                f"file {_axis_name(up_vec)}, the lab's up): the file's calibration gives the force "
+                "on the plate; its sign is inverted to give the ground reaction force",
+                file=path, where=p.name,
+                hint="check the plate's calibration (CAL_MATRIX, channel signs) or the up axis",
+            )
+            p.invert()
+    return up_vec
+
+
+def _sense_along(p: FilePlate, up_vec: np.ndarray) -> float:
+    """+1 when plate ``p``'s ground reaction force under load points along ``up_vec``."""
+    return p.loading.sense * float(np.sign(-p.rot[:, 2] @ up_vec))
 
 
 def _choose_forward(forward, up_vec, points, plates, rate, path) -> np.ndarray:
@@ -441,7 +308,7 @@ class _quiet:
         return False
 
 
-def _to_lab(p: _FilePlate, rot: np.ndarray, up_vec: np.ndarray, cop_threshold: float) -> ForcePlatform:
+def _to_lab(p: FilePlate, rot: np.ndarray, up_vec: np.ndarray, cop_threshold: float) -> ForcePlatform:
     force = p.force @ rot.T
     cop = p.cop @ rot.T
     free = p.free_moment * float(p.rot[:, 2] @ up_vec)  # about the lab vertical
@@ -451,6 +318,7 @@ def _to_lab(p: _FilePlate, rot: np.ndarray, up_vec: np.ndarray, cop_threshold: f
     return ForcePlatform(
         index=p.index, type=p.type, rate=p.rate, force=force, cop=cop, free_moment=free,
         corners=p.corners @ rot.T, channels=p.channels,
+        zero_offset_N=round(p.zero_offset_N * float(np.sign(-p.rot[:, 2] @ up_vec) or 1.0), 3),
     )
 
 
@@ -563,7 +431,7 @@ def write_c3d(
         if force.shape != (m, 3):
             raise SpecError(f"force has shape {force.shape}, expected ({m}, 3)", file=path, where=where)
         corners = np.asarray(plate["corners"], dtype=float).reshape(4, 3)
-        rot = _plate_rotation(corners, path, where)
+        rot = plate_rotation(corners, path, where)
         if rot[2, 2] > -0.99:
             raise SpecError(
                 "corners give a plate z axis that does not point down", file=path, where=where,
@@ -596,23 +464,24 @@ def write_c3d(
         c3d["parameters"]["ANALOG"]["UNITS"]["value"] = analog_units
         c3d["data"]["analogs"] = np.vstack(analog_rows)[None, :, :]
         n_pl = len(plate_corner_list)
-        c3d.add_parameter("FORCE_PLATFORM", "USED", [n_pl])
-        c3d.add_parameter("FORCE_PLATFORM", "TYPE", [2] * n_pl)
-        c3d.add_parameter("FORCE_PLATFORM", "ZERO", [1, 0])
-        chan = np.arange(1, 6 * n_pl + 1, dtype=float).reshape(n_pl, 6).T
-        c3d.add_parameter("FORCE_PLATFORM", "CHANNEL", chan)
-        c3d.add_parameter("FORCE_PLATFORM", "CORNERS", np.stack(plate_corner_list, axis=2))
-        c3d.add_parameter("FORCE_PLATFORM", "ORIGIN", np.stack(plate_origin_list, axis=1))
+        _set_param(c3d, "FORCE_PLATFORM", "USED", [n_pl], integer=True)
+        _set_param(c3d, "FORCE_PLATFORM", "TYPE", [2] * n_pl, integer=True)
+        _set_param(c3d, "FORCE_PLATFORM", "ZERO", [1, 0], integer=True)
+        chan = np.arange(1, 6 * n_pl + 1).reshape(n_pl, 6).T
+        _set_param(c3d, "FORCE_PLATFORM", "CHANNEL", chan, integer=True)
+        _set_param(c3d, "FORCE_PLATFORM", "CORNERS", np.stack(plate_corner_list, axis=2))
+        _set_param(c3d, "FORCE_PLATFORM", "ORIGIN", np.stack(plate_origin_list, axis=1))
     meta = dict(metadata or {})
     if "athlete" in meta:
         c3d.add_parameter("SUBJECTS", "NAMES", [str(meta["athlete"])])
     for key in METADATA_KEYS:
         if key in meta and meta[key] is not None:
             value = meta[key]
-            c3d.add_parameter(
-                "BLADELAB", key.upper(),
-                [float(value)] if isinstance(value, (int, float)) else [str(value)],
-            )
+            if isinstance(value, str):
+                c3d.add_parameter("BLADELAB", key.upper(), [value])
+            else:
+                integer = float(value).is_integer() and abs(float(value)) < 32768
+                _set_param(c3d, "BLADELAB", key.upper(), [value], integer=integer)
     with atomic_path(path) as tmp:
         # ezc3d appends ".c3d" to a name without it: write there, then move onto the temp name
         written = tmp if tmp.suffix.lower() == ".c3d" else tmp.with_name(tmp.name + ".c3d")
@@ -624,3 +493,14 @@ def write_c3d(
             if written != tmp and written.exists():
                 written.unlink()
     return path
+
+
+def _set_param(c3d, group: str, name: str, value, *, integer: bool = False) -> None:
+    """Set a numeric parameter, stored as INT when ``integer`` (ezc3d's platform reader needs
+    FORCE_PLATFORM:USED, TYPE, CHANNEL as integers; ``add_parameter`` alone writes floats)."""
+    arr = np.asarray(value, dtype=float)
+    c3d.add_parameter(group, name, arr)
+    if integer:
+        param = c3d["parameters"][group][name]
+        param["type"] = c3d["parameters"]["POINT"]["USED"]["type"]  # ezc3d's INT
+        param["value"] = np.rint(arr).astype(int)

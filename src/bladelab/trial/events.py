@@ -228,14 +228,30 @@ def detect_stances(
             )
         )
     if not events:
-        peak = max(float(np.max(v)) for v in fz_filtered.values())
-        raise DataError(
-            f"no stance found: the vertical force peaks at {peak:.1f} N against a threshold of "
-            f"{threshold:g} N and a minimum contact of {min_duration:g} s",
-            file=trial.source, where="platforms " + ", ".join(str(p.index) for p in trial.platforms),
-            hint="lower --threshold, or check the platform calibration",
-        )
+        raise _no_stance(trial, fz_filtered, threshold, min_duration)
     return events
+
+
+def _no_stance(trial: Trial, fz_filtered: dict[int, np.ndarray], threshold, min_duration) -> DataError:
+    """The error for a trial without stances; its hint follows what the forces look like."""
+    peak = max(float(np.max(v)) for v in fz_filtered.values())
+    low = min(float(np.min(v)) for v in fz_filtered.values())
+    message = (
+        f"no stance found: the vertical force peaks at {peak:.1f} N (lowest {low:.1f} N) against "
+        f"a threshold of {threshold:g} N and a minimum contact of {min_duration:g} s"
+    )
+    if all(float(np.min(v)) > threshold for v in fz_filtered.values()):
+        hint = ("the force never falls below the threshold: the plates are loaded all along or "
+                "not zeroed; read the file with zero-offset removal (the default) or zero the plates")
+    elif low < -max(threshold, 50.0):
+        hint = ("the force goes well below zero: a plate is not zeroed or its sign is inverted; "
+                "read the file with zero-offset removal (the default) or check its calibration")
+    else:
+        hint = "lower --threshold, or check the platform calibration"
+    return DataError(
+        message, file=trial.source,
+        where="platforms " + ", ".join(str(p.index) for p in trial.platforms), hint=hint,
+    )
 
 
 def _merge_contacts(trial, contacts, merge_distance):

@@ -41,6 +41,9 @@ class ForcePlatform:
         Plate corners [m], lab frame, shape (4, 3), in the file's order.
     channels
         Analog channel labels used by this platform.
+    zero_offset_N
+        Vertical zero offset [N] the reader removed (0 when the plate was zeroed or the removal
+        was off); see :mod:`bladelab.trial.platforms`.
     """
 
     index: int
@@ -51,6 +54,7 @@ class ForcePlatform:
     free_moment: np.ndarray
     corners: np.ndarray
     channels: tuple[str, ...] = ()
+    zero_offset_N: float = 0.0
 
     def __post_init__(self) -> None:
         force = np.asarray(self.force, dtype=float)
@@ -85,7 +89,7 @@ class ForcePlatform:
         return np.arange(self.n_samples) / self.rate
 
     def to_dict(self) -> dict[str, Any]:
-        """Summary (no samples): index, type, rate_Hz, channels, corners_m."""
+        """Summary (no samples): index, type, rate_Hz, channels, corners_m, zero_offset_N."""
         return {
             "index": self.index,
             "type": self.type,
@@ -93,6 +97,7 @@ class ForcePlatform:
             "n_samples": self.n_samples,
             "channels": list(self.channels),
             "corners_m": self.corners.round(4).tolist(),
+            "zero_offset_N": self.zero_offset_N,
         }
 
 
@@ -194,4 +199,5 @@ class Trial:
             "analogs": list(self.analogs),
             "platforms": [p.to_dict() for p in self.platforms],
             "metadata": {k: self.metadata[k] for k in METADATA_KEYS if k in self.metadata},
+            "warnings": list(self.metadata.get("warnings", [])),
         }
