@@ -128,7 +128,8 @@ def test_report_of_predict_folders(tmp_path, capsys):
     optimize_controller("able", generations=3, popsize=4, seed=2,
                         settings=ObjectiveSettings(duration=1.0), out=run)
     assert predictive_kind(run) == "run"
-    assert main(["report", str(run)]) == 0
+    assert main(["report", str(run), "--export"]) == 0
+    assert list((run / "report" / "export").glob("*/coordinates.mot"))
     index = run / "report" / "index.html"
     html = index.read_text(encoding="utf-8")
     for title in ("Optimisation: convergence and run summary", "Joint angles per leg",
@@ -226,7 +227,8 @@ def test_sweep_report_opens_in_a_browser(sweep_dir, tmp_path):
     figures, errors = inspect_page(binary, Path(rep.index), tmp_path / "shot.png",
                                    tmp_path / "profile")
     assert errors == []
-    assert len(figures) == 4 * len(rep.solutions) + 1
+    # the gait figures overlay every solution (12) + the category figure
+    assert len(figures) == 12 + 1
     assert all(figure_ok(f) for f in figures)
 
 
@@ -241,7 +243,8 @@ def test_report_of_a_parameter_file(tmp_path):
     assert abs(resim["mean speed (m/s)"] - 3.5) < 0.3
     assert resim["power-balance residual (%)"] < 2.0
     st = _table(tables, "spatiotemporal")
-    contact = st[st.variable == "contact_time"]["value (s)"]
+    _units_everywhere(st)
+    contact = st["contact time (s)"]
     assert ((contact > 0.1) & (contact < 0.35)).all()  # running contact times (seed 001 §3.1)
 
 
@@ -273,3 +276,34 @@ def test_bad_paths_exit_2_and_write_nothing(tmp_path, capsys):
 
     with pytest.raises(InputFileError, match="not a predictive result"):
         build_predictive_report(tmp_path / "empty")
+
+
+def test_report_of_the_shipped_amputee_solution(tmp_path):
+    from bladelab.runner.export import read_mot
+
+    src = SOLUTIONS / "amputee-Cat6-3.5.json"
+    rep = build_predictive_report(src, tmp_path / "r", duration=3.0, progress=False,
+                                  export=True)
+    index = Path(rep.index)
+    html = index.read_text(encoding="utf-8")
+    assert 'class="runner-animation"' in html and "Table D.1" in html
+    tables = _tables(index)
+    energy = _table(tables, "table-3-3")
+    _units_everywhere(energy)
+    # Table 3.3 from real stances only: as many as the spatiotemporal contacts
+    st = _table(tables, "spatiotemporal")
+    assert set(st["strides (count)"]) <= {3, 4}
+    blade = _table(tables, "table-d-1").iloc[0]
+    _units_everywhere(_table(tables, "table-d-1"))
+    # the sphere with seed 001's c = 0.2 s/m returns about half; the seed's bookkeeping ~100 %
+    assert 45.0 < blade["recoil (%)"] < 62.0
+    assert blade["recoil, compression from eq. 2.3 (%)"] > 99.9
+    k = _table(tables, "leg-stiffness")
+    _units_everywhere(k)
+    assert ((k["K_leg (kN/m)"] > 15) & (k["K_leg (kN/m)"] < 35)).all()
+    folder = index.parent / "export" / "amputee-cat6-3.5-m-s"
+    for name in ("coordinates.mot", "grf.mot", "external_loads.xml", "states.csv"):
+        assert (folder / name).is_file(), name
+    header, coords = read_mot(folder / "coordinates.mot")
+    assert header["inDegrees"] == "yes" and coords.time.iloc[-1] == pytest.approx(3.0)
+    assert "export/amputee-cat6-3.5-m-s/grf.mot" in html

@@ -255,3 +255,25 @@ def test_bad_figure_input_is_a_clear_error():
         time_series_bands({})
     with pytest.raises(DataError, match="signal"):
         time_series_bands({"a": []}, signal="speed")  # type: ignore[arg-type]
+
+
+def test_html_blocks_and_attached_files(tmp_path: Path):
+    from bladelab.errors import BladelabError
+    from bladelab.report.builder import EmbeddedHTML
+
+    report = Report("Blocks")
+    block = EmbeddedHTML('<div id="live"><svg></svg></div>', caption="a <caption>")
+    report.add_section("Animated", html=[block], text="text first")
+    name = report.add_file("export/run/data.txt", lambda p: p.write_text("42\n"))
+    assert name == "export/run/data.txt"
+    for bad in ("../x.txt", "/abs.txt", "index.html", "tables/x.csv"):
+        with pytest.raises(BladelabError):
+            report.add_file(bad, lambda p: None)
+    with pytest.raises(BladelabError, match="EmbeddedHTML"):
+        report.add_section("Bad", html=["<p>raw</p>"])
+    index = report.write(tmp_path / "r")
+    html = index.read_text(encoding="utf-8")
+    assert '<div id="live"><svg></svg></div>' in html  # placed as it is
+    assert "a &lt;caption&gt;" in html  # the caption is text
+    assert html.index("text first") < html.index('id="live"')
+    assert (tmp_path / "r" / "export" / "run" / "data.txt").read_text() == "42\n"

@@ -19,6 +19,8 @@ def _report(
     variant: str | None = typer.Option(None, "--variant", help="Model variant to report "
                                        "(default: linear)."),
     out: Path | None = typer.Option(None, "--out", help="Report folder (default PATH/report)."),
+    export: bool = typer.Option(False, "--export", help="Predictive results: also write each "
+                                "solution as OpenSim .mot files and a states CSV (report/export/)."),
     as_json: bool = typer.Option(False, "--json", help="Print the result as JSON."),
 ) -> None:
     """Write PATH/report/index.html: fits, K*/D*, mechanics, statistics, identifiability (a
@@ -33,7 +35,7 @@ def _report(
             raise InputFileError("not a runner parameter file (no 'parameters' mapping)",
                                  file=study_dir, hint="a file must be a parameter JSON file; "
                                  "otherwise give a study, design, predict or sweep folder")
-        pres = build_predictive_report(study_dir, out, progress=not as_json)
+        pres = build_predictive_report(study_dir, out, progress=not as_json, export=export)
         typer.echo(json.dumps(pres.to_dict(), indent=2) if as_json
                    else f"report written: {pres.index} ({len(pres.solutions)} solutions)")
         return

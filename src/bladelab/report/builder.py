@@ -2,9 +2,12 @@
 
 Workflows add their own sections (identification, prediction, design) to one :class:`Report`;
 :meth:`Report.write` renders ``index.html`` from the package's Jinja2 template with every figure
-embedded as a base64 PNG (the page opens offline, alone), writes each table also as CSV under
-``tables/``, appends a "Settings, versions and seed" section, and does it atomically: the whole
-folder is built under a temporary name beside the target and renamed into place.
+embedded as a base64 PNG and every interactive block (:class:`EmbeddedHTML`, e.g. an animation:
+inline SVG and JavaScript, nothing loaded from elsewhere) in the page, so that it opens offline,
+alone; writes each table also as CSV under ``tables/`` and any attached files
+(:meth:`Report.add_file`), appends a "Settings, versions and seed" section, and does it
+atomically: the whole folder is built under a temporary name beside the target and renamed
+into place.
 """
 
 from __future__ import annotations
@@ -20,7 +23,7 @@ import platform
 import re
 import shutil
 import tempfile
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from importlib import metadata
 from pathlib import Path
 from typing import Any
@@ -31,7 +34,14 @@ from matplotlib.figure import Figure
 
 from bladelab.errors import BladelabError
 
-__all__ = ["Report", "Section", "EmbeddedFigure", "ReportTable", "environment_versions"]
+__all__ = [
+    "EmbeddedFigure",
+    "EmbeddedHTML",
+    "Report",
+    "ReportTable",
+    "Section",
+    "environment_versions",
+]
 
 _PACKAGES = ("bladelab", "numpy", "scipy", "pandas", "numba", "mujoco", "matplotlib", "cma")
 
@@ -57,6 +67,16 @@ class EmbeddedFigure:
         return cls(base64.b64encode(buf.getvalue()).decode("ascii"), caption, alt, int(w), int(h))
 
 
+@dataclasses.dataclass(frozen=True)
+class EmbeddedHTML:
+    """A self-contained block of HTML placed in the page as it is (not escaped), e.g. an
+    animation: inline SVG and JavaScript only, nothing loaded from elsewhere (the page must
+    open offline). Its scripts must not rely on ids of other blocks."""
+
+    html: str
+    caption: str = ""
+
+
 @dataclasses.dataclass(frozen=True, eq=False)
 class ReportTable:
     """A table shown in the page and written as ``tables/<name>.csv``.
@@ -73,13 +93,15 @@ class ReportTable:
 
 @dataclasses.dataclass(eq=False)
 class Section:
-    """One titled part of the report: text paragraphs, figures and tables, in that order."""
+    """One titled part of the report: text paragraphs, HTML blocks, figures and tables, in that
+    order."""
 
     title: str
     anchor: str
     text: list[str]
     figures: list[EmbeddedFigure]
     tables: list[ReportTable]
+    blocks: list[EmbeddedHTML] = dataclasses.field(default_factory=list)
 
 
 def _slug(text: str) -> str:
@@ -157,6 +179,7 @@ class Report:
         self.settings = dict(settings or {})
         self.seed = seed
         self.sections: list[Section] = []
+        self.files: dict[str, Callable[[Path], object]] = {}
 
     def add_section(
         self,
@@ -165,6 +188,7 @@ class Report:
         figures: Sequence[Figure | tuple[str, Figure]] = (),
         tables: Sequence[pd.DataFrame | tuple[str, pd.DataFrame] | ReportTable] = (),
         text: str | None = None,
+        html: Sequence[EmbeddedHTML] = (),
     ) -> Section:
         """Append a section and return it.
 
@@ -178,6 +202,8 @@ class Report:
             DataFrames, ``(title, DataFrame)`` pairs or :class:`ReportTable` objects.
         text
             Plain text; blank lines separate paragraphs (HTML is escaped).
+        html
+            Self-contained HTML blocks (:class:`EmbeddedHTML`), shown after the text.
         """
         anchor = _slug(title)
         taken = {s.anchor for s in self.sections}
@@ -208,9 +234,28 @@ class Report:
             names.add(name)
             rendered.append(dataclasses.replace(table, name=name))
         paragraphs = [p.strip() for p in re.split(r"\n\s*\n", text or "") if p.strip()]
-        section = Section(title, anchor, paragraphs, embedded, rendered)
+        for block in html:
+            if not isinstance(block, EmbeddedHTML):
+                raise BladelabError(
+                    f"HTML block is a {type(block).__name__}, not an EmbeddedHTML",
+                    where=f"report section {title!r}",
+                )
+        section = Section(title, anchor, paragraphs, embedded, rendered, list(html))
         self.sections.append(section)
         return section
+
+    def add_file(self, name: str, write: Callable[[Path], object]) -> str:
+        """Attach a file to the report: ``write(path)`` is called by :meth:`write` to create
+        ``name`` (a relative path such as ``export/run/grf.mot``) inside the report folder, as
+        part of its atomic assembly. Returns ``name``, for a link from the page."""
+        parts = Path(name).parts
+        if not parts or Path(name).is_absolute() or ".." in parts or parts[0] in (
+            "index.html", "tables", "settings.json"
+        ):
+            raise BladelabError(f"cannot attach a file named {name!r}",
+                                hint="use a relative path inside the report folder")
+        self.files[Path(name).as_posix()] = write
+        return Path(name).as_posix()
 
     def _settings_section(self, created: str) -> Section:
         versions = environment_versions()
@@ -278,6 +323,9 @@ class Report:
                 + "\n",
                 encoding="utf-8",
             )
+            for name, write_file in self.files.items():
+                (tmp / name).parent.mkdir(parents=True, exist_ok=True)
+                write_file(tmp / name)
             (tmp / "index.html").write_text(html, encoding="utf-8")
             os.chmod(tmp, 0o755)
             old = None

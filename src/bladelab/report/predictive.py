@@ -15,6 +15,10 @@ shown (:func:`bladelab.report.predictive_sections.add_predictive_sections`) come
 ``duration`` (10 s) re-simulation recorded every 2nd step. A run's cost terms are recomputed with
 the run's own objective settings (its duration, robust sampling) and set beside the stored best
 cost; a sweep's category summary is recomputed from every cell the same way.
+
+Each solution shown is also animated in the page, and with ``export=True`` written for OpenSim
+and other tools (:func:`bladelab.runner.export.write_opensim`) into ``export/<solution>/`` of
+the report folder.
 """
 
 from __future__ import annotations
@@ -28,6 +32,7 @@ import numpy as np
 import pandas as pd
 from tqdm import tqdm
 
+from bladelab._io import read_json
 from bladelab.errors import InputFileError
 
 __all__ = ["PredictiveReport", "build_predictive_report", "default_report_dir", "predictive_kind"]
@@ -76,12 +81,7 @@ def predictive_kind(path: str | Path) -> str | None:
 
 
 def _read_json(path: Path) -> dict:
-    try:
-        data = json.loads(path.read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        raise InputFileError("file not found", file=path) from None
-    except (OSError, ValueError) as err:
-        raise InputFileError(f"cannot read JSON ({err})", file=path) from None
+    data = read_json(path, what="parameter file")
     if not isinstance(data, dict) or not isinstance(data.get("parameters"), dict):
         raise InputFileError("expected a parameter file with a 'parameters' mapping", file=path)
     return data
@@ -385,6 +385,31 @@ def _sweep_sections(
     return shown, resim, summary, cells
 
 
+def _export_section(report, results: dict) -> None:
+    """Attach each solution's OpenSim files to the report and list them in a section."""
+    import re
+
+    from bladelab.runner.export import write_opensim
+
+    rows = []
+    for label, res in results.items():
+        folder = "export/" + (re.sub(r"[^a-z0-9.]+", "-", label.lower()).strip("-") or "solution")
+        report.add_file(folder, lambda path, r=res: write_opensim(r, path, every=2))
+        for name, what in (("coordinates.mot", "coordinates, OpenSim names, rotations in deg"),
+                           ("grf.mot", "ground reaction forces per leg, OpenSim external loads"),
+                           ("external_loads.xml", "OpenSim ExternalLoads applying grf.mot"),
+                           ("states.csv", "every recorded state, units in the column names")):
+            rows.append({"solution": label, "file": f"{folder}/{name}", "content": what})
+    report.add_section(
+        "Export for OpenSim and other tools",
+        text=("Each solution shown, every 2nd recorded sample (1 kHz at the 0.25 ms step), in the "
+              "report folder. OpenSim conventions: ground frame x forward, y up, z to the right; "
+              "pelvis_tx/pelvis_ty locate the pelvis frame origin of SCONE's H0918 OpenSim model "
+              "(docs/runner-model.md, 'Export')."),
+        tables=[("Exported files (paths relative to this report)", pd.DataFrame(rows))],
+    )
+
+
 def default_report_dir(path: Path, kind: str) -> Path:
     """Where a report goes without ``out_dir``: ``path/report`` for a folder; ``<stem>-report``
     beside a parameter file, or in the current folder for a file shipped inside bladelab (never
@@ -402,6 +427,8 @@ def build_predictive_report(
     *,
     duration: float = 10.0,
     progress: bool = True,
+    export: bool = False,
+    animate: bool = True,
 ) -> PredictiveReport:
     """Write the HTML report of a predictive result (see the module docstring).
 
@@ -415,6 +442,12 @@ def build_predictive_report(
         Simulated time [s] of the re-simulations shown in the sections.
     progress
         Show a progress bar while simulating.
+    export
+        Also write each solution shown for OpenSim and other tools into
+        ``export/<solution>/`` (``coordinates.mot``, ``grf.mot``, ``external_loads.xml``,
+        ``states.csv``; every 2nd recorded sample, i.e. 1 kHz at the default 0.25 ms step).
+    animate
+        Animate each solution shown in the page.
 
     Raises
     ------
@@ -471,7 +504,9 @@ def build_predictive_report(
               "spatiotemporal variables below)."),
         tables=[("Re-simulations", pd.DataFrame(resim))],
     )
-    add_predictive_sections(rep, results, sweep_summary=sweep_summary)
+    add_predictive_sections(rep, results, sweep_summary=sweep_summary, animate=animate)
+    if export:
+        _export_section(rep, results)
     rep.settings = {"source": str(path), "kind": kind, "resimulated_s": duration,
                     "objective": settings}
     rep.seed = seed

@@ -1,12 +1,19 @@
-"""Report sections of predictive simulations (seed 001 §3: Figs. 3.1–3.9, Tables 3.1–3.3).
+"""Report sections of predictive simulations (seed 001 §3: Figs. 3.1–3.12, B.1, E.1, Tables
+3.1–3.3, D.1).
 
-:func:`add_predictive_sections` appends to a :class:`bladelab.report.Report`: joint angles per
-leg, GRF in body weights, spatiotemporal bars, joint power curves, the P+/P− table (Table 3.2
-layout: mean positive and negative power per stride in W/kg), the energy table (Table 3.3), and,
-given a sweep summary, maximum speed, metabolic cost at 4 m/s, 200/400 m times and contact times
-per category set beside seed 001's values (:func:`seed001_results`, a packaged table citing the
-seed's table, figure or text for every number). :func:`power_table`, :func:`energy_table` and
-:func:`seed_comparison` are the tables alone.
+:func:`add_predictive_sections` appends to a :class:`bladelab.report.Report`: for each solution
+an animated runner (:mod:`bladelab.report.animation`); then, all solutions overlaid in one
+figure each with a legend, mean ± SD over strides per leg over % of the gait cycle
+(:mod:`bladelab.report.predictive_figures`): joint angles and spatiotemporal variables, GRF and
+power balance, joint powers and moments, the positive-power asymmetry, muscle–tendon powers
+and excitations of every muscle, leg stiffness with the GRF–COM displacement loops; the tables
+of seed 001 with units: spatiotemporal variables, P+/P− per joint (Table 3.2), leg energy
+(Table 3.3), leg stiffness and the blade's energy (Table D.1); and, given a sweep summary,
+maximum speed, metabolic cost at 4 m/s, 200/400 m times and contact times per category beside
+seed 001's values (:func:`seed001_results`, a packaged table citing the seed's table, figure or
+text for every number). :func:`power_table`, :func:`energy_table`, :func:`blade_energy_table`,
+:func:`leg_stiffness_table`, :func:`spatiotemporal_table` and :func:`seed_comparison` are the
+tables alone.
 """
 
 from __future__ import annotations
@@ -17,11 +24,27 @@ from importlib import resources
 import numpy as np
 import pandas as pd
 
+from bladelab.report.animation import animation_html
+from bladelab.report.builder import ReportTable
+from bladelab.report.gait_cycle import GaitCycles
+from bladelab.report.predictive_figures import (
+    STYLE,
+    grf_figure,
+    joint_angles_figure,
+    joint_moment_figure,
+    joint_power_figure,
+    leg_stiffness_figure,
+    muscle_figure,
+    power_asymmetry_figure,
+    power_balance_figure,
+    spatiotemporal_figure,
+)
 from bladelab.runner.analyses import (
+    blade_energy,
     gait_events,
-    joint_angles,
     joint_powers,
     leg_energy,
+    leg_stiffness,
     spatiotemporal,
 )
 from bladelab.runner.simulate import RunnerResult, leg_names
@@ -122,16 +145,132 @@ _ENERGY_LABELS = {"E_stored": "E stored (J)", "E_generated": "E generated (J)",
                   "hysteresis": "hysteresis (J)", "recoil_pct": "recoil (%)"}
 
 
-def _solution_first(frames: list[pd.DataFrame]) -> pd.DataFrame:
+def _pm(mean: float, sd: float, digits: int = 3) -> str:
+    if not math.isfinite(mean):
+        return "–"
+    return f"{mean:.{digits}g}" + (f" ± {sd:.2g}" if math.isfinite(sd) else "")
+
+
+def _long(frames: list[pd.DataFrame]) -> pd.DataFrame:
+    frames = [f for f in frames if len(f)]
+    if not frames:
+        return pd.DataFrame(columns=["solution"])
     df = pd.concat(frames, ignore_index=True)
     return df[["solution", *[c for c in df.columns if c != "solution"]]]
 
 
-def _power_display(result: RunnerResult) -> pd.DataFrame:
-    tab = power_table(result)
-    tab["joint"] = [j if j == "total" else _joint_label(j) for j in tab.joint]
-    return tab.rename(columns={"P_pos": "P+ (W/kg)", "P_neg": "P− (W/kg)"})
+_SPATIO = ("stride_time", "step_time", "contact_time", "flight_time", "swing_time")
 
+
+def spatiotemporal_table(results: dict[str, RunnerResult]) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """Spatiotemporal variables per solution and leg: (display with "mean ± SD" cells, numbers:
+    ``<variable> (s)`` and ``<variable> SD (s)``, cycles (count))."""
+    disp, num = [], []
+    for label, res in results.items():
+        st = spatiotemporal(res)
+        for leg in dict.fromkeys(st.leg):
+            rows = st[st.leg == leg].set_index("variable")
+            d = {"solution": label, "leg": leg}
+            n = {"solution": label, "leg": leg}
+            for var in _SPATIO:
+                name = var.replace("_", " ")
+                d[f"{name} (s)"] = _pm(rows.value[var], rows.sd[var])
+                n[f"{name} (s)"] = rows.value[var]
+                n[f"{name} SD (s)"] = rows.sd[var]
+            d["strides (count)"] = n["strides (count)"] = int(rows.n["stride_time"])
+            disp.append(d)
+            num.append(n)
+    return pd.DataFrame(disp), pd.DataFrame(num)
+
+
+def power_table_long(results: dict[str, RunnerResult]) -> pd.DataFrame:
+    """:func:`power_table` of every solution, a row per solution and leg: P+ and P− [W/kg] of
+    the hip, knee, ankle or socket, the blade (RSP) and the leg's total (Table 3.2 quantities)."""
+    rows = []
+    for label, res in results.items():
+        tab = power_table(res)
+        for leg in dict.fromkeys(tab.leg):
+            row = {"solution": label, "leg": leg}
+            for r in tab[tab.leg == leg].itertuples():
+                name = {"ankle": "ankle/socket", "socket": "ankle/socket"}.get(
+                    _joint_label(r.joint), _joint_label(r.joint))
+                name = "leg total" if r.joint == "total" else name
+                row[f"{name} P+ (W/kg)"] = r.P_pos
+                row[f"{name} P− (W/kg)"] = r.P_neg
+            rows.append(row)
+    cols = ["solution", "leg"] + [f"{j} {s} (W/kg)" for j in
+                                  ("hip", "knee", "ankle/socket", "RSP", "leg total")
+                                  for s in ("P+", "P−")]
+    df = pd.DataFrame(rows)
+    return df.reindex(columns=[c for c in cols if c in df.columns])
+
+
+def leg_stiffness_table(results: dict[str, RunnerResult]) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """K_leg per solution and leg over its stances (seed 001 eq. 2.19–2.21, Fig. 3.12a):
+    (display "mean ± SD", numbers): K_leg (kN/m), peak vertical GRF (BW), COM drop Δy (cm),
+    leg compression ΔL (cm), contact time (s), stances (count)."""
+    disp, num = [], []
+    for label, res in results.items():
+        k = leg_stiffness(res)
+        bw = res.model.body_weight
+        for leg in leg_names(res.model):
+            r = k[k.leg == leg]
+            cols = {"K_leg (kN/m)": r.K_leg / 1e3, "peak vertical GRF (BW)": r.F_peak / bw,
+                    "COM drop Δy (cm)": r.delta_y * 100, "leg compression ΔL (cm)":
+                    r.delta_L * 100, "contact time (s)": r.contact_time}
+            d = {"solution": label, "leg": leg}
+            n = {"solution": label, "leg": leg}
+            for name, v in cols.items():
+                mean = float(v.mean()) if len(v) else math.nan
+                sd = float(v.std(ddof=1)) if len(v) > 1 else math.nan
+                d[name] = _pm(mean, sd)
+                n[name] = mean
+                n[name.replace(" (", " SD (")] = sd
+            d["stances (count)"] = n["stances (count)"] = len(r)
+            disp.append(d)
+            num.append(n)
+    return pd.DataFrame(disp), pd.DataFrame(num)
+
+
+def energy_table_long(results: dict[str, RunnerResult]) -> pd.DataFrame:
+    """:func:`energy_table` of every solution, a row per solution and leg, with the number of
+    stances averaged (Table 3.3 quantities)."""
+    rows = []
+    for label, res in results.items():
+        e = leg_energy(res)
+        for leg in dict.fromkeys(e.leg):
+            r = e[e.leg == leg]
+            rows.append({"solution": label, "leg": leg,
+                         **{_ENERGY_LABELS[c]: float(r[c].mean()) for c in _ENERGY_LABELS},
+                         "stances (count)": len(r)})
+    return pd.DataFrame(rows)
+
+
+def blade_energy_table(results: dict[str, RunnerResult]) -> pd.DataFrame:
+    """The blade's energy per prosthetic stance, mean per solution (seed 001 Table D.1 layout):
+    E stored, E returned, hysteresis [J], recoil [%] from the simulated compression
+    (:func:`bladelab.runner.analyses.blade_energy`), the recoil the seed's bookkeeping gives
+    (compression from the force by eq. 2.3), peak compression [mm], stances (count). Solutions
+    without a blade are left out."""
+    rows = []
+    for label, res in results.items():
+        e = blade_energy(res)
+        if not len(e) and res.model.kind != "amputee":
+            continue
+        hertz = blade_energy(res, compression="hertz") if res.model.blade_model is None else None
+        rows.append({
+            "solution": label,
+            "E stored (J)": float(e.E_stored_J.mean()) if len(e) else math.nan,
+            "E returned (J)": float(e.E_returned_J.mean()) if len(e) else math.nan,
+            "hysteresis (J)": float(e.hysteresis_J.mean()) if len(e) else math.nan,
+            "recoil (%)": float(e.recoil_pct.mean()) if len(e) else math.nan,
+            "recoil, compression from eq. 2.3 (%)":
+                float(hertz.recoil_pct.mean()) if hertz is not None and len(hertz) else math.nan,
+            "peak compression (mm)": float(e.peak_compression_m.mean() * 1e3) if len(e)
+            else math.nan,
+            "stances (count)": len(e),
+        })
+    return pd.DataFrame(rows)
 
 # Sweep summary columns and their display names (with units)
 SUMMARY_LABELS = {
@@ -250,106 +389,168 @@ def _sweep_section(report, summary: pd.DataFrame, compare_seed: bool) -> None:
     plt.close(fig)
 
 
+_STANCE_NOTE = (
+    "Strides run from a leg's touch-down to its next, stances from touch-down to lift-off; only "
+    "real steps count (SCONE's step definition, as the objective counts them): a swinging foot "
+    "or blade striking the ground is not a stance. Curves: mean over strides (stances for the "
+    "GRF), band ±1 SD, dotted lines at each solution's mean toe-off."
+)
+_BLADE_NOTE = (
+    "Blade energy (Table D.1): the blade sphere's Hunt–Crossley law F = k·δ^1.5·(1 + 1.5·c·δ̇) "
+    "with seed 001's dissipation c = 0.2 s/m returns about half the energy it stores at the "
+    "model's touch-down speeds (1–2 m/s). Seed 001's Table D.1 reports 99.7 %: it computes the "
+    "compression from the force by the elastic Hertz law (eq. 2.3, as in its eq. 2.14), and a "
+    "loop along one curve F(δ) encloses no area, whatever the dissipation; the column "
+    "'compression from eq. 2.3' repeats that bookkeeping on our simulation and gives the same "
+    "≈ 100 %. See docs/runner-model.md, 'Blade energy return'."
+)
+
+
 def add_predictive_sections(
     report,
     results: dict[str, RunnerResult],
     *,
     sweep_summary: pd.DataFrame | None = None,
     compare_seed: bool = True,
+    animate: bool = True,
+    animation_seconds: float | None = None,
 ) -> None:
-    """Append the predictive sections for the labelled simulations ``results`` (e.g.
-    ``{"able 3.5 m/s": r1, "amputee Cat6 3.5 m/s": r2}``) to ``report``; with a sweep summary
-    (:func:`bladelab.predict.reflex.sweep.summarise`) also the category section, and with
-    ``compare_seed`` seed 001's values beside ours."""
+    """Append the predictive sections for the labelled trajectories ``results`` (e.g.
+    ``{"able 3.5 m/s": r1, "amputee Cat6 3.5 m/s": r2}``; any
+    :class:`~bladelab.runner.RunnerResult`, whichever method found the gait) to ``report``.
+
+    Parameters
+    ----------
+    report
+        A :class:`bladelab.report.Report`.
+    results
+        The solutions, by label (the legend's names).
+    sweep_summary
+        A sweep's category summary (:func:`bladelab.predict.reflex.sweep.summarise`): adds the
+        category section.
+    compare_seed
+        Set seed 001's values beside ours in the category section.
+    animate
+        Add an animated runner per solution.
+    animation_seconds
+        Animate at most this much simulated time [s] per solution (default: all).
+    """
     import matplotlib.pyplot as plt
 
     for label, res in results.items():
-        names = leg_names(res.model)
-        ang = joint_angles(res)
-        fig, axes = plt.subplots(1, 2, figsize=(10, 3.5), sharey=True)
-        for ax, leg in zip(axes, names, strict=True):
-            for joint, df in ang.groupby("joint", sort=False):
-                if _leg_of(joint, names) == leg:
-                    ax.plot(df.time, df.angle_deg, label=joint)
-            ax.set_title(f"{leg} leg")
-            ax.set_xlabel("time (s)")
-            ax.legend(fontsize=7)
-        axes[0].set_ylabel("angle (deg)")
-        grf = res.leg_grf()
-        fig2, ax2 = plt.subplots(figsize=(8, 3))
-        for leg, df in grf.groupby("leg", sort=False):
-            ax2.plot(df.time, df.Fz_bw, label=f"{leg} vertical")
-            ax2.plot(df.time, df.Fx_bw, "--", label=f"{leg} horizontal")
-        ax2.set_xlabel("time (s)")
-        ax2.set_ylabel("GRF (BW)")
-        ax2.legend(fontsize=7)
-        st = spatiotemporal(res)
-        fig3, ax3 = plt.subplots(figsize=(7, 3))
-        piv = st.pivot(index="variable", columns="leg", values="value")
-        piv = piv.reindex([v for v in st.variable.unique() if v in piv.index])[list(names)]
-        piv.index = [v.replace("_time", "") for v in piv.index]
-        piv.plot.bar(ax=ax3, rot=0)
-        ax3.set_xlabel("")
-        ax3.set_ylabel("mean time (s)")
-        pw = joint_powers(res)
-        fig4, ax4 = plt.subplots(figsize=(8, 3))
-        for joint, df in pw.groupby("joint", sort=False):
-            ax4.plot(df.time, df.power / res.model.total_mass, label=joint)
-        ax4.set_xlabel("time (s)")
-        ax4.set_ylabel("power (W/kg)")
-        ax4.legend(fontsize=7, ncol=2)
-        for f in (fig, fig2, fig3, fig4):
-            f.tight_layout()
         report.add_section(
             f"Predictive simulation: {label}",
-            figures=[
-                ("Joint angles per leg", fig),
-                ("Ground reaction force in body weights", fig2),
-                ("Spatiotemporal variables", fig3),
-                ("Joint powers", fig4),
-            ],
-            tables=[
-                (
-                    "Spatiotemporal variables (means over complete cycles)",
-                    st.rename(columns={"value": "value (s)", "n": "cycles (count)"}),
-                ),
-                (
-                    "Mean positive/negative power per stride (W/kg), Table 3.2 quantities",
-                    _power_display(res),
-                ),
-                (
-                    "Energy per leg, mean over stances, Table 3.3 quantities",
-                    energy_table(res).rename(columns=_ENERGY_LABELS),
-                ),
-            ],
+            html=[animation_html(res, label=label, max_duration=animation_seconds)]
+            if animate else [],
+            text=None if animate else "Animation left out (animate=False).",
         )
-        for f in (fig, fig2, fig3, fig4):
-            plt.close(f)
-    if len(results) > 1:
-        rows_p, rows_e = [], []
-        for label, res in results.items():
-            rows_p.append(power_table_wide(res).assign(solution=label))
-            rows_e.append(energy_table_wide(res).assign(solution=label))
-        report.add_section(
-            "Joint power and leg energy of every solution",
-            tables=[
-                ("Mean positive (P+) and negative (P−) power per stride, seed 001 Table 3.2 "
-                 "layout", _solution_first(rows_p)),
-                ("Energy stored, generated, hysteresis and recoil per leg, seed 001 Table 3.3 "
-                 "layout", _solution_first(rows_e)),
-            ],
-        )
+    if not results:
+        return
+    cycles = {label: GaitCycles(res) for label, res in results.items()}
+    with plt.rc_context(STYLE):
+        _gait_sections(report, results, cycles)
+    plt.close("all")
     if sweep_summary is not None and len(sweep_summary):
         _sweep_section(report, sweep_summary, compare_seed)
 
 
+def _gait_sections(report, results: dict[str, RunnerResult], cycles: dict) -> None:
+    st_disp, st_num = spatiotemporal_table(results)
+    report.add_section(
+        "Gait cycle: joint angles and spatiotemporal variables",
+        text=_STANCE_NOTE,
+        figures=[
+            ("Joint angles per leg over % of its stride (Figs. 3.1, 3.8) and the trunk (pelvis "
+             "tilt, lumbar extension, pelvis height; Fig. B.1), mean ± SD", joint_angles_figure(
+                 cycles)),
+            ("Spatiotemporal variables, mean ± SD over cycles (Figs. 3.2, 3.9)",
+             spatiotemporal_figure({lab: spatiotemporal(r) for lab, r in results.items()})),
+        ],
+        tables=[ReportTable("Spatiotemporal variables per leg, mean ± SD over complete cycles",
+                            st_disp, "spatiotemporal", st_num)],
+    )
+    report.add_section(
+        "Ground reaction forces and power balance",
+        figures=[
+            ("Ground reaction force in body weights over % of the stance (Fig. 3.3)",
+             grf_figure(cycles)),
+            ("Power balance over the first leg's stride (Fig. 3.4): muscle, ligament, contact and "
+             "gravity power sum to the total external power, which equals the rate of change of "
+             "kinetic energy", power_balance_figure(cycles)),
+        ],
+    )
+    power_tables = {lab: power_table(r) for lab, r in results.items()}
+    wide_p = [power_table_wide(r).assign(solution=lab) for lab, r in results.items()]
+    report.add_section(
+        "Joint powers and moments",
+        text=("Joint power = (muscle + ligament) torque × angular velocity; RSP = power the blade "
+              "contact delivers to the body. P+ and P−: mean positive and negative power per "
+              "stride over the complete strides, per kg of body mass (Table 3.2 quantities; the "
+              "CSV holds the seed's one-row-per-solution layout)."),
+        figures=[
+            ("Joint powers over % of each leg's stride (Figs. 3.5, 3.10)",
+             joint_power_figure(cycles)),
+            ("Joint moments (muscle + ligament) over % of each leg's stride",
+             joint_moment_figure(cycles)),
+            ("Average positive power per leg (Fig. 3.11)", power_asymmetry_figure(power_tables)),
+        ],
+        tables=[ReportTable("Mean positive (P+) and negative (P−) power per stride, seed 001 "
+                            "Table 3.2 quantities", power_table_long(results), "table-3-2",
+                            _long(wide_p))],
+    )
+    names = [_row_label(results, i) for i in range(2)]
+    report.add_section(
+        "Muscle power and excitation",
+        text=("Muscle–tendon power F_t·(−v_mtu) per kg of body mass (positive: shortening under "
+              "tension) and excitation (0–1) of every muscle, the torso muscles of each side "
+              "included, over % of that side's stride."),
+        figures=[
+            (f"Muscle–tendon power, {names[0]} side (Figs. 3.6, C.1)", muscle_figure(cycles, 0)),
+            (f"Muscle–tendon power, {names[1]} side (Figs. 3.6, C.2)", muscle_figure(cycles, 1)),
+            (f"Excitations, {names[0]} side (Fig. E.1 for every muscle)",
+             muscle_figure(cycles, 0, "excitation")),
+            (f"Excitations, {names[1]} side (Fig. E.1 for every muscle)",
+             muscle_figure(cycles, 1, "excitation")),
+        ],
+    )
+    k_disp, k_num = leg_stiffness_table(results)
+    wide_e = [energy_table_wide(r).assign(solution=lab) for lab, r in results.items()]
+    tables = [
+        ReportTable("Leg stiffness per leg, mean ± SD over stances (eq. 2.19–2.21)", k_disp,
+                    "leg-stiffness", k_num),
+        ReportTable("Energy stored, generated, hysteresis and recoil per leg, mean over stances "
+                    "(seed 001 Table 3.3 quantities)", energy_table_long(results), "table-3-3",
+                    _long(wide_e)),
+    ]
+    blade = blade_energy_table(results)
+    if len(blade):
+        tables.append(ReportTable("Energy the blade stores and returns per prosthetic stance "
+                                  "(seed 001 Table D.1)", blade, "table-d-1"))
+    report.add_section(
+        "Leg stiffness and energy",
+        text=_STANCE_NOTE + "\n\n" + _BLADE_NOTE if len(blade) else _STANCE_NOTE,
+        figures=[("Leg stiffness and the vertical GRF against the vertical displacement of the "
+                  "centre of mass over the stance, per leg (Fig. 3.12; dot: touch-down)",
+                  leg_stiffness_figure(cycles, {lab: leg_stiffness(r)
+                                                for lab, r in results.items()}))],
+        tables=tables,
+    )
+
+
+def _row_label(results: dict[str, RunnerResult], i: int) -> str:
+    return "/".join(dict.fromkeys(leg_names(r.model)[i] for r in results.values()))
+
 __all__ = [
     "SUMMARY_LABELS",
     "add_predictive_sections",
+    "blade_energy_table",
     "energy_table",
     "energy_table_wide",
     "power_table",
+    "leg_stiffness_table",
+    "power_table_long",
     "power_table_wide",
     "seed001_results",
     "seed_comparison",
+    "spatiotemporal_table",
 ]

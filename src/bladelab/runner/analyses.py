@@ -1,14 +1,16 @@
-"""Analyses of a runner simulation (seed 001 §1.1, §2.3, §2.4, Table 3.3).
+"""Analyses of a runner simulation (seed 001 §1.1, §2.3, §2.4, Tables 3.3 and D.1).
 
-- :func:`gait_events` and :func:`spatiotemporal`: touch-downs and lift-offs per leg (vertical
-  GRF above a threshold) and stride, step, contact, flight and swing times (§1.1);
-- :func:`leg_grf`: GRF per leg in N and body weights; :func:`joint_angles` in degrees;
+- :func:`gait_events`, :func:`stances` and :func:`spatiotemporal`: touch-downs and lift-offs
+  per leg (real steps: strikes of the swinging foot are :func:`swing_contacts`) and stride,
+  step, contact, flight and swing times (§1.1);
+- :func:`leg_grf` (N, body weights); :func:`joint_angles` (deg); :func:`joint_moments` (N·m);
+  :func:`com_trajectory` (whole-body centre of mass);
 - :func:`joint_powers`: hip, knee, ankle (muscle + ligament torque × angular velocity), socket,
   and the blade (power the blade contact delivers to the body);
 - :func:`power_balance`: muscle, ligament, contact, gravity and kinetic power (eq. 2.10–2.18),
   and the residual ``P_external − P_kinetic``;
-- :func:`leg_stiffness`: K_leg = F_peak/ΔL per stance (eq. 2.19–2.21);
-- :func:`leg_energy`: energy stored, generated, hysteresis and recoil per leg (Table 3.3);
+- per stance of :func:`stances`: :func:`leg_stiffness` (K_leg, eq. 2.19–2.21),
+  :func:`leg_energy` (Table 3.3) and :func:`blade_energy` (Table D.1);
 - :func:`summary`: the JSON summary of the CLI.
 
 Powers are positive when delivered to the body segments. All tables are tidy DataFrames.
@@ -22,8 +24,16 @@ import mujoco
 import numpy as np
 import pandas as pd
 
-from bladelab.runner.model import CP_BLADE, CP_LEG
-from bladelab.runner.simulate import RC_FX, RC_FZ, RC_VX, RC_VZ, RunnerResult, leg_names
+from bladelab.runner.model import CP_BLADE, CP_EXP, CP_K, CP_LEG
+from bladelab.runner.simulate import (
+    RC_DEPTH,
+    RC_FX,
+    RC_FZ,
+    RC_VX,
+    RC_VZ,
+    RunnerResult,
+    leg_names,
+)
 
 CONTACT_THRESHOLD_N = 20.0
 STEP_LOAD_BW = 0.1  # a leg is loaded at or above this vertical GRF [body weights] (SCONE)
@@ -63,6 +73,14 @@ def _forward_pass(result: RunnerResult) -> dict[str, np.ndarray]:
 def _leg_fz(result: RunnerResult, leg: int) -> np.ndarray:
     cols = result.model.contact_params[:, CP_LEG] == leg
     return result.contacts[:, cols, RC_FZ].sum(axis=1)
+
+
+def com_trajectory(result: RunnerResult) -> pd.DataFrame:
+    """Whole-body centre of mass (wide): time [s], x_m, z_m [m], vx_m_per_s, vz_m_per_s [m/s]."""
+    fwd = _forward_pass(result)
+    com, v = fwd["com"], fwd["comv"]
+    return pd.DataFrame({"time": result.time, "x_m": com[:, 0], "z_m": com[:, 2],
+                         "vx_m_per_s": v[:, 0], "vz_m_per_s": v[:, 2]})
 
 
 def leg_grf(result: RunnerResult) -> pd.DataFrame:
@@ -173,6 +191,8 @@ def _contacts(
                     "peak_N": float(fz[a:b].max()),
                     "stance": stance,
                     "open": b == len(on),
+                    "first": int(a),
+                    "stop": int(b),
                 }
             )
     return out
@@ -234,8 +254,9 @@ def spatiotemporal(
 ) -> pd.DataFrame:
     """Mean stride, step, contact, flight and swing times [s] per leg (seed 001 §1.1).
 
-    Tidy: columns leg, variable, value, n (number of complete cycles used). Only stances with
-    both a touch-down and a lift-off inside the simulation count; NaN where there are none.
+    Tidy: columns leg, variable, value (mean [s]), sd (standard deviation over the cycles [s]),
+    n (number of complete cycles used). Only stances with both a touch-down and a lift-off
+    inside the simulation count; NaN where there are none.
     """
     ev = gait_events(result, threshold_n=threshold_n)
     names = leg_names(result.model)
@@ -256,17 +277,19 @@ def spatiotemporal(
             if len(nxt):
                 step.append(nxt[0] - t)
         stride = np.diff(td)
+        swing = [td[k + 1] - td[k] - contact[k] for k in range(min(len(stride), len(contact)))]
         mean_contact = float(np.mean(contact)) if contact else math.nan
         mean_stride = float(np.mean(stride)) if len(stride) else math.nan
         values = {
-            "stride_time": (mean_stride, len(stride)),
-            "step_time": (float(np.mean(step)) if step else math.nan, len(step)),
-            "contact_time": (mean_contact, len(contact)),
-            "flight_time": (float(np.mean(flight)) if flight else math.nan, len(flight)),
-            "swing_time": (mean_stride - mean_contact, min(len(stride), len(contact))),
+            "stride_time": (mean_stride, stride),
+            "step_time": (float(np.mean(step)) if step else math.nan, step),
+            "contact_time": (mean_contact, contact),
+            "flight_time": (float(np.mean(flight)) if flight else math.nan, flight),
+            "swing_time": (mean_stride - mean_contact, swing),
         }
-        for var, (val, n) in values.items():
-            rows.append({"leg": leg, "variable": var, "value": val, "n": n})
+        for var, (val, xs) in values.items():
+            sd = float(np.std(xs, ddof=1)) if len(xs) > 1 else math.nan
+            rows.append({"leg": leg, "variable": var, "value": val, "sd": sd, "n": len(xs)})
     return pd.DataFrame(rows)
 
 
@@ -285,15 +308,35 @@ def joint_angles(result: RunnerResult) -> pd.DataFrame:
     return pd.concat(frames, ignore_index=True)
 
 
+def _joint_torque(result: RunnerResult) -> np.ndarray:
+    """(n, n_dof) muscle + ligament (and socket/blade spring) generalized force [N·m]."""
+    return _forward_pass(result)["qfrc_muscle"] + result.ligament
+
+
+_ACTUATED = ("hip", "knee", "ankle", "socket")
+
+
+def joint_moments(result: RunnerResult) -> pd.DataFrame:
+    """Joint moments [N·m] (tidy): time [s], joint, moment_Nm: muscle + ligament torque about
+    each hip, knee, ankle and the socket (positive in the coordinate's positive sense, e.g. a
+    hip flexion moment)."""
+    torque = _joint_torque(result)
+    frames = [
+        pd.DataFrame({"time": result.time, "joint": name, "moment_Nm": torque[:, j]})
+        for j, name in enumerate(result.model.dof_names)
+        if name.startswith(_ACTUATED)
+    ]
+    return pd.concat(frames, ignore_index=True)
+
+
 def joint_powers(result: RunnerResult) -> pd.DataFrame:
     """Joint powers [W] (tidy): time, joint, power. Joints: hip/knee/ankle per side (muscle +
     ligament torque × angular velocity), ``socket_r`` and ``blade_r`` (amputee)."""
     model = result.model
-    fwd = _forward_pass(result)
-    torque = fwd["qfrc_muscle"] + result.ligament
+    torque = _joint_torque(result)
     frames = []
     for j, name in enumerate(model.dof_names):
-        if name.startswith(("hip", "knee", "ankle", "socket")):
+        if name.startswith(_ACTUATED):
             frames.append(
                 pd.DataFrame(
                     {"time": result.time, "joint": name, "power": torque[:, j] * result.qvel[:, j]}
@@ -347,16 +390,42 @@ def power_balance_residual_pct(result: RunnerResult) -> float:
     return float(np.sqrt(np.mean(pb.residual**2)) / peak * 100.0)
 
 
-def _stances(result: RunnerResult, leg: int, threshold_n: float) -> list[tuple[int, int]]:
-    on = _leg_fz(result, leg) > threshold_n
-    edges = np.flatnonzero(np.diff(on.astype(np.int8)))
-    out = []
-    for i in edges:
-        if on[i + 1]:
-            after = edges[edges > i]
-            if len(after):
-                out.append((i + 1, after[0] + 1))
-    return out
+def stances(
+    result: RunnerResult,
+    *,
+    threshold_n: float = CONTACT_THRESHOLD_N,
+    min_gap_s: float = MIN_GAP_S,
+    min_contact_s: float = MIN_CONTACT_S,
+) -> pd.DataFrame:
+    """The complete stances of both legs: the contacts of :func:`gait_events` (a step of
+    :func:`step_touchdowns` starts in each; strikes of the swinging foot excluded) with both the
+    touch-down and the lift-off inside the record.
+
+    Returns a DataFrame with columns leg, first, stop (sample indices: the stance is
+    ``first:stop``, ``stop`` the first unloaded sample), touchdown_s, liftoff_s, contact_time_s.
+    Every per-stance analysis (:func:`leg_stiffness`, :func:`leg_energy`,
+    :func:`blade_energy`) uses these stances.
+    """
+    rows = [
+        {
+            "leg": c["leg"],
+            "first": c["first"],
+            "stop": c["stop"],
+            "touchdown_s": c["start"],
+            "liftoff_s": c["end"],
+            "contact_time_s": c["end"] - c["start"],
+        }
+        for c in _contacts(result, threshold_n, min_gap_s, min_contact_s)
+        if c["stance"] and not c["open"] and c["first"] > 0
+    ]
+    cols = ["leg", "first", "stop", "touchdown_s", "liftoff_s", "contact_time_s"]
+    return pd.DataFrame(rows, columns=cols).sort_values("touchdown_s", ignore_index=True)
+
+
+def _leg_stances(result: RunnerResult, leg: int, threshold_n: float) -> list[tuple[int, int]]:
+    st = stances(result, threshold_n=threshold_n)
+    st = st[st.leg == leg_names(result.model)[leg]]
+    return list(zip(st["first"].tolist(), st["stop"].tolist(), strict=True))
 
 
 def _leg_length(result: RunnerResult, leg: int) -> float:
@@ -379,15 +448,16 @@ def _leg_length(result: RunnerResult, leg: int) -> float:
 def leg_stiffness(
     result: RunnerResult, *, threshold_n: float = CONTACT_THRESHOLD_N
 ) -> pd.DataFrame:
-    """Leg stiffness per stance (seed 001 eq. 2.19–2.21): columns leg, touchdown [s],
-    contact_time [s], F_peak [N], delta_y [m], L0 [m], theta_rad, delta_L [m], K_leg [N/m]."""
+    """Leg stiffness per stance of :func:`stances` (seed 001 eq. 2.19–2.21): columns leg,
+    touchdown [s], contact_time [s], F_peak [N], delta_y [m], L0 [m], theta_rad, delta_L [m],
+    K_leg [N/m]. Strikes of the swinging foot are not stances and do not count."""
     fwd = _forward_pass(result)
     names = leg_names(result.model)
     rows = []
     for leg in (0, 1):
         l0 = _leg_length(result, leg)
         fz = _leg_fz(result, leg)
-        for i0, i1 in _stances(result, leg, threshold_n):
+        for i0, i1 in _leg_stances(result, leg, threshold_n):
             tc = result.time[i1] - result.time[i0]
             v = float(np.mean(fwd["comv"][i0:i1, 0]))
             dy = float(fwd["com"][i0, 2] - np.min(fwd["com"][i0:i1, 2]))
@@ -407,25 +477,14 @@ def leg_stiffness(
                     "K_leg": fp / dl if dl > 0 else math.nan,
                 }
             )
-    return pd.DataFrame(
-        rows,
-        columns=[
-            "leg",
-            "touchdown",
-            "contact_time",
-            "F_peak",
-            "delta_y",
-            "L0",
-            "theta_rad",
-            "delta_L",
-            "K_leg",
-        ],
-    )
+    cols = ["leg", "touchdown", "contact_time", "F_peak", "delta_y", "L0", "theta_rad",
+            "delta_L", "K_leg"]
+    return pd.DataFrame(rows, columns=cols)
 
 
 def leg_energy(result: RunnerResult, *, threshold_n: float = CONTACT_THRESHOLD_N) -> pd.DataFrame:
-    """Energy per leg and stance from the GRF–vertical COM displacement loop (Table 3.3 layout):
-    columns leg, touchdown [s], E_stored [J] (work absorbed while the COM descends), E_generated
+    """Energy per leg and stance of :func:`stances` (strikes of the swinging foot excluded) from
+    the GRF–vertical COM displacement loop (Table 3.3 layout): columns leg, touchdown [s], E_stored [J] (work absorbed while the COM descends), E_generated
     [J] (work returned while it rises), hysteresis [J] = |stored − generated|,
     recoil_pct = 100·min/max."""
     fwd = _forward_pass(result)
@@ -433,7 +492,7 @@ def leg_energy(result: RunnerResult, *, threshold_n: float = CONTACT_THRESHOLD_N
     rows = []
     for leg in (0, 1):
         fz = _leg_fz(result, leg)
-        for i0, i1 in _stances(result, leg, threshold_n):
+        for i0, i1 in _leg_stances(result, leg, threshold_n):
             dz = np.diff(fwd["com"][i0 : i1 + 1, 2])
             f = 0.5 * (fz[i0:i1] + fz[i0 + 1 : i1 + 1])
             stored = float(-np.sum(f * np.minimum(dz, 0.0)))
@@ -452,6 +511,77 @@ def leg_energy(result: RunnerResult, *, threshold_n: float = CONTACT_THRESHOLD_N
     return pd.DataFrame(
         rows, columns=["leg", "touchdown", "E_stored", "E_generated", "hysteresis", "recoil_pct"]
     )
+
+
+def blade_energy(
+    result: RunnerResult,
+    *,
+    compression: str = "penetration",
+    threshold_n: float = CONTACT_THRESHOLD_N,
+) -> pd.DataFrame:
+    """Energy the blade contact stores and returns per prosthetic stance (seed 001 Table D.1).
+
+    E_stored = ∫F·dδ while the blade compresses, E_returned = −∫F·dδ while it recovers, summed
+    over the blade's contacts (the sphere, or a multi-link blade's soles), with F the contact's
+    vertical (normal) force [N] and δ its compression [m], over each stance of
+    :func:`stances` extended to the whole time the blade touches the ground.
+
+    Parameters
+    ----------
+    result
+        An amputee simulation (empty table for the able model).
+    compression
+        ``"penetration"``: δ is the simulated penetration of the contact (the energy the
+        Hunt–Crossley law really stores and returns, dissipation included); ``"hertz"``: δ is
+        computed back from the force by the elastic Hertz law ``δ = (F/k)^(1/n)`` (seed 001
+        eq. 2.3 as its eq. 2.14 uses it). The second cannot show any dissipation: F(δ) is then
+        one curve, and a loop along it encloses no area.
+    threshold_n
+        Vertical force [N] above which a leg is in contact (:func:`stances`).
+
+    Returns
+    -------
+    DataFrame
+        leg, touchdown_s, E_stored_J, E_returned_J, hysteresis_J (stored − returned),
+        recoil_pct (100·returned/stored), peak_force_N, peak_compression_m.
+    """
+    if compression not in ("penetration", "hertz"):
+        raise ValueError(f"compression must be 'penetration' or 'hertz', not {compression!r}")
+    cols = ["leg", "touchdown_s", "E_stored_J", "E_returned_J", "hysteresis_J", "recoil_pct",
+            "peak_force_N", "peak_compression_m"]
+    cp = result.model.contact_params
+    blade = np.flatnonzero(cp[:, CP_BLADE] == 1)
+    if not len(blade):
+        return pd.DataFrame(columns=cols)
+    force = result.contacts[:, blade, RC_FZ]
+    depth = result.contacts[:, blade, RC_DEPTH]
+    if compression == "hertz":
+        k, n = cp[blade, CP_K], cp[blade, CP_EXP]
+        depth = (np.maximum(force, 0.0) / k) ** (1.0 / n)
+    touching = (depth > 0).any(axis=1) | (force > 0).any(axis=1)
+    rows = []
+    name = leg_names(result.model)[1]
+    for i0, i1 in _leg_stances(result, 1, threshold_n):
+        t0 = float(result.time[i0])
+        while i0 > 0 and touching[i0 - 1]:
+            i0 -= 1
+        while i1 < len(touching) - 1 and touching[i1]:
+            i1 += 1
+        dd = np.diff(depth[i0 : i1 + 1], axis=0)
+        f = 0.5 * (force[i0:i1] + force[i0 + 1 : i1 + 1])
+        stored = float(np.sum(f * np.maximum(dd, 0.0)))
+        returned = float(-np.sum(f * np.minimum(dd, 0.0)))
+        rows.append({
+            "leg": name,
+            "touchdown_s": t0,
+            "E_stored_J": stored,
+            "E_returned_J": returned,
+            "hysteresis_J": stored - returned,
+            "recoil_pct": 100.0 * returned / stored if stored > 0 else math.nan,
+            "peak_force_N": float(force[i0 : i1 + 1].sum(axis=1).max()),
+            "peak_compression_m": float(depth[i0 : i1 + 1].max()),
+        })
+    return pd.DataFrame(rows, columns=cols)
 
 
 def _blade_name(model) -> str | None:

@@ -30,7 +30,6 @@ from bladelab.runner import geometry as geo
 from bladelab.runner.multilink import add_multilink_blade, multilink_contact_rows
 from bladelab.runner.params import (
     BLADE_ALIGNMENT_DEG,
-    BLADE_DISSIPATION_S_PER_M,
     BLADE_EXTRA_LENGTH_M,
     BLADE_FRICTION,
     BLADE_OFFSET_A_M,
@@ -407,7 +406,7 @@ def build_runner(
                 model.site_bodyid[site.id],
                 BLADE_RADIUS_M,
                 hertz_sphere_stiffness(BLADE_RADIUS_M, e_blade),
-                BLADE_DISSIPATION_S_PER_M,
+                params.blade_dissipation_s_per_m,
                 BLADE_FRICTION,
                 1,
                 1,

@@ -94,6 +94,12 @@ class RunnerParams(_Strict):
     #: solutions were built with (not bladelab.constants.STANDARD_GRAVITY; a change would make
     #: those fragile solutions fall).
     gravity_m_per_s2: float = Field(default=9.81, gt=0)
+    #: Hunt–Crossley dissipation c [s/m] of the blade sphere. Default: seed 001's 0.2 s/m, with
+    #: which the shipped reflex solutions were optimised; the sphere then returns about 54 % of
+    #: the energy it stores per prosthetic stance (docs/runner-model.md, "Blade energy return").
+    #: 0.02 s/m returns about 94 %, 0 s/m 100 % (an elastic blade, as seed 001's Table D.1
+    #: reports). Opt-in: a change makes those fragile solutions fall.
+    blade_dissipation_s_per_m: float = Field(default=BLADE_DISSIPATION_S_PER_M, ge=0)
 
 
 @dataclass(frozen=True)
