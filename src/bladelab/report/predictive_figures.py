@@ -85,6 +85,24 @@ def _toe_off(ax, cyc: GaitCycles, leg: str, color) -> None:
         ax.axvline(to, color=color, ls=":", lw=1.1)
 
 
+def _leg_panel(ax, cycles, colors, row: int, kind: str, curve, name) -> bool:
+    """Draw one leg's (``row``) joint of ``kind`` for every solution on ``ax``: band of
+    ``curve(cyc, dof)``, toe-off line, title from ``name(dof)``; False if no solution has it."""
+    names = []
+    for label, cyc in cycles.items():
+        leg = cyc.legs[row]
+        dofs = [d for d in cyc.leg_dofs(leg) if d.startswith(kind)]
+        if not dofs:
+            continue
+        names.append(name(dofs[0]))
+        _band(ax, curve(cyc, dofs[0]), colors[label])
+        _toe_off(ax, cyc, leg, colors[label])
+    if names:
+        shown = "/".join(_JOINT_TITLE.get(n.split("_")[0], n) for n in dict.fromkeys(names))
+        ax.set_title(f"{_row_name(cycles, row)} leg: {shown}")
+    return bool(names)
+
+
 def _cycle_grid(cycles, kinds, curve, ylabel: str, title: str, figsize) -> object:
     """Rows: legs; columns: joint kinds; ``curve(cyc, dof) -> CycleAverage``."""
     import matplotlib.pyplot as plt
@@ -94,20 +112,10 @@ def _cycle_grid(cycles, kinds, curve, ylabel: str, title: str, figsize) -> objec
     for row in range(2):
         for col, kind in enumerate(kinds):
             ax = axes[row, col]
-            names = []
-            for label, cyc in cycles.items():
-                leg = cyc.legs[row]
-                dofs = [d for d in cyc.leg_dofs(leg) if d.startswith(kind)]
-                if not dofs:
-                    continue
-                names.append(dofs[0].rsplit("_", 1)[0])
-                _band(ax, curve(cyc, dofs[0]), colors[label])
-                _toe_off(ax, cyc, leg, colors[label])
-            if not names:
+            if not _leg_panel(ax, cycles, colors, row, kind, curve,
+                              lambda d: d.rsplit("_", 1)[0]):
                 ax.set_visible(False)
                 continue
-            shown = "/".join(_JOINT_TITLE.get(n.split("_")[0], n) for n in dict.fromkeys(names))
-            ax.set_title(f"{_row_name(cycles, row)} leg: {shown}")
             ax.set_ylabel(ylabel)
             ax.axhline(0.0, color="0.6", lw=0.6)
             if row == 1:
@@ -128,16 +136,8 @@ def joint_angles_figure(cycles: Mapping[str, GaitCycles]):
     for row in range(2):
         for col, kind in enumerate(_JOINT_KINDS):
             ax = axes[row, col]
-            names = []
-            for label, cyc in cycles.items():
-                leg = cyc.legs[row]
-                dofs = [d for d in cyc.leg_dofs(leg) if d.startswith(kind)]
-                if dofs:
-                    names.append(dofs[0].split("_")[0])
-                    _band(ax, cyc.angle(dofs[0]), colors[label])
-                    _toe_off(ax, cyc, leg, colors[label])
-            shown = "/".join(_JOINT_TITLE[n] for n in dict.fromkeys(names))
-            ax.set_title(f"{_row_name(cycles, row)} leg: {shown}")
+            _leg_panel(ax, cycles, colors, row, kind, lambda c, d: c.angle(d),
+                       lambda d: d.split("_")[0])
             ax.set_ylabel("angle (deg)")
             ax.set_xlabel("% of the leg's stride")
     trunk = (("pelvis_tilt", "pelvis tilt", "angle (deg)"),
