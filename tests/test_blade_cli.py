@@ -94,3 +94,15 @@ def test_bad_inputs_exit_2_without_traceback(capsys, tmp_path):
     code, _, err = _run(capsys, "segment", str(one), "--out", str(tmp_path / "o.json"))
     assert code == 2 and "at least two points" in err
     assert not (tmp_path / "o.json").exists()
+
+
+def test_an_unknown_image_format_is_refused_before_any_work(capsys, tmp_path):
+    for args in (["blade", "show", "xtreme-cat5", "--plot", str(tmp_path / "x.txt")],
+                 ["blade", "test", "xtreme-cat5", "--plot", str(tmp_path / "y.docx")]):
+        capsys.readouterr()
+        assert main(args) == 2
+        captured = capsys.readouterr()
+        assert captured.out == ""  # nothing computed or printed
+        err = captured.err.strip().splitlines()
+        assert len(err) == 1 and "--plot" in err[0] and ".png" in err[0]
+    assert not list(tmp_path.iterdir())

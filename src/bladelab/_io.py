@@ -101,3 +101,19 @@ def read_yaml(path: str | Path, *, what: str = "YAML file", hint: str | None = N
         where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark is not None else ""
         problem = getattr(err, "problem", None) or str(err).splitlines()[0]
         raise InputFileError(f"not valid YAML: {problem}{where}", file=path, hint=hint) from None
+
+
+def figure_format(path: str | Path, *, where: str = "--plot") -> str:
+    """The image format of a figure path from its suffix (``.png`` when it has none); an
+    unsupported suffix raises :class:`~bladelab.errors.SpecError` naming ``where`` and the
+    formats matplotlib can write, before anything is drawn."""
+    from matplotlib.backend_bases import FigureCanvasBase
+
+    from bladelab.errors import SpecError
+
+    fmt = Path(path).suffix.lstrip(".").lower() or "png"
+    supported = FigureCanvasBase.get_supported_filetypes()
+    if fmt not in supported:
+        raise SpecError(f"cannot write a figure as .{fmt}", file=path, where=where,
+                        hint=f"use one of .{', .'.join(sorted(supported))} (e.g. .png)")
+    return fmt

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import typer
 
-from bladelab._io import atomic_path, write_json
+from bladelab._io import atomic_path, figure_format, write_json
 
 __all__ = ["register"]
 
@@ -42,6 +42,8 @@ def _show(
     """Show a blade: dimensions, segmentation, joints (K in N·m/deg), soles, contact."""
     from bladelab.blade import load_blade
 
+    if plot is not None:
+        figure_format(plot)  # refuse an unknown image format before any work
     spec = load_blade(blade, category=category)
     if as_yaml:
         typer.echo(spec.to_yaml(), nl=False)
@@ -109,6 +111,7 @@ def _format_summary(s: dict) -> str:
 
 
 def _save_plot(spec, path: Path) -> None:
+    fmt = figure_format(path)
     import matplotlib
 
     matplotlib.use("Agg")
@@ -119,9 +122,8 @@ def _save_plot(spec, path: Path) -> None:
     fig, ax = plt.subplots(figsize=(4.5, 5.5))
     plot_blade(spec.build(), ax, profile=spec.profile_geometry())
     fig.tight_layout()
-    suffix = path.suffix or ".png"
     with atomic_path(path) as tmp:
-        fig.savefig(tmp, format=suffix.lstrip("."), dpi=150)
+        fig.savefig(tmp, format=fmt, dpi=150)
     plt.close(fig)
 
 

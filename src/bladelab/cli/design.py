@@ -46,6 +46,10 @@ def _blade_test(
     from bladelab.design.compression import compression_test
     from bladelab.units import body_weight
 
+    if plot is not None:
+        from bladelab._io import figure_format
+
+        figure_format(plot)  # refuse an unknown image format before any work
     if not (body_mass > 0 and math.isfinite(body_mass)):
         raise SpecError(f"body mass must be > 0 kg, got {body_mass}", where="--body-mass")
     angles = _parse_floats(alignment, "--alignment")

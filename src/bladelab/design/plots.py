@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 from matplotlib.figure import Figure
 
-from bladelab._io import atomic_path
+from bladelab._io import atomic_path, figure_format
 from bladelab.design.optimum import OptimumResult, SurfaceConstraint
 from bladelab.design.space import DesignSpace
 from bladelab.design.surfaces import ResponseSurface
@@ -164,7 +164,7 @@ def contour_plot(
 def save_figure(fig: Figure, path: str | Path, *, dpi: int = 150) -> Path:
     """Save a figure atomically; the format follows the suffix (.png, .pdf, .svg)."""
     path = Path(path)
-    fmt = path.suffix.lstrip(".").lower() or "png"
+    fmt = figure_format(path, where="figure")
     with atomic_path(path) as tmp:
         fig.savefig(tmp, format=fmt, dpi=dpi)
     return path
