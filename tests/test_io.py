@@ -44,3 +44,10 @@ def test_readers_return_content_and_name_the_file_on_errors(tmp_path):
     (tmp_path / "latin1.json").write_bytes(b'{"a": "\xe9"}')
     with pytest.raises(InputFileError, match="cannot read the JSON file"):
         read_json(tmp_path / "latin1.json")
+
+
+def test_writing_onto_a_folder_is_refused_naming_it(tmp_path):
+    (tmp_path / "out").mkdir()
+    with pytest.raises(InputFileError, match="is a folder, not a file name") as err:
+        write_json(tmp_path / "out", {"x": 1})
+    assert "out" in str(err.value) and (tmp_path / "out").is_dir()

@@ -31,6 +31,11 @@ def atomic_path(target: str | Path) -> Iterator[Path]:
     On an exception the temporary file is removed and the target is left untouched.
     """
     target = Path(target)
+    if target.is_dir():
+        from bladelab.errors import InputFileError
+
+        raise InputFileError("is a folder, not a file name", file=target,
+                             hint="give the path of the file to write (e.g. add a file name)")
     target.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp_name = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".part", dir=target.parent)
     os.close(fd)
