@@ -167,6 +167,14 @@ class NLPSolution:
         """Mean forward speed [m/s]."""
         return float((self.q[-1, 0] - self.q[0, 0]) / self.period)
 
+    def to_guess(self, source: str = "collocation solution"):
+        """This solution as an initial guess (:class:`~bladelab.predict.collocation.guess.
+        StrideGuess`, muscle states included): a warm start for another problem or mesh."""
+        from bladelab.predict.collocation.guess import StrideGuess
+
+        return StrideGuess(source, self.period, self.q, self.qd, self.activation,
+                           self.tendon_force)
+
 
 class StrideNLP:
     """The collocation NLP of one periodic stride.
@@ -386,15 +394,24 @@ class StrideNLP:
                                [g.period / self.scales.period]])
 
     # -- solve --------------------------------------------------------------------------
-    def solve(self, x0: np.ndarray, *, max_iter: int = 3000, tol: float = 1e-6,
-              print_level: int = 0, options: dict | None = None) -> NLPSolution:
-        """Solve with IPOPT (exact Hessian, MUMPS with METIS ordering, monotone barrier)."""
+    def solve(self, x0: np.ndarray, *, max_iter: int = 3000, tol: float = 1e-4,
+              hessian: str = "limited-memory", print_level: int = 0,
+              options: dict | None = None) -> NLPSolution:
+        """Solve with IPOPT: MUMPS with METIS ordering; ``hessian`` ``"limited-memory"``
+        (L-BFGS with the adaptive barrier, as PredSim solves muscle-driven gaits; measured:
+        the muscle-driven tracking stride converged in 671 iterations, while the exact Hessian
+        stalled under inertia regularisation 1e7–1e10) or ``"exact"`` (monotone barrier;
+        converges on problems without muscles, e.g. the toy and torque-driven strides)."""
+        if hessian not in ("limited-memory", "exact"):
+            raise SpecError(f"unknown Hessian option {hessian!r}", where="hessian",
+                            hint="limited-memory or exact")
         opts = {
             "ipopt.max_iter": int(max_iter),
             "ipopt.tol": float(tol),
             "ipopt.constr_viol_tol": 1e-6,
             "ipopt.print_level": int(print_level),
-            "ipopt.mu_strategy": "monotone",
+            "ipopt.hessian_approximation": hessian,
+            "ipopt.mu_strategy": "adaptive" if hessian == "limited-memory" else "monotone",
             "ipopt.linear_solver": "mumps",
             "ipopt.mumps_pivot_order": 5,  # METIS
             "ipopt.nlp_scaling_method": "gradient-based",
