@@ -5,6 +5,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import pandas as pd
 import pytest
 
 from bladelab.errors import SpecError
@@ -39,3 +40,22 @@ def test_bounds_and_identification_speak_the_vocabulary():
     assert edge["K_Nm_per_deg"] == pytest.approx([10.0, 30.0])
     assert edge["K2_Nm_per_deg2"] == pytest.approx([0.0, 2.0])
     assert b.upper[2] == pytest.approx(2.0 * (180.0 / math.pi) ** 2)
+
+
+def test_blade_specs_and_reports_read_and_write_the_vocabulary():
+    from bladelab.blade import load_blade
+    from bladelab.report.tables import parameter_summary_display
+
+    spec = load_blade("xceed-cat2")
+    joint = spec.build().joints[0]
+    # the spec's K is in N·m/deg: the model holds it per radian (× 180/π), the summary per degree
+    assert joint.stiffness == pytest.approx(spec.joint_stiffness_Nm_per_deg()[0] * 180.0 / math.pi)
+    shown = spec.summary()["joints"][0]
+    assert set(shown) >= {"K_Nm_per_deg", "D_Nms_per_deg", "K2_Nm_per_deg2"}
+    assert shown["K_Nm_per_deg"] == pytest.approx(spec.joint_stiffness_Nm_per_deg()[0], rel=1e-14)
+
+    summary = pd.DataFrame({"group": ["a"], "speed_band": ["fast"], "n": [3],
+                            **{f"{c}{s}": [v] for c in ("K_Nm_per_deg", "D_Nms_per_deg")
+                               for s, v in (("", 1.5), ("_ci_low", 1.0), ("_ci_high", 2.0))}})
+    headers = list(parameter_summary_display(summary).columns)
+    assert "K* [N·m/deg] mean (95 % CI)" in headers and "D* [N·m·s/deg] mean (95 % CI)" in headers

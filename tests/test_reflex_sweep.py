@@ -309,3 +309,16 @@ def test_sigterm_stops_the_sweep_and_its_workers(tmp_path):
             if _alive(pid):
                 os.kill(pid, signal.SIGKILL)
         proc.communicate()
+
+
+def test_a_broken_cell_file_is_named_with_its_line_and_a_hint(tmp_path):
+    from bladelab.errors import InputFileError
+    from bladelab.predict.reflex.sweep import CELL_NAME, _read_cell
+
+    (tmp_path / CELL_NAME).write_text('{"format": 1,\n "settings": {"sigma": }\n}\n')
+    with pytest.raises(InputFileError, match=r"not valid JSON: .* line 2") as err:
+        _read_cell(tmp_path, "Cat6", 3.5, {})
+    assert CELL_NAME in str(err.value) and "recompute the cell" in str(err.value)
+    (tmp_path / CELL_NAME).write_text('{"format": 1}\n')
+    with pytest.raises(InputFileError, match="sweep cell Cat6 at 3.5 m/s has no settings"):
+        _read_cell(tmp_path, "Cat6", 3.5, {})

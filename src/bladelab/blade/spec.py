@@ -285,9 +285,8 @@ class BladeSpec(_Strict):
                                 hint="segment numbers are 1-based; check segmentation.n_segments")
             joints.append(CompliantJoint(
                 point=a,
-                stiffness=float(units.stiffness_per_deg_to_per_rad(k)),
-                damping=float(units.damping_per_deg_to_per_rad(j.D_Nms_per_deg)),
-                # N·m/deg² -> N·m/rad²: one factor 180/π per degree.
+                stiffness=JOINT_PARAMETERS["K"].from_edge(k),
+                damping=JOINT_PARAMETERS["D"].from_edge(j.D_Nms_per_deg),
                 stiffness_quadratic=JOINT_PARAMETERS["K2"].from_edge(j.K2_Nm_per_deg2),
             ))
         joints.sort(key=lambda jt: jt.point)
@@ -367,9 +366,8 @@ class BladeSpec(_Strict):
             "rest_distance_m": model.rest_distance,
             "joints": [
                 {"between_segments": [j.point, j.point + 1],
-                 "K_Nm_per_deg": float(units.stiffness_per_rad_to_per_deg(j.stiffness)),
-                 "D_Nms_per_deg": float(units.damping_per_rad_to_per_deg(j.damping)),
-                 "K2_Nm_per_deg2": JOINT_PARAMETERS["K2"].to_edge(j.stiffness_quadratic)}
+                 **{JOINT_PARAMETERS[n].edge_key: JOINT_PARAMETERS[n].to_edge(v) for n, v in (
+                     ("K", j.stiffness), ("D", j.damping), ("K2", j.stiffness_quadratic))}}
                 for j in model.joints],
             "soles": [{"segment": s.segment + 1, "center_x_m": s.center[0],
                        "center_z_m": s.center[1], "semi_axis_x_m": s.semi_axis_x,

@@ -8,6 +8,7 @@ from pathlib import Path
 import typer
 
 from bladelab._io import atomic_path, figure_format, write_json
+from bladelab.parameters import JOINT_PARAMETERS
 
 __all__ = ["register"]
 
@@ -97,8 +98,10 @@ def _format_summary(s: dict) -> str:
     ]
     for j in s["joints"]:
         a, b = j["between_segments"]
-        lines.append(f"  joint between segments {a} and {b}: K = {j['K_Nm_per_deg']:.2f} N·m/deg, "
-                     f"D = {j['D_Nms_per_deg']:.3f} N·m·s/deg, K2 = {j['K2_Nm_per_deg2']:.3g} N·m/deg²")
+        values = ", ".join(f"{p.name} = {j[p.edge_key]:{fmt}} {p.edge_unit}" for p, fmt in (
+            (JOINT_PARAMETERS["K"], ".2f"), (JOINT_PARAMETERS["D"], ".3f"),
+            (JOINT_PARAMETERS["K2"], ".3g")))
+        lines.append(f"  joint between segments {a} and {b}: {values}")
     for e in s["soles"]:
         lines.append(f"  sole ellipse on segment {e['segment']}: centre ({e['center_x_m'] * 1e3:.1f}, "
                      f"{e['center_z_m'] * 1e3:.1f}) mm, semi-axes {e['semi_axis_x_m'] * 1e3:.1f} × "

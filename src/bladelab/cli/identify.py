@@ -64,6 +64,7 @@ def _identify(
         raise SpecError("--blade is required to identify a stance", where="--blade",
                         hint="a built-in name (bladelab blade list) or a blade spec file")
     from bladelab.identify.identify import identify_stance
+    from bladelab.parameters import JOINT_PARAMETERS
     from bladelab.trial import read_stance_csv
 
     stance = read_stance_csv(path)
@@ -76,12 +77,13 @@ def _identify(
     if as_json:
         typer.echo(json.dumps(d, indent=2))
         return
-    lines = [f"K* = {d['K_Nm_per_deg']:.3f} N·m/deg", f"D* = {d['D_Nms_per_deg']:.4f} N·m·s/deg"]
-    if "K2_Nm_per_deg2" in d:
-        lines.append(f"K2 = {d['K2_Nm_per_deg2']:.4g} N·m/deg²")
-    if "K_ci_Nm_per_deg" in d:
-        lines.append(f"95 % CI: K [{d['K_ci_Nm_per_deg'][0]:.3f}, {d['K_ci_Nm_per_deg'][1]:.3f}], "
-                     f"D [{d['D_ci_Nms_per_deg'][0]:.4f}, {d['D_ci_Nms_per_deg'][1]:.4f}]; "
+    k, dd, k2 = (JOINT_PARAMETERS[n] for n in ("K", "D", "K2"))
+    lines = [f"K* = {d[k.edge_key]:.3f} {k.edge_unit}", f"D* = {d[dd.edge_key]:.4f} {dd.edge_unit}"]
+    if k2.edge_key in d:
+        lines.append(f"K2 = {d[k2.edge_key]:.4g} {k2.edge_unit}")
+    if k.ci_key in d:
+        k_ci, d_ci = d[k.ci_key], d[dd.ci_key]
+        lines.append(f"95 % CI: K [{k_ci[0]:.3f}, {k_ci[1]:.3f}], D [{d_ci[0]:.4f}, {d_ci[1]:.4f}]; "
                      f"K–D correlation {d['KD_correlation']:.2f}")
     lines.append(f"nRMSE GRF {d['nrmse_grf_pct']:.2f} %, distance {d['nrmse_distance_pct']:.2f} %, "
                  f"cost {d['cost']:.4g}")

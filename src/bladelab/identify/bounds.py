@@ -31,7 +31,6 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from bladelab import units
 from bladelab.errors import DataError, OptimizationError
 from bladelab.parameters import JOINT_PARAMETERS
 
@@ -267,11 +266,11 @@ def parameter_bounds(
     except DataError as err:
         if "no distance values" not in err.message:
             raise
-        k_lo, k_hi = (units.stiffness_per_deg_to_per_rad(v) for v in FALLBACK_STIFFNESS_BOUNDS_NM_PER_DEG)
+        k_lo, k_hi = (JOINT_PARAMETERS["K"].from_edge(v) for v in FALLBACK_STIFFNESS_BOUNDS_NM_PER_DEG)
         source = "fallback"
     names = ["K", "D"]
-    lo = [k_lo, units.damping_per_deg_to_per_rad(damping_nms_per_deg[0])]
-    hi = [k_hi, units.damping_per_deg_to_per_rad(damping_nms_per_deg[1])]
+    lo = [k_lo, JOINT_PARAMETERS["D"].from_edge(damping_nms_per_deg[0])]
+    hi = [k_hi, JOINT_PARAMETERS["D"].from_edge(damping_nms_per_deg[1])]
     if nonlinear:
         names.append("K2")
         lo.append(-k_hi / 0.5)

@@ -19,7 +19,6 @@ from collections.abc import Sequence
 import numpy as np
 import pandas as pd
 
-from bladelab import units
 from bladelab.blade.model import BladeModel
 from bladelab.errors import DataError, ModelError
 from bladelab.identify.bounds import (
@@ -362,12 +361,12 @@ def identification_landscape(
         res = sim.simulate_batch(problem, X[:, 0:1], X[:, 1:2], np.full((len(X), 1), k2))
         return cost.evaluate(grf_z=res.grf_z, grf_x=res.grf_x, distance=res.distance).cost
 
-    centre = [units.stiffness_per_deg_to_per_rad(ident.K_Nm_per_deg),
-              units.damping_per_deg_to_per_rad(ident.D_Nms_per_deg)]
+    K, D = JOINT_PARAMETERS["K"], JOINT_PARAMETERS["D"]
+    centre = [K.from_edge(ident.K_Nm_per_deg), D.from_edge(ident.D_Nms_per_deg)]
     box = [[c * (1 - rel_span), c * (1 + rel_span)] for c in centre]
     df = cost_landscape(fun_batch, centre, box, names=("K", "D"), n=n, rel_span=rel_span)
-    return pd.DataFrame({"K_Nm_per_deg": units.stiffness_per_rad_to_per_deg(df["K"].to_numpy()),
-                         "D_Nms_per_deg": units.damping_per_rad_to_per_deg(df["D"].to_numpy()),
+    return pd.DataFrame({K.edge_key: K.to_edge(df["K"].to_numpy()),
+                         D.edge_key: D.to_edge(df["D"].to_numpy()),
                          "cost": df["cost"].to_numpy()})
 
 

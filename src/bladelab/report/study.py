@@ -29,7 +29,6 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from bladelab import units
 from bladelab.errors import DataError, InputFileError
 from bladelab.parameters import JOINT_PARAMETERS
 
@@ -144,13 +143,14 @@ def _landscape_figure(df: pd.DataFrame, k_opt: float, d_opt: float, title: str):
     J = df.pivot_table(index="K", columns="D", values="cost").reindex(index=K, columns=D).to_numpy()
     fig = Figure(figsize=(6.4, 4.4))
     ax = fig.add_subplot(1, 1, 1)
-    kd, dd = units.stiffness_per_rad_to_per_deg(K), units.damping_per_rad_to_per_deg(D)
+    k_par, d_par = JOINT_PARAMETERS["K"], JOINT_PARAMETERS["D"]
+    kd, dd = k_par.to_edge(K), d_par.to_edge(D)
     cs = ax.contourf(dd, kd, J * 100.0, levels=20, cmap="viridis")
     ax.contour(dd, kd, J * 100.0, levels=10, colors="white", linewidths=0.4, alpha=0.6)
     fig.colorbar(cs, ax=ax, label="cost J [%]")
     ax.plot([d_opt], [k_opt], marker="*", color="#d62728", markersize=14, label="identified optimum")
-    ax.set_xlabel("D [N·m·s/deg]")
-    ax.set_ylabel("K [N·m/deg]")
+    ax.set_xlabel(f"D [{d_par.edge_unit}]")
+    ax.set_ylabel(f"K [{k_par.edge_unit}]")
     ax.set_title(title)
     ax.legend(loc="upper right")
     fig.tight_layout()
@@ -164,8 +164,9 @@ def _truth_figure(merged: pd.DataFrame):
     from matplotlib.figure import Figure
 
     fig = Figure(figsize=(10.0, 4.2))
-    for i, (col, true, label) in enumerate((
-        ("K_Nm_per_deg", "K_true", "K [N·m/deg]"), ("D_Nms_per_deg", "D_true", "D [N·m·s/deg]"))):
+    for i, (col, true, label) in enumerate(
+            (p.edge_key, f"{p.name}_true", f"{p.name} [{p.edge_unit}]")
+            for p in (JOINT_PARAMETERS["K"], JOINT_PARAMETERS["D"])):
         ax = fig.add_subplot(1, 2, i + 1)
         for g, sub in merged.groupby("group", sort=False):
             ax.scatter(sub[true], sub[col], s=22, label=g, alpha=0.85)
@@ -290,8 +291,8 @@ def build_study_report(
             if settings.get("joint") is not None:
                 model = dataclasses.replace(model, joints=(dataclasses.replace(
                     model.joints[0], point=int(settings["joint"])),))
-            K = units.stiffness_per_deg_to_per_rad(float(r["K_Nm_per_deg"]))
-            D = units.damping_per_deg_to_per_rad(float(r["D_Nms_per_deg"]))
+            K = JOINT_PARAMETERS["K"].from_edge(float(r["K_Nm_per_deg"]))
+            D = JOINT_PARAMETERS["D"].from_edge(float(r["D_Nms_per_deg"]))
             k2 = r.get("K2_Nm_per_deg2")
             K2 = 0.0 if k2 is None or not np.isfinite(k2) else JOINT_PARAMETERS["K2"].from_edge(k2)
             formulation = settings.get("formulation", DEFAULT_FORMULATION)
@@ -432,8 +433,8 @@ def build_study_report(
     )
     if landscape is not None:
         df, k_opt, d_opt = landscape
-        grid = df.assign(K_Nm_per_deg=units.stiffness_per_rad_to_per_deg(df["K"]),
-                         D_Nms_per_deg=units.damping_per_rad_to_per_deg(df["D"]))[
+        grid = df.assign(K_Nm_per_deg=JOINT_PARAMETERS["K"].to_edge(df["K"]),
+                         D_Nms_per_deg=JOINT_PARAMETERS["D"].to_edge(df["D"]))[
                              ["K_Nm_per_deg", "D_Nms_per_deg", "cost"]]
         rep.add_section(
             "Identifiability",

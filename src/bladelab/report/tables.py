@@ -13,6 +13,7 @@ import numpy as np
 import pandas as pd
 
 from bladelab.errors import DataError
+from bladelab.parameters import JOINT_PARAMETERS
 from bladelab.report.figures import SIGNALS, Signal, resample_percent
 from bladelab.trial.stance import Stance
 
@@ -187,7 +188,7 @@ _SHORT_TESTS = {
     "Dunn (Bonferroni)": "Dunn–Bonferroni",
     "Mann-Whitney U (speed band)": "Speed band (U)",
 }
-_SHORT_PARAMETERS = {"K_Nm_per_deg": "K*", "D_Nms_per_deg": "D*"}
+_SHORT_PARAMETERS = {JOINT_PARAMETERS[n].edge_key: f"{n}*" for n in ("K", "D")}
 
 
 def stats_display(results: pd.DataFrame) -> pd.DataFrame:
@@ -223,9 +224,8 @@ def stats_display(results: pd.DataFrame) -> pd.DataFrame:
 def parameter_summary_display(
     summary: pd.DataFrame,
     *,
-    parameters: Sequence[tuple[str, str]] = (
-        ("K_Nm_per_deg", "K* [N·m/deg]"),
-        ("D_Nms_per_deg", "D* [N·m·s/deg]"),
+    parameters: Sequence[tuple[str, str]] = tuple(
+        (JOINT_PARAMETERS[n].edge_key, f"{n}* [{JOINT_PARAMETERS[n].edge_unit}]") for n in ("K", "D")
     ),
     by: Sequence[str] = ("group", "speed_band"),
 ) -> pd.DataFrame:

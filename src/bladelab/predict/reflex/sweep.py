@@ -36,7 +36,7 @@ import numpy as np
 import pandas as pd
 from tqdm import tqdm
 
-from bladelab._io import atomic_open, write_json
+from bladelab._io import atomic_open, read_json, write_json
 from bladelab.errors import InputFileError, OptimizationError, SpecError
 from bladelab.predict.reflex.objective import ObjectiveSettings
 from bladelab.runner.params import blade_category
@@ -101,14 +101,15 @@ def _read_cell(folder: Path, category: str, speed: float, wanted: dict) -> dict 
                 hint="use another --out, or remove that folder to recompute the cell",
             )
         return None
+    hint = "remove that folder to recompute the cell"
+    data = read_json(path, what=f"sweep cell {where}", hint=hint)
     try:
-        data = json.loads(path.read_text(encoding="utf-8"))
         stored = {"sigma": 1.0, **data["settings"]}  # cells written before --sigma existed
-    except (OSError, ValueError, KeyError, TypeError) as err:
+    except (KeyError, TypeError) as err:
         raise InputFileError(
-            f"cannot read sweep cell {where} ({type(err).__name__}: {err})",
+            f"sweep cell {where} has no settings ({type(err).__name__}: {err})",
             file=path,
-            hint="remove that folder to recompute the cell",
+            hint=hint,
         ) from None
     if data.get("format") != CELL_FORMAT:
         raise InputFileError(f"sweep cell {where}: unknown format", file=path)
