@@ -20,12 +20,9 @@ def _read_controller(path: Path, muscle_names: tuple[str, ...]) -> list[float]:
     Format: ``{"excitations": {"glut_max_l": 0.3, ...}, "default": 0.05}``; muscles not named
     get ``default``. (The reflex controller of the predictive-running issue will extend this.)
     """
-    try:
-        data = json.loads(path.read_text())
-    except FileNotFoundError:
-        raise InputFileError("controller file not found", file=path) from None
-    except json.JSONDecodeError as err:
-        raise InputFileError(f"not valid JSON ({err})", file=path) from None
+    from bladelab._io import read_json
+
+    data = read_json(path, what="controller file")
     if not isinstance(data, dict):
         raise InputFileError("expected a JSON object", file=path)
     unknown_keys = set(data) - {"excitations", "default"}
