@@ -152,6 +152,38 @@ def test_yaml_round_trip(tmp_path):
     assert a.joints == b.joints
 
 
+def test_edited_joint_K_conflicting_with_the_category_is_an_error(tmp_path):
+    # `bladelab blade show xtreme --yaml`, joint K edited: the category used to win silently
+    data = yaml.safe_load(load_blade("xtreme").to_yaml())
+    assert data["category"] == "cat5" and data["joints"][0]["K_Nm_per_deg"] == 18.0
+    data["joints"][0]["K_Nm_per_deg"] = 25.0
+    data["joints"][0]["D_Nms_per_deg"] = 0.5
+    f = _write(tmp_path, data)
+    with pytest.raises(SpecError) as info:
+        read_blade_spec(f)
+    msg = str(info.value)
+    assert "joint K = 25 N·m/deg conflicts with category 'cat5', whose K = 18 N·m/deg" in msg
+    assert str(f) in msg and "joints.0.K_Nm_per_deg" in msg and "delete the line 'category" in msg
+    with pytest.raises(SpecError, match="conflicts with category 'cat5'"):
+        load_blade(f)
+    # without the category, the edited values are the blade's
+    del data["category"]
+    model = read_blade_spec(_write(tmp_path, data)).build()
+    assert model.joints[0].stiffness == pytest.approx(25.0 / DEG)
+    assert model.joints[0].damping == pytest.approx(0.5 / DEG)
+
+
+def test_another_category_shown_as_yaml_reads_back(tmp_path):
+    # `bladelab blade show xtreme --category cat6 --yaml` writes the category's K into the joint
+    data = yaml.safe_load(load_blade("xtreme", category="cat6").to_yaml())
+    assert data["category"] == "cat6" and data["joints"][0]["K_Nm_per_deg"] == 20.0
+    spec = read_blade_spec(_write(tmp_path, data))
+    assert spec.build().joints[0].stiffness == pytest.approx(20.0 / DEG)
+    # a category chosen on reading replaces the file's (consistent) one
+    assert read_blade_spec(_write(tmp_path, data), category="cat4").joint_stiffness_Nm_per_deg() \
+        == [16.0]
+
+
 def test_csv_profile_relative_to_spec(tmp_path):
     prof = load_blade("xceed").profile_geometry()
     sub = tmp_path / "cad"

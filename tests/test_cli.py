@@ -61,6 +61,7 @@ def test_extract(synthetic, tmp_path, capsys):
     st = read_stance_csv(out)
     assert st.sample_rate == pytest.approx(1000.0)
     assert st.grf_z.max() == pytest.approx(synth.PEAK, rel=0.02)
+    assert st.metadata["stance"] == 1  # the header numbers the stance as --stance does
     t = st.time + st.metadata["window_start_s"]
     np.testing.assert_allclose(st.clamp_pitch, synth.clamp_pitch(t), atol=np.deg2rad(0.3))
 
@@ -77,6 +78,8 @@ def test_extract_with_marker_map_and_errors_leave_no_file(synthetic, tmp_path, c
     assert list(tmp_path.iterdir()) == [mapping]  # no output, no temporary file
     code = main(["trial", "extract", str(synthetic), "--stance", "7", "--out", str(out)])
     assert code == 2 and not out.exists()
+    # numbered from 1 in the message too, as `--stance 7` and `bladelab trial stances` count
+    assert "no stance 7: the trial has 1 stance (stance 1)" in capsys.readouterr().err
     code = main(["trial", "extract", str(synthetic), "--stance", "0", "--out", str(out)])
     assert code == 2 and not out.exists()  # stance numbers start at 1
 

@@ -258,3 +258,16 @@ def test_a_run_leaves_trials_claimed_by_another_live_run(tmp_path):
         assert sorted(store.table().trial_id) == sorted(trials[2:])
         store.release("other-run")
     assert run_study(tmp_path, task=fake_task, progress=False).finished == 2
+
+
+def test_a_c3d_stance_beyond_the_trial_is_named_from_1(tmp_path):
+    # study.yaml's `stance: 9` on a one-stance trial: the message said "no stance 8"
+    import trial_synth as synth
+    from bladelab.errors import DataError
+    from bladelab.study.tasks import read_trial_stance
+
+    path = tmp_path / "one.c3d"
+    synth.write_single_plate(path)
+    with pytest.raises(DataError, match=r"no stance 9: the trial has 1 stance \(stance 1\)"):
+        read_trial_stance(str(path), 9)
+    assert read_trial_stance(str(path), 1).metadata["stance"] == 1

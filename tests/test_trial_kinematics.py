@@ -103,8 +103,11 @@ def test_missing_marker_lists_existing(synthetic):
 
 
 def test_no_such_stance(synthetic):
-    with pytest.raises(DataError, match="no stance 3"):
+    # messages number stances from 1 (as `bladelab trial stances`); the Python index is 0-based
+    with pytest.raises(DataError, match=r"no stance 4: the trial has 1 stance \(stance 1\)") as err:
         extract_stance(synthetic, 3)
+    assert "stance N is index N − 1" in str(err.value)
+    assert extract_stance(synthetic, 0).metadata["stance"] == 1
 
 
 def _gapped(tmp_path, start, stop):

@@ -60,17 +60,47 @@ def test_missing_column(tmp_path):
 @pytest.mark.parametrize(
     ("scale", "column", "unit"),
     [
-        ({"clamp_x": 1000.0, "clamp_y": 1000.0, "clamp_z": 1000.0}, "clamp_x", "mm"),
-        ({"time": 1000.0}, "time", "ms"),
-        ({"grf_x": 1e-3, "grf_y": 1e-3, "grf_z": 1e-3}, "grf_z", "kN"),
-        ({"clamp_pitch": np.pi / 180.0}, "clamp_pitch", "rad"),
+        ({"clamp_x": 1000.0, "clamp_y": 1000.0, "clamp_z": 1000.0},
+         "columns clamp_x, clamp_y, clamp_z", "millimetres"),
+        ({"distance": 1000.0}, "column distance", "millimetres"),
+        ({"time": 1000.0}, "column time", "ms"),
+        ({"grf_x": 1e-3, "grf_y": 1e-3, "grf_z": 1e-3}, "column grf_z", "kN"),
+        ({"clamp_pitch": np.pi / 180.0}, "column clamp_pitch", "rad"),
     ],
 )
 def test_wrong_units(tmp_path, scale, column, unit):
     path = _write(tmp_path, ",".join(STANCE_COLUMNS), _rows(_stance(), scale))
     with pytest.raises(DataError, match=unit) as err:
         read_stance_csv(path)
-    assert f"column {column}" in str(err.value)
+    assert column in str(err.value)
+
+
+@pytest.mark.parametrize(("scale", "unit", "divide"), [(100.0, "centimetres", 100),
+                                                        (1000.0, "millimetres", 1000)])
+def test_clamp_positions_in_cm_or_mm_are_refused_with_the_likely_unit(tmp_path, scale, unit,
+                                                                       divide):
+    # 45 cm reads as a clamp 45 m above the ground: under the old ">100 is mm" rule it passed
+    # as metres and identification ran to K* at its upper bound with exit status 0
+    st = _stance()
+    path = _write(tmp_path, ",".join(STANCE_COLUMNS),
+                  _rows(st, {"clamp_x": scale, "clamp_y": scale, "clamp_z": scale}))
+    with pytest.raises(DataError) as err:
+        read_stance_csv(path)
+    message = str(err.value)
+    assert f"clamp positions look like {unit}, not metres" in message
+    assert f"clamp_z up to {0.45 * scale:.4g}" in message
+    assert f"divide by {divide}" in message and str(path) in message
+
+
+def test_clamp_positions_in_cm_with_a_distance_in_metres(tmp_path):
+    path = _write(tmp_path, ",".join(STANCE_COLUMNS),
+                  _rows(_stance(), {"clamp_z": 100.0}))  # z alone in cm: 45 "m" high
+    with pytest.raises(DataError, match="look like centimetres"):
+        read_stance_csv(path)
+    fast = _stance()  # a clamp crossing 40 m in 0.2 s is not a runner's
+    path = _write(tmp_path, ",".join(STANCE_COLUMNS), _rows(fast, {"clamp_x": 100.0}))
+    with pytest.raises(DataError, match=r"look like centimetres.*\(200 m/s\)"):
+        read_stance_csv(path)
 
 
 def test_non_finite_and_missing_file(tmp_path):

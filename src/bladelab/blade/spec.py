@@ -223,19 +223,42 @@ class BladeSpec(_Strict):
         return self.name if self.category is None else f"{self.name}-{self.category}"
 
     def with_category(self, category: str) -> BladeSpec:
-        """A copy with another stiffness category selected."""
+        """A copy with another stiffness category selected; the joints' K [N·m/deg] become the
+        category's, so that the copy's YAML (:meth:`to_yaml`) reads back without a conflict."""
         if category not in self.categories:
             raise SpecError(f"unknown category {category!r}", where=f"{self.name}: category",
                             hint=f"choose one of {sorted(self.categories)}")
-        return self.model_copy(update={"category": category})
+        ks = self._category_stiffness(category)
+        joints = [j.model_copy(update={"K_Nm_per_deg": k}) for j, k in zip(self.joints, ks,
+                                                                            strict=True)]
+        return self.model_copy(update={"category": category, "joints": joints})
+
+    def _category_stiffness(self, category: str) -> list[float]:
+        """K [N·m/deg] per joint of ``category``."""
+        cat = self.categories[category].K_Nm_per_deg
+        return [float(k) for k in cat] if isinstance(cat, list) else [float(cat)] * len(self.joints)
+
+    def check_category(self, *, file: str | Path | None = None) -> None:
+        """Refuse a joint K that differs from the selected category's K (both given, one would
+        silently win). Raises :class:`SpecError` naming the joint, both values and the category."""
+        if self.category is None:
+            return
+        for i, (j, k) in enumerate(zip(self.joints, self._category_stiffness(self.category),
+                                       strict=True)):
+            if not math.isclose(j.K_Nm_per_deg, k, rel_tol=1e-9):
+                raise SpecError(
+                    f"joint K = {j.K_Nm_per_deg:g} N·m/deg conflicts with category "
+                    f"{self.category!r}, whose K = {k:g} N·m/deg",
+                    file=file, where=f"joints.{i}.K_Nm_per_deg",
+                    hint=f"to use K = {j.K_Nm_per_deg:g}, delete the line 'category: "
+                         f"{self.category}'; to use the category, set K_Nm_per_deg: {k:g}",
+                )
 
     def joint_stiffness_Nm_per_deg(self) -> list[float]:
         """Nominal K [N·m/deg] per joint, after applying the selected category."""
-        ks = [j.K_Nm_per_deg for j in self.joints]
         if self.category is not None:
-            cat = self.categories[self.category].K_Nm_per_deg
-            ks = list(cat) if isinstance(cat, list) else [float(cat)] * len(ks)
-        return [float(k) for k in ks]
+            return self._category_stiffness(self.category)
+        return [float(j.K_Nm_per_deg) for j in self.joints]
 
     def profile_geometry(self) -> Profile:
         """The profile polyline (clamp frame, m)."""
@@ -473,10 +496,12 @@ def spec_from_dict(data: Any, *, file: str | Path | None = None,
         if not csv.is_absolute():
             data = {**data, "profile": {**prof, "csv": str((base_dir / csv).resolve())}}
     try:
-        return BladeSpec.model_validate(data)
+        spec = BladeSpec.model_validate(data)
     except pydantic.ValidationError as err:
         where, msg = _format_validation_error(err)
         raise SpecError(msg, file=file, where=where, hint="see docs/blade-spec.md") from None
+    spec.check_category(file=file)
+    return spec
 
 
 def read_blade_spec(path: str | Path, *, category: str | None = None,

@@ -8,8 +8,8 @@ from pathlib import Path
 
 import typer
 
+from bladelab.cli.defaults import RUNNER_DT as DEFAULT_DT
 from bladelab.errors import SpecError
-from bladelab.runner.model import DEFAULT_DT
 
 
 def _parse_list(text: str, what: str, conv=str) -> list:

@@ -8,8 +8,8 @@ from pathlib import Path
 
 import typer
 
+from bladelab.cli.defaults import RUNNER_DT as DEFAULT_DT
 from bladelab.errors import InputFileError, SpecError
-from bladelab.runner.model import DEFAULT_DT
 
 runner_app = typer.Typer(help="Planar musculoskeletal runner with a running blade (seed 001).")
 

@@ -37,6 +37,7 @@ from bladelab.runner.kernel import (
 )
 from bladelab.runner.model import DEFAULT_DT, RunnerModel, contact_heights
 from bladelab.runner.muscle import equilibrium_fiber_length
+from bladelab.sim.compilation import announce_compilation
 
 # Record columns per contact: Fx, Fz [N], contact point x, z [m], point velocity vx, vz [m/s],
 # compression δ [m].
@@ -272,6 +273,10 @@ def simulate_runner(
             raise SimulationError("excitations must be in [0, 1]", where="excitations")
         u[:] = exc
     ms = np.zeros((nm, 4))
+    if controller is None:
+        announce_compilation(run_loop, "the runner's simulation loop")
+    else:
+        announce_compilation(forces, "the runner's force functions")
     mujoco.mj_forward(m, d)
     mp = model.muscle_params
     path, pstart = model.path_points, model.path_start

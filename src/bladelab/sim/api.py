@@ -20,6 +20,7 @@ from bladelab.blade.model import BladeModel
 from bladelab.errors import DataError, ModelError, SimulationError
 from bladelab.sim import kernel as _k
 from bladelab.sim.chain import Chain, build_chain
+from bladelab.sim.compilation import announce_compilation
 from bladelab.sim.motion import ClampMotion
 from bladelab.trial.stance import Stance
 
@@ -390,6 +391,8 @@ def run_kernel(problem: SimProblem, K, D, K2, *, parallel: bool = False,
     solver = _k.SolverSettings(problem.order, problem.iterations, problem.refine, with_energy)
     out = _k.KernelOutputs.zeros(K.shape[0], problem.n_samples, problem.chain.n_soles, nj)
     status = np.zeros((K.shape[0], 2), np.int64)
+    kernel = _k.simulate_batch_parallel if parallel else _k.simulate_batch_serial
+    announce_compilation(kernel, "the blade simulation kernel")
     if parallel:
         _k.simulate_batch_parallel(model, stance_drive, params, solver, out, status)
     else:

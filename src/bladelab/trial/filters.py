@@ -16,7 +16,6 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
-from scipy import interpolate, signal
 
 from bladelab.errors import DataError
 
@@ -86,6 +85,8 @@ def fill_gaps(
                 hint="raise the fill limit (max_gap) or repair the trajectory in the capture software",
             )
         if valid.size >= 2:
+            from scipy import interpolate  # here, not at the top: `bladelab trial info` stays quick
+
             interp = interpolate.CubicSpline(valid, arr[valid], axis=0)
             idx = np.flatnonzero(interior)
             arr[idx] = interp(idx)
@@ -145,6 +146,8 @@ def lowpass(
     finite = np.all(np.isfinite(arr), axis=1)
     idx = np.flatnonzero(finite)
     if idx.size:
+        from scipy import signal  # here, not at the top: `bladelab trial info` stays quick
+
         a, b = idx[0], idx[-1] + 1  # the valid span (interior gaps already filled)
         sos = signal.butter(order, cutoff, btype="low", fs=rate, output="sos")
         span = arr[a:b]

@@ -33,7 +33,6 @@ from typing import Any
 
 import numpy as np
 from pydantic import BaseModel, ConfigDict, ValidationError
-from scipy import interpolate
 
 from bladelab._io import read_yaml
 from bladelab.errors import DataError, SpecError
@@ -248,7 +247,8 @@ def extract_stance(
     trial
         The trial (markers and force platforms).
     index
-        0-based stance number as listed by :func:`~bladelab.trial.events.detect_stances`.
+        Position in :func:`~bladelab.trial.events.detect_stances`'s list, from 0 (stance N of
+        ``bladelab trial stances`` is index N − 1; error messages give the stance number N).
     markers
         Marker roles (default names when None).
     rate
@@ -268,9 +268,10 @@ def extract_stance(
     Returns
     -------
     Stance
-        Uniform time base starting at 0 at the window start; metadata holds source, stance
-        index, plates, window_start_s (trial time of t = 0), touchdown_s, toeoff_s, peak_s
-        (relative to the window), d0_m, marker names, filter settings and the trial metadata.
+        Uniform time base starting at 0 at the window start; metadata holds source, stance (its
+        number, from 1), plates, window_start_s (trial time of t = 0), touchdown_s, toeoff_s,
+        peak_s (relative to the window), d0_m, marker names, filter settings and the trial
+        metadata.
 
     Raises
     ------
@@ -282,11 +283,15 @@ def extract_stance(
     markers = markers or MarkerMap()
     events = stances if stances is not None else detect_stances(trial, threshold=threshold)
     if not 0 <= index < len(events):
+        # messages number stances from 1, as `bladelab trial stances`, --stance and study.yaml do
+        n = len(events)
         raise DataError(
-            f"no stance {index}: the trial has {len(events)} stance(s), numbered 0–{len(events) - 1}",
+            f"no stance {index + 1}: the trial has {n} stance"
+            + (" (stance 1)" if n == 1 else f"s, numbered 1–{n}"),
             file=trial.source,
-            where="--stance",
-            hint="list them with `bladelab trial stances`",
+            where="stance",
+            hint="list them with `bladelab trial stances`; in Python, extract_stance's index "
+                 "counts from 0 (stance N is index N − 1)",
         )
     ev = events[index]
     t0, t1 = stance_window(ev, margin=margin, duration=min(trial.duration, _force_duration(trial)))
@@ -306,8 +311,10 @@ def extract_stance(
         raise DataError(
             "the stance window holds fewer than 3 samples",
             file=trial.source,
-            where=f"stance {index}",
+            where=f"stance {index + 1}",
         )
+
+    from scipy import interpolate  # here, not at the top: `bladelab trial info` stays quick
 
     def spline(values: np.ndarray) -> np.ndarray:
         return interpolate.CubicSpline(kin.time, values, axis=0)(t)
@@ -328,7 +335,7 @@ def extract_stance(
     meta.update(
         {
             "source": trial.source or "",
-            "stance_index": index,
+            "stance": index + 1,  # numbered from 1, as `bladelab trial stances` lists it
             "plates": " ".join(str(p) for p in ev.plates),
             "window_start_s": round(float(t[0]), 6),
             "touchdown_s": round(ev.start_s - float(t[0]), 6),

@@ -184,6 +184,51 @@ def _parse_meta(value: str) -> Any:
     return value
 
 
+# What a clamp and a blade can do, in metres: the clamp origin stays within 2 m of the ground
+# (the lab's z = 0), moves at most 20 m/s on average over the window (sprinters peak near
+# 12 m/s), and the clamp–tip distance of a running blade is under 2 m.
+MAX_CLAMP_HEIGHT_M = 2.0
+MAX_CLAMP_SPEED_M_PER_S = 20.0
+MAX_DISTANCE_M = 2.0
+# Length units a position column may be in by mistake: (factor to metres, name).
+_LENGTH_UNITS = ((1e-2, "centimetres", 100), (1e-3, "millimetres", 1000))
+
+
+def _check_position_units(columns: dict[str, np.ndarray], path: Path) -> None:
+    """Refuse clamp positions or distances that are implausible in metres, naming the unit they
+    most likely are in (centimetres or millimetres)."""
+    duration = float(columns["time"][-1] - columns["time"][0])
+    height = float(np.max(np.abs(columns["clamp_z"])))
+    travel = max(float(np.ptp(columns[c])) for c in ("clamp_x", "clamp_y", "clamp_z"))
+    speed = travel / duration
+
+    def clamp_ok(scale: float) -> bool:
+        return height * scale <= MAX_CLAMP_HEIGHT_M and speed * scale <= MAX_CLAMP_SPEED_M_PER_S
+
+    if not clamp_ok(1.0):
+        unit = next(((name, div) for scale, name, div in _LENGTH_UNITS if clamp_ok(scale)), None)
+        evidence = (f"clamp_z up to {height:.4g} (a clamp {height:.4g} m above the ground), moving "
+                    f"{travel:.4g} in {duration:.3g} s ({speed:.4g} m/s)")
+        raise DataError(
+            f"clamp positions look like {unit[0]}, not metres: {evidence}" if unit else
+            f"clamp positions are implausible in metres: {evidence}",
+            file=path, where="columns clamp_x, clamp_y, clamp_z",
+            hint=(f"give the clamp positions in metres (divide by {unit[1]})" if unit else
+                  "give the clamp positions in metres, lab frame, z up from the ground"),
+        )
+    finite = columns["distance"][np.isfinite(columns["distance"])]
+    longest = float(np.max(np.abs(finite))) if finite.size else 0.0
+    if longest > MAX_DISTANCE_M:
+        unit = next(((name, div) for scale, name, div in _LENGTH_UNITS
+                     if longest * scale <= MAX_DISTANCE_M), None)
+        raise DataError(
+            f"distance looks like {unit[0]}, not metres: values up to {longest:.4g}" if unit else
+            f"distance is implausible in metres: values up to {longest:.4g}",
+            file=path, where="column distance",
+            hint=f"give the clamp–tip distance in metres{f' (divide by {unit[1]})' if unit else ''}",
+        )
+
+
 def _validate_columns(columns: dict[str, np.ndarray], path: Path) -> None:
     time = columns["time"]
     if len(time) < 3:
@@ -213,6 +258,7 @@ def _validate_columns(columns: dict[str, np.ndarray], path: Path) -> None:
             f"window lasts {time[-1] - time[0]:.3g} s: time looks like ms, not s",
             file=path, where="column time", hint="time must be in seconds",
         )
+    _check_position_units(columns, path)
     for name in ("clamp_x", "clamp_y", "clamp_z", "distance"):
         finite = columns[name][np.isfinite(columns[name])]
         if finite.size and np.max(np.abs(finite)) > 100.0:

@@ -52,6 +52,7 @@ from bladelab.runner.metabolics import metabolic_params
 from bladelab.runner.model import DEFAULT_DT, RunnerModel
 from bladelab.runner.muscle import equilibrium_fiber_length
 from bladelab.runner.simulate import Recording, RunnerResult, initial_qpos
+from bladelab.sim.compilation import announce_compilation
 
 DEFAULT_PREDICT_DT = DEFAULT_DT
 MAX_TOUCHDOWNS = 400
@@ -173,6 +174,7 @@ def simulate_controlled(
     q0, v0 = initial_state(model, layout, x, v_start)
     d.qpos[:] = q0
     d.qvel[:] = v0
+    announce_compilation(run_closed_loop, "the reflex controller's simulation loop")
     mujoco.mj_forward(m, d)
     nm = len(model.muscle_names)
     mp = model.muscle_params
