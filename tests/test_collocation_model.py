@@ -384,3 +384,39 @@ def test_fibre_state_and_residual_match_forward_in_motion(models):
         res = _np(cm.muscle_residual(a, ft, dft, l_mt, v_mt)).ravel()
         bound = a * FV_ERROR + FP_ERROR + 1e-4
         assert np.all(np.abs(res - expected) <= bound), np.abs(res - expected).max()
+
+
+def test_smooth_metabolic_rate_matches_forward_uchida(models):
+    """The collocation model's whole-body metabolic rate equals the forward model's
+    (bladelab.runner.metabolics) at the same fibre states, within the smooth switches' widths:
+    ≤ 0.5 % per state at random activations, excitations, fibre lengths and velocities — including
+    stretched, weakly active muscles whose total rate the forward model floors at 0."""
+    from bladelab.predict.collocation.metabolics import metabolic_rate
+    from bladelab.runner.metabolics import metabolic_params, total_metabolic_rate
+
+    runner, cm = models["able"]
+    mp = runner.muscle_params
+    nm = mp.shape[0]
+    syms = [ca.SX.sym(n, nm) for n in ("u", "a", "ft", "dft", "lmt", "vmt")]
+    f_met = ca.Function("met", syms, [metabolic_rate(runner, *syms[:4], syms[4], syms[5],
+                                                     cm.smoothing)])
+    mb = metabolic_params(runner)
+    body_mass = float(np.sum(runner.mj_model.body_mass))
+    rng = np.random.default_rng(11)
+    floored, worst = 0, 0.0
+    for _ in range(N_STATES):
+        a = rng.uniform(0.01, 1.0, nm)
+        u = np.clip(a + rng.normal(0.0, 0.3, nm), 0.01, 1.0)
+        ft = rng.uniform(0.02, 1.2, nm)
+        dft = rng.normal(0.0, 5.0, nm)
+        l_mt = np.array([p[1] + p[2] * 1.03 for p in mp]) * rng.uniform(0.9, 1.1, nm)
+        v_mt = rng.uniform(-0.5, 0.5, nm)
+        l_m, v_m, _ = (_np(x).ravel() for x in cm.fiber(l_mt, v_mt, ft, dft))
+        ms = np.stack([a, l_m, v_m, ft * mp[:, 0]], axis=1)
+        forward = total_metabolic_rate(u, ms, mp, mb, body_mass)
+        smooth = float(f_met(u, a, ft, dft, l_mt, v_mt))
+        worst = max(worst, abs(smooth - forward) / forward)
+        per_muscle_work = -(ft * mp[:, 0]) * v_m / mb[:, 0]
+        floored += int(np.sum(per_muscle_work < -200.0))
+    assert worst <= 0.005, worst  # measured 5e-4
+    assert floored > 0  # the states reach the floor at 0 (absorbed work not refunded)

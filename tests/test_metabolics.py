@@ -45,6 +45,15 @@ def test_lengthening_counts_negative_work():
     )
 
 
+def test_absorbed_work_is_never_refunded():
+    # a weakly active muscle stretched hard: h = 1 W/kg floor (A = 0.01: h_AM = 89*1.5*0.01^0.6 =
+    # 8.4, h_L = 70*0.01*1.5 = 1.05), work -5000*0.1/1 = -500 W/kg: the total is 0, not -490
+    assert muscle_metabolic_rate(0.01, 0.01, 1.0, 1.0, 5000.0, 0.1, 1.0, 50.0) == 0.0
+    # a little absorbed work only lowers the total (h + w = 238.5 - 200 > 0)
+    assert muscle_metabolic_rate(1.0, 1.0, 1.0, 1.0, 2000.0, 0.1, 1.0, 50.0) == pytest.approx(
+        133.5 + 105.0 - 200.0)
+
+
 def test_heat_floor_of_one_watt_per_kg():
     assert muscle_metabolic_rate(0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 2.0, 50.0) == pytest.approx(2.0)
 

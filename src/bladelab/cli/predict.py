@@ -66,8 +66,39 @@ def register(app: typer.Typer) -> None:
         initial_speed: float | None = typer.Option(
             None, "--initial-speed", help="Forward speed of the initial state (m/s); default --speed."
         ),
+        method: str = typer.Option(
+            "reflex", "--method", help="reflex (CMA-ES on the reflex controller) | collocation "
+            "(one periodic stride by direct collocation, CasADi + IPOPT)."
+        ),
+        max_speed: bool = typer.Option(
+            False, "--max-speed", help="Collocation: maximise the mean speed instead of --speed."
+        ),
+        mesh: int = typer.Option(50, "--mesh", help="Collocation: mesh intervals of the stride."),
+        guess: str = typer.Option(
+            "template", "--guess", help="Collocation: initial guess: template | trial (the "
+            "Fukuchi 3.5 m/s trial) | FILE (solution.json, best_iterate.json or reflex JSON)."
+        ),
+        max_iter: int = typer.Option(
+            3000, "--max-iter", help="Collocation: IPOPT iterations per stage."
+        ),
+        as_json: bool = typer.Option(
+            False, "--json", help="Collocation: print the summary as one JSON object."
+        ),
     ) -> None:
-        """Optimise the reflex controller of the runner with CMA-ES (seed 001 eq. 2.4)."""
+        """Optimise the reflex controller of the runner with CMA-ES (seed 001 eq. 2.4), or with
+        --method collocation solve one periodic stride by direct collocation (writes
+        DIR/solution.json; exit status 2 and DIR/best_iterate.json if IPOPT does not converge)."""
+        if method == "collocation":
+            from bladelab.cli.collocation import run_collocation
+
+            code = run_collocation(out=out, model=model, blade=blade, speed=speed,
+                                   max_speed=max_speed, mesh=mesh, guess=guess,
+                                   max_iter=max_iter, resume=resume, force=force,
+                                   as_json=as_json)
+            raise typer.Exit(code)
+        if method != "reflex":
+            raise SpecError(f"unknown method {method!r}", where="--method",
+                            hint="reflex or collocation")
         from bladelab.predict.reflex.controller import read_parameters
         from bladelab.predict.reflex.objective import ObjectiveSettings
         from bladelab.predict.reflex.optimize import optimize_seeds, runner_and_layout

@@ -13,7 +13,8 @@ __all__ = ["register"]
 def _report(
     study_dir: Path = typer.Argument(..., metavar="PATH", help="Study folder (study.yaml + results.sqlite), "
                                      "design folder, 'bladelab predict' or 'bladelab sweep' "
-                                     "folder, or a runner parameter JSON file."),
+                                     "folder, a runner parameter JSON file, or a collocation "
+                                     "solution.json."),
     trial: str | None = typer.Option(None, "--trial", help="Trial of the cost landscape "
                                      "(default: the first identified trial)."),
     variant: str | None = typer.Option(None, "--variant", help="Model variant to report "
@@ -32,9 +33,11 @@ def _report(
     if study_dir.is_file() or (study_dir.is_dir() and predictive_kind(study_dir) is not None
                                and not (study_dir / "study.yaml").is_file()):
         if predictive_kind(study_dir) is None:
-            raise InputFileError("not a runner parameter file (no 'parameters' mapping)",
-                                 file=study_dir, hint="a file must be a parameter JSON file; "
-                                 "otherwise give a study, design, predict or sweep folder")
+            raise InputFileError("not a runner parameter file (no 'parameters' mapping) nor a "
+                                 "collocation solution", file=study_dir,
+                                 hint="a file must be a parameter JSON file or a collocation "
+                                 "solution.json; otherwise give a study, design, predict or "
+                                 "sweep folder")
         pres = build_predictive_report(study_dir, out, progress=not as_json, export=export)
         typer.echo(json.dumps(pres.to_dict(), indent=2) if as_json
                    else f"report written: {pres.index} ({len(pres.solutions)} solutions)")

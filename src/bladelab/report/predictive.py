@@ -7,9 +7,12 @@
 - ``"sweep"``: a ``bladelab sweep`` folder (``results.csv``, ``summary.csv``,
   ``<category>/<speed>/best.json``);
 - ``"parameters"``: one parameter JSON file (keys ``model``, ``blade``, ``speed_m_per_s``,
-  ``settings`` {``dt``, ...}, ``parameters``).
+  ``settings`` {``dt``, ...}, ``parameters``);
+- ``"collocation"``: a collocation solution (``"kind": "collocation-solution"``, the
+  ``solution.json`` of ``bladelab predict --method collocation``, or its folder): its stride
+  repeated, not re-simulated (:mod:`bladelab.report.collocation`).
 
-Nothing is taken from a stored evaluation: every solution is simulated again from its parameters
+Nothing is taken from a stored evaluation: every reflex solution is simulated again from its parameters
 (:func:`bladelab.predict.reflex.objective.simulate_controlled` with the file's time step). The sections
 shown (:func:`bladelab.report.predictive_sections.add_predictive_sections`) come from a
 ``duration`` (10 s) re-simulation recorded every 2nd step. A run's cost terms are recomputed with
@@ -57,8 +60,13 @@ class PredictiveReport:
 
 
 def predictive_kind(path: str | Path) -> str | None:
-    """``"run"``, ``"runs"``, ``"sweep"``, ``"parameters"`` or None (see module docstring)."""
+    """``"run"``, ``"runs"``, ``"sweep"``, ``"parameters"``, ``"collocation"`` or None (see
+    module docstring); a collocation best iterate raises InputFileError (not a solution)."""
+    from bladelab.report.collocation import collocation_solution_file
+
     p = Path(path)
+    if collocation_solution_file(p) is not None:
+        return "collocation"
     if p.is_file():
         if p.suffix.lower() != ".json":
             return None
@@ -412,9 +420,9 @@ def _export_section(report, results: dict) -> None:
 
 def default_report_dir(path: Path, kind: str) -> Path:
     """Where a report goes without ``out_dir``: ``path/report`` for a folder; ``<stem>-report``
-    beside a parameter file, or in the current folder for a file shipped inside bladelab (never
-    into the installed package)."""
-    if kind != "parameters":
+    beside a parameter or collocation solution file, or in the current folder for a file
+    shipped inside bladelab (never into the installed package)."""
+    if kind not in ("parameters", "collocation") or path.is_dir():
         return path / "report"
     package = Path(__file__).resolve().parents[1]
     folder = Path.cwd() if path.resolve().is_relative_to(package) else path.parent
@@ -435,7 +443,8 @@ def build_predictive_report(
     Parameters
     ----------
     path
-        A ``bladelab predict`` or ``bladelab sweep`` folder, or a parameter JSON file.
+        A ``bladelab predict`` or ``bladelab sweep`` folder, a parameter JSON file, or a
+        collocation solution (``solution.json`` or its folder).
     out_dir
         Report folder; default :func:`default_report_dir`.
     duration
@@ -469,11 +478,18 @@ def build_predictive_report(
         out_dir = default_report_dir(path, kind)
     titles = {"run": "Predictive running: optimisation", "runs": "Predictive running: runs",
               "sweep": "Predictive running: blade-category sweep",
-              "parameters": "Predictive running: solution"}
+              "parameters": "Predictive running: solution",
+              "collocation": "Predictive running: collocation solution"}
     rep = Report(titles[kind], subtitle=str(path))
     sweep_summary = None
+    resim = None
     with _Counter(tqdm(desc="re-simulating", unit="sim", disable=not progress)) as bar:
-        if kind == "parameters":
+        if kind == "collocation":
+            from bladelab.report.collocation import collocation_sections
+
+            results, csol = collocation_sections(rep, path)
+            settings, seed = csol.settings.to_dict(), None
+        elif kind == "parameters":
             sol = _Solution(path, _read_json(path))
             ev, res = sol.simulate(duration)
             bar.update()
@@ -494,6 +510,20 @@ def build_predictive_report(
             results, resim, sweep_summary, cells = _sweep_sections(rep, path, duration, bar)
             first = _read_json(cells[0][2] / "best.json") if cells else {}
             settings, seed = first.get("settings") or {}, first.get("seed")
+    if resim is not None:
+        _resim_section(rep, resim, duration)
+    add_predictive_sections(rep, results, sweep_summary=sweep_summary, animate=animate)
+    if export:
+        _export_section(rep, results)
+    rep.settings = {"source": str(path), "kind": kind,
+                    "resimulated_s": None if resim is None else duration,
+                    "objective": settings}
+    rep.seed = seed
+    index = rep.write(Path(out_dir))
+    return PredictiveReport(str(index), kind, tuple(results), bar.count)
+
+
+def _resim_section(rep, resim: list, duration: float) -> None:
     rep.add_section(
         "Re-simulation of the solutions shown",
         text=(f"Each solution below is simulated again from its parameters for {duration:g} s "
@@ -504,11 +534,3 @@ def build_predictive_report(
               "spatiotemporal variables below)."),
         tables=[("Re-simulations", pd.DataFrame(resim))],
     )
-    add_predictive_sections(rep, results, sweep_summary=sweep_summary, animate=animate)
-    if export:
-        _export_section(rep, results)
-    rep.settings = {"source": str(path), "kind": kind, "resimulated_s": duration,
-                    "objective": settings}
-    rep.seed = seed
-    index = rep.write(Path(out_dir))
-    return PredictiveReport(str(index), kind, tuple(results), bar.count)

@@ -14,6 +14,12 @@ Per muscle, rates per kilogram of muscle [W/kg] (Umberger et al. 2003; Uchida et
 - total heat ``ḣ_AM + ḣ_SL`` not below 1 W/kg (Umberger's floor);
 - mechanical work rate ``ẇ = −F_ce·v_ce / m`` with the active fibre force ``F_ce`` — negative work
   (lengthening) included (Uchida 2016);
+- the muscle's total ``heat + ẇ`` not below 0 (Uchida 2016 with Umberger 2010's
+  "forbid negative total power", as OpenSim's Umberger2010 probe does it by raising the shortening
+  heat): a lengthening muscle absorbing work costs nothing, but it earns no energy back. Without
+  this floor, absorbed work is refunded one to one, and an optimiser makes every stance a
+  high-force stretch–shortening cycle (measured in collocation: 5 body-weight, 0.12 s contacts
+  at 3.5 m/s, ``docs/collocation.md``);
 - ``S = 1.5`` (aerobic), muscle mass ``m = ρ·V`` with ``V = Fmax·l_opt/σ`` (σ = the model's specific
   tension, so V is the muscle's volume of seed 001 eq. 2.1) and ρ = 1059.7 kg/m³.
 
@@ -109,7 +115,10 @@ def muscle_metabolic_rate(
     if heat < MIN_HEAT_RATE_W_PER_KG:
         heat = MIN_HEAT_RATE_W_PER_KG
     w = -f_ce * v_ce / mass
-    return (heat + w) * mass
+    total = heat + w
+    if total < 0.0:  # no energy earned back from absorbed work (Umberger 2010, Uchida 2016)
+        total = 0.0
+    return total * mass
 
 
 @njit(cache=True)

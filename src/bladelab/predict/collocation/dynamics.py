@@ -88,6 +88,8 @@ def stride_dynamics(cm: CollocationModel, *,
         inequality_bounds=np.vstack([np.tile([-1.0, 1.0], (nm, 1)),
                                      np.tile([MIN_FIBER_ALONG, MAX_FIBER_ALONG], (nm, 1))]),
         static_tendon_force=lambda q_nodes, a_nodes: static_tendon_forces(cm, q_nodes, a_nodes),
+        vertical_grf=ca.Function("vertical_grf", [q, qd],
+                                 [ca.sum1(cm.contacts(q, qd)[0][:, 1])]),
     )
 
 

@@ -12,8 +12,10 @@ The same equations and constants as the forward model; every ``if`` becomes a si
 - ``A^0.6`` is smooth on the NLP's domain (A ≥ 0.01, the minimum activation).
 
 Mechanical work rate ``−F_ce·v_ce`` with the active fibre force ``F_ce = F_T/cos α − f_p·F_max``
-(negative work included, as Uchida 2016), fibre state from
-:func:`bladelab.predict.collocation.muscles.fiber_kinematics`.
+(negative work included, as Uchida 2016; ``F_ce`` floored smoothly at 0 as the forward model
+clamps it), fibre state from
+:func:`bladelab.predict.collocation.muscles.fiber_kinematics`; each muscle's total
+``heat + work`` not below 0 (the forward model's floor): ``softplus(heat + work, w_t)``.
 """
 
 from __future__ import annotations
@@ -24,7 +26,7 @@ import casadi as ca
 import numpy as np
 
 from bladelab.predict.collocation import muscles
-from bladelab.predict.collocation.smooth import Smoothing, sigmoid, softplus
+from bladelab.predict.collocation.smooth import Smoothing, sigmoid, smooth_max0, softplus
 from bladelab.runner.metabolics import (
     AEROBIC_SCALE,
     BASAL_RATE_W_PER_KG,
@@ -52,12 +54,15 @@ class MetabolicSmoothing:
         In ``ṽ`` [l_opt/s].
     heat_w_per_kg
         Of the heat-rate floor [W/kg].
+    total_w_per_kg
+        Of the floor at 0 of a muscle's total rate (heat + work) [W/kg].
     """
 
     excitation: float = 0.01
     length: float = 0.01
     velocity: float = 0.05
     heat_w_per_kg: float = 0.1
+    total_w_per_kg: float = 0.1
 
 
 def metabolic_rate(runner, u, a, ft, dft, l_mt, v_mt, smoothing: Smoothing,
@@ -100,7 +105,9 @@ def metabolic_rate(runner, u, a, ft, dft, l_mt, v_mt, smoothing: Smoothing,
     lengthening = sigmoid(vn, w.velocity)
     heat = h_am + (1.0 - lengthening) * h_short + lengthening * h_long
     heat = MIN_HEAT_RATE_W_PER_KG + softplus(heat - MIN_HEAT_RATE_W_PER_KG, w.heat_w_per_kg)
-    f_ce = fmax * ft / cos_a - muscles.passive_force(ln, smoothing) * fmax
+    # active fibre force, not below 0 (the forward model's clamp; off equilibrium only)
+    f_ce = smooth_max0(fmax * ft / cos_a - muscles.passive_force(ln, smoothing) * fmax, 1.0)
     work = -f_ce * v_m / mass
+    total = softplus(heat + work, w.total_w_per_kg)
     body_mass = float(np.sum(runner.mj_model.body_mass))
-    return BASAL_RATE_W_PER_KG * body_mass + ca.sum1((heat + work) * mass)
+    return BASAL_RATE_W_PER_KG * body_mass + ca.sum1(total * mass)

@@ -74,6 +74,9 @@ class StrideDynamics:
     static_tendon_force
         Optional ``(q (n+1, n_dof), a (n+1, n_muscles)) -> F̃ₜ`` in static equilibrium, used
         for initial guesses without muscle states.
+    vertical_grf
+        Optional CasADi Function (q, q̇) -> total vertical ground force [N] (for tracking a
+        measured force).
     """
 
     dof_names: tuple[str, ...]
@@ -89,6 +92,7 @@ class StrideDynamics:
     inequalities: ca.Function | None = None
     inequality_bounds: np.ndarray | None = None
     static_tendon_force: Callable[[np.ndarray, np.ndarray], np.ndarray] | None = None
+    vertical_grf: ca.Function | None = None
 
     @property
     def nq(self) -> int:
@@ -111,7 +115,12 @@ class StrideWeights:
     activation
         Time-averaged mean cubed activation [-].
     acceleration
-        Time-averaged mean squared joint acceleration, in (rad/s²)² / 1e4.
+        Time-averaged mean squared joint acceleration, in (rad/s²)² / 1e4 (joints only).
+    pelvis_acceleration
+        Time-averaged mean squared pelvis acceleration: translations in (m/s²)² / 100 (so a
+        1 g bounce counts about 1), tilt in (rad/s²)² / 1e4. Penalises the ground-force
+        spikes that a stiff contact allows (the pelvis's vertical acceleration is the net
+        vertical force over the body mass, to the segments' relative motion).
     speed
         Negative mean speed [m/s] (maximum-speed problem).
     """
@@ -119,6 +128,7 @@ class StrideWeights:
     metabolic: float = 1.0
     activation: float = 1.0
     acceleration: float = 0.1
+    pelvis_acceleration: float = 0.0
     speed: float = 1.0
 
     def to_dict(self) -> dict[str, float]:
@@ -218,6 +228,7 @@ class StrideNLP:
         min_tendon_force: float = 1e-3,
         max_tendon_force: float = 3.0,
         tracking: tuple[np.ndarray, float] | None = None,
+        grf_tracking: tuple[np.ndarray, float] | None = None,
     ) -> None:
         if n < 4:
             raise SpecError(f"need at least 4 mesh intervals, got {n}", where="mesh intervals")
@@ -233,6 +244,7 @@ class StrideNLP:
         self.min_tendon_force = float(min_tendon_force)
         self.max_tendon_force = float(max_tendon_force)
         self.tracking = tracking
+        self.grf_tracking = grf_tracking
         self._build()
 
     # -- layout -------------------------------------------------------------------------
@@ -256,13 +268,17 @@ class StrideNLP:
         xdot_scaled = ca.vertcat(qd, qdd, adot, dfnt) / sx
         path = ca.vertcat(r_mb / d.residual_scale, r_hill)
         w = self.weights
+        pelvis_scale = np.array([10.0 if n_ in ("pelvis_tx", "pelvis_tz") else 100.0
+                                 for n_ in d.dof_names[:3]])
         effort = (w.activation * ca.sum1(a**3) / max(nm, 1)
-                  + w.acceleration * ca.sumsqr(qdd[3:]) / max(nq - 3, 1) / 1e4)
+                  + w.acceleration * ca.sumsqr(qdd[3:]) / max(nq - 3, 1) / 1e4
+                  + w.pelvis_acceleration * ca.sumsqr(qdd[:3] / pelvis_scale) / 3)
         met = d.metabolic_rate(q, qd, a, fnt, dfnt, e)
         ineq = (d.inequalities(q, qd, a, fnt, dfnt) if d.inequalities is not None
                 else ca.SX.zeros(0, 1))
         self.n_ineq = int(ineq.numel())
-        node = ca.Function("node", [xs, us], [xdot_scaled, path, effort, met, ineq])
+        fz = d.vertical_grf(q, qd) if d.vertical_grf is not None else ca.SX(0.0)
+        node = ca.Function("node", [xs, us], [xdot_scaled, path, effort, met, ineq, fz])
         fmap = node.map(n + 1)
 
         X = ca.MX.sym("X", self.nx, n + 1)
@@ -270,7 +286,7 @@ class StrideNLP:
         T = ca.MX.sym("T")
         period = T * s.period
         h = period / n
-        xdot, pth, eff, mets, ineqs = fmap(X, U)
+        xdot, pth, eff, mets, ineqs, fzs = fmap(X, U)
         defects = X[:, 1:] - X[:, :-1] - h / 2 * (xdot[:, 1:] + xdot[:, :-1])
         itx = d.dof_names.index("pelvis_tx")
         distance = (X[itx, n] - X[itx, 0]) * sx[itx]
@@ -311,6 +327,16 @@ class StrideNLP:
             per_node = ca.sum1(dev) / (nq - 2)
             terms["tracking"] = float(weight) * (ca.sum2(per_node[:, :-1])
                                                  + ca.sum2(per_node[:, 1:])) / (2 * n)
+        if self.grf_tracking is not None:
+            f_ref, weight = self.grf_tracking
+            f_ref = np.asarray(f_ref, float).reshape(1, -1)
+            if f_ref.shape != (1, n + 1):
+                raise SpecError(f"force reference has {f_ref.size} values, the mesh needs "
+                                f"{n + 1}", where="force tracking")
+            bw = d.mass * d.gravity
+            dev = ((fzs - f_ref) / bw) ** 2
+            terms["grf_tracking"] = float(weight) * (ca.sum2(dev[:, :-1])
+                                                     + ca.sum2(dev[:, 1:])) / (2 * n)
         if self.n_ineq:
             g.append(ca.vec(ineqs[:, :n]))
             self._g_names += [f"inequality {i}@{k}" for k in range(n) for i in range(self.n_ineq)]

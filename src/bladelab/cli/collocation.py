@@ -1,0 +1,166 @@
+"""``bladelab predict --method collocation``: one stride by direct collocation (issue 15).
+
+The command parses its options, builds the model and the initial guess, and calls
+:func:`bladelab.predict.collocation.solve.predict_stride_in_folder`, which owns the output
+folder (``solution.json`` for a converged solve, ``best_iterate.json`` otherwise). Progress goes
+to stderr, one line at each stage's start and end and every :data:`PROGRESS_EVERY_S` seconds
+in between; stdout holds the summary (one JSON object with ``--json``). A solve that does not
+converge exits with status 2 after naming IPOPT's status and the worst-violated constraints.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import time
+from pathlib import Path
+
+import typer
+
+from bladelab.errors import InputFileError, SpecError
+
+__all__ = ["FUKUCHI_STATIC", "FUKUCHI_TRIAL", "PROGRESS_EVERY_S", "TRIAL_SPEED_M_PER_S",
+           "run_collocation"]
+
+_SHARED = Path(__file__).resolve().parents[3].parent / "shared" / "data" / "real" / "fukuchi2017"
+#: The measured running trial of ``--guess trial`` and its standing trial.
+FUKUCHI_TRIAL = _SHARED / "RBDS001runT35.c3d"
+FUKUCHI_STATIC = _SHARED / "RBDS001static.c3d"
+#: Treadmill speed of that trial [m/s].
+TRIAL_SPEED_M_PER_S = 3.5
+#: Seconds between two progress lines while a stage iterates.
+PROGRESS_EVERY_S = 5.0
+#: Template speed [m/s] of a maximum-speed problem's guess.
+MAX_SPEED_TEMPLATE_M_PER_S = 4.0
+
+
+def _make_guess(runner, guess: str, *, n: int, speed: float | None):
+    """The initial guess named by ``--guess``: template, trial, or a file (a collocation
+    solution or best iterate, or a reflex-controller parameter file)."""
+    from bladelab.predict.collocation.guess import (
+        guess_from_reflex,
+        guess_from_trial,
+        template_guess,
+    )
+
+    if guess == "template":
+        return template_guess(runner, speed=speed or MAX_SPEED_TEMPLATE_M_PER_S, n=n)
+    if guess == "trial":
+        if not FUKUCHI_TRIAL.is_file():
+            raise InputFileError("the measured running trial is not there", file=FUKUCHI_TRIAL,
+                                 where="--guess trial",
+                                 hint="it needs the shared data folder beside the project "
+                                      "(../shared/data), or use --guess template")
+        static = FUKUCHI_STATIC if FUKUCHI_STATIC.is_file() else None
+        return guess_from_trial(runner, FUKUCHI_TRIAL, static=static, n=n,
+                                speed=TRIAL_SPEED_M_PER_S)
+    path = Path(guess)
+    kind = _file_kind(path)
+    if kind == "collocation":
+        from bladelab.predict.collocation.solution import CollocationSolution
+
+        sol = CollocationSolution.read(path)
+        if sol.dof_names != tuple(runner.dof_names):
+            raise SpecError("the guess is a solution of another model", file=path,
+                            where="--guess", hint=f"it is of {sol.model_spec}")
+        return sol.to_guess(f"collocation solution {path.name} ({sol.guess_source})")
+    return guess_from_reflex(path, n=n)
+
+
+def _file_kind(path: Path) -> str:
+    """``"collocation"`` or ``"reflex"`` for a ``--guess`` file."""
+    from bladelab._io import read_json
+
+    if not path.is_file():
+        raise SpecError(f"{str(path)!r} is neither template, trial nor a file", where="--guess",
+                        hint="template, trial, or the path of a solution.json, "
+                             "best_iterate.json or reflex parameter JSON file")
+    data = read_json(path, what="--guess file")
+    if isinstance(data, dict) and str(data.get("kind", "")).startswith("collocation-"):
+        return "collocation"
+    if isinstance(data, dict) and isinstance(data.get("parameters"), dict):
+        return "reflex"
+    raise InputFileError("not a collocation solution nor a reflex parameter file", file=path,
+                         where="--guess", hint="a solution.json, best_iterate.json or a "
+                                               "'bladelab predict' parameter JSON file")
+
+
+class _Progress:
+    """Progress lines on stderr: a stage's start and end, and an iteration line at most every
+    :data:`PROGRESS_EVERY_S` seconds."""
+
+    def __init__(self) -> None:
+        self.last = -math.inf
+
+    def __call__(self, p) -> None:
+        if p.event == "start":
+            typer.echo(f"{p.stage} stage: started ({p.message})", err=True)
+            self.last = time.perf_counter()
+        elif p.event == "iteration":
+            now = time.perf_counter()
+            if now - self.last >= PROGRESS_EVERY_S:
+                self.last = now
+                typer.echo(f"{p.stage} stage: iteration {p.iteration}, objective "
+                           f"{p.objective:.5g}, constraint violation {p.violation:.2g}, "
+                           f"{p.elapsed_s:.0f} s", err=True)
+        else:
+            typer.echo(f"{p.stage} stage: {p.message} after {p.iteration} iterations, "
+                       f"{p.elapsed_s:.1f} s", err=True)
+
+
+def _text(summary: dict, path: Path, solved: bool) -> str:
+    head = "solution" if summary["converged"] else "best iterate (not converged)"
+    lines = [f"{head}: {path}" + ("" if solved else " (already solved: read back)")]
+    for key, value in summary.items():
+        lines.append(f"  {key}: {value:.4g}" if isinstance(value, float)
+                     else f"  {key}: {value}")
+    return "\n".join(lines)
+
+
+def run_collocation(
+    *,
+    out: Path,
+    model: str,
+    blade: str,
+    speed: float,
+    max_speed: bool,
+    mesh: int,
+    guess: str,
+    max_iter: int,
+    resume: bool,
+    force: bool,
+    as_json: bool,
+) -> int:
+    """Run ``bladelab predict --method collocation``; returns the exit status (0 converged,
+    2 not converged)."""
+    from bladelab.predict.collocation.solution import check_model_spec, runner_from_spec
+    from bladelab.predict.collocation.solve import CollocationSettings, predict_stride_in_folder
+
+    if model not in ("able", "amputee"):
+        raise SpecError(f"unknown model {model!r}", where="--model", hint="able or amputee")
+    if not max_speed and not (math.isfinite(speed) and speed > 0):
+        raise SpecError("speed must be positive", where="--speed")
+    if mesh < 4:
+        raise SpecError(f"need at least 4 mesh intervals, got {mesh}", where="--mesh")
+    if max_iter < 1:
+        raise SpecError(f"need at least 1 iteration, got {max_iter}", where="--max-iter")
+    spec = check_model_spec({"model": model, "blade": blade})
+    settings = CollocationSettings(mesh_intervals=mesh,
+                                   speed_m_per_s=None if max_speed else float(speed),
+                                   max_iter=max_iter)
+    runner = runner_from_spec(spec)
+    result = predict_stride_in_folder(
+        out, runner, settings,
+        lambda: _make_guess(runner, guess, n=mesh, speed=settings.speed_m_per_s),
+        model_spec=spec, resume=resume, force=force, progress=_Progress())
+    sol = result.solution
+    summary = sol.summary()
+    typer.echo(json.dumps(summary) if as_json else _text(summary, result.path, result.solved))
+    if sol.converged:
+        return 0
+    worst = "; ".join(f"{name} ({value:.3g})" for name, value in sol.nlp.worst_constraints)
+    typer.echo(f"error: not converged: IPOPT status {sol.nlp.status} in the {sol.stage} stage "
+               f"after {sol.nlp.iterations} iterations; worst-violated constraints: "
+               f"{worst or 'none'}; best iterate saved to {result.path} (not a solution)",
+               err=True)
+    return 2

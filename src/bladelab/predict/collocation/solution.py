@@ -1,0 +1,651 @@
+"""A collocation solution of one stride: its file, its summary and its trajectory.
+
+:class:`CollocationSolution` holds an :class:`~bladelab.predict.collocation.transcription.
+NLPSolution` (the node values) with what is needed to read it without solving again: the
+settings, the model (``{"model": "able" | "amputee", "blade": "Cat6" | None}``), where the
+initial guess came from, the tracking stage's status, and values derived once from the model
+at the nodes: contact forces of the collocation model per contact [N], the leg of each
+contact, the metabolic energy over the stride [J] and the dynamic consistency with the forward
+model (:mod:`bladelab.predict.collocation.consistency`).
+
+The file (JSON, written atomically by :func:`bladelab._io.write_json`) has ``"kind":
+"collocation-solution"`` for a converged solve and ``"collocation-best-iterate"`` for the last
+iterate of one that did not converge; ``bladelab report`` renders only the former. Units are in
+the field names (``_s``, ``_m``, ``_N``, ``_J``, ``_mps``); node arrays are rows per node, in the
+order of ``dof_names`` and ``muscle_names``.
+
+:meth:`CollocationSolution.summary` gives the numbers of ``bladelab predict --method
+collocation --json``; :meth:`CollocationSolution.to_runner_result` the stride, repeated, as a
+:class:`~bladelab.runner.RunnerResult`, so that the forward simulation's analyses and the
+predictive report work on it.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from bladelab.errors import DataError, SpecError
+from bladelab.predict.collocation.solve import COLLOCATION_SOURCE, CollocationSettings
+
+__all__ = [
+    "BEST_ITERATE_KIND",
+    "FORMAT_VERSION",
+    "SOLUTION_KIND",
+    "CollocationSolution",
+    "check_model_spec",
+    "runner_from_spec",
+]
+
+SOLUTION_KIND = "collocation-solution"
+BEST_ITERATE_KIND = "collocation-best-iterate"
+FORMAT_VERSION = 1
+#: Vertical force of a leg above which it is in contact [N] (the forward analyses' threshold).
+CONTACT_THRESHOLD_N = 20.0
+#: Samples per mesh interval of the linear interpolation used for contact and flight times.
+_FINE = 50
+
+# node arrays: (file field, NLPSolution attribute, columns: "dof" or "muscle")
+_NODE_FIELDS = (
+    ("q", "q", "dof"),
+    ("qd", "qd", "dof"),
+    ("qdd", "qdd", "dof"),
+    ("activation", "activation", "muscle"),
+    ("tendon_force_per_Fmax", "tendon_force", "muscle"),
+    ("excitation", "excitation", "muscle"),
+    ("tendon_force_rate_per_Fmax_per_s", "tendon_force_rate", "muscle"),
+)
+
+
+def check_model_spec(spec) -> dict:
+    """The model specification ``{"model": "able" | "amputee", "blade": name | None}``,
+    checked and normalised (the able model has no blade; the amputee needs one)."""
+    if not isinstance(spec, dict) or "model" not in spec:
+        raise SpecError(f"expected {{'model': ..., 'blade': ...}}, got {spec!r}",
+                        where="model_spec")
+    model = spec["model"]
+    if model not in ("able", "amputee"):
+        raise SpecError(f"unknown model {model!r}", where="model", hint="able or amputee")
+    blade = spec.get("blade")
+    if model == "able":
+        blade = None
+    elif not isinstance(blade, str) or not blade:
+        raise SpecError("the amputee model needs a blade category", where="blade",
+                        hint="e.g. Cat6")
+    return {"model": model, "blade": blade}
+
+
+def runner_from_spec(spec: dict):
+    """Build the forward runner of a model specification (:func:`check_model_spec`)."""
+    from bladelab.runner import build_runner
+
+    spec = check_model_spec(spec)
+    if spec["model"] == "able":
+        return build_runner("able")
+    return build_runner("amputee", blade=spec["blade"])
+
+
+def _num(x) -> float | None:
+    """A float for JSON: non-finite values as null."""
+    x = float(x)
+    return x if math.isfinite(x) else None
+
+
+def _array(a: np.ndarray) -> list:
+    a = np.asarray(a, dtype=float)
+    return np.where(np.isfinite(a), a, None).tolist() if not np.all(np.isfinite(a)) \
+        else a.tolist()
+
+
+def _node_samples(cm):
+    """A CasADi Function of one sample (q, q̇, F̃ₜ, dF̃ₜ/dt) -> (l_mt, v_mt, l_m, v_m, vec(forces),
+    vec(points), vec(point velocities), passive torques) of the collocation model."""
+    import casadi as ca
+
+    nv, nm = cm.nv, cm.n_muscles
+    q, qd = ca.SX.sym("q", nv), ca.SX.sym("qd", nv)
+    ft, dft = ca.SX.sym("ft", nm), ca.SX.sym("dft", nm)
+    l_mt, v_mt = cm.mtu(q, qd)
+    l_m, v_m, _ = cm.fiber(l_mt, v_mt, ft, dft)
+    f, p, _ = cm.contacts(q, qd)
+    pv = ca.jtimes(ca.vec(p), q, qd)
+    tau_p = cm.passive(q, qd)
+    return ca.Function("node_samples", [q, qd, ft, dft],
+                       [l_mt, v_mt, l_m, v_m, ca.vec(f), ca.vec(p), pv, tau_p])
+
+
+def _evaluate(cm, q, qd, ft, dft) -> dict[str, np.ndarray]:
+    """The collocation model's quantities at samples (rows): muscles, contacts, passive."""
+    fn = _node_samples(cm).map(q.shape[0])
+    out = [np.asarray(v, dtype=float).T for v in fn(q.T, qd.T, ft.T, dft.T)]
+    nc = cm.n_contacts
+
+    def per_contact(a):  # (N, 2·nc) column-major vec of (nc, 2) -> (N, nc, 2)
+        return a.reshape(a.shape[0], 2, nc).swapaxes(1, 2)
+
+    return {"l_mt": out[0], "v_mt": out[1], "l_m": out[2], "v_m": out[3],
+            "forces": per_contact(out[4]), "points": per_contact(out[5]),
+            "point_velocities": per_contact(out[6]), "passive": out[7]}
+
+
+@dataclass(frozen=True, eq=False)
+class CollocationSolution:
+    """A solved (or the last iterate of an unsolved) stride, with its settings and model.
+
+    Attributes
+    ----------
+    nlp
+        The node values and IPOPT's report (:class:`NLPSolution`).
+    settings
+        :class:`~bladelab.predict.collocation.solve.CollocationSettings`.
+    model_spec
+        ``{"model": "able" | "amputee", "blade": name | None}``.
+    guess_source
+        Where the initial guess came from.
+    stage
+        The stage of ``nlp``: ``"predictive"`` or ``"tracking"`` (a tracking stage that did not
+        converge ends the solve).
+    tracking
+        The tracking stage's ``success``, ``status``, ``iterations``, ``wall_s`` [s],
+        ``objective``, ``max_violation``; None when there was none.
+    dof_names, muscle_names
+        Column names of the node arrays.
+    contact_forces
+        (n + 1, n_contacts, 2): friction and normal force [N] of each contact of the
+        collocation model at the nodes.
+    contact_legs
+        (n_contacts,) leg of each contact (0 left/intact, 1 right/prosthetic).
+    leg_names
+        Names of legs 0 and 1: (left, right) or (intact, prosthetic).
+    body_mass_kg, body_weight_N
+        Of the model.
+    metabolic_energy_J
+        Metabolic energy over the stride [J] (the collocation's smooth metabolic model).
+    residual
+        The dynamic-consistency breakdown
+        (:meth:`~bladelab.predict.collocation.consistency.DynamicsResidual.to_dict`, the
+        forward friction taken as ``"coulomb"``), with ``bristle_residual_pct``: the same
+        residual with the forward bristle's state reconstructed along the stride [%].
+    """
+
+    nlp: object
+    settings: CollocationSettings
+    model_spec: dict
+    guess_source: str
+    stage: str
+    tracking: dict | None
+    dof_names: tuple[str, ...]
+    muscle_names: tuple[str, ...]
+    contact_forces: np.ndarray
+    contact_legs: np.ndarray
+    leg_names: tuple[str, str]
+    body_mass_kg: float
+    body_weight_N: float
+    metabolic_energy_J: float
+    residual: dict = field(default_factory=dict)
+
+    # -- construction ---------------------------------------------------------------------
+    @classmethod
+    def from_nlp(cls, runner, nlp, *, settings: CollocationSettings, model_spec: dict,
+                 guess_source: str, stage: str = "predictive", tracking: dict | None = None,
+                 metabolic_energy_J: float | None = None, cm=None) -> CollocationSolution:
+        """A solution from an :class:`NLPSolution` of ``runner``: evaluates the contact forces
+        and the dynamic consistency at the nodes (and the metabolic energy over the stride [J],
+        trapezoidal rule of the model's metabolic rate, when not given)."""
+        from bladelab.predict.collocation.consistency import dynamics_residual
+        from bladelab.predict.collocation.model import build_collocation_model
+        from bladelab.runner.model import CP_LEG
+        from bladelab.runner.simulate import leg_names
+
+        spec = check_model_spec(model_spec)
+        if runner.kind != spec["model"]:
+            raise SpecError(f"the runner is the {runner.kind} model, the spec says "
+                            f"{spec['model']}", where="model_spec")
+        if stage not in ("predictive", "tracking"):
+            raise SpecError(f"unknown stage {stage!r}", where="stage",
+                            hint="predictive or tracking")
+        cm = cm if cm is not None else build_collocation_model(runner)
+        q = np.asarray(nlp.q, float)
+        if q.shape[1] != cm.nv or np.asarray(nlp.tendon_force).shape[1] != cm.n_muscles:
+            raise DataError(f"node arrays of {q.shape[1]} coordinates, the model has {cm.nv}",
+                            where="q", hint="the solution is not of this runner model")
+        ev = _evaluate(cm, q, np.asarray(nlp.qd, float), np.asarray(nlp.tendon_force, float),
+                       np.asarray(nlp.tendon_force_rate, float))
+        if metabolic_energy_J is None:
+            metabolic_energy_J = _metabolic_energy(cm, nlp)
+        res = dynamics_residual(nlp, runner, cm=cm).to_dict()
+        res["bristle_residual_pct"] = dynamics_residual(nlp, runner, cm=cm, friction="bristle").pct
+        return cls(
+            nlp=nlp, settings=settings, model_spec=spec, guess_source=str(guess_source),
+            stage=stage, tracking=None if tracking is None else dict(tracking),
+            dof_names=tuple(runner.dof_names), muscle_names=tuple(runner.muscle_names),
+            contact_forces=ev["forces"],
+            contact_legs=runner.contact_params[:, CP_LEG].astype(int),
+            leg_names=leg_names(runner),
+            body_mass_kg=float(runner.total_mass), body_weight_N=float(runner.body_weight),
+            metabolic_energy_J=float(metabolic_energy_J), residual=res,
+        )
+
+    # -- derived numbers ------------------------------------------------------------------
+    @property
+    def converged(self) -> bool:
+        """True if the predictive stage converged (IPOPT's success)."""
+        return bool(self.nlp.success) and self.stage == "predictive"
+
+    @property
+    def kind(self) -> str:
+        """The file kind: :data:`SOLUTION_KIND` or :data:`BEST_ITERATE_KIND`."""
+        return SOLUTION_KIND if self.converged else BEST_ITERATE_KIND
+
+    @property
+    def period_s(self) -> float:
+        """Stride time [s]."""
+        return float(self.nlp.period)
+
+    @property
+    def stride_length_m(self) -> float:
+        """Pelvis travel over the stride [m]."""
+        i = self.dof_names.index("pelvis_tx")
+        return float(self.nlp.q[-1, i] - self.nlp.q[0, i])
+
+    @property
+    def mean_speed_mps(self) -> float:
+        """Mean forward speed [m/s]."""
+        return self.stride_length_m / self.period_s
+
+    @property
+    def cost_of_transport_J_per_kg_m(self) -> float:
+        """Metabolic energy per body mass and distance [J/(kg·m)]."""
+        d = self.stride_length_m
+        return self.metabolic_energy_J / (self.body_mass_kg * d) if d > 0 else math.nan
+
+    @property
+    def dynamics_residual_pct(self) -> float:
+        """Largest inverse-dynamics difference from the forward model's forces, % of peak."""
+        v = self.residual.get("dynamics_residual_pct")
+        return math.nan if v is None else float(v)
+
+    def leg_vertical_force(self) -> np.ndarray:
+        """(n + 1, 2) vertical ground force of legs 0 and 1 at the nodes [N]."""
+        fz = self.contact_forces[:, :, 1]
+        return np.stack([fz[:, self.contact_legs == leg].sum(axis=1) for leg in (0, 1)], axis=1)
+
+    def contact_phases(self, threshold_n: float = CONTACT_THRESHOLD_N) -> dict:
+        """Per leg: stance time [s] (the longest loaded stretch of the periodic stride),
+        contacts per stride (count) and peak vertical force [N]; and the flight fraction (of
+        the stride with neither leg loaded) [-]. Loaded: vertical force above ``threshold_n``
+        [N], the node values interpolated linearly."""
+        fz = self.leg_vertical_force()
+        n = fz.shape[0] - 1
+        x = np.linspace(0.0, n, n * _FINE, endpoint=False)
+        fine = np.stack([np.interp(x, np.arange(n + 1), fz[:, j]) for j in (0, 1)], axis=1)
+        loaded = fine > threshold_n
+        dt = self.period_s / (n * _FINE)
+        legs = {}
+        for j, name in enumerate(self.leg_names):
+            runs = _periodic_runs(loaded[:, j])
+            legs[name] = {"contact_time_s": float(max(runs, default=0) * dt),
+                          "contacts": len(runs),
+                          "peak_vertical_grf_N": float(fz[:, j].max())}
+        return {"legs": legs, "flight_fraction": float(np.mean(~loaded.any(axis=1)))}
+
+    def summary(self) -> dict:
+        """The numbers ``bladelab predict --method collocation --json`` prints.
+
+        ``converged``; ``status`` (IPOPT's, of the stage that ended the solve);
+        ``mean_speed_mps``, ``stride_time_s``, ``cost_of_transport_J_per_kg_m``;
+        ``contact_time_s`` (mean over the legs) and per leg ``contact_time_<leg>_s`` [s];
+        ``peak_vertical_grf_<leg>_bw`` [body weights]; ``flight_fraction`` (of the stride);
+        ``dynamics_residual_pct``; ``iterations`` and ``wall_s`` [s] of both stages together
+        (tracking + predictive). Legs: left/right (able) or intact/prosthetic (amputee).
+        """
+        ph = self.contact_phases()
+        times = [ph["legs"][leg]["contact_time_s"] for leg in self.leg_names]
+        tr = self.tracking or {}
+        its = int(self.nlp.iterations) + (int(tr.get("iterations", 0))
+                                          if self.stage == "predictive" else 0)
+        wall = float(self.nlp.wall_s) + (float(tr.get("wall_s", 0.0))
+                                         if self.stage == "predictive" else 0.0)
+        out = {
+            "converged": self.converged,
+            "status": str(self.nlp.status),
+            "mean_speed_mps": self.mean_speed_mps,
+            "stride_time_s": self.period_s,
+            "cost_of_transport_J_per_kg_m": self.cost_of_transport_J_per_kg_m,
+            "contact_time_s": float(np.mean(times)),
+        }
+        for leg, t in zip(self.leg_names, times, strict=True):
+            out[f"contact_time_{leg}_s"] = t
+        for leg in self.leg_names:
+            out[f"peak_vertical_grf_{leg}_bw"] = (ph["legs"][leg]["peak_vertical_grf_N"]
+                                                  / self.body_weight_N)
+        out["flight_fraction"] = ph["flight_fraction"]
+        out["dynamics_residual_pct"] = self.dynamics_residual_pct
+        out["iterations"] = its
+        out["wall_s"] = wall
+        return {k: (None if isinstance(v, float) and not math.isfinite(v) else v)
+                for k, v in out.items()}
+
+    # -- conversions ----------------------------------------------------------------------
+    def to_guess(self, source: str | None = None):
+        """This solution as an initial guess (muscle states included); its source marks it as
+        a collocation solution, so :func:`~bladelab.predict.collocation.solve.predict_stride`
+        goes straight to the predictive stage."""
+        text = source or f"{COLLOCATION_SOURCE} ({self.guess_source})"
+        if not text.startswith(COLLOCATION_SOURCE):
+            text = f"{COLLOCATION_SOURCE}: {text}"
+        return self.nlp.to_guess(text)
+
+    def to_runner_result(self, n_strides: int = 3, *, refine: int = 1, runner=None, cm=None):
+        """The stride repeated ``n_strides`` times as a :class:`~bladelab.runner.RunnerResult`
+        (pelvis_tx advanced by the stride length each time), for the forward analyses and the
+        predictive report.
+
+        Between nodes, ``refine`` − 1 extra samples per interval: coordinates on the
+        trapezoidal rule's quadratic (q̇ linear), muscle states and controls linear. At every
+        sample the collocation model gives the MTU lengths and velocities [m, m/s], fibre
+        lengths and velocities [m, m/s], contact forces [N], points [m], point velocities
+        [m/s] and compression [m] (the depth of the contact point below the ground), and the
+        ligament, socket and blade-joint torques [N·m]. ``dt`` of the result is the sample
+        spacing [s]; ``fell`` is False.
+
+        ``runner``: the model (built from :attr:`model_spec` if None); ``cm`` its collocation
+        model (built if None).
+        """
+        from bladelab.predict.collocation.model import build_collocation_model
+        from bladelab.runner.simulate import RunnerResult
+
+        if isinstance(n_strides, bool) or int(n_strides) != n_strides or n_strides < 1:
+            raise SpecError(f"need at least 1 stride, got {n_strides!r}", where="n_strides")
+        if isinstance(refine, bool) or int(refine) != refine or refine < 1:
+            raise SpecError(f"need refine >= 1, got {refine!r}", where="refine")
+        n_strides, refine = int(n_strides), int(refine)
+        runner = runner if runner is not None else runner_from_spec(self.model_spec)
+        if tuple(runner.dof_names) != self.dof_names:
+            raise DataError("the runner's coordinates are not the solution's",
+                            where="runner", hint="use the model the solution was solved for")
+        cm = cm if cm is not None else build_collocation_model(runner)
+        s = self.nlp
+        q, qd = np.asarray(s.q, float), np.asarray(s.qd, float)
+        n = q.shape[0] - 1
+        period = self.period_s
+        h = period / n
+        tau = np.arange(refine) * h / refine  # offsets within an interval [s]
+        k = np.repeat(np.arange(n), refine)
+        tt = np.tile(tau, n)
+        k = np.concatenate([np.tile(k, n_strides), [n]])
+        tt = np.concatenate([np.tile(tt, n_strides), [0.0]])
+        stride = np.concatenate([np.repeat(np.arange(n_strides), n * refine),
+                                 [n_strides - 1]])
+        nxt = np.minimum(k + 1, n)
+        w = (tt / h)[:, None]
+        dv = qd[nxt] - qd[k]
+        qs = q[k] + qd[k] * tt[:, None] + dv * (tt * tt / (2 * h))[:, None]
+        qds = qd[k] + dv * w
+        itx = self.dof_names.index("pelvis_tx")
+        qs[:, itx] += stride * self.stride_length_m
+
+        def lin(a):
+            a = np.asarray(a, float)
+            return a[k] + (a[nxt] - a[k]) * w
+
+        act, ft = lin(s.activation), lin(s.tendon_force)
+        exc, dft = lin(s.excitation), lin(s.tendon_force_rate)
+        time = stride * period + k * h + tt
+        ev = _evaluate(cm, qs, qds, ft, dft)
+        fmax = runner.muscle_params[:, 0]
+        muscles = np.stack([act, ev["l_m"], ev["v_m"], ft * fmax], axis=2)
+        mtu = np.stack([ev["l_mt"], ev["v_mt"]], axis=2)
+        f, p, pv = ev["forces"], ev["points"], ev["point_velocities"]
+        depth = np.maximum(-p[:, :, 1], 0.0)
+        contacts = np.concatenate([f, p, pv, depth[:, :, None]], axis=2)
+        return RunnerResult(
+            model=runner, time=time, qpos=qs, qvel=qds, muscles=muscles, mtu=mtu,
+            excitation=exc, contacts=contacts, ligament=ev["passive"], dt=h / refine,
+            fell=False, requested_duration=n_strides * period,
+        )
+
+    # -- file -----------------------------------------------------------------------------
+    def to_dict(self) -> dict:
+        """The file's content (module docstring)."""
+        s = self.nlp
+        return {
+            "kind": self.kind,
+            "format_version": FORMAT_VERSION,
+            "model": dict(self.model_spec),
+            "settings": self.settings.to_dict(),
+            "guess_source": self.guess_source,
+            "stage": self.stage,
+            "converged": self.converged,
+            "status": str(s.status),
+            "success": bool(s.success),
+            "iterations": int(s.iterations),
+            "wall_s": _num(s.wall_s),
+            "objective": _num(s.objective),
+            "objective_terms": {k: _num(v) for k, v in s.objective_terms.items()},
+            "max_violation": _num(s.max_violation),
+            "worst_constraints": [[name, _num(v)] for name, v in s.worst_constraints],
+            "timings": {k: _num(v) for k, v in s.timings.items()},
+            "tracking": None if self.tracking is None else {
+                k: (_num(v) if isinstance(v, float) else v) for k, v in self.tracking.items()},
+            "summary": self.summary(),
+            "period_s": _num(s.period),
+            "dof_names": list(self.dof_names),
+            "muscle_names": list(self.muscle_names),
+            "time_s": _array(s.time),
+            **{name: _array(getattr(s, attr)) for name, attr, _ in _NODE_FIELDS},
+            "contact_forces_N": _array(self.contact_forces),
+            "contact_legs": [int(v) for v in self.contact_legs],
+            "leg_names": list(self.leg_names),
+            "body_mass_kg": _num(self.body_mass_kg),
+            "body_weight_N": _num(self.body_weight_N),
+            "metabolic_energy_J": _num(self.metabolic_energy_J),
+            "consistency": _jsonable(self.residual),
+        }
+
+    def write(self, path: str | Path) -> Path:
+        """Write the solution (or best iterate) as JSON, atomically: an interruption leaves
+        no half-written file. Returns the path."""
+        from bladelab._io import write_json
+
+        path = Path(path)
+        write_json(path, self.to_dict())
+        return path
+
+    @classmethod
+    def read(cls, path: str | Path) -> CollocationSolution:
+        """Read a file written by :meth:`write`.
+
+        Raises
+        ------
+        InputFileError
+            The file is missing or not JSON.
+        DataError
+            A field is missing or of the wrong kind or shape (the error names the file and the
+            field).
+        """
+        from bladelab._io import read_json
+
+        path = Path(path)
+        data = read_json(path, what="collocation solution",
+                         hint="give a solution.json or best_iterate.json of 'bladelab predict "
+                              "--method collocation'")
+        return cls.from_dict(data, file=path)
+
+    @classmethod
+    def from_dict(cls, data, *, file: str | Path | None = None) -> CollocationSolution:
+        """A solution from :meth:`to_dict`'s mapping; errors as :meth:`read`."""
+        from bladelab.predict.collocation.transcription import NLPSolution
+
+        if not isinstance(data, dict):
+            raise DataError("expected a JSON object", file=file)
+        r = _Reader(data, file)
+        kind = r.get("kind", str)
+        if kind not in (SOLUTION_KIND, BEST_ITERATE_KIND):
+            raise DataError(f"not a collocation solution (kind {kind!r})", file=file,
+                            where="kind", hint=f"expected {SOLUTION_KIND!r} or "
+                                               f"{BEST_ITERATE_KIND!r}")
+        version = r.get("format_version", int)
+        if version > FORMAT_VERSION:
+            raise DataError(f"format version {version} is newer than this bladelab's "
+                            f"({FORMAT_VERSION})", file=file, where="format_version",
+                            hint="update bladelab")
+        try:
+            spec = check_model_spec(r.get("model", dict))
+            settings = CollocationSettings.from_dict(r.get("settings", dict))
+        except SpecError as err:
+            raise DataError(err.message, file=file, where=err.where, hint=err.hint) from None
+        dofs = tuple(r.names("dof_names"))
+        muscles = tuple(r.names("muscle_names"))
+        time_s = r.array("time_s", 1)
+        n1 = time_s.shape[0]
+        if n1 < 2:
+            raise DataError("need at least 2 nodes", file=file, where="time_s")
+        arrays = {}
+        for name, attr, cols in _NODE_FIELDS:
+            width = len(dofs) if cols == "dof" else len(muscles)
+            arrays[attr] = r.array(name, 2, (n1, width))
+        legs = r.get("leg_names", list)
+        if len(legs) != 2 or not all(isinstance(v, str) for v in legs):
+            raise DataError("expected two leg names", file=file, where="leg_names")
+        contact_legs = np.asarray(r.get("contact_legs", list))
+        if contact_legs.ndim != 1 or not np.isin(contact_legs, (0, 1)).all():
+            raise DataError("expected a leg index 0 or 1 per contact", file=file,
+                            where="contact_legs")
+        forces = r.array("contact_forces_N", 3, (n1, contact_legs.size, 2))
+        tracking = data.get("tracking")
+        if tracking is not None and not isinstance(tracking, dict):
+            raise DataError("expected an object or null", file=file, where="tracking")
+        stage = r.get("stage", str)
+        if stage not in ("predictive", "tracking"):
+            raise DataError(f"unknown stage {stage!r}", file=file, where="stage")
+        worst = r.get("worst_constraints", list)
+        try:
+            worst = tuple((str(a), _float(b)) for a, b in worst)
+        except (TypeError, ValueError):
+            raise DataError("expected [name, value] pairs", file=file,
+                            where="worst_constraints") from None
+        nlp = NLPSolution(
+            time=time_s, **arrays,
+            period=r.number("period_s"),
+            objective=r.number("objective"),
+            objective_terms={str(k): _float(v) for k, v in
+                             r.get("objective_terms", dict).items()},
+            success=r.get("success", bool),
+            status=r.get("status", str),
+            iterations=r.get("iterations", int),
+            wall_s=r.number("wall_s"),
+            timings={str(k): _float(v) for k, v in r.get("timings", dict).items()},
+            max_violation=r.number("max_violation"),
+            worst_constraints=worst,
+        )
+        if not (nlp.period > 0):
+            raise DataError(f"stride time must be > 0 s, got {nlp.period}", file=file,
+                            where="period_s")
+        if kind == SOLUTION_KIND and not (nlp.success and stage == "predictive"):
+            raise DataError("marked as a solution but did not converge", file=file,
+                            where="kind")
+        return cls(
+            nlp=nlp, settings=settings, model_spec=spec, guess_source=r.get("guess_source", str),
+            stage=stage, tracking=tracking, dof_names=dofs, muscle_names=muscles,
+            contact_forces=forces, contact_legs=contact_legs.astype(int),
+            leg_names=(legs[0], legs[1]), body_mass_kg=r.number("body_mass_kg"),
+            body_weight_N=r.number("body_weight_N"),
+            metabolic_energy_J=r.number("metabolic_energy_J"),
+            residual=r.get("consistency", dict),
+        )
+
+
+def _float(v) -> float:
+    return math.nan if v is None else float(v)
+
+
+def _jsonable(obj):
+    if isinstance(obj, dict):
+        return {str(k): _jsonable(v) for k, v in obj.items()}
+    if isinstance(obj, list | tuple):
+        return [_jsonable(v) for v in obj]
+    if isinstance(obj, float | np.floating):
+        return _num(obj)
+    if isinstance(obj, np.integer):
+        return int(obj)
+    return obj
+
+
+class _Reader:
+    """Field access with errors that name the file and the field."""
+
+    _KIND = {str: "a string", int: "an integer", bool: "true or false", dict: "an object",
+             list: "a list"}
+
+    def __init__(self, data: dict, file) -> None:
+        self.data, self.file = data, file
+
+    def get(self, key: str, typ: type):
+        if key not in self.data:
+            raise DataError("missing field", file=self.file, where=key)
+        v = self.data[key]
+        ok = isinstance(v, typ) and not (typ is int and isinstance(v, bool))
+        if not ok:
+            raise DataError(f"expected {self._KIND[typ]}, got {type(v).__name__}",
+                            file=self.file, where=key)
+        return v
+
+    def number(self, key: str) -> float:
+        if key not in self.data:
+            raise DataError("missing field", file=self.file, where=key)
+        v = self.data[key]
+        if v is None:
+            return math.nan
+        if isinstance(v, bool) or not isinstance(v, int | float):
+            raise DataError(f"expected a number, got {type(v).__name__}", file=self.file,
+                            where=key)
+        return float(v)
+
+    def names(self, key: str) -> list[str]:
+        v = self.get(key, list)
+        if not all(isinstance(x, str) for x in v):
+            raise DataError("expected a list of names", file=self.file, where=key)
+        return v
+
+    def array(self, key: str, ndim: int, shape: tuple | None = None) -> np.ndarray:
+        v = self.get(key, list)
+        try:
+            a = np.array(v, dtype=float)
+        except (TypeError, ValueError):
+            raise DataError("expected numbers", file=self.file, where=key) from None
+        if a.ndim != ndim or (shape is not None and a.shape != shape):
+            want = shape if shape is not None else f"{ndim} dimensions"
+            raise DataError(f"expected shape {want}, got {a.shape}", file=self.file, where=key)
+        if not np.all(np.isfinite(a)):
+            raise DataError("holds a missing or non-finite value", file=self.file, where=key)
+        return a
+
+
+def _periodic_runs(mask: np.ndarray) -> list[int]:
+    """Lengths [samples] of the True stretches of a periodic boolean sequence (a stretch
+    across the end continues at the start)."""
+    if mask.all():
+        return [mask.size]
+    if not mask.any():
+        return []
+    start = int(np.argmin(mask))  # rotate so that the sequence starts unloaded
+    m = np.roll(mask, -start).astype(np.int8)
+    edges = np.diff(np.concatenate([[0], m, [0]]))
+    return list(np.flatnonzero(edges == -1) - np.flatnonzero(edges == 1))
+
+
+def _metabolic_energy(cm, nlp) -> float:
+    """Metabolic energy [J] over the stride: trapezoidal rule of the collocation model's
+    metabolic rate at the nodes."""
+    from bladelab.predict.collocation.dynamics import stride_dynamics
+
+    met = stride_dynamics(cm).metabolic_rate
+    rate = np.array([float(met(nlp.q[k], nlp.qd[k], nlp.activation[k], nlp.tendon_force[k],
+                               nlp.tendon_force_rate[k], nlp.excitation[k]))
+                     for k in range(nlp.q.shape[0])])
+    h = float(nlp.period) / (rate.size - 1)
+    return float(np.sum(rate[1:] + rate[:-1]) * h / 2)

@@ -1,0 +1,507 @@
+"""Solving one stride: the settings, the two-stage solve and the output folder (issue 15).
+
+:func:`predict_stride` runs the path that converges today (``docs/collocation.md``):
+
+1. **tracking** — the muscle-driven stride NLP at the prescribed speed (the guess's own speed
+   for a maximum-speed problem), minimising effort (:data:`TRACKING_WEIGHTS`) plus
+   ``tracking_weight`` × the mean squared deviation [rad²] of the joint angles from the guess:
+   a dynamically consistent stride near the guess;
+2. **predictive** — the problem asked for (cost of transport + effort at the prescribed speed,
+   or maximum speed + effort), warm-started from the tracking solution.
+
+The tracking stage is skipped when ``track_first`` is False or the guess is itself a
+collocation solution (its ``source`` starts with :data:`COLLOCATION_SOURCE`, as
+:meth:`~bladelab.predict.collocation.solution.CollocationSolution.to_guess` and
+:meth:`~bladelab.predict.collocation.transcription.NLPSolution.to_guess` write it). A stage that
+does not converge ends the solve: its last iterate is returned (``converged`` False) and is
+never written as a solution. An interrupt (Ctrl-C, SIGTERM) during a stage raises
+KeyboardInterrupt once IPOPT has returned: nothing is returned or written.
+
+Deterministic: IPOPT with MUMPS (METIS ordering) on one thread; the same runner, settings and
+guess give the same iterates, bit for bit.
+
+:func:`predict_stride_in_folder` adds the output folder of ``bladelab predict --method
+collocation``: ``solution.json`` only for a converged solve, ``best_iterate.json`` otherwise
+(never both: the stale one is removed once the new file is in place); files are written
+atomically, so an interruption leaves the previous state of the folder.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import math
+import time
+from collections.abc import Callable
+from dataclasses import asdict, dataclass, fields
+from pathlib import Path
+
+import numpy as np
+
+from bladelab.errors import InputFileError, SpecError
+from bladelab.predict.collocation.transcription import StrideWeights
+
+__all__ = [
+    "BEST_ITERATE_FILE",
+    "COLLOCATION_SOURCE",
+    "CollocationSettings",
+    "FolderResult",
+    "HESSIANS",
+    "SOLUTION_FILE",
+    "SolveProgress",
+    "TRACKING_WEIGHTS",
+    "predict_stride",
+    "predict_stride_in_folder",
+]
+
+#: The guess source prefix that marks a collocation solution (no tracking stage needed).
+COLLOCATION_SOURCE = "collocation solution"
+#: Effort weights of the tracking stage (no metabolic term).
+TRACKING_WEIGHTS = StrideWeights(metabolic=0.0, activation=1.0, acceleration=0.01)
+#: IPOPT Hessian options (:meth:`StrideNLP.solve`).
+HESSIANS = ("limited-memory", "exact")
+#: File names in a ``bladelab predict --method collocation`` folder.
+SOLUTION_FILE = "solution.json"
+BEST_ITERATE_FILE = "best_iterate.json"
+
+
+def _weights_from_dict(data, where: str) -> StrideWeights:
+    if isinstance(data, StrideWeights):
+        return data
+    if not isinstance(data, dict):
+        raise SpecError(f"expected a mapping of objective weights, got {type(data).__name__}",
+                        where=where)
+    known = {f.name for f in fields(StrideWeights)}
+    unknown = sorted(set(data) - known)
+    if unknown:
+        raise SpecError(f"unknown objective weight(s) {', '.join(unknown)}", where=where,
+                        hint=f"known: {', '.join(sorted(known))}")
+    try:
+        return StrideWeights(**{k: float(v) for k, v in data.items()})
+    except (TypeError, ValueError):
+        raise SpecError("objective weights must be numbers", where=where) from None
+
+
+@dataclass(frozen=True)
+class CollocationSettings:
+    """Settings of one stride solve.
+
+    Attributes
+    ----------
+    mesh_intervals
+        Mesh intervals n of the stride (trapezoidal collocation, n + 1 nodes).
+    speed_m_per_s
+        Prescribed mean speed [m/s]; None: the maximum-speed problem.
+    weights
+        Objective weights of the predictive stage (:class:`StrideWeights`); None: cost of
+        transport 1, activation 1, acceleration 0.1 at a prescribed speed; speed 1,
+        activation 1, acceleration 0.1 and no metabolic term for the maximum speed.
+    tracking_weight
+        Weight of the joint-angle tracking term of the tracking stage [1/rad²].
+    track_first
+        Run the tracking stage before the predictive one (module docstring).
+    hessian
+        IPOPT's Hessian: ``"limited-memory"`` (L-BFGS, adaptive barrier) or ``"exact"``.
+    tol
+        IPOPT's convergence tolerance [-].
+    max_iter
+        IPOPT's iteration limit per stage.
+    """
+
+    mesh_intervals: int = 50
+    speed_m_per_s: float | None = 3.5
+    weights: StrideWeights | None = None
+    tracking_weight: float = 100.0
+    track_first: bool = True
+    hessian: str = "limited-memory"
+    tol: float = 1e-4
+    max_iter: int = 3000
+
+    def __post_init__(self) -> None:
+        n = self.mesh_intervals
+        if isinstance(n, bool) or not isinstance(n, int | np.integer) or n < 4:
+            raise SpecError(f"need an integer of at least 4 mesh intervals, got {n!r}",
+                            where="mesh_intervals")
+        object.__setattr__(self, "mesh_intervals", int(n))
+        v = self.speed_m_per_s
+        if v is not None:
+            if isinstance(v, bool) or not isinstance(v, int | float) or not (
+                    math.isfinite(v) and v > 0):
+                raise SpecError(f"speed must be > 0 m/s or None (maximum speed), got {v!r}",
+                                where="speed_m_per_s")
+            object.__setattr__(self, "speed_m_per_s", float(v))
+        if self.weights is None:
+            w = (StrideWeights(metabolic=1.0, activation=1.0, acceleration=0.1)
+                 if v is not None else
+                 StrideWeights(metabolic=0.0, activation=1.0, acceleration=0.1, speed=1.0))
+        else:
+            w = _weights_from_dict(self.weights, "weights")
+        object.__setattr__(self, "weights", w)
+        tw = self.tracking_weight
+        if isinstance(tw, bool) or not isinstance(tw, int | float) or not (
+                math.isfinite(tw) and tw >= 0):
+            raise SpecError(f"tracking weight must be >= 0, got {tw!r}", where="tracking_weight")
+        object.__setattr__(self, "tracking_weight", float(tw))
+        if not isinstance(self.track_first, bool):
+            raise SpecError(f"expected true or false, got {self.track_first!r}",
+                            where="track_first")
+        if self.hessian not in HESSIANS:
+            raise SpecError(f"unknown Hessian option {self.hessian!r}", where="hessian",
+                            hint=" or ".join(HESSIANS))
+        if isinstance(self.tol, bool) or not isinstance(self.tol, int | float) or not (
+                math.isfinite(self.tol) and self.tol > 0):
+            raise SpecError(f"tolerance must be > 0, got {self.tol!r}", where="tol")
+        object.__setattr__(self, "tol", float(self.tol))
+        mi = self.max_iter
+        if isinstance(mi, bool) or not isinstance(mi, int | np.integer) or mi < 1:
+            raise SpecError(f"need at least 1 iteration, got {mi!r}", where="max_iter")
+        object.__setattr__(self, "max_iter", int(mi))
+
+    @property
+    def max_speed(self) -> bool:
+        """True for the maximum-speed problem."""
+        return self.speed_m_per_s is None
+
+    def to_dict(self) -> dict:
+        out = asdict(self)
+        out["weights"] = self.weights.to_dict()
+        return out
+
+    @classmethod
+    def from_dict(cls, data: dict) -> CollocationSettings:
+        """Settings from :meth:`to_dict`'s mapping; an unknown key raises SpecError naming it
+        (missing keys take their defaults)."""
+        if not isinstance(data, dict):
+            raise SpecError(f"expected a mapping of settings, got {type(data).__name__}",
+                            where="settings")
+        known = {f.name for f in fields(cls)}
+        unknown = sorted(set(data) - known)
+        if unknown:
+            raise SpecError(f"unknown setting(s) {', '.join(unknown)}", where="settings",
+                            hint=f"known: {', '.join(sorted(known))}")
+        return cls(**data)
+
+    def same_problem(self, other: CollocationSettings) -> bool:
+        """True if ``other`` poses the same NLP (mesh, speed, weights); solver options (Hessian,
+        tolerance, iterations) and the tracking stage may differ."""
+        return (self.mesh_intervals, self.speed_m_per_s, self.weights) == (
+            other.mesh_intervals, other.speed_m_per_s, other.weights)
+
+
+@dataclass(frozen=True)
+class SolveProgress:
+    """One progress report of :func:`predict_stride`.
+
+    Attributes
+    ----------
+    stage
+        ``"tracking"`` or ``"predictive"``.
+    event
+        ``"start"`` (with the problem's size in ``message``), ``"iteration"`` or ``"end"``.
+    iteration
+        IPOPT's iteration count so far.
+    objective
+        Objective value of the current iterate [-] (NaN at start).
+    violation
+        Largest constraint violation of the current iterate (scaled constraints) [-].
+    elapsed_s
+        Wall time since the stage started [s].
+    message
+        Problem size at start, IPOPT's status at the end.
+    """
+
+    stage: str
+    event: str
+    iteration: int = 0
+    objective: float = math.nan
+    violation: float = math.nan
+    elapsed_s: float = 0.0
+    message: str = ""
+
+
+def _iteration_callback(nlp, lbg: np.ndarray, ubg: np.ndarray,
+                        report: Callable[[int, float, float], None]):
+    """A CasADi iteration callback calling ``report(iteration, objective, violation)``."""
+    import casadi as ca
+
+    class _Callback(ca.Callback):
+        def __init__(self) -> None:
+            ca.Callback.__init__(self)
+            self.calls = 0
+            self.construct("stride_progress", {})
+
+        def get_n_in(self):
+            return ca.nlpsol_n_out()
+
+        def get_n_out(self):
+            return 1
+
+        def get_name_in(self, i):
+            return ca.nlpsol_out(i)
+
+        def get_name_out(self, i):
+            return "ret"
+
+        def get_sparsity_in(self, i):
+            name = ca.nlpsol_out(i)
+            if name == "f":
+                return ca.Sparsity.scalar()
+            if name in ("x", "lam_x"):
+                return ca.Sparsity.dense(nlp.n_vars)
+            if name in ("g", "lam_g"):
+                return ca.Sparsity.dense(nlp.n_cons)
+            return ca.Sparsity(0, 0)
+
+        def eval(self, arg):
+            g = np.asarray(arg[2]).ravel()
+            viol = float(np.max(np.maximum(lbg - g, g - ubg), initial=0.0))
+            report(self.calls, float(arg[1]), viol)
+            self.calls += 1
+            return [0]
+
+    return _Callback()
+
+
+@contextlib.contextmanager
+def _interrupts_recorded():
+    """Record SIGINT/SIGTERM while IPOPT runs and raise KeyboardInterrupt after it returns.
+
+    CasADi turns an interrupt inside IPOPT into the status ``NonIpopt_Exception_Thrown`` and
+    returns normally; the caller would then take the interrupted iterate for a failed solve.
+    The signals' previous handlers still run (the command line's SIGTERM handler marks the
+    run as terminated)."""
+    import signal
+    import threading
+
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    seen: list[int] = []
+    previous = {sig: signal.getsignal(sig) for sig in (signal.SIGINT, signal.SIGTERM)}
+
+    def record(signum, frame):
+        seen.append(signum)
+        handler = previous[signum]
+        if callable(handler):
+            handler(signum, frame)
+        raise KeyboardInterrupt
+
+    for sig in previous:
+        signal.signal(sig, record)
+    try:
+        yield
+    finally:
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
+    if seen:
+        raise KeyboardInterrupt
+
+
+def _solve_stage(nlp, x0: np.ndarray, settings: CollocationSettings, stage: str,
+                 progress: Callable[[SolveProgress], None] | None):
+    """Solve one NLP with the settings' IPOPT options, reporting progress; an interrupt
+    (Ctrl-C, SIGTERM) raises KeyboardInterrupt after IPOPT returns."""
+    t0 = time.perf_counter()
+    options = None
+    callback = None
+    if progress is not None:
+        progress(SolveProgress(stage, "start", message=f"{nlp.n_vars} variables, "
+                               f"{nlp.n_cons} constraints, {nlp.n} mesh intervals"))
+        _, _, lbg, ubg = nlp.bounds()
+
+        def report(it: int, obj: float, viol: float) -> None:
+            progress(SolveProgress(stage, "iteration", it, obj, viol, time.perf_counter() - t0))
+
+        callback = _iteration_callback(nlp, lbg, ubg, report)
+        options = {"iteration_callback": callback}
+    with _interrupts_recorded():
+        sol = nlp.solve(x0, max_iter=settings.max_iter, tol=settings.tol,
+                        hessian=settings.hessian, options=options)
+    del callback
+    if progress is not None:
+        progress(SolveProgress(stage, "end", sol.iterations, sol.objective, sol.max_violation,
+                               time.perf_counter() - t0, sol.status))
+    return sol
+
+
+def _stage_info(sol) -> dict:
+    return {"success": bool(sol.success), "status": sol.status, "iterations": int(sol.iterations),
+            "wall_s": float(sol.wall_s), "objective": float(sol.objective),
+            "max_violation": float(sol.max_violation)}
+
+
+def predict_stride(runner, settings: CollocationSettings, guess, *, model_spec: dict,
+                   progress: Callable[[SolveProgress], None] | None = None,
+                   track: bool | None = None):
+    """Solve one periodic stride of ``runner`` (module docstring): tracking, then predictive.
+
+    Parameters
+    ----------
+    runner
+        The forward model (:func:`bladelab.runner.build_runner`).
+    settings
+        :class:`CollocationSettings`.
+    guess
+        Initial guess (:class:`~bladelab.predict.collocation.guess.StrideGuess`), resampled to
+        the mesh; scaled to the prescribed speed (same period) if it runs at another one.
+    model_spec
+        ``{"model": "able" | "amputee", "blade": "Cat6" | None}``: how ``runner`` was built,
+        stored with the solution (:func:`~bladelab.predict.collocation.solution.runner_from_spec`
+        builds it again).
+    progress
+        Called with a :class:`SolveProgress` at each stage's start, every IPOPT iteration and
+        each stage's end.
+    track
+        Force (True) or skip (False) the tracking stage; None: ``settings.track_first`` unless
+        the guess is a collocation solution.
+
+    Returns
+    -------
+    CollocationSolution
+        ``converged`` True only if the predictive stage converged; otherwise the last iterate
+        of the stage that did not (``stage`` names it).
+    """
+    from bladelab.predict.collocation.dynamics import stride_dynamics
+    from bladelab.predict.collocation.model import build_collocation_model
+    from bladelab.predict.collocation.solution import CollocationSolution, check_model_spec
+    from bladelab.predict.collocation.transcription import StrideNLP
+
+    spec = check_model_spec(model_spec)
+    if runner.kind != spec["model"]:
+        raise SpecError(f"the runner is the {runner.kind} model, model_spec says "
+                        f"{spec['model']}", where="model_spec")
+    if not isinstance(settings, CollocationSettings):
+        raise SpecError(f"expected CollocationSettings, got {type(settings).__name__}",
+                        where="settings")
+    cm = build_collocation_model(runner)
+    dyn = stride_dynamics(cm)
+    n = settings.mesh_intervals
+    g = guess.resample(n)
+    speed = settings.speed_m_per_s
+    if speed is not None and not math.isclose(g.speed, speed, rel_tol=1e-12):
+        g = g.with_speed(speed)
+    warm = str(guess.source).startswith(COLLOCATION_SOURCE)
+    tracking_stage = (settings.track_first and not warm) if track is None else bool(track)
+    common = {"settings": settings, "model_spec": spec, "guess_source": str(guess.source),
+              "cm": cm}
+    tracking = None
+    start = g
+    if tracking_stage:
+        nlp_t = StrideNLP(dyn, n=n, speed=speed if speed is not None else g.speed,
+                          weights=TRACKING_WEIGHTS, tracking=(g.q, settings.tracking_weight))
+        sol_t = _solve_stage(nlp_t, nlp_t.initial_vector(g), settings, "tracking", progress)
+        tracking = _stage_info(sol_t)
+        if not sol_t.success:
+            return CollocationSolution.from_nlp(
+                runner, sol_t, stage="tracking", tracking=tracking,
+                metabolic_energy_J=nlp_t.energy_and_distance(sol_t)[0], **common)
+        start = sol_t.to_guess(f"{COLLOCATION_SOURCE} (tracking stage)")
+    nlp_p = StrideNLP(dyn, n=n, speed=speed, weights=settings.weights)
+    sol = _solve_stage(nlp_p, nlp_p.initial_vector(start), settings, "predictive", progress)
+    return CollocationSolution.from_nlp(
+        runner, sol, stage="predictive", tracking=tracking,
+        metabolic_energy_J=nlp_p.energy_and_distance(sol)[0], **common)
+
+
+@dataclass(frozen=True)
+class FolderResult:
+    """What :func:`predict_stride_in_folder` did.
+
+    Attributes
+    ----------
+    solution
+        The solution (or best iterate) found or read back.
+    path
+        The file it is in (``solution.json`` or ``best_iterate.json``).
+    solved
+        False when a converged solution was already in the folder (``resume``) and nothing was
+        solved.
+    """
+
+    solution: object
+    path: Path
+    solved: bool
+
+
+def _held(out: Path) -> list[str]:
+    return [n for n in (SOLUTION_FILE, BEST_ITERATE_FILE) if (out / n).exists()]
+
+
+def predict_stride_in_folder(
+    out: str | Path,
+    runner,
+    settings: CollocationSettings,
+    make_guess: Callable[[], object],
+    *,
+    model_spec: dict,
+    resume: bool = False,
+    force: bool = False,
+    progress: Callable[[SolveProgress], None] | None = None,
+) -> FolderResult:
+    """:func:`predict_stride` writing its result into the folder ``out`` (module docstring).
+
+    Parameters
+    ----------
+    out
+        Output folder (created if needed).
+    runner, settings, model_spec, progress
+        As :func:`predict_stride`.
+    make_guess
+        Returns the initial guess; not called when resuming.
+    resume
+        Continue from the folder: a converged ``solution.json`` of the same problem (model,
+        mesh, speed, weights) is returned as it is; a ``best_iterate.json`` of it is the warm
+        start of the predictive stage.
+    force
+        Start over in a folder that holds a solve (its files are replaced once the new result
+        is written).
+
+    Raises
+    ------
+    InputFileError
+        ``out`` holds a solve and neither ``resume`` nor ``force`` is given; ``resume`` without
+        a solve in the folder, or with one of another problem.
+    """
+    from bladelab.predict.collocation.solution import CollocationSolution, check_model_spec
+
+    out = Path(out)
+    spec = check_model_spec(model_spec)
+    if out.exists() and not out.is_dir():
+        raise InputFileError("is a file, not a folder", file=out, hint="give a folder for --out")
+    held = _held(out) if out.is_dir() else []
+    if resume and force:
+        raise SpecError("give --resume or --force, not both", where="--resume/--force")
+    if held and not (resume or force):
+        raise InputFileError(
+            f"the output folder holds a collocation solve ({', '.join(held)})", file=out,
+            hint="--resume continues it, --force starts over in it, or choose another --out")
+    guess = None
+    if resume:
+        if not held:
+            raise InputFileError("no collocation solve to resume from", file=out,
+                                 hint="run without --resume first, with the same --out")
+        path = out / held[0]
+        stored = CollocationSolution.read(path)
+        if stored.model_spec != spec or not stored.settings.same_problem(settings):
+            raise InputFileError(
+                f"the folder holds another problem ({_describe(stored.model_spec, stored.settings)}"
+                f"; asked: {_describe(spec, settings)})", file=path,
+                hint="resume with the same --model, --blade, --speed/--max-speed and --mesh, "
+                     "or --force to start over")
+        if stored.converged and path.name == SOLUTION_FILE:
+            return FolderResult(stored, path, False)
+        guess = stored.to_guess()
+    if guess is None:
+        guess = make_guess()
+    sol = predict_stride(runner, settings, guess, model_spec=spec, progress=progress)
+    target = out / (SOLUTION_FILE if sol.converged else BEST_ITERATE_FILE)
+    sol.write(target)
+    stale = out / (BEST_ITERATE_FILE if sol.converged else SOLUTION_FILE)
+    stale.unlink(missing_ok=True)
+    return FolderResult(sol, target, True)
+
+
+def _describe(spec: dict, settings: CollocationSettings) -> str:
+    who = spec["model"] + (f" {spec['blade']}" if spec.get("blade") else "")
+    speed = ("maximum speed" if settings.speed_m_per_s is None
+             else f"{settings.speed_m_per_s:g} m/s")
+    return f"{who}, {speed}, {settings.mesh_intervals} mesh intervals"

@@ -1,0 +1,48 @@
+"""A collocation 'solution' built from a template guess, without solving (for cheap tests of
+the solution file, its summary and conversions, the CLI's resume and the report)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from bladelab.predict.collocation import build_collocation_model
+from bladelab.predict.collocation.dynamics import stride_dynamics
+from bladelab.predict.collocation.guess import periodic_derivative, template_guess
+from bladelab.predict.collocation.solution import CollocationSolution
+from bladelab.predict.collocation.solve import CollocationSettings
+from bladelab.predict.collocation.transcription import NLPSolution
+from bladelab.runner import build_runner
+
+SPEED = 3.5  # m/s
+
+
+def fake_nlp(runner, cm, n: int, *, sink_m: float = 0.01, success: bool = True) -> NLPSolution:
+    """The template stride at 3.5 m/s on ``n`` intervals, the pelvis lowered by ``sink_m`` [m]
+    so that the stance feet carry load, activations 0.05 and static tendon forces."""
+    g = template_guess(runner, speed=SPEED, n=n)
+    q = g.q.copy()
+    q[:, runner.dof("pelvis_tz")] -= sink_m
+    act = np.full((n + 1, len(runner.muscle_names)), 0.05)
+    ft = stride_dynamics(cm).static_tendon_force(q, act)
+    return NLPSolution(
+        time=np.linspace(0.0, g.period, n + 1), q=q, qd=g.qd, activation=act, tendon_force=ft,
+        qdd=periodic_derivative(g.qd, g.period), excitation=act,
+        tendon_force_rate=periodic_derivative(ft, g.period), period=g.period, objective=1.25,
+        objective_terms={"effort": 0.25, "metabolic": 1.0}, success=success,
+        status="Solve_Succeeded" if success else "Maximum_Iterations_Exceeded", iterations=7,
+        wall_s=1.5, timings={"build_s": 0.1}, max_violation=float("nan"),
+        worst_constraints=(("path dynamics pelvis_tz@3", 0.5),),
+    )
+
+
+def fake_solution(kind: str = "able", n: int = 12, **kwargs):
+    """(runner, collocation model, CollocationSolution) of :func:`fake_nlp`."""
+    runner = build_runner("able") if kind == "able" else build_runner("amputee", blade="Cat6")
+    cm = build_collocation_model(runner)
+    nlp = fake_nlp(runner, cm, n, **kwargs)
+    sol = CollocationSolution.from_nlp(
+        runner, nlp, settings=CollocationSettings(mesh_intervals=n, speed_m_per_s=SPEED),
+        model_spec={"model": kind, "blade": "Cat6"}, guess_source="template (test)",
+        tracking={"success": True, "status": "Solve_Succeeded", "iterations": 3, "wall_s": 0.5,
+                  "objective": 0.1, "max_violation": 1e-9}, cm=cm)
+    return runner, cm, sol

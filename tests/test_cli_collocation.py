@@ -1,0 +1,88 @@
+"""``bladelab predict --method collocation`` and ``bladelab report`` of its files (issue 15):
+failure path, output folder rules, resume, bad input."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+
+from bladelab.cli import main
+from collocation_fake import SPEED, fake_solution
+
+N = 12
+
+
+@pytest.fixture(scope="module")
+def solved():
+    """A converged-looking solution of the able model at 3.5 m/s on 12 intervals (no solve)."""
+    return fake_solution("able", N)[2]
+
+
+def _predict(out, *extra):
+    return main(["predict", "--method", "collocation", "--model", "able", "--out", str(out),
+                 *extra])
+
+
+def test_a_solve_that_does_not_converge_exits_2_and_keeps_only_the_best_iterate(tmp_path, capsys):
+    out = tmp_path / "run"
+    assert _predict(out, "--speed", "3.5", "--mesh", "6", "--max-iter", "5", "--json") == 2
+    cap = capsys.readouterr()
+    summary = json.loads(cap.out)  # stdout: exactly one JSON object
+    assert summary["converged"] is False and summary["iterations"] == 5
+    assert summary["status"] == "Maximum_Iterations_Exceeded"
+    assert "tracking stage: started" in cap.err
+    assert "IPOPT status Maximum_Iterations_Exceeded in the tracking stage" in cap.err
+    assert "worst-violated constraints: path dynamics" in cap.err  # by name
+    assert sorted(p.name for p in out.iterdir()) == ["best_iterate.json"]
+    assert json.loads((out / "best_iterate.json").read_text())["kind"] == \
+        "collocation-best-iterate"
+    # a used folder is refused; --resume warm-starts the predictive stage from the iterate
+    assert _predict(out, "--mesh", "6", "--max-iter", "5") == 2
+    assert "holds a collocation solve" in capsys.readouterr().err
+    assert _predict(out, "--mesh", "6", "--max-iter", "5", "--resume") == 2
+    cap = capsys.readouterr()
+    assert "in the predictive stage" in cap.err and "tracking stage" not in cap.err
+    assert sorted(p.name for p in out.iterdir()) == ["best_iterate.json"]
+    # a best iterate is not a solution: the report refuses it
+    assert main(["report", str(out / "best_iterate.json")]) == 2
+    assert "did not converge" in capsys.readouterr().err
+
+
+def test_resume_reads_a_stored_solution_back(solved, tmp_path, capsys):
+    out = tmp_path / "run"
+    solved.write(out / "solution.json")
+    args = ("--speed", str(SPEED), "--mesh", str(N), "--json")
+    assert _predict(out, *args, "--resume") == 0
+    assert json.loads(capsys.readouterr().out) == json.loads(json.dumps(solved.summary()))
+    assert _predict(out, *args) == 2
+    assert "--resume continues it, --force starts over" in capsys.readouterr().err
+    assert _predict(out, "--speed", "4", "--mesh", str(N), "--resume") == 2
+    err = capsys.readouterr().err
+    assert "another problem" in err and "able, 3.5 m/s, 12 mesh intervals" in err
+    assert _predict(out, *args, "--resume", "--force") == 2
+
+
+def test_a_failed_force_run_removes_the_old_solution(solved, tmp_path, capsys):
+    """--force starts over: a new solve that does not converge leaves its best iterate and no
+    stale solution.json."""
+    out = tmp_path / "run"
+    solved.write(out / "solution.json")
+    assert _predict(out, "--mesh", "6", "--max-iter", "2", "--force") == 2
+    capsys.readouterr()
+    assert sorted(p.name for p in out.iterdir()) == ["best_iterate.json"]
+
+
+@pytest.mark.parametrize(("args", "where"), [
+    (("--method", "shooting"), "--method"),
+    (("--method", "collocation", "--model", "robot"), "--model"),
+    (("--method", "collocation", "--mesh", "3"), "--mesh"),
+    (("--method", "collocation", "--max-iter", "0"), "--max-iter"),
+    (("--method", "collocation", "--speed", "-1"), "--speed"),
+    (("--method", "collocation", "--guess", "no-such-file.json"), "--guess"),
+])
+def test_bad_options_are_refused_naming_the_option(args, where, tmp_path, capsys):
+    assert main(["predict", "--out", str(tmp_path / "run"), *args]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("error:") and where in err
+    assert not (tmp_path / "run" / "solution.json").exists()

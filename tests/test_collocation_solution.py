@@ -1,0 +1,284 @@
+"""The collocation solution: settings, file, summary, trajectory, dynamic consistency, the
+two-stage solve's failure path and determinism, and the report (issue 15)."""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from bladelab.errors import DataError, InputFileError, SpecError
+from bladelab.predict.collocation.consistency import (
+    dynamics_residual,
+    dynamics_residual_pct,
+    forward_generalised_forces,
+    inverse_dynamics,
+)
+from bladelab.predict.collocation.guess import template_guess
+from bladelab.predict.collocation.solution import (
+    BEST_ITERATE_KIND,
+    SOLUTION_KIND,
+    CollocationSolution,
+)
+from bladelab.predict.collocation.solve import (
+    CollocationSettings,
+    SolveProgress,
+    predict_stride,
+)
+from bladelab.predict.collocation.transcription import StrideWeights
+from collocation_fake import SPEED, fake_solution
+
+N = 12
+
+
+@pytest.fixture(scope="module")
+def able():
+    return fake_solution("able", N)
+
+
+# ---------------------------------------------------------------- settings
+
+
+def test_settings_round_trip_and_refuse_bad_values():
+    s = CollocationSettings(mesh_intervals=30, speed_m_per_s=4.0, max_iter=200)
+    assert CollocationSettings.from_dict(json.loads(json.dumps(s.to_dict()))) == s
+    assert s.weights == StrideWeights(metabolic=1.0, activation=1.0, acceleration=0.1)
+    fastest = CollocationSettings(speed_m_per_s=None)
+    assert fastest.max_speed and fastest.weights.metabolic == 0.0 and fastest.weights.speed == 1
+    assert CollocationSettings.from_dict(fastest.to_dict()) == fastest
+    for bad, where in (({"mesh_intervals": 3}, "mesh_intervals"),
+                       ({"speed_m_per_s": -1.0}, "speed_m_per_s"),
+                       ({"hessian": "bfgs"}, "hessian"), ({"tol": 0.0}, "tol"),
+                       ({"max_iter": 0}, "max_iter"), ({"tracking_weight": math.nan},
+                                                       "tracking_weight")):
+        with pytest.raises(SpecError) as err:
+            CollocationSettings(**bad)
+        assert err.value.where == where
+    with pytest.raises(SpecError, match="unknown setting"):
+        CollocationSettings.from_dict({"mesh": 50})
+    with pytest.raises(SpecError, match="unknown objective weight"):
+        CollocationSettings.from_dict({"weights": {"metabolism": 1.0}})
+
+
+# ---------------------------------------------------------------- file
+
+
+def test_file_round_trip_is_exact(able, tmp_path):
+    _, _, sol = able
+    path = sol.write(tmp_path / "solution.json")
+    data = json.loads(path.read_text())
+    assert data["kind"] == SOLUTION_KIND and data["model"] == {"model": "able", "blade": None}
+    assert data["max_violation"] is None  # NaN is written as null (strict JSON)
+    back = CollocationSolution.read(path)
+    for attr in ("time", "q", "qd", "qdd", "activation", "tendon_force", "excitation",
+                 "tendon_force_rate"):
+        np.testing.assert_array_equal(getattr(back.nlp, attr), getattr(sol.nlp, attr))
+    np.testing.assert_array_equal(back.contact_forces, sol.contact_forces)
+    assert back.settings == sol.settings and back.model_spec == sol.model_spec
+    assert back.nlp.worst_constraints == sol.nlp.worst_constraints
+    assert back.summary() == sol.summary() and back.converged
+    assert math.isnan(back.nlp.max_violation)
+    assert [p.name for p in tmp_path.iterdir()] == ["solution.json"]
+
+
+def test_a_non_converged_solve_is_a_best_iterate(able, tmp_path):
+    _, _, sol = able
+    bad = replace(sol, nlp=replace(sol.nlp, success=False, status="Maximum_Iterations_Exceeded"))
+    assert not bad.converged and bad.kind == BEST_ITERATE_KIND
+    back = CollocationSolution.read(bad.write(tmp_path / "best_iterate.json"))
+    assert not back.converged and back.summary()["converged"] is False
+    # a file claiming to be a solution must have converged
+    data = json.loads((tmp_path / "best_iterate.json").read_text())
+    data["kind"] = SOLUTION_KIND
+    (tmp_path / "liar.json").write_text(json.dumps(data))
+    with pytest.raises(DataError, match="did not converge"):
+        CollocationSolution.read(tmp_path / "liar.json")
+
+
+def test_read_errors_name_the_file_and_the_field(able, tmp_path):
+    _, _, sol = able
+    good = sol.to_dict()
+    cases = [
+        ({k: v for k, v in good.items() if k != "q"}, "q", "missing field"),
+        ({**good, "q": good["q"][:-1]}, "q", "shape"),
+        ({**good, "period_s": "long"}, "period_s", "number"),
+        ({**good, "kind": "design-study"}, "kind", "not a collocation solution"),
+        ({**good, "model": {"model": "robot"}}, "model", "unknown model"),
+        ({**good, "settings": {**good["settings"], "mesh_intervals": 2}}, "mesh_intervals",
+         "mesh intervals"),
+        ({**good, "activation": [[None] * len(r) for r in good["activation"]]}, "activation",
+         "non-finite"),
+    ]
+    for i, (data, field, text) in enumerate(cases):
+        path = tmp_path / f"bad{i}.json"
+        path.write_text(json.dumps(data))
+        with pytest.raises(DataError) as err:
+            CollocationSolution.read(path)
+        assert err.value.where == field and err.value.file == str(path), (field, err.value)
+        assert text in str(err.value)
+    (tmp_path / "broken.json").write_text('{"kind": ')
+    with pytest.raises(InputFileError, match="not valid JSON"):
+        CollocationSolution.read(tmp_path / "broken.json")
+
+
+def test_an_interrupted_write_leaves_no_file(able, tmp_path, monkeypatch):
+    _, _, sol = able
+
+    def interrupted(obj, fh, **kwargs):
+        fh.write('{"kind": "collocation-solution", ')
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr("bladelab._io.json.dump", interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        sol.write(tmp_path / "solution.json")
+    assert list(tmp_path.iterdir()) == []
+
+
+# ---------------------------------------------------------------- summary and trajectory
+
+
+def test_summary_has_the_issue_keys_per_model(able):
+    runner, _, sol = able
+    s = sol.summary()
+    legs = ("left", "right")
+    assert list(s) == [
+        "converged", "status", "mean_speed_mps", "stride_time_s",
+        "cost_of_transport_J_per_kg_m", "contact_time_s",
+        *(f"contact_time_{leg}_s" for leg in legs),
+        *(f"peak_vertical_grf_{leg}_bw" for leg in legs),
+        "flight_fraction", "dynamics_residual_pct", "iterations", "wall_s"]
+    json.dumps(s, allow_nan=False)
+    assert s["converged"] is True and s["mean_speed_mps"] == pytest.approx(SPEED)
+    assert s["stride_time_s"] == pytest.approx(sol.nlp.period)
+    assert s["iterations"] == 7 + 3 and s["wall_s"] == pytest.approx(1.5 + 0.5)
+    assert s["contact_time_s"] == pytest.approx((s["contact_time_left_s"]
+                                                 + s["contact_time_right_s"]) / 2)
+    # the sunk template: each foot loaded for part of the stride, the legs half a period apart
+    assert 0.05 < s["contact_time_left_s"] < sol.nlp.period
+    assert s["contact_time_left_s"] == pytest.approx(s["contact_time_right_s"], rel=0.05)
+    assert s["peak_vertical_grf_left_bw"] > 0.2 and 0.0 <= s["flight_fraction"] < 1.0
+    assert s["cost_of_transport_J_per_kg_m"] > 0 and math.isfinite(s["dynamics_residual_pct"])
+    fz = sol.leg_vertical_force()
+    assert s["peak_vertical_grf_left_bw"] == pytest.approx(fz[:, 0].max() / runner.body_weight)
+
+
+def test_amputee_summary_names_intact_and_prosthetic_legs():
+    _, _, sol = fake_solution("amputee", 8)
+    s = sol.summary()
+    assert sol.model_spec == {"model": "amputee", "blade": "Cat6"}
+    for key in ("contact_time_intact_s", "contact_time_prosthetic_s",
+                "peak_vertical_grf_intact_bw", "peak_vertical_grf_prosthetic_bw"):
+        assert key in s
+    assert not any("left" in k or "right" in k for k in s)
+
+
+def test_runner_result_repeats_the_stride_for_the_analyses(able):
+    from bladelab.runner.analyses import gait_events, spatiotemporal
+
+    runner, cm, sol = able
+    res = sol.to_runner_result(3, refine=2, runner=runner, cm=cm)
+    n, nv, nm, nc = N, len(runner.dof_names), len(runner.muscle_names), len(
+        runner.contact_names)
+    rows = 3 * n * 2 + 1
+    assert res.qpos.shape == (rows, nv) and res.muscles.shape == (rows, nm, 4)
+    assert res.mtu.shape == (rows, nm, 2) and res.contacts.shape == (rows, nc, 7)
+    assert res.ligament.shape == (rows, nv) and res.excitation.shape == (rows, nm)
+    assert res.dt == pytest.approx(sol.nlp.period / n / 2) and not res.fell
+    np.testing.assert_allclose(res.time[-1], 3 * sol.nlp.period)
+    # every other sample is a node; the 2nd stride is the 1st, pelvis_tx advanced
+    itx = runner.dof("pelvis_tx")
+    second = sol.nlp.q.copy()
+    second[:, itx] += sol.stride_length_m
+    np.testing.assert_allclose(res.qpos[2 * n:4 * n + 1:2], second, atol=1e-12)
+    np.testing.assert_allclose(res.contacts[:2 * n + 1:2, :, :2], sol.contact_forces, atol=1e-9)
+    fmax = runner.muscle_params[:, 0]
+    np.testing.assert_allclose(res.muscles[::2, :, 3][:n + 1], sol.nlp.tendon_force * fmax)
+    assert np.all(res.contacts[:, :, 6] >= 0)
+    ev = gait_events(res)
+    assert set(ev.leg) == {"left", "right"}
+    st = spatiotemporal(res)
+    stride = st[(st.leg == "right") & (st.variable == "stride_time")].value.iloc[0]
+    assert stride == pytest.approx(sol.nlp.period, abs=2 * res.dt)
+    with pytest.raises(SpecError, match="stride"):
+        sol.to_runner_result(0, runner=runner, cm=cm)
+
+
+# ---------------------------------------------------------------- dynamic consistency
+
+
+def test_dynamics_residual_is_small_for_consistent_states_and_large_when_perturbed(able):
+    """Accelerations that balance the forward model's forces (M·q̈ = applied − bias) give a
+    round-off residual; 100 rad/s² more at one knee gives a large one."""
+    runner, cm, sol = able
+    s = sol.nlp
+    # a sticking contact carries the collocation model's friction (within ±μ·Fn)
+    held = np.stack([np.asarray(cm.contacts(s.q[k], s.qd[k])[0])[:, 0]
+                     for k in range(s.q.shape[0])])
+    bias = inverse_dynamics(runner, s.q, s.qd, np.zeros_like(s.q))
+    for friction in ("coulomb", "bristle"):
+        fwd = forward_generalised_forces(runner, s.q, s.qd, s.tendon_force, s.period,
+                                         friction=friction, stick_friction=held)
+        assert fwd.tendon_force_mismatch < 1e-9
+        qdd = np.stack([np.linalg.solve(np.asarray(cm.mass_matrix(s.q[k])),
+                                        fwd.total[k] - bias[k]) for k in range(s.q.shape[0])])
+        r = dynamics_residual(replace(s, qdd=qdd), runner, cm=cm, friction=friction)
+        assert r.pct < 1e-6 and r.friction == friction, r
+        # the collocation model's smooth forces differ from the forward ones; not the muscles
+        assert r.collocation_pct > r.pct
+        assert set(r.component_pct) == {"muscle", "passive", "contact"}
+        assert r.component_pct["muscle"] < 1e-6 and r.contact_force_diff_N["normal"] > 0
+    fwd = forward_generalised_forces(runner, s.q, s.qd, s.tendon_force, s.period,
+                                     stick_friction=held)
+    qdd = np.stack([np.linalg.solve(np.asarray(cm.mass_matrix(s.q[k])), fwd.total[k] - bias[k])
+                    for k in range(s.q.shape[0])])
+    bumped = qdd.copy()
+    bumped[:, runner.dof("knee_angle_l")] += 100.0
+    r2 = dynamics_residual(replace(s, qdd=bumped), runner, cm=cm)
+    assert r2.pct > 5.0 and r2.per_dof["knee_angle_l"] > 1.0  # N·m
+    assert dynamics_residual_pct(replace(s, qdd=bumped), runner, cm=cm) == pytest.approx(r2.pct)
+
+
+# ---------------------------------------------------------------- the solve
+
+
+def test_a_stage_that_does_not_converge_ends_the_solve_deterministically(able):
+    runner, _, _ = able
+    settings = CollocationSettings(mesh_intervals=6, speed_m_per_s=SPEED, max_iter=4)
+    events: list[SolveProgress] = []
+    runs = [predict_stride(runner, settings, template_guess(runner, speed=SPEED, n=6),
+                           model_spec={"model": "able"}, progress=events.append)
+            for _ in range(2)]
+    a, b = runs
+    assert not a.converged and a.stage == "tracking" and a.kind == BEST_ITERATE_KIND
+    assert a.nlp.status == "Maximum_Iterations_Exceeded" and a.nlp.iterations == 4
+    assert a.nlp.worst_constraints and all(" " in name for name, _ in a.nlp.worst_constraints)
+    for attr in ("q", "qd", "qdd", "activation", "tendon_force", "excitation"):
+        np.testing.assert_array_equal(getattr(a.nlp, attr), getattr(b.nlp, attr))
+    assert a.nlp.period == b.nlp.period and a.summary()["converged"] is False
+    kinds = [(e.stage, e.event) for e in events[:len(events) // 2]]
+    assert kinds[0] == ("tracking", "start") and kinds[-1] == ("tracking", "end")
+    assert [e.iteration for e in events if e.event == "iteration"][:5] == [0, 1, 2, 3, 4]
+    # a collocation solution as the guess goes straight to the predictive stage
+    warm = predict_stride(runner, settings, a.to_guess(), model_spec={"model": "able"})
+    assert warm.stage == "predictive" and warm.tracking is None
+
+
+# ---------------------------------------------------------------- report
+
+
+def test_the_predictive_report_renders_a_collocation_solution(able, tmp_path):
+    from bladelab.report.predictive import build_predictive_report, predictive_kind
+
+    _, _, sol = able
+    path = sol.write(tmp_path / "run" / "solution.json")
+    assert predictive_kind(path) == "collocation" and predictive_kind(path.parent) == "collocation"
+    rep = build_predictive_report(path, tmp_path / "report", progress=False, animate=False)
+    assert rep.kind == "collocation" and rep.solutions == ("able-bodied 3.5 m/s (collocation)",)
+    html = (tmp_path / "report" / "index.html").read_text()
+    assert "Collocation solution" in html and "Joint angles per leg" in html
+    bad = replace(sol, nlp=replace(sol.nlp, success=False)).write(tmp_path / "best.json")
+    with pytest.raises(InputFileError, match="did not converge"):
+        predictive_kind(bad)
