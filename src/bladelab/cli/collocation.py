@@ -20,7 +20,7 @@ import typer
 from bladelab.errors import InputFileError, SpecError
 
 __all__ = ["FUKUCHI_STATIC", "FUKUCHI_TRIAL", "PROGRESS_EVERY_S", "TRIAL_SPEED_M_PER_S",
-           "run_collocation"]
+           "make_guess", "run_collocation"]
 
 _SHARED = Path(__file__).resolve().parents[3].parent / "shared" / "data" / "real" / "fukuchi2017"
 #: The measured running trial of ``--guess trial`` and its standing trial.
@@ -34,9 +34,10 @@ PROGRESS_EVERY_S = 5.0
 MAX_SPEED_TEMPLATE_M_PER_S = 4.0
 
 
-def _make_guess(runner, guess: str, *, n: int, speed: float | None):
-    """The initial guess named by ``--guess``: template, trial, or a file (a collocation
-    solution or best iterate, or a reflex-controller parameter file)."""
+def make_guess(runner, guess: str, *, n: int, speed: float | None):
+    """The initial guess named by ``--guess``: template (at ``speed`` [m/s], or
+    :data:`MAX_SPEED_TEMPLATE_M_PER_S` when None), trial, or a file (a collocation solution or
+    best iterate, or a reflex-controller parameter file), on ``n`` mesh intervals."""
     from bladelab.predict.collocation.guess import (
         guess_from_reflex,
         guess_from_trial,
@@ -151,7 +152,7 @@ def run_collocation(
     runner = runner_from_spec(spec)
     result = predict_stride_in_folder(
         out, runner, settings,
-        lambda: _make_guess(runner, guess, n=mesh, speed=settings.speed_m_per_s),
+        lambda: make_guess(runner, guess, n=mesh, speed=settings.speed_m_per_s),
         model_spec=spec, resume=resume, force=force, progress=_Progress())
     sol = result.solution
     summary = sol.summary()

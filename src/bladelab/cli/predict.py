@@ -174,10 +174,66 @@ def register(app: typer.Typer) -> None:
         chain_from: str | None = typer.Option(
             None, "--chain-from", help="Warm-start categories outwards from this one (e.g. Cat6)."
         ),
+        method: str = typer.Option(
+            "reflex", "--method", help="reflex (CMA-ES on the reflex controller) | collocation "
+            "(speed continuation and maximum speed by direct collocation, CasADi + IPOPT)."
+        ),
+        able: bool = typer.Option(
+            False, "--able", help="Collocation: sweep the able model too (first)."
+        ),
+        mesh: int | None = typer.Option(
+            None, "--mesh", help="Collocation: mesh intervals of the stride [default: 50]."
+        ),
+        guess: str | None = typer.Option(
+            None, "--guess", help="Collocation: initial guess of each model's first speed: "
+            "template | trial | FILE [default: template]."
+        ),
+        max_iter: int | None = typer.Option(
+            None, "--max-iter", help="Collocation: IPOPT iterations per stage [default: 3000]."
+        ),
+        resume: bool = typer.Option(
+            False, "--resume", help="Collocation: continue the sweep in --out (done solves "
+            "are read back)."
+        ),
+        force: bool = typer.Option(
+            False, "--force", help="Collocation: start over in an --out that holds a sweep."
+        ),
+        as_json: bool = typer.Option(
+            False, "--json", help="Collocation: print the table as one JSON object."
+        ),
     ) -> None:
         """Category × speed grid: warm-started optimisations, maximum speed, cost at 4 m/s,
         200 m and 400 m times, contact times (seed 001 §2.2.2 B–C, Table 3.1). Running it again
-        with the same --out continues: finished cells are read back, interrupted ones resumed."""
+        with the same --out continues: finished cells are read back, interrupted ones resumed.
+
+        With --method collocation: per model (--able, and the amputee with each category), the
+        speed continuation over --speeds (each speed warm-started from the previous solution)
+        and the maximum speed; DIR/<model>/speed-<v>.json, max-speed.json and the table
+        DIR/collocation-sweep.csv. A used --out needs --resume or --force; exit status 2 when a
+        model failed (after the others). The CMA-ES options do not apply."""
+        if method == "collocation":
+            from bladelab.cli.collocation_sweep import run_collocation_sweep
+
+            for given, option in ((init is not None, "--init"),
+                                  (chain_from is not None, "--chain-from")):
+                if given:
+                    raise SpecError("only with --method reflex", where=option)
+            code = run_collocation_sweep(
+                out=out, categories=categories, able=able, speeds=speeds,
+                mesh=50 if mesh is None else mesh,
+                guess="template" if guess is None else guess,
+                max_iter=3000 if max_iter is None else max_iter, jobs=jobs,
+                executor=executor, resume=resume, force=force, as_json=as_json)
+            raise typer.Exit(code)
+        if method != "reflex":
+            raise SpecError(f"unknown method {method!r}", where="--method",
+                            hint="reflex or collocation")
+        for given, option in ((able, "--able"), (mesh is not None, "--mesh"),
+                              (guess is not None, "--guess"), (max_iter is not None, "--max-iter"),
+                              (resume, "--resume"), (force, "--force"), (as_json, "--json")):
+            if given:
+                raise SpecError("only with --method collocation", where=option,
+                                hint="a reflex sweep continues by itself in the same --out")
         from bladelab.predict.reflex.sweep import run_sweep
 
         if not (math.isfinite(duration) and duration > 0):

@@ -1,0 +1,148 @@
+"""``bladelab sweep --method collocation``: speed continuation and maximum speed per model.
+
+The command parses its options and calls
+:func:`bladelab.predict.collocation.continuation.collocation_sweep`, which owns the output
+folder (one subfolder per model, ``collocation-sweep.csv``). Progress goes to stderr, one line
+per solve's start and end (and every :data:`~bladelab.cli.collocation.PROGRESS_EVERY_S`
+seconds while IPOPT iterates), each line led by the model and the problem; stdout holds the
+table (one JSON object with ``--json``). Any model that did not converge everywhere makes the
+exit status 2, after all models ran, with one ``error:`` line naming each failure.
+"""
+
+from __future__ import annotations
+
+import functools
+import json
+import math
+import time
+from pathlib import Path
+
+import typer
+
+from bladelab.errors import SpecError
+
+__all__ = ["SweepProgress", "run_collocation_sweep"]
+
+
+class SweepProgress:
+    """Progress lines on stderr for :class:`ContinuationProgress` reports: each solve's start,
+    its stages' start and end, an iteration line at most every ``every_s`` seconds [s], and
+    its result. Picklable (it runs in the worker processes of ``--jobs``)."""
+
+    def __init__(self, every_s: float | None = None) -> None:
+        from bladelab.cli.collocation import PROGRESS_EVERY_S
+
+        self.every_s = PROGRESS_EVERY_S if every_s is None else float(every_s)
+        self.last = -math.inf
+
+    def __call__(self, r) -> None:
+        head = f"{r.model}, {r.problem}:"
+        if r.event == "solve":
+            p = r.solve
+            if p.event == "start":
+                self.last = time.perf_counter()
+                typer.echo(f"{head} {p.stage} stage started ({p.message})", err=True)
+            elif p.event == "iteration":
+                now = time.perf_counter()
+                if now - self.last >= self.every_s:
+                    self.last = now
+                    typer.echo(f"{head} {p.stage} stage iteration {p.iteration}, objective "
+                               f"{p.objective:.5g}, constraint violation {p.violation:.2g}, "
+                               f"{p.elapsed_s:.0f} s", err=True)
+            else:
+                typer.echo(f"{head} {p.stage} stage: {p.message} after {p.iteration} "
+                           f"iterations, {p.elapsed_s:.1f} s", err=True)
+        elif r.event == "read":
+            typer.echo(f"{head} read back {r.path}", err=True)
+        else:
+            typer.echo(f"{head} {r.event}: {r.message}", err=True)
+
+
+def _speeds(text: str) -> list[float]:
+    try:
+        speeds = [float(t) for t in text.split(",") if t.strip()]
+    except ValueError:
+        raise SpecError(f"cannot read the speeds {text!r}", where="--speeds",
+                        hint="comma-separated speeds in m/s, e.g. 3,3.5,4") from None
+    if not speeds:
+        raise SpecError("no speed given", where="--speeds")
+    bad = [v for v in speeds if not (math.isfinite(v) and v > 0)]
+    if bad:
+        raise SpecError(f"speeds must be > 0 m/s, got {bad[0]:g}", where="--speeds")
+    return speeds
+
+
+def _text(result) -> str:
+    if not result.rows:
+        return f"no result; table: {result.table_path}"
+    keep = ["model", "problem", "prescribed_speed_mps", "converged", "mean_speed_mps",
+            "cost_of_transport_J_per_kg_m", "stride_time_s", "contact_time_s",
+            "iterations", "wall_s"]
+    lines = ["  ".join(keep)]
+    for row in result.rows:
+        cells = []
+        for k in keep:
+            v = row.get(k)
+            cells.append("-" if v is None else f"{v:.4g}" if isinstance(v, float) else str(v))
+        lines.append("  ".join(cells))
+    lines.append(f"table: {result.table_path}")
+    return "\n".join(lines)
+
+
+def run_collocation_sweep(
+    *,
+    out: Path,
+    categories: str,
+    able: bool,
+    speeds: str,
+    mesh: int,
+    guess: str,
+    max_iter: int,
+    jobs: int,
+    executor: str,
+    resume: bool,
+    force: bool,
+    as_json: bool,
+) -> int:
+    """Run ``bladelab sweep --method collocation``; returns the exit status (0 every solve
+    converged, 2 some model failed)."""
+    from bladelab.cli.collocation import make_guess
+    from bladelab.predict.collocation.continuation import collocation_sweep, sweep_models
+    from bladelab.predict.collocation.solve import CollocationSettings
+
+    if mesh < 4:
+        raise SpecError(f"need at least 4 mesh intervals, got {mesh}", where="--mesh")
+    if max_iter < 1:
+        raise SpecError(f"need at least 1 iteration, got {max_iter}", where="--max-iter")
+    if jobs < 1:
+        raise SpecError(f"need at least 1 job, got {jobs}", where="--jobs")
+    speed_list = _speeds(speeds)
+    cats = [c.strip() for c in categories.split(",") if c.strip()]
+    try:
+        models = sweep_models(cats, able=able)
+    except SpecError as err:
+        raise SpecError(err.message, where="--categories", hint=err.hint) from None
+    if guess not in ("template", "trial"):
+        path = Path(guess)
+        if not path.is_file():
+            raise SpecError(f"{guess!r} is neither template, trial nor a file", where="--guess",
+                            hint="template, trial, or the path of a solution.json, "
+                                 "best_iterate.json or reflex parameter JSON file")
+        guess = str(path.resolve())  # worker processes may start elsewhere
+    settings = CollocationSettings(mesh_intervals=mesh, speed_m_per_s=speed_list[0],
+                                   max_iter=max_iter)
+    result = collocation_sweep(
+        models, speed_list, settings, functools.partial(make_guess, guess=guess), out=out,
+        jobs=jobs, executor=executor, resume=resume, force=force, progress=SweepProgress())
+    if as_json:
+        typer.echo(json.dumps({"table": str(result.table_path), "rows": result.rows,
+                               "failures": result.failures}))
+    else:
+        typer.echo(_text(result))
+    if not result.failures:
+        return 0
+    n = len(result.failures)
+    typer.echo(f"error: {n} of {len(models)} model(s) failed:", err=True)
+    for label, what in result.failures.items():
+        typer.echo(f"error: {label}: " + "; ".join(what), err=True)
+    return 2

@@ -1,0 +1,757 @@
+"""Speed continuation, maximum speed and the collocation category sweep (issue 15).
+
+Three drivers on top of :func:`~bladelab.predict.collocation.solve.predict_stride`:
+
+- :func:`speed_continuation` solves the stride at a sequence of prescribed speeds [m/s], in the
+  order given, each warm-started from the previous converged solution
+  (``solution.to_guess().with_speed(v)``: same period and joint curves, pelvis_tx and its
+  speed scaled to the new mean speed; a collocation guess skips the tracking stage). The
+  first speed starts from ``first_guess`` (template, trial, reflex solution, or a collocation
+  solution), through the tracking stage unless it is a collocation solution.
+- :func:`max_speed` solves the maximum-speed problem (``CollocationSettings(speed_m_per_s=
+  None)``: the mean speed maximised with an effort term), warm-started from the fastest
+  converged solution of the continuation.
+- :func:`collocation_sweep` (``bladelab sweep --method collocation``) runs both for each model
+  (the able model, the amputee with each blade category), each model in its own subfolder,
+  models in parallel processes with ``jobs`` > 1, and writes the table
+  :data:`SWEEP_TABLE` after each model.
+
+Files (JSON of :class:`~bladelab.predict.collocation.solution.CollocationSolution`, written
+atomically as soon as a solve ends, so results already computed are never lost):
+``speed-<v>.json`` (``<v>`` as ``f"{v:g}"``: ``speed-3.5.json``, ``speed-4.json``) for a
+converged solve, ``speed-<v>.best_iterate.json`` for one that did not converge (never both: the
+stale one is removed once the new file is in place); ``max-speed.json`` and
+``max-speed.best_iterate.json`` likewise.
+
+Failure: a speed that does not converge is recorded (its best-iterate file, IPOPT's status in
+the table) and the continuation stops there; :attr:`ContinuationResult.last_converged_speed`
+reports the last speed that converged.
+
+Resuming: running again with the same folder reads a converged file of the same problem (model,
+mesh, speed, objective weights: :meth:`CollocationSettings.same_problem`) back instead of
+solving it; a best iterate of the same problem warm-starts that speed's predictive stage (as
+``bladelab predict --resume``). A file of another problem is an error naming it, unless
+``force`` (start over: existing files are neither read nor trusted, and are replaced).
+
+Table rows (:meth:`SolveRecord.row`, units in the names): ``model``, ``blade``, ``problem``
+(``speed`` or ``max-speed``), ``prescribed_speed_mps`` (empty for the maximum speed),
+``converged``, ``status``, ``mean_speed_mps``, ``cost_of_transport_J_per_kg_m``,
+``stride_time_s``, ``contact_time_s`` (mean of the legs), ``contact_time_<leg>_s``,
+``peak_vertical_grf_<leg>_bw`` [body weights], ``flight_fraction``, ``dynamics_residual_pct``,
+``iterations``, ``wall_s`` (of the solve, both stages; the stored value for a file read back),
+``mesh_intervals`` and ``file``. Legs are left/right (able) or intact/prosthetic (amputee).
+"""
+
+from __future__ import annotations
+
+import csv
+import dataclasses
+import math
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+from bladelab.errors import InputFileError, SpecError
+from bladelab.predict.collocation.solve import (
+    COLLOCATION_SOURCE,
+    CollocationSettings,
+    SolveProgress,
+    predict_stride,
+)
+
+__all__ = [
+    "MAX_SPEED_BEST_ITERATE_FILE",
+    "MAX_SPEED_FILE",
+    "SWEEP_TABLE",
+    "TABLE_COLUMNS",
+    "ContinuationProgress",
+    "ContinuationResult",
+    "SolveRecord",
+    "SweepResult",
+    "collocation_sweep",
+    "max_speed",
+    "max_speed_settings",
+    "model_folder",
+    "model_label",
+    "speed_continuation",
+    "speed_file",
+    "sweep_model_task",
+    "sweep_models",
+    "table_columns",
+    "write_table",
+]
+
+#: File names of the maximum-speed solve in a model's folder.
+MAX_SPEED_FILE = "max-speed.json"
+MAX_SPEED_BEST_ITERATE_FILE = "max-speed.best_iterate.json"
+#: The summary table of a sweep, in its output folder.
+SWEEP_TABLE = "collocation-sweep.csv"
+#: Columns of a table row in order; the per-leg columns (``contact_time_<leg>_s``,
+#: ``peak_vertical_grf_<leg>_bw``) follow ``contact_time_s`` in :data:`_LEGS` order.
+TABLE_COLUMNS = (
+    "model", "blade", "problem", "prescribed_speed_mps", "converged", "status",
+    "mean_speed_mps", "cost_of_transport_J_per_kg_m", "stride_time_s", "contact_time_s",
+    "flight_fraction", "dynamics_residual_pct", "iterations", "wall_s", "mesh_intervals", "file",
+)
+_LEGS = ("intact", "prosthetic", "left", "right")
+_PER_LEG = ("contact_time_{}_s", "peak_vertical_grf_{}_bw")
+
+
+def speed_file(speed: float, *, converged: bool = True) -> str:
+    """The file name of the solve at ``speed`` [m/s]: ``speed-<v:g>.json``, or
+    ``speed-<v:g>.best_iterate.json`` when it did not converge."""
+    return f"speed-{float(speed):g}" + (".json" if converged else ".best_iterate.json")
+
+
+def model_label(spec: dict) -> str:
+    """``"able"`` or ``"amputee <blade>"`` for a model specification."""
+    from bladelab.predict.collocation.solution import check_model_spec
+
+    spec = check_model_spec(spec)
+    return spec["model"] if spec["blade"] is None else f"{spec['model']} {spec['blade']}"
+
+
+def model_folder(spec: dict) -> str:
+    """A model's subfolder in a sweep: ``able`` or ``amputee-<blade>``."""
+    return model_label(spec).replace(" ", "-")
+
+
+@dataclass(frozen=True)
+class ContinuationProgress:
+    """One progress report of the drivers.
+
+    Attributes
+    ----------
+    model
+        :func:`model_label` of the model.
+    problem
+        ``"<v> m/s"`` or ``"maximum speed"``.
+    event
+        ``"read"`` (a converged file read back, ``path``), ``"start"`` (a solve starts;
+        ``message`` names its warm start), ``"solve"`` (a :class:`SolveProgress` of the solve in
+        ``solve``), ``"converged"`` or ``"failed"`` (``path``: the file written; ``message``:
+        the result).
+    path
+        The file concerned, if any.
+    message
+        Text for the event.
+    solve
+        The solver's own report (event ``"solve"``).
+    """
+
+    model: str
+    problem: str
+    event: str
+    path: Path | None = None
+    message: str = ""
+    solve: SolveProgress | None = None
+
+
+@dataclass(frozen=True)
+class SolveRecord:
+    """One solve of a driver (solved now or read back).
+
+    Attributes
+    ----------
+    problem
+        ``"speed"`` (prescribed) or ``"max-speed"``.
+    speed_mps
+        The prescribed speed [m/s]; None for the maximum speed.
+    solution
+        The :class:`CollocationSolution` (a best iterate when not converged).
+    path
+        The file it is in.
+    solved
+        False when it was read back from ``path`` (nothing solved).
+    """
+
+    problem: str
+    speed_mps: float | None
+    solution: object
+    path: Path
+    solved: bool
+
+    @property
+    def converged(self) -> bool:
+        return bool(self.solution.converged)
+
+    def row(self, relative_to: str | Path | None = None) -> dict:
+        """The table row (module docstring); ``file`` relative to ``relative_to`` if given."""
+        sol = self.solution
+        summary = sol.summary()
+        path = self.path
+        if relative_to is not None:
+            try:
+                path = self.path.relative_to(relative_to)
+            except ValueError:
+                pass
+        row = {
+            "model": model_label(sol.model_spec),
+            "blade": sol.model_spec["blade"] or "",
+            "problem": self.problem,
+            "prescribed_speed_mps": self.speed_mps,
+            "converged": summary["converged"],
+            "status": summary["status"],
+        }
+        skip = {"converged", "status", "iterations", "wall_s"}
+        row.update({k: v for k, v in summary.items() if k not in skip})
+        row.update({"iterations": summary["iterations"], "wall_s": summary["wall_s"],
+                    "mesh_intervals": sol.settings.mesh_intervals, "file": str(path)})
+        return row
+
+
+@dataclass(frozen=True)
+class ContinuationResult:
+    """What :func:`speed_continuation` did: one record per speed reached, in order (the last one
+    did not converge when the continuation stopped early).
+
+    Attributes
+    ----------
+    speeds
+        The prescribed speeds asked for [m/s], in order.
+    records
+        :class:`SolveRecord` of each speed reached.
+    """
+
+    speeds: tuple[float, ...]
+    records: tuple[SolveRecord, ...]
+
+    @property
+    def complete(self) -> bool:
+        """True if every speed converged."""
+        return len(self.records) == len(self.speeds) and all(r.converged for r in self.records)
+
+    @property
+    def failed(self) -> SolveRecord | None:
+        """The speed that did not converge (where the continuation stopped), or None."""
+        return next((r for r in self.records if not r.converged), None)
+
+    @property
+    def last_converged_speed(self) -> float | None:
+        """The last prescribed speed [m/s] that converged (in the order solved), or None."""
+        done = [r.speed_mps for r in self.records if r.converged]
+        return done[-1] if done else None
+
+    @property
+    def fastest(self) -> SolveRecord | None:
+        """The converged record of the highest prescribed speed, or None."""
+        done = [r for r in self.records if r.converged]
+        return max(done, key=lambda r: r.speed_mps) if done else None
+
+    def rows(self, relative_to: str | Path | None = None) -> list[dict]:
+        """Table rows (:meth:`SolveRecord.row`), one per speed reached."""
+        return [r.row(relative_to) for r in self.records]
+
+    def table(self):
+        """The rows as a pandas DataFrame, columns in :func:`table_columns` order."""
+        import pandas as pd
+
+        rows = self.rows()
+        return pd.DataFrame(rows, columns=table_columns(rows))
+
+
+def table_columns(rows: Sequence[dict]) -> list[str]:
+    """Column order of table rows: :data:`TABLE_COLUMNS` with the per-leg columns of the legs
+    present after ``contact_time_s``, then any other key."""
+    keys: list[str] = []
+    for row in rows:
+        keys.extend(k for k in row if k not in keys)
+    legs = [fmt.format(leg) for fmt in _PER_LEG for leg in _LEGS
+            if fmt.format(leg) in keys]
+    head = list(TABLE_COLUMNS)
+    i = head.index("contact_time_s") + 1
+    cols = head[:i] + legs + head[i:]
+    return cols + [k for k in keys if k not in cols]
+
+
+def write_table(path: str | Path, rows: Sequence[dict]) -> Path:
+    """Write table rows as CSV, atomically (columns as :func:`table_columns`; a missing or
+    non-finite value is an empty field). Returns the path."""
+    from bladelab._io import atomic_open
+
+    path = Path(path)
+    cols = table_columns(rows)
+
+    def cell(v):
+        if v is None or (isinstance(v, float) and not math.isfinite(v)):
+            return ""
+        return v
+
+    with atomic_open(path, "w", newline="", encoding="utf-8") as fh:
+        writer = csv.DictWriter(fh, fieldnames=cols)
+        writer.writeheader()
+        for row in rows:
+            writer.writerow({c: cell(row.get(c)) for c in cols})
+    return path
+
+
+# -- helpers ------------------------------------------------------------------------------
+def _describe(spec: dict, settings: CollocationSettings) -> str:
+    speed = ("maximum speed" if settings.speed_m_per_s is None
+             else f"{settings.speed_m_per_s:g} m/s")
+    return f"{model_label(spec)}, {speed}, {settings.mesh_intervals} mesh intervals"
+
+
+class _Runner:
+    """The runner, built from the model specification on first use unless given."""
+
+    def __init__(self, runner, spec: dict) -> None:
+        self._runner, self._spec = runner, spec
+
+    def __call__(self):
+        from bladelab.predict.collocation.solution import runner_from_spec
+
+        if self._runner is None:
+            self._runner = runner_from_spec(self._spec)
+        elif callable(self._runner) and not hasattr(self._runner, "dof_names"):
+            self._runner = self._runner()
+        return self._runner
+
+
+def _stored(ok: Path, best: Path, spec: dict, settings: CollocationSettings, force: bool):
+    """(converged solution, best iterate) found in ``ok`` / ``best``, each None if absent;
+    ``force`` ignores both. A file of another problem raises InputFileError."""
+    from bladelab.predict.collocation.solution import CollocationSolution
+
+    if force:
+        return None, None
+    for path in (ok, best):
+        if not path.is_file():
+            continue
+        sol = CollocationSolution.read(path)
+        if sol.model_spec != spec or not sol.settings.same_problem(settings):
+            there, asked = _describe(sol.model_spec, sol.settings), _describe(spec, settings)
+            if there == asked:
+                there, asked = (f"{there}, weights {sol.settings.weights.to_dict()}",
+                                f"weights {settings.weights.to_dict()}")
+            raise InputFileError(
+                f"holds another problem ({there}; asked: {asked})", file=path,
+                hint="resume with the same model, speeds and mesh, --force to start over, or "
+                     "choose another --out")
+        if path == ok and sol.converged:
+            return sol, None
+        return None, sol
+    return None, None
+
+
+def _solve_and_write(runner, settings: CollocationSettings, guess, *, spec: dict, ok: Path,
+                     best: Path, report: Callable[..., None], watched: bool):
+    """Solve, write the solution (or best iterate) and remove the stale other file; the
+    solver's progress goes to ``report`` when ``watched``."""
+    sol = predict_stride(runner, settings, guess, model_spec=spec,
+                         progress=(lambda p: report("solve", solve=p)) if watched else None)
+    target, stale = (ok, best) if sol.converged else (best, ok)
+    sol.write(target)
+    stale.unlink(missing_ok=True)
+    s = sol.summary()
+    if sol.converged:
+        report("converged", path=target,
+               message=f"mean speed {sol.mean_speed_mps:.4g} m/s, cost of transport "
+                       f"{sol.cost_of_transport_J_per_kg_m:.4g} J/(kg·m), "
+                       f"{s['iterations']} iterations, {s['wall_s']:.1f} s")
+    else:
+        report("failed", path=target,
+               message=f"not converged: IPOPT status {sol.nlp.status} in the {sol.stage} stage "
+                       f"after {sol.nlp.iterations} iterations; best iterate in {target.name}")
+    return sol, target
+
+
+def _check_speeds(speeds) -> tuple[float, ...]:
+    if isinstance(speeds, int | float):
+        speeds = [speeds]
+    out = []
+    for v in speeds:
+        if isinstance(v, bool) or not isinstance(v, int | float) or not (
+                math.isfinite(v) and v > 0):
+            raise SpecError(f"speeds must be > 0 m/s, got {v!r}", where="speeds")
+        out.append(float(v))
+    if not out:
+        raise SpecError("no speed given", where="speeds")
+    names = [f"{v:g}" for v in out]
+    dup = sorted({n for n in names if names.count(n) > 1})
+    if dup:
+        raise SpecError(f"speed(s) {', '.join(dup)} m/s given twice", where="speeds")
+    return tuple(out)
+
+
+# -- drivers ------------------------------------------------------------------------------
+def speed_continuation(runner, speeds: Sequence[float], settings: CollocationSettings,
+                       first_guess, *, model_spec: dict, out_dir: str | Path,
+                       progress: Callable[[ContinuationProgress], None] | None = None,
+                       force: bool = False) -> ContinuationResult:
+    """Solve the stride at each prescribed speed in order, each warm-started from the previous
+    converged solution (module docstring); files ``out_dir/speed-<v>.json``.
+
+    Parameters
+    ----------
+    runner
+        The forward model (:func:`bladelab.runner.build_runner`); None (or a callable returning
+        it): built from ``model_spec`` when a solve is needed (a rerun that only reads files
+        back builds nothing).
+    speeds
+        Prescribed mean speeds [m/s], solved in this order.
+    settings
+        :class:`CollocationSettings` of a prescribed-speed problem (mesh, weights, solver
+        options); each speed replaces its ``speed_m_per_s``.
+    first_guess
+        Initial guess of the first speed (:class:`StrideGuess`), or a callable
+        ``first_guess(runner) -> StrideGuess``, called only when it is needed.
+    model_spec
+        ``{"model": "able" | "amputee", "blade": name | None}``: how ``runner`` is built.
+    out_dir
+        Folder of the files (created if needed).
+    progress
+        Called with :class:`ContinuationProgress` reports.
+    force
+        Solve every speed, ignoring (and then replacing) files already in ``out_dir``; files of
+        speeds not reached stay (:func:`sweep_model_task` removes them).
+
+    Returns
+    -------
+    ContinuationResult
+        One record per speed reached; the continuation stops at the first speed that does not
+        converge.
+
+    Raises
+    ------
+    SpecError
+        No speed, a speed that is not > 0, a speed given twice, or maximum-speed settings.
+    InputFileError
+        A file in ``out_dir`` holds another problem (without ``force``).
+    """
+    from bladelab.predict.collocation.solution import check_model_spec
+
+    spec = check_model_spec(model_spec)
+    speeds = _check_speeds(speeds)
+    if not isinstance(settings, CollocationSettings):
+        raise SpecError(f"expected CollocationSettings, got {type(settings).__name__}",
+                        where="settings")
+    if settings.max_speed:
+        raise SpecError("the speed continuation needs the settings of a prescribed-speed "
+                        "problem", where="settings",
+                        hint="give speed_m_per_s (each speed of the continuation replaces it)")
+    out_dir = Path(out_dir)
+    if out_dir.exists() and not out_dir.is_dir():
+        raise InputFileError("is a file, not a folder", file=out_dir, hint="give a folder")
+    get_runner = _Runner(runner, spec)
+    label = model_label(spec)
+    records: list[SolveRecord] = []
+    prev = None  # the previous converged solution
+    for v in speeds:
+        problem = f"{v:g} m/s"
+
+        def report(event: str, *, path=None, message: str = "", solve=None,
+                   _problem=problem) -> None:
+            if progress is not None:
+                progress(ContinuationProgress(label, _problem, event, path, message, solve))
+
+        s_v = dataclasses.replace(settings, speed_m_per_s=v)
+        ok, best = out_dir / speed_file(v), out_dir / speed_file(v, converged=False)
+        done, iterate = _stored(ok, best, spec, s_v, force)
+        if done is not None:
+            report("read", path=ok, message="read back")
+            records.append(SolveRecord("speed", v, done, ok, False))
+            prev = done
+            continue
+        if iterate is not None:
+            guess = iterate.to_guess()
+            report("start", message=f"warm start from the best iterate {best.name}")
+        elif prev is not None:
+            guess = prev.to_guess(f"{COLLOCATION_SOURCE} at "
+                                  f"{prev.settings.speed_m_per_s:g} m/s").with_speed(v)
+            report("start", message=f"warm start from the {prev.settings.speed_m_per_s:g} m/s "
+                                    "solution")
+        else:
+            guess = first_guess(get_runner()) if callable(first_guess) else first_guess
+            report("start", message=f"from {guess.source}")
+        sol, path = _solve_and_write(get_runner(), s_v, guess, spec=spec, ok=ok, best=best,
+                                     report=report, watched=progress is not None)
+        records.append(SolveRecord("speed", v, sol, path, True))
+        if not sol.converged:
+            break
+        prev = sol
+    return ContinuationResult(speeds, tuple(records))
+
+
+def max_speed_settings(settings: CollocationSettings) -> CollocationSettings:
+    """The maximum-speed problem with the mesh and solver options of ``settings``: speed None,
+    the default maximum-speed weights (speed 1, activation 1, acceleration 0.1)."""
+    return dataclasses.replace(settings, speed_m_per_s=None, weights=None)
+
+
+def max_speed(runner, settings: CollocationSettings, guess, *, model_spec: dict,
+              out_dir: str | Path,
+              progress: Callable[[ContinuationProgress], None] | None = None,
+              force: bool = False) -> SolveRecord:
+    """Solve the maximum-speed problem warm-started from ``guess`` (the fastest converged
+    solution of :func:`speed_continuation`, a :class:`CollocationSolution` or its
+    ``to_guess()``); file ``out_dir/max-speed.json`` (``max-speed.best_iterate.json`` if it
+    does not converge). A converged file of the same problem is read back; a best iterate of
+    it is the warm start instead of ``guess`` (module docstring).
+
+    ``settings`` must pose the maximum-speed problem (``speed_m_per_s=None``;
+    :func:`max_speed_settings`). ``runner``, ``model_spec``, ``progress`` and ``force`` as
+    :func:`speed_continuation`.
+    """
+    from bladelab.predict.collocation.solution import CollocationSolution, check_model_spec
+
+    spec = check_model_spec(model_spec)
+    if not isinstance(settings, CollocationSettings):
+        raise SpecError(f"expected CollocationSettings, got {type(settings).__name__}",
+                        where="settings")
+    if not settings.max_speed:
+        raise SpecError(f"the maximum-speed problem needs speed_m_per_s None, got "
+                        f"{settings.speed_m_per_s:g} m/s", where="settings",
+                        hint="max_speed_settings(settings) gives it")
+    out_dir = Path(out_dir)
+    label = model_label(spec)
+
+    def report(event: str, *, path=None, message: str = "", solve=None) -> None:
+        if progress is not None:
+            progress(ContinuationProgress(label, "maximum speed", event, path, message, solve))
+
+    ok, best = out_dir / MAX_SPEED_FILE, out_dir / MAX_SPEED_BEST_ITERATE_FILE
+    done, iterate = _stored(ok, best, spec, settings, force)
+    if done is not None:
+        report("read", path=ok, message="read back")
+        return SolveRecord("max-speed", None, done, ok, False)
+    if iterate is not None:
+        start = iterate.to_guess()
+        report("start", message=f"warm start from the best iterate {best.name}")
+    else:
+        if isinstance(guess, CollocationSolution):
+            if guess.model_spec != spec:
+                raise SpecError(f"the warm start is a solution of {model_label(guess.model_spec)}"
+                                f", not {label}", where="guess")
+            speed = guess.settings.speed_m_per_s
+            start = guess.to_guess(f"{COLLOCATION_SOURCE} at "
+                                   + (f"{speed:g} m/s" if speed else "maximum speed"))
+        else:
+            start = guess
+        report("start", message=f"from {start.source}")
+    sol, path = _solve_and_write(_Runner(runner, spec)(), settings, start, spec=spec, ok=ok,
+                                 best=best, report=report, watched=progress is not None)
+    return SolveRecord("max-speed", None, sol, path, True)
+
+
+# -- the sweep ----------------------------------------------------------------------------
+def sweep_models(categories: Sequence[str], *, able: bool = False) -> list[dict]:
+    """Model specifications of a sweep: the able model first when ``able``, then the amputee
+    with each blade category (names as the catalogue spells them).
+
+    Raises
+    ------
+    SpecError
+        An unknown or repeated category, or no model at all.
+    """
+    from bladelab.runner.params import blade_category
+
+    models = [{"model": "able", "blade": None}] if able else []
+    seen: set[str] = set()
+    for c in categories:
+        name = blade_category(c).name
+        if name in seen:
+            raise SpecError(f"category {name} given twice", where="categories")
+        seen.add(name)
+        models.append({"model": "amputee", "blade": name})
+    if not models:
+        raise SpecError("no model to sweep", where="categories",
+                        hint="give --categories, --able, or both")
+    return models
+
+
+def _files(folder: Path) -> list[Path]:
+    """The solve files of a model folder."""
+    if not folder.is_dir():
+        return []
+    return sorted(p for p in folder.iterdir() if p.is_file() and p.suffix == ".json" and (
+        p.name.startswith("speed-") or p.name.startswith("max-speed")))
+
+
+def sweep_model_task(payload: dict) -> dict:
+    """One model of :func:`collocation_sweep` (a top-level function for the executors): the
+    speed continuation, then the maximum speed from its fastest converged solution.
+
+    ``payload``: ``model_spec``, ``speeds``, ``settings`` (:class:`CollocationSettings`),
+    ``make_guess`` (``make_guess(runner, n=..., speed=...)``), ``out`` (the sweep folder),
+    ``force``, ``progress`` (or None). Returns ``label``, ``rows`` and ``failures`` (one line
+    per solve that did not converge). With ``force``, files of the model folder that this run
+    did not write are removed once the model is done.
+    """
+    spec = payload["model_spec"]
+    settings = payload["settings"]
+    speeds = payload["speeds"]
+    out = Path(payload["out"])
+    folder = out / model_folder(spec)
+    make_guess = payload["make_guess"]
+    force = bool(payload.get("force", False))
+    progress = payload.get("progress")
+    label = model_label(spec)
+    get_runner = _Runner(None, spec)
+    cont = speed_continuation(
+        get_runner, speeds, settings,
+        lambda r: make_guess(r, n=settings.mesh_intervals, speed=float(speeds[0])),
+        model_spec=spec, out_dir=folder, progress=progress, force=force)
+    records = list(cont.records)
+    failures = []
+    if cont.failed is not None:
+        f = cont.failed
+        last = cont.last_converged_speed
+        failures.append(f"{f.speed_mps:g} m/s not converged (IPOPT status "
+                        f"{f.solution.nlp.status} in the {f.solution.stage} stage; best iterate "
+                        f"{f.path.relative_to(out)}); last converged: "
+                        + (f"{last:g} m/s" if last is not None else "none"))
+    fastest = cont.fastest
+    if fastest is None:
+        failures.append("maximum speed not attempted (no speed converged)")
+    else:
+        rec = max_speed(get_runner, max_speed_settings(settings), fastest.solution,
+                        model_spec=spec, out_dir=folder, progress=progress, force=force)
+        records.append(rec)
+        if not rec.converged:
+            failures.append(f"maximum speed not converged (IPOPT status "
+                            f"{rec.solution.nlp.status} in the {rec.solution.stage} stage; "
+                            f"best iterate {rec.path.relative_to(out)})")
+    if force:
+        keep = {r.path.resolve() for r in records}
+        for p in _files(folder):
+            if p.resolve() not in keep:
+                p.unlink(missing_ok=True)
+    return {"label": label, "rows": [r.row(out) for r in records], "failures": failures}
+
+
+@dataclass(frozen=True)
+class SweepResult:
+    """What :func:`collocation_sweep` did.
+
+    Attributes
+    ----------
+    table_path
+        The summary table (:data:`SWEEP_TABLE`).
+    rows
+        Its rows (:meth:`SolveRecord.row`), models in the order asked.
+    failures
+        Per model label, what failed (solves that did not converge, or the error that stopped
+        the model); empty when everything converged.
+    """
+
+    table_path: Path
+    rows: list[dict]
+    failures: dict[str, list[str]]
+
+    def table(self):
+        """The rows as a pandas DataFrame."""
+        import pandas as pd
+
+        return pd.DataFrame(self.rows, columns=table_columns(self.rows))
+
+
+def _held(out: Path) -> list[str]:
+    if not out.is_dir():
+        return []
+    held = [SWEEP_TABLE] if (out / SWEEP_TABLE).exists() else []
+    for sub in sorted(p for p in out.iterdir() if p.is_dir()):
+        held.extend(f"{sub.name}/{p.name}" for p in _files(sub))
+    return held
+
+
+def collocation_sweep(
+    models: Sequence[dict],
+    speeds: Sequence[float],
+    settings: CollocationSettings,
+    make_guess: Callable[..., object],
+    *,
+    out: str | Path,
+    jobs: int = 1,
+    executor: str = "local",
+    resume: bool = False,
+    force: bool = False,
+    progress: Callable[[ContinuationProgress], None] | None = None,
+) -> SweepResult:
+    """For each model, the speed continuation then the maximum speed (module docstring); each
+    model in ``out/<model_folder>``, the table ``out/collocation-sweep.csv`` rewritten
+    (atomically) after each model. A model that fails does not stop the others.
+
+    Parameters
+    ----------
+    models
+        Model specifications (:func:`sweep_models`).
+    speeds
+        Prescribed speeds [m/s] of the continuation, in order.
+    settings
+        Settings of the prescribed-speed problems (:func:`speed_continuation`); the maximum
+        speed uses :func:`max_speed_settings` of them.
+    make_guess
+        ``make_guess(runner, n=mesh_intervals, speed=first speed)`` -> the first speed's
+        initial guess of a model; picklable (a top-level function or a ``functools.partial``
+        of one) when ``jobs`` > 1.
+    out
+        Output folder.
+    jobs, executor
+        Models run in parallel on ``executor`` (:func:`bladelab.executors.make_executor`:
+        ``local`` processes, ``ray``) with ``jobs`` workers; 1: in this process.
+    resume
+        Continue a sweep in ``out``: solves already done (same problem) are read back.
+    force
+        Start over in a used ``out``: files are replaced; a model's files that this run did
+        not write are removed once the model is done.
+    progress
+        Called with each :class:`ContinuationProgress` (in the worker process when
+        ``jobs`` > 1, so it must be picklable then).
+
+    Raises
+    ------
+    InputFileError
+        ``out`` holds a sweep and neither ``resume`` nor ``force`` is given, or ``resume``
+        without one.
+    SpecError
+        Bad speeds, settings or models; ``resume`` with ``force``.
+    """
+    from bladelab.executors import make_executor
+    from bladelab.predict.collocation.solution import check_model_spec
+
+    speeds = _check_speeds(speeds)
+    if not isinstance(settings, CollocationSettings) or settings.max_speed:
+        raise SpecError("expected the CollocationSettings of a prescribed-speed problem",
+                        where="settings")
+    models = [check_model_spec(m) for m in models]
+    if not models:
+        raise SpecError("no model to sweep", where="models")
+    labels = [model_label(m) for m in models]
+    if len(set(labels)) != len(labels):
+        raise SpecError("a model is given twice", where="models")
+    if isinstance(jobs, bool) or not isinstance(jobs, int) or jobs < 1:
+        raise SpecError(f"need at least 1 job, got {jobs!r}", where="jobs")
+    if resume and force:
+        raise SpecError("give --resume or --force, not both", where="--resume/--force")
+    out = Path(out)
+    if out.exists() and not out.is_dir():
+        raise InputFileError("is a file, not a folder", file=out, hint="give a folder for --out")
+    held = _held(out)
+    if held and not (resume or force):
+        shown = ", ".join(held[:3]) + (f" and {len(held) - 3} more" if len(held) > 3 else "")
+        raise InputFileError(
+            f"the output folder holds a collocation sweep ({shown})", file=out,
+            hint="--resume continues it, --force starts over in it, or choose another --out")
+    if resume and not held:
+        raise InputFileError("no collocation sweep to resume from", file=out,
+                             hint="run without --resume first, with the same --out")
+    out.mkdir(parents=True, exist_ok=True)
+    payloads = [{"model_spec": m, "speeds": list(speeds), "settings": settings,
+                 "make_guess": make_guess, "out": str(out.resolve()), "force": bool(force),
+                 "progress": progress} for m in models]
+    table = out / SWEEP_TABLE
+    rows: dict[int, list[dict]] = {}
+    failures: dict[int, list[str]] = {}
+    for i, status, value in make_executor(executor, jobs).run(sweep_model_task, payloads):
+        if status == "ok":
+            rows[i] = value["rows"]
+            if value["failures"]:
+                failures[i] = value["failures"]
+        else:
+            failures[i] = [f"stopped by an error: {value}"]
+        write_table(table, [r for k in sorted(rows) for r in rows[k]])
+    all_rows = [r for k in sorted(rows) for r in rows[k]]
+    if not rows:
+        write_table(table, [])
+    return SweepResult(table, all_rows, {labels[k]: failures[k] for k in sorted(failures)})
