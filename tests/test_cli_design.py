@@ -98,12 +98,16 @@ def test_design_report(study, tmp_path):
     assert "ANOVA of delta_vx_m_per_s" in html and "<img" in html
 
 
-def test_design_jobs_match_serial(study, tmp_path):
-    """Runs evaluated by 2 worker processes give the serial study's results exactly."""
+def test_design_jobs_match_serial(study, tmp_path, capsys):
+    """Runs evaluated by 2 worker processes give the serial study's results exactly, and a
+    fresh folder says so ("9 evaluated, 0 resumed", not "0 evaluated, 9 resumed")."""
     out, args = study
     par = tmp_path / "par"
     i = args.index("--out")
+    capsys.readouterr()
     assert main([*args[:i], "--out", str(par), *args[i + 2:], "--jobs", "2"]) == 0
+    n_runs = len(pd.read_csv(out / "results.csv"))
+    assert f"({n_runs} evaluated, 0 resumed)" in capsys.readouterr().out
     pd.testing.assert_frame_equal(pd.read_csv(par / "results.csv"),
                                   pd.read_csv(out / "results.csv"))
 

@@ -66,3 +66,13 @@ def test_bad_settings_are_refused():
         StrideNLP(_toy(), n=2)
     with pytest.raises(SpecError, match="speed"):
         StrideNLP(_toy(), speed=-1.0)
+
+
+def test_an_objective_of_one_term_unpacks():
+    """Effort alone (metabolic weight 0): the solution still names its one term."""
+    from bladelab.predict.collocation.transcription import StrideWeights
+
+    nlp = StrideNLP(_toy(), n=10, speed=2.0, weights=StrideWeights(metabolic=0.0))
+    sol = nlp.solve(nlp.initial_vector(_bouncing_guess(10, 2.0)), hessian="exact", max_iter=5)
+    assert list(sol.objective_terms) == ["effort"]
+    assert sol.objective == pytest.approx(sol.objective_terms["effort"])

@@ -467,7 +467,10 @@ class StrideNLP:
         T = float(w[-1]) * self.scales.period
         Xs = w[:nX].reshape((self.nx, n + 1), order="F")
         Us = w[nX:nX + nU].reshape((self.nu, n + 1), order="F")
-        terms = [float(v) for v in self._terms(Xs, Us, w[-1])]
+        values = self._terms(Xs, Us, w[-1])
+        if not isinstance(values, (list, tuple)):  # a Function of one output returns it bare
+            values = [values]
+        terms = [float(v) for v in values]
         viol = np.maximum(lbg - gval, gval - ubg)
         order = np.argsort(viol)[::-1][:5]
         timings = {"build_s": t_build}
