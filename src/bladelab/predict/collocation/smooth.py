@@ -57,7 +57,7 @@ class Smoothing:
         w of the switch between activation and deactivation rates [-] (``u − a``).
     """
 
-    contact_depth_m: float = 1.0e-3
+    contact_depth_m: float = 2.5e-4  # 1 mm gave a 3.4 % dynamics residual, 0.25 mm 0.55 %
     contact_damping: float = 0.05
     spring_damper_depth_m: float = 1.0e-4
     contact_force_n: float = 1.0
