@@ -48,6 +48,11 @@ def test_template_is_a_periodic_grounded_stride(able):
     np.testing.assert_allclose(np.roll(right[:-1], -20), knee[:-1], atol=1e-9)
     with pytest.raises(SpecError, match="speed"):
         template_guess(able, speed=0.0)
+    # its force pattern: alternating half-sine stances carrying one body weight on average
+    f = g.vertical_grf_bw
+    assert f.shape == (41,) and np.trapezoid(f, dx=1 / 40) == pytest.approx(1.0, rel=0.02)
+    assert 2.2 < f.max() < 2.4 and f[0] == 0.0 and f[7] > 2.2 and f[15] == 0.0
+    assert f[27] > 2.2 and f[35] == 0.0  # the right stance, half a stride later
 
 
 def test_resampling_keeps_the_stride(able):
@@ -57,6 +62,8 @@ def test_resampling_keeps_the_stride(able):
     assert back.speed == pytest.approx(3.5)
     faster = g.with_speed(4.5)
     assert faster.speed == pytest.approx(4.5) and faster.period == g.period
+    np.testing.assert_allclose(g.resample(100).vertical_grf_bw[::2], g.vertical_grf_bw,
+                               atol=1e-12)
 
 
 @pytest.mark.skipif(not (FUKUCHI / "RBDS001runT35.c3d").is_file(), reason="shared data absent")
@@ -69,6 +76,11 @@ def test_guess_from_the_fukuchi_trial(able):
     assert 0.65 < g.period < 0.75 and "41 left-leg cycles" in g.source
     knee = -np.degrees(g.q[:, able.dof("knee_angle_l")])
     assert knee[0] < 25 and knee.max() > 90
+    # the measured force, in body weights: mean 1 over the stride, peaks 2.3–2.6 BW, two
+    # stances with flight between them
+    f = g.vertical_grf_bw
+    assert np.trapezoid(f, dx=1 / 50) == pytest.approx(1.0, rel=0.02)
+    assert 2.3 < f.max() < 2.7 and (f < 0.05).sum() > 10
     with pytest.raises(SpecError, match="running speed"):
         guess_from_trial(able, FUKUCHI / "RBDS001runT35.c3d")
 
@@ -79,3 +91,4 @@ def test_guess_from_the_shipped_reflex_solution():
     assert abs(g.speed - 3.5) < 0.2 and 0.6 < g.period < 0.85
     assert g.activation.min() >= 0.01 - 1e-12 and g.activation.max() <= 1.0
     assert g.tendon_force.min() >= 0.0 and g.tendon_force.max() < 2.0
+    assert np.trapezoid(g.vertical_grf_bw, dx=1 / 30) == pytest.approx(1.0, rel=0.05)

@@ -85,10 +85,19 @@ def test_weakly_determined_parameter_flagged_by_width():
                                  n_effective=50)
     assert res.poorly_determined[1] and not res.poorly_determined[0]
     assert "half-width" in res.reasons[1]
-    # started away from the optimum: flagged as not converged
+    # started away from the optimum: the profiles' lowest point becomes the estimate
     off = assess_identifiability(residuals, x_hat + [0.3, 0.0], [(0, 4), (-50, 50)],
                                  names=("K", "D"), n_effective=50)
-    assert "did not converge" in off.reasons[0]
+    assert off.converged and off.recentred >= 1 and "did not converge" not in off.reasons[0]
+    assert off.x[0] == pytest.approx(x_hat[0], abs=0.02)
+    assert np.allclose(off.x_start, x_hat + [0.3, 0.0]) and "estimate moved" in off.notes[0]
+    for i in range(2):
+        assert off.ci_lower[i] <= off.x[i] <= off.ci_upper[i]
+    # without re-centring it says what is wrong
+    stuck = assess_identifiability(residuals, x_hat + [0.3, 0.0], [(0, 4), (-50, 50)],
+                                   names=("K", "D"), n_effective=50, max_recentre=0)
+    assert not stuck.converged and "did not converge" in stuck.reasons[0]
+    assert stuck.ci_lower[0] <= stuck.x[0] <= stuck.ci_upper[0]  # widened to contain it
 
 
 def test_landscape_is_one_batch_and_tidy():
@@ -103,3 +112,26 @@ def test_landscape_is_one_batch_and_tidy():
     best = df.loc[df["cost"].idxmin()]
     assert best["K"] == pytest.approx(1.0) and best["D"] == pytest.approx(2.0)
     assert df["K"].min() == pytest.approx(0.5) and df["D"].max() == pytest.approx(3.0)
+
+
+def test_estimate_inside_its_interval_on_a_curved_valley_and_limits_clipped():
+    # a curved valley (banana): the given point lies on the valley's side, far from the minimum
+    t = np.linspace(0, 1, 120)
+    y = np.exp(-1.3 * t) * 0.8 + 0.01 * np.random.default_rng(4).standard_normal(120)
+
+    def residuals(X):
+        a, b = X[:, :1], X[:, 1:2]
+        return a * np.exp(-(b**2) * t[None, :]) - y
+
+    res = assess_identifiability(residuals, [0.95, 1.4], [(0.0, 3.0), (-0.5, 3.0)],
+                                 names=("K", "D"), physical_lower={"D": 0.0})
+    for i in range(2):
+        assert res.ci_lower[i] <= res.x[i] <= res.ci_upper[i]
+    assert res.ci_lower[1] >= 0.0
+    # a wide interval on a parameter near 0 is clipped at its physical minimum, with a note
+    flat = assess_identifiability(lambda X: X[:, :1] * t[None, :] + 1e-3 * X[:, 1:2] - t,
+                                  [1.0, 0.05], [(0.0, 2.0), (-5.0, 5.0)], names=("K", "D"),
+                                  n_effective=120, physical_lower={"D": 0.0})
+    assert flat.ci_lower[1] == 0.0 and flat.ci_clipped[1]
+    assert any("clipped at 0" in n for n in flat.notes)
+    assert flat.ci_lower[1] <= flat.x[1] <= flat.ci_upper[1]

@@ -102,3 +102,49 @@ def test_the_study_report_opens_in_headlesschromium(tmp_path, report):
     assert len(figures) == FIGURES
     for fig in figures:
         assert figure_ok(fig), fig
+
+
+def _flag_only(study, trial_id, *, reason="test: marked by hand"):
+    """Mark exactly one trial flagged in the study's results (others not flagged)."""
+    import sqlite3
+
+    con = sqlite3.connect(study / "results.sqlite")
+    with con:
+        con.execute("UPDATE results SET flagged = 0, flags = ''")
+        con.execute("UPDATE results SET flagged = 1, flags = ? WHERE trial_id = ?",
+                    (reason, trial_id))
+    con.close()
+
+
+def _tested(stats: pd.DataFrame) -> int:
+    """Trials in the Kruskal–Wallis test across groups (the sum of its group sizes)."""
+    kw = stats[stats["test"] == "Kruskal-Wallis H"].iloc[0]
+    return sum(int(v) for v in str(kw["n"]).split(" | "))
+
+
+def test_a_flagged_trial_is_marked_and_left_out_of_group_tests(study, report, tmp_path):
+    from bladelab.report.study_quality import FLAG_MARK
+
+    trials = pd.read_csv(report.index.parent / "tables" / "trials.csv")
+    largest = trials["group"].value_counts().index[0]  # a group that keeps members
+    trial_id = sorted(trials.loc[trials["group"] == largest, "trial_id"])[0]
+    _flag_only(study, trial_id)
+    out = tmp_path / "flagged"
+    res = build_study_report(study, out_dir=out, landscape_points=5, progress=False)
+    html = (out / "index.html").read_text(encoding="utf-8")
+    assert res.n_flagged == 1 and not res.flagged_in_statistics
+    assert "Flagged trials" in html and "test: marked by hand" in html
+    # marked in the trials table: its row carries the flag
+    row = re.search(rf"<tr><td>{trial_id}</td><td>([^<]*)</td>", html)
+    assert row is not None and row.group(1) == FLAG_MARK
+    assert "1 of " in html and "LEFT OUT" in html
+    stats = pd.read_csv(out / "tables" / "statistics.csv")
+    assert _tested(stats) == res.n_trials - 1
+    # kept with --include-flagged (the CLI option)
+    out2 = tmp_path / "kept"
+    assert main(["report", str(study), "--include-flagged", "--out", str(out2), "--json"]) == 0
+    stats2 = pd.read_csv(out2 / "tables" / "statistics.csv")
+    assert _tested(stats2) == res.n_trials
+    html2 = (out2 / "index.html").read_text(encoding="utf-8")
+    assert "KEPT in the group statistics" in html2
+    assert re.search(rf"<tr><td>{trial_id}</td><td>{FLAG_MARK}</td>", html2)

@@ -188,7 +188,9 @@ def run_example_pipeline(
         echo(f"      failed: {tid}: {msg[:160]}")
     rep = build_study_report(made.folder, progress=progress)
     t3 = time.perf_counter()
-    echo(f"[3/3] report of {rep.n_trials} trials ({t3 - t2:.1f} s)")
+    flagged = (f", {rep.n_flagged} flagged and left out of the group statistics (listed in "
+               "the report)" if rep.n_flagged else "")
+    echo(f"[3/3] report of {rep.n_trials} trials{flagged} ({t3 - t2:.1f} s)")
     return PipelineResult(
         folder=made.folder, report=rep.index, generated=made.generated, n_trials=made.n_trials,
         n_identified=run.finished + run.skipped, n_failed=len(run.failures),

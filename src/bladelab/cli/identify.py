@@ -90,8 +90,14 @@ def _identify(
     lines.append(f"{d['evaluations']} simulations ({d['optimizer']}, seed {d['seed']}, "
                  f"formulation {d['formulation']}), "
                  f"{d['wall_s']:.2f} s")
+    for note in d.get("notes", []):
+        lines.append(f"note: {note}")
     for name, why in d["poorly_determined"].items():
         lines.append(f"warning: {name} is poorly determined: {why}")
+    quality = d.get("quality") or {}
+    if quality.get("flagged"):
+        lines.append("flagged (left out of group statistics in a study report): "
+                     + "; ".join(quality["flags"]))
     typer.echo("\n".join(lines))
 
 
@@ -105,6 +111,10 @@ def _identify_study(path: Path, *, blade, seed, as_json, jobs, executor, force, 
     else:
         typer.echo(f"{run.finished} identified, {run.skipped} already done, {len(run.failures)} "
                    f"failed, of {run.total} ({run.wall_s:.1f} s, {run.executor}, {run.jobs} job(s))")
+        if run.flagged:
+            typer.echo(f"{len(run.flagged)} flagged (poorly determined or poorly fitted; left out "
+                       "of the report's group statistics unless --include-flagged): "
+                       + ", ".join(run.flagged[:10]) + (" ..." if len(run.flagged) > 10 else ""))
         for trial, msg in run.failures:
             typer.echo(f"failed: {trial}: {msg}", err=True)
     if run.failures:
@@ -113,7 +123,7 @@ def _identify_study(path: Path, *, blade, seed, as_json, jobs, executor, force, 
 
 _SHOWN = ["trial_id", "variant", "status", "athlete", "blade", "category", "configuration",
           "speed_pct_pb", "K_Nm_per_deg", "D_Nms_per_deg", "K_ci_low_Nm_per_deg",
-          "K_ci_high_Nm_per_deg", "nrmse_grf_pct", "nrmse_distance_pct", "error"]
+          "K_ci_high_Nm_per_deg", "nrmse_grf_pct", "nrmse_distance_pct", "flags", "error"]
 
 
 def _results(

@@ -22,6 +22,10 @@ def _report(
     out: Path | None = typer.Option(None, "--out", help="Report folder (default PATH/report)."),
     export: bool = typer.Option(False, "--export", help="Predictive results: also write each "
                                 "solution as OpenSim .mot files and a states CSV (report/export/)."),
+    include_flagged: bool = typer.Option(False, "--include-flagged", help="Study: keep flagged "
+                                         "trials (poorly determined or poorly fitted) in the group "
+                                         "statistics; by default they are left out, listed and "
+                                         "marked."),
     as_json: bool = typer.Option(False, "--json", help="Print the result as JSON."),
 ) -> None:
     """Write PATH/report/index.html: fits, K*/D*, mechanics, statistics, identifiability (a
@@ -53,11 +57,14 @@ def _report(
         typer.echo(json.dumps({"index": str(index)}) if as_json else f"report written: {index}")
         return
     res = build_study_report(study_dir, trial=trial, variant=variant, out_dir=out,
-                             progress=not as_json)
+                             progress=not as_json, include_flagged=include_flagged)
     if as_json:
         typer.echo(json.dumps(res.to_dict(), indent=2))
         return
     extra = f", {res.n_failed} not reported" if res.n_failed else ""
+    if res.n_flagged:
+        extra += (f", {res.n_flagged} flagged " +
+                  ("kept in" if include_flagged else "left out of") + " group statistics")
     typer.echo(f"report written: {res.index} ({res.n_trials} trials{extra})")
 
 

@@ -33,6 +33,7 @@ from bladelab.identify.optimizers import (
     minimize,
     polish,
 )
+from bladelab.identify.quality import QualityThresholds, TrialQuality, assess_quality
 
 __all__ = [
     "CMAES",
@@ -45,8 +46,11 @@ __all__ = [
     "OptimizeResult",
     "ParameterBounds",
     "ParticleSwarm",
+    "QualityThresholds",
+    "TrialQuality",
     "StanceCost",
     "assess_identifiability",
+    "assess_quality",
     "compare_spring_locations",
     "compare_spring_models",
     "contact_window",

@@ -15,16 +15,22 @@ squares RSS(θ) = ‖r(θ)‖² is the least-squares analogue of the identificat
 - **Effective sample size**: residuals of a time series are autocorrelated; by default n_eff is
   n·(1 − ρ₁)/(1 + ρ₁) with ρ₁ the lag-1 autocorrelation of the residuals at the optimum (AR(1)),
   so intervals are not over-confident because of a high sampling rate.
+- **Re-centring**: the search minimises J (a sum of nRMSEs), the profiles the RSS (a sum of their
+  squares); when a profile finds an RSS lower than at ``x_opt`` by more than a tenth of the interval
+  threshold (ΔRSS/s² > 0.1·F), that point becomes the estimate and the analysis starts again there
+  (at most ``max_recentre`` times). The estimate always lies inside its own interval (an interval
+  that would miss it, e.g. a multimodal profile, is widened, with a note); limits below a
+  parameter's physical minimum (``physical_lower``, e.g. D < 0) are clipped, with a note.
 - **Flags**: a parameter is poorly determined when its interval reaches a search bound (open), its
   half-width exceeds ``max_rel_halfwidth`` of the estimate, it correlates with another parameter
-  with |ρ| > ``max_abs_corr`` (K–D compensation), or the optimiser did not converge (a profile
-  found an RSS lower than at ``x_opt`` by more than a tenth of the interval threshold).
+  with |ρ| > ``max_abs_corr`` (K–D compensation), or the optimiser did not converge (still a
+  clearly lower RSS after the re-centrings).
 """
 
 from __future__ import annotations
 
 import dataclasses
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 
 import numpy as np
 import pandas as pd
@@ -99,8 +105,9 @@ def _profile(
     *,
     iterations: int,
     rel_step: float,
-) -> tuple[np.ndarray, int]:
-    """Minimum RSS over the other parameters at each grid value of parameter ``index``."""
+) -> tuple[np.ndarray, int, np.ndarray]:
+    """Minimum RSS over the other parameters at each grid value of parameter ``index``, the
+    evaluations used and the (m, d) parameter sets where each minimum was found."""
     d = len(x_opt)
     free = [j for j in range(d) if j != index]
     m = len(grid)
@@ -108,7 +115,8 @@ def _profile(
     X[:, index] = grid
     if not free:
         R = _eval_residuals(residual_batch, X)
-        return np.sum(R**2, axis=1), m
+        rss = np.sum(R**2, axis=1)
+        return np.where(np.isfinite(rss), rss, np.inf), m, X
     bf = b[free]
     h = rel_step * (bf[:, 1] - bf[:, 0])
     k = len(free)
@@ -136,10 +144,13 @@ def _profile(
         for i in range(m):
             r0 = R[i, 0]
             rss = float(r0 @ r0)
+            Ji = (R[i, 1 : 1 + k] - R[i, 1 + k :]).T / rows[i][1]
+            # a failed simulation (non-finite residuals) is never accepted nor stepped from
             if np.isfinite(rss) and rss < cur_rss[i]:
                 cur[i], cur_rss[i] = trial[i], rss
-                cur_r[i] = r0
-                cur_J[i] = (R[i, 1 : 1 + k] - R[i, 1 + k :]).T / rows[i][1]
+                ok = np.all(np.isfinite(Ji))
+                cur_r[i] = r0 if ok else None
+                cur_J[i] = Ji if ok else None
                 lam[i] = max(lam[i] / 3.0, 1e-9)
             else:
                 lam[i] *= 4.0
@@ -149,11 +160,15 @@ def _profile(
                 continue
             H = J.T @ J
             g = J.T @ r
-            step = -np.linalg.solve(H + lam[i] * np.diag(np.diag(H) + 1e-300), g)
+            try:
+                step = -np.linalg.solve(H + lam[i] * np.diag(np.diag(H) + 1e-300), g)
+            except np.linalg.LinAlgError:
+                step = np.full(k, np.nan)
             nxt = cur[i].copy()
-            nxt[free] = np.clip(cur[i][free] + step, bf[:, 0], bf[:, 1])
+            if np.all(np.isfinite(step)):
+                nxt[free] = np.clip(cur[i][free] + step, bf[:, 0], bf[:, 1])
             trial[i] = nxt
-    return cur_rss, evals
+    return cur_rss, evals, cur
 
 
 def _crossing(grid: np.ndarray, z: np.ndarray, center: int, threshold: float, side: int):
@@ -198,6 +213,16 @@ class Identifiability:
         Tidy DataFrame: parameter, value, rss (the profiles).
     evaluations
         Residual evaluations used.
+    converged
+        False when the profiles still found a clearly lower RSS after ``recentred`` re-centrings.
+    recentred
+        How many times the estimate moved to a lower point found by the profiles.
+    x_start
+        The ``x_opt`` given (``x`` is the estimate after re-centring).
+    ci_clipped
+        Per parameter: the lower limit was clipped to its physical minimum.
+    notes
+        What was changed (re-centring, widened or clipped intervals), for the messages.
     """
 
     names: tuple[str, ...]
@@ -214,6 +239,11 @@ class Identifiability:
     reasons: tuple[str, ...]
     profiles: pd.DataFrame
     evaluations: int
+    converged: bool = True
+    recentred: int = 0
+    x_start: np.ndarray | None = None
+    ci_clipped: tuple[bool, ...] = ()
+    notes: tuple[str, ...] = ()
 
     def to_dict(self) -> dict:
         """JSON-ready dictionary (no profiles)."""
@@ -231,6 +261,9 @@ class Identifiability:
             "poorly_determined": list(self.poorly_determined),
             "reasons": list(self.reasons),
             "evaluations": self.evaluations,
+            "converged": self.converged,
+            "recentred": self.recentred,
+            "notes": list(self.notes),
         }
 
 
@@ -247,6 +280,8 @@ def assess_identifiability(
     rel_step: float = 1e-3,
     max_rel_halfwidth: float = 0.25,
     max_abs_corr: float = 0.95,
+    max_recentre: int = 3,
+    physical_lower: Mapping[str, float] | None = None,
 ) -> Identifiability:
     """Correlation, profile-likelihood confidence intervals and flags at ``x_opt``.
 
@@ -272,56 +307,105 @@ def assess_identifiability(
         Finite-difference step as a fraction of the box width.
     max_rel_halfwidth, max_abs_corr
         Flag thresholds.
+    max_recentre
+        How often the analysis may move to a clearly lower point found by the profiles and start
+        again there; still lower after that: flagged as not converged.
+    physical_lower
+        Parameter name -> lowest physical value (e.g. 0 for a damping); interval limits below it
+        are clipped to it (``ci_clipped``, with a note).
+
+    The returned ``x`` is the estimate: ``x_opt`` itself, or the lowest point the profiles found
+    when that is clearly lower (``recentred`` > 0). The interval of every parameter contains it.
     """
     b = as_bounds(bounds)
     x = np.clip(np.asarray(x_opt, dtype=float), b[:, 0], b[:, 1])
+    x_start = x.copy()
     d = len(x)
     names = tuple(names) if names is not None else tuple(f"p{i}" for i in range(d))
     if len(names) != d:
         raise OptimizationError(f"{len(names)} names for {d} parameters", where="names")
-    r0, J = jacobian(residual_batch, x, bounds=b, rel_step=rel_step)
-    evals = 2 * d + 1
-    rss0 = float(r0 @ r0)
-    n_eff = effective_sample_size(r0, d) if n_effective is None else float(n_effective)
-    if n_eff <= d:
-        raise OptimizationError(f"n_effective={n_eff:g} must exceed the {d} parameters", where="n_effective")
-    s2 = max(rss0, 1e-300) / (n_eff - d)
-    cov, corr = _covariance(J, s2)
-    threshold = float(np.sqrt(stats.f.ppf(level, 1, n_eff - d)))
-    sd = np.sqrt(np.diag(cov))
-    half = max(1, n_profile // 2)
-    lo_ci, hi_ci, opened, frames = [], [], [], []
-    profile_min = rss0
-    for i in range(d):
-        width = b[i, 1] - b[i, 0]
-        span = min(max(3.0 * threshold * sd[i], 1e-3 * width), width)
-        left = np.linspace(max(x[i] - span, b[i, 0]), x[i], half + 1)
-        right = np.linspace(x[i], min(x[i] + span, b[i, 1]), half + 1)
-        grid = np.concatenate([left[:-1], right])
-        rss, n = _profile(residual_batch, x, b, i, grid, iterations=profile_iterations,
-                          rel_step=rel_step)
-        evals += n
-        rss_min = min(rss0, float(np.min(rss)))
-        profile_min = min(profile_min, float(np.min(rss)))
-        z = np.sqrt(np.maximum(rss - rss_min, 0.0) / s2)
-        centre = int(np.argmin(rss))  # the optimiser's point may sit slightly off the minimum
-        lo_v, lo_open = _crossing(grid, z, centre, threshold, -1)
-        hi_v, hi_open = _crossing(grid, z, centre, threshold, +1)
-        lo_open = lo_open and np.isclose(lo_v, b[i, 0])
-        hi_open = hi_open and np.isclose(hi_v, b[i, 1])
-        lo_ci.append(lo_v)
-        hi_ci.append(hi_v)
-        opened.append(bool(lo_open or hi_open))
-        frames.append(pd.DataFrame({"parameter": names[i], "value": grid, "rss": rss}))
-    lo_ci, hi_ci = np.asarray(lo_ci), np.asarray(hi_ci)
-    # the optimum should be the lowest point the profiles saw; a clearly lower RSS elsewhere means
-    # the optimiser stopped early (more evaluations, polish=True or CMA-ES)
-    not_converged = (rss0 - profile_min) / s2 > 0.1 * threshold**2
+    if not np.all(np.isfinite(x)):
+        raise OptimizationError("the optimum has non-finite parameters", where="x_opt")
+    evals = 0
+    recentred = 0
+    notes: list[str] = []
+    while True:
+        r0, J = jacobian(residual_batch, x, bounds=b, rel_step=rel_step)
+        evals += 2 * d + 1
+        if not (np.all(np.isfinite(r0)) and np.all(np.isfinite(J))):
+            raise OptimizationError("the residuals at (or next to) the optimum are not finite",
+                                    where="residual_batch",
+                                    hint="the simulation failed there; see the solver's messages")
+        rss0 = float(r0 @ r0)
+        n_eff = effective_sample_size(r0, d) if n_effective is None else float(n_effective)
+        if n_eff <= d:
+            raise OptimizationError(f"n_effective={n_eff:g} must exceed the {d} parameters",
+                                    where="n_effective")
+        s2 = max(rss0, 1e-300) / (n_eff - d)
+        cov, corr = _covariance(J, s2)
+        threshold = float(np.sqrt(stats.f.ppf(level, 1, n_eff - d)))
+        sd = np.sqrt(np.diag(cov))
+        half = max(1, n_profile // 2)
+        lo_ci, hi_ci, opened, frames = [], [], [], []
+        best_rss, best_x = rss0, x.copy()
+        for i in range(d):
+            width = b[i, 1] - b[i, 0]
+            span = min(max(3.0 * threshold * sd[i], 1e-3 * width), width)
+            left = np.linspace(max(x[i] - span, b[i, 0]), x[i], half + 1)
+            right = np.linspace(x[i], min(x[i] + span, b[i, 1]), half + 1)
+            grid = np.concatenate([left[:-1], right])
+            rss, n, where = _profile(residual_batch, x, b, i, grid,
+                                     iterations=profile_iterations, rel_step=rel_step)
+            evals += n
+            rss = np.where(np.isfinite(rss), rss, np.inf)
+            j = int(np.argmin(rss))
+            if rss[j] < best_rss:
+                best_rss, best_x = float(rss[j]), where[j].copy()
+            rss_min = min(rss0, float(rss[j]))
+            z = np.sqrt(np.maximum(rss - rss_min, 0.0) / s2)
+            lo_v, lo_open = _crossing(grid, z, j, threshold, -1)
+            hi_v, hi_open = _crossing(grid, z, j, threshold, +1)
+            lo_open = lo_open and np.isclose(lo_v, b[i, 0])
+            hi_open = hi_open and np.isclose(hi_v, b[i, 1])
+            lo_ci.append(lo_v)
+            hi_ci.append(hi_v)
+            opened.append(bool(lo_open or hi_open))
+            frames.append(pd.DataFrame({"parameter": names[i], "value": grid, "rss": rss}))
+        # the estimate should be the lowest point the profiles saw; a clearly lower RSS elsewhere
+        # means the search stopped short of the least-squares optimum (or optimised another
+        # cost: J sums nRMSEs, the RSS their squares): that point becomes the estimate and the
+        # analysis is repeated there
+        gap = (rss0 - best_rss) / s2
+        not_converged = gap > 0.1 * threshold**2
+        if not not_converged or recentred >= max_recentre:
+            break
+        recentred += 1
+        x = np.clip(best_x, b[:, 0], b[:, 1])
+    lo_ci, hi_ci = np.asarray(lo_ci, dtype=float), np.asarray(hi_ci, dtype=float)
+    if recentred:
+        moved = ", ".join(f"{n} {a:.4g} -> {c:.4g}" for n, a, c in zip(names, x_start, x, strict=True))
+        notes.append(f"estimate moved from the search's optimum to the lowest cost the profiles "
+                     f"found ({moved}; {recentred} re-centring(s))")
+    # an estimate always lies inside its own interval: a profile whose minimum is not at the
+    # estimate (multimodal or not converged) could leave it outside; the interval is widened
+    extended = [i for i in range(d) if not lo_ci[i] <= x[i] <= hi_ci[i]]
+    for i in extended:
+        lo_ci[i], hi_ci[i] = min(lo_ci[i], x[i]), max(hi_ci[i], x[i])
+        notes.append(f"interval of {names[i]} widened to contain the estimate")
+    clipped = [False] * d
+    for i, name in enumerate(names):
+        floor = (physical_lower or {}).get(name)
+        if floor is not None and lo_ci[i] < floor:
+            lo_ci[i] = floor
+            clipped[i] = True
+            notes.append(f"lower limit of {name} clipped at {floor:g} (non-physical below)")
     flags, reasons = [], []
     for i in range(d):
         why = []
         if not_converged:
-            why.append("the optimiser did not converge (the profiles found a lower cost)")
+            why.append(f"the optimiser did not converge: after {recentred} re-centring(s) the "
+                       f"profiles still found a lower cost (ΔRSS/s² = {gap:.3g}); raise max_evals "
+                       "or use --polish / CMA-ES")
         if opened[i]:
             why.append("confidence interval reaches a search bound")
         rel = 0.5 * (hi_ci[i] - lo_ci[i]) / max(abs(x[i]), 1e-300)
@@ -337,6 +421,8 @@ def assess_identifiability(
         ci_open=tuple(opened), level=float(level), n_effective=n_eff, rss=rss0,
         poorly_determined=tuple(flags), reasons=tuple(reasons),
         profiles=pd.concat(frames, ignore_index=True), evaluations=evals,
+        converged=not not_converged, recentred=recentred, x_start=x_start,
+        ci_clipped=tuple(clipped), notes=tuple(notes),
     )
 
 

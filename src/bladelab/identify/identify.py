@@ -31,6 +31,7 @@ from bladelab.identify.cost import StanceCost
 from bladelab.identify.formulations import DEFAULT_FORMULATION, DISTANCE_ONLY, formulation_drive
 from bladelab.identify.identifiability import assess_identifiability, effective_sample_size
 from bladelab.identify.optimizers import minimize
+from bladelab.identify.quality import TrialQuality, assess_quality
 from bladelab.parameters import JOINT_PARAMETERS
 from bladelab.sim.api import DEFAULT_DT
 
@@ -73,6 +74,11 @@ class Identification:
         Simulations used by the identifiability analysis.
     formulation
         How the stance drove the model (:mod:`bladelab.identify.formulations`).
+    quality
+        Quality indicators and flags (:mod:`bladelab.identify.quality`).
+    notes
+        What the identifiability step changed (estimate moved to the profiles' lowest point,
+        interval widened or clipped), in words.
     """
 
     K_Nm_per_deg: float
@@ -95,6 +101,8 @@ class Identification:
     bounds: dict
     ci_evaluations: int
     formulation: str = "seed"
+    quality: TrialQuality | None = None
+    notes: tuple[str, ...] = ()
 
     def to_dict(self) -> dict:
         """JSON-ready dictionary with the keys of the CLI's ``--json`` output."""
@@ -125,7 +133,10 @@ class Identification:
             "bic": self.bic,
             "bounds": self.bounds,
             "ci_evaluations": self.ci_evaluations,
+            "notes": list(self.notes),
         })
+        if self.quality is not None:
+            out["quality"] = self.quality.to_dict()
         return out
 
     def to_row(self) -> dict:
@@ -142,6 +153,8 @@ class Identification:
             row["K_ci_low_Nm_per_deg"], row["K_ci_high_Nm_per_deg"] = self.ci["K"]
         if "D" in self.ci:
             row["D_ci_low_Nms_per_deg"], row["D_ci_high_Nms_per_deg"] = self.ci["D"]
+        if self.quality is not None:
+            row.update(self.quality.to_row())
         return row
 
 
@@ -166,6 +179,22 @@ def _with_joint(blade: BladeModel, joint: int | None) -> BladeModel:
 
 def _to_edge(name: str, value: float) -> float:
     return JOINT_PARAMETERS[name].to_edge(value)
+
+
+PHYSICAL_LOWER: dict[str, float] = {"K": 0.0, "D": 0.0}
+"""Lowest physical value of each parameter (SI): a confidence limit below it is clipped."""
+
+
+def _edge_note(note: str) -> str:
+    """An identifiability note with the SI values of K and D in edge units (N·m/deg ...)."""
+    import re
+
+    def conv(m):
+        name, a, b = m.group(1), float(m.group(2)), float(m.group(3))
+        p = JOINT_PARAMETERS[name]
+        return f"{name} {p.to_edge(a):.4g} -> {p.to_edge(b):.4g} {p.edge_unit}"
+
+    return re.sub(r"\b(K2|K|D) ([-+0-9.eE]+) -> ([-+0-9.eE]+)", conv, note)
 
 
 def identify_stance(
@@ -291,37 +320,57 @@ def identify_stance(
         polish = nonlinear
     opt = minimize(fun_batch, box, optimizer=optimizer, seed=seed, max_evals=max_evals,
                    polish=polish)
-    res = run(opt.x[None, :])
-    terms = cost.evaluate(grf_z=res.grf_z, grf_x=res.grf_x, distance=res.distance)
+    x = np.asarray(opt.x, dtype=float)
     ci: dict[str, tuple[float, float]] = {}
+    ci_open: dict[str, bool] = {}
     corr = float("nan")
     flagged: dict[str, str] = {}
+    notes: tuple[str, ...] = ()
+    converged: bool | None = None
     ci_evals = 0
     names = bounds.names
-    r = cost.residuals(grf_z=res.grf_z, grf_x=res.grf_x, distance=res.distance)[0]
-    n_eff = effective_sample_size(r, len(names))
+    n_eff = None
     if identifiability:
-        ident = assess_identifiability(residual_batch, opt.x, box, names=names)
+        ident = assess_identifiability(residual_batch, x, box, names=names,
+                                       physical_lower=PHYSICAL_LOWER)
+        x = ident.x  # the lowest point the profiles found, if clearly below the search's optimum
         ci = {n: (_to_edge(n, lo), _to_edge(n, hi))
               for n, lo, hi in zip(names, ident.ci_lower, ident.ci_upper, strict=True)}
+        ci_open = dict(zip(names, ident.ci_open, strict=True))
         corr = float(ident.correlation[0, 1])
         flagged = {n: why for n, flag, why in zip(names, ident.poorly_determined, ident.reasons,
                                                    strict=True) if flag}
         ci_evals = ident.evaluations
         n_eff = ident.n_effective
+        converged = ident.converged
+        notes = tuple(_edge_note(n) for n in ident.notes)
+    res = run(x[None, :])
+    terms = cost.evaluate(grf_z=res.grf_z, grf_x=res.grf_x, distance=res.distance)
+    r = cost.residuals(grf_z=res.grf_z, grf_x=res.grf_x, distance=res.distance)[0]
+    if n_eff is None:
+        n_eff = effective_sample_size(r, len(names))
     rss = max(float(r @ r), 1e-300)
     k = len(names)
     aic = n_eff * math.log(rss / n_eff) + 2 * k
     bic = n_eff * math.log(rss / n_eff) + k * math.log(n_eff)
+    estimate = {n: _to_edge(n, v) for n, v in zip(names, x, strict=True)}
+    edge_bounds = {n: (_to_edge(n, lo), _to_edge(n, hi)) for n, (lo, hi) in zip(names, box, strict=True)}
+    quality = assess_quality(
+        estimate=estimate, bounds=edge_bounds, ci=ci, ci_open=ci_open, correlation=corr,
+        converged=converged, nrmse_grf_pct=100 * float(terms.nrmse_grf[0]),
+        nrmse_distance_pct=100 * float(terms.nrmse_distance[0]),
+        peak_force_measured_N=float(np.max(cost.references.get("grf_z", stance.grf_z[cost.mask]))),
+        peak_force_simulated_N=float(np.max(np.asarray(res.grf_z)[0][cost.mask])),
+    )
     return Identification(
-        K_Nm_per_deg=_to_edge("K", opt.x[0]), D_Nms_per_deg=_to_edge("D", opt.x[1]),
-        K2_Nm_per_deg2=_to_edge("K2", opt.x[2]) if nonlinear else None,
+        K_Nm_per_deg=estimate["K"], D_Nms_per_deg=estimate["D"],
+        K2_Nm_per_deg2=estimate["K2"] if nonlinear else None,
         nrmse_grf_pct=100 * float(terms.nrmse_grf[0]),
         nrmse_distance_pct=100 * float(terms.nrmse_distance[0]), cost=float(terms.cost[0]),
         evaluations=opt.evaluations, wall_s=time.perf_counter() - t0, seed=int(seed),
         optimizer=opt.optimizer, joint_point=point, ci=ci, ci_level=0.95, KD_correlation=corr,
         poorly_determined=flagged, aic=float(aic), bic=float(bic), bounds=bounds.to_dict(),
-        ci_evaluations=ci_evals, formulation=str(formulation),
+        ci_evaluations=ci_evals, formulation=str(formulation), quality=quality, notes=notes,
     )
 
 

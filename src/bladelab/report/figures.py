@@ -8,7 +8,7 @@ Groups are given as ``{group name: [items...]}`` mappings, in display order.
 from __future__ import annotations
 
 import functools
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Collection, Mapping, Sequence
 from typing import Literal, TypeVar
 
 import numpy as np
@@ -34,6 +34,7 @@ MEASURED = "#222222"
 SIMULATED = "#D55E00"
 LOADING = "#0072B2"
 UNLOADING = "#D55E00"
+FLAGGED = "#8a8a8a"
 
 _RC = {
     "font.size": 9,
@@ -114,6 +115,19 @@ def _mean_sd(stances: Sequence[Stance], name: str, n_points: int) -> tuple[np.nd
     return curves.mean(axis=0), sd
 
 
+def _trial_id(item) -> str | None:
+    meta = getattr(item, "metadata", None) or {}
+    t = meta.get("trial")
+    return None if t is None else str(t)
+
+
+def _split_flagged(items: Sequence, flagged: Collection[str]) -> tuple[list, list]:
+    """(kept, flagged) items by their ``metadata["trial"]``."""
+    keep = [it for it in items if _trial_id(it) not in flagged]
+    out = [it for it in items if _trial_id(it) in flagged]
+    return keep, out
+
+
 @_styled
 def time_series_bands(
     measured: Mapping[str, Sequence[Stance]],
@@ -121,6 +135,8 @@ def time_series_bands(
     *,
     signal: Signal = "grf",
     n_points: int = 101,
+    flagged: Collection[str] = (),
+    include_flagged: bool = False,
 ) -> Figure:
     """GRF or distance vs stance time, measured vs simulated, group mean ± SD (Figs. 1–2).
 
@@ -137,6 +153,11 @@ def time_series_bands(
         ``"grf"`` (vertical GRF [N]) or ``"distance"`` (clamp–tip distance, shown in mm).
     n_points
         Samples of the normalised curves.
+    flagged
+        Trial ids (``metadata["trial"]``) of flagged trials: drawn one by one as thin grey dotted
+        lines (measured) and, unless ``include_flagged``, left out of the mean ± SD bands.
+    include_flagged
+        Keep flagged trials in the bands (they are still drawn and marked).
     """
     if signal not in SIGNALS:
         raise DataError(f"unknown signal {signal!r}", where="signal", hint="'grf' or 'distance'")
@@ -144,12 +165,18 @@ def time_series_bands(
     name, scale, label = SIGNALS[signal]
     pct = np.linspace(0.0, 100.0, n_points)
     fig, axes = _figure(len(measured))
+    marked = False
     for ax, (group, stances) in zip(axes, measured.items(), strict=True):
         _style(ax)
-        series = [("measured", MEASURED, "-", stances)]
-        if simulated is not None and simulated.get(group):
-            series.append(("simulated", SIMULATED, "--", simulated[group]))
+        kept, bad = _split_flagged(stances, flagged)
+        sims = list(simulated.get(group, [])) if simulated is not None else []
+        series = [("measured", MEASURED, "-", stances if include_flagged else kept)]
+        if sims:
+            sims_kept, _ = _split_flagged(sims, flagged)
+            series.append(("simulated", SIMULATED, "--", sims if include_flagged else sims_kept))
         for lab, colour, ls, items in series:
+            if not items:
+                continue
             mean, sd = _mean_sd(items, name, n_points)
             ax.fill_between(
                 pct, (mean - sd) * scale, (mean + sd) * scale, color=colour, alpha=0.18, linewidth=0
@@ -162,11 +189,22 @@ def time_series_bands(
                 linewidth=1.6,
                 label=f"{lab} mean ± SD",
             )
-        ax.set_title(f"{group} (n = {len(stances)})")
+        for st in bad:
+            ax.plot(pct, resample_percent(st, name, n_points=n_points) * scale, color=FLAGGED,
+                    linestyle=":", linewidth=1.0,
+                    label=None if marked else ("flagged trial (in the band)" if include_flagged
+                                               else "flagged trial (left out)"))
+            marked = True
+        n_in = len(stances) if include_flagged else len(kept)
+        extra = f", {len(bad)} flagged" if bad else ""
+        ax.set_title(f"{group} (n = {n_in}{extra})")
         ax.set_xlabel("stance [%]")
         ax.set_ylabel(label)
         ax.set_xlim(0, 100)
-    axes[0].legend(loc="best")
+    handles = [h for ax in axes for h in ax.get_legend_handles_labels()[0]]
+    labels = [lab for ax in axes for lab in ax.get_legend_handles_labels()[1]]
+    uniq = dict(zip(labels, handles, strict=True))
+    axes[0].legend(list(uniq.values()), list(uniq), loc="best")
     return fig
 
 
@@ -176,17 +214,25 @@ def _loop_panels(
     xlabel: str,
     ylabel: str,
     get,
+    flagged: Collection[str] = (),
 ) -> Figure:
     _check_groups(mechanics, "mechanics")
     fig, axes = _figure(len(mechanics))
+    marked = False
     for ax, (group, items) in zip(axes, mechanics.items(), strict=True):
         _style(ax)
-        plotted = 0
+        plotted = n_flagged = 0
         for m in items:
             xy = get(m)
             if xy is None:
                 continue
             (xl, yl), (xu, yu) = xy
+            if _trial_id(m) in flagged:
+                ax.plot(np.concatenate([xl, xu]), np.concatenate([yl, yu]), color=FLAGGED,
+                        linewidth=1.0, linestyle=":", label=None if marked else "flagged trial")
+                marked = True
+                n_flagged += 1
+                continue
             ax.plot(
                 xl,
                 yl,
@@ -205,20 +251,30 @@ def _loop_panels(
                 label="unloading" if plotted == 0 else None,
             )
             plotted += 1
-        ax.set_title(f"{group} (n = {plotted})")
+        extra = f", {n_flagged} flagged" if n_flagged else ""
+        ax.set_title(f"{group} (n = {plotted}{extra})")
         ax.set_xlabel(xlabel)
         ax.set_ylabel(ylabel)
-        if plotted == 0:
+        if plotted + n_flagged == 0:
             ax.text(0.5, 0.5, "no data", transform=ax.transAxes, ha="center", color="#888888")
-    axes[0].legend(loc="best")
+    handles, labels = [], []
+    for ax in axes:
+        for h, lab in zip(*ax.get_legend_handles_labels(), strict=True):
+            if lab not in labels:
+                handles.append(h)
+                labels.append(lab)
+    axes[0].legend(handles, labels, loc="best")
     return fig
 
 
 @_styled
-def hysteresis_loops(mechanics: Mapping[str, Sequence[StanceMechanics]]) -> Figure:
+def hysteresis_loops(
+    mechanics: Mapping[str, Sequence[StanceMechanics]], *, flagged: Collection[str] = ()
+) -> Figure:
     """GRF vs angular deformation Δθ per group, loading and unloading branches (§3.4).
 
-    Stances without a blade angle are left out of their panel.
+    Stances without a blade angle are left out of their panel; flagged trials (ids in
+    ``flagged``, matched on ``metadata["trial"]``) are drawn grey and dotted.
     """
 
     def get(m: StanceMechanics):
@@ -229,12 +285,16 @@ def hysteresis_loops(mechanics: Mapping[str, Sequence[StanceMechanics]]) -> Figu
         (xl, yl), (xu, yu) = loop.loading, loop.unloading
         return (np.rad2deg(xl[i0:]), yl[i0:]), (np.rad2deg(xu), yu)
 
-    return _loop_panels(mechanics, xlabel="angular deformation Δθ [deg]", ylabel="GRF [N]", get=get)
+    return _loop_panels(mechanics, xlabel="angular deformation Δθ [deg]", ylabel="GRF [N]",
+                        get=get, flagged=flagged)
 
 
 @_styled
-def compressive_stiffness_curves(mechanics: Mapping[str, Sequence[StanceMechanics]]) -> Figure:
-    """Equivalent compressive stiffness K_c vs compression Δd per group (§3.5)."""
+def compressive_stiffness_curves(
+    mechanics: Mapping[str, Sequence[StanceMechanics]], *, flagged: Collection[str] = ()
+) -> Figure:
+    """Equivalent compressive stiffness K_c vs compression Δd per group (§3.5); flagged trials
+    grey and dotted."""
 
     def get(m: StanceMechanics):
         loop = m.compression_loop
@@ -243,7 +303,8 @@ def compressive_stiffness_curves(mechanics: Mapping[str, Sequence[StanceMechanic
         dd = m.compression * 1e3
         return (dd[: i + 1], kc[: i + 1]), (dd[i:], kc[i:])
 
-    return _loop_panels(mechanics, xlabel="compression Δd [mm]", ylabel="K_c [kN/m]", get=get)
+    return _loop_panels(mechanics, xlabel="compression Δd [mm]", ylabel="K_c [kN/m]", get=get,
+                        flagged=flagged)
 
 
 @_styled

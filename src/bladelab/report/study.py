@@ -60,17 +60,24 @@ class StudyReport:
         re-read.
     landscape_trial
         Trial of the cost landscape.
+    n_flagged
+        Reported trials flagged by their identification's quality.
+    flagged_in_statistics
+        Whether they were kept in the group statistics (``include_flagged``).
     """
 
     index: Path
     n_trials: int
     n_failed: int
     landscape_trial: str
+    n_flagged: int = 0
+    flagged_in_statistics: bool = False
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready dictionary."""
         return {"index": str(self.index), "n_trials": self.n_trials, "n_failed": self.n_failed,
-                "landscape_trial": self.landscape_trial}
+                "landscape_trial": self.landscape_trial, "n_flagged": self.n_flagged,
+                "flagged_in_statistics": self.flagged_in_statistics}
 
 
 
@@ -168,13 +175,18 @@ def _truth_figure(merged: pd.DataFrame):
             (p.edge_key, f"{p.name}_true", f"{p.name} [{p.edge_unit}]")
             for p in (JOINT_PARAMETERS["K"], JOINT_PARAMETERS["D"])):
         ax = fig.add_subplot(1, 2, i + 1)
-        for g, sub in merged.groupby("group", sort=False):
+        bad = merged["flagged"].fillna(False).astype(bool) if "flagged" in merged else \
+            pd.Series(False, index=merged.index)
+        for g, sub in merged[~bad].groupby("group", sort=False):
             ax.scatter(sub[true], sub[col], s=22, label=g, alpha=0.85)
             if f"{col}_ci_low" in sub and sub[f"{col}_ci_low"].notna().any():
                 ax.errorbar(sub[true], sub[col],
                             yerr=[np.clip(sub[col] - sub[f"{col}_ci_low"], 0, None),
                                   np.clip(sub[f"{col}_ci_high"] - sub[col], 0, None)],
                             fmt="none", ecolor="#999999", linewidth=0.7, capsize=1.5)
+        if bad.any():
+            ax.scatter(merged.loc[bad, true], merged.loc[bad, col], s=40, marker="x",
+                       color="#555555", label="flagged trial")
         lo = float(np.nanmin([merged[true].min(), merged[col].min()]))
         hi = float(np.nanmax([merged[true].max(), merged[col].max()]))
         pad = 0.05 * (hi - lo if hi > lo else 1.0)
@@ -199,6 +211,7 @@ def build_study_report(
     out_dir: str | Path | None = None,
     landscape_points: int = 15,
     progress: bool = True,
+    include_flagged: bool = False,
 ) -> StudyReport:
     """Write the study report ``STUDY_DIR/report/index.html`` (see the module docstring).
 
@@ -216,6 +229,9 @@ def build_study_report(
         Grid points per axis of the cost landscape.
     progress
         Show a progress bar while simulating.
+    include_flagged
+        Keep flagged trials (:mod:`bladelab.identify.quality`) in the group statistics; by
+        default they are left out (and still listed and marked).
 
     Raises
     ------
@@ -233,6 +249,7 @@ def build_study_report(
     from bladelab.mechanics import mechanics_table, stance_mechanics
     from bladelab.report import figures, tables
     from bladelab.report.builder import Report, ReportTable
+    from bladelab.report.study_quality import add_flagged_section, flag_column, row_quality
     from bladelab.stats import compare_groups, speed_band, summarize
     from bladelab.study.spec import RESULTS_FILE, load_study
     from bladelab.study.store import ResultsStore
@@ -275,6 +292,7 @@ def build_study_report(
     rows = []
     problems: list[tuple[str, str]] = [(str(r.trial_id), str(r.error)) for r in failed.itertuples()]
     landscape = None
+    flagged_ids: set[str] = set()
     formulations: set[str] = set()
     for tid, t in tqdm(trials.items(), desc="simulating", unit="trial", disable=not progress,
                        leave=False):
@@ -324,7 +342,11 @@ def build_study_report(
             ms = stance_mechanics(s_st)
         mech_m.setdefault(group, []).append(dataclasses.replace(mm, metadata={**mm.metadata, "trial": tid, "group": group, "source": "measured"}))
         mech_s.setdefault(group, []).append(dataclasses.replace(ms, metadata={**ms.metadata, "trial": tid, "group": group, "source": "simulated"}))
+        is_flagged, why = row_quality(r)
+        if is_flagged:
+            flagged_ids.add(tid)
         rows.append({
+            "flagged": is_flagged, "flags": why,
             "trial_id": tid, "athlete": t.athlete, "amputation": level, "group": group,
             "blade": t.blade, "category": entry.category, "configuration": t.configuration,
             "speed_pct_pb": t.speed_pct_pb if t.speed_pct_pb is not None else r.get("speed_pct_pb"),
@@ -332,7 +354,7 @@ def build_study_report(
                                      "K_ci_high_Nm_per_deg", "D_ci_low_Nms_per_deg",
                                      "D_ci_high_Nms_per_deg", "KD_correlation",
                                      "nrmse_grf_pct", "nrmse_distance_pct", "cost",
-                                     "evaluations", "wall_s")},
+                                     "evaluations", "wall_s", "peak_force_mismatch_pct")},
         })
         if tid == landscape_id:
             cost = StanceCost.from_stance(stance, weights=tuple(settings.get("weights", (0.5, 0.5))),
@@ -351,6 +373,17 @@ def build_study_report(
                         hint="; ".join(f"{t}: {m}" for t, m in problems[:3]))
     per_trial = pd.DataFrame(rows)
     per_trial["speed_band"] = speed_band(per_trial["speed_pct_pb"].astype(float))
+    per_trial["flagged"] = per_trial["flagged"].astype(object)
+    kept_ids = set(per_trial["trial_id"]) if include_flagged else set(per_trial["trial_id"]) - flagged_ids
+    grouped = per_trial[per_trial["trial_id"].isin(kept_ids)]  # the rows of group statistics
+
+    def kept(groups: dict) -> dict:
+        out = {g: [v for v in items if v.metadata.get("trial") in kept_ids]
+               for g, items in groups.items()}
+        return {g: v for g, v in out.items() if v}
+
+    left_out = "" if include_flagged or not flagged_ids else (
+        f" {len(flagged_ids)} flagged trial(s) are left out (see Flagged trials).")
 
     rep = Report(
         "Blade characterisation: study report", subtitle=f"{study.name} — {folder}",
@@ -359,7 +392,8 @@ def build_study_report(
                   "simulation": {"engine": "kernel", "dt_s": _sim_default_dt(),
                                  "formulation": ", ".join(sorted(formulations))},
                   "landscape_trial": landscape_id, "trials_reported": len(per_trial),
-                  "trials_failed": len(problems)},
+                  "trials_failed": len(problems), "trials_flagged": len(flagged_ids),
+                  "include_flagged": include_flagged},
         seed=study.seed,
     )
     gt_path = folder / "ground_truth.csv"
@@ -373,61 +407,79 @@ def build_study_report(
                   "docs/example-study.md). The recovered-vs-true section compares the two.")
     if problems:
         intro += "\n\nNot reported: " + "; ".join(f"{t} ({m})" for t, m in problems[:10])
+    if flagged_ids:
+        intro += (f"\n\n{len(flagged_ids)} of {len(per_trial)} trials are flagged (poorly "
+                  "determined or poorly fitted; see Flagged trials) and "
+                  + ("kept in" if include_flagged else "left out of") + " the group statistics.")
     overview = per_trial[["trial_id", "group", "configuration", "speed_pct_pb", "K_Nm_per_deg",
-                          "D_Nms_per_deg", "nrmse_grf_pct", "nrmse_distance_pct"]]
+                          "D_Nms_per_deg", "nrmse_grf_pct", "nrmse_distance_pct"]].copy()
+    overview.insert(1, "quality", flag_column(per_trial["flagged"]))
     rep.add_section("Overview", text=intro,
                     tables=[ReportTable("Trials", overview, "trials", csv=per_trial)])
+    add_flagged_section(rep, per_trial, include_flagged=include_flagged)
 
     # nRMSE tables (seed 000 Tables 1-2): amputation levels, then category groups
     for signal, title in (("grf", "nRMSE of the GRF (Table 1)"),
                           ("distance", "nRMSE of the characteristic distance (Table 2)")):
-        tr = pd.concat([tables.trial_nrmse(by_level_m, by_level_s, signal=signal),
-                        tables.trial_nrmse(measured, simulated, signal=signal)], ignore_index=True)
-        mc = pd.concat([tables.mean_curve_nrmse(by_level_m, by_level_s, signal=signal),
-                        tables.mean_curve_nrmse(measured, simulated, signal=signal)],
+        tr = pd.concat([tables.trial_nrmse(kept(by_level_m), kept(by_level_s), signal=signal),
+                        tables.trial_nrmse(kept(measured), kept(simulated), signal=signal)],
+                       ignore_index=True)
+        mc = pd.concat([tables.mean_curve_nrmse(kept(by_level_m), kept(by_level_s), signal=signal),
+                        tables.mean_curve_nrmse(kept(measured), kept(simulated), signal=signal)],
                        ignore_index=True)
         num = tables.nrmse_table(tr, mc, signal=signal)
-        rep.add_section(title, tables=[ReportTable(title, tables.nrmse_table(tr, mc, signal=signal,
+        rep.add_section(title, text=left_out.strip() or None, tables=[ReportTable(title, tables.nrmse_table(tr, mc, signal=signal,
                                                                              formatted=True),
                                                    f"nrmse-{signal}", csv=num)])
     rep.add_section(
         "GRF and distance vs time",
         text="Measured (solid) and simulated at K*, D* (dashed): group mean ± SD over stances "
-             "normalised to 0–100 % of the stance window (seed 000 Figs. 1–2).",
+             "normalised to 0–100 % of the stance window (seed 000 Figs. 1–2). Flagged trials: "
+             "grey dotted lines." + left_out,
         figures=[("Vertical GRF, measured vs simulated",
-                  figures.time_series_bands(measured, simulated, signal="grf")),
+                  figures.time_series_bands(measured, simulated, signal="grf",
+                                            flagged=flagged_ids, include_flagged=include_flagged)),
                  ("Characteristic distance, measured vs simulated",
-                  figures.time_series_bands(measured, simulated, signal="distance"))],
+                  figures.time_series_bands(measured, simulated, signal="distance",
+                                            flagged=flagged_ids, include_flagged=include_flagged))],
     )
-    summary = summarize(per_trial, values=["K_Nm_per_deg", "D_Nms_per_deg"],
+    summary = summarize(grouped, values=["K_Nm_per_deg", "D_Nms_per_deg"],
                         by=["group", "speed_band"])
     rep.add_section(
         "K* and D* per group and speed band",
-        text="Bars: mean; whiskers: 95 % t confidence interval of the mean (seed 000 Fig. 3).",
+        text="Bars: mean; whiskers: 95 % t confidence interval of the mean (seed 000 Fig. 3)."
+             + left_out,
         figures=[("K* and D* per group and speed band", figures.parameter_bars(summary))],
         tables=[ReportTable("K* and D* per group and speed band",
                             tables.parameter_summary_display(summary), "parameters", csv=summary)],
     )
     mt = mechanics_table([m for v in mech_m.values() for m in v] +
                          [m for v in mech_s.values() for m in v])
+    mt["flagged"] = mt["trial"].isin(flagged_ids)
+    mt_display = mt[[c for c in _MECH_COLUMNS if c in mt]].copy()
+    mt_display.insert(1, "quality", flag_column(mt["flagged"]))
     rep.add_section(
         "Blade mechanics",
         text="GRF–Δθ hysteresis loops (loading solid, unloading dashed) and equivalent compressive "
              "stiffness K_c vs compression Δd per group (seed 000 §3.4–3.5), measured stances; "
-             "then the simulated ones. Δθ of measured stances comes from the tip marker.",
-        figures=[("GRF vs angular deformation, measured", figures.hysteresis_loops(mech_m)),
-                 ("K_c vs compression, measured", figures.compressive_stiffness_curves(mech_m)),
-                 ("GRF vs angular deformation, simulated", figures.hysteresis_loops(mech_s))],
-        tables=[ReportTable("Peak mechanics per stance", mt[[c for c in _MECH_COLUMNS if c in mt]],
-                            "mechanics", csv=mt)],
+             "then the simulated ones. Δθ of measured stances comes from the tip marker. "
+             "Flagged trials: grey dotted lines, marked in the table.",
+        figures=[("GRF vs angular deformation, measured",
+                  figures.hysteresis_loops(mech_m, flagged=flagged_ids)),
+                 ("K_c vs compression, measured",
+                  figures.compressive_stiffness_curves(mech_m, flagged=flagged_ids)),
+                 ("GRF vs angular deformation, simulated",
+                  figures.hysteresis_loops(mech_s, flagged=flagged_ids))],
+        tables=[ReportTable("Peak mechanics per stance", mt_display, "mechanics", csv=mt)],
     )
-    st = compare_groups(per_trial, amputation="amputation", category="group",
+    st = compare_groups(grouped, amputation="amputation", category="group",
                         speed="speed_pct_pb")
     rep.add_section(
         "Statistics",
         text="Mann–Whitney U between amputation levels, Kruskal–Wallis with Dunn–Bonferroni "
              "across groups, Mann–Whitney U between speed bands (≥ 90 % vs < 90 % PB); α = 0.05; "
-             "effect size r (seed 000 §3.6).",
+             f"effect size r (seed 000 §3.6). {len(grouped)} of {len(per_trial)} trials tested."
+             + left_out,
         tables=[ReportTable("Statistical tests", tables.stats_display(st), "statistics", csv=st)]
         if len(st) else [],
     )
@@ -474,7 +526,7 @@ def build_study_report(
             lo, hi = merged.get(f"{col}_ci_low"), merged.get(f"{col}_ci_high")
             merged[f"{p}_true_in_ci"] = (lo <= merged[f"{p}_true"]) & (merged[f"{p}_true"] <= hi) \
                 if lo is not None else np.nan
-        agg = merged.groupby("group", sort=False).agg(
+        agg = merged[merged["trial_id"].isin(kept_ids)].groupby("group", sort=False).agg(
             n=("trial_id", "size"),
             K_error_median_pct=("K_error_pct", "median"),
             K_abs_error_median_pct=("K_error_pct", lambda x: float(np.median(np.abs(x)))),
@@ -493,17 +545,19 @@ def build_study_report(
                  f"median |D error| {float(np.median(np.abs(merged['D_error_pct']))):.1f} %. "
                  "The generating model is richer than the identified one (stiffening hinge, "
                  "softer ground, marker and force noise, 100 Hz kinematics), so exact recovery "
-                 f"is not expected.{secant}",
+                 f"is not expected.{secant} Flagged trials: grey crosses; the errors per group "
+                 + ("include them." if include_flagged else "leave them out."),
             figures=[("Identified vs true K and D", _truth_figure(merged))],
             tables=[("Errors per group", agg),
-                    ("Per trial", merged[[c for c in (
-                        "trial_id", "group", "speed_pct_pb", "K_true", "K_secant_peak_Nm_per_deg",
+                    ("Per trial", merged.assign(quality=flag_column(merged["flagged"]))[[c for c in (
+                        "trial_id", "quality", "group", "speed_pct_pb", "K_true", "K_secant_peak_Nm_per_deg",
                         "K_Nm_per_deg", "K_error_pct", "K_vs_secant_error_pct", "D_true",
                         "D_Nms_per_deg", "D_error_pct") if c in merged.columns]])],
         )
     index = rep.write(Path(out_dir) if out_dir is not None else folder / "report")
     return StudyReport(index=Path(index), n_trials=len(per_trial), n_failed=len(problems),
-                       landscape_trial=landscape_id)
+                       landscape_trial=landscape_id, n_flagged=len(flagged_ids),
+                       flagged_in_statistics=include_flagged)
 
 
 def _add_sensitivity_section(rep, formulations) -> None:

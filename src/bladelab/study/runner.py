@@ -86,6 +86,8 @@ class StudyRun:
         Wall-clock time [s].
     executor, jobs
         How it ran.
+    flagged
+        Trials identified now whose quality is flagged (:mod:`bladelab.identify.quality`).
     """
 
     total: int
@@ -96,6 +98,7 @@ class StudyRun:
     executor: str
     jobs: int
     claimed: int = 0
+    flagged: tuple[str, ...] = ()
 
     def to_dict(self) -> dict:
         """JSON-ready dictionary."""
@@ -208,6 +211,7 @@ def run_study(
     others = 0
     failures: list[tuple[str, str]] = []
     finished = skipped = 0
+    flagged: list[str] = []
     try:
         todo = []
         for p in payloads:
@@ -233,6 +237,8 @@ def run_study(
                 store.write(_row(p, status, value), force=force)
                 if status == "ok":
                     finished += 1
+                    if isinstance(value, dict) and value.get("flagged"):
+                        flagged.append(p["trial_id"])
                 else:
                     failures.append((p["trial_id"], str(value)))
                     bar.write(f"failed: {p['trial_id']}: {value}")
@@ -244,7 +250,7 @@ def run_study(
         store.close()
     return StudyRun(total=len(payloads), finished=finished, skipped=skipped, claimed=others,
                     failures=tuple(sorted(failures)), wall_s=time.perf_counter() - t0,
-                    executor=executor, jobs=jobs)
+                    executor=executor, jobs=jobs, flagged=tuple(sorted(flagged)))
 
 
 __all__ = ["StudyRun", "plan", "run_study", "run_task_safely", "trial_seed", "variant_name"]

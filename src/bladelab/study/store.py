@@ -3,7 +3,10 @@
 The table ``results`` has the unique key (``trial_id``, ``variant``): two runs never write the same
 row twice (without ``force`` a second insert of a finished row is ignored). The database runs in WAL
 mode and every finished task is committed on its own, so killing a run loses nothing that
-finished. Parameters carry their unit in the column name (N·m/deg, N·m·s/deg).
+finished. Parameters carry their unit in the column name (N·m/deg, N·m·s/deg). The quality columns
+(``converged``, ``at_bound``, CI half-widths, peak forces, ``flagged``, ``flags``: see
+:mod:`bladelab.identify.quality`) are added to a database written before they existed (NULL in
+its old rows).
 """
 
 from __future__ import annotations
@@ -20,6 +23,7 @@ from typing import Any
 import pandas as pd
 
 from bladelab.errors import InputFileError
+from bladelab.identify.quality import QUALITY_COLUMNS
 
 COLUMNS: dict[str, str] = {
     "trial_id": "TEXT NOT NULL",
@@ -44,6 +48,7 @@ COLUMNS: dict[str, str] = {
     "cost": "REAL",
     "aic": "REAL",
     "bic": "REAL",
+    **QUALITY_COLUMNS,
     "evaluations": "INTEGER",
     "wall_s": "REAL",
     "error": "TEXT",
@@ -75,6 +80,11 @@ class ResultsStore:
             self._con.execute(
                 f"CREATE TABLE IF NOT EXISTS results ({cols}, PRIMARY KEY (trial_id, variant))"
             )
+            # a database written by an older version lacks the newer columns (NULL there)
+            have = {r[1] for r in self._con.execute("PRAGMA table_info(results)")}
+            for name, kind in COLUMNS.items():
+                if name not in have:
+                    self._con.execute(f'ALTER TABLE results ADD COLUMN "{name}" {kind}')
             self._con.execute(
                 "CREATE TABLE IF NOT EXISTS claims (trial_id TEXT, variant TEXT, owner TEXT, "
                 "host TEXT, pid INTEGER, claimed_utc TEXT, PRIMARY KEY (trial_id, variant))"

@@ -37,6 +37,7 @@ __all__ = [
     "guess_from_result",
     "guess_from_trial",
     "template_guess",
+    "template_vertical_grf",
 ]
 
 
@@ -55,6 +56,12 @@ class StrideGuess:
         order; the last row is one period after the first.
     activation, tendon_force
         (n + 1, n_muscles) activations [-] and tendon forces normalised by Fmax [-], or None.
+    vertical_grf_bw
+        (n + 1,) total vertical ground force [body weights], or None: the stance pattern that
+        the tracking stage follows besides the joint angles (measured, simulated, or a template
+        of alternating stances). Without it, tracking the angles alone leaves the pelvis height
+        free, and the measured angles were met by one-legged hops and 20-BW bounds (docs/
+        collocation.md).
     """
 
     source: str
@@ -63,6 +70,7 @@ class StrideGuess:
     qd: np.ndarray
     activation: np.ndarray | None = None
     tendon_force: np.ndarray | None = None
+    vertical_grf_bw: np.ndarray | None = None
 
     @property
     def n_intervals(self) -> int:
@@ -89,6 +97,8 @@ class StrideGuess:
             activation=None if self.activation is None else _resample(self.activation, old, new),
             tendon_force=None if self.tendon_force is None
             else _resample(self.tendon_force, old, new),
+            vertical_grf_bw=None if self.vertical_grf_bw is None
+            else _resample(self.vertical_grf_bw[:, None], old, new)[:, 0],
         )
 
     def with_speed(self, speed: float) -> StrideGuess:
@@ -182,7 +192,26 @@ def template_guess(model: RunnerModel, *, speed: float = 3.5, n: int = 50,
         angles.update({f"hip_{side}": a["hip"], f"knee_{side}": a["knee"],
                        f"ankle_{side}": a["ankle"]})
     q = _angles_to_q(model, frac, period, speed, angles)
-    return StrideGuess(f"template at {speed:g} m/s", period, q, periodic_derivative(q, period))
+    return StrideGuess(f"template at {speed:g} m/s", period, q, periodic_derivative(q, period),
+                       vertical_grf_bw=template_vertical_grf(frac))
+
+
+def template_vertical_grf(phase: np.ndarray, *, duty: float = 0.34) -> np.ndarray:
+    """Vertical ground force [body weights] of a template stride at ``phase`` (0–1, left
+    touch-down at 0): a half-sine stance of ``duty`` (fraction of the stride) per leg, the right
+    leg half a stride later, scaled so that the stride's mean is one body weight (peak
+    π/(4·duty) = 2.3 BW at the default, as measured at 3.5 m/s: Fukuchi trial 2.3–2.6 BW,
+    contact 0.22–0.25 s of a 0.70 s stride)."""
+    if not 0.05 <= duty <= 0.5:
+        raise SpecError(f"stance duty must be within 0.05–0.5 of the stride, got {duty}",
+                        where="duty")
+    peak = math.pi / (4.0 * duty)
+    out = np.zeros_like(np.asarray(phase, float))
+    for start in (0.0, 0.5):
+        p = np.mod(np.asarray(phase, float) - start, 1.0)
+        inside = p < duty
+        out[inside] += peak * np.sin(math.pi * p[inside] / duty)
+    return out
 
 
 def guess_from_trial(model: RunnerModel, path: str | Path, *, static: str | Path | None = None,
@@ -216,7 +245,25 @@ def guess_from_trial(model: RunnerModel, path: str | Path, *, static: str | Path
     frac = np.linspace(0.0, 1.0, n + 1)
     q = _angles_to_q(model, frac, period, speed, closed)
     return StrideGuess(f"{Path(path).name}: mean of {len(good)} left-leg cycles at {speed:g} m/s",
-                       period, q, periodic_derivative(q, period))
+                       period, q, periodic_derivative(q, period),
+                       vertical_grf_bw=_measured_vertical_grf(trial, good, frac))
+
+
+def _measured_vertical_grf(trial, cycles, frac: np.ndarray) -> np.ndarray | None:
+    """The trial's total vertical platform force over its mean cycle [body weights: divided by
+    the cycle's mean force, which over a periodic stride is the runner's weight]; None without
+    platforms."""
+    if not trial.platforms:
+        return None
+    curves = []
+    for c in cycles:
+        tt = c.start_s + frac * c.period
+        fz = sum(np.interp(tt, p.time, p.force[:, 2]) for p in trial.platforms)
+        fine = c.start_s + np.linspace(0.0, 1.0, 401) * c.period
+        mean = np.mean(sum(np.interp(fine, p.time, p.force[:, 2]) for p in trial.platforms))
+        if mean > 0:
+            curves.append(fz / mean)
+    return np.mean(curves, axis=0) if curves else None
 
 
 def guess_from_result(result, *, n: int = 50) -> StrideGuess:
@@ -249,6 +296,7 @@ def guess_from_result(result, *, n: int = 50) -> StrideGuess:
         at(result.qpos), at(result.qvel),
         activation=at(result.muscles[:, :, 0]),
         tendon_force=at(result.muscles[:, :, 3] / fmax),
+        vertical_grf_bw=at(forces.sum(axis=1, keepdims=True))[:, 0] / model.body_weight,
     )
 
 

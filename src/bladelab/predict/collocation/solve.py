@@ -97,6 +97,11 @@ class CollocationSettings:
         activation 1, acceleration 0.1 and no metabolic term for the maximum speed.
     tracking_weight
         Weight of the joint-angle tracking term of the tracking stage [1/rad²].
+    grf_tracking_weight
+        Weight of the tracking stage's vertical-ground-force term [1/BW²], used when the guess
+        carries a force pattern (``StrideGuess.vertical_grf_bw``; every guess function gives
+        one). Measured: with angles alone the stage met the Fukuchi angles with a one-legged
+        hop and the template with 20-BW bounds; with the force pattern, alternating stances.
     track_first
         Run the tracking stage before the predictive one (module docstring).
     hessian
@@ -111,6 +116,7 @@ class CollocationSettings:
     speed_m_per_s: float | None = 3.5
     weights: StrideWeights | None = None
     tracking_weight: float = 100.0
+    grf_tracking_weight: float = 10.0
     track_first: bool = True
     hessian: str = "limited-memory"
     tol: float = 1e-4
@@ -141,6 +147,12 @@ class CollocationSettings:
                 math.isfinite(tw) and tw >= 0):
             raise SpecError(f"tracking weight must be >= 0, got {tw!r}", where="tracking_weight")
         object.__setattr__(self, "tracking_weight", float(tw))
+        gw = self.grf_tracking_weight
+        if isinstance(gw, bool) or not isinstance(gw, int | float) or not (
+                math.isfinite(gw) and gw >= 0):
+            raise SpecError(f"force tracking weight must be >= 0, got {gw!r}",
+                            where="grf_tracking_weight")
+        object.__setattr__(self, "grf_tracking_weight", float(gw))
         if not isinstance(self.track_first, bool):
             raise SpecError(f"expected true or false, got {self.track_first!r}",
                             where="track_first")
@@ -386,8 +398,12 @@ def predict_stride(runner, settings: CollocationSettings, guess, *, model_spec: 
     tracking = None
     start = g
     if tracking_stage:
+        grf = None
+        if g.vertical_grf_bw is not None and settings.grf_tracking_weight > 0:
+            grf = (g.vertical_grf_bw * runner.body_weight, settings.grf_tracking_weight)
         nlp_t = StrideNLP(dyn, n=n, speed=speed if speed is not None else g.speed,
-                          weights=TRACKING_WEIGHTS, tracking=(g.q, settings.tracking_weight))
+                          weights=TRACKING_WEIGHTS, tracking=(g.q, settings.tracking_weight),
+                          grf_tracking=grf)
         sol_t = _solve_stage(nlp_t, nlp_t.initial_vector(g), settings, "tracking", progress)
         tracking = _stage_info(sol_t)
         if not sol_t.success:
