@@ -148,8 +148,28 @@ class _DevTools:
         os.close(self._out_r)
 
 
-def inspect_page(binary: str, page: Path, screenshot: Path, profile: Path) -> tuple[list, list]:
-    """Load ``page``; return (figure checks, console errors) and save a full-page screenshot."""
+LAYOUT = """
+(() => ({
+  pageOverflowX: document.documentElement.scrollWidth - document.documentElement.clientWidth,
+  tables: Array.from(document.querySelectorAll("table.data")).map((t) => {
+    const box = t.closest(".table-scroll");
+    return {scrolls: box !== null && ["auto", "scroll"].includes(getComputedStyle(box).overflowX),
+            overflows: box !== null && box.scrollWidth > box.clientWidth + 1,
+            hintShown: box !== null && box.previousElementSibling !== null
+              && box.previousElementSibling.classList.contains("table-hint")
+              && !box.previousElementSibling.hidden};
+  }),
+  headings: Array.from(document.querySelectorAll("section.card h2")).map((h) => h.textContent),
+}))()
+"""
+"""Evaluated in the page with ``probe=LAYOUT``: horizontal overflow of the page, whether every
+table sits in a scrolling box (and is announced when it overflows it), the section headings."""
+
+
+def inspect_page(binary: str, page: Path, screenshot: Path, profile: Path,
+                 probe: str | None = None):
+    """Load ``page``; return (figure checks, console errors) and save a full-page screenshot;
+    with ``probe`` (a JavaScript expression) also its value: (figures, errors, value)."""
     browser = _DevTools(binary, profile)
     try:
         target = browser.send("Target.createTarget", {"url": "about:blank"})["targetId"]
@@ -171,6 +191,9 @@ def inspect_page(binary: str, page: Path, screenshot: Path, profile: Path) -> tu
             {"expression": CHECK_FIGURES, "returnByValue": True},
             session=session,
         )["result"]["value"]
+        probed = None if probe is None else browser.send(
+            "Runtime.evaluate", {"expression": probe, "returnByValue": True}, session=session,
+        )["result"].get("value")
         height = browser.send(
             "Runtime.evaluate",
             {"expression": "document.documentElement.scrollHeight", "returnByValue": True},
@@ -202,6 +225,8 @@ def inspect_page(binary: str, page: Path, screenshot: Path, profile: Path) -> tu
         ]
     finally:
         browser.close()
+    if probe is not None:
+        return figures, errors, probed
     return figures, errors
 
 

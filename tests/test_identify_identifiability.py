@@ -129,9 +129,49 @@ def test_estimate_inside_its_interval_on_a_curved_valley_and_limits_clipped():
         assert res.ci_lower[i] <= res.x[i] <= res.ci_upper[i]
     assert res.ci_lower[1] >= 0.0
     # a wide interval on a parameter near 0 is clipped at its physical minimum, with a note
-    flat = assess_identifiability(lambda X: X[:, :1] * t[None, :] + 1e-3 * X[:, 1:2] - t,
-                                  [1.0, 0.05], [(0.0, 2.0), (-5.0, 5.0)], names=("K", "D"),
-                                  n_effective=120, physical_lower={"D": 0.0})
+    y2 = t + 1e-3 * 1.0 + 0.01 * np.random.default_rng(11).standard_normal(120)
+    A = np.column_stack([t, np.full_like(t, 1e-3)])
+    x_hat, *_ = np.linalg.lstsq(A, y2, rcond=None)
+    assert 0 < x_hat[1] < 1.5  # D's estimate is positive, its interval reaches below 0
+    flat = assess_identifiability(lambda X: X @ A.T - y2, x_hat, [(0.0, 2.0), (-5.0, 5.0)],
+                                  names=("K", "D"), n_effective=120, physical_lower={"D": 0.0})
     assert flat.ci_lower[1] == 0.0 and flat.ci_clipped[1]
     assert any("clipped at 0" in n for n in flat.notes)
     assert flat.ci_lower[1] <= flat.x[1] <= flat.ci_upper[1]
+
+
+def test_hac_intervals_cover_with_autocorrelated_residuals():
+    # 60 replicates of a two-parameter fit with AR(1) noise (ρ = 0.9, correlation length ~10
+    # samples): intervals that take the residuals as independent under-cover; the Newey–West
+    # scale brings the coverage of the 95 % interval back near it
+    from bladelab.identify.identifiability import hac_inflation
+
+    n, rho, theta = 300, 0.9, np.array([1.0, 0.5])
+    t = np.linspace(0.0, 1.0, n)
+    A = np.column_stack([np.sin(2 * t), t**2])
+    rng = np.random.default_rng(11)
+    hits = {"independent": [], "hac": []}
+    for _ in range(60):
+        e = np.zeros(n)
+        w = rng.standard_normal(n) * 0.02
+        for k in range(1, n):
+            e[k] = rho * e[k - 1] + w[k]
+        y = A @ theta + e
+        x_hat, *_ = np.linalg.lstsq(A, y, rcond=None)
+
+        def residuals(X, y=y):
+            return X @ A.T - y
+
+        for name, options in (("independent", {"n_effective": n}), ("hac", {})):
+            res = assess_identifiability(residuals, x_hat, [(-5, 5), (-5, 5)], names=("a", "b"),
+                                         n_profile=15, **options)
+            hits[name].append([lo <= v <= hi for lo, v, hi in
+                               zip(res.ci_lower, theta, res.ci_upper, strict=True)])
+    cover = {k: np.mean(v, axis=0) for k, v in hits.items()}
+    assert np.all(cover["independent"] < 0.75), cover
+    # (measured: independent 37 % / 42 %, hac 92 % / 83 %; Newey–West is known to under-cover
+    # slightly in finite samples, and 60 replicates have a standard error of ~3 %)
+    assert np.all(cover["hac"] >= 0.80) and np.all(cover["hac"] > cover["independent"] + 0.35), cover
+    # the inflation of white residuals stays 1 (never narrower than independent)
+    c, _, lags = hac_inflation(rng.standard_normal(n), A)
+    assert np.all(c >= 1.0) and np.all(c < 1.6) and lags[0] <= 10

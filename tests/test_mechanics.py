@@ -161,3 +161,34 @@ def test_bad_input_is_a_clear_error():
         stance_mechanics(s, tip_x=np.zeros(3), tip_z=np.zeros(3))
     with pytest.raises(DataError, match="force component"):
         stance_mechanics(s, force="sideways")  # type: ignore[arg-type]
+
+
+def test_kc_only_above_the_distance_noise_and_efficiency_plausibility():
+    k, x0, T = 25e3, 0.08, 0.12  # N/m, m, s
+    t = np.linspace(0.0, T, 241)
+    x = x0 * np.sin(np.pi * t / T)
+    quiet = stance_mechanics(_stance(t, k * x, x, n_pre=40))
+    assert quiet.distance_noise == 0.0 and quiet.compression_threshold == pytest.approx(5e-3)
+    # 1.5 mm of noise on the distance before touch-down: K_c from 10 × 1.5 = 15 mm on
+    noisy = _stance(t, k * x, x, n_pre=400)
+    rng = np.random.default_rng(0)
+    d = noisy.distance.copy()
+    d[:400] += rng.normal(0.0, 1.5e-3, 400)
+    import dataclasses
+
+    m = stance_mechanics(dataclasses.replace(noisy, distance=d))
+    assert m.distance_noise == pytest.approx(1.5e-3, rel=0.15)
+    assert m.compression_threshold == pytest.approx(10 * m.distance_noise)
+    defined = np.isfinite(m.compressive_stiffness)
+    assert np.all(m.compression[defined] >= m.compression_threshold)
+    assert np.any((m.compression > 5e-3) & (m.compression < m.compression_threshold))
+    # a simulated stance takes its measured one's threshold
+    sim = stance_mechanics(_stance(t, k * x, x, n_pre=5), min_compression=m.compression_threshold,
+                           noise_factor=0.0)
+    assert sim.compression_threshold == m.compression_threshold
+    row = m.to_dict()
+    assert row["Kc_threshold_mm"] == pytest.approx(1e3 * m.compression_threshold)
+    assert row["Kc_at_peak_compression_kN_per_m"] == pytest.approx(k / 1e3, rel=0.01)  # d0 noisy
+    assert row["efficiency_plausible"] is True  # a lossless spring returns 100 %
+    lossy = stance_mechanics(_stance(t, k * x * np.where(t < T / 2, 1.0, 0.3), x, n_pre=5))
+    assert lossy.efficiency < 50 and lossy.to_dict()["efficiency_plausible"] is False

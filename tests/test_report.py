@@ -277,3 +277,42 @@ def test_html_blocks_and_attached_files(tmp_path: Path):
     assert "a &lt;caption&gt;" in html  # the caption is text
     assert html.index("text first") < html.index('id="live"')
     assert (tmp_path / "r" / "export" / "run" / "data.txt").read_text() == "42\n"
+
+
+def test_curves_are_normalised_over_contact_and_every_panel_has_tick_labels():
+    import dataclasses
+
+    from bladelab.report.figures import contact_span
+
+    measured, simulated, mech, _ = example_inputs()
+    # four groups: three panels on the first row, one below: the panels above the empty slots
+    # (third column) used to lose their x tick labels
+    extra = {f"{g} copy": v for g, v in list(measured.items())[:1]}
+    groups = {**measured, **extra}
+    sims = {**simulated, **{f"{g} copy": v for g, v in list(simulated.items())[:1]}}
+    for fig in (time_series_bands(groups, sims), compressive_stiffness_curves(
+            {**mech, "copy": mech[next(iter(mech))]}), hysteresis_loops(mech)):
+        fig.canvas.draw()
+        for ax in (a for a in fig.axes if a.get_visible()):
+            labels = [t.get_text() for t in ax.get_xticklabels() if t.get_visible()]
+            assert any(labels), ax.get_title()
+    # over contact: 0 % is touch-down (GRF above 20 N), 100 % toe-off; flight is left out
+    st = measured["TF (Cat 2)"][0]
+    pad = 50
+    dt = st.time[1] - st.time[0]
+    flight = dataclasses.replace(  # 50 samples of flight before the stance
+        st, time=np.concatenate([st.time[0] - dt * np.arange(pad, 0, -1), st.time]),
+        **{k: np.concatenate([np.full(pad, getattr(st, k)[0] if k != "grf_z" else 0.0),
+                              getattr(st, k)])
+           for k in ("clamp_x", "clamp_y", "clamp_z", "clamp_pitch", "grf_x", "grf_y", "grf_z",
+                     "distance")})
+    t0, t1 = contact_span(flight)
+    assert flight.grf_z[np.searchsorted(flight.time, t0)] > 20 and t0 > flight.time[pad - 1]
+    a = time_series_bands({"g": [flight]}, window="contact")
+    b = time_series_bands({"g": [flight]}, window="stance")
+    ya = a.axes[0].lines[0].get_ydata()
+    yb = b.axes[0].lines[0].get_ydata()
+    assert ya[0] > 20 and yb[0] == 0.0  # the window starts in flight, contact at touch-down
+    assert "touch-down to toe-off" in a.axes[0].get_xlabel()
+    with pytest.raises(DataError, match="unknown window"):
+        time_series_bands({"g": [flight]}, window="swing")  # type: ignore[arg-type]

@@ -47,6 +47,8 @@ def test_the_report_has_every_section_and_its_tables(study, report):
                     "How far to trust K* and D*", "Recovered vs true parameters", "Settings, versions and seed"):
         assert heading in html, heading
     assert "SYNTHETIC" in html
+    # one athlete per amputation level: the tests describe these athletes' trials
+    assert "Unit of analysis: the trial" in html and "not a population" in html
     assert len(re.findall(r'<img src="data:image/png;base64,', html)) == FIGURES
     assert report.n_trials + report.n_failed == N_TRIALS and report.n_trials >= 3
     tables = report.index.parent / "tables"
@@ -93,15 +95,22 @@ def test_the_cli_writes_the_report_with_a_chosen_landscape_trial(study, tmp_path
 
 
 def test_the_study_report_opens_in_headlesschromium(tmp_path, report):
-    from browser import chromium, figure_ok, inspect_page
+    from browser import LAYOUT, chromium, figure_ok, inspect_page
 
     binary = chromium()
-    figures, errors = inspect_page(binary, report.index, tmp_path / "study.png", tmp_path / "profile")
+    figures, errors, layout = inspect_page(binary, report.index, tmp_path / "study.png",
+                                           tmp_path / "profile", probe=LAYOUT)
     print(f"\nstudy report screenshot: {tmp_path / 'study.png'}")
     assert errors == [], f"console errors: {errors}"
     assert len(figures) == FIGURES
     for fig in figures:
         assert figure_ok(fig), fig
+    # no clipped table: the page never overflows sideways, every table scrolls in its own box
+    # and says so when it is wider than the page
+    assert layout["pageOverflowX"] <= 0, layout["pageOverflowX"]
+    assert layout["tables"] and all(t["scrolls"] for t in layout["tables"])
+    assert all(t["hintShown"] == t["overflows"] for t in layout["tables"])
+    assert any("Flagged trials" in h for h in layout["headings"])
 
 
 def _flag_only(study, trial_id, *, reason="test: marked by hand"):
@@ -148,3 +157,6 @@ def test_a_flagged_trial_is_marked_and_left_out_of_group_tests(study, report, tm
     html2 = (out2 / "index.html").read_text(encoding="utf-8")
     assert "KEPT in the group statistics" in html2
     assert re.search(rf"<tr><td>{trial_id}</td><td>{FLAG_MARK}</td>", html2)
+    # marked in the recovered-vs-true table too
+    per = pd.read_csv(out / "tables" / "recovered-vs-true-parameters-per-trial.csv")
+    assert per.set_index("trial_id").loc[trial_id, "quality"] == FLAG_MARK

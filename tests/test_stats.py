@@ -155,6 +155,18 @@ def test_summarize_gives_t_confidence_intervals():
     assert out.loc["a", "K_Nm_per_deg_ci_low"] == pytest.approx(2 - half, abs=1e-6)
     assert out.loc["a", "K_Nm_per_deg_ci_high"] == pytest.approx(2 + half, abs=1e-6)
     assert np.isnan(out.loc["b", "K_Nm_per_deg_ci_low"])
+    # a lower limit below the physical minimum is clipped and marked (issue 16: D* (−0.003, 0.458))
+    clipped = summarize(data, values=["K_Nm_per_deg"], by=["group"],
+                        lower_limits={"K_Nm_per_deg": 0.0}).set_index("group")
+    assert 2 - half < 0 and clipped.loc["a", "K_Nm_per_deg_ci_low"] == 0.0
+    assert clipped.loc["a", "K_Nm_per_deg_ci_clipped"] and not out.loc["a", "K_Nm_per_deg_ci_clipped"]
+    assert clipped.loc["a", "K_Nm_per_deg_ci_high"] == pytest.approx(2 + half, abs=1e-6)
+    from bladelab.report.tables import parameter_summary_display
+
+    shown = parameter_summary_display(
+        clipped.reset_index().assign(speed_band="all", D_Nms_per_deg=0.3, D_Nms_per_deg_ci_low=0.2,
+                                     D_Nms_per_deg_ci_high=0.4))
+    assert "(0.00‡–" in shown.iloc[0, 3]
 
 
 def test_bad_tables_are_clear_errors():
@@ -164,3 +176,39 @@ def test_bad_tables_are_clear_errors():
         kruskal_dunn(_table(A=A), value="K", by="group")
     with pytest.raises(DataError, match="missing columns"):
         compare_groups(_table(A=A, B=B))
+
+
+def test_trials_are_nested_in_athletes():
+    from bladelab.stats import athlete_means, speed_band, unit_of_analysis
+
+    rng = np.random.default_rng(7)
+    rows = []
+    for amp, group, athletes in (("TF", "TF cat 2", ("TF1", "TF2", "TF3")),
+                                 ("TT", "TT cat 5", ("TT1", "TT2", "TT3"))):
+        for a in athletes:
+            for i in range(6):
+                rows.append({"athlete": a, "amputation": amp, "group": group,
+                             "speed_pct_pb": 100.0 if i % 2 else 60.0,
+                             "K_Nm_per_deg": (16 if amp == "TF" else 20) + rng.normal(0, 1),
+                             "D_Nms_per_deg": 0.3 + rng.normal(0, 0.02)})
+    trials = pd.DataFrame(rows)
+    trials["speed_band"] = speed_band(trials["speed_pct_pb"])
+    unit = unit_of_analysis(trials)
+    assert unit.unit == "athlete" and unit.athletes_per_group["TF"] == ("TF1", "TF2", "TF3")
+    assert "athlete means" in unit.statement
+    means = athlete_means(trials, values=["K_Nm_per_deg", "D_Nms_per_deg"])
+    assert len(means) == 12 and (means["n_trials"] == 3).all()  # 6 athletes × 2 speed bands
+    tf1 = trials[(trials["athlete"] == "TF1") & (trials["speed_band"] == "≥90% PB")]
+    row = means[(means["athlete"] == "TF1") & (means["speed_band"] == "≥90% PB")].iloc[0]
+    assert row["K_Nm_per_deg"] == pytest.approx(tf1["K_Nm_per_deg"].mean())
+    res = compare_groups(means)
+    amp = res[(res["test"] == "Mann-Whitney U") & (res["parameter"] == "K_Nm_per_deg")].iloc[0]
+    assert amp["n"] == "6 | 6"  # athlete × band means, not the 18 | 18 trials
+    # one athlete per group: the tests describe that athlete's trials
+    one = trials[trials["athlete"].isin(["TF1", "TT1"])]
+    u1 = unit_of_analysis(one)
+    assert u1.unit == "trial" and "ONE athlete" in u1.statement
+    assert "TF: TF1" in u1.statement and "not a population" in u1.statement
+    mixed = trials[~trials["athlete"].isin(["TT2", "TT3"])]
+    assert unit_of_analysis(mixed).unit == "trial"
+    assert "Some groups hold a single athlete" in unit_of_analysis(mixed).statement

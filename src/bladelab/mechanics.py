@@ -14,8 +14,12 @@ Definitions (SI inside; see ``docs/mechanics.md``)
   before touch-down (F below ``contact_threshold``); when the window starts loaded, the distance
   at the first sample. ``d0=`` overrides it.
 - **Compression** Δd(t) = d0 − d(t) [m] (positive when the blade is compressed).
-- **Equivalent compressive stiffness** K_c(t) = F(t)/Δd(t) [N/m]; NaN where Δd is below
-  ``min_compression`` (K_c is undefined as Δd → 0).
+- **Equivalent compressive stiffness** K_c(t) = F(t)/Δd(t) [N/m]; NaN where Δd is below the
+  **compression threshold** max(``min_compression`` (5 mm), ``noise_factor`` (10) × σ_d), σ_d the
+  robust SD (1.4826 × median absolute deviation) of the distance over the unloaded samples before
+  touch-down (its measurement noise, which also makes d0 uncertain): K_c's relative error from the distance noise is then ≤ 1/noise_factor
+  (10 %). Near touch-down Δd → 0 and F/Δd is not defined. Its peak over the valid samples and its
+  value at peak compression (where seed 000 reports it) are both given.
 - **Blade angle** θ(t) [rad]: the direction of the clamp→tip line in the clamp frame, measured
   from the clamp's −z axis (pointing down the pylon) toward its +x axis (forward):
   θ = atan2(v_x, −v_z) with v the clamp→tip vector expressed in the clamp frame (rotated by
@@ -30,7 +34,11 @@ Definitions (SI inside; see ``docs/mechanics.md``)
   |Δθ| for the angle loop) into a loading and an unloading branch.
 - **Energy** stored = ∫ F dΔd over loading, returned = −∫ F dΔd over unloading, dissipated =
   stored − returned (the loop area, the hysteresis) [J]; efficiency η = returned/stored·100 [%]
-  (seed 001 eq. 1.2). Trapezoidal rule on the samples.
+  (seed 001 eq. 1.2). Trapezoidal rule on the samples. These are loop areas of the vertical GRF
+  against the clamp–tip distance, which are not work-conjugate (the GRF acts at a contact point
+  that rolls along the sole, and the clamp rotates): indices of the loop's shape, not the blade's
+  strain energy. :data:`PLAUSIBLE_EFFICIENCY_PCT` is the range accepted as an energy return
+  (``efficiency_plausible``); carbon-fibre blades return most of the stored energy.
 """
 
 from __future__ import annotations
@@ -46,7 +54,12 @@ from bladelab import units
 from bladelab.errors import DataError
 from bladelab.trial.stance import Stance
 
-__all__ = ["Loop", "StanceMechanics", "stance_mechanics", "mechanics_table", "blade_angle"]
+__all__ = ["PLAUSIBLE_EFFICIENCY_PCT", "Loop", "StanceMechanics", "stance_mechanics",
+           "mechanics_table", "blade_angle"]
+
+PLAUSIBLE_EFFICIENCY_PCT: tuple[float, float] = (50.0, 100.0)
+"""Efficiencies [%] plausible as a carbon-fibre blade's energy return; outside: an artefact of the
+F–Δd loop (not work-conjugate), marked ``efficiency_plausible = False``."""
 
 ForceComponent = Literal["vertical", "resultant"]
 
@@ -98,7 +111,7 @@ class StanceMechanics:
     compression
         Δd(t) = d0 − d(t) [m].
     compressive_stiffness
-        K_c(t) [N/m], NaN where Δd is too small.
+        K_c(t) [N/m], NaN where Δd is below ``compression_threshold``.
     angular_deformation
         Δθ(t) = θ0 − θ(t) [rad] or None.
     torsional_stiffness
@@ -121,6 +134,12 @@ class StanceMechanics:
         [J], from the F–Δd loop.
     efficiency
         returned/stored [%] (NaN if nothing was stored).
+    compression_threshold
+        Δd [m] from which K_c is defined (see the module docstring).
+    distance_noise
+        σ_d [m]: robust SD of the distance before touch-down (0 with fewer than 3 samples).
+    compressive_stiffness_at_peak_compression
+        K_c at the sample of maximum Δd [N/m].
     """
 
     time: np.ndarray
@@ -143,6 +162,9 @@ class StanceMechanics:
     energy_dissipated: float
     efficiency: float
     metadata: dict[str, Any] = dataclasses.field(default_factory=dict)
+    compression_threshold: float = 5e-3
+    distance_noise: float = 0.0
+    compressive_stiffness_at_peak_compression: float = float("nan")
 
     @property
     def compression_loop(self) -> Loop:
@@ -174,6 +196,9 @@ class StanceMechanics:
             "peak_force_N": self.peak_force,
             "peak_compression_m": self.peak_compression,
             "peak_Kc_kN_per_m": self.peak_compressive_stiffness / 1e3,
+            "Kc_at_peak_compression_kN_per_m": self.compressive_stiffness_at_peak_compression / 1e3,
+            "Kc_threshold_mm": self.compression_threshold * 1e3,
+            "distance_noise_mm": self.distance_noise * 1e3,
             "peak_angular_deformation_deg": float(units.rad2deg(self.peak_angular_deformation)),
             "K_at_peak_Nm_per_deg": float(
                 units.stiffness_per_rad_to_per_deg(self.torsional_stiffness_at_peak)
@@ -182,6 +207,8 @@ class StanceMechanics:
             "energy_returned_J": self.energy_returned,
             "energy_dissipated_J": self.energy_dissipated,
             "efficiency_pct": self.efficiency,
+            "efficiency_plausible": bool(
+                PLAUSIBLE_EFFICIENCY_PCT[0] <= self.efficiency <= PLAUSIBLE_EFFICIENCY_PCT[1]),
         }
 
     def to_frame(self) -> pd.DataFrame:
@@ -266,6 +293,7 @@ def stance_mechanics(
     d0: float | None = None,
     contact_threshold: float = 20.0,
     min_compression: float = 5e-3,
+    noise_factor: float = 10.0,
     min_deflection: float = np.deg2rad(1.0),
 ) -> StanceMechanics:
     """Compute Δd, K_c, Δθ, K(t), peaks, loops and energies of one stance.
@@ -289,7 +317,12 @@ def stance_mechanics(
     contact_threshold
         Force [N] above which the blade is loaded (touch-down detection).
     min_compression
-        Δd [m] below which K_c is NaN.
+        Smallest Δd [m] at which K_c is defined.
+    noise_factor
+        K_c is also NaN where Δd < noise_factor × σ_d (σ_d: robust SD of the distance before
+        touch-down);
+        0 uses ``min_compression`` alone (e.g. for a simulated stance, with the threshold of its
+        measured one).
     min_deflection
         |θ − θ0| [rad] below which K(t) is NaN.
 
@@ -324,8 +357,13 @@ def stance_mechanics(
         before = dist[:i0][np.isfinite(dist[:i0])]
         d0 = float(np.median(before)) if len(before) else float(dist[i0])
     dd = d0 - dist
+    pre = dist[:i0][np.isfinite(dist[:i0])]
+    # robust SD (1.4826 × MAD about d0): the spread of the distance in flight, insensitive to the
+    # few samples where the blade already moves just before touch-down
+    noise = float(1.4826 * np.median(np.abs(pre - np.median(pre)))) if len(pre) >= 3 else 0.0
+    threshold = max(float(min_compression), float(noise_factor) * noise)
     with np.errstate(divide="ignore", invalid="ignore"):
-        kc = np.where(dd >= min_compression, f / np.where(dd == 0, 1.0, dd), np.nan)
+        kc = np.where(dd >= threshold, f / np.where(dd == 0, 1.0, dd), np.nan)
     # Energies from the last unloaded sample on (samples before it carry no force).
     start = max(i0 - 1, 0)
     loop_dd, loop_f = dd[start:], f[start:]
@@ -389,6 +427,9 @@ def stance_mechanics(
         energy_dissipated=stored - returned,
         efficiency=efficiency,
         metadata=dict(stance.metadata),
+        compression_threshold=threshold,
+        distance_noise=noise,
+        compressive_stiffness_at_peak_compression=float(kc[i0 + int(np.argmax(dd[i0:]))]),
     )
 
 

@@ -30,8 +30,9 @@ Formulas (ranks are mid-ranks over the pooled sample, N values, tie groups of si
 
 from __future__ import annotations
 
+import dataclasses
 import itertools
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 
 import numpy as np
 import pandas as pd
@@ -42,6 +43,9 @@ from bladelab.errors import DataError
 __all__ = [
     "ALPHA",
     "RESULT_COLUMNS",
+    "UnitOfAnalysis",
+    "athlete_means",
+    "unit_of_analysis",
     "mann_whitney",
     "kruskal_dunn",
     "speed_band",
@@ -373,6 +377,7 @@ def summarize(
     values: Sequence[str],
     by: Sequence[str],
     confidence: float = 0.95,
+    lower_limits: Mapping[str, float] | None = None,
 ) -> pd.DataFrame:
     """Mean, SD, n and the t-based confidence interval of the mean per group.
 
@@ -386,13 +391,16 @@ def summarize(
         Grouping columns (e.g. ``["group", "speed_band"]``).
     confidence
         Confidence level of the interval.
+    lower_limits
+        Value column -> its lowest physical value (e.g. 0 for a stiffness or a damping): a lower
+        confidence limit below it is clipped to it and ``<value>_ci_clipped`` is True.
 
     Returns
     -------
     pandas.DataFrame
         One row per group: the ``by`` columns, ``n``, and per value ``<value>`` (mean),
-        ``<value>_sd``, ``<value>_ci_low``, ``<value>_ci_high`` (NaN interval for n < 2) — the
-        input of :func:`bladelab.report.figures.parameter_bars`.
+        ``<value>_sd``, ``<value>_ci_low``, ``<value>_ci_high`` (NaN interval for n < 2),
+        ``<value>_ci_clipped`` — the input of :func:`bladelab.report.figures.parameter_bars`.
     """
     rows = []
     for key, sub in data.groupby(list(by), sort=True):
@@ -408,8 +416,90 @@ def summarize(
                 if len(x) > 1
                 else np.nan
             )
+            low = mean - half
+            floor = (lower_limits or {}).get(v)
+            clipped = bool(floor is not None and np.isfinite(low) and low < floor)
             row.update(
-                {v: mean, f"{v}_sd": sd, f"{v}_ci_low": mean - half, f"{v}_ci_high": mean + half}
+                {v: mean, f"{v}_sd": sd, f"{v}_ci_low": max(low, floor) if clipped else low,
+                 f"{v}_ci_high": mean + half, f"{v}_ci_clipped": clipped}
             )
         rows.append(row)
     return pd.DataFrame(rows)
+
+
+@dataclasses.dataclass(frozen=True)
+class UnitOfAnalysis:
+    """What a group comparison's observations are (trials are nested in athletes).
+
+    Attributes
+    ----------
+    unit
+        ``"trial"`` (each trial one observation) or ``"athlete"`` (each athlete's mean).
+    athletes_per_group
+        Group -> the athletes in it (sorted).
+    statement
+        One paragraph for a report saying what the tests compare and what they do not.
+    """
+
+    unit: str
+    athletes_per_group: dict[str, tuple[str, ...]]
+    statement: str
+
+
+def unit_of_analysis(data: pd.DataFrame, *, athlete: str = "athlete",
+                     groups: Sequence[str] = ("amputation", "group")) -> UnitOfAnalysis:
+    """Choose the unit of analysis of group comparisons from how athletes fill the groups.
+
+    Trials of one athlete are not independent samples of a population. With at least two
+    athletes in every group of every grouping column in ``groups``, the athletes' means are
+    compared (``unit="athlete"``, see :func:`athlete_means`); otherwise the trials are, and the
+    statement says what that means: with one athlete per group the tests describe that athlete's
+    trials (their variation between trials), not a population, and a group difference cannot be
+    told apart from a difference between the athletes.
+    """
+    for col in (athlete, *groups):
+        if col not in data.columns:
+            raise DataError(f"column {col!r} not in the table", where=col,
+                            hint="the per-trial table needs the athlete of each trial")
+    per: dict[str, tuple[str, ...]] = {}
+    for col in groups:
+        for g, sub in data.groupby(col, sort=True):
+            per.setdefault(str(g), tuple(sorted(sub[athlete].astype(str).unique())))
+    counts = [len(v) for v in per.values()]
+    if counts and min(counts) >= 2:
+        n_ath = data[athlete].nunique()
+        return UnitOfAnalysis("athlete", per, (
+            f"Unit of analysis: the athlete. Every group holds at least two athletes "
+            f"({n_ath} in all), so each athlete's trials are averaged first (per group and "
+            "speed band) and the tests compare athlete means: n counts athletes, not trials. "
+            "Trials of one athlete are not independent observations."))
+    single = {g: a for g, a in per.items() if len(a) == 1}
+    listed = "; ".join(f"{g}: {a[0]}" for g, a in single.items())
+    if len(single) == len(per):
+        text = ("Unit of analysis: the trial. Each group holds ONE athlete (" + listed + "), so "
+                "these tests compare the trials of these athletes: they describe the variation "
+                "between that athlete's trials, not a population of athletes with that "
+                "amputation or blade, and a difference between groups cannot be told apart from "
+                "a difference between the athletes. p-values treat trials as independent, which "
+                "repeated trials of one person are not; read them as descriptive.")
+    else:
+        text = ("Unit of analysis: the trial. Some groups hold a single athlete (" + listed + "), "
+                "so athlete means cannot be compared in every group; trials of one athlete are "
+                "not independent, so the p-values are optimistic and describe these athletes' "
+                "trials rather than a population.")
+    return UnitOfAnalysis("trial", per, text)
+
+
+def athlete_means(data: pd.DataFrame, *, values: Sequence[str], athlete: str = "athlete",
+                  by: Sequence[str] = ("amputation", "group", "speed_band"),
+                  speed: str | None = "speed_pct_pb") -> pd.DataFrame:
+    """One row per athlete and cell of ``by``: the mean of each value over the athlete's trials.
+
+    Columns: ``athlete``, the ``by`` columns, the means of ``values`` (and of ``speed``, kept
+    for :func:`compare_groups`), ``n_trials``.
+    """
+    keys = [athlete, *[b for b in by if b in data.columns]]
+    cols = [*values, *([speed] if speed and speed in data.columns else [])]
+    out = data.groupby(keys, sort=True)[cols].mean().reset_index()
+    out["n_trials"] = data.groupby(keys, sort=True).size().to_numpy()
+    return out

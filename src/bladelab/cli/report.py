@@ -26,6 +26,9 @@ def _report(
                                          "trials (poorly determined or poorly fitted) in the group "
                                          "statistics; by default they are left out, listed and "
                                          "marked."),
+    window: str = typer.Option("contact", "--window", help="Study: normalise the GRF and "
+                               "distance curves (and nRMSE tables) over the contact (touch-down to "
+                               "toe-off, seed 000) or over the stance window (flight included)."),
     as_json: bool = typer.Option(False, "--json", help="Print the result as JSON."),
 ) -> None:
     """Write PATH/report/index.html: fits, K*/D*, mechanics, statistics, identifiability (a
@@ -57,7 +60,8 @@ def _report(
         typer.echo(json.dumps({"index": str(index)}) if as_json else f"report written: {index}")
         return
     res = build_study_report(study_dir, trial=trial, variant=variant, out_dir=out,
-                             progress=not as_json, include_flagged=include_flagged)
+                             progress=not as_json, include_flagged=include_flagged,
+                             window=window)
     if as_json:
         typer.echo(json.dumps(res.to_dict(), indent=2))
         return

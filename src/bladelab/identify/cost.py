@@ -229,6 +229,12 @@ class StanceCost:
         cost = np.where(np.isfinite(cost), cost, np.inf)
         return CostTerms(cost=cost, nrmse_grf=e_grf, nrmse_distance=e_dst)
 
+    def residual_blocks(self) -> tuple[int, ...]:
+        """Lengths of the blocks of :meth:`residuals`, one per channel in order (for
+        :func:`bladelab.identify.identifiability.hac_inflation`)."""
+        n = int(self.mask.sum())
+        return tuple(n for _ in self.references)
+
     def residuals(self, *, grf_z, distance, grf_x=None) -> np.ndarray:
         """Weighted, normalised residuals, shape (m, n_res), with ‖r‖² = Σ_c w_c·nRMSE_c².
 

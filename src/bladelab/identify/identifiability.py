@@ -12,9 +12,11 @@ squares RSS(θ) = ‖r(θ)‖² is the least-squares analogue of the identificat
   t interval; for the simulation it follows the true, curved valley (compensation shows up as a
   flat profile). Profiles are chosen over a residual bootstrap because they need no re-identification
   (a few hundred batched simulations instead of hundreds of optimisations).
-- **Effective sample size**: residuals of a time series are autocorrelated; by default n_eff is
-  n·(1 − ρ₁)/(1 + ρ₁) with ρ₁ the lag-1 autocorrelation of the residuals at the optimum (AR(1)),
-  so intervals are not over-confident because of a high sampling rate.
+- **Autocorrelated residuals**: by default (``variance="hac"``) each parameter's profile is read
+  against s²·c_i, s² = RSS/(n − d) and c_i ≥ 1 its Newey–West variance inflation computed per
+  measured channel (:func:`hac_inflation`), with n_eff,i = n/c_i; ``variance="ar1"`` uses one
+  n_eff = n·(1 − ρ₁)/(1 + ρ₁) for all (the method before issue 16, which under-covered D:
+  benchmarks/bench_coverage.py).
 - **Re-centring**: the search minimises J (a sum of nRMSEs), the profiles the RSS (a sum of their
   squares); when a profile finds an RSS lower than at ``x_opt`` by more than a tenth of the interval
   threshold (ΔRSS/s² > 0.1·F), that point becomes the estimate and the analysis starts again there
@@ -44,6 +46,9 @@ ResidualBatch = Callable[[np.ndarray], np.ndarray]
 
 
 def _eval_residuals(residual_batch: ResidualBatch, X: np.ndarray) -> np.ndarray:
+    if not np.all(np.isfinite(X)):  # never simulate a NaN candidate
+        raise OptimizationError("a non-finite parameter set reached the residual function",
+                                where="identifiability")
     R = np.atleast_2d(np.asarray(residual_batch(np.atleast_2d(X)), dtype=float))
     if R.shape[0] != len(np.atleast_2d(X)):
         raise OptimizationError(f"residual function returned {R.shape[0]} rows for {len(X)} sets",
@@ -83,6 +88,66 @@ def effective_sample_size(residuals: np.ndarray, n_parameters: int) -> float:
     rho = float(rc[1:] @ rc[:-1]) / denom if denom > 0 else 0.0
     rho = min(max(rho, 0.0), 0.999)
     return float(min(max(n * (1 - rho) / (1 + rho), n_parameters + 2), n))
+
+
+def _bandwidth(r: np.ndarray) -> int:
+    """Bartlett bandwidth of a residual block: twice the first lag at which its autocorrelation
+    is no longer positive (its correlation length), at most half the block."""
+    n = r.size
+    rc = r - r.mean()
+    denom = float(rc @ rc)
+    if n < 4 or denom <= 0:
+        return 0
+    half = n // 2
+    for k in range(1, half + 1):
+        if float(rc[k:] @ rc[:-k]) / denom <= 0.0:
+            return min(2 * k, half)
+    return half
+
+
+def hac_inflation(residuals: np.ndarray, J: np.ndarray, *,
+                  blocks: Sequence[int] | None = None) -> tuple[np.ndarray, np.ndarray, list[int]]:
+    """Variance inflation of least-squares estimates by autocorrelated residuals (Newey–West).
+
+    The sandwich covariance V = H⁻¹ S H⁻¹ (H = JᵀJ) with S = Σ_b Σ_|l|≤L_b w_l Σ_t g_t g_{t+l}ᵀ
+    (g_t = J_t r_t, Bartlett weights w_l = 1 − |l|/(L_b + 1)) summed within each residual block b
+    (a measured channel; channels come from different instruments and are taken as independent),
+    each with its own bandwidth L_b (:func:`_bandwidth`). Compared with the independent-residual
+    covariance s²H⁻¹ (s² = RSS/(n − d)), the inflation per parameter is c_i = V_ii/(s²H⁻¹)_ii,
+    floored at 1 (never narrower than the independent-residual interval).
+
+    Returns
+    -------
+    inflation, covariance, bandwidths
+        c (d,), V (d, d) and the L_b of each block.
+    """
+    r = np.asarray(residuals, dtype=float).ravel()
+    n, d = J.shape
+    sizes = [n] if not blocks else [int(b) for b in blocks]
+    if sum(sizes) != n:
+        raise OptimizationError(f"residual blocks sum to {sum(sizes)}, not {n}", where="blocks")
+    H = J.T @ J
+    w, Q = np.linalg.eigh(H)
+    floor = max(float(np.max(w)), 1e-300) * 1e-12
+    Hinv = (Q / np.maximum(w, floor)) @ Q.T
+    S = np.zeros((d, d))
+    lags = []
+    start = 0
+    for size in sizes:
+        rb, Jb = r[start:start + size], J[start:start + size]
+        start += size
+        g = Jb * rb[:, None]
+        L = _bandwidth(rb)
+        lags.append(L)
+        S += g.T @ g
+        for lag in range(1, L + 1):
+            G = g[lag:].T @ g[:-lag]
+            S += (1.0 - lag / (L + 1.0)) * (G + G.T)
+    V = Hinv @ S @ Hinv
+    s2 = float(r @ r) / max(n - d, 1)
+    iid = s2 * np.diag(Hinv)
+    c = np.where(iid > 0, np.diag(V) / np.where(iid > 0, iid, 1.0), 1.0)
+    return np.maximum(c, 1.0), V, lags
 
 
 def _covariance(J: np.ndarray, s2: float) -> tuple[np.ndarray, np.ndarray]:
@@ -223,6 +288,10 @@ class Identifiability:
         Per parameter: the lower limit was clipped to its physical minimum.
     notes
         What was changed (re-centring, widened or clipped intervals), for the messages.
+    inflation
+        Per parameter: the variance inflation c_i for autocorrelated residuals (1 without HAC).
+    bandwidths
+        Bartlett bandwidth [samples] of each residual block (HAC only).
     """
 
     names: tuple[str, ...]
@@ -244,6 +313,8 @@ class Identifiability:
     x_start: np.ndarray | None = None
     ci_clipped: tuple[bool, ...] = ()
     notes: tuple[str, ...] = ()
+    inflation: tuple[float, ...] = ()
+    bandwidths: tuple[int, ...] = ()
 
     def to_dict(self) -> dict:
         """JSON-ready dictionary (no profiles)."""
@@ -282,6 +353,8 @@ def assess_identifiability(
     max_abs_corr: float = 0.95,
     max_recentre: int = 3,
     physical_lower: Mapping[str, float] | None = None,
+    variance: str = "hac",
+    blocks: Sequence[int] | None = None,
 ) -> Identifiability:
     """Correlation, profile-likelihood confidence intervals and flags at ``x_opt``.
 
@@ -310,6 +383,13 @@ def assess_identifiability(
     max_recentre
         How often the analysis may move to a clearly lower point found by the profiles and start
         again there; still lower after that: flagged as not converged.
+    variance
+        ``"hac"`` (default): each parameter's interval scale is s² of independent residuals times
+        its Newey–West inflation for autocorrelated residuals (:func:`hac_inflation`), with
+        n_eff,i = n/c_i; ``"ar1"``: one n_eff = n(1 − ρ₁)/(1 + ρ₁) for all (the method before
+        issue 16, which under-covered). Ignored when ``n_effective`` is given.
+    blocks
+        Lengths of the residual blocks (one per measured channel, in order), for ``"hac"``.
     physical_lower
         Parameter name -> lowest physical value (e.g. 0 for a damping); interval limits below it
         are clipped to it (``ci_clipped``, with a note).
@@ -337,19 +417,34 @@ def assess_identifiability(
                                     where="residual_batch",
                                     hint="the simulation failed there; see the solver's messages")
         rss0 = float(r0 @ r0)
-        n_eff = effective_sample_size(r0, d) if n_effective is None else float(n_effective)
-        if n_eff <= d:
-            raise OptimizationError(f"n_effective={n_eff:g} must exceed the {d} parameters",
-                                    where="n_effective")
-        s2 = max(rss0, 1e-300) / (n_eff - d)
-        cov, corr = _covariance(J, s2)
-        threshold = float(np.sqrt(stats.f.ppf(level, 1, n_eff - d)))
+        n_res = r0.size
+        if n_effective is None and variance == "hac" and n_res > d + 2:
+            # every parameter gets its own scale: s² of independent residuals × its inflation
+            c, _, bandwidths = hac_inflation(r0, J, blocks=blocks)
+            n_par = np.maximum(n_res / c, d + 2.0)
+            s2 = max(rss0, 1e-300) / (n_res - d)
+            scale = s2 * c
+            thresholds = np.sqrt(stats.f.ppf(level, 1, n_par - d))
+            n_eff = float(np.min(n_par))
+            inflation = tuple(float(v) for v in c)
+        else:
+            n_eff = effective_sample_size(r0, d) if n_effective is None else float(n_effective)
+            if n_eff <= d:
+                raise OptimizationError(f"n_effective={n_eff:g} must exceed the {d} parameters",
+                                        where="n_effective")
+            s2 = max(rss0, 1e-300) / (n_eff - d)
+            scale = np.full(d, s2)
+            thresholds = np.full(d, float(np.sqrt(stats.f.ppf(level, 1, n_eff - d))))
+            bandwidths, inflation = [], (1.0,) * d
+        cov, corr = _covariance(J, 1.0)
+        cov = cov * np.sqrt(np.outer(scale, scale))  # per-parameter scales, the GN correlation
         sd = np.sqrt(np.diag(cov))
         half = max(1, n_profile // 2)
         lo_ci, hi_ci, opened, frames = [], [], [], []
         best_rss, best_x = rss0, x.copy()
         for i in range(d):
             width = b[i, 1] - b[i, 0]
+            threshold = float(thresholds[i])
             span = min(max(3.0 * threshold * sd[i], 1e-3 * width), width)
             left = np.linspace(max(x[i] - span, b[i, 0]), x[i], half + 1)
             right = np.linspace(x[i], min(x[i] + span, b[i, 1]), half + 1)
@@ -362,7 +457,7 @@ def assess_identifiability(
             if rss[j] < best_rss:
                 best_rss, best_x = float(rss[j]), where[j].copy()
             rss_min = min(rss0, float(rss[j]))
-            z = np.sqrt(np.maximum(rss - rss_min, 0.0) / s2)
+            z = np.sqrt(np.maximum(rss - rss_min, 0.0) / scale[i])
             lo_v, lo_open = _crossing(grid, z, j, threshold, -1)
             hi_v, hi_open = _crossing(grid, z, j, threshold, +1)
             lo_open = lo_open and np.isclose(lo_v, b[i, 0])
@@ -375,8 +470,9 @@ def assess_identifiability(
         # means the search stopped short of the least-squares optimum (or optimised another
         # cost: J sums nRMSEs, the RSS their squares): that point becomes the estimate and the
         # analysis is repeated there
-        gap = (rss0 - best_rss) / s2
-        not_converged = gap > 0.1 * threshold**2
+        i_min = int(np.argmin(scale))  # the most sensitive scale
+        gap = (rss0 - best_rss) / scale[i_min]
+        not_converged = gap > 0.1 * float(thresholds[i_min]) ** 2
         if not not_converged or recentred >= max_recentre:
             break
         recentred += 1
@@ -396,9 +492,11 @@ def assess_identifiability(
     for i, name in enumerate(names):
         floor = (physical_lower or {}).get(name)
         if floor is not None and lo_ci[i] < floor:
-            lo_ci[i] = floor
+            lo_ci[i] = min(floor, x[i])  # never above the estimate
             clipped[i] = True
             notes.append(f"lower limit of {name} clipped at {floor:g} (non-physical below)")
+            if x[i] < floor:
+                notes.append(f"the estimate of {name} is below its physical minimum {floor:g}")
     flags, reasons = [], []
     for i in range(d):
         why = []
@@ -422,7 +520,8 @@ def assess_identifiability(
         poorly_determined=tuple(flags), reasons=tuple(reasons),
         profiles=pd.concat(frames, ignore_index=True), evaluations=evals,
         converged=not not_converged, recentred=recentred, x_start=x_start,
-        ci_clipped=tuple(clipped), notes=tuple(notes),
+        ci_clipped=tuple(clipped), notes=tuple(notes), inflation=inflation,
+        bandwidths=tuple(int(v) for v in bandwidths),
     )
 
 

@@ -21,6 +21,9 @@ from bladelab.trial.stance import Stance
 
 __all__ = [
     "PALETTE",
+    "contact_span",
+    "normalisation_spans",
+    "paired_spans",
     "resample_percent",
     "time_series_bands",
     "hysteresis_loops",
@@ -87,7 +90,12 @@ def _figure(
     axes = fig.subplots(nrows, ncols, squeeze=False, sharex=share, sharey=share)
     for ax in axes.flat[n_panels:]:
         ax.set_visible(False)
-    return fig, list(axes.flat[:n_panels])
+    shown = list(axes.flat[:n_panels])
+    for ax in shown:
+        # shared x: matplotlib keeps tick labels on the bottom row only, so a panel above an
+        # empty slot (e.g. the last of an incomplete row's column) would have none
+        ax.tick_params(axis="x", labelbottom=True)
+    return fig, shown
 
 
 def _style(ax) -> None:
@@ -102,15 +110,58 @@ def _check_groups(groups: Mapping, what: str) -> None:
         raise DataError(f"no {what} to plot", where=what, hint="pass {group: [items...]}")
 
 
-def resample_percent(stance: Stance, name: str, *, n_points: int = 101) -> np.ndarray:
-    """Channel ``name`` of ``stance`` resampled to 0–100 % of the window (``n_points`` samples)."""
+Window = Literal["contact", "stance"]
+
+
+def contact_span(stance: Stance, *, threshold: float = 20.0) -> tuple[float, float]:
+    """(touch-down, toe-off) times [s]: the first and last sample with vertical GRF > threshold."""
+    idx = np.flatnonzero(np.asarray(stance.grf_z, float) > threshold)
+    if idx.size < 2:
+        raise DataError(f"no contact: fewer than 2 samples above {threshold:g} N",
+                        where="stance.grf_z", hint="check the force channel (N)")
+    return float(stance.time[idx[0]]), float(stance.time[idx[-1]])
+
+
+def resample_percent(
+    stance: Stance, name: str, *, n_points: int = 101, span: tuple[float, float] | None = None
+) -> np.ndarray:
+    """Channel ``name`` of ``stance`` resampled to 0–100 % of ``span`` (start, end) [s]
+    (``n_points`` samples); default span: the whole window."""
     t = stance.time
-    pct = (t - t[0]) / (t[-1] - t[0]) * 100.0
-    return np.interp(np.linspace(0.0, 100.0, n_points), pct, getattr(stance, name))
+    t0, t1 = (float(t[0]), float(t[-1])) if span is None else span
+    return np.interp(np.linspace(t0, t1, n_points), t, getattr(stance, name))
 
 
-def _mean_sd(stances: Sequence[Stance], name: str, n_points: int) -> tuple[np.ndarray, np.ndarray]:
-    curves = np.array([resample_percent(s, name, n_points=n_points) for s in stances])
+def normalisation_spans(
+    measured: Sequence[Stance],
+    *,
+    window: Window = "contact",
+    contact_threshold: float = 20.0,
+) -> dict[int, tuple[float, float] | None]:
+    """Span of each measured stance (by position): its contact (touch-down to toe-off, seed 000)
+    or None for the whole window. A simulated stance is normalised with the span of its
+    measured one, so that both curves share the measured contact."""
+    if window not in ("contact", "stance"):
+        raise DataError(f"unknown window {window!r}", where="window", hint="contact or stance")
+    return {i: contact_span(s, threshold=contact_threshold) if window == "contact" else None
+            for i, s in enumerate(measured)}
+
+
+def paired_spans(measured: Sequence[Stance], others: Sequence[Stance], spans: dict) -> list:
+    """The span of each of ``others`` from its measured stance (same trial id, else position)."""
+    by_trial = {_trial_id(m): spans[i] for i, m in enumerate(measured) if _trial_id(m) is not None}
+    return [by_trial.get(_trial_id(o), spans.get(i)) for i, o in enumerate(others)]
+
+
+WINDOW_LABELS = {"contact": "contact [%] (touch-down to toe-off)",
+                 "stance": "stance window [%]"}
+
+
+def _mean_sd(stances: Sequence[Stance], name: str, n_points: int,
+             spans: Sequence | None = None) -> tuple[np.ndarray, np.ndarray]:
+    spans = list(spans) if spans is not None else [None] * len(stances)
+    curves = np.array([resample_percent(s, name, n_points=n_points, span=sp)
+                       for s, sp in zip(stances, spans, strict=True)])
     sd = curves.std(axis=0, ddof=1) if len(curves) > 1 else np.zeros(n_points)
     return curves.mean(axis=0), sd
 
@@ -137,11 +188,15 @@ def time_series_bands(
     n_points: int = 101,
     flagged: Collection[str] = (),
     include_flagged: bool = False,
+    window: Window = "contact",
+    contact_threshold: float = 20.0,
 ) -> Figure:
-    """GRF or distance vs stance time, measured vs simulated, group mean ± SD (Figs. 1–2).
+    """GRF or distance vs time, measured vs simulated, group mean ± SD (Figs. 1–2).
 
-    Each stance is normalised to 0–100 % of its window (touch-down to toe-off) before
-    averaging, so stances of different durations share one axis.
+    Each stance is normalised to 0–100 % of its contact (touch-down to toe-off: vertical GRF
+    above ``contact_threshold`` [N], as seed 000 draws them) before averaging, so stances of
+    different durations share one axis; a simulated stance uses the contact of its measured one.
+    ``window="stance"`` normalises over the whole stance window instead (flight included).
 
     Parameters
     ----------
@@ -168,6 +223,7 @@ def time_series_bands(
     marked = False
     for ax, (group, stances) in zip(axes, measured.items(), strict=True):
         _style(ax)
+        spans = normalisation_spans(stances, window=window, contact_threshold=contact_threshold)
         kept, bad = _split_flagged(stances, flagged)
         sims = list(simulated.get(group, [])) if simulated is not None else []
         series = [("measured", MEASURED, "-", stances if include_flagged else kept)]
@@ -177,7 +233,7 @@ def time_series_bands(
         for lab, colour, ls, items in series:
             if not items:
                 continue
-            mean, sd = _mean_sd(items, name, n_points)
+            mean, sd = _mean_sd(items, name, n_points, paired_spans(stances, items, spans))
             ax.fill_between(
                 pct, (mean - sd) * scale, (mean + sd) * scale, color=colour, alpha=0.18, linewidth=0
             )
@@ -189,8 +245,9 @@ def time_series_bands(
                 linewidth=1.6,
                 label=f"{lab} mean ± SD",
             )
-        for st in bad:
-            ax.plot(pct, resample_percent(st, name, n_points=n_points) * scale, color=FLAGGED,
+        for st, sp in zip(bad, paired_spans(stances, bad, spans), strict=True):
+            ax.plot(pct, resample_percent(st, name, n_points=n_points, span=sp) * scale,
+                    color=FLAGGED,
                     linestyle=":", linewidth=1.0,
                     label=None if marked else ("flagged trial (in the band)" if include_flagged
                                                else "flagged trial (left out)"))
@@ -198,7 +255,7 @@ def time_series_bands(
         n_in = len(stances) if include_flagged else len(kept)
         extra = f", {len(bad)} flagged" if bad else ""
         ax.set_title(f"{group} (n = {n_in}{extra})")
-        ax.set_xlabel("stance [%]")
+        ax.set_xlabel(WINDOW_LABELS[window])
         ax.set_ylabel(label)
         ax.set_xlim(0, 100)
     handles = [h for ax in axes for h in ax.get_legend_handles_labels()[0]]
@@ -294,7 +351,9 @@ def compressive_stiffness_curves(
     mechanics: Mapping[str, Sequence[StanceMechanics]], *, flagged: Collection[str] = ()
 ) -> Figure:
     """Equivalent compressive stiffness K_c vs compression Δd per group (§3.5); flagged trials
-    grey and dotted."""
+    grey and dotted. K_c is drawn where Δd is above each stance's compression threshold
+    (:func:`bladelab.mechanics.stance_mechanics`: above the distance noise); the panel's median
+    threshold is a dash-dotted line, the range written beside it."""
 
     def get(m: StanceMechanics):
         loop = m.compression_loop
@@ -303,8 +362,18 @@ def compressive_stiffness_curves(
         dd = m.compression * 1e3
         return (dd[: i + 1], kc[: i + 1]), (dd[i:], kc[i:])
 
-    return _loop_panels(mechanics, xlabel="compression Δd [mm]", ylabel="K_c [kN/m]", get=get,
-                        flagged=flagged)
+    fig = _loop_panels(mechanics, xlabel="compression Δd [mm]", ylabel="K_c [kN/m]", get=get,
+                       flagged=flagged)
+    for ax, items in zip(fig.axes, mechanics.values(), strict=False):
+        th = [m.compression_threshold * 1e3 for m in items]
+        if th:
+            med = float(np.median(th))
+            ax.axvline(med, color="#999999", linewidth=0.8, linestyle="-.")
+            ax.text(med, 0.98, f" K_c from Δd ≥ {min(th):.0f}–{max(th):.0f} mm\n (median {med:.0f})"
+                    if min(th) < max(th) - 0.5 else f" K_c from Δd ≥ {med:.0f} mm",
+                    transform=ax.get_xaxis_transform(), ha="left", va="top", fontsize=7,
+                    color="#666666")
+    return fig
 
 
 @_styled

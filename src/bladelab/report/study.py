@@ -8,7 +8,8 @@ one self-contained page with:
 - nRMSE of GRF and distance per group, individual trials (mean ± SD) and group mean curves
   (seed 000 Tables 1–2), per amputation level and per category group;
 - K* and D* per group and speed band with 95 % confidence intervals (Fig. 3);
-- GRF and distance vs time, measured vs simulated, group mean ± SD (Figs. 1–2);
+- GRF and distance over contact (0–100 % from touch-down to toe-off, or the stance window with
+  ``window="stance"``), measured vs simulated, group mean ± SD (Figs. 1–2);
 - GRF–Δθ hysteresis loops and K_c vs compression per group (§3.4–3.5), peak mechanics table;
 - the statistics table (Mann–Whitney U, Kruskal–Wallis + Dunn–Bonferroni, speed bands);
 - the cost landscape J(K, D) around the optimum of one trial (identifiability);
@@ -40,9 +41,15 @@ _AMPUTATION_ABBR = {
 }
 
 
-_MECH_COLUMNS = ("trial", "group", "source", "speed_pct_pb", "peak_force_N", "peak_compression_m",
-                 "peak_Kc_kN_per_m", "peak_angular_deformation_deg", "energy_stored_J",
-                 "energy_returned_J", "efficiency_pct")
+_MECH_COLUMNS = {  # the page's mechanics table: column -> header (the CSV keeps every column)
+    "trial": "trial", "source": "source", "speed_pct_pb": "speed [% PB]",
+    "peak_force_N": "peak F [N]", "peak_compression_mm": "peak Δd [mm]",
+    "Kc_at_peak_compression_kN_per_m": "K_c at peak Δd [kN/m]",
+    "peak_Kc_kN_per_m": "peak K_c [kN/m]", "Kc_threshold_mm": "K_c from Δd ≥ [mm]",
+    "peak_angular_deformation_deg": "peak Δθ [deg]", "energy_stored_J": "E stored [J]",
+    "energy_returned_J": "E returned [J]", "efficiency_pct": "η [%]",
+    "efficiency_plausible": "η plausible",
+}
 
 
 @dataclasses.dataclass(frozen=True)
@@ -164,45 +171,6 @@ def _landscape_figure(df: pd.DataFrame, k_opt: float, d_opt: float, title: str):
     return fig
 
 
-def _truth_figure(merged: pd.DataFrame):
-    import matplotlib
-
-    matplotlib.use("Agg")
-    from matplotlib.figure import Figure
-
-    fig = Figure(figsize=(10.0, 4.2))
-    for i, (col, true, label) in enumerate(
-            (p.edge_key, f"{p.name}_true", f"{p.name} [{p.edge_unit}]")
-            for p in (JOINT_PARAMETERS["K"], JOINT_PARAMETERS["D"])):
-        ax = fig.add_subplot(1, 2, i + 1)
-        bad = merged["flagged"].fillna(False).astype(bool) if "flagged" in merged else \
-            pd.Series(False, index=merged.index)
-        for g, sub in merged[~bad].groupby("group", sort=False):
-            ax.scatter(sub[true], sub[col], s=22, label=g, alpha=0.85)
-            if f"{col}_ci_low" in sub and sub[f"{col}_ci_low"].notna().any():
-                ax.errorbar(sub[true], sub[col],
-                            yerr=[np.clip(sub[col] - sub[f"{col}_ci_low"], 0, None),
-                                  np.clip(sub[f"{col}_ci_high"] - sub[col], 0, None)],
-                            fmt="none", ecolor="#999999", linewidth=0.7, capsize=1.5)
-        if bad.any():
-            ax.scatter(merged.loc[bad, true], merged.loc[bad, col], s=40, marker="x",
-                       color="#555555", label="flagged trial")
-        lo = float(np.nanmin([merged[true].min(), merged[col].min()]))
-        hi = float(np.nanmax([merged[true].max(), merged[col].max()]))
-        pad = 0.05 * (hi - lo if hi > lo else 1.0)
-        ax.plot([lo - pad, hi + pad], [lo - pad, hi + pad], color="#333333", linewidth=1.0,
-                linestyle="--", label="identity")
-        # long whiskers (poorly determined trials) must not squash the points
-        ax.set_ylim(lo - 4 * pad, hi + 4 * pad)
-        ax.set_xlabel(f"true {label}")
-        ax.set_ylabel(f"identified {label}")
-        ax.set_title(f"{label.split(' ')[0]}: identified vs true")
-        ax.grid(True, alpha=0.3)
-    fig.axes[0].legend(loc="upper left", fontsize=7)
-    fig.tight_layout()
-    return fig
-
-
 def build_study_report(
     study_dir: str | Path,
     *,
@@ -212,6 +180,7 @@ def build_study_report(
     landscape_points: int = 15,
     progress: bool = True,
     include_flagged: bool = False,
+    window: str = "contact",
 ) -> StudyReport:
     """Write the study report ``STUDY_DIR/report/index.html`` (see the module docstring).
 
@@ -229,6 +198,9 @@ def build_study_report(
         Grid points per axis of the cost landscape.
     progress
         Show a progress bar while simulating.
+    window
+        Time normalisation of the GRF and distance curves and the nRMSE tables: ``"contact"``
+        (seed 000: 0–100 % from touch-down to toe-off) or ``"stance"`` (the whole window).
     include_flagged
         Keep flagged trials (:mod:`bladelab.identify.quality`) in the group statistics; by
         default they are left out (and still listed and marked).
@@ -246,15 +218,24 @@ def build_study_report(
     from bladelab.identify.cost import StanceCost
     from bladelab.identify.formulations import DEFAULT_FORMULATION, formulation_drive
     from bladelab.identify.identifiability import cost_landscape
-    from bladelab.mechanics import mechanics_table, stance_mechanics
+    from bladelab.mechanics import PLAUSIBLE_EFFICIENCY_PCT, mechanics_table, stance_mechanics
     from bladelab.report import figures, tables
     from bladelab.report.builder import Report, ReportTable
     from bladelab.report.study_quality import add_flagged_section, flag_column, row_quality
-    from bladelab.stats import compare_groups, speed_band, summarize
+    from bladelab.report.study_sections import add_sensitivity_section, add_truth_section
+    from bladelab.stats import (
+        athlete_means,
+        compare_groups,
+        speed_band,
+        summarize,
+        unit_of_analysis,
+    )
     from bladelab.study.spec import RESULTS_FILE, load_study
     from bladelab.study.store import ResultsStore
     from bladelab.study.tasks import read_trial_stance
 
+    if window not in ("contact", "stance"):
+        raise DataError(f"unknown window {window!r}", where="--window", hint="contact or stance")
     study, folder = load_study(study_dir)
     db = folder / RESULTS_FILE
     if not db.is_file():
@@ -334,12 +315,14 @@ def build_study_report(
             tip = None
         mm = stance_mechanics(m_st, tip_x=None if tip is None else tip[:, 0],
                               tip_z=None if tip is None else tip[:, 2], hinge=hinge)
+        # the simulated stance: K_c from the same Δd as its measured one (above the noise)
+        same = {"min_compression": mm.compression_threshold, "noise_factor": 0.0}
         local = _sim_theta_offset(model, res.deflection)
         if local is not None:
             sx, sz = _clamp_to_lab(stance, local)
-            ms = stance_mechanics(s_st, tip_x=sx, tip_z=sz, hinge=hinge)
+            ms = stance_mechanics(s_st, tip_x=sx, tip_z=sz, hinge=hinge, **same)
         else:
-            ms = stance_mechanics(s_st)
+            ms = stance_mechanics(s_st, **same)
         mech_m.setdefault(group, []).append(dataclasses.replace(mm, metadata={**mm.metadata, "trial": tid, "group": group, "source": "measured"}))
         mech_s.setdefault(group, []).append(dataclasses.replace(ms, metadata={**ms.metadata, "trial": tid, "group": group, "source": "simulated"}))
         is_flagged, why = row_quality(r)
@@ -382,6 +365,9 @@ def build_study_report(
                for g, items in groups.items()}
         return {g: v for g, v in out.items() if v}
 
+    span_words = ("measured contact (touch-down to toe-off: vertical GRF > 20 N; a simulated "
+                  "stance on the contact of its measured one)" if window == "contact"
+                  else "stance window (flight before and after contact included)")
     left_out = "" if include_flagged or not flagged_ids else (
         f" {len(flagged_ids)} flagged trial(s) are left out (see Flagged trials).")
 
@@ -393,6 +379,7 @@ def build_study_report(
                                  "formulation": ", ".join(sorted(formulations))},
                   "landscape_trial": landscape_id, "trials_reported": len(per_trial),
                   "trials_failed": len(problems), "trials_flagged": len(flagged_ids),
+                  "curve_window": window,
                   "include_flagged": include_flagged},
         seed=study.seed,
     )
@@ -421,34 +408,40 @@ def build_study_report(
     # nRMSE tables (seed 000 Tables 1-2): amputation levels, then category groups
     for signal, title in (("grf", "nRMSE of the GRF (Table 1)"),
                           ("distance", "nRMSE of the characteristic distance (Table 2)")):
-        tr = pd.concat([tables.trial_nrmse(kept(by_level_m), kept(by_level_s), signal=signal),
-                        tables.trial_nrmse(kept(measured), kept(simulated), signal=signal)],
+        win = {"signal": signal, "window": window}
+        tr = pd.concat([tables.trial_nrmse(kept(by_level_m), kept(by_level_s), **win),
+                        tables.trial_nrmse(kept(measured), kept(simulated), **win)],
                        ignore_index=True)
-        mc = pd.concat([tables.mean_curve_nrmse(kept(by_level_m), kept(by_level_s), signal=signal),
-                        tables.mean_curve_nrmse(kept(measured), kept(simulated), signal=signal)],
+        mc = pd.concat([tables.mean_curve_nrmse(kept(by_level_m), kept(by_level_s), **win),
+                        tables.mean_curve_nrmse(kept(measured), kept(simulated), **win)],
                        ignore_index=True)
         num = tables.nrmse_table(tr, mc, signal=signal)
-        rep.add_section(title, text=left_out.strip() or None, tables=[ReportTable(title, tables.nrmse_table(tr, mc, signal=signal,
+        rep.add_section(title, text=f"Over the {span_words}.{left_out}", tables=[ReportTable(title, tables.nrmse_table(tr, mc, signal=signal,
                                                                              formatted=True),
                                                    f"nrmse-{signal}", csv=num)])
     rep.add_section(
         "GRF and distance vs time",
         text="Measured (solid) and simulated at K*, D* (dashed): group mean ± SD over stances "
-             "normalised to 0–100 % of the stance window (seed 000 Figs. 1–2). Flagged trials: "
+             f"normalised to 0–100 % of the {span_words} (seed 000 Figs. 1–2; --window "
+             f"{'stance' if window == 'contact' else 'contact'} for the other). Flagged trials: "
              "grey dotted lines." + left_out,
         figures=[("Vertical GRF, measured vs simulated",
-                  figures.time_series_bands(measured, simulated, signal="grf",
+                  figures.time_series_bands(measured, simulated, signal="grf", window=window,
                                             flagged=flagged_ids, include_flagged=include_flagged)),
                  ("Characteristic distance, measured vs simulated",
-                  figures.time_series_bands(measured, simulated, signal="distance",
+                  figures.time_series_bands(measured, simulated, signal="distance", window=window,
                                             flagged=flagged_ids, include_flagged=include_flagged))],
     )
     summary = summarize(grouped, values=["K_Nm_per_deg", "D_Nms_per_deg"],
-                        by=["group", "speed_band"])
+                        by=["group", "speed_band"],
+                        lower_limits={"K_Nm_per_deg": 0.0, "D_Nms_per_deg": 0.0})
+    n_clipped = int(summary[["K_Nm_per_deg_ci_clipped", "D_Nms_per_deg_ci_clipped"]].sum().sum())
     rep.add_section(
         "K* and D* per group and speed band",
         text="Bars: mean; whiskers: 95 % t confidence interval of the mean (seed 000 Fig. 3)."
-             + left_out,
+             + left_out + (f" {n_clipped} lower limit(s) fell below 0, which is not physical for "
+                           "a stiffness or a damping: clipped at 0 and marked ‡."
+                           if n_clipped else ""),
         figures=[("K* and D* per group and speed band", figures.parameter_bars(summary))],
         tables=[ReportTable("K* and D* per group and speed band",
                             tables.parameter_summary_display(summary), "parameters", csv=summary)],
@@ -456,14 +449,36 @@ def build_study_report(
     mt = mechanics_table([m for v in mech_m.values() for m in v] +
                          [m for v in mech_s.values() for m in v])
     mt["flagged"] = mt["trial"].isin(flagged_ids)
-    mt_display = mt[[c for c in _MECH_COLUMNS if c in mt]].copy()
+    mt["peak_compression_mm"] = 1e3 * mt["peak_compression_m"]
+    mt_display = mt[[c for c in _MECH_COLUMNS if c in mt]].rename(columns=_MECH_COLUMNS)
     mt_display.insert(1, "quality", flag_column(mt["flagged"]))
+    measured_mt = mt[mt["source"] == "measured"]
+    th = measured_mt["Kc_threshold_mm"]
+    eta = measured_mt["efficiency_pct"]
+    lo_eta, hi_eta = PLAUSIBLE_EFFICIENCY_PCT
     rep.add_section(
         "Blade mechanics",
         text="GRF–Δθ hysteresis loops (loading solid, unloading dashed) and equivalent compressive "
              "stiffness K_c vs compression Δd per group (seed 000 §3.4–3.5), measured stances; "
              "then the simulated ones. Δθ of measured stances comes from the tip marker. "
-             "Flagged trials: grey dotted lines, marked in the table.",
+             "Flagged trials: grey dotted lines, marked in the table."
+             f"\n\nK_c = GRF/Δd is shown only where Δd is above the measurement noise: Δd ≥ "
+             "max(5 mm, 10 × the robust SD of the distance before touch-down), here "
+             f"{th.min():.1f}–{th.max():.1f} mm (median {th.median():.1f} mm, dash-dotted line), "
+             "so that the distance noise (and the uncertainty of d0 it causes) moves K_c by at "
+             "most 10 %; a simulated stance uses the threshold of its measured one. Near "
+             "touch-down Δd → 0 and GRF/Δd is not defined. Seed 000 reports K_c at peak "
+             "compression (18–32 kN/m), the column 'K_c at peak Δd'; 'peak K_c' is the largest "
+             "value above the threshold, reached early in loading on these stances."
+             f"\n\nPlausibility of the energies: E stored and E returned are areas of the "
+             "vertical-GRF–Δd loop. Force and clamp–tip distance are not work-conjugate (the GRF "
+             "acts at a contact point that rolls along the sole, and the clamp rotates), so they "
+             "are indices of the loop's shape, not the blade's strain energy, and their "
+             "efficiency η is not the blade's energy return: carbon-fibre blades return most of "
+             f"the energy they store. Measured η here is {eta.min():.0f}–{eta.max():.0f} %; "
+             f"{int((~measured_mt['efficiency_plausible']).sum())} of {len(measured_mt)} stances "
+             f"lie outside {lo_eta:.0f}–{hi_eta:.0f} % ('η plausible' = no): read η as a "
+             "comparison between groups, not as an energy return.",
         figures=[("GRF vs angular deformation, measured",
                   figures.hysteresis_loops(mech_m, flagged=flagged_ids)),
                  ("K_c vs compression, measured",
@@ -472,14 +487,19 @@ def build_study_report(
                   figures.hysteresis_loops(mech_s, flagged=flagged_ids))],
         tables=[ReportTable("Peak mechanics per stance", mt_display, "mechanics", csv=mt)],
     )
-    st = compare_groups(grouped, amputation="amputation", category="group",
+    unit = unit_of_analysis(grouped, athlete="athlete", groups=("amputation", "group"))
+    tested = grouped if unit.unit == "trial" else athlete_means(
+        grouped, values=["K_Nm_per_deg", "D_Nms_per_deg"], by=("amputation", "group", "speed_band"))
+    st = compare_groups(tested, amputation="amputation", category="group",
                         speed="speed_pct_pb")
     rep.add_section(
         "Statistics",
         text="Mann–Whitney U between amputation levels, Kruskal–Wallis with Dunn–Bonferroni "
              "across groups, Mann–Whitney U between speed bands (≥ 90 % vs < 90 % PB); α = 0.05; "
-             f"effect size r (seed 000 §3.6). {len(grouped)} of {len(per_trial)} trials tested."
-             + left_out,
+             f"effect size r (seed 000 §3.6). {len(grouped)} of {len(per_trial)} trials "
+             + ("tested." if unit.unit == "trial" else
+                f"averaged into {len(tested)} athlete means (per group and speed band).")
+             + left_out + "\n\n" + unit.statement,
         tables=[ReportTable("Statistical tests", tables.stats_display(st), "statistics", csv=st)]
         if len(st) else [],
     )
@@ -501,85 +521,11 @@ def build_study_report(
                                                  D_identified_Nms_per_deg=d_opt),
                 "landscape", csv=grid)],
         )
-    _add_sensitivity_section(rep, formulations)
+    add_sensitivity_section(rep, formulations)
     if synthetic:
-        gt = pd.read_csv(gt_path, comment="#")
-        merged = per_trial.merge(
-            gt[["trial_id", "K_Nm_per_deg", "D_Nms_per_deg"]].rename(
-                columns={"K_Nm_per_deg": "K_true", "D_Nms_per_deg": "D_true"}), on="trial_id")
-        merged = merged.rename(columns={
-            "K_ci_low_Nm_per_deg": "K_Nm_per_deg_ci_low", "K_ci_high_Nm_per_deg": "K_Nm_per_deg_ci_high",
-            "D_ci_low_Nms_per_deg": "D_Nms_per_deg_ci_low",
-            "D_ci_high_Nms_per_deg": "D_Nms_per_deg_ci_high"})
-        merged["K_error_pct"] = 100 * (merged["K_Nm_per_deg"] / merged["K_true"] - 1)
-        merged["D_error_pct"] = 100 * (merged["D_Nms_per_deg"] / merged["D_true"] - 1)
-        secant = ""
-        if "K_secant_peak_Nm_per_deg" in gt.columns:
-            merged = merged.merge(gt[["trial_id", "K_secant_peak_Nm_per_deg"]], on="trial_id")
-            merged["K_vs_secant_error_pct"] = 100 * (
-                merged["K_Nm_per_deg"] / merged["K_secant_peak_Nm_per_deg"] - 1)
-            secant = (f" Against the secant stiffness of the generator's stiffening hinge at its "
-                      f"peak deflection (K_secant_peak in ground_truth.csv), the median K error is "
-                      f"{float(np.median(merged['K_vs_secant_error_pct'])):+.1f} %.")
-        for p in ("K", "D"):
-            col = "K_Nm_per_deg" if p == "K" else "D_Nms_per_deg"
-            lo, hi = merged.get(f"{col}_ci_low"), merged.get(f"{col}_ci_high")
-            merged[f"{p}_true_in_ci"] = (lo <= merged[f"{p}_true"]) & (merged[f"{p}_true"] <= hi) \
-                if lo is not None else np.nan
-        agg = merged[merged["trial_id"].isin(kept_ids)].groupby("group", sort=False).agg(
-            n=("trial_id", "size"),
-            K_error_median_pct=("K_error_pct", "median"),
-            K_abs_error_median_pct=("K_error_pct", lambda x: float(np.median(np.abs(x)))),
-            D_error_median_pct=("D_error_pct", "median"),
-            D_abs_error_median_pct=("D_error_pct", lambda x: float(np.median(np.abs(x)))),
-            K_true_in_ci_pct=("K_true_in_ci", lambda x: 100 * float(np.mean(x.astype(float)))),
-            D_true_in_ci_pct=("D_true_in_ci", lambda x: 100 * float(np.mean(x.astype(float)))),
-        ).reset_index()
-        within = (np.abs(merged["K_error_pct"]) <= 5) & (np.abs(merged["D_error_pct"]) <= 20)
-        rep.add_section(
-            "Recovered vs true parameters",
-            text=f"The generator's ground truth (ground_truth.csv) against the identified K*, D* "
-                 f"(whiskers: the identification's confidence intervals). "
-                 f"{int(within.sum())} of {len(merged)} trials are within K ±5 % and D ±20 %; "
-                 f"median |K error| {float(np.median(np.abs(merged['K_error_pct']))):.1f} %, "
-                 f"median |D error| {float(np.median(np.abs(merged['D_error_pct']))):.1f} %. "
-                 "The generating model is richer than the identified one (stiffening hinge, "
-                 "softer ground, marker and force noise, 100 Hz kinematics), so exact recovery "
-                 f"is not expected.{secant} Flagged trials: grey crosses; the errors per group "
-                 + ("include them." if include_flagged else "leave them out."),
-            figures=[("Identified vs true K and D", _truth_figure(merged))],
-            tables=[("Errors per group", agg),
-                    ("Per trial", merged.assign(quality=flag_column(merged["flagged"]))[[c for c in (
-                        "trial_id", "quality", "group", "speed_pct_pb", "K_true", "K_secant_peak_Nm_per_deg",
-                        "K_Nm_per_deg", "K_error_pct", "K_vs_secant_error_pct", "D_true",
-                        "D_Nms_per_deg", "D_error_pct") if c in merged.columns]])],
-        )
+        add_truth_section(rep, per_trial, gt_path, kept_ids=kept_ids,
+                          include_flagged=include_flagged)
     index = rep.write(Path(out_dir) if out_dir is not None else folder / "report")
     return StudyReport(index=Path(index), n_trials=len(per_trial), n_failed=len(problems),
                        landscape_trial=landscape_id, n_flagged=len(flagged_ids),
                        flagged_in_statistics=include_flagged)
-
-
-def _add_sensitivity_section(rep, formulations) -> None:
-    """How far to trust K* and D*: the measured sensitivity to marker noise and rate (issue 9)."""
-    from bladelab.report.sensitivity import (
-        read_sensitivity,
-        sensitivity_figure,
-        sensitivity_summary,
-    )
-
-    table = read_sensitivity()
-    summary = sensitivity_summary(table)
-    rep.add_section(
-        "How far to trust K* and D*",
-        text="Sensitivity of the identified parameters to marker noise and kinematic sampling rate, "
-             f"measured on {table['case'].nunique()} synthetic stances from the MuJoCo runner "
-             "generator (blades " + ", ".join(sorted(table["blade"].unique())) + "), degraded "
-             "as a lab records them: clamp cluster and tip markers at 100 or 250 Hz with the noise "
-             "on the axis, 20 Hz low-pass; forces at 1 kHz with 1 % noise "
-             "(benchmarks/bench_robust.py, docs/robust-identification.md). This study was "
-             f"identified with: {', '.join(sorted(formulations))}. Dotted lines: K 5 %, D 20 %.",
-        figures=[("Sensitivity to marker noise and rate", sensitivity_figure(table))],
-        tables=[("Sensitivity: errors and CI half-widths [%]", summary)],
-    )
-

@@ -2,7 +2,9 @@
 
 nRMSE = RMSE(simulated − measured) / (max − min of the measured signal) · 100 [%] (seed 000
 §2.3), computed on individual trials (reported as mean ± SD per group) and on the group mean
-curves (each stance normalised to 0–100 % of its window, then averaged).
+curves (each stance normalised to 0–100 % of its contact, then averaged). By default both use the
+measured contact (touch-down to toe-off, vertical GRF > 20 N), as the identification's cost does;
+``window="stance"`` uses the whole window (flight included, which lowers the GRF's nRMSE).
 """
 
 from __future__ import annotations
@@ -14,7 +16,15 @@ import pandas as pd
 
 from bladelab.errors import DataError
 from bladelab.parameters import JOINT_PARAMETERS
-from bladelab.report.figures import SIGNALS, Signal, resample_percent
+from bladelab.report.figures import (
+    SIGNALS,
+    Signal,
+    Window,
+    contact_span,
+    normalisation_spans,
+    paired_spans,
+    resample_percent,
+)
 from bladelab.trial.stance import Stance
 
 __all__ = [
@@ -48,8 +58,11 @@ def trial_nrmse(
     simulated: Mapping[str, Sequence[Stance]],
     *,
     signal: Signal = "grf",
+    window: Window = "contact",
+    contact_threshold: float = 20.0,
 ) -> pd.DataFrame:
-    """nRMSE of each simulated stance against its measured one (same samples).
+    """nRMSE of each simulated stance against its measured one (same samples), over the
+    measured contact (``window="contact"``) or the whole window (``"stance"``).
 
     Returns a tidy table with columns ``group``, ``trial`` (index in the group, or the
     ``trial`` metadata), ``signal`` and ``nrmse_pct``.
@@ -65,12 +78,18 @@ def trial_nrmse(
                 hint="pass one simulated stance per measured stance, in the same order",
             )
         for i, (m, s) in enumerate(zip(stances, sims, strict=True)):
+            a, b = getattr(m, name), getattr(s, name)
+            if window == "contact":
+                t0, t1 = contact_span(m, threshold=contact_threshold)
+                keep = (m.time >= t0) & (m.time <= t1)
+                if np.shape(b) == np.shape(a):
+                    a, b = np.asarray(a)[keep], np.asarray(b)[keep]
             rows.append(
                 {
                     "group": group,
                     "trial": m.metadata.get("trial", i),
                     "signal": signal,
-                    "nrmse_pct": nrmse_pct(getattr(m, name), getattr(s, name)),
+                    "nrmse_pct": nrmse_pct(a, b),
                 }
             )
     return pd.DataFrame(rows, columns=["group", "trial", "signal", "nrmse_pct"])
@@ -82,8 +101,11 @@ def mean_curve_nrmse(
     *,
     signal: Signal = "grf",
     n_points: int = 101,
+    window: Window = "contact",
+    contact_threshold: float = 20.0,
 ) -> pd.DataFrame:
-    """nRMSE between the group mean curves (0–100 % stance) of simulated and measured stances.
+    """nRMSE between the group mean curves (0–100 % of the measured contact, or of the window)
+    of simulated and measured stances.
 
     Returns columns ``group``, ``signal``, ``nrmse_pct``.
     """
@@ -93,8 +115,12 @@ def mean_curve_nrmse(
         sims = simulated.get(group, [])
         if not stances or not sims:
             continue
-        m = np.mean([resample_percent(s, name, n_points=n_points) for s in stances], axis=0)
-        s = np.mean([resample_percent(s, name, n_points=n_points) for s in sims], axis=0)
+        spans = normalisation_spans(stances, window=window, contact_threshold=contact_threshold)
+        m = np.mean([resample_percent(s, name, n_points=n_points, span=spans[i])
+                     for i, s in enumerate(stances)], axis=0)
+        s = np.mean([resample_percent(x, name, n_points=n_points, span=sp)
+                     for x, sp in zip(sims, paired_spans(stances, sims, spans), strict=True)],
+                    axis=0)
         rows.append({"group": group, "signal": signal, "nrmse_pct": nrmse_pct(m, s)})
     return pd.DataFrame(rows, columns=["group", "signal", "nrmse_pct"])
 
@@ -229,18 +255,22 @@ def parameter_summary_display(
     ),
     by: Sequence[str] = ("group", "speed_band"),
 ) -> pd.DataFrame:
-    """``mean (CI low–high)`` per parameter from :func:`bladelab.stats.summarize` output."""
+    """``mean (CI low–high)`` per parameter from :func:`bladelab.stats.summarize` output; a lower
+    limit clipped at its physical minimum (``<value>_ci_clipped``) is marked ``‡``."""
     out = summary[list(by)].copy()
     out.columns = [c.replace("_", " ") for c in by]
     out["n"] = summary["n"].to_numpy()
     for col, label in parameters:
         digits = 3 if float(np.nanmax(np.abs(summary[col]))) < 1 else 2
+        clipped = (summary[f"{col}_ci_clipped"] if f"{col}_ci_clipped" in summary
+                   else pd.Series(False, index=summary.index))
         out[f"{label} mean (95 % CI)"] = [
-            f"{m:.{digits}f} ({lo:.{digits}f}–{hi:.{digits}f})"
+            f"{m:.{digits}f} ({lo:.{digits}f}{'‡' if c else ''}–{hi:.{digits}f})"
             if np.isfinite(lo)
             else f"{m:.{digits}f}"
-            for m, lo, hi in zip(
-                summary[col], summary[f"{col}_ci_low"], summary[f"{col}_ci_high"], strict=True
+            for m, lo, hi, c in zip(
+                summary[col], summary[f"{col}_ci_low"], summary[f"{col}_ci_high"],
+                clipped.fillna(False).astype(bool), strict=True
             )
         ]
     return out

@@ -120,6 +120,7 @@ class SimProblem:
     order: int = 2
     iterations: int = 1
     refine: int = 10
+    finer: dict = dataclasses.field(default_factory=dict, repr=False, compare=False)
 
     @property
     def n_joints(self) -> int:
@@ -231,8 +232,10 @@ class BatchResult:
     """Outputs of many parameter sets of one problem (SI units).
 
     ``grf_x``, ``grf_z``, ``distance``: (n_sets, n_samples); ``deflection``, ``torque``:
-    (n_sets, n_samples, n_joints); ``ok``: (n_sets,) False where the simulation diverged (its
-    rows are NaN); ``time`` (n_samples,) [s].
+    (n_sets, n_samples, n_joints); ``ok``: (n_sets,) False where the simulation diverged even
+    with the smaller retry steps (its rows are NaN); ``time`` (n_samples,) [s]; ``refined``:
+    (n_sets,) True where the set diverged at the problem's step and was simulated again with a
+    smaller one (:data:`RETRY_STEP_FACTORS`).
     """
 
     time: np.ndarray
@@ -245,6 +248,7 @@ class BatchResult:
     stiffness: np.ndarray
     damping: np.ndarray
     stiffness_quadratic: np.ndarray
+    refined: np.ndarray | None = None
 
     @property
     def n_sets(self) -> int:
@@ -359,6 +363,20 @@ def prepare(
     )
 
 
+RETRY_STEP_FACTORS: tuple[int, ...] = (4, 16)
+"""A kernel run that diverges is run again with the step divided by these factors, in turn."""
+
+
+def finer_problem(problem: SimProblem, factor: int) -> SimProblem:
+    """The same problem with the integration step divided by ``factor`` (cached on the problem)."""
+    if factor not in problem.finer:
+        problem.finer[factor] = prepare(
+            problem.blade, problem.stance, dt=problem.dt / factor, engine=problem.engine,
+            belt_speed=problem.belt_speed, drive=problem.drive, order=problem.order,
+            iterations=problem.iterations, refine=problem.refine)
+    return problem.finer[factor]
+
+
 def _params(problem: SimProblem, value, default: np.ndarray, name: str, n_sets: int | None):
     nj = problem.n_joints
     if value is None:
@@ -432,11 +450,20 @@ def simulate(
 
         return simulate_mujoco(problem, K[0], D[0], K2[0])
     grf, dist, qout, tau, state, energy, status = run_kernel(problem, K, D, K2)
+    used = problem
+    tried = []
+    for factor in RETRY_STEP_FACTORS:  # diverged: again with a smaller step
+        if status[0, 0] == _k.STATUS_OK:
+            break
+        tried.append(f"{used.dt:.3g} s at t = {used.time[0] + status[0, 1] * used.dt:.4g} s")
+        used = finer_problem(problem, factor)
+        grf, dist, qout, tau, state, energy, status = run_kernel(used, K, D, K2)
     if status[0, 0] != _k.STATUS_OK:
-        t_fail = problem.time[0] + status[0, 1] * problem.dt
+        tried.append(f"{used.dt:.3g} s at t = {used.time[0] + status[0, 1] * used.dt:.4g} s")
         raise SimulationError(
-            f"the kernel diverged at t = {t_fail:.4g} s", where="simulate",
-            hint="reduce dt or check the stance (clamp far below ground?) and K, D",
+            "the kernel diverged with every step tried (" + "; ".join(tried) + ")",
+            where="simulate",
+            hint="check the stance (clamp far below ground?) and K, D, or use engine='mujoco'",
         )
     return SimResult(
         time=problem.time.copy(), grf_x=grf[0, :, :, 0].sum(axis=1),
@@ -444,7 +471,7 @@ def simulate(
         deflection=qout[0], torque=tau[0], contact_state=state[0],
         energy={name: energy[0, :, i] for i, name in enumerate(_k.ENERGY_TERMS)},
         stiffness=K[0].copy(), damping=D[0].copy(), stiffness_quadratic=K2[0].copy(),
-        engine="kernel", dt=problem.dt,
+        engine="kernel", dt=used.dt,
     )
 
 
@@ -506,11 +533,25 @@ def simulate_batch(
                                                                 parallel=parallel,
                                                                 with_energy=False)
     ok = status[:, 0] == _k.STATUS_OK
+    refined = np.zeros(n_sets, dtype=bool)
+    for factor in RETRY_STEP_FACTORS:  # diverged sets: again with a smaller step
+        idx = np.flatnonzero(~ok)
+        if idx.size == 0:
+            break
+        fine = finer_problem(problem, factor)
+        g2, d2, q2, t2, _s2, _e2, st2 = run_kernel(
+            fine, np.ascontiguousarray(K[idx]), np.ascontiguousarray(D[idx]),
+            np.ascontiguousarray(K2[idx]), parallel=parallel, with_energy=False)
+        good = st2[:, 0] == _k.STATUS_OK
+        sel = idx[good]
+        grf[sel], dist[sel], qout[sel], tau[sel] = g2[good], d2[good], q2[good], t2[good]
+        ok[sel] = True
+        refined[sel] = True
     grf_x = grf[:, :, :, 0].sum(axis=2)
     grf_z = grf[:, :, :, 1].sum(axis=2)
     for arr in (grf_x, grf_z, dist, qout, tau):
         arr[~ok] = np.nan
     return BatchResult(
         time=problem.time.copy(), grf_x=grf_x, grf_z=grf_z, distance=dist, deflection=qout,
-        torque=tau, ok=ok, stiffness=K, damping=D, stiffness_quadratic=K2,
+        torque=tau, ok=ok, stiffness=K, damping=D, stiffness_quadratic=K2, refined=refined,
     )
