@@ -19,7 +19,7 @@ import typer
 
 from bladelab.errors import InputFileError, SpecError
 
-__all__ = ["FUKUCHI_STATIC", "FUKUCHI_TRIAL", "PROGRESS_EVERY_S", "TRIAL_SPEED_M_PER_S",
+__all__ = ["FUKUCHI_STATIC", "FUKUCHI_TRIAL", "PROGRESS_EVERY_S", "StageProgress", "TRIAL_SPEED_M_PER_S",
            "make_guess", "run_collocation"]
 
 _SHARED = Path(__file__).resolve().parents[3].parent / "shared" / "data" / "real" / "fukuchi2017"
@@ -86,26 +86,30 @@ def _file_kind(path: Path) -> str:
                                                "'bladelab predict' parameter JSON file")
 
 
-class _Progress:
-    """Progress lines on stderr: a stage's start and end, and an iteration line at most every
-    :data:`PROGRESS_EVERY_S` seconds."""
+class StageProgress:
+    """Progress lines on stderr for one solve's stage reports (``SolveProgress``): a stage's
+    start and end, and an iteration line at most every ``every_s`` seconds [s] (default
+    :data:`PROGRESS_EVERY_S`), each after ``prefix``. Picklable (the sweep's workers use it)."""
 
-    def __init__(self) -> None:
+    def __init__(self, prefix: str = "", every_s: float | None = None) -> None:
+        self.prefix = prefix
+        self.every_s = PROGRESS_EVERY_S if every_s is None else float(every_s)
         self.last = -math.inf
 
     def __call__(self, p) -> None:
+        head = f"{self.prefix}{p.stage} stage"
         if p.event == "start":
-            typer.echo(f"{p.stage} stage: started ({p.message})", err=True)
+            typer.echo(f"{head}: started ({p.message})", err=True)
             self.last = time.perf_counter()
         elif p.event == "iteration":
             now = time.perf_counter()
-            if now - self.last >= PROGRESS_EVERY_S:
+            if now - self.last >= self.every_s:
                 self.last = now
-                typer.echo(f"{p.stage} stage: iteration {p.iteration}, objective "
-                           f"{p.objective:.5g}, constraint violation {p.violation:.2g}, "
-                           f"{p.elapsed_s:.0f} s", err=True)
+                typer.echo(f"{head}: iteration {p.iteration}, objective {p.objective:.5g}, "
+                           f"constraint violation {p.violation:.2g}, {p.elapsed_s:.0f} s",
+                           err=True)
         else:
-            typer.echo(f"{p.stage} stage: {p.message} after {p.iteration} iterations, "
+            typer.echo(f"{head}: {p.message} after {p.iteration} iterations, "
                        f"{p.elapsed_s:.1f} s", err=True)
 
 
@@ -153,7 +157,7 @@ def run_collocation(
     result = predict_stride_in_folder(
         out, runner, settings,
         lambda: make_guess(runner, guess, n=mesh, speed=settings.speed_m_per_s),
-        model_spec=spec, resume=resume, force=force, progress=_Progress())
+        model_spec=spec, resume=resume, force=force, progress=StageProgress())
     sol = result.solution
     summary = sol.summary()
     typer.echo(json.dumps(summary) if as_json else _text(summary, result.path, result.solved))

@@ -14,7 +14,6 @@ from __future__ import annotations
 import functools
 import json
 import math
-import time
 from pathlib import Path
 
 import typer
@@ -30,28 +29,17 @@ class SweepProgress:
     its result. Picklable (it runs in the worker processes of ``--jobs``)."""
 
     def __init__(self, every_s: float | None = None) -> None:
-        from bladelab.cli.collocation import PROGRESS_EVERY_S
-
-        self.every_s = PROGRESS_EVERY_S if every_s is None else float(every_s)
-        self.last = -math.inf
+        self.every_s = every_s
+        self.stages: dict[str, object] = {}
 
     def __call__(self, r) -> None:
+        from bladelab.cli.collocation import StageProgress
+
         head = f"{r.model}, {r.problem}:"
         if r.event == "solve":
-            p = r.solve
-            if p.event == "start":
-                self.last = time.perf_counter()
-                typer.echo(f"{head} {p.stage} stage started ({p.message})", err=True)
-            elif p.event == "iteration":
-                now = time.perf_counter()
-                if now - self.last >= self.every_s:
-                    self.last = now
-                    typer.echo(f"{head} {p.stage} stage iteration {p.iteration}, objective "
-                               f"{p.objective:.5g}, constraint violation {p.violation:.2g}, "
-                               f"{p.elapsed_s:.0f} s", err=True)
-            else:
-                typer.echo(f"{head} {p.stage} stage: {p.message} after {p.iteration} "
-                           f"iterations, {p.elapsed_s:.1f} s", err=True)
+            if head not in self.stages:
+                self.stages[head] = StageProgress(f"{head} ", self.every_s)
+            self.stages[head](r.solve)
         elif r.event == "read":
             typer.echo(f"{head} read back {r.path}", err=True)
         else:
