@@ -483,7 +483,9 @@ def build_predictive_report(
     rep = Report(titles[kind], subtitle=str(path))
     sweep_summary = None
     resim = None
-    with _Counter(tqdm(desc="re-simulating", unit="sim", disable=not progress)) as bar:
+    # a collocation solution is not re-simulated: no progress bar for it
+    with _Counter(tqdm(desc="re-simulating", unit="sim",
+                       disable=not progress or kind == "collocation")) as bar:
         if kind == "collocation":
             from bladelab.report.collocation import collocation_sections
 
