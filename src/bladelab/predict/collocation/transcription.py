@@ -478,7 +478,8 @@ class StrideNLP:
                     "t_wall_nlp_hess_l"):
             if key in stats:
                 timings[key.replace("t_wall_", "") + "_s"] = float(stats[key])
-        for key in ("n_call_nlp_f", "n_call_nlp_g", "n_call_nlp_jac_g", "n_call_nlp_hess_l"):
+        for key in ("n_call_nlp_f", "n_call_nlp_g", "n_call_nlp_grad_f", "n_call_nlp_jac_g",
+                    "n_call_nlp_hess_l"):
             if key in stats:
                 timings[key.replace("n_call_", "calls_")] = float(stats[key])
         return NLPSolution(
