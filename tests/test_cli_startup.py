@@ -52,3 +52,12 @@ def test_cli_defaults_equal_the_library_defaults():
     from bladelab.runner.model import DEFAULT_DT
 
     assert RUNNER_DT == DEFAULT_DT == DEFAULT_PREDICT_DT
+
+
+def test_cli_collocation_defaults_equal_the_settings_defaults():
+    from bladelab.cli.defaults import COLLOCATION_MAX_ITER, COLLOCATION_MESH
+    from bladelab.predict.collocation.solve import CollocationSettings
+
+    settings = CollocationSettings()
+    assert (COLLOCATION_MESH, COLLOCATION_MAX_ITER) == (settings.mesh_intervals,
+                                                        settings.max_iter)

@@ -7,8 +7,13 @@ for every command, ``bladelab --help`` included; the values are copied here inst
 
 from __future__ import annotations
 
-__all__ = ["RUNNER_DT"]
+__all__ = ["COLLOCATION_MAX_ITER", "COLLOCATION_MESH", "RUNNER_DT"]
 
 # Time step of the runner's forward simulation [s]: bladelab.runner.model.DEFAULT_DT (also the
 # reflex objective's default, bladelab.predict.reflex.objective.DEFAULT_PREDICT_DT).
 RUNNER_DT = 2.5e-4
+
+# Collocation (bladelab.predict.collocation.solve.CollocationSettings): mesh intervals of the
+# stride and IPOPT's iteration limit per stage.
+COLLOCATION_MESH = 50
+COLLOCATION_MAX_ITER = 3000

@@ -8,6 +8,7 @@ from pathlib import Path
 
 import typer
 
+from bladelab.cli.defaults import COLLOCATION_MAX_ITER, COLLOCATION_MESH
 from bladelab.cli.defaults import RUNNER_DT as DEFAULT_DT
 from bladelab.errors import SpecError
 
@@ -73,13 +74,14 @@ def register(app: typer.Typer) -> None:
         max_speed: bool = typer.Option(
             False, "--max-speed", help="Collocation: maximise the mean speed instead of --speed."
         ),
-        mesh: int = typer.Option(50, "--mesh", help="Collocation: mesh intervals of the stride."),
+        mesh: int = typer.Option(COLLOCATION_MESH, "--mesh",
+                                  help="Collocation: mesh intervals of the stride."),
         guess: str = typer.Option(
             "template", "--guess", help="Collocation: initial guess: template | trial (the "
             "Fukuchi 3.5 m/s trial) | FILE (solution.json, best_iterate.json or reflex JSON)."
         ),
         max_iter: int = typer.Option(
-            3000, "--max-iter", help="Collocation: IPOPT iterations per stage."
+            COLLOCATION_MAX_ITER, "--max-iter", help="Collocation: IPOPT iterations per stage."
         ),
         as_json: bool = typer.Option(
             False, "--json", help="Collocation: print the summary as one JSON object."
@@ -182,14 +184,14 @@ def register(app: typer.Typer) -> None:
             False, "--able", help="Collocation: sweep the able model too (first)."
         ),
         mesh: int | None = typer.Option(
-            None, "--mesh", help="Collocation: mesh intervals of the stride [default: 50]."
+            None, "--mesh", help=f"Collocation: mesh intervals of the stride [default: {COLLOCATION_MESH}]."
         ),
         guess: str | None = typer.Option(
             None, "--guess", help="Collocation: initial guess of each model's first speed: "
             "template | trial | FILE [default: template]."
         ),
         max_iter: int | None = typer.Option(
-            None, "--max-iter", help="Collocation: IPOPT iterations per stage [default: 3000]."
+            None, "--max-iter", help=f"Collocation: IPOPT iterations per stage [default: {COLLOCATION_MAX_ITER}]."
         ),
         resume: bool = typer.Option(
             False, "--resume", help="Collocation: continue the sweep in --out (done solves "
