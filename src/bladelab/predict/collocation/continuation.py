@@ -52,6 +52,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from bladelab.errors import InputFileError, SpecError
+from bladelab.predict.collocation.solution import model_label, read_stored, write_solve
 from bladelab.predict.collocation.solve import (
     COLLOCATION_SOURCE,
     CollocationSettings,
@@ -101,14 +102,6 @@ def speed_file(speed: float, *, converged: bool = True) -> str:
     """The file name of the solve at ``speed`` [m/s]: ``speed-<v:g>.json``, or
     ``speed-<v:g>.best_iterate.json`` when it did not converge."""
     return f"speed-{float(speed):g}" + (".json" if converged else ".best_iterate.json")
-
-
-def model_label(spec: dict) -> str:
-    """``"able"`` or ``"amputee <blade>"`` for a model specification."""
-    from bladelab.predict.collocation.solution import check_model_spec
-
-    spec = check_model_spec(spec)
-    return spec["model"] if spec["blade"] is None else f"{spec['model']} {spec['blade']}"
 
 
 def model_folder(spec: dict) -> str:
@@ -286,12 +279,6 @@ def write_table(path: str | Path, rows: Sequence[dict]) -> Path:
 
 
 # -- helpers ------------------------------------------------------------------------------
-def _describe(spec: dict, settings: CollocationSettings) -> str:
-    speed = ("maximum speed" if settings.speed_m_per_s is None
-             else f"{settings.speed_m_per_s:g} m/s")
-    return f"{model_label(spec)}, {speed}, {settings.mesh_intervals} mesh intervals"
-
-
 class _Runner:
     """The runner, built from the model specification on first use unless given."""
 
@@ -309,29 +296,9 @@ class _Runner:
 
 
 def _stored(ok: Path, best: Path, spec: dict, settings: CollocationSettings, force: bool):
-    """(converged solution, best iterate) found in ``ok`` / ``best``, each None if absent;
-    ``force`` ignores both. A file of another problem raises InputFileError."""
-    from bladelab.predict.collocation.solution import CollocationSolution
-
-    if force:
-        return None, None
-    for path in (ok, best):
-        if not path.is_file():
-            continue
-        sol = CollocationSolution.read(path)
-        if sol.model_spec != spec or not sol.settings.same_problem(settings):
-            there, asked = _describe(sol.model_spec, sol.settings), _describe(spec, settings)
-            if there == asked:
-                there, asked = (f"{there}, weights {sol.settings.weights.to_dict()}",
-                                f"weights {settings.weights.to_dict()}")
-            raise InputFileError(
-                f"holds another problem ({there}; asked: {asked})", file=path,
-                hint="resume with the same model, speeds and mesh, --force to start over, or "
-                     "choose another --out")
-        if path == ok and sol.converged:
-            return sol, None
-        return None, sol
-    return None, None
+    """(converged solution, best iterate) in ``ok`` / ``best``
+    (:func:`~bladelab.predict.collocation.solution.read_stored`); ``force`` ignores both."""
+    return (None, None) if force else read_stored(ok, best, spec, settings)
 
 
 def _solve_and_write(runner, settings: CollocationSettings, guess, *, spec: dict, ok: Path,
@@ -340,9 +307,7 @@ def _solve_and_write(runner, settings: CollocationSettings, guess, *, spec: dict
     solver's progress goes to ``report`` when ``watched``."""
     sol = predict_stride(runner, settings, guess, model_spec=spec,
                          progress=(lambda p: report("solve", solve=p)) if watched else None)
-    target, stale = (ok, best) if sol.converged else (best, ok)
-    sol.write(target)
-    stale.unlink(missing_ok=True)
+    target = write_solve(sol, ok, best)
     s = sol.summary()
     if sol.converged:
         report("converged", path=target,

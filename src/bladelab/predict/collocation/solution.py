@@ -37,7 +37,11 @@ __all__ = [
     "SOLUTION_KIND",
     "CollocationSolution",
     "check_model_spec",
+    "describe_problem",
+    "model_label",
+    "read_stored",
     "runner_from_spec",
+    "write_solve",
 ]
 
 SOLUTION_KIND = "collocation-solution"
@@ -76,6 +80,59 @@ def check_model_spec(spec) -> dict:
         raise SpecError("the amputee model needs a blade category", where="blade",
                         hint="e.g. Cat6")
     return {"model": model, "blade": blade}
+
+
+def model_label(spec: dict) -> str:
+    """``"able"`` or ``"amputee <blade>"`` for a model specification."""
+    spec = check_model_spec(spec)
+    return spec["model"] if spec["blade"] is None else f"{spec['model']} {spec['blade']}"
+
+
+def describe_problem(spec: dict, settings: CollocationSettings) -> str:
+    """``"<model>, <speed>, <n> mesh intervals"`` of a problem (for messages)."""
+    speed = ("maximum speed" if settings.speed_m_per_s is None
+             else f"{settings.speed_m_per_s:g} m/s")
+    return f"{model_label(spec)}, {speed}, {settings.mesh_intervals} mesh intervals"
+
+
+def read_stored(ok: Path, best: Path, spec: dict, settings: CollocationSettings):
+    """(converged solution, best iterate) of one problem stored as ``ok`` / ``best`` (a
+    solution file and a best-iterate file), each None if absent; the solution is preferred.
+
+    Raises
+    ------
+    InputFileError
+        A file holds another problem (model, mesh, speed or weights).
+    """
+    from bladelab.errors import InputFileError
+
+    for path in (Path(ok), Path(best)):
+        if not path.is_file():
+            continue
+        sol = CollocationSolution.read(path)
+        if sol.model_spec != check_model_spec(spec) or not sol.settings.same_problem(settings):
+            there, asked = describe_problem(sol.model_spec, sol.settings), describe_problem(
+                spec, settings)
+            if there == asked:
+                there, asked = (f"{there}, weights {sol.settings.weights.to_dict()}",
+                                f"weights {settings.weights.to_dict()}")
+            raise InputFileError(
+                f"holds another problem ({there}; asked: {asked})", file=path,
+                hint="resume with the same model, blade, speed and mesh, --force to start "
+                     "over, or choose another --out")
+        if path == Path(ok) and sol.converged:
+            return sol, None
+        return None, sol
+    return None, None
+
+
+def write_solve(sol: CollocationSolution, ok: Path, best: Path) -> Path:
+    """Write a solve as ``ok`` (converged) or ``best`` (best iterate), then remove the other,
+    now stale, file; returns the path written."""
+    target, stale = (Path(ok), Path(best)) if sol.converged else (Path(best), Path(ok))
+    sol.write(target)
+    stale.unlink(missing_ok=True)
+    return target
 
 
 def runner_from_spec(spec: dict):

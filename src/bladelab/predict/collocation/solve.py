@@ -477,7 +477,11 @@ def predict_stride_in_folder(
         ``out`` holds a solve and neither ``resume`` nor ``force`` is given; ``resume`` without
         a solve in the folder, or with one of another problem.
     """
-    from bladelab.predict.collocation.solution import CollocationSolution, check_model_spec
+    from bladelab.predict.collocation.solution import (
+        check_model_spec,
+        read_stored,
+        write_solve,
+    )
 
     out = Path(out)
     spec = check_model_spec(model_spec)
@@ -491,33 +495,18 @@ def predict_stride_in_folder(
             f"the output folder holds a collocation solve ({', '.join(held)})", file=out,
             hint="--resume continues it, --force starts over in it, or choose another --out")
     guess = None
+    ok, best = out / SOLUTION_FILE, out / BEST_ITERATE_FILE
     if resume:
         if not held:
             raise InputFileError("no collocation solve to resume from", file=out,
                                  hint="run without --resume first, with the same --out")
-        path = out / held[0]
-        stored = CollocationSolution.read(path)
-        if stored.model_spec != spec or not stored.settings.same_problem(settings):
-            raise InputFileError(
-                f"the folder holds another problem ({_describe(stored.model_spec, stored.settings)}"
-                f"; asked: {_describe(spec, settings)})", file=path,
-                hint="resume with the same --model, --blade, --speed/--max-speed and --mesh, "
-                     "or --force to start over")
-        if stored.converged and path.name == SOLUTION_FILE:
-            return FolderResult(stored, path, False)
-        guess = stored.to_guess()
+        done, iterate = read_stored(ok, best, spec, settings)
+        if done is not None:
+            return FolderResult(done, ok, False)
+        guess = iterate.to_guess()
     if guess is None:
         guess = make_guess()
     sol = predict_stride(runner, settings, guess, model_spec=spec, progress=progress)
-    target = out / (SOLUTION_FILE if sol.converged else BEST_ITERATE_FILE)
-    sol.write(target)
-    stale = out / (BEST_ITERATE_FILE if sol.converged else SOLUTION_FILE)
-    stale.unlink(missing_ok=True)
+    target = write_solve(sol, ok, best)
     return FolderResult(sol, target, True)
 
-
-def _describe(spec: dict, settings: CollocationSettings) -> str:
-    who = spec["model"] + (f" {spec['blade']}" if spec.get("blade") else "")
-    speed = ("maximum speed" if settings.speed_m_per_s is None
-             else f"{settings.speed_m_per_s:g} m/s")
-    return f"{who}, {speed}, {settings.mesh_intervals} mesh intervals"
