@@ -1,7 +1,10 @@
 """A collocation 'solution' built from a template guess, without solving (for cheap tests of
-the solution file, its summary and conversions, the CLI's resume and the report)."""
+the solution file, its summary and conversions, the CLI's resume and the report), and a fake
+solve that returns it (for the speed continuation and the sweep)."""
 
 from __future__ import annotations
+
+import dataclasses
 
 import numpy as np
 
@@ -10,10 +13,12 @@ from bladelab.predict.collocation.dynamics import stride_dynamics
 from bladelab.predict.collocation.guess import periodic_derivative, template_guess
 from bladelab.predict.collocation.solution import CollocationSolution
 from bladelab.predict.collocation.solve import CollocationSettings
+from bladelab.predict.collocation.stored import check_model_spec, model_label
 from bladelab.predict.collocation.transcription import NLPSolution
 from bladelab.runner import build_runner
 
 SPEED = 3.5  # m/s
+MARK = 3  # the coordinate column each fake solve shifts (not pelvis_tx, column 0)
 
 
 def fake_nlp(runner, cm, n: int, *, sink_m: float = 0.01, success: bool = True) -> NLPSolution:
@@ -46,3 +51,53 @@ def fake_solution(kind: str = "able", n: int = 12, **kwargs):
         tracking={"success": True, "status": "Solve_Succeeded", "iterations": 3, "wall_s": 0.5,
                   "objective": 0.1, "max_violation": 1e-9}, cm=cm)
     return runner, cm, sol
+
+
+def fake_models(n: int) -> dict:
+    """Per model kind (able, amputee): (runner, a converged-looking solution on ``n``
+    intervals at 3.5 m/s)."""
+    out = {}
+    for kind in ("able", "amputee"):
+        runner, _, sol = fake_solution(kind, n)
+        out[kind] = (runner, sol)
+    return out
+
+
+class FakeSolve:
+    """Stands in for ``predict_stride``: the fake solution with the guess's coordinates at the
+    prescribed speed (the maximum speed: 1.2 × the guess's), coordinate ``MARK`` shifted by
+    1 mrad so that a solve's output differs from its input; fails for (model label, speed)
+    in ``fail`` (None: the maximum speed)."""
+
+    def __init__(self, fakes, fail=()):
+        self.fakes, self.fail, self.calls = fakes, set(fail), []
+
+    def __call__(self, runner, settings, guess, *, model_spec, progress=None):
+        spec = check_model_spec(model_spec)
+        base = self.fakes[spec["model"]][1]
+        v = settings.speed_m_per_s
+        g = guess.resample(settings.mesh_intervals)
+        g = g.with_speed(v if v is not None else 1.2 * g.speed)
+        q = g.q.copy()
+        q[:, MARK] += 1e-3
+        label = model_label(spec)
+        ok = (label, v) not in self.fail
+        nlp = dataclasses.replace(
+            base.nlp, q=q, qd=g.qd, period=g.period, success=ok,
+            status="Solve_Succeeded" if ok else "Maximum_Iterations_Exceeded")
+        sol = dataclasses.replace(base, nlp=nlp, settings=settings, model_spec=spec,
+                                  guess_source=guess.source, stage="predictive")
+        self.calls.append({"label": label, "speed": v, "guess": guess, "solution": sol})
+        return sol
+
+
+def install_fake_solve(fakes: dict, monkeypatch) -> FakeSolve:
+    """Replace the continuation's solve by a :class:`FakeSolve` (returned; set ``.fail`` to make
+    solves fail); runners come from ``fakes`` (:func:`fake_models`) instead of being built."""
+    from bladelab.predict.collocation import continuation
+
+    fake = FakeSolve(fakes)
+    monkeypatch.setattr(continuation, "predict_stride", fake)
+    monkeypatch.setattr(continuation, "runner_from_spec",
+                        lambda spec: fakes[check_model_spec(spec)["model"]][0])
+    return fake

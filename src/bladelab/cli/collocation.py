@@ -138,8 +138,8 @@ def run_collocation(
 ) -> int:
     """Run ``bladelab predict --method collocation``; returns the exit status (0 converged,
     2 not converged)."""
-    from bladelab.predict.collocation.solution import check_model_spec, runner_from_spec
     from bladelab.predict.collocation.solve import CollocationSettings, predict_stride_in_folder
+    from bladelab.predict.collocation.stored import check_model_spec, runner_from_spec
 
     if model not in ("able", "amputee"):
         raise SpecError(f"unknown model {model!r}", where="--model", hint="able or amputee")

@@ -1,7 +1,7 @@
 """``bladelab sweep --method collocation``: speed continuation and maximum speed per model.
 
 The command parses its options and calls
-:func:`bladelab.predict.collocation.continuation.collocation_sweep`, which owns the output
+:func:`bladelab.predict.collocation.sweep.collocation_sweep`, which owns the output
 folder (one subfolder per model, ``collocation-sweep.csv``). Progress goes to stderr, one line
 per solve's start and end (and every :data:`~bladelab.cli.collocation.PROGRESS_EVERY_S`
 seconds while IPOPT iterates), each line led by the model and the problem; stdout holds the
@@ -95,8 +95,8 @@ def run_collocation_sweep(
     """Run ``bladelab sweep --method collocation``; returns the exit status (0 every solve
     converged, 2 some model failed)."""
     from bladelab.cli.collocation import make_guess
-    from bladelab.predict.collocation.continuation import collocation_sweep, sweep_models
     from bladelab.predict.collocation.solve import CollocationSettings
+    from bladelab.predict.collocation.sweep import collocation_sweep, sweep_models
 
     if mesh < 4:
         raise SpecError(f"need at least 4 mesh intervals, got {mesh}", where="--mesh")

@@ -95,7 +95,8 @@ def collocation_sections(report, path: str | Path) -> tuple[dict, object]:
     RunnerResult} for :func:`~bladelab.report.predictive_sections.add_predictive_sections`,
     the :class:`~bladelab.predict.collocation.solution.CollocationSolution`)."""
     from bladelab.predict.collocation.model import build_collocation_model
-    from bladelab.predict.collocation.solution import CollocationSolution, runner_from_spec
+    from bladelab.predict.collocation.solution import CollocationSolution
+    from bladelab.predict.collocation.stored import runner_from_spec
 
     sol = CollocationSolution.read(path)
     runner = runner_from_spec(sol.model_spec)

@@ -30,18 +30,13 @@ import numpy as np
 
 from bladelab.errors import DataError, SpecError
 from bladelab.predict.collocation.solve import COLLOCATION_SOURCE, CollocationSettings
+from bladelab.predict.collocation.stored import FieldReader, check_model_spec, runner_from_spec
 
 __all__ = [
     "BEST_ITERATE_KIND",
     "FORMAT_VERSION",
     "SOLUTION_KIND",
     "CollocationSolution",
-    "check_model_spec",
-    "describe_problem",
-    "model_label",
-    "read_stored",
-    "runner_from_spec",
-    "write_solve",
 ]
 
 SOLUTION_KIND = "collocation-solution"
@@ -62,87 +57,6 @@ _NODE_FIELDS = (
     ("excitation", "excitation", "muscle"),
     ("tendon_force_rate_per_Fmax_per_s", "tendon_force_rate", "muscle"),
 )
-
-
-def check_model_spec(spec) -> dict:
-    """The model specification ``{"model": "able" | "amputee", "blade": name | None}``,
-    checked and normalised (the able model has no blade; the amputee needs one)."""
-    if not isinstance(spec, dict) or "model" not in spec:
-        raise SpecError(f"expected {{'model': ..., 'blade': ...}}, got {spec!r}",
-                        where="model_spec")
-    model = spec["model"]
-    if model not in ("able", "amputee"):
-        raise SpecError(f"unknown model {model!r}", where="model", hint="able or amputee")
-    blade = spec.get("blade")
-    if model == "able":
-        blade = None
-    elif not isinstance(blade, str) or not blade:
-        raise SpecError("the amputee model needs a blade category", where="blade",
-                        hint="e.g. Cat6")
-    return {"model": model, "blade": blade}
-
-
-def model_label(spec: dict) -> str:
-    """``"able"`` or ``"amputee <blade>"`` for a model specification."""
-    spec = check_model_spec(spec)
-    return spec["model"] if spec["blade"] is None else f"{spec['model']} {spec['blade']}"
-
-
-def describe_problem(spec: dict, settings: CollocationSettings) -> str:
-    """``"<model>, <speed>, <n> mesh intervals"`` of a problem (for messages)."""
-    speed = ("maximum speed" if settings.speed_m_per_s is None
-             else f"{settings.speed_m_per_s:g} m/s")
-    return f"{model_label(spec)}, {speed}, {settings.mesh_intervals} mesh intervals"
-
-
-def read_stored(ok: Path, best: Path, spec: dict, settings: CollocationSettings):
-    """(converged solution, best iterate) of one problem stored as ``ok`` / ``best`` (a
-    solution file and a best-iterate file), each None if absent; the solution is preferred.
-
-    Raises
-    ------
-    InputFileError
-        A file holds another problem (model, mesh, speed or weights).
-    """
-    from bladelab.errors import InputFileError
-
-    for path in (Path(ok), Path(best)):
-        if not path.is_file():
-            continue
-        sol = CollocationSolution.read(path)
-        if sol.model_spec != check_model_spec(spec) or not sol.settings.same_problem(settings):
-            there, asked = describe_problem(sol.model_spec, sol.settings), describe_problem(
-                spec, settings)
-            if there == asked:
-                there, asked = (f"{there}, weights {sol.settings.weights.to_dict()}",
-                                f"weights {settings.weights.to_dict()}")
-            raise InputFileError(
-                f"holds another problem ({there}; asked: {asked})", file=path,
-                hint="resume with the same model, blade, speed and mesh, --force to start "
-                     "over, or choose another --out")
-        if path == Path(ok) and sol.converged:
-            return sol, None
-        return None, sol
-    return None, None
-
-
-def write_solve(sol: CollocationSolution, ok: Path, best: Path) -> Path:
-    """Write a solve as ``ok`` (converged) or ``best`` (best iterate), then remove the other,
-    now stale, file; returns the path written."""
-    target, stale = (Path(ok), Path(best)) if sol.converged else (Path(best), Path(ok))
-    sol.write(target)
-    stale.unlink(missing_ok=True)
-    return target
-
-
-def runner_from_spec(spec: dict):
-    """Build the forward runner of a model specification (:func:`check_model_spec`)."""
-    from bladelab.runner import build_runner
-
-    spec = check_model_spec(spec)
-    if spec["model"] == "able":
-        return build_runner("able")
-    return build_runner("amputee", blade=spec["blade"])
 
 
 def _num(x) -> float | None:
@@ -251,9 +165,11 @@ class CollocationSolution:
                  metabolic_energy_J: float | None = None, cm=None) -> CollocationSolution:
         """A solution from an :class:`NLPSolution` of ``runner``: evaluates the contact forces
         and the dynamic consistency at the nodes (and the metabolic energy over the stride [J],
-        trapezoidal rule of the model's metabolic rate, when not given)."""
+        :meth:`StrideNLP.energy_and_distance` on the solution's mesh, when not given)."""
         from bladelab.predict.collocation.consistency import dynamics_residual
+        from bladelab.predict.collocation.dynamics import stride_dynamics
         from bladelab.predict.collocation.model import build_collocation_model
+        from bladelab.predict.collocation.transcription import StrideNLP
         from bladelab.runner.model import CP_LEG
         from bladelab.runner.simulate import leg_names
 
@@ -271,8 +187,9 @@ class CollocationSolution:
                             where="q", hint="the solution is not of this runner model")
         ev = _evaluate(cm, q, np.asarray(nlp.qd, float), np.asarray(nlp.tendon_force, float),
                        np.asarray(nlp.tendon_force_rate, float))
-        if metabolic_energy_J is None:
-            metabolic_energy_J = _metabolic_energy(cm, nlp)
+        if metabolic_energy_J is None:  # the NLP's own trapezoidal rule: one definition
+            metabolic_energy_J = StrideNLP(stride_dynamics(cm), n=q.shape[0] - 1,
+                                           speed=None).energy_and_distance(nlp)[0]
         res = dynamics_residual(nlp, runner, cm=cm).to_dict()
         res["bristle_residual_pct"] = dynamics_residual(nlp, runner, cm=cm, friction="bristle").pct
         return cls(
@@ -539,7 +456,7 @@ class CollocationSolution:
 
         if not isinstance(data, dict):
             raise DataError("expected a JSON object", file=file)
-        r = _Reader(data, file)
+        r = FieldReader(data, file)
         kind = r.get("kind", str)
         if kind not in (SOLUTION_KIND, BEST_ITERATE_KIND):
             raise DataError(f"not a collocation solution (kind {kind!r})", file=file,
@@ -632,56 +549,6 @@ def _jsonable(obj):
     return obj
 
 
-class _Reader:
-    """Field access with errors that name the file and the field."""
-
-    _KIND = {str: "a string", int: "an integer", bool: "true or false", dict: "an object",
-             list: "a list"}
-
-    def __init__(self, data: dict, file) -> None:
-        self.data, self.file = data, file
-
-    def get(self, key: str, typ: type):
-        if key not in self.data:
-            raise DataError("missing field", file=self.file, where=key)
-        v = self.data[key]
-        ok = isinstance(v, typ) and not (typ is int and isinstance(v, bool))
-        if not ok:
-            raise DataError(f"expected {self._KIND[typ]}, got {type(v).__name__}",
-                            file=self.file, where=key)
-        return v
-
-    def number(self, key: str) -> float:
-        if key not in self.data:
-            raise DataError("missing field", file=self.file, where=key)
-        v = self.data[key]
-        if v is None:
-            return math.nan
-        if isinstance(v, bool) or not isinstance(v, int | float):
-            raise DataError(f"expected a number, got {type(v).__name__}", file=self.file,
-                            where=key)
-        return float(v)
-
-    def names(self, key: str) -> list[str]:
-        v = self.get(key, list)
-        if not all(isinstance(x, str) for x in v):
-            raise DataError("expected a list of names", file=self.file, where=key)
-        return v
-
-    def array(self, key: str, ndim: int, shape: tuple | None = None) -> np.ndarray:
-        v = self.get(key, list)
-        try:
-            a = np.array(v, dtype=float)
-        except (TypeError, ValueError):
-            raise DataError("expected numbers", file=self.file, where=key) from None
-        if a.ndim != ndim or (shape is not None and a.shape != shape):
-            want = shape if shape is not None else f"{ndim} dimensions"
-            raise DataError(f"expected shape {want}, got {a.shape}", file=self.file, where=key)
-        if not np.all(np.isfinite(a)):
-            raise DataError("holds a missing or non-finite value", file=self.file, where=key)
-        return a
-
-
 def _periodic_runs(mask: np.ndarray) -> list[int]:
     """Lengths [samples] of the True stretches of a periodic boolean sequence (a stretch
     across the end continues at the start)."""
@@ -693,16 +560,3 @@ def _periodic_runs(mask: np.ndarray) -> list[int]:
     m = np.roll(mask, -start).astype(np.int8)
     edges = np.diff(np.concatenate([[0], m, [0]]))
     return list(np.flatnonzero(edges == -1) - np.flatnonzero(edges == 1))
-
-
-def _metabolic_energy(cm, nlp) -> float:
-    """Metabolic energy [J] over the stride: trapezoidal rule of the collocation model's
-    metabolic rate at the nodes."""
-    from bladelab.predict.collocation.dynamics import stride_dynamics
-
-    met = stride_dynamics(cm).metabolic_rate
-    rate = np.array([float(met(nlp.q[k], nlp.qd[k], nlp.activation[k], nlp.tendon_force[k],
-                               nlp.tendon_force_rate[k], nlp.excitation[k]))
-                     for k in range(nlp.q.shape[0])])
-    h = float(nlp.period) / (rate.size - 1)
-    return float(np.sum(rate[1:] + rate[:-1]) * h / 2)

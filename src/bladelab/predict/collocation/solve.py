@@ -357,7 +357,7 @@ def predict_stride(runner, settings: CollocationSettings, guess, *, model_spec: 
         the mesh; scaled to the prescribed speed (same period) if it runs at another one.
     model_spec
         ``{"model": "able" | "amputee", "blade": "Cat6" | None}``: how ``runner`` was built,
-        stored with the solution (:func:`~bladelab.predict.collocation.solution.runner_from_spec`
+        stored with the solution (:func:`~bladelab.predict.collocation.stored.runner_from_spec`
         builds it again).
     progress
         Called with a :class:`SolveProgress` at each stage's start, every IPOPT iteration and
@@ -374,7 +374,8 @@ def predict_stride(runner, settings: CollocationSettings, guess, *, model_spec: 
     """
     from bladelab.predict.collocation.dynamics import stride_dynamics
     from bladelab.predict.collocation.model import build_collocation_model
-    from bladelab.predict.collocation.solution import CollocationSolution, check_model_spec
+    from bladelab.predict.collocation.solution import CollocationSolution
+    from bladelab.predict.collocation.stored import check_model_spec
     from bladelab.predict.collocation.transcription import StrideNLP
 
     spec = check_model_spec(model_spec)
@@ -477,11 +478,7 @@ def predict_stride_in_folder(
         ``out`` holds a solve and neither ``resume`` nor ``force`` is given; ``resume`` without
         a solve in the folder, or with one of another problem.
     """
-    from bladelab.predict.collocation.solution import (
-        check_model_spec,
-        read_stored,
-        write_solve,
-    )
+    from bladelab.predict.collocation.stored import check_model_spec, read_stored, write_solve
 
     out = Path(out)
     spec = check_model_spec(model_spec)

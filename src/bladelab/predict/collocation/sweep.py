@@ -1,0 +1,287 @@
+"""The collocation category sweep, ``bladelab sweep --method collocation`` (issue 15).
+
+:func:`collocation_sweep` runs, for each model (the able model, the amputee with each blade
+category: :func:`sweep_models`), the speed continuation and then the maximum speed
+(:mod:`bladelab.predict.collocation.continuation`), each model in its own subfolder
+(:func:`~bladelab.predict.collocation.continuation.model_folder`: ``able``,
+``amputee-<blade>``), models in parallel processes with ``jobs`` > 1, and writes the table
+:data:`SWEEP_TABLE` after each model (:func:`write_table`; its rows are
+:meth:`~bladelab.predict.collocation.continuation.SolveRecord.row`, described in the
+continuation module). A model that fails does not stop the others.
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+from bladelab.errors import InputFileError, SpecError
+from bladelab.predict.collocation.continuation import (
+    ContinuationProgress,
+    LazyRunner,
+    check_speeds,
+    max_speed,
+    max_speed_settings,
+    model_folder,
+    speed_continuation,
+    table_columns,
+)
+from bladelab.predict.collocation.solve import CollocationSettings
+from bladelab.predict.collocation.stored import check_model_spec, model_label
+
+__all__ = [
+    "SWEEP_TABLE",
+    "SweepResult",
+    "collocation_sweep",
+    "sweep_model_task",
+    "sweep_models",
+    "write_table",
+]
+
+#: The summary table of a sweep, in its output folder.
+SWEEP_TABLE = "collocation-sweep.csv"
+
+
+def write_table(path: str | Path, rows: Sequence[dict]) -> Path:
+    """Write table rows as CSV, atomically (columns as :func:`table_columns`; a missing or
+    non-finite value is an empty field). Returns the path."""
+    from bladelab._io import atomic_open
+
+    path = Path(path)
+    cols = table_columns(rows)
+
+    def cell(v):
+        if v is None or (isinstance(v, float) and not math.isfinite(v)):
+            return ""
+        return v
+
+    with atomic_open(path, "w", newline="", encoding="utf-8") as fh:
+        writer = csv.DictWriter(fh, fieldnames=cols)
+        writer.writeheader()
+        for row in rows:
+            writer.writerow({c: cell(row.get(c)) for c in cols})
+    return path
+
+
+def sweep_models(categories: Sequence[str], *, able: bool = False) -> list[dict]:
+    """Model specifications of a sweep: the able model first when ``able``, then the amputee
+    with each blade category (names as the catalogue spells them).
+
+    Raises
+    ------
+    SpecError
+        An unknown or repeated category, or no model at all.
+    """
+    from bladelab.runner.params import blade_category
+
+    models = [{"model": "able", "blade": None}] if able else []
+    seen: set[str] = set()
+    for c in categories:
+        name = blade_category(c).name
+        if name in seen:
+            raise SpecError(f"category {name} given twice", where="categories")
+        seen.add(name)
+        models.append({"model": "amputee", "blade": name})
+    if not models:
+        raise SpecError("no model to sweep", where="categories",
+                        hint="give --categories, --able, or both")
+    return models
+
+
+def _files(folder: Path) -> list[Path]:
+    """The solve files of a model folder."""
+    if not folder.is_dir():
+        return []
+    return sorted(p for p in folder.iterdir() if p.is_file() and p.suffix == ".json" and (
+        p.name.startswith("speed-") or p.name.startswith("max-speed")))
+
+
+def sweep_model_task(payload: dict) -> dict:
+    """One model of :func:`collocation_sweep` (a top-level function for the executors): the
+    speed continuation, then the maximum speed from its fastest converged solution.
+
+    ``payload``: ``model_spec``, ``speeds``, ``settings`` (:class:`CollocationSettings`),
+    ``make_guess`` (``make_guess(runner, n=..., speed=...)``), ``out`` (the sweep folder),
+    ``force``, ``progress`` (or None). Returns ``label``, ``rows`` and ``failures`` (one line
+    per solve that did not converge). With ``force``, files of the model folder that this run
+    did not write are removed once the model is done.
+    """
+    spec = payload["model_spec"]
+    settings = payload["settings"]
+    speeds = payload["speeds"]
+    out = Path(payload["out"])
+    folder = out / model_folder(spec)
+    make_guess = payload["make_guess"]
+    force = bool(payload.get("force", False))
+    progress = payload.get("progress")
+    label = model_label(spec)
+    get_runner = LazyRunner(None, spec)
+    cont = speed_continuation(
+        get_runner, speeds, settings,
+        lambda r: make_guess(r, n=settings.mesh_intervals, speed=float(speeds[0])),
+        model_spec=spec, out_dir=folder, progress=progress, force=force)
+    records = list(cont.records)
+    failures = []
+    if cont.failed is not None:
+        f = cont.failed
+        last = cont.last_converged_speed
+        failures.append(f"{f.speed_mps:g} m/s not converged (IPOPT status "
+                        f"{f.solution.nlp.status} in the {f.solution.stage} stage; best iterate "
+                        f"{f.path.relative_to(out)}); last converged: "
+                        + (f"{last:g} m/s" if last is not None else "none"))
+    fastest = cont.fastest
+    if fastest is None:
+        failures.append("maximum speed not attempted (no speed converged)")
+    else:
+        rec = max_speed(get_runner, max_speed_settings(settings), fastest.solution,
+                        model_spec=spec, out_dir=folder, progress=progress, force=force)
+        records.append(rec)
+        if not rec.converged:
+            failures.append(f"maximum speed not converged (IPOPT status "
+                            f"{rec.solution.nlp.status} in the {rec.solution.stage} stage; "
+                            f"best iterate {rec.path.relative_to(out)})")
+    if force:
+        keep = {r.path.resolve() for r in records}
+        for p in _files(folder):
+            if p.resolve() not in keep:
+                p.unlink(missing_ok=True)
+    return {"label": label, "rows": [r.row(out) for r in records], "failures": failures}
+
+
+@dataclass(frozen=True)
+class SweepResult:
+    """What :func:`collocation_sweep` did.
+
+    Attributes
+    ----------
+    table_path
+        The summary table (:data:`SWEEP_TABLE`).
+    rows
+        Its rows (:meth:`SolveRecord.row`), models in the order asked.
+    failures
+        Per model label, what failed (solves that did not converge, or the error that stopped
+        the model); empty when everything converged.
+    """
+
+    table_path: Path
+    rows: list[dict]
+    failures: dict[str, list[str]]
+
+    def table(self):
+        """The rows as a pandas DataFrame."""
+        import pandas as pd
+
+        return pd.DataFrame(self.rows, columns=table_columns(self.rows))
+
+
+def _held(out: Path) -> list[str]:
+    if not out.is_dir():
+        return []
+    held = [SWEEP_TABLE] if (out / SWEEP_TABLE).exists() else []
+    for sub in sorted(p for p in out.iterdir() if p.is_dir()):
+        held.extend(f"{sub.name}/{p.name}" for p in _files(sub))
+    return held
+
+
+def collocation_sweep(
+    models: Sequence[dict],
+    speeds: Sequence[float],
+    settings: CollocationSettings,
+    make_guess: Callable[..., object],
+    *,
+    out: str | Path,
+    jobs: int = 1,
+    executor: str = "local",
+    resume: bool = False,
+    force: bool = False,
+    progress: Callable[[ContinuationProgress], None] | None = None,
+) -> SweepResult:
+    """For each model, the speed continuation then the maximum speed (module docstring); each
+    model in ``out/<model_folder>``, the table ``out/collocation-sweep.csv`` rewritten
+    (atomically) after each model. A model that fails does not stop the others.
+
+    Parameters
+    ----------
+    models
+        Model specifications (:func:`sweep_models`).
+    speeds
+        Prescribed speeds [m/s] of the continuation, in order.
+    settings
+        Settings of the prescribed-speed problems (:func:`speed_continuation`); the maximum
+        speed uses :func:`max_speed_settings` of them.
+    make_guess
+        ``make_guess(runner, n=mesh_intervals, speed=first speed)`` -> the first speed's
+        initial guess of a model; picklable (a top-level function or a ``functools.partial``
+        of one) when ``jobs`` > 1.
+    out
+        Output folder.
+    jobs, executor
+        Models run in parallel on ``executor`` (:func:`bladelab.executors.make_executor`:
+        ``local`` processes, ``ray``) with ``jobs`` workers; 1: in this process.
+    resume
+        Continue a sweep in ``out``: solves already done (same problem) are read back.
+    force
+        Start over in a used ``out``: files are replaced; a model's files that this run did
+        not write are removed once the model is done.
+    progress
+        Called with each :class:`ContinuationProgress` (in the worker process when
+        ``jobs`` > 1, so it must be picklable then).
+
+    Raises
+    ------
+    InputFileError
+        ``out`` holds a sweep and neither ``resume`` nor ``force`` is given, or ``resume``
+        without one.
+    SpecError
+        Bad speeds, settings or models; ``resume`` with ``force``.
+    """
+    from bladelab.executors import make_executor
+
+    speeds = check_speeds(speeds)
+    if not isinstance(settings, CollocationSettings) or settings.max_speed:
+        raise SpecError("expected the CollocationSettings of a prescribed-speed problem",
+                        where="settings")
+    models = [check_model_spec(m) for m in models]
+    if not models:
+        raise SpecError("no model to sweep", where="models")
+    labels = [model_label(m) for m in models]
+    if len(set(labels)) != len(labels):
+        raise SpecError("a model is given twice", where="models")
+    if isinstance(jobs, bool) or not isinstance(jobs, int) or jobs < 1:
+        raise SpecError(f"need at least 1 job, got {jobs!r}", where="jobs")
+    if resume and force:
+        raise SpecError("give --resume or --force, not both", where="--resume/--force")
+    out = Path(out)
+    if out.exists() and not out.is_dir():
+        raise InputFileError("is a file, not a folder", file=out, hint="give a folder for --out")
+    held = _held(out)
+    if held and not (resume or force):
+        shown = ", ".join(held[:3]) + (f" and {len(held) - 3} more" if len(held) > 3 else "")
+        raise InputFileError(
+            f"the output folder holds a collocation sweep ({shown})", file=out,
+            hint="--resume continues it, --force starts over in it, or choose another --out")
+    if resume and not held:
+        raise InputFileError("no collocation sweep to resume from", file=out,
+                             hint="run without --resume first, with the same --out")
+    out.mkdir(parents=True, exist_ok=True)
+    payloads = [{"model_spec": m, "speeds": list(speeds), "settings": settings,
+                 "make_guess": make_guess, "out": str(out.resolve()), "force": bool(force),
+                 "progress": progress} for m in models]
+    table = out / SWEEP_TABLE
+    rows: dict[int, list[dict]] = {}
+    failures: dict[int, list[str]] = {}
+    for i, status, value in make_executor(executor, jobs).run(sweep_model_task, payloads):
+        if status == "ok":
+            rows[i] = value["rows"]
+            if value["failures"]:
+                failures[i] = value["failures"]
+        else:
+            failures[i] = [f"stopped by an error: {value}"]
+        write_table(table, [r for k in sorted(rows) for r in rows[k]])
+    all_rows = [r for k in sorted(rows) for r in rows[k]]
+    if not rows:
+        write_table(table, [])
+    return SweepResult(table, all_rows, {labels[k]: failures[k] for k in sorted(failures)})

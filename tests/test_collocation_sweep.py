@@ -1,0 +1,155 @@
+"""The collocation category sweep, ``bladelab sweep --method collocation`` (issue 15).
+
+Solves are replaced by ``collocation_fake.FakeSolve`` (the continuation's ``predict_stride``):
+the fake solution at the guess's speed, marked so that each warm start can be traced."""
+
+from __future__ import annotations
+
+import csv
+import json
+
+import numpy as np
+import pytest
+
+from bladelab.cli import main
+from collocation_fake import fake_models, install_fake_solve
+
+N = 12
+
+
+@pytest.fixture(scope="module")
+def fakes():
+    """Per model kind: (runner, a converged-looking solution on N intervals at 3.5 m/s)."""
+    return fake_models(N)
+
+
+@pytest.fixture
+def fake_solve(fakes, monkeypatch):
+    """The continuation's solve replaced by a FakeSolve (``collocation_fake``)."""
+    return install_fake_solve(fakes, monkeypatch)
+
+
+def _sweep(out, *extra):
+    return main(["sweep", "--method", "collocation", "--out", str(out), "--mesh", str(N),
+                 "--max-iter", "1", *extra])
+
+
+def _csv(path):
+    with open(path, newline="", encoding="utf-8") as fh:
+        return list(csv.DictReader(fh))
+
+
+def test_sweep_solves_each_model_and_writes_the_table(fake_solve, tmp_path, capsys):
+    out = tmp_path / "sweep"
+    args = ("--able", "--categories", "Cat6,cat7", "--speeds", "3.5,4")
+    assert _sweep(out, *args, "--json") == 0
+    cap = capsys.readouterr()
+    result = json.loads(cap.out)
+    assert result["failures"] == {}
+    assert "amputee Cat7, 4 m/s: converged" in cap.err
+    assert sorted(p.name for p in out.iterdir()) == [
+        "able", "amputee-Cat6", "amputee-Cat7", "collocation-sweep.csv"]
+    assert sorted(p.name for p in (out / "amputee-Cat7").iterdir()) == [
+        "max-speed.json", "speed-3.5.json", "speed-4.json"]
+    # each model's chain: first speed from the template, then warm starts; the maximum speed
+    # from the 4 m/s solution
+    by_model = {}
+    for c in fake_solve.calls:
+        by_model.setdefault(c["label"], []).append(c)
+    assert list(by_model) == ["able", "amputee Cat6", "amputee Cat7"]
+    for calls in by_model.values():
+        assert [c["speed"] for c in calls] == [3.5, 4.0, None]
+        assert calls[0]["guess"].source.startswith("template at 3.5 m/s")
+        np.testing.assert_array_equal(calls[2]["guess"].q, calls[1]["solution"].nlp.q)
+    rows = _csv(out / "collocation-sweep.csv")
+    assert [(r["model"], r["problem"], r["prescribed_speed_mps"]) for r in rows] == [
+        (m, p, s) for m in ("able", "amputee Cat6", "amputee Cat7")
+        for p, s in (("speed", "3.5"), ("speed", "4.0"), ("max-speed", ""))]
+    cols = list(rows[0])
+    assert cols[:6] == ["model", "blade", "problem", "prescribed_speed_mps", "converged",
+                        "status"]
+    for col in ("mean_speed_mps", "cost_of_transport_J_per_kg_m", "stride_time_s",
+                "contact_time_intact_s", "contact_time_prosthetic_s", "contact_time_left_s",
+                "peak_vertical_grf_intact_bw", "peak_vertical_grf_right_bw", "iterations",
+                "wall_s", "mesh_intervals", "file"):
+        assert col in cols
+    assert rows[0]["contact_time_intact_s"] == "" and rows[3]["contact_time_left_s"] == ""
+    assert rows[5]["file"] == "amputee-Cat6/max-speed.json"
+    assert float(rows[5]["mean_speed_mps"]) == pytest.approx(4.8)
+    assert result["rows"][5]["mean_speed_mps"] == pytest.approx(4.8)
+    # a used folder is refused; --resume solves nothing and writes the same table
+    before = (out / "collocation-sweep.csv").read_text()
+    assert _sweep(out, *args) == 2
+    assert "holds a collocation sweep" in capsys.readouterr().err
+    fake_solve.calls.clear()
+    assert _sweep(out, *args, "--resume") == 0
+    capsys.readouterr()
+    assert fake_solve.calls == []
+    assert (out / "collocation-sweep.csv").read_text() == before
+    # --force starts over: fewer speeds, and the files this run did not write are gone
+    assert _sweep(out, "--categories", "Cat6", "--speeds", "3.5", "--force") == 0
+    capsys.readouterr()
+    assert [c["speed"] for c in fake_solve.calls] == [3.5, None]
+    assert sorted(p.name for p in (out / "amputee-Cat6").iterdir()) == [
+        "max-speed.json", "speed-3.5.json"]
+    assert len(_csv(out / "collocation-sweep.csv")) == 2
+
+
+def test_sweep_exits_2_naming_the_failed_models_after_finishing_the_others(
+        fake_solve, tmp_path, capsys):
+    out = tmp_path / "sweep"
+    fake_solve.fail = {("amputee Cat6", 4.0), ("amputee Cat7", None)}
+    assert _sweep(out, "--categories", "Cat6,Cat7,Cat4", "--speeds", "3.5,4,4.5") == 2
+    cap = capsys.readouterr()
+    assert "error: 2 of 3 model(s) failed" in cap.err
+    assert ("error: amputee Cat6: 4 m/s not converged (IPOPT status "
+            "Maximum_Iterations_Exceeded in the predictive stage; best iterate "
+            "amputee-Cat6/speed-4.best_iterate.json); last converged: 3.5 m/s") in cap.err
+    assert "error: amputee Cat7: maximum speed not converged" in cap.err
+    assert "Traceback" not in cap.err
+    rows = _csv(out / "collocation-sweep.csv")
+    got = [(r["model"], r["problem"], r["prescribed_speed_mps"], r["converged"]) for r in rows]
+    assert got == [
+        ("amputee Cat6", "speed", "3.5", "True"), ("amputee Cat6", "speed", "4.0", "False"),
+        ("amputee Cat6", "max-speed", "", "True"),  # from the 3.5 m/s solution
+        ("amputee Cat7", "speed", "3.5", "True"), ("amputee Cat7", "speed", "4.0", "True"),
+        ("amputee Cat7", "speed", "4.5", "True"), ("amputee Cat7", "max-speed", "", "False"),
+        ("amputee Cat4", "speed", "3.5", "True"), ("amputee Cat4", "speed", "4.0", "True"),
+        ("amputee Cat4", "speed", "4.5", "True"), ("amputee Cat4", "max-speed", "", "True"),
+    ]
+    assert (out / "amputee-Cat7" / "max-speed.best_iterate.json").is_file()
+
+
+def test_sweep_with_two_jobs_reads_back_in_worker_processes(fake_solve, tmp_path, capfd):
+    """--jobs 2 runs the models in a local process pool (the fake solve is not there: every
+    solve is read back)."""
+    out = tmp_path / "sweep"
+    args = ("--able", "--categories", "Cat6", "--speeds", "3.5")
+    assert _sweep(out, *args) == 0
+    before = (out / "collocation-sweep.csv").read_text()
+    solved = {p: p.stat().st_mtime_ns for p in out.rglob("*.json")}
+    capfd.readouterr()
+    assert _sweep(out, *args, "--resume", "--jobs", "2") == 0
+    # read back, not solved again: no solution file rewritten (the workers' progress lines go
+    # to the stderr they were started with, which a persistent pool of an earlier test owns)
+    assert {p: p.stat().st_mtime_ns for p in out.rglob("*.json")} == solved
+    assert (out / "collocation-sweep.csv").read_text() == before
+
+
+@pytest.mark.parametrize(("args", "where"), [
+    (("--method", "collocation", "--init", "x.json"), "--init"),
+    (("--method", "collocation", "--categories", "Cat9"), "--categories"),
+    (("--method", "collocation", "--categories", ""), "--categories"),
+    (("--method", "collocation", "--speeds", "3.5,-1"), "--speeds"),
+    (("--method", "collocation", "--mesh", "3"), "--mesh"),
+    (("--method", "collocation", "--guess", "no-such-file.json"), "--guess"),
+    (("--method", "collocation", "--resume", "--force"), "--resume/--force"),
+    (("--method", "collocation", "--resume"), "no collocation sweep to resume"),
+    (("--able",), "--able"),
+    (("--method", "shooting"), "--method"),
+])
+def test_bad_sweep_options_are_refused_naming_the_option(args, where, tmp_path, capsys):
+    assert main(["sweep", "--out", str(tmp_path / "sweep"), *args]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("error:") and where in err
+    assert not (tmp_path / "sweep" / "collocation-sweep.csv").exists()
