@@ -206,6 +206,20 @@ def test_runner_result_repeats_the_stride_for_the_analyses(able):
         sol.to_runner_result(0, runner=runner, cm=cm)
 
 
+def test_runner_result_contact_velocities_are_those_of_the_material_points(able):
+    """As the forward kernel records them: the velocity of the body's material point at the
+    contact point, so that Σ f·v (the analyses' contact power) is the power of the contacts'
+    generalised force, τ_c·q̇ (a rolling sphere's lowest point moves otherwise)."""
+    runner, cm, sol = able
+    res = sol.to_runner_result(1, refine=3, runner=runner, cm=cm)
+    f, v = res.contacts[:, :, :2], res.contacts[:, :, 4:6]
+    power = (f * v).sum(axis=(1, 2))
+    gen = np.array([np.asarray(cm.contacts(q, qd)[2]).ravel() @ qd
+                    for q, qd in zip(res.qpos, res.qvel, strict=True)])
+    scale = np.abs(f).sum(axis=(1, 2)) * np.abs(res.qvel).max() + 1.0  # [W]
+    assert np.max(np.abs(power - gen) / scale) < 1e-9
+
+
 # ---------------------------------------------------------------- dynamic consistency
 
 

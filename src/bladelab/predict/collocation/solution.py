@@ -73,8 +73,13 @@ def _array(a: np.ndarray) -> list:
 
 def _node_samples(cm):
     """A CasADi Function of one sample (q, q̇, F̃ₜ, dF̃ₜ/dt) -> (l_mt, v_mt, l_m, v_m, vec(forces),
-    vec(points), vec(point velocities), passive torques) of the collocation model."""
+    vec(points), vec(point velocities), passive torques) of the collocation model. A point's
+    velocity is that of the body's material point there (as the contact law and the forward
+    kernel take it), not the rate of the lowest point, which rolls over a turning sphere."""
     import casadi as ca
+
+    from bladelab.predict.collocation.contact import contact_point
+    from bladelab.predict.collocation.multibody import body_frames, point_velocity
 
     nv, nm = cm.nv, cm.n_muscles
     q, qd = ca.SX.sym("q", nv), ca.SX.sym("qd", nv)
@@ -82,7 +87,12 @@ def _node_samples(cm):
     l_mt, v_mt = cm.mtu(q, qd)
     l_m, v_m, _ = cm.fiber(l_mt, v_mt, ft, dft)
     f, p, _ = cm.contacts(q, qd)
-    pv = ca.jtimes(ca.vec(p), q, qd)
+    frames = body_frames(cm.tree, q)
+    vel = []
+    for row in cm.runner.contact_params:
+        point, _, body = contact_point(cm.tree, frames, row)
+        vel.append(point_velocity(frames, q, qd, body, point))
+    pv = ca.vertcat(*[v[0] for v in vel], *[v[1] for v in vel])  # as ca.vec of (nc, 2)
     tau_p = cm.passive(q, qd)
     return ca.Function("node_samples", [q, qd, ft, dft],
                        [l_mt, v_mt, l_m, v_m, ca.vec(f), ca.vec(p), pv, tau_p])
@@ -322,7 +332,8 @@ class CollocationSolution:
         trapezoidal rule's quadratic (q̇ linear), muscle states and controls linear. At every
         sample the collocation model gives the MTU lengths and velocities [m, m/s], fibre
         lengths and velocities [m, m/s], contact forces [N], points [m], point velocities
-        [m/s] and compression [m] (the depth of the contact point below the ground), and the
+        [m/s] (of the body's material point at the contact point, as the forward kernel records
+        them) and compression [m] (the depth of the contact point below the ground), and the
         ligament, socket and blade-joint torques [N·m]. ``dt`` of the result is the sample
         spacing [s]; ``fell`` is False.
 
