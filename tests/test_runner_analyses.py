@@ -247,3 +247,23 @@ def test_blade_energy_of_elastic_and_dissipative_loops(amputee):
     assert blade_energy(lossy, compression="hertz").recoil_pct.iloc[0] == pytest.approx(
         100.0, abs=0.05)
     assert blade_energy(_synthetic(build_runner("able"), stances=STANCES)).empty
+
+
+def test_blade_energy_counts_each_stance_once_under_a_smooth_contact_law(amputee):
+    """A smooth law (the collocation model's) pushes with a small force above the ground too:
+    each stance's window is where the blade penetrates, not where its force is above 0."""
+    res = _synthetic(amputee, stances=STANCES)
+    b = int(np.flatnonzero(amputee.contact_params[:, 7] == 1)[0])
+    k = amputee.contact_params[b, 3]
+    t = res.time
+    depth = np.zeros_like(t)
+    for t0, t1 in ((0.4, 0.6), (1.0, 1.2)):
+        on = (t > t0) & (t < t1)
+        depth[on] = 0.05 * np.sin(math.pi * (t[on] - t0) / (t1 - t0))
+    res.contacts[:, b, 1] = k * depth**1.5 + 0.1  # 0.1 N above the ground
+    res.contacts[:, b, 6] = depth
+    e = blade_energy(res)
+    one = k * 0.05**2.5 / 2.5  # ∫k·δ^1.5 dδ up to the peak [J]
+    assert len(e) == 2
+    np.testing.assert_allclose(e.E_stored_J, one, rtol=1e-3)
+    np.testing.assert_allclose(e.E_returned_J, one, rtol=1e-3)

@@ -558,7 +558,12 @@ def blade_energy(
     if compression == "hertz":
         k, n = cp[blade, CP_K], cp[blade, CP_EXP]
         depth = (np.maximum(force, 0.0) / k) ** (1.0 / n)
-    touching = (depth > 0).any(axis=1) | (force > 0).any(axis=1)
+        touching = (force > 0).any(axis=1)
+    else:
+        # penetrating; not 'force > 0': a smooth contact law (the collocation model's) pushes
+        # with a small force above the ground too, which would join every stance into one
+        # (the forward law's force is 0 without penetration: the same stances)
+        touching = (depth > 0).any(axis=1)
     rows = []
     name = leg_names(result.model)[1]
     for i0, i1 in _leg_stances(result, 1, threshold_n):
