@@ -170,6 +170,24 @@ def test_parallel_batch_equals_serial_bit_for_bit(xtreme_stance):
         np.testing.assert_array_equal(getattr(parallel, name), getattr(serial, name), err_msg=name)
 
 
+def test_the_kernel_is_compiled_once_whatever_parameters_are_passed(xtreme_stance):
+    """K, D, K2 given or left out (read-only broadcast views or the chain's own arrays), scalar
+    or per set: one argument type, so one compilation of the kernel (each one costs about half a
+    minute on a cold cache)."""
+    from bladelab.sim import kernel
+
+    blade, stance, _ = xtreme_stance
+    problem = prepare(blade, stance)
+    simulate(problem)
+    simulate(problem, stiffness=900.0)
+    simulate(problem, stiffness=900.0, damping=10.0, stiffness_quadratic=100.0)
+    simulate(problem, stiffness_quadratic=np.broadcast_to(100.0, (1,)))
+    simulate_batch(problem, np.broadcast_to(900.0, (2, 1)), np.array([[8.0], [9.0]]))
+    simulate_batch(problem, np.array([[800.0], [900.0]]), np.array([[8.0], [9.0]])[:, ::-1],
+                   np.zeros((2, 1)))
+    assert len(kernel.simulate_batch_serial.signatures) == 1, kernel.simulate_batch_serial.signatures
+
+
 def test_belt_speed_equals_moving_the_clamp(xtreme_stance):
     blade, stance, _ = xtreme_stance
     belt = 3.0

@@ -395,12 +395,17 @@ def _params(problem: SimProblem, value, default: np.ndarray, name: str, n_sets: 
                              where=name) from err
     if not np.all(np.isfinite(arr)) or np.any(arr < 0):
         raise ModelError(f"must be finite and >= 0, got {np.asarray(value).tolist()}", where=name)
-    return np.ascontiguousarray(arr, dtype=float)
+    # always a fresh, writable C array: numba compiles (and caches) one kernel per argument
+    # type, and a read-only array (a broadcast view) is another type than a writable one, so
+    # K, D, K2 passed or left out would each cost a full compilation of the kernel
+    return np.array(arr, dtype=float, order="C")
 
 
 def run_kernel(problem: SimProblem, K, D, K2, *, parallel: bool = False,
                 with_energy: bool = True):
     """Run the kernel for the (n_sets, nj) parameter arrays; the buffers and (n_sets, 2) status."""
+    # one argument type for the compiled kernel whatever the caller passes (see _params)
+    K, D, K2 = (np.require(a, np.float64, ["C", "W"]) for a in (K, D, K2))
     nj = K.shape[1]
     q0 = np.zeros(nj)
     model = _k.ChainModel.from_chain(problem.chain)

@@ -371,9 +371,8 @@ def simulate_mujoco(problem, K: np.ndarray, D: np.ndarray, K2: np.ndarray):
     energy = np.zeros((ns, len(_k.ENERGY_TERMS)))
     jd = np.ascontiguousarray(mj.joint_dofs)
     jq = np.ascontiguousarray(mj.joint_qpos)
-    K = np.asarray(K, float)
-    D = np.asarray(D, float)
-    K2 = np.asarray(K2, float)
+    # writable C arrays: a read-only one would make numba compile another version of the loops
+    K, D, K2 = (np.require(a, np.float64, ["C", "W"]) for a in (K, D, K2))
     acc = np.zeros(5)  # clamp work, joint, contact, friction, track dissipation
     track = contact[9] > 0.0
     track_u = np.zeros(ne)

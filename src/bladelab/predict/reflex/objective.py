@@ -161,7 +161,9 @@ def simulate_controlled(
     """
     settings = settings or ObjectiveSettings()
     layout = layout or controller_layout(model)
-    x = np.asarray(x, dtype=float)
+    # a C-contiguous copy: a strided view (a column of a population) would make numba compile
+    # another version of the closed loop
+    x = np.array(x, dtype=float, order="C")
     if x.shape != (layout.size,):
         raise SimulationError(
             f"expected {layout.size} controller parameters, got {x.shape}", where="parameters"
