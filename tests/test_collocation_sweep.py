@@ -74,6 +74,13 @@ def test_sweep_solves_each_model_and_writes_the_table(fake_solve, tmp_path, caps
                 "wall_s", "mesh_intervals", "file"):
         assert col in cols
     assert rows[0]["contact_time_intact_s"] == "" and rows[3]["contact_time_left_s"] == ""
+    # seed 001's per-stride quantities of each solution (analyses.stride_analyses)
+    for col in ("leg_stiffness_left_kN_per_m", "positive_power_knee_intact_W_per_kg",
+                "negative_power_rsp_prosthetic_W_per_kg", "leg_energy_stored_right_J",
+                "blade_energy_returned_J", "blade_recoil_pct"):
+        assert col in cols
+    assert rows[0]["blade_energy_stored_J"] == "" and float(rows[3]["blade_energy_stored_J"]) > 0
+    assert float(rows[0]["positive_power_total_W_per_kg"]) > 0
     assert rows[5]["file"] == "amputee-Cat6/max-speed.json"
     assert float(rows[5]["mean_speed_mps"]) == pytest.approx(4.8)
     assert result["rows"][5]["mean_speed_mps"] == pytest.approx(4.8)

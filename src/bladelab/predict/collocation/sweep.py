@@ -5,9 +5,14 @@ category: :func:`sweep_models`), the speed continuation and then the maximum spe
 (:mod:`bladelab.predict.collocation.continuation`), each model in its own subfolder
 (:func:`~bladelab.predict.collocation.continuation.model_folder`: ``able``,
 ``amputee-<blade>``), models in parallel processes with ``jobs`` > 1, and writes the table
-:data:`SWEEP_TABLE` after each model (:func:`write_table`; its rows are
-:meth:`~bladelab.predict.collocation.continuation.SolveRecord.row`, described in the
-continuation module). A model that fails does not stop the others.
+:data:`SWEEP_TABLE` after each model (:func:`write_table`). A model that fails does not stop
+the others.
+
+A table row is one solve: :meth:`~bladelab.predict.collocation.continuation.SolveRecord.row`
+(model, problem, convergence, speed, cost of transport, stride and contact times, peak forces;
+described in the continuation module) followed by seed 001's per-stride quantities of the
+solution, :func:`~bladelab.predict.collocation.analyses.stride_analyses` (K_leg, joint powers
+P+/P− per joint, leg energies, the blade's energy; units in the column names).
 """
 
 from __future__ import annotations
@@ -19,6 +24,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from bladelab.errors import InputFileError, SpecError
+from bladelab.predict.collocation.analyses import stride_analyses
 from bladelab.predict.collocation.continuation import (
     ContinuationProgress,
     LazyRunner,
@@ -105,9 +111,9 @@ def sweep_model_task(payload: dict) -> dict:
 
     ``payload``: ``model_spec``, ``speeds``, ``settings`` (:class:`CollocationSettings`),
     ``make_guess`` (``make_guess(runner, n=..., speed=...)``), ``out`` (the sweep folder),
-    ``force``, ``progress`` (or None). Returns ``label``, ``rows`` and ``failures`` (one line
-    per solve that did not converge). With ``force``, files of the model folder that this run
-    did not write are removed once the model is done.
+    ``force``, ``progress`` (or None). Returns ``label``, ``rows`` (module docstring) and
+    ``failures`` (one line per solve that did not converge). With ``force``, files of the model
+    folder that this run did not write are removed once the model is done.
     """
     spec = payload["model_spec"]
     settings = payload["settings"]
@@ -148,7 +154,9 @@ def sweep_model_task(payload: dict) -> dict:
         for p in _files(folder):
             if p.resolve() not in keep:
                 p.unlink(missing_ok=True)
-    return {"label": label, "rows": [r.row(out) for r in records], "failures": failures}
+    runner = get_runner()
+    rows = [r.row(out) | stride_analyses(r.solution, runner) for r in records]
+    return {"label": label, "rows": rows, "failures": failures}
 
 
 @dataclass(frozen=True)
@@ -160,7 +168,7 @@ class SweepResult:
     table_path
         The summary table (:data:`SWEEP_TABLE`).
     rows
-        Its rows (:meth:`SolveRecord.row`), models in the order asked.
+        Its rows (module docstring), models in the order asked.
     failures
         Per model label, what failed (solves that did not converge, or the error that stopped
         the model); empty when everything converged.
