@@ -174,10 +174,18 @@ def sweep_dir(tmp_path_factory) -> Path:
     return out
 
 
-def test_report_of_a_sweep(sweep_dir, tmp_path):
+@pytest.fixture(scope="module")
+def sweep_report(sweep_dir, tmp_path_factory) -> Path:
+    """``bladelab report SWEEP`` (CLI defaults), written once: checked for its content and
+    opened in the browser."""
     assert predictive_kind(sweep_dir) == "sweep"
-    assert main(["report", str(sweep_dir), "--out", str(tmp_path / "r")]) == 0
-    index = tmp_path / "r" / "index.html"
+    out = tmp_path_factory.mktemp("sweep-report") / "r"
+    assert main(["report", str(sweep_dir), "--out", str(out)]) == 0
+    return out / "index.html"
+
+
+def test_report_of_a_sweep(sweep_dir, sweep_report):
+    index = sweep_report
     html = index.read_text(encoding="utf-8")
     results = pd.read_csv(sweep_dir / "results.csv")
     for cat in ("Cat4", "Cat6"):
@@ -219,12 +227,11 @@ def test_sweep_report_leaves_out_unfinished_cells(sweep_dir, tmp_path):
     assert ("Cat6", 4.0) not in shown and ("Cat6", 3.5) in shown and ("Cat4", 4.0) in shown
 
 
-def test_sweep_report_opens_in_a_browser(sweep_dir, tmp_path):
+def test_sweep_report_opens_in_a_browser(sweep_report, tmp_path):
     from browser import chromium, figure_ok, inspect_page
 
     binary = chromium()
-    rep = build_predictive_report(sweep_dir, tmp_path / "r", duration=0.5, progress=False)
-    figures, errors = inspect_page(binary, Path(rep.index), tmp_path / "shot.png",
+    figures, errors = inspect_page(binary, sweep_report, tmp_path / "shot.png",
                                    tmp_path / "profile")
     assert errors == []
     # the gait figures overlay every solution (12) + the category figure
@@ -278,12 +285,11 @@ def test_bad_paths_exit_2_and_write_nothing(tmp_path, capsys):
         build_predictive_report(tmp_path / "empty")
 
 
-def test_report_of_the_shipped_amputee_solution(tmp_path):
+def test_report_of_the_shipped_amputee_solution(shipped_amputee_report):
     from bladelab.runner.export import read_mot
 
-    src = SOLUTIONS / "amputee-Cat6-3.5.json"
-    rep = build_predictive_report(src, tmp_path / "r", duration=3.0, progress=False,
-                                  export=True)
+    rep = shipped_amputee_report  # 3 s re-simulated, exported (conftest.py)
+    assert rep.kind == "parameters" and rep.simulations == 1
     index = Path(rep.index)
     html = index.read_text(encoding="utf-8")
     assert 'class="runner-animation"' in html and "Table D.1" in html

@@ -19,11 +19,7 @@ import pytest
 from bladelab.blade import load_blade
 from bladelab.report import Report
 from bladelab.report.animation import animation_html, runner_frames
-from bladelab.report.predictive import build_predictive_report
 from bladelab.runner import build_runner, simulate_runner
-
-SOLUTIONS = Path(__file__).resolve().parents[1] / "src" / "bladelab" / "data" / "runner"
-AMPUTEE = SOLUTIONS / "solutions" / "amputee-Cat6-3.5.json"
 
 
 @pytest.mark.parametrize("kind", ["able", "amputee", "multilink"])
@@ -92,11 +88,11 @@ CLIPPED = ("Array.from(document.querySelectorAll('.table-scroll'))"
            ".filter(t => t.scrollWidth > t.clientWidth + 1).length")
 
 
-def test_the_runner_is_animated_in_headless_chromium(tmp_path):
+def test_the_runner_is_animated_in_headless_chromium(tmp_path, shipped_amputee_report):
     from browser import CHECK_FIGURES, chromium, figure_ok
 
     binary = chromium()
-    rep = build_predictive_report(AMPUTEE, tmp_path / "report", duration=1.5, progress=False)
+    rep = shipped_amputee_report  # the shipped amputee Cat6 solution, 3 s (conftest.py)
     browser, session = _open(binary, Path(rep.index), tmp_path / "profile")
     try:
         assert _evaluate(browser, session, FRAME) == "0"
