@@ -10,7 +10,11 @@
   ``settings`` {``dt``, ...}, ``parameters``);
 - ``"collocation"``: a collocation solution (``"kind": "collocation-solution"``, the
   ``solution.json`` of ``bladelab predict --method collocation``, or its folder): its stride
-  repeated, not re-simulated (:mod:`bladelab.report.collocation`).
+  repeated, not re-simulated (:mod:`bladelab.report.collocation`);
+- ``"collocation-sweep"``: a ``bladelab sweep --method collocation`` folder
+  (``collocation-sweep.csv``): cost, contact times and GRF against speed per model, the
+  category table beside seed 001, and the maximum-speed solutions' strides
+  (:mod:`bladelab.report.collocation_sweep`).
 
 Nothing is taken from a stored evaluation: every reflex solution is simulated again from its parameters
 (:func:`bladelab.predict.reflex.objective.simulate_controlled` with the file's time step). The sections
@@ -42,7 +46,8 @@ __all__ = ["PredictiveReport", "build_predictive_report", "default_report_dir", 
 
 _KINDS_HINT = (
     "give a 'bladelab predict' folder (best.json + history.csv, or summary.json + seed-N/), "
-    "a 'bladelab sweep' folder (results.csv + summary.csv) or a parameter JSON file"
+    "a 'bladelab sweep' folder (results.csv + summary.csv, or collocation-sweep.csv), a "
+    "parameter JSON file or a collocation solution.json"
 )
 
 
@@ -60,7 +65,8 @@ class PredictiveReport:
 
 
 def predictive_kind(path: str | Path) -> str | None:
-    """``"run"``, ``"runs"``, ``"sweep"``, ``"parameters"``, ``"collocation"`` or None (see
+    """``"run"``, ``"runs"``, ``"sweep"``, ``"parameters"``, ``"collocation"``,
+    ``"collocation-sweep"`` or None (see
     module docstring); a collocation best iterate raises InputFileError (not a solution)."""
     from bladelab.report.collocation import collocation_solution_file
 
@@ -78,6 +84,10 @@ def predictive_kind(path: str | Path) -> str | None:
         return "parameters" if ok else None
     if not p.is_dir():
         return None
+    from bladelab.report.collocation_sweep import is_collocation_sweep
+
+    if is_collocation_sweep(p):
+        return "collocation-sweep"
     if (p / "results.csv").is_file() and (p / "summary.csv").is_file():
         if any(p.glob("*/*/best.json")):
             return "sweep"
@@ -479,18 +489,24 @@ def build_predictive_report(
     titles = {"run": "Predictive running: optimisation", "runs": "Predictive running: runs",
               "sweep": "Predictive running: blade-category sweep",
               "parameters": "Predictive running: solution",
-              "collocation": "Predictive running: collocation solution"}
+              "collocation": "Predictive running: collocation solution",
+              "collocation-sweep": "Predictive running: collocation sweep"}
     rep = Report(titles[kind], subtitle=str(path))
     sweep_summary = None
     resim = None
     # a collocation solution is not re-simulated: no progress bar for it
     with _Counter(tqdm(desc="re-simulating", unit="sim",
-                       disable=not progress or kind == "collocation")) as bar:
+                       disable=not progress or kind.startswith("collocation"))) as bar:
         if kind == "collocation":
             from bladelab.report.collocation import collocation_sections
 
             results, csol = collocation_sections(rep, path)
             settings, seed = csol.settings.to_dict(), None
+        elif kind == "collocation-sweep":
+            from bladelab.report.collocation_sweep import collocation_sweep_sections
+
+            results, sweep_summary = collocation_sweep_sections(rep, path)
+            settings, seed = {}, None
         elif kind == "parameters":
             sol = _Solution(path, _read_json(path))
             ev, res = sol.simulate(duration)

@@ -444,12 +444,11 @@ def add_predictive_sections(
             if animate else [],
             text=None if animate else "Animation left out (animate=False).",
         )
-    if not results:
-        return
-    cycles = {label: GaitCycles(res) for label, res in results.items()}
-    with plt.rc_context(STYLE):
-        _gait_sections(report, results, cycles)
-    plt.close("all")
+    if results:
+        cycles = {label: GaitCycles(res) for label, res in results.items()}
+        with plt.rc_context(STYLE):
+            _gait_sections(report, results, cycles)
+        plt.close("all")
     if sweep_summary is not None and len(sweep_summary):
         _sweep_section(report, sweep_summary, compare_seed)
 

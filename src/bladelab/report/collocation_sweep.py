@@ -1,0 +1,177 @@
+"""Report sections of a collocation sweep folder (``bladelab report DIR`` on the output of
+``bladelab sweep --method collocation``).
+
+The folder holds :data:`~bladelab.predict.collocation.sweep.SWEEP_TABLE` (one row per solve:
+each model's speed continuation and its maximum speed) and the solution files it names. The
+report shows, before the predictive sections that every predictive report has:
+
+- cost of transport, contact time and peak vertical ground force per leg against speed, one
+  curve per model, the maximum-speed solve marked;
+- every solve of the table, converged or not (a solve that did not converge is listed, never
+  plotted or averaged);
+- per blade category the summary that the reflex sweep's report shows (maximum speed, cost at
+  4 m/s, 200/400 m times, contact times at the maximum speed), beside seed 001's values
+  (:func:`~bladelab.report.predictive_sections.add_predictive_sections`' category section).
+
+The gait-cycle figures and seed 001's Tables 3.2, 3.3 and D.1 then come from the converged
+maximum-speed solutions (the stride repeated, not re-simulated; seed 001 reports those tables
+at the maximum speed).
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from bladelab.errors import InputFileError
+
+__all__ = ["collocation_sweep_sections", "is_collocation_sweep", "sweep_summary"]
+
+#: Speed [m/s] at which the category table reports the cost of transport (seed 001 Fig. 3.7a).
+COST_SPEED_M_PER_S = 4.0
+
+
+def is_collocation_sweep(path: str | Path) -> bool:
+    """True if ``path`` is a folder with a collocation sweep's table."""
+    from bladelab.predict.collocation.sweep import SWEEP_TABLE
+
+    p = Path(path)
+    return p.is_dir() and (p / SWEEP_TABLE).is_file()
+
+
+def read_sweep_table(folder: str | Path) -> pd.DataFrame:
+    """The sweep's table, with ``converged`` as bool.
+
+    Raises
+    ------
+    InputFileError
+        The table cannot be read or lacks a column the report needs.
+    """
+    from bladelab.predict.collocation.sweep import SWEEP_TABLE
+
+    path = Path(folder) / SWEEP_TABLE
+    try:
+        table = pd.read_csv(path)
+    except (OSError, ValueError) as err:
+        raise InputFileError(f"cannot read the sweep table ({err})", file=path,
+                             hint="run 'bladelab sweep --method collocation --resume' on the "
+                                  "folder to rewrite it") from None
+    need = {"model", "blade", "problem", "prescribed_speed_mps", "converged", "mean_speed_mps",
+            "cost_of_transport_J_per_kg_m", "file"}
+    missing = sorted(need - set(table.columns))
+    if missing:
+        raise InputFileError(f"the sweep table lacks the column(s) {', '.join(missing)}",
+                             file=path, hint="rewrite it with 'bladelab sweep --method "
+                                             "collocation --resume'")
+    table["converged"] = table["converged"].astype(str).str.lower().isin(["true", "1"])
+    return table
+
+
+def sweep_summary(table: pd.DataFrame) -> pd.DataFrame:
+    """One row per blade category (amputee models) in the reflex sweep summary's columns
+    (:func:`bladelab.predict.reflex.sweep.summarise`): max_speed [m/s] (the converged
+    maximum-speed solve), cot_4 [J/(kg·m)] (converged solve at 4 m/s), t200 and t400 [s]
+    (200 m and 400 m at the maximum speed) and the contact times [s] of each leg at the maximum
+    speed. NaN where the solve is missing or did not converge."""
+    rows = []
+    amputee = table[table.model.astype(str).str.startswith("amputee")]
+    for cat, df in amputee.groupby("blade", sort=False):
+        ok = df[df.converged]
+        top = ok[ok.problem == "max-speed"]
+        at4 = ok[(ok.problem == "speed")
+                 & np.isclose(ok.prescribed_speed_mps.astype(float), COST_SPEED_M_PER_S)]
+        vmax = float(top.mean_speed_mps.iloc[0]) if len(top) else math.nan
+        row = {"category": cat, "max_speed": vmax,
+               "cot_4": float(at4.cost_of_transport_J_per_kg_m.iloc[0]) if len(at4) else math.nan,
+               "t200": 200.0 / vmax if vmax > 0 else math.nan,
+               "t400": 400.0 / vmax if vmax > 0 else math.nan}
+        for leg in ("intact", "prosthetic"):
+            col = f"contact_time_{leg}_s"
+            row[f"contact_time_{leg}"] = (float(top[col].iloc[0]) if len(top) and col in top
+                                          else math.nan)
+        rows.append(row)
+    return pd.DataFrame(rows, columns=["category", "max_speed", "cot_4", "t200", "t400",
+                                       "contact_time_intact", "contact_time_prosthetic"])
+
+
+def _speed_figure(table: pd.DataFrame):
+    """Cost of transport, contact time and peak vertical GRF per leg against speed."""
+    import matplotlib.pyplot as plt
+
+    ok = table[table.converged]
+    legs = [c[len("contact_time_"):-2] for c in table.columns
+            if c.startswith("contact_time_") and c.endswith("_s")]
+    fig, axes = plt.subplots(1, 3, figsize=(13, 3.8))
+    quantities = [("cost_of_transport_J_per_kg_m", "cost of transport (J/(kg·m))", [""]),
+                  ("contact_time_{}_s", "contact time (s)", legs),
+                  ("peak_vertical_grf_{}_bw", "peak vertical GRF (body weights)", legs)]
+    for ax, (col, label, which) in zip(axes, quantities, strict=True):
+        for k, (model, df) in enumerate(ok.groupby("model", sort=False)):
+            df = df.sort_values("mean_speed_mps")
+            color = f"C{k}"
+            for j, leg in enumerate(which):
+                c = col.format(leg) if leg else col
+                if c not in df or df[c].isna().all():
+                    continue
+                style = "-" if j == 0 else "--"
+                name = f"{model} {leg}".strip()
+                ax.plot(df.mean_speed_mps, df[c], style, color=color, marker="o", ms=3,
+                        label=name)
+                top = df[df.problem == "max-speed"]
+                ax.plot(top.mean_speed_mps, top[c], "*", color=color, ms=10)
+        ax.set_xlabel("mean speed (m/s)")
+        ax.set_ylabel(label)
+    axes[0].legend(fontsize=7)
+    axes[1].legend(fontsize=6, ncol=1)
+    fig.tight_layout()
+    return fig
+
+
+def collocation_sweep_sections(report, folder: str | Path) -> tuple[dict, pd.DataFrame]:
+    """Add the sweep's own sections to ``report``; return ({label: RunnerResult} of the
+    converged maximum-speed solutions, for the predictive sections; the category summary
+    :func:`sweep_summary`)."""
+    import matplotlib.pyplot as plt
+
+    from bladelab.predict.collocation.model import build_collocation_model
+    from bladelab.predict.collocation.solution import CollocationSolution
+    from bladelab.predict.collocation.stored import runner_from_spec
+
+    folder = Path(folder)
+    table = read_sweep_table(folder)
+    failed = table[~table.converged]
+    fig = _speed_figure(table)
+    text = (f"{len(table)} solves, {int(table.converged.sum())} converged. Each model's speeds "
+            "were solved in the order given, each warm-started from the previous converged "
+            "speed; the maximum speed (star) from the fastest. Curves and the category table "
+            "use converged solves only.")
+    if len(failed):
+        text += (" Not converged (listed in the table, left out of the figures and the "
+                 "category table): " + ", ".join(
+                     f"{r.model} {r.problem} {r.prescribed_speed_mps if r.problem == 'speed' else ''}"
+                     .strip() for r in failed.itertuples()) + ".")
+    shown = table.rename(columns={"file": "solution file"})
+    report.add_section(
+        "Collocation sweep: speed continuation and maximum speed",
+        text=text,
+        figures=[("Cost of transport, contact time and peak vertical GRF per leg against mean "
+                  "speed (solid: left/intact leg, dashed: right/prosthetic; star: maximum "
+                  "speed)", fig)],
+        tables=[("Every solve (collocation-sweep.csv)", shown)],
+    )
+    plt.close(fig)
+    results = {}
+    for r in table[table.converged & (table.problem == "max-speed")].itertuples():
+        path = folder / str(r.file)
+        if not path.is_file():
+            raise InputFileError("a solution named in the sweep table is missing", file=path,
+                                 hint="re-run 'bladelab sweep --method collocation --resume'")
+        sol = CollocationSolution.read(path)
+        runner = runner_from_spec(sol.model_spec)
+        label = f"{r.model} max {sol.mean_speed_mps:.2f} m/s (collocation)"
+        results[label] = sol.to_runner_result(3, runner=runner,
+                                              cm=build_collocation_model(runner))
+    return results, sweep_summary(table)

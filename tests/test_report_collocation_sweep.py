@@ -1,0 +1,93 @@
+"""The report of a collocation sweep folder (bladelab.report.collocation_sweep), on the committed
+first-pass category study (benchmarks/collocation/study-4mps)."""
+
+from __future__ import annotations
+
+import math
+import shutil
+from pathlib import Path
+
+import pandas as pd
+import pytest
+
+from bladelab.errors import InputFileError
+from bladelab.report.collocation_sweep import read_sweep_table, sweep_summary
+from bladelab.report.predictive import build_predictive_report, predictive_kind
+
+STUDY = Path(__file__).resolve().parents[1] / "benchmarks" / "collocation" / "study-4mps"
+
+
+def _subset(tmp_path: Path, blades: list[str]) -> Path:
+    """A sweep folder with only the given categories (their files and table rows)."""
+    out = tmp_path / "sweep"
+    out.mkdir()
+    table = pd.read_csv(STUDY / "collocation-sweep.csv")
+    table = table[table.blade.isin(blades)]
+    for b in blades:
+        shutil.copytree(STUDY / f"amputee-{b}", out / f"amputee-{b}")
+    table.to_csv(out / "collocation-sweep.csv", index=False)
+    return out
+
+
+def test_a_collocation_sweep_folder_is_recognised():
+    assert predictive_kind(STUDY) == "collocation-sweep"
+
+
+def test_category_summary_reads_the_max_speed_and_the_4_mps_solves():
+    raw = pd.read_csv(STUDY / "collocation-sweep.csv")
+    summary = sweep_summary(read_sweep_table(STUDY)).set_index("category")
+    assert sorted(summary.index) == sorted(raw.blade.unique())
+    for blade, rows in raw.groupby("blade"):
+        fastest = rows[rows.problem == "max-speed"].iloc[0]
+        at4 = rows[(rows.problem == "speed") & (rows.prescribed_speed_mps == 4.0)].iloc[0]
+        s = summary.loc[blade]
+        assert s.max_speed == pytest.approx(fastest.mean_speed_mps)
+        assert s.max_speed > 4.0
+        assert s.cot_4 == pytest.approx(at4.cost_of_transport_J_per_kg_m)
+        assert s.t200 * s.max_speed == pytest.approx(200.0)
+        assert s.contact_time_prosthetic == pytest.approx(fastest.contact_time_prosthetic_s)
+
+
+def test_a_solve_that_did_not_converge_is_left_out_of_the_summary(tmp_path):
+    folder = _subset(tmp_path, ["Cat5"])
+    table = pd.read_csv(folder / "collocation-sweep.csv")
+    table.loc[table.problem == "max-speed", "converged"] = False
+    table.to_csv(folder / "collocation-sweep.csv", index=False)
+    s = sweep_summary(read_sweep_table(folder)).iloc[0]
+    assert math.isnan(s.max_speed) and math.isnan(s.t200)
+    assert math.isfinite(s.cot_4)
+
+
+def test_a_table_without_a_needed_column_is_refused_by_name(tmp_path):
+    folder = _subset(tmp_path, ["Cat4"])
+    table = pd.read_csv(folder / "collocation-sweep.csv").drop(columns=["mean_speed_mps"])
+    table.to_csv(folder / "collocation-sweep.csv", index=False)
+    with pytest.raises(InputFileError, match="mean_speed_mps"):
+        read_sweep_table(folder)
+
+
+def test_the_report_of_a_sweep_folder_has_its_sections(tmp_path, monkeypatch):
+    import bladelab.report.predictive_sections as sections
+
+    # the gait-cycle sections are the predictive report's own (tested with it); here only
+    # which trajectories reach them
+    shown = {}
+    monkeypatch.setattr(sections, "_gait_sections",
+                        lambda report, results, cycles: shown.update(results))
+    folder = _subset(tmp_path, ["Cat4", "Cat6"])
+    table = pd.read_csv(folder / "collocation-sweep.csv")
+    table.loc[(table.blade == "Cat4") & (table.problem == "max-speed"), "converged"] = False
+    table.to_csv(folder / "collocation-sweep.csv", index=False)
+    rep = build_predictive_report(folder, tmp_path / "report", progress=False, animate=False)
+    assert rep.kind == "collocation-sweep"
+    # only the converged maximum-speed solve is shown as a gait
+    assert len(rep.solutions) == 1 and "Cat6" in rep.solutions[0]
+    assert list(shown) == list(rep.solutions)
+    (res,) = shown.values()
+    stride = table[(table.blade == "Cat6") & (table.problem == "max-speed")].stride_time_s
+    assert res.time[-1] == pytest.approx(3 * float(stride.iloc[0]), rel=1e-6)  # three strides
+    html = Path(rep.index).read_text(encoding="utf-8")
+    assert "Collocation sweep: speed continuation and maximum speed" in html
+    assert "Not converged" in html and "amputee Cat4 max-speed" in html
+    assert "Blade categories: maximum speed and metabolic cost" in html
+    assert "seed 001" in html
