@@ -67,21 +67,28 @@ class FakeSolve:
     """Stands in for ``predict_stride``: the fake solution with the guess's coordinates at the
     prescribed speed (the maximum speed: 1.2 × the guess's), coordinate ``MARK`` shifted by
     1 mrad so that a solve's output differs from its input; fails for (model label, speed)
-    in ``fail`` (None: the maximum speed)."""
+    in ``fail`` (None: the maximum speed), and for a prescribed speed more than ``max_step``
+    [m/s] from the last speed solved successfully (None: any step)."""
 
-    def __init__(self, fakes, fail=()):
+    def __init__(self, fakes, fail=(), max_step=None):
         self.fakes, self.fail, self.calls = fakes, set(fail), []
+        self.max_step, self.last_ok_speed = max_step, None
 
     def __call__(self, runner, settings, guess, *, model_spec, progress=None):
         spec = check_model_spec(model_spec)
         base = self.fakes[spec["model"]][1]
         v = settings.speed_m_per_s
         g = guess.resample(settings.mesh_intervals)
+        last = self.last_ok_speed
+        step = abs(v - last) if v is not None and last is not None else 0.0
         g = g.with_speed(v if v is not None else 1.2 * g.speed)
         q = g.q.copy()
         q[:, MARK] += 1e-3
         label = model_label(spec)
-        ok = (label, v) not in self.fail
+        ok = (label, v) not in self.fail and (self.max_step is None
+                                              or step <= self.max_step + 1e-9)
+        if ok and v is not None:
+            self.last_ok_speed = v
         nlp = dataclasses.replace(
             base.nlp, q=q, qd=g.qd, period=g.period, success=ok,
             status="Solve_Succeeded" if ok else "Maximum_Iterations_Exceeded")

@@ -100,7 +100,7 @@ def test_a_failed_speed_stops_the_continuation_and_a_rerun_resumes_from_its_iter
     runner = fakes["able"][0]
     fake_solve.fail = {("able", 4.0)}
     res = cont.speed_continuation(runner, [3.5, 4, 4.5], _settings(), _first, model_spec=ABLE,
-                                  out_dir=tmp_path)
+                                  out_dir=tmp_path, refinements=0)
     assert not res.complete and res.failed.speed_mps == 4.0
     assert res.last_converged_speed == 3.5 and res.fastest.speed_mps == 3.5
     assert [c["speed"] for c in fake_solve.calls] == [3.5, 4.0]  # 4.5 m/s never tried
@@ -117,6 +117,38 @@ def test_a_failed_speed_stops_the_continuation_and_a_rerun_resumes_from_its_iter
     np.testing.assert_array_equal(fake_solve.calls[0]["guess"].q, failed.nlp.q)
     assert sorted(p.name for p in tmp_path.iterdir()) == [
         "speed-3.5.json", "speed-4.5.json", "speed-4.json"]
+
+
+def test_a_step_that_fails_is_halved_and_the_speed_tried_again(fakes, fake_solve, tmp_path):
+    runner = fakes["able"][0]
+    fake_solve.max_step = 0.3  # m/s: a larger step fails
+    events = []
+    res = cont.speed_continuation(runner, [3.5, 4.5], _settings(), _first, model_spec=ABLE,
+                                  out_dir=tmp_path, progress=events.append)
+    # quarter steps at most: 4.5 fails, 4.0 fails, 3.75, 4.0, 4.5 fails, 4.25, 4.5
+    assert [c["speed"] for c in fake_solve.calls] == [3.5, 4.5, 4.0, 3.75, 4.0, 4.5, 4.25, 4.5]
+    assert res.complete
+    solved = [r.speed_mps for r in res.records]
+    assert solved[0] == 3.5 and solved[-1] == 4.5
+    assert all(r.converged for r in res.records)
+    steps = np.diff(solved)
+    assert np.all(steps > 0) and np.all(steps <= 0.3 + 1e-9)
+    assert sum(e.event == "refine" for e in events) >= 2
+    assert not any(p.name.endswith("best_iterate.json") for p in tmp_path.iterdir())
+    # the retried speed starts from the intermediate solution, not its stale best iterate
+    retry = [c for c in fake_solve.calls if c["speed"] == 4.5][-1]
+    assert "at 4.25 m/s" in retry["guess"].source
+
+
+def test_refinements_are_limited_per_prescribed_speed(fakes, fake_solve, tmp_path):
+    runner = fakes["able"][0]
+    fake_solve.max_step = 0.2
+    res = cont.speed_continuation(runner, [3.5, 4.5], _settings(), _first, model_spec=ABLE,
+                                  out_dir=tmp_path, refinements=2)
+    # 4.5 fails, 4.0 fails, 3.75 fails (an eighth step is not allowed): stop at 3.75
+    assert [c["speed"] for c in fake_solve.calls] == [3.5, 4.5, 4.0, 3.75]
+    assert not res.complete and res.failed.speed_mps == 3.75
+    assert res.last_converged_speed == 3.5
 
 
 def test_a_file_of_another_problem_is_refused_unless_forced(fakes, fake_solve, tmp_path):

@@ -111,14 +111,16 @@ def test_sweep_exits_2_naming_the_failed_models_after_finishing_the_others(
     assert "error: 2 of 3 model(s) failed" in cap.err
     assert ("error: amputee Cat6: 4 m/s not converged (IPOPT status "
             "Maximum_Iterations_Exceeded in the predictive stage; best iterate "
-            "amputee-Cat6/speed-4.best_iterate.json); last converged: 3.5 m/s") in cap.err
+            "amputee-Cat6/speed-4.best_iterate.json); last converged: 3.875 m/s") in cap.err
     assert "error: amputee Cat7: maximum speed not converged" in cap.err
     assert "Traceback" not in cap.err
     rows = _csv(out / "collocation-sweep.csv")
     got = [(r["model"], r["problem"], r["prescribed_speed_mps"], r["converged"]) for r in rows]
     assert got == [
-        ("amputee Cat6", "speed", "3.5", "True"), ("amputee Cat6", "speed", "4.0", "False"),
-        ("amputee Cat6", "max-speed", "", "True"),  # from the 3.5 m/s solution
+        # 4 m/s is tried again after 3.75 and 3.875 m/s (quarter steps and below: no more)
+        ("amputee Cat6", "speed", "3.5", "True"), ("amputee Cat6", "speed", "3.75", "True"),
+        ("amputee Cat6", "speed", "3.875", "True"), ("amputee Cat6", "speed", "4.0", "False"),
+        ("amputee Cat6", "max-speed", "", "True"),  # from the 3.875 m/s solution
         ("amputee Cat7", "speed", "3.5", "True"), ("amputee Cat7", "speed", "4.0", "True"),
         ("amputee Cat7", "speed", "4.5", "True"), ("amputee Cat7", "max-speed", "", "False"),
         ("amputee Cat4", "speed", "3.5", "True"), ("amputee Cat4", "speed", "4.0", "True"),

@@ -22,9 +22,14 @@ converged solve, ``speed-<v>.best_iterate.json`` for one that did not converge (
 stale one is removed once the new file is in place); ``max-speed.json`` and
 ``max-speed.best_iterate.json`` likewise.
 
-Failure: a speed that does not converge is recorded (its best-iterate file, IPOPT's status in
-the table) and the continuation stops there; :attr:`ContinuationResult.last_converged_speed`
-reports the last speed that converged.
+Failure: a speed that does not converge from the previous converged one is tried again after
+an intermediate speed halfway between them (``speed-<mid>.json``, a record of its own), down
+to steps of 1/2^``refinements`` of the first step towards that prescribed speed (default
+:data:`DEFAULT_REFINEMENTS` = 2: quarter steps; measured on
+2026-11-25: the amputee Cat4 stride warm-started from 4 to 5 m/s was still infeasible after
+800 iterations). A speed that still does not converge is recorded (its best-iterate file,
+IPOPT's status in the table) and the continuation stops there;
+:attr:`ContinuationResult.last_converged_speed` reports the last speed that converged.
 
 Resuming: running again with the same folder reads a converged file of the same problem (model,
 mesh, speed, objective weights: :meth:`CollocationSettings.same_problem`) back instead of
@@ -68,6 +73,7 @@ __all__ = [
     "MAX_SPEED_BEST_ITERATE_FILE",
     "MAX_SPEED_FILE",
     "TABLE_COLUMNS",
+    "DEFAULT_REFINEMENTS",
     "ContinuationProgress",
     "ContinuationResult",
     "LazyRunner",
@@ -120,7 +126,8 @@ class ContinuationProgress:
         ``"read"`` (a converged file read back, ``path``), ``"start"`` (a solve starts;
         ``message`` names its warm start), ``"solve"`` (a :class:`SolveProgress` of the solve in
         ``solve``), ``"converged"`` or ``"failed"`` (``path``: the file written; ``message``:
-        the result).
+        the result), ``"refine"`` (a failed speed is tried again after an intermediate one,
+        named in ``message``).
     path
         The file concerned, if any.
     message
@@ -200,7 +207,8 @@ class ContinuationResult:
     speeds
         The prescribed speeds asked for [m/s], in order.
     records
-        :class:`SolveRecord` of each speed reached.
+        :class:`SolveRecord` of each speed reached, intermediate speeds of a refined step
+        included, in the order solved.
     """
 
     speeds: tuple[float, ...]
@@ -208,8 +216,9 @@ class ContinuationResult:
 
     @property
     def complete(self) -> bool:
-        """True if every speed converged."""
-        return len(self.records) == len(self.speeds) and all(r.converged for r in self.records)
+        """True if every prescribed speed converged."""
+        done = {f"{r.speed_mps:g}" for r in self.records if r.converged}
+        return all(f"{v:g}" in done for v in self.speeds)
 
     @property
     def failed(self) -> SolveRecord | None:
@@ -319,11 +328,16 @@ def check_speeds(speeds) -> tuple[float, ...]:
     return tuple(out)
 
 
+#: Halvings of the speed step allowed (:func:`speed_continuation`): steps down to a quarter.
+DEFAULT_REFINEMENTS = 2
+
+
 # -- drivers ------------------------------------------------------------------------------
 def speed_continuation(runner, speeds: Sequence[float], settings: CollocationSettings,
                        first_guess, *, model_spec: dict, out_dir: str | Path,
                        progress: Callable[[ContinuationProgress], None] | None = None,
-                       force: bool = False) -> ContinuationResult:
+                       force: bool = False,
+                       refinements: int = DEFAULT_REFINEMENTS) -> ContinuationResult:
     """Solve the stride at each prescribed speed in order, each warm-started from the previous
     converged solution (module docstring); files ``out_dir/speed-<v>.json``.
 
@@ -350,6 +364,10 @@ def speed_continuation(runner, speeds: Sequence[float], settings: CollocationSet
     force
         Solve every speed, ignoring (and then replacing) files already in ``out_dir``; files of
         speeds not reached stay (:func:`sweep_model_task` removes them).
+    refinements
+        Halvings of the speed step allowed when a solve does not converge from the previous
+        speed: the smallest step is the first step towards a prescribed speed / 2^refinements
+        (0: stop at the first failure).
 
     Returns
     -------
@@ -380,7 +398,12 @@ def speed_continuation(runner, speeds: Sequence[float], settings: CollocationSet
     label = model_label(spec)
     records: list[SolveRecord] = []
     prev = None  # the previous converged solution
-    for v in speeds:
+    pending = list(speeds)  # speeds still to solve, intermediate ones inserted in front
+    prescribed = {f"{v:g}" for v in speeds}
+    min_step = None  # smallest step [m/s] allowed towards the current prescribed speed
+    restart: set[str] = set()  # speeds whose stored best iterate is stale (a step was refined)
+    while pending:
+        v = pending[0]
         problem = f"{v:g} m/s"
 
         def report(event: str, *, path=None, message: str = "", solve=None,
@@ -395,8 +418,9 @@ def speed_continuation(runner, speeds: Sequence[float], settings: CollocationSet
             report("read", path=ok, message="read back")
             records.append(SolveRecord("speed", v, done, ok, False))
             prev = done
+            pending.pop(0)
             continue
-        if iterate is not None:
+        if iterate is not None and f"{v:g}" not in restart:
             guess = iterate.to_guess()
             report("start", message=f"warm start from the best iterate {best.name}")
         elif prev is not None:
@@ -409,10 +433,29 @@ def speed_continuation(runner, speeds: Sequence[float], settings: CollocationSet
             report("start", message=f"from {guess.source}")
         sol, path = _solve_and_write(get_runner(), s_v, guess, spec=spec, ok=ok, best=best,
                                      report=report, watched=progress is not None)
-        records.append(SolveRecord("speed", v, sol, path, True))
-        if not sol.converged:
+        if sol.converged:
+            records.append(SolveRecord("speed", v, sol, path, True))
+            prev = sol
+            pending.pop(0)
+            if f"{v:g}" in prescribed:
+                min_step = None
+            continue
+        mid = None
+        if prev is not None:
+            v_prev = float(prev.settings.speed_m_per_s)
+            if min_step is None:
+                min_step = abs(v - v_prev) / 2**refinements
+            mid = round(0.5 * (v_prev + v), 4)
+            if (abs(v - v_prev) / 2 < min_step - 1e-9
+                    or f"{mid:g}" in (f"{v_prev:g}", f"{v:g}")):
+                mid = None
+        if mid is None:
+            records.append(SolveRecord("speed", v, sol, path, True))
             break
-        prev = sol
+        restart.add(f"{v:g}")
+        report("refine", path=path, message=f"not converged from {v_prev:g} m/s; "
+                                            f"{mid:g} m/s first, then {v:g} m/s again")
+        pending.insert(0, mid)
     return ContinuationResult(speeds, tuple(records))
 
 
