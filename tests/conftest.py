@@ -57,3 +57,24 @@ def shipped_amputee_report(tmp_path_factory):
     return build_predictive_report(solution / "amputee-Cat6-3.5.json",
                                    tmp_path_factory.mktemp("amputee") / "r", duration=3.0,
                                    progress=False, export=True)
+
+
+#: Mesh intervals of the fake collocation solutions (``collocation_fake``).
+FAKE_MESH = 12
+
+
+@pytest.fixture(scope="module")
+def fakes():
+    """Per model kind: (runner, a converged-looking collocation solution on FAKE_MESH
+    intervals at 3.5 m/s) (``collocation_fake.fake_models``)."""
+    from collocation_fake import fake_models
+
+    return fake_models(FAKE_MESH)
+
+
+@pytest.fixture
+def fake_solve(fakes, monkeypatch):
+    """The collocation continuation's solve replaced by a ``collocation_fake.FakeSolve``."""
+    from collocation_fake import install_fake_solve
+
+    return install_fake_solve(fakes, monkeypatch)

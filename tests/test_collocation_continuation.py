@@ -17,22 +17,9 @@ from bladelab.errors import InputFileError, SpecError
 from bladelab.predict.collocation import continuation as cont
 from bladelab.predict.collocation.solution import CollocationSolution
 from bladelab.predict.collocation.solve import COLLOCATION_SOURCE, CollocationSettings
-from collocation_fake import fake_models, install_fake_solve
 
-N = 12
+N = 12  # mesh intervals: the fake solutions' (conftest.FAKE_MESH)
 ABLE = {"model": "able", "blade": None}
-
-
-@pytest.fixture(scope="module")
-def fakes():
-    """Per model kind: (runner, a converged-looking solution on N intervals at 3.5 m/s)."""
-    return fake_models(N)
-
-
-@pytest.fixture
-def fake_solve(fakes, monkeypatch):
-    """The continuation's solve replaced by a FakeSolve (``collocation_fake``)."""
-    return install_fake_solve(fakes, monkeypatch)
 
 
 def _settings(**kw):

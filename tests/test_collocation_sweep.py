@@ -12,21 +12,8 @@ import numpy as np
 import pytest
 
 from bladelab.cli import main
-from collocation_fake import fake_models, install_fake_solve
 
-N = 12
-
-
-@pytest.fixture(scope="module")
-def fakes():
-    """Per model kind: (runner, a converged-looking solution on N intervals at 3.5 m/s)."""
-    return fake_models(N)
-
-
-@pytest.fixture
-def fake_solve(fakes, monkeypatch):
-    """The continuation's solve replaced by a FakeSolve (``collocation_fake``)."""
-    return install_fake_solve(fakes, monkeypatch)
+N = 12  # mesh intervals: the fake solutions' (conftest.FAKE_MESH)
 
 
 def _sweep(out, *extra):
