@@ -3,6 +3,7 @@ two-stage solve's failure path and determinism, and the report (issue 15)."""
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 from dataclasses import replace
@@ -53,7 +54,8 @@ def test_settings_round_trip_and_refuse_bad_values():
                        ({"speed_m_per_s": -1.0}, "speed_m_per_s"),
                        ({"hessian": "bfgs"}, "hessian"), ({"tol": 0.0}, "tol"),
                        ({"max_iter": 0}, "max_iter"), ({"tracking_weight": math.nan},
-                                                       "tracking_weight")):
+                                                       "tracking_weight"),
+                       ({"warm_start_mu": 0.0}, "warm_start_mu")):
         with pytest.raises(SpecError) as err:
             CollocationSettings(**bad)
         assert err.value.where == where
@@ -278,6 +280,32 @@ def test_a_stage_that_does_not_converge_ends_the_solve_deterministically(able):
     # a collocation solution as the guess goes straight to the predictive stage
     warm = predict_stride(runner, settings, a.to_guess(), model_spec={"model": "able"})
     assert warm.stage == "predictive" and warm.tracking is None
+
+
+def test_a_warm_start_keeps_the_barrier_small_and_a_cold_one_does_not(able, monkeypatch):
+    from bladelab.predict.collocation.transcription import StrideNLP
+
+    runner, _, sol = able
+    seen = []
+    solve = StrideNLP.solve
+
+    def spy(self, x0, **kw):
+        seen.append(dict(kw.get("options") or {}))
+        return solve(self, x0, **kw)
+
+    monkeypatch.setattr(StrideNLP, "solve", spy)
+    settings = CollocationSettings(mesh_intervals=6, speed_m_per_s=SPEED, max_iter=2)
+    predict_stride(runner, settings, sol.to_guess(), model_spec={"model": "able"})
+    assert seen[-1]["ipopt.mu_init"] == 1e-4 and seen[-1]["ipopt.bound_push"] == 1e-8
+    # tracking, then the predictive stage: IPOPT's defaults in both
+    seen.clear()
+    predict_stride(runner, dataclasses.replace(settings, max_iter=200),
+                   template_guess(runner, speed=SPEED, n=6), model_spec={"model": "able"})
+    assert seen and all("ipopt.mu_init" not in o for o in seen)
+    seen.clear()
+    predict_stride(runner, dataclasses.replace(settings, warm_start_mu=None), sol.to_guess(),
+                   model_spec={"model": "able"})
+    assert "ipopt.mu_init" not in seen[-1]
 
 
 # ---------------------------------------------------------------- report
