@@ -282,7 +282,7 @@ def test_a_stage_that_does_not_converge_ends_the_solve_deterministically(able):
     assert warm.stage == "predictive" and warm.tracking is None
 
 
-def test_a_warm_start_keeps_the_barrier_small_and_a_cold_one_does_not(able, monkeypatch):
+def test_warm_start_mu_sets_the_barrier_of_a_warm_start_only(able, monkeypatch):
     from bladelab.predict.collocation.transcription import StrideNLP
 
     runner, _, sol = able
@@ -294,7 +294,8 @@ def test_a_warm_start_keeps_the_barrier_small_and_a_cold_one_does_not(able, monk
         return solve(self, x0, **kw)
 
     monkeypatch.setattr(StrideNLP, "solve", spy)
-    settings = CollocationSettings(mesh_intervals=6, speed_m_per_s=SPEED, max_iter=2)
+    settings = CollocationSettings(mesh_intervals=6, speed_m_per_s=SPEED, max_iter=2,
+                                   warm_start_mu=1e-4)
     predict_stride(runner, settings, sol.to_guess(), model_spec={"model": "able"})
     assert seen[-1]["ipopt.mu_init"] == 1e-4 and seen[-1]["ipopt.bound_push"] == 1e-8
     # tracking, then the predictive stage: IPOPT's defaults in both

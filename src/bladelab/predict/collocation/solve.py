@@ -115,10 +115,13 @@ class CollocationSettings:
         IPOPT's initial barrier parameter when the predictive stage starts from a collocation
         solution (a warm start: speed continuation, maximum speed, ``--guess solution.json``),
         with ``bound_push`` = ``bound_frac`` = 1e-8 so that the start is not pushed away from
-        the bounds it sits on; None: IPOPT's defaults (mu_init 0.1, 0.01). Measured on
-        2026-11-25 (amputee Cat6, 4 → 4.2 m/s, mesh 50): 839 iterations to objective 2.708
-        with 1e-4, 955 iterations to 3.323 (a worse optimum, the start pushed off) with the
-        defaults.
+        the bounds it sits on; None (default): IPOPT's defaults (mu_init 0.1, bound_push and
+        bound_frac 0.01). Neither is better everywhere (measured 2026-11-25, mesh 50): amputee
+        Cat6 4 → 4.2 m/s reached objective 2.708 with 1e-4 and 3.323 with the defaults; Cat5
+        4 → 5 m/s reached a cost of transport of 3.33 with 1e-4 and 2.89 with the defaults,
+        and the maximum speeds of Cat4/Cat5 were 6.99/7.32 m/s with 1e-4 against 7.53/7.71
+        m/s. The landscape has local optima 15–25 % apart along a continuation; the two
+        settings are two starts (docs/collocation.md).
     """
 
     mesh_intervals: int = 50
@@ -130,7 +133,7 @@ class CollocationSettings:
     hessian: str = "limited-memory"
     tol: float = 1e-4
     max_iter: int = 3000
-    warm_start_mu: float | None = 1e-4
+    warm_start_mu: float | None = None
 
     def __post_init__(self) -> None:
         n = self.mesh_intervals
