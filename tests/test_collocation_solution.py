@@ -151,7 +151,7 @@ def test_summary_has_the_issue_keys_per_model(able):
         "cost_of_transport_J_per_kg_m", "contact_time_s",
         *(f"contact_time_{leg}_s" for leg in legs),
         *(f"peak_vertical_grf_{leg}_bw" for leg in legs),
-        "flight_fraction", "dynamics_residual_pct", "iterations", "wall_s"]
+        "flight_fraction", "dynamics_residual_pct", "iterations", "wall_s", "warnings"]
     json.dumps(s, allow_nan=False)
     assert s["converged"] is True and s["mean_speed_mps"] == pytest.approx(SPEED)
     assert s["stride_time_s"] == pytest.approx(sol.nlp.period)
@@ -165,6 +165,19 @@ def test_summary_has_the_issue_keys_per_model(able):
     assert s["cost_of_transport_J_per_kg_m"] > 0 and math.isfinite(s["dynamics_residual_pct"])
     fz = sol.leg_vertical_force()
     assert s["peak_vertical_grf_left_bw"] == pytest.approx(fz[:, 0].max() / runner.body_weight)
+
+
+def test_a_hop_and_a_stride_on_its_bound_are_named_in_the_warnings(able):
+    _, _, sol = able
+    assert sol.gait_warnings() == [] and sol.summary()["warnings"] == ""
+    forces = sol.contact_forces.copy()
+    forces[:, sol.contact_legs == 1, :] = 0.0  # the right leg never lands
+    hop = dataclasses.replace(sol, contact_forces=forces,
+                              nlp=dataclasses.replace(sol.nlp, period=0.4))
+    warnings = hop.gait_warnings()
+    assert any("right leg never touches" in w for w in warnings)
+    assert any("bound (0.4 s)" in w for w in warnings)
+    assert "right leg never touches" in hop.summary()["warnings"]
 
 
 def test_amputee_summary_names_intact_and_prosthetic_legs():

@@ -117,8 +117,11 @@ def _text(summary: dict, path: Path, solved: bool) -> str:
     head = "solution" if summary["converged"] else "best iterate (not converged)"
     lines = [f"{head}: {path}" + ("" if solved else " (already solved: read back)")]
     for key, value in summary.items():
+        if key == "warnings":
+            continue
         lines.append(f"  {key}: {value:.4g}" if isinstance(value, float)
                      else f"  {key}: {value}")
+    lines += [f"  warning: {w}" for w in (summary.get("warnings") or "").split("; ") if w]
     return "\n".join(lines)
 
 

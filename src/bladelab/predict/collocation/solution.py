@@ -276,6 +276,24 @@ class CollocationSolution:
                           "peak_vertical_grf_N": float(fz[:, j].max())}
         return {"legs": legs, "flight_fraction": float(np.mean(~loaded.any(axis=1)))}
 
+    def gait_warnings(self) -> list[str]:
+        """What makes this converged stride no running gait, in words (empty if nothing):
+        a leg that never touches the ground (a one-legged hop), no flight phase, or a stride
+        time on a bound of the NLP (:data:`~bladelab.predict.collocation.transcription.
+        PERIOD_BOUNDS_S`). Measured on 2026-11-25: the amputee Cat6 at 4 m/s from the Fukuchi
+        trial's guess converged to a hop on the intact leg at the 0.4 s bound."""
+        from bladelab.predict.collocation.transcription import PERIOD_BOUNDS_S
+
+        ph = self.contact_phases()
+        out = [f"the {leg} leg never touches the ground (a one-legged hop, not running)"
+               for leg in self.leg_names if ph["legs"][leg]["contacts"] == 0]
+        if ph["flight_fraction"] <= 0.0:
+            out.append("no flight phase (not running)")
+        for bound in PERIOD_BOUNDS_S:
+            if math.isclose(self.period_s, bound, rel_tol=1e-3):
+                out.append(f"the stride time sits on its bound ({bound:g} s)")
+        return out
+
     def summary(self) -> dict:
         """The numbers ``bladelab predict --method collocation --json`` prints.
 
@@ -284,7 +302,8 @@ class CollocationSolution:
         ``contact_time_s`` (mean over the legs) and per leg ``contact_time_<leg>_s`` [s];
         ``peak_vertical_grf_<leg>_bw`` [body weights]; ``flight_fraction`` (of the stride);
         ``dynamics_residual_pct``; ``iterations`` and ``wall_s`` [s] of both stages together
-        (tracking + predictive). Legs: left/right (able) or intact/prosthetic (amputee).
+        (tracking + predictive); ``warnings`` (:meth:`gait_warnings`, joined by "; ", empty
+        if none). Legs: left/right (able) or intact/prosthetic (amputee).
         """
         ph = self.contact_phases()
         times = [ph["legs"][leg]["contact_time_s"] for leg in self.leg_names]
@@ -310,6 +329,7 @@ class CollocationSolution:
         out["dynamics_residual_pct"] = self.dynamics_residual_pct
         out["iterations"] = its
         out["wall_s"] = wall
+        out["warnings"] = "; ".join(self.gait_warnings())
         return {k: (None if isinstance(v, float) and not math.isfinite(v) else v)
                 for k, v in out.items()}
 

@@ -186,6 +186,10 @@ class NLPSolution:
                            self.tendon_force)
 
 
+#: Bounds of the free stride time [s] (a running stride at 3–10 m/s lies well inside).
+PERIOD_BOUNDS_S = (0.4, 1.2)
+
+
 class StrideNLP:
     """The collocation NLP of one periodic stride.
 
@@ -222,7 +226,7 @@ class StrideNLP:
         n: int = 50,
         speed: float | None = 3.5,
         weights: StrideWeights | None = None,
-        period_bounds: tuple[float, float] = (0.4, 1.2),
+        period_bounds: tuple[float, float] = PERIOD_BOUNDS_S,
         scales: VariableScales | None = None,
         min_activation: float = 0.01,
         min_tendon_force: float = 1e-3,
