@@ -58,6 +58,23 @@ def test_a_solve_that_did_not_converge_is_left_out_of_the_summary(tmp_path):
     assert math.isfinite(s.cot_4)
 
 
+def test_a_merged_folder_says_so_with_its_spread(tmp_path):
+    from bladelab.report.builder import Report
+    from bladelab.report.collocation_sweep import collocation_sweep_sections
+
+    folder = _subset(tmp_path, ["Cat6"])
+    table = pd.read_csv(folder / "collocation-sweep.csv")
+    table = table[table.problem == "speed"]  # no gait section needed
+    table["start"] = "defaults"
+    table["spread_pct"] = 37.0
+    table.to_csv(folder / "collocation-sweep.csv", index=False)
+    rep = Report("t")
+    results, summary = collocation_sweep_sections(rep, folder)
+    assert results == {} and summary.iloc[0].cot_4 > 0
+    text = " ".join(rep.sections[0].text)
+    assert "merges several paths" in text and "37 %" in text
+
+
 def test_a_table_without_a_needed_column_is_refused_by_name(tmp_path):
     folder = _subset(tmp_path, ["Cat4"])
     table = pd.read_csv(folder / "collocation-sweep.csv").drop(columns=["mean_speed_mps"])
