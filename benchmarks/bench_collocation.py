@@ -45,6 +45,13 @@ def run() -> str:
             runner, CollocationSettings(mesh_intervals=MESH, speed_m_per_s=WARM_SPEED_MPS),
             cold.to_guess().with_speed(WARM_SPEED_MPS), model_spec=spec)
         rows.append(_row(f"warm start from {SPEED_MPS:g} → {WARM_SPEED_MPS:g} m/s", warm))
+        warm_mu = predict_stride(
+            runner, CollocationSettings(mesh_intervals=MESH, speed_m_per_s=WARM_SPEED_MPS,
+                                        warm_start_mu=1e-4),
+            cold.to_guess().with_speed(WARM_SPEED_MPS), model_spec=spec)
+        rows.append(_row(f"the same, barrier start 1e-4 (`warm_start_mu`): objective "
+                         f"{warm_mu.nlp.objective:.4f} against {warm.nlp.objective:.4f}",
+                         warm_mu))
     return "\n".join([
         "## Collocation: one amputee stride (issue 15)",
         "",
