@@ -48,6 +48,23 @@ def test_category_summary_reads_the_max_speed_and_the_4_mps_solves():
         assert s.contact_time_prosthetic == pytest.approx(fastest.contact_time_prosthetic_s)
 
 
+def test_the_speed_figure_draws_each_model_s_first_leg_solid_and_the_second_dashed():
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from bladelab.report import collocation_sweep as cs
+
+    table = read_sweep_table(STUDY)
+    fig = cs._speed_figure(table)
+    contact = fig.axes[1]
+    styles = {ln.get_label(): ln.get_linestyle() for ln in contact.lines
+              if not ln.get_label().startswith("_")}
+    n_models = table.model.nunique()
+    assert len(styles) == 2 * n_models  # intact and prosthetic per model, no third 'leg'
+    assert all(v == "-" for k, v in styles.items() if k.endswith(" intact"))
+    assert all(v == "--" for k, v in styles.items() if k.endswith(" prosthetic"))
+
+
 def test_a_solve_that_did_not_converge_is_left_out_of_the_summary(tmp_path):
     folder = _subset(tmp_path, ["Cat5"])
     table = pd.read_csv(folder / "collocation-sweep.csv")

@@ -21,6 +21,7 @@ at the maximum speed).
 from __future__ import annotations
 
 import math
+import re
 from pathlib import Path
 
 import numpy as np
@@ -102,8 +103,8 @@ def _speed_figure(table: pd.DataFrame):
     import matplotlib.pyplot as plt
 
     ok = table[table.converged]
-    legs = [c[len("contact_time_"):-2] for c in table.columns
-            if c.startswith("contact_time_") and c.endswith("_s")]
+    # per-leg columns contact_time_<leg>_s (not the legs' mean, contact_time_s)
+    legs = [m.group(1) for c in table.columns if (m := re.fullmatch(r"contact_time_(.+)_s", c))]
     fig, axes = plt.subplots(1, 3, figsize=(13, 3.8))
     quantities = [("cost_of_transport_J_per_kg_m", "cost of transport (J/(kg·m))", [""]),
                   ("contact_time_{}_s", "contact time (s)", legs),
