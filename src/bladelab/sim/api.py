@@ -395,16 +395,15 @@ def _params(problem: SimProblem, value, default: np.ndarray, name: str, n_sets: 
                              where=name) from err
     if not np.all(np.isfinite(arr)) or np.any(arr < 0):
         raise ModelError(f"must be finite and >= 0, got {np.asarray(value).tolist()}", where=name)
-    # always a fresh, writable C array: numba compiles (and caches) one kernel per argument
-    # type, and a read-only array (a broadcast view) is another type than a writable one, so
-    # K, D, K2 passed or left out would each cost a full compilation of the kernel
-    return np.array(arr, dtype=float, order="C")
+    return np.ascontiguousarray(arr, dtype=float)
 
 
 def run_kernel(problem: SimProblem, K, D, K2, *, parallel: bool = False,
                 with_energy: bool = True):
     """Run the kernel for the (n_sets, nj) parameter arrays; the buffers and (n_sets, 2) status."""
-    # one argument type for the compiled kernel whatever the caller passes (see _params)
+    # writable C arrays whatever the caller passes: numba compiles (and caches) one kernel per
+    # argument type, and a read-only array (a broadcast view) is another type than a writable
+    # one, so K, D, K2 given or left out would each cost a full compilation of the kernel
     K, D, K2 = (np.require(a, np.float64, ["C", "W"]) for a in (K, D, K2))
     nj = K.shape[1]
     q0 = np.zeros(nj)
@@ -544,9 +543,8 @@ def simulate_batch(
         if idx.size == 0:
             break
         fine = finer_problem(problem, factor)
-        g2, d2, q2, t2, _s2, _e2, st2 = run_kernel(
-            fine, np.ascontiguousarray(K[idx]), np.ascontiguousarray(D[idx]),
-            np.ascontiguousarray(K2[idx]), parallel=parallel, with_energy=False)
+        g2, d2, q2, t2, _s2, _e2, st2 = run_kernel(fine, K[idx], D[idx], K2[idx],
+                                                   parallel=parallel, with_energy=False)
         good = st2[:, 0] == _k.STATUS_OK
         sel = idx[good]
         grf[sel], dist[sel], qout[sel], tau[sel] = g2[good], d2[good], q2[good], t2[good]

@@ -343,7 +343,7 @@ def _solve_stage(nlp, x0: np.ndarray, settings: CollocationSettings, stage: str,
     ``warm``), reporting progress; an interrupt (Ctrl-C, SIGTERM) raises KeyboardInterrupt
     after IPOPT returns."""
     t0 = time.perf_counter()
-    options = dict(warm_start_options(settings)) if warm else {}
+    options = warm_start_options(settings) if warm else {}
     callback = None
     if progress is not None:
         progress(SolveProgress(stage, "start", message=f"{nlp.n_vars} variables, "
