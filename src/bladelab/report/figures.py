@@ -114,11 +114,11 @@ Window = Literal["contact", "stance"]
 
 
 def contact_span(stance: Stance, *, threshold: float = 20.0) -> tuple[float, float]:
-    """(touch-down, toe-off) times [s]: the first and last sample with vertical GRF > threshold."""
-    idx = np.flatnonzero(np.asarray(stance.grf_z, float) > threshold)
-    if idx.size < 2:
-        raise DataError(f"no contact: fewer than 2 samples above {threshold:g} N",
-                        where="stance.grf_z", hint="check the force channel (N)")
+    """(touch-down, toe-off) times [s]: the first and last sample of the identification's contact
+    window (:func:`bladelab.identify.contact_window`: vertical GRF > threshold [N])."""
+    from bladelab.identify.cost import contact_window
+
+    idx = np.flatnonzero(contact_window(stance.grf_z, threshold=threshold))
     return float(stance.time[idx[0]]), float(stance.time[idx[-1]])
 
 
