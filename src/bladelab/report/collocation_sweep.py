@@ -145,17 +145,17 @@ def collocation_sweep_sections(report, folder: str | Path) -> tuple[dict, pd.Dat
     table = read_sweep_table(folder)
     failed = table[~table.converged]
     fig = _speed_figure(table)
-    text = (f"{len(table)} solves, {int(table.converged.sum())} converged. Each model's speeds "
-            "were solved in the order given, each warm-started from the previous converged "
-            "speed; the maximum speed (star) from the fastest. Curves and the category table "
-            "use converged solves only.")
+    text = f"{len(table)} solves, {int(table.converged.sum())} converged. "
     if "start" in table.columns:  # a merge of several paths (benchmarks/collocation/merge_starts.py)
         spread = pd.to_numeric(table.get("spread_pct"), errors="coerce")
-        text += (" This folder merges several paths per problem: each row is the lowest "
+        text += ("This folder merges several paths per problem: each row is the lowest "
                  "objective found (column 'start' names its path, 'objective_<path>' every "
-                 "path's); the largest spread between paths is "
-                 f"{spread.max():.0f} % of the kept objective." if spread.notna().any() else
-                 " This folder merges several paths per problem (column 'start').")
+                 "path's)" + (f"; the largest spread between paths is {spread.max():.0f} % of "
+                              "the kept objective." if spread.notna().any() else "."))
+    else:
+        text += ("Each model's speeds were solved in the order given, each warm-started from "
+                 "the previous converged speed; the maximum speed (star) from the fastest.")
+    text += " Curves and the category table use converged solves only."
     if len(failed):
         text += (" Not converged (listed in the table, left out of the figures and the "
                  "category table): " + ", ".join(
