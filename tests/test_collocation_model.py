@@ -34,12 +34,14 @@ from bladelab.runner.model import (
     JP_HI,
     JP_K,
     JP_LO,
+    JP_SK,
     JP_SK2,
     build_runner,
     contact_heights,
 )
 from bladelab.runner.muscle import (
     FIBER_DAMPING,
+    MP_TSTRAIN,
     TENDON_REF_STRAIN,
     equilibrium_fiber_length,
     force_length,
@@ -51,7 +53,8 @@ from bladelab.runner.muscle import (
 )
 
 N_STATES = 20
-KINDS = ("able", "amputee-Cat6")
+KINDS = ("able", "amputee-Cat6", "able-toes")
+MUSCLE_KINDS = ("able", "able-toes")  # the toe body's Achilles tendons are twice as compliant
 SM = Smoothing()
 
 
@@ -60,7 +63,9 @@ def models():
     """The forward runners and their collocation models, built once."""
     out = {}
     for kind in KINDS:
-        runner = build_runner("able") if kind == "able" else build_runner("amputee", blade="Cat6")
+        runner = {"able": lambda: build_runner("able"),
+                  "able-toes": lambda: build_runner("able", body="toes"),
+                  "amputee-Cat6": lambda: build_runner("amputee", blade="Cat6")}[kind]()
         out[kind] = (runner, build_collocation_model(runner))
     return out
 
@@ -208,17 +213,18 @@ def test_ligament_and_socket_torques_match_forward(models, kind):
         _, lig = _forward_forces(runner, d)
         tau = _np(cm.passive(q, qd)).ravel()
         for j, row in enumerate(jp):
-            if row[JP_SK2] != 0.0:
-                assert abs(tau[j] - lig[j]) <= socket_bound(row[JP_SK2], SM) + 1e-9
-                checked += 1
-            elif row[JP_K] != 0.0:
-                margin = min(abs(q[j] - row[JP_LO]), abs(q[j] - row[JP_HI]))
-                if margin >= 0.1:
-                    bound = ligament_bound(margin, qd[j], row[JP_K], row[JP_D], SM)
-                    assert abs(tau[j] - lig[j]) <= bound + 1e-9, (j, tau[j], lig[j])
-                    checked += 1
-            else:
+            spring = row[JP_SK] != 0.0 or row[JP_SK2] != 0.0  # socket, toe hinge
+            if not spring and row[JP_K] == 0.0:
                 assert tau[j] == 0.0 and lig[j] == 0.0
+                continue
+            bound = socket_bound(row[JP_SK2], SM) if spring else 0.0
+            if row[JP_K] != 0.0:  # a ligament (the toe hinge has both)
+                margin = min(abs(q[j] - row[JP_LO]), abs(q[j] - row[JP_HI]))
+                if margin < 0.1:
+                    continue
+                bound += ligament_bound(margin, qd[j], row[JP_K], row[JP_D], SM)
+            assert abs(tau[j] - lig[j]) <= bound + 1e-9, (j, tau[j], lig[j])
+            checked += 1
     assert checked >= 3 * N_STATES
 
 
@@ -291,10 +297,15 @@ def test_muscle_curves_match_forward_hill():
     eps = np.linspace(-0.05, 0.12, 4001)
     ft = _curve(lambda x: dg.tendon_force_curve(x, SM))(eps)
     assert np.abs(ft - [tendon_force(x) for x in eps]).max() <= FT_ERROR
+    # a more compliant tendon (8 % at Fmax): the same softplus width is a smaller share of it
+    ft8 = _curve(lambda x: dg.tendon_force_curve(x, SM, 0.08))(eps)
+    assert np.abs(ft8 - [tendon_force(x, 0.08) for x in eps]).max() <= FT_ERROR / 4
+    assert tendon_force(0.08, 0.08) == pytest.approx(1.0) and tendon_force(0.04) == 1.0
     # the inverse tendon curve is the inverse
     f = np.linspace(0.01, 2.0, 200)
-    back = _curve(lambda x: dg.tendon_force_curve(dg.tendon_strain(x, SM), SM))(f)
-    np.testing.assert_allclose(back, f, rtol=1e-10)
+    for ref in (TENDON_REF_STRAIN, 0.08):
+        back = _curve(lambda x, r=ref: dg.tendon_force_curve(dg.tendon_strain(x, SM, r), SM, r))(f)
+        np.testing.assert_allclose(back, f, rtol=1e-10)
 
 
 def test_activation_rate_matches_forward(models):
@@ -319,10 +330,11 @@ def _fibre_force(a, ln, vn, cos_a):
             + FIBER_DAMPING * vn) * cos_a
 
 
-def test_static_equilibrium_tendon_force_matches_forward(models):
+@pytest.mark.parametrize("kind", MUSCLE_KINDS)
+def test_static_equilibrium_tendon_force_matches_forward(models, kind):
     """Isometric equilibrium (ṽ = 0) at random activations and fibre lengths: the forward
     model's equilibrium fibre length and tendon force against the De Groote residual's root."""
-    runner, cm = models["able"]
+    runner, cm = models[kind]
     mp = runner.muscle_params
     nm = mp.shape[0]
     rng = np.random.default_rng(6)
@@ -334,10 +346,10 @@ def test_static_equilibrium_tendon_force_matches_forward(models):
     for _ in range(N_STATES):
         a, ln = rng.uniform(0.1, 1.0, nm), rng.uniform(0.6, 1.5, nm)
         l_mt = np.zeros(nm)
-        for i, (_, l_opt, l_ts, penn) in enumerate(mp):
+        for i, (_, l_opt, l_ts, penn, eref) in enumerate(mp):
             cos_a = np.sqrt(1.0 - (np.sin(penn) / ln[i]) ** 2)
             f = _fibre_force(a[i], ln[i], 0.0, cos_a)
-            l_mt[i] = ln[i] * l_opt * cos_a + l_ts * (1.0 + TENDON_REF_STRAIN * np.sqrt(f))
+            l_mt[i] = ln[i] * l_opt * cos_a + l_ts * (1.0 + eref * np.sqrt(f))
         forward = np.array([
             tendon_force_of_state(l_mt[i], equilibrium_fiber_length(l_mt[i], a[i], *mp[i, 1:]),
                                   *mp[i]) / mp[i, 0] for i in range(nm)])
@@ -348,11 +360,12 @@ def test_static_equilibrium_tendon_force_matches_forward(models):
     assert worst <= 0.0, worst
 
 
-def test_fibre_state_and_residual_match_forward_in_motion(models):
+@pytest.mark.parametrize("kind", MUSCLE_KINDS)
+def test_fibre_state_and_residual_match_forward_in_motion(models, kind):
     """At forward states with fibre and MTU velocities, the De Groote fibre length and velocity
     (from F̃_T and dF̃_T/dt) equal the forward fibre's, and the equilibrium residual is within
     the force–velocity fit error."""
-    runner, cm = models["able"]
+    runner, cm = models[kind]
     mp = runner.muscle_params
     nm = mp.shape[0]
     rng = np.random.default_rng(7)
@@ -361,11 +374,11 @@ def test_fibre_state_and_residual_match_forward_in_motion(models):
         vn = rng.uniform(-0.9, 0.9, nm)
         v_mt = rng.uniform(-0.5, 0.5, nm)
         l_ce, v_ce, l_mt, ft, dft, cos_a = (np.zeros(nm) for _ in range(6))
-        for i, (fmax, l_opt, l_ts, penn) in enumerate(mp):
+        for i, (fmax, l_opt, l_ts, penn, eref) in enumerate(mp):
             cos_a[i] = np.sqrt(1.0 - (np.sin(penn) / ln[i]) ** 2)
             f = max(_fibre_force(a[i], ln[i], vn[i], cos_a[i]), 0.05)  # a taut tendon
             l_ce[i], v_ce[i] = ln[i] * l_opt, vn[i] * 10.0 * l_opt
-            l_mt[i] = l_ce[i] * cos_a[i] + l_ts * (1.0 + TENDON_REF_STRAIN * np.sqrt(f))
+            l_mt[i] = l_ce[i] * cos_a[i] + l_ts * (1.0 + eref * np.sqrt(f))
             ft[i] = tendon_force_of_state(l_mt[i], l_ce[i], *mp[i]) / fmax
             h = 1e-6
             hi = tendon_force_of_state(l_mt[i] + h * v_mt[i], l_ce[i] + h * v_ce[i], *mp[i])
@@ -376,7 +389,7 @@ def test_fibre_state_and_residual_match_forward_in_motion(models):
         np.testing.assert_allclose(cos_m, cos_a, rtol=1e-5)
         # the tendon curve's softplus changes the tendon compliance by e^{−s/w}/(1 − e^{−s/w})
         v_t = v_mt - v_ce / cos_a
-        r = np.exp(-TENDON_REF_STRAIN * np.sqrt(ft) / SM.tendon_strain)
+        r = np.exp(-mp[:, MP_TSTRAIN] * np.sqrt(ft) / SM.tendon_strain)
         np.testing.assert_array_less(np.abs(v_m - v_ce), 1.01 * r / (1 - r) * np.abs(v_t) + 1e-9)
         # residual of the forward state: forward fibre force minus F̃_T, up to the fits
         forward = np.array([_fibre_force(a[i], ln[i], vn[i], cos_a[i]) for i in range(nm)])

@@ -338,3 +338,19 @@ def test_the_predictive_report_renders_a_collocation_solution(able, tmp_path):
     bad = replace(sol, nlp=replace(sol.nlp, success=False)).write(tmp_path / "best.json")
     with pytest.raises(InputFileError, match="did not converge"):
         predictive_kind(bad)
+
+
+def test_model_spec_names_the_body_only_when_it_is_not_seed_001s():
+    """Files written before the bodies existed (no "body") and "seed001" mean the same model;
+    the toe body is part of the problem's identity and of its label."""
+    from bladelab.errors import SpecError
+    from bladelab.predict.collocation.stored import check_model_spec, model_label
+
+    old = check_model_spec({"model": "able", "blade": None})
+    assert old == check_model_spec({"model": "able", "body": "seed001"}) == {
+        "model": "able", "blade": None}
+    toes = check_model_spec({"model": "amputee", "blade": "Cat6", "body": "toes"})
+    assert toes != check_model_spec({"model": "amputee", "blade": "Cat6"})
+    assert model_label(toes) == "amputee Cat6 (toes body)"
+    with pytest.raises(SpecError, match="unknown body"):
+        check_model_spec({"model": "able", "body": "human"})

@@ -244,3 +244,43 @@ def test_missing_segment_and_bad_yaml(tmp_path):
         load_runner_params(bad)
     with pytest.raises(BladelabError, match="not found"):
         load_runner_params(tmp_path / "nope.yaml")
+
+
+def test_toe_body_keeps_the_mass_and_adds_a_toe_hinge(able):
+    """The ``toes`` body: same total mass and centre of mass as seed 001's (the toes' mass is
+    taken from the calcaneus), a metatarsophalangeal hinge per foot with Sasaki et al. (2009)'s
+    spring, a toe-tip sphere level with the ball sphere, and compliant Achilles tendons only."""
+    from bladelab.runner.model import JP_SD, JP_SK, MTP_DAMPING, MTP_STIFFNESS
+    from bladelab.runner.muscle import MP_TSTRAIN
+
+    toes = build_runner("able", body="toes")
+    assert toes.total_mass == pytest.approx(able.total_mass, rel=1e-12)
+    assert set(toes.dof_names) - set(able.dof_names) == {"mtp_angle_l", "mtp_angle_r"}
+    assert toes.contact_names == ("heel_l", "toe_l", "toetip_l", "heel_r", "toe_r", "toetip_r")
+    centres = []
+    for runner in (able, toes):
+        d = mujoco.MjData(runner.mj_model)
+        d.qpos[:] = runner.stand_qpos
+        mujoco.mj_forward(runner.mj_model, d)
+        centres.append(d.subtree_com[0].copy())
+        assert contact_heights(runner, runner.stand_qpos) == pytest.approx(0.0, abs=1e-12)
+    np.testing.assert_allclose(centres[1], centres[0], atol=1e-12)
+    j = toes.dof("mtp_angle_l")
+    assert toes.joint_params[j, JP_SK] == MTP_STIFFNESS == 25.0
+    assert toes.joint_params[j, JP_SD] == MTP_DAMPING
+    tip = toes.contact_params[toes.contact_names.index("toetip_l")]
+    assert toes.mj_model.body(int(tip[1])).name == "toes_l"
+    strain = dict(zip(toes.muscle_names, toes.muscle_params[:, MP_TSTRAIN], strict=True))
+    assert strain["soleus_l"] == strain["gastroc_r"] == 0.08
+    assert strain["vasti_l"] == 0.04 and set(able.muscle_params[:, MP_TSTRAIN]) == {0.04}
+    # the toes turn the toe tip about the ball: 30° of toe extension lifts it off the ground
+    q = toes.stand_qpos.copy()
+    q[j] = np.radians(30.0)
+    h = contact_heights(toes, q)
+    assert h[toes.contact_names.index("toetip_l")] > 0.01
+    assert h[toes.contact_names.index("toe_l")] == pytest.approx(0.0, abs=1e-12)
+
+
+def test_unknown_body_is_a_clear_error():
+    with pytest.raises(SpecError, match="unknown body 'toe'"):
+        build_runner("able", body="toe")

@@ -38,7 +38,7 @@ def test_isometric_maximal_force_is_fmax_cos_pennation():
     assert tendon_force_of_state(l_mtu, l_ce, fmax, l_opt, l_ts, penn) == pytest.approx(
         fmax * math.cos(penn), rel=1e-3
     )
-    mp = np.array([[fmax, l_opt, l_ts, penn]])
+    mp = np.array([[fmax, l_opt, l_ts, penn, 0.04]])
     ms = np.array([[1.0, l_ce, 0.0, 0.0]])
     for _ in range(200):  # held isometric: stays in equilibrium
         muscle_step(mp, ms, np.array([l_mtu]), np.array([1.0]), 5e-4)
@@ -56,7 +56,7 @@ def test_force_velocity_shape():
 
 def test_activation_dynamics_first_order():
     """u = 1 from a = 0.01: a(t) = 1 − 0.99·exp(−100 t) (rate 100 /s), Euler-discretised."""
-    mp = np.array([[1000.0, 0.1, 0.2, 0.0]])
+    mp = np.array([[1000.0, 0.1, 0.2, 0.0, 0.04]])
     ms = np.array([[0.01, 0.1, 0.0, 0.0]])
     dt = 1e-4
     for _ in range(200):
@@ -69,7 +69,7 @@ def test_quick_release_shortens_fibre_with_a_compliant_tendon():
     fmax, l_opt, l_ts, penn = 3000.0, 0.1, 0.2, 0.0
     l_mtu = l_opt + l_ts * 1.04
     l_ce = equilibrium_fiber_length(l_mtu, 1.0, l_opt, l_ts, penn)
-    mp = np.array([[fmax, l_opt, l_ts, penn]])
+    mp = np.array([[fmax, l_opt, l_ts, penn, 0.04]])
     ms = np.array([[1.0, l_ce, 0.0, 0.0]])
     muscle_step(mp, ms, np.array([l_mtu - 0.004]), np.array([1.0]), 5e-4)
     f_after = tendon_force_of_state(l_mtu - 0.004, ms[0, 1], fmax, l_opt, l_ts, penn)
@@ -99,10 +99,15 @@ def test_contact_point_velocity_matches_mujoco_jacobian(amputee):
             assert res.contacts[i, c, 5] == pytest.approx(v[2], abs=1e-9)
 
 
-@pytest.mark.parametrize("kind,mass", [("able", 83.47), ("amputee", 81.43)])
+def _runner(kind: str):
+    """``able``, ``amputee`` or ``able-toes`` (the toe body: toe segment, compliant Achilles)."""
+    return build_runner("able", body="toes") if kind == "able-toes" else build_runner(kind)
+
+
+@pytest.mark.parametrize("kind,mass", [("able", 83.47), ("amputee", 81.43), ("able-toes", 83.47)])
 def test_passive_drop_comes_to_rest_with_body_weight(kind, mass):
     """Dropped 5 cm with the joints held: static vertical GRF = m·g within 1 %."""
-    runner = build_runner(kind)
+    runner = _runner(kind)
     res = simulate_runner(runner, duration=1.5, hold_pose=True, drop_height=0.05, record_every=5)
     assert not res.fell
     fz = res.contacts[:, :, 1].sum(axis=1)
@@ -131,12 +136,14 @@ def test_blade_static_compression_in_simulation(category, k_cat):
     assert depth == pytest.approx(1.5 * 81.43 * G / k_cat, rel=0.02)
 
 
-@pytest.mark.parametrize("kind,u", [("amputee", 0.05), ("amputee", 0.4), ("able", 0.2)])
+@pytest.mark.parametrize(
+    "kind,u", [("amputee", 0.05), ("amputee", 0.4), ("able", 0.2), ("able-toes", 0.2)]
+)
 def test_power_balance_with_ground_contact(kind, u):
     """2 s, constant excitations, feet/blade on the ground throughout: the RMS residual of
     P_external − P_kinetic is under 2 % of the peak kinetic power. The model collapses (no
     controller), so the fall stop is switched off to keep the full 2 s."""
-    runner = build_runner(kind)
+    runner = _runner(kind)
     res = simulate_runner(
         runner, duration=2.0, excitations=u, record_every=1, fall_height=-math.inf
     )

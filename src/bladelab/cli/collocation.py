@@ -138,6 +138,7 @@ def run_collocation(
     resume: bool,
     force: bool,
     as_json: bool,
+    body: str = "seed001",
 ) -> int:
     """Run ``bladelab predict --method collocation``; returns the exit status (0 converged,
     2 not converged)."""
@@ -152,7 +153,7 @@ def run_collocation(
         raise SpecError(f"need at least 4 mesh intervals, got {mesh}", where="--mesh")
     if max_iter < 1:
         raise SpecError(f"need at least 1 iteration, got {max_iter}", where="--max-iter")
-    spec = check_model_spec({"model": model, "blade": blade})
+    spec = check_model_spec({"model": model, "blade": blade, "body": body})
     settings = CollocationSettings(mesh_intervals=mesh,
                                    speed_m_per_s=None if max_speed else float(speed),
                                    max_iter=max_iter)

@@ -86,6 +86,10 @@ def register(app: typer.Typer) -> None:
         as_json: bool = typer.Option(
             False, "--json", help="Collocation: print the summary as one JSON object."
         ),
+        body: str = typer.Option(
+            "seed001", "--body", help="Collocation: seed001 (seed 001's model) | toes (a toe "
+            "segment and compliant Achilles tendons; docs/runner-model.md)."
+        ),
     ) -> None:
         """Optimise the reflex controller of the runner with CMA-ES (seed 001 eq. 2.4), or with
         --method collocation solve one periodic stride by direct collocation (writes
@@ -96,11 +100,14 @@ def register(app: typer.Typer) -> None:
             code = run_collocation(out=out, model=model, blade=blade, speed=speed,
                                    max_speed=max_speed, mesh=mesh, guess=guess,
                                    max_iter=max_iter, resume=resume, force=force,
-                                   as_json=as_json)
+                                   as_json=as_json, body=body)
             raise typer.Exit(code)
         if method != "reflex":
             raise SpecError(f"unknown method {method!r}", where="--method",
                             hint="reflex or collocation")
+        if body != "seed001":
+            raise SpecError("only with --method collocation", where="--body",
+                            hint="the reflex controller is tuned to seed 001's body")
         from bladelab.predict.reflex.controller import read_parameters
         from bladelab.predict.reflex.objective import ObjectiveSettings
         from bladelab.predict.reflex.optimize import optimize_seeds, runner_and_layout
@@ -203,6 +210,11 @@ def register(app: typer.Typer) -> None:
         as_json: bool = typer.Option(
             False, "--json", help="Collocation: print the table as one JSON object."
         ),
+        starts: int | None = typer.Option(
+            None, "--starts", help="Collocation: solve each problem from up to K starts (warm "
+            "start, barrier start 1e-4, template, previous-but-one solution) and keep the "
+            "best [default: 1]."
+        ),
     ) -> None:
         """Category × speed grid: warm-started optimisations, maximum speed, cost at 4 m/s,
         200 m and 400 m times, contact times (seed 001 §2.2.2 B–C, Table 3.1). Running it again
@@ -212,7 +224,8 @@ def register(app: typer.Typer) -> None:
         speed continuation over --speeds (each speed warm-started from the previous solution)
         and the maximum speed; DIR/<model>/speed-<v>.json, max-speed.json and the table
         DIR/collocation-sweep.csv. A used --out needs --resume or --force; exit status 2 when a
-        model failed (after the others). The CMA-ES options do not apply."""
+        model failed (after the others). --starts K solves each problem from up to K starts
+        and keeps the best. The CMA-ES options do not apply."""
         if method == "collocation":
             from bladelab.cli.collocation_sweep import run_collocation_sweep
 
@@ -225,14 +238,16 @@ def register(app: typer.Typer) -> None:
                 mesh=50 if mesh is None else mesh,
                 guess="template" if guess is None else guess,
                 max_iter=3000 if max_iter is None else max_iter, jobs=jobs,
-                executor=executor, resume=resume, force=force, as_json=as_json)
+                executor=executor, resume=resume, force=force, as_json=as_json,
+                starts=1 if starts is None else starts)
             raise typer.Exit(code)
         if method != "reflex":
             raise SpecError(f"unknown method {method!r}", where="--method",
                             hint="reflex or collocation")
         for given, option in ((able, "--able"), (mesh is not None, "--mesh"),
                               (guess is not None, "--guess"), (max_iter is not None, "--max-iter"),
-                              (resume, "--resume"), (force, "--force"), (as_json, "--json")):
+                              (resume, "--resume"), (force, "--force"), (as_json, "--json"),
+                              (starts is not None, "--starts")):
             if given:
                 raise SpecError("only with --method collocation", where=option,
                                 hint="a reflex sweep continues by itself in the same --out")

@@ -55,11 +55,25 @@ LIGAMENTS: dict[str, tuple[float, float, float, float]] = {
     "knee_angle": (-90.0, 0.0, 114.592, 2.86479),
     "ankle_angle": (-60.0, 60.0, 500.0, 5.0),
     "lumbar_extension": (0.0, 0.0, 500.0, 5.0),
+    "mtp_angle": (-30.0, 60.0, 100.0, 1.0),
 }
 # Socket: stiff nonlinear torsional spring τ = −(K·q + K2·q·|q|) − D·q̇ (seed 001 §2.1).
 SOCKET_STIFFNESS = 1000.0  # N·m/rad
 SOCKET_STIFFNESS_QUADRATIC = 2.0e4  # N·m/rad²
 SOCKET_DAMPING = 10.0  # N·m·s/rad
+# The toe segment of ``RunnerParams.foot = "toes"`` (docs/runner-model.md, "The toe segment").
+# Metatarsophalangeal hinge at the ball sphere's centre; passive linear spring and damper of
+# Sasaki, Neptune & Kautz (2009), 25 N·m/rad and 0.03 N·m·s/rad, about the neutral pose.
+MTP_STIFFNESS = 25.0  # N·m/rad
+MTP_DAMPING = 0.03  # N·m·s/rad
+# Share of the foot's mass in the toes: gait2392's toes/(calcn + toes) (0.2166/1.4666 kg).
+TOES_MASS_FRACTION = 0.148
+TOES_INERTIA_KG_M2 = 1.0e-4  # about its COM, every axis (a 0.18 kg, 6 cm segment: ≈ 0.6e-4)
+TOES_COM_M = (0.025, -0.01)  # toes COM from the MTP hinge (forward, up) [m], reference athlete
+TOETIP_RADIUS_M = 0.02
+TOETIP_CENTRE_M = (0.05, -0.01)  # toe-tip sphere centre from the MTP hinge; its bottom is
+# level with the ball sphere's (radius 0.03) in the neutral pose; foot length 0.27 m in all
+
 # Tangential (friction) bristle spring and damper of every contact [N/m, N·s/m].
 FRICTION_STIFFNESS = 5.0e4
 FRICTION_DAMPING = 200.0
@@ -205,6 +219,7 @@ def build_runner(
     *,
     blade: str | None = None,
     blade_model: BladeModel | None = None,
+    body: str = "seed001",
 ) -> RunnerModel:
     """Build a runner model from a parameter set (or the name ``"able"`` / ``"amputee"``).
 
@@ -218,9 +233,15 @@ def build_runner(
         Wear this multi-link blade (:class:`bladelab.blade.BladeModel`, e.g. with identified K*
         and D*) instead of the category's contact sphere (amputee only; see
         :mod:`bladelab.runner.multilink`; needs a step of about 1e-4 s).
+    body
+        The body of a built-in parameter set named by ``params``: ``"seed001"`` or ``"toes"``
+        (:data:`bladelab.runner.params.BODIES`).
     """
     if isinstance(params, str):
-        params = default_runner_params(params, blade=blade)
+        params = default_runner_params(params, blade=blade, body=body)
+    elif body != "seed001":
+        raise ModelError("body= applies to the built-in parameter sets only", where="body",
+                         hint="set foot and tendon_strain_at_fmax in the parameter file")
     elif blade is not None:
         params = runner_params_from_dict({**params.model_dump(), "blade": blade})
     amputee = params.kind == "amputee"
@@ -318,12 +339,14 @@ def build_runner(
                     pos=_v(_sub(p, pc), s),
                     size=[geo.FOOT_SPHERE_RADIUS_M * s, 0, 0],
                 )
+            if params.foot == "toes":
+                _add_toes(body, side, _v(_sub(geo.FOOT_SPHERES["toe"], pc), s), s, axis)
     par, pp, pc = geo.JOINTS["lumbar"]
     add("torso", "torso", "lumbar", "lumbar_extension", "pelvis", pp, pc)
 
     # muscles: sites on bodies, spatial tendons, tendon actuators (ctrl = −tendon force)
     names = muscle_names(params.kind)
-    mp = np.zeros((len(names), 4))
+    mp = np.zeros((len(names), 5))
     path_sites: list[str] = []
     path_start = [0]
     tendons, actuators = [], []
@@ -350,6 +373,7 @@ def build_runner(
             mt.optimal_fiber_length_m * s,
             mt.tendon_slack_length_m * s,
             mt.pennation_rad,
+            mt.tendon_strain_at_fmax,
         )
 
     analysis_model = spec.compile()
@@ -391,6 +415,14 @@ def build_runner(
                     0.0,
                 )
             )
+        if params.foot == "toes":
+            site = model.site(f"toetip_{side}")
+            contacts.append(f"toetip_{side}")
+            r_tip = TOETIP_RADIUS_M * s
+            rows.append((site.id, model.site_bodyid[site.id], r_tip,
+                         hertz_sphere_stiffness(r_tip, FOOT_PLANE_STRAIN_MODULUS),
+                         FOOT_DISSIPATION_S_PER_M, FOOT_FRICTION, leg, 0, r_tip,
+                         LAW_HUNT_CROSSLEY, 1.5, 0.0, 0.0))
     e_blade = math.nan
     if amputee and blade_model is not None:
         for i, row in enumerate(multilink_contact_rows(model, blade_model)):
@@ -426,6 +458,8 @@ def build_runner(
         if base in LIGAMENTS:
             lo, hi, k, d = LIGAMENTS[base]
             jp[i, :4] = (math.radians(lo), math.radians(hi), k, d)
+        if base == "mtp_angle":
+            jp[i, JP_SK:] = (MTP_STIFFNESS, 0.0, MTP_DAMPING)
         if dn == "socket_angle_r":
             jp[i, JP_SK:] = (SOCKET_STIFFNESS, SOCKET_STIFFNESS_QUADRATIC, SOCKET_DAMPING)
         if dn.startswith("blade_joint") and blade_model is not None:
@@ -451,6 +485,30 @@ def build_runner(
     )
     runner.stand_qpos[:] = _standing_pose(runner)
     return runner
+
+
+def _add_toes(calcn, side: str, hinge: list[float], s: float, axis: list[float]) -> None:
+    """A toe segment on a metatarsophalangeal hinge at ``hinge`` (calcaneus body frame [m]).
+
+    Its mass, :data:`TOES_MASS_FRACTION` of the foot's, is taken from the calcaneus, whose
+    centre of mass moves back so that the foot's centre of mass in the neutral pose stays
+    where seed 001's is; the calcaneus keeps its inertia (the toes' share of it is < 2 %).
+    """
+    m_foot = calcn.mass
+    m_toes = TOES_MASS_FRACTION * m_foot
+    com_toes = [hinge[0] + TOES_COM_M[0] * s, 0.0, hinge[2] + TOES_COM_M[1] * s]
+    calcn.mass = m_foot - m_toes
+    calcn.ipos = [(m_foot * c - m_toes * t) / (m_foot - m_toes)
+                  for c, t in zip(calcn.ipos, com_toes, strict=True)]
+    toes = calcn.add_body(name=f"toes_{side}", pos=hinge)
+    toes.add_joint(name=f"mtp_angle_{side}", type=mujoco.mjtJoint.mjJNT_HINGE, axis=axis)
+    toes.explicitinertial = True
+    toes.mass = m_toes
+    toes.ipos = [TOES_COM_M[0] * s, 0.0, TOES_COM_M[1] * s]
+    toes.inertia = [TOES_INERTIA_KG_M2 * s * s] * 3
+    toes.add_site(name=f"toetip_{side}",
+                  pos=[TOETIP_CENTRE_M[0] * s, 0.0, TOETIP_CENTRE_M[1] * s],
+                  size=[TOETIP_RADIUS_M * s, 0, 0])
 
 
 def _prosthetic_bottom(s: float, res_len: float) -> float:

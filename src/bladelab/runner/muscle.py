@@ -11,7 +11,8 @@ velocity ``v_max = 10·l_opt/s``:
   (Hill, a/F0 = 0.25; 0 at ṽ = −1), ``1.5 − 0.5/(1 + 10ṽ)`` when lengthening (1.5·Fmax eccentric
   plateau, slope continuous at 0);
 - passive fibre ``f_p = ((l̃ − 1)/0.6)²`` for l̃ > 1; fibre damping ``β·ṽ`` with β = 0.1 (Millard);
-- tendon ``f_t = (ε/0.04)²`` for strain ε > 0 (Geyer 2010: Fmax at 4 % strain);
+- tendon ``f_t = (ε/ε_ref)²`` for strain ε > 0, ε_ref the strain at Fmax per muscle (column
+  ``MP_TSTRAIN``; Geyer 2010's 4 % unless the parameter set says otherwise);
 - pennation at constant fibre height ``l_ce·sin α = l_opt·sin α₀``.
 
 Equilibrium ``(a·f_l·f_v + f_p + β·ṽ)·cos α = f_t`` is solved for the fibre velocity each step,
@@ -41,7 +42,7 @@ FV_ECCENTRIC = 1.5  # eccentric force plateau [Fmax]
 _LN_005 = math.log(0.05)
 
 # Columns of the muscle parameter array ``mp`` (one row per muscle).
-MP_FMAX, MP_LOPT, MP_LTS, MP_PENN = 0, 1, 2, 3
+MP_FMAX, MP_LOPT, MP_LTS, MP_PENN, MP_TSTRAIN = 0, 1, 2, 3, 4
 # Columns of the muscle state array ``ms``.
 MS_ACT, MS_LCE, MS_VCE, MS_FORCE = 0, 1, 2, 3
 
@@ -84,11 +85,11 @@ def passive_force(l_norm: float) -> float:
 
 
 @njit(cache=True)
-def tendon_force(strain: float) -> float:
-    """Tendon force f_t [-] of the tendon strain."""
+def tendon_force(strain: float, ref_strain: float = TENDON_REF_STRAIN) -> float:
+    """Tendon force f_t [-] of the tendon strain; ``ref_strain`` is the strain at Fmax."""
     if strain <= 0.0:
         return 0.0
-    x = strain / TENDON_REF_STRAIN
+    x = strain / ref_strain
     return x * x
 
 
@@ -103,16 +104,27 @@ def _cos_pennation(l_ce: float, l_opt: float, penn0: float) -> float:
 
 @njit(cache=True)
 def tendon_force_of_state(
-    l_mtu: float, l_ce: float, fmax: float, l_opt: float, l_ts: float, penn0: float
+    l_mtu: float,
+    l_ce: float,
+    fmax: float,
+    l_opt: float,
+    l_ts: float,
+    penn0: float,
+    ref_strain: float = TENDON_REF_STRAIN,
 ) -> float:
     """Tendon force [N] given the MTU length [m] and fibre length [m]."""
     l_t = l_mtu - l_ce * _cos_pennation(l_ce, l_opt, penn0)
-    return fmax * tendon_force((l_t - l_ts) / l_ts)
+    return fmax * tendon_force((l_t - l_ts) / l_ts, ref_strain)
 
 
 @njit(cache=True)
 def equilibrium_fiber_length(
-    l_mtu: float, act: float, l_opt: float, l_ts: float, penn0: float
+    l_mtu: float,
+    act: float,
+    l_opt: float,
+    l_ts: float,
+    penn0: float,
+    ref_strain: float = TENDON_REF_STRAIN,
 ) -> float:
     """Fibre length [m] in static equilibrium (ṽ = 0) at activation ``act`` (bisection)."""
     lo = 0.3 * l_opt
@@ -124,7 +136,7 @@ def equilibrium_fiber_length(
         c = _cos_pennation(mid, l_opt, penn0)
         ln = mid / l_opt
         f_fib = (act * force_length(ln) + passive_force(ln)) * c
-        f_ten = tendon_force((l_mtu - mid * c - l_ts) / l_ts)
+        f_ten = tendon_force((l_mtu - mid * c - l_ts) / l_ts, ref_strain)
         if f_fib > f_ten:
             hi = mid
         else:
@@ -138,21 +150,25 @@ def muscle_step(
 ) -> None:
     """Advance all muscles by one step and store their tendon forces.
 
-    ``mp`` (n, 4): Fmax [N], l_opt [m], l_ts [m], pennation α₀ [rad]. ``ms`` (n, 4) in/out:
+    ``mp`` (n, 5): Fmax [N], l_opt [m], l_ts [m], pennation α₀ [rad], tendon strain at Fmax
+    [-]. ``ms`` (n, 4) in/out:
     activation, fibre length [m], fibre velocity [m/s], tendon force [N] (the force to apply
     during this step, computed from the state at the step's start). ``l_mtu`` [m], ``u`` [-]
     excitations in [0, 1].
     """
+    if mp.shape[1] <= MP_TSTRAIN:
+        raise ValueError("muscle parameters need 5 columns (the last: tendon strain at Fmax)")
     n = mp.shape[0]
     for i in range(n):
         fmax = mp[i, MP_FMAX]
         l_opt = mp[i, MP_LOPT]
         l_ts = mp[i, MP_LTS]
         penn0 = mp[i, MP_PENN]
+        eref = mp[i, MP_TSTRAIN]
         act = ms[i, MS_ACT]
         l_ce = ms[i, MS_LCE]
         lm = l_mtu[i]
-        ms[i, MS_FORCE] = tendon_force_of_state(lm, l_ce, fmax, l_opt, l_ts, penn0)
+        ms[i, MS_FORCE] = tendon_force_of_state(lm, l_ce, fmax, l_opt, l_ts, penn0, eref)
         # fibre: implicit Euler, Newton on the normalised velocity
         vscale = V_MAX_OPT_PER_S * l_opt
         v = ms[i, MS_VCE] / vscale
@@ -166,8 +182,8 @@ def muscle_step(
             strain = (lm - l_new * c - l_ts) / l_ts
             g = (
                 act * fl * force_velocity(v) + passive_force(ln) + FIBER_DAMPING * v
-            ) * c - tendon_force(strain)
-            dft = 2.0 * strain / (TENDON_REF_STRAIN * TENDON_REF_STRAIN) if strain > 0.0 else 0.0
+            ) * c - tendon_force(strain, eref)
+            dft = 2.0 * strain / (eref * eref) if strain > 0.0 else 0.0
             dfp = 2.0 * (ln - 1.0) / (PASSIVE_STRAIN * PASSIVE_STRAIN) if ln > 1.0 else 0.0
             dg = (act * fl * _force_velocity_slope(v) + FIBER_DAMPING) * c + dt * vscale * (
                 dfp * c / l_opt + dft * c * c / l_ts

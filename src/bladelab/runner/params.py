@@ -78,6 +78,9 @@ class MuscleType(_Strict):
     optimal_fiber_length_m: float = Field(gt=0)
     tendon_slack_length_m: float = Field(gt=0)
     pennation_rad: float = Field(ge=0, lt=1.2)
+    #: Tendon strain at Fmax [-] (the tendon curve is ``(ε/ε_ref)²``). Default: Geyer & Herr
+    #: (2010)'s 4 %, which seed 001's model uses for every muscle.
+    tendon_strain_at_fmax: float = Field(default=0.04, gt=0.005, lt=0.2)
 
 
 class RunnerParams(_Strict):
@@ -100,6 +103,10 @@ class RunnerParams(_Strict):
     #: 0.02 s/m returns about 94 %, 0 s/m 100 % (an elastic blade, as seed 001's Table D.1
     #: reports). Opt-in: a change makes those fragile solutions fall.
     blade_dissipation_s_per_m: float = Field(default=BLADE_DISSIPATION_S_PER_M, ge=0)
+    #: The foot: ``"rigid"`` (seed 001: one calcaneus segment with a heel and a ball sphere) or
+    #: ``"toes"`` (a toe segment on a passive metatarsophalangeal hinge, with a toe-tip sphere;
+    #: docs/runner-model.md, "The toe segment"). Changes the model's coordinates.
+    foot: Literal["rigid", "toes"] = "rigid"
 
 
 @dataclass(frozen=True)
@@ -260,15 +267,33 @@ def load_runner_params(path: str | Path) -> RunnerParams:
     return runner_params_from_dict(data, source=str(path))
 
 
-def default_runner_params(kind: str = "amputee", *, blade: str | None = None) -> RunnerParams:
-    """The built-in parameter set ``able`` or ``amputee`` (seed 001), optionally another blade."""
+#: Named bodies of the built-in parameter sets. ``seed001``: seed 001's model as published
+#: (rigid foot, every tendon at 4 % strain at Fmax). ``toes``: the same body with a toe segment
+#: on a passive metatarsophalangeal hinge and triceps-surae (Achilles) tendons at 8 % strain at
+#: Fmax (docs/runner-model.md, "The toe segment and the Achilles tendon").
+BODIES = ("seed001", "toes")
+#: Tendon strain at Fmax [-] of the ``toes`` body, per muscle type (others keep 4 %).
+TOES_BODY_TENDON_STRAIN = {"soleus": 0.08, "gastroc": 0.08}
+
+
+def default_runner_params(
+    kind: str = "amputee", *, blade: str | None = None, body: str = "seed001"
+) -> RunnerParams:
+    """The built-in parameter set ``able`` or ``amputee`` (seed 001), optionally another blade
+    and another body (:data:`BODIES`)."""
     if kind not in ("able", "amputee"):
         raise SpecError(f"unknown model {kind!r}", where="model", hint="use 'able' or 'amputee'")
+    if body not in BODIES:
+        raise SpecError(f"unknown body {body!r}", where="body", hint=" or ".join(BODIES))
     text = (RUNNER_DATA_DIR / f"{kind}.yaml").read_text()
     data = yaml.safe_load(text)
     if blade is not None:
         data["blade"] = blade
-    return runner_params_from_dict(data, source=f"built-in {kind} parameters")
+    if body == "toes":
+        data["foot"] = "toes"
+        for name, strain in TOES_BODY_TENDON_STRAIN.items():
+            data["muscle_types"][name]["tendon_strain_at_fmax"] = strain
+    return runner_params_from_dict(data, source=f"built-in {kind} parameters ({body} body)")
 
 
 def blade_contact_modulus(params: RunnerParams) -> float:
@@ -285,6 +310,7 @@ def hertz_compression(force_n: float, modulus: float, radius: float) -> float:
 
 
 __all__ = [
+    "BODIES",
     "RUNNER_DATA_DIR",
     "Athlete",
     "BladeCategory",

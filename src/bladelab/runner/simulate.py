@@ -285,7 +285,7 @@ def simulate_runner(
     path_kinematics(d.site_xpos, d.cvel, d.subtree_com[1].copy(), path, pstart, mtu, seg_u)
     ms[:, 0] = np.clip(u, 0.01, 1.0) if initial_activation is None else initial_activation
     for i in range(nm):
-        ms[i, 1] = equilibrium_fiber_length(mtu[i, 0], ms[i, 0], mp[i, 1], mp[i, 2], mp[i, 3])
+        ms[i, 1] = equilibrium_fiber_length(mtu[i, 0], ms[i, 0], *mp[i, 1:])
     cp = model.contact_params
     cstate = np.zeros((cp.shape[0], 1))
     crec = np.zeros((cp.shape[0], 7))

@@ -229,7 +229,7 @@ def forward_generalised_forces(
 
     from bladelab.runner.kernel import forces, mujoco_views, path_kinematics
     from bladelab.runner.model import CP_MU
-    from bladelab.runner.muscle import MP_FMAX, MP_LOPT, MP_LTS, MP_PENN, TENDON_REF_STRAIN
+    from bladelab.runner.muscle import MP_FMAX, MP_LOPT, MP_LTS, MP_PENN, MP_TSTRAIN
 
     q, qd = np.asarray(q, float), np.asarray(qd, float)
     tendon_force = np.asarray(tendon_force, float)
@@ -286,7 +286,8 @@ def forward_generalised_forces(
                 forces(mj, arrays(idle), root, step)
     states[n] = cstate
 
-    fmax, lopt, lts, penn = (mp[:, c] for c in (MP_FMAX, MP_LOPT, MP_LTS, MP_PENN))
+    fmax, lopt, lts, penn, eref = (mp[:, c] for c in (MP_FMAX, MP_LOPT, MP_LTS, MP_PENN,
+                                                       MP_TSTRAIN))
     rise = lopt * np.sin(penn)
     muscle = np.zeros((n + 1, nv))
     passive = np.zeros((n + 1, nv))
@@ -299,8 +300,8 @@ def forward_generalised_forces(
                         mtu, seg_u)
         want = np.maximum(tendon_force[k], 0.0)
         # the fibre length at which the forward tendon carries F̃ₜ·Fmax: tendon strain
-        # 0.04·√F̃ₜ, fibre along the tendon line x = l_mt − l_t, l_ce = √(x² + (l_opt sin α₀)²)
-        along = np.maximum(mtu[:, 0] - lts * (1.0 + TENDON_REF_STRAIN * np.sqrt(want)), 0.0)
+        # ε_ref·√F̃ₜ, fibre along the tendon line x = l_mt − l_t, l_ce = √(x² + (l_opt sin α₀)²)
+        along = np.maximum(mtu[:, 0] - lts * (1.0 + eref * np.sqrt(want)), 0.0)
         ms[:, 0], ms[:, 1], ms[:, 2] = 0.01, np.maximum(np.hypot(along, rise), 1e-6), 0.0
         muscle_state = ms.copy()
         if friction == "coulomb":  # a first call for the point velocities: anchor far behind

@@ -40,20 +40,22 @@ from bladelab.runner.muscle import (
     MP_LOPT,
     MP_LTS,
     MP_PENN,
+    MP_TSTRAIN,
     PASSIVE_STRAIN,
     TENDON_REF_STRAIN,
     V_MAX_OPT_PER_S,
 )
 
 
-def tendon_force_curve(strain, smoothing: Smoothing):
-    """Normalised tendon force [-] of the tendon strain [-]: ``(softplus(ε)/ε_ref)²``."""
-    return (softplus(strain, smoothing.tendon_strain) / TENDON_REF_STRAIN) ** 2
+def tendon_force_curve(strain, smoothing: Smoothing, ref_strain=TENDON_REF_STRAIN):
+    """Normalised tendon force [-] of the tendon strain [-]: ``(softplus(ε)/ε_ref)²``,
+    ``ref_strain`` ε_ref the strain at Fmax."""
+    return (softplus(strain, smoothing.tendon_strain) / ref_strain) ** 2
 
 
-def tendon_strain(ft, smoothing: Smoothing):
+def tendon_strain(ft, smoothing: Smoothing, ref_strain=TENDON_REF_STRAIN):
     """Tendon strain [-] at normalised tendon force ``ft`` > 0 (inverse of the tendon curve)."""
-    return softplus_inverse(TENDON_REF_STRAIN * ca.sqrt(ft), smoothing.tendon_strain)
+    return softplus_inverse(ref_strain * ca.sqrt(ft), smoothing.tendon_strain)
 
 
 def force_length(l_norm):
@@ -87,7 +89,7 @@ def fiber_kinematics(mp: np.ndarray, l_mt, v_mt, ft, dft, smoothing: Smoothing):
     Parameters
     ----------
     mp
-        ``RunnerModel.muscle_params`` (n, 4).
+        ``RunnerModel.muscle_params`` (n, 5).
     l_mt, v_mt
         Muscle–tendon lengths [m] and lengthening velocities [m/s] (n,).
     ft, dft
@@ -95,11 +97,12 @@ def fiber_kinematics(mp: np.ndarray, l_mt, v_mt, ft, dft, smoothing: Smoothing):
     """
     l_ts = ca.DM(mp[:, MP_LTS])
     height = ca.DM(mp[:, MP_LOPT] * np.sin(mp[:, MP_PENN]))
+    ref = ca.DM(mp[:, MP_TSTRAIN])
     w = smoothing.tendon_strain
-    s = TENDON_REF_STRAIN * ca.sqrt(ft)
+    s = ref * ca.sqrt(ft)
     l_t = l_ts * (1.0 + softplus_inverse(s, w))
     # dε/dF̃ = dε/ds · ds/dF̃, with dε/ds = 1/(1 − e^{−s/w}) and ds/dF̃ = ε_ref/(2√F̃)
-    v_t = l_ts * (-1.0 / ca.expm1(-s / w)) * TENDON_REF_STRAIN / (2.0 * ca.sqrt(ft)) * dft
+    v_t = l_ts * (-1.0 / ca.expm1(-s / w)) * ref / (2.0 * ca.sqrt(ft)) * dft
     along = l_mt - l_t  # fibre length projected on the tendon line
     l_m = ca.sqrt(along * along + height * height)
     return l_m, along * (v_mt - v_t) / l_m, along / l_m

@@ -38,8 +38,10 @@ __all__ = [
 
 
 def check_model_spec(spec) -> dict:
-    """The model specification ``{"model": "able" | "amputee", "blade": name | None}``,
-    checked and normalised (the able model has no blade; the amputee needs one)."""
+    """The model specification ``{"model": "able" | "amputee", "blade": name | None}``, plus
+    ``"body"`` where it is not seed 001's (:data:`bladelab.runner.params.BODIES`), checked and
+    normalised (the able model has no blade; the amputee needs one; files written before the
+    bodies existed have no ``"body"`` and mean seed 001's)."""
     if not isinstance(spec, dict) or "model" not in spec:
         raise SpecError(f"expected {{'model': ..., 'blade': ...}}, got {spec!r}",
                         where="model_spec")
@@ -52,13 +54,19 @@ def check_model_spec(spec) -> dict:
     elif not isinstance(blade, str) or not blade:
         raise SpecError("the amputee model needs a blade category", where="blade",
                         hint="e.g. Cat6")
-    return {"model": model, "blade": blade}
+    from bladelab.runner.params import BODIES
+
+    body = spec.get("body", "seed001")
+    if body not in BODIES:
+        raise SpecError(f"unknown body {body!r}", where="body", hint=" or ".join(BODIES))
+    return {"model": model, "blade": blade} | ({} if body == "seed001" else {"body": body})
 
 
 def model_label(spec: dict) -> str:
     """``"able"`` or ``"amputee <blade>"`` for a model specification."""
     spec = check_model_spec(spec)
-    return spec["model"] if spec["blade"] is None else f"{spec['model']} {spec['blade']}"
+    label = spec["model"] if spec["blade"] is None else f"{spec['model']} {spec['blade']}"
+    return label + (f" ({spec['body']} body)" if "body" in spec else "")
 
 
 def describe_problem(spec: dict, settings: CollocationSettings) -> str:
@@ -73,9 +81,7 @@ def runner_from_spec(spec: dict):
     from bladelab.runner import build_runner
 
     spec = check_model_spec(spec)
-    if spec["model"] == "able":
-        return build_runner("able")
-    return build_runner("amputee", blade=spec["blade"])
+    return build_runner(spec["model"], blade=spec["blade"], body=spec.get("body", "seed001"))
 
 
 def read_stored(ok: Path, best: Path, spec: dict, settings: CollocationSettings):

@@ -188,7 +188,7 @@ def simulate_controlled(
     seg_u = np.zeros((path.shape[0], 3))
     path_kinematics(d.site_xpos, d.cvel, d.subtree_com[1].copy(), path, pstart, mtu, seg_u)
     for i in range(nm):
-        ms[i, 1] = equilibrium_fiber_length(mtu[i, 0], ms[i, 0], mp[i, 1], mp[i, 2], mp[i, 3])
+        ms[i, 1] = equilibrium_fiber_length(mtu[i, 0], ms[i, 0], *mp[i, 1:])
     u = np.zeros(nm)
     table = layout.table_for(dt)
     hist = np.zeros((history_length(layout, dt), 3 * nm + 2 * m.nq))
