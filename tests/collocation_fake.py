@@ -108,3 +108,38 @@ def install_fake_solve(fakes: dict, monkeypatch) -> FakeSolve:
     monkeypatch.setattr(continuation, "runner_from_spec",
                         lambda spec: fakes[check_model_spec(spec)["model"]][0])
     return fake
+
+
+def start_of(settings, guess) -> str:
+    """Which start of ``bladelab.predict.collocation.starts`` a solve is, from its guess and
+    settings: ``iterate`` (a stored best iterate's warm start), ``template``,
+    ``previous-but-one``, ``warm-mu-1e-4`` or ``warm``."""
+    from bladelab.predict.collocation.solve import COLLOCATION_SOURCE
+
+    if guess.source.startswith(COLLOCATION_SOURCE + " ("):  # a stored iterate's to_guess()
+        return "iterate"
+    if guess.source.startswith("template"):
+        return "template"
+    if "previous but one" in guess.source:
+        return "previous-but-one"
+    return "warm-mu-1e-4" if settings.warm_start_mu == 1e-4 else "warm"
+
+
+def objectives_by_start(fake: FakeSolve, monkeypatch, objective) -> None:
+    """Wrap the installed :class:`FakeSolve`: each solve's objective is
+    ``objective(start, speed)`` (:func:`start_of`; speed None for the maximum speed), None: it
+    does not converge. Each call records its start under ``"start"``."""
+    from bladelab.predict.collocation import continuation
+
+    def solve(runner, settings, guess, *, model_spec, progress=None):
+        sol = fake(runner, settings, guess, model_spec=model_spec, progress=progress)
+        call = fake.calls[-1]
+        call["start"] = start_of(settings, guess)
+        obj = objective(call["start"], settings.speed_m_per_s)
+        nlp = dataclasses.replace(sol.nlp, objective=1.0 if obj is None else obj)
+        if obj is None:
+            nlp = dataclasses.replace(nlp, success=False, status="Maximum_Iterations_Exceeded")
+        call["solution"] = sol = dataclasses.replace(sol, nlp=nlp)
+        return sol
+
+    monkeypatch.setattr(continuation, "predict_stride", solve)

@@ -215,3 +215,165 @@ def test_a_real_solve_that_fails_is_kept_as_best_iterate(fakes, tmp_path):
                                   progress=lambda p: p.solve and stages.append(p.solve.stage))
     assert res.failed.solution.stage == "predictive" and set(stages) == {"predictive"}
     assert sorted(p.name for p in tmp_path.iterdir()) == ["speed-3.5.best_iterate.json"]
+
+
+# -- several starts per problem (bladelab.predict.collocation.starts) ----------------------
+def _objectives(monkeypatch, fake_solve, objective):
+    from collocation_fake import objectives_by_start
+
+    objectives_by_start(fake_solve, monkeypatch, objective)
+
+
+def _solution_first(fakes):
+    # a collocation solution at 3.5 m/s
+    return lambda runner: fakes["able"][1].to_guess(f"{COLLOCATION_SOURCE}: the first guess")
+
+
+def test_each_speed_is_solved_from_several_starts_and_continued_from_the_best(
+        fakes, fake_solve, monkeypatch, tmp_path):
+    objs = {"warm": 2.0, "template": 3.0, "previous-but-one": 1.8}
+    _objectives(monkeypatch, fake_solve,
+                lambda start, v: 1.5 if (start, v) == ("warm-mu-1e-4", 4.0)
+                else objs.get(start, 2.5))
+    events = []
+    res = cont.speed_continuation(fakes["able"][0], [3.5, 4, 4.5], _settings(),
+                                  _solution_first(fakes), model_spec=ABLE, out_dir=tmp_path,
+                                  starts=4, progress=events.append)
+    calls = fake_solve.calls
+    # fixed order; the previous-but-one only from the third speed on
+    assert [(c["speed"], c["start"]) for c in calls] == [
+        (3.5, "warm"), (3.5, "warm-mu-1e-4"), (3.5, "template"),
+        (4.0, "warm"), (4.0, "warm-mu-1e-4"), (4.0, "template"),
+        (4.5, "warm"), (4.5, "warm-mu-1e-4"), (4.5, "template"), (4.5, "previous-but-one")]
+    assert calls[3]["guess"].source.startswith(COLLOCATION_SOURCE + " at 3.5 m/s")
+    assert calls[5]["guess"].source.startswith("template at 4 m/s")
+    # kept: 3.5 warm (2.0), 4 the barrier start (1.5), 4.5 the previous-but-one (1.8)
+    assert [r.row()["start"] for r in res.records] == [
+        "warm", "warm-mu-1e-4", "previous-but-one"]
+    kept4 = calls[4]["solution"]
+    assert res.records[1].solution.nlp.objective == 1.5
+    # the continuation goes on from the kept solution: 4.5's warm start is the 4 m/s barrier
+    # start's solution, its previous-but-one the 3.5 m/s warm start's
+    np.testing.assert_array_equal(calls[6]["guess"].q[:, 1:], kept4.nlp.q[:, 1:])
+    np.testing.assert_array_equal(calls[9]["guess"].q[:, 1:], calls[0]["solution"].nlp.q[:, 1:])
+    np.testing.assert_array_equal(calls[4]["guess"].q, calls[3]["guess"].q)  # same warm start
+    names = sorted(p.name for p in tmp_path.iterdir())
+    assert names == sorted(
+        [f"speed-{v}.json" for v in ("3.5", "4", "4.5")]
+        + [f"speed-{v}.{s}.json" for v in ("3.5", "4", "4.5")
+           for s in ("warm-mu-1e-4", "template")] + ["speed-4.5.previous-but-one.json"])
+    rows = res.rows(tmp_path)
+    assert rows[1]["file"] == "speed-4.warm-mu-1e-4.json"
+    assert rows[1]["objective"] == 1.5 and rows[1]["objective_warm"] == 2.0
+    assert rows[1]["starts"] == 3 and rows[1]["spread_pct"] == pytest.approx(100.0)
+    assert rows[2]["objective_previous-but-one"] == 1.8 and rows[2]["starts"] == 4
+    assert "objective_previous-but-one" not in rows[0]
+    table = res.table()
+    cols = list(table.columns)
+    assert cols[cols.index("warnings"):cols.index("warnings") + 9] == [
+        "warnings", "start", "starts", "objective", "objective_warm", "objective_warm-mu-1e-4",
+        "objective_template", "objective_previous-but-one", "spread_pct"]
+    kept = [e for e in events if e.event == "kept"]
+    assert len(kept) == 3 and kept[1].path.name == "speed-4.warm-mu-1e-4.json"
+    assert "spread 100.0 %" in kept[1].message
+    starts = [e.message for e in events if e.event == "start" and e.problem == "4 m/s"]
+    assert starts[1].startswith("start warm-mu-1e-4: warm start from the 3.5 m/s solution")
+
+
+def test_a_start_with_gait_warnings_loses_to_a_clean_one(fakes, fake_solve, monkeypatch,
+                                                         tmp_path):
+    _objectives(monkeypatch, fake_solve, lambda start, v: 1.0 if start == "warm-mu-1e-4" else 2)
+    monkeypatch.setattr(CollocationSolution, "gait_warnings",
+                        lambda self: ["a one-legged hop"] if self.nlp.objective == 1.0 else [])
+    res = cont.speed_continuation(fakes["able"][0], [3.5, 4], _settings(),
+                                  _solution_first(fakes), model_spec=ABLE, out_dir=tmp_path,
+                                  starts=2)
+    assert [r.row()["start"] for r in res.records] == ["warm", "warm"]
+    assert [r.row()["warnings"] for r in res.records] == ["", ""]
+    # 4 m/s went on from the clean 3.5 m/s solution, not the hop
+    np.testing.assert_array_equal(fake_solve.calls[2]["guess"].q[:, 1:],
+                                  fake_solve.calls[0]["solution"].nlp.q[:, 1:])
+    # every converged start a hop: the lowest kept, its warnings in the row
+    monkeypatch.setattr(CollocationSolution, "gait_warnings", lambda self: ["a hop"])
+    res = cont.speed_continuation(fakes["able"][0], [3.5], _settings(),
+                                  _solution_first(fakes), model_spec=ABLE, out_dir=tmp_path,
+                                  starts=2)
+    row = res.records[0].row()
+    assert row["start"] == "warm-mu-1e-4" and row["warnings"] == "a hop"
+
+
+def test_a_rerun_does_not_solve_starts_again(fakes, fake_solve, monkeypatch, tmp_path):
+    _objectives(monkeypatch, fake_solve,
+                lambda start, v: None if (start, v) == ("template", 4.0) else 2.0)
+    runner = fakes["able"][0]
+    args = ([3.5, 4], _settings(), _solution_first(fakes))
+    first = cont.speed_continuation(runner, *args, model_spec=ABLE, out_dir=tmp_path, starts=3)
+    assert len(fake_solve.calls) == 6 and first.complete
+    assert (tmp_path / "speed-4.template.best_iterate.json").is_file()
+    before = first.rows()
+    fake_solve.calls.clear()
+    # a failed start of a problem that converged otherwise is read back, not solved again
+    again = cont.speed_continuation(None, *args, model_spec=ABLE, out_dir=tmp_path, starts=3)
+    assert fake_solve.calls == [] and again.rows() == before
+    assert not any(r.solved for r in again.records)
+    # a start whose file is gone is solved again, alone
+    (tmp_path / "speed-4.warm-mu-1e-4.json").unlink()
+    cont.speed_continuation(runner, *args, model_spec=ABLE, out_dir=tmp_path, starts=3)
+    assert [(c["speed"], c["start"]) for c in fake_solve.calls] == [(4.0, "warm-mu-1e-4")]
+    # one start reads the warm start's files (a one-start sweep's names) back
+    fake_solve.calls.clear()
+    one = cont.speed_continuation(runner, *args, model_spec=ABLE, out_dir=tmp_path)
+    assert fake_solve.calls == [] and [r.path.name for r in one.records] == [
+        "speed-3.5.json", "speed-4.json"]
+    assert "start" not in one.rows()[0]
+
+
+def test_when_no_start_converges_the_speed_fails_and_each_start_resumes_from_its_iterate(
+        fakes, fake_solve, monkeypatch, tmp_path):
+    fail = {4.0}
+    _objectives(monkeypatch, fake_solve, lambda start, v: None if v in fail else 2.0)
+    runner = fakes["able"][0]
+    args = ([3.5, 4], _settings(), _solution_first(fakes))
+    res = cont.speed_continuation(runner, *args, model_spec=ABLE, out_dir=tmp_path, starts=2,
+                                  refinements=0)
+    assert res.failed.speed_mps == 4.0 and res.failed.path.name == "speed-4.best_iterate.json"
+    row = res.rows()[-1]
+    assert row["converged"] is False and row["start"] == "warm" and row["starts"] == 0
+    assert math.isnan(row["objective"]) and math.isnan(row["spread_pct"])
+    assert {p.name for p in tmp_path.iterdir()} >= {"speed-4.best_iterate.json",
+                                                    "speed-4.warm-mu-1e-4.best_iterate.json"}
+    fail.clear()
+    fake_solve.calls.clear()
+    res = cont.speed_continuation(runner, *args, model_spec=ABLE, out_dir=tmp_path, starts=2)
+    assert res.complete
+    assert [(c["speed"], c["start"]) for c in fake_solve.calls] == [(4.0, "iterate")] * 2
+    assert fake_solve.calls[1]["solution"].settings.warm_start_mu == 1e-4
+    assert not any(p.name.endswith("best_iterate.json") for p in tmp_path.iterdir())
+
+
+def test_max_speed_from_several_starts(fakes, fake_solve, monkeypatch, tmp_path):
+    _objectives(monkeypatch, fake_solve,
+                lambda start, v: 0.5 if (start, v) == ("template", None) else 2.0)
+    runner = fakes["able"][0]
+    res = cont.speed_continuation(runner, [3.5, 4], _settings(), _first, model_spec=ABLE,
+                                  out_dir=tmp_path, starts=4)
+    # the first speed's warm start is the template itself: no barrier start (tracking
+    # stage), no second template, so one solve
+    assert [c["guess"].source for c in fake_solve.calls if c["speed"] == 3.5] == [
+        "template at 3 m/s"]
+    fake_solve.calls.clear()
+    rec = cont.max_speed(runner, cont.max_speed_settings(_settings()), res.fastest.solution,
+                         model_spec=ABLE, out_dir=tmp_path, starts=4,
+                         previous=res.records[0].solution)
+    calls = fake_solve.calls
+    assert [c["start"] for c in calls] == ["warm", "warm-mu-1e-4", "template",
+                                           "previous-but-one"]
+    assert calls[2]["guess"].speed == pytest.approx(4.0)  # the template at the warm start's
+    np.testing.assert_array_equal(calls[3]["guess"].q, res.records[0].solution.nlp.q)
+    assert rec.path.name == "max-speed.template.json" and rec.row()["start"] == "template"
+    assert {p.name for p in rec.files} == {
+        "max-speed.template.json", "max-speed.json", "max-speed.warm-mu-1e-4.json",
+        "max-speed.previous-but-one.json"}
+    with pytest.raises(SpecError, match="1 to 4 starts"):
+        cont.max_speed(runner, cont.max_speed_settings(_settings()), res.fastest.solution,
+                       model_spec=ABLE, out_dir=tmp_path, starts=5)

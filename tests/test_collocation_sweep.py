@@ -132,6 +132,82 @@ def test_sweep_with_two_jobs_reads_back_in_worker_processes(fake_solve, tmp_path
     assert (out / "collocation-sweep.csv").read_text() == before
 
 
+#: The columns of a one-start sweep's table before the solution's stride analyses (the table
+#: before --starts existed).
+ONE_START_HEAD = [
+    "model", "blade", "problem", "prescribed_speed_mps", "converged", "status",
+    "mean_speed_mps", "cost_of_transport_J_per_kg_m", "stride_time_s", "contact_time_s",
+    "contact_time_intact_s", "contact_time_prosthetic_s", "contact_time_left_s",
+    "contact_time_right_s", "peak_vertical_grf_intact_bw", "peak_vertical_grf_prosthetic_bw",
+    "peak_vertical_grf_left_bw", "peak_vertical_grf_right_bw", "flight_fraction",
+    "dynamics_residual_pct", "iterations", "wall_s", "mesh_intervals", "file", "warnings"]
+
+
+def _header(out):
+    return (out / "collocation-sweep.csv").read_text().splitlines()[0].split(",")
+
+
+def test_one_start_writes_the_table_and_files_of_a_sweep_before_starts(fake_solve, tmp_path,
+                                                                        capsys):
+    args = ("--able", "--categories", "Cat6", "--speeds", "3.5,4")
+    assert _sweep(tmp_path / "a", *args, "--starts", "1") == 0
+    assert _sweep(tmp_path / "b", *args) == 0
+    capsys.readouterr()
+    header = _header(tmp_path / "a")
+    assert header == _header(tmp_path / "b")
+    assert header[:len(ONE_START_HEAD)] == ONE_START_HEAD
+    assert header[len(ONE_START_HEAD)] == "leg_stiffness_left_kN_per_m"  # the analyses follow
+    assert not [c for c in header if c in ("start", "starts", "objective", "spread_pct")
+                or c.startswith("objective_")]
+    assert sorted(p.name for p in (tmp_path / "a" / "able").iterdir()) == [
+        "max-speed.json", "speed-3.5.json", "speed-4.json"]
+    assert len(fake_solve.calls) == 2 * 2 * 3  # two runs, two models, three problems
+
+
+def test_several_starts_keep_the_best_per_problem_and_every_file(fake_solve, monkeypatch,
+                                                                 tmp_path, capsys):
+    from collocation_fake import objectives_by_start
+
+    # the barrier start wins at 4 m/s, the template at the maximum speed
+    best = {("warm-mu-1e-4", 4.0): 1.0, ("template", None): 0.5}
+    objectives_by_start(fake_solve, monkeypatch, lambda s, v: best.get((s, v), 2.0))
+    out = tmp_path / "sweep"
+    args = ("--categories", "Cat6", "--speeds", "3.5,4", "--starts", "3")
+    assert _sweep(out, *args, "--json") == 0
+    result = json.loads(capsys.readouterr().out)
+    assert result["failures"] == {}
+    # 3.5 m/s: the template first guess is the only start; then warm, barrier, template
+    assert [(c["speed"], c["start"]) for c in fake_solve.calls] == [
+        (3.5, "template"), (4.0, "warm"), (4.0, "warm-mu-1e-4"), (4.0, "template"),
+        (None, "warm"), (None, "warm-mu-1e-4"), (None, "template")]
+    # the maximum speed starts from the kept 4 m/s solution (the barrier start's)
+    np.testing.assert_array_equal(fake_solve.calls[4]["guess"].q,
+                                  fake_solve.calls[2]["solution"].nlp.q)
+    files = sorted(p.name for p in (out / "amputee-Cat6").iterdir())
+    assert files == sorted([
+        "speed-3.5.json", "speed-4.json", "speed-4.warm-mu-1e-4.json", "speed-4.template.json",
+        "max-speed.json", "max-speed.warm-mu-1e-4.json", "max-speed.template.json"])
+    rows = _csv(out / "collocation-sweep.csv")
+    assert [(r["start"], r["starts"]) for r in rows] == [
+        ("warm", "1"), ("warm-mu-1e-4", "3"), ("template", "3")]
+    assert rows[1]["file"] == "amputee-Cat6/speed-4.warm-mu-1e-4.json"
+    assert float(rows[1]["spread_pct"]) == pytest.approx(100.0) and rows[0]["spread_pct"] == ""
+    assert float(rows[2]["objective_warm"]) == 2.0 and float(rows[2]["objective"]) == 0.5
+    assert result["rows"][1]["start"] == "warm-mu-1e-4"
+    # --resume solves no start again and writes the same table
+    before = (out / "collocation-sweep.csv").read_text()
+    fake_solve.calls.clear()
+    assert _sweep(out, *args, "--resume") == 0
+    assert "start  starts  spread_pct" in capsys.readouterr().out
+    assert fake_solve.calls == [] and (out / "collocation-sweep.csv").read_text() == before
+    # --force keeps every start's file of this run, and removes those it did not write
+    assert _sweep(out, *args, "--force") == 0
+    assert sorted(p.name for p in (out / "amputee-Cat6").iterdir()) == files
+    assert _sweep(out, "--categories", "Cat6", "--speeds", "3.5,4", "--force") == 0
+    assert sorted(p.name for p in (out / "amputee-Cat6").iterdir()) == [
+        "max-speed.json", "speed-3.5.json", "speed-4.json"]
+
+
 @pytest.mark.parametrize(("args", "where"), [
     (("--method", "collocation", "--init", "x.json"), "--init"),
     (("--method", "collocation", "--categories", "Cat9"), "--categories"),
@@ -141,7 +217,10 @@ def test_sweep_with_two_jobs_reads_back_in_worker_processes(fake_solve, tmp_path
     (("--method", "collocation", "--guess", "no-such-file.json"), "--guess"),
     (("--method", "collocation", "--resume", "--force"), "--resume/--force"),
     (("--method", "collocation", "--resume"), "no collocation sweep to resume"),
+    (("--method", "collocation", "--starts", "0"), "--starts"),
+    (("--method", "collocation", "--starts", "5"), "--starts"),
     (("--able",), "--able"),
+    (("--starts", "2"), "--starts"),
     (("--method", "shooting"), "--method"),
 ])
 def test_bad_sweep_options_are_refused_naming_the_option(args, where, tmp_path, capsys):

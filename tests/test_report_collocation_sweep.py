@@ -89,7 +89,39 @@ def test_a_merged_folder_says_so_with_its_spread(tmp_path):
     results, summary = collocation_sweep_sections(rep, folder)
     assert results == {} and summary.iloc[0].cot_4 > 0
     text = " ".join(rep.sections[0].text)
-    assert "merges several paths" in text and "37 %" in text
+    assert "solved from several starts" in text and "37 %" in text
+    assert "warm-started from the previous converged speed;" not in text
+
+
+def test_a_several_start_folder_shows_the_spread_of_each_problem(tmp_path):
+    """The columns of 'bladelab sweep --starts K' (bladelab.predict.collocation.starts)."""
+    from bladelab.report.builder import Report
+    from bladelab.report.collocation_sweep import collocation_sweep_sections, starts_table
+
+    folder = _subset(tmp_path, ["Cat6"])
+    table = pd.read_csv(folder / "collocation-sweep.csv")
+    table = table[table.problem == "speed"].reset_index(drop=True)
+    n = len(table)
+    table["start"] = ["warm-mu-1e-4"] + ["warm"] * (n - 1)
+    table["starts"] = [3] + [1] * (n - 1)
+    table["objective"] = 2.0
+    table["objective_warm"] = [2.5] + [2.0] * (n - 1)
+    table["objective_warm-mu-1e-4"] = [2.0] + [math.nan] * (n - 1)
+    table["spread_pct"] = [25.0] + [math.nan] * (n - 1)
+    table.to_csv(folder / "collocation-sweep.csv", index=False)
+    assert starts_table(read_sweep_table(STUDY)) is None  # one start: no such table
+    shown = starts_table(read_sweep_table(folder))
+    assert list(shown.columns) == [
+        "model", "problem", "prescribed_speed_mps", "converged", "start", "starts", "objective",
+        "objective_warm", "objective_warm-mu-1e-4", "spread_pct"]
+    assert shown.spread_pct.iloc[0] == 25.0 and shown.spread_pct.iloc[1:].isna().all()
+    rep = Report("t")
+    collocation_sweep_sections(rep, folder)
+    section = rep.sections[0]
+    assert "25 %" in " ".join(section.text)
+    (per_problem,) = [t for t in section.tables if t.title.startswith("Starts per problem")]
+    assert len(per_problem.frame) == n
+    assert per_problem.frame.spread_pct.iloc[0] == 25.0
 
 
 def test_a_table_without_a_needed_column_is_refused_by_name(tmp_path):

@@ -7,6 +7,9 @@ per solve's start and end (and every :data:`~bladelab.cli.collocation.PROGRESS_E
 seconds while IPOPT iterates), each line led by the model and the problem; stdout holds the
 table (one JSON object with ``--json``). Any model that did not converge everywhere makes the
 exit status 2, after all models ran, with one ``error:`` line naming each failure.
+``--starts K`` solves each problem from up to K starts and keeps the best
+(:mod:`bladelab.predict.collocation.starts`); the table then names the kept start and the
+spread of the objectives.
 """
 
 from __future__ import annotations
@@ -66,12 +69,15 @@ def _text(result) -> str:
     keep = ["model", "problem", "prescribed_speed_mps", "converged", "mean_speed_mps",
             "cost_of_transport_J_per_kg_m", "stride_time_s", "contact_time_s",
             "iterations", "wall_s"]
+    if any("start" in row for row in result.rows):
+        keep += ["start", "starts", "spread_pct"]
     lines = ["  ".join(keep)]
     for row in result.rows:
         cells = []
         for k in keep:
             v = row.get(k)
-            cells.append("-" if v is None else f"{v:.4g}" if isinstance(v, float) else str(v))
+            missing = v is None or (isinstance(v, float) and not math.isfinite(v))
+            cells.append("-" if missing else f"{v:.4g}" if isinstance(v, float) else str(v))
         lines.append("  ".join(cells))
     lines.append(f"table: {result.table_path}")
     return "\n".join(lines)
@@ -91,11 +97,13 @@ def run_collocation_sweep(
     resume: bool,
     force: bool,
     as_json: bool,
+    starts: int = 1,
 ) -> int:
     """Run ``bladelab sweep --method collocation``; returns the exit status (0 every solve
     converged, 2 some model failed)."""
     from bladelab.cli.collocation import make_guess
     from bladelab.predict.collocation.solve import CollocationSettings
+    from bladelab.predict.collocation.starts import check_starts
     from bladelab.predict.collocation.sweep import collocation_sweep, sweep_models
 
     if mesh < 4:
@@ -104,6 +112,7 @@ def run_collocation_sweep(
         raise SpecError(f"need at least 1 iteration, got {max_iter}", where="--max-iter")
     if jobs < 1:
         raise SpecError(f"need at least 1 job, got {jobs}", where="--jobs")
+    check_starts(starts, where="--starts")
     speed_list = _speeds(speeds)
     cats = [c.strip() for c in categories.split(",") if c.strip()]
     try:
@@ -121,7 +130,8 @@ def run_collocation_sweep(
                                    max_iter=max_iter)
     result = collocation_sweep(
         models, speed_list, settings, functools.partial(make_guess, guess=guess), out=out,
-        jobs=jobs, executor=executor, resume=resume, force=force, progress=SweepProgress())
+        jobs=jobs, executor=executor, resume=resume, force=force, progress=SweepProgress(),
+        starts=starts)
     if as_json:
         typer.echo(json.dumps({"table": str(result.table_path), "rows": result.rows,
                                "failures": result.failures}))

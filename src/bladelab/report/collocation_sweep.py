@@ -9,6 +9,9 @@ report shows, before the predictive sections that every predictive report has:
   curve per model, the maximum-speed solve marked;
 - every solve of the table, converged or not (a solve that did not converge is listed, never
   plotted or averaged);
+- for a folder whose problems were solved from several starts (``bladelab sweep --method
+  collocation --starts K``, or paths merged by ``benchmarks/collocation/merge_starts.py``):
+  per problem the kept start, every start's objective and their spread (:func:`starts_table`);
 - per blade category the summary that the reflex sweep's report shows (maximum speed, cost at
   4 m/s, 200/400 m times, contact times at the maximum speed), beside seed 001's values
   (:func:`~bladelab.report.predictive_sections.add_predictive_sections`' category section).
@@ -29,7 +32,8 @@ import pandas as pd
 
 from bladelab.errors import InputFileError
 
-__all__ = ["collocation_sweep_sections", "is_collocation_sweep", "sweep_summary"]
+__all__ = ["collocation_sweep_sections", "is_collocation_sweep", "starts_table",
+           "sweep_summary"]
 
 #: Speed [m/s] at which the category table reports the cost of transport (seed 001 Fig. 3.7a).
 COST_SPEED_M_PER_S = 4.0
@@ -98,6 +102,19 @@ def sweep_summary(table: pd.DataFrame) -> pd.DataFrame:
                                        "contact_time_intact", "contact_time_prosthetic"])
 
 
+def starts_table(table: pd.DataFrame) -> pd.DataFrame | None:
+    """Per problem of a several-start table (a ``start`` column): model, problem, prescribed
+    speed, converged, the kept start, how many starts converged (where recorded), the kept
+    objective, every start's objective (``objective_<start>``) and ``spread_pct`` (largest
+    minus lowest converged objective, % of the lowest); None for a one-start table."""
+    if "start" not in table.columns:
+        return None
+    cols = ["model", "problem", "prescribed_speed_mps", "converged", "start", "starts",
+            "objective", *[c for c in table.columns if c.startswith("objective_")],
+            "spread_pct"]
+    return table[[c for c in cols if c in table.columns]].reset_index(drop=True)
+
+
 def _speed_figure(table: pd.DataFrame):
     """Cost of transport, contact time and peak vertical GRF per leg against speed."""
     import matplotlib.pyplot as plt
@@ -146,12 +163,18 @@ def collocation_sweep_sections(report, folder: str | Path) -> tuple[dict, pd.Dat
     failed = table[~table.converged]
     fig = _speed_figure(table)
     text = f"{len(table)} solves, {int(table.converged.sum())} converged. "
-    if "start" in table.columns:  # a merge of several paths (benchmarks/collocation/merge_starts.py)
+    starts = starts_table(table)
+    if starts is not None:  # --starts K, or a merge of paths (merge_starts.py)
         spread = pd.to_numeric(table.get("spread_pct"), errors="coerce")
-        text += ("This folder merges several paths per problem: each row is the lowest "
-                 "objective found (column 'start' names its path, 'objective_<path>' every "
-                 "path's)" + (f"; the largest spread between paths is {spread.max():.0f} % of "
-                              "the kept objective." if spread.notna().any() else "."))
+        text += ("Each problem was solved from several starts (the paths of a merged folder, "
+                 "or the starts of 'bladelab sweep --starts', which continues each model from "
+                 "the kept solution) and the best converged solve kept: the lowest objective, "
+                 "one without gait warnings preferred (column 'start' names it, "
+                 "'objective_<start>' every start's, empty where it did not converge or did not "
+                 "run; 'spread_pct' the largest minus the lowest converged objective in % of the "
+                 "lowest; the table 'Starts per problem' shows them)"
+                 + (f"; the largest spread between starts is {spread.max():.0f} % of the "
+                    "lowest objective." if spread.notna().any() else "."))
     else:
         text += ("Each model's speeds were solved in the order given, each warm-started from "
                  "the previous converged speed; the maximum speed (star) from the fastest.")
@@ -168,7 +191,9 @@ def collocation_sweep_sections(report, folder: str | Path) -> tuple[dict, pd.Dat
         figures=[("Cost of transport, contact time and peak vertical GRF per leg against mean "
                   "speed (solid: left/intact leg, dashed: right/prosthetic; star: maximum "
                   "speed)", fig)],
-        tables=[("Every solve (collocation-sweep.csv)", shown)],
+        tables=[("Every solve (collocation-sweep.csv)", shown)] + (
+            [] if starts is None else [
+                ("Starts per problem: objectives and spread", starts)]),
     )
     plt.close(fig)
     results = {}

@@ -44,11 +44,21 @@ Table rows (:meth:`SolveRecord.row`, units in the names): ``model``, ``blade``, 
 ``peak_vertical_grf_<leg>_bw`` [body weights], ``flight_fraction``, ``dynamics_residual_pct``,
 ``iterations``, ``wall_s`` (of the solve, both stages; the stored value for a file read back),
 ``mesh_intervals`` and ``file``. Legs are left/right (able) or intact/prosthetic (amputee).
+
+Several starts (``starts`` K > 1, :mod:`bladelab.predict.collocation.starts`): each problem is
+solved from up to K starts (the warm start above, its barrier start, the template, the
+previous-but-one solution), every start's file kept (``speed-4.json`` for the warm start,
+``speed-4.<start>.json`` for the others); the record is the kept start's (lowest converged
+objective without gait warnings), the continuation goes on from it, and its row adds
+``start``, ``starts``, ``objective``, ``objective_<start>`` and ``spread_pct``. Resuming reads
+every start's converged file back; a start's best iterate is read back too when another start
+of the problem converged, and warm-starts that start again otherwise (as with one start).
 """
 
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
@@ -60,6 +70,17 @@ from bladelab.predict.collocation.solve import (
     CollocationSettings,
     SolveProgress,
     predict_stride,
+)
+from bladelab.predict.collocation.starts import (
+    START_COLUMNS,
+    Start,
+    StartOutcome,
+    candidate,
+    check_starts,
+    plan_starts,
+    solve_starts,
+    start_columns,
+    warm_guess,
 )
 from bladelab.predict.collocation.stored import (
     check_model_spec,
@@ -127,7 +148,8 @@ class ContinuationProgress:
         ``message`` names its warm start), ``"solve"`` (a :class:`SolveProgress` of the solve in
         ``solve``), ``"converged"`` or ``"failed"`` (``path``: the file written; ``message``:
         the result), ``"refine"`` (a failed speed is tried again after an intermediate one,
-        named in ``message``).
+        named in ``message``), ``"kept"`` (several starts: the one kept, ``path``, and every
+        start's objective in ``message``).
     path
         The file concerned, if any.
     message
@@ -160,6 +182,9 @@ class SolveRecord:
         The file it is in.
     solved
         False when it was read back from ``path`` (nothing solved).
+    starts
+        Several starts: every start's :class:`StartOutcome`, in order (``solution`` and
+        ``path`` are the kept one's); empty with one start.
     """
 
     problem: str
@@ -167,6 +192,7 @@ class SolveRecord:
     solution: object
     path: Path
     solved: bool
+    starts: tuple[StartOutcome, ...] = ()
 
     @property
     def converged(self) -> bool:
@@ -194,7 +220,16 @@ class SolveRecord:
         row.update({k: v for k, v in summary.items() if k not in skip})
         row.update({"iterations": summary["iterations"], "wall_s": summary["wall_s"],
                     "mesh_intervals": sol.settings.mesh_intervals, "file": str(path)})
+        if self.starts:
+            kept = next(o.label for o in self.starts if o.path == self.path)
+            row.update(start_columns([candidate(o.label, o.solution) for o in self.starts],
+                                     kept))
         return row
+
+    @property
+    def files(self) -> tuple[Path, ...]:
+        """Every file of the record: the kept one, and each start's."""
+        return (self.path, *(o.path for o in self.starts if o.path != self.path))
 
 
 @dataclass(frozen=True)
@@ -251,7 +286,9 @@ class ContinuationResult:
 
 def table_columns(rows: Sequence[dict]) -> list[str]:
     """Column order of table rows: :data:`TABLE_COLUMNS` with the per-leg columns of the legs
-    present after ``contact_time_s``, then any other key."""
+    present after ``contact_time_s``, then ``warnings`` and the several-start columns
+    (:data:`~bladelab.predict.collocation.starts.START_COLUMNS`, ``objective_<start>`` after
+    ``objective``) of rows that have them, then any other key."""
     keys: list[str] = []
     for row in rows:
         keys.extend(k for k in row if k not in keys)
@@ -260,6 +297,9 @@ def table_columns(rows: Sequence[dict]) -> list[str]:
     head = list(TABLE_COLUMNS)
     i = head.index("contact_time_s") + 1
     cols = head[:i] + legs + head[i:]
+    per_start = [k for k in keys if k.startswith("objective_")]
+    block = ["warnings", *START_COLUMNS[:3], *per_start, *START_COLUMNS[3:]]
+    cols += [k for k in block if k in keys]
     return cols + [k for k in keys if k not in cols]
 
 
@@ -282,10 +322,18 @@ class LazyRunner:
         return self._runner
 
 
-def _stored(ok: Path, best: Path, spec: dict, settings: CollocationSettings, force: bool):
+def _stored(ok: Path, best: Path, settings: CollocationSettings, *, spec: dict, force: bool):
     """(converged solution, best iterate) in ``ok`` / ``best``
     (:func:`~bladelab.predict.collocation.stored.read_stored`); ``force`` ignores both."""
     return (None, None) if force else read_stored(ok, best, spec, settings)
+
+
+def _solve(get_runner, spec: dict, watched: bool, settings: CollocationSettings, guess,
+           ok: Path, best: Path, report: Callable[..., None]):
+    """:func:`_solve_and_write` with the runner of ``get_runner`` (for
+    :func:`~bladelab.predict.collocation.starts.solve_starts`)."""
+    return _solve_and_write(get_runner(), settings, guess, spec=spec, ok=ok, best=best,
+                            report=report, watched=watched)
 
 
 def _solve_and_write(runner, settings: CollocationSettings, guess, *, spec: dict, ok: Path,
@@ -306,6 +354,12 @@ def _solve_and_write(runner, settings: CollocationSettings, guess, *, spec: dict
                message=f"not converged: IPOPT status {sol.nlp.status} in the {sol.stage} stage "
                        f"after {sol.nlp.iterations} iterations; best iterate in {target.name}")
     return sol, target
+
+
+def _template(get_runner, speed: float, n: int):
+    from bladelab.predict.collocation.guess import template_guess
+
+    return template_guess(get_runner(), speed=speed, n=n)
 
 
 def check_speeds(speeds) -> tuple[float, ...]:
@@ -337,7 +391,8 @@ def speed_continuation(runner, speeds: Sequence[float], settings: CollocationSet
                        first_guess, *, model_spec: dict, out_dir: str | Path,
                        progress: Callable[[ContinuationProgress], None] | None = None,
                        force: bool = False,
-                       refinements: int = DEFAULT_REFINEMENTS) -> ContinuationResult:
+                       refinements: int = DEFAULT_REFINEMENTS,
+                       starts: int = 1) -> ContinuationResult:
     """Solve the stride at each prescribed speed in order, each warm-started from the previous
     converged solution (module docstring); files ``out_dir/speed-<v>.json``.
 
@@ -368,6 +423,9 @@ def speed_continuation(runner, speeds: Sequence[float], settings: CollocationSet
         Halvings of the speed step allowed when a solve does not converge from the previous
         speed: the smallest step is the first step towards a prescribed speed / 2^refinements
         (0: stop at the first failure).
+    starts
+        Starts per speed, 1 to 4 (module docstring; :mod:`~bladelab.predict.collocation.starts`):
+        1 the warm start only; more, the best of several kept and continued from.
 
     Returns
     -------
@@ -378,12 +436,14 @@ def speed_continuation(runner, speeds: Sequence[float], settings: CollocationSet
     Raises
     ------
     SpecError
-        No speed, a speed that is not > 0, a speed given twice, or maximum-speed settings.
+        No speed, a speed that is not > 0, a speed given twice, maximum-speed settings, or a
+        number of starts out of range.
     InputFileError
         A file in ``out_dir`` holds another problem (without ``force``).
     """
     spec = check_model_spec(model_spec)
     speeds = check_speeds(speeds)
+    starts = check_starts(starts)
     if not isinstance(settings, CollocationSettings):
         raise SpecError(f"expected CollocationSettings, got {type(settings).__name__}",
                         where="settings")
@@ -397,11 +457,18 @@ def speed_continuation(runner, speeds: Sequence[float], settings: CollocationSet
     get_runner = LazyRunner(runner, spec)
     label = model_label(spec)
     records: list[SolveRecord] = []
-    prev = None  # the previous converged solution
+    prev = prev2 = None  # the previous converged (kept) solution, and the one before it
     pending = list(speeds)  # speeds still to solve, intermediate ones inserted in front
     prescribed = {f"{v:g}" for v in speeds}
     min_step = None  # smallest step [m/s] allowed towards the current prescribed speed
     restart: set[str] = set()  # speeds whose stored best iterate is stale (a step was refined)
+    first: list = []  # the first guess, once made
+
+    def first_start():
+        if not first:
+            first.append(first_guess(get_runner()) if callable(first_guess) else first_guess)
+        return first[0]
+
     while pending:
         v = pending[0]
         problem = f"{v:g} m/s"
@@ -412,30 +479,36 @@ def speed_continuation(runner, speeds: Sequence[float], settings: CollocationSet
                 progress(ContinuationProgress(label, _problem, event, path, message, solve))
 
         s_v = dataclasses.replace(settings, speed_m_per_s=v)
-        ok, best = out_dir / speed_file(v), out_dir / speed_file(v, converged=False)
-        done, iterate = _stored(ok, best, spec, s_v, force)
-        if done is not None:
-            report("read", path=ok, message="read back")
-            records.append(SolveRecord("speed", v, done, ok, False))
-            prev = done
-            pending.pop(0)
-            continue
-        if iterate is not None and f"{v:g}" not in restart:
-            guess = iterate.to_guess()
-            report("start", message=f"warm start from the best iterate {best.name}")
-        elif prev is not None:
-            guess = prev.to_guess(f"{COLLOCATION_SOURCE} at "
-                                  f"{prev.settings.speed_m_per_s:g} m/s").with_speed(v)
-            report("start", message=f"warm start from the {prev.settings.speed_m_per_s:g} m/s "
-                                    "solution")
+        template = Start("template", s_v, functools.partial(
+            _template, get_runner, v, settings.mesh_intervals))
+        if prev is None:
+            warm = Start("warm", s_v, first_start)
+            plan = [warm] if starts == 1 else plan_starts(
+                starts, warm,
+                collocation_start=str(first_start().source).startswith(COLLOCATION_SOURCE),
+                template=None if str(first_start().source).startswith("template") else template,
+                previous=None)
         else:
-            guess = first_guess(get_runner()) if callable(first_guess) else first_guess
-            report("start", message=f"from {guess.source}")
-        sol, path = _solve_and_write(get_runner(), s_v, guess, spec=spec, ok=ok, best=best,
-                                     report=report, watched=progress is not None)
+            warm = Start("warm", s_v, functools.partial(warm_guess, prev, v),
+                         f"warm start from the {prev.settings.speed_m_per_s:g} m/s solution")
+            previous = None if prev2 is None else Start(
+                "previous-but-one", s_v,
+                functools.partial(warm_guess, prev2, v, " (the previous but one)"),
+                f"warm start from the {prev2.settings.speed_m_per_s:g} m/s solution (the "
+                "previous but one)")
+            plan = plan_starts(starts, warm, collocation_start=True, template=template,
+                               previous=previous)
+        ok, best = out_dir / speed_file(v), out_dir / speed_file(v, converged=False)
+        kept, outcomes = solve_starts(
+            plan, ok=ok, best=best, report=report, retry=f"{v:g}" not in restart,
+            several=starts > 1, read=functools.partial(_stored, spec=spec, force=force),
+            solve=functools.partial(_solve, get_runner, spec, progress is not None))
+        sol, path = kept.solution, kept.path
+        solved = kept.solved or any(o.solved for o in outcomes)
+        rec = SolveRecord("speed", v, sol, path, solved, outcomes)
         if sol.converged:
-            records.append(SolveRecord("speed", v, sol, path, True))
-            prev = sol
+            records.append(rec)
+            prev2, prev = prev, sol
             pending.pop(0)
             if f"{v:g}" in prescribed:
                 min_step = None
@@ -450,7 +523,7 @@ def speed_continuation(runner, speeds: Sequence[float], settings: CollocationSet
                     or f"{mid:g}" in (f"{v_prev:g}", f"{v:g}")):
                 mid = None
         if mid is None:
-            records.append(SolveRecord("speed", v, sol, path, True))
+            records.append(rec)
             break
         restart.add(f"{v:g}")
         report("refine", path=path, message=f"not converged from {v_prev:g} m/s; "
@@ -468,7 +541,7 @@ def max_speed_settings(settings: CollocationSettings) -> CollocationSettings:
 def max_speed(runner, settings: CollocationSettings, guess, *, model_spec: dict,
               out_dir: str | Path,
               progress: Callable[[ContinuationProgress], None] | None = None,
-              force: bool = False) -> SolveRecord:
+              force: bool = False, starts: int = 1, previous=None) -> SolveRecord:
     """Solve the maximum-speed problem warm-started from ``guess`` (the fastest converged
     solution of :func:`speed_continuation`, a :class:`CollocationSolution` or its
     ``to_guess()``); file ``out_dir/max-speed.json`` (``max-speed.best_iterate.json`` if it
@@ -476,12 +549,15 @@ def max_speed(runner, settings: CollocationSettings, guess, *, model_spec: dict,
     it is the warm start instead of ``guess`` (module docstring).
 
     ``settings`` must pose the maximum-speed problem (``speed_m_per_s=None``;
-    :func:`max_speed_settings`). ``runner``, ``model_spec``, ``progress`` and ``force`` as
-    :func:`speed_continuation`.
+    :func:`max_speed_settings`). ``runner``, ``model_spec``, ``progress``, ``force`` and
+    ``starts`` as :func:`speed_continuation`; with several starts the template is the template
+    guess at the warm start's speed, and ``previous`` (the second-fastest converged solution,
+    a :class:`CollocationSolution`, or None) the previous-but-one start.
     """
     from bladelab.predict.collocation.solution import CollocationSolution
 
     spec = check_model_spec(model_spec)
+    starts = check_starts(starts)
     if not isinstance(settings, CollocationSettings):
         raise SpecError(f"expected CollocationSettings, got {type(settings).__name__}",
                         where="settings")
@@ -489,32 +565,38 @@ def max_speed(runner, settings: CollocationSettings, guess, *, model_spec: dict,
         raise SpecError(f"the maximum-speed problem needs speed_m_per_s None, got "
                         f"{settings.speed_m_per_s:g} m/s", where="settings",
                         hint="max_speed_settings(settings) gives it")
-    out_dir = Path(out_dir)
     label = model_label(spec)
+    for sol, what in ((guess, "warm start"), (previous, "previous-but-one start")):
+        if isinstance(sol, CollocationSolution) and sol.model_spec != spec:
+            raise SpecError(f"the {what} is a solution of {model_label(sol.model_spec)}, not "
+                            f"{label}", where="guess" if sol is guess else "previous")
+    out_dir = Path(out_dir)
 
     def report(event: str, *, path=None, message: str = "", solve=None) -> None:
         if progress is not None:
             progress(ContinuationProgress(label, "maximum speed", event, path, message, solve))
 
-    ok, best = out_dir / MAX_SPEED_FILE, out_dir / MAX_SPEED_BEST_ITERATE_FILE
-    done, iterate = _stored(ok, best, spec, settings, force)
-    if done is not None:
-        report("read", path=ok, message="read back")
-        return SolveRecord("max-speed", None, done, ok, False)
-    if iterate is not None:
-        start = iterate.to_guess()
-        report("start", message=f"warm start from the best iterate {best.name}")
+    get_runner = LazyRunner(runner, spec)
+    if isinstance(guess, CollocationSolution):
+        warm = Start("warm", settings, functools.partial(warm_guess, guess, None))
+        source = COLLOCATION_SOURCE
     else:
-        if isinstance(guess, CollocationSolution):
-            if guess.model_spec != spec:
-                raise SpecError(f"the warm start is a solution of {model_label(guess.model_spec)}"
-                                f", not {label}", where="guess")
-            speed = guess.settings.speed_m_per_s
-            start = guess.to_guess(f"{COLLOCATION_SOURCE} at "
-                                   + (f"{speed:g} m/s" if speed else "maximum speed"))
-        else:
-            start = guess
-        report("start", message=f"from {start.source}")
-    sol, path = _solve_and_write(LazyRunner(runner, spec)(), settings, start, spec=spec, ok=ok,
-                                 best=best, report=report, watched=progress is not None)
-    return SolveRecord("max-speed", None, sol, path, True)
+        warm = Start("warm", settings, lambda: guess)
+        source = str(guess.source)
+    plan = [warm]
+    if starts > 1:
+        template = Start("template", settings, lambda: _template(
+            get_runner, warm.guess().speed, settings.mesh_intervals))
+        prev = None if previous is None else Start(
+            "previous-but-one", settings,
+            functools.partial(warm_guess, previous, None, " (the previous but one)"))
+        plan = plan_starts(starts, warm, collocation_start=source.startswith(COLLOCATION_SOURCE),
+                           template=None if source.startswith("template") else template,
+                           previous=prev)
+    ok, best = out_dir / MAX_SPEED_FILE, out_dir / MAX_SPEED_BEST_ITERATE_FILE
+    kept, outcomes = solve_starts(
+        plan, ok=ok, best=best, report=report, several=starts > 1,
+        read=functools.partial(_stored, spec=spec, force=force),
+        solve=functools.partial(_solve, get_runner, spec, progress is not None))
+    solved = kept.solved or any(o.solved for o in outcomes)
+    return SolveRecord("max-speed", None, kept.solution, kept.path, solved, outcomes)

@@ -13,6 +13,13 @@ A table row is one solve: :meth:`~bladelab.predict.collocation.continuation.Solv
 described in the continuation module) followed by seed 001's per-stride quantities of the
 solution, :func:`~bladelab.predict.collocation.analyses.stride_analyses` (K_leg, joint powers
 P+/P− per joint, leg energies, the blade's energy; units in the column names).
+
+With ``starts`` K > 1 each problem (each speed, and the maximum speed) is solved from up to K
+starts and the best kept (:mod:`bladelab.predict.collocation.starts`: the warm start, its
+barrier start, the template, the previous-but-one solution); the continuation goes on from the
+kept solution, every start's file stays in the model folder, and a row is the kept solve's
+plus the columns ``start``, ``starts``, ``objective``, ``objective_<start>`` and
+``spread_pct``.
 """
 
 from __future__ import annotations
@@ -36,6 +43,7 @@ from bladelab.predict.collocation.continuation import (
     table_columns,
 )
 from bladelab.predict.collocation.solve import CollocationSettings
+from bladelab.predict.collocation.starts import check_starts
 from bladelab.predict.collocation.stored import check_model_spec, model_label
 
 __all__ = [
@@ -111,7 +119,7 @@ def sweep_model_task(payload: dict) -> dict:
 
     ``payload``: ``model_spec``, ``speeds``, ``settings`` (:class:`CollocationSettings`),
     ``make_guess`` (``make_guess(runner, n=..., speed=...)``), ``out`` (the sweep folder),
-    ``force``, ``progress`` (or None). Returns ``label``, ``rows`` (module docstring) and
+    ``force``, ``progress`` (or None), ``starts`` (per problem; default 1). Returns ``label``, ``rows`` (module docstring) and
     ``failures`` (one line per solve that did not converge). With ``force``, files of the model
     folder that this run did not write are removed once the model is done.
     """
@@ -123,12 +131,13 @@ def sweep_model_task(payload: dict) -> dict:
     make_guess = payload["make_guess"]
     force = bool(payload.get("force", False))
     progress = payload.get("progress")
+    starts = int(payload.get("starts", 1))
     label = model_label(spec)
     get_runner = LazyRunner(None, spec)
     cont = speed_continuation(
         get_runner, speeds, settings,
         lambda r: make_guess(r, n=settings.mesh_intervals, speed=float(speeds[0])),
-        model_spec=spec, out_dir=folder, progress=progress, force=force)
+        model_spec=spec, out_dir=folder, progress=progress, force=force, starts=starts)
     records = list(cont.records)
     failures = []
     if cont.failed is not None:
@@ -142,15 +151,18 @@ def sweep_model_task(payload: dict) -> dict:
     if fastest is None:
         failures.append("maximum speed not attempted (no speed converged)")
     else:
+        done = sorted((r for r in records if r.converged), key=lambda r: r.speed_mps)
         rec = max_speed(get_runner, max_speed_settings(settings), fastest.solution,
-                        model_spec=spec, out_dir=folder, progress=progress, force=force)
+                        model_spec=spec, out_dir=folder, progress=progress, force=force,
+                        starts=starts,
+                        previous=done[-2].solution if len(done) > 1 else None)
         records.append(rec)
         if not rec.converged:
             failures.append(f"maximum speed not converged (IPOPT status "
                             f"{rec.solution.nlp.status} in the {rec.solution.stage} stage; "
                             f"best iterate {rec.path.relative_to(out)})")
     if force:
-        keep = {r.path.resolve() for r in records}
+        keep = {p.resolve() for r in records for p in r.files}
         for p in _files(folder):
             if p.resolve() not in keep:
                 p.unlink(missing_ok=True)
@@ -206,6 +218,7 @@ def collocation_sweep(
     resume: bool = False,
     force: bool = False,
     progress: Callable[[ContinuationProgress], None] | None = None,
+    starts: int = 1,
 ) -> SweepResult:
     """For each model, the speed continuation then the maximum speed (module docstring); each
     model in ``out/<model_folder>``, the table ``out/collocation-sweep.csv`` rewritten
@@ -237,6 +250,9 @@ def collocation_sweep(
     progress
         Called with each :class:`ContinuationProgress` (in the worker process when
         ``jobs`` > 1, so it must be picklable then).
+    starts
+        Starts per problem, 1 to 4 (module docstring): 1 the continuation's warm start only;
+        more, the best of several kept.
 
     Raises
     ------
@@ -262,6 +278,7 @@ def collocation_sweep(
         raise SpecError(f"need at least 1 job, got {jobs!r}", where="jobs")
     if resume and force:
         raise SpecError("give --resume or --force, not both", where="--resume/--force")
+    starts = check_starts(starts)
     out = Path(out)
     if out.exists() and not out.is_dir():
         raise InputFileError("is a file, not a folder", file=out, hint="give a folder for --out")
@@ -277,7 +294,7 @@ def collocation_sweep(
     out.mkdir(parents=True, exist_ok=True)
     payloads = [{"model_spec": m, "speeds": list(speeds), "settings": settings,
                  "make_guess": make_guess, "out": str(out.resolve()), "force": bool(force),
-                 "progress": progress} for m in models]
+                 "progress": progress, "starts": starts} for m in models]
     table = out / SWEEP_TABLE
     rows: dict[int, list[dict]] = {}
     failures: dict[int, list[str]] = {}
