@@ -92,3 +92,30 @@ def test_guess_from_the_shipped_reflex_solution():
     assert g.activation.min() >= 0.01 - 1e-12 and g.activation.max() <= 1.0
     assert g.tendon_force.min() >= 0.0 and g.tendon_force.max() < 2.0
     assert np.trapezoid(g.vertical_grf_bw, dx=1 / 30) == pytest.approx(1.0, rel=0.05)
+
+
+def test_a_seed_body_guess_starts_the_toe_body(able):
+    """A guess of seed 001's body (named columns) on the toe body: every coordinate and muscle
+    kept by name, the toe hinges neutral; a guess of the other model kind is refused."""
+    toes = build_runner("able", body="toes")
+    g = template_guess(able, speed=3.5, n=20)
+    n = g.q.shape[0]
+    rng = np.random.default_rng(3)
+    act, ft = rng.uniform(0.02, 0.5, (n, 24)), rng.uniform(0.01, 1.0, (n, 24))
+    named = g.__class__(**{**g.__dict__, "activation": act, "tendon_force": ft,
+                           "dof_names": able.dof_names, "muscle_names": able.muscle_names})
+    on = named.on_model(toes)
+    assert on.q.shape == (n, len(toes.dof_names)) and on.dof_names is None
+    for j, name in enumerate(toes.dof_names):
+        if name.startswith("mtp_angle"):
+            assert not on.q[:, j].any() and not on.qd[:, j].any()
+        else:
+            np.testing.assert_array_equal(on.q[:, j], g.q[:, able.dof(name)])
+            np.testing.assert_array_equal(on.qd[:, j], g.qd[:, able.dof(name)])
+    np.testing.assert_array_equal(on.activation, act)  # same muscles, same order
+    np.testing.assert_array_equal(on.tendon_force, ft)
+    assert named.on_model(able).q is g.q  # already the model's own columns
+    with pytest.raises(SpecError, match="not in the amputee model"):
+        named.on_model(build_runner("amputee"))
+    with pytest.raises(SpecError, match="coordinates"):
+        g.on_model(toes)  # unnamed columns of another model

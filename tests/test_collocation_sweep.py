@@ -221,6 +221,8 @@ def test_several_starts_keep_the_best_per_problem_and_every_file(fake_solve, mon
     (("--method", "collocation", "--starts", "5"), "--starts"),
     (("--able",), "--able"),
     (("--starts", "2"), "--starts"),
+    (("--body", "toes"), "--body"),
+    (("--method", "collocation", "--able", "--body", "human"), "--body"),
     (("--method", "shooting"), "--method"),
 ])
 def test_bad_sweep_options_are_refused_naming_the_option(args, where, tmp_path, capsys):
@@ -228,3 +230,16 @@ def test_bad_sweep_options_are_refused_naming_the_option(args, where, tmp_path, 
     err = capsys.readouterr().err
     assert err.startswith("error:") and where in err
     assert not (tmp_path / "sweep" / "collocation-sweep.csv").exists()
+
+
+def test_a_sweep_of_the_toe_body_has_folders_and_labels_of_its_own():
+    """The body is part of a problem's identity: its own folder beside seed 001's."""
+    from bladelab.predict.collocation.continuation import model_folder
+    from bladelab.predict.collocation.stored import model_label
+    from bladelab.predict.collocation.sweep import sweep_models
+
+    seed = sweep_models(["cat6"], able=True)
+    toes = sweep_models(["cat6"], able=True, body="toes")
+    assert [model_folder(m) for m in seed] == ["able", "amputee-Cat6"]
+    assert [model_folder(m) for m in toes] == ["able-toes", "amputee-Cat6-toes"]
+    assert [model_label(m) for m in toes] == ["able (toes body)", "amputee Cat6 (toes body)"]

@@ -61,7 +61,7 @@ def make_guess(runner, guess: str, *, n: int, speed: float | None):
         from bladelab.predict.collocation.solution import CollocationSolution
 
         sol = CollocationSolution.read(path)
-        if sol.dof_names != tuple(runner.dof_names):
+        if sol.model_spec["model"] != runner.kind:  # another body of the same kind is mapped
             raise SpecError("the guess is a solution of another model", file=path,
                             where="--guess", hint=f"it is of {sol.model_spec}")
         return sol.to_guess(f"collocation solution {path.name} ({sol.guess_source})")

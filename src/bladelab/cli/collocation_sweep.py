@@ -98,6 +98,7 @@ def run_collocation_sweep(
     force: bool,
     as_json: bool,
     starts: int = 1,
+    body: str = "seed001",
 ) -> int:
     """Run ``bladelab sweep --method collocation``; returns the exit status (0 every solve
     converged, 2 some model failed)."""
@@ -116,9 +117,10 @@ def run_collocation_sweep(
     speed_list = _speeds(speeds)
     cats = [c.strip() for c in categories.split(",") if c.strip()]
     try:
-        models = sweep_models(cats, able=able)
+        models = sweep_models(cats, able=able, body=body)
     except SpecError as err:
-        raise SpecError(err.message, where="--categories", hint=err.hint) from None
+        where = "--body" if err.where == "body" else "--categories"
+        raise SpecError(err.message, where=where, hint=err.hint) from None
     if guess not in ("template", "trial"):
         path = Path(guess)
         if not path.is_file():

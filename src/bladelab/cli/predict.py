@@ -215,6 +215,10 @@ def register(app: typer.Typer) -> None:
             "start, barrier start 1e-4, template, previous-but-one solution) and keep the "
             "best [default: 1]."
         ),
+        body: str | None = typer.Option(
+            None, "--body", help="Collocation: seed001 (seed 001's model) | toes (a toe "
+            "segment and compliant Achilles tendons) [default: seed001]."
+        ),
     ) -> None:
         """Category × speed grid: warm-started optimisations, maximum speed, cost at 4 m/s,
         200 m and 400 m times, contact times (seed 001 §2.2.2 B–C, Table 3.1). Running it again
@@ -239,7 +243,8 @@ def register(app: typer.Typer) -> None:
                 guess="template" if guess is None else guess,
                 max_iter=3000 if max_iter is None else max_iter, jobs=jobs,
                 executor=executor, resume=resume, force=force, as_json=as_json,
-                starts=1 if starts is None else starts)
+                starts=1 if starts is None else starts,
+                body="seed001" if body is None else body)
             raise typer.Exit(code)
         if method != "reflex":
             raise SpecError(f"unknown method {method!r}", where="--method",
@@ -247,7 +252,7 @@ def register(app: typer.Typer) -> None:
         for given, option in ((able, "--able"), (mesh is not None, "--mesh"),
                               (guess is not None, "--guess"), (max_iter is not None, "--max-iter"),
                               (resume, "--resume"), (force, "--force"), (as_json, "--json"),
-                              (starts is not None, "--starts")):
+                              (starts is not None, "--starts"), (body is not None, "--body")):
             if given:
                 raise SpecError("only with --method collocation", where=option,
                                 hint="a reflex sweep continues by itself in the same --out")

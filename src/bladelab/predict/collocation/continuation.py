@@ -129,8 +129,10 @@ def speed_file(speed: float, *, converged: bool = True) -> str:
 
 
 def model_folder(spec: dict) -> str:
-    """A model's subfolder in a sweep: ``able`` or ``amputee-<blade>``."""
-    return model_label(spec).replace(" ", "-")
+    """A model's subfolder in a sweep: ``able`` or ``amputee-<blade>``, with ``-<body>`` for
+    a body other than seed 001's (``able-toes``)."""
+    spec = check_model_spec(spec)
+    return "-".join(p for p in (spec["model"], spec["blade"], spec.get("body")) if p)
 
 
 @dataclass(frozen=True)

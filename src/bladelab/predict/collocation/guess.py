@@ -62,6 +62,10 @@ class StrideGuess:
         of alternating stances). Without it, tracking the angles alone leaves the pelvis height
         free, and the measured angles were met by one-legged hops and 20-BW bounds (docs/
         collocation.md).
+    dof_names, muscle_names
+        The names of the columns of ``q``/``qd`` and of the muscle arrays, where the guess
+        comes from another model (e.g. a seed-001 solution as the start of the toe body);
+        None: the target model's own. :meth:`on_model` matches them by name.
     """
 
     source: str
@@ -71,6 +75,44 @@ class StrideGuess:
     activation: np.ndarray | None = None
     tendon_force: np.ndarray | None = None
     vertical_grf_bw: np.ndarray | None = None
+    dof_names: tuple[str, ...] | None = None
+    muscle_names: tuple[str, ...] | None = None
+
+    def on_model(self, model: RunnerModel) -> StrideGuess:
+        """This guess on ``model``'s coordinates and muscles, matched by name: coordinates
+        the guess lacks (a toe hinge) start at 0 (neutral), muscles it lacks at activation 0.05
+        with tendon forces from static equilibrium. Raises if a coordinate of the guess other
+        than a toe hinge has no place in ``model`` (a guess of the other model kind)."""
+        dofs, muscles = tuple(model.dof_names), tuple(model.muscle_names)
+        if self.dof_names is None or (self.dof_names == dofs and self.muscle_names == muscles):
+            if self.q.shape[1] != len(dofs):
+                raise SpecError(f"the guess has {self.q.shape[1]} coordinates, the model "
+                                f"{len(dofs)}", where="guess",
+                                hint="a guess of another model needs its dof_names")
+            return self
+        lost = [n for n in self.dof_names if n not in dofs and not n.startswith("mtp_angle")]
+        if lost:
+            raise SpecError(f"the guess's coordinates {lost} are not in the {model.kind} model",
+                            where="guess", hint="start from a guess of the same model kind")
+
+        def cols(a, names, new, fill):
+            if a is None or names is None:
+                return None
+            out = np.full((a.shape[0], len(new)), fill)
+            for j, name in enumerate(new):
+                if name in names:
+                    out[:, j] = a[:, names.index(name)]
+            return out
+
+        keep_muscles = self.muscle_names is not None and set(muscles) <= set(self.muscle_names)
+        return replace(
+            self, q=cols(self.q, self.dof_names, dofs, 0.0),
+            qd=cols(self.qd, self.dof_names, dofs, 0.0),
+            activation=cols(self.activation, self.muscle_names, muscles, 0.05),
+            tendon_force=cols(self.tendon_force, self.muscle_names, muscles, 0.0)
+            if keep_muscles else None,
+            dof_names=None, muscle_names=None,
+            source=f"{self.source}, on the {model.kind} model's coordinates")
 
     @property
     def n_intervals(self) -> int:
@@ -297,6 +339,7 @@ def guess_from_result(result, *, n: int = 50) -> StrideGuess:
         activation=at(result.muscles[:, :, 0]),
         tendon_force=at(result.muscles[:, :, 3] / fmax),
         vertical_grf_bw=at(forces.sum(axis=1, keepdims=True))[:, 0] / model.body_weight,
+        dof_names=tuple(model.dof_names), muscle_names=tuple(model.muscle_names),
     )
 
 

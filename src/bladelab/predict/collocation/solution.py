@@ -23,7 +23,7 @@ predictive report work on it.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
@@ -341,7 +341,8 @@ class CollocationSolution:
         text = source or f"{COLLOCATION_SOURCE} ({self.guess_source})"
         if not text.startswith(COLLOCATION_SOURCE):
             text = f"{COLLOCATION_SOURCE}: {text}"
-        return self.nlp.to_guess(text)
+        return replace(self.nlp.to_guess(text), dof_names=self.dof_names,
+                       muscle_names=self.muscle_names)
 
     def to_runner_result(self, n_strides: int = 3, *, refine: int = 1, runner=None, cm=None):
         """The stride repeated ``n_strides`` times as a :class:`~bladelab.runner.RunnerResult`

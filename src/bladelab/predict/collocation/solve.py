@@ -418,7 +418,7 @@ def predict_stride(runner, settings: CollocationSettings, guess, *, model_spec: 
     cm = build_collocation_model(runner)
     dyn = stride_dynamics(cm)
     n = settings.mesh_intervals
-    g = guess.resample(n)
+    g = guess.on_model(runner).resample(n)
     speed = settings.speed_m_per_s
     if speed is not None and not math.isclose(g.speed, speed, rel_tol=1e-12):
         g = g.with_speed(speed)

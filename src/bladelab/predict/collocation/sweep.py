@@ -80,9 +80,11 @@ def write_table(path: str | Path, rows: Sequence[dict]) -> Path:
     return path
 
 
-def sweep_models(categories: Sequence[str], *, able: bool = False) -> list[dict]:
+def sweep_models(categories: Sequence[str], *, able: bool = False,
+                 body: str = "seed001") -> list[dict]:
     """Model specifications of a sweep: the able model first when ``able``, then the amputee
-    with each blade category (names as the catalogue spells them).
+    with each blade category (names as the catalogue spells them), all of one ``body``
+    (:data:`bladelab.runner.params.BODIES`).
 
     Raises
     ------
@@ -91,14 +93,14 @@ def sweep_models(categories: Sequence[str], *, able: bool = False) -> list[dict]
     """
     from bladelab.runner.params import blade_category
 
-    models = [{"model": "able", "blade": None}] if able else []
+    models = [check_model_spec({"model": "able", "body": body})] if able else []
     seen: set[str] = set()
     for c in categories:
         name = blade_category(c).name
         if name in seen:
             raise SpecError(f"category {name} given twice", where="categories")
         seen.add(name)
-        models.append({"model": "amputee", "blade": name})
+        models.append(check_model_spec({"model": "amputee", "blade": name, "body": body}))
     if not models:
         raise SpecError("no model to sweep", where="categories",
                         hint="give --categories, --able, or both")
