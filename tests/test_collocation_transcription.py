@@ -76,3 +76,39 @@ def test_an_objective_of_one_term_unpacks():
     sol = nlp.solve(nlp.initial_vector(_bouncing_guess(10, 2.0)), hessian="exact", max_iter=5)
     assert list(sol.objective_terms) == ["effort"]
     assert sol.objective == pytest.approx(sol.objective_terms["effort"])
+
+
+def test_squared_muscle_metabolic_rates_term_is_its_stated_integral():
+    """PredSim's term (StrideWeights.metabolic_squared): Σ_m (Ė_m / M)², integrated with the
+    trapezoidal rule over the stride, over the distance, / 10; and the muscles' rates add up
+    to the whole-body rate less the basal rate."""
+    from bladelab.predict.collocation import build_collocation_model
+    from bladelab.predict.collocation.dynamics import stride_dynamics
+    from bladelab.predict.collocation.guess import template_guess
+    from bladelab.predict.collocation.transcription import (
+        METABOLIC_SQUARED_SCALE,
+        StrideWeights,
+    )
+    from bladelab.runner import build_runner
+    from bladelab.runner.metabolics import BASAL_RATE_W_PER_KG
+
+    runner = build_runner("able")
+    dyn = stride_dynamics(build_collocation_model(runner))
+    n, speed = 8, 3.5
+    nlp = StrideNLP(dyn, n=n, speed=speed, weights=StrideWeights(metabolic_squared=2.0))
+    lbx, ubx, lbg, ubg = nlp.bounds()
+    sol = nlp.unpack(nlp.initial_vector(template_guess(runner, speed=speed, n=n)), {}, 0.0, 0.0,
+                     lbg, ubg, np.zeros(lbg.size))
+    per_node = np.zeros(n + 1)
+    for k in range(n + 1):
+        args = (sol.q[k], sol.qd[k], sol.activation[k], sol.tendon_force[k],
+                sol.tendon_force_rate[k], sol.excitation[k])
+        rates = np.array(dyn.muscle_metabolic_rates(*args)).ravel()
+        assert rates.sum() + BASAL_RATE_W_PER_KG * dyn.mass == pytest.approx(
+            float(dyn.metabolic_rate(*args)), rel=1e-12)
+        per_node[k] = np.sum((rates / dyn.mass) ** 2)
+    h = sol.period / n
+    expected = 2.0 * np.sum((per_node[:-1] + per_node[1:]) / 2 * h) / (
+        speed * sol.period) / METABOLIC_SQUARED_SCALE
+    assert sol.objective_terms["metabolic_squared"] == pytest.approx(expected, rel=1e-9)
+    assert expected > 0.0

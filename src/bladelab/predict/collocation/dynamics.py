@@ -15,9 +15,10 @@ import math
 import casadi as ca
 import numpy as np
 
-from bladelab.predict.collocation.metabolics import MetabolicSmoothing, metabolic_rate
+from bladelab.predict.collocation.metabolics import MetabolicSmoothing, muscle_metabolic_rates
 from bladelab.predict.collocation.model import CollocationModel
 from bladelab.predict.collocation.transcription import StrideDynamics
+from bladelab.runner.metabolics import BASAL_RATE_W_PER_KG
 from bladelab.runner.muscle import MP_LOPT, V_MAX_OPT_PER_S
 
 __all__ = ["COORDINATE_BOUNDS_DEG", "stride_dynamics"]
@@ -64,7 +65,8 @@ def stride_dynamics(cm: CollocationModel, *,
     l_mt, v_mt = cm.mtu(q, qd)
     r_mb = cm.dynamics_residual(q, qd, qdd, ft)
     r_hill = cm.muscle_residual(a, ft, dft, l_mt, v_mt)
-    met = metabolic_rate(runner, u, a, ft, dft, l_mt, v_mt, cm.smoothing, metabolic)
+    rates = muscle_metabolic_rates(runner, u, a, ft, dft, l_mt, v_mt, cm.smoothing, metabolic)
+    met = BASAL_RATE_W_PER_KG * runner.total_mass + ca.sum1(rates)
     l_m, v_m, cos_a = cm.fiber(l_mt, v_mt, ft, dft)
     l_opt = ca.DM(runner.muscle_params[:, MP_LOPT])
     v_norm = v_m / (V_MAX_OPT_PER_S * l_opt)
@@ -81,6 +83,8 @@ def stride_dynamics(cm: CollocationModel, *,
         residuals=ca.Function("residuals", [q, qd, qdd, a, ft, dft], [r_mb, r_hill]),
         activation_rate=cm.activation_rate,
         metabolic_rate=ca.Function("metabolic_rate", [q, qd, a, ft, dft, u], [met]),
+        muscle_metabolic_rates=ca.Function("muscle_metabolic_rates", [q, qd, a, ft, dft, u],
+                                           [rates]),
         q_bounds=q_b,
         qd_bounds=qd_b,
         residual_scale=scale,

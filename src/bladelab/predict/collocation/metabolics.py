@@ -37,7 +37,7 @@ from bladelab.runner.metabolics import (
 )
 from bladelab.runner.muscle import MP_FMAX, MP_LOPT, V_MAX_OPT_PER_S
 
-__all__ = ["MetabolicSmoothing", "metabolic_rate"]
+__all__ = ["MetabolicSmoothing", "metabolic_rate", "muscle_metabolic_rates"]
 
 
 @dataclass(frozen=True)
@@ -67,7 +67,16 @@ class MetabolicSmoothing:
 
 def metabolic_rate(runner, u, a, ft, dft, l_mt, v_mt, smoothing: Smoothing,
                    widths: MetabolicSmoothing | None = None):
-    """Whole-body metabolic rate [W] (basal + Σ muscles) as a CasADi expression.
+    """Whole-body metabolic rate [W] (basal + Σ muscles) as a CasADi expression (arguments as
+    :func:`muscle_metabolic_rates`)."""
+    rates = muscle_metabolic_rates(runner, u, a, ft, dft, l_mt, v_mt, smoothing, widths)
+    body_mass = float(np.sum(runner.mj_model.body_mass))
+    return BASAL_RATE_W_PER_KG * body_mass + ca.sum1(rates)
+
+
+def muscle_metabolic_rates(runner, u, a, ft, dft, l_mt, v_mt, smoothing: Smoothing,
+                           widths: MetabolicSmoothing | None = None):
+    """Metabolic rate of every muscle [W] (n_muscles,) as a CasADi expression.
 
     Parameters
     ----------
@@ -109,5 +118,4 @@ def metabolic_rate(runner, u, a, ft, dft, l_mt, v_mt, smoothing: Smoothing,
     f_ce = smooth_max0(fmax * ft / cos_a - muscles.passive_force(ln, smoothing) * fmax, 1.0)
     work = -f_ce * v_m / mass
     total = softplus(heat + work, w.total_w_per_kg)
-    body_mass = float(np.sum(runner.mj_model.body_mass))
-    return BASAL_RATE_W_PER_KG * body_mass + ca.sum1(total * mass)
+    return total * mass

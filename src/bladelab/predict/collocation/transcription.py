@@ -77,6 +77,9 @@ class StrideDynamics:
     vertical_grf
         Optional CasADi Function (q, q̇) -> total vertical ground force [N] (for tracking a
         measured force).
+    muscle_metabolic_rates
+        Optional CasADi Function (q, q̇, a, F̃ₜ, dF̃ₜ/dt, e) -> metabolic rate of every muscle
+        [W] (for :attr:`StrideWeights.metabolic_squared`).
     """
 
     dof_names: tuple[str, ...]
@@ -93,6 +96,7 @@ class StrideDynamics:
     inequality_bounds: np.ndarray | None = None
     static_tendon_force: Callable[[np.ndarray, np.ndarray], np.ndarray] | None = None
     vertical_grf: ca.Function | None = None
+    muscle_metabolic_rates: ca.Function | None = None
 
     @property
     def nq(self) -> int:
@@ -123,6 +127,13 @@ class StrideWeights:
         vertical force over the body mass, to the segments' relative motion).
     speed
         Negative mean speed [m/s] (maximum-speed problem).
+    metabolic_squared
+        PredSim's metabolic term (Falisse et al. 2019; ``S.weights.E_exp = 2``): the squared
+        metabolic rate of every muscle per body mass, summed, integrated over the stride and
+        divided by the distance, in (W/kg)²·s/m / 10 (about 1 for this model's optimum at
+        3.5 m/s). Squaring each muscle's rate makes a brief burst of high force cost more
+        than the same energy spread over a longer contact, which the energy alone does not
+        (the Umberger model's activation heat grows with A^0.6).
     """
 
     metabolic: float = 1.0
@@ -130,6 +141,7 @@ class StrideWeights:
     acceleration: float = 0.1
     pelvis_acceleration: float = 0.0
     speed: float = 1.0
+    metabolic_squared: float = 0.0
 
     def to_dict(self) -> dict[str, float]:
         return asdict(self)
@@ -185,6 +197,9 @@ class NLPSolution:
         return StrideGuess(source, self.period, self.q, self.qd, self.activation,
                            self.tendon_force)
 
+
+#: Scale of :attr:`StrideWeights.metabolic_squared` [(W/kg)²·s/m].
+METABOLIC_SQUARED_SCALE = 10.0
 
 #: Bounds of the free stride time [s] (a running stride at 3–10 m/s lies well inside).
 PERIOD_BOUNDS_S = (0.4, 1.2)
@@ -282,7 +297,15 @@ class StrideNLP:
                 else ca.SX.zeros(0, 1))
         self.n_ineq = int(ineq.numel())
         fz = d.vertical_grf(q, qd) if d.vertical_grf is not None else ca.SX(0.0)
-        node = ca.Function("node", [xs, us], [xdot_scaled, path, effort, met, ineq, fz])
+        if w.metabolic_squared:
+            if d.muscle_metabolic_rates is None:
+                raise SpecError("metabolic_squared needs the muscles' metabolic rates",
+                                where="weights", hint="build the dynamics with stride_dynamics")
+            per_kg = d.muscle_metabolic_rates(q, qd, a, fnt, dfnt, e) / d.mass
+            met_sq = ca.sumsqr(per_kg) / METABOLIC_SQUARED_SCALE
+        else:
+            met_sq = ca.SX(0.0)
+        node = ca.Function("node", [xs, us], [xdot_scaled, path, effort, met, ineq, fz, met_sq])
         fmap = node.map(n + 1)
 
         X = ca.MX.sym("X", self.nx, n + 1)
@@ -290,7 +313,7 @@ class StrideNLP:
         T = ca.MX.sym("T")
         period = T * s.period
         h = period / n
-        xdot, pth, eff, mets, ineqs, fzs = fmap(X, U)
+        xdot, pth, eff, mets, ineqs, fzs, met_sqs = fmap(X, U)
         defects = X[:, 1:] - X[:, :-1] - h / 2 * (xdot[:, 1:] + xdot[:, :-1])
         itx = d.dof_names.index("pelvis_tx")
         distance = (X[itx, n] - X[itx, 0]) * sx[itx]
@@ -312,6 +335,9 @@ class StrideNLP:
         trap = (ca.sum2(eff[:, :-1]) + ca.sum2(eff[:, 1:])) / 2 * h  # ∫ effort dt
         energy = (ca.sum2(mets[:, :-1]) + ca.sum2(mets[:, 1:])) / 2 * h  # ∫ Ė dt [J]
         terms = {"effort": trap / period}
+        if w.metabolic_squared:
+            sq = (ca.sum2(met_sqs[:, :-1]) + ca.sum2(met_sqs[:, 1:])) / 2 * h
+            terms["metabolic_squared"] = w.metabolic_squared * sq / ca.fmax(distance, 1e-3)
         if self.speed is not None:
             g.append(distance - self.speed * period)
             self._g_names.append("speed")
