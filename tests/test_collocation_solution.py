@@ -21,6 +21,7 @@ from bladelab.predict.collocation.consistency import (
 from bladelab.predict.collocation.guess import template_guess
 from bladelab.predict.collocation.solution import (
     BEST_ITERATE_KIND,
+    CONTACT_THRESHOLD_N,
     SOLUTION_KIND,
     CollocationSolution,
 )
@@ -178,6 +179,15 @@ def test_a_hop_and_a_stride_on_its_bound_are_named_in_the_warnings(able):
     assert any("right leg never touches" in w for w in warnings)
     assert any("bound (0.4 s)" in w for w in warnings)
     assert "right leg never touches" in hop.summary()["warnings"]
+    # a swinging left foot that strikes the ground mid-swing: a second loaded stretch
+    strike = sol.contact_forces.copy()
+    left = sol.leg_vertical_force()[:, 0]
+    swing = int(np.argmin(left))  # a node of the left swing
+    assert left[swing] < CONTACT_THRESHOLD_N
+    strike[swing, np.flatnonzero(sol.contact_legs == 0)[0], 1] = 5 * CONTACT_THRESHOLD_N
+    struck = dataclasses.replace(sol, contact_forces=strike).gait_warnings()
+    assert struck == ["the left leg touches the ground 2 times per stride (a swinging foot "
+                      "strikes the ground, or the stance bounces)"]
 
 
 def test_amputee_summary_names_intact_and_prosthetic_legs():

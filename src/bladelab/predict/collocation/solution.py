@@ -278,15 +278,20 @@ class CollocationSolution:
 
     def gait_warnings(self) -> list[str]:
         """What makes this converged stride no running gait, in words (empty if nothing):
-        a leg that never touches the ground (a one-legged hop), no flight phase, or a stride
-        time on a bound of the NLP (:data:`~bladelab.predict.collocation.transcription.
-        PERIOD_BOUNDS_S`). Measured on 2026-11-25: the amputee Cat6 at 4 m/s from the Fukuchi
-        trial's guess converged to a hop on the intact leg at the 0.4 s bound."""
+        a leg that never touches the ground (a one-legged hop), a leg that touches it more
+        than once per stride (a swinging foot striking the ground, or a bounce), no flight
+        phase, or a stride time on a bound of the NLP (:data:`~bladelab.predict.collocation.
+        transcription.PERIOD_BOUNDS_S`). Measured on 2026-11-25: the amputee Cat6 at 4 m/s
+        from the Fukuchi trial's guess converged to a hop on the intact leg at the 0.4 s
+        bound."""
         from bladelab.predict.collocation.transcription import PERIOD_BOUNDS_S
 
         ph = self.contact_phases()
         out = [f"the {leg} leg never touches the ground (a one-legged hop, not running)"
                for leg in self.leg_names if ph["legs"][leg]["contacts"] == 0]
+        out += [f"the {leg} leg touches the ground {ph['legs'][leg]['contacts']} times per "
+                "stride (a swinging foot strikes the ground, or the stance bounces)"
+                for leg in self.leg_names if ph["legs"][leg]["contacts"] > 1]
         if ph["flight_fraction"] <= 0.0:
             out.append("no flight phase (not running)")
         for bound in PERIOD_BOUNDS_S:
