@@ -148,9 +148,13 @@ def test_two_animations_in_one_page_play_independently(tmp_path):
     try:
         _evaluate(browser, session,
                   "document.querySelectorAll('button.anim-play')[1].click()")
-        time.sleep(1.0)
-        frames = _evaluate(browser, session, "Array.from(document.querySelectorAll("
-                                             "'.runner-animation')).map(r => r.dataset.frame)")
+        deadline = time.monotonic() + 15.0  # a loaded machine may render late: poll
+        while True:
+            time.sleep(0.5)
+            frames = _evaluate(browser, session, "Array.from(document.querySelectorAll("
+                                                 "'.runner-animation')).map(r => r.dataset.frame)")
+            if int(frames[1]) > 0 or time.monotonic() > deadline:
+                break
     finally:
         browser.close()
     assert frames[0] == "0" and int(frames[1]) > 0
