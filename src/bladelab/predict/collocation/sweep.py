@@ -42,6 +42,7 @@ from bladelab.predict.collocation.continuation import (
     speed_continuation,
     table_columns,
 )
+from bladelab.predict.collocation.model import build_collocation_model
 from bladelab.predict.collocation.solve import CollocationSettings
 from bladelab.predict.collocation.starts import check_starts
 from bladelab.predict.collocation.stored import check_model_spec, model_label
@@ -169,7 +170,8 @@ def sweep_model_task(payload: dict) -> dict:
             if p.resolve() not in keep:
                 p.unlink(missing_ok=True)
     runner = get_runner()
-    rows = [r.row(out) | stride_analyses(r.solution, runner) for r in records]
+    cm = build_collocation_model(runner)  # once for every row's analyses
+    rows = [r.row(out) | stride_analyses(r.solution, runner, cm=cm) for r in records]
     return {"label": label, "rows": rows, "failures": failures}
 
 
