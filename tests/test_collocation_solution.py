@@ -345,6 +345,10 @@ def test_the_predictive_report_renders_a_collocation_solution(able, tmp_path):
     assert rep.kind == "collocation" and rep.solutions == ("able-bodied 3.5 m/s (collocation)",)
     html = (tmp_path / "report" / "index.html").read_text()
     assert "Collocation solution" in html and "Joint angles per leg" in html
+    # the 'bladelab predict --method collocation' folder itself, as the CLI's help offers
+    rep = build_predictive_report(path.parent, tmp_path / "report2", progress=False,
+                                  animate=False)
+    assert rep.solutions == ("able-bodied 3.5 m/s (collocation)",)
     bad = replace(sol, nlp=replace(sol.nlp, success=False)).write(tmp_path / "best.json")
     with pytest.raises(InputFileError, match="did not converge"):
         predictive_kind(bad)

@@ -72,7 +72,8 @@ def _label(sol) -> str:
     who = "able-bodied" if spec["model"] == "able" else f"amputee {spec['blade']}"
     speed = ("maximum speed" if sol.settings.speed_m_per_s is None
              else f"{sol.settings.speed_m_per_s:g} m/s")
-    return f"{who} {speed} (collocation)"
+    body = f", {spec['body']} body" if "body" in spec else ""
+    return f"{who} {speed} (collocation{body})"
 
 
 def _grf_figure(sol):
@@ -98,7 +99,7 @@ def collocation_sections(report, path: str | Path) -> tuple[dict, object]:
     from bladelab.predict.collocation.solution import CollocationSolution
     from bladelab.predict.collocation.stored import runner_from_spec
 
-    sol = CollocationSolution.read(path)
+    sol = CollocationSolution.read(collocation_solution_file(path) or path)  # file or folder
     runner = runner_from_spec(sol.model_spec)
     result = sol.to_runner_result(N_STRIDES, refine=REFINE, runner=runner,
                                   cm=build_collocation_model(runner))
