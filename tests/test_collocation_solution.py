@@ -188,6 +188,15 @@ def test_a_hop_and_a_stride_on_its_bound_are_named_in_the_warnings(able):
     struck = dataclasses.replace(sol, contact_forces=strike).gait_warnings()
     assert struck == ["the left leg touches the ground 2 times per stride (a swinging foot "
                       "strikes the ground, or the stance bounces)"]
+    # a landing spike of 9 body weights on the right leg
+    spike = sol.contact_forces.copy()
+    right = np.flatnonzero(sol.contact_legs == 1)[0]
+    k = int(np.argmax(sol.leg_vertical_force()[:, 1]))
+    spike[k, right, 1] += 9.0 * sol.body_weight_N
+    assert dataclasses.replace(sol, contact_forces=spike).gait_warnings() == [
+        "the right leg's peak vertical force is "
+        f"{(sol.leg_vertical_force()[k, 1] / sol.body_weight_N + 9.0):.1f} body weights "
+        "(above 8: an impact no runner survives)"]
 
 
 def test_amputee_summary_names_intact_and_prosthetic_legs():

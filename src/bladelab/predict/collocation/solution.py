@@ -44,6 +44,13 @@ BEST_ITERATE_KIND = "collocation-best-iterate"
 FORMAT_VERSION = 1
 #: Vertical force of a leg above which it is in contact [N] (the forward analyses' threshold).
 CONTACT_THRESHOLD_N = 20.0
+#: A peak vertical ground force above this [body weights] is flagged by
+#: :meth:`CollocationSolution.gait_warnings`. Measured running peaks reach 2–3 BW at 3–5 m/s
+#: and about 5 BW at top sprint speed (impact transients included); the collocation optima
+#: that reached 10–17 BW (amputee Cat4 at 5 m/s, able at 5 m/s from a warm start) are not
+#: gaits a person could run. Our decision (2026-11-25); a flagged solve loses to a clean one
+#: among several starts.
+PEAK_GRF_WARNING_BW = 8.0
 #: Samples per mesh interval of the linear interpolation used for contact and flight times.
 _FINE = 50
 
@@ -279,8 +286,9 @@ class CollocationSolution:
     def gait_warnings(self) -> list[str]:
         """What makes this converged stride no running gait, in words (empty if nothing):
         a leg that never touches the ground (a one-legged hop), a leg that touches it more
-        than once per stride (a swinging foot striking the ground, or a bounce), no flight
-        phase, or a stride time on a bound of the NLP (:data:`~bladelab.predict.collocation.
+        than once per stride (a swinging foot striking the ground, or a bounce), a peak
+        vertical force above :data:`PEAK_GRF_WARNING_BW`, no flight phase, or a stride time on
+        a bound of the NLP (:data:`~bladelab.predict.collocation.
         transcription.PERIOD_BOUNDS_S`). Measured on 2026-11-25: the amputee Cat6 at 4 m/s
         from the Fukuchi trial's guess converged to a hop on the intact leg at the 0.4 s
         bound."""
@@ -292,6 +300,11 @@ class CollocationSolution:
         out += [f"the {leg} leg touches the ground {ph['legs'][leg]['contacts']} times per "
                 "stride (a swinging foot strikes the ground, or the stance bounces)"
                 for leg in self.leg_names if ph["legs"][leg]["contacts"] > 1]
+        weight = self.body_weight_N
+        out += [f"the {leg} leg's peak vertical force is {peak / weight:.1f} body weights "
+                f"(above {PEAK_GRF_WARNING_BW:g}: an impact no runner survives)"
+                for leg in self.leg_names
+                if (peak := ph["legs"][leg]["peak_vertical_grf_N"]) > PEAK_GRF_WARNING_BW * weight]
         if ph["flight_fraction"] <= 0.0:
             out.append("no flight phase (not running)")
         for bound in PERIOD_BOUNDS_S:
