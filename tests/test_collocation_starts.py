@@ -64,6 +64,14 @@ def test_start_columns_give_each_objective_the_count_and_the_spread():
                            labels=["warm", "template", "other"])
     assert one["starts"] == 1 and math.isnan(one["spread_pct"])  # no spread of one
     assert math.isnan(one["objective_other"])
+    # a start that ended in a hop (gait warnings) counts as converged but not in the spread
+    hop = st.start_columns([C("warm", 3.0), C("warm-mu-1e-4", 4.5, warnings=["a hop"]),
+                            C("template", 2.7)], "template")
+    assert hop["starts"] == 3 and hop["objective_warm-mu-1e-4"] == 4.5
+    assert hop["spread_pct"] == pytest.approx(100.0 * 0.3 / 2.7)
+    flagged = st.start_columns([C("warm", 3.0, warnings=["x"]), C("template", 2.7,
+                                                                 warnings=["y"])], "template")
+    assert flagged["spread_pct"] == pytest.approx(100.0 * 0.3 / 2.7)  # all flagged: all count
 
 
 # -- the starts of a problem --------------------------------------------------------------

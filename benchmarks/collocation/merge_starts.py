@@ -11,8 +11,8 @@ kept solution files (``<model>/<file>``) and a ``collocation-sweep.csv`` in the 
 plus the columns of :func:`bladelab.predict.collocation.starts.start_columns` (the same as a
 ``--starts`` sweep's): ``start`` (the label kept), ``starts`` (how many paths converged),
 ``objective``, ``objective_<label>`` for every path (NaN where that path did not converge) and
-``spread_pct`` (largest minus lowest converged objective, in % of the lowest). ``bladelab
-report OUT`` renders it.
+``spread_pct`` (largest minus lowest objective among the converged paths without gait
+warnings, in % of the lowest). ``bladelab report OUT`` renders it.
 
 Why (docs/collocation.md, "Local optima along a continuation"): the stride's landscape has
 local optima 15–25 % apart, and which one a warm-started solve reaches depends on the path and

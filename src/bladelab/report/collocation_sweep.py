@@ -105,8 +105,9 @@ def sweep_summary(table: pd.DataFrame) -> pd.DataFrame:
 def starts_table(table: pd.DataFrame) -> pd.DataFrame | None:
     """Per problem of a several-start table (a ``start`` column): model, problem, prescribed
     speed, converged, the kept start, how many starts converged (where recorded), the kept
-    objective, every start's objective (``objective_<start>``) and ``spread_pct`` (largest
-    minus lowest converged objective, % of the lowest); None for a one-start table."""
+    objective, every start's objective (``objective_<start>``) and ``spread_pct``
+    (:func:`~bladelab.predict.collocation.starts.start_columns`); None for a one-start
+    table."""
     if "start" not in table.columns:
         return None
     cols = ["model", "problem", "prescribed_speed_mps", "converged", "start", "starts",
@@ -171,8 +172,9 @@ def collocation_sweep_sections(report, folder: str | Path) -> tuple[dict, pd.Dat
                  "the kept solution) and the best converged solve kept: the lowest objective, "
                  "one without gait warnings preferred (column 'start' names it, "
                  "'objective_<start>' every start's, empty where it did not converge or did not "
-                 "run; 'spread_pct' the largest minus the lowest converged objective in % of the "
-                 "lowest; the table 'Starts per problem' shows them)"
+                 "run; 'spread_pct' the largest minus the lowest objective in % of the lowest, "
+                 "among the converged starts without gait warnings; the table 'Starts per "
+                 "problem' shows them)"
                  + (f"; the largest spread between starts is {spread.max():.0f} % of the "
                     "lowest objective." if spread.notna().any() else "."))
     else:

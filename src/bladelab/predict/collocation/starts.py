@@ -36,8 +36,9 @@ K = 1 can be resumed with a larger K; the others insert their label (``speed-4.t
 Table columns (:func:`start_columns`, shared with ``benchmarks/collocation/merge_starts.py``):
 ``start`` (the label kept), ``starts`` (how many converged), ``objective`` (the kept one's;
 empty if it did not converge), ``objective_<label>`` for each start (empty where it did not
-converge or did not run) and ``spread_pct`` (largest minus lowest converged objective, in % of
-the lowest; empty with fewer than two converged).
+converge or did not run) and ``spread_pct`` (largest minus lowest objective among the solves
+:func:`pick` chooses from: the converged starts without gait warnings, or every converged one
+if each has some; in % of the lowest; empty with fewer than two).
 """
 
 from __future__ import annotations
@@ -196,12 +197,16 @@ def start_columns(candidates: Sequence[Candidate], kept: str,
     ``spread_pct``; NaN where a value does not exist."""
     objs: Mapping[str, float] = {c.label: float(c.objective) for c in candidates
                                  if c.converged and math.isfinite(c.objective)}
-    lo = min(objs.values()) if objs else math.nan
     row = {"start": kept, "starts": len(objs), "objective": objs.get(kept, math.nan)}
     for lab in (labels if labels is not None else [c.label for c in candidates]):
         row[f"objective_{lab}"] = objs.get(lab, math.nan)
-    row["spread_pct"] = (100.0 * (max(objs.values()) - lo) / abs(lo)
-                         if len(objs) > 1 and lo != 0 else math.nan)
+    # the spread among the solves pick() chooses from: a start that ended in a hop is no
+    # rival optimum of running gaits (all converged ones when every one has warnings)
+    pool = [objs[c.label] for c in candidates if c.label in objs and not c.warnings]
+    pool = pool or list(objs.values())
+    lo = min(pool, default=math.nan)
+    row["spread_pct"] = (100.0 * (max(pool) - lo) / abs(lo)
+                         if len(pool) > 1 and lo != 0 else math.nan)
     return row
 
 
