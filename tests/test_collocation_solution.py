@@ -354,6 +354,8 @@ def test_the_predictive_report_renders_a_collocation_solution(able, tmp_path):
     assert rep.kind == "collocation" and rep.solutions == ("able-bodied 3.5 m/s (collocation)",)
     html = (tmp_path / "report" / "index.html").read_text()
     assert "Collocation solution" in html and "Joint angles per leg" in html
+    # at the measured trial's speed its joint angles are drawn beside the solution's
+    assert "Joint angles against the measured trial" in html
     # the 'bladelab predict --method collocation' folder itself, as the CLI's help offers
     rep = build_predictive_report(path.parent, tmp_path / "report2", progress=False,
                                   animate=False)

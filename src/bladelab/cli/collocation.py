@@ -18,16 +18,20 @@ from pathlib import Path
 import typer
 
 from bladelab.errors import InputFileError, SpecError
+from bladelab.predict.collocation.guess import (
+    MEASURED_STATIC,
+    MEASURED_TRIAL,
+    MEASURED_TRIAL_SPEED_M_PER_S,
+)
 
 __all__ = ["FUKUCHI_STATIC", "FUKUCHI_TRIAL", "PROGRESS_EVERY_S", "StageProgress", "TRIAL_SPEED_M_PER_S",
            "make_guess", "run_collocation"]
 
-_SHARED = Path(__file__).resolve().parents[3].parent / "shared" / "data" / "real" / "fukuchi2017"
-#: The measured running trial of ``--guess trial`` and its standing trial.
-FUKUCHI_TRIAL = _SHARED / "RBDS001runT35.c3d"
-FUKUCHI_STATIC = _SHARED / "RBDS001static.c3d"
-#: Treadmill speed of that trial [m/s].
-TRIAL_SPEED_M_PER_S = 3.5
+#: The measured running trial of ``--guess trial``, its standing trial and its treadmill speed
+#: [m/s] (one definition: :mod:`bladelab.predict.collocation.guess`).
+FUKUCHI_TRIAL = MEASURED_TRIAL
+FUKUCHI_STATIC = MEASURED_STATIC
+TRIAL_SPEED_M_PER_S = MEASURED_TRIAL_SPEED_M_PER_S
 #: Seconds between two progress lines while a stage iterates.
 PROGRESS_EVERY_S = 5.0
 #: Template speed [m/s] of a maximum-speed problem's guess.

@@ -91,6 +91,79 @@ def _grf_figure(sol):
     return fig
 
 
+#: Joints of the comparison with the measured trial: (coordinate base, label, sign) — the
+#: knee drawn as flexion (positive), as gait plots show it.
+TRIAL_JOINTS = (("hip_flexion", "hip flexion", 1.0), ("knee_angle", "knee flexion", -1.0),
+                ("ankle_angle", "ankle dorsiflexion", 1.0))
+#: Speeds [m/s] within which the measured 3.5 m/s trial is drawn beside a solution.
+TRIAL_SPEED_WINDOW_M_PER_S = 0.51
+
+
+def _from_left_touchdown(sol) -> int:
+    """Node index of the left/intact leg's touch-down (first loaded node after an unloaded one)
+    in the periodic stride; 0 if the leg is never unloaded."""
+    from bladelab.predict.collocation.solution import CONTACT_THRESHOLD_N
+
+    loaded = sol.leg_vertical_force()[:-1, 0] > CONTACT_THRESHOLD_N
+    starts = np.flatnonzero(loaded & ~np.roll(loaded, 1))
+    return int(starts[0]) if starts.size else 0
+
+
+def _trial_figure(sol, runner, trial):
+    """Joint angles of the solution and of the measured trial over % of the stride from the
+    left touch-down, per leg (``trial``: a StrideGuess of the measured stride)."""
+    import matplotlib.pyplot as plt
+
+    n = sol.nlp.q.shape[0] - 1
+    k0 = _from_left_touchdown(sol)
+    q_sol = np.vstack([np.roll(sol.nlp.q[:-1], -k0, axis=0), np.roll(sol.nlp.q[:-1], -k0,
+                                                                      axis=0)[:1]])
+    pct_sol = np.linspace(0.0, 100.0, n + 1)
+    pct_trial = np.linspace(0.0, 100.0, trial.q.shape[0])
+    fig, axes = plt.subplots(2, 3, figsize=(10, 5.2), sharex=True)
+    for row, (side, leg) in enumerate((("l", sol.leg_names[0]), ("r", sol.leg_names[1]))):
+        for col, (base, label, sign) in enumerate(TRIAL_JOINTS):
+            ax = axes[row, col]
+            name = f"{base}_{side}"
+            ax.set_title(f"{leg} leg: {label}", fontsize=9)
+            if name not in runner.dof_names:
+                ax.text(0.5, 0.5, "no such joint (prosthesis)", ha="center", va="center",
+                        transform=ax.transAxes, fontsize=8)
+                continue
+            j = runner.dof(name)
+            ax.plot(pct_sol, sign * np.degrees(q_sol[:, j]), label="collocation")
+            ax.plot(pct_trial, sign * np.degrees(trial.q[:, j]), "k--", label="measured")
+            ax.set_ylabel("angle (deg)", fontsize=8)
+            if row == 1:
+                ax.set_xlabel("% of the stride from the left touch-down", fontsize=8)
+    axes[0, 0].legend(fontsize=7)
+    fig.tight_layout()
+    return fig
+
+
+def _measured_trial(runner, sol):
+    """The measured 3.5 m/s trial's mean stride on ``runner``'s coordinates (a StrideGuess),
+    or None where it does not apply (another speed, the trial file absent) or cannot be read."""
+    from bladelab.errors import BladelabError
+    from bladelab.predict.collocation.guess import (
+        MEASURED_STATIC,
+        MEASURED_TRIAL,
+        MEASURED_TRIAL_SPEED_M_PER_S,
+        guess_from_trial,
+    )
+
+    speed = sol.mean_speed_mps
+    if (not MEASURED_TRIAL.is_file()
+            or abs(speed - MEASURED_TRIAL_SPEED_M_PER_S) > TRIAL_SPEED_WINDOW_M_PER_S):
+        return None
+    try:
+        return guess_from_trial(runner, MEASURED_TRIAL, n=100,
+                                static=MEASURED_STATIC if MEASURED_STATIC.is_file() else None,
+                                speed=MEASURED_TRIAL_SPEED_M_PER_S)
+    except BladelabError:
+        return None
+
+
 def collocation_sections(report, path: str | Path) -> tuple[dict, object]:
     """Add the collocation solution's own sections to ``report``; return ({label:
     RunnerResult} for :func:`~bladelab.report.predictive_sections.add_predictive_sections`,
@@ -153,8 +226,11 @@ def collocation_sections(report, path: str | Path) -> tuple[dict, object]:
               "collocation solution does not carry: the first row takes what the forward "
               "bristle can do at each node (sliding: −μ·Fn·sign(v); sticking, below 0.1 m/s: "
               "any force within ±μ·Fn, here the collocation's own), the second reconstructs "
-              "the anchor along the stride. The component rows show where a difference comes "
-              "from."),
+              "the anchor along the stride. That second row is near 100 % in every solve so "
+              "far: the smooth friction carries a standing foot's force by letting it slip a "
+              "few mm/s, and a reconstructed bristle, stuck, stretches by that slip over the "
+              "whole stance (docs/collocation.md, 'Dynamic consistency'); the first row is the "
+              "check. The component rows show where a difference comes from."),
         figures=[("Vertical ground reaction force per leg at the mesh nodes over % of the "
                   "stride", fig)],
         tables=[("Summary (as 'bladelab predict --method collocation --json')", summary),
@@ -164,4 +240,18 @@ def collocation_sections(report, path: str | Path) -> tuple[dict, object]:
                 ("Settings", settings)],
     )
     plt.close(fig)
+    trial = _measured_trial(runner, sol)
+    if trial is not None:
+        fig = _trial_figure(sol, runner, trial)
+        report.add_section(
+            "Joint angles against the measured trial",
+            text=("The solution's joint angles (solid) beside the measured running trial's "
+                  f"mean stride (dashed: Fukuchi et al. 2017, subject RBDS001 at "
+                  "3.5 m/s, the model's inverse kinematics of its markers, standing as zero), "
+                  "both from the left leg's touch-down. Drawn for solutions within "
+                  f"{TRIAL_SPEED_WINDOW_M_PER_S:g} m/s of the trial's speed."),
+            figures=[("Joint angles of the solution and of the measured trial over % of the "
+                      "stride", fig)],
+        )
+        plt.close(fig)
     return {_label(sol): result}, sol

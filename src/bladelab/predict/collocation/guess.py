@@ -256,6 +256,15 @@ def template_vertical_grf(phase: np.ndarray, *, duty: float = 0.34) -> np.ndarra
     return out
 
 
+#: The measured running trial of ``--guess trial`` (Fukuchi et al. 2017, subject RBDS001 at
+#: 3.5 m/s on a treadmill), its standing trial and its speed [m/s]: in the shared data folder
+#: beside the project (absent from an installed package, then ``--guess trial`` says so).
+MEASURED_TRIAL = (Path(__file__).resolve().parents[4].parent / "shared" / "data" / "real"
+                  / "fukuchi2017" / "RBDS001runT35.c3d")
+MEASURED_STATIC = MEASURED_TRIAL.with_name("RBDS001static.c3d")
+MEASURED_TRIAL_SPEED_M_PER_S = 3.5
+
+
 def guess_from_trial(model: RunnerModel, path: str | Path, *, static: str | Path | None = None,
                      n: int = 50, speed: float | None = None, markers=None) -> StrideGuess:
     """The mean left-leg stride of a measured running trial (C3D with markers and force
