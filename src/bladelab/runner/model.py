@@ -391,38 +391,26 @@ def build_runner(
 
     # contacts
     contacts, rows = [], []
-    k_foot = hertz_sphere_stiffness(geo.FOOT_SPHERE_RADIUS_M * s, FOOT_PLANE_STRAIN_MODULUS)
+
+    def sphere(name: str, radius: float, modulus: float, dissipation: float, friction: float,
+               leg: int, blade: int) -> None:
+        """A Hunt–Crossley sphere (Hertz stiffness of ``radius`` and ``modulus``) at site
+        ``name``."""
+        site = model.site(name)
+        contacts.append(name)
+        rows.append((site.id, model.site_bodyid[site.id], radius,
+                     hertz_sphere_stiffness(radius, modulus), dissipation, friction, leg, blade,
+                     radius, LAW_HUNT_CROSSLEY, 1.5, 0.0, 0.0))
+
     for side, leg in (("l", 0), ("r", 1)):
         if side == "r" and amputee:
             continue
         for sph in geo.FOOT_SPHERES:
-            site = model.site(f"{sph}_{side}")
-            contacts.append(f"{sph}_{side}")
-            rows.append(
-                (
-                    site.id,
-                    model.site_bodyid[site.id],
-                    geo.FOOT_SPHERE_RADIUS_M * s,
-                    k_foot,
-                    FOOT_DISSIPATION_S_PER_M,
-                    FOOT_FRICTION,
-                    leg,
-                    0,
-                    geo.FOOT_SPHERE_RADIUS_M * s,
-                    LAW_HUNT_CROSSLEY,
-                    1.5,
-                    0.0,
-                    0.0,
-                )
-            )
+            sphere(f"{sph}_{side}", geo.FOOT_SPHERE_RADIUS_M * s, FOOT_PLANE_STRAIN_MODULUS,
+                   FOOT_DISSIPATION_S_PER_M, FOOT_FRICTION, leg, 0)
         if params.foot == "toes":
-            site = model.site(f"toetip_{side}")
-            contacts.append(f"toetip_{side}")
-            r_tip = TOETIP_RADIUS_M * s
-            rows.append((site.id, model.site_bodyid[site.id], r_tip,
-                         hertz_sphere_stiffness(r_tip, FOOT_PLANE_STRAIN_MODULUS),
-                         FOOT_DISSIPATION_S_PER_M, FOOT_FRICTION, leg, 0, r_tip,
-                         LAW_HUNT_CROSSLEY, 1.5, 0.0, 0.0))
+            sphere(f"toetip_{side}", TOETIP_RADIUS_M * s, FOOT_PLANE_STRAIN_MODULUS,
+                   FOOT_DISSIPATION_S_PER_M, FOOT_FRICTION, leg, 0)
     e_blade = math.nan
     if amputee and blade_model is not None:
         for i, row in enumerate(multilink_contact_rows(model, blade_model)):
@@ -430,25 +418,8 @@ def build_runner(
             rows.append(row)
     elif amputee:
         e_blade = blade_contact_modulus(params)
-        site = model.site("blade_r")
-        contacts.append("blade_r")
-        rows.append(
-            (
-                site.id,
-                model.site_bodyid[site.id],
-                BLADE_RADIUS_M,
-                hertz_sphere_stiffness(BLADE_RADIUS_M, e_blade),
-                params.blade_dissipation_s_per_m,
-                BLADE_FRICTION,
-                1,
-                1,
-                BLADE_RADIUS_M,
-                LAW_HUNT_CROSSLEY,
-                1.5,
-                0.0,
-                0.0,
-            )
-        )
+        sphere("blade_r", BLADE_RADIUS_M, e_blade, params.blade_dissipation_s_per_m,
+               BLADE_FRICTION, 1, 1)
     cp = np.array(rows, dtype=np.float64)
 
     jp = np.zeros((len(dof_names), 7))
