@@ -82,17 +82,18 @@ def _start(label="warm", mu=None):
 
 def test_the_starts_come_in_a_fixed_order_and_only_where_they_apply():
     warm, template, prev = _start(), _start("template"), _start("previous-but-one")
-    plan = st.plan_starts(4, warm, collocation_start=True, template=template, previous=prev)
+    warm_source = "collocation solution at 3.5 m/s"
+    plan = st.plan_starts(4, warm, warm_source=warm_source, template=template, previous=prev)
     assert [s.label for s in plan] == ["warm", "warm-mu-1e-4", "template",
                                        "previous-but-one"]
     assert plan[1].settings.warm_start_mu == st.BARRIER_MU and plan[1].guess is warm.guess
     assert plan[1].settings.same_problem(warm.settings)
-    assert [s.label for s in st.plan_starts(3, warm, collocation_start=True, template=template,
+    assert [s.label for s in st.plan_starts(3, warm, warm_source=warm_source, template=template,
                                             previous=prev)][-1] == "template"
     # a template first guess: no barrier start (tracking stage), no second template
-    assert [s.label for s in st.plan_starts(3, warm, collocation_start=False, template=None,
-                                            previous=None)] == ["warm"]
-    assert [s.label for s in st.plan_starts(1, warm, collocation_start=True, template=template,
+    assert [s.label for s in st.plan_starts(3, warm, warm_source="template at 4 m/s",
+                                            template=template, previous=None)] == ["warm"]
+    assert [s.label for s in st.plan_starts(1, warm, warm_source=warm_source, template=template,
                                             previous=prev)] == ["warm"]
     # settings that already use the barrier start: the alternative is IPOPT's default
     other = st.barrier_start(_start(mu=st.BARRIER_MU))

@@ -486,9 +486,7 @@ def speed_continuation(runner, speeds: Sequence[float], settings: CollocationSet
         if prev is None:
             warm = Start("warm", s_v, first_start)
             plan = [warm] if starts == 1 else plan_starts(
-                starts, warm,
-                collocation_start=str(first_start().source).startswith(COLLOCATION_SOURCE),
-                template=None if str(first_start().source).startswith("template") else template,
+                starts, warm, warm_source=str(first_start().source), template=template,
                 previous=None)
         else:
             warm = Start("warm", s_v, functools.partial(warm_guess, prev, v),
@@ -498,7 +496,7 @@ def speed_continuation(runner, speeds: Sequence[float], settings: CollocationSet
                 functools.partial(warm_guess, prev2, v, " (the previous but one)"),
                 f"warm start from the {prev2.settings.speed_m_per_s:g} m/s solution (the "
                 "previous but one)")
-            plan = plan_starts(starts, warm, collocation_start=True, template=template,
+            plan = plan_starts(starts, warm, warm_source=COLLOCATION_SOURCE, template=template,
                                previous=previous)
         ok, best = out_dir / speed_file(v), out_dir / speed_file(v, converged=False)
         kept, outcomes = solve_starts(
@@ -581,10 +579,8 @@ def max_speed(runner, settings: CollocationSettings, guess, *, model_spec: dict,
     get_runner = LazyRunner(runner, spec)
     if isinstance(guess, CollocationSolution):
         warm = Start("warm", settings, functools.partial(warm_guess, guess, None))
-        source = COLLOCATION_SOURCE
     else:
         warm = Start("warm", settings, lambda: guess)
-        source = str(guess.source)
     plan = [warm]
     if starts > 1:
         template = Start("template", settings, lambda: _template(
@@ -592,8 +588,8 @@ def max_speed(runner, settings: CollocationSettings, guess, *, model_spec: dict,
         prev = None if previous is None else Start(
             "previous-but-one", settings,
             functools.partial(warm_guess, previous, None, " (the previous but one)"))
-        plan = plan_starts(starts, warm, collocation_start=source.startswith(COLLOCATION_SOURCE),
-                           template=None if source.startswith("template") else template,
+        source = COLLOCATION_SOURCE if isinstance(guess, CollocationSolution) else guess.source
+        plan = plan_starts(starts, warm, warm_source=str(source), template=template,
                            previous=prev)
     ok, best = out_dir / MAX_SPEED_FILE, out_dir / MAX_SPEED_BEST_ITERATE_FILE
     kept, outcomes = solve_starts(

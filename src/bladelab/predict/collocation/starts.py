@@ -127,14 +127,19 @@ def barrier_start(warm: Start) -> Start:
     return Start(label, dataclasses.replace(warm.settings, warm_start_mu=mu), warm.guess, text)
 
 
-def plan_starts(k: int, warm: Start, *, collocation_start: bool, template: Start | None,
+def plan_starts(k: int, warm: Start, *, warm_source: str, template: Start | None,
                 previous: Start | None) -> list[Start]:
     """The first ``k`` starts that apply, in :data:`START_ORDER` (module docstring):
-    ``warm``; its barrier start when ``collocation_start`` (the warm start is a collocation
-    solution); ``template`` and ``previous`` unless None."""
+    ``warm``; its barrier start when ``warm_source`` (the source of the warm start's guess)
+    names a collocation solution; ``template`` unless None or the warm start is itself a
+    template guess; ``previous`` unless None."""
+    from bladelab.predict.collocation.solve import COLLOCATION_SOURCE
+
     out = [warm]
-    if collocation_start:
+    if warm_source.startswith(COLLOCATION_SOURCE):
         out.append(barrier_start(warm))
+    if warm_source.startswith("template"):
+        template = None
     out += [s for s in (template, previous) if s is not None]
     return out[:k]
 
@@ -180,13 +185,19 @@ def candidate(label: str, solution) -> Candidate:
                      tuple(solution.gait_warnings()) if ok else ())
 
 
+def _choice_pool(candidates: Sequence[Candidate]) -> list[Candidate]:
+    """The solves a start is kept from: the converged ones without gait warnings, else every
+    converged one (empty if none converged)."""
+    done = [c for c in candidates if c.converged and math.isfinite(c.objective)]
+    return [c for c in done if not c.warnings] or done
+
+
 def pick(candidates: Sequence[Candidate]) -> Candidate:
     """The kept start (module docstring): the lowest objective among converged solves without
     gait warnings, else among converged ones, else the first; ties go to the earlier one."""
     if not candidates:
         raise SpecError("no start to choose from", where="starts")
-    done = [c for c in candidates if c.converged and math.isfinite(c.objective)]
-    pool = [c for c in done if not c.warnings] or done
+    pool = _choice_pool(candidates)
     return min(pool, key=lambda c: c.objective) if pool else candidates[0]
 
 
@@ -202,8 +213,7 @@ def start_columns(candidates: Sequence[Candidate], kept: str,
         row[f"objective_{lab}"] = objs.get(lab, math.nan)
     # the spread among the solves pick() chooses from: a start that ended in a hop is no
     # rival optimum of running gaits (all converged ones when every one has warnings)
-    pool = [objs[c.label] for c in candidates if c.label in objs and not c.warnings]
-    pool = pool or list(objs.values())
+    pool = [float(c.objective) for c in _choice_pool(candidates)]
     lo = min(pool, default=math.nan)
     row["spread_pct"] = (100.0 * (max(pool) - lo) / abs(lo)
                          if len(pool) > 1 and lo != 0 else math.nan)
