@@ -15,10 +15,13 @@ import math
 import casadi as ca
 import numpy as np
 
-from bladelab.predict.collocation.metabolics import MetabolicSmoothing, muscle_metabolic_rates
+from bladelab.predict.collocation.metabolics import (
+    MetabolicSmoothing,
+    muscle_metabolic_rates,
+    whole_body_rate,
+)
 from bladelab.predict.collocation.model import CollocationModel
 from bladelab.predict.collocation.transcription import StrideDynamics
-from bladelab.runner.metabolics import BASAL_RATE_W_PER_KG
 from bladelab.runner.muscle import MP_LOPT, V_MAX_OPT_PER_S
 
 __all__ = ["COORDINATE_BOUNDS_DEG", "stride_dynamics"]
@@ -66,7 +69,7 @@ def stride_dynamics(cm: CollocationModel, *,
     r_mb = cm.dynamics_residual(q, qd, qdd, ft)
     r_hill = cm.muscle_residual(a, ft, dft, l_mt, v_mt)
     rates = muscle_metabolic_rates(runner, u, a, ft, dft, l_mt, v_mt, cm.smoothing, metabolic)
-    met = BASAL_RATE_W_PER_KG * runner.total_mass + ca.sum1(rates)
+    met = whole_body_rate(runner, rates)
     l_m, v_m, cos_a = cm.fiber(l_mt, v_mt, ft, dft)
     l_opt = ca.DM(runner.muscle_params[:, MP_LOPT])
     v_norm = v_m / (V_MAX_OPT_PER_S * l_opt)

@@ -37,7 +37,7 @@ from bladelab.runner.metabolics import (
 )
 from bladelab.runner.muscle import MP_FMAX, MP_LOPT, V_MAX_OPT_PER_S
 
-__all__ = ["MetabolicSmoothing", "metabolic_rate", "muscle_metabolic_rates"]
+__all__ = ["MetabolicSmoothing", "metabolic_rate", "muscle_metabolic_rates", "whole_body_rate"]
 
 
 @dataclass(frozen=True)
@@ -69,9 +69,14 @@ def metabolic_rate(runner, u, a, ft, dft, l_mt, v_mt, smoothing: Smoothing,
                    widths: MetabolicSmoothing | None = None):
     """Whole-body metabolic rate [W] (basal + Σ muscles) as a CasADi expression (arguments as
     :func:`muscle_metabolic_rates`)."""
-    rates = muscle_metabolic_rates(runner, u, a, ft, dft, l_mt, v_mt, smoothing, widths)
-    body_mass = float(np.sum(runner.mj_model.body_mass))
-    return BASAL_RATE_W_PER_KG * body_mass + ca.sum1(rates)
+    return whole_body_rate(runner, muscle_metabolic_rates(runner, u, a, ft, dft, l_mt, v_mt,
+                                                          smoothing, widths))
+
+
+def whole_body_rate(runner, rates):
+    """Whole-body metabolic rate [W]: the basal rate of ``runner``'s mass plus the muscles'
+    ``rates`` [W] (:func:`muscle_metabolic_rates`)."""
+    return BASAL_RATE_W_PER_KG * float(np.sum(runner.mj_model.body_mass)) + ca.sum1(rates)
 
 
 def muscle_metabolic_rates(runner, u, a, ft, dft, l_mt, v_mt, smoothing: Smoothing,

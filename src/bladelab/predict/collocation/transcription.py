@@ -198,6 +198,12 @@ class NLPSolution:
                            self.tendon_force)
 
 
+def _node_pairs(values):
+    """Σ over the mesh intervals of (value at the start + value at the end) of a (1, n + 1)
+    row of node values: the trapezoidal rule's sum, times h/2 for an integral."""
+    return ca.sum2(values[:, :-1]) + ca.sum2(values[:, 1:])
+
+
 #: Scale of :attr:`StrideWeights.metabolic_squared` [(W/kg)²·s/m].
 METABOLIC_SQUARED_SCALE = 10.0
 
@@ -332,11 +338,11 @@ class StrideNLP:
             + [f"periodicity {state_names[i]}" for i in keep]
             + [f"periodicity {nm_}" for nm_ in self._control_names()]
         )
-        trap = (ca.sum2(eff[:, :-1]) + ca.sum2(eff[:, 1:])) / 2 * h  # ∫ effort dt
-        energy = (ca.sum2(mets[:, :-1]) + ca.sum2(mets[:, 1:])) / 2 * h  # ∫ Ė dt [J]
+        trap = _node_pairs(eff) / 2 * h  # ∫ effort dt
+        energy = _node_pairs(mets) / 2 * h  # ∫ Ė dt [J]
         terms = {"effort": trap / period}
         if w.metabolic_squared:
-            sq = (ca.sum2(met_sqs[:, :-1]) + ca.sum2(met_sqs[:, 1:])) / 2 * h
+            sq = _node_pairs(met_sqs) / 2 * h
             terms["metabolic_squared"] = w.metabolic_squared * sq / ca.fmax(distance, 1e-3)
         if self.speed is not None:
             g.append(distance - self.speed * period)
@@ -355,8 +361,7 @@ class StrideNLP:
                                 f"{(n + 1, nq)}", where="tracking")
             dev = (X[2:nq, :] * sx[2:nq, None] - q_ref[:, 2:].T) ** 2
             per_node = ca.sum1(dev) / (nq - 2)
-            terms["tracking"] = float(weight) * (ca.sum2(per_node[:, :-1])
-                                                 + ca.sum2(per_node[:, 1:])) / (2 * n)
+            terms["tracking"] = float(weight) * _node_pairs(per_node) / (2 * n)
         if self.grf_tracking is not None:
             f_ref, weight = self.grf_tracking
             f_ref = np.asarray(f_ref, float).reshape(1, -1)
@@ -365,8 +370,7 @@ class StrideNLP:
                                 f"{n + 1}", where="force tracking")
             bw = d.mass * d.gravity
             dev = ((fzs - f_ref) / bw) ** 2
-            terms["grf_tracking"] = float(weight) * (ca.sum2(dev[:, :-1])
-                                                     + ca.sum2(dev[:, 1:])) / (2 * n)
+            terms["grf_tracking"] = float(weight) * _node_pairs(dev) / (2 * n)
         if self.n_ineq:
             g.append(ca.vec(ineqs[:, :n]))
             self._g_names += [f"inequality {i}@{k}" for k in range(n) for i in range(self.n_ineq)]
