@@ -116,8 +116,8 @@ def _trial_figure(sol, runner, trial):
 
     n = sol.nlp.q.shape[0] - 1
     k0 = _from_left_touchdown(sol)
-    q_sol = np.vstack([np.roll(sol.nlp.q[:-1], -k0, axis=0), np.roll(sol.nlp.q[:-1], -k0,
-                                                                      axis=0)[:1]])
+    rolled = np.roll(sol.nlp.q[:-1], -k0, axis=0)
+    q_sol = np.vstack([rolled, rolled[:1]])  # periodic: the last node is the first
     pct_sol = np.linspace(0.0, 100.0, n + 1)
     pct_trial = np.linspace(0.0, 100.0, trial.q.shape[0])
     fig, axes = plt.subplots(2, 3, figsize=(10, 5.2), sharex=True)
