@@ -112,3 +112,35 @@ def test_squared_muscle_metabolic_rates_term_is_its_stated_integral():
         speed * sol.period) / METABOLIC_SQUARED_SCALE
     assert sol.objective_terms["metabolic_squared"] == pytest.approx(expected, rel=1e-9)
     assert expected > 0.0
+
+
+def test_one_built_solver_serves_every_speed():
+    """The speed is a parameter: an NLP built at 2 m/s and solved at 2.5 m/s gives the same
+    solution as one built at 2.5 m/s, and its solver is built only once."""
+    n = 16
+    shared = StrideNLP(_toy(), n=n, speed=2.0)
+    first = shared.solve(shared.initial_vector(_bouncing_guess(n, 2.0)), hessian="exact",
+                         tol=1e-8)
+    again = shared.solve(shared.initial_vector(_bouncing_guess(n, 2.5)), hessian="exact",
+                         tol=1e-8, speed=2.5)
+    fresh = StrideNLP(_toy(), n=n, speed=2.5)
+    alone = fresh.solve(fresh.initial_vector(_bouncing_guess(n, 2.5)), hessian="exact",
+                        tol=1e-8)
+    assert first.success and again.success and alone.success
+    assert first.timings["build_s"] > 10 * again.timings["build_s"]  # reused, not rebuilt
+    assert again.speed == pytest.approx(2.5, rel=1e-8)
+    assert again.objective == pytest.approx(alone.objective, rel=1e-9)
+    assert again.objective_terms["metabolic"] == pytest.approx(
+        alone.objective_terms["metabolic"], rel=1e-9)
+    np.testing.assert_allclose(again.q, alone.q, atol=1e-9)
+
+
+def test_progress_is_reported_every_iteration_of_each_solve():
+    nlp = StrideNLP(_toy(), n=10, speed=2.0)
+    for speed in (2.0, 2.2):
+        seen = []
+        sol = nlp.solve(nlp.initial_vector(_bouncing_guess(10, speed)), hessian="exact",
+                        speed=speed, progress=lambda it, f, v: seen.append((it, f, v)))
+        assert [s[0] for s in seen] == list(range(sol.iterations + 1))
+        assert seen[-1][1] == pytest.approx(sol.objective, rel=1e-9)
+    assert len(nlp._solvers) == 1

@@ -11,6 +11,15 @@ symbolic code (:mod:`.multibody`, :mod:`.paths`, :mod:`.contact`, :mod:`.muscles
 apart. What is exact and what is smoothed, by how much: ``docs/collocation.md``.
 """
 
+import os
+
+# One BLAS thread for IPOPT and MUMPS (CasADi loads its own OpenBLAS with the first solver, after
+# this): measured, the iterates depend on the number of BLAS threads (the same 60 iterations
+# from the same start ended at objectives 6.19 with two threads and 3.98 with one) and one
+# thread is as fast at these sizes. Set OPENBLAS_NUM_THREADS before the import to override.
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+os.environ.setdefault("OMP_NUM_THREADS", "1")
+
 from bladelab.predict.collocation.model import CollocationModel, build_collocation_model
 from bladelab.predict.collocation.planar import PlanarJoint, PlanarTree, planar_tree
 from bladelab.predict.collocation.smooth import Smoothing

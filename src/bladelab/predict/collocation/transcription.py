@@ -317,6 +317,9 @@ class StrideNLP:
         X = ca.MX.sym("X", self.nx, n + 1)
         U = ca.MX.sym("U", self.nu, n + 1)
         T = ca.MX.sym("T")
+        # the prescribed speed is a parameter of the NLP, so that one built (and expanded)
+        # solver serves every speed of a continuation (building it takes 14-20 s at mesh 50)
+        P = ca.MX.sym("speed")
         period = T * s.period
         h = period / n
         xdot, pth, eff, mets, ineqs, fzs, met_sqs = fmap(X, U)
@@ -345,10 +348,10 @@ class StrideNLP:
             sq = _node_pairs(met_sqs) / 2 * h
             terms["metabolic_squared"] = w.metabolic_squared * sq / ca.fmax(distance, 1e-3)
         if self.speed is not None:
-            g.append(distance - self.speed * period)
+            g.append(distance - P * period)
             self._g_names.append("speed")
             if w.metabolic:  # a zero weight drops the term (0·H would spread any inf/NaN)
-                terms["metabolic"] = w.metabolic * energy / (d.mass * self.speed * period)
+                terms["metabolic"] = w.metabolic * energy / (d.mass * P * period)
         else:
             terms["speed"] = -w.speed * distance / period
             if w.metabolic:
@@ -375,11 +378,12 @@ class StrideNLP:
             g.append(ca.vec(ineqs[:, :n]))
             self._g_names += [f"inequality {i}@{k}" for k in range(n) for i in range(self.n_ineq)]
         J = sum(terms.values())
-        self._terms = ca.Function("terms", [X, U, T], list(terms.values()))
+        self._terms = ca.Function("terms", [X, U, T, P], list(terms.values()))
         self._term_names = tuple(terms)
         self._energy = ca.Function("energy", [X, U, T], [energy, distance])
         w_all = ca.veccat(X, U, T)
-        self.nlp = {"x": w_all, "f": J, "g": ca.vertcat(*g)}
+        self.nlp = {"x": w_all, "f": J, "g": ca.vertcat(*g), "p": P}
+        self._solvers: dict[tuple, tuple[ca.Function, _ProgressRelay]] = {}
         self.n_vars = int(w_all.numel())
         self.n_cons = int(self.nlp["g"].numel())
 
@@ -456,15 +460,25 @@ class StrideNLP:
     # -- solve --------------------------------------------------------------------------
     def solve(self, x0: np.ndarray, *, max_iter: int = 3000, tol: float = 1e-4,
               hessian: str = "limited-memory", print_level: int = 0,
-              options: dict | None = None) -> NLPSolution:
+              options: dict | None = None, speed: float | None = None,
+              progress: Callable[[int, float, float], None] | None = None) -> NLPSolution:
         """Solve with IPOPT: MUMPS with METIS ordering; ``hessian`` ``"limited-memory"``
         (L-BFGS with the adaptive barrier, as PredSim solves muscle-driven gaits; measured:
         the muscle-driven tracking stride converged in 671 iterations, while the exact Hessian
         stalled under inertia regularisation 1e7–1e10) or ``"exact"`` (monotone barrier;
-        converges on problems without muscles, e.g. the toy and torque-driven strides)."""
+        converges on problems without muscles, e.g. the toy and torque-driven strides).
+
+        ``speed`` [m/s] is this solve's prescribed mean speed (default: the NLP's
+        :attr:`speed`; ignored by the maximum-speed problem). ``progress(iteration,
+        objective, violation)`` is called after every IPOPT iteration. The IPOPT solver is
+        built (expanded to SX, 14–20 s at mesh 50) on the first solve with these options and
+        reused by every later one, at any speed (``NLPSolution.timings["build_s"]`` is 0 then).
+        """
         if hessian not in ("limited-memory", "exact"):
             raise SpecError(f"unknown Hessian option {hessian!r}", where="hessian",
                             hint="limited-memory or exact")
+        if speed is not None and not (speed > 0 and math.isfinite(speed)):
+            raise SpecError(f"speed must be > 0 m/s, got {speed}", where="speed")
         opts = {
             "ipopt.max_iter": int(max_iter),
             "ipopt.tol": float(tol),
@@ -481,18 +495,40 @@ class StrideNLP:
         }
         opts.update(options or {})
         t0 = time.perf_counter()
-        solver = ca.nlpsol("stride", "ipopt", self.nlp, opts)
+        solver, relay = self._solver(opts)
         t_build = time.perf_counter() - t0
         lbx, ubx, lbg, ubg = self.bounds()
-        res = solver(x0=x0, lbx=lbx, ubx=ubx, lbg=lbg, ubg=ubg)
+        p = float(speed if speed is not None else (self.speed or 0.0))
+        relay.calls, relay.target = 0, progress
+        try:
+            res = solver(x0=x0, p=p, lbx=lbx, ubx=ubx, lbg=lbg, ubg=ubg)
+        finally:
+            relay.target = None
         wall = time.perf_counter() - t0
         stats = solver.stats()
         return self.unpack(np.asarray(res["x"]).ravel(), stats, wall, t_build, lbg, ubg,
-                           np.asarray(res["g"]).ravel())
+                           np.asarray(res["g"]).ravel(), speed=p)
+
+    #: Solvers kept per NLP (each holds the expanded graph: about 0.3 GB at mesh 50).
+    MAX_SOLVERS = 2
+
+    def _solver(self, opts: dict) -> tuple[ca.Function, _ProgressRelay]:
+        """The IPOPT solver of these options, built once (the oldest is dropped beyond
+        :attr:`MAX_SOLVERS`)."""
+        key = tuple(sorted((k, repr(v)) for k, v in opts.items()))
+        if key not in self._solvers:
+            while len(self._solvers) >= self.MAX_SOLVERS:
+                self._solvers.pop(next(iter(self._solvers)))
+            relay = _ProgressRelay(self)
+            solver = ca.nlpsol("stride", "ipopt", self.nlp, {**opts, "iteration_callback": relay})
+            self._solvers[key] = (solver, relay)
+        return self._solvers[key]
 
     def unpack(self, w: np.ndarray, stats: dict, wall: float, t_build: float,
-               lbg: np.ndarray, ubg: np.ndarray, gval: np.ndarray) -> NLPSolution:
-        """An :class:`NLPSolution` from the scaled vector and IPOPT's statistics."""
+               lbg: np.ndarray, ubg: np.ndarray, gval: np.ndarray, *,
+               speed: float | None = None) -> NLPSolution:
+        """An :class:`NLPSolution` from the scaled vector and IPOPT's statistics (``speed``:
+        the prescribed speed of the solve [m/s], default :attr:`speed`)."""
         d, n = self.dyn, self.n
         nq, nm = d.nq, d.nm
         nX, nU = self.nx * (n + 1), self.nu * (n + 1)
@@ -501,7 +537,7 @@ class StrideNLP:
         T = float(w[-1]) * self.scales.period
         Xs = w[:nX].reshape((self.nx, n + 1), order="F")
         Us = w[nX:nX + nU].reshape((self.nu, n + 1), order="F")
-        values = self._terms(Xs, Us, w[-1])
+        values = self._terms(Xs, Us, w[-1], speed if speed is not None else (self.speed or 0.0))
         if not isinstance(values, (list, tuple)):  # a Function of one output returns it bare
             values = [values]
         terms = [float(v) for v in values]
@@ -538,3 +574,50 @@ class StrideNLP:
         Us = np.hstack([sol.qdd, sol.excitation, sol.tendon_force_rate]).T / self.su[:, None]
         e, dist = self._energy(Xs, Us, sol.period / self.scales.period)
         return float(e), float(dist)
+
+
+class _ProgressRelay(ca.Callback):
+    """IPOPT's iteration callback of one built solver: calls ``target(iteration, objective,
+    max constraint violation)`` when a target is set (:meth:`StrideNLP.solve` sets it for
+    the length of one solve)."""
+
+    def __init__(self, nlp: StrideNLP) -> None:
+        ca.Callback.__init__(self)
+        self.target: Callable[[int, float, float], None] | None = None
+        self.calls = 0
+        self._n_vars, self._n_cons = nlp.n_vars, nlp.n_cons
+        _, _, self._lbg, self._ubg = nlp.bounds()
+        self.construct("stride_progress", {})
+
+    def get_n_in(self):
+        return ca.nlpsol_n_out()
+
+    def get_n_out(self):
+        return 1
+
+    def get_name_in(self, i):
+        return ca.nlpsol_out(i)
+
+    def get_name_out(self, i):
+        return "ret"
+
+    def get_sparsity_in(self, i):
+        name = ca.nlpsol_out(i)
+        if name == "f":
+            return ca.Sparsity.scalar()
+        if name in ("x", "lam_x"):
+            return ca.Sparsity.dense(self._n_vars)
+        if name in ("g", "lam_g"):
+            return ca.Sparsity.dense(self._n_cons)
+        if name == "lam_p":
+            return ca.Sparsity.dense(1)  # the speed parameter
+        return ca.Sparsity(0, 0)
+
+    def eval(self, arg):
+        if self.target is None:
+            return [0]
+        g = np.asarray(arg[2]).ravel()
+        viol = float(np.max(np.maximum(self._lbg - g, g - self._ubg), initial=0.0))
+        self.target(self.calls, float(arg[1]), viol)
+        self.calls += 1
+        return [0]
