@@ -13,6 +13,7 @@ from bladelab.blade import load_blade
 from bladelab.contact import hunt_crossley_force, smooth_spring_damper_force
 from bladelab.predict.collocation import Smoothing, build_collocation_model
 from bladelab.predict.collocation.bounds import (
+    damping_switch_bound,
     hunt_crossley_bound,
     ligament_bound,
     sliding_friction_bound,
@@ -34,6 +35,8 @@ from bladelab.runner.model import (
     JP_HI,
     JP_K,
     JP_LO,
+    JP_SD,
+    JP_SDX,
     JP_SK,
     JP_SK2,
     build_runner,
@@ -53,7 +56,7 @@ from bladelab.runner.muscle import (
 )
 
 N_STATES = 20
-KINDS = ("able", "amputee-Cat6", "able-toes")
+KINDS = ("able", "amputee-Cat6", "able-toes", "transfemoral")
 MUSCLE_KINDS = ("able", "able-toes")  # the toe body's Achilles tendons are twice as compliant
 SM = Smoothing()
 
@@ -65,7 +68,8 @@ def models():
     for kind in KINDS:
         runner = {"able": lambda: build_runner("able"),
                   "able-toes": lambda: build_runner("able", body="toes"),
-                  "amputee-Cat6": lambda: build_runner("amputee", blade="Cat6")}[kind]()
+                  "amputee-Cat6": lambda: build_runner("amputee", blade="Cat6"),
+                  "transfemoral": lambda: build_runner("transfemoral")}[kind]()
         out[kind] = (runner, build_collocation_model(runner))
     return out
 
@@ -218,6 +222,7 @@ def test_ligament_and_socket_torques_match_forward(models, kind):
                 assert tau[j] == 0.0 and lig[j] == 0.0
                 continue
             bound = socket_bound(row[JP_SK2], SM) if spring else 0.0
+            bound += damping_switch_bound(row[JP_SD], row[JP_SDX], SM)  # a hydraulic knee
             if row[JP_K] != 0.0:  # a ligament (the toe hinge has both)
                 margin = min(abs(q[j] - row[JP_LO]), abs(q[j] - row[JP_HI]))
                 if margin < 0.1:

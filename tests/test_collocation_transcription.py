@@ -138,9 +138,9 @@ def test_one_built_solver_serves_every_speed():
 def test_progress_is_reported_every_iteration_of_each_solve():
     nlp = StrideNLP(_toy(), n=10, speed=2.0)
     for speed in (2.0, 2.2):
-        seen = []
+        seen: list[tuple[int, float, float]] = []
         sol = nlp.solve(nlp.initial_vector(_bouncing_guess(10, speed)), hessian="exact",
-                        speed=speed, progress=lambda it, f, v: seen.append((it, f, v)))
+                        speed=speed, progress=lambda it, f, v, seen=seen: seen.append((it, f, v)))
         assert [s[0] for s in seen] == list(range(sol.iterations + 1))
         assert seen[-1][1] == pytest.approx(sol.objective, rel=1e-9)
     assert len(nlp._solvers) == 1

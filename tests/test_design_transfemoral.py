@@ -16,13 +16,13 @@ from bladelab.design.gait_cycle import (
     read_gait_csv,
 )
 from bladelab.design.motion_model import fit_motion_model
-from bladelab.design.prosthetic_knee import ProstheticKnee
 from bladelab.design.transfemoral import (
     RUNNER_RESPONSE_UNITS,
     RunnerEvaluator,
     simulate_transfemoral,
 )
 from bladelab.errors import DataError, InputFileError, SpecError
+from bladelab.runner.prosthetic_knee import ProstheticKnee
 
 G = 9.80665
 

@@ -11,7 +11,7 @@ Model (MuJoCo, built with ``MjSpec``; x forward, z up, pitch about +y):
   and ankle follow the gait cycle by stiff PD servos; two contact circles (heel, toe, radius
   3 cm) under the foot;
 - prosthetic leg: residual thigh + socket (60 % of the thigh mass, + 1 kg socket), hip servo;
-  the passive monocentric knee (:class:`~bladelab.design.prosthetic_knee.ProstheticKnee`) at
+  the passive monocentric knee (:class:`~bladelab.runner.prosthetic_knee.ProstheticKnee`) at
   the sound knee's height; below it a short adapter to the blade clamp, sized so that the
   standing prosthetic leg (knee to the ground, blade undeformed) is ``extra_leg_length_m``
   longer than the sound one; the multi-link blade from its :class:`BladeModel` (passive joints
@@ -45,10 +45,10 @@ from bladelab.constants import STANDARD_GRAVITY
 from bladelab.design.constraints import blade_clearance, knee_buckling, knee_extension_moment
 from bladelab.design.gait_cycle import GaitCycle, default_gait_cycle, read_gait_csv
 from bladelab.design.performance import cycle_performance
-from bladelab.design.prosthetic_knee import ProstheticKnee, knee_torque
 from bladelab.errors import ModelError, SimulationError, SpecError
 from bladelab.runner import geometry as geo
 from bladelab.runner.params import default_runner_params
+from bladelab.runner.prosthetic_knee import ProstheticKnee, knee_torque
 from bladelab.sim.chain import build_chain
 from bladelab.sim.mujoco_blade import add_blade_bodies, lowest_sole_z
 from bladelab.sim.mujoco_engine import contact_forces_3d

@@ -25,6 +25,7 @@ import numpy as np
 import pandas as pd
 
 from bladelab.runner.model import CP_BLADE, CP_EXP, CP_K, CP_LEG
+from bladelab.runner.params import PROSTHETIC_KINDS
 from bladelab.runner.simulate import (
     RC_DEPTH,
     RC_FX,
@@ -590,7 +591,7 @@ def blade_energy(
 
 
 def _blade_name(model) -> str | None:
-    if model.kind != "amputee":
+    if model.kind not in PROSTHETIC_KINDS:
         return None
     return model.blade_model.name if model.blade_model is not None else model.params.blade
 

@@ -43,6 +43,7 @@ from bladelab.runner.model import (
     JP_K,
     JP_LO,
     JP_SD,
+    JP_SDX,
     JP_SK,
     JP_SK2,
 )
@@ -54,7 +55,7 @@ from bladelab.sim.mujoco_engine import add_point_force
 # metabolics.py, muscle.py, contact.py or sim/mujoco_engine.py, bump this number so the loop
 # below is compiled again. This is not always enough (a session saw a controller edit have no
 # effect until the caches were deleted): when in doubt, `make clean-cache`.
-_CACHE_GENERATION = 11
+_CACHE_GENERATION = 12
 
 
 @functools.cache
@@ -177,8 +178,9 @@ def forces(mj, arrays, root_com, dt):
             tau = min(-jp[j, JP_K] * (q - jp[j, JP_HI]) - jp[j, JP_D] * qd, 0.0)
         elif q < jp[j, JP_LO]:
             tau = max(-jp[j, JP_K] * (q - jp[j, JP_LO]) - jp[j, JP_D] * qd, 0.0)
-        if jp[j, JP_SK] != 0.0 or jp[j, JP_SD] != 0.0:
-            tau -= jp[j, JP_SK] * q + jp[j, JP_SK2] * q * abs(q) + jp[j, JP_SD] * qd
+        if jp[j, JP_SK] != 0.0 or jp[j, JP_SD] != 0.0 or jp[j, JP_SDX] != 0.0:
+            damping = jp[j, JP_SD] if qd < 0.0 else jp[j, JP_SDX]
+            tau -= jp[j, JP_SK] * q + jp[j, JP_SK2] * q * abs(q) + damping * qd
         qfrc[j] = tau
         lig[j] = tau
     # ground contacts: sphere or ellipse (semi-axes ax, az in the site's x-z plane)

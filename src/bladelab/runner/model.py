@@ -1,4 +1,4 @@
-"""Build the planar runner (able-bodied or transtibial amputee) in MuJoCo with MjSpec.
+"""Build the planar runner (able-bodied, transtibial or transfemoral amputee) in MuJoCo with MjSpec.
 
 MuJoCo supplies the multibody dynamics, the tendon (muscle path) lengths, velocities and moment
 arms; muscles, ligaments and ground contact are computed by bladelab's own numba code
@@ -9,7 +9,9 @@ Coordinates (``RunnerModel.dof_names``, OpenSim names and signs): ``pelvis_tx``,
 (positive flexes), ``knee_angle_*`` (0 straight, negative flexes), ``ankle_angle_*`` (positive
 dorsiflexes) / ``socket_angle_r`` (amputee), ``lumbar_extension`` (positive extends). All hinges
 turn about the lab's −y axis, so that these signs hold with x forward and z up.
-Side ``l`` is the intact leg of the amputee, ``r`` the prosthetic one.
+Side ``l`` is the intact leg of the amputee, ``r`` the prosthetic one. The transfemoral runner's
+``knee_angle_r`` is its passive prosthetic knee (:mod:`bladelab.runner.prosthetic_knee`); it has
+no ``ankle_angle_r``.
 
 Geometry: SCONE H0918 (Apache-2.0), see :mod:`bladelab.runner.geometry`; masses, inertias and
 muscles: seed 001 Tables 2.1–2.2 via :mod:`bladelab.runner.params`.
@@ -38,6 +40,7 @@ from bladelab.runner.params import (
     FOOT_DISSIPATION_S_PER_M,
     FOOT_FRICTION,
     FOOT_PLANE_STRAIN_MODULUS,
+    PROSTHETIC_KINDS,
     RunnerParams,
     blade_contact_modulus,
     default_runner_params,
@@ -74,6 +77,10 @@ TOETIP_RADIUS_M = 0.02
 TOETIP_CENTRE_M = (0.05, -0.01)  # toe-tip sphere centre from the MTP hinge; its bottom is
 # level with the ball sphere's (radius 0.03) in the neutral pose; foot length 0.27 m in all
 
+# The transfemoral prosthesis's COM below the knee axis, as a fraction of the knee-to-ground
+# depth: a 1.2 kg knee unit at the top and about as much pylon and blade below (our estimate).
+PROSTHETIC_SHANK_COM = 0.4
+
 # Tangential (friction) bristle spring and damper of every contact [N/m, N·s/m].
 FRICTION_STIFFNESS = 5.0e4
 FRICTION_DAMPING = 200.0
@@ -82,8 +89,10 @@ FRICTION_DAMPING = 200.0
 CP_SITE, CP_BODY, CP_RADIUS, CP_K, CP_C, CP_MU, CP_LEG, CP_BLADE = range(8)
 CP_AZ, CP_LAW, CP_EXP, CP_DAMP, CP_WIDTH = range(8, 13)
 LAW_HUNT_CROSSLEY, LAW_SPRING_DAMPER = 0, 1
-# Columns of RunnerModel.joint_params (one row per dof).
-JP_LO, JP_HI, JP_K, JP_D, JP_SK, JP_SK2, JP_SD = range(7)
+# Columns of RunnerModel.joint_params (one row per dof). The joint spring–damper's damping is
+# JP_SD while the joint turns in the negative sense (a knee flexing) and JP_SDX in the positive
+# sense (extending): equal for every joint but a hydraulic prosthetic knee.
+JP_LO, JP_HI, JP_K, JP_D, JP_SK, JP_SK2, JP_SD, JP_SDX = range(8)
 
 
 # Default time step [s]. Under running loads 0.5 ms leaves a 2 ms stance oscillation and a 4.8 %
@@ -120,8 +129,9 @@ class RunnerModel:
         damping [N·s/m] and transition width [m] (spring–damper). Spheres have equal semi-axes;
         the multi-link blade's soles are ellipses in the site's x–z plane.
     joint_params
-        (n_dof, 7): ligament lower, upper [rad], stiffness [N·m/rad], damping [N·m·s/rad], spring
-        K [N·m/rad], K2 [N·m/rad²], D [N·m·s/rad] (the socket's).
+        (n_dof, 8): ligament lower, upper [rad], stiffness [N·m/rad], damping [N·m·s/rad], spring
+        K [N·m/rad], K2 [N·m/rad²], damping D while q̇ < 0 and while q̇ > 0 [N·m·s/rad] (the
+        socket's, a blade joint's, the toes', a prosthetic knee's).
     blade_modulus
         Plane-strain modulus E [N/m²] of the blade sphere (nan for the able model).
     stand_qpos
@@ -180,7 +190,7 @@ class RunnerModel:
         return {
             "kind": self.kind,
             "blade": None
-            if self.kind != "amputee"
+            if self.kind not in PROSTHETIC_KINDS
             else (self.blade_model.name if self.blade_model is not None else self.params.blade),
             "total_mass_kg": self.total_mass,
             "dof": list(self.dof_names),
@@ -221,7 +231,8 @@ def build_runner(
     blade_model: BladeModel | None = None,
     body: str = "seed001",
 ) -> RunnerModel:
-    """Build a runner model from a parameter set (or the name ``"able"`` / ``"amputee"``).
+    """Build a runner model from a parameter set (or the name ``"able"`` / ``"amputee"`` /
+    ``"transfemoral"``).
 
     Parameters
     ----------
@@ -245,8 +256,12 @@ def build_runner(
     elif blade is not None:
         params = runner_params_from_dict({**params.model_dump(), "blade": blade})
     amputee = params.kind == "amputee"
+    transfemoral = params.kind == "transfemoral"
+    prosthetic = params.kind in PROSTHETIC_KINDS
     if blade_model is not None and not amputee:
-        raise ModelError("only the amputee model wears a blade", where="blade_model")
+        raise ModelError("only the (transtibial) amputee model wears a multi-link blade yet",
+                         where="blade_model",
+                         hint="the transfemoral model wears its category's blade sphere")
     mr, s = scale_ratios(params)
 
     spec = mujoco.MjSpec()
@@ -295,12 +310,18 @@ def build_runner(
             f"femur_{side}", f"femur_{side}", f"hip_{side}", f"hip_flexion_{side}", "pelvis", pp, pc
         )
         par, pp, pc = geo.JOINTS[f"knee_{side}"]
-        if side == "r" and amputee:
+        if side == "r" and transfemoral:
+            _add_prosthesis(bodies, joint_child, params, s, mr, axis, parent="femur_r",
+                            pos=_v(_sub(pp, joint_child["femur_r"]), s), joint="knee_angle_r",
+                            depth=_prosthetic_bottom(s, 0.0), com_fraction=PROSTHETIC_SHANK_COM)
+        elif side == "r" and amputee:
             res_len = geo.RESIDUAL_TIBIA_FRACTION * geo.TIBIA_LENGTH_M
             com = [0.0, 0.0, -0.5 * res_len * s]
             add("tibia_res_r", "tibia_res_r", "knee_r", "knee_angle_r", "femur_r", pp, pc, com=com)
             if blade_model is None:
-                _add_prosthesis(bodies, joint_child, params, s, mr, res_len, axis)
+                _add_prosthesis(bodies, joint_child, params, s, mr, axis, parent="tibia_res_r",
+                                pos=[0.0, 0.0, -res_len * s], joint="socket_angle_r",
+                                depth=_prosthetic_bottom(s, res_len))
             else:
                 add_multilink_blade(
                     bodies,
@@ -403,7 +424,7 @@ def build_runner(
                      radius, LAW_HUNT_CROSSLEY, 1.5, 0.0, 0.0))
 
     for side, leg in (("l", 0), ("r", 1)):
-        if side == "r" and amputee:
+        if side == "r" and prosthetic:
             continue
         for sph in geo.FOOT_SPHERES:
             sphere(f"{sph}_{side}", geo.FOOT_SPHERE_RADIUS_M * s, FOOT_PLANE_STRAIN_MODULUS,
@@ -416,13 +437,13 @@ def build_runner(
         for i, row in enumerate(multilink_contact_rows(model, blade_model)):
             contacts.append(f"blade_sole{i}")
             rows.append(row)
-    elif amputee:
+    elif prosthetic:
         e_blade = blade_contact_modulus(params)
         sphere("blade_r", BLADE_RADIUS_M, e_blade, params.blade_dissipation_s_per_m,
                BLADE_FRICTION, 1, 1)
     cp = np.array(rows, dtype=np.float64)
 
-    jp = np.zeros((len(dof_names), 7))
+    jp = np.zeros((len(dof_names), 8))
     jp[:, JP_LO], jp[:, JP_HI] = -np.inf, np.inf
     for i, dn in enumerate(dof_names):
         base = dn[:-2] if dn.endswith(("_l", "_r")) else dn
@@ -430,12 +451,15 @@ def build_runner(
             lo, hi, k, d = LIGAMENTS[base]
             jp[i, :4] = (math.radians(lo), math.radians(hi), k, d)
         if base == "mtp_angle":
-            jp[i, JP_SK:] = (MTP_STIFFNESS, 0.0, MTP_DAMPING)
+            jp[i, JP_SK:] = (MTP_STIFFNESS, 0.0, MTP_DAMPING, MTP_DAMPING)
         if dn == "socket_angle_r":
-            jp[i, JP_SK:] = (SOCKET_STIFFNESS, SOCKET_STIFFNESS_QUADRATIC, SOCKET_DAMPING)
+            jp[i, JP_SK:] = (SOCKET_STIFFNESS, SOCKET_STIFFNESS_QUADRATIC, SOCKET_DAMPING,
+                             SOCKET_DAMPING)
+        if dn == "knee_angle_r" and transfemoral:
+            jp[i] = params.prosthetic_knee.joint_row()
         if dn.startswith("blade_joint") and blade_model is not None:
             j = blade_model.joints[int(dn.removeprefix("blade_joint"))]
-            jp[i, JP_SK:] = (j.stiffness, j.stiffness_quadratic, j.damping)
+            jp[i, JP_SK:] = (j.stiffness, j.stiffness_quadratic, j.damping, j.damping)
 
     runner = RunnerModel(
         params=params,
@@ -489,21 +513,29 @@ def _prosthetic_bottom(s: float, res_len: float) -> float:
     return (intact + BLADE_EXTRA_LENGTH_M) * s - res_len * s
 
 
-def _add_prosthesis(bodies, joint_child, params, s, mr, res_len, axis) -> None:
-    """Prosthesis (socket + blade mass) on the residual tibia, with the blade contact sphere.
+def _add_prosthesis(bodies, joint_child, params, s, mr, axis, *, parent: str, pos,
+                    joint: str, depth: float, com_fraction: float | None = None) -> None:
+    """The prosthesis below a hinge ``joint`` on ``parent`` at ``pos`` (parent frame [m]), with
+    the blade contact sphere: the socket, pylon and blade of the transtibial runner (on the
+    residual tibia, hinge ``socket_angle_r``) or the knee unit, pylon and blade of the
+    transfemoral runner (on the residual femur, hinge ``knee_angle_r``).
 
-    The sphere centre lies a = 0.069 m in front of and b = 0.0693 m below the prosthesis COM,
-    that offset turned by the 9° alignment (seed 001 Fig. 2.3, our reading), and low enough that
-    the prosthetic leg is 3 cm longer than the intact leg (knee to ground, straight leg).
+    The sphere's bottom lies ``depth`` [m] below the hinge (the straight prosthetic leg 3 cm
+    longer than the intact one, knee to ground). The transtibial prosthesis's COM lies
+    a = 0.069 m behind and b = 0.0693 m above the sphere centre, that offset turned by the 9°
+    alignment (seed 001 Fig. 2.3, our reading); with ``com_fraction`` the COM lies that
+    fraction of ``depth`` straight below the hinge instead.
     """
-    bottom = _prosthetic_bottom(s, res_len)
-    centre = (0.0, -(bottom - BLADE_RADIUS_M))  # (x, z) in the socket frame
-    ox, oz = geo.rotate_pitch(
-        BLADE_OFFSET_A_M * s, -BLADE_OFFSET_B_M * s, math.radians(BLADE_ALIGNMENT_DEG)
-    )
-    com = [centre[0] - ox, 0.0, centre[1] - oz]
-    body = bodies["tibia_res_r"].add_body(name="prosthesis_r", pos=[0.0, 0.0, -res_len * s])
-    body.add_joint(name="socket_angle_r", type=mujoco.mjtJoint.mjJNT_HINGE, axis=axis)
+    centre = (0.0, -(depth - BLADE_RADIUS_M))  # (x, z) in the hinge frame
+    if com_fraction is None:
+        ox, oz = geo.rotate_pitch(
+            BLADE_OFFSET_A_M * s, -BLADE_OFFSET_B_M * s, math.radians(BLADE_ALIGNMENT_DEG)
+        )
+        com = [centre[0] - ox, 0.0, centre[1] - oz]
+    else:
+        com = [0.0, 0.0, -com_fraction * depth]
+    body = bodies[parent].add_body(name="prosthesis_r", pos=list(pos))
+    body.add_joint(name=joint, type=mujoco.mjtJoint.mjJNT_HINGE, axis=axis)
     seg = params.segments["prosthesis_r"]
     ixx, iyy, izz = seg.inertia_kg_m2
     body.explicitinertial = True
@@ -532,7 +564,7 @@ def contact_heights(runner: RunnerModel, qpos: np.ndarray) -> np.ndarray:
 def _standing_pose(runner: RunnerModel) -> np.ndarray:
     """Upright pose with all contacts touching: the longer prosthetic leg's knee is flexed."""
     q = np.zeros(runner.mj_model.nq)
-    if runner.kind == "amputee":
+    if runner.kind in PROSTHETIC_KINDS:
         iknee = runner.dof("knee_angle_r")
         ihip = runner.dof("hip_flexion_r")
         lo, hi = -1.5, 0.0

@@ -24,6 +24,7 @@ from bladelab._io import read_yaml
 from bladelab.contact import hertz_sphere_stiffness
 from bladelab.errors import InputFileError, SpecError
 from bladelab.runner.geometry import LEG_MUSCLES, SHANK_MUSCLES, TORSO_MUSCLES
+from bladelab.runner.prosthetic_knee import ProstheticKnee
 
 #: Folder of the runner models' data files (parameter sets, categories, shipped solutions).
 RUNNER_DATA_DIR = Path(__file__).resolve().parents[1] / "data" / "runner"
@@ -83,10 +84,21 @@ class MuscleType(_Strict):
     tendon_strain_at_fmax: float = Field(default=0.04, gt=0.005, lt=0.2)
 
 
+#: The model kinds: seed 001's able-bodied and transtibial ("amputee") runners, and the
+#: transfemoral runner of issue 21 (docs/runner-model.md, "The transfemoral runner").
+KINDS = ("able", "amputee", "transfemoral")
+#: The kinds with a prosthetic right leg (a blade, no shank muscles on that side).
+PROSTHETIC_KINDS = ("amputee", "transfemoral")
+#: Muscles of the transfemoral runner's residual limb: the monoarticular hip muscles, whose
+#: attachments the amputation keeps (the biarticular hamstrings and rectus femoris lose their
+#: tibial insertion; where a surgeon re-attaches them is not modelled).
+RESIDUAL_THIGH_MUSCLES = ("glut_max", "iliopsoas")
+
+
 class RunnerParams(_Strict):
     """A runner parameter set (one YAML file)."""
 
-    kind: Literal["able", "amputee"]
+    kind: Literal["able", "amputee", "transfemoral"]
     blade: str = "Cat6"
     athlete: Athlete
     specific_tension_N_per_cm2: float = Field(gt=0)
@@ -107,6 +119,8 @@ class RunnerParams(_Strict):
     #: ``"toes"`` (a toe segment on a passive metatarsophalangeal hinge, with a toe-tip sphere;
     #: docs/runner-model.md, "The toe segment"). Changes the model's coordinates.
     foot: Literal["rigid", "toes"] = "rigid"
+    #: The prosthetic knee of the transfemoral runner (ignored by the other kinds).
+    prosthetic_knee: ProstheticKnee = Field(default_factory=ProstheticKnee)
 
 
 @dataclass(frozen=True)
@@ -132,13 +146,18 @@ def required_segments(kind: str) -> tuple[str, ...]:
     common = ("torso", "pelvis", "femur_l", "tibia_l", "calcn_l", "femur_r")
     if kind == "amputee":
         return common + ("tibia_res_r", "prosthesis_r")
+    if kind == "transfemoral":
+        return common + ("prosthesis_r",)
     return common + ("tibia_r", "calcn_r")
 
 
 def muscle_names(kind: str) -> tuple[str, ...]:
     """The model's muscle–tendon units in order: intact/left leg, right leg, torso."""
     left = tuple(f"{m}_l" for m in LEG_MUSCLES)
-    right_types = [m for m in LEG_MUSCLES if kind == "able" or m not in SHANK_MUSCLES]
+    if kind == "transfemoral":
+        right_types = [m for m in LEG_MUSCLES if m in RESIDUAL_THIGH_MUSCLES]
+    else:
+        right_types = [m for m in LEG_MUSCLES if kind == "able" or m not in SHANK_MUSCLES]
     right = tuple(f"{m}_r" for m in right_types)
     torso = tuple(f"{m}_{s}" for m in TORSO_MUSCLES for s in ("r", "l"))
     return left + right + torso
@@ -250,7 +269,7 @@ def runner_params_from_dict(data: dict, *, source: str | None = None) -> RunnerP
             where=where,
             hint="see bladelab/data/runner/amputee.yaml for a complete parameter set",
         ) from None
-    if params.kind == "amputee":
+    if params.kind in PROSTHETIC_KINDS:
         try:
             blade_category(params.blade)
         except SpecError as err:
@@ -279,10 +298,11 @@ TOES_BODY_TENDON_STRAIN = {"soleus": 0.08, "gastroc": 0.08}
 def default_runner_params(
     kind: str = "amputee", *, blade: str | None = None, body: str = "seed001"
 ) -> RunnerParams:
-    """The built-in parameter set ``able`` or ``amputee`` (seed 001), optionally another blade
-    and another body (:data:`BODIES`)."""
-    if kind not in ("able", "amputee"):
-        raise SpecError(f"unknown model {kind!r}", where="model", hint="use 'able' or 'amputee'")
+    """The built-in parameter set ``able`` or ``amputee`` (seed 001) or ``transfemoral`` (seed
+    002's athlete), optionally another blade and another body (:data:`BODIES`)."""
+    if kind not in KINDS:
+        raise SpecError(f"unknown model {kind!r}", where="model",
+                        hint="use " + ", ".join(repr(k) for k in KINDS))
     if body not in BODIES:
         raise SpecError(f"unknown body {body!r}", where="body", hint=" or ".join(BODIES))
     text = (RUNNER_DATA_DIR / f"{kind}.yaml").read_text()
@@ -311,6 +331,8 @@ def hertz_compression(force_n: float, modulus: float, radius: float) -> float:
 
 __all__ = [
     "BODIES",
+    "KINDS",
+    "PROSTHETIC_KINDS",
     "RUNNER_DATA_DIR",
     "Athlete",
     "BladeCategory",

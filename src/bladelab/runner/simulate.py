@@ -37,6 +37,7 @@ from bladelab.runner.kernel import (
 )
 from bladelab.runner.model import DEFAULT_DT, RunnerModel, contact_heights
 from bladelab.runner.muscle import equilibrium_fiber_length
+from bladelab.runner.params import PROSTHETIC_KINDS
 from bladelab.sim.compilation import announce_compilation
 
 # Record columns per contact: Fx, Fz [N], contact point x, z [m], point velocity vx, vz [m/s],
@@ -159,7 +160,7 @@ class RunnerResult:
 
 def leg_names(model: RunnerModel) -> tuple[str, str]:
     """Names of the left and right legs in tables: (intact, prosthetic) or (left, right)."""
-    return ("intact", "prosthetic") if model.kind == "amputee" else ("left", "right")
+    return ("intact", "prosthetic") if model.kind in PROSTHETIC_KINDS else ("left", "right")
 
 
 def initial_qpos(model: RunnerModel, state: str | dict = "stand") -> tuple[np.ndarray, np.ndarray]:

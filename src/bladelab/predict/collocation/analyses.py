@@ -35,6 +35,7 @@ import math
 import numpy as np
 
 from bladelab.errors import SpecError
+from bladelab.runner.params import PROSTHETIC_KINDS
 
 __all__ = ["JOINT_LABELS", "N_STRIDES", "REFINE", "stride_analyses"]
 
@@ -136,7 +137,7 @@ def stride_analyses(solution, runner=None, *, refine: int = REFINE, cm=None) -> 
         generated += out[f"leg_energy_generated_{leg}_J"]
     out["leg_energy_generated_total_J"] = generated
 
-    if solution.model_spec["model"] == "amputee":
+    if solution.model_spec["model"] in PROSTHETIC_KINDS:
         rows = _middle(an.blade_energy(res), "touchdown_s", period, legs[1])
         out["blade_energy_stored_J"] = _mean(rows["E_stored_J"])
         out["blade_energy_returned_J"] = _mean(rows["E_returned_J"])

@@ -108,3 +108,11 @@ def ligament_bound(margin: float, velocity: float, stiffness: float, damping: fl
 def socket_bound(stiffness_quadratic: float, smoothing: Smoothing) -> float:
     """|smooth − forward| socket torque [N·m]: ``K2·|q|·(√(q² + ε²) − |q|) ≤ K2·ε²/2``."""
     return 0.5 * stiffness_quadratic * smoothing.socket_angle_rad**2
+
+
+def damping_switch_bound(damping_negative: float, damping_positive: float,
+                         smoothing: Smoothing) -> float:
+    """|smooth − forward| torque [N·m] of a joint damped differently in its two senses (a
+    hydraulic knee): the sigmoid gate between the two dampings costs at most
+    ``|ΔD|·|q̇|·σ(−|q̇|/w)``, whose maximum over q̇ is ``0.2785·w·|ΔD|``."""
+    return 0.2785 * smoothing.damping_switch_rad_s * abs(damping_negative - damping_positive)

@@ -46,6 +46,7 @@ from bladelab.runner.model import (
     JP_K,
     JP_LO,
     JP_SD,
+    JP_SDX,
     JP_SK,
     JP_SK2,
     LAW_HUNT_CROSSLEY,
@@ -132,9 +133,14 @@ def passive_torques(q: ca.SX, qd: ca.SX, joint_params: np.ndarray, smoothing: Sm
             if math.isfinite(row[JP_LO]):
                 e = float(row[JP_LO]) - q[j]
                 tau += smooth_max0(k * softplus(e, w) - d * qd[j] * sigmoid(e, w), eps_t)
-        if row[JP_SK] != 0.0 or row[JP_SD] != 0.0:
+        if row[JP_SK] != 0.0 or row[JP_SD] != 0.0 or row[JP_SDX] != 0.0:
             absq = ca.sqrt(q[j] * q[j] + eps_s * eps_s)
             tau -= float(row[JP_SK]) * q[j] + float(row[JP_SK2]) * q[j] * absq
-            tau -= float(row[JP_SD]) * qd[j]
+            d_neg, d_pos = float(row[JP_SD]), float(row[JP_SDX])
+            if d_neg == d_pos:
+                tau -= d_neg * qd[j]
+            else:  # a hydraulic knee: one damping flexing, another extending
+                gate = sigmoid(qd[j], smoothing.damping_switch_rad_s)
+                tau -= (d_neg + (d_pos - d_neg) * gate) * qd[j]
         out.append(tau)
     return ca.vertcat(*out)

@@ -55,6 +55,9 @@ class Smoothing:
         velocity in v_max).
     activation
         w of the switch between activation and deactivation rates [-] (``u − a``).
+    damping_switch_rad_s
+        w of the switch between a joint's flexion and extension damping (a hydraulic
+        prosthetic knee) [rad/s]: off by at most 0.28·w·|D_flex − D_ext| [N·m].
     """
 
     contact_depth_m: float = 2.5e-4  # 1 mm gave a 3.4 % dynamics residual, 0.25 mm 0.55 %
@@ -69,6 +72,7 @@ class Smoothing:
     passive_length: float = 0.01
     force_velocity: float = 0.005
     activation: float = 0.005
+    damping_switch_rad_s: float = 0.01
 
     def __post_init__(self) -> None:
         for name, value in asdict(self).items():

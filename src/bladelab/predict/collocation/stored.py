@@ -38,23 +38,25 @@ __all__ = [
 
 
 def check_model_spec(spec) -> dict:
-    """The model specification ``{"model": "able" | "amputee", "blade": name | None}``, plus
+    """The model specification ``{"model": "able" | "amputee" | "transfemoral", "blade": name |
+    None}``, plus
     ``"body"`` where it is not seed 001's (:data:`bladelab.runner.params.BODIES`), checked and
     normalised (the able model has no blade; the amputee needs one; files written before the
     bodies existed have no ``"body"`` and mean seed 001's)."""
     if not isinstance(spec, dict) or "model" not in spec:
         raise SpecError(f"expected {{'model': ..., 'blade': ...}}, got {spec!r}",
                         where="model_spec")
+    from bladelab.runner.params import BODIES, KINDS
+
     model = spec["model"]
-    if model not in ("able", "amputee"):
-        raise SpecError(f"unknown model {model!r}", where="model", hint="able or amputee")
+    if model not in KINDS:
+        raise SpecError(f"unknown model {model!r}", where="model", hint=" or ".join(KINDS))
     blade = spec.get("blade")
     if model == "able":
         blade = None
     elif not isinstance(blade, str) or not blade:
-        raise SpecError("the amputee model needs a blade category", where="blade",
+        raise SpecError(f"the {model} model needs a blade category", where="blade",
                         hint="e.g. Cat6")
-    from bladelab.runner.params import BODIES
 
     body = spec.get("body", "seed001")
     if body not in BODIES:

@@ -10,6 +10,12 @@ on the shank about the knee [N·m]:
 Default values are illustrative for a sprint setting (the 3S80's resistances are adjustable and
 not published as numbers): c_f 1.5, c_e 0.8 N·m·s/rad, k_a 8 N·m/rad about q_a0 = 0, the stop at
 0° with k_s 2e4 N·m/rad and d_s 100 N·m·s/rad (a stiff bumper).
+
+The transfemoral runner (:func:`bladelab.runner.build_runner` ``"transfemoral"``) uses the same
+knee in its own sign convention (``knee_angle_r``: 0 straight, negative flexes):
+:meth:`ProstheticKnee.joint_row` gives its row of ``RunnerModel.joint_params``; there the stop is
+the joint's upper ligament limit (with a flexion stop at :attr:`ProstheticKnee.flexion_limit`)
+and the runner's ligament law applies (the stop pushes, never pulls).
 """
 
 from __future__ import annotations
@@ -38,6 +44,9 @@ class ProstheticKnee:
         Hyperextension stop q_s [rad], k_s [N·m/rad], d_s [N·m·s/rad].
     mass
         Knee mechanism mass [kg] (on the shank below the axis).
+    flexion_limit
+        Mechanical flexion stop [rad] (flexion-positive), with the stop's stiffness and
+        damping (the transfemoral runner only; 140°, about the 3S80's range).
     """
 
     flexion_damping: float = 1.5
@@ -48,6 +57,7 @@ class ProstheticKnee:
     stop_stiffness: float = 2.0e4
     stop_damping: float = 100.0
     mass: float = 1.2
+    flexion_limit: float = math.radians(140.0)
 
     def __post_init__(self) -> None:
         for name, v in asdict(self).items():
@@ -70,6 +80,21 @@ class ProstheticKnee:
 
     def to_dict(self) -> dict:
         return asdict(self)
+
+    def joint_row(self):
+        """This knee as a row of ``RunnerModel.joint_params`` (columns ``JP_*`` of
+        :mod:`bladelab.runner.model`) for a knee coordinate that is negative in flexion:
+        ligament limits (−flexion_limit, −stop_angle) with the stop's stiffness and damping,
+        the assist spring as the joint spring (about 0, so ``assist_rest_angle`` must be 0),
+        flexion damping while q̇ < 0 and extension damping while q̇ > 0."""
+        import numpy as np
+
+        if self.assist_rest_angle != 0.0:
+            raise SpecError("the runner's knee spring acts about 0: assist_rest_angle must be 0",
+                            where="prosthetic knee: assist_rest_angle")
+        return np.array([-self.flexion_limit, -self.stop_angle, self.stop_stiffness,
+                         self.stop_damping, self.assist_stiffness, 0.0, self.flexion_damping,
+                         self.extension_damping])
 
 
 @njit(cache=True)
