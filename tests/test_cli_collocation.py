@@ -86,3 +86,16 @@ def test_bad_options_are_refused_naming_the_option(args, where, tmp_path, capsys
     err = capsys.readouterr().err
     assert err.startswith("error:") and where in err
     assert not (tmp_path / "run" / "solution.json").exists()
+
+
+def test_the_transfemoral_runner_is_solved_with_its_own_blade(tmp_path, capsys):
+    """``--model transfemoral`` (issue 21) runs end to end: its default blade (Cat4) goes into
+    the file, and the legs are named intact and prosthetic."""
+    out = tmp_path / "tf"
+    code = main(["predict", "--method", "collocation", "--model", "transfemoral", "--out",
+                 str(out), "--speed", "4", "--mesh", "6", "--max-iter", "2", "--json"])
+    assert code == 2  # two iterations do not converge
+    summary = json.loads(capsys.readouterr().out)
+    assert "contact_time_prosthetic_s" in summary and "contact_time_intact_s" in summary
+    stored = json.loads((out / "best_iterate.json").read_text())
+    assert stored["model"] == {"model": "transfemoral", "blade": "Cat4"}

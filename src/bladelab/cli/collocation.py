@@ -133,7 +133,7 @@ def run_collocation(
     *,
     out: Path,
     model: str,
-    blade: str,
+    blade: str | None,
     speed: float,
     max_speed: bool,
     mesh: int,
@@ -148,9 +148,12 @@ def run_collocation(
     2 not converged)."""
     from bladelab.predict.collocation.solve import CollocationSettings, predict_stride_in_folder
     from bladelab.predict.collocation.stored import check_model_spec, runner_from_spec
+    from bladelab.runner.params import KINDS, default_runner_params
 
-    if model not in ("able", "amputee"):
-        raise SpecError(f"unknown model {model!r}", where="--model", hint="able or amputee")
+    if model not in KINDS:
+        raise SpecError(f"unknown model {model!r}", where="--model", hint=" or ".join(KINDS))
+    if blade is None and model != "able":
+        blade = default_runner_params(model).blade
     if not max_speed and not (math.isfinite(speed) and speed > 0):
         raise SpecError("speed must be positive", where="--speed")
     if mesh < 4:

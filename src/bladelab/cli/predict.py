@@ -39,8 +39,11 @@ def register(app: typer.Typer) -> None:
     @app.command("predict")
     def predict(
         out: Path = typer.Option(..., "--out", help="Output folder (checkpoint, best.json)."),
-        model: str = typer.Option("able", "--model", help="able | amputee"),
-        blade: str = typer.Option("Cat6", "--blade", help="Blade category of the amputee."),
+        model: str = typer.Option(
+            "able", "--model", help="able | amputee | transfemoral (collocation only)."),
+        blade: str | None = typer.Option(
+            None, "--blade", help="Blade category of the amputee (default Cat6; the "
+            "transfemoral runner's: Cat4)."),
         speed: float = typer.Option(3.5, "--speed", help="Prescribed speed (m/s)."),
         init: Path | None = typer.Option(None, "--init", help="Warm start: parameters JSON."),
         generations: int = typer.Option(100, "--generations", help="CMA-ES generations."),
@@ -117,6 +120,7 @@ def register(app: typer.Typer) -> None:
         if not (math.isfinite(speed) and speed > 0):
             raise SpecError("speed must be positive", where="--speed")
         _check_simulation_options(dt, robust_samples, robust_jitter)
+        blade = blade or "Cat6"
         _, layout = runner_and_layout(model, blade if model == "amputee" else None)
         x0 = read_parameters(init, layout, transfer=True) if init is not None else None
         seed_list = _parse_list(seeds, "--seeds", int)
