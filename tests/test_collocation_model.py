@@ -233,11 +233,12 @@ def test_ligament_and_socket_torques_match_forward(models, kind):
     assert checked >= 3 * N_STATES
 
 
-def test_multilink_blade_model_matches_forward():
-    """The amputee wearing a multi-link blade (extra hinge about +y, ellipse soles turned in
+@pytest.mark.parametrize("kind", ["amputee", "transfemoral"])
+def test_multilink_blade_model_matches_forward(kind):
+    """An amputee wearing a multi-link blade (extra hinge about +y, ellipse soles turned in
     their bodies, spring–damper law): inverse dynamics, contact geometry, sole normal forces
     (within the stated bound) and the blade joint's spring."""
-    runner = build_runner("amputee", blade_model=load_blade("xtreme-cat5").build())
+    runner = build_runner(kind, blade_model=load_blade("xtreme-cat5").build())
     cm = build_collocation_model(runner)
     m = runner.mj_model
     d = mujoco.MjData(m)

@@ -95,8 +95,29 @@ def test_knee_parameters_are_read_from_the_parameter_set():
         build_runner(runner_params_from_dict(data))
 
 
-def test_the_transfemoral_model_refuses_a_multilink_blade_for_now():
+def test_the_transfemoral_runner_wears_a_multilink_blade_below_its_knee():
+    """The design's blades (seed 002 varies their shape) mount under the knee unit: the total
+    mass is kept, the blade's links hang from the prosthesis below the knee, and it stands."""
     from bladelab.blade import load_blade
 
-    with pytest.raises(ModelError, match="multi-link"):
-        build_runner("transfemoral", blade_model=load_blade("xtreme-cat5"))
+    blade = load_blade("xtreme-cat5").build()
+    runner = build_runner("transfemoral", blade_model=blade)
+    assert runner.total_mass == pytest.approx(58.3, rel=1e-12)
+    assert "knee_angle_r" in runner.dof_names and "blade_joint0" in runner.dof_names
+    soles = [c for c in runner.contact_names if c.startswith("blade_sole")]
+    assert len(soles) == len(blade.soles) >= 1
+    m = runner.mj_model
+    link = m.body(m.jnt_bodyid[m.joint("blade_joint0").id])
+    parents = set()
+    b = link.id
+    while b:
+        b = int(m.body_parentid[b])
+        parents.add(m.body(b).name)
+    assert {"prosthesis_r", "femur_r"} <= parents
+    assert runner.segment_mass("prosthesis_r") == pytest.approx(
+        3.2 * 58.3 / 77.34 - blade.mass, rel=1e-9)
+    assert contact_heights(runner, runner.stand_qpos).min() == pytest.approx(0.0, abs=1e-12)
+    j = runner.dof("knee_angle_r")
+    np.testing.assert_array_equal(runner.joint_params[j], ProstheticKnee().joint_row())
+    with pytest.raises(ModelError, match="amputee"):
+        build_runner("able", blade_model=blade)

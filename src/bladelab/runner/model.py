@@ -80,6 +80,9 @@ TOETIP_CENTRE_M = (0.05, -0.01)  # toe-tip sphere centre from the MTP hinge; its
 # The transfemoral prosthesis's COM below the knee axis, as a fraction of the knee-to-ground
 # depth: a 1.2 kg knee unit at the top and about as much pylon and blade below (our estimate).
 PROSTHETIC_SHANK_COM = 0.4
+# With a multi-link blade, the knee unit and pylon (the prosthesis mass minus the blade's) have
+# their COM this far below the knee axis [m, reference athlete]: mostly the knee unit.
+PROSTHETIC_PYLON_COM_M = 0.08
 
 # Tangential (friction) bristle spring and damper of every contact [N/m, N·s/m].
 FRICTION_STIFFNESS = 5.0e4
@@ -258,10 +261,8 @@ def build_runner(
     amputee = params.kind == "amputee"
     transfemoral = params.kind == "transfemoral"
     prosthetic = params.kind in PROSTHETIC_KINDS
-    if blade_model is not None and not amputee:
-        raise ModelError("only the (transtibial) amputee model wears a multi-link blade yet",
-                         where="blade_model",
-                         hint="the transfemoral model wears its category's blade sphere")
+    if blade_model is not None and not prosthetic:
+        raise ModelError("only an amputee model wears a blade", where="blade_model")
     mr, s = scale_ratios(params)
 
     spec = mujoco.MjSpec()
@@ -311,9 +312,15 @@ def build_runner(
         )
         par, pp, pc = geo.JOINTS[f"knee_{side}"]
         if side == "r" and transfemoral:
-            _add_prosthesis(bodies, joint_child, params, s, mr, axis, parent="femur_r",
-                            pos=_v(_sub(pp, joint_child["femur_r"]), s), joint="knee_angle_r",
-                            depth=_prosthetic_bottom(s, 0.0), com_fraction=PROSTHETIC_SHANK_COM)
+            knee = {"parent": "femur_r", "pos": _v(_sub(pp, joint_child["femur_r"]), s),
+                    "joint": "knee_angle_r"}
+            depth = _prosthetic_bottom(s, 0.0)
+            if blade_model is None:
+                _add_prosthesis(bodies, joint_child, params, s, mr, axis, depth=depth,
+                                com_fraction=PROSTHETIC_SHANK_COM, **knee)
+            else:
+                add_multilink_blade(bodies, joint_child, params, s, mr, axis, blade_model,
+                                    depth, com_z=-PROSTHETIC_PYLON_COM_M, **knee)
         elif side == "r" and amputee:
             res_len = geo.RESIDUAL_TIBIA_FRACTION * geo.TIBIA_LENGTH_M
             com = [0.0, 0.0, -0.5 * res_len * s]
@@ -323,17 +330,9 @@ def build_runner(
                                 pos=[0.0, 0.0, -res_len * s], joint="socket_angle_r",
                                 depth=_prosthetic_bottom(s, res_len))
             else:
-                add_multilink_blade(
-                    bodies,
-                    joint_child,
-                    params,
-                    s,
-                    mr,
-                    res_len,
-                    axis,
-                    blade_model,
-                    _prosthetic_bottom(s, res_len),
-                )
+                add_multilink_blade(bodies, joint_child, params, s, mr, axis, blade_model,
+                                    _prosthetic_bottom(s, res_len),
+                                    pos=[0.0, 0.0, -res_len * s])
         else:
             add(
                 f"tibia_{side}",
@@ -433,7 +432,7 @@ def build_runner(
             sphere(f"toetip_{side}", TOETIP_RADIUS_M * s, FOOT_PLANE_STRAIN_MODULUS,
                    FOOT_DISSIPATION_S_PER_M, FOOT_FRICTION, leg, 0)
     e_blade = math.nan
-    if amputee and blade_model is not None:
+    if prosthetic and blade_model is not None:
         for i, row in enumerate(multilink_contact_rows(model, blade_model)):
             contacts.append(f"blade_sole{i}")
             rows.append(row)

@@ -1,4 +1,4 @@
-"""Wear a multi-link blade (:class:`bladelab.blade.BladeModel`) on the amputee runner.
+"""Wear a multi-link blade (:class:`bladelab.blade.BladeModel`) on an amputee runner.
 
 This links the characterise and predict workflows: a blade whose compliant joints carry
 identified K* and D* (``BladeModel.with_joint_parameters``) replaces seed 001's massless contact
@@ -29,8 +29,15 @@ BLADE_NAMES = BladeNames(body="blade_link{index}", joint="blade_joint{index}",
                          sole="blade_sole{index}", tip=None)
 
 
-def add_multilink_blade(bodies, joint_child, params, s, mr, res_len, axis, blade, bottom) -> None:
-    """Add the socket body and the blade's links under the residual tibia (MjSpec)."""
+def add_multilink_blade(bodies, joint_child, params, s, mr, axis, blade, bottom, *,
+                        parent: str = "tibia_res_r", pos=(0.0, 0.0, 0.0),
+                        joint: str = "socket_angle_r", com_z: float = 0.05) -> None:
+    """Add the prosthesis body on a hinge ``joint`` of ``parent`` at ``pos`` (parent frame
+    [m]) and the blade's links under it (MjSpec): the socket under the residual tibia (the
+    transtibial runner), or the knee unit and pylon under the residual femur (the
+    transfemoral runner). The body keeps the prosthesis mass minus the blade's, its COM
+    ``com_z`` [m, reference athlete] above the hinge (negative: below); the blade's lowest
+    sole point lies ``bottom`` [m] below the hinge."""
     if not blade.soles or not blade.joints:
         raise ModelError(
             "the blade needs at least one sole and one compliant joint", where="blade_model"
@@ -43,13 +50,13 @@ def add_multilink_blade(bodies, joint_child, params, s, mr, res_len, axis, blade
             where="blade_model",
             hint="the Table 2.1 prosthesis mass includes socket and blade",
         )
-    body = bodies["tibia_res_r"].add_body(name="prosthesis_r", pos=[0.0, 0.0, -res_len * s])
-    body.add_joint(name="socket_angle_r", type=mujoco.mjtJoint.mjJNT_HINGE, axis=axis)
+    body = bodies[parent].add_body(name="prosthesis_r", pos=list(pos))
+    body.add_joint(name=joint, type=mujoco.mjtJoint.mjJNT_HINGE, axis=axis)
     ixx, iyy, izz = seg.inertia_kg_m2
     f = socket_mass / seg.mass_kg * s * s
     body.explicitinertial = True
     body.mass = socket_mass
-    body.ipos = [0.0, 0.0, 0.05 * s]
+    body.ipos = [0.0, 0.0, com_z * s]
     body.inertia = [max(ixx * f, izz * f - iyy * f + 1e-6), izz * f, iyy * f]
     bodies["prosthesis_r"] = body
     joint_child["prosthesis_r"] = (0.0, 0.0, 0.0)
