@@ -35,6 +35,7 @@ import casadi as ca
 import numpy as np
 
 from bladelab.errors import SpecError
+from bladelab.predict.collocation.progress import ProgressRelay
 
 __all__ = [
     "NLPSolution",
@@ -383,7 +384,7 @@ class StrideNLP:
         self._energy = ca.Function("energy", [X, U, T], [energy, distance])
         w_all = ca.veccat(X, U, T)
         self.nlp = {"x": w_all, "f": J, "g": ca.vertcat(*g), "p": P}
-        self._solvers: dict[tuple, tuple[ca.Function, _ProgressRelay]] = {}
+        self._solvers: dict[tuple, tuple[ca.Function, ProgressRelay]] = {}
         self.n_vars = int(w_all.numel())
         self.n_cons = int(self.nlp["g"].numel())
 
@@ -512,14 +513,14 @@ class StrideNLP:
     #: Solvers kept per NLP (each holds the expanded graph: about 0.3 GB at mesh 50).
     MAX_SOLVERS = 2
 
-    def _solver(self, opts: dict) -> tuple[ca.Function, _ProgressRelay]:
+    def _solver(self, opts: dict) -> tuple[ca.Function, ProgressRelay]:
         """The IPOPT solver of these options, built once (the oldest is dropped beyond
         :attr:`MAX_SOLVERS`)."""
         key = tuple(sorted((k, repr(v)) for k, v in opts.items()))
         if key not in self._solvers:
             while len(self._solvers) >= self.MAX_SOLVERS:
                 self._solvers.pop(next(iter(self._solvers)))
-            relay = _ProgressRelay(self)
+            relay = ProgressRelay(self)
             solver = ca.nlpsol("stride", "ipopt", self.nlp, {**opts, "iteration_callback": relay})
             self._solvers[key] = (solver, relay)
         return self._solvers[key]
@@ -575,49 +576,3 @@ class StrideNLP:
         e, dist = self._energy(Xs, Us, sol.period / self.scales.period)
         return float(e), float(dist)
 
-
-class _ProgressRelay(ca.Callback):
-    """IPOPT's iteration callback of one built solver: calls ``target(iteration, objective,
-    max constraint violation)`` when a target is set (:meth:`StrideNLP.solve` sets it for
-    the length of one solve)."""
-
-    def __init__(self, nlp: StrideNLP) -> None:
-        ca.Callback.__init__(self)
-        self.target: Callable[[int, float, float], None] | None = None
-        self.calls = 0
-        self._n_vars, self._n_cons = nlp.n_vars, nlp.n_cons
-        _, _, self._lbg, self._ubg = nlp.bounds()
-        self.construct("stride_progress", {})
-
-    def get_n_in(self):
-        return ca.nlpsol_n_out()
-
-    def get_n_out(self):
-        return 1
-
-    def get_name_in(self, i):
-        return ca.nlpsol_out(i)
-
-    def get_name_out(self, i):
-        return "ret"
-
-    def get_sparsity_in(self, i):
-        name = ca.nlpsol_out(i)
-        if name == "f":
-            return ca.Sparsity.scalar()
-        if name in ("x", "lam_x"):
-            return ca.Sparsity.dense(self._n_vars)
-        if name in ("g", "lam_g"):
-            return ca.Sparsity.dense(self._n_cons)
-        if name == "lam_p":
-            return ca.Sparsity.dense(1)  # the speed parameter
-        return ca.Sparsity(0, 0)
-
-    def eval(self, arg):
-        if self.target is None:
-            return [0]
-        g = np.asarray(arg[2]).ravel()
-        viol = float(np.max(np.maximum(self._lbg - g, g - self._ubg), initial=0.0))
-        self.target(self.calls, float(arg[1]), viol)
-        self.calls += 1
-        return [0]
