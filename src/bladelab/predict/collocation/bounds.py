@@ -101,7 +101,7 @@ def ligament_bound(margin: float, velocity: float, stiffness: float, damping: fl
     Each limit's softplus excursion and sigmoid damping gate differ from the forward switch by
     at most ``(K·w + D·|q̇|)·e^{−margin/w}``; the smooth max adds at most ε_τ/2 per limit.
     """
-    w, eps = smoothing.ligament_angle_rad, smoothing.ligament_torque_nm
+    w, eps = smoothing.ligament_width(stiffness), smoothing.ligament_torque_nm
     return eps + 2.0 * (stiffness * w + damping * abs(velocity)) * math.exp(-margin / w)
 
 

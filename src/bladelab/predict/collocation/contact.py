@@ -120,12 +120,13 @@ def contact_forces(
 
 def passive_torques(q: ca.SX, qd: ca.SX, joint_params: np.ndarray, smoothing: Smoothing) -> ca.SX:
     """Smooth ligament and socket (blade-joint) torques (nv,) [N·m] at (q [rad], qd [rad/s])."""
-    w, eps_t = smoothing.ligament_angle_rad, smoothing.ligament_torque_nm
+    eps_t = smoothing.ligament_torque_nm
     eps_s = smoothing.socket_angle_rad
     out = []
     for j, row in enumerate(joint_params):
         tau = 0.0
         k, d = float(row[JP_K]), float(row[JP_D])
+        w = smoothing.ligament_width(k)
         if k != 0.0 or d != 0.0:
             if math.isfinite(row[JP_HI]):
                 e = q[j] - float(row[JP_HI])

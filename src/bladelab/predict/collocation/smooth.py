@@ -16,6 +16,7 @@ as stated); the error each causes is stated in ``docs/collocation.md`` and measu
 
 from __future__ import annotations
 
+import math
 from dataclasses import asdict, dataclass
 
 import casadi as ca
@@ -41,7 +42,13 @@ class Smoothing:
     friction_velocity_mps
         v_t of the friction ``−μ·Fn·tanh(v/v_t)`` [m/s].
     ligament_angle_rad
-        w of the softplus of a ligament's excursion beyond its limit [rad].
+        w of the softplus of a ligament's excursion beyond its limit [rad]; a stiff limit gets
+        a narrower one (:meth:`ligament_width`).
+    ligament_offset_nm
+        Largest torque the softplus adds at a limit, ``k·w·ln 2`` [N·m]: a limit stiffer than
+        ``ligament_offset_nm / (ligament_angle_rad·ln 2)`` (3.6 kN·m/rad) gets ``w = offset /
+        (k·ln 2)`` (the prosthetic knee's 20 kN·m/rad stop: 0.36 mrad; measured, the
+        0.002 rad width left 24 N·m of dynamics residual at the stop).
     ligament_torque_nm
         ε of the smooth positive part of a ligament torque [N·m].
     socket_angle_rad
@@ -67,6 +74,7 @@ class Smoothing:
     friction_velocity_mps: float = 0.03
     ligament_angle_rad: float = 0.002  # 0.01 gave the amputee a 2.6 % dynamics residual, 0.002 0.47 %
     ligament_torque_nm: float = 0.5
+    ligament_offset_nm: float = 5.0
     socket_angle_rad: float = 1.0e-3
     tendon_strain: float = 1.0e-3
     passive_length: float = 0.01
@@ -81,6 +89,13 @@ class Smoothing:
 
     def to_dict(self) -> dict[str, float]:
         return asdict(self)
+
+    def ligament_width(self, stiffness: float) -> float:
+        """The softplus width [rad] of a ligament limit of ``stiffness`` [N·m/rad]."""
+        if stiffness <= 0.0:
+            return self.ligament_angle_rad
+        return min(self.ligament_angle_rad,
+                   self.ligament_offset_nm / (stiffness * math.log(2.0)))
 
 
 def smooth_max0(x, eps: float):
