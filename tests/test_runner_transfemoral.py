@@ -72,7 +72,8 @@ def test_the_knee_is_the_3s80_law_in_the_runners_sign(runner, q_deg, qd):
     numba, used by the design evaluator) positive: τ_runner(q, q̇) = −τ_3S80(−q, −q̇); flexing
     (q̇ < 0) meets the flexion damping, extending the extension damping, and past the
     hyperextension stop (q > 0) the stop pushes back."""
-    knee = ProstheticKnee()
+    knee = runner.params.prosthetic_knee
+    assert knee == ProstheticKnee(stop_damping=10.0)  # the parameter set's bumper
     q = math.radians(q_deg)
     expected = -knee.torque(-q, -qd)
     if q > 0:  # the runner's ligament law: the stop pushes and never pulls
@@ -89,7 +90,8 @@ def test_knee_parameters_are_read_from_the_parameter_set():
     data["prosthetic_knee"]["flexion_damping"] = 4.0
     runner = build_runner(runner_params_from_dict(data))
     assert _passive_torque(runner, math.radians(-30.0), -2.0) == pytest.approx(
-        -ProstheticKnee(flexion_damping=4.0).torque(math.radians(30.0), 2.0), rel=1e-12)
+        -ProstheticKnee(flexion_damping=4.0, stop_damping=10.0).torque(math.radians(30.0), 2.0),
+        rel=1e-12)
     data["prosthetic_knee"]["assist_rest_angle"] = 0.1
     with pytest.raises(SpecError, match="assist_rest_angle"):
         build_runner(runner_params_from_dict(data))
@@ -118,6 +120,7 @@ def test_the_transfemoral_runner_wears_a_multilink_blade_below_its_knee():
         3.2 * 58.3 / 77.34 - blade.mass, rel=1e-9)
     assert contact_heights(runner, runner.stand_qpos).min() == pytest.approx(0.0, abs=1e-12)
     j = runner.dof("knee_angle_r")
-    np.testing.assert_array_equal(runner.joint_params[j], ProstheticKnee().joint_row())
+    np.testing.assert_array_equal(runner.joint_params[j],
+                                  ProstheticKnee(stop_damping=10.0).joint_row())
     with pytest.raises(ModelError, match="amputee"):
         build_runner("able", blade_model=blade)
