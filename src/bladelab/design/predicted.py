@@ -1,0 +1,174 @@
+"""Seed 002's responses from a predicted stride (issue 21): a collocation solution of an
+amputee runner (the transfemoral one, whose knee can buckle) read as seed 002 reads its
+inverse-dynamics runs.
+
+:func:`stride_responses` takes a converged :class:`~bladelab.predict.collocation.solution.
+CollocationSolution` of the periodic stride and returns (name, unit):
+
+==================================  =========  ==============================================
+``delta_vx_m_per_s``                m/s        Δv_x = I_x/m over the prosthetic stance
+``avg_vx_m_per_s``                  m/s        the stride's mean speed (prescribed or found)
+``impulse_x_Ns``                    N·s        ∫F_x dt of the prosthetic leg over its stance
+``impulse_z_Ns``                    N·s        ∫F_z dt over that stance (gross)
+``impulse_z_net_Ns``                N·s        ∫(F_z − m·g) dt
+``evaluation_E_m``                  m          bouncing-ball parameter I_x·I_z,net/(m²·g)
+``knee_moment_min_Nm``              N·m        minimum extension moment of the prosthetic
+                                               leg's GRF about the knee axis, loaded stance
+``swing_clearance_m``               m          lowest point of the prosthesis's contacts over
+                                               the middle half of its swing
+``contact_time_prosthetic_s``       s          the stance's duration
+``cost_of_transport_J_per_kg_m``    J/(kg·m)   the solution's metabolic cost of transport
+==================================  =========  ==============================================
+
+The stance is the longest loaded stretch (vertical force above 20 N, the analyses' threshold)
+of the prosthetic leg's periodic force, the node values interpolated linearly on a grid 20
+times finer (as the solution's own contact times); integrals are trapezoidal on that grid.
+"Loaded" for the knee moment: vertical force above 5 % of its peak (seed 002's knee-buckling
+check, :func:`~bladelab.design.constraints.knee_buckling`). The centre of pressure is the
+normal-force-weighted mean of the prosthetic contact points.
+"""
+
+from __future__ import annotations
+
+import mujoco
+import numpy as np
+
+from bladelab.design.constraints import knee_extension_moment
+from bladelab.design.performance import bouncing_ball
+from bladelab.errors import SpecError
+
+__all__ = ["PREDICTED_RESPONSE_UNITS", "stride_responses"]
+
+#: Units of :func:`stride_responses`' values.
+PREDICTED_RESPONSE_UNITS: dict[str, str] = {
+    "delta_vx_m_per_s": "m/s",
+    "avg_vx_m_per_s": "m/s",
+    "impulse_x_Ns": "N·s",
+    "impulse_z_Ns": "N·s",
+    "impulse_z_net_Ns": "N·s",
+    "evaluation_E_m": "m",
+    "knee_moment_min_Nm": "N·m",
+    "swing_clearance_m": "m",
+    "contact_time_prosthetic_s": "s",
+    "cost_of_transport_J_per_kg_m": "J/(kg·m)",
+}
+_FINE = 20  # interpolation points per mesh interval
+_LOADED_N = 20.0  # N
+_KNEE_LOADED = 0.05  # of the peak vertical force
+
+
+def _kinematics(runner, q: np.ndarray, qd: np.ndarray) -> dict[str, np.ndarray]:
+    """Per node: the centre of mass and its velocity (x, z), the prosthetic knee axis (x, z)
+    and the lowest point of every contact [m, m/s]."""
+    from bladelab.runner.model import CP_LEG, contact_heights
+
+    m = runner.mj_model
+    d = mujoco.MjData(m)
+    knee = m.joint("knee_angle_r").id if "knee_angle_r" in runner.dof_names else None
+    out = {k: [] for k in ("com", "com_velocity", "knee", "heights")}
+    for qk, vk in zip(q, qd, strict=True):
+        d.qpos[:], d.qvel[:] = qk, vk
+        mujoco.mj_forward(m, d)
+        mujoco.mj_subtreeVel(m, d)
+        out["com"].append(d.subtree_com[0, [0, 2]].copy())
+        out["com_velocity"].append(d.subtree_linvel[0, [0, 2]].copy())
+        out["knee"].append(d.xanchor[knee, [0, 2]].copy() if knee is not None else (np.nan,) * 2)
+        out["heights"].append(contact_heights(runner, qk))
+    res = {k: np.asarray(v) for k, v in out.items()}
+    res["prosthetic"] = runner.contact_params[:, CP_LEG] == 1
+    return res
+
+
+def _fine(values: np.ndarray) -> np.ndarray:
+    """Node values (n + 1, ...) of the periodic stride on the fine grid (n·_FINE, ...)."""
+    n = values.shape[0] - 1
+    x = np.linspace(0.0, n, n * _FINE, endpoint=False)
+    flat = values.reshape(n + 1, -1)
+    fine = np.stack([np.interp(x, np.arange(n + 1), flat[:, j]) for j in range(flat.shape[1])],
+                    axis=1)
+    return fine.reshape((n * _FINE,) + values.shape[1:])
+
+
+def _stance(loaded: np.ndarray) -> np.ndarray:
+    """Indices, in order, of the longest True stretch of a periodic mask (may wrap)."""
+    if loaded.all() or not loaded.any():
+        raise SpecError("the prosthetic leg is loaded throughout or never: no stance to read",
+                        where="solution")
+    start = int(np.argmin(loaded))  # an unloaded sample: runs do not wrap after rolling
+    m = np.roll(loaded, -start).astype(np.int8)
+    edges = np.diff(np.concatenate([[0], m, [0]]))
+    ons, offs = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)
+    k = int(np.argmax(offs - ons))
+    return (np.arange(ons[k], offs[k]) + start) % loaded.size
+
+
+def stride_responses(solution, runner, *, cm=None) -> dict[str, float]:
+    """Seed 002's responses of a predicted stride (module docstring; values in
+    :data:`PREDICTED_RESPONSE_UNITS`).
+
+    Parameters
+    ----------
+    solution
+        A converged :class:`~bladelab.predict.collocation.solution.CollocationSolution` of an
+        amputee runner.
+    runner
+        Its runner (:func:`~bladelab.predict.collocation.stored.runner_from_spec`).
+    cm
+        Its collocation model (built if not given): the contact points.
+
+    Raises
+    ------
+    SpecError
+        The solution did not converge, is of the able model, or has no prosthetic stance.
+    """
+    from bladelab.predict.collocation import build_collocation_model
+    from bladelab.predict.collocation.solution import _evaluate
+
+    if not solution.converged:
+        raise SpecError("the solve did not converge: its last iterate is not a stride",
+                        where="solution", hint="solve again (--resume) or from another guess")
+    if solution.leg_names[1] != "prosthetic":
+        raise SpecError(f"a {solution.kind} model has no prosthesis", where="solution",
+                        hint="responses are for an amputee runner")
+    nlp = solution.nlp
+    cm = cm or build_collocation_model(runner)
+    kin = _kinematics(runner, nlp.q, nlp.qd)
+    ev = _evaluate(cm, nlp.q, nlp.qd, nlp.tendon_force, nlp.tendon_force_rate)
+    pros = kin["prosthetic"]
+    f = ev["forces"][:, pros, :]  # (n + 1, k, 2): Fx, Fz on the body
+    fx, fz = f[:, :, 0].sum(axis=1), f[:, :, 1].sum(axis=1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        cop_x = (ev["points"][:, pros, 0] * f[:, :, 1]).sum(axis=1) / fz
+    n = nlp.q.shape[0] - 1
+    dt = solution.period_s / (n * _FINE)
+    fx_f, fz_f = _fine(fx), _fine(fz)
+    idx = _stance(fz_f > _LOADED_N)
+    mass, g = runner.total_mass, runner.gravity
+
+    def integral(y: np.ndarray) -> float:  # over the stance, trapezoidal, one grid step apart
+        v = y[idx]
+        return float(dt * (v.sum() - 0.5 * (v[0] + v[-1])))
+
+    i_x, i_z = integral(fx_f), integral(fz_f)
+    i_z_net = integral(fz_f - mass * g)
+    _, dvx, e = bouncing_ball(i_x, i_z_net, mass, g=g)
+    moment = knee_extension_moment(_fine(np.nan_to_num(cop_x)), 0.0, _fine(kin["knee"][:, 0]),
+                                   _fine(kin["knee"][:, 1]), fx_f, fz_f)
+    loaded = idx[fz_f[idx] > _KNEE_LOADED * fz_f[idx].max()]
+    # swing: from the stance's end round to its start; its middle half
+    n_fine = fz_f.size
+    swing = (idx[-1] + 1 + np.arange(n_fine - idx.size)) % n_fine
+    mid = swing[len(swing) // 4: len(swing) - len(swing) // 4]
+    heights = _fine(kin["heights"][:, pros]).min(axis=1)
+    return {
+        "delta_vx_m_per_s": dvx,
+        "avg_vx_m_per_s": solution.mean_speed_mps,
+        "impulse_x_Ns": i_x,
+        "impulse_z_Ns": i_z,
+        "impulse_z_net_Ns": i_z_net,
+        "evaluation_E_m": e,
+        "knee_moment_min_Nm": float(moment[loaded].min()),
+        "swing_clearance_m": float(heights[mid].min()),
+        "contact_time_prosthetic_s": float(idx.size * dt),
+        "cost_of_transport_J_per_kg_m": solution.cost_of_transport_J_per_kg_m,
+    }
