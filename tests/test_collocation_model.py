@@ -439,3 +439,35 @@ def test_smooth_metabolic_rate_matches_forward_uchida(models):
         floored += int(np.sum(per_muscle_work < -200.0))
     assert worst <= 0.005, worst  # measured 5e-4
     assert floored > 0  # the states reach the floor at 0 (absorbed work not refunded)
+
+
+def test_swing_clearance_binds_only_a_contact_moving_forward(models):
+    """The swing-clearance inequality (issue 21's toe clearance as a constraint): a stance
+    contact (at rest while the pelvis moves on) is free even when it penetrates; a contact
+    moving forward faster than the pelvis must be ``h`` above the ground (its value is its
+    height minus h)."""
+    from bladelab.predict.collocation.dynamics import SWING_ALLOWANCE_M, swing_clearance
+
+    runner, cm = models["transfemoral"]
+    q_s, qd_s = ca.SX.sym("q", cm.nv), ca.SX.sym("qd", cm.nv)
+    fn = ca.Function("clearance", [q_s, qd_s], [swing_clearance(cm, q_s, qd_s, 0.02)])
+    ix, iz, tilt = (runner.dof(n) for n in ("pelvis_tx", "pelvis_tz", "pelvis_tilt"))
+    q = runner.stand_qpos.copy()
+    q[iz] -= 0.01  # every contact 1 cm deep, as in a stance
+    stance = np.zeros(cm.nv)
+    stance[ix] = 4.0  # the body runs on; the contacts' points move forward at 4 m/s too
+    stance[tilt] = 0.0
+    heights = contact_heights(runner, q)
+    assert np.all(heights < -0.005)
+    # with the pelvis: each contact moves at the pelvis's speed, not faster: not swinging
+    values = np.asarray(fn(q, stance)).ravel()
+    assert np.all(values > heights + 0.95 * SWING_ALLOWANCE_M) and np.all(values > 0)
+    assert np.all(values <= heights + SWING_ALLOWANCE_M)
+    # a whole-body pitch at 6 rad/s about the pelvis: the contacts below it swing
+    # forward several m/s faster than the pelvis, and must clear the ground by 2 cm
+    q[iz] += 0.06
+    swing = stance.copy()
+    swing[tilt] = 6.0  # backward tilt: the top goes back, the feet forward
+    heights = contact_heights(runner, q)
+    values = np.asarray(fn(q, swing)).ravel()
+    np.testing.assert_allclose(values, heights - 0.02, atol=1e-6)

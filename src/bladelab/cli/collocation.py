@@ -143,6 +143,7 @@ def run_collocation(
     force: bool,
     as_json: bool,
     body: str = "seed001",
+    swing_clearance: float = 0.0,
 ) -> int:
     """Run ``bladelab predict --method collocation``; returns the exit status (0 converged,
     2 not converged)."""
@@ -160,10 +161,13 @@ def run_collocation(
         raise SpecError(f"need at least 4 mesh intervals, got {mesh}", where="--mesh")
     if max_iter < 1:
         raise SpecError(f"need at least 1 iteration, got {max_iter}", where="--max-iter")
+    if not (math.isfinite(swing_clearance) and 0.0 <= swing_clearance < 0.5):
+        raise SpecError(f"swing clearance must be within [0, 0.5) m, got {swing_clearance}",
+                        where="--swing-clearance")
     spec = check_model_spec({"model": model, "blade": blade, "body": body})
     settings = CollocationSettings(mesh_intervals=mesh,
                                    speed_m_per_s=None if max_speed else float(speed),
-                                   max_iter=max_iter)
+                                   max_iter=max_iter, swing_clearance_m=swing_clearance)
     runner = runner_from_spec(spec)
     result = predict_stride_in_folder(
         out, runner, settings,

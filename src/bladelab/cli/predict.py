@@ -93,6 +93,10 @@ def register(app: typer.Typer) -> None:
             "seed001", "--body", help="Collocation: seed001 (seed 001's model) | toes (a toe "
             "segment and compliant Achilles tendons; docs/runner-model.md)."
         ),
+        swing_clearance: float = typer.Option(
+            0.0, "--swing-clearance", help="Collocation: keep every swinging foot or blade "
+            "this high above the ground [m] (0: no constraint)."
+        ),
     ) -> None:
         """Optimise the reflex controller of the runner with CMA-ES (seed 001 eq. 2.4), or with
         --method collocation solve one periodic stride by direct collocation (writes
@@ -103,7 +107,8 @@ def register(app: typer.Typer) -> None:
             code = run_collocation(out=out, model=model, blade=blade, speed=speed,
                                    max_speed=max_speed, mesh=mesh, guess=guess,
                                    max_iter=max_iter, resume=resume, force=force,
-                                   as_json=as_json, body=body)
+                                   as_json=as_json, body=body,
+                                   swing_clearance=swing_clearance)
             raise typer.Exit(code)
         if method != "reflex":
             raise SpecError(f"unknown method {method!r}", where="--method",

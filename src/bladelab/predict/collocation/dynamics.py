@@ -58,9 +58,39 @@ def _bounds(dof_names) -> tuple[np.ndarray, np.ndarray]:
     return np.array(q), np.array(qd)
 
 
-def stride_dynamics(cm: CollocationModel, *,
-                    metabolic: MetabolicSmoothing | None = None) -> StrideDynamics:
-    """The :class:`StrideDynamics` of a collocation model (see the module docstring)."""
+#: Width [m/s] of the switch of the swing clearance (:func:`swing_clearance`).
+SWING_SPEED_WIDTH_MPS = 0.25
+#: Penetration [m] the swing clearance allows a contact that is not swinging (far more than a
+#: stance's few millimetres: the inequality is then inactive).
+SWING_ALLOWANCE_M = 0.1
+
+
+def swing_clearance(cm: CollocationModel, q: ca.SX, qd: ca.SX, height_m: float) -> ca.SX:
+    """Per contact, ``height − s·height_m + (1 − s)·SWING_ALLOWANCE_M`` [m], with ``height`` its
+    lowest point's height above the ground and ``s`` a smooth switch that is on (1) while the
+    contact's material point moves forward faster than the pelvis by more than
+    2·:data:`SWING_SPEED_WIDTH_MPS`: ≥ 0 keeps a swinging foot or blade ``height_m`` clear of
+    the ground, and leaves a stance contact (at rest, slower than the pelvis: s ≈ 0) free."""
+    from bladelab.predict.collocation.contact import contact_point
+    from bladelab.predict.collocation.multibody import body_frames, point_velocity
+
+    frames = body_frames(cm.tree, q)
+    v_pelvis = qd[cm.runner.dof("pelvis_tx")]
+    out = []
+    for row in cm.runner.contact_params:
+        point, depth, body = contact_point(cm.tree, frames, row)
+        vx = point_velocity(frames, q, qd, body, point)[0]
+        on = 0.5 * (1.0 + ca.tanh((vx - v_pelvis - 2.0 * SWING_SPEED_WIDTH_MPS)
+                                  / SWING_SPEED_WIDTH_MPS))
+        out.append(-depth - height_m * on + (1.0 - on) * SWING_ALLOWANCE_M)
+    return ca.vertcat(*out)
+
+
+def stride_dynamics(cm: CollocationModel, *, metabolic: MetabolicSmoothing | None = None,
+                    swing_clearance_m: float = 0.0) -> StrideDynamics:
+    """The :class:`StrideDynamics` of a collocation model (see the module docstring); with
+    ``swing_clearance_m`` > 0 [m], the path inequalities also keep every swinging contact that
+    high above the ground (:func:`swing_clearance`)."""
     runner = cm.runner
     nv, nm = cm.nv, cm.n_muscles
     q, qd, qdd = ca.SX.sym("q", nv), ca.SX.sym("qd", nv), ca.SX.sym("qdd", nv)
@@ -75,6 +105,8 @@ def stride_dynamics(cm: CollocationModel, *,
     v_norm = v_m / (V_MAX_OPT_PER_S * l_opt)
     along = l_m * cos_a / l_opt  # fibre length along the tendon line [optimal lengths]
     q_b, qd_b = _bounds(runner.dof_names)
+    clearance = (swing_clearance(cm, q, qd, float(swing_clearance_m))
+                 if swing_clearance_m > 0 else ca.SX.zeros(0, 1))
     weight = runner.total_mass * runner.gravity
     scale = np.array([weight if n.startswith("pelvis_t") and n != "pelvis_tilt" else 100.0
                       for n in runner.dof_names])
@@ -91,10 +123,11 @@ def stride_dynamics(cm: CollocationModel, *,
         q_bounds=q_b,
         qd_bounds=qd_b,
         residual_scale=scale,
-        inequalities=ca.Function("fibre_domain", [q, qd, a, ft, dft],
-                                 [ca.vertcat(v_norm, along)]),
+        inequalities=ca.Function("path_inequalities", [q, qd, a, ft, dft],
+                                 [ca.vertcat(v_norm, along, clearance)]),
         inequality_bounds=np.vstack([np.tile([-1.0, 1.0], (nm, 1)),
-                                     np.tile([MIN_FIBER_ALONG, MAX_FIBER_ALONG], (nm, 1))]),
+                                     np.tile([MIN_FIBER_ALONG, MAX_FIBER_ALONG], (nm, 1)),
+                                     np.tile([0.0, np.inf], (int(clearance.numel()), 1))]),
         static_tendon_force=lambda q_nodes, a_nodes: static_tendon_forces(cm, q_nodes, a_nodes),
         vertical_grf=ca.Function("vertical_grf", [q, qd],
                                  [ca.sum1(cm.contacts(q, qd)[0][:, 1])]),

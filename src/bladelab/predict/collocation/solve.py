@@ -123,6 +123,12 @@ class CollocationSettings:
         and the maximum speeds of Cat4/Cat5 were 6.99/7.32 m/s with 1e-4 against 7.53/7.71
         m/s. The landscape has local optima 15–25 % apart along a continuation; the two
         settings are two starts (docs/collocation.md).
+    swing_clearance_m
+        Keep every swinging foot or blade at least this high above the ground [m]: a path
+        constraint on each contact while it moves forward faster than the pelvis
+        (:func:`~bladelab.predict.collocation.dynamics.swing_clearance`); 0 (default): none.
+        Issue 21's "toe clearance as a constraint" setting (the transfemoral runner's blade
+        grazed the ground in swing without it).
     """
 
     mesh_intervals: int = 50
@@ -135,6 +141,7 @@ class CollocationSettings:
     tol: float = 1e-4
     max_iter: int = 3000
     warm_start_mu: float | None = None
+    swing_clearance_m: float = 0.0
 
     def __post_init__(self) -> None:
         n = self.mesh_intervals
@@ -189,6 +196,13 @@ class CollocationSettings:
                                 where="warm_start_mu")
             object.__setattr__(self, "warm_start_mu", float(mu))
 
+        sc = self.swing_clearance_m
+        if isinstance(sc, bool) or not isinstance(sc, int | float) or not (
+                math.isfinite(sc) and 0 <= sc < 0.5):
+            raise SpecError(f"swing clearance must be within [0, 0.5) m, got {sc!r}",
+                            where="swing_clearance_m")
+        object.__setattr__(self, "swing_clearance_m", float(sc))
+
     @property
     def max_speed(self) -> bool:
         """True for the maximum-speed problem."""
@@ -214,10 +228,11 @@ class CollocationSettings:
         return cls(**data)
 
     def same_problem(self, other: CollocationSettings) -> bool:
-        """True if ``other`` poses the same NLP (mesh, speed, weights); solver options (Hessian,
-        tolerance, iterations) and the tracking stage may differ."""
-        return (self.mesh_intervals, self.speed_m_per_s, self.weights) == (
-            other.mesh_intervals, other.speed_m_per_s, other.weights)
+        """True if ``other`` poses the same NLP (mesh, speed, weights, swing clearance); solver
+        options (Hessian, tolerance, iterations) and the tracking stage may differ."""
+        return (self.mesh_intervals, self.speed_m_per_s, self.weights,
+                self.swing_clearance_m) == (other.mesh_intervals, other.speed_m_per_s,
+                                            other.weights, other.swing_clearance_m)
 
 
 @dataclass(frozen=True)
@@ -336,16 +351,18 @@ _BUILT: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 MAX_NLPS_PER_RUNNER = 2
 
 
-def _model_functions(runner):
-    """(collocation model, stride dynamics) of ``runner``, built once."""
+def _model_functions(runner, swing_clearance_m: float = 0.0):
+    """(collocation model, stride dynamics) of ``runner``, built once (per swing clearance)."""
     from bladelab.predict.collocation.dynamics import stride_dynamics
     from bladelab.predict.collocation.model import build_collocation_model
 
-    built = _BUILT.setdefault(runner, {})
-    if "dyn" not in built:
-        cm = build_collocation_model(runner)
-        built["cm"], built["dyn"], built["nlps"] = cm, stride_dynamics(cm), {}
-    return built["cm"], built["dyn"]
+    built = _BUILT.setdefault(runner, {"dyn": {}, "nlps": {}})
+    if "cm" not in built:
+        built["cm"] = build_collocation_model(runner)
+    if swing_clearance_m not in built["dyn"]:
+        built["dyn"][swing_clearance_m] = stride_dynamics(
+            built["cm"], swing_clearance_m=swing_clearance_m)
+    return built["cm"], built["dyn"][swing_clearance_m]
 
 
 def _predictive_nlp(runner, dyn, n: int, speed: float | None, weights: StrideWeights):
@@ -355,7 +372,7 @@ def _predictive_nlp(runner, dyn, n: int, speed: float | None, weights: StrideWei
     from bladelab.predict.collocation.transcription import StrideNLP
 
     nlps = _BUILT[runner]["nlps"]
-    key = (int(n), speed is None, weights)
+    key = (int(n), speed is None, weights, id(dyn))
     if key not in nlps:
         while len(nlps) >= MAX_NLPS_PER_RUNNER:
             nlps.pop(next(iter(nlps)))
@@ -407,7 +424,7 @@ def predict_stride(runner, settings: CollocationSettings, guess, *, model_spec: 
     if not isinstance(settings, CollocationSettings):
         raise SpecError(f"expected CollocationSettings, got {type(settings).__name__}",
                         where="settings")
-    cm, dyn = _model_functions(runner)
+    cm, dyn = _model_functions(runner, settings.swing_clearance_m)
     n = settings.mesh_intervals
     g = guess.on_model(runner).resample(n)
     speed = settings.speed_m_per_s
