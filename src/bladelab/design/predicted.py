@@ -34,21 +34,17 @@ import mujoco
 import numpy as np
 
 from bladelab.design.constraints import knee_extension_moment
+from bladelab.design.evaluators import BLADE_RESPONSE_UNITS
 from bladelab.design.performance import bouncing_ball
 from bladelab.errors import SpecError
 
 __all__ = ["PREDICTED_RESPONSE_UNITS", "stride_responses"]
 
-#: Units of :func:`stride_responses`' values.
+#: Units of :func:`stride_responses`' values (seed 002's, named as the blade evaluator's).
 PREDICTED_RESPONSE_UNITS: dict[str, str] = {
-    "delta_vx_m_per_s": "m/s",
-    "avg_vx_m_per_s": "m/s",
-    "impulse_x_Ns": "N·s",
-    "impulse_z_Ns": "N·s",
-    "impulse_z_net_Ns": "N·s",
-    "evaluation_E_m": "m",
-    "knee_moment_min_Nm": "N·m",
-    "swing_clearance_m": "m",
+    **{k: BLADE_RESPONSE_UNITS[k] for k in (
+        "delta_vx_m_per_s", "avg_vx_m_per_s", "impulse_x_Ns", "impulse_z_Ns",
+        "impulse_z_net_Ns", "evaluation_E_m", "knee_moment_min_Nm", "swing_clearance_m")},
     "contact_time_prosthetic_s": "s",
     "cost_of_transport_J_per_kg_m": "J/(kg·m)",
 }
