@@ -119,3 +119,19 @@ def test_a_seed_body_guess_starts_the_toe_body(able):
         named.on_model(build_runner("amputee"))
     with pytest.raises(SpecError, match="coordinates"):
         g.on_model(toes)  # unnamed columns of another model
+
+
+def test_the_transfemoral_template_keeps_the_passive_knee_straight_in_stance():
+    """The prosthetic knee cannot be driven: the template holds it at 5° through its stance
+    (the right leg lands half a stride after the left) and flexes it in swing only."""
+    from bladelab.predict.collocation.guess import template_guess
+    from bladelab.runner import build_runner
+
+    runner = build_runner("transfemoral")
+    g = template_guess(runner, speed=5.0, n=40)
+    knee = -np.degrees(g.q[:, runner.dof("knee_angle_r")])  # flexion positive
+    phase = np.mod(np.linspace(0.0, 1.0, 41) + 0.5, 1.0)  # of the right leg
+    assert np.allclose(knee[phase < 0.35], 5.0)
+    assert 60.0 < knee.max() < 66.0 and abs(phase[np.argmax(knee)] - 0.675) < 0.03
+    intact = -np.degrees(g.q[:, runner.dof("knee_angle_l")])
+    assert intact.max() > 90.0  # the intact knee keeps the running template

@@ -6,7 +6,8 @@ next one; a guess gives the runner's coordinates and speeds at ``n + 1`` equally
 known, muscle activations and normalised tendon forces. Three sources:
 
 - :func:`template_guess`: a smooth template of running kinematics (sinusoidal hip, knee and
-  ankle angles with literature-typical ranges at 3–5 m/s, the other leg half a period later),
+  ankle angles with literature-typical ranges at 3–5 m/s, the other leg half a period later;
+  the transfemoral runner's passive knee straight in stance, :func:`prosthetic_knee_template`),
   the pelvis lowered at every node until its lowest contact point touches the ground (a guess
   that starts near the ground converges far better than a constant-height one, DESIGN.md);
 - :func:`guess_from_trial`: measured running (e.g. the Fukuchi et al. 2017 treadmill trial at
@@ -229,6 +230,8 @@ def template_guess(model: RunnerModel, *, speed: float = 3.5, n: int = 50,
         }
 
     left, right = leg(frac), leg(frac + 0.5)
+    if model.kind == "transfemoral":  # a passive knee: straight in stance, flexed in swing
+        right["knee"] = prosthetic_knee_template(frac + 0.5)
     angles = {"trunk_pitch": np.full(frac.size, 5.0 * deg)}
     for side, a in (("left", left), ("right", right)):
         angles.update({f"hip_{side}": a["hip"], f"knee_{side}": a["knee"],
@@ -236,6 +239,14 @@ def template_guess(model: RunnerModel, *, speed: float = 3.5, n: int = 50,
     q = _angles_to_q(model, frac, period, speed, angles)
     return StrideGuess(f"template at {speed:g} m/s", period, q, periodic_derivative(q, period),
                        vertical_grf_bw=template_vertical_grf(frac))
+
+
+def prosthetic_knee_template(phase: np.ndarray) -> np.ndarray:
+    """Flexion [rad] of a passive prosthetic knee over a stride (``phase`` 0–1 from that leg's
+    touch-down): 5° through a stance of 35 % of the stride (the knee on its extension stop, as
+    transfemoral sprinters run), a smooth rise to 65° at mid-swing and back before touch-down."""
+    swing = np.clip((np.mod(np.asarray(phase, float), 1.0) - 0.35) / 0.65, 0.0, 1.0)
+    return np.radians(5.0 + 30.0 * (1.0 - np.cos(2.0 * math.pi * swing)))
 
 
 def template_vertical_grf(phase: np.ndarray, *, duty: float = 0.34) -> np.ndarray:
