@@ -118,7 +118,7 @@ def stride_responses(solution, runner, *, cm=None) -> dict[str, float]:
         The solution did not converge, is of the able model, or has no prosthetic stance.
     """
     from bladelab.predict.collocation import build_collocation_model
-    from bladelab.predict.collocation.solution import _evaluate
+    from bladelab.predict.collocation.solution import evaluate_nodes
 
     if not solution.converged:
         raise SpecError("the solve did not converge: its last iterate is not a stride",
@@ -129,7 +129,7 @@ def stride_responses(solution, runner, *, cm=None) -> dict[str, float]:
     nlp = solution.nlp
     cm = cm or build_collocation_model(runner)
     kin = _kinematics(runner, nlp.q, nlp.qd)
-    ev = _evaluate(cm, nlp.q, nlp.qd, nlp.tendon_force, nlp.tendon_force_rate)
+    ev = evaluate_nodes(cm, nlp.q, nlp.qd, nlp.tendon_force, nlp.tendon_force_rate)
     pros = kin["prosthetic"]
     f = ev["forces"][:, pros, :]  # (n + 1, k, 2): Fx, Fz on the body
     fx, fz = f[:, :, 0].sum(axis=1), f[:, :, 1].sum(axis=1)

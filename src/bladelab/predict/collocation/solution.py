@@ -37,6 +37,7 @@ __all__ = [
     "FORMAT_VERSION",
     "SOLUTION_KIND",
     "CollocationSolution",
+    "evaluate_nodes",
 ]
 
 SOLUTION_KIND = "collocation-solution"
@@ -105,8 +106,11 @@ def _node_samples(cm):
                        [l_mt, v_mt, l_m, v_m, ca.vec(f), ca.vec(p), pv, tau_p])
 
 
-def _evaluate(cm, q, qd, ft, dft) -> dict[str, np.ndarray]:
-    """The collocation model's quantities at samples (rows): muscles, contacts, passive."""
+def evaluate_nodes(cm, q, qd, ft, dft) -> dict[str, np.ndarray]:
+    """The collocation model's quantities at samples (rows of q, q̇, F̃ₜ, dF̃ₜ/dt): MTU and
+    fibre lengths and velocities [m, m/s], contact ``forces`` (N, n_contacts, 2: Fx, Fz on
+    the body [N]), lowest ``points`` and their ``point_velocities`` [m, m/s], ``passive``
+    torques [N·m]."""
     fn = _node_samples(cm).map(q.shape[0])
     out = [np.asarray(v, dtype=float).T for v in fn(q.T, qd.T, ft.T, dft.T)]
     nc = cm.n_contacts
@@ -202,7 +206,7 @@ class CollocationSolution:
         if q.shape[1] != cm.nv or np.asarray(nlp.tendon_force).shape[1] != cm.n_muscles:
             raise DataError(f"node arrays of {q.shape[1]} coordinates, the model has {cm.nv}",
                             where="q", hint="the solution is not of this runner model")
-        ev = _evaluate(cm, q, np.asarray(nlp.qd, float), np.asarray(nlp.tendon_force, float),
+        ev = evaluate_nodes(cm, q, np.asarray(nlp.qd, float), np.asarray(nlp.tendon_force, float),
                        np.asarray(nlp.tendon_force_rate, float))
         if metabolic_energy_J is None:  # the NLP's own trapezoidal rule: one definition
             metabolic_energy_J = StrideNLP(stride_dynamics(cm), n=q.shape[0] - 1,
@@ -419,7 +423,7 @@ class CollocationSolution:
         act, ft = lin(s.activation), lin(s.tendon_force)
         exc, dft = lin(s.excitation), lin(s.tendon_force_rate)
         time = stride * period + k * h + tt
-        ev = _evaluate(cm, qs, qds, ft, dft)
+        ev = evaluate_nodes(cm, qs, qds, ft, dft)
         fmax = runner.muscle_params[:, 0]
         muscles = np.stack([act, ev["l_m"], ev["v_m"], ft * fmax], axis=2)
         mtu = np.stack([ev["l_mt"], ev["v_mt"]], axis=2)
