@@ -118,7 +118,7 @@ def stride_responses(solution, runner, *, cm=None) -> dict[str, float]:
         The solution did not converge, is of the able model, or has no prosthetic stance.
     """
     from bladelab.predict.collocation import build_collocation_model
-    from bladelab.predict.collocation.solution import evaluate_nodes
+    from bladelab.predict.collocation.nodes import evaluate_nodes
 
     if not solution.converged:
         raise SpecError("the solve did not converge: its last iterate is not a stride",

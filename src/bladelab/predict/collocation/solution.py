@@ -29,6 +29,7 @@ from pathlib import Path
 import numpy as np
 
 from bladelab.errors import DataError, SpecError
+from bladelab.predict.collocation.nodes import evaluate_nodes
 from bladelab.predict.collocation.solve import COLLOCATION_SOURCE, CollocationSettings
 from bladelab.predict.collocation.stored import FieldReader, check_model_spec, runner_from_spec
 
@@ -37,7 +38,6 @@ __all__ = [
     "FORMAT_VERSION",
     "SOLUTION_KIND",
     "CollocationSolution",
-    "evaluate_nodes",
 ]
 
 SOLUTION_KIND = "collocation-solution"
@@ -77,50 +77,6 @@ def _array(a: np.ndarray) -> list:
     a = np.asarray(a, dtype=float)
     return np.where(np.isfinite(a), a, None).tolist() if not np.all(np.isfinite(a)) \
         else a.tolist()
-
-
-def _node_samples(cm):
-    """A CasADi Function of one sample (q, q̇, F̃ₜ, dF̃ₜ/dt) -> (l_mt, v_mt, l_m, v_m, vec(forces),
-    vec(points), vec(point velocities), passive torques) of the collocation model. A point's
-    velocity is that of the body's material point there (as the contact law and the forward
-    kernel take it), not the rate of the lowest point, which rolls over a turning sphere."""
-    import casadi as ca
-
-    from bladelab.predict.collocation.contact import contact_point
-    from bladelab.predict.collocation.multibody import body_frames, point_velocity
-
-    nv, nm = cm.nv, cm.n_muscles
-    q, qd = ca.SX.sym("q", nv), ca.SX.sym("qd", nv)
-    ft, dft = ca.SX.sym("ft", nm), ca.SX.sym("dft", nm)
-    l_mt, v_mt = cm.mtu(q, qd)
-    l_m, v_m, _ = cm.fiber(l_mt, v_mt, ft, dft)
-    f, p, _ = cm.contacts(q, qd)
-    frames = body_frames(cm.tree, q)
-    vel = []
-    for row in cm.runner.contact_params:
-        point, _, body = contact_point(cm.tree, frames, row)
-        vel.append(point_velocity(frames, q, qd, body, point))
-    pv = ca.vertcat(*[v[0] for v in vel], *[v[1] for v in vel])  # as ca.vec of (nc, 2)
-    tau_p = cm.passive(q, qd)
-    return ca.Function("node_samples", [q, qd, ft, dft],
-                       [l_mt, v_mt, l_m, v_m, ca.vec(f), ca.vec(p), pv, tau_p])
-
-
-def evaluate_nodes(cm, q, qd, ft, dft) -> dict[str, np.ndarray]:
-    """The collocation model's quantities at samples (rows of q, q̇, F̃ₜ, dF̃ₜ/dt): MTU and
-    fibre lengths and velocities [m, m/s], contact ``forces`` (N, n_contacts, 2: Fx, Fz on
-    the body [N]), lowest ``points`` and their ``point_velocities`` [m, m/s], ``passive``
-    torques [N·m]."""
-    fn = _node_samples(cm).map(q.shape[0])
-    out = [np.asarray(v, dtype=float).T for v in fn(q.T, qd.T, ft.T, dft.T)]
-    nc = cm.n_contacts
-
-    def per_contact(a):  # (N, 2·nc) column-major vec of (nc, 2) -> (N, nc, 2)
-        return a.reshape(a.shape[0], 2, nc).swapaxes(1, 2)
-
-    return {"l_mt": out[0], "v_mt": out[1], "l_m": out[2], "v_m": out[3],
-            "forces": per_contact(out[4]), "points": per_contact(out[5]),
-            "point_velocities": per_contact(out[6]), "passive": out[7]}
 
 
 @dataclass(frozen=True, eq=False)
