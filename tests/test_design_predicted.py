@@ -101,3 +101,10 @@ def test_only_a_converged_amputee_stride_is_read(stride):
     able = dataclasses.replace(sol, leg_names=("left", "right"))
     with pytest.raises(SpecError, match="no prosthesis"):
         stride_responses(able, runner)
+
+
+def test_the_report_names_the_transfemoral_runner(stride):
+    from bladelab.report.collocation import _label
+
+    sol, _, _ = stride
+    assert _label(sol) == "transfemoral amputee Cat4 4 m/s (collocation)"

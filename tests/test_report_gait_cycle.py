@@ -69,3 +69,24 @@ def test_strides_and_stances_of_a_synthetic_run_leave_strikes_out():
     hip = cyc.angle("hip_flexion_l")
     np.testing.assert_allclose(hip.mean, 0.0)
     assert hip.n == 2
+
+
+def test_a_panel_without_cycles_says_so_instead_of_staying_empty():
+    """A leg with no complete stride (e.g. its contacts are not steps) gives empty curves; the
+    figure then writes why into the panel rather than showing empty axes."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from bladelab.report.gait_cycle import CycleAverage
+    from bladelab.report.predictive_figures import NO_CYCLE_TEXT, _band, _finish
+
+    fig, (full, empty) = plt.subplots(1, 2)
+    pct = np.linspace(0.0, 100.0, 11)
+    _band(full, CycleAverage(pct, np.sin(pct), np.full(11, np.nan), 1), "C0")
+    _band(empty, CycleAverage(pct, np.full(11, np.nan), np.full(11, np.nan), 0), "C0")
+    _finish(fig, 1)
+    said = {ax: [t.get_text() for t in ax.texts] for ax in (full, empty)}
+    assert said[empty] == [NO_CYCLE_TEXT] and said[full] == []
+    plt.close(fig)

@@ -69,7 +69,8 @@ def collocation_solution_file(path: str | Path) -> Path | None:
 
 def _label(sol) -> str:
     spec = sol.model_spec
-    who = "able-bodied" if spec["model"] == "able" else f"amputee {spec['blade']}"
+    who = {"able": "able-bodied", "amputee": f"amputee {spec['blade']}",
+           "transfemoral": f"transfemoral amputee {spec['blade']}"}[spec["model"]]
     speed = ("maximum speed" if sol.settings.speed_m_per_s is None
              else f"{sol.settings.speed_m_per_s:g} m/s")
     body = f", {spec['body']} body" if "body" in spec else ""

@@ -50,7 +50,15 @@ def _colors(labels) -> dict[str, tuple]:
     return {label: cmap(i % 10) for i, label in enumerate(labels)}
 
 
+#: Said in a panel whose curves have no data: a leg without a complete stride or stance.
+NO_CYCLE_TEXT = "no complete stride or stance of this leg\n(its contacts are not steps: see the gait warnings)"
+
+
 def _band(ax, curve: CycleAverage, color, label: str | None = None, style: str = "-") -> None:
+    """Mean curve and ±1 SD band; marks ``ax`` as holding data or not (:func:`_finish` writes
+    :data:`NO_CYCLE_TEXT` into a panel whose every curve was empty)."""
+    has_data = int(np.isfinite(np.asarray(curve.mean, float)).sum()) > 1
+    ax._bladelab_has_data = getattr(ax, "_bladelab_has_data", False) or has_data
     ax.plot(curve.pct, curve.mean, style, color=color, lw=1.6, label=label)
     if curve.n > 1 and np.isfinite(curve.sd).any():
         ax.fill_between(curve.pct, curve.mean - curve.sd, curve.mean + curve.sd, color=color,
@@ -74,6 +82,10 @@ def _legend(fig, cycles: Mapping[str, GaitCycles], colors: dict, extra=()) -> No
 
 
 def _finish(fig, n_legend: int) -> None:
+    for ax in fig.axes:
+        if ax.get_visible() and getattr(ax, "_bladelab_has_data", True) is False:
+            ax.text(0.5, 0.5, NO_CYCLE_TEXT, transform=ax.transAxes, ha="center", va="center",
+                    fontsize=8, color="#777777")
     rows = math.ceil(n_legend / 4)
     top = 1.0 - (0.045 + 0.035 * rows) * 6.0 / fig.get_size_inches()[1]
     fig.tight_layout(rect=(0, 0, 1, top))
@@ -136,8 +148,11 @@ def joint_angles_figure(cycles: Mapping[str, GaitCycles]):
     for row in range(2):
         for col, kind in enumerate(_JOINT_KINDS):
             ax = axes[row, col]
-            _leg_panel(ax, cycles, colors, row, kind, lambda c, d: c.angle(d),
-                       lambda d: d.split("_")[0])
+            if not _leg_panel(ax, cycles, colors, row, kind, lambda c, d: c.angle(d),
+                              lambda d: d.split("_")[0]):  # the transfemoral prosthesis
+                ax.text(0.5, 0.5, "no such joint (prosthesis)", transform=ax.transAxes,
+                        ha="center", va="center", fontsize=8, color="#777777")
+                ax.set_title(f"{_row_name(cycles, row)} leg")
             ax.set_ylabel("angle (deg)")
             ax.set_xlabel("% of the leg's stride")
     trunk = (("pelvis_tilt", "pelvis tilt", "angle (deg)"),

@@ -65,7 +65,8 @@ def check_model_spec(spec) -> dict:
 
 
 def model_label(spec: dict) -> str:
-    """``"able"`` or ``"amputee <blade>"`` for a model specification."""
+    """``"able"``, ``"amputee <blade>"`` or ``"transfemoral <blade>"`` for a model
+    specification."""
     spec = check_model_spec(spec)
     label = spec["model"] if spec["blade"] is None else f"{spec['model']} {spec['blade']}"
     return label + (f" ({spec['body']} body)" if "body" in spec else "")
