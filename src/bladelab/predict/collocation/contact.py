@@ -85,6 +85,15 @@ def normal_force(depth, depth_rate, row: np.ndarray, smoothing: Smoothing):
     return gate * smooth_max0(force, smoothing.contact_force_n)
 
 
+def contact_kinematics(tree: PlanarTree, frames: list[Frame], q: ca.SX, qd: ca.SX,
+                       contact_params: np.ndarray):
+    """Per contact row: (lowest point (x, z) [m], depth [m] (positive when penetrating), body,
+    velocity (x, z) [m/s] of the body's material point there)."""
+    for row in contact_params:
+        p, depth, body = contact_point(tree, frames, row)
+        yield p, depth, body, point_velocity(frames, q, qd, body, p)
+
+
 def contact_forces(
     tree: PlanarTree,
     frames: list[Frame],
@@ -106,9 +115,8 @@ def contact_forces(
     """
     forces, points = [], []
     gen = ca.SX.zeros(tree.nv)
-    for row in contact_params:
-        p, depth, body = contact_point(tree, frames, row)
-        v = point_velocity(frames, q, qd, body, p)
+    for row, (p, depth, body, v) in zip(
+            contact_params, contact_kinematics(tree, frames, q, qd, contact_params), strict=True):
         fn = normal_force(depth, -v[1], row, smoothing)
         ft = -float(row[CP_MU]) * fn * ca.tanh(v[0] / smoothing.friction_velocity_mps)
         f = ca.vertcat(ft, fn)

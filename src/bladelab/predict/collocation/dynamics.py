@@ -71,17 +71,16 @@ def swing_clearance(cm: CollocationModel, q: ca.SX, qd: ca.SX, height_m: float) 
     contact's material point moves forward faster than the pelvis by more than
     2·:data:`SWING_SPEED_WIDTH_MPS`: ≥ 0 keeps a swinging foot or blade ``height_m`` clear of
     the ground, and leaves a stance contact (at rest, slower than the pelvis: s ≈ 0) free."""
-    from bladelab.predict.collocation.contact import contact_point
-    from bladelab.predict.collocation.multibody import body_frames, point_velocity
+    from bladelab.predict.collocation.contact import contact_kinematics
+    from bladelab.predict.collocation.multibody import body_frames
+    from bladelab.predict.collocation.smooth import sigmoid
 
     frames = body_frames(cm.tree, q)
     v_pelvis = qd[cm.runner.dof("pelvis_tx")]
     out = []
-    for row in cm.runner.contact_params:
-        point, depth, body = contact_point(cm.tree, frames, row)
-        vx = point_velocity(frames, q, qd, body, point)[0]
-        on = 0.5 * (1.0 + ca.tanh((vx - v_pelvis - 2.0 * SWING_SPEED_WIDTH_MPS)
-                                  / SWING_SPEED_WIDTH_MPS))
+    for _, depth, _, v in contact_kinematics(cm.tree, frames, q, qd, cm.runner.contact_params):
+        # ½(1 + tanh((Δv − 2w)/w)): the smooth step of width w/2 centred at Δv = 2w
+        on = sigmoid(v[0] - v_pelvis - 2.0 * SWING_SPEED_WIDTH_MPS, 0.5 * SWING_SPEED_WIDTH_MPS)
         out.append(-depth - height_m * on + (1.0 - on) * SWING_ALLOWANCE_M)
     return ca.vertcat(*out)
 

@@ -6,7 +6,34 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["evaluate_nodes"]
+__all__ = ["evaluate_nodes", "on_fine_grid", "periodic_runs"]
+
+
+def on_fine_grid(values: np.ndarray, per_interval: int) -> np.ndarray:
+    """Node values (n + 1, ...) of a periodic stride, interpolated linearly onto
+    ``n·per_interval`` equally spaced samples (the last node, one period on, left out)."""
+    values = np.asarray(values, float)
+    n = values.shape[0] - 1
+    x = np.linspace(0.0, n, n * per_interval, endpoint=False)
+    flat = values.reshape(n + 1, -1)
+    fine = np.stack([np.interp(x, np.arange(n + 1), flat[:, j]) for j in range(flat.shape[1])],
+                    axis=1)
+    return fine.reshape((n * per_interval,) + values.shape[1:])
+
+
+def periodic_runs(mask: np.ndarray) -> list[tuple[int, int]]:
+    """(start index, length) [samples] of the True stretches of a periodic boolean sequence (a
+    stretch across the end continues at the start), in order from the first False sample."""
+    mask = np.asarray(mask, bool)
+    if mask.all():
+        return [(0, mask.size)]
+    if not mask.any():
+        return []
+    start = int(np.argmin(mask))  # rotate so that the sequence starts unloaded
+    m = np.roll(mask, -start).astype(np.int8)
+    edges = np.diff(np.concatenate([[0], m, [0]]))
+    ons, offs = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)
+    return [(int((on + start) % mask.size), int(off - on)) for on, off in zip(ons, offs, strict=True)]
 
 
 def _node_samples(cm):
@@ -16,8 +43,8 @@ def _node_samples(cm):
     kernel take it), not the rate of the lowest point, which rolls over a turning sphere."""
     import casadi as ca
 
-    from bladelab.predict.collocation.contact import contact_point
-    from bladelab.predict.collocation.multibody import body_frames, point_velocity
+    from bladelab.predict.collocation.contact import contact_kinematics
+    from bladelab.predict.collocation.multibody import body_frames
 
     nv, nm = cm.nv, cm.n_muscles
     q, qd = ca.SX.sym("q", nv), ca.SX.sym("qd", nv)
@@ -26,10 +53,7 @@ def _node_samples(cm):
     l_m, v_m, _ = cm.fiber(l_mt, v_mt, ft, dft)
     f, p, _ = cm.contacts(q, qd)
     frames = body_frames(cm.tree, q)
-    vel = []
-    for row in cm.runner.contact_params:
-        point, _, body = contact_point(cm.tree, frames, row)
-        vel.append(point_velocity(frames, q, qd, body, point))
+    vel = [v for *_, v in contact_kinematics(cm.tree, frames, q, qd, cm.runner.contact_params)]
     pv = ca.vertcat(*[v[0] for v in vel], *[v[1] for v in vel])  # as ca.vec of (nc, 2)
     tau_p = cm.passive(q, qd)
     return ca.Function("node_samples", [q, qd, ft, dft],

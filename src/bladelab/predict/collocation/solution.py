@@ -29,7 +29,7 @@ from pathlib import Path
 import numpy as np
 
 from bladelab.errors import DataError, SpecError
-from bladelab.predict.collocation.nodes import evaluate_nodes
+from bladelab.predict.collocation.nodes import evaluate_nodes, on_fine_grid, periodic_runs
 from bladelab.predict.collocation.solve import COLLOCATION_SOURCE, CollocationSettings
 from bladelab.predict.collocation.stored import FieldReader, check_model_spec, runner_from_spec
 
@@ -231,13 +231,11 @@ class CollocationSolution:
         [N], the node values interpolated linearly."""
         fz = self.leg_vertical_force()
         n = fz.shape[0] - 1
-        x = np.linspace(0.0, n, n * _FINE, endpoint=False)
-        fine = np.stack([np.interp(x, np.arange(n + 1), fz[:, j]) for j in (0, 1)], axis=1)
-        loaded = fine > threshold_n
+        loaded = on_fine_grid(fz, _FINE) > threshold_n
         dt = self.period_s / (n * _FINE)
         legs = {}
         for j, name in enumerate(self.leg_names):
-            runs = _periodic_runs(loaded[:, j])
+            runs = [length for _, length in periodic_runs(loaded[:, j])]
             legs[name] = {"contact_time_s": float(max(runs, default=0) * dt),
                           "contacts": len(runs),
                           "peak_vertical_grf_N": float(fz[:, j].max())}
@@ -558,15 +556,3 @@ def _jsonable(obj):
         return int(obj)
     return obj
 
-
-def _periodic_runs(mask: np.ndarray) -> list[int]:
-    """Lengths [samples] of the True stretches of a periodic boolean sequence (a stretch
-    across the end continues at the start)."""
-    if mask.all():
-        return [mask.size]
-    if not mask.any():
-        return []
-    start = int(np.argmin(mask))  # rotate so that the sequence starts unloaded
-    m = np.roll(mask, -start).astype(np.int8)
-    edges = np.diff(np.concatenate([[0], m, [0]]))
-    return list(np.flatnonzero(edges == -1) - np.flatnonzero(edges == 1))
