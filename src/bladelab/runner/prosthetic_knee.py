@@ -43,7 +43,9 @@ class ProstheticKnee:
     stop_angle, stop_stiffness, stop_damping
         Hyperextension stop q_s [rad], k_s [N·m/rad], d_s [N·m·s/rad].
     mass
-        Knee mechanism mass [kg] (on the shank below the axis).
+        Knee mechanism mass [kg] (on the shank below the axis) of the design evaluator's
+        runner; the transfemoral runner of :mod:`bladelab.runner` counts it in its
+        ``prosthesis_r`` segment instead.
     flexion_limit
         Mechanical flexion stop [rad] (flexion-positive), with the stop's stiffness and
         damping (the transfemoral runner only; 140°, about the 3S80's range).
