@@ -128,3 +128,12 @@ def test_design_bad_input(tmp_path, capsys):
     assert "no such gait-cycle file" in capsys.readouterr().err
     assert main(["design", "--out", str(tmp_path / "z"), "--runs", "bbd", "--factors",
                  "stiffness_kN_per_m=18:32,width_m=0.05:0.08"]) == 2  # BBD needs k >= 3
+    assert main(["design", "--out", str(tmp_path / "c"), "--start", str(tmp_path)]) == 2
+    assert "--start needs --evaluator collocation" in capsys.readouterr().err
+    assert main(["design", "--out", str(tmp_path / "c"), "--evaluator", "collocation",
+                 "--body-mass", "70"]) == 2
+    assert "does not apply to the collocation evaluator" in capsys.readouterr().err
+    assert main(["design", "--out", str(tmp_path / "c"), "--evaluator", "collocation",
+                 "--start", str(tmp_path / "none.json")]) == 2
+    assert "none.json" in capsys.readouterr().err
+    assert not (tmp_path / "c").exists()  # refused before any output

@@ -135,3 +135,28 @@ def test_the_transfemoral_template_keeps_the_passive_knee_straight_in_stance():
     assert 60.0 < knee.max() < 66.0 and abs(phase[np.argmax(knee)] - 0.675) < 0.03
     intact = -np.degrees(g.q[:, runner.dof("knee_angle_l")])
     assert intact.max() > 90.0  # the intact knee keeps the running template
+
+
+def test_a_sphere_stride_starts_a_multilink_blade_at_its_static_deflection():
+    from bladelab.design.blade_generator import generate_blade
+    from bladelab.predict.collocation.guess import StrideGuess, deflected_blade
+    from bladelab.runner.model import CP_BLADE
+
+    sphere = build_runner("transfemoral")
+    runner = build_runner("transfemoral", blade_model=generate_blade(
+        {"stiffness_kN_per_m": 25.0}).model)
+    blade = runner.contact_params[:, CP_BLADE] == 1
+    joints = [runner.dof(f"blade_joint{i}") for i in range(5)]
+    from bladelab.runner.model import _standing_pose
+
+    q = np.tile(_standing_pose(sphere), (3, 1))
+    q[:, sphere.dof("pelvis_tz")] += [0.0, -0.06, 0.2]  # standing, 6 cm lower, in the air
+    g = StrideGuess("test", 0.5, q, np.zeros_like(q), dof_names=sphere.dof_names,
+                    muscle_names=sphere.muscle_names).on_model(runner)
+    undeformed = np.array([contact_heights(runner, np.where(
+        np.isin(np.arange(g.q.shape[1]), joints), 0.0, row))[blade].min() for row in g.q])
+    deformed = np.array([contact_heights(runner, row)[blade].min() for row in g.q])
+    assert undeformed[1] < -0.05  # the undeformed links would meet the ground 5+ cm deep
+    assert deformed[1] == pytest.approx(-0.01, abs=1e-4)  # the deflected blade: 1 cm
+    assert np.all(g.q[2, joints] == 0.0) and np.any(g.q[1, joints] != 0.0)  # none in the air
+    assert np.array_equal(deflected_blade(sphere, q), q)  # no multi-link blade: unchanged

@@ -131,7 +131,10 @@ def _design(
         help="name=low:high,... (default: stiffness_kN_per_m=18:32,width_m=0.05:0.08,"
              "height_m=0.40:0.48,toe_length_m=0.19:0.25)."),
     runs: str = typer.Option("ccd", "--runs", help="ccd, bbd, dopt or a CSV file of runs."),
-    evaluator: str = typer.Option("blade", "--evaluator", help="blade or runner."),
+    evaluator: str = typer.Option(
+        "blade", "--evaluator",
+        help="blade (one passive stance), runner (a template gait cycle) or collocation (a "
+             "predicted transfemoral stride per design, docs/design.md)."),
     out: Path | None = typer.Option(None, "--out",
                                     help="Output folder (resumes an interrupted study); required."),
     seed: int = typer.Option(0, "--seed", help="Seed (D-optimal design, optimiser starts)."),
@@ -145,8 +148,15 @@ def _design(
         [], "--constraint",
         help="response=minimum (repeatable), e.g. knee_moment_min_Nm=0 swing_clearance_m=0.02."),
     speed: float | None = typer.Option(
-        None, "--speed", help="Touch-down speed [m/s] (default 8 blade, 7 runner)."),
-    body_mass: float = typer.Option(76.0, "--body-mass", help="Body mass [kg]."),
+        None, "--speed",
+        help="Touch-down speed [m/s] (default 8 blade, 7 runner); the stride's mean speed "
+             "(collocation, default 5)."),
+    body_mass: float | None = typer.Option(
+        None, "--body-mass", help="Body mass [kg] (blade and runner evaluators; default 76)."),
+    start: Path | None = typer.Option(
+        None, "--start",
+        help="Collocation solution of the transfemoral runner that the first design starts "
+             "from (collocation evaluator; default: the built-in centre stride)."),
     base: str = typer.Option("xtreme", "--base", help="Base blade of the generator."),
     gait: Path | None = typer.Option(None, "--gait",
                                      help="Gait-cycle CSV (runner evaluator; default built-in)."),
@@ -188,7 +198,21 @@ def _design(
         if not sep or not name.strip():
             raise SpecError(f"cannot read constraint {c!r}", where="--constraint",
                             hint="write response=minimum, e.g. knee_moment_min_Nm=0")
-    options: dict = {"body_mass_kg": body_mass, "generator": {"base": base}}
+    options: dict = {"generator": {"base": base}}
+    if evaluator == "collocation":
+        if body_mass is not None or dt is not None:
+            raise SpecError(f"--{'body-mass' if body_mass is not None else 'dt'} does not apply "
+                            "to the collocation evaluator", where="--evaluator collocation",
+                            hint="its runner is the transfemoral parameter set "
+                                 "(docs/runner-model.md); collocation has no time step")
+        options["solutions_dir"] = str(out / "strides")
+        options["factor_ranges"] = {f.name: (f.low, f.high) for f in space.factors}
+        if start is not None:
+            options["start"] = str(start)
+    else:
+        options["body_mass_kg"] = 76.0 if body_mass is None else body_mass
+        if start is not None:
+            raise SpecError("--start needs --evaluator collocation", where="--start")
     if speed is not None:
         options["speed_mps"] = speed
     if dt is not None:

@@ -240,12 +240,19 @@ class BladeEvaluator:
 
 
 def make_evaluator(kind: str, **options: Any):
-    """An evaluator by name: ``"blade"`` (:class:`BladeEvaluator`) or ``"runner"``
-    (:class:`bladelab.design.transfemoral.RunnerEvaluator`), with its options as keywords."""
+    """An evaluator by name: ``"blade"`` (:class:`BladeEvaluator`), ``"runner"``
+    (:class:`bladelab.design.transfemoral.RunnerEvaluator`) or ``"collocation"``
+    (:class:`bladelab.design.collocation_evaluator.CollocationEvaluator`), with its options as
+    keywords."""
     if kind == "blade":
         return BladeEvaluator(**options)
     if kind == "runner":
         from bladelab.design.transfemoral import RunnerEvaluator
 
         return RunnerEvaluator(**options)
-    raise SpecError(f"unknown evaluator {kind!r}", where="evaluator", hint="use 'blade' or 'runner'")
+    if kind == "collocation":
+        from bladelab.design.collocation_evaluator import CollocationEvaluator
+
+        return CollocationEvaluator(**options)
+    raise SpecError(f"unknown evaluator {kind!r}", where="evaluator",
+                    hint="use 'blade', 'runner' or 'collocation'")

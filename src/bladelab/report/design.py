@@ -47,11 +47,13 @@ def _load(design_dir: Path):
     evaluator: dict = {}
     if ev.is_file():
         from bladelab.design.evaluators import BLADE_RESPONSE_UNITS
+        from bladelab.design.predicted import PREDICTED_RESPONSE_UNITS
         from bladelab.design.transfemoral import RUNNER_RESPONSE_UNITS
 
         evaluator = read_json(ev, what="evaluator settings")
         kind = evaluator.get("evaluator")
-        units = RUNNER_RESPONSE_UNITS if kind == "runner" else BLADE_RESPONSE_UNITS
+        units = {"runner": RUNNER_RESPONSE_UNITS,
+                 "collocation": PREDICTED_RESPONSE_UNITS}.get(kind, BLADE_RESPONSE_UNITS)
     meta = {**meta, "_evaluator": evaluator}
     coded_cols = [f"{n}_coded" for n in space.names]
     skip = {"run", *space.names, *coded_cols}

@@ -81,9 +81,11 @@ class StrideGuess:
 
     def on_model(self, model: RunnerModel) -> StrideGuess:
         """This guess on ``model``'s coordinates and muscles, matched by name: coordinates
-        the guess lacks (a toe hinge) start at 0 (neutral), muscles it lacks at activation 0.05
-        with tendon forces from static equilibrium. Raises if a coordinate of the guess other
-        than a toe hinge has no place in ``model`` (a guess of the other model kind)."""
+        the guess lacks (a toe hinge) start at 0 (neutral), a multi-link blade's joints the
+        guess lacks at the blade's static deflection (:func:`deflected_blade`), muscles it
+        lacks at activation 0.05 with tendon forces from static equilibrium. Raises if a
+        coordinate of the guess other than a toe hinge has no place in ``model`` (a guess of
+        the other model kind)."""
         dofs, muscles = tuple(model.dof_names), tuple(model.muscle_names)
         if self.dof_names is None or (self.dof_names == dofs and self.muscle_names == muscles):
             if self.q.shape[1] != len(dofs):
@@ -106,9 +108,14 @@ class StrideGuess:
             return out
 
         keep_muscles = self.muscle_names is not None and set(muscles) <= set(self.muscle_names)
+        q, qd = cols(self.q, self.dof_names, dofs, 0.0), cols(self.qd, self.dof_names, dofs, 0.0)
+        blade = [j for j, name in enumerate(dofs)
+                 if name.startswith("blade_joint") and name not in self.dof_names]
+        if blade:
+            q = deflected_blade(model, q)
+            qd[:, blade] = periodic_derivative(q, self.period)[:, blade]
         return replace(
-            self, q=cols(self.q, self.dof_names, dofs, 0.0),
-            qd=cols(self.qd, self.dof_names, dofs, 0.0),
+            self, q=q, qd=qd,
             activation=cols(self.activation, self.muscle_names, muscles, 0.05),
             tendon_force=cols(self.tendon_force, self.muscle_names, muscles, 0.0)
             if keep_muscles else None,
@@ -179,6 +186,56 @@ def periodic_derivative(q: np.ndarray, period: float) -> np.ndarray:
     prv = np.vstack([body[-1:] - advance, body[:-1]])
     d = (nxt - prv) / (2 * h)
     return np.vstack([d, d[:1]])
+
+
+def deflected_blade(model: RunnerModel, q: np.ndarray, *, depth_m: float = 0.01) -> np.ndarray:
+    """``q`` (rows of coordinates) with a multi-link blade's joints at the static deflection
+    that leaves its lowest sole at most ``depth_m`` [m] deep: at each node where it is deeper,
+    a vertical load F at that sole turns joint i by ``θ_i = J_i·F / K_i`` (J the sole point's
+    vertical Jacobian column at the undeformed blade, K_i the joint's stiffness [N·m/rad]),
+    with F found by bisection. The start of a blade's stride from a stride of the sphere
+    blade, whose compression the undeformed links would otherwise meet 10 cm deep in the
+    ground."""
+    import mujoco
+
+    from bladelab.runner.model import CP_BLADE, CP_SITE
+
+    if model.blade_model is None:
+        return q
+    m = model.mj_model
+    joints = [model.dof(f"blade_joint{i}") for i in range(len(model.blade_model.joints))]
+    stiffness = np.array([j.stiffness for j in model.blade_model.joints])
+    on_blade = model.contact_params[:, CP_BLADE] == 1
+    soles = model.contact_params[on_blade]
+    out = np.array(q, dtype=float, copy=True)
+    d = mujoco.MjData(m)
+    jac = np.zeros((3, m.nv))
+    for k in range(out.shape[0]):
+        out[k, joints] = 0.0
+        depth = -contact_heights(model, out[k])[on_blade]
+        if depth.max() <= depth_m:
+            continue
+        row = soles[int(depth.argmax())]
+        site = int(row[CP_SITE])
+        d.qpos[:] = out[k]
+        mujoco.mj_kinematics(m, d)
+        mujoco.mj_comPos(m, d)
+        mujoco.mj_jacSite(m, d, jac, None, site)
+        per_newton = jac[2, joints] / stiffness  # rad/N
+
+        def deepest(force: float, k=k, per_newton=per_newton) -> float:
+            trial = out[k].copy()
+            trial[joints] = force * per_newton
+            return float(-contact_heights(model, trial)[on_blade].min())
+
+        lo, hi = 0.0, 1.0e3
+        while deepest(hi) > depth_m and hi < 1.0e6:
+            hi *= 2.0
+        for _ in range(40):
+            mid = 0.5 * (lo + hi)
+            lo, hi = (mid, hi) if deepest(mid) > depth_m else (lo, mid)
+        out[k, joints] = hi * per_newton
+    return out
 
 
 def _grounded(model: RunnerModel, q: np.ndarray) -> np.ndarray:

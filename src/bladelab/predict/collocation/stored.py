@@ -40,9 +40,11 @@ __all__ = [
 def check_model_spec(spec) -> dict:
     """The model specification ``{"model": "able" | "amputee" | "transfemoral", "blade": name |
     None}``, plus
-    ``"body"`` where it is not seed 001's (:data:`bladelab.runner.params.BODIES`), checked and
-    normalised (the able model has no blade; the amputee needs one; files written before the
-    bodies existed have no ``"body"`` and mean seed 001's)."""
+    ``"body"`` where it is not seed 001's (:data:`bladelab.runner.params.BODIES`) and
+    ``"blade_spec"`` where the runner wears a multi-link blade (the blade file's contents, as
+    :func:`bladelab.blade.spec.spec_from_dict` reads them; ``"blade"`` is then its name),
+    checked and normalised (the able model has no blade; the amputee needs one; files written
+    before the bodies existed have no ``"body"`` and mean seed 001's)."""
     if not isinstance(spec, dict) or "model" not in spec:
         raise SpecError(f"expected {{'model': ..., 'blade': ...}}, got {spec!r}",
                         where="model_spec")
@@ -61,7 +63,14 @@ def check_model_spec(spec) -> dict:
     body = spec.get("body", "seed001")
     if body not in BODIES:
         raise SpecError(f"unknown body {body!r}", where="body", hint=" or ".join(BODIES))
-    return {"model": model, "blade": blade} | ({} if body == "seed001" else {"body": body})
+    out = {"model": model, "blade": blade} | ({} if body == "seed001" else {"body": body})
+    blade_spec = spec.get("blade_spec")
+    if blade_spec is not None:
+        if model == "able" or not isinstance(blade_spec, dict):
+            raise SpecError("blade_spec must be a multi-link blade's specification (a mapping) "
+                            "of an amputee model", where="blade_spec")
+        out["blade_spec"] = blade_spec
+    return out
 
 
 def model_label(spec: dict) -> str:
@@ -84,6 +93,11 @@ def runner_from_spec(spec: dict):
     from bladelab.runner import build_runner
 
     spec = check_model_spec(spec)
+    if "blade_spec" in spec:
+        from bladelab.blade.spec import spec_from_dict
+
+        blade = spec_from_dict(spec["blade_spec"]).build()
+        return build_runner(spec["model"], blade_model=blade, body=spec.get("body", "seed001"))
     return build_runner(spec["model"], blade=spec["blade"], body=spec.get("body", "seed001"))
 
 

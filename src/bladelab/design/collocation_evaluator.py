@@ -1,0 +1,192 @@
+"""Design point -> generated blade on the transfemoral runner -> predicted stride (issue 21).
+
+:class:`CollocationEvaluator` is the design study's evaluator ``"collocation"``
+(``bladelab design --evaluator collocation``): for each design point it
+
+1. generates the multi-link blade (:func:`~bladelab.design.blade_generator.generate_blade`);
+2. builds the transfemoral runner wearing it (``build_runner("transfemoral", blade_model=…)``:
+   intact leg, residual hip muscles, the passive 3S80-class knee, the blade's links, joints
+   and soles);
+3. predicts one periodic stride at the prescribed speed by direct collocation
+   (:func:`~bladelab.predict.collocation.solve.predict_stride`), warm-started from the
+   nearest design already solved in ``solutions_dir`` (coded distance), else from ``start``;
+   a start that does not converge to a clean alternating run (no
+   :meth:`~bladelab.predict.collocation.solution.CollocationSolution.gait_warnings`) is
+   followed by the next one; the last resort is ``start`` with a tracking stage first;
+4. reads seed 002's responses off the stride
+   (:func:`~bladelab.design.predicted.stride_responses`).
+
+Every design's stride is written to ``solutions_dir/<point>.json`` (``bladelab report``
+renders it), a failed one's best iterate to ``<point>.best_iterate.json``; a design point
+with no clean stride raises :class:`~bladelab.errors.OptimizationError` naming IPOPT's status
+and the gait's defects (the study stops there with the finished runs kept: never a NaN).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Mapping
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+from typing import Any
+
+from bladelab.errors import OptimizationError, SpecError
+
+__all__ = ["CollocationEvaluator", "DEFAULT_DESIGN_SPEED_MPS"]
+
+#: Prescribed speed of a design's stride [m/s] (our choice, docs/design.md "Predicted
+#: transfemoral gaits"): the transfemoral runner's maximum speed on collocation is 5.6–5.8 m/s
+#: (sphere blade, session 9), so seed 002's sprint speeds (about 7 m/s) are out of its reach;
+#: 5 m/s is a fast run every design of the default box can hold.
+DEFAULT_DESIGN_SPEED_MPS = 5.0
+#: The start of the first design: a clean transfemoral stride wearing the default box's centre
+#: blade at :data:`DEFAULT_DESIGN_SPEED_MPS` (how it was made: the file's ``guess_source`` and
+#: benchmarks/collocation/transfemoral-design/).
+DEFAULT_START = Path(__file__).resolve().parents[1] / "data" / "runner" / "solutions" / (
+    "transfemoral-design-centre-5.json")
+_SEP = "__"
+
+
+def point_file_stem(point: Mapping[str, float]) -> str:
+    """File name stem of a design point: ``name=value__name=value`` (values to 6 digits)."""
+    return _SEP.join(f"{k}={float(v):.6g}" for k, v in point.items())
+
+
+def _point_from_stem(stem: str) -> dict[str, float] | None:
+    try:
+        return {k: float(v) for k, v in (item.split("=", 1) for item in stem.split(_SEP))}
+    except ValueError:
+        return None
+
+
+@dataclass(frozen=True)
+class CollocationEvaluator:
+    """Design point -> predicted transfemoral stride -> seed 002's responses (module docstring).
+
+    Attributes
+    ----------
+    speed_mps
+        Prescribed mean speed of the stride [m/s].
+    start
+        A collocation solution (file) of the transfemoral runner to start the first design
+        from (any blade with the same number of links); default :data:`DEFAULT_START`.
+    solutions_dir
+        Folder of the designs' strides (the warm starts of the later designs); None: a
+        ``strides`` folder is not kept and every design starts from ``start``.
+    factor_ranges
+        Factor -> (low, high) in its unit: the coding of the nearest-neighbour distance
+        (default: relative differences).
+    mesh_intervals, swing_clearance_m, max_iter
+        Collocation settings (:class:`~bladelab.predict.collocation.solve.CollocationSettings`):
+        mesh intervals, the swinging blade's minimum height [m], IPOPT's iteration limit.
+    generator
+        Options of :func:`~bladelab.design.blade_generator.generate_blade`.
+    """
+
+    speed_mps: float = DEFAULT_DESIGN_SPEED_MPS
+    start: str | None = None
+    solutions_dir: str | None = None
+    factor_ranges: Mapping[str, tuple[float, float]] = field(default_factory=dict)
+    mesh_intervals: int = 50
+    swing_clearance_m: float = 0.02
+    max_iter: int = 3000
+    generator: Mapping[str, Any] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        if not (self.speed_mps > 0 and math.isfinite(self.speed_mps)):
+            raise SpecError(f"speed must be > 0 m/s, got {self.speed_mps}", where="speed")
+        start = Path(self.start) if self.start is not None else DEFAULT_START
+        if not start.is_file():
+            from bladelab.errors import InputFileError
+
+            raise InputFileError("no such collocation solution (the first design's start)",
+                                 file=start, hint="a solution.json of the transfemoral runner")
+
+    @property
+    def units(self) -> dict[str, str]:
+        from bladelab.design.predicted import PREDICTED_RESPONSE_UNITS
+
+        return dict(PREDICTED_RESPONSE_UNITS)
+
+    def to_dict(self) -> dict:
+        d = asdict(self)
+        d["generator"] = {k: str(v) if isinstance(v, Path) else v
+                          for k, v in dict(self.generator).items()}
+        d["factor_ranges"] = {k: list(v) for k, v in dict(self.factor_ranges).items()}
+        d["start"] = str(self.start or DEFAULT_START)
+        return {"evaluator": "collocation", **d}
+
+    # -- starts ---------------------------------------------------------------------------
+    def _distance(self, a: Mapping[str, float], b: Mapping[str, float]) -> float:
+        if set(a) != set(b):
+            return math.inf
+        total = 0.0
+        for k, v in a.items():
+            lo, hi = self.factor_ranges.get(k, (0.0, 0.0))
+            span = (hi - lo) / 2 if hi > lo else max(abs(v), 1e-12)
+            total += ((v - b[k]) / span) ** 2
+        return math.sqrt(total)
+
+    def _starts(self, point: Mapping[str, float]) -> list[Path]:
+        """Solution files to start from, nearest design first, ``start`` last."""
+        found = []
+        if self.solutions_dir is not None and Path(self.solutions_dir).is_dir():
+            for f in Path(self.solutions_dir).glob("*.json"):
+                if f.name.endswith(".best_iterate.json"):
+                    continue
+                p = _point_from_stem(f.stem)
+                if p is not None and p != dict(point):
+                    found.append((self._distance(point, p), f.name, f))
+        found.sort()
+        return [f for _, _, f in found[:1]] + [Path(self.start or DEFAULT_START)]
+
+    # -- one design -----------------------------------------------------------------------
+    def __call__(self, point: Mapping[str, float]) -> dict[str, float]:
+        from bladelab.design.blade_generator import generate_blade
+        from bladelab.design.predicted import stride_responses
+        from bladelab.predict.collocation.solution import CollocationSolution
+        from bladelab.predict.collocation.solve import CollocationSettings, predict_stride
+        from bladelab.runner import build_runner
+
+        point = {k: float(v) for k, v in point.items()}
+        gen = generate_blade(point, **dict(self.generator))
+        runner = build_runner("transfemoral", blade_model=gen.model)
+        spec = {"model": "transfemoral", "blade": gen.model.name,
+                "blade_spec": gen.spec.model_dump(mode="json", exclude_none=True)}
+        settings = CollocationSettings(mesh_intervals=self.mesh_intervals,
+                                       speed_m_per_s=self.speed_mps,
+                                       swing_clearance_m=self.swing_clearance_m,
+                                       max_iter=self.max_iter)
+        starts = self._starts(point)
+        plan = [(f, False) for f in starts] + [(starts[-1], True)]
+        tried, best = [], None
+        t0 = time.perf_counter()
+        for path, track in plan:
+            source = CollocationSolution.read(path)
+            guess = source.to_guess(f"{'tracking ' if track else ''}collocation solution "
+                                    f"{path.name}")
+            sol = predict_stride(runner, settings, guess, model_spec=spec, track=track)
+            defects = sol.gait_warnings() if sol.converged else []
+            if sol.converged and not defects:
+                break
+            tried.append(f"from {path.name}{' (tracking first)' if track else ''}: "
+                         + (f"IPOPT {sol.nlp.status}" if not sol.converged
+                            else "; ".join(defects)))
+            best = best or sol
+        else:
+            if self.solutions_dir is not None:
+                out = Path(self.solutions_dir)
+                out.mkdir(parents=True, exist_ok=True)
+                best.write(out / f"{point_file_stem(point)}.best_iterate.json")
+            raise OptimizationError(
+                f"no clean stride for this blade after {len(plan)} starts "
+                f"({time.perf_counter() - t0:.0f} s): " + " | ".join(tried),
+                where="collocation evaluator",
+                hint="the last iterates are in the solutions folder; widen the box's centre "
+                     "towards this point, or give a --start stride nearer to it")
+        if self.solutions_dir is not None:
+            out = Path(self.solutions_dir)
+            out.mkdir(parents=True, exist_ok=True)
+            sol.write(out / f"{point_file_stem(point)}.json")
+        return stride_responses(sol, runner)

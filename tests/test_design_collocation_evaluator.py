@@ -1,0 +1,136 @@
+"""The collocation design evaluator's starts, files and failures, with the solve replaced by a
+stand-in (a real transfemoral solve takes minutes: docs/design.md has the measured ones)."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from bladelab.design import collocation_evaluator as ce
+from bladelab.design.evaluators import make_evaluator
+from bladelab.errors import InputFileError, OptimizationError
+from bladelab.predict.collocation import solve as solve_module
+from bladelab.predict.collocation.solution import CollocationSolution
+
+STRIDE = Path(__file__).parent / "data" / "transfemoral-4mps.json"
+CENTRE = {"stiffness_kN_per_m": 25.0, "width_m": 0.065, "height_m": 0.44, "toe_length_m": 0.22}
+RANGES = {"stiffness_kN_per_m": (18.0, 32.0), "width_m": (0.05, 0.08), "height_m": (0.40, 0.48),
+          "toe_length_m": (0.19, 0.25)}
+
+
+class _Outcome:
+    """A solve's result as the evaluator reads it: converged or not, the gait's defects."""
+
+    def __init__(self, base: CollocationSolution, converged: bool, defects: list[str]):
+        self._base, self.converged, self._defects = base, converged, defects
+        self.nlp = base.nlp if converged else type("N", (), {"status": "Infeasible_Problem_Detected"})()
+
+    def gait_warnings(self):
+        return list(self._defects)
+
+    def write(self, path):  # the base stride's file stands for this one
+        Path(path).write_bytes(STRIDE.read_bytes())
+        return Path(path)
+
+
+@pytest.fixture
+def fake(monkeypatch):
+    """Replace the solve and the responses; record each solve's start and blade."""
+    base = CollocationSolution.read(STRIDE)
+    calls, script = [], []
+
+    def predict_stride(runner, settings, guess, *, model_spec, track=None, progress=None):
+        calls.append({"source": guess.source, "track": track, "spec": model_spec,
+                      "speed": settings.speed_m_per_s, "dofs": runner.dof_names})
+        converged, defects = script.pop(0) if script else (True, [])
+        return _Outcome(base, converged, defects)
+
+    monkeypatch.setattr(solve_module, "predict_stride", predict_stride)
+    monkeypatch.setattr("bladelab.design.predicted.stride_responses",
+                        lambda sol, runner: {"delta_vx_m_per_s": 0.1})
+    return calls, script
+
+
+def _evaluator(tmp_path, **kw):
+    return make_evaluator("collocation", start=str(STRIDE), solutions_dir=str(tmp_path / "s"),
+                          factor_ranges=RANGES, **kw)
+
+
+def test_each_design_wears_its_own_generated_blade(fake, tmp_path):
+    calls, _ = fake
+    ev = _evaluator(tmp_path, speed_mps=4.5)
+    assert ev({**CENTRE}) == {"delta_vx_m_per_s": 0.1}
+    call = calls[0]
+    assert call["speed"] == 4.5
+    assert call["spec"]["model"] == "transfemoral"
+    assert call["spec"]["blade_spec"]["joints"]  # the generated blade travels with the stride
+    assert sum(d.startswith("blade_joint") for d in call["dofs"]) == 5  # 6 links
+    assert (tmp_path / "s" / f"{ce.point_file_stem(CENTRE)}.json").is_file()
+
+
+def test_a_design_starts_from_its_nearest_solved_neighbour(fake, tmp_path):
+    calls, _ = fake
+    ev = _evaluator(tmp_path)
+    near = {**CENTRE, "stiffness_kN_per_m": 32.0}
+    far = {**CENTRE, "stiffness_kN_per_m": 18.0, "width_m": 0.08}
+    ev(far)
+    ev(CENTRE)
+    assert STRIDE.name in calls[0]["source"]  # nothing solved yet: the start
+    assert ce.point_file_stem(far) in calls[1]["source"]
+    ev(near)  # the centre (distance 1 coded) is nearer than far (distance 2.24)
+    assert ce.point_file_stem(CENTRE) in calls[2]["source"]
+    assert all(c["track"] is False for c in calls)
+
+
+def test_a_start_with_a_flawed_gait_is_followed_by_the_next(fake, tmp_path):
+    calls, script = fake
+    ev = _evaluator(tmp_path)
+    ev(CENTRE)
+    script += [(True, ["the prosthetic leg touches the ground 2 times per stride"]), (True, [])]
+    ev({**CENTRE, "width_m": 0.05})
+    assert ce.point_file_stem(CENTRE) in calls[1]["source"]
+    assert STRIDE.name in calls[2]["source"] and calls[2]["track"] is False
+
+
+def test_a_design_with_no_clean_stride_is_a_named_failure(fake, tmp_path):
+    calls, script = fake
+    ev = _evaluator(tmp_path)
+    script += [(False, []), (True, ["no flight phase (not running)"])]
+    with pytest.raises(OptimizationError) as err:
+        ev(CENTRE)
+    msg = str(err.value)
+    assert "Infeasible_Problem_Detected" in msg and "no flight phase" in msg
+    assert [c["track"] for c in calls] == [False, True]  # the start, then tracking first
+    stem = ce.point_file_stem(CENTRE)
+    assert not (tmp_path / "s" / f"{stem}.json").exists()  # never stored as a solution
+    assert (tmp_path / "s" / f"{stem}.best_iterate.json").is_file()
+
+
+def test_point_file_names_read_back():
+    stem = ce.point_file_stem({"a_m": 0.065, "b": 25.0})
+    assert stem == "a_m=0.065__b=25"
+    assert ce._point_from_stem(stem) == {"a_m": 0.065, "b": 25.0}
+    assert ce._point_from_stem("solution") is None
+
+
+def test_a_missing_start_is_named(tmp_path):
+    with pytest.raises(InputFileError) as err:
+        make_evaluator("collocation", start=str(tmp_path / "none.json"))
+    assert "none.json" in str(err.value)
+
+
+def test_the_runner_of_a_multilink_stride_is_rebuilt_from_its_file():
+    from bladelab.design.blade_generator import generate_blade
+    from bladelab.predict.collocation.stored import check_model_spec, runner_from_spec
+
+    gen = generate_blade(CENTRE)
+    spec = check_model_spec({"model": "transfemoral", "blade": gen.model.name,
+                             "blade_spec": gen.spec.model_dump(mode="json", exclude_none=True)})
+    runner = runner_from_spec(json.loads(json.dumps(spec)))  # as read back from a file
+    assert runner.kind == "transfemoral" and runner.blade_model is not None
+    assert np.allclose([j.stiffness for j in runner.blade_model.joints],
+                       [j.stiffness for j in gen.model.joints], rtol=1e-12)
+    assert runner.blade_model.mass == pytest.approx(gen.model.mass, rel=1e-12)
