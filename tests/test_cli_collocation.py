@@ -80,6 +80,9 @@ def test_a_failed_force_run_removes_the_old_solution(solved, tmp_path, capsys):
     (("--method", "collocation", "--max-iter", "0"), "--max-iter"),
     (("--method", "collocation", "--speed", "-1"), "--speed"),
     (("--method", "collocation", "--swing-clearance", "-0.01"), "--swing-clearance"),
+    (("--method", "collocation", "--knee-moment-min", "0"), "--knee-moment-min"),  # able
+    (("--method", "collocation", "--model", "transfemoral", "--knee-moment-min", "5"),
+     "--knee-moment-min"),  # above 0: infeasible in swing
     (("--method", "collocation", "--guess", "no-such-file.json"), "--guess"),
 ])
 def test_bad_options_are_refused_naming_the_option(args, where, tmp_path, capsys):

@@ -130,6 +130,11 @@ def test_design_bad_input(tmp_path, capsys):
                  "stiffness_kN_per_m=18:32,width_m=0.05:0.08"]) == 2  # BBD needs k >= 3
     assert main(["design", "--out", str(tmp_path / "c"), "--start", str(tmp_path)]) == 2
     assert "--start needs --evaluator collocation" in capsys.readouterr().err
+    assert main(["design", "--out", str(tmp_path / "c"), "--knee-moment-min", "0"]) == 2
+    assert "--knee-moment-min needs --evaluator collocation" in capsys.readouterr().err
+    assert main(["design", "--out", str(tmp_path / "c"), "--evaluator", "collocation",
+                 "--knee-moment-min", "10"]) == 2
+    assert "knee moment minimum must be <= 0" in capsys.readouterr().err
     assert main(["design", "--out", str(tmp_path / "c"), "--evaluator", "collocation",
                  "--body-mass", "70"]) == 2
     assert "does not apply to the collocation evaluator" in capsys.readouterr().err

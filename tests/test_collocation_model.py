@@ -471,3 +471,35 @@ def test_swing_clearance_binds_only_a_contact_moving_forward(models):
     heights = contact_heights(runner, q)
     values = np.asarray(fn(q, swing)).ravel()
     np.testing.assert_allclose(values, heights - 0.02, atol=1e-6)
+
+
+def test_knee_moment_is_the_prosthetic_grf_moment_about_the_knee_axis(models):
+    """Seed 002's knee-buckling moment as the collocation constraint sees it, against MuJoCo's
+    knee axis and the contact forces by hand; 0 with the prosthesis in the air."""
+    from bladelab.errors import SpecError
+    from bladelab.predict.collocation.dynamics import knee_extension_moment
+    from bladelab.runner.model import CP_LEG
+
+    runner, cm = models["transfemoral"]
+    q_s, qd_s = ca.SX.sym("q", cm.nv), ca.SX.sym("qd", cm.nv)
+    fn = ca.Function("knee", [q_s, qd_s], [knee_extension_moment(cm, q_s, qd_s)])
+    m, d = runner.mj_model, mujoco.MjData(runner.mj_model)
+    rng = np.random.default_rng(21)
+    pros = runner.contact_params[:, CP_LEG] == 1
+    for _ in range(5):
+        q = runner.stand_qpos.copy()
+        q[runner.dof("pelvis_tz")] -= rng.uniform(0.005, 0.03)
+        q[runner.dof("pelvis_tilt")] += rng.uniform(-0.05, 0.05)
+        qd = rng.normal(0.0, 0.5, cm.nv)
+        d.qpos[:] = q
+        mujoco.mj_kinematics(m, d)
+        kx, _, kz = d.xanchor[m.joint("knee_angle_r").id]
+        forces, points, _ = (np.asarray(x) for x in cm.contacts(q, qd))
+        want = np.sum((points[pros, 0] - kx) * forces[pros, 1]
+                      - (points[pros, 1] - kz) * forces[pros, 0])
+        assert forces[pros, 1].sum() > 50.0  # loaded
+        assert float(fn(q, qd)) == pytest.approx(want, rel=1e-9, abs=1e-9)
+    q[runner.dof("pelvis_tz")] += 0.3  # in the air
+    assert abs(float(fn(q, qd))) < 1e-6
+    with pytest.raises(SpecError, match="no prosthetic knee"):
+        knee_extension_moment(models["amputee-Cat6"][1], q_s, qd_s)

@@ -44,7 +44,8 @@ def fake(monkeypatch):
 
     def predict_stride(runner, settings, guess, *, model_spec, track=None, progress=None):
         calls.append({"source": guess.source, "track": track, "spec": model_spec,
-                      "speed": settings.speed_m_per_s, "dofs": runner.dof_names})
+                      "speed": settings.speed_m_per_s, "dofs": runner.dof_names,
+                      "contacts": runner.contact_params.copy()})
         converged, defects = script.pop(0) if script else (True, [])
         return _Outcome(base, converged, defects)
 
@@ -66,7 +67,14 @@ def test_each_design_wears_its_own_generated_blade(fake, tmp_path):
     call = calls[0]
     assert call["speed"] == 4.5
     assert call["spec"]["model"] == "transfemoral"
-    assert call["spec"]["blade_spec"]["joints"]  # the generated blade travels with the stride
+    blade = call["spec"]["blade_spec"]  # the generated blade travels with the stride
+    assert len(blade["joints"]) == 5
+    assert blade["contact"]["stiffness_N_per_m"] == pytest.approx(1e5)  # xtreme's 1e6 × 0.1
+    assert blade["contact"]["damping_Ns_per_m"] == pytest.approx(1e3 * 0.1 ** 0.5)
+    from bladelab.runner.model import CP_BLADE, CP_K
+
+    soles = call["contacts"][call["contacts"][:, CP_BLADE] == 1]
+    assert len(soles) == 3 and np.allclose(soles[:, CP_K], 1e5)  # the runner wears them
     assert sum(d.startswith("blade_joint") for d in call["dofs"]) == 5  # 6 links
     assert (tmp_path / "s" / f"{ce.point_file_stem(CENTRE)}.json").is_file()
 

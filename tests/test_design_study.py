@@ -114,8 +114,25 @@ def test_refusals_before_and_during_evaluation(tmp_path):
     def bad(point):
         return {"y": float("nan")}
 
-    with pytest.raises(DataError, match="run 1"):
+    with pytest.raises(DataError, match="run 25"):  # the centre, evaluated first
         run_design(SPACE, evaluator=bad, out_dir=tmp_path / "p", progress=False)
     with pytest.raises(SpecError, match="unknown response"):
         run_design(SPACE, evaluator=_evaluator, out_dir=tmp_path / "q", objective="speed",
                    progress=False)
+
+
+def test_runs_are_evaluated_from_the_centre_outwards(tmp_path):
+    """So that an evaluator warm-starting from solved neighbours always has a near one."""
+    space = default_design_space()
+    seen = []
+
+    def recording(point):
+        seen.append(space.code([point[n] for n in space.names]))
+        return _evaluator(point)
+
+    res = run_design(space, runs="ccd", evaluator=recording, out_dir=tmp_path, progress=False)
+    norms = np.linalg.norm(np.array(seen), axis=1)
+    assert norms[0] == pytest.approx(0.0, abs=1e-12)  # the centre first
+    assert np.all(np.diff(norms) >= -1e-9)  # then the axial points, then the corners
+    assert len(seen) == res.design.n_runs == 25
+    assert np.allclose(np.sort(np.array(seen), axis=0), np.sort(res.design.coded, axis=0))

@@ -153,6 +153,10 @@ def _design(
              "(collocation, default 5)."),
     body_mass: float | None = typer.Option(
         None, "--body-mass", help="Body mass [kg] (blade and runner evaluators; default 76)."),
+    knee_moment_min: float | None = typer.Option(
+        None, "--knee-moment-min",
+        help="Collocation evaluator: keep the prosthetic knee's extension moment at or above "
+             "this [N·m] in every design's stride (<= 0; default: reported, not imposed)."),
     start: Path | None = typer.Option(
         None, "--start",
         help="Collocation solution of the transfemoral runner that the first design starts "
@@ -209,10 +213,13 @@ def _design(
         options["factor_ranges"] = {f.name: (f.low, f.high) for f in space.factors}
         if start is not None:
             options["start"] = str(start)
+        if knee_moment_min is not None:
+            options["knee_moment_min_Nm"] = knee_moment_min
     else:
         options["body_mass_kg"] = 76.0 if body_mass is None else body_mass
-        if start is not None:
-            raise SpecError("--start needs --evaluator collocation", where="--start")
+        for name, given in (("--start", start), ("--knee-moment-min", knee_moment_min)):
+            if given is not None:
+                raise SpecError(f"{name} needs --evaluator collocation", where=name)
     if speed is not None:
         options["speed_mps"] = speed
     if dt is not None:

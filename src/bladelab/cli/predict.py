@@ -97,6 +97,11 @@ def register(app: typer.Typer) -> None:
             0.0, "--swing-clearance", help="Collocation: keep every swinging foot or blade "
             "this high above the ground [m] (0: no constraint)."
         ),
+        knee_moment_min: float | None = typer.Option(
+            None, "--knee-moment-min", help="Collocation, transfemoral: keep the ground force's "
+            "extension moment about the prosthetic knee at or above this [N·m] (<= 0; 0: the "
+            "knee never buckles)."
+        ),
     ) -> None:
         """Optimise the reflex controller of the runner with CMA-ES (seed 001 eq. 2.4), or with
         --method collocation solve one periodic stride by direct collocation (writes
@@ -108,7 +113,8 @@ def register(app: typer.Typer) -> None:
                                    max_speed=max_speed, mesh=mesh, guess=guess,
                                    max_iter=max_iter, resume=resume, force=force,
                                    as_json=as_json, body=body,
-                                   swing_clearance=swing_clearance)
+                                   swing_clearance=swing_clearance,
+                                   knee_moment_min=knee_moment_min)
             raise typer.Exit(code)
         if method != "reflex":
             raise SpecError(f"unknown method {method!r}", where="--method",

@@ -307,7 +307,10 @@ def run_design(
             results[i] = r
             n_resumed += 1
             expected = expected or list(r)
-    todo = [i for i in range(design.n_runs) if results[i] is None]
+    # centre outwards: an evaluator that warm-starts from solved neighbours (collocation) then
+    # always finds a near one (a corner's nearest axial point, not the centre two units away)
+    todo = sorted((i for i in range(design.n_runs) if results[i] is None),
+                  key=lambda i: (round(float(np.linalg.norm(design.coded[i])), 9), i))
     finished = _evaluate_runs(evaluator, space, design, todo, jobs=jobs, executor=executor,
                               progress=progress)
     for i, raw in finished:

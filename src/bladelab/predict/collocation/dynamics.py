@@ -15,6 +15,7 @@ import math
 import casadi as ca
 import numpy as np
 
+from bladelab.errors import SpecError
 from bladelab.predict.collocation.metabolics import (
     MetabolicSmoothing,
     muscle_metabolic_rates,
@@ -85,11 +86,37 @@ def swing_clearance(cm: CollocationModel, q: ca.SX, qd: ca.SX, height_m: float) 
     return ca.vertcat(*out)
 
 
+def knee_extension_moment(cm: CollocationModel, q: ca.SX, qd: ca.SX) -> ca.SX:
+    """External extension moment [N·m] of the prosthetic contacts' ground forces about the
+    prosthetic knee's axis, ``Σ (x_c − x_k)·F_z − (z_c − z_k)·F_x`` over the contacts c (seed
+    002's knee-buckling moment, as :func:`bladelab.design.constraints.knee_extension_moment`
+    with the centre of pressure): negative flexes the knee; 0 while the prosthesis is off the
+    ground."""
+    from bladelab.predict.collocation.multibody import body_frames, point_position
+    from bladelab.runner.model import CP_LEG
+
+    runner = cm.runner
+    if runner.kind != "transfemoral":
+        raise SpecError(f"the {runner.kind} model has no prosthetic knee",
+                        where="knee_moment_min_nm", hint="a transfemoral runner's setting")
+    body = runner.mj_model.joint("knee_angle_r").bodyid[0]
+    joint = next(j for j in cm.tree.joints[body] if j.dof == runner.dof("knee_angle_r"))
+    knee = point_position(body_frames(cm.tree, q), body, joint.anchor)
+    forces, points, _ = cm.contacts(q, qd)
+    moment = 0.0
+    for c in np.flatnonzero(runner.contact_params[:, CP_LEG] == 1):
+        moment += ((points[c, 0] - knee[0]) * forces[c, 1]
+                   - (points[c, 1] - knee[1]) * forces[c, 0])
+    return moment
+
+
 def stride_dynamics(cm: CollocationModel, *, metabolic: MetabolicSmoothing | None = None,
-                    swing_clearance_m: float = 0.0) -> StrideDynamics:
+                    swing_clearance_m: float = 0.0,
+                    knee_moment_min_nm: float | None = None) -> StrideDynamics:
     """The :class:`StrideDynamics` of a collocation model (see the module docstring); with
     ``swing_clearance_m`` > 0 [m], the path inequalities also keep every swinging contact that
-    high above the ground (:func:`swing_clearance`)."""
+    high above the ground (:func:`swing_clearance`); with ``knee_moment_min_nm`` [N·m], the
+    prosthetic knee's :func:`knee_extension_moment` at or above it."""
     runner = cm.runner
     nv, nm = cm.nv, cm.n_muscles
     q, qd, qdd = ca.SX.sym("q", nv), ca.SX.sym("qd", nv), ca.SX.sym("qdd", nv)
@@ -106,6 +133,9 @@ def stride_dynamics(cm: CollocationModel, *, metabolic: MetabolicSmoothing | Non
     q_b, qd_b = _bounds(runner.dof_names)
     clearance = (swing_clearance(cm, q, qd, float(swing_clearance_m))
                  if swing_clearance_m > 0 else ca.SX.zeros(0, 1))
+    if knee_moment_min_nm is not None:  # ≥ 0 like the clearances
+        clearance = ca.vertcat(clearance, knee_extension_moment(cm, q, qd)
+                               - float(knee_moment_min_nm))
     weight = runner.total_mass * runner.gravity
     scale = np.array([weight if n.startswith("pelvis_t") and n != "pelvis_tilt" else 100.0
                       for n in runner.dof_names])

@@ -129,6 +129,12 @@ class CollocationSettings:
         (:func:`~bladelab.predict.collocation.dynamics.swing_clearance`); 0 (default): none.
         Issue 21's "toe clearance as a constraint" setting (the transfemoral runner's blade
         grazed the ground in swing without it).
+    knee_moment_min_nm
+        Keep the external extension moment of the prosthetic contacts' ground forces about the
+        prosthetic knee at or above this [N·m] at every node (seed 002's knee-buckling
+        constraint, :func:`~bladelab.predict.collocation.dynamics.knee_extension_moment`;
+        at most 0, since the moment is 0 in swing); None (default): no constraint. Transfemoral
+        runner only.
     """
 
     mesh_intervals: int = 50
@@ -142,6 +148,7 @@ class CollocationSettings:
     max_iter: int = 3000
     warm_start_mu: float | None = None
     swing_clearance_m: float = 0.0
+    knee_moment_min_nm: float | None = None
 
     def __post_init__(self) -> None:
         n = self.mesh_intervals
@@ -202,6 +209,14 @@ class CollocationSettings:
             raise SpecError(f"swing clearance must be within [0, 0.5) m, got {sc!r}",
                             where="swing_clearance_m")
         object.__setattr__(self, "swing_clearance_m", float(sc))
+        km = self.knee_moment_min_nm
+        if km is not None:
+            if isinstance(km, bool) or not isinstance(km, int | float) or not (
+                    math.isfinite(km) and km <= 0):
+                raise SpecError(f"the knee moment minimum must be <= 0 N·m or None, got {km!r}",
+                                where="knee_moment_min_nm",
+                                hint="the moment is 0 while the prosthesis is off the ground")
+            object.__setattr__(self, "knee_moment_min_nm", float(km))
 
     @property
     def max_speed(self) -> bool:
@@ -228,11 +243,13 @@ class CollocationSettings:
         return cls(**data)
 
     def same_problem(self, other: CollocationSettings) -> bool:
-        """True if ``other`` poses the same NLP (mesh, speed, weights, swing clearance); solver
-        options (Hessian, tolerance, iterations) and the tracking stage may differ."""
-        return (self.mesh_intervals, self.speed_m_per_s, self.weights,
-                self.swing_clearance_m) == (other.mesh_intervals, other.speed_m_per_s,
-                                            other.weights, other.swing_clearance_m)
+        """True if ``other`` poses the same NLP (mesh, speed, weights, swing clearance, knee
+        moment bound); solver options (Hessian, tolerance, iterations) and the tracking stage
+        may differ."""
+        return (self.mesh_intervals, self.speed_m_per_s, self.weights, self.swing_clearance_m,
+                self.knee_moment_min_nm) == (other.mesh_intervals, other.speed_m_per_s,
+                                             other.weights, other.swing_clearance_m,
+                                             other.knee_moment_min_nm)
 
 
 @dataclass(frozen=True)
@@ -351,18 +368,21 @@ _BUILT: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 MAX_NLPS_PER_RUNNER = 2
 
 
-def _model_functions(runner, swing_clearance_m: float = 0.0):
-    """(collocation model, stride dynamics) of ``runner``, built once (per swing clearance)."""
+def _model_functions(runner, swing_clearance_m: float = 0.0,
+                     knee_moment_min_nm: float | None = None):
+    """(collocation model, stride dynamics) of ``runner``, built once (per swing clearance and
+    knee moment bound)."""
     from bladelab.predict.collocation.dynamics import stride_dynamics
     from bladelab.predict.collocation.model import build_collocation_model
 
     built = _BUILT.setdefault(runner, {"dyn": {}, "nlps": {}})
     if "cm" not in built:
         built["cm"] = build_collocation_model(runner)
-    if swing_clearance_m not in built["dyn"]:
-        built["dyn"][swing_clearance_m] = stride_dynamics(
-            built["cm"], swing_clearance_m=swing_clearance_m)
-    return built["cm"], built["dyn"][swing_clearance_m]
+    key = (swing_clearance_m, knee_moment_min_nm)
+    if key not in built["dyn"]:
+        built["dyn"][key] = stride_dynamics(built["cm"], swing_clearance_m=swing_clearance_m,
+                                            knee_moment_min_nm=knee_moment_min_nm)
+    return built["cm"], built["dyn"][key]
 
 
 def _predictive_nlp(runner, dyn, n: int, speed: float | None, weights: StrideWeights):
@@ -424,7 +444,7 @@ def predict_stride(runner, settings: CollocationSettings, guess, *, model_spec: 
     if not isinstance(settings, CollocationSettings):
         raise SpecError(f"expected CollocationSettings, got {type(settings).__name__}",
                         where="settings")
-    cm, dyn = _model_functions(runner, settings.swing_clearance_m)
+    cm, dyn = _model_functions(runner, settings.swing_clearance_m, settings.knee_moment_min_nm)
     n = settings.mesh_intervals
     g = guess.on_model(runner).resample(n)
     speed = settings.speed_m_per_s
