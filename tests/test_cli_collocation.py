@@ -103,3 +103,31 @@ def test_the_transfemoral_runner_is_solved_with_its_own_blade(tmp_path, capsys):
     assert "contact_time_prosthetic_s" in summary and "contact_time_intact_s" in summary
     stored = json.loads((out / "best_iterate.json").read_text())
     assert stored["model"] == {"model": "transfemoral", "blade": "Cat4"}
+
+
+def test_a_transtibial_stride_starts_the_transfemoral_runner(tmp_path, capsys):
+    """``--guess`` with the other amputee kind's solution: mapped by name (the socket hinge
+    dropped), grounded; the able model's solution is still refused."""
+    from bladelab.predict.collocation.guess import prosthetic_stride_on
+    from bladelab.runner import build_runner
+    from bladelab.runner.model import contact_heights
+
+    _, _, transtibial = fake_solution("amputee", 12)
+    src = transtibial.write(tmp_path / "tt.json")
+    tf = build_runner("transfemoral")
+    g = prosthetic_stride_on(tf, transtibial.to_guess())
+    lowest = [contact_heights(tf, q).min() for q in g.q]
+    assert lowest == pytest.approx([-0.01] * len(lowest), abs=1e-9)
+    assert g.q.shape[1] == len(tf.dof_names) and "grounded" in g.source
+    out = tmp_path / "tf"
+    code = main(["predict", "--method", "collocation", "--model", "transfemoral", "--out",
+                 str(out), "--mesh", "6", "--max-iter", "1", "--guess", str(src),
+                 "--speed", str(SPEED)])
+    assert code == 2  # one iteration does not converge; the start was accepted
+    stored = json.loads((out / "best_iterate.json").read_text())
+    assert "transfemoral model's coordinates" in stored["guess_source"]
+    capsys.readouterr()
+    _, _, able = fake_solution("able", 12)
+    assert main(["predict", "--method", "collocation", "--model", "transfemoral", "--out",
+                 str(tmp_path / "x"), "--guess", str(able.write(tmp_path / "a.json"))]) == 2
+    assert "another model" in capsys.readouterr().err

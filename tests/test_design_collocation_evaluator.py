@@ -142,3 +142,23 @@ def test_the_runner_of_a_multilink_stride_is_rebuilt_from_its_file():
     assert np.allclose([j.stiffness for j in runner.blade_model.joints],
                        [j.stiffness for j in gen.model.joints], rtol=1e-12)
     assert runner.blade_model.mass == pytest.approx(gen.model.mass, rel=1e-12)
+
+
+def test_a_design_solved_before_is_read_back_not_solved_again(fake, tmp_path, monkeypatch):
+    import dataclasses
+
+    calls, _ = fake
+    ev = _evaluator(tmp_path)
+    spec = {"model": "transfemoral", "blade": ev.blade_spec(CENTRE)["name"],
+            "blade_spec": ev.blade_spec(CENTRE)}
+    base = CollocationSolution.read(STRIDE)  # its intact leg lands twice: flagged
+    (tmp_path / "s").mkdir()
+    stored = tmp_path / "s" / f"{ce.point_file_stem(CENTRE)}.json"
+    dataclasses.replace(base, model_spec=spec, settings=ev.settings()).write(stored)
+    ev(CENTRE)
+    assert len(calls) == 1  # a flagged stride is solved again
+    dataclasses.replace(base, model_spec=spec, settings=ev.settings()).write(stored)
+    monkeypatch.setattr(CollocationSolution, "gait_warnings", lambda self: [])
+    assert ev(CENTRE) == {"delta_vx_m_per_s": 0.1} and len(calls) == 1  # a clean one: read
+    dataclasses.replace(ev, speed_mps=4.5)(CENTRE)  # another problem: solved
+    assert len(calls) == 2

@@ -65,10 +65,18 @@ def make_guess(runner, guess: str, *, n: int, speed: float | None):
         from bladelab.predict.collocation.solution import CollocationSolution
 
         sol = CollocationSolution.read(path)
-        if sol.model_spec["model"] != runner.kind:  # another body of the same kind is mapped
-            raise SpecError("the guess is a solution of another model", file=path,
-                            where="--guess", hint=f"it is of {sol.model_spec}")
-        return sol.to_guess(f"collocation solution {path.name} ({sol.guess_source})")
+        guess = sol.to_guess(f"collocation solution {path.name} ({sol.guess_source})")
+        if sol.model_spec["model"] == runner.kind:  # another body of the same kind is mapped
+            return guess
+        from bladelab.runner.params import PROSTHETIC_KINDS
+
+        if {sol.model_spec["model"], runner.kind} <= set(PROSTHETIC_KINDS):
+            from bladelab.predict.collocation.guess import prosthetic_stride_on
+
+            return prosthetic_stride_on(runner, guess)
+        raise SpecError("the guess is a solution of another model", file=path,
+                        where="--guess", hint=f"it is of {sol.model_spec}; an amputee runner's "
+                                              "stride starts the other amputee kind")
     return guess_from_reflex(path, n=n)
 
 

@@ -17,7 +17,8 @@
    (:func:`~bladelab.design.predicted.stride_responses`).
 
 Every design's stride is written to ``solutions_dir/<point>.json`` (``bladelab report``
-renders it), a failed one's best iterate to ``<point>.best_iterate.json``; a design point
+renders it) and read back instead of solved again when the design is evaluated again (a
+resumed or re-fitted study), a failed one's best iterate to ``<point>.best_iterate.json``; a design point
 with no clean stride raises :class:`~bladelab.errors.OptimizationError` naming IPOPT's status
 and the gait's defects (the study stops there with the finished runs kept: never a NaN).
 """
@@ -188,6 +189,22 @@ class CollocationEvaluator:
         data["contact"] = contact
         return data
 
+    def _stored(self, point: Mapping[str, float], spec: dict, settings):
+        """This design's clean stride from ``solutions_dir`` if it holds one of this problem
+        (same blade, speed, mesh, weights and constraints), else None."""
+        from bladelab.predict.collocation.solution import CollocationSolution
+        from bladelab.predict.collocation.stored import check_model_spec
+
+        if self.solutions_dir is None:
+            return None
+        path = Path(self.solutions_dir) / f"{point_file_stem(point)}.json"
+        if not path.is_file():
+            return None
+        sol = CollocationSolution.read(path)
+        same = (sol.converged and sol.model_spec == check_model_spec(spec)
+                and sol.settings.same_problem(settings))
+        return sol if same and not sol.gait_warnings() else None
+
     # -- one design -----------------------------------------------------------------------
     def __call__(self, point: Mapping[str, float]) -> dict[str, float]:
         from bladelab.blade.spec import spec_from_dict
@@ -201,6 +218,9 @@ class CollocationEvaluator:
         runner = build_runner("transfemoral", blade_model=spec_from_dict(blade_spec).build())
         spec = {"model": "transfemoral", "blade": blade_spec["name"], "blade_spec": blade_spec}
         settings = self.settings()
+        stored = self._stored(point, spec, settings)
+        if stored is not None:  # solved before (an interrupted or refitted study)
+            return stride_responses(stored, runner)
         starts = self._starts(point)
         plan = [(f, False) for f in starts] + [(starts[-1], True)]
         tried, best = [], None

@@ -26,8 +26,12 @@ times finer (the solution's own contact times use the same rule on a grid 50 tim
 they agree within two steps of this grid, tested); integrals are trapezoidal on that grid.
 The contacts' lowest points, for the swing clearance, are the collocation model's.
 "Loaded" for the knee moment: vertical force above 5 % of its peak (seed 002's knee-buckling
-check, :func:`~bladelab.design.constraints.knee_buckling`). The centre of pressure is the
-normal-force-weighted mean of the prosthetic contact points.
+check, :func:`~bladelab.design.constraints.knee_buckling`). The knee moment is summed per
+node over the prosthetic contacts (r × F about MuJoCo's knee axis, as the collocation
+constraint ``CollocationSettings.knee_moment_min_nm`` sees it) and then interpolated; until
+2026-11-26 a centre of pressure was interpolated instead, which was 0 (the lab origin) at the
+unloaded node before touch-down and gave spurious minima of −150 to −300 N·m in the interval
+of touch-down.
 """
 
 from __future__ import annotations
@@ -35,7 +39,6 @@ from __future__ import annotations
 import mujoco
 import numpy as np
 
-from bladelab.design.constraints import knee_extension_moment
 from bladelab.design.evaluators import BLADE_RESPONSE_UNITS
 from bladelab.design.performance import bouncing_ball
 from bladelab.errors import SpecError
@@ -126,8 +129,11 @@ def stride_responses(solution, runner, *, cm=None) -> dict[str, float]:
     pros = kin["prosthetic"]
     f = ev["forces"][:, pros, :]  # (n + 1, k, 2): Fx, Fz on the body
     fx, fz = f[:, :, 0].sum(axis=1), f[:, :, 1].sum(axis=1)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        cop_x = (ev["points"][:, pros, 0] * f[:, :, 1]).sum(axis=1) / fz
+    # per node, Σ r × F about the knee axis over the prosthetic contacts (0 in swing), then
+    # interpolated: interpolating a centre of pressure instead would put it at the lab origin
+    # where the stance begins (no force, no centre of pressure) and invent flexing moments
+    arm = ev["points"][:, pros, :] - kin["knee"][:, None, :]
+    knee_moment = (arm[:, :, 0] * f[:, :, 1] - arm[:, :, 1] * f[:, :, 0]).sum(axis=1)
     n = nlp.q.shape[0] - 1
     dt = solution.period_s / (n * _FINE)
     fx_f, fz_f = _fine(fx), _fine(fz)
@@ -141,8 +147,7 @@ def stride_responses(solution, runner, *, cm=None) -> dict[str, float]:
     i_x, i_z = integral(fx_f), integral(fz_f)
     i_z_net = integral(fz_f - mass * g)
     _, dvx, e = bouncing_ball(i_x, i_z_net, mass, g=g)
-    moment = knee_extension_moment(_fine(np.nan_to_num(cop_x)), 0.0, _fine(kin["knee"][:, 0]),
-                                   _fine(kin["knee"][:, 1]), fx_f, fz_f)
+    moment = _fine(knee_moment)
     loaded = idx[fz_f[idx] > _KNEE_LOADED * fz_f[idx].max()]
     # swing: from the stance's end round to its start; its middle half
     n_fine = fz_f.size

@@ -32,14 +32,38 @@ from bladelab.errors import DataError, SpecError
 from bladelab.runner.model import RunnerModel, contact_heights
 
 __all__ = [
+    "DROPPABLE_COORDINATES",
     "StrideGuess",
+    "deflected_blade",
     "periodic_derivative",
+    "prosthetic_stride_on",
     "guess_from_reflex",
     "guess_from_result",
     "guess_from_trial",
     "template_guess",
     "template_vertical_grf",
 ]
+
+
+#: Coordinates of a guess that another model may lack (prefixes): the toe hinges (the seed-001
+#: body has none) and the transtibial prosthesis's socket hinge (the transfemoral runner has
+#: none: its prosthesis hangs from the knee). Any other lost coordinate refuses the mapping.
+DROPPABLE_COORDINATES = ("mtp_angle", "socket_angle")
+
+
+def prosthetic_stride_on(model: RunnerModel, guess: StrideGuess, *,
+                         depth_m: float = 0.01) -> StrideGuess:
+    """A stride of one amputee runner kind as the start of another (the transtibial runner's
+    alternating run as the transfemoral runner's: docs/design.md "Predicted transfemoral
+    gaits"): coordinates and muscles matched by name (:meth:`StrideGuess.on_model`), the
+    pelvis lowered at every node until the lowest contact is ``depth_m`` [m] deep, speeds
+    from the new coordinates, the vertical force pattern of :func:`template_vertical_grf`."""
+    g = guess.on_model(model)
+    q = _grounded(model, g.q)
+    q[:, model.dof("pelvis_tz")] -= depth_m
+    return replace(g, q=q, qd=periodic_derivative(q, g.period),
+                   vertical_grf_bw=template_vertical_grf(np.linspace(0.0, 1.0, q.shape[0])),
+                   source=f"{g.source}, grounded")
 
 
 @dataclass(frozen=True)
@@ -81,7 +105,8 @@ class StrideGuess:
 
     def on_model(self, model: RunnerModel) -> StrideGuess:
         """This guess on ``model``'s coordinates and muscles, matched by name: coordinates
-        the guess lacks (a toe hinge) start at 0 (neutral), a multi-link blade's joints the
+        the guess lacks (a toe hinge) start at 0 (neutral), coordinates ``model`` lacks are
+        dropped if they are :data:`DROPPABLE_COORDINATES`, a multi-link blade's joints the
         guess lacks at the blade's static deflection (:func:`deflected_blade`), muscles it
         lacks at activation 0.05 with tendon forces from static equilibrium. Raises if a
         coordinate of the guess other than a toe hinge has no place in ``model`` (a guess of
@@ -93,7 +118,8 @@ class StrideGuess:
                                 f"{len(dofs)}", where="guess",
                                 hint="a guess of another model needs its dof_names")
             return self
-        lost = [n for n in self.dof_names if n not in dofs and not n.startswith("mtp_angle")]
+        lost = [n for n in self.dof_names if n not in dofs
+                and not n.startswith(DROPPABLE_COORDINATES)]
         if lost:
             raise SpecError(f"the guess's coordinates {lost} are not in the {model.kind} model",
                             where="guess", hint="start from a guess of the same model kind")
