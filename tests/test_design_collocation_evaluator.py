@@ -45,6 +45,7 @@ def fake(monkeypatch):
     def predict_stride(runner, settings, guess, *, model_spec, track=None, progress=None):
         calls.append({"source": guess.source, "track": track, "spec": model_spec,
                       "speed": settings.speed_m_per_s, "dofs": runner.dof_names,
+                      "backward_euler": settings.blade_backward_euler,
                       "contacts": runner.contact_params.copy()})
         converged, defects = script.pop(0) if script else (True, [])
         return _Outcome(base, converged, defects)
@@ -65,7 +66,7 @@ def test_each_design_wears_its_own_generated_blade(fake, tmp_path):
     ev = _evaluator(tmp_path, speed_mps=4.5)
     assert ev({**CENTRE}) == {"delta_vx_m_per_s": 0.1}
     call = calls[0]
-    assert call["speed"] == 4.5
+    assert call["speed"] == 4.5 and call["backward_euler"]  # the blade's links: no ringing
     assert call["spec"]["model"] == "transfemoral"
     blade = call["spec"]["blade_spec"]  # the generated blade travels with the stride
     assert len(blade["joints"]) == 5
@@ -161,4 +162,9 @@ def test_a_design_solved_before_is_read_back_not_solved_again(fake, tmp_path, mo
     monkeypatch.setattr(CollocationSolution, "gait_warnings", lambda self: [])
     assert ev(CENTRE) == {"delta_vx_m_per_s": 0.1} and len(calls) == 1  # a clean one: read
     dataclasses.replace(ev, speed_mps=4.5)(CENTRE)  # another problem: solved
+    assert len(calls) == 2
+    start = tmp_path / "start.json"  # a start that solves this very design: read
+    dataclasses.replace(base, model_spec=spec, settings=ev.settings()).write(start)
+    stored.unlink()
+    assert dataclasses.replace(ev, start=str(start))(CENTRE)
     assert len(calls) == 2

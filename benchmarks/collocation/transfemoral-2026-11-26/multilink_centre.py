@@ -4,11 +4,12 @@ their static deflection (``guess.deflected_blade``), predictive stage only.
 
     python benchmarks/collocation/transfemoral-2026-11-26/multilink_centre.py \\
         benchmarks/collocation/transfemoral-2026-11-26/speed-4.from-transtibial-tracked.json \\
-        SOLE_SCALE SPEED OUT.json [KNEE_MOMENT_MIN_NM]
+        SOLE_SCALE SPEED OUT.json [KNEE_MOMENT_MIN_NM|none] [trapezoidal|backward-euler]
 
 Session 10 made ``src/bladelab/data/runner/solutions/transfemoral-design-centre-4.json``
-(the collocation evaluator's default start) with SOLE_SCALE 0.1 and SPEED 4; SOLE_SCALE 1
-(the generator's 10⁶ N/m soles) gave the 12-BW gait of docs/design.md.
+(the collocation evaluator's default start) in two steps: from the sphere stride with
+SOLE_SCALE 0.1, SPEED 4 (trapezoidal), then from that stride with ``none backward-euler``;
+SOLE_SCALE 1 (the generator's 10⁶ N/m soles) gave the 12-BW gait of docs/design.md.
 """
 
 from __future__ import annotations
@@ -26,7 +27,8 @@ from bladelab.predict.collocation.solve import CollocationSettings, predict_stri
 from bladelab.runner import build_runner
 
 
-def main(source: str, sole_scale: str, speed: str, out: str, knee: str | None = None) -> None:
+def main(source: str, sole_scale: str, speed: str, out: str, knee: str | None = None,
+         blade_rule: str = "trapezoidal") -> None:
     space = default_design_space()
     centre = space.point([0.0] * len(space.names))
     blade = CollocationEvaluator(start=source, sole_stiffness_scale=float(sole_scale)
@@ -35,7 +37,9 @@ def main(source: str, sole_scale: str, speed: str, out: str, knee: str | None = 
     src = CollocationSolution.read(source)
     settings = CollocationSettings(mesh_intervals=50, speed_m_per_s=float(speed),
                                    swing_clearance_m=0.02,
-                                   knee_moment_min_nm=None if knee is None else float(knee))
+                                   knee_moment_min_nm=None if knee in (None, "none")
+                                   else float(knee),
+                                   blade_backward_euler=blade_rule == "backward-euler")
     t0 = time.perf_counter()
     sol = predict_stride(runner, settings, src.to_guess(f"collocation solution {source}"),
                          model_spec={"model": "transfemoral", "blade": blade["name"],
@@ -48,4 +52,4 @@ def main(source: str, sole_scale: str, speed: str, out: str, knee: str | None = 
 
 
 if __name__ == "__main__":
-    main(*sys.argv[1:6])
+    main(*sys.argv[1:7])

@@ -43,8 +43,8 @@ __all__ = ["CollocationEvaluator", "DEFAULT_DESIGN_SPEED_MPS"]
 #: continuations to 4.5 and 5 m/s were not finished within the session).
 DEFAULT_DESIGN_SPEED_MPS = 4.0
 #: The start of the first design: a clean transfemoral stride wearing the default box's centre
-#: blade at :data:`DEFAULT_DESIGN_SPEED_MPS` (how it was made: the file's ``guess_source`` and
-#: benchmarks/collocation/transfemoral-design/).
+#: blade at :data:`DEFAULT_DESIGN_SPEED_MPS`, its joints by backward Euler (how it was made:
+#: benchmarks/collocation/transfemoral-2026-11-26/multilink_centre.py).
 DEFAULT_START = Path(__file__).resolve().parents[1] / "data" / "runner" / "solutions" / (
     "transfemoral-design-centre-4.json")
 #: Factor on the generated blade's sole contact stiffness (its damping by the square root, the
@@ -94,6 +94,9 @@ class CollocationEvaluator:
         Keep the prosthetic knee's external extension moment at or above this [N·m] in every
         design's stride (seed 002's knee-buckling constraint imposed on the predicted gait,
         ``CollocationSettings.knee_moment_min_nm``); None: a reported outcome only.
+    blade_backward_euler
+        Transcribe the blade's joints by backward Euler
+        (``CollocationSettings.blade_backward_euler``: no node-to-node ringing of its links).
     sole_stiffness_scale
         Factor on the generated blade's sole contact stiffness
         (:data:`DEFAULT_SOLE_STIFFNESS_SCALE`).
@@ -109,6 +112,7 @@ class CollocationEvaluator:
     swing_clearance_m: float = 0.02
     max_iter: int = 3000
     knee_moment_min_Nm: float | None = None
+    blade_backward_euler: bool = True
     sole_stiffness_scale: float = DEFAULT_SOLE_STIFFNESS_SCALE
     generator: Mapping[str, Any] = field(default_factory=dict)
 
@@ -171,6 +175,7 @@ class CollocationEvaluator:
                                    speed_m_per_s=self.speed_mps,
                                    swing_clearance_m=self.swing_clearance_m,
                                    knee_moment_min_nm=self.knee_moment_min_Nm,
+                                   blade_backward_euler=self.blade_backward_euler,
                                    max_iter=self.max_iter)
 
     def blade_spec(self, point: Mapping[str, float]) -> dict:
@@ -190,20 +195,24 @@ class CollocationEvaluator:
         return data
 
     def _stored(self, point: Mapping[str, float], spec: dict, settings):
-        """This design's clean stride from ``solutions_dir`` if it holds one of this problem
-        (same blade, speed, mesh, weights and constraints), else None."""
+        """This design's clean stride of this problem (same blade, speed, mesh, weights,
+        constraints and transcription) from ``solutions_dir``, or the start file if it is
+        one; else None."""
         from bladelab.predict.collocation.solution import CollocationSolution
         from bladelab.predict.collocation.stored import check_model_spec
 
-        if self.solutions_dir is None:
-            return None
-        path = Path(self.solutions_dir) / f"{point_file_stem(point)}.json"
-        if not path.is_file():
-            return None
-        sol = CollocationSolution.read(path)
-        same = (sol.converged and sol.model_spec == check_model_spec(spec)
-                and sol.settings.same_problem(settings))
-        return sol if same and not sol.gait_warnings() else None
+        paths = [Path(self.start or DEFAULT_START)]  # the start may be this very design's
+        if self.solutions_dir is not None:
+            paths.insert(0, Path(self.solutions_dir) / f"{point_file_stem(point)}.json")
+        for path in paths:
+            if not path.is_file():
+                continue
+            sol = CollocationSolution.read(path)
+            same = (sol.converged and sol.model_spec == check_model_spec(spec)
+                    and sol.settings.same_problem(settings))
+            if same and not sol.gait_warnings():
+                return sol
+        return None
 
     # -- one design -----------------------------------------------------------------------
     def __call__(self, point: Mapping[str, float]) -> dict[str, float]:

@@ -112,11 +112,14 @@ def knee_extension_moment(cm: CollocationModel, q: ca.SX, qd: ca.SX) -> ca.SX:
 
 def stride_dynamics(cm: CollocationModel, *, metabolic: MetabolicSmoothing | None = None,
                     swing_clearance_m: float = 0.0,
-                    knee_moment_min_nm: float | None = None) -> StrideDynamics:
+                    knee_moment_min_nm: float | None = None,
+                    blade_backward_euler: bool = False) -> StrideDynamics:
     """The :class:`StrideDynamics` of a collocation model (see the module docstring); with
     ``swing_clearance_m`` > 0 [m], the path inequalities also keep every swinging contact that
     high above the ground (:func:`swing_clearance`); with ``knee_moment_min_nm`` [N·m], the
-    prosthetic knee's :func:`knee_extension_moment` at or above it."""
+    prosthetic knee's :func:`knee_extension_moment` at or above it; with
+    ``blade_backward_euler``, a multi-link blade's joints are transcribed by backward Euler
+    (``StrideDynamics.backward_euler_dofs``)."""
     runner = cm.runner
     nv, nm = cm.nv, cm.n_muscles
     q, qd, qdd = ca.SX.sym("q", nv), ca.SX.sym("qd", nv), ca.SX.sym("qdd", nv)
@@ -160,6 +163,8 @@ def stride_dynamics(cm: CollocationModel, *, metabolic: MetabolicSmoothing | Non
         static_tendon_force=lambda q_nodes, a_nodes: static_tendon_forces(cm, q_nodes, a_nodes),
         vertical_grf=ca.Function("vertical_grf", [q, qd],
                                  [ca.sum1(cm.contacts(q, qd)[0][:, 1])]),
+        backward_euler_dofs=tuple(n for n in runner.dof_names if n.startswith("blade_joint"))
+        if blade_backward_euler else (),
     )
 
 

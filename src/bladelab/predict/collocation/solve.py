@@ -135,6 +135,14 @@ class CollocationSettings:
         constraint, :func:`~bladelab.predict.collocation.dynamics.knee_extension_moment`;
         at most 0, since the moment is 0 in swing); None (default): no constraint. Transfemoral
         runner only.
+    blade_backward_euler
+        Transcribe a multi-link blade's joints by backward Euler instead of the trapezoidal
+        rule (``StrideDynamics.backward_euler_dofs``): its links' modes (about 300 Hz) are
+        resolved by no mesh, and with the trapezoidal rule they ring from node to node
+        (measured 2026-11-26 on the transfemoral design stride: blade-joint accelerations
+        alternating ±1500 rad/s², sole friction forces and the knee moment alternating in
+        sign from node to node). Backward Euler damps them: first-order accurate, it lags and
+        damps the blade's own motion by O(h) (docs/design.md). No effect without such a blade.
     """
 
     mesh_intervals: int = 50
@@ -149,6 +157,7 @@ class CollocationSettings:
     warm_start_mu: float | None = None
     swing_clearance_m: float = 0.0
     knee_moment_min_nm: float | None = None
+    blade_backward_euler: bool = False
 
     def __post_init__(self) -> None:
         n = self.mesh_intervals
@@ -217,6 +226,9 @@ class CollocationSettings:
                                 where="knee_moment_min_nm",
                                 hint="the moment is 0 while the prosthesis is off the ground")
             object.__setattr__(self, "knee_moment_min_nm", float(km))
+        if not isinstance(self.blade_backward_euler, bool):
+            raise SpecError(f"expected true or false, got {self.blade_backward_euler!r}",
+                            where="blade_backward_euler")
 
     @property
     def max_speed(self) -> bool:
@@ -244,12 +256,13 @@ class CollocationSettings:
 
     def same_problem(self, other: CollocationSettings) -> bool:
         """True if ``other`` poses the same NLP (mesh, speed, weights, swing clearance, knee
-        moment bound); solver options (Hessian, tolerance, iterations) and the tracking stage
+        moment bound, blade transcription); solver options (Hessian, tolerance, iterations) and the tracking stage
         may differ."""
+        return self._problem() == other._problem()
+
+    def _problem(self) -> tuple:
         return (self.mesh_intervals, self.speed_m_per_s, self.weights, self.swing_clearance_m,
-                self.knee_moment_min_nm) == (other.mesh_intervals, other.speed_m_per_s,
-                                             other.weights, other.swing_clearance_m,
-                                             other.knee_moment_min_nm)
+                self.knee_moment_min_nm, self.blade_backward_euler)
 
 
 @dataclass(frozen=True)
@@ -369,19 +382,20 @@ MAX_NLPS_PER_RUNNER = 2
 
 
 def _model_functions(runner, swing_clearance_m: float = 0.0,
-                     knee_moment_min_nm: float | None = None):
-    """(collocation model, stride dynamics) of ``runner``, built once (per swing clearance and
-    knee moment bound)."""
+                     knee_moment_min_nm: float | None = None, blade_backward_euler: bool = False):
+    """(collocation model, stride dynamics) of ``runner``, built once (per swing clearance,
+    knee moment bound and blade transcription)."""
     from bladelab.predict.collocation.dynamics import stride_dynamics
     from bladelab.predict.collocation.model import build_collocation_model
 
     built = _BUILT.setdefault(runner, {"dyn": {}, "nlps": {}})
     if "cm" not in built:
         built["cm"] = build_collocation_model(runner)
-    key = (swing_clearance_m, knee_moment_min_nm)
+    key = (swing_clearance_m, knee_moment_min_nm, blade_backward_euler)
     if key not in built["dyn"]:
         built["dyn"][key] = stride_dynamics(built["cm"], swing_clearance_m=swing_clearance_m,
-                                            knee_moment_min_nm=knee_moment_min_nm)
+                                            knee_moment_min_nm=knee_moment_min_nm,
+                                            blade_backward_euler=blade_backward_euler)
     return built["cm"], built["dyn"][key]
 
 
@@ -444,7 +458,8 @@ def predict_stride(runner, settings: CollocationSettings, guess, *, model_spec: 
     if not isinstance(settings, CollocationSettings):
         raise SpecError(f"expected CollocationSettings, got {type(settings).__name__}",
                         where="settings")
-    cm, dyn = _model_functions(runner, settings.swing_clearance_m, settings.knee_moment_min_nm)
+    cm, dyn = _model_functions(runner, settings.swing_clearance_m, settings.knee_moment_min_nm,
+                               settings.blade_backward_euler)
     n = settings.mesh_intervals
     g = guess.on_model(runner).resample(n)
     speed = settings.speed_m_per_s

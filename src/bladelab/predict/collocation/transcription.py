@@ -81,6 +81,11 @@ class StrideDynamics:
     muscle_metabolic_rates
         Optional CasADi Function (q, q̇, a, F̃ₜ, dF̃ₜ/dt, e) -> metabolic rate of every muscle
         [W] (for :attr:`StrideWeights.metabolic_squared`).
+    backward_euler_dofs
+        Coordinates whose q and q̇ defects use the backward Euler rule
+        ``x_{k+1} − x_k − h·ẋ_{k+1}`` instead of the trapezoidal one: stiff subsystems whose
+        modes no mesh resolves (a multi-link blade's links, about 300 Hz), which the
+        trapezoidal rule, A- but not L-stable, leaves ringing from node to node.
     """
 
     dof_names: tuple[str, ...]
@@ -98,6 +103,7 @@ class StrideDynamics:
     static_tendon_force: Callable[[np.ndarray, np.ndarray], np.ndarray] | None = None
     vertical_grf: ca.Function | None = None
     muscle_metabolic_rates: ca.Function | None = None
+    backward_euler_dofs: tuple[str, ...] = ()
 
     @property
     def nq(self) -> int:
@@ -324,7 +330,16 @@ class StrideNLP:
         period = T * s.period
         h = period / n
         xdot, pth, eff, mets, ineqs, fzs, met_sqs = fmap(X, U)
-        defects = X[:, 1:] - X[:, :-1] - h / 2 * (xdot[:, 1:] + xdot[:, :-1])
+        # θ-rule per state: ½ trapezoidal, 1 backward Euler (StrideDynamics.backward_euler_dofs)
+        theta = np.full(self.nx, 0.5)
+        for name in d.backward_euler_dofs:
+            j = d.dof_names.index(name)
+            theta[[j, nq + j]] = 1.0
+        if np.all(theta == 0.5):
+            defects = X[:, 1:] - X[:, :-1] - h / 2 * (xdot[:, 1:] + xdot[:, :-1])
+        else:
+            th = ca.repmat(ca.DM(theta), 1, n)
+            defects = X[:, 1:] - X[:, :-1] - h * (th * xdot[:, 1:] + (1 - th) * xdot[:, :-1])
         itx = d.dof_names.index("pelvis_tx")
         distance = (X[itx, n] - X[itx, 0]) * sx[itx]
         # periodic: every state but pelvis_tx, which advances by the stride length `distance`
