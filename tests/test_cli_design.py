@@ -130,6 +130,8 @@ def test_design_bad_input(tmp_path, capsys):
                  "stiffness_kN_per_m=18:32,width_m=0.05:0.08"]) == 2  # BBD needs k >= 3
     assert main(["design", "--out", str(tmp_path / "c"), "--start", str(tmp_path)]) == 2
     assert "--start needs --evaluator collocation" in capsys.readouterr().err
+    assert main(["design", "--out", str(tmp_path / "c"), "--settle", "1"]) == 2
+    assert "--settle needs --evaluator collocation" in capsys.readouterr().err
     assert main(["design", "--out", str(tmp_path / "c"), "--knee-moment-min", "0"]) == 2
     assert "--knee-moment-min needs --evaluator collocation" in capsys.readouterr().err
     assert main(["design", "--out", str(tmp_path / "c"), "--evaluator", "collocation",

@@ -168,3 +168,32 @@ def test_a_design_solved_before_is_read_back_not_solved_again(fake, tmp_path, mo
     stored.unlink()
     assert dataclasses.replace(ev, start=str(start))(CENTRE)
     assert len(calls) == 2
+
+
+def test_settling_keeps_the_lowest_objective_from_the_neighbours(fake, tmp_path, monkeypatch):
+    import types
+
+    calls, _ = fake
+    ev = _evaluator(tmp_path)
+    far = {**CENTRE, "stiffness_kN_per_m": 18.0, "width_m": 0.08}
+    near = {**CENTRE, "stiffness_kN_per_m": 32.0}
+    for p in (CENTRE, near, far):
+        ev(p)
+    objectives = iter([0.95, 0.90])  # from near (distance 1), then from far (2.24)
+
+    def stored(self, point, spec, settings):
+        return types.SimpleNamespace(nlp=types.SimpleNamespace(objective=1.0))
+
+    def solve(runner, settings, guess, *, model_spec, track=None, progress=None):
+        calls.append({"source": guess.source})
+        out = _Outcome(CollocationSolution.read(STRIDE), True, [])
+        out.nlp = types.SimpleNamespace(objective=next(objectives))
+        return out
+
+    monkeypatch.setattr(ce.CollocationEvaluator, "_stored", stored)
+    monkeypatch.setattr(solve_module, "predict_stride", solve)
+    rows = ce.settle_strides(ev, [CENTRE], neighbours=2, progress=False)
+    assert rows == [{"point": CENTRE, "before": 1.0, "after": 0.90,
+                     "from": f"{ce.point_file_stem(far)}.json"}]
+    assert ce.point_file_stem(near) in calls[-2]["source"]  # nearest first
+    assert ce.point_file_stem(far) in calls[-1]["source"]

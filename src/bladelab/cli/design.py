@@ -157,6 +157,11 @@ def _design(
         None, "--knee-moment-min",
         help="Collocation evaluator: keep the prosthetic knee's extension moment at or above "
              "this [N·m] in every design's stride (<= 0; default: reported, not imposed)."),
+    settle: int = typer.Option(
+        0, "--settle",
+        help="Collocation evaluator: after the runs, up to this many settling passes (each "
+             "design solved again from its 2 nearest neighbours' strides, the lowest objective "
+             "kept; stops when no objective drops by more than 1 %)."),
     start: Path | None = typer.Option(
         None, "--start",
         help="Collocation solution of the transfemoral runner that the first design starts "
@@ -217,6 +222,8 @@ def _design(
             options["knee_moment_min_Nm"] = knee_moment_min
     else:
         options["body_mass_kg"] = 76.0 if body_mass is None else body_mass
+        if settle:
+            raise SpecError("--settle needs --evaluator collocation", where="--settle")
         for name, given in (("--start", start), ("--knee-moment-min", knee_moment_min)):
             if given is not None:
                 raise SpecError(f"{name} needs --evaluator collocation", where=name)
@@ -252,10 +259,21 @@ def _design(
         options["motion"] = load_motion_model(motion, space=space, model=motion_model,
                                               progress=True)
         _echo_motion(options["motion"])
+    if settle < 0:
+        raise SpecError(f"--settle must be >= 0, got {settle}", where="--settle")
     ev = make_evaluator(evaluator, **options)
-    result = run_design(space, runs=design, evaluator=ev, out_dir=out, seed=seed, model=model,
-                        objective=objective, sense=sense, constraints=cons, units=ev.units,
-                        jobs=jobs)
+
+    def study():
+        return run_design(space, runs=design, evaluator=ev, out_dir=out, seed=seed, model=model,
+                          objective=objective, sense=sense, constraints=cons, units=ev.units,
+                          jobs=jobs)
+
+    result = study()
+    if settle:
+        from bladelab.cli.design_settle import settle_study
+
+        if settle_study(ev, result, passes=settle, jobs=jobs):
+            result = study()  # the settled strides' responses (read back, not solved)
     typer.echo(f"{design.n_runs} runs ({result.n_evaluated} evaluated, {result.n_resumed} "
                f"resumed) -> {out}")
     for name, s in result.surfaces.items():

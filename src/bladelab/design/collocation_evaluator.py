@@ -34,7 +34,7 @@ from typing import Any
 
 from bladelab.errors import OptimizationError, SpecError
 
-__all__ = ["CollocationEvaluator", "DEFAULT_DESIGN_SPEED_MPS"]
+__all__ = ["CollocationEvaluator", "DEFAULT_DESIGN_SPEED_MPS", "settle_strides"]
 
 #: Prescribed speed of a design's stride [m/s] (our choice, docs/design.md "Predicted
 #: transfemoral gaits"): the transfemoral runner's maximum speed on collocation is 5.6–5.8 m/s
@@ -153,8 +153,8 @@ class CollocationEvaluator:
             total += ((v - b[k]) / span) ** 2
         return math.sqrt(total)
 
-    def _starts(self, point: Mapping[str, float]) -> list[Path]:
-        """Solution files to start from, nearest design first, ``start`` last."""
+    def _neighbours(self, point: Mapping[str, float]) -> list[Path]:
+        """Stride files of the other designs solved in ``solutions_dir``, nearest first."""
         found = []
         if self.solutions_dir is not None and Path(self.solutions_dir).is_dir():
             for f in Path(self.solutions_dir).glob("*.json"):
@@ -163,8 +163,41 @@ class CollocationEvaluator:
                 p = _point_from_stem(f.stem)
                 if p is not None and p != dict(point):
                     found.append((self._distance(point, p), f.name, f))
-        found.sort()
-        return [f for _, _, f in found[:1]] + [Path(self.start or DEFAULT_START)]
+        return [f for _, _, f in sorted(found)]
+
+    def _starts(self, point: Mapping[str, float]) -> list[Path]:
+        """Solution files to start from, nearest design first, ``start`` last."""
+        return self._neighbours(point)[:1] + [Path(self.start or DEFAULT_START)]
+
+    def settle(self, point: Mapping[str, float], neighbours: int = 2) -> dict:
+        """Solve this design again from its ``neighbours`` nearest solved designs and keep the
+        clean stride of lowest objective (rewriting its file). Returns ``{"point", "before",
+        "after"`` (objectives), ``"from"`` (the file that gave the kept stride, or None)}."""
+        from bladelab.blade.spec import spec_from_dict
+        from bladelab.predict.collocation.solution import CollocationSolution
+        from bladelab.predict.collocation.solve import predict_stride
+        from bladelab.runner import build_runner
+
+        point = {k: float(v) for k, v in point.items()}
+        blade_spec = self.blade_spec(point)
+        spec = {"model": "transfemoral", "blade": blade_spec["name"], "blade_spec": blade_spec}
+        settings = self.settings()
+        current = self._stored(point, spec, settings)
+        if current is None or self.solutions_dir is None:
+            raise SpecError("this design has no stored clean stride to settle",
+                            where="settle", hint="evaluate the design first")
+        runner = build_runner("transfemoral", blade_model=spec_from_dict(blade_spec).build())
+        best, source = current, None
+        for path in self._neighbours(point)[:neighbours]:
+            guess = CollocationSolution.read(path).to_guess(f"collocation solution {path.name}")
+            sol = predict_stride(runner, settings, guess, model_spec=spec, track=False)
+            if (sol.converged and not sol.gait_warnings()
+                    and sol.nlp.objective < best.nlp.objective):
+                best, source = sol, path.name
+        if source is not None:
+            best.write(Path(self.solutions_dir) / f"{point_file_stem(point)}.json")
+        return {"point": point, "before": float(current.nlp.objective),
+                "after": float(best.nlp.objective), "from": source}
 
     def settings(self):
         """The :class:`~bladelab.predict.collocation.solve.CollocationSettings` of every
@@ -262,3 +295,38 @@ class CollocationEvaluator:
             out.mkdir(parents=True, exist_ok=True)
             sol.write(out / f"{point_file_stem(point)}.json")
         return stride_responses(sol, runner)
+
+
+def settle_design_point(payload: dict) -> dict:
+    """One design's :meth:`CollocationEvaluator.settle` in a worker process."""
+    return payload["evaluator"].settle(payload["point"], payload["neighbours"])
+
+
+def settle_strides(evaluator: CollocationEvaluator, points, *, neighbours: int = 2,
+                   jobs: int = 1, progress: bool = True) -> list[dict]:
+    """One settling pass over a study's designs (:meth:`CollocationEvaluator.settle` for each
+    point, ``jobs`` worker processes). A design's stride depends on the start it was solved
+    from (local optima); a pass that lowers no objective by more than 1 % is the study's
+    evidence that its strides have settled (docs/design.md)."""
+    from tqdm.auto import tqdm
+
+    from bladelab.executors import make_executor
+
+    payloads = [{"evaluator": evaluator, "point": dict(p), "neighbours": int(neighbours)}
+                for p in points]
+    out: list[dict | None] = [None] * len(payloads)
+    failed = []
+    bar = tqdm(total=len(payloads), desc="settling strides", unit="design",
+               disable=not progress)
+    for k, status, value in make_executor("local", jobs).run(
+            settle_design_point, payloads):
+        bar.update()
+        if status == "ok":
+            out[k] = value  # in the order of the points
+        else:
+            failed.append(f"{point_file_stem(payloads[k]['point'])}: {value}")
+    bar.close()
+    if failed:
+        raise OptimizationError(f"{len(failed)} designs could not be settled "
+                                f"({'; '.join(failed[:3])})", where="settle")
+    return out

@@ -105,7 +105,8 @@ class DesignStudyResult:
         }
 
 
-def _run_file(out_dir: Path, i: int) -> Path:
+def run_file(out_dir: Path, i: int) -> Path:
+    """The file of run ``i`` (0-based) of a study in ``out_dir``."""
     return out_dir / "runs" / f"run_{i + 1:04d}.json"
 
 
@@ -302,7 +303,7 @@ def run_design(
     n_resumed = n_evaluated = 0
     expected: list[str] | None = None
     for i in range(design.n_runs):
-        r = _read_run(_run_file(out, i), design.coded[i])
+        r = _read_run(run_file(out, i), design.coded[i])
         if r is not None:
             results[i] = r
             n_resumed += 1
@@ -318,7 +319,7 @@ def run_design(
         expected = expected or list(res)
         point = space.point(design.coded[i])
         write_json(
-            _run_file(out, i),
+            run_file(out, i),
             {"run": i + 1, "coded": design.coded[i].tolist(), "point": point, "responses": res},
         )
         results[i] = res
@@ -328,7 +329,7 @@ def run_design(
         if r is None or list(r) != list(responses):
             raise DataError(
                 "stored responses differ from the other runs'",
-                file=_run_file(out, i),
+                file=run_file(out, i),
                 hint="delete that file to evaluate the run again",
             )
     for name in responses:

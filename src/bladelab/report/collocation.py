@@ -216,7 +216,11 @@ def collocation_sections(report, path: str | Path) -> tuple[dict, object]:
     report.add_section(
         "Collocation solution",
         text=("One periodic stride solved by direct collocation (CasADi + IPOPT), "
-              f"{sol.settings.mesh_intervals} mesh intervals. The figures and tables below "
+              f"{sol.settings.mesh_intervals} mesh intervals"
+              + (" (the multi-link blade's joints by backward Euler, the rest trapezoidal)"
+                 if sol.settings.blade_backward_euler and sol.model_spec.get("blade_spec")
+                 else "")
+              + ". The figures and tables below "
               f"repeat that stride {N_STRIDES} times (pelvis advanced by the stride length, "
               f"{REFINE} sample{'s' if REFINE != 1 else ''} per mesh interval on the trapezoidal "
               "interpolant); nothing is "

@@ -1,0 +1,52 @@
+"""The 25-run design study on predicted transfemoral strides (issue 21), from its stored files.
+
+The study takes about half an hour of both cores, so ``make bench`` does not run it again: it
+reads the solve times and iterations of every design's stride in the committed study folder
+(each stride file records its own), and the study's wall time from ``timing.json`` written
+beside it (``bladelab design`` run as in docs/design.md). Run the study again to measure anew::
+
+    bladelab design --evaluator collocation --jobs 2 --out benchmarks/design/transfemoral-collocation-4mps
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+STUDY = Path(__file__).resolve().parent / "design" / "transfemoral-collocation-4mps"
+
+
+def run() -> str:
+    strides = sorted((STUDY / "strides").glob("*.json"))
+    strides = [p for p in strides if not p.name.endswith(".best_iterate.json")]
+    if not strides:
+        return ("## Design study on predicted transfemoral strides (issue 21)\n\n"
+                f"No study in {STUDY.relative_to(STUDY.parents[2])}: run it first (docstring).")
+    rows = []
+    for p in strides:
+        data = json.loads(p.read_text(encoding="utf-8"))
+        rows.append((p.stem, float(data.get("wall_s", float("nan"))),
+                     int(data.get("iterations", 0)), data.get("guess_source", "")))
+    timing = STUDY / "timing.json"
+    info = json.loads(timing.read_text(encoding="utf-8")) if timing.is_file() else {}
+    walls = sorted(r[1] for r in rows)
+    lines = [
+        "## Design study on predicted transfemoral strides (issue 21)",
+        "",
+        "25-run face-centred CCD over seed 002's four factors, `--evaluator collocation` "
+        "(transfemoral runner wearing each generated 6-link blade, 4 m/s, mesh 50, backward "
+        "Euler for the blade's joints), `--jobs 2`. Target: the study ≤ 30 min on 2 cores. "
+        "Times are those the study recorded (its stride files and `timing.json`), not measured "
+        "again by `make bench`.",
+        "",
+        "| quantity | value |",
+        "|---|---|",
+        f"| study wall time, 2 workers | {info.get('wall_s', float('nan')) / 60:.1f} min "
+        f"({info.get('date', 'date not recorded')}) |",
+        f"| designs solved (strides stored) | {len(rows)} |",
+        f"| time per design point, one core: median | {walls[len(walls) // 2]:.0f} s |",
+        f"| time per design point: min … max | {walls[0]:.0f} … {walls[-1]:.0f} s |",
+        f"| IPOPT iterations per design: median | "
+        f"{sorted(r[2] for r in rows)[len(rows) // 2]} |",
+    ]
+    return "\n".join(lines)
