@@ -6,7 +6,7 @@ their static deflection (``guess.deflected_blade``), predictive stage only.
         benchmarks/collocation/transfemoral-2026-11-26/speed-4.from-transtibial-tracked.json \\
         SOLE_SCALE SPEED OUT.json [KNEE_MOMENT_MIN_NM|none] [trapezoidal|backward-euler]
 
-Session 10 made ``src/bladelab/data/runner/solutions/transfemoral-design-centre-4.json``
+Session 10 made ``src/bladelab/data/runner/collocation/transfemoral-design-centre-4.json``
 (the collocation evaluator's default start) in two steps: from the sphere stride with
 SOLE_SCALE 0.1, SPEED 4 (trapezoidal), then from that stride with ``none backward-euler``;
 SOLE_SCALE 1 (the generator's 10⁶ N/m soles) gave the 12-BW gait of docs/design.md.

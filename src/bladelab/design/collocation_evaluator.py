@@ -45,7 +45,7 @@ DEFAULT_DESIGN_SPEED_MPS = 4.0
 #: The start of the first design: a clean transfemoral stride wearing the default box's centre
 #: blade at :data:`DEFAULT_DESIGN_SPEED_MPS`, its joints by backward Euler (how it was made:
 #: benchmarks/collocation/transfemoral-2026-11-26/multilink_centre.py).
-DEFAULT_START = Path(__file__).resolve().parents[1] / "data" / "runner" / "solutions" / (
+DEFAULT_START = Path(__file__).resolve().parents[1] / "data" / "runner" / "collocation" / (
     "transfemoral-design-centre-4.json")
 #: Factor on the generated blade's sole contact stiffness (its damping by the square root, the
 #: damping ratio kept) in the design's runner, forward and collocation alike (our choice,
@@ -139,7 +139,7 @@ class CollocationEvaluator:
         d["generator"] = {k: str(v) if isinstance(v, Path) else v
                           for k, v in dict(self.generator).items()}
         d["factor_ranges"] = {k: list(v) for k, v in dict(self.factor_ranges).items()}
-        d["start"] = str(self.start or DEFAULT_START)
+        d["start"] = str(self.start) if self.start else f"built-in {DEFAULT_START.name}"
         return {"evaluator": "collocation", **d}
 
     # -- starts ---------------------------------------------------------------------------
