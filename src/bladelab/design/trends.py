@@ -94,6 +94,13 @@ SEED002_TRENDS: tuple[Trend, ...] = (
           "swing_clearance_m", ("toe_length",), -1),
 )
 
+_SCATTER = (
+    "Each design's predicted stride is one local optimum, reached from its nearest solved "
+    "neighbour's stride; on the 25-run study (docs/design.md, session 10) the scatter between "
+    "neighbouring designs is as large as the factors' main effects, so no coefficient is "
+    "significant and the surfaces are not predictive (R²pred < 0); settled strides (--settle) "
+    "come first. ")
+
 #: Why a trend does not hold, by (evaluator, trend key): see docs/design.md for the measurements.
 TREND_REASONS: dict[tuple[str, str], str] = {
     ("blade", "stiffness_increases_dvx"): (
@@ -139,6 +146,19 @@ TREND_REASONS: dict[tuple[str, str], str] = {
         "The kinematics-driven runner's swing clearance is erratic between neighbouring designs "
         "(predicted R² < 0 on the template): the passive knee's swing depends on the stance "
         "before it. The blade evaluator's geometric proxy shows the trend."),
+    ("collocation", "stiffness_increases_dvx"): (
+        _SCATTER + "The stiffness coefficient has the seed's sign (p 0.16 on that study)."),
+    ("collocation", "width_increases_dvx"): (
+        _SCATTER + "The width coefficient has the seed's sign; at a fixed target stiffness the "
+        "generator lets width change only the blade's mass and sole contact."),
+    ("collocation", "height_toe_matter_less"): (
+        _SCATTER + "The main-effect ranges compared here are within that scatter."),
+    ("collocation", "shorter_toe_lowers_knee_margin"): (
+        _SCATTER + "The knee moment minimum falls at touch-down, where the load line passes "
+        "behind the knee before the toe's lever acts."),
+    ("collocation", "longer_toe_lowers_clearance"): (
+        _SCATTER + "The 2 cm swing-clearance constraint binds in 11 of its 25 strides, which "
+        "caps the response the trend is read from."),
 }
 
 #: Reason given when no known mechanism of the evaluator explains a trend that does not hold.
