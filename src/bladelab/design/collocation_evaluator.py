@@ -173,20 +173,16 @@ class CollocationEvaluator:
         """Solve this design again from its ``neighbours`` nearest solved designs and keep the
         clean stride of lowest objective (rewriting its file). Returns ``{"point", "before",
         "after"`` (objectives), ``"from"`` (the file that gave the kept stride, or None)}."""
-        from bladelab.blade.spec import spec_from_dict
         from bladelab.predict.collocation.solution import CollocationSolution
         from bladelab.predict.collocation.solve import predict_stride
-        from bladelab.runner import build_runner
 
         point = {k: float(v) for k, v in point.items()}
-        blade_spec = self.blade_spec(point)
-        spec = {"model": "transfemoral", "blade": blade_spec["name"], "blade_spec": blade_spec}
-        settings = self.settings()
+        spec, settings = self._problem(point)
         current = self._stored(point, spec, settings)
         if current is None or self.solutions_dir is None:
             raise SpecError("this design has no stored clean stride to settle",
                             where="settle", hint="evaluate the design first")
-        runner = build_runner("transfemoral", blade_model=spec_from_dict(blade_spec).build())
+        runner = self._runner(spec)
         best, source = current, None
         for path in self._neighbours(point)[:neighbours]:
             guess = CollocationSolution.read(path).to_guess(f"collocation solution {path.name}")
@@ -210,6 +206,21 @@ class CollocationEvaluator:
                                    knee_moment_min_nm=self.knee_moment_min_Nm,
                                    blade_backward_euler=self.blade_backward_euler,
                                    max_iter=self.max_iter)
+
+    def _problem(self, point: Mapping[str, float]) -> tuple[dict, Any]:
+        """(model specification with the design's blade, collocation settings) of a design."""
+        blade = self.blade_spec(point)
+        return ({"model": "transfemoral", "blade": blade["name"], "blade_spec": blade},
+                self.settings())
+
+    @staticmethod
+    def _runner(spec: dict):
+        """The transfemoral runner wearing the blade of a model specification."""
+        from bladelab.blade.spec import spec_from_dict
+        from bladelab.runner import build_runner
+
+        return build_runner("transfemoral",
+                            blade_model=spec_from_dict(spec["blade_spec"]).build())
 
     def blade_spec(self, point: Mapping[str, float]) -> dict:
         """The design's blade file contents: the generated blade, its soles' contact stiffness
@@ -249,17 +260,13 @@ class CollocationEvaluator:
 
     # -- one design -----------------------------------------------------------------------
     def __call__(self, point: Mapping[str, float]) -> dict[str, float]:
-        from bladelab.blade.spec import spec_from_dict
         from bladelab.design.predicted import stride_responses
         from bladelab.predict.collocation.solution import CollocationSolution
         from bladelab.predict.collocation.solve import predict_stride
-        from bladelab.runner import build_runner
 
         point = {k: float(v) for k, v in point.items()}
-        blade_spec = self.blade_spec(point)
-        runner = build_runner("transfemoral", blade_model=spec_from_dict(blade_spec).build())
-        spec = {"model": "transfemoral", "blade": blade_spec["name"], "blade_spec": blade_spec}
-        settings = self.settings()
+        spec, settings = self._problem(point)
+        runner = self._runner(spec)
         stored = self._stored(point, spec, settings)
         if stored is not None:  # solved before (an interrupted or refitted study)
             return stride_responses(stored, runner)
