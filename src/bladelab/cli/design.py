@@ -150,7 +150,7 @@ def _design(
     speed: float | None = typer.Option(
         None, "--speed",
         help="Touch-down speed [m/s] (default 8 blade, 7 runner); the stride's mean speed "
-             "(collocation, default 5)."),
+             "(collocation, default 4)."),
     body_mass: float | None = typer.Option(
         None, "--body-mass", help="Body mass [kg] (blade and runner evaluators; default 76)."),
     knee_moment_min: float | None = typer.Option(
