@@ -168,6 +168,7 @@ def test_a_design_solved_before_is_read_back_not_solved_again(fake, tmp_path, mo
     stored.unlink()
     assert dataclasses.replace(ev, start=str(start))(CENTRE)
     assert len(calls) == 2
+    assert stored.is_file()  # and stored with the study's strides, a neighbour of the others
 
 
 def test_settling_keeps_the_lowest_objective_from_the_neighbours(fake, tmp_path, monkeypatch):

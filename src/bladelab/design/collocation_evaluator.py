@@ -268,7 +268,12 @@ class CollocationEvaluator:
         spec, settings = self._problem(point)
         runner = self._runner(spec)
         stored = self._stored(point, spec, settings)
-        if stored is not None:  # solved before (an interrupted or refitted study)
+        if stored is not None:  # solved before (an interrupted or refitted study), or the start
+            own = None if self.solutions_dir is None else (
+                Path(self.solutions_dir) / f"{point_file_stem(point)}.json")
+            if own is not None and not own.is_file():  # the start: a neighbour of the others
+                own.parent.mkdir(parents=True, exist_ok=True)
+                stored.write(own)
             return stride_responses(stored, runner)
         starts = self._starts(point)
         plan = [(f, False) for f in starts] + [(starts[-1], True)]
