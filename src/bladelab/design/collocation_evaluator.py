@@ -175,6 +175,7 @@ class CollocationEvaluator:
         "after"`` (objectives), ``"from"`` (the file that gave the kept stride, or None)}."""
         from bladelab.predict.collocation.solution import CollocationSolution
         from bladelab.predict.collocation.solve import predict_stride
+        from bladelab.predict.collocation.stored import runner_from_spec
 
         point = {k: float(v) for k, v in point.items()}
         spec, settings = self._problem(point)
@@ -182,7 +183,7 @@ class CollocationEvaluator:
         if current is None or self.solutions_dir is None:
             raise SpecError("this design has no stored clean stride to settle",
                             where="settle", hint="evaluate the design first")
-        runner = self._runner(spec)
+        runner = runner_from_spec(spec)
         best, source = current, None
         for path in self._neighbours(point)[:neighbours]:
             guess = CollocationSolution.read(path).to_guess(f"collocation solution {path.name}")
@@ -191,7 +192,7 @@ class CollocationEvaluator:
                     and sol.nlp.objective < best.nlp.objective):
                 best, source = sol, path.name
         if source is not None:
-            best.write(Path(self.solutions_dir) / f"{point_file_stem(point)}.json")
+            self._keep(best, point)
         return {"point": point, "before": float(current.nlp.objective),
                 "after": float(best.nlp.objective), "from": source}
 
@@ -213,15 +214,6 @@ class CollocationEvaluator:
         return ({"model": "transfemoral", "blade": blade["name"], "blade_spec": blade},
                 self.settings())
 
-    @staticmethod
-    def _runner(spec: dict):
-        """The transfemoral runner wearing the blade of a model specification."""
-        from bladelab.blade.spec import spec_from_dict
-        from bladelab.runner import build_runner
-
-        return build_runner("transfemoral",
-                            blade_model=spec_from_dict(spec["blade_spec"]).build())
-
     def blade_spec(self, point: Mapping[str, float]) -> dict:
         """The design's blade file contents: the generated blade, its soles' contact stiffness
         times ``sole_stiffness_scale`` and their damping times its square root."""
@@ -238,6 +230,20 @@ class CollocationEvaluator:
         data["contact"] = contact
         return data
 
+    def _stride_file(self, point: Mapping[str, float], suffix: str = "") -> Path | None:
+        """``solutions_dir/<point><suffix>.json``, or None without a solutions folder."""
+        if self.solutions_dir is None:
+            return None
+        return Path(self.solutions_dir) / f"{point_file_stem(point)}{suffix}.json"
+
+    def _keep(self, solution, point: Mapping[str, float], suffix: str = "") -> None:
+        """Write a design's stride (or, with ``suffix`` ".best_iterate", its failed solve's
+        last iterate) to the solutions folder, if there is one."""
+        path = self._stride_file(point, suffix)
+        if path is not None:
+            path.parent.mkdir(parents=True, exist_ok=True)
+            solution.write(path)
+
     def _stored(self, point: Mapping[str, float], spec: dict, settings):
         """This design's clean stride of this problem (same blade, speed, mesh, weights,
         constraints and transcription) from ``solutions_dir``, or the start file if it is
@@ -245,10 +251,9 @@ class CollocationEvaluator:
         from bladelab.predict.collocation.solution import CollocationSolution
         from bladelab.predict.collocation.stored import check_model_spec
 
+        own = self._stride_file(point)
         paths = [Path(self.start or DEFAULT_START)]  # the start may be this very design's
-        if self.solutions_dir is not None:
-            paths.insert(0, Path(self.solutions_dir) / f"{point_file_stem(point)}.json")
-        for path in paths:
+        for path in ([own] if own is not None else []) + paths:
             if not path.is_file():
                 continue
             sol = CollocationSolution.read(path)
@@ -263,17 +268,16 @@ class CollocationEvaluator:
         from bladelab.design.predicted import stride_responses
         from bladelab.predict.collocation.solution import CollocationSolution
         from bladelab.predict.collocation.solve import predict_stride
+        from bladelab.predict.collocation.stored import runner_from_spec
 
         point = {k: float(v) for k, v in point.items()}
         spec, settings = self._problem(point)
-        runner = self._runner(spec)
+        runner = runner_from_spec(spec)
         stored = self._stored(point, spec, settings)
         if stored is not None:  # solved before (an interrupted or refitted study), or the start
-            own = None if self.solutions_dir is None else (
-                Path(self.solutions_dir) / f"{point_file_stem(point)}.json")
+            own = self._stride_file(point)
             if own is not None and not own.is_file():  # the start: a neighbour of the others
-                own.parent.mkdir(parents=True, exist_ok=True)
-                stored.write(own)
+                self._keep(stored, point)
             return stride_responses(stored, runner)
         starts = self._starts(point)
         plan = [(f, False) for f in starts] + [(starts[-1], True)]
@@ -292,20 +296,14 @@ class CollocationEvaluator:
                             else "; ".join(defects)))
             best = best or sol
         else:
-            if self.solutions_dir is not None:
-                out = Path(self.solutions_dir)
-                out.mkdir(parents=True, exist_ok=True)
-                best.write(out / f"{point_file_stem(point)}.best_iterate.json")
+            self._keep(best, point, ".best_iterate")
             raise OptimizationError(
                 f"no clean stride for this blade after {len(plan)} starts "
                 f"({time.perf_counter() - t0:.0f} s): " + " | ".join(tried),
                 where="collocation evaluator",
                 hint="the last iterates are in the solutions folder; widen the box's centre "
                      "towards this point, or give a --start stride nearer to it")
-        if self.solutions_dir is not None:
-            out = Path(self.solutions_dir)
-            out.mkdir(parents=True, exist_ok=True)
-            sol.write(out / f"{point_file_stem(point)}.json")
+        self._keep(sol, point)
         return stride_responses(sol, runner)
 
 
