@@ -17,15 +17,8 @@ from __future__ import annotations
 import json
 import sys
 
-import numpy as np
-
 from bladelab.design.predicted import stride_responses
-from bladelab.predict.collocation.guess import (
-    StrideGuess,
-    _grounded,
-    periodic_derivative,
-    template_vertical_grf,
-)
+from bladelab.predict.collocation.guess import StrideGuess, prosthetic_stride_on
 from bladelab.predict.collocation.solution import CollocationSolution
 from bladelab.predict.collocation.solve import CollocationSettings, predict_stride
 from bladelab.runner import build_runner
@@ -34,12 +27,10 @@ from bladelab.runner import build_runner
 def main(source: str, mode: str, out: str) -> None:
     src = CollocationSolution.read(source)
     runner = build_runner("transfemoral")
-    q = np.stack([src.nlp.q[:, src.dof_names.index(n)] for n in runner.dof_names], axis=1)
-    q = _grounded(runner, q)
-    q[:, runner.dof("pelvis_tz")] -= 0.01
-    guess = StrideGuess("transtibial stride on the transfemoral runner", src.period_s, q,
-                        periodic_derivative(q, src.period_s),
-                        vertical_grf_bw=template_vertical_grf(np.linspace(0, 1, q.shape[0])))
+    # coordinates only (no muscle states), and not marked a collocation solution: a cold start
+    guess = prosthetic_stride_on(runner, StrideGuess(
+        "transtibial stride on the transfemoral runner", src.period_s, src.nlp.q, src.nlp.qd,
+        dof_names=src.dof_names))
     settings = CollocationSettings(mesh_intervals=50, speed_m_per_s=4.0, swing_clearance_m=0.02)
     sol = predict_stride(runner, settings, guess,
                          model_spec={"model": "transfemoral", "blade": "Cat4"},
