@@ -22,6 +22,7 @@ from bladelab.predict.reflex.objective import ObjectiveSettings, simulate_contro
 from bladelab.predict.reflex.optimize import load_checkpoint, optimize_controller, runner_and_layout
 from bladelab.predict.reflex.sweep import run_sweep, summarise
 from bladelab.runner.analyses import spatiotemporal
+from processes import alive, descendants
 
 TINY = {"generations": 3, "popsize": 4, "duration": 0.3, "checkpoint_every": 1}
 
@@ -250,35 +251,6 @@ def test_sweep_on_ray_matches_local(tmp_path, ray_instance):
 
 
 
-def _alive(pid: int) -> bool:
-    """Whether process ``pid`` runs (exists and is not a zombie; Linux /proc)."""
-    from pathlib import Path
-
-    try:
-        return Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0] != "Z"
-    except OSError:
-        return False
-
-
-def _descendants(pid: int) -> set[int]:
-    """Running descendant process ids of ``pid`` (Linux /proc)."""
-    from pathlib import Path
-
-    parent = {}
-    for stat in Path("/proc").glob("[0-9]*/stat"):
-        try:
-            fields = stat.read_text().rsplit(")", 1)[1].split()
-        except OSError:
-            continue
-        if fields[0] != "Z":
-            parent[int(stat.parent.name)] = int(fields[1])
-    out, frontier = set(), {pid}
-    while frontier:
-        frontier = {p for p, pp in parent.items() if pp in frontier} - out
-        out |= frontier
-    return out
-
-
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc")
 def test_sigterm_stops_the_sweep_and_its_workers(tmp_path):
     # a killed sweep (SIGTERM, as `kill` or a job scheduler sends) exits 143 and leaves no
@@ -297,16 +269,16 @@ def test_sigterm_stops_the_sweep_and_its_workers(tmp_path):
                 break  # both category tasks are optimising in their workers
             time.sleep(0.2)
         assert proc.poll() is None, proc.communicate()
-        workers = _descendants(proc.pid)
+        workers = descendants(proc.pid)
         assert len(workers) >= 2
         proc.send_signal(signal.SIGTERM)
         _, err = proc.communicate(timeout=60)
         assert proc.returncode == 143 and "terminated" in err
         time.sleep(1.0)
-        assert not [p for p in workers if _alive(p)]
+        assert not [p for p in workers if alive(p)]
     finally:  # never leave a process behind, even when the test fails
         for pid in [proc.pid, *workers]:
-            if _alive(pid):
+            if alive(pid):
                 os.kill(pid, signal.SIGKILL)
         proc.communicate()
 

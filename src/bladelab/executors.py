@@ -31,10 +31,28 @@ from bladelab.errors import BladelabError
 Task = Callable[[dict], dict]
 
 
+#: Set in the worker processes of a :class:`ProcessPool` (:func:`_mark_pool_worker`).
+_IN_POOL_WORKER = False
+
+
+def _mark_pool_worker() -> None:
+    """Initializer of a pool's workers."""
+    global _IN_POOL_WORKER
+    _IN_POOL_WORKER = True
+
+
 def run_task_safely(task: Task, payload: dict) -> tuple[str, Any]:
-    """Run ``task(payload)``; return ("ok", result) or ("failed", one-line message)."""
+    """Run ``task(payload)``; return ("ok", result) or ("failed", one-line message).
+
+    In a pool's worker an interrupt ends the worker process once the task's own clean-up
+    has run: ``concurrent.futures`` would otherwise send the KeyboardInterrupt back as a result
+    and start the next queued task (a collocation solve turns the pool's SIGTERM into one)."""
     try:
         return "ok", task(payload)
+    except KeyboardInterrupt:
+        if _IN_POOL_WORKER:
+            os._exit(143)
+        raise
     except BladelabError as err:
         return "failed", str(err)
     except Exception as err:  # noqa: BLE001 - a failing trial must not stop the study
@@ -63,12 +81,20 @@ def default_start_method() -> str:
     return "forkserver" if sys.platform.startswith("linux") else "spawn"
 
 
+#: Seconds a terminated worker has to finish its clean-up before it is killed.
+TERMINATE_GRACE_S = 5.0
+
+
 def terminate_pool(pool) -> None:
     """Stop a ``ProcessPoolExecutor``'s workers now (an interrupted run): without this, workers
     busy with long tasks outlive a killed parent and go on writing to its output folder."""
-    for proc in list((getattr(pool, "_processes", None) or {}).values()):
+    procs = [p for p in (getattr(pool, "_processes", None) or {}).values() if p.is_alive()]
+    for proc in procs:
+        proc.terminate()
+    for proc in procs:  # a worker that outlives its grace period is killed
+        proc.join(TERMINATE_GRACE_S)
         if proc.is_alive():
-            proc.terminate()
+            proc.kill()
     pool.shutdown(wait=True, cancel_futures=True)
 
 
@@ -81,7 +107,8 @@ class ProcessPool:
 
         ctx = multiprocessing.get_context(start_method or default_start_method())
         self.jobs = int(jobs)
-        self._pool = ProcessPoolExecutor(max_workers=self.jobs, mp_context=ctx)
+        self._pool = ProcessPoolExecutor(max_workers=self.jobs, mp_context=ctx,
+                                         initializer=_mark_pool_worker)
 
     def submit(self, fn: Callable, *args: Any):
         """Run ``fn(*args)`` in a worker; returns its ``concurrent.futures.Future``."""
