@@ -144,3 +144,59 @@ def test_design_bad_input(tmp_path, capsys):
                  "--start", str(tmp_path / "none.json")]) == 2
     assert "none.json" in capsys.readouterr().err
     assert not (tmp_path / "c").exists()  # refused before any output
+
+
+def test_an_interrupted_settling_pass_is_recorded_and_resumed(tmp_path, monkeypatch):
+    # a settling pass takes hours: each design is recorded as it finishes, and the next
+    # --settle resumes the pass with the designs it had not reached
+    import types
+
+    import numpy as np
+
+    import bladelab.design.collocation_evaluator as ce
+    from bladelab.cli.design_settle import RECORD_NAME, settle_study
+    from bladelab.design.space import default_design_space
+    from bladelab.design.study import run_file
+
+    space = default_design_space()
+    coded = np.array([[0, 0, 0, 0], [1, 0, 0, 0], [-1, 0, 0, 0], [0, 1, 0, 0]], float)
+    result = types.SimpleNamespace(space=space, design=types.SimpleNamespace(coded=coded),
+                                   out_dir=tmp_path)
+    for i in range(4):
+        run_file(tmp_path, i).parent.mkdir(exist_ok=True)
+        run_file(tmp_path, i).write_text("{}")
+    seen = []
+
+    def settle(evaluator, points, *, skip=(), on_design=None, stop_after=None, **_):
+        todo = [i for i in range(len(points)) if i not in set(skip)]
+        seen.append(todo)
+        for n, i in enumerate(todo):
+            if stop_after is not None and n == stop_after:
+                raise KeyboardInterrupt
+            improved = i % 2 == 1  # designs 2 and 4 get a better stride (10 % lower)
+            on_design(i, {"point": points[i], "before": 1.0, "after": 0.9 if improved else 1.0,
+                          "from": "nb.json" if improved else None})
+
+    monkeypatch.setattr(ce, "settle_strides", lambda *a, **k: settle(*a, stop_after=2, **k))
+    with pytest.raises(KeyboardInterrupt):
+        settle_study(None, result, passes=1, jobs=1)
+    record = json.loads((tmp_path / RECORD_NAME).read_text())["passes"]
+    assert [r["run"] for r in record[0]["designs"]] == [1, 2] and not record[0]["complete"]
+    assert run_file(tmp_path, 0).is_file() and not run_file(tmp_path, 1).exists()
+
+    monkeypatch.setattr(ce, "settle_strides", settle)
+    assert settle_study(None, result, passes=1, jobs=1)  # design 4 changed
+    assert seen[-1] == [2, 3]  # resumed: only the designs the pass had not reached
+    record = json.loads((tmp_path / RECORD_NAME).read_text())["passes"]
+    assert len(record) == 1 and record[0]["complete"] and record[0]["improved"] == 2
+    assert record[0]["largest_objective_drop"] == pytest.approx(0.1)
+    assert [run_file(tmp_path, i).exists() for i in range(4)] == [True, False, True, False]
+    settle_study(None, result, passes=1, jobs=1)  # a new pass: every design again
+    assert seen[-1] == [0, 1, 2, 3]
+    assert len(json.loads((tmp_path / RECORD_NAME).read_text())["passes"]) == 2
+
+    other = types.SimpleNamespace(space=space, design=types.SimpleNamespace(coded=coded[::-1]),
+                                  out_dir=tmp_path)
+    from bladelab.errors import InputFileError
+    with pytest.raises(InputFileError, match="is not run"):
+        settle_study(None, other, passes=1, jobs=1)

@@ -161,7 +161,8 @@ def _design(
         0, "--settle",
         help="Collocation evaluator: after the runs, up to this many settling passes (each "
              "design solved again from its 2 nearest neighbours' strides, the lowest objective "
-             "kept; stops when no objective drops by more than 1 %)."),
+             "kept; stops when no objective drops by more than 1 %). Recorded design by design "
+             "in settling.json: a stopped pass resumes where it stopped."),
     start: Path | None = typer.Option(
         None, "--start",
         help="Collocation solution of the transfemoral runner that the first design starts "

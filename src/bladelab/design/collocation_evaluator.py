@@ -27,7 +27,7 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
@@ -313,26 +313,35 @@ def settle_design_point(payload: dict) -> dict:
 
 
 def settle_strides(evaluator: CollocationEvaluator, points, *, neighbours: int = 2,
-                   jobs: int = 1, progress: bool = True) -> list[dict]:
+                   jobs: int = 1, progress: bool = True, skip=(),
+                   on_design: Callable[[int, dict], None] | None = None) -> list[dict | None]:
     """One settling pass over a study's designs (:meth:`CollocationEvaluator.settle` for each
     point, ``jobs`` worker processes). A design's stride depends on the start it was solved
     from (local optima); a pass that lowers no objective by more than 1 % is the study's
-    evidence that its strides have settled (docs/design.md)."""
+    evidence that its strides have settled (docs/design.md).
+
+    ``skip``: indices of designs already settled in this pass (a resumed pass; their rows are
+    None in the result). ``on_design(i, row)`` is called in this process as each design
+    finishes, so that a caller can record the pass as it goes."""
     from tqdm.auto import tqdm
 
     from bladelab.executors import make_executor
 
-    payloads = [{"evaluator": evaluator, "point": dict(p), "neighbours": int(neighbours)}
-                for p in points]
-    out: list[dict | None] = [None] * len(payloads)
+    skip = set(skip)
+    todo = [i for i in range(len(points)) if i not in skip]
+    payloads = [{"evaluator": evaluator, "point": dict(points[i]), "neighbours": int(neighbours)}
+                for i in todo]
+    out: list[dict | None] = [None] * len(points)
     failed = []
-    bar = tqdm(total=len(payloads), desc="settling strides", unit="design",
-               disable=not progress)
+    bar = tqdm(total=len(points), initial=len(points) - len(todo), desc="settling strides",
+               unit="design", disable=not progress)
     for k, status, value in make_executor("local", jobs).run(
             settle_design_point, payloads):
         bar.update()
         if status == "ok":
-            out[k] = value  # in the order of the points
+            out[todo[k]] = value  # in the order of the points
+            if on_design is not None:
+                on_design(todo[k], value)
         else:
             failed.append(f"{point_file_stem(payloads[k]['point'])}: {value}")
     bar.close()
