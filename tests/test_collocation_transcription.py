@@ -114,6 +114,32 @@ def test_squared_muscle_metabolic_rates_term_is_its_stated_integral():
     assert expected > 0.0
 
 
+def test_force_rate_term_is_its_stated_integral():
+    """StrideWeights.force_rate: Σ_m (dF̃_m/dt)² / n_m / 100, integrated with the trapezoidal
+    rule over the stride, over the stride time; computed here from the unpacked controls."""
+    from bladelab.predict.collocation import build_collocation_model
+    from bladelab.predict.collocation.dynamics import stride_dynamics
+    from bladelab.predict.collocation.guess import template_guess
+    from bladelab.predict.collocation.transcription import StrideWeights
+    from bladelab.runner import build_runner
+
+    runner = build_runner("able")
+    dyn = stride_dynamics(build_collocation_model(runner))
+    n, speed = 8, 3.5
+    nlp = StrideNLP(dyn, n=n, speed=speed, weights=StrideWeights(force_rate=3.0))
+    lbx, ubx, lbg, ubg = nlp.bounds()
+    x0 = nlp.initial_vector(template_guess(runner, speed=speed, n=n))
+    rng = np.random.default_rng(7)  # some force rates: the template's are zero
+    nX = nlp.nx * (n + 1)
+    x0[nX:nX + nlp.nu * (n + 1)] += rng.normal(0.0, 0.5, nlp.nu * (n + 1))
+    sol = nlp.unpack(x0, {}, 0.0, 0.0, lbg, ubg, np.zeros(lbg.size))
+    per_node = np.sum(sol.tendon_force_rate**2, axis=1) / dyn.nm / 100.0
+    h = sol.period / n
+    expected = 3.0 * np.sum((per_node[:-1] + per_node[1:]) / 2 * h) / sol.period
+    assert expected > 0.0
+    assert sol.objective_terms["force_rate"] == pytest.approx(expected, rel=1e-9)
+
+
 def test_one_built_solver_serves_every_speed():
     """The speed is a parameter: an NLP built at 2 m/s and solved at 2.5 m/s gives the same
     solution as one built at 2.5 m/s, and its solver is built only once."""

@@ -141,6 +141,11 @@ class StrideWeights:
         3.5 m/s). Squaring each muscle's rate makes a brief burst of high force cost more
         than the same energy spread over a longer contact, which the energy alone does not
         (the Umberger model's activation heat grows with A^0.6).
+    force_rate
+        Time-averaged mean squared rate of the normalised tendon forces, Σ_m (dF̃_m/dt)² / n_m,
+        in (1/s)² / 100 (a muscle going from 0 to F_max in 0.1 s counts 1): the cost of
+        rapid force development (Doke & Kuo 2007; van der Zee & Kuo 2021), which the energy
+        models leave out; PredSim keeps a small weight on the same controls as a regulariser.
     """
 
     metabolic: float = 1.0
@@ -149,6 +154,7 @@ class StrideWeights:
     pelvis_acceleration: float = 0.0
     speed: float = 1.0
     metabolic_squared: float = 0.0
+    force_rate: float = 0.0
 
     def to_dict(self) -> dict[str, float]:
         return asdict(self)
@@ -211,6 +217,8 @@ def _node_pairs(values):
     return ca.sum2(values[:, :-1]) + ca.sum2(values[:, 1:])
 
 
+#: Scale of :attr:`StrideWeights.force_rate` [(1/s)²].
+FORCE_RATE_SCALE = 100.0
 #: Scale of :attr:`StrideWeights.metabolic_squared` [(W/kg)²·s/m].
 METABOLIC_SQUARED_SCALE = 10.0
 
@@ -318,7 +326,9 @@ class StrideNLP:
             met_sq = ca.sumsqr(per_kg) / METABOLIC_SQUARED_SCALE
         else:
             met_sq = ca.SX(0.0)
-        node = ca.Function("node", [xs, us], [xdot_scaled, path, effort, met, ineq, fz, met_sq])
+        frate = ca.sumsqr(dfnt) / max(nm, 1) / FORCE_RATE_SCALE
+        node = ca.Function("node", [xs, us],
+                           [xdot_scaled, path, effort, met, ineq, fz, met_sq, frate])
         fmap = node.map(n + 1)
 
         X = ca.MX.sym("X", self.nx, n + 1)
@@ -329,7 +339,7 @@ class StrideNLP:
         P = ca.MX.sym("speed")
         period = T * s.period
         h = period / n
-        xdot, pth, eff, mets, ineqs, fzs, met_sqs = fmap(X, U)
+        xdot, pth, eff, mets, ineqs, fzs, met_sqs, frates = fmap(X, U)
         # θ-rule per state: ½ trapezoidal, 1 backward Euler (StrideDynamics.backward_euler_dofs)
         theta = np.full(self.nx, 0.5)
         for name in d.backward_euler_dofs:
@@ -363,6 +373,8 @@ class StrideNLP:
         if w.metabolic_squared:
             sq = _node_pairs(met_sqs) / 2 * h
             terms["metabolic_squared"] = w.metabolic_squared * sq / ca.fmax(distance, 1e-3)
+        if w.force_rate:
+            terms["force_rate"] = w.force_rate * _node_pairs(frates) / 2 * h / period
         if self.speed is not None:
             g.append(distance - P * period)
             self._g_names.append("speed")
