@@ -95,7 +95,13 @@ def tendon_force(strain: float, ref_strain: float = TENDON_REF_STRAIN) -> float:
 
 @njit(cache=True)
 def _cos_pennation(l_ce: float, l_opt: float, penn0: float) -> float:
-    h = l_opt * math.sin(penn0)
+    return _cos_pennation_of_height(l_ce, l_opt * math.sin(penn0))
+
+
+@njit(cache=True)
+def _cos_pennation_of_height(l_ce: float, h: float) -> float:
+    """cos α at fibre length ``l_ce`` [m] for the constant fibre height ``h = l_opt·sin α₀``
+    [m] (:func:`_cos_pennation` with the sine computed once)."""
     s = h / max(l_ce, 1e-6)
     if s > 0.99:
         s = 0.99
@@ -172,11 +178,12 @@ def muscle_step(
         # fibre: implicit Euler, Newton on the normalised velocity
         vscale = V_MAX_OPT_PER_S * l_opt
         v = ms[i, MS_VCE] / vscale
+        height = l_opt * math.sin(penn0)  # as _cos_pennation computes it: same results
         for _ in range(6):
             l_new = l_ce + dt * v * vscale
             if l_new < 0.2 * l_opt:
                 l_new = 0.2 * l_opt
-            c = _cos_pennation(l_new, l_opt, penn0)
+            c = _cos_pennation_of_height(l_new, height)
             ln = l_new / l_opt
             fl = force_length(ln)
             strain = (lm - l_new * c - l_ts) / l_ts

@@ -27,13 +27,14 @@ import numpy as np
 import pandas as pd
 
 from bladelab.errors import SimulationError
+from bladelab.runner.implicit import INTEGRATORS, implicit_arrays
 from bladelab.runner.kernel import (
-    forces,
     mujoco_step_addresses,
     mujoco_views,
     path_kinematics,
     record_sample,
     run_loop,
+    step_forces,
 )
 from bladelab.runner.model import DEFAULT_DT, RunnerModel, contact_heights
 from bladelab.runner.muscle import equilibrium_fiber_length
@@ -203,6 +204,7 @@ def simulate_runner(
     record_every: int = 2,
     fall_height: float | None = None,
     initial_activation: float | None = 0.01,
+    integrator: str = "explicit",
 ) -> RunnerResult:
     """Simulate the runner forward.
 
@@ -237,6 +239,10 @@ def simulate_runner(
         None starts at the initial excitations.
     fall_height
         Stop when the pelvis COM is below this height [m] (default: 60 % of standing height).
+    integrator
+        ``"explicit"`` (default: every bladelab force at the step's start, MuJoCo's
+        semi-implicit Euler) or ``"implicit"``: contacts, ligaments and the socket linearly
+        implicit (:mod:`bladelab.runner.implicit`), stable and accurate at a 1 ms step.
     """
     if not (duration > 0 and dt > 0 and math.isfinite(duration) and math.isfinite(dt)):
         raise SimulationError("duration and dt must be positive", where="duration/dt")
@@ -246,6 +252,9 @@ def simulate_runner(
             where="dt",
             hint=f"use at most 1e-3 s (default {DEFAULT_DT:g} s)",
         )
+    if integrator not in INTEGRATORS:
+        raise SimulationError(f"unknown integrator {integrator!r}", where="integrator",
+                              hint=f"use one of {', '.join(INTEGRATORS)}")
     if int(record_every) < 1 or int(control_interval) < 1:
         raise SimulationError("must be at least 1", where="record_every/control_interval")
     m = model.mj_model
@@ -277,7 +286,7 @@ def simulate_runner(
     if controller is None:
         announce_compilation(run_loop, "the runner's simulation loop")
     else:
-        announce_compilation(forces, "the runner's force functions")
+        announce_compilation(step_forces, "the runner's force functions")
     mujoco.mj_forward(m, d)
     mp = model.muscle_params
     path, pstart = model.path_points, model.path_start
@@ -299,6 +308,7 @@ def simulate_runner(
     iz = model.dof("pelvis_tz")
     mj = mujoco_views(d)
     arrays = (mp, ms, mtu, seg_u, u, path, pstart, cp, cstate, jp, crec, lig)
+    imp = implicit_arrays(m, d, path, nm, cp.shape[0], integrator)
     if controller is None:
         f1, f2 = mujoco_step_addresses()
         _, k_rec, fell = run_loop(
@@ -314,6 +324,7 @@ def simulate_runner(
             mj,
             arrays,
             rec.arrays,
+            imp,
         )
     else:
         k_rec, fell = _python_loop(
@@ -329,6 +340,7 @@ def simulate_runner(
             mj,
             arrays,
             rec.arrays,
+            imp,
         )
     return rec.result(k_rec, dt, fell, duration)
 
@@ -346,6 +358,7 @@ def _python_loop(
     mj,
     arrays,
     rec,
+    imp,
 ):
     """The time loop with a Python controller called every ``control_interval`` steps."""
     qpos, qvel, sxp, _, cvel, scom = mj[:6]
@@ -360,7 +373,7 @@ def _python_loop(
         if k % control_interval == 0:
             path_kinematics(sxp, cvel, root_com, path, pstart, mtu, seg_u)
             u[:] = np.clip(controller(k * dt, state), 0.0, 1.0)
-        forces(mj, arrays, root_com, dt)
+        step_forces(mj, arrays, imp, root_com, dt)
         if k % record_every == 0:
             record_sample(rec, k_rec, k * dt, mj, arrays)
             k_rec += 1

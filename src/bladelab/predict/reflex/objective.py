@@ -47,6 +47,7 @@ from bladelab.predict.reflex.controller import (
     controller_layout,
     history_length,
 )
+from bladelab.runner.implicit import implicit_arrays
 from bladelab.runner.kernel import mujoco_step_addresses, mujoco_views, path_kinematics
 from bladelab.runner.metabolics import metabolic_params
 from bladelab.runner.model import DEFAULT_DT, RunnerModel
@@ -80,6 +81,7 @@ class ObjectiveSettings:
     alternating_steps: bool = True
     strike_limit_bw: float = 1.0
     initial_speed: float | None = None
+    integrator: str = "explicit"
 
     @classmethod
     def from_dict(cls, d: dict) -> ObjectiveSettings:
@@ -220,6 +222,7 @@ def simulate_controlled(
     n_steps = int(round(settings.duration / dt))
     every = record_every if record_every > 0 else n_steps + 1
     rec = Recording(model, n_steps, every)
+    imp = implicit_arrays(m, d, path, nm, cp.shape[0], settings.integrator)
     f1, f2 = mujoco_step_addresses()
     arrays = (mp, ms, mtu, seg_u, u, path, pstart, cp, cstate, jp, crec, lig)
     control = (
@@ -255,6 +258,7 @@ def simulate_controlled(
         arrays,
         rec.arrays,
         control,
+        imp,
     )
     qpos = d.qpos
     t_end = k * dt
