@@ -54,7 +54,7 @@ def _state(model, dt=1e-3, activation=0.3):
     arrays = (mp, ms, mtu, seg_u, np.full(nm, activation), model.path_points, model.path_start,
               cp, np.zeros((cp.shape[0], 1)), model.joint_params, np.zeros((cp.shape[0], 7)),
               np.zeros(m.nv))
-    imp = implicit_arrays(m, d, model.path_points, nm, cp.shape[0], "implicit")
+    imp = implicit_arrays(model, m, d, "implicit")
     return m, d, arrays, root, imp
 
 
@@ -127,7 +127,8 @@ def test_implicit_step_hands_its_acceleration_to_mujoco_and_tends_to_explicit(am
 
 def test_compiled_loop_equals_mujoco_step2_loop(amputee):
     """The compiled loop's own Euler update (mj_step1/mj_step2 replaced by the stages the
-    scheme needs) gives the trajectory of the Python loop, which calls mj_step1/mj_step2."""
+    scheme needs, on the site-free model with bladelab placing the sites) gives the trajectory
+    of the Python loop, which calls mj_step1/mj_step2 on the model with sites."""
     u = np.full(len(amputee.muscle_names), 0.2)
     kw = {"duration": 0.5, "dt": 1e-3, "integrator": "implicit", "record_every": 1}
     a = simulate_runner(amputee, excitations=u, **kw)
@@ -135,6 +136,23 @@ def test_compiled_loop_equals_mujoco_step2_loop(amputee):
     np.testing.assert_allclose(a.qpos, b.qpos, atol=1e-12)
     np.testing.assert_allclose(a.contacts, b.contacts, atol=1e-8)
     np.testing.assert_allclose(a.muscles, b.muscles, rtol=1e-8, atol=1e-8)
+
+
+def test_site_kinematics_matches_mujoco(amputee):
+    """Sites placed by bladelab on the site-free model = MuJoCo's sites (1e-14 m)."""
+    from bladelab.runner.implicit import site_views
+
+    m, d, _, _, _ = _state(amputee)
+    dyn = amputee.mj_dynamics_model
+    assert dyn.nsite == 0 and dyn.nbody == m.nbody and dyn.nv == m.nv
+    dd = mujoco.MjData(dyn)
+    dd.qpos[:] = d.qpos
+    mujoco.mj_forward(dyn, dd)
+    imp = implicit_arrays(amputee, dyn, dd, "implicit", own_sites=True)
+    views = site_views(dd, imp)
+    np.testing.assert_allclose(views[2], d.site_xpos, atol=1e-14)
+    for s in imp[29]:
+        np.testing.assert_allclose(views[3][s], d.site_xmat[s], atol=1e-14)
 
 
 def test_drop_test_at_1ms(amputee):

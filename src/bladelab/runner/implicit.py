@@ -75,7 +75,7 @@ EXPLICIT, IMPLICIT = 0, 1
 INTEGRATORS = {"explicit": EXPLICIT, "implicit": IMPLICIT}
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def point_jacobian(cdof, mask, body, px, py, pz, root_com, jac):
     """``jac`` (3, nv) = ∂v/∂q̇ of the point (px, py, pz) [m] fixed to ``body``."""
     rx, ry, rz = px - root_com[0], py - root_com[1], pz - root_com[2]
@@ -90,7 +90,7 @@ def point_jacobian(cdof, mask, body, px, py, pz, root_com, jac):
             jac[2, j] = 0.0
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def path_jacobian(site_xpos, cdof, root_com, path, pstart, seg_start, seg_dof, qvel, mtu, moment):
     """MTU lengths [m] and lengthening velocities [m/s] into ``mtu`` (n, 2) and the path
     Jacobians ``moment`` (n, nv) = ∂l/∂q [m or m/rad] (minus the moment arms): straight
@@ -153,7 +153,7 @@ def path_dofs(mask: np.ndarray, path: np.ndarray) -> tuple[np.ndarray, np.ndarra
     return np.array(start, dtype=np.int64), np.array(codes, dtype=np.int64)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def dense_mass(m_csr, rowadr, rownnz, colind, out):
     """MuJoCo's mass matrix (lower-triangular CSR ``M``) into the dense symmetric ``out``."""
     for i in range(rowadr.shape[0]):
@@ -163,7 +163,7 @@ def dense_mass(m_csr, rowadr, rownnz, colind, out):
             out[c, i] = m_csr[k]
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def solve_tree(a, b, parent):
     """Solve ``a·x = b`` for a matrix with the sparsity of a kinematic tree's mass matrix
     (``a[i, j]`` ≠ 0 only if dof i is dof j, its ancestor or its descendant; ``parent[j]`` <
@@ -192,7 +192,7 @@ def solve_tree(a, b, parent):
         b[k] = s / a[k, k]
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _normal_force(cp, c, depth, rate):
     """Normal force [N] and its derivatives by depth [N/m] and depth rate [N·s/m]."""
     if cp[c, CP_LAW] == 0.0:
@@ -215,7 +215,7 @@ def _normal_force(cp, c, depth, rate):
     return fn, kn, dv
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _add_outer(a, rhs, jx, jz, kxx, kxz, kzx, kzz, dxx, dxz, dzx, dzz, qvel, dt):
     """``a += Jᵀ·(dt·D + dt²·K)·J`` and ``rhs −= dt·Jᵀ·K·J·v`` for the (x, z) rows ``jx``,
     ``jz`` of a point's Jacobian and its 2×2 stiffness ``K`` and damping ``D``."""
@@ -241,7 +241,7 @@ def _add_outer(a, rhs, jx, jz, kxx, kxz, kzx, kzz, dxx, dxz, dzx, dzz, qvel, dt)
             a[r, c] += ax * jx[c] + az * jz[c]
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def implicit_forces(mj, arrays, imp, root_com, dt):
     """Forces of one step with the stiff terms linearly implicit (module docstring): writes
     ``qfrc_applied`` (and zeroes ``xfrc_applied``), the muscle states, ``mtu``, and the
@@ -253,7 +253,7 @@ def implicit_forces(mj, arrays, imp, root_com, dt):
     qpos, qvel, site_xpos, site_xmat, _, _, _, xfrc, qfrc = mj
     mp, ms, mtu, _, u, path, pstart, cp, cstate, jp, crec, lig = arrays
     (_, mask, rowadr, rownnz, colind, mj_damp, mj_stiff, cdof, m_csr, passive, bias,
-     a, rhs, moment, jac, cjac, ckd, lkd, _, _, seg_start, seg_dof, parent) = imp
+     a, rhs, moment, jac, cjac, ckd, lkd, _, _, seg_start, seg_dof, parent) = imp[:23]
     nv = qvel.shape[0]
     xfrc[:, :] = 0.0
     path_jacobian(site_xpos, cdof, root_com, path, pstart, seg_start, seg_dof, qvel, mtu, moment)
@@ -370,13 +370,14 @@ def implicit_forces(mj, arrays, imp, root_com, dt):
         crec[c, 6] = depth if depth > 0.0 else 0.0
     solve_tree(a, rhs, parent)  # rhs := the acceleration a
     # qfrc_applied so that MuJoCo's Euler, (M + dt·D_mj)·a = F_mj + qfrc_applied, gives a
-    a[:, :] = 0.0
-    dense_mass(m_csr, rowadr, rownnz, colind, a)
     for r in range(nv):
-        s = dt * mj_damp[r] * rhs[r] - passive[r] + bias[r]
-        for c in range(nv):
-            s += a[r, c] * rhs[c]
-        qfrc[r] = s
+        qfrc[r] = dt * mj_damp[r] * rhs[r] - passive[r] + bias[r]
+    for r in range(nv):  # + M·a from the lower-triangular CSR
+        for k in range(rowadr[r], rowadr[r] + rownnz[r]):
+            c = colind[k]
+            qfrc[r] += m_csr[k] * rhs[c]
+            if c != r:
+                qfrc[c] += m_csr[k] * rhs[r]
     # the effective (end-of-step) ligament torques and contact forces, for the record
     for j in range(nv):
         lig[j] -= lkd[j, 0] * dt * (qvel[j] + dt * rhs[j]) + lkd[j, 1] * dt * rhs[j]
@@ -398,13 +399,34 @@ def implicit_forces(mj, arrays, imp, root_com, dt):
             cstate[c, 0] += dt * (vx1 - vx0)  # the anchor follows the end-of-step velocity
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
+def site_kinematics(xpos, xmat, site_body, site_pos, site_mat, oriented, site_xpos, site_xmat):
+    """Site positions [m] ``xpos[b] + xmat[b]·pos`` into ``site_xpos``, and the frames
+    ``xmat[b]·mat`` of the ``oriented`` sites into ``site_xmat`` (row-major 3×3, as MuJoCo)."""
+    for s in range(site_body.shape[0]):
+        b = site_body[s]
+        for r in range(3):
+            site_xpos[s, r] = (xpos[b, r] + xmat[b, 3 * r] * site_pos[s, 0]
+                               + xmat[b, 3 * r + 1] * site_pos[s, 1]
+                               + xmat[b, 3 * r + 2] * site_pos[s, 2])
+    for k in range(oriented.shape[0]):
+        s = oriented[k]
+        b = site_body[s]
+        for r in range(3):
+            for c in range(3):
+                site_xmat[s, 3 * r + c] = (xmat[b, 3 * r] * site_mat[s, c]
+                                           + xmat[b, 3 * r + 1] * site_mat[s, 3 + c]
+                                           + xmat[b, 3 * r + 2] * site_mat[s, 6 + c])
+
+
+@njit(cache=True, error_model="numpy")
 def implicit_begin(mptr, dptr, imp):
     """The MuJoCo stages the implicit step needs, instead of ``mj_step1``: kinematics (site
     positions and frames), centre-of-mass frames and ``cdof``, the mass matrix, ``cvel``, the
     bias forces (``mj_rne``) and, where the model has joint springs or dampers, the passive
     forces. (``mj_step1`` also checks the state, computes tendons, actuators, collisions and
-    factorises M, none of which this scheme uses.)"""
+    factorises M, none of which this scheme uses.) With a site-free model
+    (``RunnerModel.mj_dynamics_model``) the sites are placed by :func:`site_kinematics`."""
     stage = imp[18]
     call_mujoco(stage[0], mptr, dptr)
     call_mujoco(stage[1], mptr, dptr)
@@ -413,9 +435,11 @@ def implicit_begin(mptr, dptr, imp):
     call_mujoco_rne(stage[4], mptr, dptr, stage[6])
     if stage[7] != 0:
         call_mujoco(stage[5], mptr, dptr)
+    if imp[23][0] != 0:
+        site_kinematics(imp[24], imp[25], imp[26], imp[27], imp[28], imp[29], imp[30], imp[31])
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def implicit_advance(mj, imp, dt):
     """Semi-implicit Euler with the acceleration :func:`implicit_forces` solved (``imp[12]``),
     as MuJoCo's ``mj_step2`` would do it with that ``qfrc_applied``: ``v += dt·a``, then
@@ -444,11 +468,16 @@ def body_dof_mask(m: mujoco.MjModel) -> np.ndarray:
     return mask
 
 
-def implicit_arrays(m: mujoco.MjModel, d: mujoco.MjData, path: np.ndarray, n_muscles: int,
-                    n_contacts: int, integrator: str = "explicit") -> tuple:
-    """The ``imp`` tuple of :func:`implicit_forces` (model data, live MuJoCo views, work
-    arrays); its first entry, ``mode`` (1-array), selects the scheme in the compiled loops
-    (``EXPLICIT`` or ``IMPLICIT``)."""
+def implicit_arrays(model, m: mujoco.MjModel, d: mujoco.MjData, integrator: str = "explicit",
+                    own_sites: bool = False) -> tuple:
+    """The ``imp`` tuple of :func:`implicit_forces` for the :class:`RunnerModel` ``model``
+    simulated as ``m``/``d`` (model data, live MuJoCo views, work arrays); its first entry,
+    ``mode`` (1-array), selects the scheme in the compiled loops (``EXPLICIT`` or
+    ``IMPLICIT``). ``own_sites``: ``m`` is ``model.mj_dynamics_model`` (no sites) and the
+    scheme places ``model.mj_model``'s sites itself (entries 23–31; :func:`site_views`)."""
+    path = model.path_points
+    n_muscles = len(model.muscle_names)
+    n_contacts = model.contact_params.shape[0]
     nv = m.nv
     jnt = m.dof_jntid
     if integrator != "explicit" and any(
@@ -486,4 +515,42 @@ def implicit_arrays(m: mujoco.MjModel, d: mujoco.MjData, path: np.ndarray, n_mus
         seg_start,
         seg_dof,
         np.array(m.dof_parentid, dtype=np.int64),
+        *_site_arrays(model, d, own_sites),
     )
+
+
+def _site_arrays(model, d: mujoco.MjData, enabled: bool) -> tuple:
+    """Entries 23–31 of ``imp``: enabled (1-array), MuJoCo's body ``xpos``/``xmat`` views, the
+    full model's site bodies, positions and local frames, the contact sites (whose frames are
+    needed), and bladelab's site positions (nsite, 3) and frames (nsite, 9), placed once here."""
+    full = model.mj_model
+    site_mat = np.zeros((full.nsite, 9))
+    for k in range(full.nsite):
+        mujoco.mju_quat2Mat(site_mat[k], full.site_quat[k])
+    oriented = np.unique(model.contact_params[:, CP_SITE].astype(np.int64))
+    out = (
+        np.array([int(enabled)], dtype=np.int64),
+        d.xpos,
+        d.xmat,
+        np.array(full.site_bodyid, dtype=np.int64),
+        np.array(full.site_pos, dtype=float),
+        site_mat,
+        oriented,
+        np.zeros((full.nsite, 3)),
+        np.zeros((full.nsite, 9)),
+    )
+    if enabled:
+        site_kinematics(*out[1:])
+    return out
+
+
+def site_views(d: mujoco.MjData, imp: tuple, *, oriented: bool = True) -> tuple:
+    """The ``mj`` tuple of the force kernels (:func:`bladelab.runner.kernel.mujoco_views`) with
+    the sites ``imp`` places when it was built with ``own_sites``."""
+    from bladelab.runner.kernel import mujoco_views
+
+    if imp[23][0] == 0:
+        return mujoco_views(d, oriented=oriented)
+    xmat = imp[31] if oriented else np.zeros((0, 9))
+    return (d.qpos, d.qvel, imp[30], xmat, d.cvel, d.subtree_com, d.xipos, d.xfrc_applied,
+            d.qfrc_applied)

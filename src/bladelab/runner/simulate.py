@@ -27,10 +27,9 @@ import numpy as np
 import pandas as pd
 
 from bladelab.errors import SimulationError
-from bladelab.runner.implicit import INTEGRATORS, implicit_arrays
+from bladelab.runner.implicit import INTEGRATORS, implicit_arrays, site_views
 from bladelab.runner.kernel import (
     mujoco_step_addresses,
-    mujoco_views,
     path_kinematics,
     record_sample,
     run_loop,
@@ -257,10 +256,13 @@ def simulate_runner(
                               hint=f"use one of {', '.join(INTEGRATORS)}")
     if int(record_every) < 1 or int(control_interval) < 1:
         raise SimulationError("must be at least 1", where="record_every/control_interval")
-    m = model.mj_model
+    # the compiled implicit loop places the sites itself, on a site-free MuJoCo model
+    own_sites = (integrator == "implicit" and controller is None
+                 and model.mj_dynamics_model is not None)
+    m = model.mj_dynamics_model if own_sites else model.mj_model
     nm = len(model.muscle_names)
     if hold_pose:
-        m = _held_copy(model)
+        m = _held_copy(model, m)
     m.opt.timestep = dt
     d = mujoco.MjData(m)
     q0, v0 = initial_qpos(model, initial_state)
@@ -288,11 +290,13 @@ def simulate_runner(
     else:
         announce_compilation(step_forces, "the runner's force functions")
     mujoco.mj_forward(m, d)
+    imp = implicit_arrays(model, m, d, integrator, own_sites)
+    mj = site_views(d, imp)
     mp = model.muscle_params
     path, pstart = model.path_points, model.path_start
     mtu = np.zeros((nm, 2))
     seg_u = np.zeros((path.shape[0], 3))
-    path_kinematics(d.site_xpos, d.cvel, d.subtree_com[1].copy(), path, pstart, mtu, seg_u)
+    path_kinematics(mj[2], d.cvel, d.subtree_com[1].copy(), path, pstart, mtu, seg_u)
     ms[:, 0] = np.clip(u, 0.01, 1.0) if initial_activation is None else initial_activation
     for i in range(nm):
         ms[i, 1] = equilibrium_fiber_length(mtu[i, 0], ms[i, 0], *mp[i, 1:])
@@ -306,9 +310,7 @@ def simulate_runner(
     if fall_height is None:
         fall_height = 0.6 * model.stand_qpos[model.dof("pelvis_tz")]
     iz = model.dof("pelvis_tz")
-    mj = mujoco_views(d)
     arrays = (mp, ms, mtu, seg_u, u, path, pstart, cp, cstate, jp, crec, lig)
-    imp = implicit_arrays(m, d, path, nm, cp.shape[0], integrator)
     if controller is None:
         f1, f2 = mujoco_step_addresses()
         _, k_rec, fell = run_loop(
@@ -425,9 +427,10 @@ class Recording:
         )
 
 
-def _held_copy(model: RunnerModel) -> mujoco.MjModel:
-    """A copy of the MuJoCo model whose joints (all but pelvis_tz) have stiff springs."""
-    m = model.mj_model.__copy__()
+def _held_copy(model: RunnerModel, base: mujoco.MjModel) -> mujoco.MjModel:
+    """A copy of ``base`` (the runner's MuJoCo model or its site-free dynamics model) whose
+    joints (all but pelvis_tz) have stiff springs."""
+    m = base.__copy__()
     for j, name in enumerate(model.dof_names):
         if name == "pelvis_tz":
             continue
