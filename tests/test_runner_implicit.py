@@ -65,7 +65,7 @@ def test_path_jacobian_matches_lengths_and_finite_differences(amputee):
     mtu = np.zeros_like(arrays[2])
     moment = np.zeros((mtu.shape[0], m.nv))
     path_jacobian(d.site_xpos, d.cdof, root, amputee.path_points, amputee.path_start, imp[20],
-                  imp[21], d.qvel, mtu, moment)
+                  imp[21], imp[32], imp[33], d.qvel, mtu, moment)
     np.testing.assert_allclose(mtu, arrays[2], atol=1e-12)
 
     def lengths(q):

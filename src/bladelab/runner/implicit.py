@@ -33,6 +33,7 @@ centre of mass, the origin of ``cvel``) and a (body × dof) mask of which dofs m
 
 from __future__ import annotations
 
+import functools
 import math
 
 import mujoco
@@ -91,7 +92,8 @@ def point_jacobian(cdof, mask, body, px, py, pz, root_com, jac):
 
 
 @njit(cache=True, error_model="numpy")
-def path_jacobian(site_xpos, cdof, root_com, path, pstart, seg_start, seg_dof, qvel, mtu, moment):
+def path_jacobian(site_xpos, cdof, root_com, path, pstart, seg_start, seg_dof, mstart, mdof, qvel,
+                  mtu, moment):
     """MTU lengths [m] and lengthening velocities [m/s] into ``mtu`` (n, 2) and the path
     Jacobians ``moment`` (n, nv) = ∂l/∂q [m or m/rad] (minus the moment arms): straight
     segments between via points, as :func:`bladelab.runner.kernel.path_kinematics`.
@@ -99,12 +101,12 @@ def path_jacobian(site_xpos, cdof, root_com, path, pstart, seg_start, seg_dof, q
     The segment from path point k to k + 1 changes length only with the dofs between its two
     bodies (a dof that moves both ends moves them rigidly): ``seg_dof[seg_start[k]:seg_start[k
     + 1]]`` lists them, +(j + 1) where dof j moves the end k + 1, −(j + 1) where it moves the
-    end k (:func:`path_dofs`)."""
-    nv = cdof.shape[0]
+    end k (:func:`path_dofs`). ``mdof[mstart[i]:mstart[i + 1]]``: the dofs muscle i spans (the
+    other entries of its row stay 0)."""
     for i in range(pstart.shape[0] - 1):
         length = 0.0
-        for j in range(nv):
-            moment[i, j] = 0.0
+        for e in range(mstart[i], mstart[i + 1]):
+            moment[i, mdof[e]] = 0.0
         for k in range(pstart[i], pstart[i + 1] - 1):
             a = path[k, 0]
             b = path[k + 1, 0]
@@ -132,8 +134,8 @@ def path_jacobian(site_xpos, cdof, root_com, path, pstart, seg_start, seg_dof, q
                 jz = cdof[j, 5] + cdof[j, 0] * ry - cdof[j, 1] * rx
                 moment[i, j] += sign * (ux * jx + uy * jy + uz * jz)
         vel = 0.0
-        for j in range(nv):
-            vel += moment[i, j] * qvel[j]
+        for e in range(mstart[i], mstart[i + 1]):
+            vel += moment[i, mdof[e]] * qvel[mdof[e]]
         mtu[i, 0] = length
         mtu[i, 1] = vel
 
@@ -151,6 +153,19 @@ def path_dofs(mask: np.ndarray, path: np.ndarray) -> tuple[np.ndarray, np.ndarra
                     codes.append(j + 1 if mask[bb, j] else -(j + 1))
         start.append(len(codes))
     return np.array(start, dtype=np.int64), np.array(codes, dtype=np.int64)
+
+
+def muscle_dofs(seg_start: np.ndarray, seg_dof: np.ndarray, pstart: np.ndarray
+                ) -> tuple[np.ndarray, np.ndarray]:
+    """(mstart, mdof) of :func:`path_jacobian`: per muscle, the dofs its segments span."""
+    start = [0]
+    dofs: list[int] = []
+    for i in range(len(pstart) - 1):
+        spanned = sorted({abs(int(c)) - 1 for k in range(pstart[i], pstart[i + 1] - 1)
+                          for c in seg_dof[seg_start[k]:seg_start[k + 1]]})
+        dofs += spanned
+        start.append(len(dofs))
+    return np.array(start, dtype=np.int64), np.array(dofs, dtype=np.int64)
 
 
 @njit(cache=True, error_model="numpy")
@@ -256,7 +271,9 @@ def implicit_forces(mj, arrays, imp, root_com, dt):
      a, rhs, moment, jac, cjac, ckd, lkd, _, _, seg_start, seg_dof, parent) = imp[:23]
     nv = qvel.shape[0]
     xfrc[:, :] = 0.0
-    path_jacobian(site_xpos, cdof, root_com, path, pstart, seg_start, seg_dof, qvel, mtu, moment)
+    mstart, mdof = imp[32], imp[33]
+    path_jacobian(site_xpos, cdof, root_com, path, pstart, seg_start, seg_dof, mstart, mdof, qvel,
+                  mtu, moment)
     muscle_step(mp, ms, mtu[:, 0], u, dt)
     a[:, :] = 0.0
     dense_mass(m_csr, rowadr, rownnz, colind, a)
@@ -267,8 +284,8 @@ def implicit_forces(mj, arrays, imp, root_com, dt):
     for i in range(pstart.shape[0] - 1):
         f = ms[i, 3]
         if f != 0.0:
-            for j in range(nv):
-                rhs[j] -= f * moment[i, j]
+            for e in range(mstart[i], mstart[i + 1]):
+                rhs[mdof[e]] -= f * moment[i, mdof[e]]
     # ligaments and socket: diagonal stiffness and damping
     for j in range(jp.shape[0]):
         q = qpos[j]
@@ -468,6 +485,41 @@ def body_dof_mask(m: mujoco.MjModel) -> np.ndarray:
     return mask
 
 
+@functools.lru_cache(maxsize=16)
+def _structure(model) -> tuple:
+    """The per-model constant arrays of ``imp`` (kinematic tree, path and site data), built
+    once per :class:`RunnerModel` (hashed by identity): rebuilding them cost ~2 ms of Python
+    per simulation. The site-free dynamics model has the same tree as ``mj_model``."""
+    m = model.mj_model
+    hinge_slide = all(
+        int(t) in (mujoco.mjtJoint.mjJNT_HINGE, mujoco.mjtJoint.mjJNT_SLIDE) for t in m.jnt_type
+    )
+    mask = body_dof_mask(m)
+    seg_start, seg_dof = path_dofs(mask, model.path_points)
+    mstart, mdof = muscle_dofs(seg_start, seg_dof, model.path_start)
+    site_mat = np.zeros((m.nsite, 9))
+    for k in range(m.nsite):
+        mujoco.mju_quat2Mat(site_mat[k], m.site_quat[k])
+    return (
+        hinge_slide,
+        mujoco_stage_addresses(),
+        mask,
+        m.M_rowadr.astype(np.int64),
+        m.M_rownnz.astype(np.int64),
+        m.M_colind.astype(np.int64),
+        np.array(m.jnt_qposadr[m.dof_jntid], dtype=np.int64),
+        seg_start,
+        seg_dof,
+        np.array(m.dof_parentid, dtype=np.int64),
+        np.array(m.site_bodyid, dtype=np.int64),
+        np.array(m.site_pos, dtype=float),
+        site_mat,
+        np.unique(model.contact_params[:, CP_SITE].astype(np.int64)),
+        mstart,
+        mdof,
+    )
+
+
 def implicit_arrays(model, m: mujoco.MjModel, d: mujoco.MjData, integrator: str = "explicit",
                     own_sites: bool = False) -> tuple:
     """The ``imp`` tuple of :func:`implicit_forces` for the :class:`RunnerModel` ``model``
@@ -475,30 +527,40 @@ def implicit_arrays(model, m: mujoco.MjModel, d: mujoco.MjData, integrator: str 
     ``mode`` (1-array), selects the scheme in the compiled loops (``EXPLICIT`` or
     ``IMPLICIT``). ``own_sites``: ``m`` is ``model.mj_dynamics_model`` (no sites) and the
     scheme places ``model.mj_model``'s sites itself (entries 23–31; :func:`site_views`)."""
-    path = model.path_points
+    (hinge_slide, stages, mask, rowadr, rownnz, colind, qadr, seg_start, seg_dof, parent,
+     site_body, site_pos, site_mat, oriented, mstart, mdof) = _structure(model)
     n_muscles = len(model.muscle_names)
     n_contacts = model.contact_params.shape[0]
+    nsite = site_body.shape[0]
     nv = m.nv
-    jnt = m.dof_jntid
-    if integrator != "explicit" and any(
-        int(t) not in (mujoco.mjtJoint.mjJNT_HINGE, mujoco.mjtJoint.mjJNT_SLIDE) for t in m.jnt_type
-    ):
+    if integrator != "explicit" and not hinge_slide:
         raise SimulationError("the implicit scheme needs a model of hinge and slide joints only",
                               where="integrator", hint='use integrator="explicit"')
     stage = np.zeros(8, dtype=np.int64)
-    stage[:6] = mujoco_stage_addresses()
+    stage[:6] = stages
     stage[6] = d.qfrc_bias.ctypes.data
     stage[7] = int(bool(np.any(m.dof_damping != 0) or np.any(m.jnt_stiffness != 0)))
-    mask = body_dof_mask(m)
-    seg_start, seg_dof = path_dofs(mask, path)
+    sites = (
+        np.array([int(own_sites)], dtype=np.int64),
+        d.xpos,
+        d.xmat,
+        site_body,
+        site_pos,
+        site_mat,
+        oriented,
+        np.zeros((nsite, 3)),
+        np.zeros((nsite, 9)),
+    )
+    if own_sites:  # place the sites of the initial state
+        site_kinematics(*sites[1:])
     return (
         np.array([INTEGRATORS[integrator]], dtype=np.int64),
         mask,
-        m.M_rowadr.astype(np.int64),
-        m.M_rownnz.astype(np.int64),
-        m.M_colind.astype(np.int64),
+        rowadr,
+        rownnz,
+        colind,
         np.array(m.dof_damping, dtype=float),
-        np.array(m.jnt_stiffness[jnt], dtype=float),
+        np.array(m.jnt_stiffness[m.dof_jntid], dtype=float),
         d.cdof,
         d.M,
         d.qfrc_passive,
@@ -511,37 +573,14 @@ def implicit_arrays(model, m: mujoco.MjModel, d: mujoco.MjData, integrator: str 
         np.zeros((n_contacts, 5)),
         np.zeros((nv, 2)),
         stage,
-        np.array(m.jnt_qposadr[jnt], dtype=np.int64),
+        qadr,
         seg_start,
         seg_dof,
-        np.array(m.dof_parentid, dtype=np.int64),
-        *_site_arrays(model, d, own_sites),
+        parent,
+        *sites,
+        mstart,
+        mdof,
     )
-
-
-def _site_arrays(model, d: mujoco.MjData, enabled: bool) -> tuple:
-    """Entries 23–31 of ``imp``: enabled (1-array), MuJoCo's body ``xpos``/``xmat`` views, the
-    full model's site bodies, positions and local frames, the contact sites (whose frames are
-    needed), and bladelab's site positions (nsite, 3) and frames (nsite, 9), placed once here."""
-    full = model.mj_model
-    site_mat = np.zeros((full.nsite, 9))
-    for k in range(full.nsite):
-        mujoco.mju_quat2Mat(site_mat[k], full.site_quat[k])
-    oriented = np.unique(model.contact_params[:, CP_SITE].astype(np.int64))
-    out = (
-        np.array([int(enabled)], dtype=np.int64),
-        d.xpos,
-        d.xmat,
-        np.array(full.site_bodyid, dtype=np.int64),
-        np.array(full.site_pos, dtype=float),
-        site_mat,
-        oriented,
-        np.zeros((full.nsite, 3)),
-        np.zeros((full.nsite, 9)),
-    )
-    if enabled:
-        site_kinematics(*out[1:])
-    return out
 
 
 def site_views(d: mujoco.MjData, imp: tuple, *, oriented: bool = True) -> tuple:
