@@ -126,3 +126,11 @@ def test_simulate_wearing_a_multilink_blade(capsys):
     assert json.loads(capsys.readouterr().out)["blade"] == "xtreme-cat5"
     assert main(["runner", "simulate", "--wear", "nope", "--duration", "0.05"]) == 2
     assert "nope" in capsys.readouterr().err
+
+
+def test_simulate_with_the_implicit_scheme(capsys):
+    args = ["runner", "simulate", "--duration", "0.2", "--dt", "1e-3", "--json"]
+    assert main([*args, "--integrator", "implicit"]) == 0
+    assert json.loads(capsys.readouterr().out)["duration_s"] == pytest.approx(0.2)
+    assert main([*args, "--integrator", "rk4"]) == 2
+    assert "integrator" in capsys.readouterr().err

@@ -112,6 +112,6 @@ def test_the_runner_loops_announce_their_compilation(announced):
         simulate_controlled(model, layout.x0, layout=layout)
     assert announced == [
         ("run_loop", "the runner's simulation loop"),
-        ("forces", "the runner's force functions"),
+        ("step_forces", "the runner's force functions"),
         ("run_closed_loop", "the reflex controller's simulation loop"),
     ]

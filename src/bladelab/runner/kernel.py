@@ -12,18 +12,15 @@ sphere. Ligaments: joint-limit springs–dampers; the socket: ``−(K·q + K2·q
 
 from __future__ import annotations
 
-import ctypes
-import functools
 import math
-import os
 
 import mujoco
 import numpy as np
-from llvmlite import ir
-from numba import njit, types
-from numba.extending import intrinsic
+from numba import njit
 
 from bladelab.contact import hunt_crossley_force, smooth_spring_damper_force
+from bladelab.runner.implicit import IMPLICIT, implicit_advance, implicit_begin, implicit_forces
+from bladelab.runner.mjcall import call_mujoco, mujoco_step_addresses  # noqa: F401 (re-exported)
 from bladelab.runner.model import (
     CP_AZ,
     CP_BODY,
@@ -55,35 +52,7 @@ from bladelab.sim.mujoco_engine import add_point_force
 # metabolics.py, muscle.py, contact.py or sim/mujoco_engine.py, bump this number so the loop
 # below is compiled again. This is not always enough (a session saw a controller edit have no
 # effect until the caches were deleted): when in doubt, `make clean-cache`.
-_CACHE_GENERATION = 12
-
-
-@functools.cache
-def mujoco_step_addresses() -> tuple[int, int]:
-    """Addresses of ``mj_step1`` and ``mj_step2`` in the libmujoco that the bindings loaded."""
-    folder = os.path.dirname(mujoco.__file__)
-    names = sorted(n for n in os.listdir(folder) if n.startswith("libmujoco.so"))
-    lib = ctypes.CDLL(os.path.join(folder, names[-1]))
-    return (
-        ctypes.cast(lib.mj_step1, ctypes.c_void_p).value,
-        ctypes.cast(lib.mj_step2, ctypes.c_void_p).value,
-    )
-
-
-@intrinsic
-def call_mujoco(typingctx, fptr, mptr, dptr):
-    """Call ``void f(const mjModel*, mjData*)`` given the three addresses as integers."""
-    sig = types.void(types.int64, types.int64, types.int64)
-
-    def codegen(context, builder, signature, args):
-        f, m, d = args
-        i8p = ir.IntType(8).as_pointer()
-        fnty = ir.FunctionType(ir.VoidType(), [i8p, i8p])
-        fn = builder.inttoptr(f, fnty.as_pointer())
-        builder.call(fn, [builder.inttoptr(m, i8p), builder.inttoptr(d, i8p)])
-        return context.get_dummy_value()
-
-    return sig, codegen
+_CACHE_GENERATION = 13
 
 
 @njit(cache=True)
@@ -252,10 +221,15 @@ def record_sample(rec, i, t, mj, arrays):
 
 
 @njit(cache=True)
-def step_begin(f1, mptr, dptr, mj, root_com):
+def step_begin(f1, mptr, dptr, mj, root_com, imp):
     """First half of a step: MuJoCo's ``mj_step1`` (positions, velocities, forces of the
-    current state), then ``root_com`` [m] = the root subtree's COM (MuJoCo's ``cvel`` origin)."""
-    call_mujoco(f1, mptr, dptr)
+    current state; with the implicit scheme only the stages it needs,
+    :func:`bladelab.runner.implicit.implicit_begin`), then ``root_com`` [m] = the root
+    subtree's COM (MuJoCo's ``cvel`` origin)."""
+    if imp[0][0] == IMPLICIT:
+        implicit_begin(mptr, dptr, imp)
+    else:
+        call_mujoco(f1, mptr, dptr)
     subtree_com = mj[5]
     root_com[0] = subtree_com[1, 0]
     root_com[1] = subtree_com[1, 1]
@@ -263,11 +237,32 @@ def step_begin(f1, mptr, dptr, mj, root_com):
 
 
 @njit(cache=True)
-def step_end(k, k_rec, record_every, dt, iz, fall_height, mj, arrays, rec, root_com):
-    """Second half of step ``k`` (after any controller): muscle, ligament and contact forces,
+def step_forces(mj, arrays, imp, root_com, dt):
+    """The forces of one step by the scheme ``imp[0][0]`` selects: :func:`forces` (explicit)
+    or :func:`bladelab.runner.implicit.implicit_forces`."""
+    if imp[0][0] == IMPLICIT:
+        implicit_forces(mj, arrays, imp, root_com, dt)
+    else:
+        forces(mj, arrays, root_com, dt)
+
+
+@njit(cache=True)
+def step_advance(f2, mptr, dptr, mj, imp, dt):
+    """Advance the state by the step: MuJoCo's ``mj_step2`` (explicit scheme) or the implicit
+    scheme's Euler update (:func:`bladelab.runner.implicit.implicit_advance`)."""
+    if imp[0][0] == IMPLICIT:
+        implicit_advance(mj, imp, dt)
+    else:
+        call_mujoco(f2, mptr, dptr)
+
+
+@njit(cache=True)
+def step_end(k, k_rec, record_every, dt, iz, fall_height, mj, arrays, rec, root_com, imp):
+    """Second half of step ``k`` (after any controller): muscle, ligament and contact forces
+    (:func:`step_forces`; ``imp`` from :func:`bladelab.runner.implicit.implicit_arrays`),
     a sample every ``record_every`` steps. Returns (samples recorded, fell): the pelvis height
     ``qpos[iz]`` below ``fall_height`` [m] or NaN is a fall."""
-    forces(mj, arrays, root_com, dt)
+    step_forces(mj, arrays, imp, root_com, dt)
     if k % record_every == 0:
         record_sample(rec, k_rec, k * dt, mj, arrays)
         k_rec += 1
@@ -275,7 +270,8 @@ def step_end(k, k_rec, record_every, dt, iz, fall_height, mj, arrays, rec, root_
 
 
 @njit(cache=True)
-def run_loop(f1, f2, mptr, dptr, n_steps, record_every, dt, iz, fall_height, mj, arrays, rec):
+def run_loop(f1, f2, mptr, dptr, n_steps, record_every, dt, iz, fall_height, mj, arrays, rec,
+             imp):
     """The whole open-loop time loop (constant excitations ``u`` in ``arrays``) in compiled
     code, MuJoCo's C ``mj_step1``/``mj_step2`` called directly (:func:`step_begin`,
     :func:`step_end`; a controller runs between the two, as in
@@ -286,14 +282,14 @@ def run_loop(f1, f2, mptr, dptr, n_steps, record_every, dt, iz, fall_height, mj,
     k_rec = 0
     k = 0
     for k in range(n_steps + 1):
-        step_begin(f1, mptr, dptr, mj, root_com)
+        step_begin(f1, mptr, dptr, mj, root_com, imp)
         k_rec, fell = step_end(k, k_rec, record_every, dt, iz, fall_height, mj, arrays, rec,
-                               root_com)
+                               root_com, imp)
         if fell:
             return k, k_rec, True
         if k == n_steps:
             break
-        call_mujoco(f2, mptr, dptr)
+        step_advance(f2, mptr, dptr, mj, imp, dt)
     return k, k_rec, False
 
 

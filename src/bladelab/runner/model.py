@@ -139,6 +139,11 @@ class RunnerModel:
         Plane-strain modulus E [N/m²] of the blade sphere (nan for the able model).
     stand_qpos
         A standing pose with every contact just touching the ground.
+    blade_model
+        The multi-link blade worn, if any.
+    mj_dynamics_model
+        ``mj_model`` without sites (same bodies, joints and dofs), for the implicit scheme
+        (:mod:`bladelab.runner.implicit`), which places the sites itself.
     """
 
     params: RunnerParams
@@ -156,6 +161,7 @@ class RunnerModel:
     blade_modulus: float
     stand_qpos: np.ndarray = field(repr=False)
     blade_model: BladeModel | None = None
+    mj_dynamics_model: mujoco.MjModel | None = field(default=None, repr=False)
 
     @property
     def kind(self) -> str:
@@ -460,6 +466,13 @@ def build_runner(
             j = blade_model.joints[int(dn.removeprefix("blade_joint"))]
             jp[i, JP_SK:] = (j.stiffness, j.stiffness_quadratic, j.damping, j.damping)
 
+    # the implicit scheme's model: no sites either (MuJoCo's site kinematics was ~1/6 of its
+    # step); bladelab places the sites from mj_model's site_bodyid, site_pos and site_quat
+    for site in list(spec.sites):
+        spec.delete(site)
+    dynamics_model = spec.compile()
+    if dynamics_model.nbody != model.nbody or dynamics_model.nv != model.nv:
+        raise RuntimeError("the site-free dynamics model differs from the simulation model")
     runner = RunnerModel(
         params=params,
         mj_model=model,
@@ -476,6 +489,7 @@ def build_runner(
         blade_modulus=e_blade,
         stand_qpos=np.zeros(model.nq),
         blade_model=blade_model,
+        mj_dynamics_model=dynamics_model,
     )
     runner.stand_qpos[:] = _standing_pose(runner)
     return runner

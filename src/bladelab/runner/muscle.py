@@ -41,20 +41,24 @@ FV_LENGTHENING = 10.0  # lengthening branch 1.5 − 0.5/(1 + 10ṽ)
 FV_ECCENTRIC = 1.5  # eccentric force plateau [Fmax]
 _LN_005 = math.log(0.05)
 
+# The compiled functions use numpy's error model: no division here can have a zero divisor
+# (every denominator is bounded away from 0), so results are those of Python's model, without
+# its ZeroDivisionError checks in the Newton loop (measured: muscle_step ~1/3 cheaper).
+
 # Columns of the muscle parameter array ``mp`` (one row per muscle).
 MP_FMAX, MP_LOPT, MP_LTS, MP_PENN, MP_TSTRAIN = 0, 1, 2, 3, 4
 # Columns of the muscle state array ``ms``.
 MS_ACT, MS_LCE, MS_VCE, MS_FORCE = 0, 1, 2, 3
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def force_length(l_norm: float) -> float:
     """Active force–length factor f_l [-] of the normalised fibre length."""
     x = abs((l_norm - 1.0) / FL_WIDTH)
     return math.exp(_LN_005 * x * x * x)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def force_velocity(v_norm: float) -> float:
     """Force–velocity factor f_v [-] of the normalised fibre velocity (> 0 lengthening)."""
     if v_norm <= 0.0:
@@ -64,7 +68,7 @@ def force_velocity(v_norm: float) -> float:
     return FV_ECCENTRIC - (FV_ECCENTRIC - 1.0) / (1.0 + FV_LENGTHENING * v_norm)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _force_velocity_slope(v_norm: float) -> float:
     if v_norm <= 0.0:
         if v_norm <= -1.0:
@@ -75,7 +79,7 @@ def _force_velocity_slope(v_norm: float) -> float:
     return 5.0 / (d * d)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def passive_force(l_norm: float) -> float:
     """Passive fibre force f_p [-] of the normalised fibre length."""
     if l_norm <= 1.0:
@@ -84,7 +88,7 @@ def passive_force(l_norm: float) -> float:
     return x * x
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def tendon_force(strain: float, ref_strain: float = TENDON_REF_STRAIN) -> float:
     """Tendon force f_t [-] of the tendon strain; ``ref_strain`` is the strain at Fmax."""
     if strain <= 0.0:
@@ -93,16 +97,22 @@ def tendon_force(strain: float, ref_strain: float = TENDON_REF_STRAIN) -> float:
     return x * x
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _cos_pennation(l_ce: float, l_opt: float, penn0: float) -> float:
-    h = l_opt * math.sin(penn0)
+    return _cos_pennation_of_height(l_ce, l_opt * math.sin(penn0))
+
+
+@njit(cache=True, error_model="numpy")
+def _cos_pennation_of_height(l_ce: float, h: float) -> float:
+    """cos α at fibre length ``l_ce`` [m] for the constant fibre height ``h = l_opt·sin α₀``
+    [m] (:func:`_cos_pennation` with the sine computed once)."""
     s = h / max(l_ce, 1e-6)
     if s > 0.99:
         s = 0.99
     return math.sqrt(1.0 - s * s)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def tendon_force_of_state(
     l_mtu: float,
     l_ce: float,
@@ -117,7 +127,7 @@ def tendon_force_of_state(
     return fmax * tendon_force((l_t - l_ts) / l_ts, ref_strain)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def equilibrium_fiber_length(
     l_mtu: float,
     act: float,
@@ -144,9 +154,10 @@ def equilibrium_fiber_length(
     return 0.5 * (lo + hi)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def muscle_step(
-    mp: np.ndarray, ms: np.ndarray, l_mtu: np.ndarray, u: np.ndarray, dt: float
+    mp: np.ndarray, ms: np.ndarray, l_mtu: np.ndarray, u: np.ndarray, dt: float,
+    tol: float = 1e-8,
 ) -> None:
     """Advance all muscles by one step and store their tendon forces.
 
@@ -154,7 +165,9 @@ def muscle_step(
     [-]. ``ms`` (n, 4) in/out:
     activation, fibre length [m], fibre velocity [m/s], tendon force [N] (the force to apply
     during this step, computed from the state at the step's start). ``l_mtu`` [m], ``u`` [-]
-    excitations in [0, 1].
+    excitations in [0, 1]. ``tol``: the Newton iteration on the normalised fibre velocity stops
+    after a step smaller than this (1e-8 by default; the implicit scheme uses 1e-6: 2.4
+    instead of 3.3 iterations per muscle and step at 1 ms, measured).
     """
     if mp.shape[1] <= MP_TSTRAIN:
         raise ValueError("muscle parameters need 5 columns (the last: tendon strain at Fmax)")
@@ -168,7 +181,10 @@ def muscle_step(
         act = ms[i, MS_ACT]
         l_ce = ms[i, MS_LCE]
         lm = l_mtu[i]
-        ms[i, MS_FORCE] = tendon_force_of_state(lm, l_ce, fmax, l_opt, l_ts, penn0, eref)
+        height = l_opt * math.sin(penn0)  # as _cos_pennation computes it: same results
+        # the tendon force of the state (tendon_force_of_state, the sine computed once)
+        l_t = lm - l_ce * _cos_pennation_of_height(l_ce, height)
+        ms[i, MS_FORCE] = fmax * tendon_force((l_t - l_ts) / l_ts, eref)
         # fibre: implicit Euler, Newton on the normalised velocity
         vscale = V_MAX_OPT_PER_S * l_opt
         v = ms[i, MS_VCE] / vscale
@@ -176,7 +192,7 @@ def muscle_step(
             l_new = l_ce + dt * v * vscale
             if l_new < 0.2 * l_opt:
                 l_new = 0.2 * l_opt
-            c = _cos_pennation(l_new, l_opt, penn0)
+            c = _cos_pennation_of_height(l_new, height)
             ln = l_new / l_opt
             fl = force_length(ln)
             strain = (lm - l_new * c - l_ts) / l_ts
@@ -190,7 +206,7 @@ def muscle_step(
             )
             step = g / dg
             v -= step
-            if abs(step) < 1e-8:
+            if abs(step) < tol:
                 break
         l_new = l_ce + dt * v * vscale
         if l_new < 0.2 * l_opt:

@@ -27,13 +27,13 @@ import numpy as np
 import pandas as pd
 
 from bladelab.errors import SimulationError
+from bladelab.runner.implicit import INTEGRATORS, implicit_arrays, site_views
 from bladelab.runner.kernel import (
-    forces,
     mujoco_step_addresses,
-    mujoco_views,
     path_kinematics,
     record_sample,
     run_loop,
+    step_forces,
 )
 from bladelab.runner.model import DEFAULT_DT, RunnerModel, contact_heights
 from bladelab.runner.muscle import equilibrium_fiber_length
@@ -203,6 +203,7 @@ def simulate_runner(
     record_every: int = 2,
     fall_height: float | None = None,
     initial_activation: float | None = 0.01,
+    integrator: str = "explicit",
 ) -> RunnerResult:
     """Simulate the runner forward.
 
@@ -237,6 +238,10 @@ def simulate_runner(
         None starts at the initial excitations.
     fall_height
         Stop when the pelvis COM is below this height [m] (default: 60 % of standing height).
+    integrator
+        ``"explicit"`` (default: every bladelab force at the step's start, MuJoCo's
+        semi-implicit Euler) or ``"implicit"``: contacts, ligaments and the socket linearly
+        implicit (:mod:`bladelab.runner.implicit`), stable and accurate at a 1 ms step.
     """
     if not (duration > 0 and dt > 0 and math.isfinite(duration) and math.isfinite(dt)):
         raise SimulationError("duration and dt must be positive", where="duration/dt")
@@ -246,12 +251,18 @@ def simulate_runner(
             where="dt",
             hint=f"use at most 1e-3 s (default {DEFAULT_DT:g} s)",
         )
+    if integrator not in INTEGRATORS:
+        raise SimulationError(f"unknown integrator {integrator!r}", where="integrator",
+                              hint=f"use one of {', '.join(INTEGRATORS)}")
     if int(record_every) < 1 or int(control_interval) < 1:
         raise SimulationError("must be at least 1", where="record_every/control_interval")
-    m = model.mj_model
+    # the compiled implicit loop places the sites itself, on a site-free MuJoCo model
+    own_sites = (integrator == "implicit" and controller is None
+                 and model.mj_dynamics_model is not None)
+    m = model.mj_dynamics_model if own_sites else model.mj_model
     nm = len(model.muscle_names)
     if hold_pose:
-        m = _held_copy(model)
+        m = _held_copy(model, m)
     m.opt.timestep = dt
     d = mujoco.MjData(m)
     q0, v0 = initial_qpos(model, initial_state)
@@ -277,13 +288,15 @@ def simulate_runner(
     if controller is None:
         announce_compilation(run_loop, "the runner's simulation loop")
     else:
-        announce_compilation(forces, "the runner's force functions")
+        announce_compilation(step_forces, "the runner's force functions")
     mujoco.mj_forward(m, d)
+    imp = implicit_arrays(model, m, d, integrator, own_sites)
+    mj = site_views(d, imp)
     mp = model.muscle_params
     path, pstart = model.path_points, model.path_start
     mtu = np.zeros((nm, 2))
     seg_u = np.zeros((path.shape[0], 3))
-    path_kinematics(d.site_xpos, d.cvel, d.subtree_com[1].copy(), path, pstart, mtu, seg_u)
+    path_kinematics(mj[2], d.cvel, d.subtree_com[1].copy(), path, pstart, mtu, seg_u)
     ms[:, 0] = np.clip(u, 0.01, 1.0) if initial_activation is None else initial_activation
     for i in range(nm):
         ms[i, 1] = equilibrium_fiber_length(mtu[i, 0], ms[i, 0], *mp[i, 1:])
@@ -297,7 +310,6 @@ def simulate_runner(
     if fall_height is None:
         fall_height = 0.6 * model.stand_qpos[model.dof("pelvis_tz")]
     iz = model.dof("pelvis_tz")
-    mj = mujoco_views(d)
     arrays = (mp, ms, mtu, seg_u, u, path, pstart, cp, cstate, jp, crec, lig)
     if controller is None:
         f1, f2 = mujoco_step_addresses()
@@ -314,6 +326,7 @@ def simulate_runner(
             mj,
             arrays,
             rec.arrays,
+            imp,
         )
     else:
         k_rec, fell = _python_loop(
@@ -329,6 +342,7 @@ def simulate_runner(
             mj,
             arrays,
             rec.arrays,
+            imp,
         )
     return rec.result(k_rec, dt, fell, duration)
 
@@ -346,6 +360,7 @@ def _python_loop(
     mj,
     arrays,
     rec,
+    imp,
 ):
     """The time loop with a Python controller called every ``control_interval`` steps."""
     qpos, qvel, sxp, _, cvel, scom = mj[:6]
@@ -360,7 +375,7 @@ def _python_loop(
         if k % control_interval == 0:
             path_kinematics(sxp, cvel, root_com, path, pstart, mtu, seg_u)
             u[:] = np.clip(controller(k * dt, state), 0.0, 1.0)
-        forces(mj, arrays, root_com, dt)
+        step_forces(mj, arrays, imp, root_com, dt)
         if k % record_every == 0:
             record_sample(rec, k_rec, k * dt, mj, arrays)
             k_rec += 1
@@ -412,9 +427,10 @@ class Recording:
         )
 
 
-def _held_copy(model: RunnerModel) -> mujoco.MjModel:
-    """A copy of the MuJoCo model whose joints (all but pelvis_tz) have stiff springs."""
-    m = model.mj_model.__copy__()
+def _held_copy(model: RunnerModel, base: mujoco.MjModel) -> mujoco.MjModel:
+    """A copy of ``base`` (the runner's MuJoCo model or its site-free dynamics model) whose
+    joints (all but pelvis_tz) have stiff springs."""
+    m = base.__copy__()
     for j, name in enumerate(model.dof_names):
         if name == "pelvis_tz":
             continue

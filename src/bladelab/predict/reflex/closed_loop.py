@@ -16,7 +16,7 @@ from numba import njit
 
 from bladelab.predict.reflex.controller import compute_excitations, push_sensors, update_gait_states
 from bladelab.runner.analyses import MIN_STEP_S, STEP_LOAD_BW
-from bladelab.runner.kernel import call_mujoco, step_begin, step_end
+from bladelab.runner.kernel import step_advance, step_begin, step_end
 from bladelab.runner.metabolics import total_metabolic_rate
 from bladelab.runner.model import CP_LEG
 
@@ -123,7 +123,8 @@ def control_step(k, dt, mj, arrays, control):
 
 @njit(cache=True)
 def run_closed_loop(
-    f1, f2, mptr, dptr, n_steps, record_every, dt, iz, fall_height, mj, arrays, rec, control
+    f1, f2, mptr, dptr, n_steps, record_every, dt, iz, fall_height, mj, arrays, rec, control,
+    imp,
 ):
     """The runner's compiled time loop (:func:`bladelab.runner.kernel.run_loop`) with the reflex
     controller: :func:`control_step` between MuJoCo's ``mj_step1`` and the forces of every step.
@@ -132,13 +133,13 @@ def run_closed_loop(
     k_rec = 0
     k = 0
     for k in range(n_steps + 1):
-        step_begin(f1, mptr, dptr, mj, root_com)
+        step_begin(f1, mptr, dptr, mj, root_com, imp)
         control_step(k, dt, mj, arrays, control)
         k_rec, fell = step_end(k, k_rec, record_every, dt, iz, fall_height, mj, arrays, rec,
-                               root_com)
+                               root_com, imp)
         if fell:
             return k, k_rec, True
         if k == n_steps:
             break
-        call_mujoco(f2, mptr, dptr)
+        step_advance(f2, mptr, dptr, mj, imp, dt)
     return k, k_rec, False

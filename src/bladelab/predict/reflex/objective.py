@@ -47,7 +47,8 @@ from bladelab.predict.reflex.controller import (
     controller_layout,
     history_length,
 )
-from bladelab.runner.kernel import mujoco_step_addresses, mujoco_views, path_kinematics
+from bladelab.runner.implicit import implicit_arrays, site_views
+from bladelab.runner.kernel import mujoco_step_addresses, path_kinematics
 from bladelab.runner.metabolics import metabolic_params
 from bladelab.runner.model import DEFAULT_DT, RunnerModel
 from bladelab.runner.muscle import equilibrium_fiber_length
@@ -80,6 +81,7 @@ class ObjectiveSettings:
     alternating_steps: bool = True
     strike_limit_bw: float = 1.0
     initial_speed: float | None = None
+    integrator: str = "explicit"
 
     @classmethod
     def from_dict(cls, d: dict) -> ObjectiveSettings:
@@ -169,7 +171,8 @@ def simulate_controlled(
             f"expected {layout.size} controller parameters, got {x.shape}", where="parameters"
         )
     dt = settings.dt
-    m = model.mj_model
+    own_sites = settings.integrator == "implicit" and model.mj_dynamics_model is not None
+    m = model.mj_dynamics_model if own_sites else model.mj_model
     m.opt.timestep = dt
     d = mujoco.MjData(m)
     v_start = settings.speed if settings.initial_speed is None else settings.initial_speed
@@ -178,6 +181,8 @@ def simulate_controlled(
     d.qvel[:] = v0
     announce_compilation(run_closed_loop, "the reflex controller's simulation loop")
     mujoco.mj_forward(m, d)
+    imp = implicit_arrays(model, m, d, settings.integrator, own_sites)
+    mj = site_views(d, imp, oriented=False)
     nm = len(model.muscle_names)
     mp = model.muscle_params
     mb = metabolic_params(model)
@@ -186,7 +191,7 @@ def simulate_controlled(
     path, pstart = model.path_points, model.path_start
     mtu = np.zeros((nm, 2))
     seg_u = np.zeros((path.shape[0], 3))
-    path_kinematics(d.site_xpos, d.cvel, d.subtree_com[1].copy(), path, pstart, mtu, seg_u)
+    path_kinematics(mj[2], d.cvel, d.subtree_com[1].copy(), path, pstart, mtu, seg_u)
     for i in range(nm):
         ms[i, 1] = equilibrium_fiber_length(mtu[i, 0], ms[i, 0], *mp[i, 1:])
     u = np.zeros(nm)
@@ -251,10 +256,11 @@ def simulate_controlled(
         dt,
         iz,
         fall_height,
-        mujoco_views(d, oriented=False),
+        mj,
         arrays,
         rec.arrays,
         control,
+        imp,
     )
     qpos = d.qpos
     t_end = k * dt
