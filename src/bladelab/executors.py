@@ -95,7 +95,9 @@ def terminate_pool(pool) -> None:
         proc.join(TERMINATE_GRACE_S)
         if proc.is_alive():
             proc.kill()
-    pool.shutdown(wait=True, cancel_futures=True)
+    # no cancel_futures: the broken pool fails its queued futures itself, and Python 3.11's
+    # manager thread raised InvalidStateError (a traceback on stderr) on cancelled ones
+    pool.shutdown(wait=True)
 
 
 class ProcessPool:
@@ -161,8 +163,6 @@ class LocalExecutor:
                             status, value = "failed", f"worker failed: {type(err).__name__}: {err}"
                         yield i, status, value
             finally:
-                for fut in pending:
-                    fut.cancel()
                 if pending:  # interrupted (Ctrl-C, SIGTERM via the CLI, an error)
                     pool.close(abort=True)
 
