@@ -50,4 +50,20 @@ def run() -> str:
         f"| IPOPT iterations per design: median | "
         f"{sorted(r[2] for r in rows)[len(rows) // 2]} |",
     ]
+    settling = STUDY / "settling.json"
+    for rec in (json.loads(settling.read_text(encoding="utf-8"))["passes"]
+                if settling.is_file() else []):
+        if rec["complete"]:
+            lines.append(f"| settling pass {rec['pass']} (`--settle`, 2 solves per design) | "
+                         f"{rec['improved']} of {len(rec['designs'])} designs improved, largest "
+                         f"objective drop {100 * rec['largest_objective_drop']:.1f} % "
+                         f"(settled below 1 %) |")
+        else:
+            lines.append(f"| settling pass {rec['pass']} | stopped after "
+                         f"{len(rec['designs'])} designs (resumes with `--settle`) |")
+    if info.get("settle_wall_s"):
+        lines.append(f"| settling pass wall time, 2 workers | {info['settle_wall_s'] / 60:.0f} "
+                     f"min ({info.get('settle_note', '')}) |")
+    lines += ["", "Per-design times are those of the kept strides: after settling, a stride's "
+              "solve may have run on a machine shared with other work."]
     return "\n".join(lines)
