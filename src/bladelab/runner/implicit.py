@@ -42,13 +42,13 @@ from numba import njit
 
 from bladelab.contact import hunt_crossley_force, smooth_spring_damper_force
 from bladelab.errors import SimulationError
+from bladelab.runner.contact_point import lowest_point
 from bladelab.runner.mjcall import (
     call_mujoco,
     call_mujoco_rne,
     mujoco_stage_addresses,
 )
 from bladelab.runner.model import (
-    CP_AZ,
     CP_BODY,
     CP_C,
     CP_DAMP,
@@ -56,7 +56,6 @@ from bladelab.runner.model import (
     CP_K,
     CP_LAW,
     CP_MU,
-    CP_RADIUS,
     CP_SITE,
     CP_WIDTH,
     FRICTION_DAMPING,
@@ -320,22 +319,8 @@ def implicit_forces(mj, arrays, imp, root_com, dt):
         a[j, j] += dt * dj + dt * dt * kj
     # contacts: (x, z) Jacobian rows at the contact point, 2x2 stiffness and damping
     for c in range(cp.shape[0]):
-        site = int(cp[c, CP_SITE])
         body = int(cp[c, CP_BODY])
-        ax = cp[c, CP_RADIUS]
-        az = cp[c, CP_AZ]
-        if site_xmat.shape[0] > 0:
-            exx, exz = site_xmat[site, 0], site_xmat[site, 6]
-            ezx, ezz = site_xmat[site, 2], site_xmat[site, 8]
-        else:
-            exx, exz, ezx, ezz = 1.0, 0.0, 0.0, 1.0
-        h = math.sqrt((ax * exz) ** 2 + (az * ezz) ** 2)
-        ct = -ax * exz / h
-        st = -az * ezz / h
-        px = site_xpos[site, 0] + ax * ct * exx + az * st * ezx
-        py = site_xpos[site, 1]
-        pz = site_xpos[site, 2] - h
-        depth = h - site_xpos[site, 2]
+        px, py, pz, depth = lowest_point(cp, c, site_xpos, site_xmat)
         point_jacobian(cdof, mask, body, px, py, pz, root_com, jac)
         vx = 0.0
         vz = 0.0

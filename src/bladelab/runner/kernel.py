@@ -19,10 +19,10 @@ import numpy as np
 from numba import njit
 
 from bladelab.contact import hunt_crossley_force, smooth_spring_damper_force
+from bladelab.runner.contact_point import lowest_point
 from bladelab.runner.implicit import IMPLICIT, implicit_advance, implicit_begin, implicit_forces
 from bladelab.runner.mjcall import call_mujoco, mujoco_step_addresses  # noqa: F401 (re-exported)
 from bladelab.runner.model import (
-    CP_AZ,
     CP_BODY,
     CP_C,
     CP_DAMP,
@@ -30,8 +30,6 @@ from bladelab.runner.model import (
     CP_K,
     CP_LAW,
     CP_MU,
-    CP_RADIUS,
-    CP_SITE,
     CP_WIDTH,
     FRICTION_DAMPING,
     FRICTION_STIFFNESS,
@@ -154,22 +152,8 @@ def forces(mj, arrays, root_com, dt):
         lig[j] = tau
     # ground contacts: sphere or ellipse (semi-axes ax, az in the site's x-z plane)
     for c in range(cp.shape[0]):
-        site = int(cp[c, CP_SITE])
         body = int(cp[c, CP_BODY])
-        ax = cp[c, CP_RADIUS]
-        az = cp[c, CP_AZ]
-        if site_xmat.shape[0] > 0:
-            exx, exz = site_xmat[site, 0], site_xmat[site, 6]  # site x axis (world x, z)
-            ezx, ezz = site_xmat[site, 2], site_xmat[site, 8]  # site z axis
-        else:
-            exx, exz, ezx, ezz = 1.0, 0.0, 0.0, 1.0
-        h = math.sqrt((ax * exz) ** 2 + (az * ezz) ** 2)
-        ct = -ax * exz / h
-        st = -az * ezz / h
-        px = site_xpos[site, 0] + ax * ct * exx + az * st * ezx
-        py = site_xpos[site, 1]
-        pz = site_xpos[site, 2] - h
-        depth = h - site_xpos[site, 2]
+        px, py, pz, depth = lowest_point(cp, c, site_xpos, site_xmat)
         rx, ry, rz = px - root_com[0], py - root_com[1], pz - root_com[2]
         vx = cvel[body, 3] + cvel[body, 1] * rz - cvel[body, 2] * ry
         vz = cvel[body, 5] + cvel[body, 0] * ry - cvel[body, 1] * rx
