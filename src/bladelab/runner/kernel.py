@@ -50,7 +50,7 @@ from bladelab.sim.mujoco_engine import add_point_force
 # metabolics.py, muscle.py, contact.py or sim/mujoco_engine.py, bump this number so the loop
 # below is compiled again. This is not always enough (a session saw a controller edit have no
 # effect until the caches were deleted): when in doubt, `make clean-cache`.
-_CACHE_GENERATION = 13
+_CACHE_GENERATION = 14
 
 
 @njit(cache=True)

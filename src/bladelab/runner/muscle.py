@@ -123,7 +123,15 @@ def tendon_force_of_state(
     ref_strain: float = TENDON_REF_STRAIN,
 ) -> float:
     """Tendon force [N] given the MTU length [m] and fibre length [m]."""
-    l_t = l_mtu - l_ce * _cos_pennation(l_ce, l_opt, penn0)
+    return _tendon_force_of_height(l_mtu, l_ce, fmax, l_opt * math.sin(penn0), l_ts, ref_strain)
+
+
+@njit(cache=True, error_model="numpy")
+def _tendon_force_of_height(l_mtu: float, l_ce: float, fmax: float, height: float,
+                            l_ts: float, ref_strain: float) -> float:
+    """:func:`tendon_force_of_state` [N] for the fibre height ``height = l_opt·sin α₀`` [m]
+    (computed once per muscle by :func:`muscle_step`)."""
+    l_t = l_mtu - l_ce * _cos_pennation_of_height(l_ce, height)
     return fmax * tendon_force((l_t - l_ts) / l_ts, ref_strain)
 
 
@@ -181,10 +189,8 @@ def muscle_step(
         act = ms[i, MS_ACT]
         l_ce = ms[i, MS_LCE]
         lm = l_mtu[i]
-        height = l_opt * math.sin(penn0)  # as _cos_pennation computes it: same results
-        # the tendon force of the state (tendon_force_of_state, the sine computed once)
-        l_t = lm - l_ce * _cos_pennation_of_height(l_ce, height)
-        ms[i, MS_FORCE] = fmax * tendon_force((l_t - l_ts) / l_ts, eref)
+        height = l_opt * math.sin(penn0)  # as tendon_force_of_state computes it
+        ms[i, MS_FORCE] = _tendon_force_of_height(lm, l_ce, fmax, height, l_ts, eref)
         # fibre: implicit Euler, Newton on the normalised velocity
         vscale = V_MAX_OPT_PER_S * l_opt
         v = ms[i, MS_VCE] / vscale
