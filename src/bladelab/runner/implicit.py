@@ -508,6 +508,17 @@ def _structure(model) -> tuple:
     )
 
 
+def simulation_model(model, integrator: str, *, compiled_loop: bool = True
+                     ) -> tuple[mujoco.MjModel, bool]:
+    """``(MuJoCo model to step, own_sites)`` for simulating the :class:`RunnerModel` ``model``:
+    the implicit scheme in a compiled loop places the sites itself on the site-free
+    ``model.mj_dynamics_model`` (``own_sites`` True, for :func:`implicit_arrays`); otherwise
+    ``model.mj_model``."""
+    own_sites = (integrator == "implicit" and compiled_loop
+                 and model.mj_dynamics_model is not None)
+    return (model.mj_dynamics_model if own_sites else model.mj_model), own_sites
+
+
 def implicit_arrays(model, m: mujoco.MjModel, d: mujoco.MjData, integrator: str = "explicit",
                     own_sites: bool = False) -> tuple:
     """The ``imp`` tuple of :func:`implicit_forces` for the :class:`RunnerModel` ``model``

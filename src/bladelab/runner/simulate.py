@@ -27,7 +27,12 @@ import numpy as np
 import pandas as pd
 
 from bladelab.errors import SimulationError
-from bladelab.runner.implicit import INTEGRATORS, implicit_arrays, site_views
+from bladelab.runner.implicit import (
+    INTEGRATORS,
+    implicit_arrays,
+    simulation_model,
+    site_views,
+)
 from bladelab.runner.kernel import (
     mujoco_step_addresses,
     path_kinematics,
@@ -256,10 +261,7 @@ def simulate_runner(
                               hint=f"use one of {', '.join(INTEGRATORS)}")
     if int(record_every) < 1 or int(control_interval) < 1:
         raise SimulationError("must be at least 1", where="record_every/control_interval")
-    # the compiled implicit loop places the sites itself, on a site-free MuJoCo model
-    own_sites = (integrator == "implicit" and controller is None
-                 and model.mj_dynamics_model is not None)
-    m = model.mj_dynamics_model if own_sites else model.mj_model
+    m, own_sites = simulation_model(model, integrator, compiled_loop=controller is None)
     nm = len(model.muscle_names)
     if hold_pose:
         m = _held_copy(model, m)

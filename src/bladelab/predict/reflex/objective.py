@@ -47,7 +47,7 @@ from bladelab.predict.reflex.controller import (
     controller_layout,
     history_length,
 )
-from bladelab.runner.implicit import implicit_arrays, site_views
+from bladelab.runner.implicit import implicit_arrays, simulation_model, site_views
 from bladelab.runner.kernel import mujoco_step_addresses, path_kinematics
 from bladelab.runner.metabolics import metabolic_params
 from bladelab.runner.model import DEFAULT_DT, RunnerModel
@@ -171,8 +171,7 @@ def simulate_controlled(
             f"expected {layout.size} controller parameters, got {x.shape}", where="parameters"
         )
     dt = settings.dt
-    own_sites = settings.integrator == "implicit" and model.mj_dynamics_model is not None
-    m = model.mj_dynamics_model if own_sites else model.mj_model
+    m, own_sites = simulation_model(model, settings.integrator)
     m.opt.timestep = dt
     d = mujoco.MjData(m)
     v_start = settings.speed if settings.initial_speed is None else settings.initial_speed
