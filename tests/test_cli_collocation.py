@@ -83,6 +83,9 @@ def test_a_failed_force_run_removes_the_old_solution(solved, tmp_path, capsys):
     (("--method", "collocation", "--knee-moment-min", "0"), "--knee-moment-min"),  # able
     (("--method", "collocation", "--model", "transfemoral", "--knee-moment-min", "5"),
      "--knee-moment-min"),  # above 0: infeasible in swing
+    (("--method", "collocation", "--knee-flexion-max", "5"), "--knee-flexion-max"),  # able
+    (("--method", "collocation", "--model", "transfemoral", "--knee-flexion-max", "-5"),
+     "--knee-flexion-max"),
     (("--method", "collocation", "--guess", "no-such-file.json"), "--guess"),
 ])
 def test_bad_options_are_refused_naming_the_option(args, where, tmp_path, capsys):

@@ -137,6 +137,11 @@ def test_design_bad_input(tmp_path, capsys):
     assert main(["design", "--out", str(tmp_path / "c"), "--evaluator", "collocation",
                  "--knee-moment-min", "10"]) == 2
     assert "knee moment minimum must be <= 0" in capsys.readouterr().err
+    assert main(["design", "--out", str(tmp_path / "c"), "--knee-flexion-max", "5"]) == 2
+    assert "--knee-flexion-max needs --evaluator collocation" in capsys.readouterr().err
+    assert main(["design", "--out", str(tmp_path / "c"), "--evaluator", "collocation",
+                 "--knee-flexion-max", "120"]) == 2
+    assert "loaded knee's flexion limit" in capsys.readouterr().err
     assert main(["design", "--out", str(tmp_path / "c"), "--evaluator", "collocation",
                  "--body-mass", "70"]) == 2
     assert "does not apply to the collocation evaluator" in capsys.readouterr().err

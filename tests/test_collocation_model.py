@@ -503,3 +503,35 @@ def test_knee_moment_is_the_prosthetic_grf_moment_about_the_knee_axis(models):
     assert abs(float(fn(q, qd))) < 1e-6
     with pytest.raises(SpecError, match="no prosthetic knee"):
         knee_extension_moment(models["amputee-Cat6"][1], q_s, qd_s)
+
+
+def test_loaded_knee_flexion_limit_is_weighted_by_the_prosthetic_load(models):
+    """The straight-stance path function: (F_z / m·g)·(q_knee + limit), F_z the prosthetic
+    contacts' vertical force by hand; its sign says whether the loaded knee flexes past the
+    limit, and it is 0 with the prosthesis in the air whatever the knee does."""
+    from bladelab.errors import SpecError
+    from bladelab.predict.collocation.dynamics import knee_straight_while_loaded
+    from bladelab.runner.model import CP_LEG
+
+    runner, cm = models["transfemoral"]
+    q_s, qd_s = ca.SX.sym("q", cm.nv), ca.SX.sym("qd", cm.nv)
+    limit = np.radians(5.0)
+    fn = ca.Function("knee", [q_s, qd_s], [knee_straight_while_loaded(cm, q_s, qd_s, limit)])
+    pros = runner.contact_params[:, CP_LEG] == 1
+    weight = runner.total_mass * runner.gravity
+    knee = runner.dof("knee_angle_r")
+    q = runner.stand_qpos.copy()
+    q[runner.dof("pelvis_tz")] -= 0.01
+    qd = np.zeros(cm.nv)
+    for angle, sign in ((0.0, 1), (-np.radians(3.0), 1), (-np.radians(8.0), -1)):
+        q[knee] = angle
+        f_z = np.asarray(cm.contacts(q, qd)[0])[pros, 1].sum()
+        assert f_z > 50.0  # loaded
+        value = float(fn(q, qd))
+        assert value == pytest.approx(f_z / weight * (angle + limit), rel=1e-9)
+        assert np.sign(value) == sign
+    q[runner.dof("pelvis_tz")] += 0.3  # in the air: free, even flexed 60°
+    q[knee] = -np.radians(60.0)
+    assert abs(float(fn(q, qd))) < 1e-6
+    with pytest.raises(SpecError, match="no prosthetic knee"):
+        knee_straight_while_loaded(models["amputee-Cat6"][1], q_s, qd_s, limit)

@@ -51,12 +51,19 @@ def test_settings_round_trip_and_refuse_bad_values():
     fastest = CollocationSettings(speed_m_per_s=None)
     assert fastest.max_speed and fastest.weights.metabolic == 0.0 and fastest.weights.speed == 1
     assert CollocationSettings.from_dict(fastest.to_dict()) == fastest
+    straight = CollocationSettings(knee_flexion_max_loaded_deg=5)
+    assert straight.knee_flexion_max_loaded_deg == 5.0 and not straight.same_problem(
+        CollocationSettings())
+    assert CollocationSettings.from_dict(straight.to_dict()) == straight
     for bad, where in (({"mesh_intervals": 3}, "mesh_intervals"),
                        ({"speed_m_per_s": -1.0}, "speed_m_per_s"),
                        ({"hessian": "bfgs"}, "hessian"), ({"tol": 0.0}, "tol"),
                        ({"max_iter": 0}, "max_iter"), ({"tracking_weight": math.nan},
                                                        "tracking_weight"),
-                       ({"warm_start_mu": 0.0}, "warm_start_mu")):
+                       ({"warm_start_mu": 0.0}, "warm_start_mu"),
+                       ({"knee_moment_min_nm": 5.0}, "knee_moment_min_nm"),
+                       ({"knee_flexion_max_loaded_deg": -1.0}, "knee_flexion_max_loaded_deg"),
+                       ({"knee_flexion_max_loaded_deg": True}, "knee_flexion_max_loaded_deg")):
         with pytest.raises(SpecError) as err:
             CollocationSettings(**bad)
         assert err.value.where == where

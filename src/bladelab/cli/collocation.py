@@ -153,6 +153,7 @@ def run_collocation(
     body: str = "seed001",
     swing_clearance: float = 0.0,
     knee_moment_min: float | None = None,
+    knee_flexion_max: float | None = None,
 ) -> int:
     """Run ``bladelab predict --method collocation``; returns the exit status (0 converged,
     2 not converged)."""
@@ -173,19 +174,24 @@ def run_collocation(
     if not (math.isfinite(swing_clearance) and 0.0 <= swing_clearance < 0.5):
         raise SpecError(f"swing clearance must be within [0, 0.5) m, got {swing_clearance}",
                         where="--swing-clearance")
-    if knee_moment_min is not None and model != "transfemoral":
-        raise SpecError(f"the {model} model has no prosthetic knee", where="--knee-moment-min",
-                        hint="a setting of --model transfemoral")
+    for name, given in (("--knee-moment-min", knee_moment_min),
+                        ("--knee-flexion-max", knee_flexion_max)):
+        if given is not None and model != "transfemoral":
+            raise SpecError(f"the {model} model has no prosthetic knee", where=name,
+                            hint="a setting of --model transfemoral")
     spec = check_model_spec({"model": model, "blade": blade, "body": body})
     try:
         settings = CollocationSettings(mesh_intervals=mesh,
                                        speed_m_per_s=None if max_speed else float(speed),
                                        max_iter=max_iter, swing_clearance_m=swing_clearance,
-                                       knee_moment_min_nm=knee_moment_min)
-    except SpecError as err:  # the only value not checked above: name its option
-        if err.where != "knee_moment_min_nm":
+                                       knee_moment_min_nm=knee_moment_min,
+                                       knee_flexion_max_loaded_deg=knee_flexion_max)
+    except SpecError as err:  # the only values not checked above: name their options
+        option = {"knee_moment_min_nm": "--knee-moment-min",
+                  "knee_flexion_max_loaded_deg": "--knee-flexion-max"}.get(err.where)
+        if option is None:
             raise
-        raise SpecError(err.message, where="--knee-moment-min", hint=err.hint) from None
+        raise SpecError(err.message, where=option, hint=err.hint) from None
     runner = runner_from_spec(spec)
     result = predict_stride_in_folder(
         out, runner, settings,

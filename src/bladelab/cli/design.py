@@ -157,6 +157,10 @@ def _design(
         None, "--knee-moment-min",
         help="Collocation evaluator: keep the prosthetic knee's extension moment at or above "
              "this [N·m] in every design's stride (<= 0; default: reported, not imposed)."),
+    knee_flexion_max: float | None = typer.Option(
+        None, "--knee-flexion-max",
+        help="Collocation evaluator: keep the prosthetic knee within this flexion [deg] while "
+             "its blade is loaded (the straight stance; default: free)."),
     settle: int = typer.Option(
         0, "--settle",
         help="Collocation evaluator: after the runs, up to this many settling passes (each "
@@ -221,11 +225,14 @@ def _design(
             options["start"] = str(start)
         if knee_moment_min is not None:
             options["knee_moment_min_Nm"] = knee_moment_min
+        if knee_flexion_max is not None:
+            options["knee_flexion_max_loaded_deg"] = knee_flexion_max
     else:
         options["body_mass_kg"] = 76.0 if body_mass is None else body_mass
         if settle:
             raise SpecError("--settle needs --evaluator collocation", where="--settle")
-        for name, given in (("--start", start), ("--knee-moment-min", knee_moment_min)):
+        for name, given in (("--start", start), ("--knee-moment-min", knee_moment_min),
+                            ("--knee-flexion-max", knee_flexion_max)):
             if given is not None:
                 raise SpecError(f"{name} needs --evaluator collocation", where=name)
     if speed is not None:

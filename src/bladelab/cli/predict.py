@@ -102,6 +102,10 @@ def register(app: typer.Typer) -> None:
             "extension moment about the prosthetic knee at or above this [N·m] (<= 0; 0: the "
             "knee never buckles)."
         ),
+        knee_flexion_max: float | None = typer.Option(
+            None, "--knee-flexion-max", help="Collocation, transfemoral: keep the prosthetic "
+            "knee within this flexion [deg] while its blade is loaded (the straight stance)."
+        ),
     ) -> None:
         """Optimise the reflex controller of the runner with CMA-ES (seed 001 eq. 2.4), or with
         --method collocation solve one periodic stride by direct collocation (writes
@@ -114,7 +118,8 @@ def register(app: typer.Typer) -> None:
                                    max_iter=max_iter, resume=resume, force=force,
                                    as_json=as_json, body=body,
                                    swing_clearance=swing_clearance,
-                                   knee_moment_min=knee_moment_min)
+                                   knee_moment_min=knee_moment_min,
+                                   knee_flexion_max=knee_flexion_max)
             raise typer.Exit(code)
         if method != "reflex":
             raise SpecError(f"unknown method {method!r}", where="--method",

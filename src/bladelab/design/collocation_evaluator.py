@@ -94,6 +94,9 @@ class CollocationEvaluator:
         Keep the prosthetic knee's external extension moment at or above this [N·m] in every
         design's stride (seed 002's knee-buckling constraint imposed on the predicted gait,
         ``CollocationSettings.knee_moment_min_nm``); None: a reported outcome only.
+    knee_flexion_max_loaded_deg
+        Keep the prosthetic knee within this flexion [deg] while its blade is loaded
+        (``CollocationSettings.knee_flexion_max_loaded_deg``: the straight stance); None: free.
     blade_backward_euler
         Transcribe the blade's joints by backward Euler
         (``CollocationSettings.blade_backward_euler``: no node-to-node ringing of its links).
@@ -112,6 +115,7 @@ class CollocationEvaluator:
     swing_clearance_m: float = 0.02
     max_iter: int = 3000
     knee_moment_min_Nm: float | None = None
+    knee_flexion_max_loaded_deg: float | None = None
     blade_backward_euler: bool = True
     sole_stiffness_scale: float = DEFAULT_SOLE_STIFFNESS_SCALE
     generator: Mapping[str, Any] = field(default_factory=dict)
@@ -205,6 +209,7 @@ class CollocationEvaluator:
                                    speed_m_per_s=self.speed_mps,
                                    swing_clearance_m=self.swing_clearance_m,
                                    knee_moment_min_nm=self.knee_moment_min_Nm,
+                                   knee_flexion_max_loaded_deg=self.knee_flexion_max_loaded_deg,
                                    blade_backward_euler=self.blade_backward_euler,
                                    max_iter=self.max_iter)
 

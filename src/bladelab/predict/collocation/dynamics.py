@@ -110,14 +110,39 @@ def knee_extension_moment(cm: CollocationModel, q: ca.SX, qd: ca.SX) -> ca.SX:
     return moment
 
 
+def knee_straight_while_loaded(cm: CollocationModel, q: ca.SX, qd: ca.SX,
+                               max_flexion_rad: float) -> ca.SX:
+    """``(F_z / (m·g))·(q_knee + max_flexion_rad)`` [rad·body weights]: ≥ 0 keeps the
+    prosthetic knee (``knee_angle_r``, negative flexes) within ``max_flexion_rad`` of straight
+    whenever its contacts carry a vertical force F_z, and leaves it free in swing (F_z = 0).
+    The straight, loaded stance a transfemoral sprinter holds with the hip extensors, and the
+    stance in which seed 002's knee-buckling moment can stay extending."""
+    runner = cm.runner
+    if runner.kind != "transfemoral":
+        raise SpecError(f"the {runner.kind} model has no prosthetic knee",
+                        where="knee_flexion_max_loaded_deg",
+                        hint="a transfemoral runner's setting")
+    from bladelab.runner.model import CP_LEG
+
+    forces, _, _ = cm.contacts(q, qd)
+    f_z = 0.0
+    for c in np.flatnonzero(runner.contact_params[:, CP_LEG] == 1):
+        f_z += forces[c, 1]
+    weight = runner.total_mass * runner.gravity
+    return f_z / weight * (q[runner.dof("knee_angle_r")] + float(max_flexion_rad))
+
+
 def stride_dynamics(cm: CollocationModel, *, metabolic: MetabolicSmoothing | None = None,
                     swing_clearance_m: float = 0.0,
                     knee_moment_min_nm: float | None = None,
+                    knee_flexion_max_loaded_deg: float | None = None,
                     blade_backward_euler: bool = False) -> StrideDynamics:
     """The :class:`StrideDynamics` of a collocation model (see the module docstring); with
     ``swing_clearance_m`` > 0 [m], the path inequalities also keep every swinging contact that
     high above the ground (:func:`swing_clearance`); with ``knee_moment_min_nm`` [N·m], the
     prosthetic knee's :func:`knee_extension_moment` at or above it; with
+    ``knee_flexion_max_loaded_deg`` [deg], the prosthetic knee within that flexion while its
+    contacts carry load (:func:`knee_straight_while_loaded`); with
     ``blade_backward_euler``, a multi-link blade's joints are transcribed by backward Euler
     (``StrideDynamics.backward_euler_dofs``)."""
     runner = cm.runner

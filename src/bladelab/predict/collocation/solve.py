@@ -135,6 +135,12 @@ class CollocationSettings:
         constraint, :func:`~bladelab.predict.collocation.dynamics.knee_extension_moment`;
         at most 0, since the moment is 0 in swing); None (default): no constraint. Transfemoral
         runner only.
+    knee_flexion_max_loaded_deg
+        Keep the prosthetic knee within this flexion [deg] of straight while its blade
+        carries load (a path constraint weighted by the blade's vertical force,
+        :func:`~bladelab.predict.collocation.dynamics.knee_straight_while_loaded`): the
+        straight stance from which ``knee_moment_min_nm`` at 0 becomes reachable
+        (docs/design.md); None (default): no constraint. Transfemoral runner only.
     blade_backward_euler
         Transcribe a multi-link blade's joints by backward Euler instead of the trapezoidal
         rule (``StrideDynamics.backward_euler_dofs``): its links' modes (about 300 Hz) are
@@ -157,6 +163,7 @@ class CollocationSettings:
     warm_start_mu: float | None = None
     swing_clearance_m: float = 0.0
     knee_moment_min_nm: float | None = None
+    knee_flexion_max_loaded_deg: float | None = None
     blade_backward_euler: bool = False
 
     def __post_init__(self) -> None:
@@ -226,6 +233,13 @@ class CollocationSettings:
                                 where="knee_moment_min_nm",
                                 hint="the moment is 0 while the prosthesis is off the ground")
             object.__setattr__(self, "knee_moment_min_nm", float(km))
+        kf = self.knee_flexion_max_loaded_deg
+        if kf is not None:
+            if isinstance(kf, bool) or not isinstance(kf, int | float) or not (
+                    math.isfinite(kf) and 0 <= kf <= 90):
+                raise SpecError(f"the loaded knee's flexion limit must be within [0, 90] deg "
+                                f"or None, got {kf!r}", where="knee_flexion_max_loaded_deg")
+            object.__setattr__(self, "knee_flexion_max_loaded_deg", float(kf))
         if not isinstance(self.blade_backward_euler, bool):
             raise SpecError(f"expected true or false, got {self.blade_backward_euler!r}",
                             where="blade_backward_euler")
@@ -256,13 +270,14 @@ class CollocationSettings:
 
     def same_problem(self, other: CollocationSettings) -> bool:
         """True if ``other`` poses the same NLP (mesh, speed, weights, swing clearance, knee
-        moment bound, blade transcription); solver options (Hessian, tolerance, iterations) and the tracking stage
+        moment bound, loaded knee's flexion limit, blade transcription); solver options (Hessian, tolerance, iterations) and the tracking stage
         may differ."""
         return self._problem() == other._problem()
 
     def _problem(self) -> tuple:
         return (self.mesh_intervals, self.speed_m_per_s, self.weights, self.swing_clearance_m,
-                self.knee_moment_min_nm, self.blade_backward_euler)
+                self.knee_moment_min_nm, self.knee_flexion_max_loaded_deg,
+                self.blade_backward_euler)
 
 
 @dataclass(frozen=True)
@@ -382,19 +397,23 @@ MAX_NLPS_PER_RUNNER = 2
 
 
 def _model_functions(runner, swing_clearance_m: float = 0.0,
-                     knee_moment_min_nm: float | None = None, blade_backward_euler: bool = False):
+                     knee_moment_min_nm: float | None = None, blade_backward_euler: bool = False,
+                     knee_flexion_max_loaded_deg: float | None = None):
     """(collocation model, stride dynamics) of ``runner``, built once (per swing clearance,
-    knee moment bound and blade transcription)."""
+    knee moment bound, loaded knee's flexion limit and blade transcription)."""
     from bladelab.predict.collocation.dynamics import stride_dynamics
     from bladelab.predict.collocation.model import build_collocation_model
 
     built = _BUILT.setdefault(runner, {"dyn": {}, "nlps": {}})
     if "cm" not in built:
         built["cm"] = build_collocation_model(runner)
-    key = (swing_clearance_m, knee_moment_min_nm, blade_backward_euler)
+    key = (swing_clearance_m, knee_moment_min_nm, blade_backward_euler,
+           knee_flexion_max_loaded_deg)
     if key not in built["dyn"]:
         built["dyn"][key] = stride_dynamics(built["cm"], swing_clearance_m=swing_clearance_m,
                                             knee_moment_min_nm=knee_moment_min_nm,
+                                            knee_flexion_max_loaded_deg=(
+                                                knee_flexion_max_loaded_deg),
                                             blade_backward_euler=blade_backward_euler)
     return built["cm"], built["dyn"][key]
 
@@ -459,7 +478,8 @@ def predict_stride(runner, settings: CollocationSettings, guess, *, model_spec: 
         raise SpecError(f"expected CollocationSettings, got {type(settings).__name__}",
                         where="settings")
     cm, dyn = _model_functions(runner, settings.swing_clearance_m, settings.knee_moment_min_nm,
-                               settings.blade_backward_euler)
+                               settings.blade_backward_euler,
+                               settings.knee_flexion_max_loaded_deg)
     n = settings.mesh_intervals
     g = guess.on_model(runner).resample(n)
     speed = settings.speed_m_per_s
