@@ -530,6 +530,15 @@ def test_loaded_knee_flexion_limit_is_weighted_by_the_prosthetic_load(models):
         value = float(fn(q, qd))
         assert value == pytest.approx(f_z / weight * (angle + limit), rel=1e-9)
         assert np.sign(value) == sign
+    # the NLP's path inequalities end with it, bounded below by 0
+    from bladelab.predict.collocation.dynamics import stride_dynamics
+
+    dyn = stride_dynamics(cm, knee_flexion_max_loaded_deg=5.0)
+    nm = cm.n_muscles
+    a = ft = dft = np.full(nm, 0.1)
+    path = np.asarray(dyn.inequalities(q, qd, a, ft, dft)).ravel()
+    assert path.size == 2 * nm + 1 and path[-1] == pytest.approx(float(fn(q, qd)), rel=1e-12)
+    np.testing.assert_array_equal(dyn.inequality_bounds[-1], [0.0, np.inf])
     q[runner.dof("pelvis_tz")] += 0.3  # in the air: free, even flexed 60°
     q[knee] = -np.radians(60.0)
     assert abs(float(fn(q, qd))) < 1e-6

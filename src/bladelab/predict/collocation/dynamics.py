@@ -164,6 +164,9 @@ def stride_dynamics(cm: CollocationModel, *, metabolic: MetabolicSmoothing | Non
     if knee_moment_min_nm is not None:  # ≥ 0 like the clearances
         clearance = ca.vertcat(clearance, knee_extension_moment(cm, q, qd)
                                - float(knee_moment_min_nm))
+    if knee_flexion_max_loaded_deg is not None:
+        clearance = ca.vertcat(clearance, knee_straight_while_loaded(
+            cm, q, qd, math.radians(knee_flexion_max_loaded_deg)))
     weight = runner.total_mass * runner.gravity
     scale = np.array([weight if n.startswith("pelvis_t") and n != "pelvis_tilt" else 100.0
                       for n in runner.dof_names])
