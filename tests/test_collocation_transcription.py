@@ -202,3 +202,33 @@ def test_backward_euler_rows_for_stiff_coordinates():
     assert np.abs(trap_z).max() > 1e-3  # which the trapezoidal rule does not accept
     x_rows = [k for k in be if "pelvis_tx" in k]
     np.testing.assert_allclose([be[k] for k in x_rows], [trap[k] for k in x_rows], atol=1e-12)
+
+
+def test_interval_mean_inequalities_are_imposed_on_each_intervals_mean():
+    """``StrideDynamics.interval_mean_inequalities``: those rows of the path inequalities are
+    imposed on (g_k + g_{k+1})/2 per interval, the others at the nodes; a value alternating in
+    sign from node to node (the trapezoidal rule's period-2 mode) has interval means near 0."""
+    import dataclasses
+
+    n = 20
+    q, qd = ca.SX.sym("q", 3), ca.SX.sym("qd", 3)
+    a, f, df = (ca.SX.sym(s, 1) for s in ("a", "f", "df"))
+    ineq = ca.Function("ineq", [q, qd, a, f, df], [ca.vertcat(qd[1], q[1])])
+    toy = dataclasses.replace(_toy(), inequalities=ineq,
+                              inequality_bounds=np.array([[-1.0, 1.0], [-1.0, 1.0]]))
+    g = _bouncing_guess(n, 2.0)
+    ringing = dataclasses.replace(g, qd=g.qd.copy())
+    ringing.qd[:, 1] = 0.3 * (-1.0) ** np.arange(n + 1)  # ±0.3 m/s from node to node
+
+    def rows(dyn):
+        nlp = StrideNLP(dyn, n=n, speed=2.0)
+        fn = ca.Function("g", [nlp.nlp["x"], nlp.nlp["p"]], [nlp.nlp["g"]])
+        values = np.asarray(fn(nlp.initial_vector(ringing), 2.0)).ravel()
+        return np.array([values[i] for i, name in enumerate(nlp._g_names)
+                         if name.startswith("inequality ")]).reshape(n, 2)
+
+    at_nodes = rows(toy)
+    means = rows(dataclasses.replace(toy, interval_mean_inequalities=(0,)))
+    np.testing.assert_allclose(np.abs(at_nodes[:, 0]), 0.3, rtol=1e-9)  # ringing at nodes
+    np.testing.assert_allclose(means[:, 0], 0.0, atol=1e-9)  # its interval means vanish
+    np.testing.assert_allclose(means[:, 1], at_nodes[:, 1], atol=1e-12)  # row 1 untouched

@@ -13,7 +13,8 @@ CollocationSolution` of the periodic stride and returns (name, unit):
 ``impulse_z_net_Ns``                N·s        ∫(F_z − m·g) dt
 ``evaluation_E_m``                  m          bouncing-ball parameter I_x·I_z,net/(m²·g)
 ``knee_moment_min_Nm``              N·m        minimum extension moment of the prosthetic
-                                               leg's GRF about the knee axis, loaded stance
+                                               leg's GRF about the knee axis over the loaded
+                                               stance's mesh intervals (their means)
 ``swing_clearance_m``               m          lowest point of the prosthesis's contacts over
                                                the middle half of its swing
 ``contact_time_prosthetic_s``       s          the stance's duration
@@ -25,13 +26,18 @@ of the prosthetic leg's periodic force, the node values interpolated linearly on
 times finer (the solution's own contact times use the same rule on a grid 50 times finer:
 they agree within two steps of this grid, tested); integrals are trapezoidal on that grid.
 The contacts' lowest points, for the swing clearance, are the collocation model's.
-"Loaded" for the knee moment: vertical force above 5 % of its peak (seed 002's knee-buckling
-check, :func:`~bladelab.design.constraints.knee_buckling`). The knee moment is summed per
-node over the prosthetic contacts (r × F about MuJoCo's knee axis, as the collocation
-constraint ``CollocationSettings.knee_moment_min_nm`` sees it) and then interpolated; until
-2026-11-26 a centre of pressure was interpolated instead, which was 0 (the lab origin) at the
-unloaded node before touch-down and gave spurious minima of −150 to −300 N·m in the interval
-of touch-down.
+The knee moment is summed per node over the prosthetic contacts (r × F about MuJoCo's knee
+axis) and its minimum taken over the mesh intervals' means (the mean of each interval's two
+nodes, as the collocation constraint ``CollocationSettings.knee_moment_min_nm`` sees it) of
+the loaded intervals (mean vertical force above 5 % of its peak, seed 002's knee-buckling
+check, :func:`~bladelab.design.constraints.knee_buckling`). Node values alternate: a sliding
+blade sole rings by ±1 mm from node to node (the trapezoidal rule's period-2 mode), its
+friction saturating at ±μ·F_n, and the moment swings by ±20–60 N·m about a mean that the
+momentum balance, which integrates interval means, sees (measured on the design's centre
+stride, session 12); until then the minimum over the nodes, interpolated, was reported and
+was that ringing's trough. Until 2026-11-26 a centre of pressure was interpolated instead,
+which was 0 (the lab origin) at the unloaded node before touch-down and gave spurious minima
+of −150 to −300 N·m in the interval of touch-down.
 """
 
 from __future__ import annotations
@@ -147,8 +153,9 @@ def stride_responses(solution, runner, *, cm=None) -> dict[str, float]:
     i_x, i_z = integral(fx_f), integral(fz_f)
     i_z_net = integral(fz_f - mass * g)
     _, dvx, e = bouncing_ball(i_x, i_z_net, mass, g=g)
-    moment = _fine(knee_moment)
-    loaded = idx[fz_f[idx] > _KNEE_LOADED * fz_f[idx].max()]
+    mean_moment = 0.5 * (knee_moment[:-1] + knee_moment[1:])  # per mesh interval
+    mean_fz = 0.5 * (fz[:-1] + fz[1:])
+    loaded = mean_fz > _KNEE_LOADED * fz_f[idx].max()
     # swing: from the stance's end round to its start; its middle half
     n_fine = fz_f.size
     swing = (idx[-1] + 1 + np.arange(n_fine - idx.size)) % n_fine
@@ -161,7 +168,7 @@ def stride_responses(solution, runner, *, cm=None) -> dict[str, float]:
         "impulse_z_Ns": i_z,
         "impulse_z_net_Ns": i_z_net,
         "evaluation_E_m": e,
-        "knee_moment_min_Nm": float(moment[loaded].min()),
+        "knee_moment_min_Nm": float(mean_moment[loaded].min()),
         "swing_clearance_m": float(heights[mid].min()),
         "contact_time_prosthetic_s": float(idx.size * dt),
         "cost_of_transport_J_per_kg_m": solution.cost_of_transport_J_per_kg_m,

@@ -140,7 +140,8 @@ def stride_dynamics(cm: CollocationModel, *, metabolic: MetabolicSmoothing | Non
     """The :class:`StrideDynamics` of a collocation model (see the module docstring); with
     ``swing_clearance_m`` > 0 [m], the path inequalities also keep every swinging contact that
     high above the ground (:func:`swing_clearance`); with ``knee_moment_min_nm`` [N·m], the
-    prosthetic knee's :func:`knee_extension_moment` at or above it; with
+    prosthetic knee's :func:`knee_extension_moment` at or above it (on each mesh interval's
+    mean: ``StrideDynamics.interval_mean_inequalities``); with
     ``knee_flexion_max_loaded_deg`` [deg], the prosthetic knee within that flexion while its
     contacts carry load (:func:`knee_straight_while_loaded`); with
     ``blade_backward_euler``, a multi-link blade's joints are transcribed by backward Euler
@@ -161,7 +162,9 @@ def stride_dynamics(cm: CollocationModel, *, metabolic: MetabolicSmoothing | Non
     q_b, qd_b = _bounds(runner.dof_names)
     clearance = (swing_clearance(cm, q, qd, float(swing_clearance_m))
                  if swing_clearance_m > 0 else ca.SX.zeros(0, 1))
-    if knee_moment_min_nm is not None:  # ≥ 0 like the clearances
+    interval_mean = ()
+    if knee_moment_min_nm is not None:  # ≥ 0 like the clearances, on each interval's mean
+        interval_mean = (2 * nm + int(clearance.numel()),)
         clearance = ca.vertcat(clearance, knee_extension_moment(cm, q, qd)
                                - float(knee_moment_min_nm))
     if knee_flexion_max_loaded_deg is not None:
@@ -193,6 +196,7 @@ def stride_dynamics(cm: CollocationModel, *, metabolic: MetabolicSmoothing | Non
                                  [ca.sum1(cm.contacts(q, qd)[0][:, 1])]),
         backward_euler_dofs=tuple(n for n in runner.dof_names if n.startswith("blade_joint"))
         if blade_backward_euler else (),
+        interval_mean_inequalities=interval_mean,
     )
 
 

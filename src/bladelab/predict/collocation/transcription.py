@@ -86,6 +86,12 @@ class StrideDynamics:
         ``x_{k+1} − x_k − h·ẋ_{k+1}`` instead of the trapezoidal one: stiff subsystems whose
         modes no mesh resolves (a multi-link blade's links, about 300 Hz), which the
         trapezoidal rule, A- but not L-stable, leaves ringing from node to node.
+    interval_mean_inequalities
+        Rows of ``inequalities`` imposed on each interval's mean of its two nodes' values
+        instead of at the nodes: quantities made of contact forces, whose node values can
+        alternate from node to node (a stance contact sliding ±1 mm each node, the
+        trapezoidal rule's period-2 mode, its friction saturating ±μ·F_n) while the
+        momentum balance integrates only their interval means.
     """
 
     dof_names: tuple[str, ...]
@@ -104,6 +110,7 @@ class StrideDynamics:
     vertical_grf: ca.Function | None = None
     muscle_metabolic_rates: ca.Function | None = None
     backward_euler_dofs: tuple[str, ...] = ()
+    interval_mean_inequalities: tuple[int, ...] = ()
 
     @property
     def nq(self) -> int:
@@ -403,7 +410,12 @@ class StrideNLP:
             dev = ((fzs - f_ref) / bw) ** 2
             terms["grf_tracking"] = float(weight) * _node_pairs(dev) / (2 * n)
         if self.n_ineq:
-            g.append(ca.vec(ineqs[:, :n]))
+            imposed = ineqs[:, :n]
+            if d.interval_mean_inequalities:
+                means = 0.5 * (ineqs[:, :n] + ineqs[:, 1:])
+                imposed = ca.vertcat(*[means[i, :] if i in d.interval_mean_inequalities
+                                       else imposed[i, :] for i in range(self.n_ineq)])
+            g.append(ca.vec(imposed))
             self._g_names += [f"inequality {i}@{k}" for k in range(n) for i in range(self.n_ineq)]
         J = sum(terms.values())
         self._terms = ca.Function("terms", [X, U, T, P], list(terms.values()))
