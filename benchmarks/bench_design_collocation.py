@@ -1,4 +1,5 @@
-"""The 25-run design study on predicted transfemoral strides (issue 21), from its stored files.
+"""The 25-run design studies on predicted transfemoral strides (issue 21), from their stored
+files: the free gait, and the knee-safe one (the knee's extension moment kept at or above 0).
 
 The study takes about half an hour of both cores, so ``make bench`` does not run it again: it
 reads the solve times and iterations of every design's stride in the committed study folder
@@ -6,6 +7,9 @@ reads the solve times and iterations of every design's stride in the committed s
 beside it (``bladelab design`` run as in docs/design.md). Run the study again to measure anew::
 
     bladelab design --evaluator collocation --jobs 2 --out benchmarks/design/transfemoral-collocation-4mps
+    bladelab design --evaluator collocation --jobs 2 --knee-moment-min 0 \
+        --start benchmarks/collocation/transfemoral-2026-11-26/knee-safe-centre-4.json \
+        --out benchmarks/design/transfemoral-collocation-4mps-knee-safe
 """
 
 from __future__ import annotations
@@ -13,25 +17,35 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-STUDY = Path(__file__).resolve().parent / "design" / "transfemoral-collocation-4mps"
+_DESIGN = Path(__file__).resolve().parent / "design"
+#: (folder, what distinguishes it)
+STUDIES = (
+    (_DESIGN / "transfemoral-collocation-4mps", "free gait"),
+    (_DESIGN / "transfemoral-collocation-4mps-knee-safe",
+     "knee-safe: knee moment ≥ 0 N·m on every mesh interval (`--knee-moment-min 0`)"),
+)
 
 
 def run() -> str:
-    strides = sorted((STUDY / "strides").glob("*.json"))
+    return "\n\n".join(_study(folder, what) for folder, what in STUDIES)
+
+
+def _study(study: Path, what: str) -> str:
+    strides = sorted((study / "strides").glob("*.json"))
     strides = [p for p in strides if not p.name.endswith(".best_iterate.json")]
     if not strides:
-        return ("## Design study on predicted transfemoral strides (issue 21)\n\n"
-                f"No study in {STUDY.relative_to(STUDY.parents[2])}: run it first (docstring).")
+        return (f"## Design study on predicted transfemoral strides (issue 21): {what}\n\n"
+                f"No study in {study.relative_to(study.parents[2])}: run it first (docstring).")
     rows = []
     for p in strides:
         data = json.loads(p.read_text(encoding="utf-8"))
         rows.append((p.stem, float(data.get("wall_s", float("nan"))),
                      int(data.get("iterations", 0)), data.get("guess_source", "")))
-    timing = STUDY / "timing.json"
+    timing = study / "timing.json"
     info = json.loads(timing.read_text(encoding="utf-8")) if timing.is_file() else {}
     walls = sorted(r[1] for r in rows)
     lines = [
-        "## Design study on predicted transfemoral strides (issue 21)",
+        f"## Design study on predicted transfemoral strides (issue 21): {what}",
         "",
         "25-run face-centred CCD over seed 002's four factors, `--evaluator collocation` "
         "(transfemoral runner wearing each generated 6-link blade, 4 m/s, mesh 50, backward "
@@ -50,7 +64,7 @@ def run() -> str:
         f"| IPOPT iterations per design: median | "
         f"{sorted(r[2] for r in rows)[len(rows) // 2]} |",
     ]
-    settling = STUDY / "settling.json"
+    settling = study / "settling.json"
     for rec in (json.loads(settling.read_text(encoding="utf-8"))["passes"]
                 if settling.is_file() else []):
         if rec["complete"]:
