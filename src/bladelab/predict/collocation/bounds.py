@@ -61,12 +61,11 @@ def spring_damper_bound(
     depth: float, depth_rate: float, stiffness: float, damping: float, width: float,
     smoothing: Smoothing,
 ) -> float:
-    """Largest |smooth − forward| spring–damper normal force [N] at ``depth`` ≥ w' (where the
-    forward cubic onset is complete; w' = max(w, ε')).
+    """Largest |smooth − forward| spring–damper normal force [N] at ``depth`` [m]: at any depth
+    for a forward onset of width w > 0, from ε' on for a sharp one (w = 0).
 
-    Smooth ``gate(δ)·m0(k·m0(δ; ε') + c·δ̇; ε_F)`` against ``max(k·δ + c·δ̇, 0)``: the depth
-    smoothing adds ``k·(m0(δ; ε') − δ)``, the outer smooth max ``m0(x; ε_F) − max(x, 0)``, the
-    gate ``(1 − gate(δ))·m0(x; ε_F)``.
+    Smooth ``smoothstep(δ/w)·m0(k·δ + c·δ̇; ε_F)`` against ``smoothstep(δ/w)·max(k·δ + c·δ̇,
+    0)``: the same onset, so the outer smooth max alone differs, ``smoothstep·(m0 − max)``.
 
     Parameters
     ----------
@@ -76,14 +75,14 @@ def spring_damper_bound(
         k [N/m], c [N·s/m], transition width w [m] (``RunnerModel.contact_params``).
     """
     eps = smoothing.spring_damper_depth_m
-    w = max(width, eps)
-    if depth < w:
-        raise ValueError(f"the bound holds from the onset width {w} m on, got depth {depth} m")
-    x = stiffness * (depth + smooth_max0_excess(depth, eps)) + damping * depth_rate
-    excess = smooth_max0_excess(x, smoothing.contact_force_n)
-    gate = 0.5 * (1.0 + math.tanh(8.0 * (depth - 0.5 * w) / w))
-    return stiffness * smooth_max0_excess(depth, eps) + excess + (1.0 - gate) * (
-        max(x, 0.0) + excess)
+    if width <= 0 and depth < eps:
+        raise ValueError(f"a sharp onset's bound holds from {eps} m on, got depth {depth} m")
+    w = width if width > 0 else eps
+    if depth <= 0:
+        return 0.0
+    gate = 1.0 if depth >= w else (depth / w) ** 2 * (3.0 - 2.0 * depth / w)
+    x = stiffness * depth + damping * depth_rate
+    return gate * smooth_max0_excess(x, smoothing.contact_force_n)
 
 
 def sliding_friction_bound(slip_velocity: float, normal_force: float, friction: float,

@@ -9,8 +9,8 @@ read from ``RunnerModel.contact_params`` and ``RunnerModel.joint_params``:
 - **Hunt–Crossley** (law 0): forward ``k·δⁿ·max(1 + 1.5·c·δ̇, 0)`` for δ > 0; here
   ``k·δ_sⁿ·x_s`` with ``δ_s = smooth_max0(δ, ε_d)`` and ``x_s = smooth_max0(1 + 1.5·c·δ̇, ε_x)``.
 - **Spring–damper** (law 1, multi-link blade soles): forward ``smoothstep(δ/w)·max(kδ + cδ̇, 0)``;
-  here ``gate(δ)·smooth_max0(k·δ_s + c·δ̇, ε_F)`` with a tanh gate rising over [0, w'] and
-  ``δ_s`` smoothed with ε' (w' = max(w, ε')).
+  here ``smoothstep(δ/w)·smooth_max0(k·δ + c·δ̇, ε_F)``, the same C¹ cubic onset (over ε'
+  where the forward onset is sharp, w = 0).
 - **Friction**: forward an elastic–plastic bristle with a state, ``−μ·Fn`` while sliding;
   here ``−μ·Fn·tanh(v_x/v_t)`` (no state). The two agree while sliding; while the forward
   bristle sticks, its force is any value within ±μ·Fn that the anchor's state gives.
@@ -78,10 +78,14 @@ def normal_force(depth, depth_rate, row: np.ndarray, smoothing: Smoothing):
         d = smooth_max0(depth, smoothing.contact_depth_m)
         x = smooth_max0(1.0 + 1.5 * c * depth_rate, smoothing.contact_damping)
         return k * d ** float(row[CP_EXP]) * x
-    eps = smoothing.spring_damper_depth_m
-    width = max(float(row[CP_WIDTH]), eps)
-    gate = 0.5 * (1.0 + ca.tanh(8.0 * (depth - 0.5 * width) / width))
-    force = k * smooth_max0(depth, eps) + float(row[CP_DAMP]) * depth_rate
+    # the forward law's own cubic onset smoothstep(δ/w), C¹ and 0 for δ ≤ 0, so that the two
+    # agree from first touch (a tanh gate, used until session 12, gave 40-60 % of the forward
+    # force at a touching-down sole's first node: dynamics residuals of 19-48 %); a sharp
+    # forward onset (w = 0) gets the cubic over ε'
+    width = float(row[CP_WIDTH]) if row[CP_WIDTH] > 0 else smoothing.spring_damper_depth_m
+    x = depth / width
+    gate = ca.if_else(x <= 0.0, 0.0, ca.if_else(x >= 1.0, 1.0, x * x * (3.0 - 2.0 * x)))
+    force = k * depth + float(row[CP_DAMP]) * depth_rate
     return gate * smooth_max0(force, smoothing.contact_force_n)
 
 
