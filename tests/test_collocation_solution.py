@@ -204,6 +204,14 @@ def test_a_hop_and_a_stride_on_its_bound_are_named_in_the_warnings(able):
         "the right leg's peak vertical force is "
         f"{(sol.leg_vertical_force()[k, 1] / sol.body_weight_N + 9.0):.1f} body weights "
         "(above 8: an impact no runner survives)"]
+    # a stride the forward model does not reproduce (a residual of 9 % of the peak force)
+    inconsistent = dataclasses.replace(sol, residual={**sol.residual,
+                                                      "dynamics_residual_pct": 9.0})
+    assert inconsistent.gait_warnings() == [
+        "the dynamics residual against the forward model is 9.0 % (above 5 %: the smoothed "
+        "model's gait only)"]
+    assert dataclasses.replace(sol, residual={**sol.residual, "dynamics_residual_pct": 4.9}
+                               ).gait_warnings() == []
 
 
 def test_amputee_summary_names_intact_and_prosthetic_legs():

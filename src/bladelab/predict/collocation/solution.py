@@ -52,6 +52,12 @@ CONTACT_THRESHOLD_N = 20.0
 #: gaits a person could run. Our decision (2026-11-25); a flagged solve loses to a clean one
 #: among several starts.
 PEAK_GRF_WARNING_BW = 8.0
+#: A dynamics residual against the forward model above this [% of the peak generalised
+#: force] is flagged by :meth:`CollocationSolution.gait_warnings`: the stride is then the gait
+#: of the smoothed model only. Clean solves measure 0.4–2.4 %; strides that placed a node where
+#: the smooth and forward contact laws differed (a blade sole's onset, fixed in session 12)
+#: reached 9–48 %. Our decision (session 12).
+RESIDUAL_WARNING_PCT = 5.0
 #: Samples per mesh interval of the linear interpolation used for contact and flight times.
 _FINE = 50
 
@@ -245,8 +251,8 @@ class CollocationSolution:
         """What makes this converged stride no running gait, in words (empty if nothing):
         a leg that never touches the ground (a one-legged hop), a leg that touches it more
         than once per stride (a swinging foot striking the ground, or a bounce), a peak
-        vertical force above :data:`PEAK_GRF_WARNING_BW`, no flight phase, or a stride time on
-        a bound of the NLP (:data:`~bladelab.predict.collocation.
+        vertical force above :data:`PEAK_GRF_WARNING_BW`, no flight phase, a dynamics residual
+        above :data:`RESIDUAL_WARNING_PCT`, or a stride time on a bound of the NLP (:data:`~bladelab.predict.collocation.
         transcription.PERIOD_BOUNDS_S`). Measured on 2026-11-25: the amputee Cat6 at 4 m/s
         from the Fukuchi trial's guess converged to a hop on the intact leg at the 0.4 s
         bound."""
@@ -268,6 +274,10 @@ class CollocationSolution:
         for bound in PERIOD_BOUNDS_S:
             if math.isclose(self.period_s, bound, rel_tol=1e-3):
                 out.append(f"the stride time sits on its bound ({bound:g} s)")
+        residual = self.dynamics_residual_pct
+        if residual > RESIDUAL_WARNING_PCT:  # nan (not recorded) is not flagged
+            out.append(f"the dynamics residual against the forward model is {residual:.1f} % "
+                       f"(above {RESIDUAL_WARNING_PCT:g} %: the smoothed model's gait only)")
         return out
 
     def summary(self) -> dict:
