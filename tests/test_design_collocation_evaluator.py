@@ -24,9 +24,16 @@ RANGES = {"stiffness_kN_per_m": (18.0, 32.0), "width_m": (0.05, 0.08), "height_m
 class _Outcome:
     """A solve's result as the evaluator reads it: converged or not, the gait's defects."""
 
-    def __init__(self, base: CollocationSolution, converged: bool, defects: list[str]):
+    stage = "predictive"
+
+    def __init__(self, base: CollocationSolution, converged: bool, defects: list[str],
+                 status: str = "Infeasible_Problem_Detected", violation: float = 1.0):
         self._base, self.converged, self._defects = base, converged, defects
-        self.nlp = base.nlp if converged else type("N", (), {"status": "Infeasible_Problem_Detected"})()
+        self.nlp = base.nlp if converged else type(
+            "N", (), {"status": status, "max_violation": violation, "iterations": 3000})()
+
+    def to_guess(self, source):
+        return type("G", (), {"source": source})()
 
     def gait_warnings(self):
         return list(self._defects)
@@ -47,8 +54,7 @@ def fake(monkeypatch):
                       "speed": settings.speed_m_per_s, "dofs": runner.dof_names,
                       "backward_euler": settings.blade_backward_euler,
                       "contacts": runner.contact_params.copy()})
-        converged, defects = script.pop(0) if script else (True, [])
-        return _Outcome(base, converged, defects)
+        return _Outcome(base, *(script.pop(0) if script else (True, [])))
 
     monkeypatch.setattr(solve_module, "predict_stride", predict_stride)
     monkeypatch.setattr("bladelab.design.predicted.stride_responses",
@@ -116,6 +122,21 @@ def test_a_design_with_no_clean_stride_is_a_named_failure(fake, tmp_path):
     stem = ce.point_file_stem(CENTRE)
     assert not (tmp_path / "s" / f"{stem}.json").exists()  # never stored as a solution
     assert (tmp_path / "s" / f"{stem}.best_iterate.json").is_file()
+
+
+def test_a_solve_stopped_by_the_iteration_limit_near_feasibility_is_continued(fake, tmp_path):
+    """A start that ran out of iterations on a nearly feasible iterate is solved once more from
+    that iterate (predictive only) before the next start is tried; one far from feasible is
+    not."""
+    calls, script = fake
+    ev = _evaluator(tmp_path)
+    script += [(False, [], "Maximum_Iterations_Exceeded", 1e-5), (True, [])]
+    ev(CENTRE)
+    assert len(calls) == 2 and "continued after 3000 iterations" in calls[1]["source"]
+    assert calls[1]["track"] is False
+    script += [(False, [], "Maximum_Iterations_Exceeded", 0.5), (True, [])]
+    ev({**CENTRE, "width_m": 0.05})
+    assert len(calls) == 4 and "continued" not in calls[3]["source"]  # the next start instead
 
 
 def test_point_file_names_read_back():
