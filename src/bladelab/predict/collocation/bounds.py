@@ -14,6 +14,7 @@ from functools import lru_cache
 
 import numpy as np
 
+from bladelab.contact import smoothstep
 from bladelab.predict.collocation.smooth import Smoothing
 
 
@@ -78,11 +79,8 @@ def spring_damper_bound(
     if width <= 0 and depth < eps:
         raise ValueError(f"a sharp onset's bound holds from {eps} m on, got depth {depth} m")
     w = width if width > 0 else eps
-    if depth <= 0:
-        return 0.0
-    gate = 1.0 if depth >= w else (depth / w) ** 2 * (3.0 - 2.0 * depth / w)
     x = stiffness * depth + damping * depth_rate
-    return gate * smooth_max0_excess(x, smoothing.contact_force_n)
+    return smoothstep(depth / w) * smooth_max0_excess(x, smoothing.contact_force_n)
 
 
 def sliding_friction_bound(slip_velocity: float, normal_force: float, friction: float,

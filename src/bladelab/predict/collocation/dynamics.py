@@ -86,6 +86,17 @@ def swing_clearance(cm: CollocationModel, q: ca.SX, qd: ca.SX, height_m: float) 
     return ca.vertcat(*out)
 
 
+def _prosthetic_contacts(runner, setting: str) -> np.ndarray:
+    """Indices of the prosthetic leg's contact rows of a transfemoral runner; SpecError naming
+    ``setting`` for a runner without a prosthetic knee."""
+    from bladelab.runner.model import CP_LEG
+
+    if runner.kind != "transfemoral":
+        raise SpecError(f"the {runner.kind} model has no prosthetic knee", where=setting,
+                        hint="a transfemoral runner's setting")
+    return np.flatnonzero(runner.contact_params[:, CP_LEG] == 1)
+
+
 def knee_extension_moment(cm: CollocationModel, q: ca.SX, qd: ca.SX) -> ca.SX:
     """External extension moment [N·m] of the prosthetic contacts' ground forces about the
     prosthetic knee's axis, ``Σ (x_c − x_k)·F_z − (z_c − z_k)·F_x`` over the contacts c (seed
@@ -93,18 +104,15 @@ def knee_extension_moment(cm: CollocationModel, q: ca.SX, qd: ca.SX) -> ca.SX:
     with the centre of pressure): negative flexes the knee; 0 while the prosthesis is off the
     ground."""
     from bladelab.predict.collocation.multibody import body_frames, point_position
-    from bladelab.runner.model import CP_LEG
 
     runner = cm.runner
-    if runner.kind != "transfemoral":
-        raise SpecError(f"the {runner.kind} model has no prosthetic knee",
-                        where="knee_moment_min_nm", hint="a transfemoral runner's setting")
+    prosthetic = _prosthetic_contacts(runner, "knee_moment_min_nm")
     body = runner.mj_model.joint("knee_angle_r").bodyid[0]
     joint = next(j for j in cm.tree.joints[body] if j.dof == runner.dof("knee_angle_r"))
     knee = point_position(body_frames(cm.tree, q), body, joint.anchor)
     forces, points, _ = cm.contacts(q, qd)
     moment = 0.0
-    for c in np.flatnonzero(runner.contact_params[:, CP_LEG] == 1):
+    for c in prosthetic:
         moment += ((points[c, 0] - knee[0]) * forces[c, 1]
                    - (points[c, 1] - knee[1]) * forces[c, 0])
     return moment
@@ -118,15 +126,10 @@ def knee_straight_while_loaded(cm: CollocationModel, q: ca.SX, qd: ca.SX,
     The straight, loaded stance a transfemoral sprinter holds with the hip extensors, and the
     stance in which seed 002's knee-buckling moment can stay extending."""
     runner = cm.runner
-    if runner.kind != "transfemoral":
-        raise SpecError(f"the {runner.kind} model has no prosthetic knee",
-                        where="knee_flexion_max_loaded_deg",
-                        hint="a transfemoral runner's setting")
-    from bladelab.runner.model import CP_LEG
-
+    prosthetic = _prosthetic_contacts(runner, "knee_flexion_max_loaded_deg")
     forces, _, _ = cm.contacts(q, qd)
     f_z = 0.0
-    for c in np.flatnonzero(runner.contact_params[:, CP_LEG] == 1):
+    for c in prosthetic:
         f_z += forces[c, 1]
     weight = runner.total_mass * runner.gravity
     return f_z / weight * (q[runner.dof("knee_angle_r")] + float(max_flexion_rad))

@@ -252,8 +252,8 @@ class CollocationSolution:
         a leg that never touches the ground (a one-legged hop), a leg that touches it more
         than once per stride (a swinging foot striking the ground, or a bounce), a peak
         vertical force above :data:`PEAK_GRF_WARNING_BW`, no flight phase, a dynamics residual
-        above :data:`RESIDUAL_WARNING_PCT`, or a stride time on a bound of the NLP (:data:`~bladelab.predict.collocation.
-        transcription.PERIOD_BOUNDS_S`). Measured on 2026-11-25: the amputee Cat6 at 4 m/s
+        above :data:`RESIDUAL_WARNING_PCT`, or a stride time on a bound of the NLP
+        (:data:`~bladelab.predict.collocation.transcription.PERIOD_BOUNDS_S`). Measured on 2026-11-25: the amputee Cat6 at 4 m/s
         from the Fukuchi trial's guess converged to a hop on the intact leg at the 0.4 s
         bound."""
         from bladelab.predict.collocation.transcription import PERIOD_BOUNDS_S

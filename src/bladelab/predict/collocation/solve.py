@@ -270,8 +270,8 @@ class CollocationSettings:
 
     def same_problem(self, other: CollocationSettings) -> bool:
         """True if ``other`` poses the same NLP (mesh, speed, weights, swing clearance, knee
-        moment bound, loaded knee's flexion limit, blade transcription); solver options (Hessian, tolerance, iterations) and the tracking stage
-        may differ."""
+        moment bound, loaded knee's flexion limit, blade transcription); solver options
+        (Hessian, tolerance, iterations) and the tracking stage may differ."""
         return self._problem() == other._problem()
 
     def _problem(self) -> tuple:
