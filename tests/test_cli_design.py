@@ -205,3 +205,63 @@ def test_an_interrupted_settling_pass_is_recorded_and_resumed(tmp_path, monkeypa
     from bladelab.errors import InputFileError
     with pytest.raises(InputFileError, match="is not run"):
         settle_study(None, other, passes=1, jobs=1)
+
+
+def _collocation_copy(study, tmp_path, residuals: dict[int, float], missing=()):
+    """The blade study's folder as if its runs were collocation strides: every run's stride is
+    the built-in clean transfemoral stride, run ``i``'s dynamics residual set to
+    ``residuals[i]`` [%]."""
+    import shutil
+
+    from bladelab.design.collocation_evaluator import DEFAULT_START, point_file_stem
+
+    out, _ = study
+    copy = tmp_path / "coll"
+    shutil.copytree(out, copy)
+    (copy / "evaluator.json").write_text(json.dumps(
+        {"evaluator": "collocation", "solutions_dir": "elsewhere/strides"}))
+    stride = json.loads(DEFAULT_START.read_text())
+    table = pd.read_csv(copy / "results.csv")
+    names = ["stiffness_kN_per_m", "toe_length_m"]
+    (copy / "strides").mkdir()
+    for _, row in table.iterrows():
+        run = int(row["run"])
+        if run in missing:
+            continue
+        data = json.loads(json.dumps(stride))
+        data["consistency"]["dynamics_residual_pct"] = residuals.get(run, 1.0)
+        (copy / "strides" / f"{point_file_stem({n: row[n] for n in names})}.json").write_text(
+            json.dumps(data))
+    return copy, table
+
+
+def test_design_report_leaves_out_flagged_strides(study, tmp_path):
+    """A collocation study's run whose stride fails today's checks (a 12 % residual) is named
+    in the report and left out of its surfaces; a run whose stride file is missing is kept and
+    said to be unchecked."""
+    from bladelab.report.design import _load, design_report_sections
+
+    copy, table = _collocation_copy(study, tmp_path, {3: 12.0}, missing=(5,))
+    meta, _, _, surfaces = _load(copy)  # the strides found inside the moved study's folder
+    checks = meta["_strides"]
+    assert checks.loc[checks["run"] == 3, "excluded"].item()
+    assert "12.0 %" in checks.loc[checks["run"] == 3, "warnings"].item()
+    assert checks.loc[checks["run"] == 5, "warnings"].item() == "stride file not found"
+    assert not checks.loc[checks["run"] != 3, "excluded"].any()
+    fitted = next(iter(surfaces.values()))
+    assert len(fitted.y) == len(table) - 1
+    sections = {s["title"]: s for s in design_report_sections(copy)}
+    strides = sections["Design study: predicted strides"]
+    assert "1 carry warnings" in strides["text"] and "1 stride files were not found" in \
+        strides["text"]
+    runs = dict(sections["Design study: response surfaces"]["tables"])["Runs"]
+    assert runs.loc[runs["run"] == 3, "stride"].item() == "left out (warnings)"
+
+
+def test_design_report_refuses_too_few_clean_strides(study, tmp_path):
+    from bladelab.errors import InputFileError
+    from bladelab.report.design import _load
+
+    copy, _ = _collocation_copy(study, tmp_path, {1: 9.0, 2: 9.0, 3: 9.0, 4: 9.0})
+    with pytest.raises(InputFileError, match="only 5 of 9 runs have clean strides"):
+        _load(copy)

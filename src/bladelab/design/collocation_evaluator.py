@@ -34,7 +34,7 @@ from typing import Any
 
 from bladelab.errors import OptimizationError, SpecError
 
-__all__ = ["CollocationEvaluator", "DEFAULT_DESIGN_SPEED_MPS", "settle_strides"]
+__all__ = ["CollocationEvaluator", "DEFAULT_DESIGN_SPEED_MPS", "settle_strides", "stride_checks"]
 
 #: Prescribed speed of a design's stride [m/s] (our choice, docs/design.md "Predicted
 #: transfemoral gaits"): the transfemoral runner's maximum speed on collocation is 5.6–5.8 m/s
@@ -374,3 +374,43 @@ def settle_strides(evaluator: CollocationEvaluator, points, *, neighbours: int =
         raise OptimizationError(f"{len(failed)} designs could not be settled "
                                 f"({'; '.join(failed[:3])})", where="settle")
     return out
+
+
+def _solutions_folder(design_dir: Path, solutions_dir: str | None) -> Path | None:
+    """A study's strides folder: ``solutions_dir`` as recorded (absolute, or relative to the
+    folder the study was run from), else a folder of that name inside ``design_dir`` (a study
+    moved or cloned elsewhere)."""
+    if not solutions_dir:
+        return None
+    recorded = Path(solutions_dir)
+    for path in (recorded, design_dir / recorded.name):
+        if path.is_dir():
+            return path
+    return None
+
+
+def stride_checks(design_dir: str | Path, evaluator: Mapping[str, Any],
+                  points: list[Mapping[str, float]]) -> list[dict]:
+    """Each run's stride of a collocation design study, checked again as it is now on disk:
+    one row per point with ``stride`` (file name, or None when not found), ``converged``,
+    ``dynamics_residual_pct`` [%], ``iterations`` and ``warnings`` (its
+    :meth:`~bladelab.predict.collocation.solution.CollocationSolution.gait_warnings`, "; "
+    -joined; "" when clean). A study's results may hold strides written before a check existed
+    (the 5 % residual gate came after the free-gait study): the report marks those runs and
+    leaves them out of its surfaces rather than average them in silently."""
+    from bladelab.predict.collocation.solution import CollocationSolution
+
+    folder = _solutions_folder(Path(design_dir), evaluator.get("solutions_dir"))
+    rows = []
+    for point in points:
+        row = {"stride": None, "converged": None, "dynamics_residual_pct": math.nan,
+               "iterations": None, "warnings": "stride file not found"}
+        path = folder / f"{point_file_stem(point)}.json" if folder is not None else None
+        if path is not None and path.is_file():
+            sol = CollocationSolution.read(path)
+            warnings = sol.gait_warnings() if sol.converged else [f"IPOPT {sol.nlp.status}"]
+            row = {"stride": path.name, "converged": bool(sol.converged),
+                   "dynamics_residual_pct": sol.dynamics_residual_pct,
+                   "iterations": int(sol.nlp.iterations), "warnings": "; ".join(warnings)}
+        rows.append(row)
+    return rows

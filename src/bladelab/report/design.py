@@ -58,12 +58,39 @@ def _load(design_dir: Path):
     coded_cols = [f"{n}_coded" for n in space.names]
     skip = {"run", *space.names, *coded_cols}
     responses = [c for c in table.columns if c not in skip]
+    checks = _stride_checks(design_dir, evaluator, space, table)
+    meta["_strides"] = checks
+    fitted = table if checks is None else table[~checks["excluded"].to_numpy(bool)]
     terms = parse_terms(meta.get("model", "quadratic"), space.names)
-    coded = table[coded_cols].to_numpy(float)
-    surfaces = {r: fit_surface(coded, table[r].to_numpy(float), factor_names=space.names,
+    if len(fitted) < len(terms):
+        raise InputFileError(
+            f"only {len(fitted)} of {len(table)} runs have clean strides, fewer than the "
+            f"{len(terms)} terms of the {meta.get('model', 'quadratic')} surface",
+            file=design_dir, hint="re-solve the flagged runs: delete their runs/*.json and "
+            "run the same 'bladelab design' command again")
+    coded = fitted[coded_cols].to_numpy(float)
+    surfaces = {r: fit_surface(coded, fitted[r].to_numpy(float), factor_names=space.names,
                                model=terms, response=r, unit=units.get(r, ""))
                 for r in responses}
     return meta, space, table, surfaces
+
+
+def _stride_checks(design_dir: Path, evaluator: dict, space, table: pd.DataFrame
+                   ) -> pd.DataFrame | None:
+    """A collocation study's strides checked again (:func:`~bladelab.design.
+    collocation_evaluator.stride_checks`), one row per run, with ``excluded`` True for a run
+    whose stride carries gait warnings (a missing stride file cannot be checked: kept, and
+    said); None for other evaluators."""
+    if evaluator.get("evaluator") != "collocation":
+        return None
+    from bladelab.design.collocation_evaluator import stride_checks
+
+    points = [{n: float(row[n]) for n in space.names} for _, row in table.iterrows()]
+    checks = pd.DataFrame(stride_checks(design_dir, evaluator, points))
+    checks.insert(0, "run", table["run"].to_numpy())
+    checks["excluded"] = [bool(w) and pd.notna(s)
+                          for w, s in zip(checks["warnings"], checks["stride"], strict=True)]
+    return checks
 
 
 def design_report_sections(design_dir: str | Path) -> list[dict[str, Any]]:
@@ -87,11 +114,32 @@ def design_report_sections(design_dir: str | Path) -> list[dict[str, Any]]:
                    f"model {meta.get('model')}, factors: "
                    + ", ".join(f"{f.name} {f.low:g}–{f.high:g} {f.unit}".strip()
                                for f in space.factors) + ".")
+    checks = meta.get("_strides")
+    fit_text = "Predicted R² comes from PRESS (leave-one-out)."
+    if checks is not None and checks["excluded"].any():
+        fit_text += (f" The surfaces, contours and optimum below are fitted to the "
+                     f"{int((~checks['excluded']).sum())} runs with clean strides: "
+                     f"{int(checks['excluded'].sum())} runs (marked in the table of runs, "
+                     "listed under 'predicted strides') are left out, so the optimum can "
+                     "differ from the study's optimum.json.")
+        lev = next(iter(surfaces.values())).leverage
+        if (lev >= 1.0 - 1e-10).any():
+            n_one = int((lev >= 1.0 - 1e-10).sum())
+            fit_text += (f" Predicted R² and the leave-one-out error are blank: without "
+                         f"those runs {n_one} of the remaining runs "
+                         f"{'has' if n_one == 1 else 'have'} leverage 1 (the surface passes "
+                         "exactly through such a run whatever its value), so no leave-one-out "
+                         "prediction exists.")
+    runs = table if checks is None else table.assign(stride=[
+        "left out (warnings)" if x else ("clean" if not w else w)
+        for w, x in zip(checks["warnings"], checks["excluded"], strict=True)])
     sections: list[dict[str, Any]] = [{
         "title": "Design study: response surfaces",
-        "text": design_text + "\n\nPredicted R² comes from PRESS (leave-one-out).",
-        "tables": [("Surface fits", fit), ("Runs", table)],
+        "text": design_text + "\n\n" + fit_text,
+        "tables": [("Surface fits", fit), ("Runs", runs)],
     }]
+    if checks is not None:
+        sections.append(_strides_section(checks))
     shown = [objective, *[c for c in constraints if c != objective]]
     sections.append({
         "title": "Design study: main effects",
@@ -134,6 +182,28 @@ def design_report_sections(design_dir: str | Path) -> list[dict[str, Any]]:
             tabs.append(("Constraints at the optimum", pd.DataFrame(cons_rows)))
         sections.append({"title": "Design study: optimum", "text": text, "tables": tabs})
     return sections
+
+
+def _strides_section(checks: pd.DataFrame) -> dict[str, Any]:
+    """The predicted strides of a collocation study: each run's stride as checked now."""
+    from bladelab.predict.collocation.solution import RESIDUAL_WARNING_PCT
+
+    flagged = checks[checks["excluded"]]
+    missing = int(checks["stride"].isna().sum())
+    text = (f"Each run's stride file checked again by today's gait checks (no swinging foot "
+            f"striking the ground, flight in each step, peak vertical force, dynamics residual "
+            f"against the forward model at most {RESIDUAL_WARNING_PCT:g} %). "
+            f"{len(checks) - len(flagged) - missing} of {len(checks)} strides are clean; "
+            f"{len(flagged)} carry warnings and are left out of the surfaces"
+            + (f"; {missing} stride files were not found (their runs are kept, unchecked)"
+               if missing else "") + ".")
+    shown = checks.assign(stride=checks["stride"].notna()).drop(columns=["excluded"]).rename(
+        columns={"stride": "file found", "dynamics_residual_pct": "dynamics residual (%)"})
+    tables = [("Strides (files in the study's strides folder, named by the design point)",
+               shown)]
+    if len(flagged):
+        tables.insert(0, ("Runs left out", flagged[["run", "warnings"]]))
+    return {"title": "Design study: predicted strides", "text": text, "tables": tables}
 
 
 def _motion_section(design_dir: Path, meta: dict) -> dict[str, Any] | None:
