@@ -101,6 +101,18 @@ def test_not_estimable():
         evaluate_trends(surf, alpha=1.5)
 
 
+def test_a_response_held_by_every_solve_is_not_a_trend():
+    """A knee-safe study holds the knee moment at >= 0 N·m in every stride: its surface is
+    a bound, so the knee trend is not estimable (even where the numbers would say 'holds'),
+    and the other trends are judged as before."""
+    held = {"knee_moment_min_Nm": "held at or above 0 N·m"}
+    v = _by_key(evaluate_trends(_surfaces(HOLD), evaluator="collocation", held=held))
+    knee = v["shorter_toe_lowers_knee_margin"]
+    assert knee.verdict == "not estimable" and "held at or above 0 N·m" in knee.evidence
+    assert all(x.verdict == "holds" for k, x in v.items() if k != knee.key)
+    assert _by_key(evaluate_trends(_surfaces(HOLD)))[knee.key].verdict == "holds"
+
+
 def test_roles_map_other_factor_names():
     names = ("k", "w", "h", "toe")
     surf = _surfaces(HOLD, names=names)

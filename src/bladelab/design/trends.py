@@ -227,6 +227,7 @@ def evaluate_trends(
     roles: Mapping[str, str] | None = None,
     alpha: float = 0.05,
     trends: tuple[Trend, ...] = SEED002_TRENDS,
+    held: Mapping[str, str] | None = None,
 ) -> list[TrendVerdict]:
     """Check seed 002's trends on fitted response surfaces (see the module docstring).
 
@@ -241,6 +242,10 @@ def evaluate_trends(
         ``height_m``, ``toe_length_m``).
     alpha
         Significance level of the coefficient t-tests.
+    held
+        Response -> how every solve of the study held it (a constraint of each design's
+        stride, e.g. the knee moment kept at or above 0 N·m): a trend on such a response is
+        not estimable, since the response is a bound the solve enforced, not an outcome.
 
     Returns
     -------
@@ -258,6 +263,12 @@ def evaluate_trends(
         test = sign_test if tr.sign else size_test
         base = {"key": tr.key, "statement": tr.statement, "response": tr.response, "test": test}
         surf = surfaces.get(tr.response)
+        if tr.response in (held or {}):
+            out.append(TrendVerdict(**base, verdict="not estimable", evidence=(
+                f"{tr.response} is {held[tr.response]}: a constraint of each design's "
+                "stride, not an outcome; what holding it costs shows in the other responses "
+                "(cost of transport, feasibility)")))
+            continue
         if surf is None:
             out.append(TrendVerdict(**base, verdict="not estimable",
                                     evidence=f"the study has no response {tr.response}"))

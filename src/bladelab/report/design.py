@@ -244,7 +244,11 @@ def trends_section(surfaces, evaluator: dict | None = None) -> dict[str, Any]:
     evaluator = evaluator or {}
     kind = evaluator.get("evaluator")
     roles = (evaluator.get("generator") or {}).get("roles")
-    verdicts = evaluate_trends(surfaces, evaluator=kind, roles=roles)
+    held = {}
+    if evaluator.get("knee_moment_min_Nm") is not None:
+        held["knee_moment_min_Nm"] = (f"held at or above {evaluator['knee_moment_min_Nm']:g} "
+                                      "N·m on every loaded interval by the solve")
+    verdicts = evaluate_trends(surfaces, evaluator=kind, roles=roles, held=held)
     counts = {v: sum(1 for x in verdicts if x.verdict == v)
               for v in ("holds", "does not hold", "not estimable")}
     text = (f"The trends seed 002 reports, checked on this study's fitted surfaces "
