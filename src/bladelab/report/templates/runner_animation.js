@@ -58,8 +58,8 @@
               head: el("polygon", {fill: COLORS.grf}, g)};
     });
     var clock = el("text", {x: 12, y: 22, "font-size": 14, fill: "#1d2330"}, svg);
-    var key = el("text", {x: W - 12, y: 22, "font-size": 12, "text-anchor": "end",
-                          fill: "#5b6475"}, svg);
+    // the key goes under the clock: beside it, a long title ran into it
+    var key = el("text", {x: 12, y: 40, "font-size": 12, fill: "#5b6475"}, svg);
     key.textContent = data.legs[0] + " leg blue, " + data.legs[1] + " leg red" +
       (data.has_blade ? ", blade orange" : "") + "; GRF green (1 BW = " + data.bw_length_m + " m)";
 
