@@ -136,3 +136,75 @@ def test_runs_are_evaluated_from_the_centre_outwards(tmp_path):
     assert np.all(np.diff(norms) >= -1e-9)  # then the axial points, then the corners
     assert len(seen) == res.design.n_runs == 25
     assert np.allclose(np.sort(np.array(seen), axis=0), np.sort(res.design.coded, axis=0))
+
+
+def _no_gait_at_short_toe(point):
+    """The analytic evaluator, failing (as a solve with no clean stride does) at the two
+    corners with the shortest toe, the lowest stiffness and the narrowest blade."""
+    from bladelab.errors import OptimizationError
+
+    c = SPACE.code([point[n] for n in SPACE.names])
+    if c[0] < -0.5 and c[1] < -0.5 and c[3] < -0.5:
+        raise OptimizationError("no clean stride for this blade", where="test evaluator")
+    return _evaluator(point)
+
+
+@pytest.mark.parametrize("jobs", [1, 2])
+def test_failed_runs_are_recorded_and_skipped_on_request(tmp_path, jobs):
+    """Without skip_failed a failed run stops the study (its reason recorded); with it the
+    surfaces are fitted to the 23 runs that finished, failed.csv names the 2 others, and the
+    next call does not evaluate them again; once they succeed the record is gone."""
+    from bladelab.errors import BladelabError
+
+    with pytest.raises(BladelabError, match="no clean stride") as err:
+        run_design(SPACE, evaluator=_no_gait_at_short_toe, out_dir=tmp_path, progress=False,
+                   jobs=jobs)
+    assert "run " in str(err.value) and not (tmp_path / "results.csv").exists()
+    assert len(list((tmp_path / "runs").glob("*.failed.json"))) >= 1
+    res = run_design(SPACE, evaluator=_no_gait_at_short_toe, out_dir=tmp_path, progress=False,
+                     jobs=jobs, skip_failed=True, objective="delta_vx_m_per_s")
+    failed = {r for r, c in enumerate(res.design.coded, 1)
+              if c[0] < -0.5 and c[1] < -0.5 and c[3] < -0.5}
+    assert set(res.failed) == failed and len(failed) == 2
+    assert all("no clean stride" in why for why in res.failed.values())
+    table = pd.read_csv(tmp_path / "results.csv")
+    assert len(table) == 23 and not set(table["run"]) & failed
+    listed = pd.read_csv(tmp_path / "failed.csv")
+    assert set(listed["run"]) == failed and "error" in listed.columns
+    surface = res.surfaces["delta_vx_m_per_s"]
+    assert len(surface.y) == 23
+    assert surface.r2 == pytest.approx(1.0)  # the analytic response is quadratic
+    calls = []
+
+    def counting(point):
+        calls.append(point)
+        return _no_gait_at_short_toe(point)
+
+    again = run_design(SPACE, evaluator=counting, out_dir=tmp_path, progress=False,
+                       skip_failed=True)
+    assert not calls and set(again.failed) == failed  # recorded failures are not retried
+    if jobs == 1:  # the report names them
+        from bladelab.report.design import design_report_sections
+
+        sections = {x["title"]: x for x in design_report_sections(tmp_path)}
+        gone = sections["Design study: runs without a result"]
+        assert set(dict(gone["tables"])["Failed runs"]["run"]) == failed
+        assert "25 runs (ccd design; 2 failed" in sections[
+            "Design study: response surfaces"]["text"]
+    fixed = run_design(SPACE, evaluator=_evaluator, out_dir=tmp_path, progress=False)
+    assert fixed.n_evaluated == 2 and not fixed.failed
+    assert not (tmp_path / "failed.csv").exists()
+    assert not list((tmp_path / "runs").glob("*.failed.json"))
+
+
+def test_too_many_failed_runs_cannot_fit_the_model(tmp_path):
+    def mostly_failing(point):
+        from bladelab.errors import OptimizationError
+
+        if SPACE.code([point[n] for n in SPACE.names])[0] != 0.0:
+            raise OptimizationError("no stride", where="test evaluator")
+        return _evaluator(point)
+
+    with pytest.raises(SpecError, match="runs failed .* cannot fit the model"):
+        run_design(SPACE, evaluator=mostly_failing, out_dir=tmp_path, progress=False,
+                   skip_failed=True)

@@ -167,6 +167,11 @@ def _design(
              "design solved again from its 2 nearest neighbours' strides, the lowest objective "
              "kept; stops when no objective drops by more than 1 %). Recorded design by design "
              "in settling.json: a stopped pass resumes where it stopped."),
+    skip_failed: bool = typer.Option(
+        False, "--skip-failed",
+        help="Record runs whose evaluation fails (runs/run_NNNN.failed.json, failed.csv), do "
+             "not evaluate runs recorded as failed again, and fit the surfaces to the runs that "
+             "finished (default: a failed run stops the study)."),
     start: Path | None = typer.Option(
         None, "--start",
         help="Collocation solution of the transfemoral runner that the first design starts "
@@ -274,7 +279,7 @@ def _design(
     def study():
         return run_design(space, runs=design, evaluator=ev, out_dir=out, seed=seed, model=model,
                           objective=objective, sense=sense, constraints=cons, units=ev.units,
-                          jobs=jobs)
+                          jobs=jobs, skip_failed=skip_failed)
 
     result = study()
     if settle:
@@ -284,6 +289,10 @@ def _design(
             result = study()  # the settled strides' responses (read back, not solved)
     typer.echo(f"{design.n_runs} runs ({result.n_evaluated} evaluated, {result.n_resumed} "
                f"resumed) -> {out}")
+    if result.failed:
+        typer.echo(f"{len(result.failed)} runs failed and are left out of the surfaces "
+                   f"(failed.csv): " + "; ".join(f"run {k}: {v[:120]}"
+                                                  for k, v in result.failed.items()), err=True)
     for name, s in result.surfaces.items():
         typer.echo(f"  {name:22s} R² {s.r2:6.3f}  R²adj {s.r2_adj:6.3f}  R²pred {s.r2_pred:6.3f}")
     if result.optimum is not None:

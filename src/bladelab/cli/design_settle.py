@@ -46,9 +46,10 @@ def _read_record(out, points) -> list[dict]:
     return record
 
 
-def _run_pass(evaluator, points, current: dict, out, *, jobs: int, save) -> bool:
-    """Settle the designs of pass ``current`` not yet in it, recording each as it finishes;
-    True if a stride changed."""
+def _run_pass(evaluator, points, current: dict, out, *, jobs: int, save,
+              failed=frozenset()) -> bool:
+    """Settle the designs of pass ``current`` not yet in it (nor the ``failed`` run indices,
+    which have no stride), recording each as it finishes; True if a stride changed."""
     from bladelab.design.collocation_evaluator import settle_strides
     from bladelab.design.study import run_file
 
@@ -63,7 +64,7 @@ def _run_pass(evaluator, points, current: dict, out, *, jobs: int, save) -> bool
         save()
 
     settle_strides(evaluator, points, jobs=jobs, on_design=done,
-                   skip=[r["run"] - 1 for r in current["designs"]])
+                   skip=[r["run"] - 1 for r in current["designs"]] + sorted(failed))
     return changed
 
 
@@ -73,6 +74,7 @@ def settle_study(evaluator, result, *, passes: int, jobs: int) -> bool:
     study must be read again)."""
     space, design, out = result.space, result.design, result.out_dir
     points = [space.point(c) for c in design.coded]
+    failed = frozenset(run - 1 for run in getattr(result, "failed", {}))  # no stride to settle
     record = _read_record(out, points)
     changed_any = False
 
@@ -88,13 +90,14 @@ def settle_study(evaluator, result, *, passes: int, jobs: int) -> bool:
             current = {"pass": len(record) + 1, "complete": False, "designs": []}
             record.append(current)
             save()
-        changed_any |= _run_pass(evaluator, points, current, out, jobs=jobs, save=save)
+        changed_any |= _run_pass(evaluator, points, current, out, jobs=jobs, save=save,
+                                 failed=failed)
         worst = max(_drop(r) for r in current["designs"])
         current.update(complete=True, largest_objective_drop=worst,
                        improved=sum(r["from"] is not None for r in current["designs"]))
         save()
-        typer.echo(f"settling pass {current['pass']}: {current['improved']} of {len(points)} "
-                   f"designs improved, largest objective drop {100 * worst:.2f} %")
+        typer.echo(f"settling pass {current['pass']}: {current['improved']} of "
+                   f"{len(points) - len(failed)} designs improved, largest objective drop {100 * worst:.2f} %")
         if worst <= SETTLED_REL:
             break
     else:

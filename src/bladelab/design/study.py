@@ -12,6 +12,10 @@ stopped. It then writes, atomically:
 - ``surfaces.json``, ``coefficients.csv``, ``anova.csv``: the fitted surfaces;
 - ``estimability.json``: the rank/conditioning report of the design for the model;
 - ``optimum.json``: the constrained optimum (if an objective is given);
+- ``failed.csv``: with ``skip_failed``, the runs that have no result (run, factors, coded,
+  ``error``), each also in ``runs/run_NNNN.failed.json``; ``results.csv`` and the surfaces then
+  hold the other runs only (a design point a simulation cannot solve is a finding, e.g. a
+  blade with no knee-safe gait, and is never a NaN in the table);
 - ``motion.json``: with an evaluator that adapts the motion to the design (its ``motion``
   attribute, a :class:`~bladelab.design.motion_model.MotionModel`): the motion model, its terms,
   coding and leave-one-blade-out errors. Its factors must be the design's (checked before any
@@ -68,6 +72,8 @@ class DesignStudyResult:
         Where the files were written.
     n_evaluated, n_resumed
         Runs evaluated now and runs read back from an earlier, interrupted study.
+    failed
+        Run number (1-based) -> why it has no result (``skip_failed``; empty otherwise).
     """
 
     space: DesignSpace
@@ -81,6 +87,7 @@ class DesignStudyResult:
     out_dir: Path
     n_evaluated: int
     n_resumed: int
+    failed: dict[int, str] = field(default_factory=dict)
 
     def coefficients(self) -> pd.DataFrame:
         """Tidy coefficient table of all surfaces."""
@@ -110,6 +117,21 @@ def run_file(out_dir: Path, i: int) -> Path:
     return out_dir / "runs" / f"run_{i + 1:04d}.json"
 
 
+def failed_run_file(out_dir: Path, i: int) -> Path:
+    """The record of run ``i`` (0-based) when its evaluation failed."""
+    return out_dir / "runs" / f"run_{i + 1:04d}.failed.json"
+
+
+def _read_failure(path: Path, coded: np.ndarray) -> str | None:
+    """The recorded reason of a failed run of this design, or None."""
+    try:
+        data = json.loads(path.read_text(encoding="utf-8"))
+        same = np.allclose(np.asarray(data["coded"], float), coded, atol=1e-9)
+        return str(data["error"]) if same else None
+    except (OSError, ValueError, KeyError, TypeError):
+        return None
+
+
 def _read_run(path: Path, coded: np.ndarray) -> dict[str, float] | None:
     """Responses of a finished run, or None if absent; error if it belongs to another study."""
     if not path.is_file():
@@ -135,43 +157,33 @@ def evaluate_design_run(payload: dict) -> dict:
 
 
 def _evaluate_runs(evaluator, space: DesignSpace, design: Design, todo: list[int], *, jobs: int,
-                   executor: str, progress: bool) -> Iterator[tuple[int, object]]:
-    """Yield (run index, raw responses) of the runs ``todo`` as they finish: in this process
-    (``jobs`` 1; an evaluator's error propagates, naming the run) or on an executor (errors
-    are collected and raised, naming the runs, after the other runs have finished)."""
+                   executor: str, progress: bool
+                   ) -> Iterator[tuple[int, object, BladelabError | str | None]]:
+    """Yield (run index, raw responses, None) or (run index, None, the error) for the runs
+    ``todo`` as they finish: in this process (``jobs`` 1; the error is the evaluator's
+    :class:`BladelabError`, others propagate) or on an executor (the error in words)."""
     bar = tqdm(total=len(todo), desc="design runs", unit="run", disable=not progress)
     if jobs <= 1:
         for i in todo:
-            point = space.point(design.coded[i])
             try:
-                raw = evaluator(dict(point))
-            except BladelabError as err:
-                raise type(err)(
-                    f"run {i + 1} ({', '.join(f'{k}={v:g}' for k, v in point.items())}): "
-                    f"{err.message}",
-                    file=err.file, where=err.where, hint=err.hint,
-                ) from err
+                raw, err = evaluator(dict(space.point(design.coded[i]))), None
+            except BladelabError as exc:
+                raw, err = None, exc
             bar.update()
-            yield i, raw
+            yield i, raw, err
         bar.close()
         return
     from bladelab.executors import make_executor
 
     payloads = [{"evaluator": evaluator, "point": space.point(design.coded[i])} for i in todo]
-    failed = []
     for k, status, value in make_executor(executor, jobs).run(evaluate_design_run, payloads):
         bar.update()
-        if status == "ok":
-            yield todo[k], value
-        else:
-            failed.append(f"run {todo[k] + 1}: {value}")
+        yield (todo[k], value, None) if status == "ok" else (todo[k], None, str(value))
     bar.close()
-    if failed:
-        raise BladelabError(
-            f"{len(failed)} of {len(todo)} runs failed ({'; '.join(failed[:3])})",
-            where="design runs", hint="the finished runs are stored; fix the cause and run "
-                                      "again with the same output folder to resume",
-        )
+
+
+def _point_text(point: Mapping[str, float]) -> str:
+    return ", ".join(f"{k}={v:g}" for k, v in point.items())
 
 
 def _check_responses(
@@ -225,6 +237,7 @@ def run_design(
     progress: bool = True,
     jobs: int = 1,
     executor: str = "local",
+    skip_failed: bool = False,
 ) -> DesignStudyResult:
     """Evaluate a design, fit a surface per response and find the constrained optimum.
 
@@ -263,6 +276,13 @@ def run_design(
         Worker processes and ``"local"`` (a process pool) or ``"ray"``
         (:mod:`bladelab.executors`); with ``jobs`` > 1 the evaluator must be picklable. Every
         finished run is stored before a failed one is reported.
+    skip_failed
+        False (default): a run whose evaluation fails stops the study (serially at once, in
+        parallel after the other runs), its reason recorded in ``runs/run_NNNN.failed.json``;
+        the next call evaluates it again. True: failed runs are recorded and left out, runs
+        recorded as failed before are not evaluated again, and the surfaces are fitted to the
+        runs that finished (refused, naming the failed runs, if those cannot estimate the
+        model); ``failed.csv`` lists them.
     """
     if not callable(evaluator):
         raise SpecError("evaluator must be callable", where="evaluator")
@@ -300,6 +320,7 @@ def run_design(
 
     frame = design.to_frame(space)
     results: list[dict[str, float] | None] = [None] * design.n_runs
+    failed: dict[int, str] = {}  # run index -> reason
     n_resumed = n_evaluated = 0
     expected: list[str] | None = None
     for i in range(design.n_runs):
@@ -308,38 +329,70 @@ def run_design(
             results[i] = r
             n_resumed += 1
             expected = expected or list(r)
+        elif skip_failed and (why := _read_failure(failed_run_file(out, i),
+                                                   design.coded[i])) is not None:
+            failed[i] = why
     # centre outwards: an evaluator that warm-starts from solved neighbours (collocation) then
     # always finds a near one (a corner's nearest axial point, not the centre two units away)
-    todo = sorted((i for i in range(design.n_runs) if results[i] is None),
+    todo = sorted((i for i in range(design.n_runs) if results[i] is None and i not in failed),
                   key=lambda i: (round(float(np.linalg.norm(design.coded[i])), 9), i))
     finished = _evaluate_runs(evaluator, space, design, todo, jobs=jobs, executor=executor,
                               progress=progress)
-    for i, raw in finished:
+    failed_now = []
+    for i, raw, err in finished:
+        point = space.point(design.coded[i])
+        if err is not None:
+            why = err.message if isinstance(err, BladelabError) else str(err)
+            write_json(failed_run_file(out, i), {"run": i + 1, "coded": design.coded[i].tolist(),
+                                                 "point": point, "error": why})
+            failed[i] = why
+            failed_now.append(f"run {i + 1} ({_point_text(point)}): {why}")
+            if isinstance(err, BladelabError) and not skip_failed:  # serial: stop at once
+                raise type(err)(failed_now[-1], file=err.file, where=err.where,
+                                hint=err.hint) from err
+            continue
         res = _check_responses(raw, i + 1, expected)
         expected = expected or list(res)
-        point = space.point(design.coded[i])
         write_json(
             run_file(out, i),
             {"run": i + 1, "coded": design.coded[i].tolist(), "point": point, "responses": res},
         )
+        failed_run_file(out, i).unlink(missing_ok=True)
         results[i] = res
         n_evaluated += 1
+    if failed_now and not skip_failed:
+        raise BladelabError(
+            f"{len(failed_now)} of {len(todo)} runs failed ({'; '.join(failed_now[:3])})",
+            where="design runs", hint="the finished runs are stored; fix the cause and run "
+                                      "again with the same output folder to resume, or give "
+                                      "--skip-failed to fit the surfaces without them")
+    done = [i for i in range(design.n_runs) if i not in failed]
     responses = tuple(expected or ())
-    for i, r in enumerate(results):
-        if r is None or list(r) != list(responses):
+    for i in done:
+        if results[i] is None or list(results[i]) != list(responses):
             raise DataError(
                 "stored responses differ from the other runs'",
                 file=run_file(out, i),
                 hint="delete that file to evaluate the run again",
             )
+    if failed:
+        try:
+            report = require_estimable(design.coded[done], terms, space.names)
+        except SpecError as err:
+            raise SpecError(
+                f"{len(failed)} runs failed (runs {', '.join(str(i + 1) for i in sorted(failed))}"
+                f"), and the {len(done)} that finished cannot fit the model: {err.message}",
+                where="design runs", hint=err.hint) from None
+    _write_failed(out, frame, failed)
+    frame = frame.iloc[done].reset_index(drop=True)
     for name in responses:
-        frame[name] = [r[name] for r in results]  # type: ignore[index]
+        frame[name] = [results[i][name] for i in done]  # type: ignore[index]
     with atomic_path(out / "results.csv") as tmp:
         frame.to_csv(tmp, index=False)
 
     surfaces = {
         name: fit_surface(
-            design.coded, frame[name].to_numpy(), factor_names=space.names, model=terms,
+            design.coded[done], frame[name].to_numpy(), factor_names=space.names, model=terms,
             response=name, unit=units.get(name, ""),
         )
         for name in responses
@@ -383,4 +436,17 @@ def run_design(
         out_dir=out,
         n_evaluated=n_evaluated,
         n_resumed=n_resumed,
+        failed={i + 1: why for i, why in sorted(failed.items())},
     )
+
+
+def _write_failed(out: Path, frame: pd.DataFrame, failed: Mapping[int, str]) -> None:
+    """``failed.csv``: the design's rows of the failed runs with their ``error`` (removed
+    when no run failed)."""
+    path = out / "failed.csv"
+    if not failed:
+        path.unlink(missing_ok=True)
+        return
+    rows = frame.iloc[sorted(failed)].assign(error=[failed[i] for i in sorted(failed)])
+    with atomic_path(path) as tmp:
+        rows.to_csv(tmp, index=False)

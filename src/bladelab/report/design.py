@@ -60,6 +60,8 @@ def _load(design_dir: Path):
     responses = [c for c in table.columns if c not in skip]
     checks = _stride_checks(design_dir, evaluator, space, table)
     meta["_strides"] = checks
+    failed_csv = design_dir / "failed.csv"
+    meta["_failed"] = pd.read_csv(failed_csv) if failed_csv.is_file() else None
     fitted = table if checks is None else table[~checks["excluded"].to_numpy(bool)]
     terms = parse_terms(meta.get("model", "quadratic"), space.names)
     if len(fitted) < len(terms):
@@ -110,7 +112,12 @@ def design_report_sections(design_dir: str | Path) -> list[dict[str, Any]]:
     fit = pd.DataFrame([
         {"response": r, "unit": s.unit, "R2": s.r2, "R2_adj": s.r2_adj, "R2_pred": s.r2_pred,
          "loo_rmse": s.loo_rmse} for r, s in surfaces.items()])
-    design_text = (f"{len(table)} runs ({meta.get('design', {}).get('kind', '?')} design), "
+    failed = meta.get("_failed")
+    n_failed = 0 if failed is None else len(failed)
+    design_text = (f"{len(table) + n_failed} runs ({meta.get('design', {}).get('kind', '?')} "
+                   "design"
+                   + (f"; {n_failed} failed and have no result: see 'runs without a result'"
+                      if n_failed else "") + "), "
                    f"model {meta.get('model')}, factors: "
                    + ", ".join(f"{f.name} {f.low:g}–{f.high:g} {f.unit}".strip()
                                for f in space.factors) + ".")
@@ -138,6 +145,15 @@ def design_report_sections(design_dir: str | Path) -> list[dict[str, Any]]:
         "text": design_text + "\n\n" + fit_text,
         "tables": [("Surface fits", fit), ("Runs", runs)],
     }]
+    if n_failed:
+        sections.append({
+            "title": "Design study: runs without a result",
+            "text": (f"{n_failed} runs failed (the evaluator found no result; recorded in "
+                     "runs/run_NNNN.failed.json). They are not in the surfaces, which are "
+                     f"fitted to the {len(table)} runs that finished: the surfaces describe "
+                     "the region where the evaluator succeeds, and a failed region is a "
+                     "finding in itself (e.g. blades with no knee-safe gait)."),
+            "tables": [("Failed runs", failed)]})
     if checks is not None:
         sections.append(_strides_section(checks))
     shown = [objective, *[c for c in constraints if c != objective]]
