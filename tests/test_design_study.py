@@ -208,3 +208,17 @@ def test_too_many_failed_runs_cannot_fit_the_model(tmp_path):
     with pytest.raises(SpecError, match="runs failed .* cannot fit the model"):
         run_design(SPACE, evaluator=mostly_failing, out_dir=tmp_path, progress=False,
                    skip_failed=True)
+
+
+def test_contours_cross_out_runs_without_a_result(tmp_path):
+    res = run_design(SPACE, evaluator=_evaluator, out_dir=tmp_path, progress=False)
+    surface = res.surfaces["delta_vx_m_per_s"]
+    fig = contour_plot(surface, SPACE, x="stiffness_kN_per_m", y="toe_length_m",
+                       missing=res.design.coded[:2], missing_label="failed runs (projected)")
+    ax = fig.axes[0]
+    crosses = [ln for ln in ax.get_lines() if ln.get_label() == "failed runs (projected)"]
+    assert len(crosses) == 1 and len(crosses[0].get_xdata()) == 2
+    assert crosses[0].get_xdata()[0] == pytest.approx(
+        SPACE.point(res.design.coded[0])["stiffness_kN_per_m"])
+    plain = contour_plot(surface, SPACE, x="stiffness_kN_per_m", y="toe_length_m")
+    assert not [ln for ln in plain.axes[0].get_lines() if "failed" in ln.get_label()]

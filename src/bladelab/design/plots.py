@@ -92,6 +92,8 @@ def contour_plot(
     optimum: OptimumResult | None = None,
     n: int = 81,
     show_runs: bool = True,
+    missing: np.ndarray | None = None,
+    missing_label: str = "failed runs (projected)",
 ) -> Figure:
     """Contours of a fitted surface over two factors, others held at ``at``.
 
@@ -113,6 +115,9 @@ def contour_plot(
         Grid points per axis.
     show_runs
         Mark the design runs (projected onto the plane).
+    missing
+        Coded points (rows) of runs that are not in the surface (failed, or left out): marked
+        with a red cross and ``missing_label``.
     """
     _check(surface, space)
     ix, iy = space.index(x), space.index(y)
@@ -146,6 +151,10 @@ def contour_plot(
         rx = fx.mid + surface.coded[:, ix] * fx.half_range
         ry = fy.mid + surface.coded[:, iy] * fy.half_range
         ax.plot(rx, ry, "o", ms=3, color="w", mec="k", mew=0.5, label="runs (projected)")
+    if missing is not None and len(missing):
+        miss = np.atleast_2d(np.asarray(missing, float))
+        ax.plot(fx.mid + miss[:, ix] * fx.half_range, fy.mid + miss[:, iy] * fy.half_range,
+                "x", ms=8, mew=2, color="r", clip_on=False, zorder=4, label=missing_label)
     if optimum is not None:
         ox = fx.mid + optimum.coded[fx.name] * fx.half_range
         oy = fy.mid + optimum.coded[fy.name] * fy.half_range
@@ -192,6 +201,7 @@ def write_design_figures(result, out_dir: str | Path, *, objective: str,
     cons = [SurfaceConstraint(result.surfaces[k], float(v)) for k, v in constraints.items()]
     for x, y in figure_pairs(result.space.names):
         fig = contour_plot(result.surfaces[objective], result.space, x=x, y=y, constraints=cons,
-                           optimum=result.optimum)
+                           optimum=result.optimum,
+                           missing=result.design.coded[[r - 1 for r in result.failed]])
         written.append(save_figure(fig, fig_dir / f"contour_{objective}_{x}_{y}.png"))
     return written

@@ -14,6 +14,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import pandas as pd
 
 from bladelab._io import read_json
@@ -170,9 +171,19 @@ def design_report_sections(design_dir: str | Path) -> list[dict[str, Any]]:
                                       conservative=bool(meta.get("conservative", False)))
     except OptimizationError as err:
         why = str(err)
+    coded_cols = [f"{n}_coded" for n in space.names]
+    marks, labels = [], []  # runs not in the surfaces, crossed out on the contours
+    if n_failed:
+        marks.append(failed[coded_cols].to_numpy(float))
+        labels.append("failed runs")
+    if checks is not None and checks["excluded"].any():
+        marks.append(table.loc[checks["excluded"].to_numpy(bool), coded_cols].to_numpy(float))
+        labels.append("runs left out")
     figs = [(f"{objective} over {x} and {y}; constraints hatched on their infeasible side",
              contour_plot(surfaces[objective], space, x=x, y=y, constraints=cons,
-                          optimum=optimum)) for x, y in figure_pairs(space.names)]
+                          optimum=optimum, missing=np.vstack(marks) if marks else None,
+                          missing_label=" and ".join(labels) + " (projected)"))
+            for x, y in figure_pairs(space.names)]
     sections.append({"title": "Design study: contours and constraints", "figures": figs})
     anova = surfaces[objective].anova
     sections.append({"title": f"Design study: ANOVA of {objective}",
