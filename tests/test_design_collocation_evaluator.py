@@ -179,6 +179,9 @@ def test_a_design_solved_before_is_read_back_not_solved_again(fake, tmp_path, mo
     dataclasses.replace(base, model_spec=spec, settings=ev.settings()).write(stored)
     ev(CENTRE)
     assert len(calls) == 1  # a flagged stride is solved again
+    previous = tmp_path / "s" / f"{ce.point_file_stem(CENTRE)}.previous.json"
+    assert previous.is_file()  # and kept beside the new one, not overwritten
+    assert ev._neighbours({**CENTRE, "width_m": 0.05}) == [stored]  # not a neighbour
     dataclasses.replace(base, model_spec=spec, settings=ev.settings()).write(stored)
     monkeypatch.setattr(CollocationSolution, "gait_warnings", lambda self: [])
     assert ev(CENTRE) == {"delta_vx_m_per_s": 0.1} and len(calls) == 1  # a clean one: read
@@ -190,6 +193,13 @@ def test_a_design_solved_before_is_read_back_not_solved_again(fake, tmp_path, mo
     assert dataclasses.replace(ev, start=str(start))(CENTRE)
     assert len(calls) == 2
     assert stored.is_file()  # and stored with the study's strides, a neighbour of the others
+    # a stride of another problem in its place is replaced by the start, and kept aside
+    other = dataclasses.replace(ev, speed_mps=4.5)
+    dataclasses.replace(base, model_spec=spec, settings=other.settings()).write(stored)
+    previous.unlink()
+    assert dataclasses.replace(ev, start=str(start))(CENTRE) and len(calls) == 2
+    assert CollocationSolution.read(stored).settings.same_problem(ev.settings())
+    assert CollocationSolution.read(previous).settings.speed_m_per_s == 4.5
 
 
 def test_settling_keeps_the_lowest_objective_from_the_neighbours(fake, tmp_path, monkeypatch):
@@ -204,7 +214,7 @@ def test_settling_keeps_the_lowest_objective_from_the_neighbours(fake, tmp_path,
     objectives = iter([0.95, 0.90])  # from near (distance 1), then from far (2.24)
 
     def stored(self, point, spec, settings):
-        return types.SimpleNamespace(nlp=types.SimpleNamespace(objective=1.0))
+        return types.SimpleNamespace(nlp=types.SimpleNamespace(objective=1.0)), None
 
     def solve(runner, settings, guess, *, model_spec, track=None, progress=None):
         calls.append({"source": guess.source})

@@ -162,7 +162,7 @@ class CollocationEvaluator:
         found = []
         if self.solutions_dir is not None and Path(self.solutions_dir).is_dir():
             for f in Path(self.solutions_dir).glob("*.json"):
-                if f.name.endswith(".best_iterate.json"):
+                if f.name.endswith((".best_iterate.json", ".previous.json")):
                     continue
                 p = _point_from_stem(f.stem)
                 if p is not None and p != dict(point):
@@ -183,7 +183,7 @@ class CollocationEvaluator:
 
         point = {k: float(v) for k, v in point.items()}
         spec, settings = self._problem(point)
-        current = self._stored(point, spec, settings)
+        current, _ = self._stored(point, spec, settings)
         if current is None or self.solutions_dir is None:
             raise SpecError("this design has no stored clean stride to settle",
                             where="settle", hint="evaluate the design first")
@@ -249,10 +249,19 @@ class CollocationEvaluator:
             path.parent.mkdir(parents=True, exist_ok=True)
             solution.write(path)
 
+    def _replace(self, solution, point: Mapping[str, float]) -> None:
+        """Write a design's new stride; a stride file it replaces that this problem could not
+        use (flagged by a later gait check, or of other settings) is kept as
+        ``<point>.previous.json``: results already computed are not lost."""
+        own = self._stride_file(point)
+        if own is not None and own.is_file():
+            own.replace(self._stride_file(point, ".previous"))
+        self._keep(solution, point)
+
     def _stored(self, point: Mapping[str, float], spec: dict, settings):
-        """This design's clean stride of this problem (same blade, speed, mesh, weights,
-        constraints and transcription) from ``solutions_dir``, or the start file if it is
-        one; else None."""
+        """(stride, its file): this design's clean stride of this problem (same blade,
+        speed, mesh, weights, constraints and transcription) from ``solutions_dir``, or the
+        start file if it is one; else (None, None)."""
         from bladelab.predict.collocation.solution import CollocationSolution
         from bladelab.predict.collocation.stored import check_model_spec
 
@@ -265,8 +274,8 @@ class CollocationEvaluator:
             same = (sol.converged and sol.model_spec == check_model_spec(spec)
                     and sol.settings.same_problem(settings))
             if same and not sol.gait_warnings():
-                return sol
-        return None
+                return sol, path
+        return None, None
 
     # -- one design -----------------------------------------------------------------------
     def __call__(self, point: Mapping[str, float]) -> dict[str, float]:
@@ -278,11 +287,11 @@ class CollocationEvaluator:
         point = {k: float(v) for k, v in point.items()}
         spec, settings = self._problem(point)
         runner = runner_from_spec(spec)
-        stored = self._stored(point, spec, settings)
+        stored, source = self._stored(point, spec, settings)
         if stored is not None:  # solved before (an interrupted or refitted study), or the start
             own = self._stride_file(point)
-            if own is not None and not own.is_file():  # the start: a neighbour of the others
-                self._keep(stored, point)
+            if own is not None and source != own:  # the start: a neighbour of the others
+                self._replace(stored, point)
             return stride_responses(stored, runner)
         starts = self._starts(point)
         plan = [(f, False) for f in starts] + [(starts[-1], True)]
@@ -312,7 +321,7 @@ class CollocationEvaluator:
                 where="collocation evaluator",
                 hint="the last iterates are in the solutions folder; widen the box's centre "
                      "towards this point, or give a --start stride nearer to it")
-        self._keep(sol, point)
+        self._replace(sol, point)
         return stride_responses(sol, runner)
 
 
