@@ -265,3 +265,15 @@ def test_design_report_refuses_too_few_clean_strides(study, tmp_path):
     copy, _ = _collocation_copy(study, tmp_path, {1: 9.0, 2: 9.0, 3: 9.0, 4: 9.0})
     with pytest.raises(InputFileError, match="only 5 of 9 runs have clean strides"):
         _load(copy)
+
+
+def test_report_of_an_unfinished_design_study_says_so(study, tmp_path, capsys):
+    import shutil
+
+    out, _ = study
+    partial = tmp_path / "partial"
+    shutil.copytree(out, partial)
+    (partial / "results.csv").unlink()
+    assert main(["report", str(partial), "--out", str(tmp_path / "r")]) == 2
+    err = capsys.readouterr().err
+    assert "not finished (9 runs done" in err and "Traceback" not in err

@@ -59,6 +59,13 @@ def _report(
         index = build_design_report(study_dir, out)
         typer.echo(json.dumps({"index": str(index)}) if as_json else f"report written: {index}")
         return
+    if (study_dir / "study.json").is_file() and (study_dir / "runs").is_dir():
+        done = len([f for f in (study_dir / "runs").glob("run_*.json")
+                    if not f.name.endswith(".failed.json")])
+        raise InputFileError(
+            f"this design study is not finished ({done} runs done, no results.csv yet)",
+            file=study_dir, hint="run the same 'bladelab design ... --out' command again to "
+            "finish it (finished runs are read back), or add --skip-failed if runs fail")
     res = build_study_report(study_dir, trial=trial, variant=variant, out_dir=out,
                              progress=not as_json, include_flagged=include_flagged,
                              window=window)

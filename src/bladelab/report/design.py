@@ -297,6 +297,8 @@ def build_design_report(design_dir: str | Path, out_dir: str | Path | None = Non
     meta = {}
     if (design_dir / "study.json").is_file():
         meta = read_json(design_dir / "study.json", what="design study file")
+    if (design_dir / "evaluator.json").is_file():  # e.g. the knee bound every stride was held to
+        meta["evaluator"] = read_json(design_dir / "evaluator.json", what="evaluator settings")
     sections = design_report_sections(design_dir)
     rep = Report("Blade design study", subtitle=str(design_dir), settings=meta,
                  seed=meta.get("seed"))
