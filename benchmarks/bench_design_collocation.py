@@ -32,7 +32,8 @@ def run() -> str:
 
 def _study(study: Path, what: str) -> str:
     strides = sorted((study / "strides").glob("*.json"))
-    strides = [p for p in strides if not p.name.endswith(".best_iterate.json")]
+    strides = [p for p in strides
+               if not p.name.endswith((".best_iterate.json", ".previous.json"))]
     if not strides:
         return (f"## Design study on predicted transfemoral strides (issue 21): {what}\n\n"
                 f"No study in {study.relative_to(study.parents[2])}: run it first (docstring).")
@@ -59,6 +60,8 @@ def _study(study: Path, what: str) -> str:
         f"({info.get('date', 'date not recorded')}) |",
         f"| designs solved (strides stored; the centre is the built-in start, read back) | "
         f"{len(rows)} |",
+        f"| designs with no clean stride (`--skip-failed`: runs/*.failed.json, failed.csv) | "
+        f"{len(list((study / 'runs').glob('*.failed.json')))} |",
         f"| time per design point, one core: median | {walls[len(walls) // 2]:.0f} s |",
         f"| time per design point: min … max | {walls[0]:.0f} … {walls[-1]:.0f} s |",
         f"| IPOPT iterations per design: median | "

@@ -191,6 +191,10 @@ def test_failed_runs_are_recorded_and_skipped_on_request(tmp_path, jobs):
         assert set(dict(gone["tables"])["Failed runs"]["run"]) == failed
         assert "25 runs (ccd design; 2 failed" in sections[
             "Design study: response surfaces"]["text"]
+        levels = dict(gone["tables"])["Failed runs per factor level"]
+        short = levels[(levels["factor"] == "toe_length_m") & (levels["coded level"] == -1)]
+        assert short[["runs", "failed"]].values.tolist() == [[9, 2]]
+        assert levels.loc[levels["factor"] == "height_m", "failed"].tolist() == [1, 0, 1]
     fixed = run_design(SPACE, evaluator=_evaluator, out_dir=tmp_path, progress=False)
     assert fixed.n_evaluated == 2 and not fixed.failed
     assert not (tmp_path / "failed.csv").exists()

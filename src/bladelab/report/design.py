@@ -130,14 +130,14 @@ def design_report_sections(design_dir: str | Path) -> list[dict[str, Any]]:
                      f"{int(checks['excluded'].sum())} runs (marked in the table of runs, "
                      "listed under 'predicted strides') are left out, so the optimum can "
                      "differ from the study's optimum.json.")
-        lev = next(iter(surfaces.values())).leverage
-        if (lev >= 1.0 - 1e-10).any():
-            n_one = int((lev >= 1.0 - 1e-10).sum())
-            fit_text += (f" Predicted R² and the leave-one-out error are blank: without "
-                         f"those runs {n_one} of the remaining runs "
-                         f"{'has' if n_one == 1 else 'have'} leverage 1 (the surface passes "
-                         "exactly through such a run whatever its value), so no leave-one-out "
-                         "prediction exists.")
+    lev = next(iter(surfaces.values())).leverage
+    if (lev >= 1.0 - 1e-10).any():
+        n_one = int((lev >= 1.0 - 1e-10).sum())
+        fit_text += (f" Predicted R² and the leave-one-out error are blank: {n_one} of the "
+                     f"{len(lev)} runs fitted {'has' if n_one == 1 else 'have'} leverage 1 "
+                     "(the surface passes exactly through such a run whatever its value, as "
+                     "when runs of the design are missing), so no leave-one-out prediction "
+                     "exists and the surfaces' predictive power is unknown.")
     runs = table if checks is None else table.assign(stride=[
         "left out (warnings)" if x else ("clean" if not w else w)
         for w, x in zip(checks["warnings"], checks["excluded"], strict=True)])
@@ -154,7 +154,10 @@ def design_report_sections(design_dir: str | Path) -> list[dict[str, Any]]:
                      f"fitted to the {len(table)} runs that finished: the surfaces describe "
                      "the region where the evaluator succeeds, and a failed region is a "
                      "finding in itself (e.g. blades with no knee-safe gait)."),
-            "tables": [("Failed runs", failed)]})
+            "tables": [("Failed runs", failed.drop(columns=[c for c in failed.columns
+                                                            if c.endswith("_coded")])),
+                       ("Failed runs per factor level", _failures_by_level(space, table,
+                                                                           failed))]})
     if checks is not None:
         sections.append(_strides_section(checks))
     shown = [objective, *[c for c in constraints if c != objective]]
@@ -211,6 +214,21 @@ def design_report_sections(design_dir: str | Path) -> list[dict[str, Any]]:
     return sections
 
 
+def _failures_by_level(space, table: pd.DataFrame, failed: pd.DataFrame) -> pd.DataFrame:
+    """Per factor and coded level: runs of the design, how many failed, and the fraction
+    (where the evaluator fails, e.g. one end of a factor's range)."""
+    rows = []
+    for f in space.factors:
+        col = f"{f.name}_coded"
+        done, bad = table[col].round(6), failed[col].round(6)
+        for level in sorted(set(done) | set(bad)):
+            n_bad, n = int((bad == level).sum()), int((bad == level).sum() + (done == level).sum())
+            rows.append({"factor": f.name, "coded level": level,
+                         "value": f.mid + level * f.half_range, "unit": f.unit, "runs": n,
+                         "failed": n_bad, "failed (%)": 100.0 * n_bad / n})
+    return pd.DataFrame(rows)
+
+
 def _strides_section(checks: pd.DataFrame) -> dict[str, Any]:
     """The predicted strides of a collocation study: each run's stride as checked now."""
     from bladelab.predict.collocation.solution import RESIDUAL_WARNING_PCT
@@ -221,7 +239,8 @@ def _strides_section(checks: pd.DataFrame) -> dict[str, Any]:
             f"striking the ground, flight in each step, peak vertical force, dynamics residual "
             f"against the forward model at most {RESIDUAL_WARNING_PCT:g} %). "
             f"{len(checks) - len(flagged) - missing} of {len(checks)} strides are clean; "
-            f"{len(flagged)} carry warnings and are left out of the surfaces"
+            + (f"{len(flagged)} carry warnings and are left out of the surfaces"
+               if len(flagged) else "none carries warnings")
             + (f"; {missing} stride files were not found (their runs are kept, unchecked)"
                if missing else "") + ".")
     shown = checks.assign(stride=checks["stride"].notna()).drop(columns=["excluded"]).rename(
