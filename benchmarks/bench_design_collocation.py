@@ -37,8 +37,11 @@ def _study(study: Path, what: str) -> str:
     if not strides:
         return (f"## Design study on predicted transfemoral strides (issue 21): {what}\n\n"
                 f"No study in {study.relative_to(study.parents[2])}: run it first (docstring).")
-    rows = []
+    from bladelab.predict.collocation.solution import CollocationSolution
+
+    rows, flagged = [], 0
     for p in strides:
+        flagged += bool(CollocationSolution.read(p).gait_warnings())
         data = json.loads(p.read_text(encoding="utf-8"))
         rows.append((p.stem, float(data.get("wall_s", float("nan"))),
                      int(data.get("iterations", 0)), data.get("guess_source", "")))
@@ -60,6 +63,8 @@ def _study(study: Path, what: str) -> str:
         f"({info.get('date', 'date not recorded')}) |",
         f"| designs solved (strides stored; the centre is the built-in start, read back) | "
         f"{len(rows)} |",
+        f"| … of which flagged by today's gait checks (left out of the report's surfaces) | "
+        f"{flagged} |",
         f"| designs with no clean stride (`--skip-failed`: runs/*.failed.json, failed.csv) | "
         f"{len(list((study / 'runs').glob('*.failed.json')))} |",
         f"| time per design point, one core: median | {walls[len(walls) // 2]:.0f} s |",
