@@ -40,11 +40,10 @@ def _study(study: Path, what: str) -> str:
     from bladelab.predict.collocation.solution import CollocationSolution
 
     rows, flagged = [], 0
-    for p in strides:
-        flagged += bool(CollocationSolution.read(p).gait_warnings())
-        data = json.loads(p.read_text(encoding="utf-8"))
-        rows.append((p.stem, float(data.get("wall_s", float("nan"))),
-                     int(data.get("iterations", 0)), data.get("guess_source", "")))
+    for p in strides:  # each file read once: its solve's record and today's gait checks
+        sol = CollocationSolution.read(p)
+        flagged += bool(sol.gait_warnings())
+        rows.append((p.stem, float(sol.nlp.wall_s), int(sol.nlp.iterations), sol.guess_source))
     timing = study / "timing.json"
     info = json.loads(timing.read_text(encoding="utf-8")) if timing.is_file() else {}
     walls = sorted(r[1] for r in rows)

@@ -166,7 +166,7 @@ def test_an_interrupted_settling_pass_is_recorded_and_resumed(tmp_path, monkeypa
     space = default_design_space()
     coded = np.array([[0, 0, 0, 0], [1, 0, 0, 0], [-1, 0, 0, 0], [0, 1, 0, 0]], float)
     result = types.SimpleNamespace(space=space, design=types.SimpleNamespace(coded=coded),
-                                   out_dir=tmp_path)
+                                   out_dir=tmp_path, failed={})
     for i in range(4):
         run_file(tmp_path, i).parent.mkdir(exist_ok=True)
         run_file(tmp_path, i).write_text("{}")
@@ -201,7 +201,7 @@ def test_an_interrupted_settling_pass_is_recorded_and_resumed(tmp_path, monkeypa
     assert len(json.loads((tmp_path / RECORD_NAME).read_text())["passes"]) == 2
 
     other = types.SimpleNamespace(space=space, design=types.SimpleNamespace(coded=coded[::-1]),
-                                  out_dir=tmp_path)
+                                  out_dir=tmp_path, failed={})
     from bladelab.errors import InputFileError
     with pytest.raises(InputFileError, match="is not run"):
         settle_study(None, other, passes=1, jobs=1)

@@ -74,7 +74,7 @@ def settle_study(evaluator, result, *, passes: int, jobs: int) -> bool:
     study must be read again)."""
     space, design, out = result.space, result.design, result.out_dir
     points = [space.point(c) for c in design.coded]
-    failed = frozenset(run - 1 for run in getattr(result, "failed", {}))  # no stride to settle
+    failed = frozenset(run - 1 for run in result.failed)  # no stride to settle
     record = _read_record(out, points)
     changed_any = False
 
@@ -97,7 +97,8 @@ def settle_study(evaluator, result, *, passes: int, jobs: int) -> bool:
                        improved=sum(r["from"] is not None for r in current["designs"]))
         save()
         typer.echo(f"settling pass {current['pass']}: {current['improved']} of "
-                   f"{len(points) - len(failed)} designs improved, largest objective drop {100 * worst:.2f} %")
+                   f"{len(points) - len(failed)} designs improved, largest objective drop "
+                   f"{100 * worst:.2f} %")
         if worst <= SETTLED_REL:
             break
     else:

@@ -222,7 +222,8 @@ def _failures_by_level(space, table: pd.DataFrame, failed: pd.DataFrame) -> pd.D
         col = f"{f.name}_coded"
         done, bad = table[col].round(6), failed[col].round(6)
         for level in sorted(set(done) | set(bad)):
-            n_bad, n = int((bad == level).sum()), int((bad == level).sum() + (done == level).sum())
+            n_bad = int((bad == level).sum())
+            n = n_bad + int((done == level).sum())
             rows.append({"factor": f.name, "coded level": level,
                          "value": f.mid + level * f.half_range, "unit": f.unit, "runs": n,
                          "failed": n_bad, "failed (%)": 100.0 * n_bad / n})
