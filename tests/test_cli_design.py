@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 
+import numpy as np
 import pandas as pd
 import pytest
 
@@ -277,3 +278,29 @@ def test_report_of_an_unfinished_design_study_says_so(study, tmp_path, capsys):
     assert main(["report", str(partial), "--out", str(tmp_path / "r")]) == 2
     err = capsys.readouterr().err
     assert "not finished (9 runs done" in err and "Traceback" not in err
+
+
+def test_design_report_shows_what_the_start_decides(study, tmp_path):
+    """A settling record with two clean strides of the same designs: the report gives each
+    response's start spread and R² ceiling beside the fits, and names the responses whose
+    ceiling is below 0.8."""
+    from bladelab.report.design import design_report_sections
+
+    copy, table = _collocation_copy(study, tmp_path, {})
+    y = table["delta_vx_m_per_s"].to_numpy(float)
+    big = 3.0 * float(np.std(y, ddof=1))  # the start moves it more than the designs do
+    designs = [{"run": r, "before": 1.0, "responses_before": {"delta_vx_m_per_s": y[r - 1]},
+                "tries": [{"from": "n.json", "converged": True, "objective": 1.01,
+                           "responses": {"delta_vx_m_per_s": y[r - 1] + big}}]}
+               for r in (1, 2)]
+    (copy / "settling.json").write_text(json.dumps({"passes": [{"pass": 1,
+                                                                "designs": designs}]}))
+    sections = {s["title"]: s for s in design_report_sections(copy)}
+    spread = sections["Design study: what the solver's start decides"]
+    table_ = dict(spread["tables"])["Start spread of the responses"].set_index("response")
+    assert table_.loc["delta_vx_m_per_s", "within_sd"] == pytest.approx(big / np.sqrt(2))
+    assert table_.loc["delta_vx_m_per_s", "r2_ceiling"] == 0.0
+    assert "delta_vx_m_per_s" in spread["text"] and "below 0.8" in spread["text"]
+    fits = dict(sections["Design study: response surfaces"]["tables"])["Surface fits"]
+    assert fits.set_index("response").loc["delta_vx_m_per_s",
+                                          "R2 ceiling (start spread)"] == 0.0

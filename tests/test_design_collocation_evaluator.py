@@ -219,13 +219,19 @@ def test_settling_keeps_the_lowest_objective_from_the_neighbours(fake, tmp_path,
     def solve(runner, settings, guess, *, model_spec, track=None, progress=None):
         calls.append({"source": guess.source})
         out = _Outcome(CollocationSolution.read(STRIDE), True, [])
-        out.nlp = types.SimpleNamespace(objective=next(objectives))
+        out.nlp = types.SimpleNamespace(objective=next(objectives), status="Solve_Succeeded")
         return out
 
     monkeypatch.setattr(ce.CollocationEvaluator, "_stored", stored)
     monkeypatch.setattr(solve_module, "predict_stride", solve)
     rows = ce.settle_strides(ev, [CENTRE], neighbours=2, progress=False)
+    tries = rows[0].pop("tries")
     assert rows == [{"point": CENTRE, "before": 1.0, "after": 0.90,
-                     "from": f"{ce.point_file_stem(far)}.json"}]
+                     "from": f"{ce.point_file_stem(far)}.json",
+                     "responses_before": {"delta_vx_m_per_s": 0.1}}]
+    # every start's stride is recorded, kept or not: the spread between local optima
+    assert [t["from"] for t in tries] == [f"{ce.point_file_stem(p)}.json" for p in (near, far)]
+    assert [t["objective"] for t in tries] == [0.95, 0.90]
+    assert all(t["converged"] and t["responses"] == {"delta_vx_m_per_s": 0.1} for t in tries)
     assert ce.point_file_stem(near) in calls[-2]["source"]  # nearest first
     assert ce.point_file_stem(far) in calls[-1]["source"]

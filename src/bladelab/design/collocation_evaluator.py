@@ -176,7 +176,12 @@ class CollocationEvaluator:
     def settle(self, point: Mapping[str, float], neighbours: int = 2) -> dict:
         """Solve this design again from its ``neighbours`` nearest solved designs and keep the
         clean stride of lowest objective (rewriting its file). Returns ``{"point", "before",
-        "after"`` (objectives), ``"from"`` (the file that gave the kept stride, or None)}."""
+        "after"`` (objectives), ``"from"`` (the file that gave the kept stride, or None),
+        ``"responses_before"`` (the stored stride's responses) and ``"tries"``: per start,
+        ``{"from", "converged", "status", "objective", "warnings", "responses"}`` (responses
+        of a clean stride only). Every clean stride of a design is a local optimum of the same
+        problem: their spread is what the start decides (:mod:`bladelab.design.start_spread`)."""
+        from bladelab.design.predicted import stride_responses
         from bladelab.predict.collocation.solution import CollocationSolution
         from bladelab.predict.collocation.solve import predict_stride
         from bladelab.predict.collocation.stored import runner_from_spec
@@ -188,17 +193,24 @@ class CollocationEvaluator:
             raise SpecError("this design has no stored clean stride to settle",
                             where="settle", hint="evaluate the design first")
         runner = runner_from_spec(spec)
-        best, source = current, None
+        best, source, tries = current, None, []
         for path in self._neighbours(point)[:neighbours]:
             guess = CollocationSolution.read(path).to_guess(f"collocation solution {path.name}")
             sol = predict_stride(runner, settings, guess, model_spec=spec, track=False)
-            if (sol.converged and not sol.gait_warnings()
-                    and sol.nlp.objective < best.nlp.objective):
+            warnings = sol.gait_warnings() if sol.converged else []
+            clean = sol.converged and not warnings
+            tries.append({"from": path.name, "converged": bool(sol.converged),
+                          "status": str(sol.nlp.status),
+                          "objective": float(sol.nlp.objective) if sol.converged else None,
+                          "warnings": list(warnings),
+                          "responses": stride_responses(sol, runner) if clean else None})
+            if clean and sol.nlp.objective < best.nlp.objective:
                 best, source = sol, path.name
         if source is not None:
             self._keep(best, point)
         return {"point": point, "before": float(current.nlp.objective),
-                "after": float(best.nlp.objective), "from": source}
+                "after": float(best.nlp.objective), "from": source,
+                "responses_before": stride_responses(current, runner), "tries": tries}
 
     def settings(self):
         """The :class:`~bladelab.predict.collocation.solve.CollocationSettings` of every

@@ -123,6 +123,10 @@ def design_report_sections(design_dir: str | Path) -> list[dict[str, Any]]:
                    + ", ".join(f"{f.name} {f.low:g}–{f.high:g} {f.unit}".strip()
                                for f in space.factors) + ".")
     checks = meta.get("_strides")
+    spread = _start_spread(design_dir, meta, table, checks)
+    if spread is not None:
+        fit = fit.merge(spread[["response", "r2_ceiling"]].rename(
+            columns={"r2_ceiling": "R2 ceiling (start spread)"}), on="response", how="left")
     fit_text = "Predicted R² comes from PRESS (leave-one-out)."
     if checks is not None and checks["excluded"].any():
         fit_text += (f" The surfaces, contours and optimum below are fitted to the "
@@ -160,6 +164,8 @@ def design_report_sections(design_dir: str | Path) -> list[dict[str, Any]]:
                                                                            failed))]})
     if checks is not None:
         sections.append(_strides_section(checks))
+    if spread is not None:
+        sections.append(_spread_section(spread))
     shown = [objective, *[c for c in constraints if c != objective]]
     sections.append({
         "title": "Design study: main effects",
@@ -251,6 +257,50 @@ def _strides_section(checks: pd.DataFrame) -> dict[str, Any]:
     if len(flagged):
         tables.insert(0, ("Runs left out", flagged[["run", "warnings"]]))
     return {"title": "Design study: predicted strides", "text": text, "tables": tables}
+
+
+def _start_spread(design_dir: Path, meta: dict, table: pd.DataFrame,
+                  checks: pd.DataFrame | None) -> pd.DataFrame | None:
+    """The start spread of a collocation study's responses
+    (:func:`~bladelab.design.start_spread.start_spread`) over its fitted runs; None when it
+    has no design solved to two clean strides."""
+    if (meta.get("_evaluator") or {}).get("evaluator") != "collocation":
+        return None
+    from bladelab.design.predicted import PREDICTED_RESPONSE_UNITS
+    from bladelab.design.start_spread import start_spread
+
+    runs = table["run"] if checks is None else table.loc[~checks["excluded"].to_numpy(bool),
+                                                         "run"]
+    spread = start_spread(design_dir, units=PREDICTED_RESPONSE_UNITS,
+                          fitted_runs=[int(r) for r in runs])
+    spread = spread[spread["across_sd"] > 0]  # a prescribed response (the speed) has none
+    return None if spread.empty else spread.reset_index(drop=True)
+
+
+def _spread_section(spread: pd.DataFrame) -> dict[str, Any]:
+    """What the solver's start decides: the responses' spread between clean strides of the
+    same design against their spread across the designs."""
+    from bladelab.design.start_spread import NEAR_PCT
+
+    low = spread[spread["r2_ceiling"] < 0.8]
+    text = ("Each design's stride is a local optimum. The settling passes solve each design "
+            "again from its neighbours' strides; "
+            f"{int(spread['designs'].max())} designs have two or more distinct clean strides "
+            "in the settling record (settling.json). within_sd is the pooled standard "
+            "deviation of a response between clean strides of the same design (the start's "
+            "error), within_sd_near the same for strides within "
+            f"{NEAR_PCT:g} % of the design's lowest objective (from designs_near designs), "
+            "across_sd its spread across the study's fitted runs. R² ceiling = "
+            "1 − within_sd²/across_sd²: the share of the responses' variance a perfect surface "
+            "could explain if each run carried this start error (an estimate, not a bound: "
+            "the kept stride is the best found, not a random one).")
+    if len(low):
+        text += (f" {len(low)} of {len(spread)} responses have a ceiling below 0.8 "
+                 f"({', '.join(low['response'])}): no surface model can predict them to "
+                 "R² 0.8 from strides of this quality; each design would have to be solved to "
+                 "its global optimum (more settling passes, more starts).")
+    return {"title": "Design study: what the solver's start decides",
+            "text": text, "tables": [("Start spread of the responses", spread)]}
 
 
 def _motion_section(design_dir: Path, meta: dict) -> dict[str, Any] | None:
