@@ -55,6 +55,7 @@ def test_pooled_spread_and_ceiling(tmp_path):
     # within 5 % of each design's best: design 1 {3 (1.9), 2 (1.95)}; design 2 only 5.0
     assert out.loc["y", "designs_near"] == 1
     assert out.loc["y", "within_sd_near"] == pytest.approx(math.sqrt(0.5))
+    assert out.loc["y", "r2_ceiling_near"] == pytest.approx(1 - 0.5 / np.var(across, ddof=1))
     # only the fitted runs count across designs
     part = start_spread(tmp_path, fitted_runs=[1, 2]).set_index("response")
     assert part.loc["y", "across_sd"] == pytest.approx(np.std([0.0, 2.0], ddof=1))

@@ -23,7 +23,9 @@ Per response (``results.csv``'s columns; values in their units):
   carried this start error. A response whose ceiling is below a target R² cannot reach it
   by any surface model; only solving each design to its global optimum would help. The
   kept stride is the best of those found, not a random one, so its error can be smaller:
-  the ceiling is an estimate, not a bound.
+  the ceiling is an estimate, not a bound. ``r2_ceiling_near`` is the same from
+  ``within_sd_near``: the ceiling if every design were solved to within ``near_pct`` of its
+  best objective.
 """
 
 from __future__ import annotations
@@ -83,7 +85,7 @@ def start_spread(design_dir: str | Path, *, responses: Sequence[str] | None = No
     design_dir = Path(design_dir)
     path = design_dir / "settling.json"
     cols = ["response", "unit", "designs", "strides", "within_sd", "designs_near",
-            "within_sd_near", "across_sd", "r2_ceiling"]
+            "within_sd_near", "across_sd", "r2_ceiling", "r2_ceiling_near"]
     if not path.is_file():
         return pd.DataFrame(columns=cols)
     strides = design_strides(read_json(path, what="settling record"))
@@ -109,12 +111,14 @@ def start_spread(design_dir: str | Path, *, responses: Sequence[str] | None = No
         within_near, _ = _pooled_sd(near)
         n_near = sum(len(g) >= 2 for g in near)
         across = float(table[name].std(ddof=1)) if name in table and len(table) > 1 else np.nan
-        ceiling = (max(0.0, 1.0 - within ** 2 / across ** 2)
-                   if np.isfinite(within) and across > 0 else np.nan)
+        ceiling, ceiling_near = (
+            max(0.0, 1.0 - sd ** 2 / across ** 2) if np.isfinite(sd) and across > 0 else np.nan
+            for sd in (within, within_near))
         rows.append({"response": name, "unit": (units or {}).get(name, ""),
                      "designs": sum(len(g) >= 2 for g in groups),
                      "strides": int(sum(len(g) for g in groups if len(g) >= 2)),
                      "within_sd": within, "designs_near": n_near,
                      "within_sd_near": within_near,
-                     "across_sd": across, "r2_ceiling": ceiling})
+                     "across_sd": across, "r2_ceiling": ceiling,
+                     "r2_ceiling_near": ceiling_near})
     return pd.DataFrame(rows, columns=cols)

@@ -293,7 +293,9 @@ def _spread_section(spread: pd.DataFrame) -> dict[str, Any]:
             "across_sd its spread across the study's fitted runs. R² ceiling = "
             "1 − within_sd²/across_sd²: the share of the responses' variance a perfect surface "
             "could explain if each run carried this start error (an estimate, not a bound: "
-            "the kept stride is the best found, not a random one).")
+            "the kept stride is the best found, not a random one); r2_ceiling_near the same "
+            "from within_sd_near, the ceiling if every design were solved that close to its "
+            "best.")
     if len(low):
         text += (f" {len(low)} of {len(spread)} responses have a ceiling below 0.8 "
                  f"({', '.join(low['response'])}): no surface model can predict them to "
