@@ -11,7 +11,7 @@ from numba import njit
 from bladelab.runner.model import CP_AZ, CP_RADIUS, CP_SITE
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)  # no reference counting (bladelab.runner.kernel)
 def lowest_point(cp, c, site_xpos, site_xmat):
     """``(px, py, pz, depth)`` [m] of contact ``c``: the lowest point of its ellipse
     (semi-axes ``ax``, ``az`` in its site's x–z plane; a sphere when equal) and its depth below

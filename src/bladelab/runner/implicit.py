@@ -69,16 +69,17 @@ from bladelab.runner.model import (
     JP_SK,
     JP_SK2,
 )
-from bladelab.runner.muscle import muscle_step
+from bladelab.runner.muscle import fibre_heights, muscle_step
 
 EXPLICIT, IMPLICIT = 0, 1
 # The muscles' Newton tolerance on the normalised fibre velocity in this scheme (the explicit
 # scheme's: 1e-8; a step below 1e-6·v_max leaves an error of order 1e-12·v_max).
 NEWTON_TOL = 1e-6
 INTEGRATORS = {"explicit": EXPLICIT, "implicit": IMPLICIT}
+# ``_nrt=False``: no reference counting in the per-step kernels (bladelab.runner.kernel).
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", _nrt=False)
 def point_jacobian(cdof, mask, body, px, py, pz, root_com, jac):
     """``jac`` (3, nv) = ∂v/∂q̇ of the point (px, py, pz) [m] fixed to ``body``."""
     rx, ry, rz = px - root_com[0], py - root_com[1], pz - root_com[2]
@@ -93,7 +94,7 @@ def point_jacobian(cdof, mask, body, px, py, pz, root_com, jac):
             jac[2, j] = 0.0
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", _nrt=False)
 def path_jacobian(site_xpos, cdof, root_com, path, pstart, seg_start, seg_dof, mstart, mdof, qvel,
                   mtu, moment):
     """MTU lengths [m] and lengthening velocities [m/s] into ``mtu`` (n, 2) and the path
@@ -170,7 +171,7 @@ def muscle_dofs(seg_start: np.ndarray, seg_dof: np.ndarray, pstart: np.ndarray
     return np.array(start, dtype=np.int64), np.array(dofs, dtype=np.int64)
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", _nrt=False)
 def dense_mass(m_csr, rowadr, rownnz, colind, out):
     """MuJoCo's mass matrix (lower-triangular CSR ``M``) into the dense symmetric ``out``."""
     for i in range(rowadr.shape[0]):
@@ -180,7 +181,7 @@ def dense_mass(m_csr, rowadr, rownnz, colind, out):
             out[c, i] = m_csr[k]
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", _nrt=False)
 def solve_tree(a, b, parent):
     """Solve ``a·x = b`` for a matrix with the sparsity of a kinematic tree's mass matrix
     (``a[i, j]`` ≠ 0 only if dof i is dof j, its ancestor or its descendant; ``parent[j]`` <
@@ -209,7 +210,7 @@ def solve_tree(a, b, parent):
         b[k] = s / a[k, k]
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", _nrt=False)
 def _normal_force(cp, c, depth, rate):
     """Normal force [N] and its derivatives by depth [N/m] and depth rate [N·s/m]."""
     if cp[c, CP_LAW] == 0.0:
@@ -232,7 +233,7 @@ def _normal_force(cp, c, depth, rate):
     return fn, kn, dv
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", _nrt=False)
 def _add_outer(a, rhs, jx, jz, kxx, kxz, kzx, kzz, dxx, dxz, dzx, dzz, qvel, dt):
     """``a += Jᵀ·(dt·D + dt²·K)·J`` and ``rhs −= dt·Jᵀ·K·J·v`` for the (x, z) rows ``jx``,
     ``jz`` of a point's Jacobian and its 2×2 stiffness ``K`` and damping ``D``."""
@@ -258,7 +259,7 @@ def _add_outer(a, rhs, jx, jz, kxx, kxz, kzx, kzz, dxx, dxz, dzx, dzz, qvel, dt)
             a[r, c] += ax * jx[c] + az * jz[c]
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", _nrt=False)
 def implicit_forces(mj, arrays, imp, root_com, dt):
     """Forces of one step with the stiff terms linearly implicit (module docstring): writes
     ``qfrc_applied`` (and zeroes ``xfrc_applied``), the muscle states, ``mtu``, and the
@@ -276,7 +277,7 @@ def implicit_forces(mj, arrays, imp, root_com, dt):
     mstart, mdof = imp[32], imp[33]
     path_jacobian(site_xpos, cdof, root_com, path, pstart, seg_start, seg_dof, mstart, mdof, qvel,
                   mtu, moment)
-    muscle_step(mp, ms, mtu[:, 0], u, dt, NEWTON_TOL)
+    muscle_step(mp, ms, mtu[:, 0], u, dt, NEWTON_TOL, imp[34])
     a[:, :] = 0.0
     dense_mass(m_csr, rowadr, rownnz, colind, a)
     for j in range(nv):
@@ -404,7 +405,7 @@ def implicit_forces(mj, arrays, imp, root_com, dt):
             cstate[c, 0] += dt * (vx1 - vx0)  # the anchor follows the end-of-step velocity
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", _nrt=False)
 def site_kinematics(xpos, xmat, site_body, site_pos, site_mat, oriented, site_xpos, site_xmat):
     """Site positions [m] ``xpos[b] + xmat[b]·pos`` into ``site_xpos``, and the frames
     ``xmat[b]·mat`` of the ``oriented`` sites into ``site_xmat`` (row-major 3×3, as MuJoCo)."""
@@ -424,7 +425,7 @@ def site_kinematics(xpos, xmat, site_body, site_pos, site_mat, oriented, site_xp
                                            + xmat[b, 3 * r + 2] * site_mat[s, 6 + c])
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", _nrt=False)
 def implicit_begin(mptr, dptr, imp):
     """The MuJoCo stages the implicit step needs, instead of ``mj_step1``: kinematics (site
     positions and frames), centre-of-mass frames and ``cdof``, the mass matrix, ``cvel``, the
@@ -444,7 +445,7 @@ def implicit_begin(mptr, dptr, imp):
         site_kinematics(imp[24], imp[25], imp[26], imp[27], imp[28], imp[29], imp[30], imp[31])
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", _nrt=False)
 def implicit_advance(mj, imp, dt):
     """Semi-implicit Euler with the acceleration :func:`implicit_forces` solved (``imp[12]``),
     as MuJoCo's ``mj_step2`` would do it with that ``qfrc_applied``: ``v += dt·a``, then
@@ -525,7 +526,9 @@ def implicit_arrays(model, m: mujoco.MjModel, d: mujoco.MjData, integrator: str 
     simulated as ``m``/``d`` (model data, live MuJoCo views, work arrays); its first entry,
     ``mode`` (1-array), selects the scheme in the compiled loops (``EXPLICIT`` or
     ``IMPLICIT``). ``own_sites``: ``m`` is ``model.mj_dynamics_model`` (no sites) and the
-    scheme places ``model.mj_model``'s sites itself (entries 23–31; :func:`site_views`)."""
+    scheme places ``model.mj_model``'s sites itself (entries 23–31; :func:`site_views`). The
+    last entry holds the fibre heights of ``model.muscle_params`` (the muscle parameters the
+    force arrays must carry, as they carry its paths), computed per simulation."""
     (hinge_slide, stages, mask, rowadr, rownnz, colind, qadr, seg_start, seg_dof, parent,
      site_body, site_pos, site_mat, oriented, mstart, mdof) = _structure(model)
     n_muscles = len(model.muscle_names)
@@ -579,6 +582,7 @@ def implicit_arrays(model, m: mujoco.MjModel, d: mujoco.MjData, integrator: str 
         *sites,
         mstart,
         mdof,
+        fibre_heights(model.muscle_params),
     )
 
 

@@ -50,10 +50,21 @@ from bladelab.sim.mujoco_engine import add_point_force
 # metabolics.py, muscle.py, contact.py or sim/mujoco_engine.py, bump this number so the loop
 # below is compiled again. This is not always enough (a session saw a controller edit have no
 # effect until the caches were deleted): when in doubt, `make clean-cache`.
-_CACHE_GENERATION = 14
+_CACHE_GENERATION = 15
+
+# The per-step kernels here and in implicit.py, muscle.py and contact_point.py allocate nothing
+# and are compiled without numba's reference counting (``_nrt=False``, numba's option for it):
+# with it, every call to them incremented and decremented the count of each array in its tuple
+# arguments (``mj``, ``arrays``, ``imp``: ~60 arrays) with an atomic instruction, 15-20 % of the
+# implicit 1 ms step (perf, issue 20). The functions they call inherit the setting; an
+# allocation in any of them fails to compile ("NRT required but not enabled"), and none may
+# return an array (its caller would get a reference it does not own). ``run_loop`` allocates
+# and keeps the counting. ``inline="always"`` (numba inlines the function's code into its
+# compiled callers, which must then also be compiled without counting): step_forces and
+# record_sample into step_end, which saves a copy of the argument tuples per step.
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def path_kinematics(site_xpos, cvel, root_com, path, pstart, mtu, seg_u):
     """MTU lengths [m] and lengthening velocities [m/s] into ``mtu`` (n, 2); unit vectors of the
     path segments into ``seg_u`` (one row per path point, the last of each muscle unused)."""
@@ -90,7 +101,7 @@ def path_kinematics(site_xpos, cvel, root_com, path, pstart, mtu, seg_u):
         mtu[i, 1] = vel
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def forces(mj, arrays, root_com, dt):
     """Muscles, ligaments and contacts for one step; writes ``xfrc`` and ``qfrc``.
 
@@ -188,23 +199,39 @@ def forces(mj, arrays, root_com, dt):
         crec[c, 6] = depth if depth > 0.0 else 0.0
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False, inline="always")
+def _copy_row(dst, i, src):
+    """``dst[i] = src`` for a 1-D ``src``: a loop, as numba's slice assignment may allocate a
+    temporary copy (which needs the reference counting these kernels go without)."""
+    for j in range(src.shape[0]):
+        dst[i, j] = src[j]
+
+
+@njit(cache=True, _nrt=False, inline="always")
+def _copy_block(dst, i, src):
+    """``dst[i] = src`` for a 2-D ``src`` (a loop, as :func:`_copy_row`)."""
+    for j in range(src.shape[0]):
+        for k in range(src.shape[1]):
+            dst[i, j, k] = src[j, k]
+
+
+@njit(cache=True, _nrt=False, inline="always")
 def record_sample(rec, i, t, mj, arrays):
     """Store sample ``i`` at time ``t`` [s] in ``rec`` = (t, qpos, qvel, muscles, mtu,
     excitation, contacts, ligament) arrays (:class:`bladelab.runner.simulate.Recording`)."""
     rec_t, rec_q, rec_v, rec_ms, rec_mtu, rec_u, rec_c, rec_l = rec
     _, ms, mtu, _, u, _, _, _, _, _, crec, lig = arrays
     rec_t[i] = t
-    rec_q[i, :] = mj[0]
-    rec_v[i, :] = mj[1]
-    rec_ms[i, :, :] = ms
-    rec_mtu[i, :, :] = mtu
-    rec_u[i, :] = u
-    rec_c[i, :, :] = crec
-    rec_l[i, :] = lig
+    _copy_row(rec_q, i, mj[0])
+    _copy_row(rec_v, i, mj[1])
+    _copy_block(rec_ms, i, ms)
+    _copy_block(rec_mtu, i, mtu)
+    _copy_row(rec_u, i, u)
+    _copy_block(rec_c, i, crec)
+    _copy_row(rec_l, i, lig)
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def step_begin(f1, mptr, dptr, mj, root_com, imp):
     """First half of a step: MuJoCo's ``mj_step1`` (positions, velocities, forces of the
     current state; with the implicit scheme only the stages it needs,
@@ -220,7 +247,7 @@ def step_begin(f1, mptr, dptr, mj, root_com, imp):
     root_com[2] = subtree_com[1, 2]
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False, inline="always")
 def step_forces(mj, arrays, imp, root_com, dt):
     """The forces of one step by the scheme ``imp[0][0]`` selects: :func:`forces` (explicit)
     or :func:`bladelab.runner.implicit.implicit_forces`."""
@@ -230,7 +257,7 @@ def step_forces(mj, arrays, imp, root_com, dt):
         forces(mj, arrays, root_com, dt)
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def step_advance(f2, mptr, dptr, mj, imp, dt):
     """Advance the state by the step: MuJoCo's ``mj_step2`` (explicit scheme) or the implicit
     scheme's Euler update (:func:`bladelab.runner.implicit.implicit_advance`)."""
@@ -240,7 +267,7 @@ def step_advance(f2, mptr, dptr, mj, imp, dt):
         call_mujoco(f2, mptr, dptr)
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def step_end(k, k_rec, record_every, dt, iz, fall_height, mj, arrays, rec, root_com, imp):
     """Second half of step ``k`` (after any controller): muscle, ligament and contact forces
     (:func:`step_forces`; ``imp`` from :func:`bladelab.runner.implicit.implicit_arrays`),

@@ -45,6 +45,9 @@ _LN_005 = math.log(0.05)
 # (every denominator is bounded away from 0), so results are those of Python's model, without
 # its ZeroDivisionError checks in the Newton loop (measured: muscle_step ~1/3 cheaper).
 
+# muscle_step: ``_nrt=False``, no reference counting per step (bladelab.runner.kernel); the
+# functions it calls inherit it.
+
 # Columns of the muscle parameter array ``mp`` (one row per muscle).
 MP_FMAX, MP_LOPT, MP_LTS, MP_PENN, MP_TSTRAIN = 0, 1, 2, 3, 4
 # Columns of the muscle state array ``ms``.
@@ -105,7 +108,10 @@ def _cos_pennation(l_ce: float, l_opt: float, penn0: float) -> float:
 @njit(cache=True, error_model="numpy")
 def _cos_pennation_of_height(l_ce: float, h: float) -> float:
     """cos α at fibre length ``l_ce`` [m] for the constant fibre height ``h = l_opt·sin α₀``
-    [m] (:func:`_cos_pennation` with the sine computed once)."""
+    [m] (:func:`_cos_pennation` with the sine computed once). Unpennate fibres (``h`` = 0,
+    half of H0918's muscles) skip the division and root: the same 1.0."""
+    if h == 0.0:
+        return 1.0
     s = h / max(l_ce, 1e-6)
     if s > 0.99:
         s = 0.99
@@ -162,10 +168,16 @@ def equilibrium_fiber_length(
     return 0.5 * (lo + hi)
 
 
-@njit(cache=True, error_model="numpy")
+def fibre_heights(mp: np.ndarray) -> np.ndarray:
+    """The constant fibre heights ``l_opt·sin α₀`` [m] of the muscles ``mp`` (the values
+    :func:`muscle_step` computes each step: Python's ``math.sin`` is the same libm ``sin``)."""
+    return np.array([row[MP_LOPT] * math.sin(row[MP_PENN]) for row in mp], dtype=float)
+
+
+@njit(cache=True, error_model="numpy", _nrt=False)
 def muscle_step(
     mp: np.ndarray, ms: np.ndarray, l_mtu: np.ndarray, u: np.ndarray, dt: float,
-    tol: float = 1e-8,
+    tol: float = 1e-8, height: np.ndarray | None = None,
 ) -> None:
     """Advance all muscles by one step and store their tendon forces.
 
@@ -175,7 +187,9 @@ def muscle_step(
     during this step, computed from the state at the step's start). ``l_mtu`` [m], ``u`` [-]
     excitations in [0, 1]. ``tol``: the Newton iteration on the normalised fibre velocity stops
     after a step smaller than this (1e-8 by default; the implicit scheme uses 1e-6: 2.4
-    instead of 3.3 iterations per muscle and step at 1 ms, measured).
+    instead of 3.3 iterations per muscle and step at 1 ms, measured). ``height`` [m]: the fibre
+    heights ``l_opt·sin α₀`` (:func:`fibre_heights`) when the caller keeps them between steps
+    (the same values: one ``sin`` per muscle and step less); None computes them here.
     """
     if mp.shape[1] <= MP_TSTRAIN:
         raise ValueError("muscle parameters need 5 columns (the last: tendon strain at Fmax)")
@@ -189,8 +203,11 @@ def muscle_step(
         act = ms[i, MS_ACT]
         l_ce = ms[i, MS_LCE]
         lm = l_mtu[i]
-        height = l_opt * math.sin(penn0)  # as tendon_force_of_state computes it
-        ms[i, MS_FORCE] = _tendon_force_of_height(lm, l_ce, fmax, height, l_ts, eref)
+        if height is None:
+            h = l_opt * math.sin(penn0)  # as tendon_force_of_state computes it
+        else:
+            h = height[i]
+        ms[i, MS_FORCE] = _tendon_force_of_height(lm, l_ce, fmax, h, l_ts, eref)
         # fibre: implicit Euler, Newton on the normalised velocity
         vscale = V_MAX_OPT_PER_S * l_opt
         v = ms[i, MS_VCE] / vscale
@@ -198,7 +215,7 @@ def muscle_step(
             l_new = l_ce + dt * v * vscale
             if l_new < 0.2 * l_opt:
                 l_new = 0.2 * l_opt
-            c = _cos_pennation_of_height(l_new, height)
+            c = _cos_pennation_of_height(l_new, h)
             ln = l_new / l_opt
             fl = force_length(ln)
             strain = (lm - l_new * c - l_ts) / l_ts

@@ -391,7 +391,8 @@ def _python_loop(
 
 class Recording:
     """Preallocated arrays of a simulation's samples (``arrays``: the tuple the compiled loops
-    fill, :func:`bladelab.runner.kernel.record_sample`)."""
+    fill, :func:`bladelab.runner.kernel.record_sample`). Left uninitialised: :meth:`result`
+    hands out only the samples recorded (zeroing the ~8 MB of a 10 s run: ~0.2 ms)."""
 
     def __init__(self, model: RunnerModel, n_steps: int, every: int) -> None:
         m = model.mj_model
@@ -400,14 +401,14 @@ class Recording:
         n = n_steps // every + 1
         self.model = model
         self.arrays = (
-            np.zeros(n),  # time [s]
-            np.zeros((n, m.nq)),
-            np.zeros((n, m.nv)),
-            np.zeros((n, nm, 4)),
-            np.zeros((n, nm, 2)),
-            np.zeros((n, nm)),
-            np.zeros((n, nc, 7)),
-            np.zeros((n, m.nv)),
+            np.empty(n),  # time [s]
+            np.empty((n, m.nq)),
+            np.empty((n, m.nv)),
+            np.empty((n, nm, 4)),
+            np.empty((n, nm, 2)),
+            np.empty((n, nm)),
+            np.empty((n, nc, 7)),
+            np.empty((n, m.nv)),
         )
 
     def result(self, n: int, dt: float, fell: bool, duration: float) -> RunnerResult:
