@@ -235,3 +235,24 @@ def test_settling_keeps_the_lowest_objective_from_the_neighbours(fake, tmp_path,
     assert all(t["converged"] and t["responses"] == {"delta_vx_m_per_s": 0.1} for t in tries)
     assert ce.point_file_stem(near) in calls[-2]["source"]  # nearest first
     assert ce.point_file_stem(far) in calls[-1]["source"]
+
+
+def test_settling_records_a_failed_start_without_responses(fake, tmp_path, monkeypatch):
+    """A start that does not converge is recorded with IPOPT's status and no objective or
+    responses, and the stored stride stays."""
+    calls, script = fake
+    ev = _evaluator(tmp_path)
+    near = {**CENTRE, "stiffness_kN_per_m": 32.0}
+    for p in (CENTRE, near):
+        ev(p)
+    before = ev._stride_file(CENTRE).read_bytes()
+    stored = CollocationSolution.read(STRIDE)  # the design's stride, as _stored reads it
+    monkeypatch.setattr(ce.CollocationEvaluator, "_stored",
+                        lambda self, point, spec, settings: (stored, None))
+    script.append((False, [], "Maximum_Iterations_Exceeded"))
+    row = ev.settle(CENTRE, neighbours=1)
+    assert row["from"] is None and row["after"] == row["before"]
+    assert row["tries"] == [{"from": f"{ce.point_file_stem(near)}.json", "converged": False,
+                             "status": "Maximum_Iterations_Exceeded", "objective": None,
+                             "warnings": [], "responses": None}]
+    assert ev._stride_file(CENTRE).read_bytes() == before
