@@ -301,6 +301,7 @@ def test_design_report_shows_what_the_start_decides(study, tmp_path):
     assert table_.loc["delta_vx_m_per_s", "within_sd"] == pytest.approx(big / np.sqrt(2))
     assert table_.loc["delta_vx_m_per_s", "r2_ceiling"] == 0.0
     assert "delta_vx_m_per_s" in spread["text"] and "below 0.8" in spread["text"]
+    assert "With 2 designs the spread is a rough estimate" in spread["text"]
     fits = dict(sections["Design study: response surfaces"]["tables"])["Surface fits"]
     assert fits.set_index("response").loc["delta_vx_m_per_s",
                                           "R2 ceiling (start spread)"] == 0.0

@@ -277,6 +277,10 @@ def _start_spread(design_dir: Path, meta: dict, table: pd.DataFrame,
     return None if spread.empty else spread.reset_index(drop=True)
 
 
+#: Fewer designs with two clean strides than this: the report calls the start spread rough.
+ROUGH_SPREAD_DESIGNS = 5
+
+
 def _spread_section(spread: pd.DataFrame) -> dict[str, Any]:
     """What the solver's start decides: the responses' spread between clean strides of the
     same design against their spread across the designs."""
@@ -296,6 +300,10 @@ def _spread_section(spread: pd.DataFrame) -> dict[str, Any]:
             "the kept stride is the best found, not a random one); r2_ceiling_near the same "
             "from within_sd_near, the ceiling if every design were solved that close to its "
             "best.")
+    n_designs = int(spread["designs"].max())
+    if n_designs < ROUGH_SPREAD_DESIGNS:
+        text += (f" With {n_designs} designs the spread is a rough estimate: settle more "
+                 "designs (--settle) before reading the ceilings.")
     if len(low):
         text += (f" {len(low)} of {len(spread)} responses have a ceiling below 0.8 "
                  f"({', '.join(low['response'])}): no surface model can predict them to "
