@@ -98,8 +98,8 @@ _SCATTER = (
     "Each design's predicted stride is one local optimum, reached from a neighbouring "
     "design's stride; on the 25-run study (docs/design.md) one settling pass lowered 12 of 25 "
     "objectives, by up to 22 %, and two clean strides of the same design differ in Δv_x by "
-    "0.06 m/s (SD) against 0.07 m/s across all designs: the start caps the R² of Δv_x near "
-    "0.24 and of E at 0 (the report's 'what the solver's start decides'), so these trends "
+    "0.06 m/s (SD) against 0.07 m/s across all designs: the start caps the R² of Δv_x at "
+    "about 0.3 and of E at 0 (the report's 'what the solver's start decides'), so these trends "
     "cannot be resolved from strides of this quality. ")
 
 #: Why a trend does not hold, by (evaluator, trend key): see docs/design.md for the measurements.
