@@ -67,10 +67,12 @@ def design_strides(record: Mapping) -> dict[int, list[tuple[float, dict]]]:
 
 
 def _pooled_sd(groups: Sequence[np.ndarray]) -> tuple[float, int]:
-    """Pooled SD about each group's mean, and its degrees of freedom."""
-    ss = sum(float(((g - g.mean()) ** 2).sum()) for g in groups if len(g) >= 2)
-    dof = sum(len(g) - 1 for g in groups if len(g) >= 2)
-    return (float(np.sqrt(ss / dof)) if dof else float("nan")), dof
+    """Pooled SD about each group's mean over the groups of two or more values, and how many
+    such groups there are."""
+    used = [g for g in groups if len(g) >= 2]
+    ss = sum(float(((g - g.mean()) ** 2).sum()) for g in used)
+    dof = sum(len(g) - 1 for g in used)
+    return (float(np.sqrt(ss / dof)) if dof else float("nan")), len(used)
 
 
 def start_spread(design_dir: str | Path, *, responses: Sequence[str] | None = None,
@@ -107,15 +109,14 @@ def start_spread(design_dir: str | Path, *, responses: Sequence[str] | None = No
             groups.append(np.array([v for _, v in vals], float))
             near.append(np.array([v for o, v in vals
                                   if o <= best + abs(best) * near_pct / 100.0], float))
-        within, _ = _pooled_sd(groups)
-        within_near, _ = _pooled_sd(near)
-        n_near = sum(len(g) >= 2 for g in near)
+        within, n_designs = _pooled_sd(groups)
+        within_near, n_near = _pooled_sd(near)
         across = float(table[name].std(ddof=1)) if name in table and len(table) > 1 else np.nan
         ceiling, ceiling_near = (
             max(0.0, 1.0 - sd ** 2 / across ** 2) if np.isfinite(sd) and across > 0 else np.nan
             for sd in (within, within_near))
         rows.append({"response": name, "unit": (units or {}).get(name, ""),
-                     "designs": sum(len(g) >= 2 for g in groups),
+                     "designs": n_designs,
                      "strides": int(sum(len(g) for g in groups if len(g) >= 2)),
                      "within_sd": within, "designs_near": n_near,
                      "within_sd_near": within_near,

@@ -287,9 +287,10 @@ def _spread_section(spread: pd.DataFrame) -> dict[str, Any]:
     from bladelab.design.start_spread import NEAR_PCT
 
     low = spread[spread["r2_ceiling"] < 0.8]
+    n_designs = int(spread["designs"].max())
     text = ("Each design's stride is a local optimum. The settling passes solve each design "
             "again from its neighbours' strides; "
-            f"{int(spread['designs'].max())} designs have two or more distinct clean strides "
+            f"{n_designs} designs have two or more distinct clean strides "
             "in the settling record (settling.json). within_sd is the pooled standard "
             "deviation of a response between clean strides of the same design (the start's "
             "error), within_sd_near the same for strides within "
@@ -300,7 +301,6 @@ def _spread_section(spread: pd.DataFrame) -> dict[str, Any]:
             "the kept stride is the best found, not a random one); r2_ceiling_near the same "
             "from within_sd_near, the ceiling if every design were solved that close to its "
             "best.")
-    n_designs = int(spread["designs"].max())
     if n_designs < ROUGH_SPREAD_DESIGNS:
         text += (f" With {n_designs} designs the spread is a rough estimate: settle more "
                  "designs (--settle) before reading the ceilings.")
