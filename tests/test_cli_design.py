@@ -143,6 +143,11 @@ def test_design_bad_input(tmp_path, capsys):
     assert main(["design", "--out", str(tmp_path / "c"), "--evaluator", "collocation",
                  "--knee-flexion-max", "120"]) == 2
     assert "loaded knee's flexion limit" in capsys.readouterr().err
+    assert main(["design", "--out", str(tmp_path / "c"), "--reference-weight", "10"]) == 2
+    assert "--reference-weight needs --evaluator collocation" in capsys.readouterr().err
+    assert main(["design", "--out", str(tmp_path / "c"), "--evaluator", "collocation",
+                 "--reference-weight", "-1"]) == 2
+    assert "reference weight must be >= 0" in capsys.readouterr().err
     assert main(["design", "--out", str(tmp_path / "c"), "--evaluator", "collocation",
                  "--body-mass", "70"]) == 2
     assert "does not apply to the collocation evaluator" in capsys.readouterr().err

@@ -73,6 +73,30 @@ def test_settings_round_trip_and_refuse_bad_values():
         CollocationSettings.from_dict({"weights": {"metabolism": 1.0}})
 
 
+def test_a_reference_term_is_part_of_the_problem_by_its_file_name():
+    kept = CollocationSettings(reference="/a/centre.json", reference_weight=10,
+                               reference_dofs=["hip_flexion_l"])
+    assert CollocationSettings.from_dict(json.loads(json.dumps(kept.to_dict()))) == kept
+    moved = CollocationSettings(reference="elsewhere/centre.json", reference_weight=10.0,
+                                reference_dofs=("hip_flexion_l",))
+    assert kept.same_problem(moved)  # a study cloned into another folder
+    for other in (CollocationSettings(), CollocationSettings(
+            reference="/a/other.json", reference_weight=10, reference_dofs=["hip_flexion_l"]),
+                  CollocationSettings(reference="/a/centre.json", reference_weight=30,
+                                      reference_dofs=["hip_flexion_l"]),
+                  CollocationSettings(reference="/a/centre.json", reference_weight=10)):
+        assert not kept.same_problem(other)
+    # a reference without weight is no term at all
+    assert CollocationSettings(reference="/a/centre.json").same_problem(CollocationSettings())
+    for bad, where in (({"reference_weight": -1.0, "reference": "r.json"}, "reference_weight"),
+                       ({"reference_weight": 1.0}, "reference"),
+                       ({"reference_weight": 1.0, "reference": "r.json",
+                         "reference_dofs": "hip_flexion_l"}, "reference_dofs")):
+        with pytest.raises(SpecError) as err:
+            CollocationSettings(**bad)
+        assert err.value.where == where
+
+
 # ---------------------------------------------------------------- file
 
 

@@ -232,3 +232,25 @@ def test_interval_mean_inequalities_are_imposed_on_each_intervals_mean():
     np.testing.assert_allclose(np.abs(at_nodes[:, 0]), 0.3, rtol=1e-9)  # ringing at nodes
     np.testing.assert_allclose(means[:, 0], 0.0, atol=1e-9)  # its interval means vanish
     np.testing.assert_allclose(means[:, 1], at_nodes[:, 1], atol=1e-12)  # row 1 untouched
+
+
+def test_tracking_term_follows_only_the_named_coordinates():
+    """tracking=(q_ref, w, dofs): w × the time-averaged mean squared deviation of the named
+    coordinates only; the default follows pelvis tilt and every joint; an unknown name is
+    refused with the model's coordinates in the hint."""
+    n, speed = 20, 2.0
+    guess = _bouncing_guess(n, speed)
+    q_ref = guess.q.copy()
+    q_ref[:, 2] = 0.3  # the tilt's reference is 0.3 rad off the guess's 0
+    q_ref[:, 1] += 1.0  # a translation: not followed by default
+    ref = {}
+    for key, dofs in (("default", ()), ("tz", (["pelvis_tz"],))):
+        nlp = StrideNLP(_toy(), n=n, speed=speed, tracking=(q_ref, 2.0, *dofs))
+        lbx, ubx, lbg, ubg = nlp.bounds()
+        x0 = nlp.initial_vector(guess)
+        ref[key] = nlp.unpack(x0, {}, 0.0, 0.0, lbg, ubg, np.zeros(lbg.size))
+    assert ref["default"].objective_terms["tracking"] == pytest.approx(2.0 * 0.3**2, rel=1e-9)
+    assert ref["tz"].objective_terms["tracking"] == pytest.approx(2.0, rel=1e-9)
+    with pytest.raises(SpecError, match="hip_flexion_l") as err:
+        StrideNLP(_toy(), n=n, speed=speed, tracking=(q_ref, 2.0, ["hip_flexion_l"]))
+    assert "pelvis_tilt" in err.value.hint

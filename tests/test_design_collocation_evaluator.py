@@ -11,7 +11,7 @@ import pytest
 
 from bladelab.design import collocation_evaluator as ce
 from bladelab.design.evaluators import make_evaluator
-from bladelab.errors import InputFileError, OptimizationError
+from bladelab.errors import InputFileError, OptimizationError, SpecError
 from bladelab.predict.collocation import solve as solve_module
 from bladelab.predict.collocation.solution import CollocationSolution
 
@@ -53,6 +53,8 @@ def fake(monkeypatch):
         calls.append({"source": guess.source, "track": track, "spec": model_spec,
                       "speed": settings.speed_m_per_s, "dofs": runner.dof_names,
                       "backward_euler": settings.blade_backward_euler,
+                      "reference": (settings.reference, settings.reference_weight,
+                                    settings.reference_dofs),
                       "contacts": runner.contact_params.copy()})
         return _Outcome(base, *(script.pop(0) if script else (True, [])))
 
@@ -256,3 +258,25 @@ def test_settling_records_a_failed_start_without_responses(fake, tmp_path, monke
                              "status": "Maximum_Iterations_Exceeded", "objective": None,
                              "warnings": [], "responses": None}]
     assert ev._stride_file(CENTRE).read_bytes() == before
+
+
+def test_a_reference_weight_keeps_the_athletes_joints_near_the_start(fake, tmp_path):
+    """reference_weight: every design's stride follows the start stride's trunk, intact-leg and
+    residual-hip angles (not the prosthetic knee or the blade); a stride solved freely is not
+    this problem's, and is solved again."""
+    import dataclasses
+
+    calls, _ = fake
+    ev = _evaluator(tmp_path, reference_weight=10)
+    ev(CENTRE)
+    path, weight, dofs = calls[-1]["reference"]
+    assert Path(path) == STRIDE and weight == 10.0 and dofs == ce.REFERENCE_DOFS
+    assert "knee_angle_r" not in dofs and not any(d.startswith("blade") for d in dofs)
+    assert set(dofs) <= set(calls[-1]["dofs"])
+    free = dataclasses.replace(ev, reference_weight=0.0)
+    assert calls[-1]["reference"][1] == 10.0 and not free.settings().same_problem(ev.settings())
+    free(CENTRE)
+    assert len(calls) == 2 and calls[-1]["reference"] == (None, 0.0, None)
+    with pytest.raises(SpecError) as err:
+        _evaluator(tmp_path, reference_weight=-1.0)
+    assert err.value.where == "reference_weight"

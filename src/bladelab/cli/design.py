@@ -161,6 +161,12 @@ def _design(
         None, "--knee-flexion-max",
         help="Collocation evaluator: keep the prosthetic knee within this flexion [deg] while "
              "its blade is loaded (the straight stance; default: free)."),
+    reference_weight: float | None = typer.Option(
+        None, "--reference-weight",
+        help="Collocation evaluator: keep the athlete's own joints (trunk, intact leg, "
+             "residual hip) near the start stride's, this weight [1/rad²] × their mean "
+             "squared deviation added to the objective: every blade run with the same "
+             "technique (docs/design.md; default 0: the gait predicted freely)."),
     settle: int = typer.Option(
         0, "--settle",
         help="Collocation evaluator: after the runs, up to this many settling passes (each "
@@ -232,12 +238,15 @@ def _design(
             options["knee_moment_min_Nm"] = knee_moment_min
         if knee_flexion_max is not None:
             options["knee_flexion_max_loaded_deg"] = knee_flexion_max
+        if reference_weight is not None:
+            options["reference_weight"] = reference_weight
     else:
         options["body_mass_kg"] = 76.0 if body_mass is None else body_mass
         if settle:
             raise SpecError("--settle needs --evaluator collocation", where="--settle")
         for name, given in (("--start", start), ("--knee-moment-min", knee_moment_min),
-                            ("--knee-flexion-max", knee_flexion_max)):
+                            ("--knee-flexion-max", knee_flexion_max),
+                            ("--reference-weight", reference_weight)):
             if given is not None:
                 raise SpecError(f"{name} needs --evaluator collocation", where=name)
     if speed is not None:

@@ -34,7 +34,8 @@ from typing import Any
 
 from bladelab.errors import OptimizationError, SpecError
 
-__all__ = ["CollocationEvaluator", "DEFAULT_DESIGN_SPEED_MPS", "settle_strides", "stride_checks"]
+__all__ = ["CollocationEvaluator", "DEFAULT_DESIGN_SPEED_MPS", "REFERENCE_DOFS", "settle_strides",
+           "stride_checks"]
 
 #: Prescribed speed of a design's stride [m/s] (our choice, docs/design.md "Predicted
 #: transfemoral gaits"): the transfemoral runner's maximum speed on collocation is 5.6–5.8 m/s
@@ -55,6 +56,11 @@ DEFAULT_START = Path(__file__).resolve().parents[1] / "data" / "runner" / "collo
 #: run in 154 s. 10⁵ N/m (three soles: 3·10⁵ N/m against the blade's 18–32 kN/m) adds 6–10 %
 #: to the blade's compression at a given load.
 DEFAULT_SOLE_STIFFNESS_SCALE = 0.1
+#: The athlete's own coordinates that :attr:`CollocationEvaluator.reference_weight` keeps near
+#: the start stride: trunk, pelvis tilt, the intact leg and the residual hip. The prosthetic
+#: knee and the blade's joints move as the blade makes them (our choice, docs/design.md).
+REFERENCE_DOFS = ("pelvis_tilt", "lumbar_extension", "hip_flexion_l", "knee_angle_l",
+                  "ankle_angle_l", "hip_flexion_r")
 _SEP = "__"
 
 
@@ -103,6 +109,12 @@ class CollocationEvaluator:
     sole_stiffness_scale
         Factor on the generated blade's sole contact stiffness
         (:data:`DEFAULT_SOLE_STIFFNESS_SCALE`).
+    reference_weight
+        Keep the athlete's own joints (:data:`REFERENCE_DOFS`) near the ``start`` stride's:
+        this weight [1/rad²] × their time-averaged mean squared deviation is added to the
+        objective (``CollocationSettings.reference_weight``), so that every blade is run with
+        the same technique and its responses are the blade's (seed 002 imposed measured
+        kinematics); 0 (default): the gait is predicted freely.
     generator
         Options of :func:`~bladelab.design.blade_generator.generate_blade`.
     """
@@ -118,6 +130,7 @@ class CollocationEvaluator:
     knee_flexion_max_loaded_deg: float | None = None
     blade_backward_euler: bool = True
     sole_stiffness_scale: float = DEFAULT_SOLE_STIFFNESS_SCALE
+    reference_weight: float = 0.0
     generator: Mapping[str, Any] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
@@ -217,13 +230,18 @@ class CollocationEvaluator:
         design's stride (checked when the evaluator is made)."""
         from bladelab.predict.collocation.solve import CollocationSettings
 
+        reference = {}
+        if self.reference_weight:
+            reference = {"reference": str(self.start or DEFAULT_START),
+                         "reference_weight": self.reference_weight,
+                         "reference_dofs": REFERENCE_DOFS}
         return CollocationSettings(mesh_intervals=self.mesh_intervals,
                                    speed_m_per_s=self.speed_mps,
                                    swing_clearance_m=self.swing_clearance_m,
                                    knee_moment_min_nm=self.knee_moment_min_Nm,
                                    knee_flexion_max_loaded_deg=self.knee_flexion_max_loaded_deg,
                                    blade_backward_euler=self.blade_backward_euler,
-                                   max_iter=self.max_iter)
+                                   max_iter=self.max_iter, **reference)
 
     def _problem(self, point: Mapping[str, float]) -> tuple[dict, Any]:
         """(model specification with the design's blade, collocation settings) of a design."""

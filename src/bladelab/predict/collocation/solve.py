@@ -149,6 +149,15 @@ class CollocationSettings:
         alternating ±1500 rad/s², sole friction forces and the knee moment alternating in
         sign from node to node). Backward Euler damps them: first-order accurate, it lags and
         damps the blade's own motion by O(h) (docs/design.md). No effect without such a blade.
+    reference, reference_weight, reference_dofs
+        A collocation solution file of the same runner whose joint angles the predictive
+        stage stays near: ``reference_weight`` [1/rad²] × the time-averaged mean squared
+        deviation of the coordinates ``reference_dofs`` (None: pelvis tilt and every joint)
+        from the reference's, on the normalised stride. Weight 0 (default): none, the gait
+        is predicted freely. The design study's "athlete keeps their technique" setting
+        (docs/design.md): without it the optimum's split of the horizontal impulse between
+        the legs is barely determined and depends on the start. The problem's identity
+        (:meth:`same_problem`) holds the reference's file name, not its folder.
     """
 
     mesh_intervals: int = 50
@@ -165,6 +174,9 @@ class CollocationSettings:
     knee_moment_min_nm: float | None = None
     knee_flexion_max_loaded_deg: float | None = None
     blade_backward_euler: bool = False
+    reference: str | None = None
+    reference_weight: float = 0.0
+    reference_dofs: tuple[str, ...] | None = None
 
     def __post_init__(self) -> None:
         n = self.mesh_intervals
@@ -243,6 +255,26 @@ class CollocationSettings:
         if not isinstance(self.blade_backward_euler, bool):
             raise SpecError(f"expected true or false, got {self.blade_backward_euler!r}",
                             where="blade_backward_euler")
+        self._check_reference()
+
+    def _check_reference(self) -> None:
+        rw = self.reference_weight
+        if isinstance(rw, bool) or not isinstance(rw, int | float) or not (
+                math.isfinite(rw) and rw >= 0):
+            raise SpecError(f"the reference weight must be >= 0, got {rw!r}",
+                            where="reference_weight")
+        object.__setattr__(self, "reference_weight", float(rw))
+        if self.reference is not None:
+            object.__setattr__(self, "reference", str(self.reference))
+        if rw > 0 and self.reference is None:
+            raise SpecError("a reference weight needs a reference solution", where="reference",
+                            hint="give the solution file whose joint angles to stay near")
+        dofs = self.reference_dofs
+        if dofs is not None:
+            if isinstance(dofs, str) or not all(isinstance(d, str) for d in dofs) or not dofs:
+                raise SpecError(f"expected a list of coordinate names, got {dofs!r}",
+                                where="reference_dofs")
+            object.__setattr__(self, "reference_dofs", tuple(dofs))
 
     @property
     def max_speed(self) -> bool:
@@ -252,6 +284,8 @@ class CollocationSettings:
     def to_dict(self) -> dict:
         out = asdict(self)
         out["weights"] = self.weights.to_dict()
+        if self.reference_dofs is not None:
+            out["reference_dofs"] = list(self.reference_dofs)
         return out
 
     @classmethod
@@ -277,7 +311,13 @@ class CollocationSettings:
     def _problem(self) -> tuple:
         return (self.mesh_intervals, self.speed_m_per_s, self.weights, self.swing_clearance_m,
                 self.knee_moment_min_nm, self.knee_flexion_max_loaded_deg,
-                self.blade_backward_euler)
+                self.blade_backward_euler) + self._reference_key()
+
+    def _reference_key(self) -> tuple:
+        """(reference file name, weight, coordinates), or () without a reference term."""
+        if not self.reference_weight:
+            return ()
+        return (Path(self.reference).name, self.reference_weight, self.reference_dofs)
 
 
 @dataclass(frozen=True)
@@ -418,18 +458,37 @@ def _model_functions(runner, swing_clearance_m: float = 0.0,
     return built["cm"], built["dyn"][key]
 
 
-def _predictive_nlp(runner, dyn, n: int, speed: float | None, weights: StrideWeights):
+def _reference_tracking(runner, settings: CollocationSettings) -> tuple | None:
+    """The predictive stage's reference term ``(q_ref, weight, dofs)`` on the mesh
+    (:attr:`CollocationSettings.reference`), or None."""
+    if not settings.reference_weight:
+        return None
+    from bladelab.predict.collocation.solution import CollocationSolution
+
+    path = Path(settings.reference)
+    if not path.is_file():
+        raise InputFileError("no such reference solution", file=path,
+                             hint="the collocation solution whose joint angles the gait stays "
+                                  "near (settings: reference)")
+    ref = CollocationSolution.read(path).to_guess(f"{COLLOCATION_SOURCE} {path.name}")
+    q = ref.on_model(runner).resample(settings.mesh_intervals).q
+    return (q, settings.reference_weight, settings.reference_dofs)
+
+
+def _predictive_nlp(runner, dyn, n: int, speed: float | None, weights: StrideWeights,
+                    reference: tuple | None = None, reference_key: tuple = ()):
     """The predictive :class:`~bladelab.predict.collocation.transcription.StrideNLP` of this
-    mesh, problem (prescribed speed, or maximum speed when ``speed`` is None) and weights,
-    built once per runner; the speed itself is a parameter of each solve."""
+    mesh, problem (prescribed speed, or maximum speed when ``speed`` is None), weights and
+    reference term (``reference_key`` names it), built once per runner; the speed itself is a
+    parameter of each solve."""
     from bladelab.predict.collocation.transcription import StrideNLP
 
     nlps = _BUILT[runner]["nlps"]
-    key = (int(n), speed is None, weights, id(dyn))
+    key = (int(n), speed is None, weights, id(dyn), reference_key)
     if key not in nlps:
         while len(nlps) >= MAX_NLPS_PER_RUNNER:
             nlps.pop(next(iter(nlps)))
-        nlps[key] = StrideNLP(dyn, n=n, speed=speed, weights=weights)
+        nlps[key] = StrideNLP(dyn, n=n, speed=speed, weights=weights, tracking=reference)
     else:
         nlps[key] = nlps.pop(key)  # most recently used last
     return nlps[key]
@@ -505,7 +564,8 @@ def predict_stride(runner, settings: CollocationSettings, guess, *, model_spec: 
                 runner, sol_t, stage="tracking", tracking=tracking,
                 metabolic_energy_J=nlp_t.energy_and_distance(sol_t)[0], **common)
         start = sol_t.to_guess(f"{COLLOCATION_SOURCE} (tracking stage)")
-    nlp_p = _predictive_nlp(runner, dyn, n, speed, settings.weights)
+    nlp_p = _predictive_nlp(runner, dyn, n, speed, settings.weights,
+                            _reference_tracking(runner, settings), settings._reference_key())
     sol = _solve_stage(nlp_p, nlp_p.initial_vector(start), settings, "predictive", progress,
                        warm=warm and not tracking_stage, speed=speed)
     return CollocationSolution.from_nlp(

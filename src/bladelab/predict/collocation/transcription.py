@@ -256,10 +256,11 @@ class StrideNLP:
         Bounds of the normalised tendon forces [-] (> 0: the inverse tendon curve of the
         De Groote formulation diverges at 0).
     tracking
-        ``(q_ref, weight)``: add ``weight`` × the time-averaged mean squared deviation [rad²]
-        of the joint angles (pelvis tilt and the joints, not the pelvis translations) from
-        ``q_ref`` ((n + 1, n_dof), nodes of the mesh) — a tracking problem that makes a guess
-        dynamically consistent before the predictive solve.
+        ``(q_ref, weight)`` or ``(q_ref, weight, dofs)``: add ``weight`` × the time-averaged
+        mean squared deviation [rad²] of the joint angles from ``q_ref`` ((n + 1, n_dof),
+        nodes of the mesh) — those named in ``dofs``, by default pelvis tilt and every joint
+        (not the pelvis translations): a tracking problem that makes a guess dynamically
+        consistent before the predictive solve, or a reference the predicted gait stays near.
     """
 
     def __init__(
@@ -274,7 +275,7 @@ class StrideNLP:
         min_activation: float = 0.01,
         min_tendon_force: float = 1e-3,
         max_tendon_force: float = 3.0,
-        tracking: tuple[np.ndarray, float] | None = None,
+        tracking: tuple | None = None,
         grf_tracking: tuple[np.ndarray, float] | None = None,
     ) -> None:
         if n < 4:
@@ -392,13 +393,15 @@ class StrideNLP:
             if w.metabolic:
                 terms["metabolic"] = w.metabolic * energy / (d.mass * ca.fmax(distance, 1e-3))
         if self.tracking is not None:
-            q_ref, weight = self.tracking
+            q_ref, weight, *dofs = self.tracking
             q_ref = np.asarray(q_ref, float)
             if q_ref.shape != (n + 1, nq):
                 raise SpecError(f"tracking reference has shape {q_ref.shape}, the mesh needs "
                                 f"{(n + 1, nq)}", where="tracking")
-            dev = (X[2:nq, :] * sx[2:nq, None] - q_ref[:, 2:].T) ** 2
-            per_node = ca.sum1(dev) / (nq - 2)
+            rows = self._tracked_rows(dofs[0] if dofs else None)
+            dev = ca.vertcat(*[(X[i, :] * sx[i] - q_ref[:, i].reshape(1, -1)) ** 2
+                               for i in rows])
+            per_node = ca.sum1(dev) / len(rows)
             terms["tracking"] = float(weight) * _node_pairs(per_node) / (2 * n)
         if self.grf_tracking is not None:
             f_ref, weight = self.grf_tracking
@@ -426,6 +429,18 @@ class StrideNLP:
         self._solvers: dict[tuple, tuple[ca.Function, ProgressRelay]] = {}
         self.n_vars = int(w_all.numel())
         self.n_cons = int(self.nlp["g"].numel())
+
+    def _tracked_rows(self, dofs) -> list[int]:
+        """Rows of q that a tracking term follows: ``dofs`` by name (None: all but the
+        pelvis translations)."""
+        names = list(self.dyn.dof_names)
+        if dofs is None:
+            return list(range(2, len(names)))
+        unknown = [d for d in dofs if d not in names]
+        if unknown or not dofs:
+            raise SpecError(f"cannot track {', '.join(unknown) or 'no coordinate'}",
+                            where="tracking", hint=f"coordinates: {', '.join(names)}")
+        return [names.index(d) for d in dofs]
 
     def _state_names(self) -> list[str]:
         d = self.dyn
