@@ -262,6 +262,21 @@ def test_design_report_leaves_out_flagged_strides(study, tmp_path):
         strides["text"]
     runs = dict(sections["Design study: response surfaces"]["tables"])["Runs"]
     assert runs.loc[runs["run"] == 3, "stride"].item() == "left out (warnings)"
+    assert "the gait predicted freely" in strides["text"]
+
+
+def test_design_report_says_the_technique_was_kept(study, tmp_path):
+    """A study solved with a reference weight says so, with the weight and the knee bound."""
+    from bladelab.report.design import design_report_sections
+
+    copy, _ = _collocation_copy(study, tmp_path, {})
+    (copy / "evaluator.json").write_text(json.dumps(
+        {"evaluator": "collocation", "solutions_dir": "strides", "speed_mps": 4.0,
+         "reference_weight": 10.0, "knee_moment_min_Nm": 0.0}))
+    text = {s["title"]: s for s in design_report_sections(copy)}[
+        "Design study: predicted strides"]["text"]
+    assert "at 4 m/s" in text and "10 /rad²" in text and "intact leg" in text
+    assert "held at or above 0 N·m" in text and "predicted freely" not in text
 
 
 def test_design_report_refuses_too_few_clean_strides(study, tmp_path):

@@ -163,7 +163,7 @@ def design_report_sections(design_dir: str | Path) -> list[dict[str, Any]]:
                        ("Failed runs per factor level", _failures_by_level(space, table,
                                                                            failed))]})
     if checks is not None:
-        sections.append(_strides_section(checks))
+        sections.append(_strides_section(checks, meta.get("_evaluator") or {}))
     if spread is not None:
         sections.append(_spread_section(spread))
     shown = [objective, *[c for c in constraints if c != objective]]
@@ -236,14 +236,36 @@ def _failures_by_level(space, table: pd.DataFrame, failed: pd.DataFrame) -> pd.D
     return pd.DataFrame(rows)
 
 
-def _strides_section(checks: pd.DataFrame) -> dict[str, Any]:
-    """The predicted strides of a collocation study: each run's stride as checked now."""
+def _problem_posed(evaluator: dict) -> str:
+    """One sentence on the stride problem every design was solved with."""
+    speed = evaluator.get("speed_mps")
+    text = (f"Every design's stride is a periodic stride at {speed:g} m/s "
+            if isinstance(speed, int | float) else "Every design's stride is a periodic stride ")
+    weight = evaluator.get("reference_weight") or 0.0
+    if weight > 0:
+        text += ("of least metabolic cost and effort, with the athlete's own joints (trunk, "
+                 "intact leg, residual hip) kept near the start stride's: "
+                 f"{weight:g} /rad² × their mean squared deviation added to the objective "
+                 "(the same technique on every blade; the prosthetic knee and the blade move "
+                 "freely)")
+    else:
+        text += "of least metabolic cost and effort, the gait predicted freely"
+    if evaluator.get("knee_moment_min_Nm") is not None:
+        text += (f"; the prosthetic knee's extension moment held at or above "
+                 f"{evaluator['knee_moment_min_Nm']:g} N·m")
+    return text + ". "
+
+
+def _strides_section(checks: pd.DataFrame, evaluator: dict) -> dict[str, Any]:
+    """The predicted strides of a collocation study: the problem posed, and each run's stride
+    as checked now."""
     from bladelab.predict.collocation.solution import RESIDUAL_WARNING_PCT
 
     flagged = checks[checks["excluded"]]
     missing = int(checks["stride"].isna().sum())
-    text = (f"Each run's stride file checked again by today's gait checks (no swinging foot "
-            f"striking the ground, flight in each step, peak vertical force, dynamics residual "
+    text = (_problem_posed(evaluator)
+            + "Each run's stride file checked again by today's gait checks (no swinging foot "
+            "striking the ground, flight in each step, peak vertical force, dynamics residual "
             f"against the forward model at most {RESIDUAL_WARNING_PCT:g} %). "
             f"{len(checks) - len(flagged) - missing} of {len(checks)} strides are clean; "
             + (f"{len(flagged)} carry warnings and are left out of the surfaces"
