@@ -280,3 +280,23 @@ def test_a_reference_weight_keeps_the_athletes_joints_near_the_start(fake, tmp_p
     with pytest.raises(SpecError) as err:
         _evaluator(tmp_path, reference_weight=-1.0)
     assert err.value.where == "reference_weight"
+
+
+def test_a_design_tries_its_nearest_solved_neighbours_in_turn(fake, tmp_path):
+    calls, script = fake
+    ev = _evaluator(tmp_path)
+    solved = [CENTRE] + [{**CENTRE, "width_m": w} for w in (0.05, 0.08)] + [
+        {**CENTRE, "stiffness_kN_per_m": 18.0}, {**CENTRE, "height_m": 0.40}]
+    for p in solved:
+        ev(p)
+    del calls[:]
+    target = {**CENTRE, "width_m": 0.05, "height_m": 0.40}
+    script += [(False, [])] * (ce.START_NEIGHBOURS + 1) + [(True, [])]
+    ev(target)
+    sources = [c["source"] for c in calls]
+    assert len(sources) == ce.START_NEIGHBOURS + 2  # the neighbours, the start, tracking
+    # nearest first: the two at distance 1, then the centre (1.41), never the far ones
+    assert {s.split()[-1] for s in sources[:2]} == {
+        f"{ce.point_file_stem(solved[1])}.json", f"{ce.point_file_stem(solved[4])}.json"}
+    assert ce.point_file_stem(CENTRE) in sources[2]
+    assert STRIDE.name in sources[3] and STRIDE.name in sources[4] and calls[4]["track"]

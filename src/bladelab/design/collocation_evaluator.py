@@ -9,7 +9,7 @@
    and soles);
 3. predicts one periodic stride at the prescribed speed by direct collocation
    (:func:`~bladelab.predict.collocation.solve.predict_stride`), warm-started from the
-   nearest design already solved in ``solutions_dir`` (coded distance), else from ``start``;
+   nearest designs already solved in ``solutions_dir`` (coded distance), then from ``start``;
    a start that does not converge to a clean alternating run (no
    :meth:`~bladelab.predict.collocation.solution.CollocationSolution.gait_warnings`) is
    followed by the next one; the last resort is ``start`` with a tracking stage first;
@@ -61,6 +61,11 @@ DEFAULT_SOLE_STIFFNESS_SCALE = 0.1
 #: knee and the blade's joints move as the blade makes them (our choice, docs/design.md).
 REFERENCE_DOFS = ("pelvis_tilt", "lumbar_extension", "hip_flexion_l", "knee_angle_l",
                   "ankle_angle_l", "hip_flexion_r")
+#: Solved designs a new design may start from, nearest first, before the study's start
+#: (a start that gives no clean stride is followed by the next; measured session 15: with the
+#: technique kept, two axial designs got a 10-BW hop or no convergence from the centre, their
+#: only neighbour then).
+START_NEIGHBOURS = 3
 _SEP = "__"
 
 
@@ -183,8 +188,9 @@ class CollocationEvaluator:
         return [f for _, _, f in sorted(found)]
 
     def _starts(self, point: Mapping[str, float]) -> list[Path]:
-        """Solution files to start from, nearest design first, ``start`` last."""
-        return self._neighbours(point)[:1] + [Path(self.start or DEFAULT_START)]
+        """Solution files to start from: the :data:`START_NEIGHBOURS` nearest solved designs,
+        nearest first, then ``start``."""
+        return self._neighbours(point)[:START_NEIGHBOURS] + [Path(self.start or DEFAULT_START)]
 
     def settle(self, point: Mapping[str, float], neighbours: int = 2) -> dict:
         """Solve this design again from its ``neighbours`` nearest solved designs and keep the
