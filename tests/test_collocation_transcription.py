@@ -254,3 +254,16 @@ def test_tracking_term_follows_only_the_named_coordinates():
     with pytest.raises(SpecError, match="hip_flexion_l") as err:
         StrideNLP(_toy(), n=n, speed=speed, tracking=(q_ref, 2.0, ["hip_flexion_l"]))
     assert "pelvis_tilt" in err.value.hint
+
+
+def test_period_tracking_term_is_the_squared_log_ratio_of_the_stride_times():
+    n, speed = 20, 2.0
+    guess = _bouncing_guess(n, speed)  # a 0.6 s stride
+    nlp = StrideNLP(_toy(), n=n, speed=speed, period_tracking=(0.5, 3.0))
+    lbx, ubx, lbg, ubg = nlp.bounds()
+    sol = nlp.unpack(nlp.initial_vector(guess), {}, 0.0, 0.0, lbg, ubg, np.zeros(lbg.size))
+    assert sol.period == pytest.approx(0.6)
+    assert sol.objective_terms["period_tracking"] == pytest.approx(3.0 * np.log(1.2) ** 2,
+                                                                   rel=1e-9)
+    with pytest.raises(SpecError, match="reference stride time"):
+        StrideNLP(_toy(), n=n, speed=speed, period_tracking=(0.0, 3.0))

@@ -280,6 +280,15 @@ def test_a_reference_weight_keeps_the_athletes_joints_near_the_start(fake, tmp_p
     with pytest.raises(SpecError) as err:
         _evaluator(tmp_path, reference_weight=-1.0)
     assert err.value.where == "reference_weight"
+    # every design starts from the reference (the study's start), its neighbours after it
+    ev({**CENTRE, "width_m": 0.05})
+    assert STRIDE.name in calls[-1]["source"] and calls[-1]["track"] is False
+    _, script = fake
+    script += [(False, [])] * 2 + [(True, [])]
+    ev({**CENTRE, "width_m": 0.08})
+    assert [c["source"].split()[-1] for c in calls[-3:]] == [
+        STRIDE.name, f"{ce.point_file_stem(CENTRE)}.json",
+        f"{ce.point_file_stem({**CENTRE, 'width_m': 0.05})}.json"]
 
 
 def test_a_design_tries_its_nearest_solved_neighbours_in_turn(fake, tmp_path):

@@ -153,7 +153,10 @@ class CollocationSettings:
         A collocation solution file of the same runner whose joint angles the predictive
         stage stays near: ``reference_weight`` [1/rad²] × the time-averaged mean squared
         deviation of the coordinates ``reference_dofs`` (None: pelvis tilt and every joint)
-        from the reference's, on the normalised stride. Weight 0 (default): none, the gait
+        from the reference's, on the normalised stride, plus the same weight × ln(T/T_ref)²
+        of the stride time T against the reference's (the cadence: measured session 15, with
+        the angles alone the design strides split into 0.51 s and 0.59 s strides, both
+        within 7° of the reference's angles). Weight 0 (default): none, the gait
         is predicted freely. The design study's "athlete keeps their technique" setting
         (docs/design.md): without it the optimum's split of the horizontal impulse between
         the legs is barely determined and depends on the start. The problem's identity
@@ -458,11 +461,11 @@ def _model_functions(runner, swing_clearance_m: float = 0.0,
     return built["cm"], built["dyn"][key]
 
 
-def _reference_tracking(runner, settings: CollocationSettings) -> tuple | None:
-    """The predictive stage's reference term ``(q_ref, weight, dofs)`` on the mesh
-    (:attr:`CollocationSettings.reference`), or None."""
+def _reference_tracking(runner, settings: CollocationSettings) -> tuple:
+    """The predictive stage's reference terms (:attr:`CollocationSettings.reference`):
+    ``((q_ref, weight, dofs) on the mesh, (T_ref, weight))``, or (None, None)."""
     if not settings.reference_weight:
-        return None
+        return None, None
     from bladelab.predict.collocation.solution import CollocationSolution
 
     path = Path(settings.reference)
@@ -472,11 +475,12 @@ def _reference_tracking(runner, settings: CollocationSettings) -> tuple | None:
                                   "near (settings: reference)")
     ref = CollocationSolution.read(path).to_guess(f"{COLLOCATION_SOURCE} {path.name}")
     q = ref.on_model(runner).resample(settings.mesh_intervals).q
-    return (q, settings.reference_weight, settings.reference_dofs)
+    return (q, settings.reference_weight, settings.reference_dofs), (
+        ref.period, settings.reference_weight)
 
 
 def _predictive_nlp(runner, dyn, n: int, speed: float | None, weights: StrideWeights,
-                    reference: tuple | None = None, reference_key: tuple = ()):
+                    reference: tuple = (None, None), reference_key: tuple = ()):
     """The predictive :class:`~bladelab.predict.collocation.transcription.StrideNLP` of this
     mesh, problem (prescribed speed, or maximum speed when ``speed`` is None), weights and
     reference term (``reference_key`` names it), built once per runner; the speed itself is a
@@ -488,7 +492,8 @@ def _predictive_nlp(runner, dyn, n: int, speed: float | None, weights: StrideWei
     if key not in nlps:
         while len(nlps) >= MAX_NLPS_PER_RUNNER:
             nlps.pop(next(iter(nlps)))
-        nlps[key] = StrideNLP(dyn, n=n, speed=speed, weights=weights, tracking=reference)
+        nlps[key] = StrideNLP(dyn, n=n, speed=speed, weights=weights, tracking=reference[0],
+                              period_tracking=reference[1])
     else:
         nlps[key] = nlps.pop(key)  # most recently used last
     return nlps[key]

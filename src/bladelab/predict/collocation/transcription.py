@@ -261,6 +261,9 @@ class StrideNLP:
         nodes of the mesh) — those named in ``dofs``, by default pelvis tilt and every joint
         (not the pelvis translations): a tracking problem that makes a guess dynamically
         consistent before the predictive solve, or a reference the predicted gait stays near.
+    period_tracking
+        ``(T_ref, weight)``: add ``weight`` × ln(T/T_ref)², the squared relative deviation of
+        the stride time T from ``T_ref`` [s] (the reference's cadence).
     """
 
     def __init__(
@@ -277,6 +280,7 @@ class StrideNLP:
         max_tendon_force: float = 3.0,
         tracking: tuple | None = None,
         grf_tracking: tuple[np.ndarray, float] | None = None,
+        period_tracking: tuple[float, float] | None = None,
     ) -> None:
         if n < 4:
             raise SpecError(f"need at least 4 mesh intervals, got {n}", where="mesh intervals")
@@ -293,6 +297,7 @@ class StrideNLP:
         self.max_tendon_force = float(max_tendon_force)
         self.tracking = tracking
         self.grf_tracking = grf_tracking
+        self.period_tracking = period_tracking
         self._build()
 
     # -- layout -------------------------------------------------------------------------
@@ -403,6 +408,12 @@ class StrideNLP:
                                for i in rows])
             per_node = ca.sum1(dev) / len(rows)
             terms["tracking"] = float(weight) * _node_pairs(per_node) / (2 * n)
+        if self.period_tracking is not None:
+            t_ref, weight = (float(v) for v in self.period_tracking)
+            if not (t_ref > 0 and math.isfinite(t_ref)):
+                raise SpecError(f"reference stride time must be > 0 s, got {t_ref}",
+                                where="period tracking")
+            terms["period_tracking"] = weight * ca.log(period / t_ref) ** 2
         if self.grf_tracking is not None:
             f_ref, weight = self.grf_tracking
             f_ref = np.asarray(f_ref, float).reshape(1, -1)
