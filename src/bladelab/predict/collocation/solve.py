@@ -201,17 +201,8 @@ class CollocationSettings:
         else:
             w = _weights_from_dict(self.weights, "weights")
         object.__setattr__(self, "weights", w)
-        tw = self.tracking_weight
-        if isinstance(tw, bool) or not isinstance(tw, int | float) or not (
-                math.isfinite(tw) and tw >= 0):
-            raise SpecError(f"tracking weight must be >= 0, got {tw!r}", where="tracking_weight")
-        object.__setattr__(self, "tracking_weight", float(tw))
-        gw = self.grf_tracking_weight
-        if isinstance(gw, bool) or not isinstance(gw, int | float) or not (
-                math.isfinite(gw) and gw >= 0):
-            raise SpecError(f"force tracking weight must be >= 0, got {gw!r}",
-                            where="grf_tracking_weight")
-        object.__setattr__(self, "grf_tracking_weight", float(gw))
+        self._check_weight("tracking_weight", "tracking weight")
+        self._check_weight("grf_tracking_weight", "force tracking weight")
         if not isinstance(self.track_first, bool):
             raise SpecError(f"expected true or false, got {self.track_first!r}",
                             where="track_first")
@@ -260,13 +251,17 @@ class CollocationSettings:
                             where="blade_backward_euler")
         self._check_reference()
 
+    def _check_weight(self, name: str, what: str) -> None:
+        """A weight field: a finite number >= 0, stored as float."""
+        w = getattr(self, name)
+        if isinstance(w, bool) or not isinstance(w, int | float) or not (
+                math.isfinite(w) and w >= 0):
+            raise SpecError(f"{what} must be >= 0, got {w!r}", where=name)
+        object.__setattr__(self, name, float(w))
+
     def _check_reference(self) -> None:
+        self._check_weight("reference_weight", "the reference weight")
         rw = self.reference_weight
-        if isinstance(rw, bool) or not isinstance(rw, int | float) or not (
-                math.isfinite(rw) and rw >= 0):
-            raise SpecError(f"the reference weight must be >= 0, got {rw!r}",
-                            where="reference_weight")
-        object.__setattr__(self, "reference_weight", float(rw))
         if self.reference is not None:
             object.__setattr__(self, "reference", str(self.reference))
         if rw > 0 and self.reference is None:
