@@ -143,12 +143,17 @@ class CollocationEvaluator:
         if not (self.sole_stiffness_scale > 0 and math.isfinite(self.sole_stiffness_scale)):
             raise SpecError(f"sole_stiffness_scale must be > 0, got {self.sole_stiffness_scale}",
                             where="sole_stiffness_scale")
-        start = Path(self.start) if self.start is not None else DEFAULT_START
+        start = self.start_file
         if not start.is_file():
             from bladelab.errors import InputFileError
 
             raise InputFileError("no such collocation solution (the first design's start)",
                                  file=start, hint="a solution.json of the transfemoral runner")
+
+    @property
+    def start_file(self) -> Path:
+        """The first design's start (and the reference): ``start``, else :data:`DEFAULT_START`."""
+        return Path(self.start) if self.start is not None else DEFAULT_START
 
     @property
     def units(self) -> dict[str, str]:
@@ -193,9 +198,8 @@ class CollocationEvaluator:
         first and the neighbours after it (every design from the same start: measured session
         15, a chain of neighbours carried a 0.59 s stride away from the reference's 0.53 s
         into a third of the box)."""
-        start = Path(self.start or DEFAULT_START)
         near = self._neighbours(point)[:START_NEIGHBOURS]
-        return [start, *near] if self.reference_weight else [*near, start]
+        return [self.start_file, *near] if self.reference_weight else [*near, self.start_file]
 
     def settle(self, point: Mapping[str, float], neighbours: int = 2) -> dict:
         """Solve this design again from its ``neighbours`` nearest solved designs and keep the
@@ -243,7 +247,7 @@ class CollocationEvaluator:
 
         reference = {}
         if self.reference_weight:
-            reference = {"reference": str(self.start or DEFAULT_START),
+            reference = {"reference": str(self.start_file),
                          "reference_weight": self.reference_weight,
                          "reference_dofs": REFERENCE_DOFS}
         return CollocationSettings(mesh_intervals=self.mesh_intervals,
@@ -307,7 +311,7 @@ class CollocationEvaluator:
         from bladelab.predict.collocation.stored import check_model_spec
 
         own = self._stride_file(point)
-        paths = [Path(self.start or DEFAULT_START)]  # the start may be this very design's
+        paths = [self.start_file]  # the start may be this very design's
         for path in ([own] if own is not None else []) + paths:
             if not path.is_file():
                 continue
@@ -336,7 +340,7 @@ class CollocationEvaluator:
             return stride_responses(stored, runner)
         # each start as it is, then the study's start with a tracking stage first
         plan = [(f, False) for f in self._starts(point)] + [
-            (Path(self.start or DEFAULT_START), True)]
+            (self.start_file, True)]
         tried, best = [], None
         t0 = time.perf_counter()
         for path, track in plan:

@@ -474,21 +474,22 @@ def _reference_tracking(runner, settings: CollocationSettings) -> tuple:
         ref.period, settings.reference_weight)
 
 
-def _predictive_nlp(runner, dyn, n: int, speed: float | None, weights: StrideWeights,
-                    reference: tuple = (None, None), reference_key: tuple = ()):
-    """The predictive :class:`~bladelab.predict.collocation.transcription.StrideNLP` of this
-    mesh, problem (prescribed speed, or maximum speed when ``speed`` is None), weights and
-    reference term (``reference_key`` names it), built once per runner; the speed itself is a
+def _predictive_nlp(runner, dyn, settings: CollocationSettings):
+    """The predictive :class:`~bladelab.predict.collocation.transcription.StrideNLP` of the
+    settings' mesh, problem (prescribed speed, or maximum speed), weights and reference term,
+    built once per runner (the reference file is read only then); the speed itself is a
     parameter of each solve."""
     from bladelab.predict.collocation.transcription import StrideNLP
 
+    n, speed = settings.mesh_intervals, settings.speed_m_per_s
     nlps = _BUILT[runner]["nlps"]
-    key = (int(n), speed is None, weights, id(dyn), reference_key)
+    key = (n, speed is None, settings.weights, id(dyn), settings._reference_key())
     if key not in nlps:
         while len(nlps) >= MAX_NLPS_PER_RUNNER:
             nlps.pop(next(iter(nlps)))
-        nlps[key] = StrideNLP(dyn, n=n, speed=speed, weights=weights, tracking=reference[0],
-                              period_tracking=reference[1])
+        tracking, period_tracking = _reference_tracking(runner, settings)
+        nlps[key] = StrideNLP(dyn, n=n, speed=speed, weights=settings.weights,
+                              tracking=tracking, period_tracking=period_tracking)
     else:
         nlps[key] = nlps.pop(key)  # most recently used last
     return nlps[key]
@@ -564,8 +565,7 @@ def predict_stride(runner, settings: CollocationSettings, guess, *, model_spec: 
                 runner, sol_t, stage="tracking", tracking=tracking,
                 metabolic_energy_J=nlp_t.energy_and_distance(sol_t)[0], **common)
         start = sol_t.to_guess(f"{COLLOCATION_SOURCE} (tracking stage)")
-    nlp_p = _predictive_nlp(runner, dyn, n, speed, settings.weights,
-                            _reference_tracking(runner, settings), settings._reference_key())
+    nlp_p = _predictive_nlp(runner, dyn, settings)
     sol = _solve_stage(nlp_p, nlp_p.initial_vector(start), settings, "predictive", progress,
                        warm=warm and not tracking_stage, speed=speed)
     return CollocationSolution.from_nlp(
