@@ -266,6 +266,8 @@ def _run_sections(report, folders: dict[str, Path], duration: float, bar) -> tup
             "J_gait (–)": ev.j_gait,
             "J_inj (N·m)": ev.j_inj,
             "J_lean (deg)": ev.j_lean,
+            **({"J_track (rad²)": ev.j_track, "tracked strides (count)": ev.track_strides}
+               if (sol.data.get("settings") or {}).get("track") else {}),
             "fell (yes/no)": bool(ev.fell),
             "simulated (s)": ev.duration,
             "mean speed (m/s)": ev.mean_speed,
@@ -343,7 +345,7 @@ def _sweep_sections(
         ct = {f"contact_time_{leg}": st.value[(st.leg == leg)
                                              & (st.variable == "contact_time")].iloc[0]
               for leg in ("intact", "prosthetic")}
-        rows.append({"category": cat, "speed": speed, **ev.to_dict(), **ct})
+        rows.append({"category": cat, "speed": speed, **ev.to_dict(tracking=False), **ct})
         sims[(cat, speed)] = (sol, ev0, res)
     results = pd.DataFrame(rows)
     summary = summarise(results)

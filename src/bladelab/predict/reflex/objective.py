@@ -40,13 +40,14 @@ from dataclasses import asdict, dataclass
 import mujoco
 import numpy as np
 
-from bladelab.errors import SimulationError
+from bladelab.errors import SimulationError, SpecError
 from bladelab.predict.reflex.closed_loop import STEP_STATE_SIZE, run_closed_loop
 from bladelab.predict.reflex.controller import (
     ControllerLayout,
     controller_layout,
     history_length,
 )
+from bladelab.predict.reflex.tracking import cached_reference, tracking_error
 from bladelab.runner.implicit import implicit_arrays, simulation_model, site_views
 from bladelab.runner.kernel import mujoco_step_addresses, path_kinematics
 from bladelab.runner.metabolics import metabolic_params
@@ -57,6 +58,8 @@ from bladelab.sim.compilation import announce_compilation
 
 DEFAULT_PREDICT_DT = DEFAULT_DT
 MAX_TOUCHDOWNS = 400
+#: Sampling interval of the angles a tracking term compares [s].
+TRACK_SAMPLE_S = 2e-3
 
 
 @dataclass(frozen=True)
@@ -82,6 +85,17 @@ class ObjectiveSettings:
     strike_limit_bw: float = 1.0
     initial_speed: float | None = None
     integrator: str = "explicit"
+    track: str | None = None
+    w_track: float = 0.0
+    track_skip: float = 1.0
+
+    def __post_init__(self) -> None:
+        if self.w_track < 0 or not math.isfinite(self.w_track):
+            raise SpecError(f"the tracking weight must be >= 0, got {self.w_track}",
+                            where="w_track")
+        if self.w_track > 0 and self.track is None:
+            raise SpecError("a tracking weight needs a stride to track", where="track",
+                            hint="a collocation solution file (bladelab predict --track)")
 
     @classmethod
     def from_dict(cls, d: dict) -> ObjectiveSettings:
@@ -111,9 +125,15 @@ class Evaluation:
     mean_speed: float
     metabolic_energy: float
     n_steps: int
+    j_track: float = 0.0
+    track_strides: int = 0
 
-    def to_dict(self) -> dict:
-        return {k: (float(v) if isinstance(v, float) else v) for k, v in asdict(self).items()}
+    def to_dict(self, *, tracking: bool = True) -> dict:
+        """The terms by name; ``tracking=False`` leaves out ``j_track`` and ``track_strides``
+        (tables of runs that track nothing)."""
+        skip = () if tracking else ("j_track", "track_strides")
+        return {k: (float(v) if isinstance(v, float) else v) for k, v in asdict(self).items()
+                if k not in skip}
 
 
 def initial_state(
@@ -222,7 +242,16 @@ def simulate_controlled(
     steps[3] = -1.0
     bw, mass = model.body_weight, model.total_mass
     n_steps = int(round(settings.duration / dt))
-    every = record_every if record_every > 0 else n_steps + 1
+    reference = cached_reference(settings.track) if settings.track is not None else None
+    if reference is not None:
+        reference.check_model(model.kind, model.params.blade if model.kind == "amputee" else None,
+                              "track")
+    if record_every > 0:
+        every = record_every
+    elif reference is not None:
+        every = max(1, int(round(TRACK_SAMPLE_S / dt)))
+    else:
+        every = n_steps + 1
     rec = Recording(model, n_steps, every)
     f1, f2 = mujoco_step_addresses()
     arrays = (mp, ms, mtu, seg_u, u, path, pstart, cp, cstate, jp, crec, lig)
@@ -264,12 +293,19 @@ def simulate_controlled(
     qpos = d.qpos
     t_end = k * dt
     distance = float(qpos[ix] - q0[ix]) if math.isfinite(qpos[ix]) else 0.0
-    ev = _evaluate(settings, acc, td[: int(acc[3])], t_end, distance, bool(fell), mass, q0[ix])
-    result = rec.result(k_rec, dt, bool(fell), settings.duration) if record_every > 0 else None
-    return ev, result
+    touchdowns = td[: int(acc[3])]
+    result = rec.result(k_rec, dt, bool(fell), settings.duration) if every <= n_steps else None
+    track = (0.0, 0)
+    if reference is not None:
+        index = np.array([model.dof(name) for name in reference.dof_names], dtype=np.int64)
+        track = tracking_error(result.time, result.qpos, touchdowns, reference, index,
+                               settings.track_skip, settings.duration)
+    ev = _evaluate(settings, acc, touchdowns, t_end, distance, bool(fell), mass, q0[ix], track)
+    return ev, (result if record_every > 0 else None)
 
 
-def _evaluate(settings, acc, td, t_end, distance, fell, mass, x0) -> Evaluation:
+def _evaluate(settings, acc, td, t_end, distance, fell, mass, x0,
+              track: tuple[float, int] = (0.0, 0)) -> Evaluation:
     s = settings
     v_min, v_max = s.speed - s.speed_tolerance, s.speed + s.speed_tolerance
     times = np.concatenate([[0.0], td[:, 0]])
@@ -298,6 +334,7 @@ def _evaluate(settings, acc, td, t_end, distance, fell, mass, x0) -> Evaluation:
     if not all(math.isfinite(v) for v in (j_cot, j_inj, j_lean)):
         j_cot, j_inj, j_lean = 1e3, 1e3, 1e3
     cost = s.w_cot * j_cot + s.w_gait * j_gait + s.w_inj * j_inj + s.w_lean * j_lean
+    cost += s.w_track * track[0]
     return Evaluation(
         cost=float(cost),
         j_cot=float(j_cot),
@@ -310,6 +347,8 @@ def _evaluate(settings, acc, td, t_end, distance, fell, mass, x0) -> Evaluation:
         mean_speed=float(distance / t) if t > 0 else 0.0,
         metabolic_energy=float(acc[0]),
         n_steps=int(len(td)),
+        j_track=float(track[0]),
+        track_strides=int(track[1]),
     )
 
 

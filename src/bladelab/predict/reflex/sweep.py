@@ -262,7 +262,7 @@ def category_task(payload: dict) -> dict:
             row = {
                 "category": cat,
                 "speed": float(speed),
-                **res.best.to_dict(),
+                **res.best.to_dict(tracking=False),  # a sweep tracks nothing
                 "generations": res.generations,
                 "evaluations": res.evaluations,
                 "wall_time_s": res.wall_time_s,
