@@ -181,7 +181,9 @@ def test_a_tracked_run_and_its_report(tmp_path, capsys):
     j = best["evaluation"]["j_track"]
     assert 0.0 < j <= NO_STRIDE
     capsys.readouterr()
-    assert main(["report", str(run)]) == 0
+    assert main(["report", str(run), "--json"]) == 0
+    shown = json.loads(capsys.readouterr().out)["solutions"]
+    assert shown[-1] == f"tracked collocation stride ({CAT6_4.name})" and len(shown) == 2
     tables = {p.stem: pd.read_csv(p) for p in (run / "report" / "tables").glob("*.csv")}
     summary = tables[next(k for k in tables if "run-summary" in k)].iloc[0]
     assert summary["J_track (rad²)"] == pytest.approx(j, rel=1e-9)

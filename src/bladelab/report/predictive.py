@@ -532,6 +532,8 @@ def build_predictive_report(
             settings, seed = first.get("settings") or {}, first.get("seed")
     if resim is not None:
         _resim_section(rep, resim, duration)
+    if kind in ("parameters", "run", "runs"):
+        results = _with_tracked_stride(results, settings)
     add_predictive_sections(rep, results, sweep_summary=sweep_summary, animate=animate)
     if export:
         _export_section(rep, results)
@@ -541,6 +543,18 @@ def build_predictive_report(
     rep.seed = seed
     index = rep.write(Path(out_dir))
     return PredictiveReport(str(index), kind, tuple(results), bar.count)
+
+
+def _with_tracked_stride(results: dict, settings: dict) -> dict:
+    """``results`` and, for a run that tracked a collocation stride (``settings["track"]``,
+    ``bladelab predict --track``), that stride beside it in every figure and table."""
+    track = settings.get("track")
+    if not track:
+        return results
+    from bladelab.predict.collocation.solution import CollocationSolution
+
+    stride = CollocationSolution.read(track).to_runner_result()
+    return {**results, f"tracked collocation stride ({Path(track).name})": stride}
 
 
 def _resim_section(rep, resim: list, duration: float) -> None:
