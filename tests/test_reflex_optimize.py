@@ -5,6 +5,7 @@ Sweeps: tests/test_predict_sweep.py."""
 from __future__ import annotations
 
 import json
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -154,6 +155,27 @@ def test_robust_evaluation_is_the_mean_over_jittered_copies():
              for xi in [x, *copies]]
     got = evaluate_candidates({"model": "able", "settings": robust.to_dict(), "xs": [x.tolist()]})
     assert got[0]["cost"] == pytest.approx(np.mean(costs), rel=1e-12)
+
+
+def test_verification_copies_are_not_the_objectives(monkeypatch):
+    # a solution optimised to survive the objective's jittered copies must be checked on others
+    import bladelab.predict.reflex.optimize as opt
+
+    x = runner_and_layout("able", None)[1].x0
+    seen = opt.jittered_parameters(x, 4, 1e-3)
+    checked = opt.jittered_parameters(x, 4, 1e-3, opt.VERIFY_JITTER_SEED)
+    assert not any(np.allclose(a, b) for a in seen for b in checked)
+    seeds = []
+    real = opt.jittered_parameters
+
+    def spy(*args, **kwargs):
+        seeds.append(args[3] if len(args) > 3 else kwargs.get("seed"))
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(opt, "jittered_parameters", spy)
+    shipped = Path(opt.__file__).resolve().parents[2] / "data/runner/solutions/able-3.5.json"
+    opt.verify_solution(shipped, duration=0.5, jittered_copies=1, jitter=1e-9)
+    assert seeds == [opt.VERIFY_JITTER_SEED]
 
 
 def test_a_warm_start_is_never_lost():
