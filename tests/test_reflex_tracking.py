@@ -195,3 +195,10 @@ def test_simulation_refuses_a_stride_of_another_runner():
     settings = ObjectiveSettings(duration=0.5, track=str(CAT6_4), w_track=1.0)
     with pytest.raises(InputFileError, match="same runner"):
         simulate_controlled(model, layout.vector({}), layout=layout, settings=settings)
+
+
+def test_a_missing_stride_names_the_setting(tmp_path):
+    model, layout = runner_and_layout("amputee", "Cat6")
+    settings = ObjectiveSettings(duration=0.5, track=str(tmp_path / "gone.json"), w_track=1.0)
+    with pytest.raises(InputFileError, match="settings.track"):
+        simulate_controlled(model, layout.vector({}), layout=layout, settings=settings)

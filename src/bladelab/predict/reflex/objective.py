@@ -40,7 +40,7 @@ from dataclasses import asdict, dataclass
 import mujoco
 import numpy as np
 
-from bladelab.errors import SimulationError, SpecError
+from bladelab.errors import InputFileError, SimulationError, SpecError
 from bladelab.predict.reflex.closed_loop import STEP_STATE_SIZE, run_closed_loop
 from bladelab.predict.reflex.controller import (
     ControllerLayout,
@@ -242,7 +242,7 @@ def simulate_controlled(
     steps[3] = -1.0
     bw, mass = model.body_weight, model.total_mass
     n_steps = int(round(settings.duration / dt))
-    reference = cached_reference(settings.track) if settings.track is not None else None
+    reference = _tracked_stride(settings.track) if settings.track is not None else None
     if reference is not None:
         reference.check_model(model.kind, model.params.blade if model.kind == "amputee" else None,
                               "track")
@@ -302,6 +302,18 @@ def simulate_controlled(
                                settings.track_skip, settings.duration)
     ev = _evaluate(settings, acc, touchdowns, t_end, distance, bool(fell), mass, q0[ix], track)
     return ev, (result if record_every > 0 else None)
+
+
+def _tracked_stride(path: str):
+    """The run's tracked stride (``settings.track``); a missing file names the setting."""
+    from pathlib import Path
+
+    if not Path(path).is_file():
+        raise InputFileError(
+            "the stride this run tracks is not there", file=path, where="settings.track",
+            hint="a relative path is read from the current folder: run from the folder the "
+            "run was made in (for the committed runs, the repository root)")
+    return cached_reference(path)
 
 
 def _evaluate(settings, acc, td, t_end, distance, fell, mass, x0,
