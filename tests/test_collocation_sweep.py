@@ -243,3 +243,12 @@ def test_a_sweep_of_the_toe_body_has_folders_and_labels_of_its_own():
     assert [model_folder(m) for m in seed] == ["able", "amputee-Cat6"]
     assert [model_folder(m) for m in toes] == ["able-toes", "amputee-Cat6-toes"]
     assert [model_label(m) for m in toes] == ["able (toes body)", "amputee Cat6 (toes body)"]
+
+
+def test_a_model_failing_at_its_first_speed_is_told_to_try_another_guess(
+        fake_solve, tmp_path, capsys):
+    fake_solve.fail = {("amputee Cat6", 3.5)}
+    assert _sweep(tmp_path / "sweep", "--categories", "Cat6", "--speeds", "3.5,4") == 2
+    err = capsys.readouterr().err
+    assert "last converged: none (the first speed starts from --guess: try another one" in err
+    assert "maximum speed not attempted" in err

@@ -149,7 +149,9 @@ def sweep_model_task(payload: dict) -> dict:
         failures.append(f"{f.speed_mps:g} m/s not converged (IPOPT status "
                         f"{f.solution.nlp.status} in the {f.solution.stage} stage; best iterate "
                         f"{f.path.relative_to(out)}); last converged: "
-                        + (f"{last:g} m/s" if last is not None else "none"))
+                        + (f"{last:g} m/s" if last is not None else
+                           "none (the first speed starts from --guess: try another one, "
+                           "e.g. --guess trial or a converged solution file)"))
     fastest = cont.fastest
     if fastest is None:
         failures.append("maximum speed not attempted (no speed converged)")
