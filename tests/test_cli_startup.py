@@ -54,6 +54,13 @@ def test_cli_defaults_equal_the_library_defaults():
     assert RUNNER_DT == DEFAULT_DT == DEFAULT_PREDICT_DT
 
 
+def test_cli_track_weight_equals_the_library_default():
+    from bladelab.cli.defaults import TRACK_WEIGHT
+    from bladelab.predict.reflex.tracking import DEFAULT_WEIGHT
+
+    assert TRACK_WEIGHT == DEFAULT_WEIGHT
+
+
 def test_cli_collocation_defaults_equal_the_settings_defaults():
     from bladelab.cli.defaults import COLLOCATION_MAX_ITER, COLLOCATION_MESH
     from bladelab.predict.collocation.solve import CollocationSettings

@@ -7,7 +7,7 @@ for every command, ``bladelab --help`` included; the values are copied here inst
 
 from __future__ import annotations
 
-__all__ = ["COLLOCATION_MAX_ITER", "COLLOCATION_MESH", "RUNNER_DT"]
+__all__ = ["COLLOCATION_MAX_ITER", "COLLOCATION_MESH", "RUNNER_DT", "TRACK_WEIGHT"]
 
 # Time step of the runner's forward simulation [s]: bladelab.runner.model.DEFAULT_DT (also the
 # reflex objective's default, bladelab.predict.reflex.objective.DEFAULT_PREDICT_DT).
@@ -17,3 +17,7 @@ RUNNER_DT = 2.5e-4
 # stride and IPOPT's iteration limit per stage.
 COLLOCATION_MESH = 50
 COLLOCATION_MAX_ITER = 3000
+
+# Weight of the reflex route's tracking term [1/rad²]:
+# bladelab.predict.reflex.tracking.DEFAULT_WEIGHT.
+TRACK_WEIGHT = 1000.0

@@ -8,13 +8,9 @@ from pathlib import Path
 
 import typer
 
-from bladelab.cli.defaults import COLLOCATION_MAX_ITER, COLLOCATION_MESH
+from bladelab.cli.defaults import COLLOCATION_MAX_ITER, COLLOCATION_MESH, TRACK_WEIGHT
 from bladelab.cli.defaults import RUNNER_DT as DEFAULT_DT
 from bladelab.errors import SpecError
-
-#: Default weight of the reflex route's tracking term [1/rad²]: 10° of rms error costs 30, as
-#: much as running 30 % of the simulation outside the speed window (w_gait = 100).
-TRACK_WEIGHT = 1000.0
 
 
 def _parse_list(text: str, what: str, conv=str) -> list:

@@ -36,6 +36,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import asdict, dataclass
+from pathlib import Path
 
 import mujoco
 import numpy as np
@@ -306,8 +307,6 @@ def simulate_controlled(
 
 def _tracked_stride(path: str):
     """The run's tracked stride (``settings.track``); a missing file names the setting."""
-    from pathlib import Path
-
     if not Path(path).is_file():
         raise InputFileError(
             "the stride this run tracks is not there", file=path, where="settings.track",
