@@ -215,3 +215,77 @@ def test_a_folder_holding_a_run_is_refused_unless_resumed_or_forced(tmp_path, ca
     assert (tmp_path / "history.csv").read_text() == history
     optimize_controller("able", out=tmp_path, force=True, **{**args, "seed": 4})
     assert (tmp_path / "history.csv").read_text() != history
+
+
+def test_robust_copies_can_start_at_other_speeds():
+    # issue 20's "±5 % of the initial speed" inside the objective: copies alternate 1 + s, 1 - s
+    from bladelab.predict.reflex.objective import simulate_controlled
+    from bladelab.predict.reflex.optimize import robust_copies
+
+    model, layout = runner_and_layout("able", None)
+    x = layout.x0
+    plain = ObjectiveSettings(duration=0.6, robust_samples=4, robust_jitter=1e-4)
+    assert all(s is plain for _, s in robust_copies(x, plain))
+    changed = ObjectiveSettings(duration=0.6, robust_samples=4, robust_jitter=1e-4,
+                                robust_speed_change=0.05, initial_speed=4.0)
+    copies = robust_copies(x, changed)
+    assert [s.initial_speed for _, s in copies] == pytest.approx([4.2, 3.8, 4.2])
+    # the same parameter jitter as without the speed change
+    for (a, _), (b, _) in zip(copies, robust_copies(x, plain), strict=True):
+        np.testing.assert_array_equal(a, b)
+    costs = [simulate_controlled(model, x, layout=layout, settings=changed)[0].cost]
+    costs += [simulate_controlled(model, xj, layout=layout, settings=s)[0].cost
+              for xj, s in copies]
+    assert len(set(costs)) == 4
+    got = evaluate_candidates({"model": "able", "settings": changed.to_dict(),
+                               "xs": [x.tolist()]})
+    assert got[0]["cost"] == pytest.approx(np.mean(costs), rel=1e-12)
+
+
+def test_per_generation_copies_are_new_every_generation_and_resume_exactly(tmp_path):
+    from bladelab.predict.reflex.optimize import generation_jitter_seed, jittered_parameters
+
+    fixed = ObjectiveSettings(duration=0.5, robust_samples=2, robust_jitter=1e-3)
+    fresh = ObjectiveSettings(duration=0.5, robust_samples=2, robust_jitter=1e-3,
+                              robust_directions="per-generation")
+    x0 = runner_and_layout("able", None)[1].x0
+    assert generation_jitter_seed(fixed, 3, 1) == generation_jitter_seed(fixed, 4, 2)
+    seeds = [generation_jitter_seed(fresh, 3, g) for g in (1, 2)] + [
+        generation_jitter_seed(fresh, 4, 1)]
+    dirs = [jittered_parameters(x0, 1, 1e-3, s)[0] for s in seeds]
+    assert not any(np.array_equal(a, b) for i, a in enumerate(dirs) for b in dirs[i + 1:])
+    assert seeds[0] == generation_jitter_seed(fresh, 3, 1)
+
+    kw = {"x0": x0, "popsize": 4, "settings": fresh}
+    full = _run(generations=3, **kw)
+    # the warm start once, then every generation its candidates and the best so far again
+    assert full.evaluations == 1 + 3 * (4 + 1)
+    # the best's cost is its cost on the last generation's copies
+    last = evaluate_candidates({"model": "able", "settings": fresh.to_dict(),
+                                "jitter_seed": generation_jitter_seed(fresh, 3, 3),
+                                "xs": [full.x.tolist()]})
+    assert full.best_cost == pytest.approx(last[0]["cost"], rel=1e-12)
+    _run(generations=1, out=tmp_path / "r", checkpoint_every=1, **kw)
+    resumed = _run(generations=3, out=tmp_path / "r", resume=True, **kw)
+    assert resumed.history == full.history
+    np.testing.assert_array_equal(resumed.x, full.x)
+
+
+def test_verify_solution_from_changed_initial_speeds():
+    import bladelab.predict.reflex.optimize as opt
+
+    shipped = Path(opt.__file__).resolve().parents[2] / "data/runner/solutions/able-3.5.json"
+    out = opt.verify_solution(shipped, duration=0.5, initial_speed_change=0.05)
+    speeds = [c["initial_speed_m_per_s"] for c in out["initial_speed"]]
+    assert speeds == pytest.approx([3.5 * 1.05, 3.5 * 0.95])
+    assert len({out["cost"], *(c["cost"] for c in out["initial_speed"])}) == 3
+    assert out["ok"] == all(c["ok"] for c in [out, *out["initial_speed"]])
+    assert "initial_speed" not in opt.verify_solution(shipped, duration=0.5)
+
+
+@pytest.mark.parametrize(("option", "value"), [("--robust-directions", "sometimes"),
+                                                ("--robust-speed-change", "0.7")])
+def test_cli_refuses_bad_robust_copies(tmp_path, capsys, option, value):
+    assert main(["predict", option, value, "--out", str(tmp_path / "x")]) == 2
+    assert option in capsys.readouterr().err
+    assert not (tmp_path / "x").exists()

@@ -35,6 +35,17 @@ def _check_simulation_options(dt: float, robust_samples: int, robust_jitter: flo
         raise SpecError("must be in (0, 0.1)", where="--robust-jitter")
 
 
+def _check_robust_copies(directions: str, speed_change: float) -> None:
+    """The options of how the robust copies differ from the nominal simulation."""
+    from bladelab.predict.reflex.objective import ROBUST_DIRECTIONS
+
+    if directions not in ROBUST_DIRECTIONS:
+        raise SpecError(f"unknown value {directions!r}", where="--robust-directions",
+                        hint=" or ".join(ROBUST_DIRECTIONS))
+    if not (math.isfinite(speed_change) and 0 <= speed_change < 0.5):
+        raise SpecError("must be in [0, 0.5)", where="--robust-speed-change")
+
+
 def register(app: typer.Typer) -> None:
     @app.command("predict")
     def predict(
@@ -66,6 +77,15 @@ def register(app: typer.Typer) -> None:
         ),
         robust_jitter: float = typer.Option(
             1e-6, "--robust-jitter", help="Relative parameter jitter of the copies."
+        ),
+        robust_directions: str = typer.Option(
+            "fixed", "--robust-directions", help="fixed (the copies' jitter directions drawn "
+            "once per run) | per-generation (drawn anew every generation; the best so far is "
+            "simulated on each generation's copies too)."
+        ),
+        robust_speed_change: float = typer.Option(
+            0.0, "--robust-speed-change", help="Start the copies at (1 + s), (1 - s), ... × the "
+            "initial speed (relative; 0.05: the ±5 % acceptance test inside the objective)."
         ),
         initial_speed: float | None = typer.Option(
             None, "--initial-speed", help="Forward speed of the initial state (m/s); default --speed."
@@ -154,6 +174,7 @@ def register(app: typer.Typer) -> None:
         if not (math.isfinite(speed) and speed > 0):
             raise SpecError("speed must be positive", where="--speed")
         _check_simulation_options(dt, robust_samples, robust_jitter)
+        _check_robust_copies(robust_directions, robust_speed_change)
         if integrator not in ("explicit", "implicit"):
             raise SpecError(f"unknown integrator {integrator!r}", where="--integrator",
                             hint="explicit or implicit")
@@ -194,6 +215,8 @@ def register(app: typer.Typer) -> None:
                 dt=dt,
                 robust_samples=robust_samples,
                 robust_jitter=robust_jitter,
+                robust_directions=robust_directions,
+                robust_speed_change=robust_speed_change,
                 initial_speed=initial_speed,
                 integrator=integrator,
                 track=None if track is None else str(track),

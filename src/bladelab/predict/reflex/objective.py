@@ -27,9 +27,14 @@ The simulation stops early once the model has fallen (pelvis below 60 % of stand
 
 Robust evaluation (``robust_samples`` = n > 1, :func:`bladelab.predict.reflex.optimize.evaluate_candidates`):
 a candidate's cost is the mean over the nominal simulation and n − 1 copies with the
-parameters jittered by ``robust_jitter`` (relative, fixed seeded directions), and it counts as
+parameters jittered by ``robust_jitter`` (relative, seeded directions), and it counts as
 fallen if any copy falls. A reflex gait is chaotic: without this, CMA-ES finds controllers that
 survive only on the exact floating-point path and fall after a 1e-9 change (docs/predictive.md).
+``robust_directions`` "fixed" draws the copies' directions once for the whole run;
+"per-generation" draws new ones every generation (seeded by the run's seed and the generation,
+so a resume is exact), so that a controller cannot learn to survive a handful of fixed copies
+and no others. ``robust_speed_change`` s > 0 also starts the copies at (1 ± s) × the initial
+speed, alternately (the ±5 % initial-speed acceptance test of issue 20 inside the objective).
 """
 
 from __future__ import annotations
@@ -61,6 +66,8 @@ DEFAULT_PREDICT_DT = DEFAULT_DT
 MAX_TOUCHDOWNS = 400
 #: Sampling interval of the angles a tracking term compares [s].
 TRACK_SAMPLE_S = 2e-3
+#: How the robust copies' jitter directions are drawn (:class:`ObjectiveSettings`).
+ROBUST_DIRECTIONS = ("fixed", "per-generation")
 
 
 @dataclass(frozen=True)
@@ -82,6 +89,8 @@ class ObjectiveSettings:
     squared_penalty: float = 0.0
     robust_samples: int = 1
     robust_jitter: float = 1e-6
+    robust_directions: str = "fixed"
+    robust_speed_change: float = 0.0
     alternating_steps: bool = True
     strike_limit_bw: float = 1.0
     initial_speed: float | None = None
@@ -91,6 +100,12 @@ class ObjectiveSettings:
     track_skip: float = 1.0
 
     def __post_init__(self) -> None:
+        if self.robust_directions not in ROBUST_DIRECTIONS:
+            raise SpecError(f"unknown robust directions {self.robust_directions!r}",
+                            where="robust_directions", hint=" or ".join(ROBUST_DIRECTIONS))
+        if not (math.isfinite(self.robust_speed_change) and 0 <= self.robust_speed_change < 0.5):
+            raise SpecError(f"must be in [0, 0.5), got {self.robust_speed_change}",
+                            where="robust_speed_change")
         if self.w_track < 0 or not math.isfinite(self.w_track):
             raise SpecError(f"the tracking weight must be >= 0, got {self.w_track}",
                             where="w_track")

@@ -70,12 +70,13 @@ def evaluate_candidates(payload: dict) -> list[dict]:
     """
     model, layout = runner_and_layout(payload["model"], payload.get("blade"))
     settings = ObjectiveSettings.from_dict(payload["settings"])
+    seed = payload.get("jitter_seed", OBJECTIVE_JITTER_SEED)
     out = []
     for x in payload["xs"]:
         x = np.asarray(x, float)
         ev, _ = simulate_controlled(model, x, layout=layout, settings=settings)
         if settings.robust_samples > 1:
-            ev = robust_evaluation(ev, model, x, layout, settings)
+            ev = robust_evaluation(ev, model, x, layout, settings, seed=seed)
         out.append(ev.to_dict())
     return out
 
@@ -89,23 +90,48 @@ VERIFY_JITTER_SEED = 20261126
 
 
 def jittered_parameters(x: np.ndarray, n: int, jitter: float,
-                        seed: int = OBJECTIVE_JITTER_SEED) -> list[np.ndarray]:
+                        seed: int | Sequence[int] = OBJECTIVE_JITTER_SEED) -> list[np.ndarray]:
     """``n`` copies of ``x`` moved by ``jitter`` (relative; absolute 1e-3·jitter near zero)
-    along fixed directions (seeded by ``seed``: the same for every candidate and run)."""
+    along directions seeded by ``seed`` (the same for every candidate given the same seed)."""
     rng = np.random.default_rng(seed)
     scale = jitter * (np.abs(x) + 1e-3)
     return [x + scale * rng.standard_normal(x.shape) for _ in range(n)]
 
 
+def generation_jitter_seed(settings: ObjectiveSettings, run_seed: int,
+                           generation: int) -> int | list[int]:
+    """The seed of the robust copies' directions in ``generation`` (0: the warm start's
+    evaluation): the objective's fixed seed, or with ``robust_directions="per-generation"`` one
+    of the run's seed and the generation (new directions every generation, the same on resume)."""
+    if settings.robust_directions == "per-generation":
+        return [OBJECTIVE_JITTER_SEED, int(run_seed), int(generation)]
+    return OBJECTIVE_JITTER_SEED
+
+
+def robust_copies(x: np.ndarray, settings: ObjectiveSettings,
+                  seed: int | Sequence[int] = OBJECTIVE_JITTER_SEED,
+                  ) -> list[tuple[np.ndarray, ObjectiveSettings]]:
+    """The ``settings.robust_samples`` − 1 copies of a candidate: its parameters jittered
+    (:func:`jittered_parameters`) and, with ``robust_speed_change`` s > 0, the initial speed
+    [m/s] times 1 + s, 1 − s, 1 + s, ... (nominal settings otherwise)."""
+    xs = jittered_parameters(x, settings.robust_samples - 1, settings.robust_jitter, seed)
+    s = settings.robust_speed_change
+    if s == 0:
+        return [(xj, settings) for xj in xs]
+    v0 = settings.speed if settings.initial_speed is None else settings.initial_speed
+    return [(xj, replace(settings, initial_speed=v0 * (1 + s if k % 2 == 0 else 1 - s)))
+            for k, xj in enumerate(xs)]
+
+
 def robust_evaluation(
     nominal: Evaluation, model: RunnerModel, x: np.ndarray, layout: ControllerLayout,
-    settings: ObjectiveSettings,
+    settings: ObjectiveSettings, seed: int | Sequence[int] = OBJECTIVE_JITTER_SEED,
 ) -> Evaluation:
     """The nominal evaluation of ``x`` with the cost averaged over ``settings.robust_samples``
-    − 1 jittered copies (:func:`jittered_parameters`; any fall counts)."""
+    − 1 copies (:func:`robust_copies` with directions seeded by ``seed``; any fall counts)."""
     costs, fell = [nominal.cost], nominal.fell
-    for xj in jittered_parameters(x, settings.robust_samples - 1, settings.robust_jitter):
-        ev, _ = simulate_controlled(model, xj, layout=layout, settings=settings)
+    for xj, copy_settings in robust_copies(x, settings, seed):
+        ev, _ = simulate_controlled(model, xj, layout=layout, settings=copy_settings)
         costs.append(ev.cost)
         fell = fell or ev.fell
     return replace(nominal, cost=float(np.mean(costs)), fell=fell)
@@ -154,13 +180,15 @@ class _Evaluator:
         elif self.jobs > 1:
             self._pool = ProcessPool(self.jobs)
 
-    def __call__(self, xs: Sequence[np.ndarray]) -> list[dict]:
+    def __call__(self, xs: Sequence[np.ndarray],
+                 jitter_seed: int | Sequence[int] = OBJECTIVE_JITTER_SEED) -> list[dict]:
         xs = [np.asarray(x, float).tolist() for x in xs]
+        base = {**self.base, "jitter_seed": jitter_seed}
         if self._pool is None and self._ray is None:
-            return evaluate_candidates({**self.base, "xs": xs})
+            return evaluate_candidates({**base, "xs": xs})
         n = self.jobs
         chunks = [xs[i::n] for i in range(n)]
-        payloads = [{**self.base, "xs": c} for c in chunks if c]
+        payloads = [{**base, "xs": c} for c in chunks if c]
         if self._pool is not None:
             results = self._pool.map(evaluate_candidates, payloads)
         else:
@@ -354,15 +382,26 @@ def optimize_controller(
         executor, jobs, {"model": model, "blade": blade, "settings": settings.to_dict()}
     )
     try:
+        fresh = settings.robust_samples > 1 and settings.robust_directions == "per-generation"
         if state is None and x0 is not None:
             # a warm start is evaluated first: the best is never worse than the start (CMA-ES
             # samples around it and, from a fragile gait, may not find as good a point soon)
-            ev0 = evaluator([best_x])[0]
+            ev0 = evaluator([best_x], generation_jitter_seed(settings, seed, 0))[0]
             best_f, best_ev = float(ev0["cost"]), ev0
             evals += 1
         while gen < generations:
             xs = es.ask()
-            evs = evaluator(xs)
+            jitter_seed = generation_jitter_seed(settings, seed, gen + 1)
+            if fresh and best_ev is not None:
+                # new copies every generation: the best so far is simulated on this
+                # generation's copies too, and a candidate replaces it only if it beats it on
+                # the same copies (a best that survived only its own generation's copies falls
+                # on the next one's and is replaced)
+                *evs, best_ev = evaluator([*xs, best_x], jitter_seed)
+                best_f = float(best_ev["cost"])
+                evals += 1
+            else:
+                evs = evaluator(xs, jitter_seed)
             fs = [e["cost"] for e in evs]
             es.tell(xs, fs)
             gen += 1
@@ -533,6 +572,7 @@ def verify_solution(
     max_power_residual_pct: float = 2.0,
     jittered_copies: int = 0,
     jitter: float = 1e-9,
+    initial_speed_change: float = 0.0,
 ) -> dict:
     """Re-simulate a parameter file and check the shipped-solution criteria.
 
@@ -552,8 +592,10 @@ def verify_solution(
     criteria must also hold for n copies of the parameters moved by ``jitter`` (relative,
     :func:`jittered_parameters`, along directions other than the objective's robust copies):
     a gait that survives only on one floating-point path (another
-    CPU, compiler or library version) is not a solution. Returns the measured values (the
-    copies' under ``"jittered"``) and ``ok``.
+    CPU, compiler or library version) is not a solution. With ``initial_speed_change`` c > 0
+    they must also hold from an initial speed [m/s] (1 + c) and (1 − c) times the file's (issue
+    20: ±5 %). Returns the measured values (the copies' under ``"jittered"``, the changed starts'
+    under ``"initial_speed"``) and ``ok``.
     """
 
     from bladelab.predict.reflex.controller import read_parameters
@@ -573,6 +615,14 @@ def verify_solution(
             for xj in jittered_parameters(x, jittered_copies, jitter, VERIFY_JITTER_SEED)
         ]
         out["ok"] = bool(out["ok"] and all(c["ok"] for c in out["jittered"]))
+    if initial_speed_change > 0:
+        v0 = settings.speed if settings.initial_speed is None else settings.initial_speed
+        out["initial_speed"] = []
+        for factor in (1 + initial_speed_change, 1 - initial_speed_change):
+            changed = replace(settings, initial_speed=v0 * factor)
+            check = _check_gait(runner, layout, x, changed, limits)
+            out["initial_speed"].append({"initial_speed_m_per_s": v0 * factor, **check})
+        out["ok"] = bool(out["ok"] and all(c["ok"] for c in out["initial_speed"]))
     return out
 
 
@@ -639,7 +689,9 @@ def _strides(time: np.ndarray, steps: list[tuple[float, int, float]]) -> list[tu
 
 __all__ = [
     "OptimizationResult",
+    "generation_jitter_seed",
     "jittered_parameters",
+    "robust_copies",
     "robust_evaluation",
     "runner_and_layout",
     "stored_settings",
