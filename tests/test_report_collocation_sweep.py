@@ -157,3 +157,46 @@ def test_the_report_of_a_sweep_folder_has_its_sections(tmp_path, monkeypatch):
     assert "Not converged" in html and "amputee Cat4 max-speed" in html
     assert "Blade categories: maximum speed and metabolic cost" in html
     assert "seed 001" in html
+
+
+def _flag(folder: Path, blade: str, problem: str, why: str = "a one-legged hop") -> None:
+    table = pd.read_csv(folder / "collocation-sweep.csv")
+    table["warnings"] = ""
+    table.loc[(table.blade == blade) & (table.problem == problem), "warnings"] = why
+    table.to_csv(folder / "collocation-sweep.csv", index=False)
+
+
+def test_a_flagged_solve_is_a_cross_off_the_curves_and_out_of_the_summary(tmp_path):
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from bladelab.report import collocation_sweep as cs
+
+    folder = _subset(tmp_path, ["Cat5", "Cat6"])
+    _flag(folder, "Cat5", "max-speed")
+    table = read_sweep_table(folder)
+    assert table.flagged.sum() == 1 and not read_sweep_table(STUDY).flagged.any()
+    summary = sweep_summary(table).set_index("category")
+    assert math.isnan(summary.loc["Cat5", "max_speed"]) and math.isfinite(summary.loc["Cat5", "cot_4"])
+    assert math.isfinite(summary.loc["Cat6", "max_speed"])
+    flagged_speed = float(table[table.flagged].mean_speed_mps.iloc[0])
+    cost = cs._speed_figure(table).axes[0]
+    curves = [ln for ln in cost.lines if ln.get_linestyle() == "-"]
+    crosses = [ln for ln in cost.lines if ln.get_marker() == "x" and len(ln.get_xdata())]
+    assert all(flagged_speed not in ln.get_xdata() for ln in curves)
+    assert [list(ln.get_xdata()) for ln in crosses] == [[flagged_speed]]
+    assert "flagged (gait warnings)" in [ln.get_label() for ln in cost.lines]
+
+
+def test_the_section_names_the_flagged_solves(tmp_path, monkeypatch):
+    import bladelab.report.predictive_sections as sections
+
+    shown = {}
+    monkeypatch.setattr(sections, "_gait_sections",
+                        lambda report, results, cycles: shown.update(results))
+    folder = _subset(tmp_path, ["Cat6"])
+    _flag(folder, "Cat6", "max-speed", "the stride time sits on its bound (0.4 s)")
+    rep = build_predictive_report(folder, tmp_path / "report", progress=False, animate=False)
+    html = Path(rep.index).read_text(encoding="utf-8")
+    assert "Converged but flagged by the gait checks" in html and "amputee Cat6 max-speed" in html
+    assert list(shown) == [s for s in rep.solutions] and "flagged" in rep.solutions[0]

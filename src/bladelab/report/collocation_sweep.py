@@ -8,7 +8,9 @@ report shows, before the predictive sections that every predictive report has:
 - cost of transport, contact time and peak vertical ground force per leg against speed, one
   curve per model, the maximum-speed solve marked;
 - every solve of the table, converged or not (a solve that did not converge is listed, never
-  plotted or averaged);
+  plotted or averaged; a converged solve that the gait checks flag, its ``warnings`` column not
+  empty: a hop, a stride on its bound, a double contact, an impact peak, is drawn as a cross
+  off the curves and left out of the category table, and the text names it);
 - for a folder whose problems were solved from several starts (``bladelab sweep --method
   collocation --starts K``, or paths merged by ``benchmarks/collocation/merge_starts.py``):
   per problem the kept start, every start's objective and their spread (:func:`starts_table`);
@@ -48,7 +50,8 @@ def is_collocation_sweep(path: str | Path) -> bool:
 
 
 def read_sweep_table(folder: str | Path) -> pd.DataFrame:
-    """The sweep's table, with ``converged`` as bool.
+    """The sweep's table, with ``converged`` as bool and ``flagged`` (bool) added: converged,
+    but with gait warnings (a table written before the warnings existed flags nothing).
 
     Raises
     ------
@@ -72,6 +75,9 @@ def read_sweep_table(folder: str | Path) -> pd.DataFrame:
                              file=path, hint="rewrite it with 'bladelab sweep --method "
                                              "collocation --resume'")
     table["converged"] = table["converged"].astype(str).str.lower().isin(["true", "1"])
+    warnings = (table["warnings"].fillna("").astype(str).str.strip() if "warnings" in table
+                else pd.Series("", index=table.index))
+    table["flagged"] = table["converged"] & warnings.str.len().gt(0)
     return table
 
 
@@ -80,11 +86,12 @@ def sweep_summary(table: pd.DataFrame) -> pd.DataFrame:
     (:func:`bladelab.predict.reflex.sweep.summarise`): max_speed [m/s] (the converged
     maximum-speed solve), cot_4 [J/(kg·m)] (converged solve at 4 m/s), t200 and t400 [s]
     (200 m and 400 m at the maximum speed) and the contact times [s] of each leg at the maximum
-    speed. NaN where the solve is missing or did not converge."""
+    speed. NaN where the solve is missing, did not converge or is flagged by the gait checks
+    (``flagged`` of :func:`read_sweep_table`)."""
     rows = []
     amputee = table[table.model.astype(str).str.startswith("amputee")]
     for cat, df in amputee.groupby("blade", sort=False):
-        ok = df[df.converged]
+        ok = df[df.converged & ~df["flagged"]] if "flagged" in df else df[df.converged]
         top = ok[ok.problem == "max-speed"]
         at4 = ok[(ok.problem == "speed")
                  & np.isclose(ok.prescribed_speed_mps.astype(float), COST_SPEED_M_PER_S)]
@@ -116,10 +123,18 @@ def starts_table(table: pd.DataFrame) -> pd.DataFrame | None:
     return table[[c for c in cols if c in table.columns]].reset_index(drop=True)
 
 
+def _problem_name(row) -> str:
+    """'amputee Cat4 speed 5.0' or 'able max-speed' for the text."""
+    return (f"{row.model} {row.problem} "
+            f"{row.prescribed_speed_mps if row.problem == 'speed' else ''}").strip()
+
+
 def _speed_figure(table: pd.DataFrame):
-    """Cost of transport, contact time and peak vertical GRF per leg against speed."""
+    """Cost of transport, contact time and peak vertical GRF per leg against speed: curves
+    through the clean converged solves, a cross for each flagged one."""
     import matplotlib.pyplot as plt
 
+    flagged = table.get("flagged", pd.Series(False, index=table.index))
     ok = table[table.converged]
     # per-leg columns contact_time_<leg>_s (not the legs' mean, contact_time_s)
     legs = [m.group(1) for c in table.columns if (m := re.fullmatch(r"contact_time_(.+)_s", c))]
@@ -137,10 +152,15 @@ def _speed_figure(table: pd.DataFrame):
                     continue
                 style = "-" if j == 0 else "--"
                 name = f"{model} {leg}".strip()
-                ax.plot(df.mean_speed_mps, df[c], style, color=color, marker="o", ms=3,
+                bad = flagged.loc[df.index].to_numpy(bool)
+                clean = df[~bad]
+                ax.plot(clean.mean_speed_mps, clean[c], style, color=color, marker="o", ms=3,
                         label=name)
-                top = df[df.problem == "max-speed"]
+                top = clean[clean.problem == "max-speed"]
                 ax.plot(top.mean_speed_mps, top[c], "*", color=color, ms=10)
+                ax.plot(df.mean_speed_mps[bad], df[c][bad], "x", color=color, ms=7, mew=1.5)
+        if flagged.any():
+            ax.plot([], [], "x", color="0.3", label="flagged (gait warnings)")
         ax.set_xlabel("mean speed (m/s)")
         ax.set_ylabel(label)
     axes[0].legend(fontsize=7)
@@ -180,12 +200,17 @@ def collocation_sweep_sections(report, folder: str | Path) -> tuple[dict, pd.Dat
     else:
         text += ("Each model's speeds were solved in the order given, each warm-started from "
                  "the previous converged speed; the maximum speed (star) from the fastest.")
-    text += " Curves and the category table use converged solves only."
+    text += (" Curves and the category table use converged solves without gait warnings "
+             "only.")
+    flagged = table[table.flagged]
+    if len(flagged):
+        text += (" Converged but flagged by the gait checks (drawn as crosses, left out of the "
+                 "curves and the category table; the table's 'warnings' column says why): "
+                 + ", ".join(_problem_name(r) for r in flagged.itertuples()) + ".")
     if len(failed):
         text += (" Not converged (listed in the table, left out of the figures and the "
-                 "category table): " + ", ".join(
-                     f"{r.model} {r.problem} {r.prescribed_speed_mps if r.problem == 'speed' else ''}"
-                     .strip() for r in failed.itertuples()) + ".")
+                 "category table): " + ", ".join(_problem_name(r) for r in failed.itertuples())
+                 + ".")
     shown = table.rename(columns={"file": "solution file"})
     report.add_section(
         "Collocation sweep: speed continuation and maximum speed",
@@ -206,7 +231,8 @@ def collocation_sweep_sections(report, folder: str | Path) -> tuple[dict, pd.Dat
                                  hint="re-run 'bladelab sweep --method collocation --resume'")
         sol = CollocationSolution.read(path)
         runner = runner_from_spec(sol.model_spec)
-        label = f"{r.model} max {sol.mean_speed_mps:.2f} m/s (collocation)"
+        label = (f"{r.model} max {sol.mean_speed_mps:.2f} m/s (collocation"
+                 + (", flagged)" if r.flagged else ")"))
         results[label] = sol.to_runner_result(3, runner=runner,
                                               cm=build_collocation_model(runner))
     return results, sweep_summary(table)
