@@ -353,6 +353,46 @@ def test_a_stage_that_does_not_converge_ends_the_solve_deterministically(able):
     assert warm.stage == "predictive" and warm.tracking is None
 
 
+def test_a_locally_infeasible_tracking_stage_is_solved_again_from_its_iterate(able, monkeypatch):
+    # the control flow of predict_stride: IPOPT's statuses are relabelled per call (a local
+    # infeasibility was seen on one host for the able template at 4 m/s)
+    from bladelab.predict.collocation.transcription import StrideNLP
+
+    runner, _, _ = able
+    calls, statuses = [], []
+    solve = StrideNLP.solve
+
+    def fake(self, x0, **kw):
+        sol = solve(self, x0, **kw)
+        status = statuses[len(calls)] if len(calls) < len(statuses) else None
+        if status is not None:
+            sol = dataclasses.replace(sol, success=status == "Solve_Succeeded", status=status)
+        calls.append((np.asarray(x0).copy(), sol, self.initial_vector(sol.to_guess("x"))))
+        return sol
+
+    monkeypatch.setattr(StrideNLP, "solve", fake)
+    settings = CollocationSettings(mesh_intervals=6, speed_m_per_s=SPEED, max_iter=5)
+    guess = template_guess(runner, speed=SPEED, n=6)
+    statuses[:] = ["Infeasible_Problem_Detected", "Solve_Succeeded"]
+    out = predict_stride(runner, settings, guess, model_spec={"model": "able"})
+    assert len(calls) == 3 and out.stage == "predictive"  # tracking, its restart, predictive
+    (_, first, first_iterate), (x_restart, restart, _), _ = calls
+    np.testing.assert_array_equal(x_restart, first_iterate)  # from the iterate, not the guess
+    assert out.tracking["restarted_after"] == "Infeasible_Problem_Detected"
+    assert out.tracking["iterations"] == first.iterations + restart.iterations == 10
+    # a second local infeasibility ends the solve: one restart, no loop
+    calls.clear()
+    statuses[:] = ["Restoration_Failed", "Infeasible_Problem_Detected"]
+    out = predict_stride(runner, settings, guess, model_spec={"model": "able"})
+    assert len(calls) == 2 and out.stage == "tracking" and not out.converged
+    assert out.nlp.status == "Infeasible_Problem_Detected"
+    # a tracking stage that runs out of iterations is not restarted
+    calls.clear()
+    statuses[:] = ["Maximum_Iterations_Exceeded"]
+    out = predict_stride(runner, settings, guess, model_spec={"model": "able"})
+    assert len(calls) == 1 and "restarted_after" not in out.tracking
+
+
 def test_warm_start_mu_sets_the_barrier_of_a_warm_start_only(able, monkeypatch):
     from bladelab.predict.collocation.transcription import StrideNLP
 
