@@ -140,7 +140,7 @@ def test_resume_keeps_the_runs_settings(tmp_path):
 
 def test_robust_evaluation_is_the_mean_over_jittered_copies():
     from bladelab.predict.reflex.objective import simulate_controlled
-    from bladelab.predict.reflex.optimize import jittered_parameters
+    from bladelab.predict.reflex.robust import jittered_parameters
 
     model, layout = runner_and_layout("able", None)
     robust = ObjectiveSettings(duration=1.0, robust_samples=3, robust_jitter=1e-4)
@@ -159,11 +159,12 @@ def test_robust_evaluation_is_the_mean_over_jittered_copies():
 
 def test_verification_copies_are_not_the_objectives(monkeypatch):
     # a solution optimised to survive the objective's jittered copies must be checked on others
-    import bladelab.predict.reflex.optimize as opt
+    import bladelab.predict.reflex.robust as robust
+    import bladelab.predict.reflex.verify as opt
 
     x = runner_and_layout("able", None)[1].x0
-    seen = opt.jittered_parameters(x, 4, 1e-3)
-    checked = opt.jittered_parameters(x, 4, 1e-3, opt.VERIFY_JITTER_SEED)
+    seen = robust.jittered_parameters(x, 4, 1e-3)
+    checked = robust.jittered_parameters(x, 4, 1e-3, robust.VERIFY_JITTER_SEED)
     assert not any(np.allclose(a, b) for a in seen for b in checked)
     seeds = []
     real = opt.jittered_parameters
@@ -175,7 +176,7 @@ def test_verification_copies_are_not_the_objectives(monkeypatch):
     monkeypatch.setattr(opt, "jittered_parameters", spy)
     shipped = Path(opt.__file__).resolve().parents[2] / "data/runner/solutions/able-3.5.json"
     opt.verify_solution(shipped, duration=0.5, jittered_copies=1, jitter=1e-9)
-    assert seeds == [opt.VERIFY_JITTER_SEED]
+    assert seeds == [robust.VERIFY_JITTER_SEED]
 
 
 def test_a_warm_start_is_never_lost():
@@ -220,7 +221,7 @@ def test_a_folder_holding_a_run_is_refused_unless_resumed_or_forced(tmp_path, ca
 def test_robust_copies_can_start_at_other_speeds():
     # issue 20's "±5 % of the initial speed" inside the objective: copies alternate 1 + s, 1 - s
     from bladelab.predict.reflex.objective import simulate_controlled
-    from bladelab.predict.reflex.optimize import robust_copies
+    from bladelab.predict.reflex.robust import robust_copies
 
     model, layout = runner_and_layout("able", None)
     x = layout.x0
@@ -243,7 +244,7 @@ def test_robust_copies_can_start_at_other_speeds():
 
 
 def test_per_generation_copies_are_new_every_generation_and_resume_exactly(tmp_path):
-    from bladelab.predict.reflex.optimize import generation_jitter_seed, jittered_parameters
+    from bladelab.predict.reflex.robust import generation_jitter_seed, jittered_parameters
 
     fixed = ObjectiveSettings(duration=0.5, robust_samples=2, robust_jitter=1e-3)
     fresh = ObjectiveSettings(duration=0.5, robust_samples=2, robust_jitter=1e-3,
@@ -272,7 +273,7 @@ def test_per_generation_copies_are_new_every_generation_and_resume_exactly(tmp_p
 
 
 def test_verify_solution_from_changed_initial_speeds():
-    import bladelab.predict.reflex.optimize as opt
+    import bladelab.predict.reflex.verify as opt
 
     shipped = Path(opt.__file__).resolve().parents[2] / "data/runner/solutions/able-3.5.json"
     out = opt.verify_solution(shipped, duration=0.5, initial_speed_change=0.05)

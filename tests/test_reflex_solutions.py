@@ -9,7 +9,8 @@ from pathlib import Path
 import pytest
 
 import bladelab
-from bladelab.predict.reflex.optimize import runner_and_layout, verify_solution
+from bladelab.predict.reflex.optimize import runner_and_layout
+from bladelab.predict.reflex.verify import verify_solution
 
 SOLUTIONS = Path(bladelab.__file__).parent / "data" / "runner" / "solutions"
 SHIPPED = sorted(SOLUTIONS.glob("*.json"))  # in_progress/ is not searched
@@ -63,7 +64,7 @@ def _stride_times(force, bw=700.0, dt=0.001):
     """Strides (start, end) [s] of :func:`_strides` on a (n, 2) vertical GRF record [N]."""
     import numpy as np
 
-    from bladelab.predict.reflex.optimize import _strides
+    from bladelab.predict.reflex.verify import _strides
     from bladelab.runner.analyses import step_touchdowns
 
     t = np.arange(len(force)) * dt
@@ -102,7 +103,7 @@ def test_strides_run_from_step_to_step_of_each_leg():
 def test_same_leg_steps_count_hops_and_gallops():
     import numpy as np
 
-    from bladelab.predict.reflex.optimize import _same_leg_steps
+    from bladelab.predict.reflex.verify import _same_leg_steps
     from bladelab.runner.analyses import step_touchdowns
 
     t = np.arange(0.0, 3.0, 0.001)

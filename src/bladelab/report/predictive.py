@@ -155,7 +155,7 @@ class _Solution:
 
     def evaluate(self, nominal_ev):
         """The evaluation as the optimiser computed it (robust mean where the run used it)."""
-        from bladelab.predict.reflex.optimize import robust_evaluation
+        from bladelab.predict.reflex.robust import robust_evaluation
 
         s = self.settings()
         if s.robust_samples > 1:

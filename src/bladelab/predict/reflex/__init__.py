@@ -21,9 +21,9 @@ from bladelab.predict.reflex.optimize import (
     optimize_controller,
     runner_and_layout,
     stored_settings,
-    verify_solution,
 )
 from bladelab.predict.reflex.sweep import finished_cell, run_sweep, summarise
+from bladelab.predict.reflex.verify import verify_solution
 
 __all__ = [
     "ControllerLayout",

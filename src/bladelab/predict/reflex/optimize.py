@@ -31,16 +31,21 @@ import os
 import pickle
 import time
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field, fields, replace
+from dataclasses import dataclass, field, fields
 from pathlib import Path
 
 import numpy as np
 
-from bladelab._io import atomic_open, atomic_path, read_json, write_json
+from bladelab._io import atomic_open, atomic_path, write_json
 from bladelab.errors import InputFileError, OptimizationError
 from bladelab.executors import ProcessPool, RayExecutor
 from bladelab.predict.reflex.controller import ControllerLayout, controller_layout, write_parameters
 from bladelab.predict.reflex.objective import Evaluation, ObjectiveSettings, simulate_controlled
+from bladelab.predict.reflex.robust import (
+    OBJECTIVE_JITTER_SEED,
+    generation_jitter_seed,
+    robust_evaluation,
+)
 from bladelab.runner.model import RunnerModel, build_runner
 
 CHECKPOINT_FORMAT = 1
@@ -79,62 +84,6 @@ def evaluate_candidates(payload: dict) -> list[dict]:
             ev = robust_evaluation(ev, model, x, layout, settings, seed=seed)
         out.append(ev.to_dict())
     return out
-
-
-#: Seed of the directions of the objective's jittered copies (``robust_samples``).
-OBJECTIVE_JITTER_SEED = 20261121
-#: Seed of :func:`verify_solution`'s copies: other directions than the objective's, so that a
-#: solution optimised to survive its copies is checked on copies it has not seen (measured in
-#: session 16: a run that survived its 4 objective copies at 1e-3 fell in 5 of 8 others).
-VERIFY_JITTER_SEED = 20261126
-
-
-def jittered_parameters(x: np.ndarray, n: int, jitter: float,
-                        seed: int | Sequence[int] = OBJECTIVE_JITTER_SEED) -> list[np.ndarray]:
-    """``n`` copies of ``x`` moved by ``jitter`` (relative; absolute 1e-3·jitter near zero)
-    along directions seeded by ``seed`` (the same for every candidate given the same seed)."""
-    rng = np.random.default_rng(seed)
-    scale = jitter * (np.abs(x) + 1e-3)
-    return [x + scale * rng.standard_normal(x.shape) for _ in range(n)]
-
-
-def generation_jitter_seed(settings: ObjectiveSettings, run_seed: int,
-                           generation: int) -> int | list[int]:
-    """The seed of the robust copies' directions in ``generation`` (0: the warm start's
-    evaluation): the objective's fixed seed, or with ``robust_directions="per-generation"`` one
-    of the run's seed and the generation (new directions every generation, the same on resume)."""
-    if settings.robust_directions == "per-generation":
-        return [OBJECTIVE_JITTER_SEED, int(run_seed), int(generation)]
-    return OBJECTIVE_JITTER_SEED
-
-
-def robust_copies(x: np.ndarray, settings: ObjectiveSettings,
-                  seed: int | Sequence[int] = OBJECTIVE_JITTER_SEED,
-                  ) -> list[tuple[np.ndarray, ObjectiveSettings]]:
-    """The ``settings.robust_samples`` − 1 copies of a candidate: its parameters jittered
-    (:func:`jittered_parameters`) and, with ``robust_speed_change`` s > 0, the initial speed
-    [m/s] times 1 + s, 1 − s, 1 + s, ... (nominal settings otherwise)."""
-    xs = jittered_parameters(x, settings.robust_samples - 1, settings.robust_jitter, seed)
-    s = settings.robust_speed_change
-    if s == 0:
-        return [(xj, settings) for xj in xs]
-    v0 = settings.speed if settings.initial_speed is None else settings.initial_speed
-    return [(xj, replace(settings, initial_speed=v0 * (1 + s if k % 2 == 0 else 1 - s)))
-            for k, xj in enumerate(xs)]
-
-
-def robust_evaluation(
-    nominal: Evaluation, model: RunnerModel, x: np.ndarray, layout: ControllerLayout,
-    settings: ObjectiveSettings, seed: int | Sequence[int] = OBJECTIVE_JITTER_SEED,
-) -> Evaluation:
-    """The nominal evaluation of ``x`` with the cost averaged over ``settings.robust_samples``
-    − 1 copies (:func:`robust_copies` with directions seeded by ``seed``; any fall counts)."""
-    costs, fell = [nominal.cost], nominal.fell
-    for xj, copy_settings in robust_copies(x, settings, seed):
-        ev, _ = simulate_controlled(model, xj, layout=layout, settings=copy_settings)
-        costs.append(ev.cost)
-        fell = fell or ev.fell
-    return replace(nominal, cost=float(np.mean(costs)), fell=fell)
 
 
 def stored_settings(
@@ -561,141 +510,10 @@ def load_checkpoint(path: str | Path) -> dict:
     return state
 
 
-def verify_solution(
-    path: str | Path,
-    *,
-    model: str | None = None,
-    blade: str | None = None,
-    speed: float | None = None,
-    duration: float = 10.0,
-    speed_tolerance: float = 0.1,
-    max_power_residual_pct: float = 2.0,
-    jittered_copies: int = 0,
-    jitter: float = 1e-9,
-    initial_speed_change: float = 0.0,
-) -> dict:
-    """Re-simulate a parameter file and check the shipped-solution criteria.
-
-    The simulation uses the objective settings the file was optimised with (its ``settings``:
-    time step, initial speed, weights; without robust sampling), at ``speed`` for ``duration``.
-
-    Criteria (all recomputed from the file, nothing trusted from it): ``duration`` [s] without a
-    fall; mean speed within ``speed_tolerance`` [m/s] of ``speed`` (default: the file's
-    ``speed_m_per_s``); steps (SCONE's definition, :func:`bladelab.runner.analyses.step_touchdowns`:
-    bounces, scuffs below 0.1 body weight and strikes of the swinging foot are not steps)
-    alternating between the legs after the first (``same_leg_steps`` 0: no hop or gallop); a
-    flight phase (no leg loaded above 20 N) in every stride (one step of a leg to its next);
-    reported, not a criterion: ``swing_contacts`` (a swinging foot striking the ground,
-    :func:`bladelab.runner.analyses.swing_contacts`) and the largest one's peak force [N];
-    power-balance residual below
-    ``max_power_residual_pct`` % (runner analyses). With ``jittered_copies`` = n > 0 the same
-    criteria must also hold for n copies of the parameters moved by ``jitter`` (relative,
-    :func:`jittered_parameters`, along directions other than the objective's robust copies):
-    a gait that survives only on one floating-point path (another
-    CPU, compiler or library version) is not a solution. With ``initial_speed_change`` c > 0
-    they must also hold from an initial speed [m/s] (1 + c) and (1 − c) times the file's (issue
-    20: ±5 %). Returns the measured values (the copies' under ``"jittered"``, the changed starts'
-    under ``"initial_speed"``) and ``ok``.
-    """
-
-    from bladelab.predict.reflex.controller import read_parameters
-
-    data = read_json(path, what="parameter file")
-    model = model or data.get("model", "able")
-    blade = blade or data.get("blade")
-    speed = float(speed if speed is not None else data.get("speed_m_per_s", 3.5))
-    runner, layout = runner_and_layout(model, blade)
-    x = read_parameters(path, layout)
-    settings = stored_settings(data, speed=speed, duration=duration, nominal=True)
-    limits = (duration, speed, speed_tolerance, max_power_residual_pct)
-    out = _check_gait(runner, layout, x, settings, limits)
-    if jittered_copies > 0:
-        out["jittered"] = [
-            _check_gait(runner, layout, xj, settings, limits)
-            for xj in jittered_parameters(x, jittered_copies, jitter, VERIFY_JITTER_SEED)
-        ]
-        out["ok"] = bool(out["ok"] and all(c["ok"] for c in out["jittered"]))
-    if initial_speed_change > 0:
-        v0 = settings.speed if settings.initial_speed is None else settings.initial_speed
-        out["initial_speed"] = []
-        for factor in (1 + initial_speed_change, 1 - initial_speed_change):
-            changed = replace(settings, initial_speed=v0 * factor)
-            check = _check_gait(runner, layout, x, changed, limits)
-            out["initial_speed"].append({"initial_speed_m_per_s": v0 * factor, **check})
-        out["ok"] = bool(out["ok"] and all(c["ok"] for c in out["initial_speed"]))
-    return out
-
-
-def _check_gait(runner, layout, x, settings: ObjectiveSettings, limits: tuple) -> dict:
-    """Simulate ``x`` and measure the shipped-solution criteria (:func:`verify_solution`)."""
-    from bladelab.runner.analyses import (
-        CONTACT_THRESHOLD_N,
-        power_balance_residual_pct,
-        step_touchdowns,
-        swing_contacts,
-    )
-
-    duration, speed, tolerance, max_residual = limits
-    ev, res = simulate_controlled(runner, x, layout=layout, settings=settings, record_every=2)
-    leg = res.model.contact_params[:, 6]
-    forces = np.stack([res.contacts[:, leg == i, 1].sum(axis=1) for i in (0, 1)], axis=1)
-    loaded = forces > CONTACT_THRESHOLD_N
-    airborne = ~(loaded[:, 0] | loaded[:, 1])
-    steps = step_touchdowns(res.time, forces, runner.body_weight)
-    flights = [bool(np.any(airborne[a:b])) for a, b in _strides(res.time, steps)]
-    same_leg = _same_leg_steps(steps)
-    residual = power_balance_residual_pct(res)
-    out = {
-        "fell": ev.fell,
-        "duration_s": ev.duration,
-        "mean_speed_m_per_s": ev.mean_speed,
-        "strides": len(flights),
-        "strides_with_flight": int(sum(flights)),
-        "same_leg_steps": same_leg,
-        "swing_contacts": int(len(swings := swing_contacts(res))),
-        "swing_contact_peak_N": float(swings.peak_N.max()) if len(swings) else 0.0,
-        "power_balance_residual_pct": residual,
-        "cost": ev.cost,
-    }
-    out["ok"] = bool(
-        not ev.fell
-        and ev.duration >= duration - 1e-9
-        and abs(ev.mean_speed - speed) <= tolerance
-        and len(flights) >= 2
-        and all(flights)
-        and same_leg == 0
-        and residual <= max_residual
-    )
-    return out
-
-
-def _same_leg_steps(steps: list[tuple[float, int, float]]) -> int:
-    """Steps after the second by the same leg as the step before (hops, gallops, a scuff
-    counted as a step), of :func:`bladelab.runner.analyses.step_touchdowns`' ``steps``."""
-    order = [leg for _, leg, _ in steps]
-    return sum(1 for i in range(2, len(order)) if order[i] == order[i - 1])
-
-
-def _strides(time: np.ndarray, steps: list[tuple[float, int, float]]) -> list[tuple[int, int]]:
-    """Sample ranges of every stride of both legs: from one step of a leg (``steps`` of
-    :func:`bladelab.runner.analyses.step_touchdowns`, time [s] and leg) to its next step."""
-    out = []
-    for leg in (0, 1):
-        t = [ts for ts, side, _ in steps if side == leg]
-        idx = np.searchsorted(time, t)
-        out += list(zip(idx[:-1].tolist(), idx[1:].tolist(), strict=True))
-    return out
-
-
 __all__ = [
     "OptimizationResult",
-    "generation_jitter_seed",
-    "jittered_parameters",
-    "robust_copies",
-    "robust_evaluation",
     "runner_and_layout",
     "stored_settings",
-    "verify_solution",
     "evaluate_candidates",
     "load_checkpoint",
     "optimize_controller",

@@ -1,0 +1,85 @@
+"""Robust evaluation of a reflex controller: jittered copies of its parameters (issue 20).
+
+A candidate's cost with ``ObjectiveSettings.robust_samples`` = n > 1 is the mean over the
+nominal simulation and n − 1 copies (:func:`robust_copies`): the parameters moved by
+``robust_jitter`` (relative) along seeded directions, and with ``robust_speed_change`` s > 0
+started at (1 ± s) × the initial speed. The directions are the same for every candidate of a
+generation (:func:`generation_jitter_seed`: fixed for the run, or new every generation).
+:func:`bladelab.predict.reflex.verify.verify_solution` checks along other directions
+(:data:`VERIFY_JITTER_SEED`).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import replace
+
+import numpy as np
+
+from bladelab.predict.reflex.controller import ControllerLayout
+from bladelab.predict.reflex.objective import Evaluation, ObjectiveSettings, simulate_controlled
+from bladelab.runner.model import RunnerModel
+
+__all__ = [
+    "OBJECTIVE_JITTER_SEED",
+    "VERIFY_JITTER_SEED",
+    "generation_jitter_seed",
+    "jittered_parameters",
+    "robust_copies",
+    "robust_evaluation",
+]
+
+#: Seed of the directions of the objective's jittered copies (``robust_samples``).
+OBJECTIVE_JITTER_SEED = 20261121
+#: Seed of :func:`~bladelab.predict.reflex.verify.verify_solution`'s copies: other directions than the objective's, so that a
+#: solution optimised to survive its copies is checked on copies it has not seen (measured in
+#: session 16: a run that survived its 4 objective copies at 1e-3 fell in 5 of 8 others).
+VERIFY_JITTER_SEED = 20261126
+
+
+def jittered_parameters(x: np.ndarray, n: int, jitter: float,
+                        seed: int | Sequence[int] = OBJECTIVE_JITTER_SEED) -> list[np.ndarray]:
+    """``n`` copies of ``x`` moved by ``jitter`` (relative; absolute 1e-3·jitter near zero)
+    along directions seeded by ``seed`` (the same for every candidate given the same seed)."""
+    rng = np.random.default_rng(seed)
+    scale = jitter * (np.abs(x) + 1e-3)
+    return [x + scale * rng.standard_normal(x.shape) for _ in range(n)]
+
+
+def generation_jitter_seed(settings: ObjectiveSettings, run_seed: int,
+                           generation: int) -> int | list[int]:
+    """The seed of the robust copies' directions in ``generation`` (0: the warm start's
+    evaluation): the objective's fixed seed, or with ``robust_directions="per-generation"`` one
+    of the run's seed and the generation (new directions every generation, the same on resume)."""
+    if settings.robust_directions == "per-generation":
+        return [OBJECTIVE_JITTER_SEED, int(run_seed), int(generation)]
+    return OBJECTIVE_JITTER_SEED
+
+
+def robust_copies(x: np.ndarray, settings: ObjectiveSettings,
+                  seed: int | Sequence[int] = OBJECTIVE_JITTER_SEED,
+                  ) -> list[tuple[np.ndarray, ObjectiveSettings]]:
+    """The ``settings.robust_samples`` − 1 copies of a candidate: its parameters jittered
+    (:func:`jittered_parameters`) and, with ``robust_speed_change`` s > 0, the initial speed
+    [m/s] times 1 + s, 1 − s, 1 + s, ... (nominal settings otherwise)."""
+    xs = jittered_parameters(x, settings.robust_samples - 1, settings.robust_jitter, seed)
+    s = settings.robust_speed_change
+    if s == 0:
+        return [(xj, settings) for xj in xs]
+    v0 = settings.speed if settings.initial_speed is None else settings.initial_speed
+    return [(xj, replace(settings, initial_speed=v0 * (1 + s if k % 2 == 0 else 1 - s)))
+            for k, xj in enumerate(xs)]
+
+
+def robust_evaluation(
+    nominal: Evaluation, model: RunnerModel, x: np.ndarray, layout: ControllerLayout,
+    settings: ObjectiveSettings, seed: int | Sequence[int] = OBJECTIVE_JITTER_SEED,
+) -> Evaluation:
+    """The nominal evaluation of ``x`` with the cost averaged over ``settings.robust_samples``
+    − 1 copies (:func:`robust_copies` with directions seeded by ``seed``; any fall counts)."""
+    costs, fell = [nominal.cost], nominal.fell
+    for xj, copy_settings in robust_copies(x, settings, seed):
+        ev, _ = simulate_controlled(model, xj, layout=layout, settings=copy_settings)
+        costs.append(ev.cost)
+        fell = fell or ev.fell
+    return replace(nominal, cost=float(np.mean(costs)), fell=fell)

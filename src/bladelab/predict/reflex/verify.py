@@ -1,0 +1,143 @@
+"""Checks of a shipped reflex solution (:func:`verify_solution`): it runs, at its speed, with
+flight and alternating steps, and so do copies of it moved along unseen directions and started
+at other initial speeds."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+
+from bladelab._io import read_json
+from bladelab.predict.reflex.objective import ObjectiveSettings, simulate_controlled
+from bladelab.predict.reflex.optimize import runner_and_layout, stored_settings
+from bladelab.predict.reflex.robust import VERIFY_JITTER_SEED, jittered_parameters
+
+__all__ = ["verify_solution"]
+
+
+def verify_solution(
+    path: str | Path,
+    *,
+    model: str | None = None,
+    blade: str | None = None,
+    speed: float | None = None,
+    duration: float = 10.0,
+    speed_tolerance: float = 0.1,
+    max_power_residual_pct: float = 2.0,
+    jittered_copies: int = 0,
+    jitter: float = 1e-9,
+    initial_speed_change: float = 0.0,
+) -> dict:
+    """Re-simulate a parameter file and check the shipped-solution criteria.
+
+    The simulation uses the objective settings the file was optimised with (its ``settings``:
+    time step, initial speed, weights; without robust sampling), at ``speed`` for ``duration``.
+
+    Criteria (all recomputed from the file, nothing trusted from it): ``duration`` [s] without a
+    fall; mean speed within ``speed_tolerance`` [m/s] of ``speed`` (default: the file's
+    ``speed_m_per_s``); steps (SCONE's definition, :func:`bladelab.runner.analyses.step_touchdowns`:
+    bounces, scuffs below 0.1 body weight and strikes of the swinging foot are not steps)
+    alternating between the legs after the first (``same_leg_steps`` 0: no hop or gallop); a
+    flight phase (no leg loaded above 20 N) in every stride (one step of a leg to its next);
+    reported, not a criterion: ``swing_contacts`` (a swinging foot striking the ground,
+    :func:`bladelab.runner.analyses.swing_contacts`) and the largest one's peak force [N];
+    power-balance residual below
+    ``max_power_residual_pct`` % (runner analyses). With ``jittered_copies`` = n > 0 the same
+    criteria must also hold for n copies of the parameters moved by ``jitter`` (relative,
+    :func:`jittered_parameters`, along directions other than the objective's robust copies):
+    a gait that survives only on one floating-point path (another
+    CPU, compiler or library version) is not a solution. With ``initial_speed_change`` c > 0
+    they must also hold from an initial speed [m/s] (1 + c) and (1 − c) times the file's (issue
+    20: ±5 %). Returns the measured values (the copies' under ``"jittered"``, the changed starts'
+    under ``"initial_speed"``) and ``ok``.
+    """
+
+    from bladelab.predict.reflex.controller import read_parameters
+
+    data = read_json(path, what="parameter file")
+    model = model or data.get("model", "able")
+    blade = blade or data.get("blade")
+    speed = float(speed if speed is not None else data.get("speed_m_per_s", 3.5))
+    runner, layout = runner_and_layout(model, blade)
+    x = read_parameters(path, layout)
+    settings = stored_settings(data, speed=speed, duration=duration, nominal=True)
+    limits = (duration, speed, speed_tolerance, max_power_residual_pct)
+    out = _check_gait(runner, layout, x, settings, limits)
+    if jittered_copies > 0:
+        out["jittered"] = [
+            _check_gait(runner, layout, xj, settings, limits)
+            for xj in jittered_parameters(x, jittered_copies, jitter, VERIFY_JITTER_SEED)
+        ]
+        out["ok"] = bool(out["ok"] and all(c["ok"] for c in out["jittered"]))
+    if initial_speed_change > 0:
+        v0 = settings.speed if settings.initial_speed is None else settings.initial_speed
+        out["initial_speed"] = []
+        for factor in (1 + initial_speed_change, 1 - initial_speed_change):
+            changed = replace(settings, initial_speed=v0 * factor)
+            check = _check_gait(runner, layout, x, changed, limits)
+            out["initial_speed"].append({"initial_speed_m_per_s": v0 * factor, **check})
+        out["ok"] = bool(out["ok"] and all(c["ok"] for c in out["initial_speed"]))
+    return out
+
+
+def _check_gait(runner, layout, x, settings: ObjectiveSettings, limits: tuple) -> dict:
+    """Simulate ``x`` and measure the shipped-solution criteria (:func:`verify_solution`)."""
+    from bladelab.runner.analyses import (
+        CONTACT_THRESHOLD_N,
+        power_balance_residual_pct,
+        step_touchdowns,
+        swing_contacts,
+    )
+
+    duration, speed, tolerance, max_residual = limits
+    ev, res = simulate_controlled(runner, x, layout=layout, settings=settings, record_every=2)
+    leg = res.model.contact_params[:, 6]
+    forces = np.stack([res.contacts[:, leg == i, 1].sum(axis=1) for i in (0, 1)], axis=1)
+    loaded = forces > CONTACT_THRESHOLD_N
+    airborne = ~(loaded[:, 0] | loaded[:, 1])
+    steps = step_touchdowns(res.time, forces, runner.body_weight)
+    flights = [bool(np.any(airborne[a:b])) for a, b in _strides(res.time, steps)]
+    same_leg = _same_leg_steps(steps)
+    residual = power_balance_residual_pct(res)
+    out = {
+        "fell": ev.fell,
+        "duration_s": ev.duration,
+        "mean_speed_m_per_s": ev.mean_speed,
+        "strides": len(flights),
+        "strides_with_flight": int(sum(flights)),
+        "same_leg_steps": same_leg,
+        "swing_contacts": int(len(swings := swing_contacts(res))),
+        "swing_contact_peak_N": float(swings.peak_N.max()) if len(swings) else 0.0,
+        "power_balance_residual_pct": residual,
+        "cost": ev.cost,
+    }
+    out["ok"] = bool(
+        not ev.fell
+        and ev.duration >= duration - 1e-9
+        and abs(ev.mean_speed - speed) <= tolerance
+        and len(flights) >= 2
+        and all(flights)
+        and same_leg == 0
+        and residual <= max_residual
+    )
+    return out
+
+
+def _same_leg_steps(steps: list[tuple[float, int, float]]) -> int:
+    """Steps after the second by the same leg as the step before (hops, gallops, a scuff
+    counted as a step), of :func:`bladelab.runner.analyses.step_touchdowns`' ``steps``."""
+    order = [leg for _, leg, _ in steps]
+    return sum(1 for i in range(2, len(order)) if order[i] == order[i - 1])
+
+
+def _strides(time: np.ndarray, steps: list[tuple[float, int, float]]) -> list[tuple[int, int]]:
+    """Sample ranges of every stride of both legs: from one step of a leg (``steps`` of
+    :func:`bladelab.runner.analyses.step_touchdowns`, time [s] and leg) to its next step."""
+    out = []
+    for leg in (0, 1):
+        t = [ts for ts, side, _ in steps if side == leg]
+        idx = np.searchsorted(time, t)
+        out += list(zip(idx[:-1].tolist(), idx[1:].tolist(), strict=True))
+    return out
