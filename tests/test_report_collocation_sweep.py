@@ -188,15 +188,44 @@ def test_a_flagged_solve_is_a_cross_off_the_curves_and_out_of_the_summary(tmp_pa
     assert "flagged (gait warnings)" in [ln.get_label() for ln in cost.lines]
 
 
-def test_the_section_names_the_flagged_solves(tmp_path, monkeypatch):
+def test_a_flagged_maximum_speed_gait_is_labelled(tmp_path, monkeypatch):
+    # the best-of-paths study's Cat4 maximum-speed stride peaks at 8.4 BW (flagged today)
     import bladelab.report.predictive_sections as sections
 
     shown = {}
     monkeypatch.setattr(sections, "_gait_sections",
                         lambda report, results, cycles: shown.update(results))
-    folder = _subset(tmp_path, ["Cat6"])
-    _flag(folder, "Cat6", "max-speed", "the stride time sits on its bound (0.4 s)")
+    study = STUDY.parent / "study-2026-11-25" / "amputee"
+    folder = tmp_path / "sweep"
+    shutil.copytree(study / "amputee-Cat4", folder / "amputee-Cat4")
+    table = pd.read_csv(study / "collocation-sweep.csv")
+    table[table.blade == "Cat4"].to_csv(folder / "collocation-sweep.csv", index=False)
     rep = build_predictive_report(folder, tmp_path / "report", progress=False, animate=False)
     html = Path(rep.index).read_text(encoding="utf-8")
-    assert "Converged but flagged by the gait checks" in html and "amputee Cat6 max-speed" in html
-    assert list(shown) == [s for s in rep.solutions] and "flagged" in rep.solutions[0]
+    assert "Converged but flagged by the gait checks" in html
+    assert "amputee Cat4 max-speed" in html
+    assert list(shown) == list(rep.solutions) and "flagged" in rep.solutions[0]
+
+
+def test_an_older_table_is_judged_by_today_s_gait_checks(tmp_path):
+    # the best-of-paths study's table predates the gait warnings; its Cat4 5 m/s stride peaks
+    # at 11 BW, which today's checks flag from the solution file itself
+    from bladelab.predict.collocation.solution import CollocationSolution
+    from bladelab.report.builder import Report
+    from bladelab.report.collocation_sweep import collocation_sweep_sections
+
+    study = STUDY.parent / "study-2026-11-25" / "amputee"
+    out = tmp_path / "sweep"
+    shutil.copytree(study / "amputee-Cat4", out / "amputee-Cat4")
+    table = pd.read_csv(study / "collocation-sweep.csv")
+    table = table[(table.blade == "Cat4") & (table.problem == "speed")]
+    table.to_csv(out / "collocation-sweep.csv", index=False)
+    assert not read_sweep_table(out).flagged.any()  # nothing recorded
+    five = table[table.prescribed_speed_mps == 5.0].iloc[0]
+    assert CollocationSolution.read(out / five.file).gait_warnings()
+    rep = Report("t")
+    _, summary = collocation_sweep_sections(rep, out)
+    text = " ".join(rep.sections[0].text)
+    assert "flagged by the gait checks" in text and "amputee Cat4 speed 5.0" in text
+    assert "amputee Cat4 speed 4.0" not in text
+    assert math.isfinite(summary.iloc[0].cot_4)

@@ -9,8 +9,9 @@ report shows, before the predictive sections that every predictive report has:
   curve per model, the maximum-speed solve marked;
 - every solve of the table, converged or not (a solve that did not converge is listed, never
   plotted or averaged; a converged solve that the gait checks flag, its ``warnings`` column not
-  empty: a hop, a stride on its bound, a double contact, an impact peak, is drawn as a cross
-  off the curves and left out of the category table, and the text names it);
+  empty: a hop, a stride on its bound, a double contact, an impact peak; the checks are run
+  again on each solution file, so an older table is judged by today's checks) is drawn as a
+  cross off the curves and left out of the category table, and the text names it);
 - for a folder whose problems were solved from several starts (``bladelab sweep --method
   collocation --starts K``, or paths merged by ``benchmarks/collocation/merge_starts.py``):
   per problem the kept start, every start's objective and their spread (:func:`starts_table`);
@@ -123,6 +124,24 @@ def starts_table(table: pd.DataFrame) -> pd.DataFrame | None:
     return table[[c for c in cols if c in table.columns]].reset_index(drop=True)
 
 
+def _with_current_warnings(table: pd.DataFrame, folder: Path) -> pd.DataFrame:
+    """The table with ``warnings`` and ``flagged`` from today's gait checks, re-run on each
+    converged solve's file (a table written before a check existed says nothing of it); a
+    row whose file is missing keeps its recorded warnings."""
+    from bladelab.predict.collocation.solution import CollocationSolution
+
+    table = table.copy()
+    if "warnings" not in table:
+        table["warnings"] = ""
+    table["warnings"] = table["warnings"].fillna("").astype(str)
+    for i, row in table[table.converged].iterrows():
+        path = folder / str(row["file"])
+        if path.is_file():
+            table.loc[i, "warnings"] = "; ".join(CollocationSolution.read(path).gait_warnings())
+    table["flagged"] = table.converged & table.warnings.str.strip().str.len().gt(0)
+    return table
+
+
 def _problem_name(row) -> str:
     """'amputee Cat4 speed 5.0' or 'able max-speed' for the text."""
     return (f"{row.model} {row.problem} "
@@ -180,7 +199,7 @@ def collocation_sweep_sections(report, folder: str | Path) -> tuple[dict, pd.Dat
     from bladelab.predict.collocation.stored import runner_from_spec
 
     folder = Path(folder)
-    table = read_sweep_table(folder)
+    table = _with_current_warnings(read_sweep_table(folder), folder)
     failed = table[~table.converged]
     fig = _speed_figure(table)
     text = f"{len(table)} solves, {int(table.converged.sum())} converged. "
