@@ -205,6 +205,7 @@ def test_a_flagged_maximum_speed_gait_is_labelled(tmp_path, monkeypatch):
     assert "Converged but flagged by the gait checks" in html
     assert "amputee Cat4 max-speed" in html
     assert list(shown) == list(rep.solutions) and "flagged" in rep.solutions[0]
+    assert "A dash: nothing to report" in html  # the category table says why Cat4 has none
 
 
 def test_an_older_table_is_judged_by_today_s_gait_checks(tmp_path):

@@ -372,13 +372,18 @@ def _sweep_section(report, summary: pd.DataFrame, compare_seed: bool) -> None:
         summary.rename(columns=SUMMARY_LABELS),
     )]
     text = None
+    if summary.drop(columns="category").isna().to_numpy().any():
+        text = ("A dash: nothing to report for that category (no solution at that speed, one "
+                "that did not converge, or, in a collocation sweep, one flagged by the gait "
+                "checks: the sweep's first section names it).")
     if seed is not None:
         tables.append(("bladelab beside seed 001 (Fig. 3.7, Table 3.1, Fig. 3.9)",
                        seed_comparison(summary)))
-        text = ("Seed 001's values come from its §3.2 text and Table 3.1 (every number is stated "
-                "there; the source column names the table or figure that shows it). 'within seed "
-                "range' asks whether our value lies within the seed's spread over its five "
-                "categories.")
+        text = ((text + " ") if text else "") + (
+            "Seed 001's values come from its §3.2 text and Table 3.1 (every number is stated "
+            "there; the source column names the table or figure that shows it). 'within seed "
+            "range' asks whether our value lies within the seed's spread over its five "
+            "categories.")
     report.add_section(
         "Blade categories: maximum speed and metabolic cost",
         figures=[("Metabolic cost at 4 m/s and maximum speed per category "
