@@ -35,17 +35,6 @@ def _check_simulation_options(dt: float, robust_samples: int, robust_jitter: flo
         raise SpecError("must be in (0, 0.1)", where="--robust-jitter")
 
 
-def _check_robust_copies(directions: str, speed_change: float) -> None:
-    """The options of how the robust copies differ from the nominal simulation."""
-    from bladelab.predict.reflex.objective import ROBUST_DIRECTIONS
-
-    if directions not in ROBUST_DIRECTIONS:
-        raise SpecError(f"unknown value {directions!r}", where="--robust-directions",
-                        hint=" or ".join(ROBUST_DIRECTIONS))
-    if not (math.isfinite(speed_change) and 0 <= speed_change < 0.5):
-        raise SpecError("must be in [0, 0.5)", where="--robust-speed-change")
-
-
 def register(app: typer.Typer) -> None:
     @app.command("predict")
     def predict(
@@ -166,7 +155,7 @@ def register(app: typer.Typer) -> None:
             raise SpecError("only with --method collocation", where="--body",
                             hint="the reflex controller is tuned to seed 001's body")
         from bladelab.predict.reflex.controller import read_parameters
-        from bladelab.predict.reflex.objective import ObjectiveSettings
+        from bladelab.predict.reflex.objective import ObjectiveSettings, check_robust_copies
         from bladelab.predict.reflex.optimize import optimize_seeds, runner_and_layout
 
         if model not in ("able", "amputee"):
@@ -174,7 +163,8 @@ def register(app: typer.Typer) -> None:
         if not (math.isfinite(speed) and speed > 0):
             raise SpecError("speed must be positive", where="--speed")
         _check_simulation_options(dt, robust_samples, robust_jitter)
-        _check_robust_copies(robust_directions, robust_speed_change)
+        check_robust_copies(robust_directions, robust_speed_change,
+                            where=("--robust-directions", "--robust-speed-change"))
         if integrator not in ("explicit", "implicit"):
             raise SpecError(f"unknown integrator {integrator!r}", where="--integrator",
                             hint="explicit or implicit")

@@ -70,6 +70,19 @@ TRACK_SAMPLE_S = 2e-3
 ROBUST_DIRECTIONS = ("fixed", "per-generation")
 
 
+def check_robust_copies(directions: str, speed_change: float, *,
+                        where: tuple[str, str] = ("robust_directions", "robust_speed_change"),
+                        ) -> None:
+    """Refuse robust-copy options :class:`ObjectiveSettings` cannot use: ``directions`` one
+    of :data:`ROBUST_DIRECTIONS`, ``speed_change`` in [0, 0.5); ``where`` names the two (the
+    fields, or the command line's options)."""
+    if directions not in ROBUST_DIRECTIONS:
+        raise SpecError(f"unknown value {directions!r}", where=where[0],
+                        hint=" or ".join(ROBUST_DIRECTIONS))
+    if not (math.isfinite(speed_change) and 0 <= speed_change < 0.5):
+        raise SpecError(f"must be in [0, 0.5), got {speed_change}", where=where[1])
+
+
 @dataclass(frozen=True)
 class ObjectiveSettings:
     """Weights and ranges of the objective (seed 001 §2.2.1). Speeds [m/s], load [N·m], tilt
@@ -100,18 +113,18 @@ class ObjectiveSettings:
     track_skip: float = 1.0
 
     def __post_init__(self) -> None:
-        if self.robust_directions not in ROBUST_DIRECTIONS:
-            raise SpecError(f"unknown robust directions {self.robust_directions!r}",
-                            where="robust_directions", hint=" or ".join(ROBUST_DIRECTIONS))
-        if not (math.isfinite(self.robust_speed_change) and 0 <= self.robust_speed_change < 0.5):
-            raise SpecError(f"must be in [0, 0.5), got {self.robust_speed_change}",
-                            where="robust_speed_change")
+        check_robust_copies(self.robust_directions, self.robust_speed_change)
         if self.w_track < 0 or not math.isfinite(self.w_track):
             raise SpecError(f"the tracking weight must be >= 0, got {self.w_track}",
                             where="w_track")
         if self.w_track > 0 and self.track is None:
             raise SpecError("a tracking weight needs a stride to track", where="track",
                             hint="a collocation solution file (bladelab predict --track)")
+
+    @property
+    def start_speed(self) -> float:
+        """Forward speed of the initial state [m/s]: ``initial_speed``, else ``speed``."""
+        return self.speed if self.initial_speed is None else self.initial_speed
 
     @classmethod
     def from_dict(cls, d: dict) -> ObjectiveSettings:
@@ -210,7 +223,7 @@ def simulate_controlled(
     m, own_sites = simulation_model(model, settings.integrator)
     m.opt.timestep = dt
     d = mujoco.MjData(m)
-    v_start = settings.speed if settings.initial_speed is None else settings.initial_speed
+    v_start = settings.start_speed
     q0, v0 = initial_state(model, layout, x, v_start)
     d.qpos[:] = q0
     d.qvel[:] = v0
@@ -390,8 +403,10 @@ def evaluate(
 
 
 __all__ = [
+    "ROBUST_DIRECTIONS",
     "Evaluation",
     "ObjectiveSettings",
+    "check_robust_copies",
     "evaluate",
     "initial_state",
     "simulate_controlled",

@@ -66,7 +66,7 @@ def robust_copies(x: np.ndarray, settings: ObjectiveSettings,
     s = settings.robust_speed_change
     if s == 0:
         return [(xj, settings) for xj in xs]
-    v0 = settings.speed if settings.initial_speed is None else settings.initial_speed
+    v0 = settings.start_speed
     return [(xj, replace(settings, initial_speed=v0 * (1 + s if k % 2 == 0 else 1 - s)))
             for k, xj in enumerate(xs)]
 

@@ -72,7 +72,7 @@ def verify_solution(
         ]
         out["ok"] = bool(out["ok"] and all(c["ok"] for c in out["jittered"]))
     if initial_speed_change > 0:
-        v0 = settings.speed if settings.initial_speed is None else settings.initial_speed
+        v0 = settings.start_speed
         out["initial_speed"] = []
         for factor in (1 + initial_speed_change, 1 - initial_speed_change):
             changed = replace(settings, initial_speed=v0 * factor)
