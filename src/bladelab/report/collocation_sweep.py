@@ -76,9 +76,14 @@ def read_sweep_table(folder: str | Path) -> pd.DataFrame:
                              file=path, hint="rewrite it with 'bladelab sweep --method "
                                              "collocation --resume'")
     table["converged"] = table["converged"].astype(str).str.lower().isin(["true", "1"])
-    warnings = (table["warnings"].fillna("").astype(str).str.strip() if "warnings" in table
-                else pd.Series("", index=table.index))
-    table["flagged"] = table["converged"] & warnings.str.len().gt(0)
+    table["warnings"] = (table["warnings"].fillna("").astype(str) if "warnings" in table
+                         else "")
+    return _flag(table)
+
+
+def _flag(table: pd.DataFrame) -> pd.DataFrame:
+    """Set ``flagged``: converged, with a non-empty ``warnings``."""
+    table["flagged"] = table.converged & table.warnings.str.strip().str.len().gt(0)
     return table
 
 
@@ -92,7 +97,7 @@ def sweep_summary(table: pd.DataFrame) -> pd.DataFrame:
     rows = []
     amputee = table[table.model.astype(str).str.startswith("amputee")]
     for cat, df in amputee.groupby("blade", sort=False):
-        ok = df[df.converged & ~df["flagged"]] if "flagged" in df else df[df.converged]
+        ok = df[df.converged & ~df.flagged]
         top = ok[ok.problem == "max-speed"]
         at4 = ok[(ok.problem == "speed")
                  & np.isclose(ok.prescribed_speed_mps.astype(float), COST_SPEED_M_PER_S)]
@@ -124,22 +129,20 @@ def starts_table(table: pd.DataFrame) -> pd.DataFrame | None:
     return table[[c for c in cols if c in table.columns]].reset_index(drop=True)
 
 
-def _with_current_warnings(table: pd.DataFrame, folder: Path) -> pd.DataFrame:
-    """The table with ``warnings`` and ``flagged`` from today's gait checks, re-run on each
-    converged solve's file (a table written before a check existed says nothing of it); a
-    row whose file is missing keeps its recorded warnings."""
+def _with_current_warnings(table: pd.DataFrame, folder: Path) -> tuple[pd.DataFrame, dict]:
+    """(the table with ``warnings`` and ``flagged`` from today's gait checks, re-run on each
+    converged solve's file (a table written before a check existed says nothing of it), {row
+    index: the solution read}); a row whose file is missing keeps its recorded warnings."""
     from bladelab.predict.collocation.solution import CollocationSolution
 
     table = table.copy()
-    if "warnings" not in table:
-        table["warnings"] = ""
-    table["warnings"] = table["warnings"].fillna("").astype(str)
+    solutions = {}
     for i, row in table[table.converged].iterrows():
         path = folder / str(row["file"])
         if path.is_file():
-            table.loc[i, "warnings"] = "; ".join(CollocationSolution.read(path).gait_warnings())
-    table["flagged"] = table.converged & table.warnings.str.strip().str.len().gt(0)
-    return table
+            solutions[i] = CollocationSolution.read(path)
+            table.loc[i, "warnings"] = "; ".join(solutions[i].gait_warnings())
+    return _flag(table), solutions
 
 
 def _problem_name(row) -> str:
@@ -153,7 +156,7 @@ def _speed_figure(table: pd.DataFrame):
     through the clean converged solves, a cross for each flagged one."""
     import matplotlib.pyplot as plt
 
-    flagged = table.get("flagged", pd.Series(False, index=table.index))
+    flagged = table.flagged
     ok = table[table.converged]
     # per-leg columns contact_time_<leg>_s (not the legs' mean, contact_time_s)
     legs = [m.group(1) for c in table.columns if (m := re.fullmatch(r"contact_time_(.+)_s", c))]
@@ -195,11 +198,10 @@ def collocation_sweep_sections(report, folder: str | Path) -> tuple[dict, pd.Dat
     import matplotlib.pyplot as plt
 
     from bladelab.predict.collocation.model import build_collocation_model
-    from bladelab.predict.collocation.solution import CollocationSolution
     from bladelab.predict.collocation.stored import runner_from_spec
 
     folder = Path(folder)
-    table = _with_current_warnings(read_sweep_table(folder), folder)
+    table, solutions = _with_current_warnings(read_sweep_table(folder), folder)
     failed = table[~table.converged]
     fig = _speed_figure(table)
     text = f"{len(table)} solves, {int(table.converged.sum())} converged. "
@@ -244,11 +246,11 @@ def collocation_sweep_sections(report, folder: str | Path) -> tuple[dict, pd.Dat
     plt.close(fig)
     results = {}
     for r in table[table.converged & (table.problem == "max-speed")].itertuples():
-        path = folder / str(r.file)
-        if not path.is_file():
-            raise InputFileError("a solution named in the sweep table is missing", file=path,
+        if r.Index not in solutions:
+            raise InputFileError("a solution named in the sweep table is missing",
+                                 file=folder / str(r.file),
                                  hint="re-run 'bladelab sweep --method collocation --resume'")
-        sol = CollocationSolution.read(path)
+        sol = solutions[r.Index]
         runner = runner_from_spec(sol.model_spec)
         label = (f"{r.model} max {sol.mean_speed_mps:.2f} m/s (collocation"
                  + (", flagged)" if r.flagged else ")"))
