@@ -175,3 +175,45 @@ def test_initial_speed_sets_the_starting_state_not_the_target(able):
         firsts[v0] = res.qvel[0, ix]
     assert firsts[None] == pytest.approx(4.0, abs=0.02)
     assert firsts[3.0] == pytest.approx(3.0, abs=0.02)
+
+
+def test_a_push_changes_the_forward_speed_at_its_step_and_nothing_before(able):
+    # ObjectiveSettings.push = (time [s], relative change): the pelvis's forward velocity is
+    # multiplied by 1 + change at that instant; the run is the unpushed one until then
+    model, layout = able
+    ix = model.dof("pelvis_tx")
+    plain = ObjectiveSettings(duration=0.4, dt=1e-3, integrator="implicit")
+    pushed = ObjectiveSettings(duration=0.4, dt=1e-3, integrator="implicit", push=(0.2, 0.05))
+    _, a = simulate_controlled(model, layout.x0, layout=layout, settings=plain, record_every=1)
+    _, b = simulate_controlled(model, layout.x0, layout=layout, settings=pushed, record_every=1)
+    k = int(np.searchsorted(a.time, 0.2 - 1e-9))
+    assert a.time[k] == pytest.approx(0.2)
+    np.testing.assert_array_equal(a.qvel[:k], b.qvel[:k])
+    np.testing.assert_array_equal(a.qpos[:k + 1], b.qpos[:k + 1])
+    assert b.qvel[k, ix] == pytest.approx(1.05 * a.qvel[k, ix], rel=1e-12)
+    others = np.arange(a.qvel.shape[1]) != ix
+    np.testing.assert_array_equal(a.qvel[k, others], b.qvel[k, others])
+    # afterwards the pushed body is ahead by about the extra speed times the time since
+    dx = b.qpos[k + 50, ix] - a.qpos[k + 50, ix]
+    assert dx == pytest.approx(0.05 * a.qvel[k, ix] * 0.05, rel=0.3)
+    # a push of zero is no push
+    zero = ObjectiveSettings(duration=0.4, dt=1e-3, integrator="implicit", push=(0.2, 0.0))
+    _, c = simulate_controlled(model, layout.x0, layout=layout, settings=zero, record_every=1)
+    np.testing.assert_array_equal(a.qpos, c.qpos)
+
+
+@pytest.mark.parametrize("push", [(11.0, 0.05), (1.0, 0.6), (-1.0, 0.05)])
+def test_a_push_outside_the_run_is_refused(push):
+    from bladelab.errors import SpecError
+
+    with pytest.raises(SpecError, match="push"):
+        ObjectiveSettings(duration=10.0, push=push)
+
+
+def test_pushed_copies_need_room_for_the_push():
+    from bladelab.errors import SpecError
+
+    with pytest.raises(SpecError, match="robust_push"):
+        ObjectiveSettings(duration=4.0, robust_push=0.02)
+    s = ObjectiveSettings(duration=10.0, robust_push=0.02, push=(5.0, -0.02))
+    assert ObjectiveSettings.from_dict(s.to_dict()) == s

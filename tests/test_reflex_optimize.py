@@ -243,6 +243,33 @@ def test_robust_copies_can_start_at_other_speeds():
     assert got[0]["cost"] == pytest.approx(np.mean(costs), rel=1e-12)
 
 
+def test_robust_copies_can_be_pushed_in_mid_run():
+    # robust_push p: copy k is pushed by +p, -p, ... at a seeded time inside the push window
+    from bladelab.predict.reflex.objective import push_window
+    from bladelab.predict.reflex.robust import robust_copies
+
+    x = runner_and_layout("able", None)[1].x0
+    pushed = ObjectiveSettings(duration=10.0, robust_samples=5, robust_push=0.03)
+    copies = robust_copies(x, pushed, seed=[1, 2])
+    lo, hi = push_window(10.0)
+    assert 0 < lo < hi < 10.0
+    times = [s.push[0] for _, s in copies]
+    assert all(lo <= t <= hi for t in times) and len(set(times)) == 4
+    assert [s.push[1] for _, s in copies] == [0.03, -0.03, 0.03, -0.03]
+    assert all(s.initial_speed is None and s.robust_push == 0.03 for _, s in copies)
+    # the same times for the same seed, others for another; the jitter directions do not
+    # depend on the pushes
+    assert [s.push for _, s in robust_copies(x, pushed, seed=[1, 2])] == [s.push for _, s in copies]
+    assert [s.push[0] for _, s in robust_copies(x, pushed, seed=[1, 3])] != times
+    plain = ObjectiveSettings(duration=10.0, robust_samples=5)
+    for (a, _), (b, _) in zip(copies, robust_copies(x, plain, seed=[1, 2]), strict=True):
+        np.testing.assert_array_equal(a, b)
+    both = ObjectiveSettings(duration=10.0, robust_samples=3, robust_push=0.03,
+                             robust_speed_change=0.05, initial_speed=4.0)
+    assert [(s.initial_speed, s.push[1]) for _, s in robust_copies(x, both)] == [
+        (pytest.approx(4.2), 0.03), (pytest.approx(3.8), -0.03)]
+
+
 def test_per_generation_copies_are_new_every_generation_and_resume_exactly(tmp_path):
     from bladelab.predict.reflex.robust import generation_jitter_seed, jittered_parameters
 
@@ -284,9 +311,16 @@ def test_verify_solution_from_changed_initial_speeds():
     assert "initial_speed" not in opt.verify_solution(shipped, duration=0.5)
 
 
-@pytest.mark.parametrize(("option", "value"), [("--robust-directions", "sometimes"),
-                                                ("--robust-speed-change", "0.7")])
-def test_cli_refuses_bad_robust_copies(tmp_path, capsys, option, value):
-    assert main(["predict", option, value, "--out", str(tmp_path / "x")]) == 2
-    assert option in capsys.readouterr().err
+@pytest.mark.parametrize(("option", "value", "named"), [
+    ("--robust-directions", "sometimes", "--robust-directions"),
+    ("--robust-speed-change", "0.7", "--robust-speed-change"),
+    ("--robust-push", "-0.1", "--robust-push"),
+    ("--robust-push", "0.02", "--duration"),  # the default 10 s has room; 4 s has not
+])
+def test_cli_refuses_bad_robust_copies(tmp_path, capsys, option, value, named):
+    args = ["predict", option, value, "--out", str(tmp_path / "x")]
+    if named == "--duration":
+        args += ["--duration", "4"]
+    assert main(args) == 2
+    assert named in capsys.readouterr().err
     assert not (tmp_path / "x").exists()

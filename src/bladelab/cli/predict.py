@@ -76,6 +76,10 @@ def register(app: typer.Typer) -> None:
             0.0, "--robust-speed-change", help="Start the copies at (1 + s), (1 - s), ... × the "
             "initial speed (relative; 0.05: the ±5 % acceptance test inside the objective)."
         ),
+        robust_push: float = typer.Option(
+            0.0, "--robust-push", help="Push each copy once in mid-run: its forward speed "
+            "times (1 + p), (1 - p), ... at a seeded time (relative; tests the gait's basin)."
+        ),
         initial_speed: float | None = typer.Option(
             None, "--initial-speed", help="Forward speed of the initial state (m/s); default --speed."
         ),
@@ -163,8 +167,9 @@ def register(app: typer.Typer) -> None:
         if not (math.isfinite(speed) and speed > 0):
             raise SpecError("speed must be positive", where="--speed")
         _check_simulation_options(dt, robust_samples, robust_jitter)
-        check_robust_copies(robust_directions, robust_speed_change,
-                            where=("--robust-directions", "--robust-speed-change"))
+        check_robust_copies(robust_directions, robust_speed_change, robust_push, duration,
+                            where=("--robust-directions", "--robust-speed-change",
+                                   "--robust-push", "--duration"))
         if integrator not in ("explicit", "implicit"):
             raise SpecError(f"unknown integrator {integrator!r}", where="--integrator",
                             hint="explicit or implicit")
@@ -207,6 +212,7 @@ def register(app: typer.Typer) -> None:
                 robust_jitter=robust_jitter,
                 robust_directions=robust_directions,
                 robust_speed_change=robust_speed_change,
+                robust_push=robust_push,
                 initial_speed=initial_speed,
                 integrator=integrator,
                 track=None if track is None else str(track),

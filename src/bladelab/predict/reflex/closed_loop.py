@@ -124,15 +124,20 @@ def control_step(k, dt, mj, arrays, control):
 @njit(cache=True)
 def run_closed_loop(
     f1, f2, mptr, dptr, n_steps, record_every, dt, iz, fall_height, mj, arrays, rec, control,
-    imp,
+    imp, push,
 ):
     """The runner's compiled time loop (:func:`bladelab.runner.kernel.run_loop`) with the reflex
     controller: :func:`control_step` between MuJoCo's ``mj_step1`` and the forces of every step.
+    ``push`` = (step, factor, dof): at that step (−1: never) the dof's velocity is multiplied by
+    the factor (a push; :class:`~bladelab.predict.reflex.objective.ObjectiveSettings.push`).
     Stops after ``n_steps`` or at a fall; returns (last step, samples recorded, fell)."""
     root_com = np.zeros(3)
     k_rec = 0
     k = 0
+    push_step = int(push[0])
     for k in range(n_steps + 1):
+        if k == push_step:
+            mj[1][int(push[2])] *= push[1]
         step_begin(f1, mptr, dptr, mj, root_com, imp)
         control_step(k, dt, mj, arrays, control)
         k_rec, fell = step_end(k, k_rec, record_every, dt, iz, fall_height, mj, arrays, rec,

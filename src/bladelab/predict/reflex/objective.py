@@ -35,6 +35,10 @@ survive only on the exact floating-point path and fall after a 1e-9 change (docs
 so a resume is exact), so that a controller cannot learn to survive a handful of fixed copies
 and no others. ``robust_speed_change`` s > 0 also starts the copies at (1 ± s) × the initial
 speed, alternately (the ±5 % initial-speed acceptance test of issue 20 inside the objective).
+``robust_push`` p > 0 pushes copy k once, at a time drawn from its seed in
+:func:`push_window`: its forward (pelvis) speed times 1 + p (k even) or 1 − p (k odd) from
+that instant (``push`` = (time [s], relative change) of one simulation). The start's first
+steps test a gait's transient; a push in mid-run tests its basin of attraction (docs/predictive.md).
 """
 
 from __future__ import annotations
@@ -70,17 +74,40 @@ TRACK_SAMPLE_S = 2e-3
 ROBUST_DIRECTIONS = ("fixed", "per-generation")
 
 
-def check_robust_copies(directions: str, speed_change: float, *,
-                        where: tuple[str, str] = ("robust_directions", "robust_speed_change"),
+def check_robust_copies(directions: str, speed_change: float, push: float = 0.0,
+                        duration: float = math.inf, *,
+                        where: tuple[str, ...] = ("robust_directions", "robust_speed_change",
+                                                  "robust_push", "duration"),
                         ) -> None:
     """Refuse robust-copy options :class:`ObjectiveSettings` cannot use: ``directions`` one
-    of :data:`ROBUST_DIRECTIONS`, ``speed_change`` in [0, 0.5); ``where`` names the two (the
-    fields, or the command line's options)."""
+    of :data:`ROBUST_DIRECTIONS`, ``speed_change`` and ``push`` in [0, 0.5), a push only in a
+    simulation of at least :data:`MIN_PUSH_DURATION` [s]; ``where`` names them (the fields, or
+    the command line's options)."""
     if directions not in ROBUST_DIRECTIONS:
         raise SpecError(f"unknown value {directions!r}", where=where[0],
                         hint=" or ".join(ROBUST_DIRECTIONS))
-    if not (math.isfinite(speed_change) and 0 <= speed_change < 0.5):
-        raise SpecError(f"must be in [0, 0.5), got {speed_change}", where=where[1])
+    for value, name in ((speed_change, where[1]), (push, where[2])):
+        if not (math.isfinite(value) and 0 <= value < 0.5):
+            raise SpecError(f"must be in [0, 0.5), got {value}", where=name)
+    if push > 0 and duration < MIN_PUSH_DURATION:
+        raise SpecError(f"a push needs a simulation of at least {MIN_PUSH_DURATION:g} s "
+                        f"(after the start's first steps, with time to fall), got {duration:g} s",
+                        where=where[3], hint=f"a longer {where[3]}, or no {where[2]}")
+
+
+def push_window(duration: float) -> tuple[float, float]:
+    """Times [s] between which a robust copy's push falls (``robust_push``): after the start's
+    first steps (:data:`PUSH_AFTER` s) and early enough that a gait it fells falls before the
+    end (:data:`PUSH_BEFORE_END` s before it; measured: 1–5 s after a 2 % push)."""
+    return PUSH_AFTER, duration - PUSH_BEFORE_END
+
+
+#: A robust copy's push (``robust_push``) comes this long [s] after the start ...
+PUSH_AFTER = 2.0
+#: ... and this long [s] before the end of the simulation.
+PUSH_BEFORE_END = 4.0
+#: The shortest simulation [s] a push fits into.
+MIN_PUSH_DURATION = PUSH_AFTER + PUSH_BEFORE_END + 1.0
 
 
 @dataclass(frozen=True)
@@ -104,6 +131,8 @@ class ObjectiveSettings:
     robust_jitter: float = 1e-6
     robust_directions: str = "fixed"
     robust_speed_change: float = 0.0
+    robust_push: float = 0.0
+    push: tuple[float, float] | None = None
     alternating_steps: bool = True
     strike_limit_bw: float = 1.0
     initial_speed: float | None = None
@@ -113,7 +142,13 @@ class ObjectiveSettings:
     track_skip: float = 1.0
 
     def __post_init__(self) -> None:
-        check_robust_copies(self.robust_directions, self.robust_speed_change)
+        check_robust_copies(self.robust_directions, self.robust_speed_change,
+                            self.robust_push, self.duration)
+        if self.push is not None:
+            t, change = self.push
+            if not (0 <= t <= self.duration and -0.5 < change < 0.5):
+                raise SpecError(f"a push at {t} s changing the speed by {change} (relative) does "
+                                f"not fit a {self.duration} s simulation", where="push")
         if self.w_track < 0 or not math.isfinite(self.w_track):
             raise SpecError(f"the tracking weight must be >= 0, got {self.w_track}",
                             where="w_track")
@@ -130,8 +165,8 @@ class ObjectiveSettings:
     def from_dict(cls, d: dict) -> ObjectiveSettings:
         """Settings from :meth:`to_dict`'s output (JSON lists back to tuples)."""
         d = dict(d)
-        for key in ("knee_load_range", "pelvis_tilt_range_deg"):
-            if key in d:
+        for key in ("knee_load_range", "pelvis_tilt_range_deg", "push"):
+            if d.get(key) is not None:
                 d[key] = tuple(d[key])
         return cls(**d)
 
@@ -282,6 +317,9 @@ def simulate_controlled(
     else:
         every = n_steps + 1
     rec = Recording(model, n_steps, every)
+    push = np.array([-1.0, 1.0, ix])
+    if settings.push is not None:
+        push[:2] = round(settings.push[0] / dt), 1.0 + settings.push[1]
     f1, f2 = mujoco_step_addresses()
     arrays = (mp, ms, mtu, seg_u, u, path, pstart, cp, cstate, jp, crec, lig)
     control = (
@@ -318,6 +356,7 @@ def simulate_controlled(
         rec.arrays,
         control,
         imp,
+        push,
     )
     qpos = d.qpos
     t_end = k * dt

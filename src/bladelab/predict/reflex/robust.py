@@ -3,7 +3,8 @@
 A candidate's cost with ``ObjectiveSettings.robust_samples`` = n > 1 is the mean over the
 nominal simulation and n − 1 copies (:func:`robust_copies`): the parameters moved by
 ``robust_jitter`` (relative) along seeded directions, and with ``robust_speed_change`` s > 0
-started at (1 ± s) × the initial speed. The directions are the same for every candidate of a
+started at (1 ± s) × the initial speed, and with ``robust_push`` p > 0 pushed once in mid-run
+(forward speed times 1 ± p at a seeded time). The directions and push times are the same for every candidate of a
 generation (:func:`generation_jitter_seed`: fixed for the run, or new every generation).
 :func:`bladelab.predict.reflex.verify.verify_solution` checks along other directions
 (:data:`VERIFY_JITTER_SEED`).
@@ -17,7 +18,12 @@ from dataclasses import replace
 import numpy as np
 
 from bladelab.predict.reflex.controller import ControllerLayout
-from bladelab.predict.reflex.objective import Evaluation, ObjectiveSettings, simulate_controlled
+from bladelab.predict.reflex.objective import (
+    Evaluation,
+    ObjectiveSettings,
+    push_window,
+    simulate_controlled,
+)
 from bladelab.runner.model import RunnerModel
 
 __all__ = [
@@ -25,6 +31,7 @@ __all__ = [
     "VERIFY_JITTER_SEED",
     "generation_jitter_seed",
     "jittered_parameters",
+    "push_times",
     "robust_copies",
     "robust_evaluation",
 ]
@@ -35,6 +42,8 @@ OBJECTIVE_JITTER_SEED = 20261121
 #: solution optimised to survive its copies is checked on copies it has not seen (measured in
 #: session 16: a run that survived its 4 objective copies at 1e-3 fell in 5 of 8 others).
 VERIFY_JITTER_SEED = 20261126
+#: Appended to a copies' seed for their push times (a stream apart from their directions).
+PUSH_STREAM = 1
 
 
 def jittered_parameters(x: np.ndarray, n: int, jitter: float,
@@ -60,15 +69,36 @@ def robust_copies(x: np.ndarray, settings: ObjectiveSettings,
                   seed: int | Sequence[int] = OBJECTIVE_JITTER_SEED,
                   ) -> list[tuple[np.ndarray, ObjectiveSettings]]:
     """The ``settings.robust_samples`` − 1 copies of a candidate: its parameters jittered
-    (:func:`jittered_parameters`) and, with ``robust_speed_change`` s > 0, the initial speed
-    [m/s] times 1 + s, 1 − s, 1 + s, ... (nominal settings otherwise)."""
-    xs = jittered_parameters(x, settings.robust_samples - 1, settings.robust_jitter, seed)
-    s = settings.robust_speed_change
-    if s == 0:
-        return [(xj, settings) for xj in xs]
+    (:func:`jittered_parameters`); with ``robust_speed_change`` s > 0 the initial speed [m/s]
+    times 1 + s, 1 − s, 1 + s, ...; with ``robust_push`` p > 0 a push changing the forward
+    speed by +p, −p, +p, ... (relative) at times drawn uniformly in
+    :func:`~bladelab.predict.reflex.objective.push_window` from ``seed`` (nominal settings
+    otherwise)."""
+    n = settings.robust_samples - 1
+    xs = jittered_parameters(x, n, settings.robust_jitter, seed)
+    s, p = settings.robust_speed_change, settings.robust_push
     v0 = settings.start_speed
-    return [(xj, replace(settings, initial_speed=v0 * (1 + s if k % 2 == 0 else 1 - s)))
-            for k, xj in enumerate(xs)]
+    times = push_times(n, settings.duration, seed)
+    copies = []
+    for k, xj in enumerate(xs):
+        sign = 1.0 if k % 2 == 0 else -1.0
+        changes = {}
+        if s > 0:
+            changes["initial_speed"] = v0 * (1 + sign * s)
+        if p > 0:
+            changes["push"] = (float(times[k]), sign * p)
+        copies.append((xj, replace(settings, **changes) if changes else settings))
+    return copies
+
+
+def push_times(n: int, duration: float, seed: int | Sequence[int] = OBJECTIVE_JITTER_SEED,
+               ) -> np.ndarray:
+    """``n`` push times [s], uniform in :func:`~bladelab.predict.reflex.objective.push_window`
+    of a ``duration`` [s] simulation, drawn from ``seed`` (independently of the copies' jitter
+    directions)."""
+    lo, hi = push_window(duration)
+    rng = np.random.default_rng([*np.atleast_1d(seed).tolist(), PUSH_STREAM])
+    return rng.uniform(lo, max(lo, hi), n)
 
 
 def robust_evaluation(
