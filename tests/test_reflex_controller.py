@@ -173,6 +173,45 @@ def test_early_swing_knee_flexion_offset_acts_in_swing_only(amputee):
             assert np.count_nonzero(u) == (1 if state == SWING else 0)
 
 
+def test_swing_leg_placement_sees_the_delayed_forward_speed(amputee):
+    # S11100.<hip muscle>_<side>-pelvis_tx.KV·(V0 − v(t − 50 ms)) (our addition): in Liftoff,
+    # Swing and Landing only, on the pelvis's forward velocity 50 ms ago; gain 0 by default
+    layout = controller_layout(amputee)
+    dt = 1e-3
+    table = layout.table_for(dt)
+    muscles, dofs = list(amputee.muscle_names), list(amputee.dof_names)
+    nm, nq = len(muscles), len(dofs)
+    ix = dofs.index("pelvis_tx")
+    assert layout.x0[layout.index("S11100.iliopsoas_r-pelvis_tx.KV")] == 0.0
+    hist = np.zeros((history_length(layout, dt), 3 * nm + 2 * nq))
+    cs = np.zeros(4)
+    ms = np.zeros((nm, 4))
+    ms[:, 1] = 0.1
+    mp = amputee.muscle_params
+    qvel = np.zeros(nq)
+    for k in range(60):  # forward speed 3.0 m/s until 50 steps ago, 4.0 m/s since
+        qvel[ix] = 3.0 if k < 10 else 4.0
+        push_sensors(hist, cs, ms, mp, np.zeros(nq), qvel)
+    for side, leg in (("l", 0), ("r", 1)):
+        for muscle in ("iliopsoas", "glut_max"):
+            p = np.zeros(layout.size)
+            p[layout.index(f"S11100.{muscle}_{side}-pelvis_tx.KV")] = -0.5
+            p[layout.index(f"S11100.{muscle}_{side}-pelvis_tx.V0")] = 3.4
+            target = muscles.index(f"{muscle}_{side}")
+            for state in (EARLY_STANCE, LATE_STANCE, LIFTOFF, SWING, LANDING):
+                cs[:2] = EARLY_STANCE
+                cs[leg] = state
+                u = np.zeros(nm)
+                compute_excitations(u, table, p, hist, cs, nm, nq)
+                swinging = state in (LIFTOFF, SWING, LANDING)
+                # -0.5·(3.4 − 3.0) < 0 is clipped; the 4.0 m/s of 49 steps ago is not seen yet
+                assert u[target] == 0.0 and np.count_nonzero(u) == 0
+                p[layout.index(f"S11100.{muscle}_{side}-pelvis_tx.V0")] = 2.8
+                compute_excitations(u, table, p, hist, cs, nm, nq)
+                assert u[target] == pytest.approx(0.1 if swinging else 0.0), (side, muscle, state)
+                p[layout.index(f"S11100.{muscle}_{side}-pelvis_tx.V0")] = 3.4
+
+
 def test_parameter_json_roundtrip_and_errors(tmp_path, able, amputee):
     la = controller_layout(able)
     x = la.x0 + 0.01

@@ -16,13 +16,16 @@ SCONE's ``MuscleReflex`` and ``DofReflex`` with delayed sensors:
 
 - length ``KL·(L(t−d) − L0)`` (L = fibre length / optimal length; negative part dropped where SCONE
   sets ``allow_neg_L = 0``), force ``KF·F(t−d)`` (F = tendon force / Fmax), constant ``C0``;
-- DOF (pelvis tilt, lumbar extension) ``KP·(P0 − q(t−d)) + KV·(0 − q̇(t−d))`` [rad, rad/s].
+- DOF (pelvis tilt, lumbar extension) ``KP·(P0 − q(t−d)) + KV·(V0 − q̇(t−d))`` [rad, rad/s],
+  V0 = 0 but for the swing-leg placement below.
 
 The reflex structure is SCONE's ``H0918RS2v3`` controller (Apache-2.0, T. Geijtenbeek) with separate
 parameters per leg (``symmetric = 0``, as ``ControllerGH2010v12Asym``), plus constant offsets
 ``C0`` per muscle in stance and in swing (Geyer & Herr's S0 / ΔS terms), a Swing-only ``C0`` of
 the short head of biceps femoris (early-swing knee flexion so the trailing foot clears the
-ground in running; docs/predictive.md) and DOF reflexes for the torso muscles about the lumbar
+ground in running; docs/predictive.md), a swing-leg placement reflex (hip flexor and extensor
+of the swinging leg on the pelvis's forward velocity, ``KV·(V0 − v)`` [m/s]; our addition, 0
+by default) and DOF reflexes for the torso muscles about the lumbar
 joint (the seed's model has torso muscles; H0918 has none). The prosthetic leg has no shank muscles: reflexes to or from them are left out on that side.
 
 Parameters form a named flat vector (:class:`ControllerLayout`, names like SCONE's ``.par``:
@@ -100,7 +103,19 @@ _LEG_REFLEXES: list[tuple] = [
     (_SWING, "hamstrings", None, "KL", "L0", T_LENGTH, HAM_DELAY, (0.2, 1.2)),
     (_SWING, "bifemsh", None, "KF", None, T_FORCE, KNEE_DELAY, (0.2,)),
     (_SWING, "glut_max", None, "KL", "L0", T_LENGTH, HIP_DELAY, (1.0, 0.85)),
+    # swing-leg placement on the forward speed (our addition, docs/predictive.md): the hip
+    # flexor and extensor of the swinging leg see the pelvis's delayed forward velocity,
+    # KV·(V0 − v), so a faster body can reach further forward (a foot-placement feedback,
+    # as Song & Geyer 2015's swing-leg target angle or Raibert's hopper). Gains 0 by default:
+    # older parameter files run exactly as before.
+    (_SWING, "iliopsoas", "pelvis_tx", "KV", "V0", T_DOF_VEL, VES_DELAY, (0.0, 3.5)),
+    (_SWING, "glut_max", "pelvis_tx", "KV", "V0", T_DOF_VEL, VES_DELAY, (0.0, 3.5)),
 ]
+# Search scale of the gains on the forward velocity (per m/s; the default 0.02 would move an
+# excitation by only 0.002 for a 0.1 m/s change of speed).
+_GAIN_SCALE = {"pelvis_tx": 0.5}
+# Bounds of the reflexes' offset parameters: L0 [optimal fibre lengths], V0 [m/s].
+_OFFSET_BOUNDS = {"L0": (0.0, 2.0), "V0": (0.0, 10.0)}
 _LEG_MUSCLES = (
     "hamstrings",
     "bifemsh",
@@ -253,14 +268,14 @@ def controller_layout(model) -> ControllerLayout:
                 par.get(f"{scone_key}.{gname}", vals[0]),
                 -10.0,
                 10.0,
+                _GAIN_SCALE.get(source),
             )
             off, off_const = -1, 0.0
             if oname is not None:
                 off = param(
                     f"{mask}.{tname if source is None else tname + '-' + source}.{oname}",
                     par.get(f"{scone_key}.{oname}", vals[1]),
-                    0.0,
-                    2.0,
+                    *_OFFSET_BOUNDS[oname],
                 )
             elif kind == T_DOF_POS:
                 off_const = PELVIS_TILT_REF
@@ -452,7 +467,7 @@ def compute_excitations(u, table, p, hist, cs, nm, nq):
         elif kind == T_DOF_POS:
             u[tgt] += g * (off - delayed(hist, cs, 3 * nm + src, d))
         elif kind == T_DOF_VEL:
-            u[tgt] += -g * delayed(hist, cs, 3 * nm + nq + src, d)
+            u[tgt] += g * (off - delayed(hist, cs, 3 * nm + nq + src, d))
     for i in range(nm):
         if u[i] < 0.0:
             u[i] = 0.0
