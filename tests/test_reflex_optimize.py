@@ -98,6 +98,8 @@ def test_cli_predict_and_errors(tmp_path, capsys):
             "4",
             "--duration",
             "0.5",
+            "--strike-limit",
+            "0.3",
             "--out",
             str(tmp_path / "p"),
         ]
@@ -105,6 +107,8 @@ def test_cli_predict_and_errors(tmp_path, capsys):
     assert code == 0
     summary = json.loads((tmp_path / "p" / "summary.json").read_text())
     assert summary["best"]["generations"] == 2
+    best = json.loads((tmp_path / "p" / "best.json").read_text())
+    assert best["settings"]["strike_limit_bw"] == 0.3
     code = main(
         [
             "predict",
@@ -311,11 +315,25 @@ def test_verify_solution_from_changed_initial_speeds():
     assert "initial_speed" not in opt.verify_solution(shipped, duration=0.5)
 
 
+def test_verify_solution_after_pushes():
+    import bladelab.predict.reflex.verify as opt
+
+    shipped = Path(opt.__file__).resolve().parents[2] / "data/runner/solutions/able-3.5.json"
+    out = opt.verify_solution(shipped, duration=3.0, push_change=0.3, push_phases=2)
+    assert [(c["push_time_s"], c["push_change"]) for c in out["pushed"]] == [
+        (2.0, 0.3), (2.0, -0.3), (2.5, 0.3), (2.5, -0.3)]
+    # a 30 % push changes the run: other costs, and the runs are judged like the nominal one
+    assert len({out["cost"], *(c["cost"] for c in out["pushed"])}) == 5
+    assert out["ok"] == all(c["ok"] for c in [out, *out["pushed"]])
+    assert "pushed" not in opt.verify_solution(shipped, duration=0.5)
+
+
 @pytest.mark.parametrize(("option", "value", "named"), [
     ("--robust-directions", "sometimes", "--robust-directions"),
     ("--robust-speed-change", "0.7", "--robust-speed-change"),
     ("--robust-push", "-0.1", "--robust-push"),
     ("--robust-push", "0.02", "--duration"),  # the default 10 s has room; 4 s has not
+    ("--strike-limit", "-0.2", "--strike-limit"),
 ])
 def test_cli_refuses_bad_robust_copies(tmp_path, capsys, option, value, named):
     args = ["predict", option, value, "--out", str(tmp_path / "x")]

@@ -83,6 +83,10 @@ def register(app: typer.Typer) -> None:
         initial_speed: float | None = typer.Option(
             None, "--initial-speed", help="Forward speed of the initial state (m/s); default --speed."
         ),
+        strike_limit: float = typer.Option(
+            1.0, "--strike-limit", help="A step whose swinging foot strikes the ground earns "
+            "max(0, 1 - peak/limit) of its credit (body weights; issue 20 accepts at most 0.2)."
+        ),
         integrator: str = typer.Option(
             "explicit", "--integrator", help="Reflex: explicit (the default 0.25 ms scheme) | "
             "implicit (stiff forces linearly implicit, stable at --dt 1e-3: 3-4x cheaper)."
@@ -173,6 +177,9 @@ def register(app: typer.Typer) -> None:
         if integrator not in ("explicit", "implicit"):
             raise SpecError(f"unknown integrator {integrator!r}", where="--integrator",
                             hint="explicit or implicit")
+        if not (math.isfinite(strike_limit) and strike_limit >= 0):
+            raise SpecError("must be >= 0 body weights (0: a strike takes all the step's credit)",
+                            where="--strike-limit")
         blade = blade or "Cat6"
         _, layout = runner_and_layout(model, blade if model == "amputee" else None)
         if track is not None:
@@ -214,6 +221,7 @@ def register(app: typer.Typer) -> None:
                 robust_speed_change=robust_speed_change,
                 robust_push=robust_push,
                 initial_speed=initial_speed,
+                strike_limit_bw=strike_limit,
                 integrator=integrator,
                 track=None if track is None else str(track),
                 w_track=0.0 if track is None else track_weight,

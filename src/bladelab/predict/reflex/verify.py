@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 
 from bladelab._io import read_json
-from bladelab.predict.reflex.objective import ObjectiveSettings, simulate_controlled
+from bladelab.predict.reflex.objective import PUSH_AFTER, ObjectiveSettings, simulate_controlled
 from bladelab.predict.reflex.optimize import runner_and_layout, stored_settings
 from bladelab.predict.reflex.robust import VERIFY_JITTER_SEED, jittered_parameters
 
@@ -29,6 +29,8 @@ def verify_solution(
     jittered_copies: int = 0,
     jitter: float = 1e-9,
     initial_speed_change: float = 0.0,
+    push_change: float = 0.0,
+    push_phases: int = 5,
 ) -> dict:
     """Re-simulate a parameter file and check the shipped-solution criteria.
 
@@ -50,8 +52,12 @@ def verify_solution(
     a gait that survives only on one floating-point path (another
     CPU, compiler or library version) is not a solution. With ``initial_speed_change`` c > 0
     they must also hold from an initial speed [m/s] (1 + c) and (1 − c) times the file's (issue
-    20: ±5 %). Returns the measured values (the copies' under ``"jittered"``, the changed starts'
-    under ``"initial_speed"``) and ``ok``.
+    20: ±5 %). With ``push_change`` p > 0 they must hold after a push (forward speed times
+    1 + p and 1 − p) at each of ``push_phases`` times spread over the second after
+    :data:`~bladelab.predict.reflex.objective.PUSH_AFTER` (the stride's phases; the basin of
+    the gait, not of its start). Returns the measured values (the copies' under
+    ``"jittered"``, the changed starts' under ``"initial_speed"``, the pushed runs' under
+    ``"pushed"``) and ``ok``.
     """
 
     from bladelab.predict.reflex.controller import read_parameters
@@ -79,6 +85,13 @@ def verify_solution(
             check = _check_gait(runner, layout, x, changed, limits)
             out["initial_speed"].append({"initial_speed_m_per_s": v0 * factor, **check})
         out["ok"] = bool(out["ok"] and all(c["ok"] for c in out["initial_speed"]))
+    if push_change > 0:
+        out["pushed"] = []
+        for t in PUSH_AFTER + np.arange(push_phases) / push_phases:
+            for change in (push_change, -push_change):
+                check = _check_gait(runner, layout, x, replace(settings, push=(t, change)), limits)
+                out["pushed"].append({"push_time_s": float(t), "push_change": change, **check})
+        out["ok"] = bool(out["ok"] and all(c["ok"] for c in out["pushed"]))
     return out
 
 
