@@ -242,9 +242,23 @@ def test_sweep_report_opens_in_a_browser(sweep_report, tmp_path):
 def test_report_of_a_parameter_file(tmp_path):
     src = SOLUTIONS / "able-3.5.json"  # the shipped solution
     rep = build_predictive_report(src, tmp_path / "r", duration=2.0, progress=False)
-    assert rep.kind == "parameters" and rep.simulations == 1
+    # the re-simulation, then issue 20's robustness runs: the nominal, 4 copies and 2 other
+    # starts (2 s has no room for a push)
+    assert rep.kind == "parameters" and rep.simulations == 1 + (1 + 4 + 2)
     tables = _tables(Path(rep.index))
     resim = _table(tables, "re-simulations").iloc[0]
+    judged = _table(tables, "judged-runs")
+    _units_everywhere(judged)
+    assert len(judged) == 7 and not any("pushed-runs" in k for k in tables)
+    nominal = judged.iloc[0]  # the same simulation as the re-simulation's
+    for column in ("mean speed (m/s)", "power-balance residual (%)", "swing contacts (count)"):
+        assert nominal[column] == pytest.approx(resim[column], rel=1e-9), column
+    # a run that falls never meets the acceptance; the text's verdict follows the table
+    assert not (judged["meets the acceptance (yes/no)"] & ~judged["runs the whole time (yes/no)"]).any()
+    html = Path(rep.index).read_text(encoding="utf-8")
+    met = judged["meets the acceptance (yes/no)"].all()
+    assert ("Issue 20&#x27;s acceptance: met" in html or "Issue 20's acceptance: met" in html) == met
+    assert "No pushes" in html
     # a running solution: 2 s without a fall near its 3.5 m/s, energy conserved (power balance)
     assert not resim["fell (yes/no)"] and resim["simulated (s)"] == pytest.approx(2.0)
     assert abs(resim["mean speed (m/s)"] - 3.5) < 0.3
@@ -253,6 +267,53 @@ def test_report_of_a_parameter_file(tmp_path):
     _units_everywhere(st)
     contact = st["contact time (s)"]
     assert ((contact > 0.1) & (contact < 0.35)).all()  # running contact times (seed 001 §3.1)
+
+
+class _Sections:
+    """Collects what a section function adds (a stand-in for the report builder)."""
+
+    def __init__(self) -> None:
+        self.sections = []
+
+    def add_section(self, title, text="", tables=(), figures=()):
+        self.sections.append((title, text, dict(tables)))
+
+
+def _check(fell=False, ok=True, peak_bw=0.1, tilt=-10.0, **extra) -> dict:
+    return {"fell": fell, "ok": ok, "duration_s": 5.0 if fell else 10.0,
+            "mean_speed_m_per_s": 4.0, "strides": 12, "strides_with_flight": 12,
+            "same_leg_steps": 0, "power_balance_residual_pct": 0.5, "swing_contacts": 1,
+            "swing_contact_peak_N": 80.0 * 9.81 * peak_bw, "swing_contact_peak_bw": peak_bw,
+            "pelvis_tilt_mean_deg": tilt, "pelvis_tilt_min_deg": tilt - 5,
+            "pelvis_tilt_max_deg": tilt + 5, **extra}
+
+
+def test_robustness_section_judges_issue_20_by_hand():
+    from bladelab.report.predictive_robustness import robustness_section
+
+    out = {**_check(),
+           "jittered": [_check(), _check(peak_bw=0.25), _check(fell=True, ok=False), _check()],
+           "initial_speed": [_check(tilt=-17.0, initial_speed_m_per_s=3.675),
+                             _check(initial_speed_m_per_s=3.325)],
+           "pushed": [_check(push_time_s=2.0, push_change=0.02),
+                      _check(fell=True, ok=False, push_time_s=2.0, push_change=-0.02)]}
+    rep = _Sections()
+    robustness_section(rep, out, 10.0)
+    (title, text, tables), = rep.sections
+    judged = tables["Judged runs (issue 20's acceptance)"]
+    # strike above 0.2 BW (copy 2), a fall (copy 3), mean tilt outside -16...-2 deg (+5 %)
+    assert judged["meets the acceptance (yes/no)"].tolist() == [
+        True, True, False, False, True, False, True]
+    assert judged.run.tolist()[5] == "start 3.675 m/s"
+    assert "not met by 3 of 7 judged runs" in text
+    pushed = tables["Pushed runs (the gait's basin; not judged)"]
+    assert pushed["runs the whole time (yes/no)"].tolist() == [True, False]
+    assert "1 of 2 pushed runs keep running" in text
+    out["jittered"] = [_check()] * 4
+    out["initial_speed"] = [_check(initial_speed_m_per_s=v) for v in (3.675, 3.325)]
+    rep = _Sections()
+    robustness_section(rep, out, 10.0)
+    assert "acceptance: met by every judged run" in rep.sections[0][1]
 
 
 def test_a_shipped_file_reports_into_the_current_folder(tmp_path, monkeypatch):
@@ -289,7 +350,7 @@ def test_report_of_the_shipped_amputee_solution(shipped_amputee_report):
     from bladelab.runner.export import read_mot
 
     rep = shipped_amputee_report  # 3 s re-simulated, exported (conftest.py)
-    assert rep.kind == "parameters" and rep.simulations == 1
+    assert rep.kind == "parameters" and rep.simulations == 1 + (1 + 4 + 2)
     index = Path(rep.index)
     html = index.read_text(encoding="utf-8")
     assert 'class="runner-animation"' in html and "Table D.1" in html

@@ -217,3 +217,22 @@ def test_pushed_copies_need_room_for_the_push():
         ObjectiveSettings(duration=4.0, robust_push=0.02)
     s = ObjectiveSettings(duration=10.0, robust_push=0.02, push=(5.0, -0.02))
     assert ObjectiveSettings.from_dict(s.to_dict()) == s
+
+
+def test_the_power_balance_can_leave_out_a_push(able):
+    # a push adds kinetic energy without external work: one spike in the residual, which
+    # skip_times leaves out (verify_solution does for its pushed runs)
+    from bladelab.runner.analyses import power_balance_residual_pct
+
+    model, layout = able
+    kw = {"duration": 0.4, "dt": 1e-3, "integrator": "implicit"}
+    _, plain = simulate_controlled(model, layout.x0, layout=layout,
+                                   settings=ObjectiveSettings(**kw), record_every=2)
+    _, pushed = simulate_controlled(model, layout.x0, layout=layout,
+                                    settings=ObjectiveSettings(**kw, push=(0.2, 0.05)),
+                                    record_every=2)
+    base = power_balance_residual_pct(plain)
+    assert power_balance_residual_pct(pushed) > 3 * base
+    assert power_balance_residual_pct(pushed, skip_times=(0.2,)) < 1.5 * base
+    # leaving out the same samples of the unpushed run changes it little
+    assert power_balance_residual_pct(plain, skip_times=(0.2,)) == pytest.approx(base, rel=0.2)

@@ -242,8 +242,10 @@ def _read_history(folder: Path) -> pd.DataFrame:
     return h
 
 
-def _run_sections(report, folders: dict[str, Path], duration: float, bar) -> tuple[dict, list]:
-    """Convergence + run summary sections; returns ({label: result}, re-simulation rows)."""
+def _run_sections(report, folders: dict[str, Path], duration: float,
+                  bar) -> tuple[dict, list, Path]:
+    """Convergence + run summary sections; returns ({label: result}, re-simulation rows, the
+    parameter file shown)."""
     histories, rows, sols = {}, [], {}
     for name, folder in folders.items():
         histories[name] = _read_history(folder)
@@ -293,7 +295,7 @@ def _run_sections(report, folders: dict[str, Path], duration: float, bar) -> tup
     ev, res = sol.simulate(duration)
     bar.update()
     label = f"{sol.label()} (best of {name})" if len(folders) > 1 else sol.label()
-    return {label: res}, [_resim_row(label, sol, ev, res)]
+    return {label: res}, [_resim_row(label, sol, ev, res)], sol.path
 
 
 def _sweep_cells(folder: Path) -> tuple[list[tuple[str, float, Path]], list[str]]:
@@ -449,6 +451,7 @@ def build_predictive_report(
     progress: bool = True,
     export: bool = False,
     animate: bool = True,
+    robustness: bool = True,
 ) -> PredictiveReport:
     """Write the HTML report of a predictive result (see the module docstring).
 
@@ -469,6 +472,10 @@ def build_predictive_report(
         ``states.csv``; every 2nd recorded sample, i.e. 1 kHz at the default 0.25 ms step).
     animate
         Animate each solution shown in the page.
+    robustness
+        For one solution or run: re-simulate it as copies, from other initial speeds and
+        pushed, and judge issue 20's acceptance
+        (:mod:`bladelab.report.predictive_robustness`).
 
     Raises
     ------
@@ -495,7 +502,7 @@ def build_predictive_report(
               "collocation-sweep": "Predictive running: collocation sweep"}
     rep = Report(titles[kind], subtitle=str(path))
     sweep_summary = None
-    resim = None
+    resim = checked = None
     # a collocation solution is not re-simulated: no progress bar for it
     with _Counter(tqdm(desc="re-simulating", unit="sim",
                        disable=not progress or kind.startswith("collocation"))) as bar:
@@ -515,6 +522,7 @@ def build_predictive_report(
             bar.update()
             results = {sol.label(): res}
             resim = [_resim_row(sol.label(), sol, ev, res)]
+            shown = path
             settings = sol.data.get("settings") or {}
             seed = sol.data.get("seed")
         elif kind in ("run", "runs"):
@@ -523,15 +531,25 @@ def build_predictive_report(
             else:
                 folders = {p.name: p for p in sorted(path.glob("seed-*"))
                            if (p / "best.json").is_file()}
-            results, resim = _run_sections(rep, folders, duration, bar)
+            results, resim, shown = _run_sections(rep, folders, duration, bar)
             first = _read_json(next(iter(folders.values())) / "best.json")
             settings, seed = first.get("settings") or {}, first.get("seed")
         else:
             results, resim, sweep_summary, cells = _sweep_sections(rep, path, duration, bar)
             first = _read_json(cells[0][2] / "best.json") if cells else {}
             settings, seed = first.get("settings") or {}, first.get("seed")
+        if robustness and kind in ("parameters", "run", "runs"):
+            from bladelab.report.predictive_robustness import robustness_runs
+
+            checked = robustness_runs(shown, duration)
+            for _ in range(checked["simulations"]):
+                bar.update()
     if resim is not None:
         _resim_section(rep, resim, duration)
+    if checked is not None:
+        from bladelab.report.predictive_robustness import robustness_section
+
+        robustness_section(rep, checked, duration)
     if kind in ("parameters", "run", "runs"):
         results = _with_tracked_stride(results, settings)
     add_predictive_sections(rep, results, sweep_summary=sweep_summary, animate=animate)

@@ -19,6 +19,7 @@ Powers are positive when delivered to the body segments. All tables are tidy Dat
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 
 import mujoco
 import numpy as np
@@ -381,10 +382,18 @@ def power_balance(result: RunnerResult) -> pd.DataFrame:
     )
 
 
-def power_balance_residual_pct(result: RunnerResult) -> float:
+def power_balance_residual_pct(result: RunnerResult, *, skip_times: Sequence[float] = ()) -> float:
     """RMS of ``P_external − P_kinetic`` in % of the peak |P_kinetic| (first and last samples
-    excluded: one-sided differences)."""
-    pb = power_balance(result).iloc[1:-1]
+    excluded: one-sided differences; so are the samples within two samples of each of
+    ``skip_times`` [s], e.g. a push that changes the kinetic energy without external work)."""
+    pb = power_balance(result)
+    keep = np.ones(len(pb), dtype=bool)
+    keep[[0, -1]] = False
+    if len(skip_times) and len(result.time) > 1:
+        spacing = float(result.time[1] - result.time[0])
+        for t in skip_times:
+            keep &= np.abs(pb.time.to_numpy() - t) > 2.5 * spacing
+    pb = pb[keep]
     peak = float(np.max(np.abs(pb.kinetic))) if len(pb) else 0.0
     if peak == 0.0:
         return 0.0

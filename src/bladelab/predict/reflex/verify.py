@@ -43,8 +43,9 @@ def verify_solution(
     bounces, scuffs below 0.1 body weight and strikes of the swinging foot are not steps)
     alternating between the legs after the first (``same_leg_steps`` 0: no hop or gallop); a
     flight phase (no leg loaded above 20 N) in every stride (one step of a leg to its next);
-    reported, not a criterion: ``swing_contacts`` (a swinging foot striking the ground,
-    :func:`bladelab.runner.analyses.swing_contacts`) and the largest one's peak force [N];
+    reported, not criteria: ``swing_contacts`` (a swinging foot striking the ground,
+    :func:`bladelab.runner.analyses.swing_contacts`) and the largest one's peak force [N] and
+    [body weights], the pelvis tilt's mean, minimum and maximum [deg];
     power-balance residual below
     ``max_power_residual_pct`` % (runner analyses). With ``jittered_copies`` = n > 0 the same
     criteria must also hold for n copies of the parameters moved by ``jitter`` (relative,
@@ -113,7 +114,9 @@ def _check_gait(runner, layout, x, settings: ObjectiveSettings, limits: tuple) -
     steps = step_touchdowns(res.time, forces, runner.body_weight)
     flights = [bool(np.any(airborne[a:b])) for a, b in _strides(res.time, steps)]
     same_leg = _same_leg_steps(steps)
-    residual = power_balance_residual_pct(res)
+    residual = power_balance_residual_pct(
+        res, skip_times=() if settings.push is None else (settings.push[0],))
+    tilt = np.degrees(res.qpos[:, runner.dof("pelvis_tilt")])
     out = {
         "fell": ev.fell,
         "duration_s": ev.duration,
@@ -123,6 +126,11 @@ def _check_gait(runner, layout, x, settings: ObjectiveSettings, limits: tuple) -
         "same_leg_steps": same_leg,
         "swing_contacts": int(len(swings := swing_contacts(res))),
         "swing_contact_peak_N": float(swings.peak_N.max()) if len(swings) else 0.0,
+        "swing_contact_peak_bw": (float(swings.peak_N.max()) / runner.body_weight
+                                  if len(swings) else 0.0),
+        "pelvis_tilt_mean_deg": float(tilt.mean()),
+        "pelvis_tilt_min_deg": float(tilt.min()),
+        "pelvis_tilt_max_deg": float(tilt.max()),
         "power_balance_residual_pct": residual,
         "cost": ev.cost,
     }
