@@ -164,6 +164,11 @@ def test_report_of_predict_folders(tmp_path, capsys):
     assert "best of seed-" in out["solutions"][0]
     runs = _table(_tables(Path(out["index"])), "run-summary")
     assert sorted(runs.run) == ["seed-1", "seed-2"]
+    # the best seed agrees with itself; two seeds never settle a cell (issue 20 needs 3)
+    best = runs["recomputed cost (–)"].idxmin()
+    assert runs["agrees with the best seed (yes/no)"][best]
+    html = Path(out["index"]).read_text(encoding="utf-8")
+    assert "of 2 seeds reach the best seed" in html and "not settled" in html
 
 
 @pytest.fixture(scope="module")

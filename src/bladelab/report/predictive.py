@@ -276,6 +276,14 @@ def _run_sections(report, folders: dict[str, Path], duration: float,
         })
         sols[name] = (sol, ev.cost)
     table = pd.DataFrame(rows)
+    agreement = ""
+    if len(rows) > 1:
+        from bladelab.predict.reflex.agreement import seed_agreement
+
+        agree = seed_agreement(table["recomputed cost (–)"].tolist(),
+                               table["mean speed (m/s)"].tolist())
+        table["agrees with the best seed (yes/no)"] = list(agree.agreeing)
+        agreement = " Seeds, on the same copies: " + agree.describe()
     import matplotlib.pyplot as plt
 
     fig = _convergence_figure(histories)
@@ -286,8 +294,11 @@ def _run_sections(report, folders: dict[str, Path], duration: float,
                  table)],
         text=("Every cost term is recomputed from best.json's parameters with the run's objective "
               "settings (simulated time, time step, robust sampling) and set beside the cost the "
-              "optimiser stored. Wall time: elapsed time of the optimisation summed over resumes "
-              "(blank for runs written before it was recorded)."),
+              "optimiser stored (a run whose copies changed every generation stored its best's "
+              "cost on its last generation's copies; the recomputed cost uses the fixed copies "
+              "every run shares, so the two differ). Wall time: elapsed time of the "
+              "optimisation summed over resumes (blank for runs written before it was "
+              f"recorded).{agreement}"),
     )
     plt.close(fig)
     name = min(sols, key=lambda n: sols[n][1])
