@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import json
 
+import math
+
 import numpy as np
 import pytest
 
@@ -210,6 +212,54 @@ def test_swing_leg_placement_sees_the_delayed_forward_speed(amputee):
                 compute_excitations(u, table, p, hist, cs, nm, nq)
                 assert u[target] == pytest.approx(0.1 if swinging else 0.0), (side, muscle, state)
                 p[layout.index(f"S11100.{muscle}_{side}-pelvis_tx.V0")] = 3.4
+
+
+def test_swing_leg_placement_on_the_mean_speed_of_the_last_stride(amputee):
+    # S11100.<hip muscle>_<side>-pelvis_tx.KS·(S0 − mean forward speed over SPEED_WINDOW,
+    # ending 50 ms ago), from the pelvis's position; a shorter window while the history fills
+    from bladelab.predict.reflex.controller import SPEED_WINDOW
+
+    layout = controller_layout(amputee)
+    dt = 1e-3
+    table = layout.table_for(dt)
+    muscles, dofs = list(amputee.muscle_names), list(amputee.dof_names)
+    nm, nq = len(muscles), len(dofs)
+    ix = dofs.index("pelvis_tx")
+    nh = history_length(layout, dt)
+    assert nh == round((0.05 + SPEED_WINDOW) / dt) + 2
+    hist = np.zeros((nh, 3 * nm + 2 * nq))
+    cs = np.zeros(4)
+    cs[0] = SWING
+    ms = np.zeros((nm, 4))
+    ms[:, 1] = 0.1
+    p = np.zeros(layout.size)
+    p[layout.index("S11100.iliopsoas_l-pelvis_tx.KS")] = -2.0
+    p[layout.index("S11100.iliopsoas_l-pelvis_tx.S0")] = 3.0
+    target = muscles.index("iliopsoas_l")
+    q, qd = np.zeros(nq), np.zeros(nq)
+
+    def step(x, v):
+        q[ix], qd[ix] = x, v
+        push_sensors(hist, cs, ms, amputee.muscle_params, q, qd)
+        u = np.zeros(nm)
+        compute_excitations(u, table, p, hist, cs, nm, nq)
+        return u[target]
+
+    # at the first sample the history holds nothing older: the (delayed) velocity, 3.4 m/s
+    assert step(0.0, 3.4) == pytest.approx(-2.0 * (3.0 - 3.4))
+    # 3.4 m/s on average but a velocity sensor swinging by ±0.3 m/s within the stride: once the
+    # window is full the term sees the mean only
+    for k in range(1, 2 * nh):
+        u = step(3.4 * k * dt, 3.4 + 0.3 * math.sin(2 * math.pi * k * dt / SPEED_WINDOW))
+    assert u == pytest.approx(-2.0 * (3.0 - 3.4), rel=1e-9)
+    # a runner 0.1 m/s faster for the whole window and the delay: 0.2 more excitation
+    x = 3.4 * (2 * nh - 1) * dt
+    for _ in range(nh):
+        x += 3.5 * dt
+        u = step(x, 3.5)
+    assert u == pytest.approx(-2.0 * (3.0 - 3.5), rel=1e-9)
+    cs[0] = EARLY_STANCE  # swing reflexes only
+    assert step(x + 3.5 * dt, 3.5) == 0.0
 
 
 def test_parameter_json_roundtrip_and_errors(tmp_path, able, amputee):

@@ -57,11 +57,17 @@ LATE_STANCE_THRESHOLD = 0.0
 LANDING_THRESHOLD = 0.0
 
 # Term kinds of the reflex table.
-T_CONST, T_LENGTH, T_LENGTH_POS, T_FORCE, T_DOF_POS, T_DOF_VEL = range(6)
+T_CONST, T_LENGTH, T_LENGTH_POS, T_FORCE, T_DOF_POS, T_DOF_VEL, T_DOF_MEAN_VEL = range(7)
 # Columns of the reflex table (float64): kind, target muscle, leg (−1 = always on), state mask,
 # source (muscle or dof index), delay [steps], gain parameter index, offset parameter index (−1:
-# use the constant), offset constant.
-R_KIND, R_TARGET, R_LEG, R_MASK, R_SOURCE, R_DELAY, R_GAIN, R_OFFSET, R_OFFSET_CONST = range(9)
+# use the constant), offset constant, averaging window (T_DOF_MEAN_VEL: [s] in ``table``, steps
+# in ``table_for``), time step [s] (set by ``table_for``).
+(R_KIND, R_TARGET, R_LEG, R_MASK, R_SOURCE, R_DELAY, R_GAIN, R_OFFSET, R_OFFSET_CONST,
+ R_WINDOW, R_DT) = range(11)
+#: Window [s] of the swing-leg placement's mean forward speed: about one stride at 3–4 m/s, so
+#: the mean is steady over a steady gait (the pelvis's velocity swings by ±0.3 m/s within a
+#: stride) and moves only when the runner speeds up or slows down.
+SPEED_WINDOW = 0.7
 
 _ALL = "S11111"
 _STANCE = "S00011"
@@ -110,12 +116,18 @@ _LEG_REFLEXES: list[tuple] = [
     # older parameter files run exactly as before.
     (_SWING, "iliopsoas", "pelvis_tx", "KV", "V0", T_DOF_VEL, VES_DELAY, (0.0, 3.5)),
     (_SWING, "glut_max", "pelvis_tx", "KV", "V0", T_DOF_VEL, VES_DELAY, (0.0, 3.5)),
+    # the same on the mean forward speed over the last SPEED_WINDOW (session 18: the
+    # instantaneous velocity swings within every stride, and a gain on it that CMA-ES can
+    # take up fells a tuned gait; after a push the tuned gaits speed up stride by stride and
+    # lean further forward until they fall, a runaway a placement on the mean speed can stop)
+    (_SWING, "iliopsoas", "pelvis_tx", "KS", "S0", T_DOF_MEAN_VEL, VES_DELAY, (0.0, 3.5)),
+    (_SWING, "glut_max", "pelvis_tx", "KS", "S0", T_DOF_MEAN_VEL, VES_DELAY, (0.0, 3.5)),
 ]
 # Search scale of the gains on the forward velocity [1/(m/s)], times CMA-ES's sigma: small,
 # because a stable gait of session 17 falls at 2.7 s when one such gain alone is set to 0.01.
-_GAIN_SCALE = {"pelvis_tx": 0.05}
-# Bounds of the reflexes' offset parameters: L0 [optimal fibre lengths], V0 [m/s].
-_OFFSET_BOUNDS = {"L0": (0.0, 2.0), "V0": (0.0, 10.0)}
+_GAIN_SCALE = {("pelvis_tx", "KV"): 0.05, ("pelvis_tx", "KS"): 0.5}
+# Bounds of the reflexes' offset parameters: L0 [optimal fibre lengths], V0, S0 [m/s].
+_OFFSET_BOUNDS = {"L0": (0.0, 2.0), "V0": (0.0, 10.0), "S0": (0.0, 10.0)}
 _LEG_MUSCLES = (
     "hamstrings",
     "bifemsh",
@@ -209,9 +221,11 @@ class ControllerLayout:
         return {n: float(v) for n, v in zip(self.names, x, strict=True)}
 
     def table_for(self, dt: float) -> np.ndarray:
-        """The reflex table with delays in steps of ``dt`` [s]."""
+        """The reflex table with delays and averaging windows in steps of ``dt`` [s]."""
         t = self.table.copy()
         t[:, R_DELAY] = np.round(self.delays_s / dt)
+        t[:, R_WINDOW] = np.round(t[:, R_WINDOW] / dt)
+        t[:, R_DT] = dt
         return t
 
 
@@ -268,7 +282,7 @@ def controller_layout(model) -> ControllerLayout:
                 par.get(f"{scone_key}.{gname}", vals[0]),
                 -10.0,
                 10.0,
-                _GAIN_SCALE.get(source),
+                _GAIN_SCALE.get((source, gname)),
             )
             off, off_const = -1, 0.0
             if oname is not None:
@@ -279,9 +293,9 @@ def controller_layout(model) -> ControllerLayout:
                 )
             elif kind == T_DOF_POS:
                 off_const = PELVIS_TILT_REF
-            rows.append(
-                (kind, muscles.index(tname), leg, _mask_bits(mask), src, 0, gain, off, off_const)
-            )
+            window = SPEED_WINDOW if kind == T_DOF_MEAN_VEL else 0.0
+            rows.append((kind, muscles.index(tname), leg, _mask_bits(mask), src, 0, gain, off,
+                         off_const, window, 0.0))
             delays.append(delay)
         # constant offsets per muscle in stance and swing, then (our addition,
         # docs/predictive.md) bifemsh in Swing only: early-swing knee flexion so the trailing
@@ -292,9 +306,8 @@ def controller_layout(model) -> ControllerLayout:
                     continue
                 tname = f"{mname}_{side}"
                 gain = param(f"{mask}.{tname}.C0", 0.0, -1.0, 1.0, scale)
-                rows.append(
-                    (T_CONST, muscles.index(tname), leg, _mask_bits(mask), -1, 0, gain, -1, 0.0)
-                )
+                rows.append((T_CONST, muscles.index(tname), leg, _mask_bits(mask), -1, 0, gain,
+                             -1, 0.0, 0.0, 0.0))
                 delays.append(0.0)
     if "lumbar_extension" in dofs:
         src = dofs.index("lumbar_extension")
@@ -303,7 +316,8 @@ def controller_layout(model) -> ControllerLayout:
             for side in ("r", "l"):
                 tname = f"{mname}_{side}"
                 if tname in muscles:
-                    rows.append((kind, muscles.index(tname), -1, 31, src, 0, gain, -1, 0.0))
+                    rows.append((kind, muscles.index(tname), -1, 31, src, 0, gain, -1, 0.0,
+                                 0.0, 0.0))
                     delays.append(HIP_DELAY if kind != T_CONST else 0.0)
     return ControllerLayout(
         kind=model.kind,
@@ -468,6 +482,16 @@ def compute_excitations(u, table, p, hist, cs, nm, nq):
             u[tgt] += g * (off - delayed(hist, cs, 3 * nm + src, d))
         elif kind == T_DOF_VEL:
             u[tgt] += g * (off - delayed(hist, cs, 3 * nm + nq + src, d))
+        elif kind == T_DOF_MEAN_VEL:
+            # mean velocity over the window ending d steps ago, from the position's change;
+            # while fewer samples exist the window shrinks (at the very start: the velocity)
+            w = min(int(table[r, R_WINDOW]), int(cs[3]) - 1 - d)
+            if w >= 1:
+                v = (delayed(hist, cs, 3 * nm + src, d)
+                     - delayed(hist, cs, 3 * nm + src, d + w)) / (w * table[r, R_DT])
+            else:
+                v = delayed(hist, cs, 3 * nm + nq + src, d)
+            u[tgt] += g * (off - v)
     for i in range(nm):
         if u[i] < 0.0:
             u[i] = 0.0
@@ -476,8 +500,10 @@ def compute_excitations(u, table, p, hist, cs, nm, nq):
 
 
 def history_length(layout: ControllerLayout, dt: float) -> int:
-    """Rows of the sensor ring buffer for the longest delay at step ``dt`` [s]."""
-    return int(round(float(layout.delays_s.max(initial=0.0)) / dt)) + 2
+    """Rows of the sensor ring buffer for the longest delay (plus averaging window) at step
+    ``dt`` [s]."""
+    reach = layout.delays_s + layout.table[:, R_WINDOW] if len(layout.delays_s) else [0.0]
+    return int(round(float(np.max(reach)) / dt)) + 2
 
 
 __all__ = [
