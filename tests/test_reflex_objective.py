@@ -236,3 +236,31 @@ def test_the_power_balance_can_leave_out_a_push(able):
     assert power_balance_residual_pct(pushed, skip_times=(0.2,)) < 1.5 * base
     # leaving out the same samples of the unpushed run changes it little
     assert power_balance_residual_pct(plain, skip_times=(0.2,)) == pytest.approx(base, rel=0.2)
+
+
+def test_the_closed_loop_sees_the_mean_speed_placement_once_its_window_is_full():
+    # the compiled loop runs the controller's current terms (a stale cached loop once ran an
+    # older formula: bladelab._numba_cache); the mean-speed placement is off until the history
+    # holds its window and delay, then acts
+    from pathlib import Path
+
+    import bladelab.predict.reflex.controller as ctl
+    from bladelab.predict.reflex.controller import SPEED_WINDOW, VES_DELAY, read_parameters
+
+    model = build_runner("able")
+    layout = controller_layout(model)
+    shipped = Path(ctl.__file__).resolve().parents[2] / "data/runner/solutions/able-3.5.json"
+    x = read_parameters(shipped, layout)
+    s = ObjectiveSettings(duration=1.2)
+    _, a = simulate_controlled(model, x, layout=layout, settings=s, record_every=4)
+    x[layout.index("S11100.glut_max_l-pelvis_tx.KS")] = 1.0
+    x[layout.index("S11100.glut_max_l-pelvis_tx.S0")] = 0.0  # -3.5 m/s·1: glut_max off
+    _, b = simulate_controlled(model, x, layout=layout, settings=s, record_every=4)
+    on = SPEED_WINDOW + VES_DELAY
+    before = a.time < on - 1e-3
+    np.testing.assert_array_equal(a.qpos[before], b.qpos[before])
+    assert not np.array_equal(a.qpos[~before], b.qpos[~before])
+    gmax = list(model.muscle_names).index("glut_max_l")
+    # the left glut_max's excitation is the first to change, after the window is full
+    changed = a.time[a.excitation[:, gmax] != b.excitation[:, gmax]]
+    assert len(changed) and changed[0] >= on - 1e-3

@@ -25,6 +25,8 @@ import math
 
 from numba import njit
 
+from bladelab._numba_cache import refresh_stale_caches
+
 
 @njit(cache=True, fastmath=False)
 def smoothstep(x: float) -> float:
@@ -154,3 +156,6 @@ def stribeck_friction_coefficient(
         dynamic_coefficient + 2.0 * (static_coefficient - dynamic_coefficient) / (1.0 + ratio * ratio)
     )
     return mu if slip_velocity >= 0.0 else -mu
+
+
+refresh_stale_caches(globals())

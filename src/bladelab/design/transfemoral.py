@@ -40,6 +40,7 @@ import mujoco
 import numpy as np
 from numba import njit
 
+from bladelab._numba_cache import refresh_stale_caches
 from bladelab.blade.model import BladeModel
 from bladelab.constants import STANDARD_GRAVITY
 from bladelab.design.constraints import blade_clearance, knee_buckling, knee_extension_moment
@@ -541,3 +542,6 @@ class RunnerEvaluator:
         if self.motion is not None:
             out["predicted_period_s"] = float(cycle.period)
         return out
+
+
+refresh_stale_caches(globals())

@@ -8,6 +8,7 @@ import math
 
 from numba import njit
 
+from bladelab._numba_cache import refresh_stale_caches
 from bladelab.runner.model import CP_AZ, CP_RADIUS, CP_SITE
 
 
@@ -31,3 +32,6 @@ def lowest_point(cp, c, site_xpos, site_xmat):
     py = site_xpos[site, 1]
     pz = site_xpos[site, 2] - h
     return px, py, pz, h - site_xpos[site, 2]
+
+
+refresh_stale_caches(globals())

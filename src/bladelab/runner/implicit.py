@@ -40,6 +40,7 @@ import mujoco
 import numpy as np
 from numba import njit
 
+from bladelab._numba_cache import refresh_stale_caches
 from bladelab.contact import hunt_crossley_force, smooth_spring_damper_force
 from bladelab.errors import SimulationError
 from bladelab.runner.contact_point import lowest_point
@@ -596,3 +597,6 @@ def site_views(d: mujoco.MjData, imp: tuple, *, oriented: bool = True) -> tuple:
     xmat = imp[31] if oriented else np.zeros((0, 9))
     return (d.qpos, d.qvel, imp[30], xmat, d.cvel, d.subtree_com, d.xipos, d.xfrc_applied,
             d.qfrc_applied)
+
+
+refresh_stale_caches(globals())

@@ -18,6 +18,7 @@ import mujoco
 import numpy as np
 from numba import njit
 
+from bladelab._numba_cache import refresh_stale_caches
 from bladelab.contact import hunt_crossley_force, smooth_spring_damper_force
 from bladelab.runner.contact_point import lowest_point
 from bladelab.runner.implicit import IMPLICIT, implicit_advance, implicit_begin, implicit_forces
@@ -45,12 +46,9 @@ from bladelab.runner.model import (
 from bladelab.runner.muscle import muscle_step
 from bladelab.sim.mujoco_engine import add_point_force
 
-# numba's cache is keyed on the content of the file that defines a function, not on the files of
-# the functions it calls: after editing a compiled function in muscle.py,
-# metabolics.py, muscle.py, contact.py or sim/mujoco_engine.py, bump this number so the loop
-# below is compiled again. This is not always enough (a session saw a controller edit have no
-# effect until the caches were deleted): when in doubt, `make clean-cache`.
-_CACHE_GENERATION = 15
+# numba's cache is keyed on the file that defines a function, not on the files of the functions
+# it calls; bladelab._numba_cache (called at the end of this module) flushes it whenever a
+# compiled source of bladelab changes (this file used to carry a number to bump by hand).
 
 # The per-step kernels here and in implicit.py, muscle.py and contact_point.py allocate nothing
 # and are compiled without numba's reference counting (``_nrt=False``, numba's option for it):
@@ -319,3 +317,6 @@ def mujoco_views(d: mujoco.MjData, *, oriented: bool = True) -> tuple:
         d.xfrc_applied,
         d.qfrc_applied,
     )
+
+
+refresh_stale_caches(globals())

@@ -28,6 +28,8 @@ import math
 import numpy as np
 from numba import njit
 
+from bladelab._numba_cache import refresh_stale_caches
+
 V_MAX_OPT_PER_S = 10.0
 ACTIVATION_RATE = 100.0
 DEACTIVATION_RATE = 25.0
@@ -241,3 +243,6 @@ def muscle_step(
         rate = ACTIVATION_RATE if ui > act else DEACTIVATION_RATE
         act += dt * rate * (ui - act)
         ms[i, MS_ACT] = min(max(act, MIN_ACTIVATION), 1.0)
+
+
+refresh_stale_caches(globals())

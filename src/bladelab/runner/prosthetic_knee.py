@@ -25,6 +25,7 @@ from dataclasses import asdict, dataclass
 
 from numba import njit
 
+from bladelab._numba_cache import refresh_stale_caches
 from bladelab.errors import SpecError
 
 __all__ = ["ProstheticKnee", "knee_torque"]
@@ -107,3 +108,6 @@ def knee_torque(p, q, qd):
     if q < p[4]:
         tau += -p[5] * (q - p[4]) - p[6] * qd
     return tau
+
+
+refresh_stale_caches(globals())

@@ -30,6 +30,7 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit, prange
 
+from bladelab._numba_cache import refresh_stale_caches
 from bladelab.constants import STANDARD_GRAVITY
 from bladelab.sim.chain import Chain
 from bladelab.sim.sole import (
@@ -737,3 +738,6 @@ def simulate_batch_serial(model, drive, params, solver, out, status):
                           out.energy[s]))
         status[s, 0] = st
         status[s, 1] = at
+
+
+refresh_stale_caches(globals())

@@ -25,6 +25,7 @@ import mujoco
 import numpy as np
 from numba import njit
 
+from bladelab._numba_cache import refresh_stale_caches
 from bladelab.blade.model import BladeModel
 from bladelab.constants import STANDARD_GRAVITY
 from bladelab.contact import stick_slip_friction_coefficient
@@ -432,3 +433,6 @@ def simulate_mujoco(problem, K: np.ndarray, D: np.ndarray, K2: np.ndarray):
         stiffness=np.asarray(K, float).copy(), damping=np.asarray(D, float).copy(),
         stiffness_quadratic=np.asarray(K2, float).copy(), engine="mujoco", dt=dt,
     )
+
+
+refresh_stale_caches(globals())

@@ -15,6 +15,7 @@ import math
 
 from numba import njit
 
+from bladelab._numba_cache import refresh_stale_caches
 from bladelab.contact import (
     hunt_crossley_force,
     smooth_spring_damper_force,
@@ -221,3 +222,6 @@ def sole_contact(contact, cx, cz, s, c, a, b, ox, oz, vox, voz, om, ground_vx):
     if fn > 0.0:
         mu, dmu = friction(contact, slip)
     return px, pz, -mu * fn, fn, depth, rate, slip, kn, cn, mu, dmu, fel
+
+
+refresh_stale_caches(globals())

@@ -24,6 +24,7 @@ import numpy as np
 from numba import njit
 
 from bladelab import units
+from bladelab._numba_cache import refresh_stale_caches
 from bladelab.blade.model import BladeModel
 from bladelab.constants import STANDARD_GRAVITY
 from bladelab.errors import ModelError, SimulationError
@@ -305,3 +306,6 @@ def generate_stance(
         "tip_z": rec[sl, 10 + nj + 2 * ne].copy(),
     }
     return stance, truth
+
+
+refresh_stale_caches(globals())

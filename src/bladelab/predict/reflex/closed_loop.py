@@ -14,6 +14,7 @@ import math
 import numpy as np
 from numba import njit
 
+from bladelab._numba_cache import refresh_stale_caches
 from bladelab.predict.reflex.controller import compute_excitations, push_sensors, update_gait_states
 from bladelab.runner.analyses import MIN_STEP_S, STEP_LOAD_BW
 from bladelab.runner.kernel import step_advance, step_begin, step_end
@@ -148,3 +149,6 @@ def run_closed_loop(
             break
         step_advance(f2, mptr, dptr, mj, imp, dt)
     return k, k_rec, False
+
+
+refresh_stale_caches(globals())

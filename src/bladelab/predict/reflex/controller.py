@@ -45,6 +45,7 @@ import numpy as np
 from numba import njit
 
 from bladelab._io import read_json, write_json
+from bladelab._numba_cache import refresh_stale_caches
 from bladelab.errors import InputFileError, SpecError
 from bladelab.runner.params import RUNNER_DATA_DIR
 
@@ -484,14 +485,13 @@ def compute_excitations(u, table, p, hist, cs, nm, nq):
             u[tgt] += g * (off - delayed(hist, cs, 3 * nm + nq + src, d))
         elif kind == T_DOF_MEAN_VEL:
             # mean velocity over the window ending d steps ago, from the position's change;
-            # while fewer samples exist the window shrinks (at the very start: the velocity)
-            w = min(int(table[r, R_WINDOW]), int(cs[3]) - 1 - d)
-            if w >= 1:
+            # off until the history holds the whole window (the start's first steps are
+            # left to the other reflexes)
+            w = int(table[r, R_WINDOW])
+            if int(cs[3]) - 1 - d >= w:
                 v = (delayed(hist, cs, 3 * nm + src, d)
                      - delayed(hist, cs, 3 * nm + src, d + w)) / (w * table[r, R_DT])
-            else:
-                v = delayed(hist, cs, 3 * nm + nq + src, d)
-            u[tgt] += g * (off - v)
+                u[tgt] += g * (off - v)
     for i in range(nm):
         if u[i] < 0.0:
             u[i] = 0.0
@@ -518,3 +518,6 @@ __all__ = [
     "update_gait_states",
     "write_parameters",
 ]
+
+
+refresh_stale_caches(globals())
