@@ -270,7 +270,7 @@ def _run_sections(report, folders: dict[str, Path], duration: float,
             "J_lean (deg)": ev.j_lean,
             **({"J_track (rad²)": ev.j_track, "tracked strides (count)": ev.track_strides}
                if (sol.data.get("settings") or {}).get("track") else {}),
-            "fell (yes/no)": bool(ev.fell),
+            "fell, nominal or a robust copy (yes/no)": bool(ev.fell),
             "simulated (s)": ev.duration,
             "mean speed (m/s)": ev.mean_speed,
         })
