@@ -174,20 +174,24 @@ def test_early_swing_knee_flexion_offset_acts_in_swing_only(amputee):
             assert np.count_nonzero(u) == (1 if state == SWING else 0)
 
 
+def _sensor_setup(model, dt: float):
+    """The amputee's layout, its table at ``dt`` [s], muscle names, muscle and dof counts, the
+    pelvis_tx index, an empty sensor history, controller state and muscle state."""
+    layout = controller_layout(model)
+    muscles, dofs = list(model.muscle_names), list(model.dof_names)
+    nm, nq = len(muscles), len(dofs)
+    hist = np.zeros((history_length(layout, dt), 3 * nm + 2 * nq))
+    ms = np.zeros((nm, 4))
+    ms[:, 1] = 0.1
+    return (layout, layout.table_for(dt), muscles, nm, nq, dofs.index("pelvis_tx"), hist,
+            np.zeros(4), ms)
+
+
 def test_swing_leg_placement_sees_the_delayed_forward_speed(amputee):
     # S11100.<hip muscle>_<side>-pelvis_tx.KV·(V0 − v(t − 50 ms)) (our addition): in Liftoff,
     # Swing and Landing only, on the pelvis's forward velocity 50 ms ago; gain 0 by default
-    layout = controller_layout(amputee)
-    dt = 1e-3
-    table = layout.table_for(dt)
-    muscles, dofs = list(amputee.muscle_names), list(amputee.dof_names)
-    nm, nq = len(muscles), len(dofs)
-    ix = dofs.index("pelvis_tx")
+    layout, table, muscles, nm, nq, ix, hist, cs, ms = _sensor_setup(amputee, 1e-3)
     assert layout.x0[layout.index("S11100.iliopsoas_r-pelvis_tx.KV")] == 0.0
-    hist = np.zeros((history_length(layout, dt), 3 * nm + 2 * nq))
-    cs = np.zeros(4)
-    ms = np.zeros((nm, 4))
-    ms[:, 1] = 0.1
     mp = amputee.muscle_params
     qvel = np.zeros(nq)
     for k in range(60):  # forward speed 3.0 m/s until 50 steps ago, 4.0 m/s since
@@ -218,19 +222,11 @@ def test_swing_leg_placement_on_the_mean_speed_of_the_last_stride(amputee):
     # ending 50 ms ago), from the pelvis's position; off until the history holds the window
     from bladelab.predict.reflex.controller import SPEED_WINDOW
 
-    layout = controller_layout(amputee)
     dt = 1e-3
-    table = layout.table_for(dt)
-    muscles, dofs = list(amputee.muscle_names), list(amputee.dof_names)
-    nm, nq = len(muscles), len(dofs)
-    ix = dofs.index("pelvis_tx")
-    nh = history_length(layout, dt)
+    layout, table, muscles, nm, nq, ix, hist, cs, ms = _sensor_setup(amputee, dt)
+    nh = len(hist)
     assert nh == round((0.05 + SPEED_WINDOW) / dt) + 2
-    hist = np.zeros((nh, 3 * nm + 2 * nq))
-    cs = np.zeros(4)
     cs[0] = SWING
-    ms = np.zeros((nm, 4))
-    ms[:, 1] = 0.1
     p = np.zeros(layout.size)
     p[layout.index("S11100.iliopsoas_l-pelvis_tx.KS")] = -2.0
     p[layout.index("S11100.iliopsoas_l-pelvis_tx.S0")] = 3.0
