@@ -11,7 +11,7 @@ import pytest
 SRC = Path(__file__).resolve().parents[1] / "src" / "bladelab"
 
 FOUNDATION = {"bladelab", "units", "constants", "errors", "_io", "parameters", "contact",
-              "executors"}
+              "executors", "numba_cache"}
 # wing -> the wings it may import (besides itself); docs/architecture.md draws the same graph
 ALLOWED: dict[str, set[str]] = {
     **{name: FOUNDATION for name in FOUNDATION},

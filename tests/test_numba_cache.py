@@ -1,4 +1,4 @@
-"""bladelab._numba_cache: a compiled module's on-disk cache is flushed when bladelab's compiled
+"""bladelab.numba_cache: a compiled module's on-disk cache is flushed when bladelab's compiled
 sources change (numba keys a cached function on its own file only)."""
 
 from __future__ import annotations
@@ -6,7 +6,7 @@ from __future__ import annotations
 import importlib
 import sys
 
-import bladelab._numba_cache as nc
+import bladelab.numba_cache as nc
 
 
 def _module(tmp_path, name: str):

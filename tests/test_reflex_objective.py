@@ -240,7 +240,7 @@ def test_the_power_balance_can_leave_out_a_push(able):
 
 def test_the_closed_loop_sees_the_mean_speed_placement_once_its_window_is_full():
     # the compiled loop runs the controller's current terms (a stale cached loop once ran an
-    # older formula: bladelab._numba_cache); the mean-speed placement is off until the history
+    # older formula: bladelab.numba_cache); the mean-speed placement is off until the history
     # holds its window and delay, then acts
     from pathlib import Path
 

@@ -25,7 +25,7 @@ import math
 
 from numba import njit
 
-from bladelab._numba_cache import refresh_stale_caches
+from bladelab.numba_cache import refresh_stale_caches
 
 
 @njit(cache=True, fastmath=False)

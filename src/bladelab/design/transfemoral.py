@@ -40,13 +40,13 @@ import mujoco
 import numpy as np
 from numba import njit
 
-from bladelab._numba_cache import refresh_stale_caches
 from bladelab.blade.model import BladeModel
 from bladelab.constants import STANDARD_GRAVITY
 from bladelab.design.constraints import blade_clearance, knee_buckling, knee_extension_moment
 from bladelab.design.gait_cycle import GaitCycle, default_gait_cycle, read_gait_csv
 from bladelab.design.performance import cycle_performance
 from bladelab.errors import ModelError, SimulationError, SpecError
+from bladelab.numba_cache import refresh_stale_caches
 from bladelab.runner import geometry as geo
 from bladelab.runner.params import default_runner_params
 from bladelab.runner.prosthetic_knee import ProstheticKnee, knee_torque

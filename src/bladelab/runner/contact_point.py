@@ -8,7 +8,7 @@ import math
 
 from numba import njit
 
-from bladelab._numba_cache import refresh_stale_caches
+from bladelab.numba_cache import refresh_stale_caches
 from bladelab.runner.model import CP_AZ, CP_RADIUS, CP_SITE
 
 

@@ -40,9 +40,9 @@ import mujoco
 import numpy as np
 from numba import njit
 
-from bladelab._numba_cache import refresh_stale_caches
 from bladelab.contact import hunt_crossley_force, smooth_spring_damper_force
 from bladelab.errors import SimulationError
+from bladelab.numba_cache import refresh_stale_caches
 from bladelab.runner.contact_point import lowest_point
 from bladelab.runner.mjcall import (
     call_mujoco,

@@ -18,8 +18,8 @@ import mujoco
 import numpy as np
 from numba import njit
 
-from bladelab._numba_cache import refresh_stale_caches
 from bladelab.contact import hunt_crossley_force, smooth_spring_damper_force
+from bladelab.numba_cache import refresh_stale_caches
 from bladelab.runner.contact_point import lowest_point
 from bladelab.runner.implicit import IMPLICIT, implicit_advance, implicit_begin, implicit_forces
 from bladelab.runner.mjcall import call_mujoco, mujoco_step_addresses  # noqa: F401 (re-exported)
@@ -47,7 +47,7 @@ from bladelab.runner.muscle import muscle_step
 from bladelab.sim.mujoco_engine import add_point_force
 
 # numba's cache is keyed on the file that defines a function, not on the files of the functions
-# it calls; bladelab._numba_cache (called at the end of this module) flushes it whenever a
+# it calls; bladelab.numba_cache (called at the end of this module) flushes it whenever a
 # compiled source of bladelab changes (this file used to carry a number to bump by hand).
 
 # The per-step kernels here and in implicit.py, muscle.py and contact_point.py allocate nothing

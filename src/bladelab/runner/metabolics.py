@@ -33,7 +33,7 @@ import math
 import numpy as np
 from numba import njit
 
-from bladelab._numba_cache import refresh_stale_caches
+from bladelab.numba_cache import refresh_stale_caches
 from bladelab.runner.muscle import V_MAX_OPT_PER_S, force_length
 
 MUSCLE_DENSITY = 1059.7  # kg/m^3

@@ -28,7 +28,7 @@ import math
 import numpy as np
 from numba import njit
 
-from bladelab._numba_cache import refresh_stale_caches
+from bladelab.numba_cache import refresh_stale_caches
 
 V_MAX_OPT_PER_S = 10.0
 ACTIVATION_RATE = 100.0

@@ -25,8 +25,8 @@ from dataclasses import asdict, dataclass
 
 from numba import njit
 
-from bladelab._numba_cache import refresh_stale_caches
 from bladelab.errors import SpecError
+from bladelab.numba_cache import refresh_stale_caches
 
 __all__ = ["ProstheticKnee", "knee_torque"]
 

@@ -30,8 +30,8 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit, prange
 
-from bladelab._numba_cache import refresh_stale_caches
 from bladelab.constants import STANDARD_GRAVITY
+from bladelab.numba_cache import refresh_stale_caches
 from bladelab.sim.chain import Chain
 from bladelab.sim.sole import (
     contact_elastic_energy,

@@ -25,11 +25,11 @@ import mujoco
 import numpy as np
 from numba import njit
 
-from bladelab._numba_cache import refresh_stale_caches
 from bladelab.blade.model import BladeModel
 from bladelab.constants import STANDARD_GRAVITY
 from bladelab.contact import stick_slip_friction_coefficient
 from bladelab.errors import SimulationError
+from bladelab.numba_cache import refresh_stale_caches
 from bladelab.sim import kernel as _k
 from bladelab.sim import sole as _sole
 from bladelab.sim.chain import Chain

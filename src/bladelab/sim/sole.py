@@ -15,13 +15,13 @@ import math
 
 from numba import njit
 
-from bladelab._numba_cache import refresh_stale_caches
 from bladelab.contact import (
     hunt_crossley_force,
     smooth_spring_damper_force,
     smoothstep,
     stick_slip_friction_coefficient,
 )
+from bladelab.numba_cache import refresh_stale_caches
 
 
 @njit(cache=True, inline="always", error_model="numpy")

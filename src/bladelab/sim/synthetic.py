@@ -24,10 +24,10 @@ import numpy as np
 from numba import njit
 
 from bladelab import units
-from bladelab._numba_cache import refresh_stale_caches
 from bladelab.blade.model import BladeModel
 from bladelab.constants import STANDARD_GRAVITY
 from bladelab.errors import ModelError, SimulationError
+from bladelab.numba_cache import refresh_stale_caches
 from bladelab.sim.chain import build_chain
 from bladelab.sim.mujoco_engine import MujocoBlade, build_spec
 from bladelab.trial.stance import Stance

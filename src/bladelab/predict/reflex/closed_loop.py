@@ -14,7 +14,7 @@ import math
 import numpy as np
 from numba import njit
 
-from bladelab._numba_cache import refresh_stale_caches
+from bladelab.numba_cache import refresh_stale_caches
 from bladelab.predict.reflex.controller import compute_excitations, push_sensors, update_gait_states
 from bladelab.runner.analyses import MIN_STEP_S, STEP_LOAD_BW
 from bladelab.runner.kernel import step_advance, step_begin, step_end

@@ -45,8 +45,8 @@ import numpy as np
 from numba import njit
 
 from bladelab._io import read_json, write_json
-from bladelab._numba_cache import refresh_stale_caches
 from bladelab.errors import InputFileError, SpecError
+from bladelab.numba_cache import refresh_stale_caches
 from bladelab.runner.params import RUNNER_DATA_DIR
 
 EARLY_STANCE, LATE_STANCE, LIFTOFF, SWING, LANDING = range(5)
