@@ -72,27 +72,26 @@ def verify_solution(
     settings = stored_settings(data, speed=speed, duration=duration, nominal=True)
     limits = (duration, speed, speed_tolerance, max_power_residual_pct)
     out = _check_gait(runner, layout, x, settings, limits)
+
+    def also(key: str, runs: list[tuple[dict, np.ndarray, ObjectiveSettings]]) -> None:
+        # more runs under ``key`` (each: what it changed, parameters, settings); all must pass
+        out[key] = [{**what, **_check_gait(runner, layout, xr, sr, limits)}
+                    for what, xr, sr in runs]
+        out["ok"] = bool(out["ok"] and all(c["ok"] for c in out[key]))
+
     if jittered_copies > 0:
-        out["jittered"] = [
-            _check_gait(runner, layout, xj, settings, limits)
-            for xj in jittered_parameters(x, jittered_copies, jitter, VERIFY_JITTER_SEED)
-        ]
-        out["ok"] = bool(out["ok"] and all(c["ok"] for c in out["jittered"]))
+        also("jittered", [({}, xj, settings) for xj in
+                          jittered_parameters(x, jittered_copies, jitter, VERIFY_JITTER_SEED)])
     if initial_speed_change > 0:
-        v0 = settings.start_speed
-        out["initial_speed"] = []
-        for factor in (1 + initial_speed_change, 1 - initial_speed_change):
-            changed = replace(settings, initial_speed=v0 * factor)
-            check = _check_gait(runner, layout, x, changed, limits)
-            out["initial_speed"].append({"initial_speed_m_per_s": v0 * factor, **check})
-        out["ok"] = bool(out["ok"] and all(c["ok"] for c in out["initial_speed"]))
+        speeds = [settings.start_speed * (1 + c)
+                  for c in (initial_speed_change, -initial_speed_change)]
+        also("initial_speed", [({"initial_speed_m_per_s": v}, x,
+                                replace(settings, initial_speed=v)) for v in speeds])
     if push_change > 0:
-        out["pushed"] = []
-        for t in PUSH_AFTER + np.arange(push_phases) / push_phases:
-            for change in (push_change, -push_change):
-                check = _check_gait(runner, layout, x, replace(settings, push=(t, change)), limits)
-                out["pushed"].append({"push_time_s": float(t), "push_change": change, **check})
-        out["ok"] = bool(out["ok"] and all(c["ok"] for c in out["pushed"]))
+        pushes = [(float(t), c) for t in PUSH_AFTER + np.arange(push_phases) / push_phases
+                  for c in (push_change, -push_change)]
+        also("pushed", [({"push_time_s": t, "push_change": c}, x, replace(settings, push=(t, c)))
+                        for t, c in pushes])
     return out
 
 
