@@ -10,6 +10,7 @@ import pytest
 
 from bladelab.errors import InputFileError, SpecError
 from bladelab.predict.reflex.controller import (
+    CONTROLLER_STATE_SIZE,
     EARLY_STANCE,
     LANDING,
     LATE_STANCE,
@@ -46,7 +47,7 @@ def test_delay_returns_the_value_from_d_steps_ago():
     nm, nq = 1, 2
     mp = np.array([[1000.0, 0.1, 0.2, 0.0, 0.04]])
     hist = np.zeros((6, 3 * nm + 2 * nq))
-    cs = np.zeros(4)
+    cs = np.zeros(CONTROLLER_STATE_SIZE)
     for k in range(10):
         ms = np.array([[0.1, 0.1 * (1 + k), 0.0, 10.0 * k]])  # L = 1 + k, F = k/100
         push_sensors(hist, cs, ms, mp, np.array([k, -k], float), np.zeros(2))
@@ -59,7 +60,7 @@ def test_delay_returns_the_value_from_d_steps_ago():
 def test_delay_before_history_is_filled_gives_the_first_sample():
     mp = np.array([[1000.0, 0.1, 0.2, 0.0, 0.04]])
     hist = np.zeros((5, 3 + 2))
-    cs = np.zeros(4)
+    cs = np.zeros(CONTROLLER_STATE_SIZE)
     push_sensors(hist, cs, np.array([[0.1, 0.07, 0.0, 0.0]]), mp, np.array([0.3]), np.zeros(1))
     assert delayed(hist, cs, 0, 3) == pytest.approx(0.7)
     assert delayed(hist, cs, 3, 3) == pytest.approx(0.3)
@@ -184,7 +185,7 @@ def _sensor_setup(model, dt: float):
     ms = np.zeros((nm, 4))
     ms[:, 1] = 0.1
     return (layout, layout.table_for(dt), muscles, nm, nq, dofs.index("pelvis_tx"), hist,
-            np.zeros(4), ms)
+            np.zeros(CONTROLLER_STATE_SIZE), ms)
 
 
 def test_swing_leg_placement_sees_the_delayed_forward_speed(amputee):
@@ -256,6 +257,39 @@ def test_swing_leg_placement_on_the_mean_speed_of_the_last_stride(amputee):
     assert u == pytest.approx(-2.0 * (3.0 - 3.5), rel=1e-9)
     cs[0] = EARLY_STANCE  # swing reflexes only
     assert step(x + 3.5 * dt, 3.5) == 0.0
+
+
+def test_mean_speed_reflexes_with_a_run_up_act_from_the_start(amputee):
+    # cs[4] = 1 (ObjectiveSettings.run_up): before the window is full, the positions before the
+    # first sample are the first sample's moved back at its velocity; the stance leg's hip
+    # muscles have the same term in EarlyStance/LateStance
+    dt = 1e-3
+    layout, table, muscles, nm, nq, ix, hist, cs, ms = _sensor_setup(amputee, dt)
+    cs[0], cs[1], cs[4] = SWING, EARLY_STANCE, 1.0
+    p = np.zeros(layout.size)
+    for name, gain, s0 in (("S11100.iliopsoas_l", -1.0, 3.0), ("S00011.glut_max_r", 1.5, 3.8)):
+        p[layout.index(f"{name}-pelvis_tx.KS")] = gain
+        p[layout.index(f"{name}-pelvis_tx.S0")] = s0
+    swing, stance = muscles.index("iliopsoas_l"), muscles.index("glut_max_r")
+    q, qd = np.zeros(nq), np.zeros(nq)
+    u = np.zeros(nm)
+    q[ix], qd[ix] = 5.0, 3.6  # the start: 3.6 m/s
+    push_sensors(hist, cs, ms, amputee.muscle_params, q, qd)
+    compute_excitations(u, table, p, hist, cs, nm, nq)
+    assert u[swing] == pytest.approx(-1.0 * (3.0 - 3.6), rel=1e-9)
+    assert u[stance] == pytest.approx(1.5 * (3.8 - 3.6), rel=1e-9)
+    # 0.2 s later at 3.1 m/s: the window ending 50 ms ago holds 0.15 s at 3.1 and 0.55 s of
+    # run-up at 3.6 m/s
+    for k in range(1, 201):
+        q[ix], qd[ix] = 5.0 + 3.1 * k * dt, 3.1
+        push_sensors(hist, cs, ms, amputee.muscle_params, q, qd)
+    compute_excitations(u, table, p, hist, cs, nm, nq)
+    v = (0.15 * 3.1 + 0.55 * 3.6) / 0.7
+    assert u[swing] == pytest.approx(-1.0 * (3.0 - v), rel=1e-9)
+    assert u[stance] == pytest.approx(1.5 * (3.8 - v), rel=1e-9)
+    cs[4] = 0.0  # without a run-up: off until the window is full
+    compute_excitations(u, table, p, hist, cs, nm, nq)
+    assert u[swing] == 0.0 and u[stance] == 0.0
 
 
 def test_parameter_json_roundtrip_and_errors(tmp_path, able, amputee):

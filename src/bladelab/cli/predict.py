@@ -25,6 +25,29 @@ def _parse_list(text: str, what: str, conv=str) -> list:
     return items
 
 
+def _run_recipe_sweep(out, categories, recipe, seeds, track_study, init, jobs, executor,
+                      checkpoint_every) -> None:
+    """``bladelab sweep --recipe``: the recipe (a name or a JSON file) per category × seed."""
+    from bladelab.predict.reflex.recipe import STABLE_GAIT_RECIPE, Recipe
+    from bladelab.predict.reflex.recipe_sweep import run_recipe_sweep
+
+    if recipe == "stable-gait":
+        chosen = STABLE_GAIT_RECIPE
+    elif Path(recipe).is_file():
+        chosen = Recipe.read(recipe)
+    else:
+        raise SpecError(f"no recipe {recipe!r}", where="--recipe",
+                        hint="stable-gait, or the path of a recipe JSON")
+    if init is not None and not init.is_file():
+        raise SpecError("file not found", file=init, where="--init")
+    table = run_recipe_sweep(
+        _parse_list(categories, "--categories"),
+        _parse_list(seeds or "1,2,3", "--seeds", int),
+        out=out, recipe=chosen, init=init, track_study=track_study, jobs=jobs,
+        executor=executor, checkpoint_every=checkpoint_every)
+    typer.echo(table.to_string(index=False))
+
+
 def _check_simulation_options(dt: float, robust_samples: int, robust_jitter: float) -> None:
     """The time step [s] and the robust-evaluation options shared by predict and sweep."""
     if not (math.isfinite(dt) and 0 < dt <= 2e-3):
@@ -86,6 +109,11 @@ def register(app: typer.Typer) -> None:
         strike_limit: float = typer.Option(
             1.0, "--strike-limit", help="A step whose swinging foot strikes the ground earns "
             "max(0, 1 - peak/limit) of its credit (body weights; issue 20 accepts at most 0.2)."
+        ),
+        run_up: bool = typer.Option(
+            False, "--run-up", help="Reflex: the reflexes on the mean forward speed act from "
+            "the start, as if the runner had moved at the initial speed before it (else they "
+            "wait for a full window of the run)."
         ),
         integrator: str = typer.Option(
             "explicit", "--integrator", help="Reflex: explicit (the default 0.25 ms scheme) | "
@@ -222,6 +250,7 @@ def register(app: typer.Typer) -> None:
                 robust_push=robust_push,
                 initial_speed=initial_speed,
                 strike_limit_bw=strike_limit,
+                run_up=run_up,
                 integrator=integrator,
                 track=None if track is None else str(track),
                 w_track=0.0 if track is None else track_weight,
@@ -297,6 +326,19 @@ def register(app: typer.Typer) -> None:
             None, "--body", help="Collocation: seed001 (seed 001's model) | toes (a toe "
             "segment and compliant Achilles tendons) [default: seed001]."
         ),
+        recipe: str | None = typer.Option(
+            None, "--recipe", help="Reflex: run a recipe of stages per category and seed "
+            "instead of the speed grid: stable-gait (issue 20's stages, then speed "
+            "continuation on the speed reached) | FILE (a recipe JSON)."
+        ),
+        seeds: str | None = typer.Option(
+            None, "--seeds", help="Reflex, with --recipe: CMA-ES seeds per category "
+            "[default: 1,2,3]."
+        ),
+        track_study: Path | None = typer.Option(
+            None, "--track-study", help="Reflex, with --recipe: the collocation study whose "
+            "strides the tracking stages follow (amputee-<category>/speed-<v>.json)."
+        ),
     ) -> None:
         """Category × speed grid: warm-started optimisations, maximum speed, cost at 4 m/s,
         200 m and 400 m times, contact times (seed 001 §2.2.2 B–C, Table 3.1). Running it again
@@ -307,7 +349,14 @@ def register(app: typer.Typer) -> None:
         and the maximum speed; DIR/<model>/speed-<v>.json, max-speed.json and the table
         DIR/collocation-sweep.csv. A used --out needs --resume or --force; exit status 2 when a
         model failed (after the others). --starts K solves each problem from up to K starts
-        and keeps the best. The CMA-ES options do not apply."""
+        and keeps the best. The CMA-ES options do not apply.
+
+        With --recipe: per category and seed (--seeds), the recipe's stages, each warm-started
+        from the one before, then the speed raised by continuation on the speed reached;
+        DIR/<category>/seed-<n>/ (one folder per level, levels.json), DIR/levels.csv and
+        DIR/summary.csv (whether each category's seeds agree, maximum speeds). The grid options
+        (--speeds, --generations, --popsize, --sigma, --duration, --dt, --robust-*) are the
+        recipe's. Running it again with the same --out continues."""
         if method == "collocation":
             from bladelab.cli.collocation_sweep import run_collocation_sweep
 
@@ -334,6 +383,18 @@ def register(app: typer.Typer) -> None:
             if given:
                 raise SpecError("only with --method collocation", where=option,
                                 hint="a reflex sweep continues by itself in the same --out")
+        if recipe is not None:
+            for given, option in ((initial_speed is not None, "--initial-speed"),
+                                  (chain_from is not None, "--chain-from")):
+                if given:
+                    raise SpecError("not with --recipe (the recipe sets it)", where=option)
+            _run_recipe_sweep(out, categories, recipe, seeds, track_study, init, jobs,
+                              executor, checkpoint_every)
+            return
+        for given, option in ((seeds is not None, "--seeds"),
+                              (track_study is not None, "--track-study")):
+            if given:
+                raise SpecError("only with --recipe", where=option)
         from bladelab.predict.reflex.sweep import run_sweep
 
         if not (math.isfinite(duration) and duration > 0):

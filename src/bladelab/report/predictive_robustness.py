@@ -1,56 +1,27 @@
-"""The robustness section of a predictive report: issue 20's acceptance, re-simulated.
-
-A reflex gait that survives only its own floating-point path, its own start or no change of
-speed is not a prediction (docs/predictive.md, "Robust evaluation"). The section re-simulates
-the solution shown (:func:`bladelab.predict.reflex.verify.verify_solution`):
-
-- nominally, and as :data:`COPIES` copies with the parameters moved by :data:`COPY_JITTER`
-  (relative, along directions no optimiser saw);
-- from initial speeds :data:`START_CHANGE` above and below the file's;
-- pushed once (forward speed × (1 ± :data:`PUSH_CHANGE`)) at :data:`PUSH_PHASES` phases of a
-  stride: not part of the acceptance, the size of the gait's basin.
-
-Issue 20's acceptance, judged per run: it runs the whole time with the shipped-solution
-criteria (speed, flight, alternating steps, power balance), no swinging foot strikes the
-ground above :data:`STRIKE_LIMIT_BW` body weights, and the mean pelvis tilt lies inside the
-objective's window (seed 001: −16…−2°).
-"""
+"""The robustness section of a predictive report: issue 20's acceptance, re-simulated
+(:mod:`bladelab.predict.reflex.acceptance`: the judged runs, the pushes that measure the
+gait's basin, and what a run must show)."""
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import pandas as pd
 
-__all__ = ["COPIES", "COPY_JITTER", "PUSH_CHANGE", "START_CHANGE", "robustness_runs",
-           "robustness_section"]
+from bladelab.predict.reflex.acceptance import (
+    COPIES,
+    COPY_JITTER,
+    PUSH_CHANGE,
+    PUSH_PHASES,
+    START_CHANGE,
+    STRIKE_LIMIT_BW,
+    acceptance_runs,
+    judged_runs,
+    meets_acceptance,
+)
 
-#: Issue 20: every shipped solution survives 4 copies moved by 1e-3 ...
-COPIES = 4
-COPY_JITTER = 1e-3
-#: ... and a ±5 % change of the initial speed; no swinging foot above 0.2 body weights.
-START_CHANGE = 0.05
-STRIKE_LIMIT_BW = 0.2
-#: The pushes that measure the basin (relative change of forward speed, phases of a stride).
-PUSH_CHANGE = 0.02
-PUSH_PHASES = 5
+__all__ = ["robustness_runs", "robustness_section"]
 
-
-def robustness_runs(path: Path, duration: float) -> dict:
-    """:func:`~bladelab.predict.reflex.verify.verify_solution`'s result for the parameter file
-    ``path`` re-simulated for ``duration`` [s] as above (pushes only when ``duration`` is at
-    least :data:`~bladelab.predict.reflex.objective.MIN_PUSH_DURATION`; ``"pushed"`` is then
-    empty); ``"simulations"`` counts the runs."""
-    from bladelab.predict.reflex.objective import MIN_PUSH_DURATION
-    from bladelab.predict.reflex.verify import verify_solution
-
-    pushes = duration >= MIN_PUSH_DURATION
-    out = verify_solution(path, duration=duration, jittered_copies=COPIES, jitter=COPY_JITTER,
-                          initial_speed_change=START_CHANGE,
-                          push_change=PUSH_CHANGE if pushes else 0.0, push_phases=PUSH_PHASES)
-    out.setdefault("pushed", [])
-    out["simulations"] = 1 + sum(len(out[k]) for k in ("jittered", "initial_speed", "pushed"))
-    return out
+#: Re-simulations of a solution shown (:func:`~bladelab.predict.reflex.acceptance.acceptance_runs`).
+robustness_runs = acceptance_runs
 
 
 def robustness_section(rep, out: dict, duration: float) -> None:
@@ -59,12 +30,7 @@ def robustness_section(rep, out: dict, duration: float) -> None:
 
     pushes = bool(out["pushed"])
     window = ObjectiveSettings().pelvis_tilt_range_deg
-    judged = [("nominal", out)]
-    judged += [(f"copy {k + 1}, moved by {COPY_JITTER:g}", c)
-               for k, c in enumerate(out["jittered"])]
-    judged += [(f"start {c['initial_speed_m_per_s']:.3f} m/s", c)
-               for c in out["initial_speed"]]
-    table = pd.DataFrame([_row(name, c, window) for name, c in judged])
+    table = pd.DataFrame([_row(name, c, window) for name, c in judged_runs(out)])
     failed = [r["run"] for _, r in table.iterrows() if not r["meets the acceptance (yes/no)"]]
     tables = [("Judged runs (issue 20's acceptance)", table)]
     if pushes:
@@ -100,11 +66,9 @@ def robustness_section(rep, out: dict, duration: float) -> None:
 
 
 def _row(name: str, c: dict, window: tuple[float, float]) -> dict:
-    tilt_ok = window[0] <= c["pelvis_tilt_mean_deg"] <= window[1]
-    strikes_ok = c["swing_contact_peak_bw"] <= STRIKE_LIMIT_BW
     return {
         "run": name,
-        "meets the acceptance (yes/no)": bool(c["ok"] and strikes_ok and tilt_ok),
+        "meets the acceptance (yes/no)": meets_acceptance(c, window),
         "runs the whole time (yes/no)": not c["fell"],
         "simulated (s)": c["duration_s"],
         "mean speed (m/s)": c["mean_speed_m_per_s"],

@@ -65,6 +65,8 @@ T_CONST, T_LENGTH, T_LENGTH_POS, T_FORCE, T_DOF_POS, T_DOF_VEL, T_DOF_MEAN_VEL =
 # in ``table_for``), time step [s] (set by ``table_for``).
 (R_KIND, R_TARGET, R_LEG, R_MASK, R_SOURCE, R_DELAY, R_GAIN, R_OFFSET, R_OFFSET_CONST,
  R_WINDOW, R_DT) = range(11)
+#: Length of the controller state ``cs`` of the compiled part (below).
+CONTROLLER_STATE_SIZE = 5
 #: Window [s] of the swing-leg placement's mean forward speed: about one stride at 3–4 m/s, so
 #: the mean is steady over a steady gait (the pelvis's velocity swings by ±0.3 m/s within a
 #: stride) and moves only when the runner speeds up or slows down.
@@ -123,6 +125,10 @@ _LEG_REFLEXES: list[tuple] = [
     # lean further forward until they fall, a runaway a placement on the mean speed can stop)
     (_SWING, "iliopsoas", "pelvis_tx", "KS", "S0", T_DOF_MEAN_VEL, VES_DELAY, (0.0, 3.5)),
     (_SWING, "glut_max", "pelvis_tx", "KS", "S0", T_DOF_MEAN_VEL, VES_DELAY, (0.0, 3.5)),
+    # and for the stance leg's hip muscles, which pitch the trunk (session 19): a runner who is
+    # too fast can straighten up and brake, as people do (gains 0 by default)
+    (_STANCE, "iliopsoas", "pelvis_tx", "KS", "S0", T_DOF_MEAN_VEL, VES_DELAY, (0.0, 3.5)),
+    (_STANCE, "glut_max", "pelvis_tx", "KS", "S0", T_DOF_MEAN_VEL, VES_DELAY, (0.0, 3.5)),
 ]
 # Search scale of the gains on the forward velocity [1/(m/s)], times CMA-ES's sigma: small,
 # because a stable gait of session 17 falls at 2.7 s when one such gain alone is set to 0.01.
@@ -377,7 +383,8 @@ def write_parameters(
 # ----------------------------------------------------------------------------- compiled part
 # Sensor channels in the history buffer: per muscle L, V, F (3 per muscle), then per dof q, qd.
 # Controller state ``cs`` (float64 array): per leg the gait state (cs[0], cs[1]); cs[2] = write
-# position in the history; cs[3] = number of samples written.
+# position in the history; cs[3] = number of samples written; cs[4] = 1: a run-up (the mean
+# velocity reflexes act from the start, the runner having moved at its initial velocity before).
 
 
 @njit(cache=True)
@@ -455,6 +462,18 @@ def update_gait_states(cs, crec, cp, qpos, ix_pelvis, body_weight, thresholds, l
 
 
 @njit(cache=True)
+def _position_with_run_up(hist, cs, nm, nq, dof, age, n, dt):
+    """Position of ``dof`` ``age`` samples (of ``dt`` [s]) ago when ``n`` samples are written;
+    before the first sample, the first sample's position moved back at its velocity (a
+    run-up)."""
+    if age <= n - 1:
+        return delayed(hist, cs, 3 * nm + dof, age)
+    first_q = delayed(hist, cs, 3 * nm + dof, n - 1)
+    first_v = delayed(hist, cs, 3 * nm + nq + dof, n - 1)
+    return first_q - first_v * (age - (n - 1)) * dt
+
+
+@njit(cache=True)
 def compute_excitations(u, table, p, hist, cs, nm, nq):
     """Excitations ``u`` from the reflex table, parameters ``p`` and the delayed sensors."""
     u[:] = 0.0
@@ -485,12 +504,18 @@ def compute_excitations(u, table, p, hist, cs, nm, nq):
             u[tgt] += g * (off - delayed(hist, cs, 3 * nm + nq + src, d))
         elif kind == T_DOF_MEAN_VEL:
             # mean velocity over the window ending d steps ago, from the position's change;
-            # off until the history holds the whole window (the start's first steps are
-            # left to the other reflexes)
+            # until the history holds the whole window: off, or with a run-up (cs[4] = 1)
+            # the position before the start extrapolated at the first sample's velocity
             w = int(table[r, R_WINDOW])
-            if int(cs[3]) - 1 - d >= w:
+            n = int(cs[3])
+            if n - 1 - d >= w:
                 v = (delayed(hist, cs, 3 * nm + src, d)
                      - delayed(hist, cs, 3 * nm + src, d + w)) / (w * table[r, R_DT])
+                u[tgt] += g * (off - v)
+            elif cs[4] > 0.0 and n > 0:
+                h = table[r, R_DT]
+                v = (_position_with_run_up(hist, cs, nm, nq, src, d, n, h)
+                     - _position_with_run_up(hist, cs, nm, nq, src, d + w, n, h)) / (w * h)
                 u[tgt] += g * (off - v)
     for i in range(nm):
         if u[i] < 0.0:
@@ -508,6 +533,7 @@ def history_length(layout: ControllerLayout, dt: float) -> int:
 
 __all__ = [
     "ControllerLayout",
+    "CONTROLLER_STATE_SIZE",
     "STATE_NAMES",
     "compute_excitations",
     "controller_layout",

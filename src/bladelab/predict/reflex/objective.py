@@ -53,6 +53,7 @@ import numpy as np
 from bladelab.errors import InputFileError, SimulationError, SpecError
 from bladelab.predict.reflex.closed_loop import STEP_STATE_SIZE, run_closed_loop
 from bladelab.predict.reflex.controller import (
+    CONTROLLER_STATE_SIZE,
     ControllerLayout,
     controller_layout,
     history_length,
@@ -113,7 +114,9 @@ MIN_PUSH_DURATION = PUSH_AFTER + PUSH_BEFORE_END + 1.0
 @dataclass(frozen=True)
 class ObjectiveSettings:
     """Weights and ranges of the objective (seed 001 §2.2.1). Speeds [m/s], load [N·m], tilt
-    [deg], times [s]."""
+    [deg], times [s]. ``run_up``: the reflexes on the mean forward speed act from the start, as
+    if the runner had moved at the initial velocity before it (else they wait for a full
+    window of the run)."""
 
     speed: float = 3.5
     speed_tolerance: float = 0.1
@@ -136,6 +139,7 @@ class ObjectiveSettings:
     alternating_steps: bool = True
     strike_limit_bw: float = 1.0
     initial_speed: float | None = None
+    run_up: bool = False
     integrator: str = "explicit"
     track: str | None = None
     w_track: float = 0.0
@@ -280,7 +284,8 @@ def simulate_controlled(
     u = np.zeros(nm)
     table = layout.table_for(dt)
     hist = np.zeros((history_length(layout, dt), 3 * nm + 2 * m.nq))
-    cs = np.zeros(4)
+    cs = np.zeros(CONTROLLER_STATE_SIZE)
+    cs[4] = 1.0 if settings.run_up else 0.0
     cs[0] = 3.0  # start in swing; the first contact starts a stance
     cs[1] = 3.0
     cp = model.contact_params

@@ -1,0 +1,354 @@
+"""Staged optimisation of one blade category and seed (issue 20): a recipe of CMA-ES stages.
+
+One stage of seed 001's objective from SCONE's parameters does not find a running gait at
+4 m/s, and a gait found without perturbations is a slow fall (docs/predictive.md, "Warm start
+from a collocation stride"). What found stable gaits for Cat6 is a sequence of stages, each
+warm-started from the one before (:data:`STABLE_GAIT_RECIPE`):
+
+1. ``track``: seed 001's objective plus a term pulling the gait towards the collocation stride
+   of the same runner, blade and speed (``--track``), 4 s;
+2. ``stable``: seed 001's objective over twice the acceptance's 10 s, with copies that break
+   the floating-point path (new every generation);
+3. ``basin``: 15 s with the copies pushed by ±2 % of their forward speed in mid-run;
+4. ``start``: copies that also start at ±1 % of the initial speed.
+
+Then the speed is raised by **continuation on the speed reached** (issue 20: not a fixed
+grid): the recipe's ``continuation`` stage runs at the speed the last level reached plus
+``speed_step`` [m/s], from that level's gait and starting at that speed, until a level falls in
+its nominal 10 s or gains less than ``min_gain`` [m/s]. The maximum speed is the fastest level
+that runs.
+
+Output of one task (:func:`run_recipe`), ``OUT/<category>/seed-<n>/``: ``recipe.json`` (the
+recipe, the task and its warm start: running again with another is an error), one folder per
+level (``1-track``, ..., ``speed-4.25``; each an :func:`optimize_controller` run folder) and
+``levels.json``, one row per finished level (its 10 s re-simulation, :func:`level_row`),
+rewritten atomically after each. Running the same task again continues it: finished levels
+are read back, an interrupted one resumes from its checkpoint. A recipe may grow between runs
+(stages added after the finished ones, more or fewer continuation levels); one that defines a
+finished level otherwise is refused.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import math
+from collections.abc import Callable
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from bladelab._io import read_json, write_json
+from bladelab.errors import InputFileError, SpecError
+from bladelab.predict.reflex.objective import ObjectiveSettings
+
+__all__ = ["STABLE_GAIT_RECIPE", "Recipe", "Stage", "level_row", "maximum_speed", "recipe_task",
+           "run_recipe", "track_file"]
+
+RECIPE_NAME = "recipe.json"
+LEVELS_NAME = "levels.json"
+RECIPE_FORMAT = 1
+#: The first stage's warm start unless told otherwise: the shipped amputee solution.
+SHIPPED_START = "amputee-Cat6-3.5.json"
+#: The collocation stride's weight in a tracking stage [1/rad²] (docs/predictive.md).
+TRACK_WEIGHT = 1000.0
+
+
+@dataclass(frozen=True)
+class Stage:
+    """One CMA-ES run of a recipe: ``generations``, initial step ``sigma`` (× each parameter's
+    scale), ``popsize`` candidates; ``track``: add the collocation stride's tracking term;
+    ``settings``: :class:`ObjectiveSettings` fields for this stage (over the recipe's
+    ``base``)."""
+
+    name: str
+    generations: int
+    sigma: float
+    popsize: int = 16
+    track: bool = False
+    settings: dict = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        if not self.name or "/" in self.name:
+            raise SpecError(f"a stage needs a plain name, got {self.name!r}", where="stage.name")
+        if self.generations < 1 or self.popsize < 2 or not self.sigma > 0:
+            raise SpecError(f"stage {self.name!r} needs generations >= 1, popsize >= 2 and "
+                            "sigma > 0", where=f"stage {self.name}")
+
+
+@dataclass(frozen=True)
+class Recipe:
+    """The stages of a task and its speed continuation. Speeds [m/s]."""
+
+    stages: tuple[Stage, ...]
+    continuation: Stage | None = None
+    base: dict = field(default_factory=dict)
+    speed: float = 4.0
+    initial_speed: float = 3.5
+    speed_step: float = 0.2
+    min_gain: float = 0.05
+    max_levels: int = 6
+
+    def __post_init__(self) -> None:
+        if not self.stages:
+            raise SpecError("a recipe needs at least one stage", where="stages")
+        names = [s.name for s in self.stages]
+        if len(set(names)) != len(names):
+            raise SpecError(f"stage names repeat: {names}", where="stages")
+        if not (self.speed > 0 and self.initial_speed > 0 and self.speed_step > 0
+                and self.min_gain >= 0 and self.max_levels >= 0):
+            raise SpecError("a recipe needs speed, initial_speed, speed_step > 0, min_gain >= 0 "
+                            "and max_levels >= 0", where="recipe")
+        for stage in (*self.stages, *([self.continuation] if self.continuation else [])):
+            self.settings_for(stage, self.speed, self.initial_speed, None)  # checks the fields
+
+    def settings_for(self, stage: Stage, speed: float, initial_speed: float,
+                     track: Path | None) -> ObjectiveSettings:
+        """The objective settings of ``stage`` at ``speed`` from ``initial_speed`` [m/s]."""
+        known = set(ObjectiveSettings.__dataclass_fields__)
+        given = {**self.base, **stage.settings}
+        unknown = sorted(set(given) - known)
+        if unknown:
+            raise SpecError(f"unknown objective setting(s) {unknown} in stage {stage.name!r}",
+                            where="recipe", hint=f"known: {', '.join(sorted(known))}")
+        d = {**given, "speed": float(speed), "initial_speed": float(initial_speed)}
+        if stage.track and track is not None:
+            d.update(track=str(track), w_track=TRACK_WEIGHT)
+        return ObjectiveSettings.from_dict(d)
+
+    def to_dict(self) -> dict:
+        return asdict(self)
+
+    @classmethod
+    def from_dict(cls, d: dict) -> Recipe:
+        d = dict(d)
+        try:
+            d["stages"] = tuple(Stage(**s) for s in d["stages"])
+            if d.get("continuation") is not None:
+                d["continuation"] = Stage(**d["continuation"])
+            return cls(**d)
+        except (KeyError, TypeError) as e:
+            raise SpecError(f"not a recipe: {e}", where="recipe",
+                            hint="see bladelab.predict.reflex.recipe.STABLE_GAIT_RECIPE") from e
+
+    @classmethod
+    def read(cls, path: str | Path) -> Recipe:
+        """A recipe from a JSON file (:meth:`to_dict`'s form)."""
+        data = read_json(path, what="recipe")
+        try:
+            return cls.from_dict(data)
+        except SpecError as e:
+            raise InputFileError(str(e), file=path, hint=e.hint) from e
+
+
+_FAST = {"integrator": "implicit", "dt": 1e-3}
+_COPIES = {"robust_jitter": 1e-6, "robust_directions": "per-generation"}
+
+#: The stages that found stable Cat6 gaits at 4 m/s (sessions 16–19, docs/predictive.md), on
+#: the fast scheme (implicit, 1 ms); about 5 h of one core per category and seed.
+STABLE_GAIT_RECIPE = Recipe(
+    stages=(
+        Stage("track", 1000, 0.3, popsize=32, track=True, settings={"duration": 4.0}),
+        Stage("stable", 600, 0.2, settings={"duration": 20.0, "robust_samples": 3, **_COPIES}),
+        Stage("basin", 400, 0.1, settings={"duration": 15.0, "robust_samples": 3,
+                                           "robust_push": 0.02, **_COPIES}),
+        Stage("start", 400, 0.1, settings={"duration": 15.0, "robust_samples": 5,
+                                           "robust_push": 0.02, "robust_speed_change": 0.01,
+                                           **_COPIES}),
+    ),
+    continuation=Stage("faster", 200, 0.1, settings={"duration": 15.0, "robust_samples": 3,
+                                                     "robust_push": 0.02, **_COPIES}),
+    base=_FAST,
+)
+
+
+def track_file(study: str | Path, category: str, speed: float) -> Path:
+    """The collocation stride of ``category`` at ``speed`` [m/s] in a collocation study folder
+    (``STUDY/amputee-<category>/speed-<v>.json``, or under ``STUDY/amputee/``)."""
+    study = Path(study)
+    name = Path(f"amputee-{category}") / f"speed-{speed:g}.json"
+    for path in (study / name, study / "amputee" / name):
+        if path.is_file():
+            return path.resolve()
+    raise InputFileError(f"no collocation stride of {category} at {speed:g} m/s",
+                         file=study / name, where="--track-study",
+                         hint="bladelab study collocation writes one (docs/collocation.md)")
+
+
+def level_row(path: Path, speed: float) -> dict:
+    """A finished level's gait (its ``best.json``) re-simulated nominally for 10 s at ``speed``
+    [m/s] (:func:`~bladelab.predict.reflex.verify.verify_solution`): cost, mean speed [m/s],
+    fell, swing contacts, mean pelvis tilt [deg], and issue 20's acceptance
+    (:func:`~bladelab.predict.reflex.acceptance.acceptance_runs`; only for a gait that runs)."""
+    from bladelab.predict.reflex.acceptance import acceptance_runs, meets_acceptance
+    from bladelab.predict.reflex.verify import verify_solution
+
+    v = verify_solution(path, speed=speed, duration=10.0)
+    row = {
+        "cost": float(v["cost"]),
+        "mean_speed_m_per_s": float(v["mean_speed_m_per_s"]),
+        "fell": bool(v["fell"]),
+        "simulated_s": float(v["duration_s"]),
+        "swing_contacts": int(v["swing_contacts"]),
+        "swing_contact_peak_bw": float(v["swing_contact_peak_bw"]),
+        "pelvis_tilt_mean_deg": float(v["pelvis_tilt_mean_deg"]),
+        "nominal_meets_acceptance": meets_acceptance(v),
+        "accepted": False,
+    }
+    if not v["fell"]:
+        row["accepted"] = bool(acceptance_runs(path, 10.0, pushes=False)["accepted"])
+    return row
+
+
+def _digest(x: np.ndarray) -> str:
+    return hashlib.sha256(np.ascontiguousarray(x, dtype=float).tobytes()).hexdigest()
+
+
+def run_recipe(
+    category: str,
+    seed: int,
+    *,
+    out: str | Path,
+    recipe: Recipe = STABLE_GAIT_RECIPE,
+    init: str | Path | None = None,
+    track_study: str | Path | None = None,
+    checkpoint_every: int = 5,
+    progress: Callable[[str, dict], None] | None = None,
+) -> list[dict]:
+    """Run (or continue) ``recipe`` for the amputee with blade ``category`` and CMA-ES seed
+    ``seed`` in ``out/<category>/seed-<seed>/``; returns the rows of ``levels.json`` (see the
+    module docstring). ``init``: the first stage's warm start (parameters JSON; default the
+    shipped amputee solution); ``track_study``: the collocation study of the tracking stages
+    (:func:`track_file`); ``progress(level, row)`` after each finished level."""
+    from bladelab.predict.reflex.controller import read_parameters
+    from bladelab.predict.reflex.optimize import (
+        CHECKPOINT_NAME,
+        optimize_controller,
+        runner_and_layout,
+    )
+    from bladelab.runner.params import RUNNER_DATA_DIR, blade_category
+
+    blade_category(category)
+    folder = Path(out) / category / f"seed-{seed}"
+    _, layout = runner_and_layout("amputee", category)
+    init = Path(init) if init is not None else RUNNER_DATA_DIR / "solutions" / SHIPPED_START
+    x = read_parameters(init, layout, transfer=True)
+    track = None
+    if any(s.track for s in recipe.stages):
+        if track_study is None:
+            raise SpecError("the recipe tracks a collocation stride: give the study",
+                            where="--track-study")
+        track = track_file(track_study, category, recipe.speed)
+    task = {"format": RECIPE_FORMAT, "category": category, "seed": int(seed),
+            "recipe": recipe.to_dict(), "init_sha256": _digest(x),
+            "track": None if track is None else str(track)}
+    held = folder / RECIPE_NAME
+    rows = _read_levels(folder)
+    if held.is_file():
+        _check_same_task(read_json(held, what="recipe task"), _as_json(task), rows, held)
+    write_json(held, task)
+    done = {r["level"]: r for r in rows}
+
+    def level(name: str, stage: Stage, speed: float, start: float, x0: np.ndarray) -> dict:
+        sub = folder / name
+        if name in done:
+            return done[name]
+        settings = recipe.settings_for(stage, speed, start, track if stage.track else None)
+        resume = (sub / CHECKPOINT_NAME).is_file()
+        res = optimize_controller("amputee", blade=category, speed=speed, x0=x0,
+                                  generations=stage.generations, popsize=stage.popsize,
+                                  sigma=stage.sigma, seed=int(seed), jobs=1, out=sub,
+                                  resume=resume, force=not resume,
+                                  checkpoint_every=checkpoint_every, settings=settings)
+        row = {"category": category, "seed": int(seed), "level": name, "stage": stage.name,
+               "prescribed_speed_m_per_s": float(speed), "initial_speed_m_per_s": float(start),
+               "generations": res.generations, "wall_time_s": res.wall_time_s,
+               "best_cost_in_run": res.best_cost, **level_row(sub / "best.json", speed)}
+        rows.append(row)
+        write_json(folder / LEVELS_NAME, rows)
+        if progress is not None:
+            progress(f"{category} seed {seed} {name}", row)
+        return row
+
+    speed, start = recipe.speed, recipe.initial_speed
+    for i, stage in enumerate(recipe.stages, start=1):
+        name = f"{i}-{stage.name}"
+        row = level(name, stage, speed, start, x)
+        x = read_parameters(folder / name / "best.json", layout)
+    if recipe.continuation is None or row["fell"]:
+        return rows
+    reached = row["mean_speed_m_per_s"]
+    for _ in range(recipe.max_levels):
+        target = round(reached + recipe.speed_step, 2)
+        start = round(reached, 2)
+        name = f"speed-{target:g}"
+        row = level(name, recipe.continuation, target, start, x)
+        if row["fell"] or row["mean_speed_m_per_s"] < reached + recipe.min_gain:
+            break
+        reached = row["mean_speed_m_per_s"]
+        x = read_parameters(folder / name / "best.json", layout)
+    return rows
+
+
+def _check_same_task(old: dict, new: dict, rows: list[dict], path: Path) -> None:
+    """Refuse a task folder started with another warm start or stride, or whose finished
+    levels the new recipe defines otherwise (stages may be added after them, the number of
+    continuation levels may change)."""
+    for key, what in (("format", "format"), ("category", "category"), ("seed", "seed"),
+                      ("init_sha256", "warm start (--init)"), ("track", "tracked stride")):
+        if old.get(key) != new.get(key):
+            raise InputFileError(f"this task folder was started with another {what}", file=path,
+                                 hint="use the first run's options, or another --out")
+    a, b = old["recipe"], new["recipe"]
+    same = {k: a.get(k) == b.get(k) for k in a}
+    for row in rows:
+        level = row["level"]
+        if level.startswith("speed-"):
+            keys = ("continuation", "stages", "base", "speed", "initial_speed", "speed_step",
+                    "min_gain")
+            changed = not all(same.get(k, False) for k in keys)
+        else:
+            i = int(level.split("-", 1)[0]) - 1
+            changed = (not (same["base"] and same["speed"] and same["initial_speed"])
+                       or i >= len(b["stages"]) or a["stages"][i] != b["stages"][i])
+        if changed:
+            raise InputFileError(f"this task folder was started with another recipe: its "
+                                 f"finished level {level} would be defined otherwise", file=path,
+                                 hint="use the first run's recipe (stages may be added after "
+                                 "the finished ones), or another --out")
+
+
+def _as_json(obj: dict) -> dict:
+    """``obj`` as it reads back from JSON (tuples become lists)."""
+    import json
+
+    return json.loads(json.dumps(obj))
+
+
+def _read_levels(folder: Path) -> list[dict]:
+    path = folder / LEVELS_NAME
+    if not path.is_file():
+        return []
+    rows = read_json(path, what="levels of a recipe task")
+    if not isinstance(rows, list):
+        raise InputFileError("not a list of levels", file=path, hint="delete it to re-check "
+                             "the levels (their runs are kept)")
+    return rows
+
+
+def recipe_task(payload: dict) -> list[dict]:
+    """:func:`run_recipe` for executors: ``payload`` holds its arguments (the recipe as a
+    dict)."""
+    payload = dict(payload)
+    recipe = Recipe.from_dict(payload.pop("recipe"))
+    category, seed = payload.pop("category"), payload.pop("seed")
+    return run_recipe(category, seed, recipe=recipe, **payload)
+
+
+def maximum_speed(rows: list[dict]) -> tuple[float, dict | None]:
+    """The fastest level that ran its nominal 10 s [m/s] and its row (NaN, None: none ran)."""
+    ran = [r for r in rows if not r["fell"]]
+    if not ran:
+        return math.nan, None
+    top = max(ran, key=lambda r: r["mean_speed_m_per_s"])
+    return float(top["mean_speed_m_per_s"]), top

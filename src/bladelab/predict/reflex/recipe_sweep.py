@@ -1,0 +1,135 @@
+"""The category sweep of issue 20: a recipe (:mod:`bladelab.predict.reflex.recipe`) per blade
+category and seed, and whether each category's seeds agree.
+
+Tasks (category × seed) run on an executor of :mod:`bladelab.executors`, one core each. After
+every finished task the tables are rebuilt from every task folder on disk (finished levels of
+unfinished tasks included), atomically:
+
+- ``OUT/levels.csv``: one row per finished level of every task (:func:`level_row`'s values,
+  prescribed and initial speed [m/s], generations, wall time [s]);
+- ``OUT/summary.csv``: one row per category (:func:`summarise_levels`).
+
+A category has settled (issue 20) when at least three seeds agree at the recipe's speed (the
+last stage's gait, re-simulated nominally for 10 s with the same settings, so on the same
+"copy"): costs within 2 % of the best seed's and speeds within 0.05 m/s
+(:func:`~bladelab.predict.reflex.agreement.seed_agreement`). The maximum speed is reported per
+seed with its spread; it is not part of the verdict, because seeds that reach different speeds
+are not compared on the same cost.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import pandas as pd
+from tqdm import tqdm
+
+from bladelab._io import atomic_open, read_json
+from bladelab.errors import OptimizationError
+from bladelab.predict.reflex.recipe import LEVELS_NAME, STABLE_GAIT_RECIPE, Recipe, maximum_speed
+
+__all__ = ["run_recipe_sweep", "summarise_levels"]
+
+
+def _levels_on_disk(out: Path) -> list[dict]:
+    rows = []
+    for path in sorted(out.glob(f"*/seed-*/{LEVELS_NAME}")):
+        rows.extend(read_json(path, what="levels of a recipe task"))
+    return rows
+
+
+def summarise_levels(levels: pd.DataFrame, last_stage: str) -> pd.DataFrame:
+    """Per category: the seeds whose ``last_stage`` level finished, their agreement at the
+    recipe's speed (costs and speeds of that level), and each seed's maximum speed [m/s]
+    (fastest level that ran) with its spread and how many of them meet issue 20's
+    acceptance."""
+    from bladelab.predict.reflex.agreement import seed_agreement
+
+    cols = ["category", "seeds (count)", "agreeing seeds (count)", "settled (yes/no)",
+            "cost spread (%)", "speed spread (m/s)", "best cost", "speed of the best (m/s)",
+            "maximum speed (m/s)", "maximum speed spread (m/s)",
+            "maximum-speed gaits meeting the acceptance (count)"]
+    out = []
+    for cat, df in levels.groupby("category", sort=False):
+        base = df[df.stage == last_stage]
+        base = base[~base.fell.astype(bool)]
+        agreement = (seed_agreement(base.cost.tolist(), base.mean_speed_m_per_s.tolist())
+                     if len(base) else None)
+        tops = [maximum_speed(g.to_dict("records")) for _, g in df.groupby("seed")]
+        speeds = [v for v, _ in tops if math.isfinite(v)]
+        best = base.loc[base.cost.idxmin()] if len(base) else None
+        out.append({
+            "category": cat,
+            "seeds (count)": int(df.seed.nunique()),
+            "agreeing seeds (count)": sum(agreement.agreeing) if agreement else 0,
+            "settled (yes/no)": bool(agreement and agreement.settled),
+            "cost spread (%)": agreement.cost_spread_pct if agreement else math.nan,
+            "speed spread (m/s)": agreement.speed_spread_m_per_s if agreement else math.nan,
+            "best cost": float(best.cost) if best is not None else math.nan,
+            "speed of the best (m/s)": (float(best.mean_speed_m_per_s) if best is not None
+                                        else math.nan),
+            "maximum speed (m/s)": max(speeds) if speeds else math.nan,
+            "maximum speed spread (m/s)": (max(speeds) - min(speeds)) if speeds else math.nan,
+            "maximum-speed gaits meeting the acceptance (count)":
+                sum(bool(r and r["accepted"]) for _, r in tops),
+        })
+    return pd.DataFrame(out, columns=cols)
+
+
+def _write_tables(out: Path, recipe: Recipe) -> pd.DataFrame:
+    levels = pd.DataFrame(_levels_on_disk(out))
+    summary = (summarise_levels(levels, recipe.stages[-1].name) if len(levels)
+               else summarise_levels(pd.DataFrame(columns=["category", "stage", "fell", "seed"]),
+                                     recipe.stages[-1].name))
+    with atomic_open(out / "levels.csv") as fh:
+        levels.to_csv(fh, index=False)
+    with atomic_open(out / "summary.csv") as fh:
+        summary.to_csv(fh, index=False)
+    return summary
+
+
+def run_recipe_sweep(
+    categories: list[str],
+    seeds: list[int],
+    *,
+    out: str | Path,
+    recipe: Recipe = STABLE_GAIT_RECIPE,
+    init: str | Path | None = None,
+    track_study: str | Path | None = None,
+    jobs: int = 1,
+    executor: str = "local",
+    checkpoint_every: int = 5,
+    progress: bool = True,
+) -> pd.DataFrame:
+    """Run (or continue) ``recipe`` for every category × seed in ``out`` (module docstring);
+    returns the per-category summary. ``jobs`` tasks run at once on ``executor``; a task that
+    fails is named in the error raised after the others finished (their results are kept)."""
+    from bladelab.executors import make_executor
+    from bladelab.predict.reflex.recipe import recipe_task
+    from bladelab.runner.params import blade_category
+
+    for c in categories:
+        blade_category(c)
+    if not seeds:
+        raise OptimizationError("no seeds", where="--seeds")
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    payloads = [{"category": c, "seed": int(s), "out": str(out.resolve()),
+                 "recipe": recipe.to_dict(), "init": str(Path(init).resolve()) if init else None,
+                 "track_study": str(Path(track_study).resolve()) if track_study else None,
+                 "checkpoint_every": int(checkpoint_every)}
+                for c in categories for s in seeds]
+    ex = make_executor(executor, jobs)
+    failed = []
+    with tqdm(total=len(payloads), desc="recipe tasks (category × seed)", unit="task",
+              disable=not progress) as bar:
+        for i, status, value in ex.run(recipe_task, payloads):
+            if status != "ok":
+                failed.append(f"{payloads[i]['category']} seed {payloads[i]['seed']}: {value}")
+            _write_tables(out, recipe)
+            bar.update(1)
+    summary = _write_tables(out, recipe)
+    if failed:
+        raise OptimizationError("recipe task(s) failed: " + "; ".join(failed))
+    return summary
