@@ -183,6 +183,50 @@ def test_verification_copies_are_not_the_objectives(monkeypatch):
     assert seeds == [robust.VERIFY_JITTER_SEED]
 
 
+def test_verification_copies_move_the_files_parameters_by_name(tmp_path, monkeypatch):
+    # each parameter's moves are drawn from the seed and its name: reordering or adding
+    # parameters changes no other parameter's moves; only the moved ones move
+    import bladelab.predict.reflex.robust as robust
+
+    x = np.array([1.0, -2.0, 0.5, 3.0])
+    names = ["a", "b", "c", "d"]
+    one = robust.jittered_parameters(x, 3, 1e-3, 7, names=names)
+    swapped = robust.jittered_parameters(x[[2, 0, 3, 1]], 3, 1e-3, 7, names=["c", "a", "d", "b"])
+    grown = robust.jittered_parameters(np.insert(x, 1, 9.0), 3, 1e-3, 7,
+                                       names=["a", "new", "b", "c", "d"])
+    part = robust.jittered_parameters(x, 3, 1e-3, 7, names=names,
+                                      moved=np.array([True, False, True, True]))
+    for k in range(3):
+        assert np.all(one[k] != x)
+        np.testing.assert_array_equal(swapped[k], one[k][[2, 0, 3, 1]])
+        np.testing.assert_array_equal(np.delete(grown[k], 1), one[k])
+        np.testing.assert_array_equal(part[k][[0, 2, 3]], one[k][[0, 2, 3]])
+        assert part[k][1] == x[1]
+    assert len({tuple(c) for c in one}) == 3  # three different copies
+    # verify_solution moves only the file's parameters: a file without the placement terms
+    # keeps them at their defaults in every copy
+    import bladelab.predict.reflex.verify as verify
+
+    _, layout = runner_and_layout("able", None)
+    held = {n: v for n, v in layout.to_dict(layout.x0).items() if "pelvis_tx" not in n}
+    path = tmp_path / "old.json"
+    path.write_text(json.dumps({"model": "able", "speed_m_per_s": 3.5, "parameters": held}))
+    copies = []
+    real = robust.jittered_parameters
+
+    def spy(*args, **kwargs):
+        copies.extend(real(*args, **kwargs))
+        return copies
+
+    monkeypatch.setattr(verify, "jittered_parameters", spy)
+    verify.verify_solution(path, duration=0.2, jittered_copies=2, jitter=1e-3)
+    placement = np.array(["pelvis_tx" in n for n in layout.names])
+    assert placement.sum() >= 8
+    for c in copies:
+        np.testing.assert_array_equal(c[placement], layout.x0[placement])
+        assert np.all(c[~placement] != layout.x0[~placement])
+
+
 def test_a_warm_start_is_never_lost():
     # from the shipped able solution a wide first step (sigma 3) scatters every candidate to a
     # worse cost; the best stays the start itself, evaluated once before the first generation

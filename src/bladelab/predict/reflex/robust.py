@@ -12,6 +12,7 @@ generation (:func:`generation_jitter_seed`: fixed for the run, or new every gene
 
 from __future__ import annotations
 
+import zlib
 from collections.abc import Sequence
 from dataclasses import replace
 
@@ -47,12 +48,26 @@ PUSH_STREAM = 1
 
 
 def jittered_parameters(x: np.ndarray, n: int, jitter: float,
-                        seed: int | Sequence[int] = OBJECTIVE_JITTER_SEED) -> list[np.ndarray]:
+                        seed: int | Sequence[int] = OBJECTIVE_JITTER_SEED, *,
+                        names: Sequence[str] | None = None,
+                        moved: np.ndarray | None = None) -> list[np.ndarray]:
     """``n`` copies of ``x`` moved by ``jitter`` (relative; absolute 1e-3·jitter near zero)
-    along directions seeded by ``seed`` (the same for every candidate given the same seed)."""
-    rng = np.random.default_rng(seed)
+    along directions seeded by ``seed`` (the same for every candidate given the same seed).
+
+    With ``names`` (the layout's parameter names) each parameter's moves are drawn from
+    ``seed`` and its name, so they do not depend on which other parameters the layout has or
+    in what order; ``moved`` (bool per parameter, default all) leaves the others unmoved."""
     scale = jitter * (np.abs(x) + 1e-3)
-    return [x + scale * rng.standard_normal(x.shape) for _ in range(n)]
+    if names is None:
+        rng = np.random.default_rng(seed)
+        z = np.stack([rng.standard_normal(x.shape) for _ in range(n)]) if n else np.zeros((0,))
+    else:
+        base = np.atleast_1d(seed).tolist()
+        z = np.stack([np.random.default_rng([*base, zlib.crc32(name.encode())]).standard_normal(n)
+                      for name in names], axis=1)
+    if moved is not None:
+        scale = np.where(moved, scale, 0.0)
+    return [x + scale * z[k] for k in range(n)]
 
 
 def generation_jitter_seed(settings: ObjectiveSettings, run_seed: int,

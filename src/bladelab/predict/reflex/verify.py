@@ -49,7 +49,9 @@ def verify_solution(
     power-balance residual below
     ``max_power_residual_pct`` % (runner analyses). With ``jittered_copies`` = n > 0 the same
     criteria must also hold for n copies of the parameters moved by ``jitter`` (relative,
-    :func:`jittered_parameters`, along directions other than the objective's robust copies):
+    :func:`jittered_parameters`, along directions other than the objective's robust copies;
+    only the parameters the file holds move, each along a direction drawn from its name, so
+    the copies do not change when the controller layout grows):
     a gait that survives only on one floating-point path (another
     CPU, compiler or library version) is not a solution. With ``initial_speed_change`` c > 0
     they must also hold from an initial speed [m/s] (1 + c) and (1 − c) times the file's (issue
@@ -69,6 +71,9 @@ def verify_solution(
     speed = float(speed if speed is not None else data.get("speed_m_per_s", 3.5))
     runner, layout = runner_and_layout(model, blade)
     x = read_parameters(path, layout)
+    # the copies move the file's own parameters, each along a direction of its name: the same
+    # copies whatever parameters a later layout adds (at their defaults, unmoved)
+    own = np.array([name in (data.get("parameters") or {}) for name in layout.names])
     settings = stored_settings(data, speed=speed, duration=duration, nominal=True)
     limits = (duration, speed, speed_tolerance, max_power_residual_pct)
     out = _check_gait(runner, layout, x, settings, limits)
@@ -81,7 +86,8 @@ def verify_solution(
 
     if jittered_copies > 0:
         also("jittered", [({}, xj, settings) for xj in
-                          jittered_parameters(x, jittered_copies, jitter, VERIFY_JITTER_SEED)])
+                          jittered_parameters(x, jittered_copies, jitter, VERIFY_JITTER_SEED,
+                                              names=layout.names, moved=own)])
     if initial_speed_change > 0:
         speeds = [settings.start_speed * (1 + c)
                   for c in (initial_speed_change, -initial_speed_change)]
