@@ -100,6 +100,9 @@ def test_cli_predict_and_errors(tmp_path, capsys):
             "0.5",
             "--strike-limit",
             "0.3",
+            "--lean-weight",
+            "2",
+            "--run-up",
             "--out",
             str(tmp_path / "p"),
         ]
@@ -109,6 +112,7 @@ def test_cli_predict_and_errors(tmp_path, capsys):
     assert summary["best"]["generations"] == 2
     best = json.loads((tmp_path / "p" / "best.json").read_text())
     assert best["settings"]["strike_limit_bw"] == 0.3
+    assert best["settings"]["w_lean"] == 2.0 and best["settings"]["run_up"] is True
     code = main(
         [
             "predict",
@@ -378,6 +382,7 @@ def test_verify_solution_after_pushes():
     ("--robust-push", "-0.1", "--robust-push"),
     ("--robust-push", "0.02", "--duration"),  # the default 10 s has room; 4 s has not
     ("--strike-limit", "-0.2", "--strike-limit"),
+    ("--lean-weight", "nan", "--lean-weight"),
 ])
 def test_cli_refuses_bad_robust_copies(tmp_path, capsys, option, value, named):
     args = ["predict", option, value, "--out", str(tmp_path / "x")]

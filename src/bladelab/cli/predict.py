@@ -110,6 +110,10 @@ def register(app: typer.Typer) -> None:
             1.0, "--strike-limit", help="A step whose swinging foot strikes the ground earns "
             "max(0, 1 - peak/limit) of its credit (body weights; issue 20 accepts at most 0.2)."
         ),
+        lean_weight: float = typer.Option(
+            0.1, "--lean-weight", help="Weight of the pelvis tilt outside -16...-2 deg "
+            "(seed 001's 0.1 per degree, averaged over the run)."
+        ),
         run_up: bool = typer.Option(
             False, "--run-up", help="Reflex: the reflexes on the mean forward speed act from "
             "the start, as if the runner had moved at the initial speed before it (else they "
@@ -205,6 +209,8 @@ def register(app: typer.Typer) -> None:
         if integrator not in ("explicit", "implicit"):
             raise SpecError(f"unknown integrator {integrator!r}", where="--integrator",
                             hint="explicit or implicit")
+        if not (math.isfinite(lean_weight) and lean_weight >= 0):
+            raise SpecError("must be >= 0", where="--lean-weight")
         if not (math.isfinite(strike_limit) and strike_limit >= 0):
             raise SpecError("must be >= 0 body weights (0: a strike takes all the step's credit)",
                             where="--strike-limit")
@@ -250,6 +256,7 @@ def register(app: typer.Typer) -> None:
                 robust_push=robust_push,
                 initial_speed=initial_speed,
                 strike_limit_bw=strike_limit,
+                w_lean=lean_weight,
                 run_up=run_up,
                 integrator=integrator,
                 track=None if track is None else str(track),

@@ -97,8 +97,8 @@ def stored_settings(
     d["speed"] = float(speed)
     if duration is not None:
         d["duration"] = float(duration)
-    if nominal:
-        d["robust_samples"] = 1
+    if nominal:  # one simulation: no copies, so none of their starts or pushes either
+        d.update(robust_samples=1, robust_speed_change=0.0, robust_push=0.0)
     return ObjectiveSettings.from_dict(d)
 
 
