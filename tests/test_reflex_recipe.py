@@ -200,7 +200,7 @@ def test_category_table_by_hand():
     assert bool(t.loc["Cat6", "settled (yes/no)"])
     assert t.loc["Cat6", "cost spread (%)"] == pytest.approx(100 * 10 / 60)
     assert t.loc["Cat6", "speed spread (m/s)"] == pytest.approx(0.22)
-    assert t.loc["Cat6", "best cost"] == 60.0
+    assert t.loc["Cat6", "best cost (–)"] == 60.0
     # maximum speed per seed = fastest level that ran: 3.65, 3.55 (3.9 fell), 3.37, 3.20
     assert t.loc["Cat6", "maximum speed (m/s)"] == pytest.approx(3.65)
     assert t.loc["Cat6", "maximum speed spread (m/s)"] == pytest.approx(0.45)
@@ -209,7 +209,7 @@ def test_category_table_by_hand():
     assert t.loc["Cat7", "agreeing seeds (count)"] == 1  # the fallen seed is not compared
     assert t.loc["Cat7", "maximum speed (m/s)"] == pytest.approx(3.1)
     assert math.isnan(summarise_levels(pd.DataFrame(rows[-1:]), "start")
-                      .loc[0, "best cost"])
+                      .loc[0, "best cost (–)"])
 
 
 def test_cli_recipe_sweep(tmp_path, capsys, monkeypatch):
@@ -236,3 +236,26 @@ def test_cli_recipe_sweep(tmp_path, capsys, monkeypatch):
     summary = pd.read_csv(tmp_path / "sw" / "summary.csv")
     assert summary.category.tolist() == ["Cat6"] and summary["seeds (count)"].tolist() == [2]
     assert "Cat6" in capsys.readouterr().out
+
+
+def test_report_of_a_recipe_sweep_resimulates_every_level(tmp_path):
+    from bladelab.predict.reflex.recipe_sweep import run_recipe_sweep
+    from bladelab.report.predictive import build_predictive_report, predictive_kind
+
+    one = Recipe(stages=(Stage("a", 1, 1e-4, popsize=2, settings={"duration": 0.3}),),
+                 speed=3.5, initial_speed=3.5)
+    run_recipe_sweep(["Cat6"], [1, 2], out=tmp_path / "rs", recipe=one, progress=False,
+                     init=SHIPPED_AMPUTEE)
+    assert predictive_kind(tmp_path / "rs") == "recipe-sweep"
+    rep = build_predictive_report(tmp_path / "rs", out_dir=tmp_path / "report", progress=False,
+                                  animate=False)
+    assert rep.kind == "recipe-sweep" and rep.simulations == 3  # 2 levels + the gait shown
+    assert len(rep.solutions) == 1 and rep.solutions[0].startswith("Cat6 seed ")
+    folder = tmp_path / "report"
+    levels = pd.read_csv(next(folder.glob("tables/*levels-re-simulated.csv")))
+    assert levels["as in levels.json (yes/no)"].astype(bool).all()
+    assert levels["seed"].tolist() == [1, 2]
+    categories = pd.read_csv(next(folder.glob("tables/*categories.csv")))
+    assert categories["seed 001 maximum speed (m/s)"].iloc[0] > 4  # Table 3.1: 4.27–4.675
+    assert not categories["settled (yes/no)"].iloc[0]  # 2 seeds: issue 20 needs 3
+    assert "Speed reached per level and seed" in (folder / "index.html").read_text()

@@ -11,6 +11,10 @@
 - ``"collocation"``: a collocation solution (``"kind": "collocation-solution"``, the
   ``solution.json`` of ``bladelab predict --method collocation``, or its folder): its stride
   repeated, not re-simulated (:mod:`bladelab.report.collocation`);
+- ``"recipe-sweep"``: a ``bladelab sweep --recipe`` folder (``levels.csv``,
+  ``<category>/seed-<n>/levels.json``): every level re-simulated and judged, the category
+  table with the seeds' agreement, and each category's fastest gait
+  (:mod:`bladelab.report.recipe_sweep`);
 - ``"collocation-sweep"``: a ``bladelab sweep --method collocation`` folder
   (``collocation-sweep.csv``): cost, contact times and GRF against speed per model, the
   category table beside seed 001, and the maximum-speed solutions' strides
@@ -65,8 +69,8 @@ class PredictiveReport:
 
 
 def predictive_kind(path: str | Path) -> str | None:
-    """``"run"``, ``"runs"``, ``"sweep"``, ``"parameters"``, ``"collocation"``,
-    ``"collocation-sweep"`` or None (see
+    """``"run"``, ``"runs"``, ``"sweep"``, ``"recipe-sweep"``, ``"parameters"``,
+    ``"collocation"``, ``"collocation-sweep"`` or None (see
     module docstring); a collocation best iterate raises InputFileError (not a solution)."""
     from bladelab.report.collocation import collocation_solution_file
 
@@ -88,6 +92,10 @@ def predictive_kind(path: str | Path) -> str | None:
 
     if is_collocation_sweep(p):
         return "collocation-sweep"
+    from bladelab.report.recipe_sweep import is_recipe_sweep
+
+    if is_recipe_sweep(p):
+        return "recipe-sweep"
     if (p / "results.csv").is_file() and (p / "summary.csv").is_file():
         if any(p.glob("*/*/best.json")):
             return "sweep"
@@ -508,6 +516,7 @@ def build_predictive_report(
         out_dir = default_report_dir(path, kind)
     titles = {"run": "Predictive running: optimisation", "runs": "Predictive running: runs",
               "sweep": "Predictive running: blade-category sweep",
+              "recipe-sweep": "Predictive running: blade-category sweep by recipes",
               "parameters": "Predictive running: solution",
               "collocation": "Predictive running: collocation solution",
               "collocation-sweep": "Predictive running: collocation sweep"}
@@ -545,6 +554,19 @@ def build_predictive_report(
             results, resim, shown = _run_sections(rep, folders, duration, bar)
             first = _read_json(next(iter(folders.values())) / "best.json")
             settings, seed = first.get("settings") or {}, first.get("seed")
+        elif kind == "recipe-sweep":
+            from bladelab.report.recipe_sweep import recipe_sweep_sections
+
+            _, files = recipe_sweep_sections(rep, path, bar)
+            results, resim = {}, []
+            for label, file in files.items():
+                sol = _Solution(file, _read_json(file))
+                ev, res = sol.simulate(duration)
+                bar.update()
+                results[label] = res
+                resim.append(_resim_row(label, sol, ev, res))
+            first = _read_json(next(iter(files.values()))) if files else {}
+            settings, seed = first.get("settings") or {}, None
         else:
             results, resim, sweep_summary, cells = _sweep_sections(rep, path, duration, bar)
             first = _read_json(cells[0][2] / "best.json") if cells else {}

@@ -47,7 +47,7 @@ def summarise_levels(levels: pd.DataFrame, last_stage: str) -> pd.DataFrame:
     from bladelab.predict.reflex.agreement import seed_agreement
 
     cols = ["category", "seeds (count)", "agreeing seeds (count)", "settled (yes/no)",
-            "cost spread (%)", "speed spread (m/s)", "best cost", "speed of the best (m/s)",
+            "cost spread (%)", "speed spread (m/s)", "best cost (–)", "speed of the best (m/s)",
             "maximum speed (m/s)", "maximum speed spread (m/s)",
             "maximum-speed gaits meeting the acceptance (count)"]
     out = []
@@ -66,7 +66,7 @@ def summarise_levels(levels: pd.DataFrame, last_stage: str) -> pd.DataFrame:
             "settled (yes/no)": bool(agreement and agreement.settled),
             "cost spread (%)": agreement.cost_spread_pct if agreement else math.nan,
             "speed spread (m/s)": agreement.speed_spread_m_per_s if agreement else math.nan,
-            "best cost": float(best.cost) if best is not None else math.nan,
+            "best cost (–)": float(best.cost) if best is not None else math.nan,
             "speed of the best (m/s)": (float(best.mean_speed_m_per_s) if best is not None
                                         else math.nan),
             "maximum speed (m/s)": max(speeds) if speeds else math.nan,
