@@ -144,6 +144,7 @@ def test_level_row_is_the_gaits_ten_second_rerun_and_judges_the_acceptance():
     # weights (issue 20's limit: 0.2), so even its nominal run fails the acceptance
     assert row["swing_contact_peak_bw"] > 0.3
     assert not row["nominal_meets_acceptance"] and not row["accepted"]
+    assert row["judged_at_m_per_s"] == round(v["mean_speed_m_per_s"], 2)  # its own speed
 
 
 def test_recipes_check_their_fields_and_read_back(tmp_path):

@@ -34,17 +34,20 @@ PUSH_CHANGE = 0.02
 PUSH_PHASES = 5
 
 
-def acceptance_runs(path: str | Path, duration: float = 10.0, *, pushes: bool = True) -> dict:
+def acceptance_runs(path: str | Path, duration: float = 10.0, *, pushes: bool = True,
+                    speed: float | None = None) -> dict:
     """:func:`~bladelab.predict.reflex.verify.verify_solution`'s result for the parameter file
     ``path`` re-simulated for ``duration`` [s] as above (pushes when ``pushes`` and
     ``duration`` is at least :data:`~bladelab.predict.reflex.objective.MIN_PUSH_DURATION`;
-    ``"pushed"`` is otherwise empty); ``"simulations"`` counts the runs and ``"accepted"`` says
-    whether every judged run meets the acceptance."""
+    ``"pushed"`` is otherwise empty), at ``speed`` [m/s] (default the file's prescribed speed:
+    every judged run's mean speed must lie within 0.1 m/s of it); ``"simulations"`` counts the
+    runs and ``"accepted"`` says whether every judged run meets the acceptance."""
     from bladelab.predict.reflex.objective import MIN_PUSH_DURATION
     from bladelab.predict.reflex.verify import verify_solution
 
     pushes = pushes and duration >= MIN_PUSH_DURATION
-    out = verify_solution(path, duration=duration, jittered_copies=COPIES, jitter=COPY_JITTER,
+    out = verify_solution(path, speed=speed, duration=duration, jittered_copies=COPIES,
+                          jitter=COPY_JITTER,
                           initial_speed_change=START_CHANGE,
                           push_change=PUSH_CHANGE if pushes else 0.0, push_phases=PUSH_PHASES)
     out.setdefault("pushed", [])

@@ -176,10 +176,12 @@ def track_file(study: str | Path, category: str, speed: float) -> Path:
 
 
 def level_row(path: Path, speed: float) -> dict:
-    """A finished level's gait (its ``best.json``) re-simulated nominally for 10 s at ``speed``
-    [m/s] (:func:`~bladelab.predict.reflex.verify.verify_solution`): cost, mean speed [m/s],
-    fell, swing contacts, mean pelvis tilt [deg], and issue 20's acceptance
-    (:func:`~bladelab.predict.reflex.acceptance.acceptance_runs`; only for a gait that runs)."""
+    """A finished level's gait (its ``best.json``) re-simulated nominally for 10 s at the
+    prescribed ``speed`` [m/s] (:func:`~bladelab.predict.reflex.verify.verify_solution`): cost,
+    mean speed [m/s], fell, swing contacts, mean pelvis tilt [deg]; and, for a gait that runs,
+    issue 20's acceptance (:func:`~bladelab.predict.reflex.acceptance.acceptance_runs`) at the
+    speed it reached (rounded to 0.01 m/s): a gait is judged at its own speed, and its copies
+    and changed starts must reach that speed too (±0.1 m/s)."""
     from bladelab.predict.reflex.acceptance import acceptance_runs, meets_acceptance
     from bladelab.predict.reflex.verify import verify_solution
 
@@ -192,11 +194,15 @@ def level_row(path: Path, speed: float) -> dict:
         "swing_contacts": int(v["swing_contacts"]),
         "swing_contact_peak_bw": float(v["swing_contact_peak_bw"]),
         "pelvis_tilt_mean_deg": float(v["pelvis_tilt_mean_deg"]),
-        "nominal_meets_acceptance": meets_acceptance(v),
+        "judged_at_m_per_s": None,
+        "nominal_meets_acceptance": False,
         "accepted": False,
     }
     if not v["fell"]:
-        row["accepted"] = bool(acceptance_runs(path, 10.0, pushes=False)["accepted"])
+        judged = round(row["mean_speed_m_per_s"], 2)
+        acc = acceptance_runs(path, 10.0, pushes=False, speed=judged)
+        row.update(judged_at_m_per_s=judged, nominal_meets_acceptance=meets_acceptance(acc),
+                   accepted=bool(acc["accepted"]))
     return row
 
 
