@@ -83,6 +83,19 @@ def test_stages_chain_and_the_speed_rises_by_continuation_until_it_stops_gaining
     assert json.loads((folder / "levels.json").read_text()) == rows
 
 
+def test_the_able_runner_is_a_task_like_a_category(tmp_path, monkeypatch):
+    _fake_levels(monkeypatch, {"1-a": 3.3, "2-b": 3.4, "speed-3.6": 3.41})
+    rows = run_recipe("able", 1, out=tmp_path, recipe=_tiny())
+    assert [r["category"] for r in rows] == ["able"] * 3
+    _, layout = runner_and_layout("able", None)
+    start = load_checkpoint(tmp_path / "able" / "seed-1" / "1-a" / "checkpoint.pkl")
+    assert start["model"] == "able" and start["blade"] is None
+    shipped = SHIPPED_AMPUTEE.with_name("able-3.5.json")  # the able model's shipped solution
+    np.testing.assert_array_equal(
+        np.asarray(start["es"].x0),
+        np.clip(read_parameters(shipped, layout), layout.lower, layout.upper))
+
+
 def test_continuation_stops_at_a_fall_and_after_max_levels(tmp_path, monkeypatch):
     _fake_levels(monkeypatch, {"1-a": 3.3, "2-b": 3.4, "speed-3.6": 3.7}, falls=("speed-3.6",))
     rows = run_recipe("Cat6", 1, out=tmp_path / "fall", recipe=_tiny(), init=SHIPPED_AMPUTEE)
@@ -172,6 +185,10 @@ def test_tracking_stages_need_the_collocation_stride(tmp_path):
     path = track_file(STUDY, "Cat5", 4.0)
     assert path == (STUDY / "amputee" / "amputee-Cat5" / "speed-4.json").resolve()
     assert track_file(STUDY / "amputee", "Cat5", 4.0) == path
+    able = track_file(STUDY, "able", 4.0)
+    assert able == (STUDY / "able" / "able" / "speed-4.json").resolve()
+    with pytest.raises(SpecError, match="Cat9"):
+        track_file(STUDY, "Cat9", 4.0)
     with pytest.raises(InputFileError, match="no collocation stride of Cat6 at 4.4"):
         track_file(STUDY, "Cat6", 4.4)
     with pytest.raises(SpecError, match="--track-study"):

@@ -336,7 +336,8 @@ def register(app: typer.Typer) -> None:
         recipe: str | None = typer.Option(
             None, "--recipe", help="Reflex: run a recipe of stages per category and seed "
             "instead of the speed grid: stable-gait (issue 20's stages, then speed "
-            "continuation on the speed reached) | FILE (a recipe JSON)."
+            "continuation on the speed reached) | FILE (a recipe JSON); 'able' among "
+            "--categories adds the able-bodied runner."
         ),
         seeds: str | None = typer.Option(
             None, "--seeds", help="Reflex, with --recipe: CMA-ES seeds per category "

@@ -42,14 +42,16 @@ from bladelab._io import read_json, write_json
 from bladelab.errors import InputFileError, SpecError
 from bladelab.predict.reflex.objective import ObjectiveSettings
 
-__all__ = ["STABLE_GAIT_RECIPE", "Recipe", "Stage", "level_row", "maximum_speed", "recipe_task",
-           "run_recipe", "track_file"]
+__all__ = ["ABLE", "STABLE_GAIT_RECIPE", "Recipe", "Stage", "level_row", "maximum_speed",
+           "model_of", "recipe_task", "run_recipe", "track_file"]
 
 RECIPE_NAME = "recipe.json"
 LEVELS_NAME = "levels.json"
 RECIPE_FORMAT = 1
-#: The first stage's warm start unless told otherwise: the shipped amputee solution.
-SHIPPED_START = "amputee-Cat6-3.5.json"
+#: The first stage's warm start unless told otherwise: the shipped solution of the model.
+SHIPPED_START = {"amputee": "amputee-Cat6-3.5.json", "able": "able-3.5.json"}
+#: The pseudo-category of the able-bodied runner (its tasks sit beside the blade categories').
+ABLE = "able"
 #: The collocation stride's weight in a tracking stage [1/rad²] (docs/predictive.md).
 TRACK_WEIGHT = 1000.0
 
@@ -162,12 +164,25 @@ STABLE_GAIT_RECIPE = Recipe(
 )
 
 
+def model_of(category: str) -> tuple[str, str | None]:
+    """(model, blade) of a task's category: ``"able"`` is the able-bodied runner, any other
+    name a blade category of the amputee (checked)."""
+    from bladelab.runner.params import blade_category
+
+    if category == ABLE:
+        return "able", None
+    blade_category(category)
+    return "amputee", category
+
+
 def track_file(study: str | Path, category: str, speed: float) -> Path:
-    """The collocation stride of ``category`` at ``speed`` [m/s] in a collocation study folder
-    (``STUDY/amputee-<category>/speed-<v>.json``, or under ``STUDY/amputee/``)."""
+    """The collocation stride of ``category`` (``"able"`` or a blade category) at ``speed``
+    [m/s] in a collocation study folder (``STUDY/amputee-<category>/speed-<v>.json`` or
+    ``STUDY/able/speed-<v>.json``, or one level down under ``amputee/`` or ``able/``)."""
     study = Path(study)
-    name = Path(f"amputee-{category}") / f"speed-{speed:g}.json"
-    for path in (study / name, study / "amputee" / name):
+    model, _ = model_of(category)
+    name = Path(ABLE if model == "able" else f"amputee-{category}") / f"speed-{speed:g}.json"
+    for path in (study / name, study / model / name):
         if path.is_file():
             return path.resolve()
     raise InputFileError(f"no collocation stride of {category} at {speed:g} m/s",
@@ -221,10 +236,10 @@ def run_recipe(
     checkpoint_every: int = 5,
     progress: Callable[[str, dict], None] | None = None,
 ) -> list[dict]:
-    """Run (or continue) ``recipe`` for the amputee with blade ``category`` and CMA-ES seed
-    ``seed`` in ``out/<category>/seed-<seed>/``; returns the rows of ``levels.json`` (see the
-    module docstring). ``init``: the first stage's warm start (parameters JSON; default the
-    shipped amputee solution); ``track_study``: the collocation study of the tracking stages
+    """Run (or continue) ``recipe`` for the amputee with blade ``category`` (or the able-bodied
+    runner: ``"able"``) and CMA-ES seed ``seed`` in ``out/<category>/seed-<seed>/``; returns
+    the rows of ``levels.json`` (see the module docstring). ``init``: the first stage's warm
+    start (parameters JSON; default the model's shipped solution); ``track_study``: the collocation study of the tracking stages
     (:func:`track_file`); ``progress(level, row)`` after each finished level."""
     from bladelab.predict.reflex.controller import read_parameters
     from bladelab.predict.reflex.optimize import (
@@ -232,12 +247,13 @@ def run_recipe(
         optimize_controller,
         runner_and_layout,
     )
-    from bladelab.runner.params import RUNNER_DATA_DIR, blade_category
+    from bladelab.runner.params import RUNNER_DATA_DIR
 
-    blade_category(category)
+    model, blade = model_of(category)
     folder = Path(out) / category / f"seed-{seed}"
-    _, layout = runner_and_layout("amputee", category)
-    init = Path(init) if init is not None else RUNNER_DATA_DIR / "solutions" / SHIPPED_START
+    _, layout = runner_and_layout(model, blade)
+    init = (Path(init) if init is not None
+            else RUNNER_DATA_DIR / "solutions" / SHIPPED_START[model])
     x = read_parameters(init, layout, transfer=True)
     track = None
     if any(s.track for s in recipe.stages):
@@ -261,7 +277,7 @@ def run_recipe(
             return done[name]
         settings = recipe.settings_for(stage, speed, start, track if stage.track else None)
         resume = (sub / CHECKPOINT_NAME).is_file()
-        res = optimize_controller("amputee", blade=category, speed=speed, x0=x0,
+        res = optimize_controller(model, blade=blade, speed=speed, x0=x0,
                                   generations=stage.generations, popsize=stage.popsize,
                                   sigma=stage.sigma, seed=int(seed), jobs=1, out=sub,
                                   resume=resume, force=not resume,

@@ -102,15 +102,15 @@ def run_recipe_sweep(
     checkpoint_every: int = 5,
     progress: bool = True,
 ) -> pd.DataFrame:
-    """Run (or continue) ``recipe`` for every category × seed in ``out`` (module docstring);
+    """Run (or continue) ``recipe`` for every category × seed in ``out`` (module docstring;
+    ``"able"`` among the categories: the able-bodied runner);
     returns the per-category summary. ``jobs`` tasks run at once on ``executor``; a task that
     fails is named in the error raised after the others finished (their results are kept)."""
     from bladelab.executors import make_executor
-    from bladelab.predict.reflex.recipe import recipe_task
-    from bladelab.runner.params import blade_category
+    from bladelab.predict.reflex.recipe import model_of, recipe_task
 
     for c in categories:
-        blade_category(c)
+        model_of(c)
     if not seeds:
         raise OptimizationError("no seeds", where="--seeds")
     out = Path(out)
