@@ -239,8 +239,9 @@ def run_recipe(
     """Run (or continue) ``recipe`` for the amputee with blade ``category`` (or the able-bodied
     runner: ``"able"``) and CMA-ES seed ``seed`` in ``out/<category>/seed-<seed>/``; returns
     the rows of ``levels.json`` (see the module docstring). ``init``: the first stage's warm
-    start (parameters JSON; default the model's shipped solution); ``track_study``: the collocation study of the tracking stages
-    (:func:`track_file`); ``progress(level, row)`` after each finished level."""
+    start (parameters JSON; default the model's shipped solution); ``track_study``: the
+    collocation study of the tracking stages (:func:`track_file`); ``progress(level, row)``
+    after each finished level."""
     from bladelab.predict.reflex.controller import read_parameters
     from bladelab.predict.reflex.optimize import (
         CHECKPOINT_NAME,
