@@ -9,8 +9,11 @@ warm-started from the one before (:data:`STABLE_GAIT_RECIPE`):
    of the same runner, blade and speed (``--track``), 4 s;
 2. ``stable``: seed 001's objective over twice the acceptance's 10 s, with copies that break
    the floating-point path (new every generation);
-3. ``basin``: 15 s with the copies pushed by ±2 % of their forward speed in mid-run;
-4. ``start``: copies that also start at ±1 % of the initial speed.
+3. ``basin``: 15 s with the copies pushed by ±2 % of their forward speed in mid-run, and the
+   mean-speed reflexes acting from the start (``run_up``);
+4. ``start``, ``start5``: copies that also start at ±3 %, then ±5 % of the initial speed;
+5. ``clear``: and the swinging blade's strikes and the trunk's lean in the objective
+   (``strike_limit_bw`` 0.5, ``w_lean`` 2), issue 20's last two criteria.
 
 Then the speed is raised by **continuation on the speed reached** (issue 20: not a fixed
 grid): the recipe's ``continuation`` stage runs at the speed the last level reached plus
@@ -145,21 +148,26 @@ class Recipe:
 
 _FAST = {"integrator": "implicit", "dt": 1e-3}
 _COPIES = {"robust_jitter": 1e-6, "robust_directions": "per-generation"}
+_STARTS = {**_COPIES, "duration": 15.0, "robust_samples": 5, "robust_push": 0.03,
+           "run_up": True}
+_CLEAR = {**_STARTS, "robust_speed_change": 0.05, "strike_limit_bw": 0.5, "w_lean": 2.0}
 
-#: The stages that found stable Cat6 gaits at 4 m/s (sessions 16–19, docs/predictive.md), on
-#: the fast scheme (implicit, 1 ms); about 5 h of one core per category and seed.
+#: The stages that found Cat6's stable and start-robust gaits at 4 m/s (sessions 16–19,
+#: docs/predictive.md "Warm start from a collocation stride", stages 1, 2L, P, S), on the fast
+#: scheme (implicit, 1 ms): tracking, a long horizon, pushes, then the starts taught step by
+#: step with the run-up, and last the blade's clearance and the lean. Several hours of one core
+#: per category and seed.
 STABLE_GAIT_RECIPE = Recipe(
     stages=(
         Stage("track", 1000, 0.3, popsize=32, track=True, settings={"duration": 4.0}),
         Stage("stable", 600, 0.2, settings={"duration": 20.0, "robust_samples": 3, **_COPIES}),
         Stage("basin", 400, 0.1, settings={"duration": 15.0, "robust_samples": 3,
-                                           "robust_push": 0.02, **_COPIES}),
-        Stage("start", 400, 0.1, settings={"duration": 15.0, "robust_samples": 5,
-                                           "robust_push": 0.02, "robust_speed_change": 0.01,
-                                           **_COPIES}),
+                                           "robust_push": 0.02, "run_up": True, **_COPIES}),
+        Stage("start", 200, 0.1, settings={**_STARTS, "robust_speed_change": 0.03}),
+        Stage("start5", 200, 0.1, settings={**_STARTS, "robust_speed_change": 0.05}),
+        Stage("clear", 400, 0.1, settings=_CLEAR),
     ),
-    continuation=Stage("faster", 200, 0.1, settings={"duration": 15.0, "robust_samples": 3,
-                                                     "robust_push": 0.02, **_COPIES}),
+    continuation=Stage("faster", 200, 0.1, settings=_CLEAR),
     base=_FAST,
 )
 
