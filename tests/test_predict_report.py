@@ -296,7 +296,8 @@ def _check(fell=False, ok=True, peak_bw=0.1, tilt=-10.0, **extra) -> dict:
 def test_robustness_section_judges_issue_20_by_hand():
     from bladelab.report.predictive_robustness import robustness_section
 
-    out = {**_check(),
+    # as verify_solution returns it: "ok" is every run's verdict, "nominal_ok" the nominal's
+    out = {**_check(ok=False), "nominal_ok": True,
            "jittered": [_check(), _check(peak_bw=0.25), _check(fell=True, ok=False), _check()],
            "initial_speed": [_check(tilt=-17.0, initial_speed_m_per_s=3.675),
                              _check(initial_speed_m_per_s=3.325)],
@@ -316,6 +317,7 @@ def test_robustness_section_judges_issue_20_by_hand():
     assert "1 of 2 pushed runs keep running" in text
     out["jittered"] = [_check()] * 4
     out["initial_speed"] = [_check(initial_speed_m_per_s=v) for v in (3.675, 3.325)]
+    out["ok"] = True
     rep = _Sections()
     robustness_section(rep, out, 10.0)
     assert "acceptance: met by every judged run" in rep.sections[0][1]

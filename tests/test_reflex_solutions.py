@@ -66,6 +66,14 @@ def test_shipped_solution_runs(path):
     assert out["ok"]
 
 
+def test_the_nominal_verdict_is_kept_apart_from_the_added_runs():
+    # the shipped amputee gait runs nominally but falls from a 5 % faster start (at ~1.3 s)
+    path = SOLUTIONS / "amputee-Cat6-3.5.json"
+    out = verify_solution(path, initial_speed_change=0.05)
+    assert out["nominal_ok"] and not out["fell"]
+    assert any(c["fell"] for c in out["initial_speed"]) and not out["ok"]
+
+
 def _stride_times(force, bw=700.0, dt=0.001):
     """Strides (start, end) [s] of :func:`_strides` on a (n, 2) vertical GRF record [N]."""
     import numpy as np

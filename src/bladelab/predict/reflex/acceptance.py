@@ -58,7 +58,7 @@ def acceptance_runs(path: str | Path, duration: float = 10.0, *, pushes: bool = 
 
 def judged_runs(out: dict) -> list[tuple[str, dict]]:
     """(name, run) of every judged run of :func:`acceptance_runs`' result ``out``."""
-    judged = [("nominal", out)]
+    judged = [("nominal", {**out, "ok": out.get("nominal_ok", out["ok"])})]
     judged += [(f"copy {k + 1}, moved by {COPY_JITTER:g}", c)
                for k, c in enumerate(out["jittered"])]
     judged += [(f"start {c['initial_speed_m_per_s']:.3f} m/s", c)

@@ -205,7 +205,7 @@ def level_row(path: Path, speed: float) -> dict:
     issue 20's acceptance (:func:`~bladelab.predict.reflex.acceptance.acceptance_runs`) at the
     speed it reached (rounded to 0.01 m/s): a gait is judged at its own speed, and its copies
     and changed starts must reach that speed too (±0.1 m/s)."""
-    from bladelab.predict.reflex.acceptance import acceptance_runs, meets_acceptance
+    from bladelab.predict.reflex.acceptance import acceptance_runs, judged_runs, meets_acceptance
     from bladelab.predict.reflex.verify import verify_solution
 
     v = verify_solution(path, speed=speed, duration=10.0)
@@ -224,7 +224,8 @@ def level_row(path: Path, speed: float) -> dict:
     if not v["fell"]:
         judged = round(row["mean_speed_m_per_s"], 2)
         acc = acceptance_runs(path, 10.0, pushes=False, speed=judged)
-        row.update(judged_at_m_per_s=judged, nominal_meets_acceptance=meets_acceptance(acc),
+        nominal = judged_runs(acc)[0][1]
+        row.update(judged_at_m_per_s=judged, nominal_meets_acceptance=meets_acceptance(nominal),
                    accepted=bool(acc["accepted"]))
     return row
 

@@ -60,7 +60,7 @@ def verify_solution(
     :data:`~bladelab.predict.reflex.objective.PUSH_AFTER` (the stride's phases; the basin of
     the gait, not of its start). Returns the measured values (the copies' under
     ``"jittered"``, the changed starts' under ``"initial_speed"``, the pushed runs' under
-    ``"pushed"``) and ``ok``.
+    ``"pushed"``), ``nominal_ok`` (the nominal run alone) and ``ok`` (every run).
     """
 
     from bladelab.predict.reflex.controller import read_parameters
@@ -77,6 +77,7 @@ def verify_solution(
     settings = stored_settings(data, speed=speed, duration=duration, nominal=True)
     limits = (duration, speed, speed_tolerance, max_power_residual_pct)
     out = _check_gait(runner, layout, x, settings, limits)
+    out["nominal_ok"] = out["ok"]  # "ok" below: the nominal and every added run
 
     def also(key: str, runs: list[tuple[dict, np.ndarray, ObjectiveSettings]]) -> None:
         # more runs under ``key`` (each: what it changed, parameters, settings); all must pass
