@@ -253,7 +253,9 @@ def test_cli_recipe_sweep(tmp_path, capsys, monkeypatch):
         (s, lv) for s in (1, 2) for lv in ("1-a", "2-b", "speed-3.6")]
     summary = pd.read_csv(tmp_path / "sw" / "summary.csv")
     assert summary.category.tolist() == ["Cat6"] and summary["seeds (count)"].tolist() == [2]
-    assert "Cat6" in capsys.readouterr().out
+    out = capsys.readouterr().out
+    assert "Cat6 seed 2 speed-3.6: 1 generations, runs 10 s, 3.41 m/s, cost 50" in out
+    assert "agreeing seeds" in out  # the category table
 
 
 def test_report_of_a_recipe_sweep_resimulates_every_level(tmp_path):

@@ -370,11 +370,23 @@ def _read_levels(folder: Path) -> list[dict]:
 
 def recipe_task(payload: dict) -> list[dict]:
     """:func:`run_recipe` for executors: ``payload`` holds its arguments (the recipe as a
-    dict)."""
+    dict; ``announce``: print a line per finished level)."""
     payload = dict(payload)
     recipe = Recipe.from_dict(payload.pop("recipe"))
     category, seed = payload.pop("category"), payload.pop("seed")
+    if payload.pop("announce", False):
+        payload["progress"] = _announce
     return run_recipe(category, seed, recipe=recipe, **payload)
+
+
+def _announce(level: str, row: dict) -> None:
+    """One line per finished level (a sweep's tasks run for hours)."""
+    from tqdm import tqdm
+
+    verdict = (f"falls at {row['simulated_s']:.2f} s" if row["fell"] else
+               "runs 10 s" + (", meets issue 20's acceptance" if row["accepted"] else ""))
+    tqdm.write(f"{level}: {row['generations']} generations, {verdict}, "
+               f"{row['mean_speed_m_per_s']:.2f} m/s, cost {row['cost']:.4g}")
 
 
 def maximum_speed(rows: list[dict]) -> tuple[float, dict | None]:

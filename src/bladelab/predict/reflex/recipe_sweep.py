@@ -118,7 +118,7 @@ def run_recipe_sweep(
     payloads = [{"category": c, "seed": int(s), "out": str(out.resolve()),
                  "recipe": recipe.to_dict(), "init": str(Path(init).resolve()) if init else None,
                  "track_study": str(Path(track_study).resolve()) if track_study else None,
-                 "checkpoint_every": int(checkpoint_every)}
+                 "checkpoint_every": int(checkpoint_every), "announce": bool(progress)}
                 for c in categories for s in seeds]
     ex = make_executor(executor, jobs)
     failed = []
