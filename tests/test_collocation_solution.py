@@ -67,6 +67,14 @@ def test_settings_round_trip_and_refuse_bad_values():
         with pytest.raises(SpecError) as err:
             CollocationSettings(**bad)
         assert err.value.where == where
+    upright = CollocationSettings(pelvis_tilt_range_deg=[-16, -2])
+    assert upright.pelvis_tilt_range_deg == (-16.0, -2.0)
+    assert not upright.same_problem(CollocationSettings())
+    assert CollocationSettings.from_dict(json.loads(json.dumps(upright.to_dict()))) == upright
+    for bad in ((-2, -16), (-70, 0), (-16,), "ab", (-16, math.inf), (True, 2)):
+        with pytest.raises(SpecError) as err:
+            CollocationSettings(pelvis_tilt_range_deg=bad)
+        assert err.value.where == "pelvis_tilt_range_deg"
     with pytest.raises(SpecError, match="unknown setting"):
         CollocationSettings.from_dict({"mesh": 50})
     with pytest.raises(SpecError, match="unknown objective weight"):
@@ -351,6 +359,27 @@ def test_a_stage_that_does_not_converge_ends_the_solve_deterministically(able):
     # a collocation solution as the guess goes straight to the predictive stage
     warm = predict_stride(runner, settings, a.to_guess(), model_spec={"model": "able"})
     assert warm.stage == "predictive" and warm.tracking is None
+
+
+def test_a_pelvis_tilt_range_bounds_every_node(able):
+    # IPOPT's iterates stay inside the bounds: after a few iterations the tilt of every node
+    # lies in the range, where the same solve without it leaves the range
+    runner, _, _ = able
+    guess = template_guess(runner, speed=SPEED, n=6)
+    tilt = runner.dof("pelvis_tilt")
+    free = predict_stride(runner, CollocationSettings(mesh_intervals=6, speed_m_per_s=SPEED,
+                                                      max_iter=3), guess,
+                          model_spec={"model": "able"})
+    seen = np.degrees(free.nlp.q[:, tilt])
+    lo, hi = float(seen.min()) + 0.25 * np.ptp(seen), float(seen.max()) - 0.25 * np.ptp(seen)
+    assert hi > lo + 0.1
+    bounded = predict_stride(
+        runner, CollocationSettings(mesh_intervals=6, speed_m_per_s=SPEED, max_iter=3,
+                                    pelvis_tilt_range_deg=(lo, hi)),
+        guess, model_spec={"model": "able"})
+    got = np.degrees(bounded.nlp.q[:, tilt])
+    assert got.min() >= lo - 1e-6 and got.max() <= hi + 1e-6
+    assert bounded.settings.pelvis_tilt_range_deg == (lo, hi)
 
 
 def test_a_locally_infeasible_tracking_stage_is_solved_again_from_its_iterate(able, monkeypatch):

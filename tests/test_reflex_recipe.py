@@ -138,6 +138,29 @@ def test_a_task_resumes_and_refuses_another_recipe(tmp_path, monkeypatch):
     assert [r["level"] for r in fewer] == [r["level"] for r in first]
 
 
+def test_a_task_folder_moved_with_its_study_continues(tmp_path, monkeypatch):
+    import shutil
+
+    _fake_levels(monkeypatch, {"1-a": 3.3})
+    tracked = Recipe(stages=(Stage("a", 1, 0.05, popsize=2, track=True,
+                                   settings={"duration": 0.3}),), speed=4.0, initial_speed=3.5)
+    study = tmp_path / "study" / "amputee-Cat6"
+    study.mkdir(parents=True)
+    shutil.copy(STUDY / "amputee" / "amputee-Cat6" / "speed-4.json", study / "speed-4.json")
+    first = run_recipe("Cat6", 1, out=tmp_path / "a", recipe=tracked, init=SHIPPED_AMPUTEE,
+                       track_study=tmp_path / "study")
+    shutil.copytree(tmp_path / "a", tmp_path / "b")
+    shutil.copytree(tmp_path / "study", tmp_path / "moved")
+    again = run_recipe("Cat6", 1, out=tmp_path / "b", recipe=tracked, init=SHIPPED_AMPUTEE,
+                       track_study=tmp_path / "moved")
+    assert again == first
+    shutil.copy(ROOT / "benchmarks" / "collocation" / "upright-2026-11-27" / "amputee-Cat6"
+                / "speed-4.json", tmp_path / "moved" / "amputee-Cat6" / "speed-4.json")
+    with pytest.raises(InputFileError, match="another tracked stride"):
+        run_recipe("Cat6", 1, out=tmp_path / "b", recipe=tracked, init=SHIPPED_AMPUTEE,
+                   track_study=tmp_path / "moved")
+
+
 def test_a_recipe_may_grow_after_its_finished_stages(tmp_path, monkeypatch):
     seen = _fake_levels(monkeypatch, {"1-a": 3.3, "2-b": 3.4, "3-c": 3.5, "speed-3.7": 3.5})
     short = replace(_tiny(), stages=_tiny().stages[:1], continuation=None)

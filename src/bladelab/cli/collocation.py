@@ -137,6 +137,18 @@ def _text(summary: dict, path: Path, solved: bool) -> str:
     return "\n".join(lines)
 
 
+def _tilt_range(text: str | None) -> tuple[float, float] | None:
+    """``--tilt-range LO,HI`` [deg] as a pair of numbers (checked by CollocationSettings)."""
+    if text is None:
+        return None
+    try:
+        lo, hi = (float(v) for v in text.split(","))
+    except ValueError:
+        raise SpecError(f"expected two numbers LO,HI [deg], got {text!r}", where="--tilt-range",
+                        hint="e.g. --tilt-range=-16,-2 (seed 001's window)") from None
+    return lo, hi
+
+
 def run_collocation(
     *,
     out: Path,
@@ -154,6 +166,7 @@ def run_collocation(
     swing_clearance: float = 0.0,
     knee_moment_min: float | None = None,
     knee_flexion_max: float | None = None,
+    tilt_range: str | None = None,
 ) -> int:
     """Run ``bladelab predict --method collocation``; returns the exit status (0 converged,
     2 not converged)."""
@@ -185,10 +198,12 @@ def run_collocation(
                                        speed_m_per_s=None if max_speed else float(speed),
                                        max_iter=max_iter, swing_clearance_m=swing_clearance,
                                        knee_moment_min_nm=knee_moment_min,
-                                       knee_flexion_max_loaded_deg=knee_flexion_max)
+                                       knee_flexion_max_loaded_deg=knee_flexion_max,
+                                       pelvis_tilt_range_deg=_tilt_range(tilt_range))
     except SpecError as err:  # the only values not checked above: name their options
         option = {"knee_moment_min_nm": "--knee-moment-min",
-                  "knee_flexion_max_loaded_deg": "--knee-flexion-max"}.get(err.where)
+                  "knee_flexion_max_loaded_deg": "--knee-flexion-max",
+                  "pelvis_tilt_range_deg": "--tilt-range"}.get(err.where)
         if option is None:
             raise
         raise SpecError(err.message, where=option, hint=err.hint) from None

@@ -168,6 +168,11 @@ def register(app: typer.Typer) -> None:
             None, "--knee-flexion-max", help="Collocation, transfemoral: keep the prosthetic "
             "knee within this flexion [deg] while its blade is loaded (the straight stance)."
         ),
+        tilt_range: str | None = typer.Option(
+            None, "--tilt-range", help="Collocation: keep the pelvis tilt within LO,HI [deg] "
+            "at every node (forward lean negative), e.g. --tilt-range=-16,-2 (seed 001's "
+            "window)."
+        ),
     ) -> None:
         """Optimise the reflex controller of the runner with CMA-ES (seed 001 eq. 2.4), or with
         --method collocation solve one periodic stride by direct collocation (writes
@@ -186,7 +191,8 @@ def register(app: typer.Typer) -> None:
                                    as_json=as_json, body=body,
                                    swing_clearance=swing_clearance,
                                    knee_moment_min=knee_moment_min,
-                                   knee_flexion_max=knee_flexion_max)
+                                   knee_flexion_max=knee_flexion_max,
+                                   tilt_range=tilt_range)
             raise typer.Exit(code)
         if method != "reflex":
             raise SpecError(f"unknown method {method!r}", where="--method",
@@ -194,6 +200,9 @@ def register(app: typer.Typer) -> None:
         if body != "seed001":
             raise SpecError("only with --method collocation", where="--body",
                             hint="the reflex controller is tuned to seed 001's body")
+        if tilt_range is not None:
+            raise SpecError("only with --method collocation", where="--tilt-range",
+                            hint="the reflex objective's window: --lean-weight")
         from bladelab.predict.reflex.controller import read_parameters
         from bladelab.predict.reflex.objective import ObjectiveSettings, check_robust_copies
         from bladelab.predict.reflex.optimize import optimize_seeds, runner_and_layout

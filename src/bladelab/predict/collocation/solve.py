@@ -36,6 +36,7 @@ atomically, so an interruption leaves the previous state of the folder.
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import math
 import time
 import weakref
@@ -159,6 +160,12 @@ class CollocationSettings:
         alternating ±1500 rad/s², sole friction forces and the knee moment alternating in
         sign from node to node). Backward Euler damps them: first-order accurate, it lags and
         damps the blade's own motion by O(h) (docs/design.md). No effect without such a blade.
+    pelvis_tilt_range_deg
+        (lo, hi) [deg]: keep the pelvis tilt inside this range at every node (bounds; forward
+        lean negative), e.g. seed 001's window (-16, -2) that issue 20 asks of a reflex gait;
+        None (default): the coordinate's own bounds (-60, 30). A stride the reflex
+        controller tracks (``bladelab predict --track``) passes its lean on: the Cat6 4 m/s
+        stride without it leans -17.8° on average (docs/collocation.md).
     reference, reference_weight, reference_dofs
         A collocation solution file of the same runner whose joint angles the predictive
         stage stays near: ``reference_weight`` [1/rad²] × the time-averaged mean squared
@@ -187,6 +194,7 @@ class CollocationSettings:
     knee_moment_min_nm: float | None = None
     knee_flexion_max_loaded_deg: float | None = None
     blade_backward_euler: bool = False
+    pelvis_tilt_range_deg: tuple[float, float] | None = None
     reference: str | None = None
     reference_weight: float = 0.0
     reference_dofs: tuple[str, ...] | None = None
@@ -259,7 +267,27 @@ class CollocationSettings:
         if not isinstance(self.blade_backward_euler, bool):
             raise SpecError(f"expected true or false, got {self.blade_backward_euler!r}",
                             where="blade_backward_euler")
+        self._check_tilt_range()
         self._check_reference()
+
+    def _check_tilt_range(self) -> None:
+        """``pelvis_tilt_range_deg``: None or (lo, hi) [deg] with lo < hi inside the pelvis
+        tilt's own bounds, stored as a tuple of floats."""
+        from bladelab.predict.collocation.dynamics import COORDINATE_BOUNDS_DEG
+
+        tr = self.pelvis_tilt_range_deg
+        if tr is None:
+            return
+        lo_all, hi_all = COORDINATE_BOUNDS_DEG["pelvis_tilt"]
+        ok = (not isinstance(tr, str | bytes) and len(tr) == 2
+              and all(isinstance(v, int | float) and not isinstance(v, bool)
+                      and math.isfinite(v) for v in tr)
+              and lo_all <= tr[0] < tr[1] <= hi_all)
+        if not ok:
+            raise SpecError(f"the pelvis tilt range must be (lo, hi) [deg] with {lo_all:g} <= "
+                            f"lo < hi <= {hi_all:g}, got {tr!r}", where="pelvis_tilt_range_deg",
+                            hint="seed 001's window is -16, -2 (forward lean negative)")
+        object.__setattr__(self, "pelvis_tilt_range_deg", (float(tr[0]), float(tr[1])))
 
     def _check_weight(self, name: str, what: str) -> None:
         """A weight field: a finite number >= 0, stored as float."""
@@ -294,6 +322,8 @@ class CollocationSettings:
         out["weights"] = self.weights.to_dict()
         if self.reference_dofs is not None:
             out["reference_dofs"] = list(self.reference_dofs)
+        if self.pelvis_tilt_range_deg is not None:
+            out["pelvis_tilt_range_deg"] = list(self.pelvis_tilt_range_deg)
         return out
 
     @classmethod
@@ -312,14 +342,15 @@ class CollocationSettings:
 
     def same_problem(self, other: CollocationSettings) -> bool:
         """True if ``other`` poses the same NLP (mesh, speed, weights, swing clearance, knee
-        moment bound, loaded knee's flexion limit, blade transcription); solver options
+        moment bound, loaded knee's flexion limit, blade transcription, pelvis tilt range);
+        solver options
         (Hessian, tolerance, iterations) and the tracking stage may differ."""
         return self._problem() == other._problem()
 
     def _problem(self) -> tuple:
         return (self.mesh_intervals, self.speed_m_per_s, self.weights, self.swing_clearance_m,
                 self.knee_moment_min_nm, self.knee_flexion_max_loaded_deg,
-                self.blade_backward_euler) + self._reference_key()
+                self.blade_backward_euler, self.pelvis_tilt_range_deg) + self._reference_key()
 
     def _reference_key(self) -> tuple:
         """(reference file name, weight, coordinates), or () without a reference term."""
@@ -446,9 +477,11 @@ MAX_NLPS_PER_RUNNER = 2
 
 def _model_functions(runner, swing_clearance_m: float = 0.0,
                      knee_moment_min_nm: float | None = None, blade_backward_euler: bool = False,
-                     knee_flexion_max_loaded_deg: float | None = None):
+                     knee_flexion_max_loaded_deg: float | None = None,
+                     pelvis_tilt_range_deg: tuple[float, float] | None = None):
     """(collocation model, stride dynamics) of ``runner``, built once (per swing clearance,
-    knee moment bound, loaded knee's flexion limit and blade transcription)."""
+    knee moment bound, loaded knee's flexion limit and blade transcription; a pelvis tilt
+    range narrows the bounds of the dynamics built without it)."""
     from bladelab.predict.collocation.dynamics import stride_dynamics
     from bladelab.predict.collocation.model import build_collocation_model
 
@@ -463,7 +496,15 @@ def _model_functions(runner, swing_clearance_m: float = 0.0,
                                             knee_flexion_max_loaded_deg=(
                                                 knee_flexion_max_loaded_deg),
                                             blade_backward_euler=blade_backward_euler)
-    return built["cm"], built["dyn"][key]
+    if pelvis_tilt_range_deg is None:
+        return built["cm"], built["dyn"][key]
+    narrowed = (*key, tuple(pelvis_tilt_range_deg))
+    if narrowed not in built["dyn"]:
+        dyn = built["dyn"][key]
+        q_bounds = dyn.q_bounds.copy()
+        q_bounds[dyn.dof_names.index("pelvis_tilt")] = np.radians(pelvis_tilt_range_deg)
+        built["dyn"][narrowed] = dataclasses.replace(dyn, q_bounds=q_bounds)
+    return built["cm"], built["dyn"][narrowed]
 
 
 def _reference_tracking(runner, settings: CollocationSettings) -> tuple:
@@ -549,7 +590,8 @@ def predict_stride(runner, settings: CollocationSettings, guess, *, model_spec: 
                         where="settings")
     cm, dyn = _model_functions(runner, settings.swing_clearance_m, settings.knee_moment_min_nm,
                                settings.blade_backward_euler,
-                               settings.knee_flexion_max_loaded_deg)
+                               settings.knee_flexion_max_loaded_deg,
+                               settings.pelvis_tilt_range_deg)
     n = settings.mesh_intervals
     g = guess.on_model(runner).resample(n)
     speed = settings.speed_m_per_s

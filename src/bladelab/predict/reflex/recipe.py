@@ -273,7 +273,9 @@ def run_recipe(
         track = track_file(track_study, category, recipe.speed)
     task = {"format": RECIPE_FORMAT, "category": category, "seed": int(seed),
             "recipe": recipe.to_dict(), "init_sha256": _digest(x),
-            "track": None if track is None else str(track)}
+            "track": None if track is None else str(track),
+            "track_sha256": None if track is None else hashlib.sha256(
+                track.read_bytes()).hexdigest()}
     held = folder / RECIPE_NAME
     rows = _read_levels(folder)
     if held.is_file():
@@ -323,11 +325,13 @@ def run_recipe(
 
 
 def _check_same_task(old: dict, new: dict, rows: list[dict], path: Path) -> None:
-    """Refuse a task folder started with another warm start or stride, or whose finished
-    levels the new recipe defines otherwise (stages may be added after them, the number of
-    continuation levels may change)."""
+    """Refuse a task folder started with another warm start or stride (compared by content),
+    or whose finished levels the new recipe defines otherwise (stages may be added after them,
+    the number of continuation levels may change)."""
+    # by content: a task folder copied with its study to another machine or folder continues
     for key, what in (("format", "format"), ("category", "category"), ("seed", "seed"),
-                      ("init_sha256", "warm start (--init)"), ("track", "tracked stride")):
+                      ("init_sha256", "warm start (--init)"),
+                      ("track_sha256", "tracked stride")):
         if old.get(key) != new.get(key):
             raise InputFileError(f"this task folder was started with another {what}", file=path,
                                  hint="use the first run's options, or another --out")
