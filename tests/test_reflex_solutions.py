@@ -74,6 +74,18 @@ def test_the_nominal_verdict_is_kept_apart_from_the_added_runs():
     assert any(c["fell"] for c in out["initial_speed"]) and not out["ok"]
 
 
+def test_the_acceptance_judges_a_gait_at_the_speed_it_reaches():
+    from bladelab.predict.reflex.acceptance import acceptance_runs
+
+    path = SOLUTIONS / "amputee-Cat6-3.5.json"
+    out = acceptance_runs(path, 2.0, pushes=False, speed="reached")
+    nominal = verify_solution(path, duration=2.0)
+    assert out["judged_at_m_per_s"] == round(nominal["mean_speed_m_per_s"], 2)
+    assert out["mean_speed_m_per_s"] == nominal["mean_speed_m_per_s"]
+    assert out["simulations"] == 1 + 1 + 4 + 2  # the speed's run, the nominal, copies, starts
+    assert acceptance_runs(path, 2.0, pushes=False)["judged_at_m_per_s"] is None
+
+
 def _stride_times(force, bw=700.0, dt=0.001):
     """Strides (start, end) [s] of :func:`_strides` on a (n, 2) vertical GRF record [N]."""
     import numpy as np

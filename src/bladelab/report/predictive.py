@@ -574,7 +574,7 @@ def build_predictive_report(
         if robustness and kind in ("parameters", "run", "runs"):
             from bladelab.report.predictive_robustness import robustness_runs
 
-            checked = robustness_runs(shown, duration)
+            checked = robustness_runs(shown, duration, speed="reached")
             for _ in range(checked["simulations"]):
                 bar.update()
     if resim is not None:

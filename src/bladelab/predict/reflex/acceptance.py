@@ -35,23 +35,31 @@ PUSH_PHASES = 5
 
 
 def acceptance_runs(path: str | Path, duration: float = 10.0, *, pushes: bool = True,
-                    speed: float | None = None) -> dict:
+                    speed: float | str | None = None) -> dict:
     """:func:`~bladelab.predict.reflex.verify.verify_solution`'s result for the parameter file
     ``path`` re-simulated for ``duration`` [s] as above (pushes when ``pushes`` and
     ``duration`` is at least :data:`~bladelab.predict.reflex.objective.MIN_PUSH_DURATION`;
-    ``"pushed"`` is otherwise empty), at ``speed`` [m/s] (default the file's prescribed speed:
-    every judged run's mean speed must lie within 0.1 m/s of it); ``"simulations"`` counts the
+    ``"pushed"`` is otherwise empty), at ``speed`` [m/s] (default the file's prescribed speed;
+    ``"reached"``: the nominal run's mean speed, rounded to 0.01 m/s, so that a gait is judged
+    at its own speed; every judged run's mean speed must lie within 0.1 m/s of it);
+    ``"judged_at_m_per_s"`` is that speed (None: the file's), ``"simulations"`` counts the
     runs and ``"accepted"`` says whether every judged run meets the acceptance."""
     from bladelab.predict.reflex.objective import MIN_PUSH_DURATION
     from bladelab.predict.reflex.verify import verify_solution
 
+    extra = 0
+    if speed == "reached":
+        nominal = verify_solution(path, duration=duration)
+        speed, extra = round(float(nominal["mean_speed_m_per_s"]), 2), 1
     pushes = pushes and duration >= MIN_PUSH_DURATION
     out = verify_solution(path, speed=speed, duration=duration, jittered_copies=COPIES,
                           jitter=COPY_JITTER,
                           initial_speed_change=START_CHANGE,
                           push_change=PUSH_CHANGE if pushes else 0.0, push_phases=PUSH_PHASES)
     out.setdefault("pushed", [])
-    out["simulations"] = 1 + sum(len(out[k]) for k in ("jittered", "initial_speed", "pushed"))
+    out["judged_at_m_per_s"] = speed
+    out["simulations"] = 1 + extra + sum(len(out[k])
+                                         for k in ("jittered", "initial_speed", "pushed"))
     out["accepted"] = all(meets_acceptance(c) for _, c in judged_runs(out))
     return out
 

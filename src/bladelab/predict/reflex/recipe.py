@@ -222,7 +222,7 @@ def level_row(path: Path, speed: float) -> dict:
         "accepted": False,
     }
     if not v["fell"]:
-        judged = round(row["mean_speed_m_per_s"], 2)
+        judged = round(row["mean_speed_m_per_s"], 2)  # as acceptance_runs(speed="reached")
         acc = acceptance_runs(path, 10.0, pushes=False, speed=judged)
         nominal = judged_runs(acc)[0][1]
         row.update(judged_at_m_per_s=judged, nominal_meets_acceptance=meets_acceptance(nominal),

@@ -35,7 +35,9 @@ def verify_solution(
     """Re-simulate a parameter file and check the shipped-solution criteria.
 
     The simulation uses the objective settings the file was optimised with (its ``settings``:
-    time step, initial speed, weights; without robust sampling), at ``speed`` for ``duration``.
+    time step, initial speed, weights; without robust sampling), at ``speed`` for ``duration``;
+    ``speed`` changes what the run is judged against, not its start (a file without an initial
+    speed starts at the speed it was optimised at).
 
     Criteria (all recomputed from the file, nothing trusted from it): ``duration`` [s] without a
     fall; mean speed within ``speed_tolerance`` [m/s] of ``speed`` (default: the file's
@@ -68,13 +70,17 @@ def verify_solution(
     data = read_json(path, what="parameter file")
     model = model or data.get("model", "able")
     blade = blade or data.get("blade")
-    speed = float(speed if speed is not None else data.get("speed_m_per_s", 3.5))
+    own_speed = float(data.get("speed_m_per_s", 3.5))
+    speed = float(speed if speed is not None else own_speed)
     runner, layout = runner_and_layout(model, blade)
     x = read_parameters(path, layout)
     # the copies move the file's own parameters, each along a direction of its name: the same
     # copies whatever parameters a later layout adds (at their defaults, unmoved)
     own = np.array([name in (data.get("parameters") or {}) for name in layout.names])
     settings = stored_settings(data, speed=speed, duration=duration, nominal=True)
+    if settings.initial_speed is None:  # judged at another speed, it starts as it was run
+        settings = replace(settings, initial_speed=float(
+            (data.get("settings") or {}).get("speed", own_speed)))
     limits = (duration, speed, speed_tolerance, max_power_residual_pct)
     out = _check_gait(runner, layout, x, settings, limits)
     out["nominal_ok"] = out["ok"]  # "ok" below: the nominal and every added run
