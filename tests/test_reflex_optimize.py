@@ -231,6 +231,20 @@ def test_verification_copies_move_the_files_parameters_by_name(tmp_path, monkeyp
         assert np.all(c[~placement] != layout.x0[~placement])
 
 
+def test_fixed_parameters_are_held_and_a_resume_keeps_them(tmp_path):
+    # CMA-ES over the free parameters only; resuming equals not stopping
+    _, layout = runner_and_layout("able", None)
+    fixed = [0, 5, layout.size - 1]
+    kw = {"generations": 3, "popsize": 4, "sigma": 0.5, "fixed": fixed}
+    full = _run(out=tmp_path / "full", **kw)
+    np.testing.assert_array_equal(full.x[fixed], np.clip(layout.x0, layout.lower,
+                                                         layout.upper)[fixed])
+    _run(out=tmp_path / "part", **{**kw, "generations": 1, "checkpoint_every": 1})
+    resumed = _run(out=tmp_path / "part", resume=True, **kw)
+    np.testing.assert_array_equal(resumed.x, full.x)
+    assert resumed.history == full.history
+
+
 def test_a_warm_start_is_never_lost():
     # from the shipped able solution a wide first step (sigma 3) scatters every candidate to a
     # worse cost; the best stays the start itself, evaluated once before the first generation

@@ -96,6 +96,25 @@ def test_the_able_runner_is_a_task_like_a_category(tmp_path, monkeypatch):
         np.clip(read_parameters(shipped, layout), layout.lower, layout.upper))
 
 
+def test_a_stage_holds_its_fixed_parameters(tmp_path, monkeypatch):
+    _fake_levels(monkeypatch, {"1-a": 3.3})
+    held = Recipe(stages=(Stage("a", 2, 0.5, popsize=4, settings={"duration": 0.3},
+                                fixed=["*-pelvis_tx.*"]),), speed=3.5, initial_speed=3.5)
+    run_recipe("Cat6", 1, out=tmp_path, recipe=held, init=SHIPPED_AMPUTEE)
+    _, layout = runner_and_layout("amputee", "Cat6")
+    idx = held.stages[0].fixed_indices(layout.names)
+    assert len(idx) == 24 and all("-pelvis_tx." in layout.names[i] for i in idx)
+    state = load_checkpoint(tmp_path / "Cat6" / "seed-1" / "1-a" / "checkpoint.pkl")
+    start = np.clip(read_parameters(SHIPPED_AMPUTEE, layout), layout.lower, layout.upper)
+    sub = state["subspace"]  # CMA-ES searches the others only
+    assert state["es"].N == layout.size - 24 and not set(sub.free) & set(idx)
+    for z in state["es"].ask():  # every candidate keeps them, and moves the others
+        x = sub.expand(z)
+        np.testing.assert_array_equal(x[idx], start[idx])
+        assert np.count_nonzero(np.delete(x - start, idx)) > 100
+    assert STABLE_GAIT_RECIPE.stages[0].fixed == ("*-pelvis_tx.*",)  # track and stable
+
+
 def test_continuation_stops_at_a_fall_and_after_max_levels(tmp_path, monkeypatch):
     _fake_levels(monkeypatch, {"1-a": 3.3, "2-b": 3.4, "speed-3.6": 3.7}, falls=("speed-3.6",))
     rows = run_recipe("Cat6", 1, out=tmp_path / "fall", recipe=_tiny(), init=SHIPPED_AMPUTEE)

@@ -112,6 +112,23 @@ class _Randn:
         return self.rng.standard_normal(shape)
 
 
+class _Subspace:
+    """The free parameters of a run that holds others fixed: CMA-ES sees ``reduce(x)``, the
+    simulations ``expand(z)`` (the held values in place; picklable for the checkpoint)."""
+
+    def __init__(self, start: np.ndarray, fixed: Sequence[int]) -> None:
+        self.held = np.asarray(start, float).copy()
+        self.free = np.setdiff1d(np.arange(self.held.size), np.asarray(fixed, int))
+
+    def reduce(self, x: np.ndarray) -> np.ndarray:
+        return np.asarray(x, float)[self.free]
+
+    def expand(self, z) -> np.ndarray:
+        x = self.held.copy()
+        x[self.free] = z
+        return x
+
+
 class _Evaluator:
     """Evaluates a list of vectors: in-process, on a persistent local process pool, or Ray
     (:mod:`bladelab.executors`)."""
@@ -209,6 +226,7 @@ def optimize_controller(
     checkpoint_every: int = 5,
     settings: ObjectiveSettings | None = None,
     progress: Callable[[int, float, float], None] | None = None,
+    fixed: Sequence[int] = (),
 ) -> OptimizationResult:
     """Optimise the reflex controller of a runner with CMA-ES.
 
@@ -247,6 +265,9 @@ def optimize_controller(
         Objective settings (speed is taken from ``speed``).
     progress
         Called after each generation with (generation, best cost, generation median).
+    fixed
+        Indices of parameters held at their initial values: CMA-ES searches the others only
+        (a resumed run keeps its own; the checkpoint's ``subspace``).
     """
     import cma
 
@@ -297,6 +318,7 @@ def optimize_controller(
         elapsed = list(state.get("elapsed", [math.nan] * len(history)))
         seed = state["seed"]
         settings = ObjectiveSettings.from_dict(state["settings"])  # the run's own objective settings
+        subspace = state.get("subspace")
     else:
         start = layout.x0 if x0 is None else np.asarray(x0, float)
         if start.shape != (layout.size,):
@@ -322,7 +344,13 @@ def optimize_controller(
             "tolstagnation": 10**9,
             "tolflatfitness": 10**9,
         }
-        es = cma.CMAEvolutionStrategy(start.tolist(), float(sigma), opts)
+        subspace = _Subspace(start, fixed) if len(fixed) else None
+        if subspace is not None:  # CMA-ES searches the free parameters only
+            opts["CMA_stds"] = subspace.reduce(layout.std).tolist()
+            opts["bounds"] = [subspace.reduce(layout.lower).tolist(),
+                              subspace.reduce(layout.upper).tolist()]
+        es = cma.CMAEvolutionStrategy(
+            (start if subspace is None else subspace.reduce(start)).tolist(), float(sigma), opts)
         gen, evals, history = 0, 0, []
         best_x, best_f, best_ev = start.copy(), math.inf, None
         elapsed0, elapsed = 0.0, []
@@ -339,7 +367,8 @@ def optimize_controller(
             best_f, best_ev = float(ev0["cost"]), ev0
             evals += 1
         while gen < generations:
-            xs = es.ask()
+            zs = es.ask()
+            xs = zs if subspace is None else [subspace.expand(z) for z in zs]
             jitter_seed = generation_jitter_seed(settings, seed, gen + 1)
             if fresh and best_ev is not None:
                 # new copies every generation: the best so far is simulated on this
@@ -352,7 +381,7 @@ def optimize_controller(
             else:
                 evs = evaluator(xs, jitter_seed)
             fs = [e["cost"] for e in evs]
-            es.tell(xs, fs)
+            es.tell(zs, fs)
             gen += 1
             evals += len(xs)
             i = int(np.argmin(fs))
@@ -380,6 +409,7 @@ def optimize_controller(
                     settings,
                     elapsed,
                     elapsed0 if not elapsed else elapsed[-1],
+                    subspace,
                 )
     except BaseException:
         evaluator.close(abort=True)
@@ -444,6 +474,7 @@ def _save(
     settings,
     elapsed,
     wall_time_s,
+    subspace,
 ) -> None:
     import cma
 
@@ -466,6 +497,7 @@ def _save(
         "best_eval": best_ev,
         "elapsed": list(elapsed),
         "elapsed_s": wall_time_s,
+        "subspace": subspace,
     }
     with atomic_path(out_dir / CHECKPOINT_NAME) as tmp:
         tmp.write_bytes(pickle.dumps(state, protocol=4))

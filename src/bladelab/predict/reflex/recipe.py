@@ -8,7 +8,8 @@ warm-started from the one before (:data:`STABLE_GAIT_RECIPE`):
 1. ``track``: seed 001's objective plus a term pulling the gait towards the collocation stride
    of the same runner, blade and speed (``--track``), 4 s;
 2. ``stable``: seed 001's objective over twice the acceptance's 10 s, with copies that break
-   the floating-point path (new every generation);
+   the floating-point path (new every generation); in these two the reflexes on the forward
+   speed stay off (held at gain 0);
 3. ``basin``: 15 s with the copies pushed by ±2 % of their forward speed in mid-run, and the
    mean-speed reflexes acting from the start (``run_up``);
 4. ``start``, ``start5``: copies that also start at ±3 %, then ±5 % of the initial speed;
@@ -37,6 +38,7 @@ import hashlib
 import math
 from collections.abc import Callable
 from dataclasses import asdict, dataclass, field
+from fnmatch import fnmatch
 from pathlib import Path
 
 import numpy as np
@@ -64,7 +66,8 @@ class Stage:
     """One CMA-ES run of a recipe: ``generations``, initial step ``sigma`` (× each parameter's
     scale), ``popsize`` candidates; ``track``: add the collocation stride's tracking term;
     ``settings``: :class:`ObjectiveSettings` fields for this stage (over the recipe's
-    ``base``)."""
+    ``base``); ``fixed``: patterns (``fnmatch``) of parameter names held at their values from
+    the stage before."""
 
     name: str
     generations: int
@@ -72,8 +75,14 @@ class Stage:
     popsize: int = 16
     track: bool = False
     settings: dict = field(default_factory=dict)
+    fixed: tuple[str, ...] = ()
+
+    def fixed_indices(self, names: tuple[str, ...]) -> list[int]:
+        """Indices of the parameters ``fixed`` names among ``names``."""
+        return [i for i, n in enumerate(names) if any(fnmatch(n, p) for p in self.fixed)]
 
     def __post_init__(self) -> None:
+        object.__setattr__(self, "fixed", tuple(self.fixed))
         if not self.name or "/" in self.name:
             raise SpecError(f"a stage needs a plain name, got {self.name!r}", where="stage.name")
         if self.generations < 1 or self.popsize < 2 or not self.sigma > 0:
@@ -151,6 +160,12 @@ _COPIES = {"robust_jitter": 1e-6, "robust_directions": "per-generation"}
 _STARTS = {**_COPIES, "duration": 15.0, "robust_samples": 5, "robust_push": 0.03,
            "run_up": True}
 _CLEAR = {**_STARTS, "robust_speed_change": 0.05, "strike_limit_bw": 0.5, "w_lean": 2.0}
+#: The reflexes on the forward speed (controller.py: placement and trunk pitch), held at their
+#: defaults (gain 0) until a gait runs: sampled from the start (search scale 0.5 per m/s) with
+#: S0 = 3.5 m/s and a gait at 1–3 m/s they add about ±0.3 excitation to every candidate
+#: (session 19: a tracking stage with them ended at cost 189 with a gait falling at 3.8 s;
+#: session 16's, before these terms existed, at 148 with a gait running 4 s).
+_SPEED_TERMS = ("*-pelvis_tx.*",)
 
 #: The stages that found Cat6's stable and start-robust gaits at 4 m/s (sessions 16–19,
 #: docs/predictive.md "Warm start from a collocation stride", stages 1, 2L, P, S), on the fast
@@ -159,8 +174,10 @@ _CLEAR = {**_STARTS, "robust_speed_change": 0.05, "strike_limit_bw": 0.5, "w_lea
 #: per category and seed.
 STABLE_GAIT_RECIPE = Recipe(
     stages=(
-        Stage("track", 1000, 0.3, popsize=32, track=True, settings={"duration": 4.0}),
-        Stage("stable", 600, 0.2, settings={"duration": 20.0, "robust_samples": 3, **_COPIES}),
+        Stage("track", 1000, 0.3, popsize=32, track=True, settings={"duration": 4.0},
+              fixed=_SPEED_TERMS),
+        Stage("stable", 600, 0.2, settings={"duration": 20.0, "robust_samples": 3, **_COPIES},
+              fixed=_SPEED_TERMS),
         Stage("basin", 400, 0.1, settings={"duration": 15.0, "robust_samples": 3,
                                            "robust_push": 0.02, "run_up": True, **_COPIES}),
         Stage("start", 200, 0.1, settings={**_STARTS, "robust_speed_change": 0.03}),
@@ -293,7 +310,8 @@ def run_recipe(
                                   generations=stage.generations, popsize=stage.popsize,
                                   sigma=stage.sigma, seed=int(seed), jobs=1, out=sub,
                                   resume=resume, force=not resume,
-                                  checkpoint_every=checkpoint_every, settings=settings)
+                                  checkpoint_every=checkpoint_every, settings=settings,
+                                  fixed=stage.fixed_indices(layout.names))
         row = {"category": category, "seed": int(seed), "level": name, "stage": stage.name,
                "prescribed_speed_m_per_s": float(speed), "initial_speed_m_per_s": float(start),
                "generations": res.generations, "wall_time_s": res.wall_time_s,
