@@ -76,9 +76,8 @@ def _speeds_figure(levels: pd.DataFrame, verdicts: dict[str, str]):
 def recipe_sweep_sections(report, folder: Path, bar) -> tuple[pd.DataFrame, dict[str, Path]]:
     """Add the sweep's sections; return the recomputed category table and the parameter files
     of the gaits to show (per category, the fastest level of any seed that runs)."""
-    from bladelab.predict.reflex.agreement import seed_agreement
     from bladelab.predict.reflex.recipe import Recipe, level_row, maximum_speed
-    from bladelab.predict.reflex.recipe_sweep import summarise_levels
+    from bladelab.predict.reflex.recipe_sweep import category_agreement, summarise_levels
 
     tasks = _tasks(folder)
     rows, same = [], []
@@ -95,9 +94,8 @@ def recipe_sweep_sections(report, folder: Path, bar) -> tuple[pd.DataFrame, dict
     summary = _beside_seed001(summarise_levels(levels, last_stage))
     verdicts, sentences = {}, []
     for cat, df in levels.groupby("category", sort=False):
-        base = df[(df.stage == last_stage) & ~df.fell.astype(bool)]
-        if len(base):
-            a = seed_agreement(base.cost.tolist(), base.mean_speed_m_per_s.tolist())
+        a = category_agreement(df, last_stage)
+        if a is not None:
             verdicts[cat] = "settled" if a.settled else "not settled"
             sentences.append(f"{cat} at the recipe's speed ({last_stage}): {a.describe()}")
         else:
@@ -131,7 +129,8 @@ def recipe_sweep_sections(report, folder: Path, bar) -> tuple[pd.DataFrame, dict
               "'Recipes'). Every finished level is simulated again here for 10 s with its own "
               "settings and, if it runs, judged by issue 20's acceptance at the speed it reached "
               "(4 copies moved by 1e-3 and ±5 % initial speed, each within 0.1 m/s of that "
-              "speed, swing contacts ≤ 0.2 BW, mean pelvis tilt in −16…−2°); the table of categories comes from these re-simulations. A category "
+              "speed, swing contacts ≤ 0.2 BW, mean pelvis tilt in −16…−2°); the table of "
+              "categories comes from these re-simulations. A category "
               "has settled when at least 3 seeds agree at the recipe's speed (cost within 2 %, "
               "speed within 0.05 m/s of the best seed's).\n\n" + " ".join(sentences)),
         figures=[("Speed reached per level and seed (× fell in its 10 s re-simulation, ★ meets "

@@ -37,6 +37,7 @@ Everything in the simulation loop is compiled with numba (:func:`control_step`).
 
 from __future__ import annotations
 
+import hashlib
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -371,6 +372,11 @@ def read_parameters(
     return layout.vector(params, source=str(path))
 
 
+def parameter_digest(x: np.ndarray) -> str:
+    """SHA-256 of a parameter vector's little-endian float64 bytes (identifies a warm start)."""
+    return hashlib.sha256(np.ascontiguousarray(x, dtype="<f8").tobytes()).hexdigest()
+
+
 def write_parameters(
     path: str | Path, layout: ControllerLayout, x: np.ndarray, **meta: object
 ) -> Path:
@@ -539,6 +545,7 @@ __all__ = [
     "controller_layout",
     "delayed",
     "history_length",
+    "parameter_digest",
     "push_sensors",
     "read_parameters",
     "update_gait_states",

@@ -247,9 +247,6 @@ def level_row(path: Path, speed: float) -> dict:
     return row
 
 
-def _digest(x: np.ndarray) -> str:
-    return hashlib.sha256(np.ascontiguousarray(x, dtype=float).tobytes()).hexdigest()
-
 
 def run_recipe(
     category: str,
@@ -268,7 +265,7 @@ def run_recipe(
     start (parameters JSON; default the model's shipped solution); ``track_study``: the
     collocation study of the tracking stages (:func:`track_file`); ``progress(level, row)``
     after each finished level."""
-    from bladelab.predict.reflex.controller import read_parameters
+    from bladelab.predict.reflex.controller import parameter_digest, read_parameters
     from bladelab.predict.reflex.optimize import (
         CHECKPOINT_NAME,
         optimize_controller,
@@ -289,7 +286,7 @@ def run_recipe(
                             where="--track-study")
         track = track_file(track_study, category, recipe.speed)
     task = {"format": RECIPE_FORMAT, "category": category, "seed": int(seed),
-            "recipe": recipe.to_dict(), "init_sha256": _digest(x),
+            "recipe": recipe.to_dict(), "init_sha256": parameter_digest(x),
             "track": None if track is None else str(track),
             "track_sha256": None if track is None else hashlib.sha256(
                 track.read_bytes()).hexdigest()}

@@ -29,7 +29,7 @@ from bladelab._io import atomic_open, read_json
 from bladelab.errors import OptimizationError
 from bladelab.predict.reflex.recipe import LEVELS_NAME, STABLE_GAIT_RECIPE, Recipe, maximum_speed
 
-__all__ = ["run_recipe_sweep", "summarise_levels"]
+__all__ = ["category_agreement", "run_recipe_sweep", "summarise_levels"]
 
 
 def _levels_on_disk(out: Path) -> list[dict]:
@@ -39,23 +39,31 @@ def _levels_on_disk(out: Path) -> list[dict]:
     return rows
 
 
+def category_agreement(levels: pd.DataFrame, last_stage: str):
+    """How one category's seeds agree at the recipe's speed: the
+    :class:`~bladelab.predict.reflex.agreement.SeedAgreement` of the ``last_stage`` levels that
+    ran their 10 s (None: none did)."""
+    from bladelab.predict.reflex.agreement import seed_agreement
+
+    base = levels[(levels.stage == last_stage) & ~levels.fell.astype(bool)]
+    if not len(base):
+        return None
+    return seed_agreement(base.cost.tolist(), base.mean_speed_m_per_s.tolist())
+
+
 def summarise_levels(levels: pd.DataFrame, last_stage: str) -> pd.DataFrame:
     """Per category: the seeds whose ``last_stage`` level finished, their agreement at the
     recipe's speed (costs and speeds of that level), and each seed's maximum speed [m/s]
     (fastest level that ran) with its spread and how many of them meet issue 20's
     acceptance."""
-    from bladelab.predict.reflex.agreement import seed_agreement
-
     cols = ["category", "seeds (count)", "agreeing seeds (count)", "settled (yes/no)",
             "cost spread (%)", "speed spread (m/s)", "best cost (–)", "speed of the best (m/s)",
             "maximum speed (m/s)", "maximum speed spread (m/s)",
             "maximum-speed gaits meeting the acceptance (count)"]
     out = []
     for cat, df in levels.groupby("category", sort=False):
-        base = df[df.stage == last_stage]
-        base = base[~base.fell.astype(bool)]
-        agreement = (seed_agreement(base.cost.tolist(), base.mean_speed_m_per_s.tolist())
-                     if len(base) else None)
+        base = df[(df.stage == last_stage) & ~df.fell.astype(bool)]
+        agreement = category_agreement(df, last_stage)
         tops = [maximum_speed(g.to_dict("records")) for _, g in df.groupby("seed")]
         speeds = [v for v, _ in tops if math.isfinite(v)]
         best = base.loc[base.cost.idxmin()] if len(base) else None

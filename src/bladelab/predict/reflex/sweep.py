@@ -27,7 +27,6 @@ names the cell and the setting.
 
 from __future__ import annotations
 
-import hashlib
 import json
 import math
 from pathlib import Path
@@ -81,9 +80,6 @@ def _wanted(payload: dict) -> dict:
         }
     )
 
-
-def _digest(x: np.ndarray) -> str:
-    return hashlib.sha256(np.ascontiguousarray(x, dtype="<f8").tobytes()).hexdigest()
 
 
 def _read_cell(folder: Path, category: str, speed: float, wanted: dict) -> dict | None:
@@ -198,7 +194,7 @@ def category_task(payload: dict) -> dict:
     newly finished cell, ``results.csv`` and ``summary.csv`` are rewritten from every finished
     cell of the sweep on disk.
     """
-    from bladelab.predict.reflex.controller import read_parameters
+    from bladelab.predict.reflex.controller import parameter_digest, read_parameters
     from bladelab.predict.reflex.optimize import (
         CHECKPOINT_NAME,
         optimize_controller,
@@ -217,7 +213,7 @@ def category_task(payload: dict) -> dict:
     for speed in payload["speeds"]:
         folder = cell_dir(out, cat, speed)
         data = _read_cell(folder, cat, speed, wanted)
-        digest = _digest(x)
+        digest = parameter_digest(x)
         if data is not None and data.get("x0_sha256") != digest:
             raise SpecError(
                 f"sweep cell {cat} at {speed:g} m/s was started from another initial guess",
