@@ -247,9 +247,9 @@ def test_sweep_report_opens_in_a_browser(sweep_report, tmp_path):
 def test_report_of_a_parameter_file(tmp_path):
     src = SOLUTIONS / "able-3.5.json"  # the shipped solution
     rep = build_predictive_report(src, tmp_path / "r", duration=2.0, progress=False)
-    # the re-simulation, then issue 20's robustness runs: the speed the gait reaches (it is
-    # judged at it), the nominal, 4 copies and 2 other starts (2 s has no room for a push)
-    assert rep.kind == "parameters" and rep.simulations == 1 + (1 + 1 + 4 + 2)
+    # the re-simulation, then issue 20's robustness runs: the nominal (judged at the speed it
+    # reaches), 4 copies and 2 other starts (2 s has no room for a push)
+    assert rep.kind == "parameters" and rep.simulations == 1 + (1 + 4 + 2)
     tables = _tables(Path(rep.index))
     resim = _table(tables, "re-simulations").iloc[0]
     judged = _table(tables, "judged-runs")
@@ -297,7 +297,8 @@ def test_robustness_section_judges_issue_20_by_hand():
     from bladelab.report.predictive_robustness import robustness_section
 
     # as verify_solution returns it: "ok" is every run's verdict, "nominal_ok" the nominal's
-    out = {**_check(ok=False), "nominal_ok": True,
+    out = {**_check(ok=False), "nominal_ok": True, "judged_at_m_per_s": 3.5,
+           "judged_at_reached_speed": False,
            "jittered": [_check(), _check(peak_bw=0.25), _check(fell=True, ok=False), _check()],
            "initial_speed": [_check(tilt=-17.0, initial_speed_m_per_s=3.675),
                              _check(initial_speed_m_per_s=3.325)],
@@ -312,14 +313,14 @@ def test_robustness_section_judges_issue_20_by_hand():
         True, True, False, False, True, False, True]
     assert judged.run.tolist()[5] == "start 3.675 m/s"
     assert "not met by 3 of 7 judged runs" in text
-    assert "speed within 0.1 m/s of the prescribed" in text
+    assert "speed within 0.1 m/s of 3.50 m/s, the prescribed speed" in text
     pushed = tables["Pushed runs (the gait's basin; not judged)"]
     assert pushed["runs the whole time (yes/no)"].tolist() == [True, False]
     assert "1 of 2 pushed runs keep running" in text
     out["jittered"] = [_check()] * 4
     out["initial_speed"] = [_check(initial_speed_m_per_s=v) for v in (3.675, 3.325)]
     out["ok"] = True
-    out["judged_at_m_per_s"] = 3.35
+    out["judged_at_m_per_s"], out["judged_at_reached_speed"] = 3.35, True
     rep = _Sections()
     robustness_section(rep, out, 10.0)
     assert "acceptance: met by every judged run" in rep.sections[0][1]
@@ -360,7 +361,7 @@ def test_report_of_the_shipped_amputee_solution(shipped_amputee_report):
     from bladelab.runner.export import read_mot
 
     rep = shipped_amputee_report  # 3 s re-simulated, exported (conftest.py)
-    assert rep.kind == "parameters" and rep.simulations == 1 + (1 + 1 + 4 + 2)
+    assert rep.kind == "parameters" and rep.simulations == 1 + (1 + 4 + 2)  # the re-simulation, the nominal, copies, starts
     index = Path(rep.index)
     html = index.read_text(encoding="utf-8")
     assert 'class="runner-animation"' in html and "Table D.1" in html

@@ -60,6 +60,51 @@ def test_resume_equals_no_stop(tmp_path):
     np.testing.assert_array_equal(resumed.x, full.x)
 
 
+def _as_if_older(ckpt: Path, drop: int, held: list[int]) -> None:
+    """Rewrite a checkpoint as the layout without parameter ``drop`` would have written it (a
+    run that held ``drop`` fixed searched exactly that layout's parameters); ``held``: what the
+    older run itself held fixed (indices below ``drop``)."""
+    import pickle
+
+    from bladelab.predict.reflex.optimize import _Subspace
+
+    state = pickle.loads(ckpt.read_bytes())
+    keep = np.delete(np.arange(len(state["parameter_names"])), drop)
+    state["parameter_names"] = [state["parameter_names"][i] for i in keep]
+    state["best_x"] = state["best_x"][keep]
+    state["subspace"] = _Subspace(state["subspace"].held[keep], held) if held else None
+    ckpt.write_bytes(pickle.dumps(state, protocol=4))
+
+
+@pytest.mark.parametrize("subspace", [False, True])
+def test_a_checkpoint_resumes_after_the_layout_grew(tmp_path, subspace):
+    # a run written before a parameter was added goes on searching what it searched, the new
+    # parameter held at its default: the same as a run that held it fixed from the start
+    _, layout = runner_and_layout("able", None)
+    new, also = 7, [3] if subspace else []  # the added parameter; one the old run held
+    full = _run(out=tmp_path / "full", fixed=[*also, new])
+    _run(out=tmp_path / "part", generations=2, checkpoint_every=1, fixed=[*also, new])
+    _as_if_older(tmp_path / "part" / "checkpoint.pkl", new, also)
+    resumed = _run(out=tmp_path / "part", resume=True)
+    assert resumed.history == full.history
+    np.testing.assert_array_equal(resumed.x, full.x)
+    assert resumed.x[new] == layout.x0[new]
+    best = json.loads((tmp_path / "part" / "best.json").read_text())["parameters"]
+    assert list(best) == list(layout.names)
+
+
+def test_a_checkpoint_of_a_layout_that_lost_parameters_is_refused(tmp_path):
+    import pickle
+
+    _run(out=tmp_path / "r", generations=1)
+    ckpt = tmp_path / "r" / "checkpoint.pkl"
+    state = pickle.loads(ckpt.read_bytes())
+    state["parameter_names"] = [*state["parameter_names"][:-1], "S00011.gone_l.KF"]
+    ckpt.write_bytes(pickle.dumps(state, protocol=4))
+    with pytest.raises(InputFileError, match="another controller layout"):
+        _run(out=tmp_path / "r", resume=True)
+
+
 def test_parallel_workers_give_the_serial_result():
     a = _run(generations=2, popsize=4)
     b = _run(generations=2, popsize=4, jobs=2)

@@ -46,8 +46,9 @@ def _fake_levels(monkeypatch, speeds: dict[str, float], falls: tuple[str, ...] =
     """level_row stand-in: the mean speed [m/s] of each level by name (no 10 s runs)."""
     seen = []
 
-    def fake(path: Path, speed: float) -> dict:
-        name = path.parent.name
+    def fake(path: Path) -> dict:
+        # the level's prescribed speed, as the gait file says (level_row judges it there)
+        name, speed = path.parent.name, json.loads(path.read_text())["speed_m_per_s"]
         seen.append((name, speed))
         return {"cost": 50.0, "mean_speed_m_per_s": speeds[name], "fell": name in falls,
                 "accepted": False}
@@ -191,8 +192,8 @@ def test_a_recipe_may_grow_after_its_finished_stages(tmp_path, monkeypatch):
 
 
 def test_level_row_is_the_gaits_ten_second_rerun_and_judges_the_acceptance():
-    row = level_row(SHIPPED_AMPUTEE, 3.5)
-    v = verify_solution(SHIPPED_AMPUTEE, speed=3.5, duration=10.0)
+    row = level_row(SHIPPED_AMPUTEE)
+    v = verify_solution(SHIPPED_AMPUTEE, speed=3.5, duration=10.0)  # its prescribed speed
     assert row["cost"] == v["cost"] and row["mean_speed_m_per_s"] == v["mean_speed_m_per_s"]
     assert not row["fell"] and row["simulated_s"] == pytest.approx(10.0)
     # the shipped amputee gait strikes the ground with its swinging blade at ~0.38 body

@@ -82,8 +82,19 @@ def test_the_acceptance_judges_a_gait_at_the_speed_it_reaches():
     nominal = verify_solution(path, duration=2.0)
     assert out["judged_at_m_per_s"] == round(nominal["mean_speed_m_per_s"], 2)
     assert out["mean_speed_m_per_s"] == nominal["mean_speed_m_per_s"]
-    assert out["simulations"] == 1 + 1 + 4 + 2  # the speed's run, the nominal, copies, starts
-    assert acceptance_runs(path, 2.0, pushes=False)["judged_at_m_per_s"] is None
+    assert out["judged_at_reached_speed"] and out["nominal_ok"]
+    # one nominal simulation serves the reached speed and the verdict: its cost is the
+    # objective at the file's own prescribed speed, as a plain re-simulation's
+    assert out["cost"] == nominal["cost"]
+    assert out["simulations"] == 1 + 4 + 2  # the nominal, copies, starts
+    prescribed = acceptance_runs(path, 2.0, pushes=False)
+    assert prescribed["judged_at_m_per_s"] == 3.5 and not prescribed["judged_at_reached_speed"]
+    # the copies are judged at the reached speed: the same runs as a call at that speed
+    at = acceptance_runs(path, 2.0, pushes=False, speed=out["judged_at_m_per_s"])
+    assert [c["cost"] for c in at["jittered"]] == [c["cost"] for c in out["jittered"]]
+    assert [c["ok"] for c in at["jittered"]] == [c["ok"] for c in out["jittered"]]
+    with pytest.raises(ValueError, match="reached"):
+        verify_solution(path, speed="fastest")
 
 
 def _stride_times(force, bw=700.0, dt=0.001):

@@ -69,8 +69,10 @@ def robustness_section(rep, out: dict, duration: float) -> None:
 def _judged_speed(out: dict) -> str:
     """What the runs' speed is judged against: the speed the nominal run reached (a gait is
     judged at its own speed), or the prescribed one."""
-    v = out.get("judged_at_m_per_s")
-    return "the prescribed" if v is None else f"{v:.2f} m/s, the speed the nominal run reaches"
+    v = out["judged_at_m_per_s"]
+    if out.get("judged_at_reached_speed"):
+        return f"{v:.2f} m/s, the speed the nominal run reaches"
+    return f"{v:.2f} m/s, the prescribed speed" + (" (the nominal run falls)" if out["fell"] else "")
 
 
 def _row(name: str, c: dict, window: tuple[float, float]) -> dict:

@@ -85,8 +85,7 @@ def recipe_sweep_sections(report, folder: Path, bar) -> tuple[pd.DataFrame, dict
     for task, recipe, stored in tasks:
         last_stage = Recipe.from_dict(recipe["recipe"]).stages[-1].name
         for r in stored:
-            again = {**r, **level_row(task / r["level"] / "best.json",
-                                      r["prescribed_speed_m_per_s"])}
+            again = {**r, **level_row(task / r["level"] / "best.json")}
             bar.update()
             rows.append(again)
             same.append(all(_same(r.get(k), again[k]) for k in _COMPARED))

@@ -116,9 +116,11 @@ class _Subspace:
     """The free parameters of a run that holds others fixed: CMA-ES sees ``reduce(x)``, the
     simulations ``expand(z)`` (the held values in place; picklable for the checkpoint)."""
 
-    def __init__(self, start: np.ndarray, fixed: Sequence[int]) -> None:
+    def __init__(self, start: np.ndarray, fixed: Sequence[int],
+                 free: Sequence[int] | None = None) -> None:
         self.held = np.asarray(start, float).copy()
-        self.free = np.setdiff1d(np.arange(self.held.size), np.asarray(fixed, int))
+        self.free = (np.setdiff1d(np.arange(self.held.size), np.asarray(fixed, int))
+                     if free is None else np.asarray(free, int))
 
     def reduce(self, x: np.ndarray) -> np.ndarray:
         return np.asarray(x, float)[self.free]
@@ -255,7 +257,9 @@ def optimize_controller(
         Output folder (checkpoint, best.json, history.csv); None writes nothing.
     resume
         Continue from ``out/checkpoint.pkl`` (with the checkpoint's seed and objective settings;
-        ``x0``, ``popsize``, ``sigma`` and ``settings`` are then ignored).
+        ``x0``, ``popsize``, ``sigma`` and ``settings`` are then ignored). A checkpoint written
+        before the controller layout grew resumes with the added parameters held at their
+        defaults (they stay switched off in that run).
     force
         Start a new run in an ``out`` that holds one (its files are replaced as the new run
         writes them); without ``force`` or ``resume`` such a folder is refused.
@@ -304,11 +308,7 @@ def optimize_controller(
                 hint="resume with the same --model, --blade and --speed",
             )
         if list(state["parameter_names"]) != list(layout.names):
-            raise InputFileError(
-                "checkpoint was written for another controller layout",
-                file=ckpt,
-                hint="warm-start a new run from its best.json with --init instead",
-            )
+            _resume_in_grown_layout(state, layout, ckpt)
         es = state["es"]
         gen, evals = state["generation"], state["evaluations"]
         history = list(state["history"])
@@ -518,6 +518,35 @@ def _save(
         w = csv.writer(fh)
         w.writerow(["generation", "evaluations", "best", "median", "sigma", "elapsed_s"])
         w.writerows((*row, t) for row, t in zip(history, elapsed, strict=True))
+
+
+def _resume_in_grown_layout(state: dict, layout, ckpt: Path) -> None:
+    """Carry a checkpoint written before the controller layout grew into ``layout`` (in place):
+    the run goes on searching the parameters it searched, the added ones held at their
+    defaults (a resumed run continues exactly, the added terms switched off as in older
+    parameter files). A layout that lost or reordered parameters is refused."""
+    old, new = list(state["parameter_names"]), list(layout.names)
+    where = {name: i for i, name in enumerate(new)}
+    idx = [where.get(name, -1) for name in old]
+    if min(idx) < 0 or idx != sorted(idx):
+        raise InputFileError(
+            "checkpoint was written for another controller layout",
+            file=ckpt,
+            hint="warm-start a new run from its best.json with --init instead",
+        )
+    idx = np.asarray(idx)
+
+    def grown(x: np.ndarray) -> np.ndarray:
+        out = layout.x0.copy()
+        out[idx] = np.asarray(x, float)
+        return out
+
+    sub = state.get("subspace")
+    held = grown(sub.held if sub is not None else state["best_x"])
+    free = idx[sub.free] if sub is not None else idx
+    state["subspace"] = _Subspace(held, (), free=free)
+    state["best_x"] = grown(state["best_x"])
+    state["parameter_names"] = new
 
 
 def load_checkpoint(path: str | Path) -> dict:

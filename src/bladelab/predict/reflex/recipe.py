@@ -215,37 +215,30 @@ def track_file(study: str | Path, category: str, speed: float) -> Path:
                          hint="bladelab study collocation writes one (docs/collocation.md)")
 
 
-def level_row(path: Path, speed: float) -> dict:
-    """A finished level's gait (its ``best.json``) re-simulated nominally for 10 s at the
-    prescribed ``speed`` [m/s] (:func:`~bladelab.predict.reflex.verify.verify_solution`): cost,
-    mean speed [m/s], fell, swing contacts, mean pelvis tilt [deg]; and, for a gait that runs,
-    issue 20's acceptance (:func:`~bladelab.predict.reflex.acceptance.acceptance_runs`) at the
-    speed it reached (rounded to 0.01 m/s): a gait is judged at its own speed, and its copies
-    and changed starts must reach that speed too (±0.1 m/s)."""
+def level_row(path: Path) -> dict:
+    """A finished level's gait (its ``best.json``) re-simulated for 10 s and judged by issue
+    20's acceptance (:func:`~bladelab.predict.reflex.acceptance.acceptance_runs`) at the speed
+    it reached (rounded to 0.01 m/s): a gait is judged at its own speed, and its copies and
+    changed starts must reach that speed too (±0.1 m/s). Returns the nominal run's cost (the
+    objective at the level's prescribed speed), mean speed [m/s], fell, swing contacts and
+    their peak [body weights], mean pelvis tilt [deg]; and, for a gait that runs, the speed
+    judged at [m/s] and the verdicts (for one that falls: None and False)."""
     from bladelab.predict.reflex.acceptance import acceptance_runs, judged_runs, meets_acceptance
-    from bladelab.predict.reflex.verify import verify_solution
 
-    v = verify_solution(path, speed=speed, duration=10.0)
-    row = {
-        "cost": float(v["cost"]),
-        "mean_speed_m_per_s": float(v["mean_speed_m_per_s"]),
-        "fell": bool(v["fell"]),
-        "simulated_s": float(v["duration_s"]),
-        "swing_contacts": int(v["swing_contacts"]),
-        "swing_contact_peak_bw": float(v["swing_contact_peak_bw"]),
-        "pelvis_tilt_mean_deg": float(v["pelvis_tilt_mean_deg"]),
-        "judged_at_m_per_s": None,
-        "nominal_meets_acceptance": False,
-        "accepted": False,
+    acc = acceptance_runs(path, 10.0, pushes=False, speed="reached")
+    runs = not acc["fell"]
+    return {
+        "cost": float(acc["cost"]),
+        "mean_speed_m_per_s": float(acc["mean_speed_m_per_s"]),
+        "fell": bool(acc["fell"]),
+        "simulated_s": float(acc["duration_s"]),
+        "swing_contacts": int(acc["swing_contacts"]),
+        "swing_contact_peak_bw": float(acc["swing_contact_peak_bw"]),
+        "pelvis_tilt_mean_deg": float(acc["pelvis_tilt_mean_deg"]),
+        "judged_at_m_per_s": acc["judged_at_m_per_s"] if runs else None,
+        "nominal_meets_acceptance": runs and meets_acceptance(judged_runs(acc)[0][1]),
+        "accepted": runs and bool(acc["accepted"]),
     }
-    if not v["fell"]:
-        judged = round(row["mean_speed_m_per_s"], 2)  # as acceptance_runs(speed="reached")
-        acc = acceptance_runs(path, 10.0, pushes=False, speed=judged)
-        nominal = judged_runs(acc)[0][1]
-        row.update(judged_at_m_per_s=judged, nominal_meets_acceptance=meets_acceptance(nominal),
-                   accepted=bool(acc["accepted"]))
-    return row
-
 
 
 def run_recipe(
@@ -312,7 +305,7 @@ def run_recipe(
         row = {"category": category, "seed": int(seed), "level": name, "stage": stage.name,
                "prescribed_speed_m_per_s": float(speed), "initial_speed_m_per_s": float(start),
                "generations": res.generations, "wall_time_s": res.wall_time_s,
-               "best_cost_in_run": res.best_cost, **level_row(sub / "best.json", speed)}
+               "best_cost_in_run": res.best_cost, **level_row(sub / "best.json")}
         rows.append(row)
         write_json(folder / LEVELS_NAME, rows)
         if progress is not None:
