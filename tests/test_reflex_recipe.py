@@ -116,6 +116,20 @@ def test_a_stage_holds_its_fixed_parameters(tmp_path, monkeypatch):
     assert STABLE_GAIT_RECIPE.stages[0].fixed == ("*-pelvis_tx.*",)  # track and stable
 
 
+def test_a_stage_searches_only_its_free_parameters():
+    _, layout = runner_and_layout("amputee", "Cat6")
+    knee = Stage("k", 1, 1.0, free=("S01000.*", "*.offset"), fixed=("knee*", "ankle*"))
+    held = set(knee.fixed_indices(layout.names))
+    searched = [layout.names[i] for i in range(layout.size) if i not in held]
+    assert searched == ["pelvis_tilt.offset", "hip_flexion_l.offset", "hip_flexion_r.offset",
+                        "S01000.bifemsh_l.C0", "S01000.bifemsh_r.C0"]
+    # a stage without "free" is written as before stages had it (finished task folders of
+    # older recipes still compare equal); one with it reads back
+    assert "free" not in STABLE_GAIT_RECIPE.to_dict()["stages"][0]
+    both = Recipe(stages=(Stage("a", 1, 0.1), knee))
+    assert Recipe.from_dict(json.loads(json.dumps(both.to_dict()))) == both
+
+
 def test_continuation_stops_at_a_fall_and_after_max_levels(tmp_path, monkeypatch):
     _fake_levels(monkeypatch, {"1-a": 3.3, "2-b": 3.4, "speed-3.6": 3.7}, falls=("speed-3.6",))
     rows = run_recipe("Cat6", 1, out=tmp_path / "fall", recipe=_tiny(), init=SHIPPED_AMPUTEE)
@@ -305,7 +319,10 @@ def test_report_of_a_recipe_sweep_resimulates_every_level(tmp_path):
     from bladelab.predict.reflex.recipe_sweep import run_recipe_sweep
     from bladelab.report.predictive import build_predictive_report, predictive_kind
 
-    one = Recipe(stages=(Stage("a", 1, 1e-4, popsize=2, settings={"duration": 0.3}),),
+    # one stage that searches only a parameter without effect (the target speed of a
+    # mean-speed reflex at gain 0): every level is the shipped gait, which runs its 10 s
+    one = Recipe(stages=(Stage("a", 1, 1e-4, popsize=2, settings={"duration": 0.3},
+                               free=("S11100.iliopsoas_r-pelvis_tx.S0",)),),
                  speed=3.5, initial_speed=3.5)
     run_recipe_sweep(["Cat6"], [1, 2], out=tmp_path / "rs", recipe=one, progress=False,
                      init=SHIPPED_AMPUTEE)

@@ -67,7 +67,8 @@ class Stage:
     scale), ``popsize`` candidates; ``track``: add the collocation stride's tracking term;
     ``settings``: :class:`ObjectiveSettings` fields for this stage (over the recipe's
     ``base``); ``fixed``: patterns (``fnmatch``) of parameter names held at their values from
-    the stage before."""
+    the stage before; ``free``: if given, patterns of the only parameters searched (the others
+    held as by ``fixed``)."""
 
     name: str
     generations: int
@@ -76,13 +77,18 @@ class Stage:
     track: bool = False
     settings: dict = field(default_factory=dict)
     fixed: tuple[str, ...] = ()
+    free: tuple[str, ...] = ()
 
     def fixed_indices(self, names: tuple[str, ...]) -> list[int]:
-        """Indices of the parameters ``fixed`` names among ``names``."""
-        return [i for i, n in enumerate(names) if any(fnmatch(n, p) for p in self.fixed)]
+        """Indices of the parameters held among ``names``: those ``fixed`` names, and with
+        ``free`` those it does not name."""
+        return [i for i, n in enumerate(names)
+                if any(fnmatch(n, p) for p in self.fixed)
+                or (self.free and not any(fnmatch(n, p) for p in self.free))]
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "fixed", tuple(self.fixed))
+        object.__setattr__(self, "free", tuple(self.free))
         if not self.name or "/" in self.name:
             raise SpecError(f"a stage needs a plain name, got {self.name!r}", where="stage.name")
         if self.generations < 1 or self.popsize < 2 or not self.sigma > 0:
@@ -131,7 +137,11 @@ class Recipe:
         return ObjectiveSettings.from_dict(d)
 
     def to_dict(self) -> dict:
-        return asdict(self)
+        d = asdict(self)
+        for stage in (*d["stages"], d["continuation"] or {}):
+            if not stage.get("free", True):  # as written before stages had it
+                del stage["free"]
+        return d
 
     @classmethod
     def from_dict(cls, d: dict) -> Recipe:
