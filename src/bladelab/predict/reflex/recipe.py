@@ -289,7 +289,7 @@ def run_recipe(
                             where="--track-study")
         track = track_file(track_study, category, recipe.speed)
     task = {"format": RECIPE_FORMAT, "category": category, "seed": int(seed),
-            "recipe": recipe.to_dict(), "init_sha256": parameter_digest(x),
+            "recipe": recipe.to_dict(), "init_sha256": parameter_digest(x, layout),
             "track": None if track is None else str(track),
             "track_sha256": None if track is None else hashlib.sha256(
                 track.read_bytes()).hexdigest()}

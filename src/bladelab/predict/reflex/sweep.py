@@ -213,7 +213,7 @@ def category_task(payload: dict) -> dict:
     for speed in payload["speeds"]:
         folder = cell_dir(out, cat, speed)
         data = _read_cell(folder, cat, speed, wanted)
-        digest = parameter_digest(x)
+        digest = parameter_digest(x, layout)
         if data is not None and data.get("x0_sha256") != digest:
             raise SpecError(
                 f"sweep cell {cat} at {speed:g} m/s was started from another initial guess",
