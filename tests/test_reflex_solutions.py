@@ -9,6 +9,7 @@ from pathlib import Path
 import pytest
 
 import bladelab
+from bladelab.errors import SpecError
 from bladelab.predict.reflex.optimize import runner_and_layout
 from bladelab.predict.reflex.verify import verify_solution
 
@@ -93,7 +94,7 @@ def test_the_acceptance_judges_a_gait_at_the_speed_it_reaches():
     at = acceptance_runs(path, 2.0, pushes=False, speed=out["judged_at_m_per_s"])
     assert [c["cost"] for c in at["jittered"]] == [c["cost"] for c in out["jittered"]]
     assert [c["ok"] for c in at["jittered"]] == [c["ok"] for c in out["jittered"]]
-    with pytest.raises(ValueError, match="reached"):
+    with pytest.raises(SpecError, match="reached"):
         verify_solution(path, speed="fastest")
 
 

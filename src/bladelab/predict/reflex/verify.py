@@ -10,6 +10,7 @@ from pathlib import Path
 import numpy as np
 
 from bladelab._io import read_json
+from bladelab.errors import SpecError
 from bladelab.predict.reflex.objective import PUSH_AFTER, ObjectiveSettings, simulate_controlled
 from bladelab.predict.reflex.optimize import runner_and_layout, stored_settings
 from bladelab.predict.reflex.robust import VERIFY_JITTER_SEED, jittered_parameters
@@ -65,9 +66,10 @@ def verify_solution(
     :data:`~bladelab.predict.reflex.objective.PUSH_AFTER` (the stride's phases; the basin of
     the gait, not of its start). Returns the measured values (the copies' under
     ``"jittered"``, the changed starts' under ``"initial_speed"``, the pushed runs' under
-    ``"pushed"``), ``judged_at_m_per_s`` (the speed judged at [m/s]; ``judged_at_reached_speed``: whether
-    it is the reached one, not the prescribed one for a nominal run that falls), ``nominal_ok`` (the
-    nominal run alone) and ``ok`` (every run).
+    ``"pushed"``), ``judged_at_m_per_s`` (the speed judged at [m/s]),
+    ``judged_at_reached_speed`` (whether that is the reached speed: not for a nominal run that
+    falls, judged at the prescribed one), ``nominal_ok`` (the nominal run alone) and ``ok``
+    (every run).
     """
 
     from bladelab.predict.reflex.controller import read_parameters
@@ -78,7 +80,8 @@ def verify_solution(
     own_speed = float(data.get("speed_m_per_s", 3.5))
     reached = speed == "reached"
     if isinstance(speed, str) and not reached:
-        raise ValueError(f"speed must be a number [m/s], None or 'reached', not {speed!r}")
+        raise SpecError(f"speed must be a number [m/s], None or 'reached', not {speed!r}",
+                        where="speed")
     speed = own_speed if speed is None or reached else float(speed)
     runner, layout = runner_and_layout(model, blade)
     x = read_parameters(path, layout)
