@@ -101,25 +101,27 @@ def test_gait_state_machine_walks_through_the_cycle():
 
 
 def test_an_unloading_running_leg_lifts_off_before_it_leaves_the_ground():
-    # liftoff_load_threshold_<side> (our addition): a running leg in late stance goes to
-    # Liftoff when its load falls below it, without double support; 0 (the default) never
+    # liftoff_load_margin_<side> (our addition): a running leg in late stance goes to Liftoff
+    # when its load falls below its stance threshold plus the margin, without double
+    # support; 0 (the default) never
     bw, leg_len = 800.0, 1.0
     qpos = np.zeros(3)
-    for liftoff, want in ((0.0, LATE_STANCE), (0.9, LIFTOFF)):
+    for liftoff, want in ((0.0, LATE_STANCE), (0.5, LATE_STANCE), (0.7, LIFTOFF)):
         thr = np.array([0.2, 0.2, liftoff, 0.0])
         cs = np.array([LATE_STANCE, SWING, 0, 0], float)
         update_gait_states(cs, *_crec(1600, 0, -0.2, -0.3), qpos, 0, bw, thr, leg_len)
         assert cs[0] == LATE_STANCE  # 2 BW: still pushing
         update_gait_states(cs, *_crec(640, 0, -0.3, -0.2), qpos, 0, bw, thr, leg_len)
-        assert cs[0] == want and cs[1] == SWING  # 0.8 BW, the other leg in the air
+        # 0.8 BW, the other leg in the air: below 0.2 + 0.7 BW, not below 0.2 + 0.5
+        assert cs[0] == want and cs[1] == SWING
         update_gait_states(cs, *_crec(0, 0, -0.4, -0.1), qpos, 0, bw, thr, leg_len)
         assert cs[0] == SWING
     layout = controller_layout(build_runner("able"))
-    assert layout.x0[layout.index("liftoff_load_threshold_l")] == 0.0
+    assert layout.x0[layout.index("liftoff_load_margin_l")] == 0.0
 
 
 def test_warm_start_digest_is_unchanged_by_parameters_added_at_their_defaults(amputee):
-    # task folders store the digest of their warm start; the liftoff thresholds (added later)
+    # task folders store the digest of their warm start; the liftoff margins (added later)
     # at their defaults leave it as the layout without them would have computed it
     import hashlib
 
@@ -127,7 +129,7 @@ def test_warm_start_digest_is_unchanged_by_parameters_added_at_their_defaults(am
 
     layout = controller_layout(amputee)
     x = layout.x0 + 0.01 * np.arange(layout.size)
-    added = [layout.index(f"liftoff_load_threshold_{s}") for s in ("l", "r")]
+    added = [layout.index(f"liftoff_load_margin_{s}") for s in ("l", "r")]
     x[added] = layout.x0[added]
     older = np.delete(x, added).astype("<f8").tobytes()
     assert parameter_digest(x, layout) == hashlib.sha256(older).hexdigest()

@@ -7,8 +7,9 @@ Each leg is in one of five states (SCONE's ``GaitStateController``): ``EarlyStan
 - EarlyStance → LateStance when the leg's contact points are behind the pelvis (sagittal position
   ``(x_contact − x_pelvis) / leg length`` below ``late_stance_threshold``);
 - LateStance → Liftoff when the other leg is in contact (double support, walking) or, our
-  addition for running, when the leg's load falls below ``liftoff_load_threshold_<side>`` (the
-  push-off unloads it; 0, the default, never: SCONE's machine);
+  addition for running, when the leg's load falls below its stance threshold plus
+  ``liftoff_load_margin_<side>`` (the push-off unloads it; 0, the default, never: SCONE's
+  machine);
 - any stance state → Swing when contact is lost;
 - Swing → Landing when the sagittal position exceeds ``landing_threshold``; Swing/Landing →
   EarlyStance on contact.
@@ -274,7 +275,7 @@ def controller_layout(model) -> ControllerLayout:
     # leg never sees double support, so SCONE's Liftoff state never comes and the swing
     # reflexes start only after lift-off; 0 keeps SCONE's machine (docs/predictive.md)
     for side in ("l", "r"):
-        param(f"liftoff_load_threshold_{side}", 0.0, 0.0, 3.0, 0.2)
+        param(f"liftoff_load_margin_{side}", 0.0, 0.0, 3.0, 0.5)
     for dof in INITIAL_DOFS:
         for side in ("l", "r") if dof != "pelvis_tilt" else ("",):
             dn = f"{dof}_{side}" if side else dof
@@ -382,7 +383,7 @@ def read_parameters(
 #: Parameters added after task folders (recipes, sweep cells) first stored the digests of their
 #: warm starts (:func:`parameter_digest`): left out of a digest while at their defaults, so
 #: those folders continue in the grown layout (name prefixes).
-_ADDED_AFTER_DIGESTS = ("liftoff_load_threshold_",)
+_ADDED_AFTER_DIGESTS = ("liftoff_load_margin_",)
 
 
 def parameter_digest(x: np.ndarray, layout: ControllerLayout | None = None) -> str:
@@ -448,8 +449,8 @@ def delayed(hist, cs, channel, steps):
 @njit(cache=True)
 def update_gait_states(cs, crec, cp, qpos, ix_pelvis, body_weight, thresholds, leg_length):
     """Advance each leg's gait state from the contact forces (see module docstring);
-    ``thresholds``: the stance load thresholds of both legs, then their liftoff load
-    thresholds [body weights]."""
+    ``thresholds``: the stance load thresholds of both legs, then their liftoff load margins
+    [body weights]."""
     contact = np.zeros(2)
     sag = np.zeros(2)
     npts = np.zeros(2)
@@ -472,7 +473,7 @@ def update_gait_states(cs, crec, cp, qpos, ix_pelvis, body_weight, thresholds, l
         elif st == LATE_STANCE:
             if not on:
                 st = SWING
-            elif other or load < thresholds[2 + leg]:
+            elif other or load < thresholds[leg] + thresholds[2 + leg]:
                 st = LIFTOFF
         elif st == LIFTOFF:
             if not on:

@@ -297,8 +297,8 @@ def simulate_controlled(
     iz = model.dof("pelvis_tz")
     itilt = model.dof("pelvis_tilt")
     knee_idx = np.array([model.dof(n) for n in ("knee_angle_l", "knee_angle_r")], dtype=np.int64)
-    thresholds = np.array([x[layout.index(f"{kind}_load_threshold_{side}")]
-                           for kind in ("stance", "liftoff") for side in ("l", "r")])
+    thresholds = np.array([x[layout.index(name + side)] for name in
+                           ("stance_load_threshold_", "liftoff_load_margin_") for side in "lr"])
     leg_length = float(model.stand_qpos[iz])
     fall_height = 0.6 * leg_length
     ranges = np.array([*settings.knee_load_range, *settings.pelvis_tilt_range_deg], dtype=float)
