@@ -382,7 +382,8 @@ def read_parameters(
 
 #: Parameters added after task folders (recipes, sweep cells) first stored the digests of their
 #: warm starts (:func:`parameter_digest`): left out of a digest while at their defaults, so
-#: those folders continue in the grown layout (name prefixes).
+#: those folders continue in the grown layout (name prefixes). A parameter added to the layout
+#: later belongs here too, or every task folder written before it refuses to continue.
 _ADDED_AFTER_DIGESTS = ("liftoff_load_margin_",)
 
 
