@@ -118,15 +118,15 @@ def test_a_stage_holds_its_fixed_parameters(tmp_path, monkeypatch):
 
 def test_a_stage_searches_only_its_free_parameters():
     _, layout = runner_and_layout("amputee", "Cat6")
-    knee = Stage("k", 1, 1.0, free=("S01000.*", "*.offset"), fixed=("knee*", "ankle*"))
-    held = set(knee.fixed_indices(layout.names))
+    offsets = Stage("o", 1, 1.0, free=("S01000.*", "*.offset"), fixed=("knee*", "ankle*"))
+    held = set(offsets.fixed_indices(layout.names))
     searched = [layout.names[i] for i in range(layout.size) if i not in held]
     assert searched == ["pelvis_tilt.offset", "hip_flexion_l.offset", "hip_flexion_r.offset",
                         "S01000.bifemsh_l.C0", "S01000.bifemsh_r.C0"]
     # a stage without "free" is written as before stages had it (finished task folders of
     # older recipes still compare equal); one with it reads back
     assert "free" not in STABLE_GAIT_RECIPE.to_dict()["stages"][0]
-    both = Recipe(stages=(Stage("a", 1, 0.1), knee))
+    both = Recipe(stages=(Stage("a", 1, 0.1), offsets))
     assert Recipe.from_dict(json.loads(json.dumps(both.to_dict()))) == both
 
 
