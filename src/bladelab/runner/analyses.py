@@ -383,21 +383,36 @@ def power_balance(result: RunnerResult) -> pd.DataFrame:
 
 
 def power_balance_residual_pct(result: RunnerResult, *, skip_times: Sequence[float] = ()) -> float:
-    """RMS of ``P_external − P_kinetic`` in % of the peak |P_kinetic| (first and last samples
-    excluded: one-sided differences; so are the samples within two samples of each of
-    ``skip_times`` [s], e.g. a push that changes the kinetic energy without external work)."""
+    """RMS of the power-balance residual in % of the peak |P_kinetic|, over the samples with a
+    neighbour on each side, less those within two samples of each of ``skip_times`` [s] (e.g.
+    a push that changes the kinetic energy without external work).
+
+    The kinetic power at a sample is a central difference, ``(E_{k+1} − E_{k−1})/2h``: the
+    mean power over the two sample intervals around it. The external power is averaged over
+    the same window (Simpson's rule, ``(P_{k−1} + 4·P_k + P_{k+1})/6``) before the two are
+    compared, so the residual measures the simulation, not the sampling: comparing the central
+    difference with the power at the sample itself has an error of ``h²·P''/6``, which under
+    running loads sampled every 1 ms is ~0.46 % of the peak for any time step (measured on the
+    shipped amputee reflex solution, 2026-11-27; explicit 0.0625 ms: 0.46 % against 0.13 %
+    sampled every step). Until then this was that comparison."""
     pb = power_balance(result)
-    keep = np.ones(len(pb), dtype=bool)
-    keep[[0, -1]] = False
-    if len(skip_times) and len(result.time) > 1:
+    if len(pb) < 3:
+        return 0.0
+    ext = pb.external.to_numpy()
+    kinetic = pb.kinetic.to_numpy()[1:-1]
+    residual = (ext[:-2] + 4.0 * ext[1:-1] + ext[2:]) / 6.0 - kinetic
+    keep = np.ones(len(residual), dtype=bool)
+    if len(skip_times):
         spacing = float(result.time[1] - result.time[0])
+        centre = pb.time.to_numpy()[1:-1]
         for t in skip_times:
-            keep &= np.abs(pb.time.to_numpy() - t) > 2.5 * spacing
-    pb = pb[keep]
-    peak = float(np.max(np.abs(pb.kinetic))) if len(pb) else 0.0
+            keep &= np.abs(centre - t) > 2.5 * spacing
+    if not keep.any():
+        return 0.0
+    peak = float(np.max(np.abs(kinetic[keep])))
     if peak == 0.0:
         return 0.0
-    return float(np.sqrt(np.mean(pb.residual**2)) / peak * 100.0)
+    return float(np.sqrt(np.mean(residual[keep] ** 2)) / peak * 100.0)
 
 
 def stances(

@@ -21,7 +21,7 @@ from numba import njit
 from bladelab.contact import hunt_crossley_force, smooth_spring_damper_force
 from bladelab.numba_cache import refresh_stale_caches
 from bladelab.runner.contact_point import lowest_point
-from bladelab.runner.implicit import IMPLICIT, implicit_advance, implicit_begin, implicit_forces
+from bladelab.runner.implicit import EXPLICIT, implicit_advance, implicit_begin, implicit_forces
 from bladelab.runner.mjcall import call_mujoco, mujoco_step_addresses  # noqa: F401 (re-exported)
 from bladelab.runner.model import (
     CP_BODY,
@@ -235,7 +235,7 @@ def step_begin(f1, mptr, dptr, mj, root_com, imp):
     current state; with the implicit scheme only the stages it needs,
     :func:`bladelab.runner.implicit.implicit_begin`), then ``root_com`` [m] = the root
     subtree's COM (MuJoCo's ``cvel`` origin)."""
-    if imp[0][0] == IMPLICIT:
+    if imp[0][0] != EXPLICIT:
         implicit_begin(mptr, dptr, imp)
     else:
         call_mujoco(f1, mptr, dptr)
@@ -249,7 +249,7 @@ def step_begin(f1, mptr, dptr, mj, root_com, imp):
 def step_forces(mj, arrays, imp, root_com, dt):
     """The forces of one step by the scheme ``imp[0][0]`` selects: :func:`forces` (explicit)
     or :func:`bladelab.runner.implicit.implicit_forces`."""
-    if imp[0][0] == IMPLICIT:
+    if imp[0][0] != EXPLICIT:
         implicit_forces(mj, arrays, imp, root_com, dt)
     else:
         forces(mj, arrays, root_com, dt)
@@ -259,7 +259,7 @@ def step_forces(mj, arrays, imp, root_com, dt):
 def step_advance(f2, mptr, dptr, mj, imp, dt):
     """Advance the state by the step: MuJoCo's ``mj_step2`` (explicit scheme) or the implicit
     scheme's Euler update (:func:`bladelab.runner.implicit.implicit_advance`)."""
-    if imp[0][0] == IMPLICIT:
+    if imp[0][0] != EXPLICIT:
         implicit_advance(mj, imp, dt)
     else:
         call_mujoco(f2, mptr, dptr)

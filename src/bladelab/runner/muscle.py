@@ -179,7 +179,8 @@ def fibre_heights(mp: np.ndarray) -> np.ndarray:
 @njit(cache=True, error_model="numpy", _nrt=False)
 def muscle_step(
     mp: np.ndarray, ms: np.ndarray, l_mtu: np.ndarray, u: np.ndarray, dt: float,
-    tol: float = 1e-8, height: np.ndarray | None = None,
+    tol: float = 1e-8, height: np.ndarray | None = None, l_prev: np.ndarray | None = None,
+    v_mtu: np.ndarray | None = None,
 ) -> None:
     """Advance all muscles by one step and store their tendon forces.
 
@@ -192,6 +193,12 @@ def muscle_step(
     instead of 3.3 iterations per muscle and step at 1 ms, measured). ``height`` [m]: the fibre
     heights ``l_opt·sin α₀`` (:func:`fibre_heights`) when the caller keeps them between steps
     (the same values: one ``sin`` per muscle and step less); None computes them here.
+
+    Second order (the Newmark scheme, :mod:`bladelab.runner.implicit`): with ``l_prev`` (the
+    fibre lengths [m] of the previous step, in/out; 0 where there is none yet) the fibre takes
+    a BDF2 step, ``l' = (4·l − l_prev)/3 + (2/3)·dt·v'``, in equilibrium with the MTU length
+    at the step's end, ``l_mtu + dt·v_mtu`` [m, m/s]. Without them: implicit Euler against
+    the step's start length (first order).
     """
     if mp.shape[1] <= MP_TSTRAIN:
         raise ValueError("muscle parameters need 5 columns (the last: tendon strain at Fmax)")
@@ -210,11 +217,20 @@ def muscle_step(
         else:
             h = height[i]
         ms[i, MS_FORCE] = _tendon_force_of_height(lm, l_ce, fmax, h, l_ts, eref)
-        # fibre: implicit Euler, Newton on the normalised velocity
+        # fibre: implicit Euler (or BDF2), Newton on the normalised velocity
+        base = l_ce
+        step_dt = dt
+        if l_prev is not None:
+            if v_mtu is not None:
+                lm = lm + dt * v_mtu[i]
+            if l_prev[i] > 0.0:
+                base = (4.0 * l_ce - l_prev[i]) / 3.0
+                step_dt = dt * (2.0 / 3.0)
+            l_prev[i] = l_ce
         vscale = V_MAX_OPT_PER_S * l_opt
         v = ms[i, MS_VCE] / vscale
         for _ in range(6):
-            l_new = l_ce + dt * v * vscale
+            l_new = base + step_dt * v * vscale
             if l_new < 0.2 * l_opt:
                 l_new = 0.2 * l_opt
             c = _cos_pennation_of_height(l_new, h)
@@ -226,14 +242,14 @@ def muscle_step(
             ) * c - tendon_force(strain, eref)
             dft = 2.0 * strain / (eref * eref) if strain > 0.0 else 0.0
             dfp = 2.0 * (ln - 1.0) / (PASSIVE_STRAIN * PASSIVE_STRAIN) if ln > 1.0 else 0.0
-            dg = (act * fl * _force_velocity_slope(v) + FIBER_DAMPING) * c + dt * vscale * (
+            dg = (act * fl * _force_velocity_slope(v) + FIBER_DAMPING) * c + step_dt * vscale * (
                 dfp * c / l_opt + dft * c * c / l_ts
             )
             step = g / dg
             v -= step
             if abs(step) < tol:
                 break
-        l_new = l_ce + dt * v * vscale
+        l_new = base + step_dt * v * vscale
         if l_new < 0.2 * l_opt:
             l_new = 0.2 * l_opt
         ms[i, MS_LCE] = l_new

@@ -29,6 +29,8 @@ import pandas as pd
 from bladelab.errors import SimulationError
 from bladelab.runner.implicit import (
     INTEGRATORS,
+    NEWMARK,
+    implicit_advance,
     implicit_arrays,
     simulation_model,
     site_views,
@@ -245,8 +247,11 @@ def simulate_runner(
         Stop when the pelvis COM is below this height [m] (default: 60 % of standing height).
     integrator
         ``"explicit"`` (default: every bladelab force at the step's start, MuJoCo's
-        semi-implicit Euler) or ``"implicit"``: contacts, ligaments and the socket linearly
-        implicit (:mod:`bladelab.runner.implicit`), stable and accurate at a 1 ms step.
+        semi-implicit Euler), ``"newmark"``: contacts, ligaments and the socket linearly
+        implicit in Newmark's trapezoidal rule, muscle fibres by BDF2
+        (:mod:`bladelab.runner.implicit`), stable at a 1 ms step and there more accurate than
+        the explicit scheme at 0.25 ms, or ``"implicit"``: its first-order predecessor
+        (semi-implicit Euler, kept for runs made with it).
     """
     if not (duration > 0 and dt > 0 and math.isfinite(duration) and math.isfinite(dt)):
         raise SimulationError("duration and dt must be positive", where="duration/dt")
@@ -385,7 +390,10 @@ def _python_loop(
             return k_rec, True
         if k == n_steps:
             break
-        step2(m, d)
+        if imp[0][0] == NEWMARK:
+            implicit_advance(mj, imp, dt)
+        else:
+            step2(m, d)
     return k_rec, False
 
 

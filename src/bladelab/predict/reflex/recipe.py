@@ -157,15 +157,22 @@ class Recipe:
 
     @classmethod
     def read(cls, path: str | Path) -> Recipe:
-        """A recipe from a JSON file (:meth:`to_dict`'s form)."""
+        """A recipe from a JSON file: :meth:`to_dict`'s form, or a task's ``recipe.json``
+        (the recipe it was made with)."""
         data = read_json(path, what="recipe")
+        if isinstance(data, dict) and "stages" not in data and isinstance(data.get("recipe"),
+                                                                          dict):
+            data = data["recipe"]
         try:
             return cls.from_dict(data)
         except SpecError as e:
             raise InputFileError(str(e), file=path, hint=e.hint) from e
 
 
-_FAST = {"integrator": "implicit", "dt": 1e-3}
+#: The recipes' scheme: Newmark at 1 ms (bladelab.runner.implicit; until 2026-11-27 the
+#: first-order "implicit" one, whose gaits fall within 2 s under Newmark: a task folder made
+#: with it continues with its own recipe.json's recipe, --recipe FILE).
+_FAST = {"integrator": "newmark", "dt": 1e-3}
 _COPIES = {"robust_jitter": 1e-6, "robust_directions": "per-generation"}
 _STARTS = {**_COPIES, "duration": 15.0, "robust_samples": 5, "robust_push": 0.03,
            "run_up": True}
