@@ -17,7 +17,12 @@ import bladelab.predict.reflex.recipe as recipe_module
 from bladelab.cli import main
 from bladelab.errors import InputFileError, SpecError
 from bladelab.predict.reflex.controller import read_parameters
-from bladelab.predict.reflex.optimize import load_checkpoint, runner_and_layout
+from bladelab.predict.reflex.objective import simulate_controlled
+from bladelab.predict.reflex.optimize import (
+    load_checkpoint,
+    runner_and_layout,
+    stored_settings,
+)
 from bladelab.predict.reflex.recipe import (
     STABLE_GAIT_RECIPE,
     Recipe,
@@ -215,6 +220,14 @@ def test_level_row_is_the_gaits_ten_second_rerun_and_judges_the_acceptance():
     assert row["swing_contact_peak_bw"] > 0.3
     assert not row["nominal_meets_acceptance"] and not row["accepted"]
     assert row["judged_at_m_per_s"] == round(v["mean_speed_m_per_s"], 2)  # its own speed
+    # and whether it also runs at half its time step, as a direct simulation at that step says
+    data = json.loads(SHIPPED_AMPUTEE.read_text())
+    runner, layout = runner_and_layout("amputee", "Cat6")
+    settings = stored_settings(data, speed=3.5, duration=10.0, nominal=True)
+    assert settings.dt == pytest.approx(2.5e-4)
+    ev, _ = simulate_controlled(runner, read_parameters(SHIPPED_AMPUTEE, layout), layout=layout,
+                                settings=replace(settings, dt=1.25e-4))
+    assert row["runs_at_half_step"] == (not ev.fell)
 
 
 def test_recipes_check_their_fields_and_read_back(tmp_path):

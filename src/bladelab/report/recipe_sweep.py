@@ -109,7 +109,8 @@ def recipe_sweep_sections(report, folder: Path, bar) -> tuple[pd.DataFrame, dict
     table = levels[["category", "seed", "level", "prescribed_speed_m_per_s",
                     "initial_speed_m_per_s", "generations", "mean_speed_m_per_s", "cost",
                     "fell", "swing_contact_peak_bw", "pelvis_tilt_mean_deg",
-                    "judged_at_m_per_s", "nominal_meets_acceptance", "accepted"]].assign(
+                    "judged_at_m_per_s", "nominal_meets_acceptance", "accepted",
+                    "runs_at_half_step"]].assign(
         **{"as in levels.json (yes/no)": same})
     table = table.rename(columns={
         "prescribed_speed_m_per_s": "prescribed speed (m/s)",
@@ -120,7 +121,8 @@ def recipe_sweep_sections(report, folder: Path, bar) -> tuple[pd.DataFrame, dict
         "pelvis_tilt_mean_deg": "pelvis tilt mean (deg)",
         "judged_at_m_per_s": "judged at (m/s)",
         "nominal_meets_acceptance": "nominal run meets the acceptance (yes/no)",
-        "accepted": "meets issue 20's acceptance (yes/no)"})
+        "accepted": "meets issue 20's acceptance (yes/no)",
+        "runs_at_half_step": "runs 10 s at half the time step (yes/no)"})
     report.add_section(
         "Recipe sweep: categories and seeds",
         text=("Each category was optimised by a recipe of CMA-ES stages per seed, then its "

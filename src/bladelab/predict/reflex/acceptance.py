@@ -13,7 +13,10 @@ the shipped-solution criteria (speed, flight, alternating steps, power balance),
 foot strikes the ground above :data:`STRIKE_LIMIT_BW` body weights, and the mean pelvis tilt
 lies inside the objective's window (seed 001: −16…−2°). Pushes (forward speed × (1 ±
 :data:`PUSH_CHANGE`) at :data:`PUSH_PHASES` phases of a stride) are simulated too, not judged:
-they measure the size of the gait's basin.
+they measure the size of the gait's basin. So is the nominal run at half the file's time step
+(``refined``): reported beside the verdict, not yet part of it (session 21: no gait of the
+first-order scheme runs at half its step; the Newmark scheme's gaits are the first to be
+checked).
 """
 
 from __future__ import annotations
@@ -35,13 +38,14 @@ PUSH_PHASES = 5
 
 
 def acceptance_runs(path: str | Path, duration: float = 10.0, *, pushes: bool = True,
-                    speed: float | str | None = None) -> dict:
+                    speed: float | str | None = None, refined: bool = False) -> dict:
     """:func:`~bladelab.predict.reflex.verify.verify_solution`'s result for the parameter file
     ``path`` re-simulated for ``duration`` [s] as above (pushes when ``pushes`` and
     ``duration`` is at least :data:`~bladelab.predict.reflex.objective.MIN_PUSH_DURATION`;
     ``"pushed"`` is otherwise empty), at ``speed`` [m/s] (default the file's prescribed speed;
     ``"reached"``: the nominal run's mean speed, rounded to 0.01 m/s, so that a gait is judged
-    at its own speed; every judged run's mean speed must lie within 0.1 m/s of it);
+    at its own speed; every judged run's mean speed must lie within 0.1 m/s of it), and with
+    ``refined`` the nominal run at half the time step (``"refined"``, not judged);
     ``"judged_at_m_per_s"`` is that speed, ``"simulations"`` counts the runs and
     ``"accepted"`` says whether every judged run meets the acceptance."""
     from bladelab.predict.reflex.objective import MIN_PUSH_DURATION
@@ -51,9 +55,12 @@ def acceptance_runs(path: str | Path, duration: float = 10.0, *, pushes: bool = 
     out = verify_solution(path, speed=speed, duration=duration, jittered_copies=COPIES,
                           jitter=COPY_JITTER,
                           initial_speed_change=START_CHANGE,
-                          push_change=PUSH_CHANGE if pushes else 0.0, push_phases=PUSH_PHASES)
+                          push_change=PUSH_CHANGE if pushes else 0.0, push_phases=PUSH_PHASES,
+                          refined_step=refined)
     out.setdefault("pushed", [])
-    out["simulations"] = 1 + sum(len(out[k]) for k in ("jittered", "initial_speed", "pushed"))
+    out.setdefault("refined", [])
+    out["simulations"] = 1 + sum(len(out[k]) for k in ("jittered", "initial_speed", "pushed",
+                                                         "refined"))
     out["accepted"] = all(meets_acceptance(c) for _, c in judged_runs(out))
     return out
 

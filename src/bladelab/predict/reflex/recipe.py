@@ -238,12 +238,14 @@ def level_row(path: Path) -> dict:
     it reached (rounded to 0.01 m/s): a gait is judged at its own speed, and its copies and
     changed starts must reach that speed too (±0.1 m/s). Returns the nominal run's cost (the
     objective at the level's prescribed speed), mean speed [m/s], fell, swing contacts and
-    their peak [body weights], mean pelvis tilt [deg]; and, for a gait that runs, the speed
-    judged at [m/s] and the verdicts (for one that falls: None and False)."""
+    their peak [body weights], mean pelvis tilt [deg]; for a gait that runs, the speed judged
+    at [m/s] and the verdicts (for one that falls: None and False); and whether the nominal
+    run also runs, and meets the acceptance, at half the time step (reported, not judged)."""
     from bladelab.predict.reflex.acceptance import acceptance_runs, judged_runs, meets_acceptance
 
-    acc = acceptance_runs(path, 10.0, pushes=False, speed="reached")
+    acc = acceptance_runs(path, 10.0, pushes=False, speed="reached", refined=True)
     runs = not acc["fell"]
+    half = acc["refined"][0]
     return {
         "cost": float(acc["cost"]),
         "mean_speed_m_per_s": float(acc["mean_speed_m_per_s"]),
@@ -255,6 +257,8 @@ def level_row(path: Path) -> dict:
         "judged_at_m_per_s": acc["judged_at_m_per_s"] if runs else None,
         "nominal_meets_acceptance": runs and meets_acceptance(judged_runs(acc)[0][1]),
         "accepted": runs and bool(acc["accepted"]),
+        "runs_at_half_step": not half["fell"],
+        "half_step_meets_acceptance": meets_acceptance(half),
     }
 
 
