@@ -158,11 +158,12 @@ def test_site_kinematics_matches_mujoco(amputee):
         np.testing.assert_allclose(views[3][s], d.site_xmat[s], atol=1e-14)
 
 
-def test_drop_test_at_1ms(amputee):
+@pytest.mark.parametrize("integrator", ["implicit", "newmark"])
+def test_drop_test_at_1ms(amputee, integrator):
     """Joints held by MuJoCo springs (taken implicitly too), 5 cm drop, 1 ms step: the
-    static GRF equals body weight within 0.1 %."""
+    static GRF equals body weight within 0.1 % (measured −0.002 % and −0.008 %)."""
     res = simulate_runner(amputee, duration=1.5, hold_pose=True, drop_height=0.05, record_every=5,
-                          dt=1e-3, integrator="implicit")
+                          dt=1e-3, integrator=integrator)
     fz = res.contacts[res.time > 1.3, :, 1].sum(axis=1).mean()
     assert fz == pytest.approx(amputee.body_weight, rel=1e-3)
 
