@@ -13,13 +13,8 @@ import numpy as np
 import pytest
 
 from bladelab.runner import build_runner, power_balance, power_balance_residual_pct, simulate_runner
-from bladelab.runner.implicit import (
-    dense_mass,
-    implicit_arrays,
-    implicit_forces,
-    path_jacobian,
-    solve_tree,
-)
+from bladelab.runner.implicit import dense_mass, implicit_forces, path_jacobian, solve_tree
+from bladelab.runner.implicit_setup import implicit_arrays
 from bladelab.runner.kernel import forces, mujoco_views, path_kinematics
 from bladelab.runner.muscle import equilibrium_fiber_length
 from bladelab.runner.simulate import initial_qpos
@@ -143,7 +138,7 @@ def test_compiled_loop_equals_python_loop(amputee, integrator):
 
 def test_site_kinematics_matches_mujoco(amputee):
     """Sites placed by bladelab on the site-free model = MuJoCo's sites (1e-14 m)."""
-    from bladelab.runner.implicit import site_views
+    from bladelab.runner.implicit_setup import site_views
 
     m, d, _, _, _ = _state(amputee)
     dyn = amputee.mj_dynamics_model

@@ -268,7 +268,7 @@ def step_advance(f2, mptr, dptr, mj, imp, dt):
 @njit(cache=True, _nrt=False)
 def step_end(k, k_rec, record_every, dt, iz, fall_height, mj, arrays, rec, root_com, imp):
     """Second half of step ``k`` (after any controller): muscle, ligament and contact forces
-    (:func:`step_forces`; ``imp`` from :func:`bladelab.runner.implicit.implicit_arrays`),
+    (:func:`step_forces`; ``imp`` from :func:`bladelab.runner.implicit_setup.implicit_arrays`),
     a sample every ``record_every`` steps. Returns (samples recorded, fell): the pelvis height
     ``qpos[iz]`` below ``fall_height`` [m] or NaN is a fall."""
     step_forces(mj, arrays, imp, root_com, dt)

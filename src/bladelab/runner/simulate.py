@@ -27,14 +27,8 @@ import numpy as np
 import pandas as pd
 
 from bladelab.errors import SimulationError
-from bladelab.runner.implicit import (
-    INTEGRATORS,
-    NEWMARK,
-    implicit_advance,
-    implicit_arrays,
-    simulation_model,
-    site_views,
-)
+from bladelab.runner.implicit import INTEGRATORS, NEWMARK, implicit_advance
+from bladelab.runner.implicit_setup import implicit_arrays, simulation_model, site_views
 from bladelab.runner.kernel import (
     mujoco_step_addresses,
     path_kinematics,

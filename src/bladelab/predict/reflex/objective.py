@@ -59,7 +59,7 @@ from bladelab.predict.reflex.controller import (
     history_length,
 )
 from bladelab.predict.reflex.tracking import cached_reference, tracking_error
-from bladelab.runner.implicit import implicit_arrays, simulation_model, site_views
+from bladelab.runner.implicit_setup import implicit_arrays, simulation_model, site_views
 from bladelab.runner.kernel import mujoco_step_addresses, path_kinematics
 from bladelab.runner.metabolics import metabolic_params
 from bladelab.runner.model import DEFAULT_DT, RunnerModel
