@@ -5,13 +5,14 @@ Sweeps: tests/test_predict_sweep.py."""
 from __future__ import annotations
 
 import json
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 import pytest
 
 from bladelab.cli import main
-from bladelab.errors import InputFileError
+from bladelab.errors import InputFileError, SpecError
 from bladelab.predict.reflex.objective import ObjectiveSettings
 from bladelab.predict.reflex.optimize import (
     evaluate_candidates,
@@ -381,6 +382,33 @@ def test_robust_copies_can_be_pushed_in_mid_run():
         (pytest.approx(4.2), 0.03), (pytest.approx(3.8), -0.03)]
 
 
+def test_the_last_robust_copy_can_run_at_half_the_step():
+    # robust_half_step: the last copy halves the time step (and only that changes); the
+    # evaluated cost is the mean with that copy simulated at the half step
+    from bladelab.predict.reflex.objective import simulate_controlled
+    from bladelab.predict.reflex.robust import robust_copies
+
+    model, layout = runner_and_layout("able", None)
+    x = layout.x0
+    base = {"duration": 0.6, "robust_samples": 3, "robust_jitter": 1e-4, "dt": 1e-3,
+            "integrator": "newmark"}
+    plain = ObjectiveSettings(**base)
+    halved = ObjectiveSettings(**base, robust_half_step=True)
+    copies = robust_copies(x, halved)
+    assert [s.dt for _, s in copies] == [1e-3, 5e-4]
+    assert copies[1][1] == replace(halved, dt=5e-4) and copies[0][1] is halved
+    for (a, _), (b, _) in zip(copies, robust_copies(x, plain), strict=True):
+        np.testing.assert_array_equal(a, b)
+    costs = [simulate_controlled(model, x, layout=layout, settings=halved)[0].cost]
+    costs += [simulate_controlled(model, xj, layout=layout, settings=s)[0].cost
+              for xj, s in copies]
+    got = evaluate_candidates({"model": "able", "settings": halved.to_dict(),
+                               "xs": [x.tolist()]})
+    assert got[0]["cost"] == pytest.approx(np.mean(costs), rel=1e-12)
+    with pytest.raises(SpecError, match="robust_half_step"):
+        ObjectiveSettings(robust_half_step=True)
+
+
 def test_per_generation_copies_are_new_every_generation_and_resume_exactly(tmp_path):
     from bladelab.predict.reflex.robust import generation_jitter_seed, jittered_parameters
 
@@ -449,4 +477,10 @@ def test_cli_refuses_bad_robust_copies(tmp_path, capsys, option, value, named):
         args += ["--duration", "4"]
     assert main(args) == 2
     assert named in capsys.readouterr().err
+    assert not (tmp_path / "x").exists()
+
+
+def test_cli_refuses_a_half_step_copy_without_copies(tmp_path, capsys):
+    assert main(["predict", "--robust-half-step", "--out", str(tmp_path / "x")]) == 2
+    assert "--robust-half-step" in capsys.readouterr().err
     assert not (tmp_path / "x").exists()

@@ -103,6 +103,10 @@ def register(app: typer.Typer) -> None:
             0.0, "--robust-push", help="Push each copy once in mid-run: its forward speed "
             "times (1 + p), (1 - p), ... at a seeded time (relative; tests the gait's basin)."
         ),
+        robust_half_step: bool = typer.Option(
+            False, "--robust-half-step", help="Run the last copy at half the time step (a gait "
+            "must not live on the discretisation; needs --robust-samples 2 or more)."
+        ),
         initial_speed: float | None = typer.Option(
             None, "--initial-speed", help="Forward speed of the initial state (m/s); default --speed."
         ),
@@ -218,6 +222,9 @@ def register(app: typer.Typer) -> None:
         check_robust_copies(robust_directions, robust_speed_change, robust_push, duration,
                             where=("--robust-directions", "--robust-speed-change",
                                    "--robust-push", "--duration"))
+        if robust_half_step and robust_samples < 2:
+            raise SpecError("the half-step run is one of the robust copies: there is none",
+                            where="--robust-half-step", hint="--robust-samples 2 or more")
         if integrator not in INTEGRATORS:
             raise SpecError(f"unknown integrator {integrator!r}", where="--integrator",
                             hint=f"one of {', '.join(INTEGRATORS)}")
@@ -266,6 +273,7 @@ def register(app: typer.Typer) -> None:
                 robust_directions=robust_directions,
                 robust_speed_change=robust_speed_change,
                 robust_push=robust_push,
+                robust_half_step=robust_half_step,
                 initial_speed=initial_speed,
                 strike_limit_bw=strike_limit,
                 w_lean=lean_weight,

@@ -4,7 +4,8 @@ A candidate's cost with ``ObjectiveSettings.robust_samples`` = n > 1 is the mean
 nominal simulation and n − 1 copies (:func:`robust_copies`): the parameters moved by
 ``robust_jitter`` (relative) along seeded directions, and with ``robust_speed_change`` s > 0
 started at (1 ± s) × the initial speed, and with ``robust_push`` p > 0 pushed once in mid-run
-(forward speed times 1 ± p at a seeded time). The directions and push times are the same for every candidate of a
+(forward speed times 1 ± p at a seeded time), and with ``robust_half_step`` the last copy
+runs at half the time step. The directions and push times are the same for every candidate of a
 generation (:func:`generation_jitter_seed`: fixed for the run, or new every generation).
 :func:`bladelab.predict.reflex.verify.verify_solution` checks along other directions
 (:data:`VERIFY_JITTER_SEED`).
@@ -87,8 +88,8 @@ def robust_copies(x: np.ndarray, settings: ObjectiveSettings,
     (:func:`jittered_parameters`); with ``robust_speed_change`` s > 0 the initial speed [m/s]
     times 1 + s, 1 − s, 1 + s, ...; with ``robust_push`` p > 0 a push changing the forward
     speed by +p, −p, +p, ... (relative) at times drawn uniformly in
-    :func:`~bladelab.predict.reflex.objective.push_window` from ``seed`` (nominal settings
-    otherwise)."""
+    :func:`~bladelab.predict.reflex.objective.push_window` from ``seed``; with
+    ``robust_half_step`` the last copy at half the time step (nominal settings otherwise)."""
     n = settings.robust_samples - 1
     xs = jittered_parameters(x, n, settings.robust_jitter, seed)
     s, p = settings.robust_speed_change, settings.robust_push
@@ -102,6 +103,8 @@ def robust_copies(x: np.ndarray, settings: ObjectiveSettings,
             changes["initial_speed"] = v0 * (1 + sign * s)
         if p > 0:
             changes["push"] = (float(times[k]), sign * p)
+        if settings.robust_half_step and k == n - 1:
+            changes["dt"] = settings.dt / 2
         copies.append((xj, replace(settings, **changes) if changes else settings))
     return copies
 
