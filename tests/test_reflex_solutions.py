@@ -44,9 +44,10 @@ def test_verification_uses_the_files_own_objective_settings(tmp_path):
     other = simulate_controlled(runner, layout.x0, layout=layout, settings=default)[0].cost
     assert out["cost"] == pytest.approx(want, rel=1e-12)
     assert abs(want - other) > 1e-6 * abs(want)  # the settings do change the cost
-    # a file optimised with pushed copies (which need >= 7 s) re-simulates for any duration
+    # a file optimised with pushed copies (which need >= 7 s) and a half-step copy
+    # re-simulates for any duration, once, at its own step
     pushed = {"duration": 15.0, "robust_samples": 3, "robust_push": 0.02,
-              "robust_speed_change": 0.01}
+              "robust_speed_change": 0.01, "robust_half_step": True}
     path = write_parameters(tmp_path / "p.json", layout, layout.x0, speed_m_per_s=3.5,
                             settings=pushed)
     assert verify_solution(path, duration=0.6)["cost"] == pytest.approx(other, rel=1e-12)

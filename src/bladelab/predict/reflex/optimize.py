@@ -97,8 +97,9 @@ def stored_settings(
     d["speed"] = float(speed)
     if duration is not None:
         d["duration"] = float(duration)
-    if nominal:  # one simulation: no copies, so none of their starts or pushes either
-        d.update(robust_samples=1, robust_speed_change=0.0, robust_push=0.0)
+    if nominal:  # one simulation: no copies, so none of their starts, pushes or steps either
+        d.update(robust_samples=1, robust_speed_change=0.0, robust_push=0.0,
+                 robust_half_step=False)
     return ObjectiveSettings.from_dict(d)
 
 
