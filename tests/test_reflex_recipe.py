@@ -249,6 +249,10 @@ def test_recipes_check_their_fields_and_read_back(tmp_path):
     s = STABLE_GAIT_RECIPE.settings_for(stage, 4.0, 3.5, None)
     assert (s.integrator, s.dt, s.duration, s.robust_samples, s.speed, s.initial_speed) == (
         "newmark", 1e-3, 20.0, 3, 4.0, 3.5)
+    # every stage with robust copies runs its last one at half the step; tracking has none
+    for st in STABLE_GAIT_RECIPE.stages:
+        got = STABLE_GAIT_RECIPE.settings_for(st, 4.0, 3.5, None)
+        assert got.robust_half_step == (got.robust_samples > 1)
     # a task's recipe.json reads back as the recipe it was made with (the committed run was
     # made with the first-order scheme before the recipes moved to Newmark)
     task = Path("benchmarks/runs/recipe-upright-2026-11-27/Cat6/seed-1/recipe.json")
