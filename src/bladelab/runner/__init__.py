@@ -20,6 +20,7 @@ from bladelab.runner.analyses import (
     summary,
     swing_contacts,
 )
+from bladelab.runner.clearance import swing_clearance
 from bladelab.runner.model import RunnerModel, build_runner, contact_heights
 from bladelab.runner.params import (
     BladeCategory,
@@ -61,5 +62,6 @@ __all__ = [
     "simulate_runner",
     "spatiotemporal",
     "summary",
+    "swing_clearance",
     "swing_contacts",
 ]

@@ -560,9 +560,12 @@ def _add_prosthesis(bodies, joint_child, params, s, mr, axis, *, parent: str, po
     joint_child["prosthesis_r"] = (0.0, 0.0, 0.0)
 
 
-def contact_heights(runner: RunnerModel, qpos: np.ndarray) -> np.ndarray:
-    """Lowest point height [m] of every contact sphere at a pose (negative = penetrating)."""
-    data = mujoco.MjData(runner.mj_model)
+def contact_heights(runner: RunnerModel, qpos: np.ndarray,
+                    data: mujoco.MjData | None = None) -> np.ndarray:
+    """Lowest point height [m] of every contact sphere at a pose (negative = penetrating);
+    ``data``: a ``MjData`` of ``runner.mj_model`` to reuse (poses in a loop)."""
+    if data is None:
+        data = mujoco.MjData(runner.mj_model)
     data.qpos[:] = qpos
     mujoco.mj_kinematics(runner.mj_model, data)
     out = []
