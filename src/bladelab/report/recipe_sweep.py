@@ -110,7 +110,7 @@ def recipe_sweep_sections(report, folder: Path, bar) -> tuple[pd.DataFrame, dict
                     "initial_speed_m_per_s", "generations", "mean_speed_m_per_s", "cost",
                     "fell", "swing_contact_peak_bw", "pelvis_tilt_mean_deg",
                     "judged_at_m_per_s", "nominal_meets_acceptance", "accepted",
-                    "runs_at_half_step"]].assign(
+                    "runs_at_half_step", "half_step_speed_m_per_s"]].assign(
         **{"as in levels.json (yes/no)": same})
     table = table.rename(columns={
         "prescribed_speed_m_per_s": "prescribed speed (m/s)",
@@ -122,7 +122,8 @@ def recipe_sweep_sections(report, folder: Path, bar) -> tuple[pd.DataFrame, dict
         "judged_at_m_per_s": "judged at (m/s)",
         "nominal_meets_acceptance": "nominal run meets the acceptance (yes/no)",
         "accepted": "meets issue 20's acceptance (yes/no)",
-        "runs_at_half_step": "runs 10 s at half the time step (yes/no)"})
+        "runs_at_half_step": "runs 10 s at half the time step (yes/no)",
+        "half_step_speed_m_per_s": "mean speed at half the time step (m/s)"})
     report.add_section(
         "Recipe sweep: categories and seeds",
         text=("Each category was optimised by a recipe of CMA-ES stages per seed, then its "
