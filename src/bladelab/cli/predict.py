@@ -220,11 +220,10 @@ def register(app: typer.Typer) -> None:
             raise SpecError("speed must be positive", where="--speed")
         _check_simulation_options(dt, robust_samples, robust_jitter)
         check_robust_copies(robust_directions, robust_speed_change, robust_push, duration,
+                            half_step=robust_half_step, samples=robust_samples,
                             where=("--robust-directions", "--robust-speed-change",
-                                   "--robust-push", "--duration"))
-        if robust_half_step and robust_samples < 2:
-            raise SpecError("the half-step run is one of the robust copies: there is none",
-                            where="--robust-half-step", hint="--robust-samples 2 or more")
+                                   "--robust-push", "--duration", "--robust-half-step",
+                                   "--robust-samples"))
         if integrator not in INTEGRATORS:
             raise SpecError(f"unknown integrator {integrator!r}", where="--integrator",
                             hint=f"one of {', '.join(INTEGRATORS)}")

@@ -33,17 +33,18 @@ def swing_clearance(result: RunnerResult) -> pd.DataFrame:
     names = leg_names(model)
     st = stances(result)
     data = mujoco.MjData(model.mj_model)
+    # every sample's contact heights once: the two legs' swings overlap in the flight phases
+    heights = np.array([contact_heights(model, q, data) for q in result.qpos])
     rows = []
     for leg in (0, 1):
-        cols = model.contact_params[:, CP_LEG] == leg
+        lowest = heights[:, model.contact_params[:, CP_LEG] == leg].min(axis=1)
         mine = st[st.leg == names[leg]].sort_values("touchdown_s")
         for (_, a), (_, b) in zip(mine.iloc[:-1].iterrows(), mine.iloc[1:].iterrows(),
                                   strict=True):
             idx = np.arange(int(a["stop"]), int(b["first"]))
             if len(idx) == 0:
                 continue
-            low = np.array([contact_heights(model, result.qpos[i], data)[cols].min()
-                            for i in idx])
+            low = lowest[idx]
             above = np.flatnonzero(low > 0.0)
             if len(above):
                 idx, low = idx[above[0]:above[-1] + 1], low[above[0]:above[-1] + 1]

@@ -281,7 +281,7 @@ def implicit_forces(mj, arrays, imp, root_com, dt):
     mstart, mdof = imp[32], imp[33]
     path_jacobian(site_xpos, cdof, root_com, path, pstart, seg_start, seg_dof, mstart, mdof, qvel,
                   mtu, moment)
-    if imp[0][0] == NEWMARK:
+    if newmark:
         muscle_step(mp, ms, mtu[:, 0], u, dt, NEWTON_TOL, imp[34], imp[35], mtu[:, 1])
     else:
         muscle_step(mp, ms, mtu[:, 0], u, dt, NEWTON_TOL, imp[34])

@@ -79,14 +79,17 @@ ROBUST_DIRECTIONS = ("fixed", "per-generation")
 
 
 def check_robust_copies(directions: str, speed_change: float, push: float = 0.0,
-                        duration: float = math.inf, *,
+                        duration: float = math.inf, *, half_step: bool = False,
+                        samples: int = 1,
                         where: tuple[str, ...] = ("robust_directions", "robust_speed_change",
-                                                  "robust_push", "duration"),
+                                                  "robust_push", "duration",
+                                                  "robust_half_step", "robust_samples"),
                         ) -> None:
     """Refuse robust-copy options :class:`ObjectiveSettings` cannot use: ``directions`` one
     of :data:`ROBUST_DIRECTIONS`, ``speed_change`` and ``push`` in [0, 0.5), a push only in a
-    simulation of at least :data:`MIN_PUSH_DURATION` [s]; ``where`` names them (the fields, or
-    the command line's options)."""
+    simulation of at least :data:`MIN_PUSH_DURATION` [s], a half-step copy only with at least
+    one copy (``samples`` ≥ 2); ``where`` names them (the fields, or the command line's
+    options)."""
     if directions not in ROBUST_DIRECTIONS:
         raise SpecError(f"unknown value {directions!r}", where=where[0],
                         hint=" or ".join(ROBUST_DIRECTIONS))
@@ -97,6 +100,9 @@ def check_robust_copies(directions: str, speed_change: float, push: float = 0.0,
         raise SpecError(f"a push needs a simulation of at least {MIN_PUSH_DURATION:g} s "
                         f"(after the start's first steps, with time to fall), got {duration:g} s",
                         where=where[3], hint=f"a longer {where[3]}, or no {where[2]}")
+    if half_step and samples < 2:
+        raise SpecError("the half-step run is one of the robust copies: there is none",
+                        where=where[4], hint=f"{where[5]} of at least 2")
 
 
 def push_window(duration: float) -> tuple[float, float]:
@@ -151,10 +157,8 @@ class ObjectiveSettings:
 
     def __post_init__(self) -> None:
         check_robust_copies(self.robust_directions, self.robust_speed_change,
-                            self.robust_push, self.duration)
-        if self.robust_half_step and self.robust_samples < 2:
-            raise SpecError("the half-step run is one of the robust copies: there is none",
-                            where="robust_half_step", hint="robust_samples of at least 2")
+                            self.robust_push, self.duration, half_step=self.robust_half_step,
+                            samples=self.robust_samples)
         if self.push is not None:
             t, change = self.push
             if not (0 <= t <= self.duration and -0.5 < change < 0.5):
