@@ -245,7 +245,7 @@ def level_row(path: Path) -> dict:
     their peak [body weights], mean pelvis tilt [deg]; for a gait that runs, the speed judged
     at [m/s] and the verdicts (for one that falls: None and False); and whether the nominal
     run also runs, and meets the acceptance, at half the time step, and its mean speed there
-    [m/s] (reported, not judged: at 1 ms Newmark a gait runs about 4 % faster than at finer
+    [m/s] (None if it falls there; reported, not judged: at 1 ms Newmark a gait runs about 4 % faster than at finer
     steps, docs/predictive.md)."""
     from bladelab.predict.reflex.acceptance import acceptance_runs, judged_runs, meets_acceptance
 
@@ -264,7 +264,7 @@ def level_row(path: Path) -> dict:
         "nominal_meets_acceptance": runs and meets_acceptance(judged_runs(acc)[0][1]),
         "accepted": runs and bool(acc["accepted"]),
         "runs_at_half_step": not half["fell"],
-        "half_step_speed_m_per_s": float(half["mean_speed_m_per_s"]),
+        "half_step_speed_m_per_s": None if half["fell"] else float(half["mean_speed_m_per_s"]),
         "half_step_meets_acceptance": meets_acceptance(half),
     }
 
