@@ -111,7 +111,9 @@ def recipe_sweep_sections(report, folder: Path, bar) -> tuple[pd.DataFrame, dict
                     "fell", "swing_contact_peak_bw", "pelvis_tilt_mean_deg",
                     "judged_at_m_per_s", "nominal_meets_acceptance", "accepted",
                     "runs_at_half_step", "half_step_speed_m_per_s"]].assign(
-        **{"as in levels.json (yes/no)": same})
+        **{"as in levels.json (yes/no)": same,
+           # None where a level falls at half the step; all None would print as "None"
+           "half_step_speed_m_per_s": levels.half_step_speed_m_per_s.astype(float)})
     table = table.rename(columns={
         "prescribed_speed_m_per_s": "prescribed speed (m/s)",
         "initial_speed_m_per_s": "initial speed (m/s)",
