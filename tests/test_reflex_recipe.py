@@ -37,6 +37,7 @@ from bladelab.predict.reflex.verify import verify_solution
 ROOT = Path(__file__).resolve().parents[1]
 SHIPPED_AMPUTEE = ROOT / "src" / "bladelab" / "data" / "runner" / "solutions" / "amputee-Cat6-3.5.json"
 STUDY = ROOT / "benchmarks" / "collocation" / "study-2026-11-25"
+SETTLED_GAIT = ROOT / "benchmarks" / "runs" / "newmark-settled-2026-11-27" / "best.json"
 
 
 def _tiny(max_levels: int = 3) -> Recipe:
@@ -47,16 +48,23 @@ def _tiny(max_levels: int = 3) -> Recipe:
         speed=3.5, initial_speed=3.5, speed_step=0.2, min_gain=0.05, max_levels=max_levels)
 
 
-def _fake_levels(monkeypatch, speeds: dict[str, float], falls: tuple[str, ...] = ()) -> list:
-    """level_row stand-in: the mean speed [m/s] of each level by name (no 10 s runs)."""
+def _fake_levels(monkeypatch, speeds: dict[str, float], falls: tuple[str, ...] = (),
+                 half: dict[str, float | None] | None = None) -> list:
+    """level_row stand-in: the mean speed [m/s] of each level by name (no 10 s runs); ``half``:
+    a level's speed at half the step (None: it falls there; a level not named has no such
+    run, as rows written before session 21)."""
     seen = []
 
     def fake(path: Path) -> dict:
         # the level's prescribed speed, as the gait file says (level_row judges it there)
         name, speed = path.parent.name, json.loads(path.read_text())["speed_m_per_s"]
         seen.append((name, speed))
-        return {"cost": 50.0, "mean_speed_m_per_s": speeds[name], "fell": name in falls,
-                "accepted": False}
+        row = {"cost": 50.0, "mean_speed_m_per_s": speeds[name], "fell": name in falls,
+               "accepted": False}
+        if half is not None and name in half:
+            row |= {"runs_at_half_step": half[name] is not None,
+                    "half_step_speed_m_per_s": half[name]}
+        return row
 
     monkeypatch.setattr(recipe_module, "level_row", fake)
     return seen
@@ -146,6 +154,45 @@ def test_continuation_stops_at_a_fall_and_after_max_levels(tmp_path, monkeypatch
     _fake_levels(monkeypatch, {"1-a": 3.3, "2-b": 3.4}, falls=("2-b",))
     rows = run_recipe("Cat6", 1, out=tmp_path / "none", recipe=_tiny(), init=SHIPPED_AMPUTEE)
     assert [r["level"] for r in rows] == ["1-a", "2-b"]  # a fallen last stage: no continuation
+
+
+def test_continuation_judges_the_speed_at_half_the_step(tmp_path, monkeypatch):
+    # the prescription follows the speed at the recipe's step (3.4 -> 3.6, 3.62 -> 3.82); the
+    # gain is the settled one: 3.30 -> 3.48 gains, 3.48 -> 3.50 does not, although at the
+    # recipe's step 3.62 -> 3.70 would
+    half = {"1-a": 3.2, "2-b": 3.30, "speed-3.6": 3.48, "speed-3.82": 3.50}
+    seen = _fake_levels(monkeypatch, {"1-a": 3.3, "2-b": 3.4, "speed-3.6": 3.62,
+                                      "speed-3.82": 3.70}, half=half)
+    rows = run_recipe("Cat6", 1, out=tmp_path / "gain", recipe=_tiny(), init=SHIPPED_AMPUTEE)
+    assert [n for n, _ in seen] == ["1-a", "2-b", "speed-3.6", "speed-3.82"]
+    assert [r["initial_speed_m_per_s"] for r in rows][2:] == [3.4, 3.62]
+    # a level that falls at half the step has not settled: the continuation stops there, and
+    # a last stage that does not settle is not continued
+    seen = _fake_levels(monkeypatch, {"1-a": 3.3, "2-b": 3.4, "speed-3.6": 3.62},
+                        half={"2-b": 3.3, "speed-3.6": None})
+    rows = run_recipe("Cat6", 1, out=tmp_path / "fall", recipe=_tiny(), init=SHIPPED_AMPUTEE)
+    assert [r["level"] for r in rows] == ["1-a", "2-b", "speed-3.6"]
+    _fake_levels(monkeypatch, {"1-a": 3.3, "2-b": 3.4}, half={"2-b": None})
+    rows = run_recipe("Cat6", 1, out=tmp_path / "none", recipe=_tiny(), init=SHIPPED_AMPUTEE)
+    assert [r["level"] for r in rows] == ["1-a", "2-b"]
+
+
+def test_maximum_speed_is_the_fastest_settled_speed():
+    def row(speed, half="absent", fell=False):
+        r = {"mean_speed_m_per_s": speed, "fell": fell}
+        if half != "absent":
+            r |= {"runs_at_half_step": half is not None, "half_step_speed_m_per_s": half}
+        return r
+
+    # 3.9 falls at half the step, 3.8 falls; 3.7 settles at 3.55, 3.6 at 3.58
+    rows = [row(3.6, 3.58), row(3.7, 3.55), row(3.9, None), row(3.8, 3.7, fell=True)]
+    speed, top = recipe_module.maximum_speed(rows)
+    assert speed == 3.58 and top is rows[0]
+    assert recipe_module.settled_speed(row(3.5)) == 3.5  # written before half-step runs
+    # in a table (pandas) a row without the half-step run reads NaN: its nominal speed
+    assert recipe_module.settled_speed({"mean_speed_m_per_s": 3.5, "fell": False,
+                                        "runs_at_half_step": math.nan}) == 3.5
+    assert math.isnan(recipe_module.maximum_speed([row(3.9, None)])[0])
 
 
 def test_a_task_resumes_and_refuses_another_recipe(tmp_path, monkeypatch):
@@ -315,6 +362,23 @@ def test_category_table_by_hand():
                       .loc[0, "best cost (–)"])
 
 
+def test_category_table_compares_settled_speeds():
+    def level(seed, cost, speed, half):
+        return {**_level("Cat5", seed, "start", cost, speed),
+                "runs_at_half_step": half is not None, "half_step_speed_m_per_s": half}
+
+    # at the recipe's step the three seeds agree (3.40-3.42 m/s); at half the step seed 3 is
+    # 0.10 m/s slower, and seed 4 falls there (not compared, although it is the cheapest)
+    rows = [level(1, 60.0, 3.40, 3.30), level(2, 60.5, 3.41, 3.31), level(3, 60.9, 3.42, 3.20),
+            level(4, 50.0, 3.60, None)]
+    t = summarise_levels(pd.DataFrame(rows), "start").iloc[0]
+    assert t["seeds (count)"] == 4 and t["agreeing seeds (count)"] == 2
+    assert not t["settled (yes/no)"]
+    assert t["best cost (–)"] == 60.0 and t["speed of the best (m/s)"] == 3.30
+    assert t["speed spread (m/s)"] == pytest.approx(0.11)
+    assert t["maximum speed (m/s)"] == 3.31
+
+
 def test_cli_recipe_sweep(tmp_path, capsys, monkeypatch):
     bad = tmp_path / "bad.json"
     bad.write_text("{")
@@ -348,21 +412,27 @@ def test_report_of_a_recipe_sweep_resimulates_every_level(tmp_path):
     from bladelab.report.predictive import build_predictive_report, predictive_kind
 
     # one stage that searches only a parameter without effect (the target speed of a
-    # mean-speed reflex at gain 0): every level is the shipped gait, which runs its 10 s
+    # mean-speed reflex at gain 0): every level is the warm start, a gait that runs its 10 s
+    # at 1 ms and at half of it (the shipped 3.5 m/s gait falls at half its step, so no level
+    # would be shown)
     one = Recipe(stages=(Stage("a", 1, 1e-4, popsize=2, settings={"duration": 0.3},
                                free=("S11100.iliopsoas_r-pelvis_tx.S0",)),),
-                 speed=3.5, initial_speed=3.5)
+                 base={"integrator": "newmark", "dt": 1e-3}, speed=4.0, initial_speed=3.5)
     run_recipe_sweep(["Cat6"], [1, 2], out=tmp_path / "rs", recipe=one, progress=False,
-                     init=SHIPPED_AMPUTEE)
+                     init=SETTLED_GAIT)
     assert predictive_kind(tmp_path / "rs") == "recipe-sweep"
     rep = build_predictive_report(tmp_path / "rs", out_dir=tmp_path / "report", progress=False,
                                   animate=False)
     assert rep.kind == "recipe-sweep" and rep.simulations == 3  # 2 levels + the gait shown
-    assert len(rep.solutions) == 1 and rep.solutions[0].startswith("Cat6 seed ")
     folder = tmp_path / "report"
     levels = pd.read_csv(next(folder.glob("tables/*levels-re-simulated.csv")))
     assert levels["as in levels.json (yes/no)"].astype(bool).all()
     assert levels["seed"].tolist() == [1, 2]
+    # the gait shown is labelled with its speed at half the step, not at its own
+    half = levels["mean speed at half the time step (m/s)"]
+    assert len(rep.solutions) == 1 and rep.solutions[0].startswith("Cat6 seed ")
+    assert f"({half.max():.2f} m/s at half the step" in rep.solutions[0]
+    assert (levels["mean speed (m/s)"] - half).min() > 0.05  # 1 ms runs faster (README)
     categories = pd.read_csv(next(folder.glob("tables/*categories.csv")))
     assert categories["seed 001 maximum speed (m/s)"].iloc[0] > 4  # Table 3.1: 4.27–4.675
     assert not categories["settled (yes/no)"].iloc[0]  # 2 seeds: issue 20 needs 3

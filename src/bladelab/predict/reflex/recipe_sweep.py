@@ -11,10 +11,12 @@ unfinished tasks included), atomically:
 
 A category has settled (issue 20) when at least three seeds agree at the recipe's speed (the
 last stage's gait, re-simulated nominally for 10 s with the same settings, so on the same
-"copy"): costs within 2 % of the best seed's and speeds within 0.05 m/s
-(:func:`~bladelab.predict.reflex.agreement.seed_agreement`). The maximum speed is reported per
-seed with its spread; it is not part of the verdict, because seeds that reach different speeds
-are not compared on the same cost.
+"copy"): costs within 2 % of the best seed's and settled speeds within 0.05 m/s
+(:func:`~bladelab.predict.reflex.agreement.seed_agreement`). Speeds here are settled speeds
+(:func:`~bladelab.predict.reflex.recipe.settled_speed`: at half the time step), and a level
+that falls at either step is not compared. The maximum speed is reported per seed with its
+spread; it is not part of the verdict, because seeds that reach different speeds are not
+compared on the same cost.
 """
 
 from __future__ import annotations
@@ -27,7 +29,13 @@ from tqdm import tqdm
 
 from bladelab._io import atomic_open, read_json
 from bladelab.errors import OptimizationError
-from bladelab.predict.reflex.recipe import LEVELS_NAME, STABLE_GAIT_RECIPE, Recipe, maximum_speed
+from bladelab.predict.reflex.recipe import (
+    LEVELS_NAME,
+    STABLE_GAIT_RECIPE,
+    Recipe,
+    maximum_speed,
+    settled_speed,
+)
 
 __all__ = ["category_agreement", "run_recipe_sweep", "summarise_levels"]
 
@@ -39,31 +47,43 @@ def _levels_on_disk(out: Path) -> list[dict]:
     return rows
 
 
+def _settled_levels(levels: pd.DataFrame, last_stage: str) -> pd.DataFrame:
+    """The ``last_stage`` levels that settle in the time step, with their
+    ``settled_speed_m_per_s``."""
+    speeds = [settled_speed(r) for r in levels.to_dict("records")]
+    levels = levels.assign(settled_speed_m_per_s=pd.Series(speeds, index=levels.index,
+                                                           dtype=float))
+    return levels[(levels.stage == last_stage) & levels.settled_speed_m_per_s.notna()]
+
+
+def _agreement(base: pd.DataFrame):
+    from bladelab.predict.reflex.agreement import seed_agreement
+
+    if not len(base):
+        return None
+    return seed_agreement(base.cost.tolist(), base.settled_speed_m_per_s.tolist())
+
+
 def category_agreement(levels: pd.DataFrame, last_stage: str):
     """How one category's seeds agree at the recipe's speed: the
     :class:`~bladelab.predict.reflex.agreement.SeedAgreement` of the ``last_stage`` levels that
-    ran their 10 s (None: none did)."""
-    from bladelab.predict.reflex.agreement import seed_agreement
-
-    base = levels[(levels.stage == last_stage) & ~levels.fell.astype(bool)]
-    if not len(base):
-        return None
-    return seed_agreement(base.cost.tolist(), base.mean_speed_m_per_s.tolist())
+    ran their 10 s at both time steps, on their settled speeds (None: none did)."""
+    return _agreement(_settled_levels(levels, last_stage))
 
 
 def summarise_levels(levels: pd.DataFrame, last_stage: str) -> pd.DataFrame:
     """Per category: the seeds whose ``last_stage`` level finished, their agreement at the
-    recipe's speed (costs and speeds of that level), and each seed's maximum speed [m/s]
-    (fastest level that ran) with its spread and how many of them meet issue 20's
-    acceptance."""
+    recipe's speed (costs and settled speeds of that level), and each seed's maximum speed
+    [m/s] (fastest settled speed of a level that settles) with its spread and how many of
+    them meet issue 20's acceptance."""
     cols = ["category", "seeds (count)", "agreeing seeds (count)", "settled (yes/no)",
             "cost spread (%)", "speed spread (m/s)", "best cost (–)", "speed of the best (m/s)",
             "maximum speed (m/s)", "maximum speed spread (m/s)",
             "maximum-speed gaits meeting the acceptance (count)"]
     out = []
     for cat, df in levels.groupby("category", sort=False):
-        base = df[(df.stage == last_stage) & ~df.fell.astype(bool)]
-        agreement = category_agreement(df, last_stage)
+        base = _settled_levels(df, last_stage)
+        agreement = _agreement(base)
         tops = [maximum_speed(g.to_dict("records")) for _, g in df.groupby("seed")]
         speeds = [v for v, _ in tops if math.isfinite(v)]
         best = base.loc[base.cost.idxmin()] if len(base) else None
@@ -75,7 +95,7 @@ def summarise_levels(levels: pd.DataFrame, last_stage: str) -> pd.DataFrame:
             "cost spread (%)": agreement.cost_spread_pct if agreement else math.nan,
             "speed spread (m/s)": agreement.speed_spread_m_per_s if agreement else math.nan,
             "best cost (–)": float(best.cost) if best is not None else math.nan,
-            "speed of the best (m/s)": (float(best.mean_speed_m_per_s) if best is not None
+            "speed of the best (m/s)": (float(best.settled_speed_m_per_s) if best is not None
                                         else math.nan),
             "maximum speed (m/s)": max(speeds) if speeds else math.nan,
             "maximum speed spread (m/s)": (max(speeds) - min(speeds)) if speeds else math.nan,
