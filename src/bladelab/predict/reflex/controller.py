@@ -12,7 +12,11 @@ Each leg is in one of five states (SCONE's ``GaitStateController``): ``EarlyStan
   machine);
 - any stance state → Swing when contact is lost;
 - Swing → Landing when the sagittal position exceeds ``landing_threshold``; Swing/Landing →
-  EarlyStance on contact.
+  EarlyStance on contact. SCONE (since 2019) moves a leg from Swing to EarlyStance only if
+  it is also in front of the other leg, so that a trailing foot touching the ground stays in
+  Swing; we do not, and gaits found here use it: two Cat6 gaits that let the trailing blade
+  touch above their stance threshold fall within 4 s with SCONE's condition (session 22,
+  docs/predictive.md).
 
 In each state a set of reflexes adds to a muscle's excitation (the sum is clipped to [0, 1]),
 SCONE's ``MuscleReflex`` and ``DofReflex`` with delayed sensors:
