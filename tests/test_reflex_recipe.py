@@ -193,6 +193,15 @@ def test_maximum_speed_is_the_fastest_settled_speed():
     assert recipe_module.settled_speed({"mean_speed_m_per_s": 3.5, "fell": False,
                                         "runs_at_half_step": math.nan}) == 3.5
     assert math.isnan(recipe_module.maximum_speed([row(3.9, None)])[0])
+    # the finest step a row holds decides; a fall at any step means no settled speed
+    assert recipe_module.settled_speed({**row(3.7, 3.55), "runs_at_quarter_step": True,
+                                        "quarter_step_speed_m_per_s": 3.47}) == 3.47
+    assert recipe_module.settled_speed({**row(3.7, 3.55), "runs_at_quarter_step": False,
+                                        "quarter_step_speed_m_per_s": None}) is None
+    # a row of session 21 that ran at half the step but did not keep its speed there
+    assert recipe_module.settled_speed({"mean_speed_m_per_s": 3.5, "fell": False,
+                                        "runs_at_half_step": True,
+                                        "half_step_speed_m_per_s": None}) == 3.5
 
 
 def test_a_task_resumes_and_refuses_another_recipe(tmp_path, monkeypatch):
@@ -272,14 +281,27 @@ def test_level_row_is_the_gaits_ten_second_rerun_and_judges_the_acceptance():
     runner, layout = runner_and_layout("amputee", "Cat6")
     settings = stored_settings(data, speed=3.5, duration=10.0, nominal=True)
     assert settings.dt == pytest.approx(2.5e-4)
-    ev, _ = simulate_controlled(runner, read_parameters(SHIPPED_AMPUTEE, layout), layout=layout,
-                                settings=replace(settings, dt=1.25e-4))
-    assert row["runs_at_half_step"] == (not ev.fell)
-    # its speed there, only for a run that does not fall (a fall's mean speed is no speed)
-    if ev.fell:
-        assert row["half_step_speed_m_per_s"] is None
-    else:
-        assert row["half_step_speed_m_per_s"] == pytest.approx(ev.mean_speed, rel=1e-12)
+    x = read_parameters(SHIPPED_AMPUTEE, layout)
+    for name, dt in (("half", 1.25e-4), ("quarter", 6.25e-5)):
+        ev, _ = simulate_controlled(runner, x, layout=layout, settings=replace(settings, dt=dt))
+        assert row[f"runs_at_{name}_step"] == (not ev.fell)
+        # its speed there, only for a run that does not fall (a fall's mean speed is no speed)
+        if ev.fell:
+            assert row[f"{name}_step_speed_m_per_s"] is None
+            assert row["step_speed_change_m_per_s"] is None
+        else:
+            assert row[f"{name}_step_speed_m_per_s"] == pytest.approx(ev.mean_speed, rel=1e-12)
+
+
+def test_a_gait_that_settles_has_a_speed_at_every_step():
+    """The committed settled gait runs at 1, 0.5 and 0.25 ms (its README): its settled speed is
+    the quarter step's, and the change from the half step is reported."""
+    row = level_row(SETTLED_GAIT)
+    assert row["runs_at_half_step"] and row["runs_at_quarter_step"]
+    half, quarter = row["half_step_speed_m_per_s"], row["quarter_step_speed_m_per_s"]
+    assert row["step_speed_change_m_per_s"] == pytest.approx(abs(quarter - half), rel=1e-12)
+    assert recipe_module.settled_speed(row) == quarter
+    assert row["mean_speed_m_per_s"] - quarter > 0.05  # 1 ms runs faster (README: 0.15 m/s)
 
 
 def test_recipes_check_their_fields_and_read_back(tmp_path):
@@ -365,7 +387,8 @@ def test_category_table_by_hand():
 def test_category_table_compares_settled_speeds():
     def level(seed, cost, speed, half):
         return {**_level("Cat5", seed, "start", cost, speed),
-                "runs_at_half_step": half is not None, "half_step_speed_m_per_s": half}
+                "runs_at_half_step": half is not None, "half_step_speed_m_per_s": half,
+                "step_speed_change_m_per_s": None if half is None else 0.01 * seed}
 
     # at the recipe's step the three seeds agree (3.40-3.42 m/s); at half the step seed 3 is
     # 0.10 m/s slower, and seed 4 falls there (not compared, although it is the cheapest)
@@ -377,6 +400,8 @@ def test_category_table_compares_settled_speeds():
     assert t["best cost (–)"] == 60.0 and t["speed of the best (m/s)"] == 3.30
     assert t["speed spread (m/s)"] == pytest.approx(0.11)
     assert t["maximum speed (m/s)"] == 3.31
+    # the step's uncertainty of the compared speeds: seeds 1-3 (seed 4 falls at half the step)
+    assert t["largest speed change from half to a quarter of the step (m/s)"] == 0.03
 
 
 def test_cli_recipe_sweep(tmp_path, capsys, monkeypatch):
@@ -428,11 +453,11 @@ def test_report_of_a_recipe_sweep_resimulates_every_level(tmp_path):
     levels = pd.read_csv(next(folder.glob("tables/*levels-re-simulated.csv")))
     assert levels["as in levels.json (yes/no)"].astype(bool).all()
     assert levels["seed"].tolist() == [1, 2]
-    # the gait shown is labelled with its speed at half the step, not at its own
-    half = levels["mean speed at half the time step (m/s)"]
+    # the gait shown is labelled with its speed at a quarter of the step, not at its own
+    fine = levels["mean speed at a quarter of the time step (m/s)"]
     assert len(rep.solutions) == 1 and rep.solutions[0].startswith("Cat6 seed ")
-    assert f"({half.max():.2f} m/s at half the step" in rep.solutions[0]
-    assert (levels["mean speed (m/s)"] - half).min() > 0.05  # 1 ms runs faster (README)
+    assert f"({fine.max():.2f} m/s at a quarter of the step" in rep.solutions[0]
+    assert (levels["mean speed (m/s)"] - fine).min() > 0.05  # 1 ms runs faster (README)
     categories = pd.read_csv(next(folder.glob("tables/*categories.csv")))
     assert categories["seed 001 maximum speed (m/s)"].iloc[0] > 4  # Table 3.1: 4.27–4.675
     assert not categories["settled (yes/no)"].iloc[0]  # 2 seeds: issue 20 needs 3

@@ -13,8 +13,8 @@ the shipped-solution criteria (speed, flight, alternating steps, power balance),
 foot strikes the ground above :data:`STRIKE_LIMIT_BW` body weights, and the mean pelvis tilt
 lies inside the objective's window (seed 001: −16…−2°). Pushes (forward speed × (1 ±
 :data:`PUSH_CHANGE`) at :data:`PUSH_PHASES` phases of a stride) are simulated too, not judged:
-they measure the size of the gait's basin. So is the nominal run at half the file's time step
-(``refined``): reported beside the verdict, not yet part of it (session 21: no gait of the
+they measure the size of the gait's basin. So are the nominal runs at finer time steps
+(``refined``): reported beside the verdict, not part of it (session 21: no gait of the
 first-order scheme runs at half its step; the Newmark scheme's gaits are the first to be
 checked).
 """
@@ -38,14 +38,15 @@ PUSH_PHASES = 5
 
 
 def acceptance_runs(path: str | Path, duration: float = 10.0, *, pushes: bool = True,
-                    speed: float | str | None = None, refined: bool = False) -> dict:
+                    speed: float | str | None = None, refined: int = 0) -> dict:
     """:func:`~bladelab.predict.reflex.verify.verify_solution`'s result for the parameter file
     ``path`` re-simulated for ``duration`` [s] as above (pushes when ``pushes`` and
     ``duration`` is at least :data:`~bladelab.predict.reflex.objective.MIN_PUSH_DURATION`;
     ``"pushed"`` is otherwise empty), at ``speed`` [m/s] (default the file's prescribed speed;
     ``"reached"``: the nominal run's mean speed, rounded to 0.01 m/s, so that a gait is judged
     at its own speed; every judged run's mean speed must lie within 0.1 m/s of it), and with
-    ``refined`` the nominal run at half the time step (``"refined"``, not judged);
+    ``refined`` = n the nominal run at the time step halved 1…n times (``"refined"``, not
+    judged);
     ``"judged_at_m_per_s"`` is that speed, ``"simulations"`` counts the runs and
     ``"accepted"`` says whether every judged run meets the acceptance."""
     from bladelab.predict.reflex.objective import MIN_PUSH_DURATION

@@ -19,12 +19,12 @@ warm-started from the one before (:data:`STABLE_GAIT_RECIPE`):
 Then the speed is raised by **continuation on the speed reached** (issue 20: not a fixed
 grid): the recipe's ``continuation`` stage runs at the speed the last level reached plus
 ``speed_step`` [m/s], from that level's gait and starting at that speed, until a level does not
-settle in the time step (falls in its nominal 10 s, at the recipe's step or at half of it) or
-its settled speed gains less than ``min_gain`` [m/s]. A level's **settled speed**
-(:func:`settled_speed`) is its mean speed at half the step: at Newmark's 1 ms a gait runs
-about 4 % faster than at 0.5 or 0.25 ms, which agree within 0.02 m/s (docs/predictive.md,
-session 21). The prescription follows the speed at the recipe's own step, the one the
-optimiser mostly sees. The maximum speed is the fastest settled speed of a level that settles.
+settle in the time step (falls in its nominal 10 s, at the recipe's step, at half or at a
+quarter of it) or its settled speed gains less than ``min_gain`` [m/s]. A level's **settled
+speed** (:func:`settled_speed`) is its mean speed at a quarter of the step: at Newmark's 1 ms
+the gaits run 0.1–0.2 m/s faster than at finer steps (docs/predictive.md, session 22). The
+prescription follows the speed at the recipe's own step, the one the optimiser mostly sees.
+The maximum speed is the fastest settled speed of a level that settles.
 
 Output of one task (:func:`run_recipe`), ``OUT/<category>/seed-<n>/``: ``recipe.json`` (the
 recipe, the task and its warm start: running again with another is an error), one folder per
@@ -248,14 +248,17 @@ def level_row(path: Path) -> dict:
     objective at the level's prescribed speed), mean speed [m/s], fell, swing contacts and
     their peak [body weights], mean pelvis tilt [deg]; for a gait that runs, the speed judged
     at [m/s] and the verdicts (for one that falls: None and False); and whether the nominal
-    run also runs, and meets the acceptance, at half the time step, and its mean speed there
-    [m/s] (None if it falls there): the speed the continuation and the tables use
-    (:func:`settled_speed`); whether it meets the acceptance there is reported, not judged."""
+    run also runs at half and at a quarter of the time step, its mean speed there [m/s]
+    (None where it falls), how much that speed changed from half to a quarter of the step
+    [m/s] (the step's uncertainty of the speed) and whether it meets the acceptance at half
+    the step (reported, not judged). The quarter-step speed is the level's
+    :func:`settled_speed`."""
     from bladelab.predict.reflex.acceptance import acceptance_runs, judged_runs, meets_acceptance
 
-    acc = acceptance_runs(path, 10.0, pushes=False, speed="reached", refined=True)
+    acc = acceptance_runs(path, 10.0, pushes=False, speed="reached", refined=2)
     runs = not acc["fell"]
-    half = acc["refined"][0]
+    half, quarter = acc["refined"]
+    speeds = [None if r["fell"] else float(r["mean_speed_m_per_s"]) for r in (half, quarter)]
     return {
         "cost": float(acc["cost"]),
         "mean_speed_m_per_s": float(acc["mean_speed_m_per_s"]),
@@ -268,8 +271,12 @@ def level_row(path: Path) -> dict:
         "nominal_meets_acceptance": runs and meets_acceptance(judged_runs(acc)[0][1]),
         "accepted": runs and bool(acc["accepted"]),
         "runs_at_half_step": not half["fell"],
-        "half_step_speed_m_per_s": None if half["fell"] else float(half["mean_speed_m_per_s"]),
+        "half_step_speed_m_per_s": speeds[0],
         "half_step_meets_acceptance": meets_acceptance(half),
+        "runs_at_quarter_step": not quarter["fell"],
+        "quarter_step_speed_m_per_s": speeds[1],
+        "step_speed_change_m_per_s": (None if None in speeds
+                                      else abs(speeds[1] - speeds[0])),
     }
 
 
@@ -435,17 +442,35 @@ def _announce(level: str, row: dict) -> None:
                f"{row['mean_speed_m_per_s']:.2f} m/s, cost {row['cost']:.4g}")
 
 
+#: A level's runs at finer time steps (:func:`level_row`): whether it runs, its speed [m/s];
+#: coarse to fine.
+_REFINED = (("runs_at_half_step", "half_step_speed_m_per_s"),
+            ("runs_at_quarter_step", "quarter_step_speed_m_per_s"))
+
+
 def settled_speed(row: dict) -> float | None:
-    """A level's speed once the time step has settled [m/s]: the mean speed of its 10 s
-    re-simulation at half its step (:func:`level_row`); None if it falls at either step. A row
-    written before levels were simulated at half the step (no ``runs_at_half_step``, or NaN
-    in a table) gives its nominal speed."""
+    """A level's speed at the finest time step it was simulated at [m/s] (:func:`level_row`:
+    a quarter of its step); None if it falls at any step. At Newmark's 1 ms the gaits run
+    0.1–0.2 m/s faster than at finer steps, which still differ by 0.02–0.09 m/s
+    (``step_speed_change_m_per_s``; docs/predictive.md, session 22). A row written before
+    levels were simulated at finer steps (session 21: no quarter step, or no half step, or
+    no speed kept there; NaN in a table) gives the finest speed it holds."""
     if bool(row["fell"]):
         return None
-    half = row.get("runs_at_half_step")
-    if half is None or (isinstance(half, float) and math.isnan(half)):
-        return float(row["mean_speed_m_per_s"])
-    return float(row["half_step_speed_m_per_s"]) if bool(half) else None
+    speed = float(row["mean_speed_m_per_s"])
+    for runs_key, speed_key in _REFINED:
+        runs = row.get(runs_key)
+        if _missing(runs):
+            continue
+        if not bool(runs):
+            return None
+        if not _missing(row.get(speed_key)):
+            speed = float(row[speed_key])
+    return speed
+
+
+def _missing(value) -> bool:
+    return value is None or (isinstance(value, float) and math.isnan(value))
 
 
 def maximum_speed(rows: list[dict]) -> tuple[float, dict | None]:

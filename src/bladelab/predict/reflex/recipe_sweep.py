@@ -73,11 +73,15 @@ def category_agreement(levels: pd.DataFrame, last_stage: str):
 
 def summarise_levels(levels: pd.DataFrame, last_stage: str) -> pd.DataFrame:
     """Per category: the seeds whose ``last_stage`` level finished, their agreement at the
-    recipe's speed (costs and settled speeds of that level), and each seed's maximum speed
+    recipe's speed (costs and settled speeds of that level; beside the seeds' speed spread,
+    the largest change of those levels' speed from half to a quarter of the time step, which
+    bounds what a spread below it means), and each seed's maximum speed
     [m/s] (fastest settled speed of a level that settles) with its spread and how many of
     them meet issue 20's acceptance."""
     cols = ["category", "seeds (count)", "agreeing seeds (count)", "settled (yes/no)",
-            "cost spread (%)", "speed spread (m/s)", "best cost (–)", "speed of the best (m/s)",
+            "cost spread (%)", "speed spread (m/s)",
+            "largest speed change from half to a quarter of the step (m/s)",
+            "best cost (–)", "speed of the best (m/s)",
             "maximum speed (m/s)", "maximum speed spread (m/s)",
             "maximum-speed gaits meeting the acceptance (count)"]
     out = []
@@ -94,6 +98,9 @@ def summarise_levels(levels: pd.DataFrame, last_stage: str) -> pd.DataFrame:
             "settled (yes/no)": bool(agreement and agreement.settled),
             "cost spread (%)": agreement.cost_spread_pct if agreement else math.nan,
             "speed spread (m/s)": agreement.speed_spread_m_per_s if agreement else math.nan,
+            "largest speed change from half to a quarter of the step (m/s)": (
+                float(base.step_speed_change_m_per_s.astype(float).max())
+                if "step_speed_change_m_per_s" in base and len(base) else math.nan),
             "best cost (–)": float(best.cost) if best is not None else math.nan,
             "speed of the best (m/s)": (float(best.settled_speed_m_per_s) if best is not None
                                         else math.nan),

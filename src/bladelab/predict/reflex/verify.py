@@ -32,7 +32,7 @@ def verify_solution(
     initial_speed_change: float = 0.0,
     push_change: float = 0.0,
     push_phases: int = 5,
-    refined_step: bool = False,
+    refined_step: int = 0,
 ) -> dict:
     """Re-simulate a parameter file and check the shipped-solution criteria.
 
@@ -65,12 +65,12 @@ def verify_solution(
     20: ±5 %). With ``push_change`` p > 0 they must hold after a push (forward speed times
     1 + p and 1 − p) at each of ``push_phases`` times spread over the second after
     :data:`~bladelab.predict.reflex.objective.PUSH_AFTER` (the stride's phases; the basin of
-    the gait, not of its start). With ``refined_step`` they must also hold at half the file's
-    time step, same scheme: a gait that runs only at the step it was optimised at lives on the
-    discretisation, not on the model (the step is a budget; a result must have settled in
-    it). Returns the measured values (the copies' under ``"jittered"``, the changed starts'
-    under ``"initial_speed"``, the pushed runs' under ``"pushed"``, the half-step run under
-    ``"refined"``), ``judged_at_m_per_s`` (the speed judged at [m/s]),
+    the gait, not of its start). With ``refined_step`` = n > 0 (True: 1) they must also hold
+    at the file's time step halved n times (dt/2, ..., dt/2ⁿ), same scheme: a gait that runs
+    only at the step it was optimised at lives on the discretisation, not on the model (the
+    step is a budget; a result must have settled in it). Returns the measured values (the
+    copies' under ``"jittered"``, the changed starts' under ``"initial_speed"``, the pushed
+    runs' under ``"pushed"``, the refined runs under ``"refined"``, finest last), ``judged_at_m_per_s`` (the speed judged at [m/s]),
     ``judged_at_reached_speed`` (whether that is the reached speed: not for a nominal run that
     falls, judged at the prescribed one), ``nominal_ok`` (the nominal run alone) and ``ok``
     (every run).
@@ -130,7 +130,8 @@ def verify_solution(
         also("pushed", [({"push_time_s": t, "push_change": c}, x, replace(settings, push=(t, c)))
                         for t, c in pushes])
     if refined_step:
-        also("refined", [({"dt_s": settings.dt / 2}, x, replace(settings, dt=settings.dt / 2))])
+        steps = [settings.dt / 2 ** h for h in range(1, int(refined_step) + 1)]
+        also("refined", [({"dt_s": dt}, x, replace(settings, dt=dt)) for dt in steps])
     return out
 
 
