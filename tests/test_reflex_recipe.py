@@ -430,6 +430,20 @@ def test_cli_recipe_sweep(tmp_path, capsys, monkeypatch):
     out = capsys.readouterr().out
     assert "Cat6 seed 2 speed-3.6: 1 generations, runs 10 s, 3.41 m/s, cost 50" in out
     assert "agreeing seeds" in out  # the category table
+    # a level simulated at finer steps says how fast it runs there, or that it falls there
+    recipe_module._announce("L", {"generations": 3, "fell": False, "accepted": False,
+                                  "simulated_s": 10.0, "mean_speed_m_per_s": 3.7, "cost": 40.0,
+                                  "runs_at_half_step": True, "half_step_speed_m_per_s": 3.6,
+                                  "runs_at_quarter_step": True,
+                                  "quarter_step_speed_m_per_s": 3.55})
+    recipe_module._announce("M", {"generations": 3, "fell": False, "accepted": False,
+                                  "simulated_s": 10.0, "mean_speed_m_per_s": 3.7, "cost": 40.0,
+                                  "runs_at_half_step": True, "half_step_speed_m_per_s": 3.6,
+                                  "runs_at_quarter_step": False,
+                                  "quarter_step_speed_m_per_s": None})
+    out = capsys.readouterr().out
+    assert "L: 3 generations, runs 10 s, 3.70 m/s (3.55 m/s at a quarter of the step)" in out
+    assert "M: 3 generations, runs 10 s, 3.70 m/s (falls at a finer step)" in out
 
 
 def test_report_of_a_recipe_sweep_resimulates_every_level(tmp_path):

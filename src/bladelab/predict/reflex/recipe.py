@@ -438,8 +438,12 @@ def _announce(level: str, row: dict) -> None:
 
     verdict = (f"falls at {row['simulated_s']:.2f} s" if row["fell"] else
                "runs 10 s" + (", meets issue 20's acceptance" if row["accepted"] else ""))
+    settled = settled_speed(row)
+    finer = ("" if "runs_at_quarter_step" not in row or row["fell"] else
+             " (falls at a finer step)" if settled is None else
+             f" ({settled:.2f} m/s at a quarter of the step)")
     tqdm.write(f"{level}: {row['generations']} generations, {verdict}, "
-               f"{row['mean_speed_m_per_s']:.2f} m/s, cost {row['cost']:.4g}")
+               f"{row['mean_speed_m_per_s']:.2f} m/s{finer}, cost {row['cost']:.4g}")
 
 
 #: A level's runs at finer time steps (:func:`level_row`): whether it runs, its speed [m/s];
