@@ -150,7 +150,7 @@ def recipe_sweep_sections(report, folder: Path, bar) -> tuple[pd.DataFrame, dict
               "has settled when at least 3 seeds agree at the recipe's speed (cost within 2 %, "
               "speed within 0.05 m/s of the best seed's). Speeds compared between seeds and "
               "the maximum speeds are settled speeds: the 10 s re-simulation at a quarter of "
-              "the level's time step (at Newmark's 1 ms the gaits run 0.1–0.2 m/s faster "
+              "the level's time step (at Newmark's 1 ms the gaits run 0.09–0.25 m/s faster "
               "than at finer steps, which still differ by a few hundredths of a m/s: the "
               "levels table gives the change from half to a quarter of the step); a level "
               "that falls at any of these steps is not compared.\n\n" + " ".join(sentences)),

@@ -22,7 +22,7 @@ grid): the recipe's ``continuation`` stage runs at the speed the last level reac
 settle in the time step (falls in its nominal 10 s, at the recipe's step, at half or at a
 quarter of it) or its settled speed gains less than ``min_gain`` [m/s]. A level's **settled
 speed** (:func:`settled_speed`) is its mean speed at a quarter of the step: at Newmark's 1 ms
-the gaits run 0.1–0.2 m/s faster than at finer steps (docs/predictive.md, session 22). The
+the gaits run 0.09–0.25 m/s faster than at finer steps (docs/predictive.md, session 22). The
 prescription follows the speed at the recipe's own step, the one the optimiser mostly sees.
 The maximum speed is the fastest settled speed of a level that settles.
 
@@ -455,10 +455,10 @@ _REFINED = (("runs_at_half_step", "half_step_speed_m_per_s"),
 def settled_speed(row: dict) -> float | None:
     """A level's speed at the finest time step it was simulated at [m/s] (:func:`level_row`:
     a quarter of its step); None if it falls at any step. At Newmark's 1 ms the gaits run
-    0.1–0.2 m/s faster than at finer steps, which still differ by 0.02–0.09 m/s
-    (``step_speed_change_m_per_s``; docs/predictive.md, session 22). A row written before
-    levels were simulated at finer steps (session 21: no quarter step, or no half step, or
-    no speed kept there; NaN in a table) gives the finest speed it holds."""
+    0.09–0.25 m/s faster than at an eighth of it, and each halving still moves the speed by
+    up to 0.09 m/s (``step_speed_change_m_per_s``; docs/predictive.md, session 22). A row
+    written before levels were simulated at finer steps (session 21: no quarter step, or no
+    half step, or no speed kept there; NaN in a table) gives the finest speed it holds."""
     if bool(row["fell"]):
         return None
     speed = float(row["mean_speed_m_per_s"])
