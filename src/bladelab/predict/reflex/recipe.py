@@ -456,7 +456,7 @@ def settled_speed(row: dict) -> float | None:
     """A level's speed at the finest time step it was simulated at [m/s] (:func:`level_row`:
     a quarter of its step); None if it falls at any step. At Newmark's 1 ms the gaits run
     0.09–0.25 m/s faster than at an eighth of it, and each halving still moves the speed by
-    up to 0.09 m/s (``step_speed_change_m_per_s``; docs/predictive.md, session 22). A row
+    up to 0.11 m/s (``step_speed_change_m_per_s``; docs/predictive.md, session 22). A row
     written before levels were simulated at finer steps (session 21: no quarter step, or no
     half step, or no speed kept there; NaN in a table) gives the finest speed it holds."""
     if bool(row["fell"]):
