@@ -483,5 +483,4 @@ def maximum_speed(rows: list[dict]) -> tuple[float, dict | None]:
     ran = [(v, r) for r in rows if (v := settled_speed(r)) is not None]
     if not ran:
         return math.nan, None
-    top = max(ran, key=lambda vr: vr[0])
-    return top[0], top[1]
+    return max(ran, key=lambda vr: vr[0])

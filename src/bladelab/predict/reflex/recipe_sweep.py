@@ -13,8 +13,8 @@ A category has settled (issue 20) when at least three seeds agree at the recipe'
 last stage's gait, re-simulated nominally for 10 s with the same settings, so on the same
 "copy"): costs within 2 % of the best seed's and settled speeds within 0.05 m/s
 (:func:`~bladelab.predict.reflex.agreement.seed_agreement`). Speeds here are settled speeds
-(:func:`~bladelab.predict.reflex.recipe.settled_speed`: at half the time step), and a level
-that falls at either step is not compared. The maximum speed is reported per seed with its
+(:func:`~bladelab.predict.reflex.recipe.settled_speed`: at a quarter of the time step), and a
+level that falls at any of its steps is not compared. The maximum speed is reported per seed with its
 spread; it is not part of the verdict, because seeds that reach different speeds are not
 compared on the same cost.
 """
@@ -67,7 +67,7 @@ def _agreement(base: pd.DataFrame):
 def category_agreement(levels: pd.DataFrame, last_stage: str):
     """How one category's seeds agree at the recipe's speed: the
     :class:`~bladelab.predict.reflex.agreement.SeedAgreement` of the ``last_stage`` levels that
-    ran their 10 s at both time steps, on their settled speeds (None: none did)."""
+    ran their 10 s at every time step, on their settled speeds (None: none did)."""
     return _agreement(_settled_levels(levels, last_stage))
 
 

@@ -70,7 +70,8 @@ def verify_solution(
     only at the step it was optimised at lives on the discretisation, not on the model (the
     step is a budget; a result must have settled in it). Returns the measured values (the
     copies' under ``"jittered"``, the changed starts' under ``"initial_speed"``, the pushed
-    runs' under ``"pushed"``, the refined runs under ``"refined"``, finest last), ``judged_at_m_per_s`` (the speed judged at [m/s]),
+    runs' under ``"pushed"``, the refined runs under ``"refined"``, finest last),
+    ``judged_at_m_per_s`` (the speed judged at [m/s]),
     ``judged_at_reached_speed`` (whether that is the reached speed: not for a nominal run that
     falls, judged at the prescribed one), ``nominal_ok`` (the nominal run alone) and ``ok``
     (every run).
