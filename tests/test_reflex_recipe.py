@@ -193,6 +193,12 @@ def test_maximum_speed_is_the_fastest_settled_speed():
     assert recipe_module.settled_speed({"mean_speed_m_per_s": 3.5, "fell": False,
                                         "runs_at_half_step": math.nan}) == 3.5
     assert math.isnan(recipe_module.maximum_speed([row(3.9, None)])[0])
+    # accepted=True: the fastest that also meets the acceptance (NaN or None: it does not)
+    graded = [row(3.6, 3.58) | {"accepted": True}, row(3.7, 3.62) | {"accepted": False},
+              row(3.8, 3.7) | {"accepted": math.nan}]
+    assert recipe_module.maximum_speed(graded)[0] == 3.7
+    assert recipe_module.maximum_speed(graded, accepted=True) == (3.58, graded[0])
+    assert math.isnan(recipe_module.maximum_speed(graded[1:], accepted=True)[0])
     # the finest step a row holds decides; a fall at any step means no settled speed
     assert recipe_module.settled_speed({**row(3.7, 3.55), "runs_at_quarter_step": True,
                                         "quarter_step_speed_m_per_s": 3.47}) == 3.47
@@ -377,6 +383,9 @@ def test_category_table_by_hand():
     assert t.loc["Cat6", "maximum speed (m/s)"] == pytest.approx(3.65)
     assert t.loc["Cat6", "maximum speed spread (m/s)"] == pytest.approx(0.45)
     assert t.loc["Cat6", "maximum-speed gaits meeting the acceptance (count)"] == 1
+    # issue 20's maximum speed: only seed 1's 3.65 m/s level meets the acceptance
+    assert t.loc["Cat6", "maximum speed meeting the acceptance (m/s)"] == pytest.approx(3.65)
+    assert math.isnan(t.loc["Cat7", "maximum speed meeting the acceptance (m/s)"])
     assert not t.loc["Cat7", "settled (yes/no)"]
     assert t.loc["Cat7", "agreeing seeds (count)"] == 1  # the fallen seed is not compared
     assert t.loc["Cat7", "maximum speed (m/s)"] == pytest.approx(3.1)

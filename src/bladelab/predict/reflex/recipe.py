@@ -477,10 +477,12 @@ def _missing(value) -> bool:
     return value is None or (isinstance(value, float) and math.isnan(value))
 
 
-def maximum_speed(rows: list[dict]) -> tuple[float, dict | None]:
+def maximum_speed(rows: list[dict], *, accepted: bool = False) -> tuple[float, dict | None]:
     """The fastest :func:`settled_speed` of the levels that settle [m/s] and its row (NaN,
-    None: none does)."""
-    ran = [(v, r) for r in rows if (v := settled_speed(r)) is not None]
+    None: none does); with ``accepted``, of the levels that also meet issue 20's acceptance
+    (the row's ``accepted``: issue 20's maximum speed, docs/predictive.md, session 23)."""
+    ran = [(v, r) for r in rows if (v := settled_speed(r)) is not None
+           and (not accepted or r.get("accepted") == 1)]  # True (numpy's too); not None, NaN
     if not ran:
         return math.nan, None
     return max(ran, key=lambda vr: vr[0])
