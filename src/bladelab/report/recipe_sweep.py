@@ -153,7 +153,10 @@ def recipe_sweep_sections(report, folder: Path, bar) -> tuple[pd.DataFrame, dict
               "the level's time step (at Newmark's 1 ms the gaits run 0.09–0.25 m/s faster "
               "than at finer steps, which still differ by a few hundredths of a m/s: the "
               "levels table gives the change from half to a quarter of the step); a level "
-              "that falls at any of these steps is not compared.\n\n" + " ".join(sentences)),
+              "that falls at any of these steps is not compared. Issue 20's maximum speed is "
+              "the fastest settled speed of a level that meets the acceptance (last column "
+              "of the categories table; '–': none does yet), beside the fastest of all."
+              "\n\n" + " ".join(sentences)),
         figures=[("Speed reached per level and seed at the level's time step (filled) and at "
                   "a quarter of it (open: the settled speed; none where it falls at a finer "
                   "step); × fell in its 10 s re-simulation, ★ meets issue 20's acceptance; "
