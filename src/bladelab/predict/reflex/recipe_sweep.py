@@ -110,17 +110,10 @@ def summarise_levels(levels: pd.DataFrame, last_stage: str) -> pd.DataFrame:
             "maximum speed spread (m/s)": (max(speeds) - min(speeds)) if speeds else math.nan,
             "maximum-speed gaits meeting the acceptance (count)":
                 sum(bool(r and r["accepted"]) for _, r in tops),
-            "maximum speed meeting the acceptance (m/s)": _fastest_accepted(df),
+            "maximum speed meeting the acceptance (m/s)":
+                maximum_speed(df.to_dict("records"), accepted=True)[0],
         })
     return pd.DataFrame(out, columns=cols)
-
-
-def _fastest_accepted(df: pd.DataFrame) -> float:
-    """The fastest settled speed of a level of any seed that meets the acceptance [m/s]
-    (NaN: none does)."""
-    speeds = [maximum_speed(g.to_dict("records"), accepted=True)[0]
-              for _, g in df.groupby("seed")]
-    return max((v for v in speeds if math.isfinite(v)), default=math.nan)
 
 
 def _write_tables(out: Path, recipe: Recipe) -> pd.DataFrame:
