@@ -1,7 +1,7 @@
-"""Collocation speed (issue 15): one amputee stride at a prescribed speed, from the template
+"""Collocation speed: one amputee stride at a prescribed speed, from the template
 guess and warm-started, on one core.
 
-Targets (issue 15): ≤ 10 min from the template guess, ≤ 2 min from a warm start. Reported per
+Targets: ≤ 10 min from the template guess, ≤ 2 min from a warm start. Reported per
 solve: wall time, IPOPT iterations per stage, and the time per evaluation of the objective,
 constraints, objective gradient and constraint Jacobian (IPOPT's own counters, CasADi
 ``stats()``). The plausibility of the gait is a separate matter (docs/collocation.md).
@@ -33,7 +33,8 @@ def _row(label: str, sol) -> str:
 
 def run() -> str:
     from bladelab.predict.collocation.guess import template_guess
-    from bladelab.predict.collocation.solve import CollocationSettings, predict_stride
+    from bladelab.predict.collocation.settings import CollocationSettings
+    from bladelab.predict.collocation.solve import predict_stride
     from bladelab.runner import build_runner
 
     spec = {"model": "amputee", "blade": "Cat6"}
@@ -54,7 +55,7 @@ def run() -> str:
                          f"{warm_mu.nlp.objective:.4f} against {warm.nlp.objective:.4f}",
                          warm_mu))
     return "\n".join([
-        "## Collocation: one amputee stride (issue 15)",
+        "## Collocation: one amputee stride",
         "",
         f"Amputee with the Cat6 blade sphere, mesh {MESH} intervals, one core "
         "(`OMP_NUM_THREADS=1`), L-BFGS, tol 1e-4. Targets: ≤ 10 min from the template guess, "

@@ -1,4 +1,4 @@
-"""The whole collocation category study (issue 15), from its stored files.
+"""The whole collocation category study, from its stored files.
 
 Six models (able, amputee Cat4, Cat5, Cat6, Cat6High, Cat7) × speed continuation (4, 5 m/s)
 + maximum speed, from the measured trial's guess, 2 workers: once with one start per problem,
@@ -23,7 +23,7 @@ STUDIES = (("study-timed-2026-11-26", "one start per problem"),
 
 def run() -> str:
     parts = [
-        "## Collocation: the whole category study (issue 15)",
+        "## Collocation: the whole category study",
         "",
         "Six models × speed continuation (4, 5 m/s) + maximum speed, mesh 50, from the "
         "Fukuchi trial's guess, `--jobs 2`. Target: ≤ 30 min on 2 cores. Times are those the "

@@ -1,4 +1,4 @@
-"""Coverage of the 95 % confidence intervals of K* and D* (issue 16).
+"""Coverage of the 95 % confidence intervals of K* and D*.
 
 How often does the interval contain the true value? Stances come from the MuJoCo runner generator
 (``bladelab.sim.synthetic.generate_stance``, not the identification model; the cases of
@@ -8,10 +8,10 @@ markers at 100 Hz with 1 mm noise, 20 Hz low-pass, forces 1 kHz with 1 % noise).
 identified with the default formulation (utilised friction), PSO 20 × 30, and its interval
 computed three ways:
 
-- ``ar1``: the profile likelihood with one AR(1) effective sample size (before issue 16);
+- ``ar1``: the profile likelihood with one AR(1) effective sample size (the method before ``hac+sys``);
 - ``hac``: the profile likelihood with a per-parameter Newey–West scale, per measured channel
   (``bladelab.identify.identifiability.hac_inflation``);
-- ``hac+sys`` (the default since issue 16): ``hac`` widened in quadrature by the systematic error
+- ``hac+sys`` (the default): ``hac`` widened in quadrature by the systematic error
   of the measurement pipeline, ±1.96·σ_sys·estimate (``SYSTEMATIC_REL_SD`` in
   ``bladelab.identify.identify``), σ_sys the smallest σ (step 0.1 %) for which the degraded
   stances reach 95 % coverage. Two sets of stances are drawn with different seeds; σ_sys is
@@ -137,7 +137,7 @@ def run() -> str:
     from bladelab.identify.identify import SYSTEMATIC_REL_SD
 
     lines = [
-        "## Coverage of the 95 % intervals of K* and D* (issue 16)",
+        "## Coverage of the 95 % intervals of K* and D*",
         "",
         f"{N_STANCES} + {N_STANCES} stances from the MuJoCo runner generator (calibration seed "
         f"{CALIBRATION_SEED}, held-out seed {HELD_OUT_SEED}; blades xtreme-cat5 and xceed-cat2, "
@@ -147,7 +147,7 @@ def run() -> str:
         f"fraction of stances whose true value lies in the 95 % interval ({wall:.0f} s).",
         "",
         "- **ar1**: profile likelihood, one AR(1) effective sample size for all parameters (the "
-        "method before issue 16).",
+        "method before hac+sys).",
         "- **hac**: profile likelihood whose scale per parameter is s² of independent residuals × "
         "its Newey–West inflation for autocorrelated residuals, per measured channel (Bartlett "
         "bandwidth = twice the residual's correlation length).",

@@ -61,7 +61,7 @@ def run() -> str:
                                         objective="stiffness_at_bw_N_per_m"), repeat=1)
     rows.append(("25-run study, generator + compression-test evaluator (no simulation)", t_study))
 
-    # the simulation evaluators (issue 8, part B)
+    # the simulation evaluators
     from bladelab.design.evaluators import BladeEvaluator
     from bladelab.design.transfemoral import RunnerEvaluator
 

@@ -1,4 +1,4 @@
-"""The 25-run design studies on predicted transfemoral strides (issue 21), from their stored
+"""The 25-run design studies on predicted transfemoral strides, from their stored
 files: the free gait, and the knee-safe one (the knee's extension moment kept at or above 0).
 
 The study takes about half an hour of both cores, so ``make bench`` does not run it again: it
@@ -35,7 +35,7 @@ def _study(study: Path, what: str) -> str:
     strides = [p for p in strides
                if not p.name.endswith((".best_iterate.json", ".previous.json"))]
     if not strides:
-        return (f"## Design study on predicted transfemoral strides (issue 21): {what}\n\n"
+        return (f"## Design study on predicted transfemoral strides: {what}\n\n"
                 f"No study in {study.relative_to(study.parents[2])}: run it first (docstring).")
     from bladelab.predict.collocation.solution import CollocationSolution
 
@@ -48,7 +48,7 @@ def _study(study: Path, what: str) -> str:
     info = json.loads(timing.read_text(encoding="utf-8")) if timing.is_file() else {}
     walls = sorted(r[1] for r in rows)
     lines = [
-        f"## Design study on predicted transfemoral strides (issue 21): {what}",
+        f"## Design study on predicted transfemoral strides: {what}",
         "",
         "25-run face-centred CCD over seed 002's four factors, `--evaluator collocation` "
         "(transfemoral runner wearing each generated 6-link blade, 4 m/s, mesh 50, backward "

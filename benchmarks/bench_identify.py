@@ -1,4 +1,4 @@
-"""Identification speed and accuracy-per-evaluation (issue 4).
+"""Identification speed and accuracy-per-evaluation.
 
 1. One stance, PSO 20 × 30 = 600 simulations, set-up included (kernel compiled and cached), one core.
 2. A 50-stance study on 2 cores, end to end (``run_study``, process pool, confidence intervals on).
@@ -55,7 +55,7 @@ def run() -> str:
     stances = _stances()
     name, k, d, blade, stance = stances[0]
     identify_stance(stance, blade, seed=0, identifiability=False)  # compile / load the cache
-    lines = ["## Identification (issue 4)", ""]
+    lines = ["## Identification", ""]
 
     # 1. one stance, 600 simulations
     rows = ["| stance | K err % | D err % | wall (search only) s | CPU (search only) s | "

@@ -1,4 +1,4 @@
-"""Robust identification under realistic motion capture (issue 9): a measurement study.
+"""Robust identification under realistic motion capture: a measurement study.
 
 Stances come from a generator that is NOT the identification model: the MuJoCo point-mass runner
 carrying the blade (``bladelab.sim.synthetic.generate_stance``: consistent clamp path, the blade
@@ -209,7 +209,7 @@ def run() -> str:
     gd = df[df["formulation"] == "grf-driven"]
     ok_gd = np.mean((gd["K_err_pct"].abs() < 5) & (gd["D_err_pct"].abs() < 20))
     lines = [
-        "## Robust identification under realistic motion capture (issue 9)",
+        "## Robust identification under realistic motion capture",
         "",
         f"{len(cases)} stances from the MuJoCo runner generator (not the identification model): "
         f"blades {', '.join(BLADES)}, speeds {min(c['speed'] for c in cases):.1f}–"

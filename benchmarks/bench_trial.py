@@ -7,10 +7,10 @@ import statistics
 import subprocess
 import sys
 import time
-from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[1]
-FILE = ROOT.parent / "shared" / "data" / "real" / "fukuchi2017" / "RBDS001runT35.c3d"
+from bladelab.datasets import measured_running_trial
+
+FILE = measured_running_trial()  # package data (bladelab.datasets): Fukuchi et al. 2017, 3.5 m/s
 REPEATS = 7
 
 

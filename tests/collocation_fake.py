@@ -10,10 +10,11 @@ import numpy as np
 
 from bladelab.predict.collocation import build_collocation_model
 from bladelab.predict.collocation.dynamics import stride_dynamics
-from bladelab.predict.collocation.guess import periodic_derivative, template_guess
+from bladelab.predict.collocation.guess import template_guess
+from bladelab.predict.collocation.settings import CollocationSettings
 from bladelab.predict.collocation.solution import CollocationSolution
-from bladelab.predict.collocation.solve import CollocationSettings
 from bladelab.predict.collocation.stored import check_model_spec, model_label
+from bladelab.predict.collocation.stride_guess import periodic_derivative
 from bladelab.predict.collocation.transcription import NLPSolution
 from bladelab.runner import build_runner
 
@@ -117,7 +118,7 @@ def start_of(settings, guess) -> str:
     """Which start of ``bladelab.predict.collocation.starts`` a solve is, from its guess and
     settings: ``iterate`` (a stored best iterate's warm start), ``template``,
     ``previous-but-one``, ``warm-mu-1e-4`` or ``warm``."""
-    from bladelab.predict.collocation.solve import COLLOCATION_SOURCE
+    from bladelab.predict.collocation.stride_guess import COLLOCATION_SOURCE
 
     if guess.source.startswith(COLLOCATION_SOURCE + " ("):  # a stored iterate's to_guess()
         return "iterate"

@@ -1,4 +1,9 @@
-"""Shared fixtures: paths to the real data in ../shared/data."""
+"""Fixtures and the paths of the real data files the tests read.
+
+The measured running dataset (Fukuchi et al. 2017) is package data, found through
+:mod:`bladelab.datasets`; OpenSim's walking trials and SCONE's H0918 model are test data in
+``tests/data/`` (each folder with its licence and a README).
+"""
 
 from __future__ import annotations
 
@@ -6,30 +11,38 @@ from pathlib import Path
 
 import pytest
 
+from bladelab.datasets import (
+    measured_forces_table,
+    measured_running_trial,
+    measured_static_trial,
+    measured_subject_table,
+)
+
 PROJECT_ROOT = Path(__file__).resolve().parents[1]
-SHARED_DATA = PROJECT_ROOT.parent / "shared" / "data"
+#: Test-only data files (not shipped in the package).
+TEST_DATA = Path(__file__).resolve().parent / "data"
+
+#: Subject RBDS001 (62 kg) running on a treadmill at 3.5 m/s, and standing (package data).
+FUKUCHI_RUN = measured_running_trial()
+FUKUCHI_STATIC = measured_static_trial()
+#: The dataset's subject table and subject RBDS004's treadmill forces at 2.5 m/s (package data).
+FUKUCHI_INFO = measured_subject_table()
+FUKUCHI_FORCES = measured_forces_table()
+#: Two overground walking trials from OpenSim's test data (two type-2 force platforms).
+WALKING = (TEST_DATA / "opensim-walking" / "walking2.c3d",
+           TEST_DATA / "opensim-walking" / "walking5.c3d")
+#: SCONE's planar H0918 model (OpenSim 4 and Hyfydy files).
+SCONE_H0918 = TEST_DATA / "scone-h0918"
 
 
 @pytest.fixture(scope="session")
-def shared_data() -> Path:
-    """The folder ``../shared/data`` (real C3D files and reference models)."""
-    if not SHARED_DATA.is_dir():
-        pytest.fail(f"{SHARED_DATA} not found: clone bladelab beside the shared/ folder")
-    return SHARED_DATA
-
-
-FUKUCHI_RUN = "real/fukuchi2017/RBDS001runT35.c3d"
-FUKUCHI_STATIC = "real/fukuchi2017/RBDS001static.c3d"
-
-
-@pytest.fixture(scope="session")
-def fukuchi_trials(shared_data):
+def fukuchi_trials():
     """The Fukuchi 3.5 m/s running trial and its static trial, in the same lab axes."""
     from bladelab.trial import read_c3d
 
-    run = read_c3d(shared_data / FUKUCHI_RUN)
+    run = read_c3d(FUKUCHI_RUN)
     ax = run.metadata["axes"]
-    return run, read_c3d(shared_data / FUKUCHI_STATIC, forward=ax["forward"], up=ax["up"])
+    return run, read_c3d(FUKUCHI_STATIC, forward=ax["forward"], up=ax["up"])
 
 
 @pytest.fixture(scope="session")

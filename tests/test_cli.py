@@ -12,8 +12,7 @@ import pytest
 import trial_synth as synth
 from bladelab.cli import main
 from bladelab.trial.stance import read_stance_csv
-
-FUKUCHI = "real/fukuchi2017/RBDS001runT35.c3d"
+from conftest import FUKUCHI_RUN as FUKUCHI
 
 
 @pytest.fixture(scope="module")
@@ -23,11 +22,11 @@ def synthetic(tmp_path_factory):
     return path
 
 
-def test_info(shared_data, capsys):
-    assert main(["trial", "info", str(shared_data / FUKUCHI)]) == 0
+def test_info(capsys):
+    assert main(["trial", "info", str(FUKUCHI)]) == 0
     out = capsys.readouterr().out
     assert "platform 1: type 4, 300 Hz" in out and "R.Heel.Bottom" in out and "units mm" in out
-    assert main(["trial", "info", str(shared_data / FUKUCHI), "--json"]) == 0
+    assert main(["trial", "info", str(FUKUCHI), "--json"]) == 0
     info = json.loads(capsys.readouterr().out)
     assert info["marker_rate_Hz"] == 150.0 and info["platforms"][0]["type"] == 4
     assert info["platforms"][0]["channels"] == ["F1X", "F1Y", "F1Z", "M1X", "M1Y", "M1Z"]

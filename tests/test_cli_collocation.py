@@ -1,4 +1,4 @@
-"""``bladelab predict --method collocation`` and ``bladelab report`` of its files (issue 15):
+"""``bladelab predict --method collocation`` and ``bladelab report`` of its files:
 failure path, output folder rules, resume, bad input."""
 
 from __future__ import annotations
@@ -99,7 +99,7 @@ def test_bad_options_are_refused_naming_the_option(args, where, tmp_path, capsys
 
 
 def test_the_transfemoral_runner_is_solved_with_its_own_blade(tmp_path, capsys):
-    """``--model transfemoral`` (issue 21) runs end to end: its default blade (Cat4) goes into
+    """``--model transfemoral`` runs end to end: its default blade (Cat4) goes into
     the file, and the legs are named intact and prosthetic."""
     out = tmp_path / "tf"
     code = main(["predict", "--method", "collocation", "--model", "transfemoral", "--out",

@@ -130,27 +130,28 @@ def test_design_bad_input(tmp_path, capsys):
     assert main(["design", "--out", str(tmp_path / "z"), "--runs", "bbd", "--factors",
                  "stiffness_kN_per_m=18:32,width_m=0.05:0.08"]) == 2  # BBD needs k >= 3
     assert main(["design", "--out", str(tmp_path / "c"), "--start", str(tmp_path)]) == 2
-    assert "--start needs --evaluator collocation" in capsys.readouterr().err
+    assert "--start: only with --evaluator collocation" in capsys.readouterr().err
     assert main(["design", "--out", str(tmp_path / "c"), "--settle", "1"]) == 2
-    assert "--settle needs --evaluator collocation" in capsys.readouterr().err
+    assert "--settle: only with --evaluator collocation" in capsys.readouterr().err
     assert main(["design", "--out", str(tmp_path / "c"), "--knee-moment-min", "0"]) == 2
-    assert "--knee-moment-min needs --evaluator collocation" in capsys.readouterr().err
+    assert "--knee-moment-min: only with --evaluator collocation" in capsys.readouterr().err
     assert main(["design", "--out", str(tmp_path / "c"), "--evaluator", "collocation",
                  "--knee-moment-min", "10"]) == 2
     assert "knee moment minimum must be <= 0" in capsys.readouterr().err
     assert main(["design", "--out", str(tmp_path / "c"), "--knee-flexion-max", "5"]) == 2
-    assert "--knee-flexion-max needs --evaluator collocation" in capsys.readouterr().err
+    assert "--knee-flexion-max: only with --evaluator collocation" in capsys.readouterr().err
     assert main(["design", "--out", str(tmp_path / "c"), "--evaluator", "collocation",
                  "--knee-flexion-max", "120"]) == 2
     assert "loaded knee's flexion limit" in capsys.readouterr().err
     assert main(["design", "--out", str(tmp_path / "c"), "--reference-weight", "10"]) == 2
-    assert "--reference-weight needs --evaluator collocation" in capsys.readouterr().err
+    assert "--reference-weight: only with --evaluator collocation" in capsys.readouterr().err
     assert main(["design", "--out", str(tmp_path / "c"), "--evaluator", "collocation",
                  "--reference-weight", "-1"]) == 2
     assert "reference weight must be >= 0" in capsys.readouterr().err
     assert main(["design", "--out", str(tmp_path / "c"), "--evaluator", "collocation",
                  "--body-mass", "70"]) == 2
-    assert "does not apply to the collocation evaluator" in capsys.readouterr().err
+    assert ("--body-mass: only with --evaluator blade or --evaluator runner, not with "
+            "--evaluator collocation") in capsys.readouterr().err
     assert main(["design", "--out", str(tmp_path / "c"), "--evaluator", "collocation",
                  "--start", str(tmp_path / "none.json")]) == 2
     assert "none.json" in capsys.readouterr().err
@@ -165,7 +166,7 @@ def test_an_interrupted_settling_pass_is_recorded_and_resumed(tmp_path, monkeypa
     import numpy as np
 
     import bladelab.design.collocation_evaluator as ce
-    from bladelab.cli.design_settle import RECORD_NAME, settle_study
+    from bladelab.design.settling import RECORD_NAME, settle_study
     from bladelab.design.space import default_design_space
     from bladelab.design.study import run_file
 
@@ -196,7 +197,8 @@ def test_an_interrupted_settling_pass_is_recorded_and_resumed(tmp_path, monkeypa
     assert run_file(tmp_path, 0).is_file() and not run_file(tmp_path, 1).exists()
 
     monkeypatch.setattr(ce, "settle_strides", settle)
-    assert settle_study(None, result, passes=1, jobs=1)  # design 4 changed
+    outcome = settle_study(None, result, passes=1, jobs=1)
+    assert outcome.changed and outcome.passes == 1  # design 4 changed
     assert seen[-1] == [2, 3]  # resumed: only the designs the pass had not reached
     record = json.loads((tmp_path / RECORD_NAME).read_text())["passes"]
     assert len(record) == 1 and record[0]["complete"] and record[0]["improved"] == 2

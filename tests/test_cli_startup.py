@@ -11,6 +11,8 @@ import sys
 
 import pytest
 
+from conftest import FUKUCHI_RUN
+
 HEAVY = ("numba", "mujoco", "matplotlib", "pandas", "casadi", "scipy.signal")
 
 _PROBE = """
@@ -40,31 +42,53 @@ def test_help_imports_no_heavy_library(args):
     assert result["heavy"] == []
 
 
-def test_trial_info_imports_no_heavy_library(shared_data):
-    result = _run(["trial", "info", str(shared_data / "real/fukuchi2017/RBDS001runT35.c3d")])
+def test_trial_info_imports_no_heavy_library():
+    result = _run(["trial", "info", str(FUKUCHI_RUN)])
     assert result["code"] == 0 and "platform 1: type 4" in result["out"]
     assert result["heavy"] == []
 
 
-def test_cli_defaults_equal_the_library_defaults():
-    from bladelab.cli.defaults import RUNNER_DT
-    from bladelab.predict.reflex.objective import DEFAULT_PREDICT_DT
+def test_the_reflex_time_step_is_the_runner_models():
+    from bladelab.predict import defaults
+    from bladelab.predict.reflex.objective import DEFAULT_PREDICT_DT, ObjectiveSettings
     from bladelab.runner.model import DEFAULT_DT
 
-    assert RUNNER_DT == DEFAULT_DT == DEFAULT_PREDICT_DT
+    assert defaults.TIME_STEP_S == DEFAULT_DT == DEFAULT_PREDICT_DT == ObjectiveSettings().dt
 
 
-def test_cli_track_weight_equals_the_library_default():
-    from bladelab.cli.defaults import TRACK_WEIGHT
+def test_the_cli_shows_the_library_defaults():
+    """The option defaults of predict, sweep, design and blade test are the settings objects'
+    (one definition each: bladelab.predict.defaults and bladelab.design.defaults)."""
+    import typer.main
+
+    from bladelab.cli import app
+    from bladelab.design import defaults as dd
+    from bladelab.design.evaluators import BladeEvaluator
+    from bladelab.predict import defaults as pd
+    from bladelab.predict.collocation.settings import CollocationSettings
+    from bladelab.predict.reflex.objective import ObjectiveSettings
     from bladelab.predict.reflex.tracking import DEFAULT_WEIGHT
 
-    assert TRACK_WEIGHT == DEFAULT_WEIGHT
+    group = typer.main.get_command(app)
 
+    def default(command: list[str], option: str):
+        cmd = group
+        for name in command:
+            cmd = cmd.commands[name]
+        return next(p.default for p in cmd.params if option in p.opts)
 
-def test_cli_collocation_defaults_equal_the_settings_defaults():
-    from bladelab.cli.defaults import COLLOCATION_MAX_ITER, COLLOCATION_MESH
-    from bladelab.predict.collocation.solve import CollocationSettings
-
-    settings = CollocationSettings()
-    assert (COLLOCATION_MESH, COLLOCATION_MAX_ITER) == (settings.mesh_intervals,
-                                                        settings.max_iter)
+    obj, coll = ObjectiveSettings(), CollocationSettings()
+    predict = ["predict"]
+    assert default(predict, "--speed") == obj.speed == coll.speed_m_per_s == pd.SPEED_M_PER_S
+    assert default(predict, "--dt") == obj.dt
+    assert default(predict, "--duration") == obj.duration
+    assert default(predict, "--robust-jitter") == obj.robust_jitter
+    assert default(predict, "--strike-limit") == obj.strike_limit_bw
+    assert default(predict, "--lean-weight") == obj.w_lean
+    assert default(predict, "--integrator") == obj.integrator
+    assert default(predict, "--track-weight") == DEFAULT_WEIGHT
+    assert default(predict, "--mesh") == coll.mesh_intervals
+    assert default(predict, "--max-iter") == coll.max_iter
+    assert default(["sweep"], "--mesh") == coll.mesh_intervals
+    assert default(["blade", "test"], "--body-mass") == BladeEvaluator().body_mass_kg
+    assert default(["blade", "test"], "--max-displacement") == dd.COMPRESSION_MAX_DISPLACEMENT_M

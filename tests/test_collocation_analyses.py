@@ -21,7 +21,7 @@ from bladelab.predict.collocation import build_collocation_model
 from bladelab.predict.collocation.analyses import stride_analyses
 from bladelab.predict.collocation.solution import CollocationSolution
 from bladelab.predict.collocation.stored import runner_from_spec
-from bladelab.runner.model import CP_BLADE, CP_BODY, CP_EXP, CP_K
+from bladelab.runner.layout import CP_BLADE, CP_BODY, CP_EXP, CP_K
 
 SOLUTION = (Path(__file__).resolve().parents[1] / "benchmarks" / "collocation" / "study-4mps"
             / "amputee-Cat6" / "speed-4.json")

@@ -1,4 +1,4 @@
-"""Speed continuation and maximum speed (issue 15).
+"""Speed continuation and maximum speed.
 
 The success paths replace the solve (``continuation.predict_stride``) by
 ``collocation_fake.FakeSolve``, which returns the fake solution of ``collocation_fake`` at the
@@ -15,8 +15,9 @@ import pytest
 
 from bladelab.errors import InputFileError, SpecError
 from bladelab.predict.collocation import continuation as cont
+from bladelab.predict.collocation.settings import CollocationSettings
 from bladelab.predict.collocation.solution import CollocationSolution
-from bladelab.predict.collocation.solve import COLLOCATION_SOURCE, CollocationSettings
+from bladelab.predict.collocation.stride_guess import COLLOCATION_SOURCE
 
 N = 12  # mesh intervals: the fake solutions' (conftest.FAKE_MESH)
 ABLE = {"model": "able", "blade": None}

@@ -7,6 +7,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from bladelab.datasets import measured_running_trial, measured_static_trial
 from bladelab.errors import SpecError
 from bladelab.predict.collocation.guess import (
     guess_from_reflex,
@@ -16,7 +17,6 @@ from bladelab.predict.collocation.guess import (
 from bladelab.runner import build_runner
 from bladelab.runner.model import contact_heights
 
-FUKUCHI = Path(__file__).resolve().parents[1].parent / "shared/data/real/fukuchi2017"
 SOLUTIONS = Path(__file__).resolve().parents[1] / "src/bladelab/data/runner/solutions"
 
 
@@ -66,10 +66,9 @@ def test_resampling_keeps_the_stride(able):
                                atol=1e-12)
 
 
-@pytest.mark.skipif(not (FUKUCHI / "RBDS001runT35.c3d").is_file(), reason="shared data absent")
 def test_guess_from_the_fukuchi_trial(able):
-    g = guess_from_trial(able, FUKUCHI / "RBDS001runT35.c3d",
-                         static=FUKUCHI / "RBDS001static.c3d", speed=3.5, n=50)
+    g = guess_from_trial(able, measured_running_trial(),
+                         static=measured_static_trial(), speed=3.5, n=50)
     _check_stride(able, g, 3.5)
     # 3.5 m/s treadmill running: stride ~0.70 s (the force platforms' touch-downs); knee
     # nearly straight at touch-down, flexed > 90° in swing
@@ -82,7 +81,7 @@ def test_guess_from_the_fukuchi_trial(able):
     assert np.trapezoid(f, dx=1 / 50) == pytest.approx(1.0, rel=0.02)
     assert 2.3 < f.max() < 2.7 and (f < 0.05).sum() > 10
     with pytest.raises(SpecError, match="running speed"):
-        guess_from_trial(able, FUKUCHI / "RBDS001runT35.c3d")
+        guess_from_trial(able, measured_running_trial())
 
 
 def test_guess_from_the_shipped_reflex_solution():
@@ -139,8 +138,8 @@ def test_the_transfemoral_template_keeps_the_passive_knee_straight_in_stance():
 
 def test_a_sphere_stride_starts_a_multilink_blade_at_its_static_deflection():
     from bladelab.design.blade_generator import generate_blade
-    from bladelab.predict.collocation.guess import StrideGuess, deflected_blade
-    from bladelab.runner.model import CP_BLADE
+    from bladelab.predict.collocation.stride_guess import StrideGuess, deflected_blade
+    from bladelab.runner.layout import CP_BLADE
 
     sphere = build_runner("transfemoral")
     runner = build_runner("transfemoral", blade_model=generate_blade(

@@ -1,4 +1,4 @@
-"""Issue 15, "same model on both sides": the CasADi collocation model equals the forward model
+"""The same model on both sides: the CasADi collocation model equals the forward model
 (MuJoCo + bladelab's numba kernels) at random states, exactly or within the stated bounds of
 its smooth approximations (bladelab.predict.collocation.bounds, docs/collocation.md)."""
 
@@ -21,7 +21,7 @@ from bladelab.predict.collocation.bounds import (
     spring_damper_bound,
 )
 from bladelab.runner.kernel import forces, mujoco_views, path_kinematics
-from bladelab.runner.model import (
+from bladelab.runner.layout import (
     CP_BLADE,
     CP_BODY,
     CP_C,
@@ -39,9 +39,8 @@ from bladelab.runner.model import (
     JP_SDX,
     JP_SK,
     JP_SK2,
-    build_runner,
-    contact_heights,
 )
+from bladelab.runner.model import build_runner, contact_heights
 from bladelab.runner.muscle import (
     FIBER_DAMPING,
     MP_TSTRAIN,
@@ -443,7 +442,7 @@ def test_smooth_metabolic_rate_matches_forward_uchida(models):
 
 
 def test_swing_clearance_binds_only_a_contact_moving_forward(models):
-    """The swing-clearance inequality (issue 21's toe clearance as a constraint): a stance
+    """The swing-clearance inequality (the toe clearance as a constraint): a stance
     contact (at rest while the pelvis moves on) is free even when it penetrates; a contact
     moving forward faster than the pelvis must be ``h`` above the ground (its value is its
     height minus h)."""
@@ -479,7 +478,7 @@ def test_knee_moment_is_the_prosthetic_grf_moment_about_the_knee_axis(models):
     knee axis and the contact forces by hand; 0 with the prosthesis in the air."""
     from bladelab.errors import SpecError
     from bladelab.predict.collocation.dynamics import knee_extension_moment
-    from bladelab.runner.model import CP_LEG
+    from bladelab.runner.layout import CP_LEG
 
     runner, cm = models["transfemoral"]
     q_s, qd_s = ca.SX.sym("q", cm.nv), ca.SX.sym("qd", cm.nv)
@@ -512,7 +511,7 @@ def test_loaded_knee_flexion_limit_is_weighted_by_the_prosthetic_load(models):
     limit, and it is 0 with the prosthesis in the air whatever the knee does."""
     from bladelab.errors import SpecError
     from bladelab.predict.collocation.dynamics import knee_straight_while_loaded
-    from bladelab.runner.model import CP_LEG
+    from bladelab.runner.layout import CP_LEG
 
     runner, cm = models["transfemoral"]
     q_s, qd_s = ca.SX.sym("q", cm.nv), ca.SX.sym("qd", cm.nv)

@@ -1,5 +1,5 @@
 """The collocation solution: settings, file, summary, trajectory, dynamic consistency, the
-two-stage solve's failure path and determinism, and the report (issue 15)."""
+two-stage solve's failure path and determinism, and the report."""
 
 from __future__ import annotations
 
@@ -19,17 +19,14 @@ from bladelab.predict.collocation.consistency import (
     inverse_dynamics,
 )
 from bladelab.predict.collocation.guess import template_guess
+from bladelab.predict.collocation.settings import CollocationSettings
 from bladelab.predict.collocation.solution import (
     BEST_ITERATE_KIND,
     CONTACT_THRESHOLD_N,
     SOLUTION_KIND,
     CollocationSolution,
 )
-from bladelab.predict.collocation.solve import (
-    CollocationSettings,
-    SolveProgress,
-    predict_stride,
-)
+from bladelab.predict.collocation.solve import SolveProgress, predict_stride
 from bladelab.predict.collocation.transcription import StrideWeights
 from collocation_fake import SPEED, fake_solution
 

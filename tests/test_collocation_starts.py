@@ -15,7 +15,7 @@ import pytest
 
 from bladelab.errors import SpecError
 from bladelab.predict.collocation import starts as st
-from bladelab.predict.collocation.solve import CollocationSettings
+from bladelab.predict.collocation.settings import CollocationSettings
 
 MERGE = Path(__file__).resolve().parents[1] / "benchmarks" / "collocation" / "merge_starts.py"
 

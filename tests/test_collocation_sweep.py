@@ -1,4 +1,4 @@
-"""The collocation category sweep, ``bladelab sweep --method collocation`` (issue 15).
+"""The collocation category sweep, ``bladelab sweep --method collocation``.
 
 Solves are replaced by ``collocation_fake.FakeSolve`` (the continuation's ``predict_stride``):
 the fake solution at the guess's speed, marked so that each warm start can be traced."""

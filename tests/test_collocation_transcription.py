@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from bladelab.errors import SpecError
-from bladelab.predict.collocation.guess import StrideGuess
+from bladelab.predict.collocation.stride_guess import StrideGuess
 from bladelab.predict.collocation.transcription import StrideDynamics, StrideNLP
 
 M, G, K = 80.0, 9.81, 2.0e4  # kg, m/s², N/m

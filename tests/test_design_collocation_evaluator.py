@@ -12,7 +12,6 @@ import pytest
 from bladelab.design import collocation_evaluator as ce
 from bladelab.design.evaluators import make_evaluator
 from bladelab.errors import InputFileError, OptimizationError, SpecError
-from bladelab.predict.collocation import solve as solve_module
 from bladelab.predict.collocation.solution import CollocationSolution
 
 STRIDE = Path(__file__).parent / "data" / "transfemoral-4mps.json"
@@ -58,9 +57,8 @@ def fake(monkeypatch):
                       "contacts": runner.contact_params.copy()})
         return _Outcome(base, *(script.pop(0) if script else (True, [])))
 
-    monkeypatch.setattr(solve_module, "predict_stride", predict_stride)
-    monkeypatch.setattr("bladelab.design.predicted.stride_responses",
-                        lambda sol, runner: {"delta_vx_m_per_s": 0.1})
+    monkeypatch.setattr(ce, "predict_stride", predict_stride)
+    monkeypatch.setattr(ce, "stride_responses", lambda sol, runner: {"delta_vx_m_per_s": 0.1})
     return calls, script
 
 
@@ -80,7 +78,7 @@ def test_each_design_wears_its_own_generated_blade(fake, tmp_path):
     assert len(blade["joints"]) == 5
     assert blade["contact"]["stiffness_N_per_m"] == pytest.approx(1e5)  # xtreme's 1e6 × 0.1
     assert blade["contact"]["damping_Ns_per_m"] == pytest.approx(1e3 * 0.1 ** 0.5)
-    from bladelab.runner.model import CP_BLADE, CP_K
+    from bladelab.runner.layout import CP_BLADE, CP_K
 
     soles = call["contacts"][call["contacts"][:, CP_BLADE] == 1]
     assert len(soles) == 3 and np.allclose(soles[:, CP_K], 1e5)  # the runner wears them
@@ -225,7 +223,7 @@ def test_settling_keeps_the_lowest_objective_from_the_neighbours(fake, tmp_path,
         return out
 
     monkeypatch.setattr(ce.CollocationEvaluator, "_stored", stored)
-    monkeypatch.setattr(solve_module, "predict_stride", solve)
+    monkeypatch.setattr(ce, "predict_stride", solve)
     rows = ce.settle_strides(ev, [CENTRE], neighbours=2, progress=False)
     tries = rows[0].pop("tries")
     assert rows == [{"point": CENTRE, "before": 1.0, "after": 0.90,

@@ -8,12 +8,8 @@ import numpy as np
 import pytest
 
 from bladelab.design import default_design_space, generate_blade
-from bladelab.design.evaluators import (
-    BLADE_RESPONSE_UNITS,
-    BladeEvaluator,
-    make_evaluator,
-    swing_clearance,
-)
+from bladelab.design.evaluators import BladeEvaluator, make_evaluator, swing_clearance
+from bladelab.design.responses import BLADE_RESPONSE_UNITS
 from bladelab.errors import SpecError
 
 G = 9.80665

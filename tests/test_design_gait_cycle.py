@@ -93,29 +93,29 @@ def test_bad_leg_and_no_cycle(trials):
         gait_cycles_from_trial(run, leg="right", max_period_s=0.1)
 
 
-def test_cli_writes_the_gait_csv(tmp_path, shared_data, capsys):
+def test_cli_writes_the_gait_csv(tmp_path, capsys):
     out = tmp_path / "cycle.csv"
-    assert main(["design", "gait-cycle", str(shared_data / RUN), "--static",
-                 str(shared_data / STATIC), "--leg", "right", "--out", str(out)]) == 0
+    assert main(["design", "gait-cycle", str(RUN), "--static",
+                 str(STATIC), "--leg", "right", "--out", str(out)]) == 0
     text = capsys.readouterr().out
     assert "cycles of the right leg" in text
     cyc = read_gait_csv(out)
-    run = read_c3d(shared_data / RUN)
+    run = read_c3d(RUN)
     stride, _, _ = _stride_and_stance(run)
     assert cyc.period == pytest.approx(stride, abs=2 / 300)
     assert np.degrees(cyc.angles["knee_prosthetic"]).max() > 80
 
 
-def test_cli_errors(tmp_path, shared_data, capsys):
+def test_cli_errors(tmp_path, capsys):
     # a standing trial has no force platforms: no stance, clear error, exit 2, no file
     out = tmp_path / "x.csv"
-    assert main(["design", "gait-cycle", str(shared_data / STATIC), "--out", str(out)]) == 2
+    assert main(["design", "gait-cycle", str(STATIC), "--out", str(out)]) == 2
     err = capsys.readouterr().err
     assert err.startswith("error:") and "force platforms" in err and "Traceback" not in err
     assert not out.exists()
     mp = tmp_path / "map.yaml"
     mp.write_text("right:\n  thigh_distal: [R.Knee.Marker]\n")
-    assert main(["design", "gait-cycle", str(shared_data / RUN), "--markers", str(mp),
+    assert main(["design", "gait-cycle", str(RUN), "--markers", str(mp),
                  "--out", str(out)]) == 2
     err = capsys.readouterr().err
     assert "R.Knee.Marker" in err and "RBDS001runT35.c3d" in err

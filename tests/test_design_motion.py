@@ -21,6 +21,7 @@ from bladelab.design.motion import (
     read_motion_file,
 )
 from bladelab.errors import InputFileError, SpecError
+from conftest import FUKUCHI_RUN, FUKUCHI_STATIC
 
 SPACE2 = DesignSpace.parse("stiffness_kN_per_m=18:32,width_m=0.05:0.08")
 SPACE1 = DesignSpace.parse("stiffness_kN_per_m=18:32")
@@ -193,11 +194,10 @@ def test_motion_file_errors_name_file_row_and_field(tmp_path, fmt):
         read_motion_file(bad)
 
 
-def test_trial_entry_gives_the_measured_mean_cycle(tmp_path, shared_data):
+def test_trial_entry_gives_the_measured_mean_cycle(tmp_path):
     """A C3D entry: the mean cycle of the Fukuchi 3.5 m/s trial (force-plate stride 0.701 s,
     swing knee flexion above 80°), beside a gait-CSV entry."""
-    run = shared_data / "real" / "fukuchi2017" / "RBDS001runT35.c3d"
-    static = shared_data / "real" / "fukuchi2017" / "RBDS001static.c3d"
+    run, static = FUKUCHI_RUN, FUKUCHI_STATIC
     _true_cycle(25.0).to_frame().to_csv(tmp_path / "g.csv", index=False)
     path = tmp_path / "m.yaml"
     path.write_text(yaml.safe_dump({"cycles": [
@@ -335,5 +335,5 @@ def test_design_command_motion_errors(tmp_path, capsys):
     args = ["design", "--factors", "stiffness_kN_per_m=18:32,width_m=0.05:0.08", "--evaluator",
             "blade", "--motion", str(good), "--out", str(out)]
     assert main(args) == 2
-    assert "--motion needs --evaluator runner" in capsys.readouterr().err
+    assert "--motion: only with --evaluator runner" in capsys.readouterr().err
     assert not out.exists()

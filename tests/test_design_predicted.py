@@ -1,7 +1,7 @@
-"""Seed 002's responses from a predicted transfemoral stride (issue 21).
+"""Seed 002's responses from a predicted transfemoral stride.
 
 The fixture ``tests/data/transfemoral-4mps.json`` is a converged collocation stride of the
-transfemoral runner at 4 m/s (mesh 50, from the template guess, session 9; dynamics residual
+transfemoral runner at 4 m/s (mesh 50, from the template guess; dynamics residual
 1.4 %). Its intact foot strikes the ground during the prosthetic stance, so the test of the
 impulses adds the intact leg's over the same window."""
 
@@ -14,7 +14,8 @@ import numpy as np
 import pytest
 
 from bladelab.design import predicted
-from bladelab.design.predicted import PREDICTED_RESPONSE_UNITS, stride_responses
+from bladelab.design.predicted import stride_responses
+from bladelab.design.responses import PREDICTED_RESPONSE_UNITS
 from bladelab.errors import SpecError
 from bladelab.predict.collocation.solution import CollocationSolution
 from bladelab.predict.collocation.stored import runner_from_spec

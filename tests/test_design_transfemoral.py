@@ -16,11 +16,8 @@ from bladelab.design.gait_cycle import (
     read_gait_csv,
 )
 from bladelab.design.motion_model import fit_motion_model
-from bladelab.design.transfemoral import (
-    RUNNER_RESPONSE_UNITS,
-    RunnerEvaluator,
-    simulate_transfemoral,
-)
+from bladelab.design.responses import RUNNER_RESPONSE_UNITS
+from bladelab.design.transfemoral import RunnerEvaluator, simulate_transfemoral
 from bladelab.errors import DataError, InputFileError, SpecError
 from bladelab.runner.prosthetic_knee import ProstheticKnee
 

@@ -7,6 +7,7 @@ import pytest
 
 from bladelab.errors import DataError, OptimizationError
 from bladelab.identify.cost import StanceCost, contact_window, nrmse
+from conftest import FUKUCHI_FORCES
 
 
 def _signals(n=101):
@@ -98,9 +99,9 @@ def test_bad_options():
         StanceCost.from_arrays(grf_z=grf_z, distance=nan)
 
 
-def test_real_running_forces(shared_data):
+def test_real_running_forces():
     """Real treadmill forces (Fukuchi 2017, 300 Hz, vertical = Fy): contacts and flight."""
-    table = np.loadtxt(shared_data / "real/fukuchi2017/RBDS0041runT252forces.txt", skiprows=1)
+    table = np.loadtxt(FUKUCHI_FORCES, skiprows=1)
     fz = table[:600, 2]  # two seconds
     mask = contact_window(fz, threshold=60.0)  # treadmill: flight reads 10-40 N
     edges = np.flatnonzero(np.diff(mask.astype(int)))

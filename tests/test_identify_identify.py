@@ -182,7 +182,7 @@ def test_nonlinear_polish_estimate_inside_its_interval(tmp_path, capsys, monkeyp
 
     assert main(args) == 0
     inside(json.loads(capsys.readouterr().out))
-    # a search that stops off the optimum in the long K–K2 valley (issue 16: K* 14.09 with a 95 %
+    # a search that stops off the optimum in the long K–K2 valley (seen once: K* 14.09 with a 95 %
     # CI of [8.71, 10.45]): the profiles' lowest point becomes the estimate, said in a note
     real = identify_module.minimize
 

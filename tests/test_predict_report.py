@@ -164,7 +164,7 @@ def test_report_of_predict_folders(tmp_path, capsys):
     assert "best of seed-" in out["solutions"][0]
     runs = _table(_tables(Path(out["index"])), "run-summary")
     assert sorted(runs.run) == ["seed-1", "seed-2"]
-    # the best seed agrees with itself; two seeds never settle a cell (issue 20 needs 3)
+    # the best seed agrees with itself; two seeds never settle a cell (it needs 3)
     best = runs["recomputed cost (–)"].idxmin()
     assert runs["agrees with the best seed (yes/no)"][best]
     html = Path(out["index"]).read_text(encoding="utf-8")
@@ -247,7 +247,7 @@ def test_sweep_report_opens_in_a_browser(sweep_report, tmp_path):
 def test_report_of_a_parameter_file(tmp_path):
     src = SOLUTIONS / "able-3.5.json"  # the shipped solution
     rep = build_predictive_report(src, tmp_path / "r", duration=2.0, progress=False)
-    # the re-simulation, then issue 20's robustness runs: the nominal (judged at the speed it
+    # the re-simulation, then the acceptance's robustness runs: the nominal (judged at the speed it
     # reaches), 4 copies and 2 other starts (2 s has no room for a push)
     assert rep.kind == "parameters" and rep.simulations == 1 + (1 + 4 + 2)
     tables = _tables(Path(rep.index))
@@ -262,7 +262,7 @@ def test_report_of_a_parameter_file(tmp_path):
     assert not (judged["meets the acceptance (yes/no)"] & ~judged["runs the whole time (yes/no)"]).any()
     html = Path(rep.index).read_text(encoding="utf-8")
     met = judged["meets the acceptance (yes/no)"].all()
-    assert ("Issue 20&#x27;s acceptance: met" in html or "Issue 20's acceptance: met" in html) == met
+    assert ("Stable-gait acceptance: met" in html) == met
     assert "No pushes" in html
     # a running solution: 2 s without a fall near its 3.5 m/s, energy conserved (power balance)
     assert not resim["fell (yes/no)"] and resim["simulated (s)"] == pytest.approx(2.0)
@@ -293,7 +293,7 @@ def _check(fell=False, ok=True, peak_bw=0.1, tilt=-10.0, **extra) -> dict:
             "pelvis_tilt_max_deg": tilt + 5, **extra}
 
 
-def test_robustness_section_judges_issue_20_by_hand():
+def test_robustness_section_judges_the_acceptance_by_hand():
     from bladelab.report.predictive_robustness import robustness_section
 
     # as verify_solution returns it: "ok" is every run's verdict, "nominal_ok" the nominal's
@@ -307,7 +307,7 @@ def test_robustness_section_judges_issue_20_by_hand():
     rep = _Sections()
     robustness_section(rep, out, 10.0)
     (title, text, tables), = rep.sections
-    judged = tables["Judged runs (issue 20's acceptance)"]
+    judged = tables["Judged runs (the stable-gait acceptance)"]
     # strike above 0.2 BW (copy 2), a fall (copy 3), mean tilt outside -16...-2 deg (+5 %)
     assert judged["meets the acceptance (yes/no)"].tolist() == [
         True, True, False, False, True, False, True]

@@ -1,4 +1,4 @@
-"""When the seeds of one cell agree (issue 20: a settled cell), by hand."""
+"""When the seeds of one cell agree (a settled cell), by hand."""
 
 from __future__ import annotations
 

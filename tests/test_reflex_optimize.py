@@ -331,7 +331,7 @@ def test_a_folder_holding_a_run_is_refused_unless_resumed_or_forced(tmp_path, ca
 
 
 def test_robust_copies_can_start_at_other_speeds():
-    # issue 20's "±5 % of the initial speed" inside the objective: copies alternate 1 + s, 1 - s
+    # the acceptance's "±5 % of the initial speed" inside the objective: copies alternate 1 + s, 1 - s
     from bladelab.predict.reflex.objective import simulate_controlled
     from bladelab.predict.reflex.robust import robust_copies
 

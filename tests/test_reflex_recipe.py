@@ -1,4 +1,4 @@
-"""Recipes of CMA-ES stages per category and seed (issue 20): stage chaining, speed
+"""Recipes of CMA-ES stages per category and seed: stage chaining, speed
 continuation on the speed reached, resuming, the checks of a task folder, the category table
 with the seeds' agreement, the CLI."""
 
@@ -52,7 +52,7 @@ def _fake_levels(monkeypatch, speeds: dict[str, float], falls: tuple[str, ...] =
                  half: dict[str, float | None] | None = None) -> list:
     """level_row stand-in: the mean speed [m/s] of each level by name (no 10 s runs); ``half``:
     a level's speed at half the step (None: it falls there; a level not named has no such
-    run, as rows written before session 21)."""
+    run, as rows written before levels were simulated at finer steps)."""
     seen = []
 
     def fake(path: Path) -> dict:
@@ -204,7 +204,7 @@ def test_maximum_speed_is_the_fastest_settled_speed():
                                         "quarter_step_speed_m_per_s": 3.47}) == 3.47
     assert recipe_module.settled_speed({**row(3.7, 3.55), "runs_at_quarter_step": False,
                                         "quarter_step_speed_m_per_s": None}) is None
-    # a row of session 21 that ran at half the step but did not keep its speed there
+    # an older row that ran at half the step but did not keep its speed there
     assert recipe_module.settled_speed({"mean_speed_m_per_s": 3.5, "fell": False,
                                         "runs_at_half_step": True,
                                         "half_step_speed_m_per_s": None}) == 3.5
@@ -278,7 +278,7 @@ def test_level_row_is_the_gaits_ten_second_rerun_and_judges_the_acceptance():
     assert row["cost"] == v["cost"] and row["mean_speed_m_per_s"] == v["mean_speed_m_per_s"]
     assert not row["fell"] and row["simulated_s"] == pytest.approx(10.0)
     # the shipped amputee gait strikes the ground with its swinging blade at ~0.38 body
-    # weights (issue 20's limit: 0.2), so even its nominal run fails the acceptance
+    # weights (the acceptance's limit: 0.2), so even its nominal run fails the acceptance
     assert row["swing_contact_peak_bw"] > 0.3
     assert not row["nominal_meets_acceptance"] and not row["accepted"]
     assert row["judged_at_m_per_s"] == round(v["mean_speed_m_per_s"], 2)  # its own speed
@@ -383,7 +383,7 @@ def test_category_table_by_hand():
     assert t.loc["Cat6", "maximum speed (m/s)"] == pytest.approx(3.65)
     assert t.loc["Cat6", "maximum speed spread (m/s)"] == pytest.approx(0.45)
     assert t.loc["Cat6", "maximum-speed gaits meeting the acceptance (count)"] == 1
-    # issue 20's maximum speed: only seed 1's 3.65 m/s level meets the acceptance
+    # the maximum speed meeting the acceptance: only seed 1's 3.65 m/s level meets it
     assert t.loc["Cat6", "maximum speed meeting the acceptance (m/s)"] == pytest.approx(3.65)
     assert math.isnan(t.loc["Cat7", "maximum speed meeting the acceptance (m/s)"])
     assert not t.loc["Cat7", "settled (yes/no)"]
@@ -483,5 +483,5 @@ def test_report_of_a_recipe_sweep_resimulates_every_level(tmp_path):
     assert (levels["mean speed (m/s)"] - fine).min() > 0.05  # 1 ms runs faster (README)
     categories = pd.read_csv(next(folder.glob("tables/*categories.csv")))
     assert categories["seed 001 maximum speed (m/s)"].iloc[0] > 4  # Table 3.1: 4.27–4.675
-    assert not categories["settled (yes/no)"].iloc[0]  # 2 seeds: issue 20 needs 3
+    assert not categories["settled (yes/no)"].iloc[0]  # 2 seeds: settling needs 3
     assert "Speed reached per level and seed" in (folder / "index.html").read_text()

@@ -1,4 +1,4 @@
-"""Tracking a collocation stride with the reflex controller (issue 20's warm start)."""
+"""Tracking a collocation stride with the reflex controller (the reflex optimisation's warm start)."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""Robust identification (issue 9): the utilised-friction formulation against the seed's.
+"""Robust identification: the utilised-friction formulation against the seed's.
 
 Stances come from the MuJoCo runner generator (not the identification model) and are degraded
 as a motion-capture lab records them (``bladelab.example.degrade_stance``: cluster and tip
@@ -78,7 +78,7 @@ def test_confidence_intervals_widen_with_noise(clean_case):
         deg = degrade_stance(stance, tip=tip, marker_rate_hz=100.0, marker_noise_m=marker_noise,
                              force_noise_frac=force_noise, seed=5)
         # the statistical interval (without the calibrated systematic term, a floor that does
-        # not depend on the noise: issue 16)
+        # not depend on the noise)
         ident = identify_stance(deg, blade, seed=0, ci_systematic=False)
         assert ident.formulation == DEFAULT_FORMULATION == "utilised-friction"
         widths.append({n: hi - lo for n, (lo, hi) in ident.ci.items()})
@@ -86,7 +86,7 @@ def test_confidence_intervals_widen_with_noise(clean_case):
         assert k_lo <= 17.0 * 1.03 and k_hi >= 17.0 * 0.97  # near the truth
     assert widths[1]["K"] > 1.2 * widths[0]["K"]
     # D's interval is set mostly by the smooth, structured part of the residual (the model's
-    # mismatch), which the Newey–West scale counts at any noise level (issue 16): it does not
+    # mismatch), which the Newey–West scale counts at any noise level: it does not
     # shrink with less noise (measured 0.050 at 0.5 mm, 0.047 N·m·s/deg at 3 mm)
     assert widths[1]["D"] > 0.8 * widths[0]["D"]
     # with it (the default), D's interval is at least ±1.96 × 3 % of the estimate

@@ -14,7 +14,7 @@ from bladelab.predict.reflex.objective import simulate_controlled
 from bladelab.predict.reflex.optimize import runner_and_layout, stored_settings
 from bladelab.runner.analyses import stances, swing_contacts
 from bladelab.runner.clearance import swing_clearance
-from bladelab.runner.model import CP_BLADE
+from bladelab.runner.layout import CP_BLADE
 from bladelab.runner.params import RUNNER_DATA_DIR
 
 SHIPPED = RUNNER_DATA_DIR / "solutions" / "amputee-Cat6-3.5.json"

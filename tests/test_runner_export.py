@@ -22,6 +22,7 @@ from bladelab.runner.export import (
     read_mot,
     write_opensim,
 )
+from conftest import SCONE_H0918
 from test_runner_analyses import STANCES, _synthetic
 
 
@@ -110,7 +111,7 @@ def test_the_centre_of_pressure_keeps_the_moment_of_the_contact_forces():
     assert cop[i] * fz[i] == pytest.approx(moment)
 
 
-def test_opensim_reads_the_export_and_poses_its_model_as_bladelab(files, shared_data, tmp_path,
+def test_opensim_reads_the_export_and_poses_its_model_as_bladelab(files, tmp_path,
                                                                   monkeypatch):
     if "casadi" in sys.modules and not os.environ.get("BLADELAB_FRESH_INTERPRETER"):
         # OpenSim's Moco library clashes with a casadi package already loaded in this process
@@ -134,7 +135,7 @@ def test_opensim_reads_the_export_and_poses_its_model_as_bladelab(files, shared_
     loads = osim.ExternalLoads(str(files["external_loads"]), True)
     assert loads.getSize() == 2 and loads.getDataFileName() == "grf.mot"
     # the able runner's exported pose put into SCONE's H0918 OpenSim model: same segments
-    model = osim.Model(str(shared_data / "models" / "scone-h0918" / "H0918M_osim4.osim"))
+    model = osim.Model(str(SCONE_H0918 / "H0918M_osim4.osim"))
     state = model.initSystem()
     able = build_runner("able")
     res = simulate_runner(able, duration=0.05, excitations=0.1, initial_state="gait",

@@ -250,7 +250,8 @@ def test_toe_body_keeps_the_mass_and_adds_a_toe_hinge(able):
     """The ``toes`` body: same total mass and centre of mass as seed 001's (the toes' mass is
     taken from the calcaneus), a metatarsophalangeal hinge per foot with Sasaki et al. (2009)'s
     spring, a toe-tip sphere level with the ball sphere, and compliant Achilles tendons only."""
-    from bladelab.runner.model import JP_SD, JP_SK, MTP_DAMPING, MTP_STIFFNESS
+    from bladelab.runner.layout import JP_SD, JP_SK
+    from bladelab.runner.model import MTP_DAMPING, MTP_STIFFNESS
     from bladelab.runner.muscle import MP_TSTRAIN
 
     toes = build_runner("able", body="toes")

@@ -1,4 +1,4 @@
-"""The transfemoral runner (issue 21): seed 002's athlete on seed 001's body, a passive
+"""The transfemoral runner: seed 002's athlete on seed 001's body, a passive
 3S80-class prosthetic knee on the residual thigh, the category's blade sphere."""
 
 from __future__ import annotations

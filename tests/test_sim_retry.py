@@ -1,5 +1,5 @@
 """A diverging kernel run is retried with a smaller step; no NaN reaches an optimiser or the CI
-step; the seed formulation completes on the example trial TT1_cat5_02 (issue 16)."""
+step; the seed formulation completes on the example trial TT1_cat5_02."""
 
 from __future__ import annotations
 

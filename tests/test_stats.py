@@ -155,7 +155,7 @@ def test_summarize_gives_t_confidence_intervals():
     assert out.loc["a", "K_Nm_per_deg_ci_low"] == pytest.approx(2 - half, abs=1e-6)
     assert out.loc["a", "K_Nm_per_deg_ci_high"] == pytest.approx(2 + half, abs=1e-6)
     assert np.isnan(out.loc["b", "K_Nm_per_deg_ci_low"])
-    # a lower limit below the physical minimum is clipped and marked (issue 16: D* (−0.003, 0.458))
+    # a lower limit below the physical minimum is clipped and marked (as D* (−0.003, 0.458) was)
     clipped = summarize(data, values=["K_Nm_per_deg"], by=["group"],
                         lower_limits={"K_Nm_per_deg": 0.0}).set_index("group")
     assert 2 - half < 0 and clipped.loc["a", "K_Nm_per_deg_ci_low"] == 0.0

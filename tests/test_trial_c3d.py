@@ -13,24 +13,23 @@ import trial_synth as synth
 from bladelab.errors import BladelabError, DataError, InputFileError, SpecError
 from bladelab.trial.c3d import C3DWarning, plate_corners, read_c3d, write_c3d
 from bladelab.units import body_weight
+from conftest import FUKUCHI_FORCES, FUKUCHI_INFO, FUKUCHI_STATIC, WALKING
+from conftest import FUKUCHI_RUN as FUKUCHI
 
-FUKUCHI = "real/fukuchi2017/RBDS001runT35.c3d"
-WALKING = ("real/opensim-walking/walking2.c3d", "real/opensim-walking/walking5.c3d")
 
-
-def _subject_mass(shared_data, subject: int) -> float:
-    info = pd.read_csv(shared_data / "real/fukuchi2017/RBDSinfo.txt", sep="\t")
+def _subject_mass(subject: int) -> float:
+    info = pd.read_csv(FUKUCHI_INFO, sep="\t")
     return float(info.loc[info["Subject"] == subject, "Mass"].iloc[0])
 
 
 @pytest.fixture(scope="module")
-def fukuchi(shared_data):
-    return read_c3d(shared_data / FUKUCHI)
+def fukuchi():
+    return read_c3d(FUKUCHI)
 
 
-def test_type4_calibration_matrix_by_hand(shared_data, fukuchi):
+def test_type4_calibration_matrix_by_hand(fukuchi):
     """Vertical GRF = CAL_MATRIX @ raw analogs, rotated by the plate axes derived by hand."""
-    c = ezc3d.c3d(str(shared_data / FUKUCHI))
+    c = ezc3d.c3d(str(FUKUCHI))
     fp = c["parameters"]["FORCE_PLATFORM"]
     raw = c["data"]["analogs"][0]  # 6 channels as stored (scaled)
     cal = np.asarray(fp["CAL_MATRIX"]["value"])[:, :, 0]
@@ -49,8 +48,8 @@ def test_type4_calibration_matrix_by_hand(shared_data, fukuchi):
     assert np.max(np.abs(raw[2])) < 10.0 < np.max(force[:, 2])
 
 
-def test_fukuchi_forces_are_physiological(shared_data, fukuchi):
-    bw = body_weight(_subject_mass(shared_data, 1))  # RBDSinfo.txt: 62 kg
+def test_fukuchi_forces_are_physiological(fukuchi):
+    bw = body_weight(_subject_mass(1))  # RBDSinfo.txt: 62 kg
     fz = fukuchi.platforms[0].force[:, 2]
     # on a treadmill the mean vertical GRF over many strides equals body weight
     assert abs(fz.mean() / bw - 1.0) < 0.05
@@ -70,14 +69,14 @@ def test_fukuchi_axes_and_units(fukuchi):
     assert np.nanmedian(foot[:, 0]) > 0.05  # toes point forward
 
 
-@pytest.mark.parametrize("name", [FUKUCHI, *WALKING])
-def test_cop_and_free_moment_match_ezc3d_module(shared_data, name):
+@pytest.mark.parametrize("name", [FUKUCHI, *WALKING], ids=lambda p: p.name)
+def test_cop_and_free_moment_match_ezc3d_module(name):
     """ezc3d's own force-platform module is an independent implementation of COP and Tz.
 
     ezc3d keeps the file's zero offsets, so the comparison reads the file as it is.
     """
-    trial = read_c3d(shared_data / name, zero_offset=False)
-    c = ezc3d.c3d(str(shared_data / name), extract_forceplat_data=True)
+    trial = read_c3d(name, zero_offset=False)
+    c = ezc3d.c3d(str(name), extract_forceplat_data=True)
     axes = trial.metadata["axes"]
     perm = np.zeros((3, 3))
     for row, key in enumerate(("forward", "lateral", "up")):
@@ -109,14 +108,14 @@ def test_fukuchi_cop_under_the_stance_foot(fukuchi):
     assert np.all((plate.cop[loaded, :2] >= lo[:2] - 1e-9) & (plate.cop[loaded, :2] <= hi[:2] + 1e-9))
 
 
-def test_forces_txt_export_agrees_on_matching_quantities(shared_data, fukuchi):
+def test_forces_txt_export_agrees_on_matching_quantities(fukuchi):
     """RBDS0041runT252forces.txt is another runner's 2.5 m/s trial (not RBDS001 at 3.5 m/s).
 
     What matches: rate and length (300 Hz, 30 s), file axes (y up: COPy = 0 = plate surface),
     sign conventions (GRF on the runner, vertical positive; Fx brakes then propels along +x),
     peak/mean vertical force ratio (mean = body weight on a treadmill) and contact times.
     """
-    txt = pd.read_csv(shared_data / "real/fukuchi2017/RBDS0041runT252forces.txt", sep="\t")
+    txt = pd.read_csv(FUKUCHI_FORCES, sep="\t")
     plate = fukuchi.platforms[0]
     assert len(txt) == plate.n_samples == 9000
     # vertical = file y in both; our plate surface is file y = 0 like the export's COPy
@@ -143,11 +142,11 @@ def test_forces_txt_export_agrees_on_matching_quantities(shared_data, fukuchi):
     assert 0.2 < ours / ty < 5.0
 
 
-@pytest.mark.parametrize("name", WALKING)
-def test_walking_plates_zero_offset(shared_data, name):
+@pytest.mark.parametrize("name", WALKING, ids=lambda p: p.name)
+def test_walking_plates_zero_offset(name):
     """The OpenSim walking plates read −14 to −20 N unloaded: removed as a constant offset."""
-    raw = read_c3d(shared_data / name, zero_offset=False)
-    zeroed = read_c3d(shared_data / name)
+    raw = read_c3d(name, zero_offset=False)
+    zeroed = read_c3d(name)
     for p0, p1 in zip(raw.platforms, zeroed.platforms, strict=True):
         fz = p0.force[:, 2]
         by_hand = np.median(fz)  # the plates are unloaded most of the time
@@ -160,16 +159,16 @@ def test_walking_plates_zero_offset(shared_data, name):
     assert "warnings" not in zeroed.metadata
 
 
-def test_fukuchi_zeroed_plate_is_left_alone(shared_data, fukuchi):
+def test_fukuchi_zeroed_plate_is_left_alone(fukuchi):
     """A zeroed plate (unloaded level within 5 N) reads exactly as the file gives it."""
-    raw = read_c3d(shared_data / FUKUCHI, zero_offset=False)
+    raw = read_c3d(FUKUCHI, zero_offset=False)
     assert fukuchi.platforms[0].zero_offset_N == 0.0
     np.testing.assert_array_equal(fukuchi.platforms[0].force, raw.platforms[0].force)
 
 
-def test_walking_two_type2_platforms(shared_data):
+def test_walking_two_type2_platforms():
     for name in WALKING:
-        trial = read_c3d(shared_data / name)
+        trial = read_c3d(name)
         assert [p.type for p in trial.platforms] == [2, 2]
         assert trial.metadata["axes"]["up"] == "+z"
         # gaps are NaN, never zeros
@@ -234,8 +233,8 @@ def test_not_a_c3d(tmp_path):
 
 
 @pytest.mark.parametrize("fraction", [0.02, 0.5, 0.99])
-def test_truncated_c3d(shared_data, tmp_path, fraction):
-    data = (shared_data / WALKING[0]).read_bytes()
+def test_truncated_c3d(tmp_path, fraction):
+    data = WALKING[0].read_bytes()
     bad = tmp_path / "truncated.c3d"
     bad.write_bytes(data[: int(len(data) * fraction)])
     with pytest.raises(InputFileError, match="truncated") as err:
@@ -243,45 +242,45 @@ def test_truncated_c3d(shared_data, tmp_path, fraction):
     assert str(bad) in str(err.value)
 
 
-def test_truncated_inside_parameters(shared_data, tmp_path):
-    data = (shared_data / WALKING[0]).read_bytes()
+def test_truncated_inside_parameters(tmp_path):
+    data = WALKING[0].read_bytes()
     bad = tmp_path / "truncated.c3d"
     bad.write_bytes(data[:700])
     with pytest.raises(InputFileError):
         read_c3d(bad)
 
 
-def _patched_copy(shared_data, tmp_path, group, name, value):
-    c = ezc3d.c3d(str(shared_data / WALKING[0]))
+def _patched_copy(tmp_path, group, name, value):
+    c = ezc3d.c3d(str(WALKING[0]))
     c["parameters"][group][name]["value"] = value
     out = tmp_path / "patched.c3d"
     c.write(str(out))
     return out
 
 
-def test_unsupported_platform_type(shared_data, tmp_path):
-    path = _patched_copy(shared_data, tmp_path, "FORCE_PLATFORM", "TYPE", np.array([2, 5]))
+def test_unsupported_platform_type(tmp_path):
+    path = _patched_copy(tmp_path, "FORCE_PLATFORM", "TYPE", np.array([2, 5]))
     with pytest.raises(DataError, match="type 5 is not supported") as err:
         read_c3d(path)
     assert "platform 2" in str(err.value) and str(path) in str(err.value)
 
 
-def test_missing_platform_channel(shared_data, tmp_path):
+def test_missing_platform_channel(tmp_path):
     chan = np.arange(1, 13).reshape(2, 6).T.copy()
     chan[0, 1] = 40
-    path = _patched_copy(shared_data, tmp_path, "FORCE_PLATFORM", "CHANNEL", chan)
+    path = _patched_copy(tmp_path, "FORCE_PLATFORM", "CHANNEL", chan)
     with pytest.raises(DataError, match="analog channel"):
         read_c3d(path)
 
 
-def test_static_trial_without_analogs_has_no_platforms(shared_data, tmp_path):
-    trial = read_c3d(shared_data / "real/fukuchi2017/RBDS001static.c3d")
+def test_static_trial_without_analogs_has_no_platforms(tmp_path):
+    trial = read_c3d(FUKUCHI_STATIC)
     assert trial.platforms == ()
 
 
-def test_axis_options(shared_data, tmp_path):
+def test_axis_options(tmp_path):
     path = tmp_path / "copy.c3d"
-    shutil.copy(shared_data / WALKING[0], path)
+    shutil.copy(WALKING[0], path)
     trial = read_c3d(path, forward="-y", up="+z")
     assert trial.metadata["axes"] == {"forward": "-y", "lateral": "+x", "up": "+z"}
     with pytest.raises(BladelabError, match="vertical"):

@@ -1,4 +1,4 @@
-"""C3D files from other vendors and eras (issue 17): one file per quirk, written here to
+"""C3D files from other vendors and eras: one file per quirk, written here to
 reproduce what the public c3d.org samples show, read back through ``read_c3d``.
 
 Files are written with ezc3d, or, where ezc3d cannot write the quirk (a stale header, another

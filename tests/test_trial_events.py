@@ -12,8 +12,8 @@ from bladelab.errors import DataError
 from bladelab.trial.c3d import plate_corners, read_c3d, write_c3d
 from bladelab.trial.events import classify_stances, detect_stances
 from bladelab.units import body_weight
-
-FUKUCHI = "real/fukuchi2017/RBDS001runT35.c3d"
+from conftest import FUKUCHI_INFO, WALKING
+from conftest import FUKUCHI_RUN as FUKUCHI
 
 
 def _runs(mask):
@@ -28,12 +28,12 @@ def _hand_stances(fz, rate, threshold=20.0, min_duration=0.05):
 
 
 @pytest.fixture(scope="module")
-def fukuchi(shared_data):
-    return read_c3d(shared_data / FUKUCHI)
+def fukuchi():
+    return read_c3d(FUKUCHI)
 
 
-def test_fukuchi_stances_match_hand_thresholding(shared_data, fukuchi):
-    c = ezc3d.c3d(str(shared_data / FUKUCHI))
+def test_fukuchi_stances_match_hand_thresholding(fukuchi):
+    c = ezc3d.c3d(str(FUKUCHI))
     cal = np.asarray(c["parameters"]["FORCE_PLATFORM"]["CAL_MATRIX"]["value"])[2, 2, 0]
     fz = -cal * c["data"]["analogs"][0][2]  # F1Z, plate z points down: vertical = −Fz
     rate = c["header"]["analogs"]["frame_rate"]
@@ -47,8 +47,8 @@ def test_fukuchi_stances_match_hand_thresholding(shared_data, fukuchi):
         assert ev.impulse_z_Ns == pytest.approx(np.trapezoid(fz[s:e], t), rel=0.03)
 
 
-def test_fukuchi_stances_are_physiological(shared_data, fukuchi):
-    info = pd.read_csv(shared_data / "real/fukuchi2017/RBDSinfo.txt", sep="\t")
+def test_fukuchi_stances_are_physiological(fukuchi):
+    info = pd.read_csv(FUKUCHI_INFO, sep="\t")
     bw = body_weight(float(info.loc[info["Subject"] == 1, "Mass"].iloc[0]))
     events = detect_stances(fukuchi)
     peaks = np.array([e.peak_fz_N for e in events]) / bw
@@ -61,9 +61,8 @@ def test_fukuchi_stances_are_physiological(shared_data, fukuchi):
     assert np.median([e.impulse_z_Ns for e in events]) == pytest.approx(bw * step, rel=0.08)
 
 
-@pytest.mark.parametrize("name", ["walking2.c3d", "walking5.c3d"])
-def test_walking_both_platforms_found(shared_data, name):
-    path = shared_data / "real/opensim-walking" / name
+@pytest.mark.parametrize("path", WALKING, ids=lambda p: p.name)
+def test_walking_both_platforms_found(path):
     c = ezc3d.c3d(str(path))
     analogs = c["data"]["analogs"][0]
     rate = c["header"]["analogs"]["frame_rate"]

@@ -51,15 +51,15 @@ def _hand_knee(path, side):
     return np.sign(cross) * np.arccos(np.clip(dot / norm, -1.0, 1.0))
 
 
-def test_knee_angle_equals_hand_computation(trials, shared_data):
+def test_knee_angle_equals_hand_computation(trials):
     """Unfiltered module angle = hand vector maths on the raw file coordinates, minus the
     static trial's mean (a few frames across the trial, both legs)."""
     run, static = trials
     ja = sagittal_angles(run, static=static, cutoff_hz=None)
     frames = [37, 512, 1999, 4321]
     for side, s in (("right", "R"), ("left", "L")):
-        raw = _hand_knee(shared_data / RUN, s)
-        offset = float(np.mean(_hand_knee(shared_data / STATIC, s)))
+        raw = _hand_knee(RUN, s)
+        offset = float(np.mean(_hand_knee(STATIC, s)))
         assert ja.offsets[f"knee_{side}"] == pytest.approx(offset, abs=1e-9)
         np.testing.assert_allclose(ja.angles[f"knee_{side}"][frames], raw[frames] - offset,
                                    atol=1e-9)

@@ -16,6 +16,7 @@ from bladelab.trial.kinematics import (
     extract_stance,
     load_marker_map,
 )
+from conftest import FUKUCHI_RUN
 
 
 @pytest.fixture(scope="module")
@@ -144,9 +145,9 @@ def test_gap_outside_the_window_does_not_matter(tmp_path):
     assert np.all(np.isfinite(st.distance))
 
 
-def test_real_file_mechanics_with_mapped_foot_markers(shared_data):
+def test_real_file_mechanics_with_mapped_foot_markers():
     """Mechanics only: the runner's right foot markers stand in for the clamp and tip roles."""
-    trial = read_c3d(shared_data / "real/fukuchi2017/RBDS001runT35.c3d")
+    trial = read_c3d(FUKUCHI_RUN)
     mm = MarkerMap(clamp_anterior="R.MT1", clamp_posterior="R.Heel.Bottom", tip="R.Shank.Top.Lateral")
     events = detect_stances(trial)
     st = extract_stance(trial, 0, markers=mm, marker_cutoff=None, force_cutoff=None, stances=events)

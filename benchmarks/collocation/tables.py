@@ -19,7 +19,7 @@ import math
 import re
 from pathlib import Path
 
-# Seed 001 (docs of issue 15: /work/shared/seeds/001_*.txt), per blade category.
+# Seed 001 (/work/shared/seeds/001_*.txt), per blade category.
 # Table 3.2: P+ and P− [W/kg] of the intact hip, knee, ankle, the prosthetic hip, knee, RSP,
 # and the TOTAL (both legs), P− as printed (magnitudes).
 _T32 = {

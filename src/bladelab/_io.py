@@ -16,6 +16,8 @@ from collections.abc import Iterator
 from pathlib import Path
 from typing import IO, Any
 
+from bladelab.errors import InputFileError, SpecError
+
 
 def _umask() -> int:
     """The process's umask (read by setting it and setting it back)."""
@@ -32,8 +34,6 @@ def atomic_path(target: str | Path) -> Iterator[Path]:
     """
     target = Path(target)
     if target.is_dir():
-        from bladelab.errors import InputFileError
-
         raise InputFileError("is a folder, not a file name", file=target,
                              hint="give the path of the file to write (e.g. add a file name)")
     target.parent.mkdir(parents=True, exist_ok=True)
@@ -66,8 +66,6 @@ def write_json(target: str | Path, obj: Any) -> None:
 
 
 def _read_text(path: Path, what: str, hint: str | None) -> str:
-    from bladelab.errors import InputFileError
-
     if not path.is_file():
         raise InputFileError(f"{what} not found", file=path, hint=hint)
     try:
@@ -80,8 +78,6 @@ def _read_text(path: Path, what: str, hint: str | None) -> str:
 def read_json(path: str | Path, *, what: str = "JSON file", hint: str | None = None) -> Any:
     """The content of a JSON file; a missing, unreadable or invalid file raises
     :class:`~bladelab.errors.InputFileError` naming it (``what`` says what the file is)."""
-    from bladelab.errors import InputFileError
-
     path = Path(path)
     text = _read_text(path, what, hint)
     try:
@@ -93,9 +89,7 @@ def read_json(path: str | Path, *, what: str = "JSON file", hint: str | None = N
 
 def read_yaml(path: str | Path, *, what: str = "YAML file", hint: str | None = None) -> Any:
     """The content of a YAML file (``safe_load``); errors as :func:`read_json`."""
-    import yaml
-
-    from bladelab.errors import InputFileError
+    import yaml  # deferred: the CLI imports _io at start-up; few commands read YAML
 
     path = Path(path)
     text = _read_text(path, what, hint)
@@ -112,9 +106,8 @@ def figure_format(path: str | Path, *, where: str = "--plot") -> str:
     """The image format of a figure path from its suffix (``.png`` when it has none); an
     unsupported suffix raises :class:`~bladelab.errors.SpecError` naming ``where`` and the
     formats matplotlib can write, before anything is drawn."""
+    # deferred: the CLI imports _io at start-up; matplotlib takes ~0.5 s
     from matplotlib.backend_bases import FigureCanvasBase
-
-    from bladelab.errors import SpecError
 
     fmt = Path(path).suffix.lstrip(".").lower() or "png"
     supported = FigureCanvasBase.get_supported_filetypes()

@@ -1,12 +1,15 @@
 """``python -m bladelab.demo`` (``make demo``): the characterise workflow on the example study.
 
+Everything is written under ``examples/`` in the current working directory (:func:`examples_dir`;
+``make demo`` runs it from the project root), never inside the installation.
+
 1. Generates (or reuses) the **synthetic** example study in ``examples/sprint-study/``
    (``bladelab example make``; see ``docs/example-study.md``): 50 C3D trials of seed 000's cohort.
 2. Identifies K* and D* of every trial with 2 worker processes (``bladelab identify --jobs 2``).
 3. Writes the study report ``examples/sprint-study/report/index.html`` (``bladelab report``).
-4. Runs the trial pipeline on one real recording from the shared data, when it is there
-   (``../shared/data/real/fukuchi2017/RBDS001runT35.c3d``: a recreational runner, 62 kg, treadmill
-   at 3.5 m/s): its stances with peak forces in body weights.
+4. Runs the trial pipeline on one real recording shipped with bladelab
+   (:func:`bladelab.datasets.measured_running_trial`, Fukuchi et al. 2017: a recreational runner,
+   62 kg, treadmill at 3.5 m/s): its stances with peak forces in body weights.
 
 5. Runs the design example (seed 002, ``docs/design.md``): a 25-run face-centred CCD over the
    default design space with the blade evaluator into ``examples/design-study/`` and its report
@@ -25,27 +28,40 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from bladelab.errors import BladelabError, InputFileError
+import pandas as pd
 
-PROJECT_ROOT = Path(__file__).resolve().parents[2]
-DEMO_TRIAL = PROJECT_ROOT.parent / "shared" / "data" / "real" / "fukuchi2017" / "RBDS001runT35.c3d"
-DEMO_MASS_KG = 62.0  # RBDSinfo.txt, subject RBDS001
+from bladelab.datasets import MEASURED_SUBJECT_MASS_KG, measured_running_trial
+from bladelab.design import BladeEvaluator, default_design_space, run_design
+from bladelab.design.plots import write_design_figures
+from bladelab.design.trends import evaluate_trends
+from bladelab.errors import BladelabError
+from bladelab.example.study import make_example_study
+from bladelab.report.design import build_design_report
+from bladelab.report.study import build_study_report
+from bladelab.study import run_study
+from bladelab.trial import detect_stances, read_c3d
+from bladelab.units import body_weight
+
+#: Mass [kg] of the runner of the demo's real trial (subject RBDS001, ``RBDSinfo.txt``).
+DEMO_MASS_KG = MEASURED_SUBJECT_MASS_KG
 
 
-def run(path: Path = DEMO_TRIAL, *, rows: int = 5) -> str:
-    """Run the trial pipeline on the real trial ``path`` and return the printed summary.
+def examples_dir() -> Path:
+    """The folder the demo writes into: ``examples/`` under the current working directory (read
+    when called), so that ``make demo`` from the project root fills ``examples/`` there and an
+    installed bladelab writes beside the user, never into the installation."""
+    return Path.cwd() / "examples"
+
+
+def run(path: str | Path | None = None, *, rows: int = 5) -> str:
+    """Run the trial pipeline on the real trial ``path`` (default: the shipped
+    :func:`~bladelab.datasets.measured_running_trial`, a 62 kg runner) and return the printed
+    summary.
 
     The first ``rows`` stances are listed (numbered from 1, as ``bladelab trial stances``); the
     ranges cover all of them.
     """
-    from bladelab.trial import detect_stances, read_c3d
-    from bladelab.units import body_weight
-
-    if not path.is_file():
-        raise InputFileError(
-            "demo trial not found", file=path,
-            hint="the demo needs the shared data folder beside the project (../shared/data)",
-        )
+    path = measured_running_trial() if path is None else Path(path)
     trial = read_c3d(path)
     stances = detect_stances(trial)
     bw = body_weight(DEMO_MASS_KG)
@@ -73,13 +89,14 @@ def run(path: Path = DEMO_TRIAL, *, rows: int = 5) -> str:
     return "\n".join(lines)
 
 
-DESIGN_DIR = PROJECT_ROOT / "examples" / "design-study"
 #: Illustrative constraint thresholds of the design example (blade-evaluator proxies).
 DESIGN_CONSTRAINTS = {"knee_moment_min_Nm": -30.0, "swing_clearance_m": 0.07}
 
 
-def design_example(out_dir: Path = DESIGN_DIR, *, seed: int = 0) -> tuple[Path, list[str]]:
-    """Run (or resume) the design example and write its report; returns (report, summary lines).
+def design_example(out_dir: str | Path | None = None, *, seed: int = 0) -> tuple[Path, list[str]]:
+    """Run (or resume) the design example in ``out_dir`` (default ``examples/design-study`` under
+    the current folder, :func:`examples_dir`) and write its report; returns (report, summary
+    lines).
 
     A 25-run face-centred central composite design over :func:`default_design_space` with the
     blade evaluator (8 m/s, 76 kg), objective Δv_x, constraints :data:`DESIGN_CONSTRAINTS`.
@@ -87,10 +104,8 @@ def design_example(out_dir: Path = DESIGN_DIR, *, seed: int = 0) -> tuple[Path, 
     import matplotlib
 
     matplotlib.use("Agg")
-    from bladelab.design import BladeEvaluator, default_design_space, run_design
-    from bladelab.design.plots import write_design_figures
-    from bladelab.report.design import build_design_report
 
+    out_dir = examples_dir() / "design-study" if out_dir is None else Path(out_dir)
     ev = BladeEvaluator()
     res = run_design(default_design_space(), runs="ccd", evaluator=ev, out_dir=out_dir, seed=seed,
                      objective="delta_vx_m_per_s", constraints=DESIGN_CONSTRAINTS, units=ev.units)
@@ -104,8 +119,6 @@ def design_example(out_dir: Path = DESIGN_DIR, *, seed: int = 0) -> tuple[Path, 
         pt = ", ".join(f"{k}={v:.4g}" for k, v in o.point.items())
         lines.append(f"  optimum Δv_x {o.predicted:+.3f} m/s (PI {o.pi[0]:+.3f} .. {o.pi[1]:+.3f})"
                      f" at {pt}")
-    from bladelab.design.trends import evaluate_trends
-
     verdicts = evaluate_trends(res.surfaces, evaluator="blade")
     lines.append("  seed 002 trends: " + "; ".join(f"{v.statement}: {v.verdict}"
                                                    for v in verdicts))
@@ -159,7 +172,8 @@ def run_example_pipeline(
     Parameters
     ----------
     folder
-        Study folder (default ``examples/sprint-study`` in the project).
+        Study folder (default ``examples/sprint-study`` under the current folder,
+        :func:`examples_dir`).
     seed
         Study seed.
     jobs
@@ -171,11 +185,8 @@ def run_example_pipeline(
     echo
         Where the step lines go.
     """
-    from bladelab.example.study import make_example_study
-    from bladelab.report.study import build_study_report
-    from bladelab.study import run_study
-
     t0 = time.perf_counter()
+    folder = examples_dir() / "sprint-study" if folder is None else Path(folder)
     made = make_example_study(folder, seed=seed, jobs=jobs, n_trials=n_trials, progress=progress)
     t1 = time.perf_counter()
     echo(f"[1/3] example study {'generated' if made.generated else 'reused'}: {made.folder} "
@@ -200,8 +211,6 @@ def run_example_pipeline(
 
 def _summary(report: Path) -> list[str]:
     """Headline numbers from the report's CSV tables."""
-    import pandas as pd
-
     tables = report.parent / "tables"
     out = []
     grf = tables / "nrmse-grf.csv"
@@ -235,10 +244,7 @@ def main() -> int:
               "(docs/example-study.md)", flush=True)
         res = run_example_pipeline(jobs=2, echo=lambda s: print(s, flush=True))
         print("\n".join(_summary(res.report)))
-        try:
-            print("\n" + run())
-        except BladelabError as err:
-            print(f"(real trial skipped: {err})")
+        print("\n" + run())
         print("\nbladelab demo: the design workflow (seed 002, docs/design.md)", flush=True)
         design_report, design_lines = design_example()
         print("\n".join(design_lines))

@@ -24,6 +24,7 @@ import os
 import sys
 import traceback
 from collections.abc import Callable, Iterator, Sequence
+from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from typing import Any
 
 from bladelab.errors import BladelabError
@@ -105,8 +106,6 @@ class ProcessPool:
     workers at once when its block raises (Ctrl-C, SIGTERM via the CLI, an error)."""
 
     def __init__(self, jobs: int, *, start_method: str | None = None) -> None:
-        from concurrent.futures import ProcessPoolExecutor
-
         ctx = multiprocessing.get_context(start_method or default_start_method())
         self.jobs = int(jobs)
         self._pool = ProcessPoolExecutor(max_workers=self.jobs, mp_context=ctx,
@@ -146,8 +145,6 @@ class LocalExecutor:
         self.start_method = start_method or default_start_method()
 
     def run(self, task: Task, payloads: Sequence[dict]) -> Iterator[tuple[int, str, Any]]:
-        from concurrent.futures import FIRST_COMPLETED, wait
-
         if not payloads:
             return
         with ProcessPool(min(self.jobs, len(payloads)), start_method=self.start_method) as pool:
@@ -174,7 +171,7 @@ class RayExecutor:
 
     def __init__(self, jobs: int = 2) -> None:
         try:
-            import ray  # noqa: F401
+            import ray  # noqa: F401  # deferred: ray is an optional extra
         except ImportError:
             raise BladelabError(
                 "the Ray executor needs the 'ray' package, which is not installed",
@@ -183,7 +180,7 @@ class RayExecutor:
         self.jobs = int(jobs)
 
     def run(self, task: Task, payloads: Sequence[dict]) -> Iterator[tuple[int, str, Any]]:
-        import ray
+        import ray  # deferred: ray is an optional extra
 
         if not payloads:
             return
@@ -208,7 +205,7 @@ class RayExecutor:
 def start_local_ray(num_cpus: int) -> bool:
     """Start a quiet local Ray instance with ``num_cpus`` CPUs, its workers on this process's
     ``sys.path``, unless one is running; True when this call started it."""
-    import ray
+    import ray  # deferred: ray is an optional extra
 
     if ray.is_initialized():
         return False

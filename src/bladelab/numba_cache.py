@@ -3,7 +3,7 @@
 numba keys a cached function on its own source file (time stamp and size) and its own bytecode;
 the machine code of the functions it calls, from other files, is compiled into it. After an
 edit to a callee in another file, the caller's cached code is stale and runs the old callee
-(session 18: a new reflex term had no effect in the closed loop, and a changed one kept its old
+(2026-11-27: a new reflex term had no effect in the closed loop, and a changed one kept its old
 formula, until the cache was deleted; kernel.py's ``_CACHE_GENERATION`` was the manual fix).
 
 :func:`refresh_stale_caches`, called at the end of every module that defines cached compiled
@@ -18,6 +18,8 @@ from __future__ import annotations
 import functools
 import hashlib
 from pathlib import Path
+
+from numba.core.registry import CPUDispatcher
 
 __all__ = ["refresh_stale_caches", "sources_digest"]
 
@@ -40,8 +42,6 @@ def refresh_stale_caches(namespace: dict) -> bool:
     """Flush the on-disk cache of the compiled functions defined in the module ``namespace``
     (its ``globals()``) if bladelab's compiled sources changed since the module's last flush
     (a stamp file beside the cache). Returns whether it flushed."""
-    from numba.core.registry import CPUDispatcher
-
     module = namespace["__name__"]
     dispatchers = [v for v in namespace.values()
                    if isinstance(v, CPUDispatcher) and v.py_func.__module__ == module

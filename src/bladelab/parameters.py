@@ -13,6 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from bladelab import units
+from bladelab.errors import SpecError
 
 __all__ = ["JOINT_PARAMETERS", "JointParameter", "joint_parameter"]
 
@@ -71,8 +72,6 @@ JOINT_PARAMETERS: dict[str, JointParameter] = {
 
 def joint_parameter(name: str) -> JointParameter:
     """The parameter called ``name`` (``K``, ``D`` or ``K2``)."""
-    from bladelab.errors import SpecError
-
     try:
         return JOINT_PARAMETERS[name]
     except KeyError:

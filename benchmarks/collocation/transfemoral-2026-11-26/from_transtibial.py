@@ -6,10 +6,11 @@ pelvis lowered until a contact is 1 cm deep at every node, the template's force 
         benchmarks/collocation/study-2026-11-25-cat6-starts/amputee-Cat6/speed-4.warm-mu-1e-4.json \\
         track|notrack OUT.json
 
-Session 9 wrote ``speed-4.from-transtibial-tracked.json`` (track) and
-``speed-4.from-transtibial.json`` (notrack) this way (docs/design.md, "Predicted transfemoral
-gaits"); the maximum-speed files came from ``bladelab predict --method collocation --model
-transfemoral --max-speed --swing-clearance 0.02 --guess <that file>``.
+``speed-4.from-transtibial-tracked.json`` (track) and
+``speed-4.from-transtibial.json`` (notrack) were written this way on 2026-11-26
+(docs/design.md, "Predicted transfemoral gaits"); the maximum-speed files came from
+``bladelab predict --method collocation --model transfemoral --max-speed --swing-clearance 0.02
+--guess <that file>``.
 """
 
 from __future__ import annotations
@@ -18,9 +19,11 @@ import json
 import sys
 
 from bladelab.design.predicted import stride_responses
-from bladelab.predict.collocation.guess import StrideGuess, prosthetic_stride_on
+from bladelab.predict.collocation.guess import prosthetic_stride_on
+from bladelab.predict.collocation.settings import CollocationSettings
 from bladelab.predict.collocation.solution import CollocationSolution
-from bladelab.predict.collocation.solve import CollocationSettings, predict_stride
+from bladelab.predict.collocation.solve import predict_stride
+from bladelab.predict.collocation.stride_guess import StrideGuess
 from bladelab.runner import build_runner
 
 

@@ -1,12 +1,12 @@
 """The transfemoral runner wearing the design box's centre blade, from the sphere blade's clean
 4 m/s run: the common coordinates and muscle states copied by name, the blade's joints at
-their static deflection (``guess.deflected_blade``), predictive stage only.
+their static deflection (``stride_guess.deflected_blade``), predictive stage only.
 
     python benchmarks/collocation/transfemoral-2026-11-26/multilink_centre.py \\
         benchmarks/collocation/transfemoral-2026-11-26/speed-4.from-transtibial-tracked.json \\
         SOLE_SCALE SPEED OUT.json [KNEE_MOMENT_MIN_NM|none] [trapezoidal|backward-euler]
 
-Session 10 made ``src/bladelab/data/runner/collocation/transfemoral-design-centre-4.json``
+On 2026-11-26 it made ``src/bladelab/data/runner/collocation/transfemoral-design-centre-4.json``
 (the collocation evaluator's default start) in two steps: from the sphere stride with
 SOLE_SCALE 0.1, SPEED 4 (trapezoidal), then from that stride with ``none backward-euler``;
 SOLE_SCALE 1 (the generator's 10⁶ N/m soles) gave the 12-BW gait of docs/design.md.
@@ -22,8 +22,9 @@ from bladelab.blade.spec import spec_from_dict
 from bladelab.design.collocation_evaluator import CollocationEvaluator
 from bladelab.design.predicted import stride_responses
 from bladelab.design.space import default_design_space
+from bladelab.predict.collocation.settings import CollocationSettings
 from bladelab.predict.collocation.solution import CollocationSolution
-from bladelab.predict.collocation.solve import CollocationSettings, predict_stride
+from bladelab.predict.collocation.solve import predict_stride
 from bladelab.runner import build_runner
 
 

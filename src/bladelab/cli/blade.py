@@ -21,7 +21,7 @@ def _list(
     as_json: bool = typer.Option(False, "--json", help="Print JSON instead of a table."),
 ) -> None:
     """List the built-in blades (family-category names usable wherever a blade is asked for)."""
-    from bladelab.blade import blade_catalogue
+    from bladelab.blade import blade_catalogue  # deferred: keeps bladelab --help fast
 
     table = blade_catalogue()
     if as_json:
@@ -41,7 +41,7 @@ def _show(
     plot: Path | None = typer.Option(None, "--plot", help="Also draw the blade to this image file."),
 ) -> None:
     """Show a blade: dimensions, segmentation, joints (K in N·m/deg), soles, contact."""
-    from bladelab.blade import load_blade
+    from bladelab.blade import load_blade  # deferred: keeps bladelab --help fast
 
     if plot is not None:
         figure_format(plot)  # refuse an unknown image format before any work
@@ -67,6 +67,7 @@ def _segment(
     out: Path | None = typer.Option(None, "--out", help="Write the result as JSON to this file."),
 ) -> None:
     """Segment a profile polyline: smallest N whose error is below --max-error."""
+    # deferred: keeps bladelab --help fast
     from bladelab.blade import read_profile_csv, segment_profile
 
     prof = read_profile_csv(profile)
@@ -120,7 +121,7 @@ def _save_plot(spec, path: Path) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from bladelab.blade import plot_blade
+    from bladelab.blade import plot_blade  # deferred: keeps bladelab --help fast
 
     fig, ax = plt.subplots(figsize=(4.5, 5.5))
     plot_blade(spec.build(), ax, profile=spec.profile_geometry())

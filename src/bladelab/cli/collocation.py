@@ -1,11 +1,13 @@
-"""``bladelab predict --method collocation``: one stride by direct collocation (issue 15).
+"""``bladelab predict --method collocation``: one stride by direct collocation.
 
-The command parses its options, builds the model and the initial guess, and calls
-:func:`bladelab.predict.collocation.solve.predict_stride_in_folder`, which owns the output
-folder (``solution.json`` for a converged solve, ``best_iterate.json`` otherwise). Progress goes
-to stderr, one line at each stage's start and end and every :data:`PROGRESS_EVERY_S` seconds
-in between; stdout holds the summary (one JSON object with ``--json``). A solve that does not
-converge exits with status 2 after naming IPOPT's status and the worst-violated constraints.
+The command parses its options into
+:class:`~bladelab.predict.collocation.settings.CollocationSettings` and calls
+:func:`bladelab.predict.collocation.named_runs.solve_named_stride`, which builds the runner and
+the initial guess and owns the output folder (``solution.json`` for a converged solve,
+``best_iterate.json`` otherwise). Progress goes to stderr, one line at each stage's start and
+end and every :data:`PROGRESS_EVERY_S` seconds in between; stdout holds the summary (one JSON
+object with ``--json``). A solve that does not converge exits with status 2 after naming
+IPOPT's status and the worst-violated constraints.
 """
 
 from __future__ import annotations
@@ -17,85 +19,23 @@ from pathlib import Path
 
 import typer
 
-from bladelab.errors import InputFileError, SpecError
-from bladelab.predict.collocation.guess import (
-    MEASURED_STATIC,
-    MEASURED_TRIAL,
-    MEASURED_TRIAL_SPEED_M_PER_S,
-)
+from bladelab.cli.panels import renamed
+from bladelab.errors import BladelabError, SpecError
+from bladelab.predict.collocation.named_runs import solve_named_stride
+from bladelab.predict.collocation.settings import CollocationSettings
 
-__all__ = ["FUKUCHI_STATIC", "FUKUCHI_TRIAL", "PROGRESS_EVERY_S", "StageProgress", "TRIAL_SPEED_M_PER_S",
-           "make_guess", "run_collocation"]
+__all__ = ["OPTIONS", "PROGRESS_EVERY_S", "StageProgress", "run_collocation"]
 
-#: The measured running trial of ``--guess trial``, its standing trial and its treadmill speed
-#: [m/s] (one definition: :mod:`bladelab.predict.collocation.guess`).
-FUKUCHI_TRIAL = MEASURED_TRIAL
-FUKUCHI_STATIC = MEASURED_STATIC
-TRIAL_SPEED_M_PER_S = MEASURED_TRIAL_SPEED_M_PER_S
 #: Seconds between two progress lines while a stage iterates.
 PROGRESS_EVERY_S = 5.0
-#: Template speed [m/s] of a maximum-speed problem's guess.
-MAX_SPEED_TEMPLATE_M_PER_S = 4.0
-
-
-def make_guess(runner, guess: str, *, n: int, speed: float | None):
-    """The initial guess named by ``--guess``: template (at ``speed`` [m/s], or
-    :data:`MAX_SPEED_TEMPLATE_M_PER_S` when None), trial, or a file (a collocation solution or
-    best iterate, or a reflex-controller parameter file), on ``n`` mesh intervals."""
-    from bladelab.predict.collocation.guess import (
-        guess_from_reflex,
-        guess_from_trial,
-        template_guess,
-    )
-
-    if guess == "template":
-        return template_guess(runner, speed=speed or MAX_SPEED_TEMPLATE_M_PER_S, n=n)
-    if guess == "trial":
-        if not FUKUCHI_TRIAL.is_file():
-            raise InputFileError("the measured running trial is not there", file=FUKUCHI_TRIAL,
-                                 where="--guess trial",
-                                 hint="it needs the shared data folder beside the project "
-                                      "(../shared/data), or use --guess template")
-        static = FUKUCHI_STATIC if FUKUCHI_STATIC.is_file() else None
-        return guess_from_trial(runner, FUKUCHI_TRIAL, static=static, n=n,
-                                speed=TRIAL_SPEED_M_PER_S)
-    path = Path(guess)
-    kind = _file_kind(path)
-    if kind == "collocation":
-        from bladelab.predict.collocation.solution import CollocationSolution
-
-        sol = CollocationSolution.read(path)
-        guess = sol.to_guess(f"collocation solution {path.name} ({sol.guess_source})")
-        if sol.model_spec["model"] == runner.kind:  # another body of the same kind is mapped
-            return guess
-        from bladelab.runner.params import PROSTHETIC_KINDS
-
-        if {sol.model_spec["model"], runner.kind} <= set(PROSTHETIC_KINDS):
-            from bladelab.predict.collocation.guess import prosthetic_stride_on
-
-            return prosthetic_stride_on(runner, guess)
-        raise SpecError("the guess is a solution of another model", file=path,
-                        where="--guess", hint=f"it is of {sol.model_spec}; an amputee runner's "
-                                              "stride starts the other amputee kind")
-    return guess_from_reflex(path, n=n)
-
-
-def _file_kind(path: Path) -> str:
-    """``"collocation"`` or ``"reflex"`` for a ``--guess`` file."""
-    from bladelab._io import read_json
-
-    if not path.is_file():
-        raise SpecError(f"{str(path)!r} is neither template, trial nor a file", where="--guess",
-                        hint="template, trial, or the path of a solution.json, "
-                             "best_iterate.json or reflex parameter JSON file")
-    data = read_json(path, what="--guess file")
-    if isinstance(data, dict) and str(data.get("kind", "")).startswith("collocation-"):
-        return "collocation"
-    if isinstance(data, dict) and isinstance(data.get("parameters"), dict):
-        return "reflex"
-    raise InputFileError("not a collocation solution nor a reflex parameter file", file=path,
-                         where="--guess", hint="a solution.json, best_iterate.json or a "
-                                               "'bladelab predict' parameter JSON file")
+#: Library argument or ``CollocationSettings`` field -> the option that sets it.
+OPTIONS = {
+    "model": "--model", "blade": "--blade", "body": "--body", "guess": "--guess",
+    "mesh_intervals": "--mesh", "speed_m_per_s": "--speed", "max_iter": "--max-iter",
+    "swing_clearance_m": "--swing-clearance", "knee_moment_min_nm": "--knee-moment-min",
+    "knee_flexion_max_loaded_deg": "--knee-flexion-max",
+    "pelvis_tilt_range_deg": "--tilt-range",
+}
 
 
 class StageProgress:
@@ -162,56 +102,26 @@ def run_collocation(
     resume: bool,
     force: bool,
     as_json: bool,
-    body: str = "seed001",
-    swing_clearance: float = 0.0,
-    knee_moment_min: float | None = None,
-    knee_flexion_max: float | None = None,
-    tilt_range: str | None = None,
+    body: str,
+    swing_clearance: float,
+    knee_moment_min: float | None,
+    knee_flexion_max: float | None,
+    tilt_range: str | None,
 ) -> int:
     """Run ``bladelab predict --method collocation``; returns the exit status (0 converged,
     2 not converged)."""
-    from bladelab.predict.collocation.solve import CollocationSettings, predict_stride_in_folder
-    from bladelab.predict.collocation.stored import check_model_spec, runner_from_spec
-    from bladelab.runner.params import KINDS, default_runner_params
-
-    if model not in KINDS:
-        raise SpecError(f"unknown model {model!r}", where="--model", hint=" or ".join(KINDS))
-    if blade is None and model != "able":
-        blade = default_runner_params(model).blade
-    if not max_speed and not (math.isfinite(speed) and speed > 0):
-        raise SpecError("speed must be positive", where="--speed")
-    if mesh < 4:
-        raise SpecError(f"need at least 4 mesh intervals, got {mesh}", where="--mesh")
-    if max_iter < 1:
-        raise SpecError(f"need at least 1 iteration, got {max_iter}", where="--max-iter")
-    if not (math.isfinite(swing_clearance) and 0.0 <= swing_clearance < 0.5):
-        raise SpecError(f"swing clearance must be within [0, 0.5) m, got {swing_clearance}",
-                        where="--swing-clearance")
-    for name, given in (("--knee-moment-min", knee_moment_min),
-                        ("--knee-flexion-max", knee_flexion_max)):
-        if given is not None and model != "transfemoral":
-            raise SpecError(f"the {model} model has no prosthetic knee", where=name,
-                            hint="a setting of --model transfemoral")
-    spec = check_model_spec({"model": model, "blade": blade, "body": body})
+    tilt = _tilt_range(tilt_range)
     try:
-        settings = CollocationSettings(mesh_intervals=mesh,
-                                       speed_m_per_s=None if max_speed else float(speed),
-                                       max_iter=max_iter, swing_clearance_m=swing_clearance,
-                                       knee_moment_min_nm=knee_moment_min,
-                                       knee_flexion_max_loaded_deg=knee_flexion_max,
-                                       pelvis_tilt_range_deg=_tilt_range(tilt_range))
-    except SpecError as err:  # the only values not checked above: name their options
-        option = {"knee_moment_min_nm": "--knee-moment-min",
-                  "knee_flexion_max_loaded_deg": "--knee-flexion-max",
-                  "pelvis_tilt_range_deg": "--tilt-range"}.get(err.where)
-        if option is None:
-            raise
-        raise SpecError(err.message, where=option, hint=err.hint) from None
-    runner = runner_from_spec(spec)
-    result = predict_stride_in_folder(
-        out, runner, settings,
-        lambda: make_guess(runner, guess, n=mesh, speed=settings.speed_m_per_s),
-        model_spec=spec, resume=resume, force=force, progress=StageProgress())
+        settings = CollocationSettings(
+            mesh_intervals=mesh, speed_m_per_s=None if max_speed else float(speed),
+            max_iter=max_iter, swing_clearance_m=swing_clearance,
+            knee_moment_min_nm=knee_moment_min, knee_flexion_max_loaded_deg=knee_flexion_max,
+            pelvis_tilt_range_deg=tilt)
+        result = solve_named_stride(out, model=model, blade=blade, body=body,
+                                    settings=settings, guess=guess, resume=resume, force=force,
+                                    progress=StageProgress())
+    except BladelabError as err:
+        raise renamed(err, OPTIONS) from None
     sol = result.solution
     summary = sol.summary()
     typer.echo(json.dumps(summary) if as_json else _text(summary, result.path, result.solved))

@@ -1,7 +1,7 @@
 """``bladelab sweep --method collocation``: speed continuation and maximum speed per model.
 
 The command parses its options and calls
-:func:`bladelab.predict.collocation.sweep.collocation_sweep`, which owns the output
+:func:`bladelab.predict.collocation.named_runs.sweep_named_models`, which owns the output
 folder (one subfolder per model, ``collocation-sweep.csv``). Progress goes to stderr, one line
 per solve's start and end (and every :data:`~bladelab.cli.collocation.PROGRESS_EVERY_S`
 seconds while IPOPT iterates), each line led by the model and the problem; stdout holds the
@@ -14,16 +14,26 @@ spread of the objectives.
 
 from __future__ import annotations
 
-import functools
 import json
 import math
 from pathlib import Path
 
 import typer
 
-from bladelab.errors import SpecError
+from bladelab.cli.collocation import StageProgress
+from bladelab.cli.panels import renamed
+from bladelab.errors import BladelabError, SpecError
+from bladelab.predict.collocation.named_runs import sweep_named_models
 
-__all__ = ["SweepProgress", "run_collocation_sweep"]
+__all__ = ["OPTIONS", "SweepProgress", "run_collocation_sweep"]
+
+#: Library argument or ``CollocationSettings`` field -> the option that sets it (an unknown
+#: blade is an unknown category).
+OPTIONS = {
+    "categories": "--categories", "blade": "--categories", "model": "--categories",
+    "body": "--body", "speeds": "--speeds", "guess": "--guess", "mesh_intervals": "--mesh",
+    "max_iter": "--max-iter", "starts": "--starts", "jobs": "--jobs",
+}
 
 
 class SweepProgress:
@@ -36,8 +46,6 @@ class SweepProgress:
         self.stages: dict[str, object] = {}
 
     def __call__(self, r) -> None:
-        from bladelab.cli.collocation import StageProgress
-
         head = f"{r.model}, {r.problem}:"
         if r.event == "solve":
             if head not in self.stages:
@@ -97,43 +105,20 @@ def run_collocation_sweep(
     resume: bool,
     force: bool,
     as_json: bool,
-    starts: int = 1,
-    body: str = "seed001",
+    starts: int,
+    body: str,
 ) -> int:
     """Run ``bladelab sweep --method collocation``; returns the exit status (0 every solve
     converged, 2 some model failed)."""
-    from bladelab.cli.collocation import make_guess
-    from bladelab.predict.collocation.solve import CollocationSettings
-    from bladelab.predict.collocation.starts import check_starts
-    from bladelab.predict.collocation.sweep import collocation_sweep, sweep_models
-
-    if mesh < 4:
-        raise SpecError(f"need at least 4 mesh intervals, got {mesh}", where="--mesh")
-    if max_iter < 1:
-        raise SpecError(f"need at least 1 iteration, got {max_iter}", where="--max-iter")
-    if jobs < 1:
-        raise SpecError(f"need at least 1 job, got {jobs}", where="--jobs")
-    check_starts(starts, where="--starts")
     speed_list = _speeds(speeds)
     cats = [c.strip() for c in categories.split(",") if c.strip()]
     try:
-        models = sweep_models(cats, able=able, body=body)
-    except SpecError as err:
-        where = "--body" if err.where == "body" else "--categories"
-        raise SpecError(err.message, where=where, hint=err.hint) from None
-    if guess not in ("template", "trial"):
-        path = Path(guess)
-        if not path.is_file():
-            raise SpecError(f"{guess!r} is neither template, trial nor a file", where="--guess",
-                            hint="template, trial, or the path of a solution.json, "
-                                 "best_iterate.json or reflex parameter JSON file")
-        guess = str(path.resolve())  # worker processes may start elsewhere
-    settings = CollocationSettings(mesh_intervals=mesh, speed_m_per_s=speed_list[0],
-                                   max_iter=max_iter)
-    result = collocation_sweep(
-        models, speed_list, settings, functools.partial(make_guess, guess=guess), out=out,
-        jobs=jobs, executor=executor, resume=resume, force=force, progress=SweepProgress(),
-        starts=starts)
+        result = sweep_named_models(
+            out, categories=cats, speeds=speed_list, able=able, body=body, guess=guess,
+            mesh_intervals=mesh, max_iter=max_iter, starts=starts, jobs=jobs,
+            executor=executor, resume=resume, force=force, progress=SweepProgress())
+    except BladelabError as err:
+        raise renamed(err, OPTIONS) from None
     if as_json:
         typer.echo(json.dumps({"table": str(result.table_path), "rows": result.rows,
                                "failures": result.failures}))
@@ -142,7 +127,8 @@ def run_collocation_sweep(
     if not result.failures:
         return 0
     n = len(result.failures)
-    typer.echo(f"error: {n} of {len(models)} model(s) failed:", err=True)
+    n_models = len(cats) + int(able)  # the sweep refuses a repeated category
+    typer.echo(f"error: {n} of {n_models} model(s) failed:", err=True)
     for label, what in result.failures.items():
         typer.echo(f"error: {label}: " + "; ".join(what), err=True)
     return 2

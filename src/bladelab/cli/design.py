@@ -1,21 +1,50 @@
 """``bladelab design``: a response-surface design study; ``bladelab design gait-cycle``: the mean
 gait cycle of a measured trial; ``bladelab blade test``: compression test.
 
+``bladelab design``'s options sit in help panels by the evaluator they belong to
+(:data:`DESIGN_PANELS`): an option given for another evaluator is refused, naming it and its
+evaluator (:func:`~bladelab.cli.panels.refuse_other_methods`). The evaluator itself is built by
+:func:`bladelab.design.settings.build_evaluator` from
+:class:`~bladelab.design.settings.EvaluatorSettings`, the study run (and settled) by
+:func:`bladelab.design.settling.run_settled_design`; the option defaults are the library's
+(:mod:`bladelab.design.defaults`, which imports nothing: ``--help`` stays fast).
+
 ``bladelab blade test`` is added to the ``blade`` group of :mod:`bladelab.cli.blade` from here
 (this module is registered after it).
 """
 
 from __future__ import annotations
 
-import json
 import math
 from pathlib import Path
 
 import typer
 
-from bladelab.errors import SpecError
+from bladelab._io import figure_format
+from bladelab.cli.blade import blade_app
+from bladelab.cli.panels import Panel, PanelGroup, refuse_other_methods, renamed
+from bladelab.design import defaults
+from bladelab.errors import BladelabError, InputFileError, SpecError
 
-__all__ = ["register"]
+__all__ = ["DESIGN_PANELS", "OPTIONS", "register"]
+
+STUDY = "Study"
+BLADE_RUNNER = "Blade and runner evaluator"
+RUNNER = "Runner evaluator"
+COLLOCATION = "Collocation evaluator"
+#: ``bladelab design``: its panels and the evaluators their options belong to.
+DESIGN_PANELS = (Panel(STUDY), Panel(BLADE_RUNNER, ("blade", "runner")),
+                 Panel(RUNNER, ("runner",)), Panel(COLLOCATION, ("collocation",)))
+#: ``EvaluatorSettings`` field -> the option that sets it.
+OPTIONS = {
+    "kind": "--evaluator", "speed_mps": "--speed", "body_mass_kg": "--body-mass",
+    "dt_s": "--dt", "base": "--base", "gait": "--gait", "motion": "--motion",
+    "motion_model": "--motion-model", "start": "--start",
+    "knee_moment_min_Nm": "--knee-moment-min",
+    "knee_flexion_max_loaded_deg": "--knee-flexion-max",
+    "reference_weight": "--reference-weight",
+}
+_FACTORS = ",".join(f"{name}={low:g}:{high:g}" for name, low, high, *_ in defaults.DESIGN_FACTORS)
 
 
 def _parse_floats(text: str, what: str) -> list[float]:
@@ -29,192 +58,10 @@ def _parse_floats(text: str, what: str) -> list[float]:
     return vals
 
 
-def _blade_test(
-    blade: str = typer.Argument(..., help="Built-in blade name or blade spec file."),
-    category: str | None = typer.Option(None, "--category", help="Stiffness category, e.g. cat5."),
-    alignment: str = typer.Option("0,-8,8", "--alignment",
-                                  help="Alignment angles [deg], comma-separated."),
-    body_mass: float = typer.Option(76.0, "--body-mass", help="Body mass [kg] (load = m·g)."),
-    max_displacement: float = typer.Option(0.08, "--max-displacement",
-                                           help="Largest clamp displacement [m]."),
-    tip: str = typer.Option("held", "--tip", help="held (seed 002's fixture) or free."),
-    plot: Path | None = typer.Option(None, "--plot", help="Draw the force–displacement curves."),
-    as_json: bool = typer.Option(False, "--json", help="Print JSON (curves included)."),
-) -> None:
-    """Virtual compression test: force–displacement curve and stiffness at body-weight load."""
-    from bladelab.blade import load_blade
-    from bladelab.design.compression import compression_test
-    from bladelab.units import body_weight
-
-    if plot is not None:
-        from bladelab._io import figure_format
-
-        figure_format(plot)  # refuse an unknown image format before any work
-    if not (body_mass > 0 and math.isfinite(body_mass)):
-        raise SpecError(f"body mass must be > 0 kg, got {body_mass}", where="--body-mass")
-    angles = _parse_floats(alignment, "--alignment")
-    spec = load_blade(blade, category=category)
-    model = spec.build()
-    load = body_weight(body_mass)
-    results = []
-    from bladelab.design.compression import vertical_stiffness
-    from bladelab.errors import ModelError
-
-    if tip == "held":
-        try:
-            vertical_stiffness(model, alignment_deg=angles[0], tip="held")
-        except ModelError:
-            tip = "free"
-            typer.echo("note: this blade cannot compress with its support held (fewer than two "
-                       "compliant joints between clamp and support); testing with tip free",
-                       err=True)
-    for a in angles:
-        try:
-            r = compression_test(model, max_displacement=max_displacement, n_steps=40, load=load,
-                                 alignment_deg=a, tip=tip)
-        except SpecError as err:
-            if err.where != "load":
-                raise
-            r = compression_test(model, max_displacement=max_displacement, n_steps=40,
-                                 alignment_deg=a, tip=tip)
-        results.append(r)
-    if as_json:
-        def _clean(v):
-            if isinstance(v, float) and not math.isfinite(v):
-                return None
-            if isinstance(v, dict):
-                return {k: _clean(x) for k, x in v.items()}
-            if isinstance(v, list):
-                return [_clean(x) for x in v]
-            return v
-
-        typer.echo(json.dumps(_clean({"blade": model.name, "body_mass_kg": body_mass,
-                                      "load_N": load, "tests": [r.to_dict() for r in results]}),
-                              indent=2))
-    else:
-        typer.echo(f"{model.name}: virtual compression test (tip {tip}), load m·g = {load:.0f} N")
-        typer.echo(" alignment_deg  k_linear_kN_per_m  k_at_bw_kN_per_m  displacement_at_bw_mm")
-        for r in results:
-            at = ("not reached" if math.isnan(r.stiffness_at_load) else
-                  f"{r.stiffness_at_load / 1e3:16.2f}  {r.displacement_at_load * 1e3:21.1f}")
-            typer.echo(f"{r.alignment_deg:14.1f}  {r.stiffness_linear / 1e3:17.2f}  {at}")
-    if plot is not None:
-        _plot_compression(results, model.name, load, plot)
-        typer.echo(f"wrote {plot}", err=True)
-
-
-def _plot_compression(results, name: str, load: float, path: Path) -> None:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    from bladelab.design.plots import save_figure
-
-    fig, ax = plt.subplots(figsize=(5, 4))
-    for r in results:
-        ax.plot(r.displacement * 1e3, r.force, label=f"{r.alignment_deg:+g}°")
-    ax.axhline(load, color="0.5", ls="--", lw=0.8, label="body weight")
-    ax.set_xlabel("clamp displacement [mm]")
-    ax.set_ylabel("vertical force [N]")
-    ax.set_title(f"{name}: virtual compression test")
-    ax.legend(title="alignment")
-    fig.tight_layout()
-    save_figure(fig, path)
-    plt.close(fig)
-
-
-def _design(
-    ctx: typer.Context,
-    factors: str | None = typer.Option(
-        None, "--factors",
-        help="name=low:high,... (default: stiffness_kN_per_m=18:32,width_m=0.05:0.08,"
-             "height_m=0.40:0.48,toe_length_m=0.19:0.25)."),
-    runs: str = typer.Option("ccd", "--runs", help="ccd, bbd, dopt or a CSV file of runs."),
-    evaluator: str = typer.Option(
-        "blade", "--evaluator",
-        help="blade (one passive stance), runner (a template gait cycle) or collocation (a "
-             "predicted transfemoral stride per design, docs/design.md)."),
-    out: Path | None = typer.Option(None, "--out",
-                                    help="Output folder (resumes an interrupted study); required."),
-    seed: int = typer.Option(0, "--seed", help="Seed (D-optimal design, optimiser starts)."),
-    jobs: int = typer.Option(1, "--jobs", help="Worker processes for the runs."),
-    n_runs: int | None = typer.Option(None, "--n-runs", help="Runs of a D-optimal design."),
-    model: str = typer.Option("quadratic", "--model",
-                              help="Surface model: quadratic, linear, interaction, or terms."),
-    objective: str = typer.Option("delta_vx_m_per_s", "--objective", help="Response to maximise."),
-    sense: str = typer.Option("max", "--sense", help="max or min."),
-    constraint: list[str] = typer.Option(
-        [], "--constraint",
-        help="response=minimum (repeatable), e.g. knee_moment_min_Nm=0 swing_clearance_m=0.02."),
-    speed: float | None = typer.Option(
-        None, "--speed",
-        help="Touch-down speed [m/s] (default 8 blade, 7 runner); the stride's mean speed "
-             "(collocation, default 4)."),
-    body_mass: float | None = typer.Option(
-        None, "--body-mass", help="Body mass [kg] (blade and runner evaluators; default 76)."),
-    knee_moment_min: float | None = typer.Option(
-        None, "--knee-moment-min",
-        help="Collocation evaluator: keep the prosthetic knee's extension moment at or above "
-             "this [N·m] in every design's stride (<= 0; default: reported, not imposed)."),
-    knee_flexion_max: float | None = typer.Option(
-        None, "--knee-flexion-max",
-        help="Collocation evaluator: keep the prosthetic knee within this flexion [deg] while "
-             "its blade is loaded (the straight stance; default: free)."),
-    reference_weight: float | None = typer.Option(
-        None, "--reference-weight",
-        help="Collocation evaluator: keep the athlete's own joints (trunk, intact leg, "
-             "residual hip) near the start stride's, this weight [1/rad²] × their mean "
-             "squared deviation added to the objective: every blade run with the same "
-             "technique (docs/design.md; default 0: the gait predicted freely)."),
-    settle: int = typer.Option(
-        0, "--settle",
-        help="Collocation evaluator: after the runs, up to this many settling passes (each "
-             "design solved again from its 2 nearest neighbours' strides, the lowest objective "
-             "kept; stops when no objective drops by more than 1 %). Recorded design by design "
-             "in settling.json: a stopped pass resumes where it stopped."),
-    skip_failed: bool = typer.Option(
-        False, "--skip-failed",
-        help="Record runs whose evaluation fails (runs/run_NNNN.failed.json, failed.csv), do "
-             "not evaluate runs recorded as failed again, and fit the surfaces to the runs that "
-             "finished (default: a failed run stops the study)."),
-    start: Path | None = typer.Option(
-        None, "--start",
-        help="Collocation solution of the transfemoral runner that the first design starts "
-             "from (collocation evaluator; default: the built-in centre stride)."),
-    base: str = typer.Option("xtreme", "--base", help="Base blade of the generator."),
-    gait: Path | None = typer.Option(None, "--gait",
-                                     help="Gait-cycle CSV (runner evaluator; default built-in)."),
-    motion: Path | None = typer.Option(
-        None, "--motion",
-        help="Motion file (YAML/CSV: gait cycles with their blades): each design runs the "
-             "cycle predicted by seed 002's motion model (runner evaluator; not with --gait)."),
-    motion_model: str | None = typer.Option(
-        None, "--motion-model",
-        help="Motion model: auto (quadratic if the cycles can estimate it, else linear), "
-             "quadratic, linear, or terms (default: the file's model:, else auto)."),
-    dt: float | None = typer.Option(None, "--dt", help="Simulation step [s] of the evaluator."),
-    figures: bool = typer.Option(True, "--figures/--no-figures", help="Write figures."),
-) -> None:
-    """Run a design study: DOE -> evaluator per run -> surfaces, ANOVA, optimum, figures.
-
-    ``bladelab design gait-cycle TRIAL.c3d ...`` makes a gait-cycle CSV for ``--gait``; a motion
-    file of several such cycles (one per blade or trial) adapts the motion per design.
-    """
-    if ctx.invoked_subcommand is not None:
-        return
-    if out is None:
-        raise typer.BadParameter("missing option '--out' (the study's output folder)",
-                                 param_hint="--out")
-    from bladelab.design import DesignSpace, default_design_space, make_design, run_design
-    from bladelab.design.evaluators import make_evaluator
-    from bladelab.design.terms import parse_terms
-
-    space = DesignSpace.parse(factors) if factors else default_design_space()
-    if jobs < 1:
-        raise SpecError(f"--jobs must be >= 1, got {jobs}", where="--jobs")
+def _constraints(given: list[str]) -> dict[str, float]:
+    """``--constraint response=minimum`` (repeatable) as {response: minimum}."""
     cons: dict[str, float] = {}
-    for c in constraint:
+    for c in given:
         name, sep, value = c.partition("=")
         try:
             cons[name.strip()] = float(value)
@@ -223,79 +70,203 @@ def _design(
         if not sep or not name.strip():
             raise SpecError(f"cannot read constraint {c!r}", where="--constraint",
                             hint="write response=minimum, e.g. knee_moment_min_Nm=0")
-    options: dict = {"generator": {"base": base}}
-    if evaluator == "collocation":
-        if body_mass is not None or dt is not None:
-            raise SpecError(f"--{'body-mass' if body_mass is not None else 'dt'} does not apply "
-                            "to the collocation evaluator", where="--evaluator collocation",
-                            hint="its runner is the transfemoral parameter set "
-                                 "(docs/runner-model.md); collocation has no time step")
-        options["solutions_dir"] = str(out / "strides")
-        options["factor_ranges"] = {f.name: (f.low, f.high) for f in space.factors}
-        if start is not None:
-            options["start"] = str(start)
-        if knee_moment_min is not None:
-            options["knee_moment_min_Nm"] = knee_moment_min
-        if knee_flexion_max is not None:
-            options["knee_flexion_max_loaded_deg"] = knee_flexion_max
-        if reference_weight is not None:
-            options["reference_weight"] = reference_weight
+    return cons
+
+
+def _blade_test(
+    blade: str = typer.Argument(..., help="Built-in blade name or blade spec file."),
+    category: str | None = typer.Option(None, "--category", help="Stiffness category, e.g. cat5."),
+    alignment: str = typer.Option(
+        ",".join(f"{a:g}" for a in defaults.COMPRESSION_ALIGNMENTS_DEG), "--alignment",
+        help="Alignment angles [deg], comma-separated."),
+    body_mass: float = typer.Option(defaults.BODY_MASS_KG, "--body-mass",
+                                    help="Body mass [kg] (load = m·g)."),
+    max_displacement: float = typer.Option(defaults.COMPRESSION_MAX_DISPLACEMENT_M,
+                                           "--max-displacement",
+                                           help="Largest clamp displacement [m]."),
+    tip: str = typer.Option("held", "--tip", help="held (seed 002's fixture) or free."),
+    plot: Path | None = typer.Option(None, "--plot", help="Draw the force–displacement curves."),
+    as_json: bool = typer.Option(False, "--json", help="Print JSON (curves included)."),
+) -> None:
+    """Virtual compression test: force–displacement curve and stiffness at body-weight load."""
+    if plot is not None:
+        figure_format(plot)  # refuse an unknown image format before any work
+    if not (body_mass > 0 and math.isfinite(body_mass)):
+        raise SpecError(f"body mass must be > 0 kg, got {body_mass}", where="--body-mass")
+    angles = _parse_floats(alignment, "--alignment")
+    # deferred: keeps bladelab --help fast
+    from bladelab.design.blade_test import plot_blade_test, virtual_blade_test
+
+    result = virtual_blade_test(blade, category=category, alignments_deg=angles,
+                                body_mass_kg=body_mass, max_displacement_m=max_displacement,
+                                tip=tip)
+    if result.tip_freed:
+        typer.echo("note: this blade cannot compress with its support held (fewer than two "
+                   "compliant joints between clamp and support); testing with tip free", err=True)
+    if as_json:
+        import json  # deferred: keeps bladelab --help fast
+
+        typer.echo(json.dumps(result.to_dict(), indent=2))
     else:
-        options["body_mass_kg"] = 76.0 if body_mass is None else body_mass
-        if settle:
-            raise SpecError("--settle needs --evaluator collocation", where="--settle")
-        for name, given in (("--start", start), ("--knee-moment-min", knee_moment_min),
-                            ("--knee-flexion-max", knee_flexion_max),
-                            ("--reference-weight", reference_weight)):
-            if given is not None:
-                raise SpecError(f"{name} needs --evaluator collocation", where=name)
-    if speed is not None:
-        options["speed_mps"] = speed
-    if dt is not None:
-        if not (dt > 0 and math.isfinite(dt)):
-            raise SpecError(f"--dt must be > 0 s, got {dt}", where="--dt")
-        options["dt"] = dt
+        typer.echo(f"{result.blade}: virtual compression test (tip {result.tip}), load m·g = "
+                   f"{result.load_N:.0f} N")
+        typer.echo(" alignment_deg  k_linear_kN_per_m  k_at_bw_kN_per_m  displacement_at_bw_mm")
+        for r in result.tests:
+            at = ("not reached" if math.isnan(r.stiffness_at_load) else
+                  f"{r.stiffness_at_load / 1e3:16.2f}  {r.displacement_at_load * 1e3:21.1f}")
+            typer.echo(f"{r.alignment_deg:14.1f}  {r.stiffness_linear / 1e3:17.2f}  {at}")
+    if plot is not None:
+        plot_blade_test(result, plot)
+        typer.echo(f"wrote {plot}", err=True)
+
+
+def _design(
+    ctx: typer.Context,
+    # -- the study (every evaluator) -----------------------------------------------------
+    factors: str | None = typer.Option(
+        None, "--factors", rich_help_panel=STUDY,
+        help=f"name=low:high,... in each factor's unit (default: {_FACTORS})."),
+    runs: str = typer.Option(defaults.RUNS, "--runs", rich_help_panel=STUDY,
+                             help="ccd, bbd, dopt or a CSV file of runs."),
+    evaluator: str = typer.Option(
+        "blade", "--evaluator", rich_help_panel=STUDY,
+        help="blade (one passive stance), runner (a template gait cycle) or collocation (a "
+             "predicted transfemoral stride per design, docs/design.md)."),
+    out: Path | None = typer.Option(None, "--out", rich_help_panel=STUDY,
+                                    help="Output folder (resumes an interrupted study); required."),
+    seed: int = typer.Option(defaults.SEED, "--seed", rich_help_panel=STUDY,
+                             help="Seed (D-optimal design, optimiser starts)."),
+    jobs: int = typer.Option(1, "--jobs", rich_help_panel=STUDY,
+                             help="Worker processes for the runs."),
+    n_runs: int | None = typer.Option(None, "--n-runs", rich_help_panel=STUDY,
+                                      help="Runs of a D-optimal design."),
+    model: str = typer.Option(defaults.SURFACE_MODEL, "--model", rich_help_panel=STUDY,
+                              help="Surface model: quadratic, linear, interaction, or terms."),
+    objective: str = typer.Option(defaults.OBJECTIVE, "--objective", rich_help_panel=STUDY,
+                                  help="Response to optimise."),
+    sense: str = typer.Option(defaults.SENSE, "--sense", rich_help_panel=STUDY,
+                              help="max or min."),
+    constraint: list[str] = typer.Option(
+        [], "--constraint", rich_help_panel=STUDY,
+        help="response=minimum in the response's unit (repeatable), e.g. "
+             "knee_moment_min_Nm=0 swing_clearance_m=0.02."),
+    speed: float | None = typer.Option(
+        None, "--speed", rich_help_panel=STUDY,
+        help=f"Touch-down speed [m/s] (default {defaults.BLADE_SPEED_MPS:g} blade, "
+             f"{defaults.RUNNER_SPEED_MPS:g} runner); the stride's mean speed (collocation, "
+             f"default {defaults.COLLOCATION_SPEED_MPS:g})."),
+    base: str = typer.Option(defaults.BASE_BLADE, "--base", rich_help_panel=STUDY,
+                             help="Base blade of the generator."),
+    skip_failed: bool = typer.Option(
+        False, "--skip-failed", rich_help_panel=STUDY,
+        help="Record runs whose evaluation fails (runs/run_NNNN.failed.json, failed.csv), do "
+             "not evaluate runs recorded as failed again, and fit the surfaces to the runs that "
+             "finished (default: a failed run stops the study)."),
+    figures: bool = typer.Option(True, "--figures/--no-figures", rich_help_panel=STUDY,
+                                 help="Write figures."),
+    # -- blade and runner evaluators -------------------------------------------------------
+    body_mass: float | None = typer.Option(
+        None, "--body-mass", rich_help_panel=BLADE_RUNNER,
+        help=f"Body mass [kg] (default {defaults.BODY_MASS_KG:g})."),
+    dt: float | None = typer.Option(None, "--dt", rich_help_panel=BLADE_RUNNER,
+                                    help="Simulation step [s] of the evaluator."),
+    # -- runner evaluator ------------------------------------------------------------------
+    gait: Path | None = typer.Option(None, "--gait", rich_help_panel=RUNNER,
+                                     help="Gait-cycle CSV (default built-in)."),
+    motion: Path | None = typer.Option(
+        None, "--motion", rich_help_panel=RUNNER,
+        help="Motion file (YAML/CSV: gait cycles with their blades): each design runs the "
+             "cycle predicted by seed 002's motion model (not with --gait)."),
+    motion_model: str | None = typer.Option(
+        None, "--motion-model", rich_help_panel=RUNNER,
+        help="Motion model: auto (quadratic if the cycles can estimate it, else linear), "
+             "quadratic, linear, or terms (default: the file's model:, else auto)."),
+    # -- collocation evaluator -------------------------------------------------------------
+    start: Path | None = typer.Option(
+        None, "--start", rich_help_panel=COLLOCATION,
+        help="Collocation solution of the transfemoral runner that the first design starts "
+             "from (default: the built-in centre stride)."),
+    knee_moment_min: float | None = typer.Option(
+        None, "--knee-moment-min", rich_help_panel=COLLOCATION,
+        help="Keep the prosthetic knee's extension moment at or above this [N·m] in every "
+             "design's stride (<= 0; default: reported, not imposed)."),
+    knee_flexion_max: float | None = typer.Option(
+        None, "--knee-flexion-max", rich_help_panel=COLLOCATION,
+        help="Keep the prosthetic knee within this flexion [deg] while its blade is loaded "
+             "(the straight stance; default: free)."),
+    reference_weight: float | None = typer.Option(
+        None, "--reference-weight", rich_help_panel=COLLOCATION,
+        help="Keep the athlete's own joints (trunk, intact leg, residual hip) near the start "
+             "stride's, this weight [1/rad²] × their mean squared deviation added to the "
+             "objective: every blade run with the same technique (docs/design.md; default 0: "
+             "the gait predicted freely)."),
+    settle: int = typer.Option(
+        0, "--settle", rich_help_panel=COLLOCATION,
+        help="After the runs, up to this many settling passes (each design solved again from "
+             "its 2 nearest neighbours' strides, the lowest objective kept; stops when no "
+             f"objective drops by more than {100 * defaults.SETTLED_REL:g} %). Recorded design "
+             "by design in settling.json: a stopped pass resumes where it stopped."),
+) -> None:
+    """Run a design study: DOE -> evaluator per run -> surfaces, ANOVA, optimum, figures.
+
+    ``bladelab design gait-cycle TRIAL.c3d ...`` makes a gait-cycle CSV for ``--gait``; a motion
+    file of several such cycles (one per blade or trial) adapts the motion per design. An
+    option of another evaluator is refused.
+    """
+    if ctx.invoked_subcommand is not None:
+        return
+    if out is None:
+        raise typer.BadParameter("missing option '--out' (the study's output folder)",
+                                 param_hint="--out")
+    # deferred: keeps bladelab --help fast
+    from bladelab.design import doe, settling, terms
+
+    # deferred: keeps bladelab --help fast
+    from bladelab.design.settings import EVALUATORS, EvaluatorSettings, build_evaluator
+
+    # deferred: keeps bladelab --help fast
+    from bladelab.design.space import DesignSpace, default_design_space
+
+    if evaluator not in EVALUATORS:
+        raise SpecError(f"unknown evaluator {evaluator!r}", where="--evaluator",
+                        hint=", ".join(EVALUATORS))
+    refuse_other_methods(ctx, evaluator, DESIGN_PANELS,
+                         labels={e: f"--evaluator {e}" for e in EVALUATORS})
+    space = DesignSpace.parse(factors) if factors else default_design_space()
+    if jobs < 1:
+        raise SpecError(f"--jobs must be >= 1, got {jobs}", where="--jobs")
+    cons = _constraints(constraint)
     if gait is not None and motion is not None:
         raise SpecError("--gait (one cycle for every design) and --motion (a predicted cycle per "
                         "design) exclude each other", where="--gait/--motion",
                         hint="give one of them")
-    if evaluator != "runner" and (gait is not None or motion is not None):
-        raise SpecError(f"--{'gait' if gait is not None else 'motion'} needs --evaluator runner",
-                        where="--evaluator")
     if motion_model is not None and motion is None:
         raise SpecError("--motion-model needs --motion", where="--motion-model")
-    from bladelab.errors import InputFileError
-
-    if gait is not None:
-        if not gait.is_file():
-            raise InputFileError("no such gait-cycle file", file=gait,
-                                 hint="a CSV with time_s and the joint angles (docs/design.md)")
-        options["gait"] = str(gait)
-    design = make_design(runs, space, n_runs=n_runs, model=model, seed=seed)
-    from bladelab.design.doe import require_estimable
-
-    require_estimable(design, parse_terms(model, space.names), space.names)
-    if motion is not None:
-        from bladelab.design.motion import load_motion_model
-
-        options["motion"] = load_motion_model(motion, space=space, model=motion_model,
-                                              progress=True)
-        _echo_motion(options["motion"])
     if settle < 0:
         raise SpecError(f"--settle must be >= 0, got {settle}", where="--settle")
-    ev = make_evaluator(evaluator, **options)
-
-    def study():
-        return run_design(space, runs=design, evaluator=ev, out_dir=out, seed=seed, model=model,
-                          objective=objective, sense=sense, constraints=cons, units=ev.units,
-                          jobs=jobs, skip_failed=skip_failed)
-
-    result = study()
-    if settle:
-        from bladelab.cli.design_settle import settle_study
-
-        if settle_study(ev, result, passes=settle, jobs=jobs):
-            result = study()  # the settled strides' responses (read back, not solved)
+    try:
+        ev_settings = EvaluatorSettings(
+            kind=evaluator, speed_mps=speed, body_mass_kg=body_mass, dt_s=dt, base=base,
+            gait=gait, motion=motion, motion_model=motion_model, start=start,
+            knee_moment_min_Nm=knee_moment_min, knee_flexion_max_loaded_deg=knee_flexion_max,
+            reference_weight=reference_weight)
+    except BladelabError as err:
+        raise renamed(err, OPTIONS) from None
+    design = doe.make_design(runs, space, n_runs=n_runs, model=model, seed=seed)
+    doe.require_estimable(design, terms.parse_terms(model, space.names), space.names)
+    try:
+        ev = build_evaluator(ev_settings, space, out, progress=True)
+    except BladelabError as err:
+        raise renamed(err, OPTIONS) from None
+    if motion is not None:
+        _echo_motion(ev.motion)
+    result, settled = settling.run_settled_design(
+        space, evaluator=ev, out_dir=out, settle_passes=settle, jobs=jobs, progress=typer.echo,
+        runs=design, seed=seed, model=model, objective=objective, sense=sense,
+        constraints=cons, units=ev.units, skip_failed=skip_failed)
+    if settled is not None and not settled.settled:
+        typer.echo(f"not settled after {settled.passes} passes (largest drop above "
+                   f"{100 * settling.SETTLED_REL:g} %)", err=True)
     typer.echo(f"{design.n_runs} runs ({result.n_evaluated} evaluated, {result.n_resumed} "
                f"resumed) -> {out}")
     if result.failed:
@@ -312,12 +283,11 @@ def _design(
     elif result.optimum_error:
         typer.echo(f"no optimum: {result.optimum_error}")
     if figures:
+        # deferred: matplotlib loads only when figures are written
         from bladelab.design.plots import write_design_figures
 
         for p in write_design_figures(result, out, objective=objective, constraints=cons):
             typer.echo(f"wrote {p}", err=True)
-
-
 def _echo_motion(mm) -> None:
     """One summary line of the motion model, and its leave-one-blade-out errors."""
     def fmt(v: float, scale: float = 1.0, digits: int = 2) -> str:
@@ -345,12 +315,12 @@ def _gait_cycle(
     up: str = typer.Option("auto", "--up", help="File axis that is up."),
 ) -> None:
     """Mean gait cycle of a measured trial (joint angles from markers) as a gait-cycle CSV."""
-    import numpy as np
+    import numpy as np  # deferred: keeps bladelab --help fast
 
-    from bladelab._io import atomic_path
-    from bladelab.design.gait_cycle import average_gait_cycle, gait_cycles_from_trial
-    from bladelab.errors import InputFileError
-    from bladelab.trial import read_c3d
+    from bladelab.design import gait_cycle  # deferred: keeps bladelab --help fast
+    from bladelab.trial import read_c3d  # deferred: keeps bladelab --help fast
+
+    # deferred: keeps bladelab --help fast
     from bladelab.trial.joint_angles import load_joint_marker_map
 
     if samples < 8:
@@ -364,12 +334,12 @@ def _gait_cycle(
     st = None
     if static is not None:
         st = read_c3d(static, forward=ax.get("forward", forward), up=ax.get("up", up))
-    cycles = gait_cycles_from_trial(trial, leg=leg, markers=mmap, static=st,
-                                    cutoff_hz=cutoff if cutoff > 0 else None, n=samples)
-    mean = average_gait_cycle(cycles, source=f"{trial_file}: mean of {len(cycles)} {leg}-leg "
-                                             "cycles")
-    with atomic_path(out) as tmp:
-        mean.to_frame().to_csv(tmp, index=False, float_format="%.6g")
+    cycles = gait_cycle.gait_cycles_from_trial(trial, leg=leg, markers=mmap, static=st,
+                                               cutoff_hz=cutoff if cutoff > 0 else None,
+                                               n=samples)
+    mean = gait_cycle.average_gait_cycle(
+        cycles, source=f"{trial_file}: mean of {len(cycles)} {leg}-leg cycles")
+    gait_cycle.write_gait_csv(mean, out)
     periods = np.array([c.period for c in cycles])
     a = {k: np.degrees(v) for k, v in mean.angles.items()}
     sd = {k: float(np.mean(np.degrees(np.std([c.angles[k] for c in cycles], axis=0))))
@@ -387,10 +357,8 @@ def _gait_cycle(
 
 def register(app: typer.Typer) -> None:
     """Add ``bladelab design`` (with ``design gait-cycle``) and ``bladelab blade test``."""
-    from bladelab.cli.blade import blade_app
-
     blade_app.command("test")(_blade_test)
-    design_app = typer.Typer()
+    design_app = typer.Typer(cls=PanelGroup)
     design_app.callback(invoke_without_command=True)(_design)
     design_app.command("gait-cycle")(_gait_cycle)
     app.add_typer(design_app, name="design")

@@ -7,6 +7,8 @@ from pathlib import Path
 
 import typer
 
+from bladelab.errors import SpecError
+
 __all__ = ["register"]
 
 example_app = typer.Typer(
@@ -18,7 +20,7 @@ example_app = typer.Typer(
 @example_app.command("make")
 def _make(
     out_dir: Path = typer.Argument(
-        None, help="Study folder to write (default: examples/sprint-study in the project)."),
+        None, help="Study folder to write (default: examples/sprint-study in the current folder)."),
     seed: int = typer.Option(0, "--seed", help="Study seed: the same seed gives the same trials."),
     force: bool = typer.Option(False, "--force", help="Regenerate even if a complete study is there."),
     jobs: int = typer.Option(2, "--jobs", "-j", help="Worker processes."),
@@ -27,8 +29,7 @@ def _make(
     as_json: bool = typer.Option(False, "--json", help="Print the result as JSON."),
 ) -> None:
     """Generate the example study: C3D trials, study.yaml and ground_truth.csv."""
-    from bladelab.errors import SpecError
-    from bladelab.example.study import make_example_study
+    from bladelab.example.study import make_example_study  # deferred: keeps bladelab --help fast
 
     if jobs < 1:
         raise SpecError(f"--jobs must be >= 1, got {jobs}", where="--jobs")

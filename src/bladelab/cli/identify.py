@@ -7,7 +7,9 @@ from pathlib import Path
 
 import typer
 
+from bladelab._io import atomic_open
 from bladelab.errors import InputFileError, SpecError
+from bladelab.parameters import JOINT_PARAMETERS
 
 __all__ = ["register"]
 
@@ -44,6 +46,7 @@ def _identify(
     if grf not in ("z", "zx", "xz"):
         raise SpecError(f"unknown GRF components {grf!r}", where="--grf", hint="z or zx")
     components = ("z",) if grf == "z" else ("z", "x")
+    # deferred: keeps bladelab --help fast
     from bladelab.identify.formulations import DEFAULT_FORMULATION, FORMULATIONS
 
     if formulation is not None and formulation not in FORMULATIONS:
@@ -63,9 +66,8 @@ def _identify(
     if blade is None:
         raise SpecError("--blade is required to identify a stance", where="--blade",
                         hint="a built-in name (bladelab blade list) or a blade spec file")
-    from bladelab.identify.identify import identify_stance
-    from bladelab.parameters import JOINT_PARAMETERS
-    from bladelab.trial import read_stance_csv
+    from bladelab.identify.identify import identify_stance  # deferred: keeps bladelab --help fast
+    from bladelab.trial import read_stance_csv  # deferred: keeps bladelab --help fast
 
     stance = read_stance_csv(path)
     ident = identify_stance(stance, blade, optimizer=optimizer, seed=0 if seed is None else seed,
@@ -102,7 +104,7 @@ def _identify(
 
 
 def _identify_study(path: Path, *, blade, seed, as_json, jobs, executor, force, settings) -> None:
-    from bladelab.study.runner import run_study
+    from bladelab.study.runner import run_study  # deferred: keeps bladelab --help fast
 
     run = run_study(path, blade=blade, settings=settings, jobs=jobs, executor=executor, force=force,
                     progress=not as_json, seed=seed)
@@ -132,8 +134,7 @@ def _results(
     output: Path | None = typer.Option(None, "--output", "-o", help="Write the CSV to this file."),
 ) -> None:
     """Print (or export as CSV) the results table of a study."""
-    from bladelab._io import atomic_open
-    from bladelab.study.store import open_results
+    from bladelab.study.store import open_results  # deferred: keeps bladelab --help fast
 
     df = open_results(study_dir)
     if output is not None:

@@ -1,451 +1,389 @@
-"""``bladelab predict`` and ``bladelab sweep``: predictive running (seed 001 §2.2)."""
+"""``bladelab predict`` and ``bladelab sweep``: predictive running (seed 001 §2.2).
+
+Each command has two methods behind ``--method``: ``reflex`` (CMA-ES on the reflex controller,
+:mod:`bladelab.cli.reflex`) and ``collocation`` (direct collocation with CasADi and IPOPT,
+:mod:`bladelab.cli.collocation`, :mod:`bladelab.cli.collocation_sweep`). Every option sits in
+one help panel, and the panel says which method it belongs to (:data:`PREDICT_PANELS`,
+:data:`SWEEP_PANELS`): ``--help`` lists the options panel by panel, and an option given for
+another method is refused, naming the option and its method
+(:func:`~bladelab.cli.panels.refuse_other_methods`). The option defaults are the library's
+(:mod:`bladelab.predict.defaults`, which imports nothing: ``--help`` stays fast).
+"""
 
 from __future__ import annotations
 
-import json
-import math
 from pathlib import Path
 
 import typer
 
-from bladelab.cli.defaults import COLLOCATION_MAX_ITER, COLLOCATION_MESH, TRACK_WEIGHT
-from bladelab.cli.defaults import RUNNER_DT as DEFAULT_DT
+from bladelab.cli.panels import Panel, PanelCommand, refuse_other_methods
 from bladelab.errors import SpecError
+from bladelab.predict import defaults
+
+__all__ = ["METHODS", "PREDICT_PANELS", "SWEEP_PANELS", "register"]
+
+#: The methods of ``--method``.
+METHODS = ("reflex", "collocation")
+
+COMMON = "Common"
+REFLEX = "Reflex controller (CMA-ES)"
+COLLOCATION = "Collocation"
+GRID = "Reflex speed grid (without --recipe)"
+RECIPE = "Reflex recipe (with --recipe)"
+
+#: ``bladelab predict``: its panels and the methods their options belong to.
+PREDICT_PANELS = (Panel(COMMON), Panel(REFLEX, ("reflex",)),
+                  Panel(COLLOCATION, ("collocation",)))
+#: ``bladelab sweep``: the reflex method runs the speed grid, or with ``--recipe`` a recipe.
+SWEEP_PANELS = (Panel(COMMON), Panel(REFLEX, ("reflex", "recipe")), Panel(GRID, ("reflex",)),
+                Panel(RECIPE, ("recipe",)), Panel(COLLOCATION, ("collocation",)))
+#: How the command line selects each method (in error messages).
+LABELS = {"reflex": "--method reflex", "recipe": "--recipe",
+          "collocation": "--method collocation"}
+#: Hints added to the error of an option given for another method.
+PREDICT_HINTS = {
+    "--body": "the reflex controller is tuned to seed 001's body",
+    "--tilt-range": "the reflex objective's pelvis window: --lean-weight",
+}
+SWEEP_HINTS = {
+    "--resume": "a reflex sweep continues by itself in the same --out",
+    "--force": "a reflex sweep continues by itself in the same --out",
+    **{option: "the recipe sets it" for option in (
+        "--generations", "--popsize", "--sigma", "--seed", "--duration", "--dt",
+        "--robust-samples", "--robust-jitter", "--initial-speed", "--chain-from")},
+}
+
+_METHOD_HELP = ("reflex: CMA-ES on the reflex controller | collocation: {what} by direct "
+                "collocation (CasADi + IPOPT).")
 
 
-def _parse_list(text: str, what: str, conv=str) -> list:
-    try:
-        items = [conv(t.strip()) for t in text.split(",") if t.strip()]
-    except ValueError:
-        raise SpecError(
-            f"cannot read {what} {text!r}", where=what, hint="comma-separated"
-        ) from None
-    if not items:
-        raise SpecError(f"no {what} given", where=what)
-    return items
+def _method(method: str) -> str:
+    if method not in METHODS:
+        raise SpecError(f"unknown method {method!r}", where="--method",
+                        hint=" or ".join(METHODS))
+    return method
 
 
-def _run_recipe_sweep(out, categories, recipe, seeds, track_study, init, jobs, executor,
-                      checkpoint_every) -> None:
-    """``bladelab sweep --recipe``: the recipe (a name or a JSON file) per category × seed."""
-    from bladelab.predict.reflex.recipe import STABLE_GAIT_RECIPE, Recipe
-    from bladelab.predict.reflex.recipe_sweep import run_recipe_sweep
-
-    if recipe == "stable-gait":
-        chosen = STABLE_GAIT_RECIPE
-    elif Path(recipe).is_file():
-        chosen = Recipe.read(recipe)
-    else:
-        raise SpecError(f"no recipe {recipe!r}", where="--recipe",
-                        hint="stable-gait, or the path of a recipe JSON")
-    if init is not None and not init.is_file():
-        raise SpecError("file not found", file=init, where="--init")
-    table = run_recipe_sweep(
-        _parse_list(categories, "--categories"),
-        _parse_list(seeds or "1,2,3", "--seeds", int),
-        out=out, recipe=chosen, init=init, track_study=track_study, jobs=jobs,
-        executor=executor, checkpoint_every=checkpoint_every)
-    typer.echo(table.to_string(index=False))
-
-
-def _check_simulation_options(dt: float, robust_samples: int, robust_jitter: float) -> None:
-    """The time step [s] and the robust-evaluation options shared by predict and sweep."""
-    if not (math.isfinite(dt) and 0 < dt <= 2e-3):
-        raise SpecError("time step must be in (0, 2e-3] s", where="--dt")
-    if robust_samples < 1:
-        raise SpecError("must be at least 1", where="--robust-samples")
-    if not (math.isfinite(robust_jitter) and 0 < robust_jitter < 0.1):
-        raise SpecError("must be in (0, 0.1)", where="--robust-jitter")
+def _csv(values) -> str:
+    return ",".join(str(v) for v in values)
 
 
 def register(app: typer.Typer) -> None:
-    @app.command("predict")
+    @app.command("predict", cls=PanelCommand)
     def predict(
-        out: Path = typer.Option(..., "--out", help="Output folder (checkpoint, best.json)."),
-        model: str = typer.Option(
-            "able", "--model", help="able | amputee | transfemoral (collocation only)."),
-        blade: str | None = typer.Option(
-            None, "--blade", help="Blade category of the amputee (default Cat6; the "
-            "transfemoral runner's: Cat4)."),
-        speed: float = typer.Option(3.5, "--speed", help="Prescribed speed (m/s)."),
-        init: Path | None = typer.Option(None, "--init", help="Warm start: parameters JSON."),
-        generations: int = typer.Option(100, "--generations", help="CMA-ES generations."),
-        popsize: int = typer.Option(16, "--popsize", help="Candidates per generation."),
-        sigma: float = typer.Option(1.0, "--sigma", help="Initial step (× parameter scale)."),
-        seeds: str = typer.Option("1", "--seeds", help="Comma-separated seeds: one run each."),
-        jobs: int = typer.Option(1, "--jobs", help="Parallel worker processes."),
-        executor: str = typer.Option("local", "--executor", help="local | ray"),
-        resume: bool = typer.Option(False, "--resume", help="Continue from the checkpoint."),
-        force: bool = typer.Option(
-            False, "--force", help="Start over in an --out that holds a run (replacing it)."
-        ),
-        duration: float = typer.Option(10.0, "--duration", help="Simulated time (s)."),
-        checkpoint_every: int = typer.Option(5, "--checkpoint-every", help="Generations."),
-        dt: float = typer.Option(
-            DEFAULT_DT, "--dt", help="Time step (s); 5e-4 only for quick exploratory runs."
-        ),
-        robust_samples: int = typer.Option(
-            1, "--robust-samples", help="Simulations per candidate (nominal + jittered copies)."
-        ),
-        robust_jitter: float = typer.Option(
-            1e-6, "--robust-jitter", help="Relative parameter jitter of the copies."
-        ),
-        robust_directions: str = typer.Option(
-            "fixed", "--robust-directions", help="fixed (the copies' jitter directions drawn "
-            "once per run) | per-generation (drawn anew every generation; the best so far is "
-            "simulated on each generation's copies too)."
-        ),
-        robust_speed_change: float = typer.Option(
-            0.0, "--robust-speed-change", help="Start the copies at (1 + s), (1 - s), ... × the "
-            "initial speed (relative; 0.05: the ±5 % acceptance test inside the objective)."
-        ),
-        robust_push: float = typer.Option(
-            0.0, "--robust-push", help="Push each copy once in mid-run: its forward speed "
-            "times (1 + p), (1 - p), ... at a seeded time (relative; tests the gait's basin)."
-        ),
-        robust_half_step: bool = typer.Option(
-            False, "--robust-half-step", help="Run the last copy at half the time step (a gait "
-            "must not live on the discretisation; needs --robust-samples 2 or more)."
-        ),
-        initial_speed: float | None = typer.Option(
-            None, "--initial-speed", help="Forward speed of the initial state (m/s); default --speed."
-        ),
-        strike_limit: float = typer.Option(
-            1.0, "--strike-limit", help="A step whose swinging foot strikes the ground earns "
-            "max(0, 1 - peak/limit) of its credit (body weights; issue 20 accepts at most 0.2)."
-        ),
-        lean_weight: float = typer.Option(
-            0.1, "--lean-weight", help="Weight of the pelvis tilt outside -16...-2 deg "
-            "(seed 001's 0.1 per degree, averaged over the run)."
-        ),
-        run_up: bool = typer.Option(
-            False, "--run-up", help="Reflex: the reflexes on the mean forward speed act from "
-            "the start, as if the runner had moved at the initial speed before it (else they "
-            "wait for a full window of the run)."
-        ),
-        integrator: str = typer.Option(
-            "explicit", "--integrator", help="Reflex: explicit (the default 0.25 ms scheme) | "
-            "newmark (stiff forces linearly implicit, second-order rule, at --dt 1e-3 more "
-            "accurate than explicit at 0.25 ms and 4x cheaper) | implicit (its first-order "
-            "predecessor, for runs made with it)."
-        ),
-        track: Path | None = typer.Option(
-            None, "--track", help="Reflex: add a term that pulls the gait towards this "
-            "collocation stride of the same runner (solution.json; its joint angles and stride "
-            "time, stride by stride); then run again with --init OUT/best.json and no --track."
-        ),
-        track_weight: float = typer.Option(
-            TRACK_WEIGHT, "--track-weight", help="Reflex: weight of the tracking term "
-            "[1/rad²] (with --track)."
-        ),
+        ctx: typer.Context,
+        # -- common ----------------------------------------------------------------------
+        out: Path = typer.Option(
+            ..., "--out", rich_help_panel=COMMON,
+            help="Output folder: the reflex run's checkpoint and best.json, or the collocation "
+                 "solve's solution.json."),
         method: str = typer.Option(
-            "reflex", "--method", help="reflex (CMA-ES on the reflex controller) | collocation "
-            "(one periodic stride by direct collocation, CasADi + IPOPT)."
-        ),
+            "reflex", "--method", rich_help_panel=COMMON,
+            help=_METHOD_HELP.format(what="one periodic stride")),
+        model: str = typer.Option(
+            "able", "--model", rich_help_panel=COMMON,
+            help="able | amputee | transfemoral (the transfemoral runner: collocation "
+                 "only)."),
+        blade: str | None = typer.Option(
+            None, "--blade", rich_help_panel=COMMON,
+            help=f"Blade category of the amputee [default: {defaults.REFLEX_BLADE}; "
+                 "collocation: the runner's own blade, Cat4 for the transfemoral runner]."),
+        speed: float = typer.Option(
+            defaults.SPEED_M_PER_S, "--speed", rich_help_panel=COMMON,
+            help="Prescribed mean speed [m/s]."),
+        resume: bool = typer.Option(
+            False, "--resume", rich_help_panel=COMMON,
+            help="Continue from the checkpoint (reflex) or from the folder's solve "
+                 "(collocation)."),
+        force: bool = typer.Option(
+            False, "--force", rich_help_panel=COMMON,
+            help="Start over in an --out that holds a run (replacing it)."),
+        # -- reflex controller (CMA-ES) ----------------------------------------------------
+        init: Path | None = typer.Option(
+            None, "--init", rich_help_panel=REFLEX, help="Warm start: parameters JSON."),
+        seeds: str = typer.Option(
+            str(defaults.SEED), "--seeds", rich_help_panel=REFLEX,
+            help="Comma-separated CMA-ES seeds: one run each."),
+        generations: int = typer.Option(
+            defaults.GENERATIONS, "--generations", rich_help_panel=REFLEX,
+            help="CMA-ES generations."),
+        popsize: int = typer.Option(
+            defaults.POPULATION_SIZE, "--popsize", rich_help_panel=REFLEX,
+            help="Candidates per generation."),
+        sigma: float = typer.Option(
+            defaults.INITIAL_STEP, "--sigma", rich_help_panel=REFLEX,
+            help="Initial step [× parameter scale]."),
+        jobs: int = typer.Option(1, "--jobs", rich_help_panel=REFLEX,
+                                 help="Parallel worker processes."),
+        executor: str = typer.Option("local", "--executor", rich_help_panel=REFLEX,
+                                     help="local | ray"),
+        checkpoint_every: int = typer.Option(
+            defaults.CHECKPOINT_EVERY, "--checkpoint-every", rich_help_panel=REFLEX,
+            help="Generations between two checkpoints."),
+        duration: float = typer.Option(
+            defaults.DURATION_S, "--duration", rich_help_panel=REFLEX,
+            help="Simulated time [s]."),
+        dt: float = typer.Option(
+            defaults.TIME_STEP_S, "--dt", rich_help_panel=REFLEX,
+            help="Time step [s]; 5e-4 only for quick exploratory runs."),
+        robust_samples: int = typer.Option(
+            defaults.ROBUST_SAMPLES, "--robust-samples", rich_help_panel=REFLEX,
+            help="Simulations per candidate (nominal + jittered copies)."),
+        robust_jitter: float = typer.Option(
+            defaults.ROBUST_JITTER, "--robust-jitter", rich_help_panel=REFLEX,
+            help="Relative parameter jitter of the copies [-]."),
+        robust_directions: str = typer.Option(
+            defaults.ROBUST_DIRECTIONS, "--robust-directions", rich_help_panel=REFLEX,
+            help="fixed (the copies' jitter directions drawn once per run) | per-generation "
+                 "(drawn anew every generation; the best so far is simulated on each "
+                 "generation's copies too)."),
+        robust_speed_change: float = typer.Option(
+            0.0, "--robust-speed-change", rich_help_panel=REFLEX,
+            help="Start the copies at (1 + s), (1 - s), ... × the initial speed (relative "
+                 "[-]; 0.05: the ±5 % acceptance test inside the objective)."),
+        robust_push: float = typer.Option(
+            0.0, "--robust-push", rich_help_panel=REFLEX,
+            help="Push each copy once in mid-run: its forward speed times (1 + p), (1 - p), "
+                 "... at a seeded time (relative [-]; tests the gait's basin)."),
+        robust_half_step: bool = typer.Option(
+            False, "--robust-half-step", rich_help_panel=REFLEX,
+            help="Run the last copy at half the time step (a gait must not live on the "
+                 "discretisation; needs --robust-samples 2 or more)."),
+        initial_speed: float | None = typer.Option(
+            None, "--initial-speed", rich_help_panel=REFLEX,
+            help="Forward speed of the initial state [m/s]; default --speed."),
+        strike_limit: float = typer.Option(
+            defaults.STRIKE_LIMIT_BW, "--strike-limit", rich_help_panel=REFLEX,
+            help="A step whose swinging foot strikes the ground earns max(0, 1 - peak/limit) "
+                 "of its credit [body weights]; the stable-gait acceptance allows at most "
+                 "0.2 body weights."),
+        lean_weight: float = typer.Option(
+            defaults.LEAN_WEIGHT_PER_DEG, "--lean-weight", rich_help_panel=REFLEX,
+            help="Weight of the pelvis tilt outside -16...-2 deg [1/deg], averaged over the "
+                 "run (seed 001's)."),
+        run_up: bool = typer.Option(
+            False, "--run-up", rich_help_panel=REFLEX,
+            help="The reflexes on the mean forward speed act from the start, as if the "
+                 "runner had moved at the initial speed before it (else they wait for a full "
+                 "window of the run)."),
+        integrator: str = typer.Option(
+            defaults.INTEGRATOR, "--integrator", rich_help_panel=REFLEX,
+            help="explicit (the default 0.25 ms scheme) | newmark (stiff forces linearly "
+                 "implicit, second-order rule, at --dt 1e-3 more accurate than explicit at "
+                 "0.25 ms and 4x cheaper) | implicit (its first-order predecessor, for runs "
+                 "made with it)."),
+        track: Path | None = typer.Option(
+            None, "--track", rich_help_panel=REFLEX,
+            help="Add a term that pulls the gait towards this collocation stride of the same "
+                 "runner (solution.json; its joint angles and stride time, stride by stride); "
+                 "then run again with --init OUT/best.json and no --track."),
+        track_weight: float = typer.Option(
+            defaults.TRACK_WEIGHT_PER_RAD2, "--track-weight", rich_help_panel=REFLEX,
+            help="Weight of the tracking term [1/rad²] (with --track)."),
+        # -- collocation -------------------------------------------------------------------
         max_speed: bool = typer.Option(
-            False, "--max-speed", help="Collocation: maximise the mean speed instead of --speed."
-        ),
-        mesh: int = typer.Option(COLLOCATION_MESH, "--mesh",
-                                  help="Collocation: mesh intervals of the stride."),
+            False, "--max-speed", rich_help_panel=COLLOCATION,
+            help="Maximise the mean speed instead of prescribing --speed."),
+        mesh: int = typer.Option(
+            defaults.MESH_INTERVALS, "--mesh", rich_help_panel=COLLOCATION,
+            help="Mesh intervals of the stride."),
         guess: str = typer.Option(
-            "template", "--guess", help="Collocation: initial guess: template | trial (the "
-            "Fukuchi 3.5 m/s trial) | FILE (solution.json, best_iterate.json or reflex JSON)."
-        ),
+            defaults.GUESS, "--guess", rich_help_panel=COLLOCATION,
+            help="Initial guess: template | trial (the Fukuchi 3.5 m/s trial) | FILE "
+                 "(solution.json, best_iterate.json or reflex JSON)."),
         max_iter: int = typer.Option(
-            COLLOCATION_MAX_ITER, "--max-iter", help="Collocation: IPOPT iterations per stage."
-        ),
+            defaults.MAX_ITER, "--max-iter", rich_help_panel=COLLOCATION,
+            help="IPOPT iterations per stage."),
         as_json: bool = typer.Option(
-            False, "--json", help="Collocation: print the summary as one JSON object."
-        ),
+            False, "--json", rich_help_panel=COLLOCATION,
+            help="Print the summary as one JSON object."),
         body: str = typer.Option(
-            "seed001", "--body", help="Collocation: seed001 (seed 001's model) | toes (a toe "
-            "segment and compliant Achilles tendons; docs/runner-model.md)."
-        ),
+            defaults.BODY, "--body", rich_help_panel=COLLOCATION,
+            help="seed001 (seed 001's model) | toes (a toe segment and compliant Achilles "
+                 "tendons; docs/runner-model.md)."),
         swing_clearance: float = typer.Option(
-            0.0, "--swing-clearance", help="Collocation: keep every swinging foot or blade "
-            "this high above the ground [m] (0: no constraint)."
-        ),
+            0.0, "--swing-clearance", rich_help_panel=COLLOCATION,
+            help="Keep every swinging foot or blade this high above the ground [m] (0: no "
+                 "constraint)."),
         knee_moment_min: float | None = typer.Option(
-            None, "--knee-moment-min", help="Collocation, transfemoral: keep the ground force's "
-            "extension moment about the prosthetic knee at or above this [N·m] (<= 0; 0: the "
-            "knee never buckles)."
-        ),
+            None, "--knee-moment-min", rich_help_panel=COLLOCATION,
+            help="Transfemoral runner: keep the ground force's extension moment about the "
+                 "prosthetic knee at or above this [N·m] (<= 0; 0: the knee never buckles)."),
         knee_flexion_max: float | None = typer.Option(
-            None, "--knee-flexion-max", help="Collocation, transfemoral: keep the prosthetic "
-            "knee within this flexion [deg] while its blade is loaded (the straight stance)."
-        ),
+            None, "--knee-flexion-max", rich_help_panel=COLLOCATION,
+            help="Transfemoral runner: keep the prosthetic knee within this flexion [deg] "
+                 "while its blade is loaded (the straight stance)."),
         tilt_range: str | None = typer.Option(
-            None, "--tilt-range", help="Collocation: keep the pelvis tilt within LO,HI [deg] "
-            "at every node (forward lean negative), e.g. --tilt-range=-16,-2 (seed 001's "
-            "window)."
-        ),
+            None, "--tilt-range", rich_help_panel=COLLOCATION,
+            help="Keep the pelvis tilt within LO,HI [deg] at every node (forward lean "
+                 "negative), e.g. --tilt-range=-16,-2 (seed 001's window)."),
     ) -> None:
-        """Optimise the reflex controller of the runner with CMA-ES (seed 001 eq. 2.4), or with
-        --method collocation solve one periodic stride by direct collocation (writes
-        DIR/solution.json; exit status 2 and DIR/best_iterate.json if IPOPT does not converge)."""
+        """Predict a running gait: optimise the reflex controller of the runner with CMA-ES
+        (seed 001 eq. 2.4), or with --method collocation solve one periodic stride by direct
+        collocation (writes DIR/solution.json; exit status 2 and DIR/best_iterate.json if
+        IPOPT does not converge). An option of the other method is refused."""
+        method = _method(method)
+        refuse_other_methods(ctx, method, PREDICT_PANELS, labels=LABELS, hints=PREDICT_HINTS)
         if method == "collocation":
+            # deferred: keeps bladelab --help fast
             from bladelab.cli.collocation import run_collocation
 
-            for given, option in ((track is not None, "--track"),
-                                  (integrator != "explicit", "--integrator")):
-                if given:
-                    raise SpecError("only with --method reflex", where=option)
+            raise typer.Exit(run_collocation(
+                out=out, model=model, blade=blade, speed=speed, max_speed=max_speed, mesh=mesh,
+                guess=guess, max_iter=max_iter, resume=resume, force=force, as_json=as_json,
+                body=body, swing_clearance=swing_clearance, knee_moment_min=knee_moment_min,
+                knee_flexion_max=knee_flexion_max, tilt_range=tilt_range))
+        from bladelab.cli.reflex import run_reflex  # deferred: keeps bladelab --help fast
 
-            code = run_collocation(out=out, model=model, blade=blade, speed=speed,
-                                   max_speed=max_speed, mesh=mesh, guess=guess,
-                                   max_iter=max_iter, resume=resume, force=force,
-                                   as_json=as_json, body=body,
-                                   swing_clearance=swing_clearance,
-                                   knee_moment_min=knee_moment_min,
-                                   knee_flexion_max=knee_flexion_max,
-                                   tilt_range=tilt_range)
-            raise typer.Exit(code)
-        if method != "reflex":
-            raise SpecError(f"unknown method {method!r}", where="--method",
-                            hint="reflex or collocation")
-        if body != "seed001":
-            raise SpecError("only with --method collocation", where="--body",
-                            hint="the reflex controller is tuned to seed 001's body")
-        if tilt_range is not None:
-            raise SpecError("only with --method collocation", where="--tilt-range",
-                            hint="the reflex objective's window: --lean-weight")
-        from bladelab.predict.reflex.controller import read_parameters
-        from bladelab.predict.reflex.objective import ObjectiveSettings, check_robust_copies
-        from bladelab.predict.reflex.optimize import optimize_seeds, runner_and_layout
-        from bladelab.runner.implicit import INTEGRATORS
+        run_reflex(
+            out=out, model=model, blade=blade, speed=speed, init=init, seeds=seeds,
+            generations=generations, popsize=popsize, sigma=sigma, jobs=jobs,
+            executor=executor, resume=resume, force=force, checkpoint_every=checkpoint_every,
+            duration=duration, dt=dt, robust_samples=robust_samples,
+            robust_jitter=robust_jitter, robust_directions=robust_directions,
+            robust_speed_change=robust_speed_change, robust_push=robust_push,
+            robust_half_step=robust_half_step, initial_speed=initial_speed,
+            strike_limit=strike_limit, lean_weight=lean_weight, run_up=run_up,
+            integrator=integrator, track=track, track_weight=track_weight)
 
-        if model not in ("able", "amputee"):
-            raise SpecError(f"unknown model {model!r}", where="--model", hint="able or amputee")
-        if not (math.isfinite(speed) and speed > 0):
-            raise SpecError("speed must be positive", where="--speed")
-        _check_simulation_options(dt, robust_samples, robust_jitter)
-        check_robust_copies(robust_directions, robust_speed_change, robust_push, duration,
-                            half_step=robust_half_step, samples=robust_samples,
-                            where=("--robust-directions", "--robust-speed-change",
-                                   "--robust-push", "--duration", "--robust-half-step",
-                                   "--robust-samples"))
-        if integrator not in INTEGRATORS:
-            raise SpecError(f"unknown integrator {integrator!r}", where="--integrator",
-                            hint=f"one of {', '.join(INTEGRATORS)}")
-        if not (math.isfinite(lean_weight) and lean_weight >= 0):
-            raise SpecError("must be >= 0", where="--lean-weight")
-        if not (math.isfinite(strike_limit) and strike_limit >= 0):
-            raise SpecError("must be >= 0 body weights (0: a strike takes all the step's credit)",
-                            where="--strike-limit")
-        blade = blade or "Cat6"
-        _, layout = runner_and_layout(model, blade if model == "amputee" else None)
-        if track is not None:
-            from bladelab.predict.reflex.tracking import GaitReference
-
-            if not (math.isfinite(track_weight) and track_weight > 0):
-                raise SpecError("must be > 0", where="--track-weight")
-            reference = GaitReference.read(track)
-            reference.check_model(model, blade if model == "amputee" else None, "--track")
-        x0 = read_parameters(init, layout, transfer=True) if init is not None else None
-        seed_list = _parse_list(seeds, "--seeds", int)
-
-        def show(seed: int, gen: int, best: float, median: float) -> None:
-            typer.echo(f"seed {seed} generation {gen}: best {best:.4g}, median {median:.4g}")
-
-        results = optimize_seeds(
-            model,
-            seeds=seed_list,
-            out=out,
-            progress=show,
-            blade=blade,
-            speed=speed,
-            x0=x0,
-            generations=generations,
-            popsize=popsize,
-            sigma=sigma,
-            jobs=jobs,
-            executor=executor,
-            resume=resume,
-            force=force,
-            checkpoint_every=checkpoint_every,
-            settings=ObjectiveSettings(
-                speed=speed,
-                duration=duration,
-                dt=dt,
-                robust_samples=robust_samples,
-                robust_jitter=robust_jitter,
-                robust_directions=robust_directions,
-                robust_speed_change=robust_speed_change,
-                robust_push=robust_push,
-                robust_half_step=robust_half_step,
-                initial_speed=initial_speed,
-                strike_limit_bw=strike_limit,
-                w_lean=lean_weight,
-                run_up=run_up,
-                integrator=integrator,
-                track=None if track is None else str(track),
-                w_track=0.0 if track is None else track_weight,
-            ),
-        )
-        best = min(results, key=lambda r: r.best_cost)
-        typer.echo(json.dumps(best.to_dict(), indent=2))
-
-    @app.command("sweep")
+    @app.command("sweep", cls=PanelCommand)
     def sweep(
-        out: Path = typer.Option(..., "--out", help="Output folder (re-run to continue)."),
-        categories: str = typer.Option("Cat4,Cat5,Cat6,Cat6High,Cat7", "--categories"),
-        speeds: str = typer.Option("3.5,4.0,4.5,5.0", "--speeds", help="Speeds (m/s), rising."),
-        init: Path | None = typer.Option(None, "--init", help="Amputee parameters JSON."),
-        generations: int = typer.Option(100, "--generations"),
-        popsize: int = typer.Option(16, "--popsize"),
-        sigma: float = typer.Option(
-            1.0, "--sigma", help="Initial step (× parameter scale); 0.05–0.2 from a solution."
-        ),
-        seed: int = typer.Option(1, "--seed"),
-        jobs: int = typer.Option(1, "--jobs"),
-        executor: str = typer.Option("local", "--executor", help="local | ray"),
-        duration: float = typer.Option(10.0, "--duration", help="Simulated time (s)."),
-        dt: float = typer.Option(DEFAULT_DT, "--dt", help="Time step (s)."),
-        robust_samples: int = typer.Option(
-            1, "--robust-samples", help="Simulations per candidate (nominal + jittered copies)."
-        ),
-        robust_jitter: float = typer.Option(
-            1e-6, "--robust-jitter", help="Relative parameter jitter of the copies."
-        ),
-        initial_speed: float | None = typer.Option(
-            None,
-            "--initial-speed",
-            help="Forward speed of every cell's initial state (m/s); default the first speed.",
-        ),
-        checkpoint_every: int = typer.Option(5, "--checkpoint-every", help="Generations."),
-        chain_from: str | None = typer.Option(
-            None, "--chain-from", help="Warm-start categories outwards from this one (e.g. Cat6)."
-        ),
+        ctx: typer.Context,
+        # -- common ----------------------------------------------------------------------
+        out: Path = typer.Option(..., "--out", rich_help_panel=COMMON,
+                                 help="Output folder (re-run to continue)."),
         method: str = typer.Option(
-            "reflex", "--method", help="reflex (CMA-ES on the reflex controller) | collocation "
-            "(speed continuation and maximum speed by direct collocation, CasADi + IPOPT)."
-        ),
-        able: bool = typer.Option(
-            False, "--able", help="Collocation: sweep the able model too (first)."
-        ),
-        mesh: int | None = typer.Option(
-            None, "--mesh", help=f"Collocation: mesh intervals of the stride [default: {COLLOCATION_MESH}]."
-        ),
-        guess: str | None = typer.Option(
-            None, "--guess", help="Collocation: initial guess of each model's first speed: "
-            "template | trial | FILE [default: template]."
-        ),
-        max_iter: int | None = typer.Option(
-            None, "--max-iter", help=f"Collocation: IPOPT iterations per stage [default: {COLLOCATION_MAX_ITER}]."
-        ),
-        resume: bool = typer.Option(
-            False, "--resume", help="Collocation: continue the sweep in --out (done solves "
-            "are read back)."
-        ),
-        force: bool = typer.Option(
-            False, "--force", help="Collocation: start over in an --out that holds a sweep."
-        ),
-        as_json: bool = typer.Option(
-            False, "--json", help="Collocation: print the table as one JSON object."
-        ),
-        starts: int | None = typer.Option(
-            None, "--starts", help="Collocation: solve each problem from up to K starts (warm "
-            "start, barrier start 1e-4, template, previous-but-one solution) and keep the "
-            "best [default: 1]."
-        ),
-        body: str | None = typer.Option(
-            None, "--body", help="Collocation: seed001 (seed 001's model) | toes (a toe "
-            "segment and compliant Achilles tendons) [default: seed001]."
-        ),
+            "reflex", "--method", rich_help_panel=COMMON,
+            help=_METHOD_HELP.format(what="speed continuation and maximum speed")),
+        categories: str = typer.Option(
+            _csv(defaults.SWEEP_CATEGORIES), "--categories", rich_help_panel=COMMON,
+            help="Blade categories, comma-separated."),
+        speeds: str = typer.Option(
+            _csv(defaults.SWEEP_SPEEDS_M_PER_S), "--speeds", rich_help_panel=COMMON,
+            help="Speeds [m/s], rising, comma-separated (not used by a recipe, which raises "
+                 "the speed by continuation)."),
+        jobs: int = typer.Option(1, "--jobs", rich_help_panel=COMMON,
+                                 help="Parallel worker processes."),
+        executor: str = typer.Option("local", "--executor", rich_help_panel=COMMON,
+                                     help="local | ray"),
+        # -- reflex controller (CMA-ES), grid and recipe -----------------------------------
+        init: Path | None = typer.Option(
+            None, "--init", rich_help_panel=REFLEX, help="Amputee parameters JSON."),
+        checkpoint_every: int = typer.Option(
+            defaults.CHECKPOINT_EVERY, "--checkpoint-every", rich_help_panel=REFLEX,
+            help="Generations between two checkpoints."),
+        # -- reflex speed grid -------------------------------------------------------------
+        generations: int = typer.Option(
+            defaults.GENERATIONS, "--generations", rich_help_panel=GRID,
+            help="CMA-ES generations."),
+        popsize: int = typer.Option(
+            defaults.POPULATION_SIZE, "--popsize", rich_help_panel=GRID,
+            help="Candidates per generation."),
+        sigma: float = typer.Option(
+            defaults.INITIAL_STEP, "--sigma", rich_help_panel=GRID,
+            help="Initial step [× parameter scale]; 0.05–0.2 from a solution."),
+        seed: int = typer.Option(defaults.SEED, "--seed", rich_help_panel=GRID,
+                                 help="CMA-ES seed."),
+        duration: float = typer.Option(
+            defaults.DURATION_S, "--duration", rich_help_panel=GRID,
+            help="Simulated time [s]."),
+        dt: float = typer.Option(defaults.TIME_STEP_S, "--dt", rich_help_panel=GRID,
+                                 help="Time step [s]."),
+        robust_samples: int = typer.Option(
+            defaults.ROBUST_SAMPLES, "--robust-samples", rich_help_panel=GRID,
+            help="Simulations per candidate (nominal + jittered copies)."),
+        robust_jitter: float = typer.Option(
+            defaults.ROBUST_JITTER, "--robust-jitter", rich_help_panel=GRID,
+            help="Relative parameter jitter of the copies [-]."),
+        initial_speed: float | None = typer.Option(
+            None, "--initial-speed", rich_help_panel=GRID,
+            help="Forward speed of every cell's initial state [m/s]; default the first "
+                 "speed."),
+        chain_from: str | None = typer.Option(
+            None, "--chain-from", rich_help_panel=GRID,
+            help="Warm-start categories outwards from this one (e.g. Cat6)."),
+        # -- reflex recipe -----------------------------------------------------------------
         recipe: str | None = typer.Option(
-            None, "--recipe", help="Reflex: run a recipe of stages per category and seed "
-            "instead of the speed grid: stable-gait (issue 20's stages, then speed "
-            "continuation on the speed reached) | FILE (a recipe JSON); 'able' among "
-            "--categories adds the able-bodied runner."
-        ),
-        seeds: str | None = typer.Option(
-            None, "--seeds", help="Reflex, with --recipe: CMA-ES seeds per category "
-            "[default: 1,2,3]."
-        ),
+            None, "--recipe", rich_help_panel=REFLEX,
+            help="Run a recipe of stages per category and seed instead of the speed grid: "
+                 "stable-gait (stages that track a collocation stride, then make the gait "
+                 "survive a long horizon, pushes, other starts, and penalise swing strikes "
+                 "and lean; then speed continuation on the speed reached) | FILE (a recipe "
+                 "JSON); 'able' among --categories adds the able-bodied runner."),
+        seeds: str = typer.Option(
+            _csv(defaults.RECIPE_SEEDS), "--seeds", rich_help_panel=RECIPE,
+            help="CMA-ES seeds per category, comma-separated."),
         track_study: Path | None = typer.Option(
-            None, "--track-study", help="Reflex, with --recipe: the collocation study whose "
-            "strides the tracking stages follow (amputee-<category>/speed-<v>.json)."
-        ),
+            None, "--track-study", rich_help_panel=RECIPE,
+            help="The collocation study whose strides the tracking stages follow "
+                 "(amputee-<category>/speed-<v>.json)."),
+        # -- collocation -------------------------------------------------------------------
+        able: bool = typer.Option(False, "--able", rich_help_panel=COLLOCATION,
+                                  help="Sweep the able model too (first)."),
+        mesh: int = typer.Option(defaults.MESH_INTERVALS, "--mesh", rich_help_panel=COLLOCATION,
+                                 help="Mesh intervals of the stride."),
+        guess: str = typer.Option(
+            defaults.GUESS, "--guess", rich_help_panel=COLLOCATION,
+            help="Initial guess of each model's first speed: template | trial | FILE."),
+        max_iter: int = typer.Option(defaults.MAX_ITER, "--max-iter",
+                                     rich_help_panel=COLLOCATION,
+                                     help="IPOPT iterations per stage."),
+        resume: bool = typer.Option(
+            False, "--resume", rich_help_panel=COLLOCATION,
+            help="Continue the sweep in --out (done solves are read back)."),
+        force: bool = typer.Option(False, "--force", rich_help_panel=COLLOCATION,
+                                   help="Start over in an --out that holds a sweep."),
+        as_json: bool = typer.Option(False, "--json", rich_help_panel=COLLOCATION,
+                                     help="Print the table as one JSON object."),
+        starts: int = typer.Option(
+            defaults.STARTS, "--starts", rich_help_panel=COLLOCATION,
+            help="Solve each problem from up to K starts (warm start, barrier start 1e-4, "
+                 "template, previous-but-one solution) and keep the best."),
+        body: str = typer.Option(
+            defaults.BODY, "--body", rich_help_panel=COLLOCATION,
+            help="seed001 (seed 001's model) | toes (a toe segment and compliant Achilles "
+                 "tendons)."),
     ) -> None:
         """Category × speed grid: warm-started optimisations, maximum speed, cost at 4 m/s,
         200 m and 400 m times, contact times (seed 001 §2.2.2 B–C, Table 3.1). Running it again
         with the same --out continues: finished cells are read back, interrupted ones resumed.
+
+        With --recipe: per category and seed (--seeds), the recipe's stages, each warm-started
+        from the one before, then the speed raised by continuation on the speed reached;
+        DIR/<category>/seed-<n>/ (one folder per level, levels.json), DIR/levels.csv and
+        DIR/summary.csv (whether each category's seeds agree, maximum speeds). The recipe sets
+        its own speeds, generations, population, steps, durations, time steps and copies (the
+        grid's options are refused). Running it again with the same --out continues.
 
         With --method collocation: per model (--able, and the amputee with each category), the
         speed continuation over --speeds (each speed warm-started from the previous solution)
         and the maximum speed; DIR/<model>/speed-<v>.json, max-speed.json and the table
         DIR/collocation-sweep.csv. A used --out needs --resume or --force; exit status 2 when a
         model failed (after the others). --starts K solves each problem from up to K starts
-        and keeps the best. The CMA-ES options do not apply.
+        and keeps the best.
 
-        With --recipe: per category and seed (--seeds), the recipe's stages, each warm-started
-        from the one before, then the speed raised by continuation on the speed reached;
-        DIR/<category>/seed-<n>/ (one folder per level, levels.json), DIR/levels.csv and
-        DIR/summary.csv (whether each category's seeds agree, maximum speeds). The grid options
-        (--speeds, --generations, --popsize, --sigma, --duration, --dt, --robust-*) are the
-        recipe's. Running it again with the same --out continues."""
-        if method == "collocation":
+        An option of another method (or of the grid with --recipe) is refused."""
+        method = _method(method)
+        mode = "recipe" if method == "reflex" and recipe is not None else method
+        refuse_other_methods(ctx, mode, SWEEP_PANELS, labels=LABELS, hints=SWEEP_HINTS)
+        if mode == "collocation":
+            # deferred: keeps bladelab --help fast
             from bladelab.cli.collocation_sweep import run_collocation_sweep
 
-            for given, option in ((init is not None, "--init"),
-                                  (chain_from is not None, "--chain-from")):
-                if given:
-                    raise SpecError("only with --method reflex", where=option)
-            code = run_collocation_sweep(
-                out=out, categories=categories, able=able, speeds=speeds,
-                mesh=50 if mesh is None else mesh,
-                guess="template" if guess is None else guess,
-                max_iter=3000 if max_iter is None else max_iter, jobs=jobs,
-                executor=executor, resume=resume, force=force, as_json=as_json,
-                starts=1 if starts is None else starts,
-                body="seed001" if body is None else body)
-            raise typer.Exit(code)
-        if method != "reflex":
-            raise SpecError(f"unknown method {method!r}", where="--method",
-                            hint="reflex or collocation")
-        for given, option in ((able, "--able"), (mesh is not None, "--mesh"),
-                              (guess is not None, "--guess"), (max_iter is not None, "--max-iter"),
-                              (resume, "--resume"), (force, "--force"), (as_json, "--json"),
-                              (starts is not None, "--starts"), (body is not None, "--body")):
-            if given:
-                raise SpecError("only with --method collocation", where=option,
-                                hint="a reflex sweep continues by itself in the same --out")
-        if recipe is not None:
-            for given, option in ((initial_speed is not None, "--initial-speed"),
-                                  (chain_from is not None, "--chain-from")):
-                if given:
-                    raise SpecError("not with --recipe (the recipe sets it)", where=option)
-            _run_recipe_sweep(out, categories, recipe, seeds, track_study, init, jobs,
-                              executor, checkpoint_every)
-            return
-        for given, option in ((seeds is not None, "--seeds"),
-                              (track_study is not None, "--track-study")):
-            if given:
-                raise SpecError("only with --recipe", where=option)
-        from bladelab.predict.reflex.sweep import run_sweep
+            raise typer.Exit(run_collocation_sweep(
+                out=out, categories=categories, able=able, speeds=speeds, mesh=mesh,
+                guess=guess, max_iter=max_iter, jobs=jobs, executor=executor, resume=resume,
+                force=force, as_json=as_json, starts=starts, body=body))
+        from bladelab.cli import reflex  # deferred: keeps bladelab --help fast
 
-        if not (math.isfinite(duration) and duration > 0):
-            raise SpecError("must be positive", where="--duration")
-        _check_simulation_options(dt, robust_samples, robust_jitter)
-        if init is not None and not init.is_file():
-            raise SpecError("file not found", file=init, where="--init")
-        table = run_sweep(
-            _parse_list(categories, "--categories"),
-            _parse_list(speeds, "--speeds", float),
-            out=out,
-            init=init,
-            generations=generations,
-            popsize=popsize,
-            sigma=sigma,
-            seed=seed,
-            jobs=jobs,
-            executor=executor,
-            duration=duration,
-            dt=dt,
-            robust_samples=robust_samples,
-            robust_jitter=robust_jitter,
-            initial_speed=initial_speed,
-            checkpoint_every=checkpoint_every,
-            chain_from=chain_from,
-        )
-        typer.echo(table.to_string(index=False))
+        if mode == "recipe":
+            reflex.run_recipe_sweep(out=out, categories=categories, recipe=recipe, seeds=seeds,
+                                    track_study=track_study, init=init, jobs=jobs,
+                                    executor=executor, checkpoint_every=checkpoint_every)
+            return
+        reflex.run_reflex_sweep(
+            out=out, categories=categories, speeds=speeds, init=init, generations=generations,
+            popsize=popsize, sigma=sigma, seed=seed, jobs=jobs, executor=executor,
+            duration=duration, dt=dt, robust_samples=robust_samples,
+            robust_jitter=robust_jitter, initial_speed=initial_speed,
+            checkpoint_every=checkpoint_every, chain_from=chain_from)

@@ -7,6 +7,8 @@ from pathlib import Path
 
 import typer
 
+from bladelab.errors import InputFileError
+
 __all__ = ["register"]
 
 
@@ -33,9 +35,10 @@ def _report(
 ) -> None:
     """Write PATH/report/index.html: fits, K*/D*, mechanics, statistics, identifiability (a
     study); surfaces and optimum (a design study); or the re-simulated predictive solutions."""
-    from bladelab.errors import InputFileError
+
+    # deferred: keeps bladelab --help fast
     from bladelab.report.predictive import build_predictive_report, predictive_kind
-    from bladelab.report.study import build_study_report
+    from bladelab.report.study import build_study_report  # deferred: keeps bladelab --help fast
 
     if study_dir.is_file() or (study_dir.is_dir() and predictive_kind(study_dir) is not None
                                and not (study_dir / "study.yaml").is_file()):
@@ -53,6 +56,7 @@ def _report(
         raise InputFileError("no such study folder, predictive result or parameter file",
                              file=study_dir, hint="give the folder that holds study.yaml, a "
                              "'bladelab predict'/'sweep' folder or a parameter JSON file")
+    # deferred: keeps bladelab --help fast
     from bladelab.report.design import build_design_report, is_design_folder
 
     if is_design_folder(study_dir):  # a 'bladelab design' folder (study.json from run_design)

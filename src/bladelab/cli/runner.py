@@ -8,8 +8,10 @@ from pathlib import Path
 
 import typer
 
-from bladelab.cli.defaults import RUNNER_DT as DEFAULT_DT
+from bladelab._io import read_json
 from bladelab.errors import InputFileError, SpecError
+from bladelab.predict.defaults import TIME_STEP_S
+from bladelab.units import damping_per_deg_to_per_rad, stiffness_per_deg_to_per_rad
 
 runner_app = typer.Typer(help="Planar musculoskeletal runner with a running blade (seed 001).")
 
@@ -20,7 +22,6 @@ def _read_controller(path: Path, muscle_names: tuple[str, ...]) -> list[float]:
     Format: ``{"excitations": {"glut_max_l": 0.3, ...}, "default": 0.05}``; muscles not named
     get ``default``. (The reflex controller of the predictive-running issue will extend this.)
     """
-    from bladelab._io import read_json
 
     data = read_json(path, what="controller file")
     if not isinstance(data, dict):
@@ -61,8 +62,7 @@ def _wear(name: str, links: int | None, k_deg: float | None, d_deg: float | None
     """A BladeModel from the blade module, with optional link count and K*, D*."""
     import numpy as np
 
-    from bladelab.blade import load_blade, multilink_blade
-    from bladelab.units import damping_per_deg_to_per_rad, stiffness_per_deg_to_per_rad
+    from bladelab.blade import load_blade, multilink_blade  # deferred: keeps bladelab --help fast
 
     if links is not None:
         return multilink_blade(name, n_links=links, K_Nm_per_deg=k_deg, D_Nms_per_deg=d_deg)
@@ -106,7 +106,9 @@ def simulate_cmd(
         None, "--controller", help="Controller JSON (constant excitations); none: 0.05 for all."
     ),
     duration: float = typer.Option(10.0, "--duration", help="Simulated time [s]."),
-    dt: float = typer.Option(DEFAULT_DT, "--dt", help="Time step [s] (1e-4 with --wear)."),
+    dt: float | None = typer.Option(
+        None, "--dt", help=f"Time step [s] (default: the runner model's, {TIME_STEP_S:g} s; "
+                           "1e-4 s with --wear and the explicit integrator)."),
     integrator: str = typer.Option(
         "explicit", "--integrator",
         help="explicit (default), newmark (contacts, ligaments and socket linearly implicit, "
@@ -121,8 +123,10 @@ def simulate_cmd(
 ) -> None:
     """Simulate a runner forward and print its summary (optionally write states, GRF, events,
     power balance and muscle states as CSV into --out)."""
+    # deferred: keeps bladelab --help fast
     from bladelab.runner import analyses, build_runner, load_runner_params, simulate_runner
-    from bladelab.runner.export import write_simulation
+    from bladelab.runner.export import write_simulation  # deferred: keeps bladelab --help fast
+    from bladelab.runner.model import DEFAULT_DT  # deferred: keeps bladelab --help fast
 
     if model not in ("able", "amputee"):
         raise SpecError(f"unknown model {model!r}", where="--model", hint="use able or amputee")
@@ -135,8 +139,9 @@ def simulate_cmd(
         if model != "amputee":
             raise SpecError("only the amputee model wears a blade", where="--wear")
         blade_model = _wear(wear, links, k_deg, d_deg)
-        if dt == DEFAULT_DT and integrator == "explicit":
+        if dt in (None, DEFAULT_DT) and integrator == "explicit":
             dt = 1e-4  # the blade's sole contact needs a finer step
+    dt = DEFAULT_DT if dt is None else dt
     if params is not None:
         p = load_runner_params(params)
         if p.kind != model:
@@ -185,7 +190,7 @@ def blades_cmd(
     as_json: bool = typer.Option(False, "--json", help="Print as JSON."),
 ) -> None:
     """List the blade categories (seed 001 Table 2.3)."""
-    from bladelab.runner import blade_catalogue
+    from bladelab.runner import blade_catalogue  # deferred: keeps bladelab --help fast
 
     rows = [c.to_dict() for c in blade_catalogue().values()]
     if as_json:

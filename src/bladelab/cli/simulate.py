@@ -9,6 +9,7 @@ import typer
 
 from bladelab._io import atomic_open
 from bladelab.errors import ModelError
+from bladelab.parameters import JOINT_PARAMETERS
 
 __all__ = ["register"]
 
@@ -44,10 +45,9 @@ def _simulate(
     belt_speed: float = typer.Option(0.0, "--belt-speed", help="Treadmill belt speed [m/s]."),
 ) -> None:
     """Simulate a blade driven by the clamp motion of a stance; write GRF, distance, deflection."""
-    from bladelab.blade import load_blade
-    from bladelab.parameters import JOINT_PARAMETERS
-    from bladelab.sim import prepare, simulate
-    from bladelab.trial.stance import read_stance_csv
+    from bladelab.blade import load_blade  # deferred: keeps bladelab --help fast
+    from bladelab.sim import prepare, simulate  # deferred: keeps bladelab --help fast
+    from bladelab.trial.stance import read_stance_csv  # deferred: keeps bladelab --help fast
 
     if engine not in ("kernel", "mujoco"):
         raise ModelError(f"unknown engine {engine!r}", where="--engine", hint="kernel or mujoco")

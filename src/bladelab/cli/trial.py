@@ -24,8 +24,8 @@ _ZERO = typer.Option(True, "--zero-offset/--no-zero-offset",
 def _read(path: Path, forward: str, up: str, zero_offset: bool = True):
     import warnings
 
-    from bladelab.trial import C3DWarning
-    from bladelab.trial.c3d import read_c3d
+    from bladelab.trial import C3DWarning  # deferred: keeps bladelab --help fast
+    from bladelab.trial.c3d import read_c3d  # deferred: keeps bladelab --help fast
 
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", C3DWarning)
@@ -87,6 +87,7 @@ def _stances(
     zero_offset: bool = _ZERO,
 ) -> None:
     """List the stances: start, end, contact time, peak vertical force, vertical impulse."""
+    # deferred: keeps bladelab --help fast
     from bladelab.trial.events import classify_stances, detect_stances
 
     trial = _read(file, forward, up, zero_offset)
@@ -132,8 +133,9 @@ def _extract(
     zero_offset: bool = _ZERO,
 ) -> None:
     """Write one stance as a stance CSV (clamp pose, GRF, distance; docs/stance-csv.md)."""
+    # deferred: keeps bladelab --help fast
     from bladelab.trial.kinematics import MarkerMap, extract_stance, load_marker_map
-    from bladelab.trial.stance import write_stance_csv
+    from bladelab.trial.stance import write_stance_csv  # deferred: keeps bladelab --help fast
 
     marker_map = load_marker_map(markers) if markers else MarkerMap()
     trial = _read(file, forward, up, zero_offset)

@@ -18,48 +18,63 @@ The pieces, each usable on its own:
 - :mod:`~bladelab.design.evaluators`: design point -> blade -> simulation -> responses.
 """
 
-from bladelab.design.blade_generator import GeneratedBlade, generate_blade
-from bladelab.design.compression import (
-    CompressionTestResult,
-    compression_test,
-    vertical_stiffness,
-)
-from bladelab.design.constraints import (
-    ClearanceResult,
-    KneeBucklingResult,
-    blade_clearance,
-    knee_buckling,
-    knee_extension_moment,
-)
-from bladelab.design.doe import (
-    Design,
-    EstimabilityReport,
-    box_behnken,
-    central_composite,
-    d_optimal,
-    estimability,
-    make_design,
-    read_runs_csv,
-    require_estimable,
-)
-from bladelab.design.evaluators import BladeEvaluator, make_evaluator, swing_clearance
-from bladelab.design.motion import load_motion_model, read_motion_file
-from bladelab.design.motion_model import MotionModel, fit_motion_model
-from bladelab.design.optimum import OptimumResult, SurfaceConstraint, constrained_optimum
-from bladelab.design.performance import (
-    CyclePerformance,
-    StancePerformance,
-    bouncing_ball,
-    cycle_performance,
-    performance_by_leg,
-    performance_by_stance,
-    stance_performance,
-)
-from bladelab.design.space import DesignSpace, Factor, default_design_space
-from bladelab.design.study import DesignStudyResult, run_design
-from bladelab.design.surfaces import ResponseSurface, SurfacePrediction, fit_surface
-from bladelab.design.terms import model_terms, parse_terms
-from bladelab.design.trends import SEED002_TRENDS, TrendVerdict, evaluate_trends, trends_frame
+import importlib
+
+# Public name -> the module that defines it. The names load on first use (PEP 562), so that
+# importing a light module of the package (``bladelab.design.defaults``, which the command
+# line's help reads) does not load pandas and scipy.
+_EXPORTS: dict[str, str] = {
+    "blade_clearance": "constraints",
+    "BladeEvaluator": "evaluators",
+    "bouncing_ball": "performance",
+    "box_behnken": "doe",
+    "central_composite": "doe",
+    "ClearanceResult": "constraints",
+    "compression_test": "compression",
+    "CompressionTestResult": "compression",
+    "constrained_optimum": "optimum",
+    "cycle_performance": "performance",
+    "CyclePerformance": "performance",
+    "d_optimal": "doe",
+    "default_design_space": "space",
+    "Design": "doe",
+    "DesignSpace": "space",
+    "DesignStudyResult": "study",
+    "estimability": "doe",
+    "EstimabilityReport": "doe",
+    "evaluate_trends": "trends",
+    "Factor": "space",
+    "fit_motion_model": "motion_model",
+    "fit_surface": "surfaces",
+    "generate_blade": "blade_generator",
+    "GeneratedBlade": "blade_generator",
+    "knee_buckling": "constraints",
+    "knee_extension_moment": "constraints",
+    "KneeBucklingResult": "constraints",
+    "load_motion_model": "motion",
+    "make_design": "doe",
+    "make_evaluator": "evaluators",
+    "model_terms": "terms",
+    "MotionModel": "motion_model",
+    "OptimumResult": "optimum",
+    "parse_terms": "terms",
+    "performance_by_leg": "performance",
+    "performance_by_stance": "performance",
+    "read_motion_file": "motion",
+    "read_runs_csv": "doe",
+    "require_estimable": "doe",
+    "ResponseSurface": "surfaces",
+    "run_design": "study",
+    "SEED002_TRENDS": "trends",
+    "stance_performance": "performance",
+    "StancePerformance": "performance",
+    "SurfaceConstraint": "optimum",
+    "SurfacePrediction": "surfaces",
+    "swing_clearance": "evaluators",
+    "trends_frame": "trends",
+    "TrendVerdict": "trends",
+    "vertical_stiffness": "compression",
+}
 
 __all__ = [
     "BladeEvaluator",
@@ -113,3 +128,24 @@ __all__ = [
     "trends_frame",
     "vertical_stiffness",
 ]
+
+
+def __getattr__(name: str):
+    """A public name (or a submodule) of the package, imported on first use."""
+    if name.startswith("__"):
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    module = _EXPORTS.get(name)
+    if module is not None:
+        value = getattr(importlib.import_module(f"{__name__}.{module}"), name)
+        globals()[name] = value
+        return value
+    try:
+        return importlib.import_module(f"{__name__}.{name}")
+    except ModuleNotFoundError as err:
+        if err.name != f"{__name__}.{name}":
+            raise
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}") from None
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(__all__))

@@ -1,4 +1,4 @@
-"""Design point -> multi-link blade spec (issue 8, "Design space -> blade").
+"""Design point -> multi-link blade spec.
 
 :func:`generate_blade` turns the four design factors of seed 002 into a multi-link blade (default
 6 rigid links joined by 5 spring-dampers, as seed 002), starting from a base blade spec with a
@@ -45,6 +45,7 @@ from bladelab.blade.catalogue import load_blade
 from bladelab.blade.model import BladeModel
 from bladelab.blade.profile import ProfileElement, profile_from_elements
 from bladelab.blade.spec import BladeSpec, spec_from_dict
+from bladelab.design import defaults
 from bladelab.design.compression import vertical_stiffness
 from bladelab.errors import ModelError, SpecError
 
@@ -244,7 +245,7 @@ def lumped_beam_stiffness(
 def generate_blade(
     point: Mapping[str, float],
     *,
-    base: str | Path | BladeSpec = "xtreme",
+    base: str | Path | BladeSpec = defaults.BASE_BLADE,
     n_links: int = 6,
     mode: str = "target",
     roles: Mapping[str, str] | None = None,

@@ -1,4 +1,4 @@
-"""Design point -> generated blade on the transfemoral runner -> predicted stride (issue 21).
+"""Design point -> generated blade on the transfemoral runner -> predicted stride.
 
 :class:`CollocationEvaluator` is the design study's evaluator ``"collocation"``
 (``bladelab design --evaluator collocation``): for each design point it
@@ -32,7 +32,18 @@ from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
 
-from bladelab.errors import OptimizationError, SpecError
+from tqdm.auto import tqdm
+
+from bladelab.design import defaults
+from bladelab.design.blade_generator import generate_blade
+from bladelab.design.predicted import stride_responses
+from bladelab.design.responses import PREDICTED_RESPONSE_UNITS
+from bladelab.errors import InputFileError, OptimizationError, SpecError
+from bladelab.executors import make_executor
+from bladelab.predict.collocation.settings import CollocationSettings
+from bladelab.predict.collocation.solution import CollocationSolution
+from bladelab.predict.collocation.solve import predict_stride
+from bladelab.predict.collocation.stored import check_model_spec, runner_from_spec
 
 __all__ = ["CollocationEvaluator", "DEFAULT_DESIGN_SPEED_MPS", "REFERENCE_DOFS", "settle_strides",
            "stride_checks"]
@@ -40,9 +51,9 @@ __all__ = ["CollocationEvaluator", "DEFAULT_DESIGN_SPEED_MPS", "REFERENCE_DOFS",
 #: Prescribed speed of a design's stride [m/s] (our choice, docs/design.md "Predicted
 #: transfemoral gaits"): the transfemoral runner's maximum speed on collocation is 5.6–5.8 m/s
 #: (sphere blade), so seed 002's sprint speeds (about 7 m/s) are out of its reach; 4 m/s is
-#: the speed of the clean multi-link stride the first design starts from (session 10: the
-#: continuations to 4.5 and 5 m/s were not finished within the session).
-DEFAULT_DESIGN_SPEED_MPS = 4.0
+#: the speed of the clean multi-link stride the first design starts from (2026-11-26: the
+#: continuations to 4.5 and 5 m/s were not finished).
+DEFAULT_DESIGN_SPEED_MPS = defaults.COLLOCATION_SPEED_MPS
 #: The start of the first design: a clean transfemoral stride wearing the default box's centre
 #: blade at :data:`DEFAULT_DESIGN_SPEED_MPS`, its joints by backward Euler (how it was made:
 #: benchmarks/collocation/transfemoral-2026-11-26/multilink_centre.py).
@@ -62,7 +73,7 @@ DEFAULT_SOLE_STIFFNESS_SCALE = 0.1
 REFERENCE_DOFS = ("pelvis_tilt", "lumbar_extension", "hip_flexion_l", "knee_angle_l",
                   "ankle_angle_l", "hip_flexion_r")
 #: Solved designs a new design may start from, nearest first, before the study's start
-#: (a start that gives no clean stride is followed by the next; measured session 15: with the
+#: (a start that gives no clean stride is followed by the next; measured 2026-11-26: with the
 #: technique kept, two axial designs got a 10-BW hop or no convergence from the centre, their
 #: only neighbour then).
 START_NEIGHBOURS = 3
@@ -99,8 +110,9 @@ class CollocationEvaluator:
         Factor -> (low, high) in its unit: the coding of the nearest-neighbour distance
         (default: relative differences).
     mesh_intervals, swing_clearance_m, max_iter
-        Collocation settings (:class:`~bladelab.predict.collocation.solve.CollocationSettings`):
-        mesh intervals, the swinging blade's minimum height [m], IPOPT's iteration limit.
+        Collocation settings
+        (:class:`~bladelab.predict.collocation.settings.CollocationSettings`): mesh intervals,
+        the swinging blade's minimum height [m], IPOPT's iteration limit.
     knee_moment_min_Nm
         Keep the prosthetic knee's external extension moment at or above this [N·m] in every
         design's stride (seed 002's knee-buckling constraint imposed on the predicted gait,
@@ -145,8 +157,6 @@ class CollocationEvaluator:
                             where="sole_stiffness_scale")
         start = self.start_file
         if not start.is_file():
-            from bladelab.errors import InputFileError
-
             raise InputFileError("no such collocation solution (the first design's start)",
                                  file=start, hint="a solution.json of the transfemoral runner")
 
@@ -157,8 +167,6 @@ class CollocationEvaluator:
 
     @property
     def units(self) -> dict[str, str]:
-        from bladelab.design.predicted import PREDICTED_RESPONSE_UNITS
-
         return dict(PREDICTED_RESPONSE_UNITS)
 
     def to_dict(self) -> dict:
@@ -195,8 +203,8 @@ class CollocationEvaluator:
     def _starts(self, point: Mapping[str, float]) -> list[Path]:
         """Solution files to start from: the :data:`START_NEIGHBOURS` nearest solved designs,
         nearest first, then ``start``; with a reference weight, ``start`` (the reference)
-        first and the neighbours after it (every design from the same start: measured session
-        15, a chain of neighbours carried a 0.59 s stride away from the reference's 0.53 s
+        first and the neighbours after it (every design from the same start: measured
+        2026-11-26, a chain of neighbours carried a 0.59 s stride away from the reference's 0.53 s
         into a third of the box)."""
         near = self._neighbours(point)[:START_NEIGHBOURS]
         return [self.start_file, *near] if self.reference_weight else [*near, self.start_file]
@@ -209,11 +217,6 @@ class CollocationEvaluator:
         ``{"from", "converged", "status", "objective", "warnings", "responses"}`` (responses
         of a clean stride only). Every clean stride of a design is a local optimum of the same
         problem: their spread is what the start decides (:mod:`bladelab.design.start_spread`)."""
-        from bladelab.design.predicted import stride_responses
-        from bladelab.predict.collocation.solution import CollocationSolution
-        from bladelab.predict.collocation.solve import predict_stride
-        from bladelab.predict.collocation.stored import runner_from_spec
-
         point = {k: float(v) for k, v in point.items()}
         spec, settings = self._problem(point)
         current, _ = self._stored(point, spec, settings)
@@ -241,10 +244,8 @@ class CollocationEvaluator:
                 "responses_before": stride_responses(current, runner), "tries": tries}
 
     def settings(self):
-        """The :class:`~bladelab.predict.collocation.solve.CollocationSettings` of every
+        """The :class:`~bladelab.predict.collocation.settings.CollocationSettings` of every
         design's stride (checked when the evaluator is made)."""
-        from bladelab.predict.collocation.solve import CollocationSettings
-
         reference = {}
         if self.reference_weight:
             reference = {"reference": str(self.start_file),
@@ -267,8 +268,6 @@ class CollocationEvaluator:
     def blade_spec(self, point: Mapping[str, float]) -> dict:
         """The design's blade file contents: the generated blade, its soles' contact stiffness
         times ``sole_stiffness_scale`` and their damping times its square root."""
-        from bladelab.design.blade_generator import generate_blade
-
         data = generate_blade(point, **dict(self.generator)).spec.model_dump(
             mode="json", exclude_none=True)
         contact = dict(data.get("contact", {}))
@@ -307,9 +306,6 @@ class CollocationEvaluator:
         """(stride, its file): this design's clean stride of this problem (same blade,
         speed, mesh, weights, constraints and transcription) from ``solutions_dir``, or the
         start file if it is one; else (None, None)."""
-        from bladelab.predict.collocation.solution import CollocationSolution
-        from bladelab.predict.collocation.stored import check_model_spec
-
         own = self._stride_file(point)
         paths = [self.start_file]  # the start may be this very design's
         for path in ([own] if own is not None else []) + paths:
@@ -324,11 +320,6 @@ class CollocationEvaluator:
 
     # -- one design -----------------------------------------------------------------------
     def __call__(self, point: Mapping[str, float]) -> dict[str, float]:
-        from bladelab.design.predicted import stride_responses
-        from bladelab.predict.collocation.solution import CollocationSolution
-        from bladelab.predict.collocation.solve import predict_stride
-        from bladelab.predict.collocation.stored import runner_from_spec
-
         point = {k: float(v) for k, v in point.items()}
         spec, settings = self._problem(point)
         runner = runner_from_spec(spec)
@@ -380,7 +371,7 @@ def _continuable(solution) -> bool:
     """True for a predictive solve stopped by IPOPT's iteration limit on a nearly feasible
     iterate: the knee-safe strides of the box's corners need 1900-2200 iterations where the
     free ones needed 600-1000, and an axial design stopped at 3000 with a violation of 1e-5
-    (session 12)."""
+    (measured 2026-11-26)."""
     nlp = solution.nlp
     return (not solution.converged and solution.stage == "predictive"
             and nlp.status == "Maximum_Iterations_Exceeded"
@@ -403,10 +394,6 @@ def settle_strides(evaluator: CollocationEvaluator, points, *, neighbours: int =
     ``skip``: indices of designs already settled in this pass (a resumed pass; their rows are
     None in the result). ``on_design(i, row)`` is called in this process as each design
     finishes, so that a caller can record the pass as it goes."""
-    from tqdm.auto import tqdm
-
-    from bladelab.executors import make_executor
-
     skip = set(skip)
     todo = [i for i in range(len(points)) if i not in skip]
     payloads = [{"evaluator": evaluator, "point": dict(points[i]), "neighbours": int(neighbours)}
@@ -453,8 +440,6 @@ def stride_checks(design_dir: str | Path, evaluator: Mapping[str, Any],
     -joined; "" when clean). A study's results may hold strides written before a check existed
     (the 5 % residual gate came after the free-gait study): the report marks those runs and
     leaves them out of its surfaces rather than average them in silently."""
-    from bladelab.predict.collocation.solution import CollocationSolution
-
     folder = _solutions_folder(Path(design_dir), evaluator.get("solutions_dir"))
     rows = []
     for point in points:

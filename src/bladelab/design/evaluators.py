@@ -1,4 +1,4 @@
-"""Design evaluators: design point -> generated blade -> simulation -> responses (issue 8).
+"""Design evaluators: design point -> generated blade -> simulation -> responses.
 
 An evaluator is a picklable callable ``{factor: value in its unit} -> {response: value}`` for
 :func:`~bladelab.design.study.run_design`.
@@ -58,33 +58,20 @@ import numpy as np
 
 from bladelab.blade.model import BladeModel
 from bladelab.constants import STANDARD_GRAVITY
+from bladelab.design import defaults
 from bladelab.design.blade_generator import generate_blade
 from bladelab.design.constraints import knee_extension_moment
 from bladelab.design.performance import bouncing_ball
+from bladelab.design.responses import BLADE_RESPONSE_UNITS
 from bladelab.errors import SpecError
+from bladelab.sim.synthetic import generate_stance
 
 __all__ = [
-    "BLADE_RESPONSE_UNITS",
     "BladeEvaluator",
     "make_evaluator",
     "swing_clearance",
 ]
 
-#: Units of the blade evaluator's responses (for tables and plots).
-BLADE_RESPONSE_UNITS: dict[str, str] = {
-    "delta_vx_m_per_s": "m/s",
-    "avg_vx_m_per_s": "m/s",
-    "impulse_x_Ns": "N·s",
-    "impulse_z_Ns": "N·s",
-    "impulse_z_net_Ns": "N·s",
-    "evaluation_E_m": "m",
-    "peak_grf_z_N": "N",
-    "contact_time_s": "s",
-    "compression_m": "m",
-    "knee_moment_min_Nm": "N·m",
-    "swing_clearance_m": "m",
-    "blade_mass_kg": "kg",
-}
 
 
 def _ellipse_lowest_z(e, pitch: float) -> float:
@@ -142,8 +129,8 @@ class BladeEvaluator:
         ``base``, ``n_links``, ``roles``).
     """
 
-    speed_mps: float = 8.0
-    body_mass_kg: float = 76.0
+    speed_mps: float = defaults.BLADE_SPEED_MPS
+    body_mass_kg: float = defaults.BODY_MASS_KG
     touchdown_angle_deg: float = -25.0
     touchdown_vertical_speed_mps: float = -0.5
     pylon_length_m: float = 0.45
@@ -180,8 +167,6 @@ class BladeEvaluator:
 
     def __call__(self, point: Mapping[str, float]) -> dict[str, float]:
         """Responses of one design point (see the module table)."""
-        from bladelab.sim.synthetic import generate_stance
-
         blade = self.blade(point).model
         stance, truth = generate_stance(
             blade, speed_mps=self.speed_mps, body_mass_kg=self.body_mass_kg,
@@ -247,10 +232,14 @@ def make_evaluator(kind: str, **options: Any):
     if kind == "blade":
         return BladeEvaluator(**options)
     if kind == "runner":
+        # a design run with another evaluator never needs the runner models:
+        # deferred: the transfemoral runner loads them (~0.45 s)
         from bladelab.design.transfemoral import RunnerEvaluator
 
         return RunnerEvaluator(**options)
     if kind == "collocation":
+        # a design run with another evaluator never needs CasADi or the runner models:
+        # deferred: the collocation evaluator loads them (~0.4 s on top of the runner's)
         from bladelab.design.collocation_evaluator import CollocationEvaluator
 
         return CollocationEvaluator(**options)

@@ -46,7 +46,9 @@ import numpy as np
 import pandas as pd
 from scipy.interpolate import CubicSpline
 
+from bladelab._io import atomic_path
 from bladelab.errors import DataError, InputFileError, SpecError
+from bladelab.trial.cycles import joint_angle_cycles
 
 __all__ = [
     "ANGLE_NAMES",
@@ -57,6 +59,7 @@ __all__ = [
     "gait_cycle_from_trial",
     "gait_cycles_from_trial",
     "read_gait_csv",
+    "write_gait_csv",
 ]
 
 ANGLE_NAMES: tuple[str, ...] = ("hip_sound", "knee_sound", "ankle_sound", "hip_prosthetic",
@@ -159,6 +162,14 @@ def default_gait_cycle(*, period_s: float = 0.52, trunk_pitch_deg: float = 10.0,
         "trunk_pitch": np.full(n, math.radians(trunk_pitch_deg)),
     }
     return GaitCycle(period_s, ph, angles, "bladelab template (literature-typical sprint angles)")
+
+
+def write_gait_csv(cycle: GaitCycle, path: str | Path) -> Path:
+    """Write ``cycle`` as a gait-cycle CSV (:meth:`GaitCycle.to_frame`'s layout, the one
+    :func:`read_gait_csv` reads; 6 significant digits), atomically; returns the path."""
+    with atomic_path(path) as tmp:
+        cycle.to_frame().to_csv(tmp, index=False, float_format="%.6g")
+    return Path(path)
 
 
 def read_gait_csv(path: str | Path) -> GaitCycle:
@@ -280,8 +291,6 @@ def gait_cycles_from_trial(
     DataError
         Missing markers or platforms, the sound leg has no foot markers, or no complete cycle.
     """
-    from bladelab.trial.cycles import joint_angle_cycles
-
     if leg not in _OTHER:
         raise SpecError(f"leg must be 'left' or 'right', got {leg!r}", where="--leg")
     sound = _OTHER[leg]

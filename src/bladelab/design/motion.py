@@ -40,9 +40,15 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+import pandas as pd
+from tqdm.auto import tqdm
 
 from bladelab._io import read_yaml
+from bladelab.design.gait_cycle import gait_cycle_from_trial, read_gait_csv
+from bladelab.design.motion_model import MotionModel, fit_motion_model
 from bladelab.errors import BladelabError, InputFileError, SpecError
+from bladelab.trial import read_c3d
+from bladelab.trial.joint_angles import load_joint_marker_map
 
 __all__ = [
     "MOTION_KEYS",
@@ -138,8 +144,6 @@ def _raw_rows(path: Path) -> tuple[list[Any], str | None]:
     """The file's entries as mappings of raw values, and the YAML ``model:`` key."""
     suffix = path.suffix.lower()
     if suffix == ".csv":
-        import pandas as pd
-
         try:
             df = pd.read_csv(path, dtype=str, keep_default_na=False, skipinitialspace=True)
         except (OSError, ValueError) as err:
@@ -300,12 +304,6 @@ def load_motion_cycles(motion: MotionFile, *, n: int = 100, progress: bool = Fal
     ``gait`` entries are read; ``trial`` entries give their mean cycle of ``n`` samples (a C3D
     file named by several entries is read once). Each cycle's ``source`` starts with its row.
     """
-    from tqdm.auto import tqdm
-
-    from bladelab.design.gait_cycle import gait_cycle_from_trial, read_gait_csv
-    from bladelab.trial import read_c3d
-    from bladelab.trial.joint_angles import load_joint_marker_map
-
     trials: dict = {}
 
     def c3d(p: Path, forward: str, up: str):
@@ -367,8 +365,6 @@ def load_motion_model(
         With its coding, so that ``predict_point({factor: value})`` works; ``to_dict()`` gives
         the model, its terms and the leave-one-blade-out errors (period [s], angles [deg]).
     """
-    from bladelab.design.motion_model import fit_motion_model
-
     motion = read_motion_file(path, space=space)
     cycles = load_motion_cycles(motion, progress=progress)
     x = motion.values()
@@ -409,8 +405,6 @@ def check_motion_factors(motion, names: Sequence[str]) -> None:
 def as_motion_model(motion):
     """A :class:`~bladelab.design.motion_model.MotionModel` as it is, or one fitted from a motion
     file path (:func:`load_motion_model`, coded over the cycles' own blades)."""
-    from bladelab.design.motion_model import MotionModel
-
     if isinstance(motion, MotionModel):
         return motion
     if isinstance(motion, (str, Path)):

@@ -17,6 +17,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from bladelab.design.doe import require_estimable
 from bladelab.design.gait_cycle import ANGLE_NAMES, GaitCycle
 from bladelab.design.terms import model_matrix, parse_terms, term_name
 from bladelab.errors import DataError, SpecError
@@ -174,8 +175,6 @@ def _rms(err: np.ndarray) -> float:
 
 def _motion_terms(coded: np.ndarray, model, names: Sequence[str], n_blades: int):
     """(model label, terms, estimability report); ``"auto"``: quadratic, else linear."""
-    from bladelab.design.doe import require_estimable
-
     n = coded.shape[0]
 
     def refuse(err: SpecError, what: str) -> SpecError:

@@ -1,4 +1,4 @@
-"""Seed 002's responses from a predicted stride (issue 21): a collocation solution of an
+"""Seed 002's responses from a predicted stride: a collocation solution of an
 amputee runner (the transfemoral one, whose knee can buckle) read as seed 002 reads its
 inverse-dynamics runs.
 
@@ -34,7 +34,7 @@ check, :func:`~bladelab.design.constraints.knee_buckling`). Node values alternat
 blade sole rings by ±1 mm from node to node (the trapezoidal rule's period-2 mode), its
 friction saturating at ±μ·F_n, and the moment swings by ±20–60 N·m about a mean that the
 momentum balance, which integrates interval means, sees (measured on the design's centre
-stride, session 12); until then the minimum over the nodes, interpolated, was reported and
+stride, 2026-11-26); until then the minimum over the nodes, interpolated, was reported and
 was that ringing's trough. Until 2026-11-26 a centre of pressure was interpolated instead,
 which was 0 (the lab origin) at the unloaded node before touch-down and gave spurious minima
 of −150 to −300 N·m in the interval of touch-down.
@@ -45,21 +45,14 @@ from __future__ import annotations
 import mujoco
 import numpy as np
 
-from bladelab.design.evaluators import BLADE_RESPONSE_UNITS
 from bladelab.design.performance import bouncing_ball
 from bladelab.errors import SpecError
-from bladelab.predict.collocation.nodes import on_fine_grid, periodic_runs
+from bladelab.predict.collocation import build_collocation_model
+from bladelab.predict.collocation.nodes import evaluate_nodes, on_fine_grid, periodic_runs
+from bladelab.runner.layout import CP_LEG
 
-__all__ = ["PREDICTED_RESPONSE_UNITS", "stride_responses"]
+__all__ = ["stride_responses"]
 
-#: Units of :func:`stride_responses`' values (seed 002's, named as the blade evaluator's).
-PREDICTED_RESPONSE_UNITS: dict[str, str] = {
-    **{k: BLADE_RESPONSE_UNITS[k] for k in (
-        "delta_vx_m_per_s", "avg_vx_m_per_s", "impulse_x_Ns", "impulse_z_Ns",
-        "impulse_z_net_Ns", "evaluation_E_m", "knee_moment_min_Nm", "swing_clearance_m")},
-    "contact_time_prosthetic_s": "s",
-    "cost_of_transport_J_per_kg_m": "J/(kg·m)",
-}
 _FINE = 20  # interpolation points per mesh interval
 _LOADED_N = 20.0  # N
 _KNEE_LOADED = 0.05  # of the peak vertical force
@@ -68,8 +61,6 @@ _KNEE_LOADED = 0.05  # of the peak vertical force
 def _kinematics(runner, q: np.ndarray, qd: np.ndarray) -> dict[str, np.ndarray]:
     """Per node: the centre of mass and its velocity (x, z) and the prosthetic knee axis (x, z)
     [m, m/s]; and which contacts are the prosthesis's."""
-    from bladelab.runner.model import CP_LEG
-
     m = runner.mj_model
     d = mujoco.MjData(m)
     knee = m.joint("knee_angle_r").id if "knee_angle_r" in runner.dof_names else None
@@ -102,7 +93,7 @@ def _stance(loaded: np.ndarray) -> np.ndarray:
 
 def stride_responses(solution, runner, *, cm=None) -> dict[str, float]:
     """Seed 002's responses of a predicted stride (module docstring; values in
-    :data:`PREDICTED_RESPONSE_UNITS`).
+    :data:`~bladelab.design.responses.PREDICTED_RESPONSE_UNITS`).
 
     Parameters
     ----------
@@ -119,9 +110,6 @@ def stride_responses(solution, runner, *, cm=None) -> dict[str, float]:
     SpecError
         The solution did not converge, is of the able model, or has no prosthetic stance.
     """
-    from bladelab.predict.collocation import build_collocation_model
-    from bladelab.predict.collocation.nodes import evaluate_nodes
-
     if not solution.converged:
         raise SpecError("the solve did not converge: its last iterate is not a stride",
                         where="solution", hint="solve again (--resume) or from another guess")

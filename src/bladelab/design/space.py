@@ -16,6 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from bladelab.design import defaults
 from bladelab.errors import SpecError
 
 __all__ = ["Factor", "DesignSpace", "default_design_space", "CODED_TOLERANCE"]
@@ -268,11 +269,4 @@ def default_design_space() -> DesignSpace:
     ``xtreme`` blade, the blade generator's default base). Replace them with the ranges of the
     blades you can build.
     """
-    return DesignSpace(
-        (
-            Factor("stiffness_kN_per_m", 18.0, 32.0, "kN/m", "vertical stiffness"),
-            Factor("width_m", 0.05, 0.08, "m", "width"),
-            Factor("height_m", 0.40, 0.48, "m", "height"),
-            Factor("toe_length_m", 0.19, 0.25, "m", "toe length"),
-        )
-    )
+    return DesignSpace(tuple(Factor(*f) for f in defaults.DESIGN_FACTORS))

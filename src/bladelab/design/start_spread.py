@@ -5,7 +5,7 @@ pass starts each design from its solved neighbours), the same design can give an
 stride, of a slightly different objective and different responses. Computer experiments are
 called deterministic, but these are not, in this sense: the start plays the part of the
 replicate error of a physical experiment. :func:`start_spread` measures it from the settling
-record (``settling.json``, :mod:`bladelab.cli.design_settle`), where every settled design keeps
+record (``settling.json``, :mod:`bladelab.design.settling`), where every settled design keeps
 the responses of its stored stride and of each start's clean stride.
 
 Per response (``results.csv``'s columns; values in their units):
@@ -37,6 +37,7 @@ import numpy as np
 import pandas as pd
 
 from bladelab._io import read_json
+from bladelab.design.settling import RECORD_NAME
 
 __all__ = ["NEAR_PCT", "design_strides", "start_spread"]
 
@@ -85,7 +86,7 @@ def start_spread(design_dir: str | Path, *, responses: Sequence[str] | None = No
     Returns an empty frame when the study has no settling record or no design with two
     distinct clean strides."""
     design_dir = Path(design_dir)
-    path = design_dir / "settling.json"
+    path = design_dir / RECORD_NAME
     cols = ["response", "unit", "designs", "strides", "within_sd", "designs_near",
             "within_sd_near", "across_sd", "r2_ceiling", "r2_ceiling_near"]
     if not path.is_file():

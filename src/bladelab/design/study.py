@@ -35,12 +35,15 @@ import pandas as pd
 from tqdm.auto import tqdm
 
 from bladelab._io import atomic_path, write_json
+from bladelab.design import defaults
 from bladelab.design.doe import Design, EstimabilityReport, make_design, require_estimable
+from bladelab.design.motion import check_motion_factors
 from bladelab.design.optimum import OptimumResult, SurfaceConstraint, constrained_optimum
 from bladelab.design.space import DesignSpace
 from bladelab.design.surfaces import ResponseSurface, fit_surface
 from bladelab.design.terms import parse_terms
 from bladelab.errors import BladelabError, DataError, OptimizationError, SpecError
+from bladelab.executors import make_executor
 
 __all__ = ["DesignStudyResult", "run_design"]
 
@@ -173,8 +176,6 @@ def _evaluate_runs(evaluator, space: DesignSpace, design: Design, todo: list[int
             yield i, raw, err
         bar.close()
         return
-    from bladelab.executors import make_executor
-
     payloads = [{"evaluator": evaluator, "point": space.point(design.coded[i])} for i in todo]
     for k, status, value in make_executor(executor, jobs).run(evaluate_design_run, payloads):
         bar.update()
@@ -222,15 +223,15 @@ def _check_responses(
 def run_design(
     space: DesignSpace,
     *,
-    runs: str | Path | Design | np.ndarray = "ccd",
+    runs: str | Path | Design | np.ndarray = defaults.RUNS,
     evaluator: Evaluator,
     out_dir: str | Path,
-    seed: int = 0,
-    model: str | Sequence = "quadratic",
+    seed: int = defaults.SEED,
+    model: str | Sequence = defaults.SURFACE_MODEL,
     n_runs: int | None = None,
     n_center: int = 1,
     objective: str | None = None,
-    sense: str = "max",
+    sense: str = defaults.SENSE,
     constraints: Mapping[str, float] | None = None,
     units: Mapping[str, str] | None = None,
     conservative: bool = False,
@@ -292,8 +293,6 @@ def run_design(
     report = require_estimable(design, terms, space.names)  # refuse before any evaluation
     motion = getattr(evaluator, "motion", None)
     if motion is not None and hasattr(motion, "predict_point"):
-        from bladelab.design.motion import check_motion_factors
-
         check_motion_factors(motion, space.names)
     else:
         motion = None

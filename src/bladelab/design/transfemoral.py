@@ -1,6 +1,7 @@
 """Kinematics-driven planar transfemoral-amputee runner with a multi-link blade (seed 002).
 
-Model (MuJoCo, built with ``MjSpec``; x forward, z up, pitch about +y):
+Model (MuJoCo, built by :func:`bladelab.runner.kinematic_transfemoral.build_kinematic_transfemoral`;
+x forward, z up, pitch about +y):
 
 - root: slide x, slide z (free) and the trunk pitch hinge at the hips; the pelvis carries the
   head-arms-trunk mass (``torso`` + ``pelvis`` of the runner parameters); the biological segment
@@ -42,157 +43,25 @@ from numba import njit
 
 from bladelab.blade.model import BladeModel
 from bladelab.constants import STANDARD_GRAVITY
+from bladelab.design import defaults
+from bladelab.design.blade_generator import generate_blade
 from bladelab.design.constraints import blade_clearance, knee_buckling, knee_extension_moment
 from bladelab.design.gait_cycle import GaitCycle, default_gait_cycle, read_gait_csv
+from bladelab.design.motion import as_motion_model
 from bladelab.design.performance import cycle_performance
-from bladelab.errors import ModelError, SimulationError, SpecError
+from bladelab.design.responses import RUNNER_RESPONSE_UNITS
+from bladelab.errors import SimulationError, SpecError
 from bladelab.numba_cache import refresh_stale_caches
-from bladelab.runner import geometry as geo
-from bladelab.runner.params import default_runner_params
+from bladelab.runner.kinematic_transfemoral import (
+    KinematicTransfemoral,
+    build_kinematic_transfemoral,
+)
 from bladelab.runner.prosthetic_knee import ProstheticKnee, knee_torque
 from bladelab.sim.chain import build_chain
-from bladelab.sim.mujoco_blade import add_blade_bodies, lowest_sole_z
 from bladelab.sim.mujoco_engine import contact_forces_3d
 
-__all__ = ["RUNNER_RESPONSE_UNITS", "RunnerEvaluator", "TransfemoralResult",
-           "simulate_transfemoral"]
+__all__ = ["RunnerEvaluator", "TransfemoralResult", "simulate_transfemoral"]
 
-FOOT_RADIUS_M = 0.03
-_SOCKET_KG = 1.0
-_FOOT_CIRCLES = ((-0.05, -0.06), (0.15, -0.06))  # heel, toe centres below the ankle [m]
-_SERVOS = ("trunk", "hip_s", "knee_s", "ankle_s", "hip_p")
-
-RUNNER_RESPONSE_UNITS: dict[str, str] = {
-    "delta_vx_m_per_s": "m/s",
-    "avg_vx_m_per_s": "m/s",
-    "impulse_x_Ns": "N·s",
-    "impulse_z_Ns": "N·s",
-    "evaluation_E_m": "m",
-    "peak_grf_z_prosthetic_N": "N",
-    "contact_time_prosthetic_s": "s",
-    "knee_moment_min_Nm": "N·m",
-    "swing_clearance_m": "m",
-    "knee_flexion_max_stance_deg": "deg",
-}
-
-
-def _body(parent, name, pos, mass, com, inertia):
-    b = parent.add_body(name=name, pos=list(pos))
-    b.explicitinertial = True
-    b.mass = float(mass)
-    b.ipos = list(com)
-    b.inertia = [max(float(inertia), 1e-8)] * 3
-    return b
-
-
-def _hinge(body, name):
-    body.add_joint(name=name, type=mujoco.mjtJoint.mjJNT_HINGE, axis=[0, 1, 0])
-
-
-def _standing_depth(blade: BladeModel) -> float:
-    """Depth [m] of the lowest undeformed sole point below the clamp at pitch 0."""
-    low = min(0.0, lowest_sole_z(blade))
-    return -min(low, float(np.min(np.asarray(blade.points)[:, 1])))
-
-
-@dataclass(frozen=True)
-class _Built:
-    model: Any
-    sites: np.ndarray
-    axes: np.ndarray
-    site_body: np.ndarray
-    n_soles: int
-    blade_q: np.ndarray
-    blade_d: np.ndarray
-    servo_q: np.ndarray
-    servo_d: np.ndarray
-    knee_q: int
-    knee_d: int
-    knee_body: int
-    seg_bodies: np.ndarray
-    tip_site: int
-    adapter: float
-
-
-def _build(blade: BladeModel, body_mass: float, height: float, knee: ProstheticKnee,
-           extra_leg: float, dt: float, knee_offset: float = 0.0) -> _Built:
-    params = default_runner_params("able")
-    s = height / params.athlete.height_m
-    seg = params.segments
-    bio = (seg["torso"].mass_kg + seg["pelvis"].mass_kg + seg["femur_l"].mass_kg
-           + seg["tibia_l"].mass_kg + seg["calcn_l"].mass_kg + 0.6 * seg["femur_r"].mass_kg)
-    prosthesis = _SOCKET_KG + knee.mass + blade.mass
-    if body_mass <= prosthesis + 10.0:
-        raise ModelError(f"body mass {body_mass} kg is too small for the prosthesis "
-                         f"({prosthesis:.1f} kg)", where="body_mass_kg")
-    mr = (body_mass - prosthesis) / bio  # the model's total mass equals body_mass
-    thigh = (0.226 + 0.17) * s
-    shank = geo.TIBIA_LENGTH_M * s
-    ankle_h = 0.06 + FOOT_RADIUS_M
-    spec = mujoco.MjSpec()
-    spec.modelname = "bladelab_transfemoral"
-    spec.option.timestep = dt
-    spec.option.integrator = mujoco.mjtIntegrator.mjINT_EULER
-    spec.option.gravity = [0.0, 0.0, -STANDARD_GRAVITY]
-    spec.option.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_CONTACT)
-    bx = _body(spec.worldbody, "root_x", (0, 0, 0), 1e-6, (0, 0, 0), 1e-9)
-    bx.add_joint(name="root_x", type=mujoco.mjtJoint.mjJNT_SLIDE, axis=[1, 0, 0])
-    bz = _body(bx, "root_z", (0, 0, 0), 1e-6, (0, 0, 0), 1e-9)
-    bz.add_joint(name="root_z", type=mujoco.mjtJoint.mjJNT_SLIDE, axis=[0, 0, 1])
-    hat_m = (seg["torso"].mass_kg + seg["pelvis"].mass_kg) * mr
-    pelvis = _body(bz, "pelvis", (0, 0, 0), hat_m, (0, 0, 0.30 * s), hat_m * (0.3 * s) ** 2 / 3)
-    _hinge(pelvis, "trunk")
-    # sound leg
-    th_s = _body(pelvis, "thigh_s", (0, 0, 0), seg["femur_l"].mass_kg * mr, (0, 0, -0.17 * s),
-                 seg["femur_l"].inertia_kg_m2[2] * mr * s * s)
-    _hinge(th_s, "hip_s")
-    sh_s = _body(th_s, "shank_s", (0, 0, -thigh), seg["tibia_l"].mass_kg * mr,
-                 (0, 0, -0.1867 * s), seg["tibia_l"].inertia_kg_m2[2] * mr * s * s)
-    _hinge(sh_s, "knee_s")
-    ft = _body(sh_s, "foot_s", (0, 0, -shank), seg["calcn_l"].mass_kg * mr, (0.05, 0, -0.04),
-               seg["calcn_l"].inertia_kg_m2[2] * mr * s * s)
-    _hinge(ft, "ankle_s")
-    for i, (x, z) in enumerate(_FOOT_CIRCLES):
-        ft.add_site(name=f"foot{i}", type=mujoco.mjtGeom.mjGEOM_ELLIPSOID, pos=[x, 0, z],
-                    size=[FOOT_RADIUS_M, 0.02, FOOT_RADIUS_M])
-    # prosthetic leg
-    m_th = 0.6 * seg["femur_r"].mass_kg * mr + _SOCKET_KG
-    th_p = _body(pelvis, "thigh_p", (0, 0, 0), m_th, (0, 0, -0.15 * s),
-                 0.6 * seg["femur_r"].inertia_kg_m2[2] * mr * s * s)
-    _hinge(th_p, "hip_p")
-    depth = _standing_depth(blade)
-    adapter = shank + ankle_h + extra_leg - depth
-    if adapter < 0.01:
-        raise ModelError(f"the blade is too tall for this leg ({depth * 1e3:.0f} mm below the "
-                         "clamp)", where=f"{blade.name}: transfemoral runner",
-                         hint="lower extra_leg_length_m or use a shorter blade")
-    kb = _body(th_p, "knee_p", (0, 0, -thigh), knee.mass, (0, 0, -0.03),
-               knee.mass * 0.05**2)
-    _hinge(kb, "knee_p")
-    parent = _body(kb, "clamp", (knee_offset, 0, -adapter), 1e-6, (0, 0, 0), 1e-9)
-    parent.add_site(name="clamp", pos=[0, 0, 0])
-    add_blade_bodies(parent, blade, stiffness=[j.stiffness for j in blade.joints],
-                     damping=[j.damping for j in blade.joints], min_inertia=1e-8)
-    m = spec.compile()
-    ne = len(blade.soles)
-    names = [f"sole{e}" for e in range(ne)] + ["foot0", "foot1"]
-    sites = np.array([m.site(n).id for n in names])
-    axes = np.array([[e.semi_axis_x, e.semi_axis_z] for e in blade.soles]
-                    + [[FOOT_RADIUS_M, FOOT_RADIUS_M]] * 2, float)
-    jn = [f"joint{i + 1}" for i in range(len(blade.joints))]
-    return _Built(
-        model=m, sites=sites, axes=axes, site_body=np.ascontiguousarray(m.site_bodyid[sites]),
-        n_soles=ne,
-        blade_q=np.array([m.jnt_qposadr[m.joint(n).id] for n in jn], np.int64),
-        blade_d=np.array([m.jnt_dofadr[m.joint(n).id] for n in jn], np.int64),
-        servo_q=np.array([m.jnt_qposadr[m.joint(n).id] for n in _SERVOS], np.int64),
-        servo_d=np.array([m.jnt_dofadr[m.joint(n).id] for n in _SERVOS], np.int64),
-        knee_q=int(m.jnt_qposadr[m.joint("knee_p").id]),
-        knee_d=int(m.jnt_dofadr[m.joint("knee_p").id]),
-        knee_body=int(m.body("knee_p").id),
-        seg_bodies=np.array([m.body(f"seg{k}").id for k in range(blade.n_segments)]),
-        tip_site=int(m.site("tip").id), adapter=float(adapter),
-    )
 
 
 def _joint_targets(cycle: GaitCycle, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -321,8 +190,8 @@ def simulate_transfemoral(
     blade: BladeModel,
     *,
     cycle: GaitCycle | None = None,
-    speed_mps: float = 7.0,
-    body_mass_kg: float = 76.0,
+    speed_mps: float = defaults.RUNNER_SPEED_MPS,
+    body_mass_kg: float = defaults.BODY_MASS_KG,
     height_m: float = 1.75,
     knee: ProstheticKnee | None = None,
     extra_leg_length_m: float = 0.02,
@@ -364,7 +233,8 @@ def simulate_transfemoral(
     cycle = cycle or default_gait_cycle()
     knee = knee or ProstheticKnee()
     chain = build_chain(blade)
-    b = _build(blade, body_mass_kg, height_m, knee, extra_leg_length_m, dt, knee_offset_m)
+    b = build_kinematic_transfemoral(blade, body_mass_kg, height_m, knee, extra_leg_length_m,
+                                     dt, knee_offset_m)
     m = b.model
     d = mujoco.MjData(m)
     nsub = max(1, int(round(1.0 / (sample_rate * dt))))
@@ -425,7 +295,7 @@ def _ellipse_low(xpos, xmat, a, c):
             xpos[2] + a * ct * xmat[6] + c * st * xmat[8])
 
 
-def _lowest(d, b: _Built, *, soles_only: bool = False) -> float:
+def _lowest(d, b: KinematicTransfemoral, *, soles_only: bool = False) -> float:
     zs = [_ellipse_low(d.site_xpos[s], d.site_xmat[s], *b.axes[e])[1]
           for e, s in enumerate(b.sites[:b.n_soles])]
     if not soles_only:
@@ -433,7 +303,7 @@ def _lowest(d, b: _Built, *, soles_only: bool = False) -> float:
     return float(min(zs))
 
 
-def _sample(d, b: _Built, out: np.ndarray, mean: np.ndarray):
+def _sample(d, b: KinematicTransfemoral, out: np.ndarray, mean: np.ndarray):
     ne = b.n_soles
     lows = [_ellipse_low(d.site_xpos[s], d.site_xmat[s], *b.axes[e])
             for e, s in enumerate(b.sites[:ne])]
@@ -448,7 +318,7 @@ def _sample(d, b: _Built, out: np.ndarray, mean: np.ndarray):
             d.xpos[b.knee_body, 0], d.xpos[b.knee_body, 2], d.qpos[b.knee_q], cop, pts)
 
 
-def _result(t, rec, b: _Built, m, speed: float, period: float) -> TransfemoralResult:
+def _result(t, rec, b: KinematicTransfemoral, m, speed: float, period: float) -> TransfemoralResult:
     arr = np.array([r[:10] for r in rec], float)
     pts = np.array([r[10] for r in rec], float)
     com = arr[:, 4:6]
@@ -494,8 +364,8 @@ class RunnerEvaluator:
     """
 
     gait: str | None = None
-    speed_mps: float = 7.0
-    body_mass_kg: float = 76.0
+    speed_mps: float = defaults.RUNNER_SPEED_MPS
+    body_mass_kg: float = defaults.BODY_MASS_KG
     height_m: float = 1.75
     knee_margin_Nm: float = 0.0
     clearance_threshold_m: float = 0.0
@@ -505,8 +375,6 @@ class RunnerEvaluator:
 
     def __post_init__(self) -> None:
         if self.motion is not None:
-            from bladelab.design.motion import as_motion_model
-
             if self.gait is not None:
                 raise SpecError("give either gait (one cycle for every design) or motion (a "
                                 "predicted cycle per design), not both", where="runner evaluator")
@@ -527,8 +395,6 @@ class RunnerEvaluator:
         return {"evaluator": "runner", **d}
 
     def __call__(self, point: Mapping[str, float]) -> dict[str, float]:
-        from bladelab.design.blade_generator import generate_blade
-
         blade = generate_blade(point, **dict(self.generator)).model
         if self.motion is not None:
             cycle = self.motion.predict_point(point)

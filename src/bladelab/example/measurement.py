@@ -60,8 +60,10 @@ from scipy import interpolate
 
 from bladelab.constants import STANDARD_GRAVITY
 from bladelab.errors import DataError
-from bladelab.trial.c3d import plate_corners
+from bladelab.trial.c3d import plate_corners, write_c3d
+from bladelab.trial.kinematics import extract_stance
 from bladelab.trial.stance import Stance
+from bladelab.trial.trial import ForcePlatform, Trial
 
 __all__ = [
     "CLAMP_CLUSTER",
@@ -129,16 +131,12 @@ class MeasuredTrial:
 
     def write_c3d(self, path: str | Path, *, metadata: Mapping[str, Any] | None = None) -> Path:
         """Write the recording as a C3D file (atomically) with :func:`bladelab.trial.write_c3d`."""
-        from bladelab.trial.c3d import write_c3d
-
         return write_c3d(path, markers=self.markers, marker_rate=self.marker_rate,
                          platforms=self.platforms, analog_rate=self.analog_rate,
                          metadata=metadata)
 
     def to_trial(self, *, metadata: Mapping[str, Any] | None = None):
         """The recording as an in-memory :class:`bladelab.trial.Trial` (no file)."""
-        from bladelab.trial.trial import ForcePlatform, Trial
-
         plates = tuple(
             ForcePlatform(index=k + 1, type=2, rate=self.analog_rate, force=p["force"],
                           cop=np.where(p["force"][:, 2:3] >= 20.0, p["cop"], np.nan),
@@ -460,8 +458,6 @@ def degrade_stance(
         holds the pipeline's keys plus ``clean_time_offset_s`` (clean time = time + offset) and
         the measurement settings.
     """
-    from bladelab.trial.kinematics import extract_stance
-
     long, tip_long = extend_flight(stance, tip=tip, before_s=flight_s, after_s=flight_s)
     rec = measure_stance(long, tip=tip_long, marker_rate_hz=marker_rate_hz,
                          analog_rate_hz=rate_hz, marker_noise_m=marker_noise_m,

@@ -42,7 +42,11 @@ import yaml
 
 from bladelab import __version__, units
 from bladelab._io import atomic_open, atomic_path
+from bladelab.blade import load_blade, multilink_blade
 from bladelab.errors import BladelabError, DataError
+from bladelab.example.measurement import extend_flight, measure_stance
+from bladelab.executors import make_executor
+from bladelab.sim.synthetic import generate_stance
 
 __all__ = [
     "COHORT",
@@ -180,8 +184,9 @@ class ExampleStudy:
 
 
 def default_example_dir() -> Path:
-    """``examples/sprint-study`` under the project root (beside ``src/``)."""
-    return Path(__file__).resolve().parents[3] / "examples" / "sprint-study"
+    """``examples/sprint-study`` under the current working directory (read when called; never
+    inside the installation)."""
+    return Path.cwd() / "examples" / "sprint-study"
 
 
 def _touchdown(speed_mps: float) -> tuple[float, float]:
@@ -240,8 +245,6 @@ def plan_trials(seed: int = 0, *, n_trials: int | None = None) -> list[TrialPlan
 
 
 def _true_blade(plan: dict, settings: dict):
-    from bladelab.blade import load_blade, multilink_blade
-
     spec = load_blade(plan["blade"])
     n_links = int(settings["n_links"])
     K, D = plan["K_Nm_per_deg"], plan["D_Nms_per_deg"]
@@ -270,9 +273,6 @@ def generate_trial(payload: dict) -> dict:
     (:meth:`GeneratorSettings.to_dict`), ``path`` (the C3D file to write). Returns the
     ground-truth row of the trial.
     """
-    from bladelab.example.measurement import extend_flight, measure_stance
-    from bladelab.sim.synthetic import generate_stance
-
     plan, s = payload["plan"], payload["settings"]
     model = _true_blade(plan, s)
     clean, truth = generate_stance(
@@ -416,8 +416,6 @@ def make_example_study(
         a complete study (the manifest is written last).
     """
     from tqdm import tqdm
-
-    from bladelab.executors import make_executor
 
     t0 = time.perf_counter()
     folder = Path(out_dir) if out_dir is not None else default_example_dir()

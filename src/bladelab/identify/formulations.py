@@ -1,4 +1,4 @@
-"""Identification formulations: how the measured stance drives the model (issue 9).
+"""Identification formulations: how the measured stance drives the model.
 
 A *formulation* names the way the simulated blade is tied to the measured stance during
 identification; it maps to a clamp :class:`bladelab.sim.Drive`:

@@ -15,7 +15,7 @@ squares RSS(θ) = ‖r(θ)‖² is the least-squares analogue of the identificat
 - **Autocorrelated residuals**: by default (``variance="hac"``) each parameter's profile is read
   against s²·c_i, s² = RSS/(n − d) and c_i ≥ 1 its Newey–West variance inflation computed per
   measured channel (:func:`hac_inflation`), with n_eff,i = n/c_i; ``variance="ar1"`` uses one
-  n_eff = n·(1 − ρ₁)/(1 + ρ₁) for all (the method before issue 16, which under-covered D:
+  n_eff = n·(1 − ρ₁)/(1 + ρ₁) for all (the earlier default, which under-covered D:
   benchmarks/bench_coverage.py).
 - **Re-centring**: the search minimises J (a sum of nRMSEs), the profiles the RSS (a sum of their
   squares); when a profile finds an RSS lower than at ``x_opt`` by more than a tenth of the interval
@@ -386,8 +386,8 @@ def assess_identifiability(
     variance
         ``"hac"`` (default): each parameter's interval scale is s² of independent residuals times
         its Newey–West inflation for autocorrelated residuals (:func:`hac_inflation`), with
-        n_eff,i = n/c_i; ``"ar1"``: one n_eff = n(1 − ρ₁)/(1 + ρ₁) for all (the method before
-        issue 16, which under-covered). Ignored when ``n_effective`` is given.
+        n_eff,i = n/c_i; ``"ar1"``: one n_eff = n(1 − ρ₁)/(1 + ρ₁) for all (the earlier
+        default, which under-covered). Ignored when ``n_effective`` is given.
     blocks
         Lengths of the residual blocks (one per measured channel, in order), for ``"hac"``.
     physical_lower

@@ -13,12 +13,15 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import re
 import time
 from collections.abc import Sequence
 
 import numpy as np
 import pandas as pd
 
+from bladelab import sim
+from bladelab.blade import load_blade
 from bladelab.blade.model import BladeModel
 from bladelab.errors import DataError, ModelError, OptimizationError
 from bladelab.identify.bounds import (
@@ -29,7 +32,11 @@ from bladelab.identify.bounds import (
 )
 from bladelab.identify.cost import StanceCost
 from bladelab.identify.formulations import DEFAULT_FORMULATION, DISTANCE_ONLY, formulation_drive
-from bladelab.identify.identifiability import assess_identifiability, effective_sample_size
+from bladelab.identify.identifiability import (
+    assess_identifiability,
+    cost_landscape,
+    effective_sample_size,
+)
 from bladelab.identify.optimizers import minimize
 from bladelab.identify.quality import TrialQuality, assess_quality
 from bladelab.parameters import JOINT_PARAMETERS
@@ -161,8 +168,6 @@ class Identification:
 def _as_model(blade: BladeModel | str) -> BladeModel:
     if isinstance(blade, BladeModel):
         return blade
-    from bladelab.blade import load_blade
-
     return load_blade(blade).build()
 
 
@@ -213,8 +218,6 @@ def _with_systematic(ci: dict, estimate: dict) -> dict:
 
 def _edge_note(note: str) -> str:
     """An identifiability note with the SI values of K and D in edge units (N·m/deg ...)."""
-    import re
-
     def conv(m):
         name, a, b = m.group(1), float(m.group(2)), float(m.group(3))
         p = JOINT_PARAMETERS[name]
@@ -304,8 +307,6 @@ def identify_stance(
     OptimizationError
         Bad bounds or options.
     """
-    from bladelab import sim
-
     t0 = time.perf_counter()
     drive = formulation_drive(formulation)
     if formulation in DISTANCE_ONLY:
@@ -436,9 +437,6 @@ def identification_landscape(
     identification's own). Returns a tidy DataFrame with columns
     ``K_Nm_per_deg``, ``D_Nms_per_deg``, ``cost`` (K2, if any, held at its identified value).
     """
-    from bladelab import sim
-    from bladelab.identify.identifiability import cost_landscape
-
     model = _with_joint(_as_model(blade), ident.joint_point)
     if (ident.formulation if formulation is None else formulation) in DISTANCE_ONLY:
         weights = (0.0, 1.0)

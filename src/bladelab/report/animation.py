@@ -26,7 +26,7 @@ import numpy as np
 
 from bladelab.report.builder import EmbeddedHTML
 from bladelab.runner.export import leg_ground_force
-from bladelab.runner.model import CP_AZ, CP_BLADE, CP_BODY, CP_LEG, CP_RADIUS, CP_SITE
+from bladelab.runner.layout import CP_AZ, CP_BLADE, CP_BODY, CP_LEG, CP_RADIUS, CP_SITE
 from bladelab.runner.simulate import RunnerResult, leg_names
 
 __all__ = ["RunnerFrames", "animation_html", "runner_frames"]

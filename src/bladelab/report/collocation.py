@@ -23,7 +23,22 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from bladelab.errors import InputFileError
+from bladelab.errors import BladelabError, InputFileError
+from bladelab.predict.collocation.guess import (
+    MEASURED_STATIC,
+    MEASURED_TRIAL,
+    MEASURED_TRIAL_SPEED_M_PER_S,
+    guess_from_trial,
+)
+from bladelab.predict.collocation.model import build_collocation_model
+from bladelab.predict.collocation.solution import (
+    BEST_ITERATE_KIND,
+    CONTACT_THRESHOLD_N,
+    SOLUTION_KIND,
+    CollocationSolution,
+)
+from bladelab.predict.collocation.solve import SOLUTION_FILE
+from bladelab.predict.collocation.stored import runner_from_spec
 
 __all__ = ["N_STRIDES", "REFINE", "collocation_sections", "collocation_solution_file"]
 
@@ -50,9 +65,6 @@ def collocation_solution_file(path: str | Path) -> Path | None:
     InputFileError
         ``path`` is a best iterate (a solve that did not converge).
     """
-    from bladelab.predict.collocation.solution import BEST_ITERATE_KIND, SOLUTION_KIND
-    from bladelab.predict.collocation.solve import SOLUTION_FILE
-
     p = Path(path)
     if p.is_dir():
         p = p / SOLUTION_FILE
@@ -103,8 +115,6 @@ TRIAL_SPEED_WINDOW_M_PER_S = 0.51
 def _from_left_touchdown(sol) -> int:
     """Node index of the left/intact leg's touch-down (first loaded node after an unloaded one)
     in the periodic stride; 0 if the leg is never unloaded."""
-    from bladelab.predict.collocation.solution import CONTACT_THRESHOLD_N
-
     loaded = sol.leg_vertical_force()[:-1, 0] > CONTACT_THRESHOLD_N
     starts = np.flatnonzero(loaded & ~np.roll(loaded, 1))
     return int(starts[0]) if starts.size else 0
@@ -145,14 +155,6 @@ def _trial_figure(sol, runner, trial):
 def _measured_trial(runner, sol):
     """The measured 3.5 m/s trial's mean stride on ``runner``'s coordinates (a StrideGuess),
     or None where it does not apply (another speed, the trial file absent) or cannot be read."""
-    from bladelab.errors import BladelabError
-    from bladelab.predict.collocation.guess import (
-        MEASURED_STATIC,
-        MEASURED_TRIAL,
-        MEASURED_TRIAL_SPEED_M_PER_S,
-        guess_from_trial,
-    )
-
     speed = sol.mean_speed_mps
     if (not MEASURED_TRIAL.is_file()
             or abs(speed - MEASURED_TRIAL_SPEED_M_PER_S) > TRIAL_SPEED_WINDOW_M_PER_S):
@@ -169,10 +171,6 @@ def collocation_sections(report, path: str | Path) -> tuple[dict, object]:
     """Add the collocation solution's own sections to ``report``; return ({label:
     RunnerResult} for :func:`~bladelab.report.predictive_sections.add_predictive_sections`,
     the :class:`~bladelab.predict.collocation.solution.CollocationSolution`)."""
-    from bladelab.predict.collocation.model import build_collocation_model
-    from bladelab.predict.collocation.solution import CollocationSolution
-    from bladelab.predict.collocation.stored import runner_from_spec
-
     sol = CollocationSolution.read(collocation_solution_file(path) or path)  # file or folder
     runner = runner_from_spec(sol.model_spec)
     result = sol.to_runner_result(N_STRIDES, refine=REFINE, runner=runner,

@@ -34,6 +34,10 @@ import numpy as np
 import pandas as pd
 
 from bladelab.errors import InputFileError
+from bladelab.predict.collocation.model import build_collocation_model
+from bladelab.predict.collocation.solution import CollocationSolution
+from bladelab.predict.collocation.stored import runner_from_spec
+from bladelab.predict.collocation.sweep import SWEEP_TABLE
 
 __all__ = ["collocation_sweep_sections", "is_collocation_sweep", "starts_table",
            "sweep_summary"]
@@ -44,8 +48,6 @@ COST_SPEED_M_PER_S = 4.0
 
 def is_collocation_sweep(path: str | Path) -> bool:
     """True if ``path`` is a folder with a collocation sweep's table."""
-    from bladelab.predict.collocation.sweep import SWEEP_TABLE
-
     p = Path(path)
     return p.is_dir() and (p / SWEEP_TABLE).is_file()
 
@@ -59,8 +61,6 @@ def read_sweep_table(folder: str | Path) -> pd.DataFrame:
     InputFileError
         The table cannot be read or lacks a column the report needs.
     """
-    from bladelab.predict.collocation.sweep import SWEEP_TABLE
-
     path = Path(folder) / SWEEP_TABLE
     try:
         table = pd.read_csv(path)
@@ -133,8 +133,6 @@ def _with_current_warnings(table: pd.DataFrame, folder: Path) -> tuple[pd.DataFr
     """(the table with ``warnings`` and ``flagged`` from today's gait checks, re-run on each
     converged solve's file (a table written before a check existed says nothing of it), {row
     index: the solution read}); a row whose file is missing keeps its recorded warnings."""
-    from bladelab.predict.collocation.solution import CollocationSolution
-
     table = table.copy()
     solutions = {}
     for i, row in table[table.converged].iterrows():
@@ -196,9 +194,6 @@ def collocation_sweep_sections(report, folder: str | Path) -> tuple[dict, pd.Dat
     converged maximum-speed solutions, for the predictive sections; the category summary
     :func:`sweep_summary`)."""
     import matplotlib.pyplot as plt
-
-    from bladelab.predict.collocation.model import build_collocation_model
-    from bladelab.predict.collocation.stored import runner_from_spec
 
     folder = Path(folder)
     table, solutions = _with_current_warnings(read_sweep_table(folder), folder)

@@ -18,7 +18,22 @@ import numpy as np
 import pandas as pd
 
 from bladelab._io import read_json
-from bladelab.errors import InputFileError
+from bladelab.design.collocation_evaluator import stride_checks
+from bladelab.design.optimum import SurfaceConstraint, constrained_optimum
+from bladelab.design.plots import contour_plot, figure_pairs, main_effects_plot
+from bladelab.design.responses import (
+    BLADE_RESPONSE_UNITS,
+    PREDICTED_RESPONSE_UNITS,
+    RUNNER_RESPONSE_UNITS,
+)
+from bladelab.design.space import DesignSpace
+from bladelab.design.start_spread import NEAR_PCT, start_spread
+from bladelab.design.surfaces import fit_surface
+from bladelab.design.terms import parse_terms
+from bladelab.design.trends import evaluate_trends, trends_frame
+from bladelab.errors import InputFileError, OptimizationError
+from bladelab.predict.collocation.solution import RESIDUAL_WARNING_PCT
+from bladelab.report.builder import Report
 
 __all__ = ["build_design_report", "design_report_sections", "is_design_folder", "trends_section"]
 
@@ -30,10 +45,6 @@ def is_design_folder(path: str | Path) -> bool:
 
 
 def _load(design_dir: Path):
-    from bladelab.design.space import DesignSpace
-    from bladelab.design.surfaces import fit_surface
-    from bladelab.design.terms import parse_terms
-
     if not is_design_folder(design_dir):
         raise InputFileError("not a design-study folder (no study.json / results.csv)",
                              file=design_dir, hint="run 'bladelab design --out DIR' first")
@@ -47,10 +58,6 @@ def _load(design_dir: Path):
     ev = design_dir / "evaluator.json"
     evaluator: dict = {}
     if ev.is_file():
-        from bladelab.design.evaluators import BLADE_RESPONSE_UNITS
-        from bladelab.design.predicted import PREDICTED_RESPONSE_UNITS
-        from bladelab.design.transfemoral import RUNNER_RESPONSE_UNITS
-
         evaluator = read_json(ev, what="evaluator settings")
         kind = evaluator.get("evaluator")
         units = {"runner": RUNNER_RESPONSE_UNITS,
@@ -86,8 +93,6 @@ def _stride_checks(design_dir: Path, evaluator: dict, space, table: pd.DataFrame
     said); None for other evaluators."""
     if evaluator.get("evaluator") != "collocation":
         return None
-    from bladelab.design.collocation_evaluator import stride_checks
-
     points = [{n: float(row[n]) for n in space.names} for _, row in table.iterrows()]
     checks = pd.DataFrame(stride_checks(design_dir, evaluator, points))
     checks.insert(0, "run", table["run"].to_numpy())
@@ -101,10 +106,6 @@ def design_report_sections(design_dir: str | Path) -> list[dict[str, Any]]:
     import matplotlib
 
     matplotlib.use("Agg")
-    from bladelab.design.optimum import SurfaceConstraint, constrained_optimum
-    from bladelab.design.plots import contour_plot, figure_pairs, main_effects_plot
-    from bladelab.errors import OptimizationError
-
     design_dir = Path(design_dir)
     meta, space, table, surfaces = _load(design_dir)
     objective = meta.get("objective") or next(iter(surfaces))
@@ -259,8 +260,6 @@ def _problem_posed(evaluator: dict) -> str:
 def _strides_section(checks: pd.DataFrame, evaluator: dict) -> dict[str, Any]:
     """The predicted strides of a collocation study: the problem posed, and each run's stride
     as checked now."""
-    from bladelab.predict.collocation.solution import RESIDUAL_WARNING_PCT
-
     flagged = checks[checks["excluded"]]
     missing = int(checks["stride"].isna().sum())
     text = (_problem_posed(evaluator)
@@ -288,9 +287,6 @@ def _start_spread(design_dir: Path, meta: dict, table: pd.DataFrame,
     has no design solved to two clean strides."""
     if (meta.get("_evaluator") or {}).get("evaluator") != "collocation":
         return None
-    from bladelab.design.predicted import PREDICTED_RESPONSE_UNITS
-    from bladelab.design.start_spread import start_spread
-
     runs = table["run"] if checks is None else table.loc[~checks["excluded"].to_numpy(bool),
                                                          "run"]
     spread = start_spread(design_dir, units=PREDICTED_RESPONSE_UNITS,
@@ -306,8 +302,6 @@ ROUGH_SPREAD_DESIGNS = 5
 def _spread_section(spread: pd.DataFrame) -> dict[str, Any]:
     """What the solver's start decides: the responses' spread between clean strides of the
     same design against their spread across the designs."""
-    from bladelab.design.start_spread import NEAR_PCT
-
     low = spread[spread["r2_ceiling"] < 0.8]
     n_designs = int(spread["designs"].max())
     text = ("Each design's stride is a local optimum. The settling passes solve each design "
@@ -368,8 +362,6 @@ def trends_section(surfaces, evaluator: dict | None = None) -> dict[str, Any]:
     (:func:`bladelab.design.trends.evaluate_trends`), with the test used and, for a trend that
     does not hold, the reason. ``evaluator`` is the study's ``evaluator.json`` (its kind selects
     the reasons; its generator ``roles`` map factors to stiffness/width/height/toe length)."""
-    from bladelab.design.trends import evaluate_trends, trends_frame
-
     evaluator = evaluator or {}
     kind = evaluator.get("evaluator")
     roles = (evaluator.get("generator") or {}).get("roles")
@@ -393,8 +385,6 @@ def trends_section(surfaces, evaluator: dict | None = None) -> dict[str, Any]:
 
 def build_design_report(design_dir: str | Path, out_dir: str | Path | None = None) -> Path:
     """Write the design report to ``out_dir`` (default ``design_dir/report``); returns index."""
-    from bladelab.report.builder import Report
-
     design_dir = Path(design_dir)
     meta = {}
     if (design_dir / "study.json").is_file():

@@ -16,6 +16,7 @@ import pandas as pd
 from matplotlib.figure import Figure
 
 from bladelab.errors import DataError
+from bladelab.identify.cost import contact_window
 from bladelab.mechanics import StanceMechanics
 from bladelab.trial.stance import Stance
 
@@ -116,8 +117,6 @@ Window = Literal["contact", "stance"]
 def contact_span(stance: Stance, *, threshold: float = 20.0) -> tuple[float, float]:
     """(touch-down, toe-off) times [s]: the first and last sample of the identification's contact
     window (:func:`bladelab.identify.contact_window`: vertical GRF > threshold [N])."""
-    from bladelab.identify.cost import contact_window
-
     idx = np.flatnonzero(contact_window(stance.grf_z, threshold=threshold))
     return float(stance.time[idx[0]]), float(stance.time[idx[-1]])
 

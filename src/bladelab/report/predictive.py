@@ -37,6 +37,7 @@ from __future__ import annotations
 import dataclasses
 import json
 import math
+import re
 from pathlib import Path
 
 import numpy as np
@@ -45,6 +46,21 @@ from tqdm import tqdm
 
 from bladelab._io import read_json
 from bladelab.errors import InputFileError
+from bladelab.predict.collocation.solution import CollocationSolution
+from bladelab.predict.reflex.agreement import seed_agreement
+from bladelab.predict.reflex.controller import read_parameters
+from bladelab.predict.reflex.objective import simulate_controlled
+from bladelab.predict.reflex.optimize import runner_and_layout, stored_settings
+from bladelab.predict.reflex.robust import robust_evaluation
+from bladelab.predict.reflex.sweep import finished_cell, summarise
+from bladelab.report.builder import Report
+from bladelab.report.collocation import collocation_sections, collocation_solution_file
+from bladelab.report.collocation_sweep import collocation_sweep_sections, is_collocation_sweep
+from bladelab.report.predictive_robustness import robustness_runs, robustness_section
+from bladelab.report.predictive_sections import add_predictive_sections
+from bladelab.report.recipe_sweep import is_recipe_sweep, recipe_sweep_sections
+from bladelab.runner.analyses import power_balance_residual_pct, spatiotemporal, swing_contacts
+from bladelab.runner.export import write_opensim
 
 __all__ = ["PredictiveReport", "build_predictive_report", "default_report_dir", "predictive_kind"]
 
@@ -72,8 +88,6 @@ def predictive_kind(path: str | Path) -> str | None:
     """``"run"``, ``"runs"``, ``"sweep"``, ``"recipe-sweep"``, ``"parameters"``,
     ``"collocation"``, ``"collocation-sweep"`` or None (see
     module docstring); a collocation best iterate raises InputFileError (not a solution)."""
-    from bladelab.report.collocation import collocation_solution_file
-
     p = Path(path)
     if collocation_solution_file(p) is not None:
         return "collocation"
@@ -88,12 +102,8 @@ def predictive_kind(path: str | Path) -> str | None:
         return "parameters" if ok else None
     if not p.is_dir():
         return None
-    from bladelab.report.collocation_sweep import is_collocation_sweep
-
     if is_collocation_sweep(p):
         return "collocation-sweep"
-    from bladelab.report.recipe_sweep import is_recipe_sweep
-
     if is_recipe_sweep(p):
         return "recipe-sweep"
     if (p / "results.csv").is_file() and (p / "summary.csv").is_file():
@@ -124,9 +134,6 @@ class _Solution:
     x: np.ndarray | None = None
 
     def __post_init__(self) -> None:
-        from bladelab.predict.reflex.controller import read_parameters
-        from bladelab.predict.reflex.optimize import runner_and_layout
-
         kind = self.data.get("model", "able")
         if kind not in ("able", "amputee"):
             raise InputFileError(f"unknown model {kind!r}", file=self.path, where="model")
@@ -149,22 +156,16 @@ class _Solution:
 
     def settings(self, duration: float | None = None, *, nominal: bool = False):
         """The run's objective settings (unknown keys dropped), optionally another duration."""
-        from bladelab.predict.reflex.optimize import stored_settings
-
         return stored_settings(self.data, speed=self.speed, duration=duration, nominal=nominal)
 
     def simulate(self, duration: float | None = None):
         """(Evaluation, RunnerResult) of a nominal simulation recorded every 2nd step."""
-        from bladelab.predict.reflex.objective import simulate_controlled
-
         s = self.settings(duration, nominal=True)
         return simulate_controlled(self.model, self.x, layout=self.layout, settings=s,
                                    record_every=2)
 
     def evaluate(self, nominal_ev):
         """The evaluation as the optimiser computed it (robust mean where the run used it)."""
-        from bladelab.predict.reflex.robust import robust_evaluation
-
         s = self.settings()
         if s.robust_samples > 1:
             return robust_evaluation(nominal_ev, self.model, self.x, self.layout, s)
@@ -199,8 +200,6 @@ def _close(a: float, b: float) -> bool:
 
 
 def _resim_row(label: str, sol: _Solution, ev, res) -> dict:
-    from bladelab.runner.analyses import power_balance_residual_pct, swing_contacts
-
     swings = swing_contacts(res)
     return {
         "solution": label,
@@ -286,8 +285,6 @@ def _run_sections(report, folders: dict[str, Path], duration: float,
     table = pd.DataFrame(rows)
     agreement = ""
     if len(rows) > 1:
-        from bladelab.predict.reflex.agreement import seed_agreement
-
         agree = seed_agreement(table["recomputed cost (–)"].tolist(),
                                table["mean speed (m/s)"].tolist())
         table["agrees with the best seed (yes/no)"] = list(agree.agreeing)
@@ -321,8 +318,6 @@ def _sweep_cells(folder: Path) -> tuple[list[tuple[str, float, Path]], list[str]
     """The sweep's finished cells (category, prescribed speed [m/s], folder), in results.csv's
     category order, and the names of the unfinished ones (still optimising or stopped: their
     best.json is an interim best, so they are left out)."""
-    from bladelab.predict.reflex.sweep import finished_cell
-
     try:
         res = pd.read_csv(folder / "results.csv")
         order = list(dict.fromkeys(res.category.astype(str)))
@@ -352,9 +347,6 @@ def _sweep_sections(
 ) -> tuple[dict, list, pd.DataFrame, list[tuple[str, float, Path]]]:
     """Add the sweep's sections; return the solutions shown, their re-simulation rows, the
     recomputed category summary and the finished cells (:func:`_sweep_cells`)."""
-    from bladelab.predict.reflex.sweep import summarise
-    from bladelab.runner.analyses import spatiotemporal
-
     cells, unfinished = _sweep_cells(folder)
     rows, sims = [], {}
     for cat, speed, cell in cells:
@@ -428,10 +420,6 @@ def _sweep_sections(
 
 def _export_section(report, results: dict) -> None:
     """Attach each solution's OpenSim files to the report and list them in a section."""
-    import re
-
-    from bladelab.runner.export import write_opensim
-
     rows = []
     for label, res in results.items():
         folder = "export/" + (re.sub(r"[^a-z0-9.]+", "-", label.lower()).strip("-") or "solution")
@@ -493,7 +481,7 @@ def build_predictive_report(
         Animate each solution shown in the page.
     robustness
         For one solution or run: re-simulate it as copies, from other initial speeds and
-        pushed, and judge issue 20's acceptance
+        pushed, and judge the stable-gait acceptance
         (:mod:`bladelab.report.predictive_robustness`).
 
     Raises
@@ -505,9 +493,6 @@ def build_predictive_report(
     import matplotlib
 
     matplotlib.use("Agg")
-    from bladelab.report.builder import Report
-    from bladelab.report.predictive_sections import add_predictive_sections
-
     path = Path(path)
     kind = predictive_kind(path)
     if kind is None:
@@ -527,13 +512,9 @@ def build_predictive_report(
     with _Counter(tqdm(desc="re-simulating", unit="sim",
                        disable=not progress or kind.startswith("collocation"))) as bar:
         if kind == "collocation":
-            from bladelab.report.collocation import collocation_sections
-
             results, csol = collocation_sections(rep, path)
             settings, seed = csol.settings.to_dict(), None
         elif kind == "collocation-sweep":
-            from bladelab.report.collocation_sweep import collocation_sweep_sections
-
             results, sweep_summary = collocation_sweep_sections(rep, path)
             settings, seed = {}, None
         elif kind == "parameters":
@@ -555,8 +536,6 @@ def build_predictive_report(
             first = _read_json(next(iter(folders.values())) / "best.json")
             settings, seed = first.get("settings") or {}, first.get("seed")
         elif kind == "recipe-sweep":
-            from bladelab.report.recipe_sweep import recipe_sweep_sections
-
             _, files = recipe_sweep_sections(rep, path, bar)
             results, resim = {}, []
             for label, file in files.items():
@@ -572,16 +551,12 @@ def build_predictive_report(
             first = _read_json(cells[0][2] / "best.json") if cells else {}
             settings, seed = first.get("settings") or {}, first.get("seed")
         if robustness and kind in ("parameters", "run", "runs"):
-            from bladelab.report.predictive_robustness import robustness_runs
-
             checked = robustness_runs(shown, duration, speed="reached")
             for _ in range(checked["simulations"]):
                 bar.update()
     if resim is not None:
         _resim_section(rep, resim, duration)
     if checked is not None:
-        from bladelab.report.predictive_robustness import robustness_section
-
         robustness_section(rep, checked, duration)
     if kind in ("parameters", "run", "runs"):
         results = _with_tracked_stride(results, settings)
@@ -602,8 +577,6 @@ def _with_tracked_stride(results: dict, settings: dict) -> dict:
     track = settings.get("track")
     if not track:
         return results
-    from bladelab.predict.collocation.solution import CollocationSolution
-
     stride = CollocationSolution.read(track).to_runner_result()
     return {**results, f"tracked collocation stride ({Path(track).name})": stride}
 

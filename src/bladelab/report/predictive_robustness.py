@@ -1,4 +1,4 @@
-"""The robustness section of a predictive report: issue 20's acceptance, re-simulated
+"""The robustness section of a predictive report: the stable-gait acceptance, re-simulated
 (:mod:`bladelab.predict.reflex.acceptance`: the judged runs, the pushes that measure the
 gait's basin, and what a run must show)."""
 
@@ -17,6 +17,7 @@ from bladelab.predict.reflex.acceptance import (
     judged_runs,
     meets_acceptance,
 )
+from bladelab.predict.reflex.objective import MIN_PUSH_DURATION, ObjectiveSettings
 
 __all__ = ["robustness_runs", "robustness_section"]
 
@@ -26,13 +27,11 @@ robustness_runs = acceptance_runs
 
 def robustness_section(rep, out: dict, duration: float) -> None:
     """Add the section of :func:`robustness_runs`' result ``out`` (runs of ``duration`` [s])."""
-    from bladelab.predict.reflex.objective import MIN_PUSH_DURATION, ObjectiveSettings
-
     pushes = bool(out["pushed"])
     window = ObjectiveSettings().pelvis_tilt_range_deg
     table = pd.DataFrame([_row(name, c, window) for name, c in judged_runs(out)])
     failed = [r["run"] for _, r in table.iterrows() if not r["meets the acceptance (yes/no)"]]
-    tables = [("Judged runs (issue 20's acceptance)", table)]
+    tables = [("Judged runs (the stable-gait acceptance)", table)]
     if pushes:
         pushed = pd.DataFrame([
             _row(f"push {100 * c['push_change']:+g} % at {c['push_time_s']:.1f} s", c, window)
@@ -47,13 +46,13 @@ def robustness_section(rep, out: dict, duration: float) -> None:
     else:
         push_text = (f"No pushes: a re-simulation shorter than {MIN_PUSH_DURATION:g} s has no "
                      "room for one.")
-    verdict = ("Issue 20's acceptance: met by every judged run." if not failed else
-               f"Issue 20's acceptance: not met by {len(failed)} of {len(table)} judged runs "
+    verdict = ("Stable-gait acceptance: met by every judged run." if not failed else
+               f"Stable-gait acceptance: not met by {len(failed)} of {len(table)} judged runs "
                f"({', '.join(failed[:4])}{', …' if len(failed) > 4 else ''}).")
     rep.add_section(
         "Robustness: copies, other starts and pushes",
         text=(f"{verdict} Each run below is simulated again for {duration:g} s from the "
-              f"solution's parameters. Judged (issue 20): the nominal run, {COPIES} copies with "
+              f"solution's parameters. Judged: the nominal run, {COPIES} copies with "
               f"the parameters moved by {COPY_JITTER:g} (relative, along directions no "
               f"optimiser saw) and starts at ±{100 * START_CHANGE:g} % of the initial speed. A "
               "run meets the acceptance when it runs the whole time with the shipped-solution "

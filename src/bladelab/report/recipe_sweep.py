@@ -1,7 +1,7 @@
 """The report sections of a recipe sweep (``bladelab sweep --recipe``, :mod:`bladelab.predict.reflex.recipe_sweep`).
 
 Every finished level of every task is re-simulated (:func:`~bladelab.predict.reflex.recipe.level_row`:
-10 s nominal and, for a gait that runs, issue 20's acceptance), and the category table is
+10 s nominal and, for a gait that runs, the stable-gait acceptance), and the category table is
 recomputed from these re-simulations, not read from ``summary.csv``; ``levels.json``'s stored
 rows are compared with them.
 """
@@ -15,6 +15,16 @@ import pandas as pd
 
 from bladelab._io import read_json
 from bladelab.errors import InputFileError
+from bladelab.predict.reflex.recipe import (
+    LEVELS_NAME,
+    RECIPE_NAME,
+    Recipe,
+    level_row,
+    maximum_speed,
+    settled_speed,
+)
+from bladelab.predict.reflex.recipe_sweep import category_agreement, summarise_levels
+from bladelab.report.predictive_sections import seed001_results
 
 __all__ = ["is_recipe_sweep", "recipe_sweep_sections"]
 
@@ -23,15 +33,11 @@ _COMPARED = ("cost", "mean_speed_m_per_s", "fell", "accepted")
 
 def is_recipe_sweep(path: Path) -> bool:
     """Whether ``path`` is a ``bladelab sweep --recipe`` folder."""
-    from bladelab.predict.reflex.recipe import LEVELS_NAME
-
     return path.is_dir() and (path / "levels.csv").is_file() and any(
         path.glob(f"*/seed-*/{LEVELS_NAME}"))
 
 
 def _tasks(folder: Path) -> list[tuple[Path, dict, list[dict]]]:
-    from bladelab.predict.reflex.recipe import LEVELS_NAME, RECIPE_NAME
-
     out = []
     for levels in sorted(folder.glob(f"*/seed-*/{LEVELS_NAME}")):
         task = levels.parent
@@ -45,8 +51,6 @@ def _tasks(folder: Path) -> list[tuple[Path, dict, list[dict]]]:
 
 def _speeds_figure(levels: pd.DataFrame, verdicts: dict[str, str]):
     import matplotlib.pyplot as plt
-
-    from bladelab.predict.reflex.recipe import settled_speed
 
     cats = list(dict.fromkeys(levels.category))
     fig, axes = plt.subplots(1, len(cats), figsize=(4.2 * len(cats), 3.6), squeeze=False,
@@ -81,9 +85,6 @@ def _speeds_figure(levels: pd.DataFrame, verdicts: dict[str, str]):
 def recipe_sweep_sections(report, folder: Path, bar) -> tuple[pd.DataFrame, dict[str, Path]]:
     """Add the sweep's sections; return the recomputed category table and the parameter files
     of the gaits to show (per category, the fastest level of any seed that runs)."""
-    from bladelab.predict.reflex.recipe import Recipe, level_row, maximum_speed
-    from bladelab.predict.reflex.recipe_sweep import category_agreement, summarise_levels
-
     tasks = _tasks(folder)
     rows, same = [], []
     last_stage = None
@@ -132,7 +133,7 @@ def recipe_sweep_sections(report, folder: Path, bar) -> tuple[pd.DataFrame, dict
         "pelvis_tilt_mean_deg": "pelvis tilt mean (deg)",
         "judged_at_m_per_s": "judged at (m/s)",
         "nominal_meets_acceptance": "nominal run meets the acceptance (yes/no)",
-        "accepted": "meets issue 20's acceptance (yes/no)",
+        "accepted": "meets the stable-gait acceptance (yes/no)",
         "runs_at_half_step": "runs 10 s at half the time step (yes/no)",
         "half_step_speed_m_per_s": "mean speed at half the time step (m/s)",
         "runs_at_quarter_step": "runs 10 s at a quarter of the time step (yes/no)",
@@ -143,7 +144,7 @@ def recipe_sweep_sections(report, folder: Path, bar) -> tuple[pd.DataFrame, dict
         text=("Each category was optimised by a recipe of CMA-ES stages per seed, then its "
               "speed raised by continuation on the speed reached (docs/predictive.md, "
               "'Recipes'). Every finished level is simulated again here for 10 s with its own "
-              "settings and, if it runs, judged by issue 20's acceptance at the speed it reached "
+              "settings and, if it runs, judged by the stable-gait acceptance at the speed it reached "
               "(4 copies moved by 1e-3 and ±5 % initial speed, each within 0.1 m/s of that "
               "speed, swing contacts ≤ 0.2 BW, mean pelvis tilt in −16…−2°); the table of "
               "categories comes from these re-simulations. A category "
@@ -153,13 +154,13 @@ def recipe_sweep_sections(report, folder: Path, bar) -> tuple[pd.DataFrame, dict
               "the level's time step (at Newmark's 1 ms the gaits run 0.09–0.25 m/s faster "
               "than at finer steps, which still differ by a few hundredths of a m/s: the "
               "levels table gives the change from half to a quarter of the step); a level "
-              "that falls at any of these steps is not compared. Issue 20's maximum speed is "
+              "that falls at any of these steps is not compared. The maximum speed is "
               "the fastest settled speed of a level that meets the acceptance (last column "
               "of the categories table; '–': none does yet), beside the fastest of all."
               "\n\n" + " ".join(sentences)),
         figures=[("Speed reached per level and seed at the level's time step (filled) and at "
                   "a quarter of it (open: the settled speed; none where it falls at a finer "
-                  "step); × fell in its 10 s re-simulation, ★ meets issue 20's acceptance; "
+                  "step); × fell in its 10 s re-simulation, ★ meets the stable-gait acceptance; "
                   "dashed: the prescribed speed",
                   _speeds_figure(levels, verdicts))],
         tables=[("Categories", summary), ("Levels, re-simulated", table)],
@@ -169,8 +170,6 @@ def recipe_sweep_sections(report, folder: Path, bar) -> tuple[pd.DataFrame, dict
 
 def _beside_seed001(summary: pd.DataFrame) -> pd.DataFrame:
     """The category table with seed 001's maximum speed [m/s] beside ours (Table 3.1)."""
-    from bladelab.report.predictive_sections import seed001_results
-
     seed = seed001_results()
     seed = seed[seed.quantity == "max_speed"].set_index("category").value
     col = summary.columns.get_loc("maximum speed (m/s)") + 1

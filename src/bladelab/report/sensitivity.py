@@ -1,7 +1,7 @@
 """How far to trust K* and D*: their sensitivity to marker noise and kinematic sampling rate.
 
-The numbers come from the robust-identification measurement study (``benchmarks/bench_robust.py``,
-issue 9): stances made by the MuJoCo runner generator (not the identification model), degraded
+The numbers come from the robust-identification measurement study (``benchmarks/bench_robust.py``):
+stances made by the MuJoCo runner generator (not the identification model), degraded
 as a lab records them (clamp cluster and tip markers at 100 or 250 Hz with 0–3 mm noise per
 coordinate, 20 Hz low-pass; forces at 1 kHz with 1 % noise) and identified with each
 formulation. The benchmark writes the table into the package (``data/sensitivity/``), so every

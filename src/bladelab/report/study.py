@@ -30,8 +30,24 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from bladelab import sim
+from bladelab.blade import load_blade
 from bladelab.errors import DataError, InputFileError
+from bladelab.identify.cost import StanceCost
+from bladelab.identify.formulations import DEFAULT_FORMULATION, formulation_drive
+from bladelab.identify.identifiability import cost_landscape
+from bladelab.mechanics import PLAUSIBLE_EFFICIENCY_PCT, mechanics_table, stance_mechanics
 from bladelab.parameters import JOINT_PARAMETERS
+from bladelab.report import figures, tables
+from bladelab.report.builder import Report, ReportTable
+from bladelab.report.study_quality import add_flagged_section, flag_column, row_quality
+from bladelab.report.study_sections import add_sensitivity_section, add_truth_section
+from bladelab.sim import DEFAULT_DT
+from bladelab.stats import athlete_means, compare_groups, speed_band, summarize, unit_of_analysis
+from bladelab.study.spec import RESULTS_FILE, load_study
+from bladelab.study.store import ResultsStore
+from bladelab.study.tasks import read_trial_stance
+from bladelab.trial import blade_kinematics, read_c3d
 
 __all__ = ["StudyReport", "build_study_report"]
 
@@ -90,13 +106,9 @@ class StudyReport:
 
 def _sim_default_dt() -> float:
     """The kernel's default time step [s], used for every re-simulation in the report."""
-    from bladelab.sim import DEFAULT_DT
-
     return DEFAULT_DT
 
 def _blade_model(ref: str, folder: Path):
-    from bladelab.blade import load_blade
-
     p = Path(ref)
     if p.suffix in (".yaml", ".yml") and not p.is_absolute():
         p = folder / p
@@ -109,8 +121,6 @@ def _measured_tip(file: Path, stance) -> np.ndarray | None:
     if file.suffix.lower() != ".c3d":
         return None
     from scipy import interpolate
-
-    from bladelab.trial import blade_kinematics, read_c3d
 
     trial = read_c3d(file)
     t0 = float(stance.metadata.get("window_start_s", 0.0))
@@ -213,26 +223,6 @@ def build_study_report(
         No successfully identified trial, or an unknown ``trial``/``variant``.
     """
     from tqdm import tqdm
-
-    from bladelab import sim
-    from bladelab.identify.cost import StanceCost
-    from bladelab.identify.formulations import DEFAULT_FORMULATION, formulation_drive
-    from bladelab.identify.identifiability import cost_landscape
-    from bladelab.mechanics import PLAUSIBLE_EFFICIENCY_PCT, mechanics_table, stance_mechanics
-    from bladelab.report import figures, tables
-    from bladelab.report.builder import Report, ReportTable
-    from bladelab.report.study_quality import add_flagged_section, flag_column, row_quality
-    from bladelab.report.study_sections import add_sensitivity_section, add_truth_section
-    from bladelab.stats import (
-        athlete_means,
-        compare_groups,
-        speed_band,
-        summarize,
-        unit_of_analysis,
-    )
-    from bladelab.study.spec import RESULTS_FILE, load_study
-    from bladelab.study.store import ResultsStore
-    from bladelab.study.tasks import read_trial_stance
 
     if window not in ("contact", "stance"):
         raise DataError(f"unknown window {window!r}", where="--window", hint="contact or stance")

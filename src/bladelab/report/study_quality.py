@@ -12,6 +12,8 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
+from bladelab.identify.quality import QualityThresholds
+
 __all__ = ["FLAG_MARK", "add_flagged_section", "flag_column", "row_quality"]
 
 FLAG_MARK = "⚑ flagged"
@@ -34,8 +36,6 @@ def flag_column(flagged: pd.Series) -> list[str]:
 
 def add_flagged_section(rep, per_trial: pd.DataFrame, *, include_flagged: bool) -> None:
     """The "Flagged trials" section: every flagged trial with its reasons, and what was done."""
-    from bladelab.identify.quality import QualityThresholds
-
     th = QualityThresholds()
     flagged = per_trial[per_trial["flagged"].fillna(False).astype(bool)]
     unassessed = int(per_trial["flagged"].isna().sum())

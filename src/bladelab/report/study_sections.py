@@ -10,6 +10,7 @@ import numpy as np
 import pandas as pd
 
 from bladelab.parameters import JOINT_PARAMETERS
+from bladelab.report.sensitivity import read_sensitivity, sensitivity_figure, sensitivity_summary
 from bladelab.report.study_quality import flag_column
 
 __all__ = ["add_sensitivity_section", "add_truth_section"]
@@ -114,13 +115,7 @@ def add_truth_section(rep, per_trial: pd.DataFrame, gt_path: Path, *, kept_ids: 
 
 
 def add_sensitivity_section(rep, formulations) -> None:
-    """How far to trust K* and D*: the measured sensitivity to marker noise and rate (issue 9)."""
-    from bladelab.report.sensitivity import (
-        read_sensitivity,
-        sensitivity_figure,
-        sensitivity_summary,
-    )
-
+    """How far to trust K* and D*: the measured sensitivity to marker noise and rate."""
     table = read_sensitivity()
     summary = sensitivity_summary(table)
     rep.add_section(

@@ -25,7 +25,8 @@ import mujoco
 import numpy as np
 import pandas as pd
 
-from bladelab.runner.model import CP_BLADE, CP_EXP, CP_K, CP_LEG
+from bladelab.runner.layout import CP_BLADE, CP_EXP, CP_K, CP_LEG
+from bladelab.runner.model import contact_heights
 from bladelab.runner.params import PROSTHETIC_KINDS
 from bladelab.runner.simulate import (
     RC_DEPTH,
@@ -463,8 +464,6 @@ def _leg_length(result: RunnerResult, leg: int) -> float:
     mujoco.mj_kinematics(model.mj_model, d)
     side = "l" if leg == 0 else "r"
     hip = d.xanchor[model.mj_model.joint(f"hip_flexion_{side}").id, 2]
-    from bladelab.runner.model import contact_heights
-
     h = contact_heights(model, q)
     cols = model.contact_params[:, CP_LEG] == leg
     return float(hip - h[cols].min())

@@ -2,9 +2,9 @@
 
 A strike of a swinging foot (:func:`bladelab.runner.analyses.swing_contacts`) says only that
 it touched and how hard. The clearance says by how much a swing missed the ground, or how
-deep it went in (negative), so it gives a margin where the strikes give a verdict: issue 20's
-limit of 0.2 body weights is about 15 mm of the Cat6 blade's sphere in the ground, its
-reflex gaits' strikes 23–25 mm (docs/predictive.md).
+deep it went in (negative), so it gives a margin where the strikes give a verdict: the
+stable-gait acceptance's limit of 0.2 body weights is about 15 mm of the Cat6 blade's sphere
+in the ground, its reflex gaits' strikes 23–25 mm (docs/predictive.md).
 """
 
 from __future__ import annotations
@@ -14,7 +14,8 @@ import numpy as np
 import pandas as pd
 
 from bladelab.runner.analyses import stances
-from bladelab.runner.model import CP_LEG, contact_heights
+from bladelab.runner.layout import CP_LEG
+from bladelab.runner.model import contact_heights
 from bladelab.runner.simulate import RunnerResult, leg_names
 
 __all__ = ["swing_clearance"]

@@ -9,7 +9,7 @@ import math
 from numba import njit
 
 from bladelab.numba_cache import refresh_stale_caches
-from bladelab.runner.model import CP_AZ, CP_RADIUS, CP_SITE
+from bladelab.runner.layout import CP_AZ, CP_RADIUS, CP_SITE
 
 
 @njit(cache=True, _nrt=False)  # no reference counting (bladelab.runner.kernel)

@@ -37,7 +37,7 @@ from bladelab._io import atomic_open, write_json
 from bladelab.errors import InputFileError
 from bladelab.runner import analyses
 from bladelab.runner.geometry import REFERENCE_HEIGHT_M
-from bladelab.runner.model import CP_BODY, CP_LEG
+from bladelab.runner.layout import CP_BODY, CP_LEG
 from bladelab.runner.simulate import (
     RC_DEPTH,
     RC_FX,

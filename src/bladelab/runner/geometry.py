@@ -1,11 +1,11 @@
 """Segment geometry and muscle paths of the planar runner, ported from SCONE's H0918 model.
 
 Source: ``H0918.hfd`` of SCONE (scone-core, Copyright Thomas Geijtenbeek, Apache License 2.0;
-copy in ``shared/data/models/scone-h0918/``). Its numbers were typed into the tables below; no
-SCONE code is used or run. Hyfydy gives every position relative to the centre of mass (COM) of
-its body in OpenSim axes (x forward, y up, z right); :func:`to_lab` converts to bladelab's lab
-frame (x forward, y left, z up). All lengths are for the reference athlete (1.80 m) and are
-scaled with the athlete's height.
+a copy with its licence in the project's ``tests/data/scone-h0918/``). Its numbers were typed
+into the tables below; no SCONE code is used or run. Hyfydy gives every position relative to the
+centre of mass (COM) of its body in OpenSim axes (x forward, y up, z right); :func:`to_lab`
+converts to bladelab's lab frame (x forward, y left, z up). All lengths are for the reference
+athlete (1.80 m) and are scaled with the athlete's height.
 
 Additions that H0918 does not have (seed 001 §2.1 has them; values are ours, see
 docs/runner-model.md): the lumbar joint is free (H0918 locks it), six torso muscles (rectus

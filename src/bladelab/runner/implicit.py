@@ -28,7 +28,7 @@ zero), so MuJoCo's ``mj_step2`` produces exactly ``a``. The recorded contact for
 torques are the end-of-step (effective) ones, so the power balance checks the forces that
 acted.
 
-``"newmark"`` is the second-order version (issue 20): Newmark's average-acceleration rule
+``"newmark"`` is the second-order version: Newmark's average-acceleration rule
 (β = 1/4, γ = 1/2, the trapezoidal rule), linearised the same way. The forces are evaluated
 once per step, at the predicted state ``q* = q + dt·v + dt²/4·a``, ``v* = v + dt/2·a``
 (:func:`implicit_advance`); then
@@ -58,11 +58,7 @@ from numba import njit
 from bladelab.contact import hunt_crossley_force, smooth_spring_damper_force
 from bladelab.numba_cache import refresh_stale_caches
 from bladelab.runner.contact_point import lowest_point
-from bladelab.runner.mjcall import (
-    call_mujoco,
-    call_mujoco_rne,
-)
-from bladelab.runner.model import (
+from bladelab.runner.layout import (
     CP_BODY,
     CP_C,
     CP_DAMP,
@@ -71,8 +67,6 @@ from bladelab.runner.model import (
     CP_LAW,
     CP_MU,
     CP_WIDTH,
-    FRICTION_DAMPING,
-    FRICTION_STIFFNESS,
     JP_D,
     JP_HI,
     JP_K,
@@ -82,6 +76,11 @@ from bladelab.runner.model import (
     JP_SK,
     JP_SK2,
 )
+from bladelab.runner.mjcall import (
+    call_mujoco,
+    call_mujoco_rne,
+)
+from bladelab.runner.model import FRICTION_DAMPING, FRICTION_STIFFNESS
 from bladelab.runner.muscle import muscle_step
 
 EXPLICIT, IMPLICIT, NEWMARK = 0, 1, 2

@@ -12,8 +12,9 @@ import numpy as np
 
 from bladelab.errors import SimulationError
 from bladelab.runner.implicit import INTEGRATORS, site_kinematics
+from bladelab.runner.kernel import mujoco_views
+from bladelab.runner.layout import CP_SITE
 from bladelab.runner.mjcall import mujoco_stage_addresses
-from bladelab.runner.model import CP_SITE
 from bladelab.runner.muscle import fibre_heights
 
 
@@ -177,8 +178,6 @@ def implicit_arrays(model, m: mujoco.MjModel, d: mujoco.MjData, integrator: str 
 def site_views(d: mujoco.MjData, imp: tuple, *, oriented: bool = True) -> tuple:
     """The ``mj`` tuple of the force kernels (:func:`bladelab.runner.kernel.mujoco_views`) with
     the sites ``imp`` places when it was built with ``own_sites``."""
-    from bladelab.runner.kernel import mujoco_views
-
     if imp[23][0] == 0:
         return mujoco_views(d, oriented=oriented)
     xmat = imp[31] if oriented else np.zeros((0, 9))

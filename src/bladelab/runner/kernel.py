@@ -22,8 +22,7 @@ from bladelab.contact import hunt_crossley_force, smooth_spring_damper_force
 from bladelab.numba_cache import refresh_stale_caches
 from bladelab.runner.contact_point import lowest_point
 from bladelab.runner.implicit import EXPLICIT, implicit_advance, implicit_begin, implicit_forces
-from bladelab.runner.mjcall import call_mujoco, mujoco_step_addresses  # noqa: F401 (re-exported)
-from bladelab.runner.model import (
+from bladelab.runner.layout import (
     CP_BODY,
     CP_C,
     CP_DAMP,
@@ -32,8 +31,6 @@ from bladelab.runner.model import (
     CP_LAW,
     CP_MU,
     CP_WIDTH,
-    FRICTION_DAMPING,
-    FRICTION_STIFFNESS,
     JP_D,
     JP_HI,
     JP_K,
@@ -43,6 +40,8 @@ from bladelab.runner.model import (
     JP_SK,
     JP_SK2,
 )
+from bladelab.runner.mjcall import call_mujoco, mujoco_step_addresses  # noqa: F401 (re-exported)
+from bladelab.runner.model import FRICTION_DAMPING, FRICTION_STIFFNESS
 from bladelab.runner.muscle import muscle_step
 from bladelab.sim.mujoco_engine import add_point_force
 
@@ -54,7 +53,7 @@ from bladelab.sim.mujoco_engine import add_point_force
 # and are compiled without numba's reference counting (``_nrt=False``, numba's option for it):
 # with it, every call to them incremented and decremented the count of each array in its tuple
 # arguments (``mj``, ``arrays``, ``imp``: ~60 arrays) with an atomic instruction, 15-20 % of the
-# implicit 1 ms step (perf, issue 20). The functions they call inherit the setting; an
+# implicit 1 ms step (measured with perf). The functions they call inherit the setting; an
 # allocation in any of them fails to compile ("NRT required but not enabled"), and none may
 # return an array (its caller would get a reference it does not own). ``run_loop`` allocates
 # and keeps the counting. ``inline="always"`` (numba inlines the function's code into its

@@ -29,6 +29,16 @@ from bladelab.blade.model import BladeModel
 from bladelab.contact import hertz_sphere_stiffness
 from bladelab.errors import ModelError
 from bladelab.runner import geometry as geo
+from bladelab.runner.layout import (
+    CP_AZ,
+    CP_BLADE,
+    CP_RADIUS,
+    CP_SITE,
+    JP_HI,
+    JP_LO,
+    JP_SK,
+    LAW_HUNT_CROSSLEY,
+)
 from bladelab.runner.multilink import add_multilink_blade, multilink_contact_rows
 from bladelab.runner.params import (
     BLADE_ALIGNMENT_DEG,
@@ -87,15 +97,6 @@ PROSTHETIC_PYLON_COM_M = 0.08
 # Tangential (friction) bristle spring and damper of every contact [N/m, N·s/m].
 FRICTION_STIFFNESS = 5.0e4
 FRICTION_DAMPING = 200.0
-
-# Columns of RunnerModel.contact_params.
-CP_SITE, CP_BODY, CP_RADIUS, CP_K, CP_C, CP_MU, CP_LEG, CP_BLADE = range(8)
-CP_AZ, CP_LAW, CP_EXP, CP_DAMP, CP_WIDTH = range(8, 13)
-LAW_HUNT_CROSSLEY, LAW_SPRING_DAMPER = 0, 1
-# Columns of RunnerModel.joint_params (one row per dof). The joint spring–damper's damping is
-# JP_SD while the joint turns in the negative sense (a knee flexing) and JP_SDX in the positive
-# sense (extending): equal for every joint but a hydraulic prosthetic knee.
-JP_LO, JP_HI, JP_K, JP_D, JP_SK, JP_SK2, JP_SD, JP_SDX = range(8)
 
 
 # Default time step [s]. Under running loads 0.5 ms leaves a 2 ms stance oscillation and a 4.8 %

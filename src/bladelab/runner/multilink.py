@@ -21,6 +21,7 @@ import mujoco
 
 from bladelab.blade.model import BladeModel
 from bladelab.errors import ModelError
+from bladelab.runner.layout import LAW_HUNT_CROSSLEY, LAW_SPRING_DAMPER
 from bladelab.sim.mujoco_blade import BladeNames, add_blade_bodies, lowest_sole_z
 
 CLAMP_OFFSET_X_M = -0.03
@@ -66,8 +67,6 @@ def add_multilink_blade(bodies, joint_child, params, s, mr, axis, blade, bottom,
 
 def multilink_contact_rows(model: mujoco.MjModel, blade: BladeModel) -> list[tuple]:
     """Contact parameter rows (``RunnerModel.contact_params`` layout) of the blade's soles."""
-    from bladelab.runner.model import LAW_HUNT_CROSSLEY, LAW_SPRING_DAMPER
-
     c = blade.contact
     law = LAW_HUNT_CROSSLEY if c.law == "hunt_crossley" else LAW_SPRING_DAMPER
     rows = []

@@ -85,7 +85,7 @@ class MuscleType(_Strict):
 
 
 #: The model kinds: seed 001's able-bodied and transtibial ("amputee") runners, and the
-#: transfemoral runner of issue 21 (docs/runner-model.md, "The transfemoral runner").
+#: transfemoral runner (docs/runner-model.md, "The transfemoral runner").
 KINDS = ("able", "amputee", "transfemoral")
 #: The kinds with a prosthetic right leg (a blade, no shank muscles on that side).
 PROSTHETIC_KINDS = ("amputee", "transfemoral")

@@ -23,6 +23,7 @@ from __future__ import annotations
 import math
 from dataclasses import asdict, dataclass
 
+import numpy as np
 from numba import njit
 
 from bladelab.errors import SpecError
@@ -71,8 +72,6 @@ class ProstheticKnee:
 
     def as_array(self):
         """(c_f, c_e, k_a, q_a0, q_s, k_s, d_s) for :func:`knee_torque`."""
-        import numpy as np
-
         return np.array([self.flexion_damping, self.extension_damping, self.assist_stiffness,
                          self.assist_rest_angle, self.stop_angle, self.stop_stiffness,
                          self.stop_damping], float)
@@ -86,12 +85,10 @@ class ProstheticKnee:
 
     def joint_row(self):
         """This knee as a row of ``RunnerModel.joint_params`` (columns ``JP_*`` of
-        :mod:`bladelab.runner.model`) for a knee coordinate that is negative in flexion:
+        :mod:`bladelab.runner.layout`) for a knee coordinate that is negative in flexion:
         ligament limits (−flexion_limit, −stop_angle) with the stop's stiffness and damping,
         the assist spring as the joint spring (about 0, so ``assist_rest_angle`` must be 0),
         flexion damping while q̇ < 0 and extension damping while q̇ > 0."""
-        import numpy as np
-
         if self.assist_rest_angle != 0.0:
             raise SpecError("the runner's knee spring acts about 0: assist_rest_angle must be 0",
                             where="prosthetic knee: assist_rest_angle")

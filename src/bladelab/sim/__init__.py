@@ -10,10 +10,8 @@ Method notes: ``docs/blade-model.md``.
 
 from bladelab.sim.api import (
     DEFAULT_DT,
-    BatchResult,
     Drive,
     SimProblem,
-    SimResult,
     prepare,
     simulate,
     simulate_batch,
@@ -22,6 +20,7 @@ from bladelab.sim.api import (
 from bladelab.sim.chain import Chain, build_chain
 from bladelab.sim.kernel import ENERGY_TERMS
 from bladelab.sim.motion import ClampMotion
+from bladelab.sim.result import BatchResult, SimResult
 from bladelab.sim.synthetic import generate_stance
 
 __all__ = [

@@ -34,6 +34,7 @@ from bladelab.sim import kernel as _k
 from bladelab.sim import sole as _sole
 from bladelab.sim.chain import Chain
 from bladelab.sim.mujoco_blade import add_blade_bodies
+from bladelab.sim.result import SimResult
 
 CLAMP_ARMATURE = 1.0e6  # kg (slides) and kg·m² (pitch hinge)
 
@@ -351,8 +352,6 @@ class MujocoBlade:
 
 def simulate_mujoco(problem, K: np.ndarray, D: np.ndarray, K2: np.ndarray):
     """Run one parameter set of a prescribed-clamp problem on MuJoCo; returns a SimResult."""
-    from bladelab.sim.api import SimResult
-
     blade = problem.blade
     chain = problem.chain
     mj = MujocoBlade(blade, build_spec(blade, stiffness=K, damping=D, dt=problem.dt))

@@ -24,7 +24,8 @@ import numpy as np
 
 from bladelab import __version__
 from bladelab.executors import make_executor, run_task_safely
-from bladelab.study.spec import RESULTS_FILE, Study, load_study
+from bladelab.identify.formulations import DEFAULT_FORMULATION
+from bladelab.study.spec import RESULTS_FILE, IdentificationSettings, Study, load_study
 from bladelab.study.store import ResultsStore
 
 DEFAULT_TASK = "bladelab.study.tasks:identify_trial"
@@ -39,8 +40,6 @@ def trial_seed(study_seed: int, trial_id: str) -> int:
 def variant_name(settings: dict) -> str:
     """The model variant of a settings dict: ``linear`` or ``nonlinear``, ``@j<point>`` if a joint
     is forced, ``+<formulation>`` for a formulation other than the default (e.g. ``linear+seed``)."""
-    from bladelab.identify.formulations import DEFAULT_FORMULATION
-
     name = "nonlinear" if settings.get("nonlinear") else "linear"
     if settings.get("joint") is not None:
         name += f"@j{settings['joint']}"
@@ -199,8 +198,6 @@ def run_study(
         study = study.model_copy(update={"seed": int(seed)})
     merged = study.identification.model_dump(mode="json")
     if settings:
-        from bladelab.study.spec import IdentificationSettings
-
         merged = IdentificationSettings.model_validate({**merged, **settings}).model_dump(mode="json")
     fn = _resolve_task(task)
     if blade is not None and Path(blade).is_file():

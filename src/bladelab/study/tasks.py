@@ -2,7 +2,12 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 from bladelab.errors import DataError
+from bladelab.identify.formulations import DEFAULT_FORMULATION
+from bladelab.identify.identify import identify_stance
+from bladelab.trial import extract_stance, read_c3d, read_stance_csv
 
 
 def read_trial_stance(file: str, stance: int = 1):
@@ -11,10 +16,6 @@ def read_trial_stance(file: str, stance: int = 1):
     A C3D trial goes through :func:`bladelab.trial.extract_stance` with its defaults (stance
     ``stance`` counted from 1 among the detected stances, markers 20 Hz, forces 75 Hz, 1000 Hz).
     """
-    from pathlib import Path
-
-    from bladelab.trial import extract_stance, read_c3d, read_stance_csv
-
     if Path(file).suffix.lower() == ".c3d":
         stance_obj = extract_stance(read_c3d(file), int(stance) - 1)
         return stance_obj
@@ -32,9 +33,6 @@ def identify_trial(payload: dict) -> dict:
     ``stance`` (1-based stance number; a stance CSV holds one), ``blade`` (name or spec path),
     ``settings`` (identification settings), ``seed``.
     """
-    from bladelab.identify.formulations import DEFAULT_FORMULATION
-    from bladelab.identify.identify import identify_stance
-
     stance = read_trial_stance(payload["file"], payload.get("stance", 1))
     s = payload["settings"]
     ident = identify_stance(

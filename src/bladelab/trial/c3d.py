@@ -28,6 +28,7 @@ The lab frame
 from __future__ import annotations
 
 import os
+import warnings
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
@@ -297,8 +298,6 @@ def _choose_forward(forward, up_vec, points, plates, rate, path) -> np.ndarray:
 
 class _quiet:
     def __enter__(self):
-        import warnings
-
         self._w = warnings.catch_warnings()
         self._w.__enter__()
         warnings.simplefilter("ignore", RuntimeWarning)

@@ -17,8 +17,11 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.interpolate import CubicSpline
 
 from bladelab.errors import DataError, SpecError
+from bladelab.trial.events import detect_stances
+from bladelab.trial.joint_angles import sagittal_angles, stance_legs
 
 __all__ = ["AngleCycle", "joint_angle_cycles"]
 
@@ -77,11 +80,6 @@ def joint_angle_cycles(
     DataError
         Missing markers or platforms, or no complete cycle of ``leg``.
     """
-    from scipy.interpolate import CubicSpline
-
-    from bladelab.trial.events import detect_stances
-    from bladelab.trial.joint_angles import sagittal_angles, stance_legs
-
     if leg not in SIDES:
         raise SpecError(f"leg must be 'left' or 'right', got {leg!r}", where="--leg")
     other = SIDES[1 - SIDES.index(leg)]

@@ -1,6 +1,6 @@
 """Predictive running by direct collocation: the CasADi side of the runner model.
 
-The model layer (issue 15, "same model on both sides"): :func:`build_collocation_model` derives,
+The model layer ("same model on both sides"): :func:`build_collocation_model` derives,
 from the very :class:`bladelab.runner.RunnerModel` that the forward simulation runs, CasADi
 Functions of the planar multibody dynamics (implicit inverse dynamics, exact against MuJoCo's
 ``mj_inverse``), the muscle paths (lengths, velocities, moment arms, exact against

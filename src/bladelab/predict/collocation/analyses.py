@@ -1,4 +1,4 @@
-"""Seed 001's per-stride quantities of a collocation solution (Tables 3.2, 3.3, D.1; issue 15).
+"""Seed 001's per-stride quantities of a collocation solution (Tables 3.2, 3.3, D.1).
 
 :func:`stride_analyses` repeats the solved stride :data:`N_STRIDES` times
 (:meth:`~bladelab.predict.collocation.solution.CollocationSolution.to_runner_result`,
@@ -35,6 +35,8 @@ import math
 import numpy as np
 
 from bladelab.errors import SpecError
+from bladelab.predict.collocation.stored import runner_from_spec
+from bladelab.runner import analyses as an
 from bladelab.runner.params import PROSTHETIC_KINDS
 
 __all__ = ["JOINT_LABELS", "N_STRIDES", "REFINE", "stride_analyses"]
@@ -86,9 +88,6 @@ def stride_analyses(solution, runner=None, *, refine: int = REFINE, cm=None) -> 
     DataError
         ``runner`` is not the solution's model.
     """
-    from bladelab.predict.collocation.stored import runner_from_spec
-    from bladelab.runner import analyses as an
-
     if isinstance(refine, bool) or int(refine) != refine or refine < 1:
         raise SpecError(f"need refine >= 1, got {refine!r}", where="refine")
     runner = runner if runner is not None else runner_from_spec(solution.model_spec)

@@ -1,4 +1,4 @@
-"""Dynamic consistency of a collocation solution with the forward model (issue 15).
+"""Dynamic consistency of a collocation solution with the forward model.
 
 At every node of a stride (coordinates q, speeds q̇, accelerations q̈ and normalised tendon
 forces F̃ₜ of a collocation solution), MuJoCo's inverse dynamics of the runner's own model
@@ -45,10 +45,15 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
+import mujoco
 import numpy as np
 
 from bladelab.errors import DataError, SpecError
+from bladelab.predict.collocation.model import build_collocation_model
+from bladelab.runner.kernel import forces, mujoco_views, path_kinematics
+from bladelab.runner.layout import CP_BODY, CP_MU, CP_SITE
 from bladelab.runner.model import DEFAULT_DT, RunnerModel
+from bladelab.runner.muscle import MP_FMAX, MP_LOPT, MP_LTS, MP_PENN, MP_TSTRAIN
 
 __all__ = [
     "FRICTION_MODES",
@@ -180,8 +185,6 @@ def inverse_dynamics(runner: RunnerModel, q: np.ndarray, qd: np.ndarray,
                      qdd: np.ndarray) -> np.ndarray:
     """MuJoCo's inverse dynamics (``mj_inverse``: ``qfrc_inverse``) of the runner's model at
     each row of q [m, rad], q̇ [m/s, rad/s], q̈ [m/s², rad/s²]: (n, n_dof) [N, N·m]."""
-    import mujoco
-
     m = runner.mj_model
     d = mujoco.MjData(m)
     out = np.empty((q.shape[0], m.nv))
@@ -225,12 +228,6 @@ def forward_generalised_forces(
     dt
         Time step [s] of the friction state's reconstruction (the forward model's).
     """
-    import mujoco
-
-    from bladelab.runner.kernel import forces, mujoco_views, path_kinematics
-    from bladelab.runner.model import CP_MU
-    from bladelab.runner.muscle import MP_FMAX, MP_LOPT, MP_LTS, MP_PENN, MP_TSTRAIN
-
     q, qd = np.asarray(q, float), np.asarray(qd, float)
     tendon_force = np.asarray(tendon_force, float)
     _check_shapes(runner, q, qd, tendon_force)
@@ -333,10 +330,6 @@ def forward_generalised_forces(
 
 def _contact_generalised(m, d, cp: np.ndarray, crec: np.ndarray) -> np.ndarray:
     """Jᵀ·f [N, N·m] of the contact rows ``crec`` (Fx, Fz at the contact points)."""
-    import mujoco
-
-    from bladelab.runner.model import CP_BODY, CP_SITE
-
     out = np.zeros(m.nv)
     for c in range(cp.shape[0]):
         if crec[c, 0] == 0.0 and crec[c, 1] == 0.0:
@@ -390,8 +383,6 @@ def dynamics_residual(solution, runner: RunnerModel, *, cm=None, friction: str =
     :class:`~bladelab.predict.collocation.transcription.NLPSolution`), with the breakdown of
     :class:`DynamicsResidual`. ``cm``: the collocation model of ``runner`` (built if None);
     ``friction``: how the forward friction is taken (module docstring)."""
-    from bladelab.predict.collocation.model import build_collocation_model
-
     s = _nodes(solution)
     q, qd, qdd = (np.asarray(a, float) for a in (s.q, s.qd, s.qdd))
     ft = np.asarray(s.tendon_force, float)

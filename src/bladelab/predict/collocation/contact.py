@@ -30,7 +30,7 @@ import numpy as np
 from bladelab.predict.collocation.multibody import Frame, point_force, point_velocity, rotate
 from bladelab.predict.collocation.planar import PlanarTree
 from bladelab.predict.collocation.smooth import Smoothing, sigmoid, smooth_max0, softplus
-from bladelab.runner.model import (
+from bladelab.runner.layout import (
     CP_AZ,
     CP_C,
     CP_DAMP,
@@ -79,7 +79,7 @@ def normal_force(depth, depth_rate, row: np.ndarray, smoothing: Smoothing):
         x = smooth_max0(1.0 + 1.5 * c * depth_rate, smoothing.contact_damping)
         return k * d ** float(row[CP_EXP]) * x
     # the forward law's own cubic onset smoothstep(δ/w), C¹ and 0 for δ ≤ 0, so that the two
-    # agree from first touch (a tanh gate, used until session 12, gave 40-60 % of the forward
+    # agree from first touch (a tanh gate, used until 2026-11-26, gave 40-60 % of the forward
     # force at a touching-down sole's first node: dynamics residuals of 19-48 %); a sharp
     # forward onset (w = 0) gets the cubic over ε'
     width = float(row[CP_WIDTH]) if row[CP_WIDTH] > 0 else smoothing.spring_damper_depth_m

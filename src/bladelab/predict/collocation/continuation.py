@@ -1,4 +1,4 @@
-"""Speed continuation and maximum speed of one model (issue 15).
+"""Speed continuation and maximum speed of one model.
 
 Two drivers on top of :func:`~bladelab.predict.collocation.solve.predict_stride`:
 
@@ -64,12 +64,17 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
+import pandas as pd
+
 from bladelab.errors import InputFileError, SpecError
+from bladelab.predict.collocation.guess import template_guess
+from bladelab.predict.collocation.settings import CollocationSettings
+from bladelab.predict.collocation.solution import CollocationSolution
 from bladelab.predict.collocation.solve import (
-    COLLOCATION_SOURCE,
-    CollocationSettings,
     SolveProgress,
     predict_stride,
+    read_stored,
+    write_solve,
 )
 from bladelab.predict.collocation.starts import (
     START_COLUMNS,
@@ -82,13 +87,8 @@ from bladelab.predict.collocation.starts import (
     start_columns,
     warm_guess,
 )
-from bladelab.predict.collocation.stored import (
-    check_model_spec,
-    model_label,
-    read_stored,
-    runner_from_spec,
-    write_solve,
-)
+from bladelab.predict.collocation.stored import check_model_spec, model_label, runner_from_spec
+from bladelab.predict.collocation.stride_guess import COLLOCATION_SOURCE
 
 __all__ = [
     "MAX_SPEED_BEST_ITERATE_FILE",
@@ -280,8 +280,6 @@ class ContinuationResult:
 
     def table(self):
         """The rows as a pandas DataFrame, columns in :func:`table_columns` order."""
-        import pandas as pd
-
         rows = self.rows()
         return pd.DataFrame(rows, columns=table_columns(rows))
 
@@ -326,7 +324,7 @@ class LazyRunner:
 
 def _stored(ok: Path, best: Path, settings: CollocationSettings, *, spec: dict, force: bool):
     """(converged solution, best iterate) in ``ok`` / ``best``
-    (:func:`~bladelab.predict.collocation.stored.read_stored`); ``force`` ignores both."""
+    (:func:`~bladelab.predict.collocation.solve.read_stored`); ``force`` ignores both."""
     return (None, None) if force else read_stored(ok, best, spec, settings)
 
 
@@ -359,8 +357,6 @@ def _solve_and_write(runner, settings: CollocationSettings, guess, *, spec: dict
 
 
 def _template(get_runner, speed: float, n: int):
-    from bladelab.predict.collocation.guess import template_guess
-
     return template_guess(get_runner(), speed=speed, n=n)
 
 
@@ -554,8 +550,6 @@ def max_speed(runner, settings: CollocationSettings, guess, *, model_spec: dict,
     guess at the warm start's speed, and ``previous`` (the second-fastest converged solution,
     a :class:`CollocationSolution`, or None) the previous-but-one start.
     """
-    from bladelab.predict.collocation.solution import CollocationSolution
-
     spec = check_model_spec(model_spec)
     starts = check_starts(starts)
     if not isinstance(settings, CollocationSettings):

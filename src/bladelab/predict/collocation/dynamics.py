@@ -16,13 +16,17 @@ import casadi as ca
 import numpy as np
 
 from bladelab.errors import SpecError
+from bladelab.predict.collocation.contact import contact_kinematics
 from bladelab.predict.collocation.metabolics import (
     MetabolicSmoothing,
     muscle_metabolic_rates,
     whole_body_rate,
 )
 from bladelab.predict.collocation.model import CollocationModel
+from bladelab.predict.collocation.multibody import body_frames, point_position
+from bladelab.predict.collocation.smooth import sigmoid
 from bladelab.predict.collocation.transcription import StrideDynamics
+from bladelab.runner.layout import CP_LEG
 from bladelab.runner.muscle import MP_LOPT, V_MAX_OPT_PER_S
 
 __all__ = ["COORDINATE_BOUNDS_DEG", "stride_dynamics"]
@@ -72,10 +76,6 @@ def swing_clearance(cm: CollocationModel, q: ca.SX, qd: ca.SX, height_m: float) 
     contact's material point moves forward faster than the pelvis by more than
     2·:data:`SWING_SPEED_WIDTH_MPS`: ≥ 0 keeps a swinging foot or blade ``height_m`` clear of
     the ground, and leaves a stance contact (at rest, slower than the pelvis: s ≈ 0) free."""
-    from bladelab.predict.collocation.contact import contact_kinematics
-    from bladelab.predict.collocation.multibody import body_frames
-    from bladelab.predict.collocation.smooth import sigmoid
-
     frames = body_frames(cm.tree, q)
     v_pelvis = qd[cm.runner.dof("pelvis_tx")]
     out = []
@@ -89,8 +89,6 @@ def swing_clearance(cm: CollocationModel, q: ca.SX, qd: ca.SX, height_m: float) 
 def _prosthetic_contacts(runner, setting: str) -> np.ndarray:
     """Indices of the prosthetic leg's contact rows of a transfemoral runner; SpecError naming
     ``setting`` for a runner without a prosthetic knee."""
-    from bladelab.runner.model import CP_LEG
-
     if runner.kind != "transfemoral":
         raise SpecError(f"the {runner.kind} model has no prosthetic knee", where=setting,
                         hint="a transfemoral runner's setting")
@@ -103,8 +101,6 @@ def knee_extension_moment(cm: CollocationModel, q: ca.SX, qd: ca.SX) -> ca.SX:
     002's knee-buckling moment, as :func:`bladelab.design.constraints.knee_extension_moment`
     with the centre of pressure): negative flexes the knee; 0 while the prosthesis is off the
     ground."""
-    from bladelab.predict.collocation.multibody import body_frames, point_position
-
     runner = cm.runner
     prosthetic = _prosthetic_contacts(runner, "knee_moment_min_nm")
     body = runner.mj_model.joint("knee_angle_r").bodyid[0]

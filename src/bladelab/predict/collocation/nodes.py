@@ -4,7 +4,11 @@ file, its forward re-play and seed 002's responses)."""
 
 from __future__ import annotations
 
+import casadi as ca
 import numpy as np
+
+from bladelab.predict.collocation.contact import contact_kinematics
+from bladelab.predict.collocation.multibody import body_frames
 
 __all__ = ["evaluate_nodes", "on_fine_grid", "periodic_runs"]
 
@@ -41,11 +45,6 @@ def _node_samples(cm):
     vec(points), vec(point velocities), passive torques) of the collocation model. A point's
     velocity is that of the body's material point there (as the contact law and the forward
     kernel take it), not the rate of the lowest point, which rolls over a turning sphere."""
-    import casadi as ca
-
-    from bladelab.predict.collocation.contact import contact_kinematics
-    from bladelab.predict.collocation.multibody import body_frames
-
     nv, nm = cm.nv, cm.n_muscles
     q, qd = ca.SX.sym("q", nv), ca.SX.sym("qd", nv)
     ft, dft = ca.SX.sym("ft", nm), ca.SX.sym("dft", nm)

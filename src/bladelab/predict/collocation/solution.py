@@ -28,10 +28,22 @@ from pathlib import Path
 
 import numpy as np
 
+from bladelab._io import read_json, write_json
 from bladelab.errors import DataError, SpecError
+from bladelab.predict.collocation.consistency import dynamics_residual
+from bladelab.predict.collocation.dynamics import stride_dynamics
+from bladelab.predict.collocation.model import build_collocation_model
 from bladelab.predict.collocation.nodes import evaluate_nodes, on_fine_grid, periodic_runs
-from bladelab.predict.collocation.solve import COLLOCATION_SOURCE, CollocationSettings
+from bladelab.predict.collocation.settings import CollocationSettings
 from bladelab.predict.collocation.stored import FieldReader, check_model_spec, runner_from_spec
+from bladelab.predict.collocation.stride_guess import COLLOCATION_SOURCE, StrideGuess
+from bladelab.predict.collocation.transcription import (
+    PERIOD_BOUNDS_S,
+    NLPSolution,
+    StrideNLP,
+)
+from bladelab.runner.layout import CP_LEG
+from bladelab.runner.simulate import RunnerResult, leg_names
 
 __all__ = [
     "BEST_ITERATE_KIND",
@@ -55,8 +67,8 @@ PEAK_GRF_WARNING_BW = 8.0
 #: A dynamics residual against the forward model above this [% of the peak generalised
 #: force] is flagged by :meth:`CollocationSolution.gait_warnings`: the stride is then the gait
 #: of the smoothed model only. Clean solves measure 0.4–2.4 %; strides that placed a node where
-#: the smooth and forward contact laws differed (a blade sole's onset, fixed in session 12)
-#: reached 9–48 %. Our decision (session 12).
+#: the smooth and forward contact laws differed (a blade sole's onset, fixed on 2026-11-26)
+#: reached 9–48 %. Our decision.
 RESIDUAL_WARNING_PCT = 5.0
 #: Samples per mesh interval of the linear interpolation used for contact and flight times.
 _FINE = 50
@@ -94,7 +106,7 @@ class CollocationSolution:
     nlp
         The node values and IPOPT's report (:class:`NLPSolution`).
     settings
-        :class:`~bladelab.predict.collocation.solve.CollocationSettings`.
+        :class:`~bladelab.predict.collocation.settings.CollocationSettings`.
     model_spec
         ``{"model": "able" | "amputee", "blade": name | None}``.
     guess_source
@@ -149,13 +161,6 @@ class CollocationSolution:
         """A solution from an :class:`NLPSolution` of ``runner``: evaluates the contact forces
         and the dynamic consistency at the nodes (and the metabolic energy over the stride [J],
         :meth:`StrideNLP.energy_and_distance` on the solution's mesh, when not given)."""
-        from bladelab.predict.collocation.consistency import dynamics_residual
-        from bladelab.predict.collocation.dynamics import stride_dynamics
-        from bladelab.predict.collocation.model import build_collocation_model
-        from bladelab.predict.collocation.transcription import StrideNLP
-        from bladelab.runner.model import CP_LEG
-        from bladelab.runner.simulate import leg_names
-
         spec = check_model_spec(model_spec)
         if runner.kind != spec["model"]:
             raise SpecError(f"the runner is the {runner.kind} model, the spec says "
@@ -256,8 +261,6 @@ class CollocationSolution:
         (:data:`~bladelab.predict.collocation.transcription.PERIOD_BOUNDS_S`). Measured on 2026-11-25: the amputee Cat6 at 4 m/s
         from the Fukuchi trial's guess converged to a hop on the intact leg at the 0.4 s
         bound."""
-        from bladelab.predict.collocation.transcription import PERIOD_BOUNDS_S
-
         ph = self.contact_phases()
         out = [f"the {leg} leg never touches the ground (a one-legged hop, not running)"
                for leg in self.leg_names if ph["legs"][leg]["contacts"] == 0]
@@ -320,7 +323,7 @@ class CollocationSolution:
                 for k, v in out.items()}
 
     # -- conversions ----------------------------------------------------------------------
-    def to_guess(self, source: str | None = None):
+    def to_guess(self, source: str | None = None) -> StrideGuess:
         """This solution as an initial guess (muscle states included); its source marks it as
         a collocation solution, so :func:`~bladelab.predict.collocation.solve.predict_stride`
         goes straight to the predictive stage."""
@@ -347,9 +350,6 @@ class CollocationSolution:
         ``runner``: the model (built from :attr:`model_spec` if None); ``cm`` its collocation
         model (built if None).
         """
-        from bladelab.predict.collocation.model import build_collocation_model
-        from bladelab.runner.simulate import RunnerResult
-
         if isinstance(n_strides, bool) or int(n_strides) != n_strides or n_strides < 1:
             raise SpecError(f"need at least 1 stride, got {n_strides!r}", where="n_strides")
         if isinstance(refine, bool) or int(refine) != refine or refine < 1:
@@ -441,8 +441,6 @@ class CollocationSolution:
     def write(self, path: str | Path) -> Path:
         """Write the solution (or best iterate) as JSON, atomically: an interruption leaves
         no half-written file. Returns the path."""
-        from bladelab._io import write_json
-
         path = Path(path)
         write_json(path, self.to_dict())
         return path
@@ -459,8 +457,6 @@ class CollocationSolution:
             A field is missing or of the wrong kind or shape (the error names the file and the
             field).
         """
-        from bladelab._io import read_json
-
         path = Path(path)
         data = read_json(path, what="collocation solution",
                          hint="give a solution.json or best_iterate.json of 'bladelab predict "
@@ -470,8 +466,6 @@ class CollocationSolution:
     @classmethod
     def from_dict(cls, data, *, file: str | Path | None = None) -> CollocationSolution:
         """A solution from :meth:`to_dict`'s mapping; errors as :meth:`read`."""
-        from bladelab.predict.collocation.transcription import NLPSolution
-
         if not isinstance(data, dict):
             raise DataError("expected a JSON object", file=file)
         r = FieldReader(data, file)

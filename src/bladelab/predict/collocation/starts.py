@@ -8,7 +8,7 @@ keep one. The starts, in this fixed order (:data:`START_ORDER`), the first K tha
 
 1. ``warm``: the continuation's own warm start (the previous speed's kept solution, the first
    guess at the first speed, the fastest kept speed for the maximum speed), with the
-   settings' :attr:`~bladelab.predict.collocation.solve.CollocationSettings.warm_start_mu`
+   settings' :attr:`~bladelab.predict.collocation.settings.CollocationSettings.warm_start_mu`
    (the only start of K = 1: today's sweep);
 2. ``warm-mu-1e-4`` (the barrier start): the same warm start with ``warm_start_mu`` 1e-4
    (:data:`BARRIER_MU`); ``warm-mu-default`` (IPOPT's defaults) when the settings already use
@@ -50,6 +50,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from bladelab.errors import SpecError
+from bladelab.predict.collocation.stride_guess import COLLOCATION_SOURCE
 
 __all__ = [
     "BARRIER_MU",
@@ -104,7 +105,7 @@ class Start:
     label
         Its name in file names and table columns (module docstring).
     settings
-        The problem's :class:`~bladelab.predict.collocation.solve.CollocationSettings` (the
+        The problem's :class:`~bladelab.predict.collocation.settings.CollocationSettings` (the
         barrier start changes ``warm_start_mu`` only).
     guess
         ``guess() -> StrideGuess``, called only when the start is solved.
@@ -133,8 +134,6 @@ def plan_starts(k: int, warm: Start, *, warm_source: str, template: Start | None
     ``warm``; its barrier start when ``warm_source`` (the source of the warm start's guess)
     names a collocation solution; ``template`` unless None or the warm start is itself a
     template guess; ``previous`` unless None."""
-    from bladelab.predict.collocation.solve import COLLOCATION_SOURCE
-
     out = [warm]
     if warm_source.startswith(COLLOCATION_SOURCE):
         out.append(barrier_start(warm))
@@ -308,8 +307,6 @@ def solve_starts(plan: Sequence[Start], *, ok: Path, best: Path, read, solve,
 def warm_guess(solution, speed: float | None, note: str = ""):
     """A solution as a warm start, its source naming its speed (``collocation solution at
     4 m/s`` + ``note``), scaled to ``speed`` [m/s] unless None."""
-    from bladelab.predict.collocation.solve import COLLOCATION_SOURCE
-
     v = solution.settings.speed_m_per_s
     g = solution.to_guess(f"{COLLOCATION_SOURCE} at "
                           + (f"{v:g} m/s" if v else "maximum speed") + note)

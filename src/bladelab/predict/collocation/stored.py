@@ -1,39 +1,35 @@
-"""A stored solve: its model specification, its file's fields, reading it back and writing it.
+"""A stored solve's model specification and its file's fields.
 
-The helpers around :class:`~bladelab.predict.collocation.solution.CollocationSolution`'s file
-that ``bladelab predict --method collocation --resume`` and the speed continuation
-(:mod:`bladelab.predict.collocation.continuation`) share:
+The helpers around :class:`~bladelab.predict.collocation.solution.CollocationSolution`'s file:
 
 - the model specification ``{"model": "able" | "amputee", "blade": name | None}``:
   :func:`check_model_spec`, :func:`model_label`, :func:`runner_from_spec`, and
   :func:`describe_problem` (model, speed and mesh of a problem, for messages);
-- :class:`FieldReader`: a JSON object's fields, with errors naming the file and the field;
-- :func:`read_stored` (the converged solution or best iterate of one problem, refusing a file
-  of another problem) and :func:`write_solve` (write one, remove the stale other).
+- :class:`FieldReader`: a JSON object's fields, with errors naming the file and the field.
+
+Reading a stored solve back for a resume and writing one are
+:func:`~bladelab.predict.collocation.solve.read_stored` and
+:func:`~bladelab.predict.collocation.solve.write_solve`.
 """
 
 from __future__ import annotations
 
 import math
-from pathlib import Path
-from typing import TYPE_CHECKING
 
 import numpy as np
 
-from bladelab.errors import DataError, InputFileError, SpecError
-
-if TYPE_CHECKING:
-    from bladelab.predict.collocation.solution import CollocationSolution
-    from bladelab.predict.collocation.solve import CollocationSettings
+from bladelab.blade.spec import spec_from_dict
+from bladelab.errors import DataError, SpecError
+from bladelab.predict.collocation.settings import CollocationSettings
+from bladelab.runner.model import build_runner
+from bladelab.runner.params import BODIES, KINDS
 
 __all__ = [
     "FieldReader",
     "check_model_spec",
     "describe_problem",
     "model_label",
-    "read_stored",
     "runner_from_spec",
-    "write_solve",
 ]
 
 
@@ -48,8 +44,6 @@ def check_model_spec(spec) -> dict:
     if not isinstance(spec, dict) or "model" not in spec:
         raise SpecError(f"expected {{'model': ..., 'blade': ...}}, got {spec!r}",
                         where="model_spec")
-    from bladelab.runner.params import BODIES, KINDS
-
     model = spec["model"]
     if model not in KINDS:
         raise SpecError(f"unknown model {model!r}", where="model", hint=" or ".join(KINDS))
@@ -90,55 +84,11 @@ def describe_problem(spec: dict, settings: CollocationSettings) -> str:
 
 def runner_from_spec(spec: dict):
     """Build the forward runner of a model specification (:func:`check_model_spec`)."""
-    from bladelab.runner import build_runner
-
     spec = check_model_spec(spec)
     if "blade_spec" in spec:
-        from bladelab.blade.spec import spec_from_dict
-
         blade = spec_from_dict(spec["blade_spec"]).build()
         return build_runner(spec["model"], blade_model=blade, body=spec.get("body", "seed001"))
     return build_runner(spec["model"], blade=spec["blade"], body=spec.get("body", "seed001"))
-
-
-def read_stored(ok: Path, best: Path, spec: dict, settings: CollocationSettings):
-    """(converged solution, best iterate) of one problem stored as ``ok`` / ``best`` (a
-    solution file and a best-iterate file), each None if absent; the solution is preferred.
-
-    Raises
-    ------
-    InputFileError
-        A file holds another problem (model, mesh, speed or weights).
-    """
-    from bladelab.predict.collocation.solution import CollocationSolution
-
-    for path in (Path(ok), Path(best)):
-        if not path.is_file():
-            continue
-        sol = CollocationSolution.read(path)
-        if sol.model_spec != check_model_spec(spec) or not sol.settings.same_problem(settings):
-            there, asked = describe_problem(sol.model_spec, sol.settings), describe_problem(
-                spec, settings)
-            if there == asked:
-                there, asked = (f"{there}, weights {sol.settings.weights.to_dict()}",
-                                f"weights {settings.weights.to_dict()}")
-            raise InputFileError(
-                f"holds another problem ({there}; asked: {asked})", file=path,
-                hint="resume with the same model, blade, speed and mesh, --force to start "
-                     "over, or choose another --out")
-        if path == Path(ok) and sol.converged:
-            return sol, None
-        return None, sol
-    return None, None
-
-
-def write_solve(sol: CollocationSolution, ok: Path, best: Path) -> Path:
-    """Write a solve as ``ok`` (converged) or ``best`` (best iterate), then remove the other,
-    now stale, file; returns the path written."""
-    target, stale = (Path(ok), Path(best)) if sol.converged else (Path(best), Path(ok))
-    sol.write(target)
-    stale.unlink(missing_ok=True)
-    return target
 
 
 class FieldReader:

@@ -1,4 +1,4 @@
-"""The collocation category sweep, ``bladelab sweep --method collocation`` (issue 15).
+"""The collocation category sweep, ``bladelab sweep --method collocation``.
 
 :func:`collocation_sweep` runs, for each model (the able model, the amputee with each blade
 category: :func:`sweep_models`), the speed continuation and then the maximum speed
@@ -30,7 +30,11 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
+import pandas as pd
+
+from bladelab._io import atomic_open
 from bladelab.errors import InputFileError, SpecError
+from bladelab.executors import make_executor
 from bladelab.predict.collocation.analyses import stride_analyses
 from bladelab.predict.collocation.continuation import (
     ContinuationProgress,
@@ -43,9 +47,10 @@ from bladelab.predict.collocation.continuation import (
     table_columns,
 )
 from bladelab.predict.collocation.model import build_collocation_model
-from bladelab.predict.collocation.solve import CollocationSettings
+from bladelab.predict.collocation.settings import CollocationSettings
 from bladelab.predict.collocation.starts import check_starts
 from bladelab.predict.collocation.stored import check_model_spec, model_label
+from bladelab.runner.params import blade_category
 
 __all__ = [
     "SWEEP_TABLE",
@@ -63,8 +68,6 @@ SWEEP_TABLE = "collocation-sweep.csv"
 def write_table(path: str | Path, rows: Sequence[dict]) -> Path:
     """Write table rows as CSV, atomically (columns as :func:`table_columns`; a missing or
     non-finite value is an empty field). Returns the path."""
-    from bladelab._io import atomic_open
-
     path = Path(path)
     cols = table_columns(rows)
 
@@ -92,8 +95,6 @@ def sweep_models(categories: Sequence[str], *, able: bool = False,
     SpecError
         An unknown or repeated category, or no model at all.
     """
-    from bladelab.runner.params import blade_category
-
     models = [check_model_spec({"model": "able", "body": body})] if able else []
     seen: set[str] = set()
     for c in categories:
@@ -198,8 +199,6 @@ class SweepResult:
 
     def table(self):
         """The rows as a pandas DataFrame."""
-        import pandas as pd
-
         return pd.DataFrame(self.rows, columns=table_columns(self.rows))
 
 
@@ -268,8 +267,6 @@ def collocation_sweep(
     SpecError
         Bad speeds, settings or models; ``resume`` with ``force``.
     """
-    from bladelab.executors import make_executor
-
     speeds = check_speeds(speeds)
     if not isinstance(settings, CollocationSettings) or settings.max_speed:
         raise SpecError("expected the CollocationSettings of a prescribed-speed problem",

@@ -36,6 +36,11 @@ import numpy as np
 
 from bladelab.errors import SpecError
 from bladelab.predict.collocation.progress import ProgressRelay
+from bladelab.predict.collocation.stride_guess import (
+    COLLOCATION_SOURCE,
+    StrideGuess,
+    periodic_derivative,
+)
 
 __all__ = [
     "NLPSolution",
@@ -209,11 +214,9 @@ class NLPSolution:
         """Mean forward speed [m/s]."""
         return float((self.q[-1, 0] - self.q[0, 0]) / self.period)
 
-    def to_guess(self, source: str = "collocation solution"):
-        """This solution as an initial guess (:class:`~bladelab.predict.collocation.guess.
+    def to_guess(self, source: str = COLLOCATION_SOURCE) -> StrideGuess:
+        """This solution as an initial guess (:class:`~bladelab.predict.collocation.stride_guess.
         StrideGuess`, muscle states included): a warm start for another problem or mesh."""
-        from bladelab.predict.collocation.guess import StrideGuess
-
         return StrideGuess(source, self.period, self.q, self.qd, self.activation,
                            self.tendon_force)
 
@@ -499,12 +502,10 @@ class StrideNLP:
         return lbx, ubx, lbg, ubg
 
     def initial_vector(self, guess) -> np.ndarray:
-        """The scaled NLP vector of a :class:`~bladelab.predict.collocation.guess.StrideGuess`
-        (resampled to the mesh; where the guess has no muscle states, activations 0.05 and the
-        tendon forces of static equilibrium, else 0.05; accelerations by differentiating the
-        speeds)."""
-        from bladelab.predict.collocation.guess import periodic_derivative
-
+        """The scaled NLP vector of a :class:`~bladelab.predict.collocation.stride_guess.
+        StrideGuess` (resampled to the mesh; where the guess has no muscle states, activations
+        0.05 and the tendon forces of static equilibrium, else 0.05; accelerations by
+        differentiating the speeds)."""
         d, n = self.dyn, self.n
         g = guess.resample(n)
         act = g.activation if g.activation is not None else np.full((n + 1, d.nm), 0.05)

@@ -1,4 +1,4 @@
-"""Issue 20's acceptance of a reflex gait, re-simulated from its parameter file.
+"""The stable-gait acceptance of a reflex gait, re-simulated from its parameter file.
 
 A reflex gait that survives only its own floating-point path, its own start or no change of
 speed is not a prediction (docs/predictive.md, "Robust evaluation"). Judged runs
@@ -14,7 +14,7 @@ foot strikes the ground above :data:`STRIKE_LIMIT_BW` body weights, and the mean
 lies inside the objective's window (seed 001: −16…−2°). Pushes (forward speed × (1 ±
 :data:`PUSH_CHANGE`) at :data:`PUSH_PHASES` phases of a stride) are simulated too, not judged:
 they measure the size of the gait's basin. So are the nominal runs at finer time steps
-(``refined``): reported beside the verdict, not part of it (session 21: no gait of the
+(``refined``): reported beside the verdict, not part of it (measured 2026-11-27: no gait of the
 first-order scheme runs at half its step; the Newmark scheme's gaits are the first to be
 checked).
 """
@@ -23,10 +23,13 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from bladelab.predict.reflex.objective import MIN_PUSH_DURATION, ObjectiveSettings
+from bladelab.predict.reflex.verify import verify_solution
+
 __all__ = ["COPIES", "COPY_JITTER", "PUSH_CHANGE", "PUSH_PHASES", "START_CHANGE",
            "STRIKE_LIMIT_BW", "acceptance_runs", "judged_runs", "meets_acceptance"]
 
-#: Issue 20: every shipped solution survives 4 copies moved by 1e-3 ...
+#: Every shipped solution survives 4 copies moved by 1e-3 ...
 COPIES = 4
 COPY_JITTER = 1e-3
 #: ... and a ±5 % change of the initial speed; no swinging foot above 0.2 body weights.
@@ -49,9 +52,6 @@ def acceptance_runs(path: str | Path, duration: float = 10.0, *, pushes: bool = 
     judged);
     ``"judged_at_m_per_s"`` is that speed, ``"simulations"`` counts the runs and
     ``"accepted"`` says whether every judged run meets the acceptance."""
-    from bladelab.predict.reflex.objective import MIN_PUSH_DURATION
-    from bladelab.predict.reflex.verify import verify_solution
-
     pushes = pushes and duration >= MIN_PUSH_DURATION
     out = verify_solution(path, speed=speed, duration=duration, jittered_copies=COPIES,
                           jitter=COPY_JITTER,
@@ -78,9 +78,7 @@ def judged_runs(out: dict) -> list[tuple[str, dict]]:
 
 def meets_acceptance(run: dict, window: tuple[float, float] | None = None) -> bool:
     """Whether one re-simulated run (a :func:`verify_solution` result or one of its copies)
-    meets issue 20's acceptance; ``window``: pelvis tilt [deg], default the objective's."""
-    from bladelab.predict.reflex.objective import ObjectiveSettings
-
+    meets the stable-gait acceptance; ``window``: pelvis tilt [deg], default the objective's."""
     lo, hi = window or ObjectiveSettings().pelvis_tilt_range_deg
     return bool(run["ok"] and run["swing_contact_peak_bw"] <= STRIKE_LIMIT_BW
                 and lo <= run["pelvis_tilt_mean_deg"] <= hi)

@@ -1,7 +1,7 @@
-"""When independent optimisations of one cell agree: the cell has settled (issue 20).
+"""When independent optimisations of one cell agree: the cell has settled.
 
 CMA-ES from a warm start finds one local optimum per seed; a reflex gait is chaotic, so two
-seeds rarely end at the same cost. Issue 20 calls a cell settled when its seeds' best costs
+seeds rarely end at the same cost. A cell has settled when its seeds' best costs
 agree within 2 % and their speeds within 0.05 m/s. We read "its seeds agree" as: at least
 :data:`MIN_SEEDS` seeds reach the best seed's cost within :data:`COST_TOLERANCE` (relative)
 and its mean speed within :data:`SPEED_TOLERANCE` [m/s], all evaluated on the same copies (a
@@ -55,7 +55,7 @@ class SeedAgreement:
         return (f"{n} of {self.seeds} seeds reach the best seed's cost within "
                 f"{100 * COST_TOLERANCE:g} % and its speed within {SPEED_TOLERANCE:g} m/s "
                 f"(all seeds: costs {self.cost_spread_pct:.1f} % and speeds "
-                f"{self.speed_spread_m_per_s:.3f} m/s apart): {verdict} (issue 20 needs "
+                f"{self.speed_spread_m_per_s:.3f} m/s apart): {verdict} (settling needs "
                 f"{MIN_SEEDS} agreeing seeds).")
 
 

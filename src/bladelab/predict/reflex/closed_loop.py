@@ -18,8 +18,8 @@ from bladelab.numba_cache import refresh_stale_caches
 from bladelab.predict.reflex.controller import compute_excitations, push_sensors, update_gait_states
 from bladelab.runner.analyses import MIN_STEP_S, STEP_LOAD_BW
 from bladelab.runner.kernel import step_advance, step_begin, step_end
+from bladelab.runner.layout import CP_LEG
 from bladelab.runner.metabolics import total_metabolic_rate
-from bladelab.runner.model import CP_LEG
 
 STEP_STATE_SIZE = 5  # left loaded, right loaded, time [s] and leg of the last step, striking leg + 1
 

@@ -15,8 +15,8 @@ Each leg is in one of five states (SCONE's ``GaitStateController``): ``EarlyStan
   EarlyStance on contact. SCONE (since 2019) moves a leg from Swing to EarlyStance only if
   it is also in front of the other leg, so that a trailing foot touching the ground stays in
   Swing; we do not, and gaits found here use it: two Cat6 gaits that let the trailing blade
-  touch above their stance threshold fall within 4 s with SCONE's condition (session 22,
-  docs/predictive.md).
+  touch above their stance threshold fall within 4 s with SCONE's condition (measured
+  2026-11-27, docs/predictive.md).
 
 In each state a set of reflexes adds to a muscle's excitation (the sum is clipped to [0, 1]),
 SCONE's ``MuscleReflex`` and ``DofReflex`` with delayed sensors:
@@ -127,19 +127,19 @@ _LEG_REFLEXES: list[tuple] = [
     # older parameter files run exactly as before.
     (_SWING, "iliopsoas", "pelvis_tx", "KV", "V0", T_DOF_VEL, VES_DELAY, (0.0, 3.5)),
     (_SWING, "glut_max", "pelvis_tx", "KV", "V0", T_DOF_VEL, VES_DELAY, (0.0, 3.5)),
-    # the same on the mean forward speed over the last SPEED_WINDOW (session 18: the
+    # the same on the mean forward speed over the last SPEED_WINDOW (the
     # instantaneous velocity swings within every stride, and a gain on it that CMA-ES can
     # take up fells a tuned gait; after a push the tuned gaits speed up stride by stride and
     # lean further forward until they fall, a runaway a placement on the mean speed can stop)
     (_SWING, "iliopsoas", "pelvis_tx", "KS", "S0", T_DOF_MEAN_VEL, VES_DELAY, (0.0, 3.5)),
     (_SWING, "glut_max", "pelvis_tx", "KS", "S0", T_DOF_MEAN_VEL, VES_DELAY, (0.0, 3.5)),
-    # and for the stance leg's hip muscles, which pitch the trunk (session 19): a runner who is
+    # and for the stance leg's hip muscles, which pitch the trunk: a runner who is
     # too fast can straighten up and brake, as people do (gains 0 by default)
     (_STANCE, "iliopsoas", "pelvis_tx", "KS", "S0", T_DOF_MEAN_VEL, VES_DELAY, (0.0, 3.5)),
     (_STANCE, "glut_max", "pelvis_tx", "KS", "S0", T_DOF_MEAN_VEL, VES_DELAY, (0.0, 3.5)),
 ]
 # Search scale of the gains on the forward velocity [1/(m/s)], times CMA-ES's sigma: small,
-# because a stable gait of session 17 falls at 2.7 s when one such gain alone is set to 0.01.
+# because an earlier stable gait falls at 2.7 s when one such gain alone is set to 0.01.
 _GAIN_SCALE = {("pelvis_tx", "KV"): 0.05, ("pelvis_tx", "KS"): 0.5}
 # Bounds of the reflexes' offset parameters: L0 [optimal fibre lengths], V0, S0 [m/s].
 _OFFSET_BOUNDS = {"L0": (0.0, 2.0), "V0": (0.0, 10.0), "S0": (0.0, 10.0)}
@@ -275,7 +275,7 @@ def controller_layout(model) -> ControllerLayout:
 
     for side in ("l", "r"):
         param(f"stance_load_threshold_{side}", par.get("stance_load_threshold", 0.28), 0.01, 1.0)
-    # swing initiation before the foot leaves the ground in running (session 20): a running
+    # swing initiation before the foot leaves the ground in running: a running
     # leg never sees double support, so SCONE's Liftoff state never comes and the swing
     # reflexes start only after lift-off; 0 keeps SCONE's machine (docs/predictive.md)
     for side in ("l", "r"):

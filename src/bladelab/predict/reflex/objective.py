@@ -34,13 +34,13 @@ survive only on the exact floating-point path and fall after a 1e-9 change (docs
 "per-generation" draws new ones every generation (seeded by the run's seed and the generation,
 so a resume is exact), so that a controller cannot learn to survive a handful of fixed copies
 and no others. ``robust_speed_change`` s > 0 also starts the copies at (1 ± s) × the initial
-speed, alternately (the ±5 % initial-speed acceptance test of issue 20 inside the objective).
+speed, alternately (the stable-gait acceptance's ±5 % initial-speed test inside the objective).
 ``robust_push`` p > 0 pushes copy k once, at a time drawn from its seed in
 :func:`push_window`: its forward (pelvis) speed times 1 + p (k even) or 1 − p (k odd) from
 that instant (``push`` = (time [s], relative change) of one simulation). The start's first
 steps test a gait's transient; a push in mid-run tests its basin of attraction (docs/predictive.md).
 ``robust_half_step`` runs the last copy at half the time step: a gait that survives only the
-step it is optimised at lives on the discretisation (session 21: the first Newmark gait to
+step it is optimised at lives on the discretisation (2026-11-27: the first Newmark gait to
 run 10 s at 1 ms falls at 1.95 s at 0.5 ms).
 """
 
@@ -54,6 +54,7 @@ import mujoco
 import numpy as np
 
 from bladelab.errors import InputFileError, SimulationError, SpecError
+from bladelab.predict import defaults
 from bladelab.predict.reflex.closed_loop import STEP_STATE_SIZE, run_closed_loop
 from bladelab.predict.reflex.controller import (
     CONTROLLER_STATE_SIZE,
@@ -65,12 +66,12 @@ from bladelab.predict.reflex.tracking import cached_reference, tracking_error
 from bladelab.runner.implicit_setup import implicit_arrays, simulation_model, site_views
 from bladelab.runner.kernel import mujoco_step_addresses, path_kinematics
 from bladelab.runner.metabolics import metabolic_params
-from bladelab.runner.model import DEFAULT_DT, RunnerModel
+from bladelab.runner.model import RunnerModel, contact_heights
 from bladelab.runner.muscle import equilibrium_fiber_length
 from bladelab.runner.simulate import Recording, RunnerResult, initial_qpos
 from bladelab.sim.compilation import announce_compilation
 
-DEFAULT_PREDICT_DT = DEFAULT_DT
+DEFAULT_PREDICT_DT = defaults.TIME_STEP_S
 MAX_TOUCHDOWNS = 400
 #: Sampling interval of the angles a tracking term compares [s].
 TRACK_SAMPLE_S = 2e-3
@@ -127,30 +128,30 @@ class ObjectiveSettings:
     if the runner had moved at the initial velocity before it (else they wait for a full
     window of the run)."""
 
-    speed: float = 3.5
+    speed: float = defaults.SPEED_M_PER_S
     speed_tolerance: float = 0.1
-    duration: float = 10.0
+    duration: float = defaults.DURATION_S
     dt: float = DEFAULT_PREDICT_DT
     w_cot: float = 0.1
     w_gait: float = 100.0
     w_inj: float = 0.1
-    w_lean: float = 0.1
+    w_lean: float = defaults.LEAN_WEIGHT_PER_DEG
     knee_load_range: tuple[float, float] = (-100.0, 100.0)
     pelvis_tilt_range_deg: tuple[float, float] = (-16.0, -2.0)
     abs_penalty: float = 1.0
     squared_penalty: float = 0.0
-    robust_samples: int = 1
-    robust_jitter: float = 1e-6
-    robust_directions: str = "fixed"
+    robust_samples: int = defaults.ROBUST_SAMPLES
+    robust_jitter: float = defaults.ROBUST_JITTER
+    robust_directions: str = defaults.ROBUST_DIRECTIONS
     robust_speed_change: float = 0.0
     robust_push: float = 0.0
     robust_half_step: bool = False
     push: tuple[float, float] | None = None
     alternating_steps: bool = True
-    strike_limit_bw: float = 1.0
+    strike_limit_bw: float = defaults.STRIKE_LIMIT_BW
     initial_speed: float | None = None
     run_up: bool = False
-    integrator: str = "explicit"
+    integrator: str = defaults.INTEGRATOR
     track: str | None = None
     w_track: float = 0.0
     track_skip: float = 1.0
@@ -228,8 +229,6 @@ def initial_state(
     q, v = initial_qpos(model, "gait")
     for dof, val in pose.items():
         q[model.dof(dof)] = val
-    from bladelab.runner.model import contact_heights
-
     q[model.dof("pelvis_tz")] -= contact_heights(model, q).min()
     v[model.dof("pelvis_tx")] = speed
     return q, v

@@ -39,6 +39,7 @@ import numpy as np
 from bladelab._io import atomic_open, atomic_path, write_json
 from bladelab.errors import InputFileError, OptimizationError
 from bladelab.executors import ProcessPool, RayExecutor
+from bladelab.predict import defaults
 from bladelab.predict.reflex.controller import ControllerLayout, controller_layout, write_parameters
 from bladelab.predict.reflex.objective import Evaluation, ObjectiveSettings, simulate_controlled
 from bladelab.predict.reflex.robust import (
@@ -214,19 +215,19 @@ class OptimizationResult:
 def optimize_controller(
     model: str = "able",
     *,
-    blade: str | None = "Cat6",
-    speed: float = 3.5,
+    blade: str | None = defaults.REFLEX_BLADE,
+    speed: float = defaults.SPEED_M_PER_S,
     x0: np.ndarray | None = None,
-    generations: int = 100,
-    popsize: int = 16,
-    sigma: float = 1.0,
-    seed: int = 1,
+    generations: int = defaults.GENERATIONS,
+    popsize: int = defaults.POPULATION_SIZE,
+    sigma: float = defaults.INITIAL_STEP,
+    seed: int = defaults.SEED,
     jobs: int = 1,
     executor: str = "local",
     out: str | Path | None = None,
     resume: bool = False,
     force: bool = False,
-    checkpoint_every: int = 5,
+    checkpoint_every: int = defaults.CHECKPOINT_EVERY,
     settings: ObjectiveSettings | None = None,
     progress: Callable[[int, float, float], None] | None = None,
     fixed: Sequence[int] = (),
@@ -274,6 +275,8 @@ def optimize_controller(
         Indices of parameters held at their initial values: CMA-ES searches the others only
         (a resumed run keeps its own; the checkpoint's ``subspace``).
     """
+    # (simulating, verifying or re-simulating a solution imports this module, never cma)
+    # deferred: cma takes ~2 s to import (it loads matplotlib)
     import cma
 
     base_settings = settings or ObjectiveSettings()
@@ -477,7 +480,7 @@ def _save(
     wall_time_s,
     subspace,
 ) -> None:
-    import cma
+    import cma  # deferred: cma takes ~2 s to import (see optimize_controller)
 
     out_dir.mkdir(parents=True, exist_ok=True)
     state = {

@@ -1,4 +1,4 @@
-"""Staged optimisation of one blade category and seed (issue 20): a recipe of CMA-ES stages.
+"""Staged optimisation of one blade category and seed: a recipe of CMA-ES stages.
 
 One stage of seed 001's objective from SCONE's parameters does not find a running gait at
 4 m/s, and a gait found without perturbations is a slow fall (docs/predictive.md, "Warm start
@@ -14,15 +14,15 @@ warm-started from the one before (:data:`STABLE_GAIT_RECIPE`):
    mean-speed reflexes acting from the start (``run_up``);
 4. ``start``, ``start5``: copies that also start at ±3 %, then ±5 % of the initial speed;
 5. ``clear``: and the swinging blade's strikes and the trunk's lean in the objective
-   (``strike_limit_bw`` 0.5, ``w_lean`` 2), issue 20's last two criteria.
+   (``strike_limit_bw`` 0.5, ``w_lean`` 2), the stable-gait acceptance's last two criteria.
 
-Then the speed is raised by **continuation on the speed reached** (issue 20: not a fixed
+Then the speed is raised by **continuation on the speed reached** (not a fixed
 grid): the recipe's ``continuation`` stage runs at the speed the last level reached plus
 ``speed_step`` [m/s], from that level's gait and starting at that speed, until a level does not
 settle in the time step (falls in its nominal 10 s, at the recipe's step, at half or at a
 quarter of it) or its settled speed gains less than ``min_gain`` [m/s]. A level's **settled
 speed** (:func:`settled_speed`) is its mean speed at a quarter of the step: at Newmark's 1 ms
-the gaits run 0.09–0.25 m/s faster than at finer steps (docs/predictive.md, session 22). The
+the gaits run 0.09–0.25 m/s faster than at finer steps (docs/predictive.md). The
 prescription follows the speed at the recipe's own step, the one the optimiser mostly sees.
 The maximum speed is the fastest settled speed of a level that settles.
 
@@ -39,6 +39,7 @@ finished level otherwise is refused.
 from __future__ import annotations
 
 import hashlib
+import json
 import math
 from collections.abc import Callable
 from dataclasses import asdict, dataclass, field
@@ -46,10 +47,15 @@ from fnmatch import fnmatch
 from pathlib import Path
 
 import numpy as np
+from tqdm import tqdm
 
 from bladelab._io import read_json, write_json
 from bladelab.errors import InputFileError, SpecError
+from bladelab.predict.reflex.acceptance import acceptance_runs, judged_runs, meets_acceptance
+from bladelab.predict.reflex.controller import parameter_digest, read_parameters
 from bladelab.predict.reflex.objective import ObjectiveSettings
+from bladelab.predict.reflex.optimize import CHECKPOINT_NAME, optimize_controller, runner_and_layout
+from bladelab.runner.params import RUNNER_DATA_DIR, blade_category
 
 __all__ = ["ABLE", "STABLE_GAIT_RECIPE", "Recipe", "Stage", "level_row", "maximum_speed",
            "model_of", "recipe_task", "run_recipe", "settled_speed", "track_file"]
@@ -188,12 +194,12 @@ _CLEAR = {**_STARTS, "robust_speed_change": 0.05, "strike_limit_bw": 0.5, "w_lea
 #: The reflexes on the forward speed (controller.py: placement and trunk pitch), held at their
 #: defaults (gain 0) until a gait runs: sampled from the start (search scale 0.5 per m/s) with
 #: S0 = 3.5 m/s and a gait at 1–3 m/s they add about ±0.3 excitation to every candidate
-#: (session 19: a tracking stage with them ended at cost 189 with a gait falling at 3.8 s;
-#: session 16's, before these terms existed, at 148 with a gait running 4 s).
+#: (measured 2026-11-27: a tracking stage with them ended at cost 189 with a gait falling at
+#: 3.8 s; one run before these terms existed, at 148 with a gait running 4 s).
 _SPEED_TERMS = ("*-pelvis_tx.*",)
 
-#: The stages that found Cat6's stable and start-robust gaits at 4 m/s (sessions 16–19,
-#: docs/predictive.md "Warm start from a collocation stride", stages 1, 2L, P, S), on the fast
+#: The stages that found Cat6's stable and start-robust gaits at 4 m/s
+#: (docs/predictive.md "Warm start from a collocation stride", stages 1, 2L, P, S), on the fast
 #: scheme (implicit, 1 ms): tracking, a long horizon, pushes, then the starts taught step by
 #: step with the run-up, and last the blade's clearance and the lean. Several hours of one core
 #: per category and seed.
@@ -217,8 +223,6 @@ STABLE_GAIT_RECIPE = Recipe(
 def model_of(category: str) -> tuple[str, str | None]:
     """(model, blade) of a task's category: ``"able"`` is the able-bodied runner, any other
     name a blade category of the amputee (checked)."""
-    from bladelab.runner.params import blade_category
-
     if category == ABLE:
         return "able", None
     blade_category(category)
@@ -241,8 +245,8 @@ def track_file(study: str | Path, category: str, speed: float) -> Path:
 
 
 def level_row(path: Path) -> dict:
-    """A finished level's gait (its ``best.json``) re-simulated for 10 s and judged by issue
-    20's acceptance (:func:`~bladelab.predict.reflex.acceptance.acceptance_runs`) at the speed
+    """A finished level's gait (its ``best.json``) re-simulated for 10 s and judged by the
+    stable-gait acceptance (:func:`~bladelab.predict.reflex.acceptance.acceptance_runs`) at the speed
     it reached (rounded to 0.01 m/s): a gait is judged at its own speed, and its copies and
     changed starts must reach that speed too (±0.1 m/s). Returns the nominal run's cost (the
     objective at the level's prescribed speed), mean speed [m/s], fell, swing contacts and
@@ -253,8 +257,6 @@ def level_row(path: Path) -> dict:
     [m/s] (the step's uncertainty of the speed) and whether it meets the acceptance at half
     the step (reported, not judged). The quarter-step speed is the level's
     :func:`settled_speed`."""
-    from bladelab.predict.reflex.acceptance import acceptance_runs, judged_runs, meets_acceptance
-
     acc = acceptance_runs(path, 10.0, pushes=False, speed="reached", refined=2)
     runs = not acc["fell"]
     half, quarter = acc["refined"]
@@ -297,14 +299,6 @@ def run_recipe(
     start (parameters JSON; default the model's shipped solution); ``track_study``: the
     collocation study of the tracking stages (:func:`track_file`); ``progress(level, row)``
     after each finished level."""
-    from bladelab.predict.reflex.controller import parameter_digest, read_parameters
-    from bladelab.predict.reflex.optimize import (
-        CHECKPOINT_NAME,
-        optimize_controller,
-        runner_and_layout,
-    )
-    from bladelab.runner.params import RUNNER_DATA_DIR
-
     model, blade = model_of(category)
     folder = Path(out) / category / f"seed-{seed}"
     _, layout = runner_and_layout(model, blade)
@@ -405,8 +399,6 @@ def _check_same_task(old: dict, new: dict, rows: list[dict], path: Path) -> None
 
 def _as_json(obj: dict) -> dict:
     """``obj`` as it reads back from JSON (tuples become lists)."""
-    import json
-
     return json.loads(json.dumps(obj))
 
 
@@ -434,10 +426,8 @@ def recipe_task(payload: dict) -> list[dict]:
 
 def _announce(level: str, row: dict) -> None:
     """One line per finished level (a sweep's tasks run for hours)."""
-    from tqdm import tqdm
-
     verdict = (f"falls at {row['simulated_s']:.2f} s" if row["fell"] else
-               "runs 10 s" + (", meets issue 20's acceptance" if row["accepted"] else ""))
+               "runs 10 s" + (", meets the stable-gait acceptance" if row["accepted"] else ""))
     settled = settled_speed(row)
     finer = ("" if "runs_at_quarter_step" not in row or row["fell"] else
              " (falls at a finer step)" if settled is None else
@@ -456,8 +446,8 @@ def settled_speed(row: dict) -> float | None:
     """A level's speed at the finest time step it was simulated at [m/s] (:func:`level_row`:
     a quarter of its step); None if it falls at any step. At Newmark's 1 ms the gaits run
     0.09–0.25 m/s faster than at an eighth of it, and each halving still moves the speed by
-    up to 0.11 m/s (``step_speed_change_m_per_s``; docs/predictive.md, session 22). A row
-    written before levels were simulated at finer steps (session 21: no quarter step, or no
+    up to 0.11 m/s (``step_speed_change_m_per_s``; docs/predictive.md). A row
+    written before levels were simulated at finer steps (no quarter step, or no
     half step, or no speed kept there; NaN in a table) gives the finest speed it holds."""
     if bool(row["fell"]):
         return None
@@ -479,8 +469,9 @@ def _missing(value) -> bool:
 
 def maximum_speed(rows: list[dict], *, accepted: bool = False) -> tuple[float, dict | None]:
     """The fastest :func:`settled_speed` of the levels that settle [m/s] and its row (NaN,
-    None: none does); with ``accepted``, of the levels that also meet issue 20's acceptance
-    (the row's ``accepted``: issue 20's maximum speed, docs/predictive.md, session 23)."""
+    None: none does); with ``accepted``, of the levels that also meet the stable-gait
+    acceptance (the row's ``accepted``: the maximum speed meeting the acceptance,
+    docs/predictive.md)."""
     ran = [(v, r) for r in rows if (v := settled_speed(r)) is not None
            and (not accepted or r.get("accepted") == 1)]  # True (numpy's too); not None, NaN
     if not ran:

@@ -1,4 +1,4 @@
-"""The category sweep of issue 20: a recipe (:mod:`bladelab.predict.reflex.recipe`) per blade
+"""The reflex category sweep: a recipe (:mod:`bladelab.predict.reflex.recipe`) per blade
 category and seed, and whether each category's seeds agree.
 
 Tasks (category × seed) run on an executor of :mod:`bladelab.executors`, one core each. After
@@ -9,7 +9,7 @@ unfinished tasks included), atomically:
   prescribed and initial speed [m/s], generations, wall time [s]);
 - ``OUT/summary.csv``: one row per category (:func:`summarise_levels`).
 
-A category has settled (issue 20) when at least three seeds agree at the recipe's speed (the
+A category has settled when at least three seeds agree at the recipe's speed (the
 last stage's gait, re-simulated nominally for 10 s with the same settings, so on the same
 "copy"): costs within 2 % of the best seed's and settled speeds within 0.05 m/s
 (:func:`~bladelab.predict.reflex.agreement.seed_agreement`). Speeds here are settled speeds
@@ -29,11 +29,15 @@ from tqdm import tqdm
 
 from bladelab._io import atomic_open, read_json
 from bladelab.errors import OptimizationError
+from bladelab.executors import make_executor
+from bladelab.predict.reflex.agreement import seed_agreement
 from bladelab.predict.reflex.recipe import (
     LEVELS_NAME,
     STABLE_GAIT_RECIPE,
     Recipe,
     maximum_speed,
+    model_of,
+    recipe_task,
     settled_speed,
 )
 
@@ -57,8 +61,6 @@ def _settled_levels(levels: pd.DataFrame, last_stage: str) -> pd.DataFrame:
 
 
 def _agreement(base: pd.DataFrame):
-    from bladelab.predict.reflex.agreement import seed_agreement
-
     if not len(base):
         return None
     return seed_agreement(base.cost.tolist(), base.settled_speed_m_per_s.tolist())
@@ -77,8 +79,8 @@ def summarise_levels(levels: pd.DataFrame, last_stage: str) -> pd.DataFrame:
     the largest change of those levels' speed from half to a quarter of the time step, which
     bounds what a spread below it means), and each seed's maximum speed
     [m/s] (fastest settled speed of a level that settles) with its spread and how many of
-    them meet issue 20's acceptance; and the fastest settled speed of a level that meets it
-    (issue 20's maximum speed)."""
+    them meet the stable-gait acceptance; and the fastest settled speed of a level that meets
+    it (the maximum speed meeting the acceptance)."""
     cols = ["category", "seeds (count)", "agreeing seeds (count)", "settled (yes/no)",
             "cost spread (%)", "speed spread (m/s)",
             "largest speed change from half to a quarter of the step (m/s)",
@@ -145,9 +147,6 @@ def run_recipe_sweep(
     ``"able"`` among the categories: the able-bodied runner);
     returns the per-category summary. ``jobs`` tasks run at once on ``executor``; a task that
     fails is named in the error raised after the others finished (their results are kept)."""
-    from bladelab.executors import make_executor
-    from bladelab.predict.reflex.recipe import model_of, recipe_task
-
     for c in categories:
         model_of(c)
     if not seeds:

@@ -1,4 +1,4 @@
-"""Robust evaluation of a reflex controller: jittered copies of its parameters (issue 20).
+"""Robust evaluation of a reflex controller: jittered copies of its parameters.
 
 A candidate's cost with ``ObjectiveSettings.robust_samples`` = n > 1 is the mean over the
 nominal simulation and n − 1 copies (:func:`robust_copies`): the parameters moved by
@@ -41,8 +41,8 @@ __all__ = [
 #: Seed of the directions of the objective's jittered copies (``robust_samples``).
 OBJECTIVE_JITTER_SEED = 20261121
 #: Seed of :func:`~bladelab.predict.reflex.verify.verify_solution`'s copies: other directions than the objective's, so that a
-#: solution optimised to survive its copies is checked on copies it has not seen (measured in
-#: session 16: a run that survived its 4 objective copies at 1e-3 fell in 5 of 8 others).
+#: solution optimised to survive its copies is checked on copies it has not seen (measured on
+#: 2026-11-26: a run that survived its 4 objective copies at 1e-3 fell in 5 of 8 others).
 VERIFY_JITTER_SEED = 20261126
 #: Appended to a copies' seed for their push times (a stream apart from their directions).
 PUSH_STREAM = 1

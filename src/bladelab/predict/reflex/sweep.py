@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import json
 import math
+import threading
 from pathlib import Path
 
 import numpy as np
@@ -37,8 +38,13 @@ from tqdm import tqdm
 
 from bladelab._io import atomic_open, read_json, write_json
 from bladelab.errors import InputFileError, OptimizationError, SpecError
-from bladelab.predict.reflex.objective import ObjectiveSettings
-from bladelab.runner.params import blade_category
+from bladelab.executors import make_executor
+from bladelab.predict import defaults
+from bladelab.predict.reflex.controller import parameter_digest, read_parameters
+from bladelab.predict.reflex.objective import ObjectiveSettings, simulate_controlled
+from bladelab.predict.reflex.optimize import CHECKPOINT_NAME, optimize_controller, runner_and_layout
+from bladelab.runner.analyses import spatiotemporal
+from bladelab.runner.params import blade_catalogue, blade_category
 
 CELL_NAME = "cell.json"
 CELL_FORMAT = 1
@@ -84,8 +90,6 @@ def _wanted(payload: dict) -> dict:
 
 def _read_cell(folder: Path, category: str, speed: float, wanted: dict) -> dict | None:
     """The cell's ``cell.json`` (None if it has none); an error if its settings differ."""
-    from bladelab.predict.reflex.optimize import CHECKPOINT_NAME
-
     path = folder / CELL_NAME
     where = f"{category} at {speed:g} m/s"
     if not path.is_file():
@@ -125,10 +129,6 @@ def _read_cell(folder: Path, category: str, speed: float, wanted: dict) -> dict 
 
 def _contact_times(category: str, x: np.ndarray, settings: ObjectiveSettings) -> dict:
     """Mean contact time [s] per leg of the solution ``x``, re-simulated with ``settings``."""
-    from bladelab.predict.reflex.objective import simulate_controlled
-    from bladelab.predict.reflex.optimize import runner_and_layout
-    from bladelab.runner.analyses import spatiotemporal
-
     model, layout = runner_and_layout("amputee", category)
     _, res = simulate_controlled(model, x, layout=layout, settings=settings, record_every=2)
     st = spatiotemporal(res)
@@ -194,13 +194,6 @@ def category_task(payload: dict) -> dict:
     newly finished cell, ``results.csv`` and ``summary.csv`` are rewritten from every finished
     cell of the sweep on disk.
     """
-    from bladelab.predict.reflex.controller import parameter_digest, read_parameters
-    from bladelab.predict.reflex.optimize import (
-        CHECKPOINT_NAME,
-        optimize_controller,
-        runner_and_layout,
-    )
-
     cat = payload["category"]
     out = Path(payload["out"])
     _, layout = runner_and_layout("amputee", cat)
@@ -291,8 +284,6 @@ class _CellProgress:
 
     def __init__(self, out: Path, categories: list[str], speeds: list[float], *,
                  enabled: bool, every: float = 2.0) -> None:
-        import threading
-
         self.out, self.categories, self.speeds = out, categories, speeds
         self.bar = tqdm(total=len(categories) * len(speeds), desc="sweep cells",
                         unit="cell", disable=not enabled)
@@ -338,8 +329,6 @@ def _run_wave(ex, payloads: list[dict], bar) -> list[dict]:
 
 def _chain(ex, base, categories, speeds, init, chain_from, bar) -> list[dict]:
     """Waves of first-speed optimisations outwards from ``chain_from``, then speed chains."""
-    from bladelab.runner.params import blade_catalogue
-
     stiff = {name: c.stiffness_n_per_m for name, c in blade_catalogue().items()}
     ordered = sorted(categories, key=lambda c: stiff[blade_category(c).name])
     names = [blade_category(c).name for c in ordered]
@@ -418,18 +407,18 @@ def run_sweep(
     *,
     out: str | Path,
     init: str | Path | None = None,
-    generations: int = 100,
-    popsize: int = 16,
-    sigma: float = 1.0,
-    seed: int = 1,
+    generations: int = defaults.GENERATIONS,
+    popsize: int = defaults.POPULATION_SIZE,
+    sigma: float = defaults.INITIAL_STEP,
+    seed: int = defaults.SEED,
     jobs: int = 1,
     executor: str = "local",
-    duration: float = 10.0,
+    duration: float = defaults.DURATION_S,
     dt: float | None = None,
-    robust_samples: int = 1,
-    robust_jitter: float = 1e-6,
+    robust_samples: int = defaults.ROBUST_SAMPLES,
+    robust_jitter: float = defaults.ROBUST_JITTER,
     initial_speed: float | None = None,
-    checkpoint_every: int = 5,
+    checkpoint_every: int = defaults.CHECKPOINT_EVERY,
     chain_from: str | None = None,
     progress: bool = True,
 ) -> pd.DataFrame:
@@ -475,8 +464,6 @@ def run_sweep(
     progress
         Show a progress bar of finished cells (read back ones included).
     """
-    from bladelab.executors import make_executor
-
     for c in categories:
         blade_category(c)
     if not speeds or any(not (s > 0) for s in speeds):

@@ -1,4 +1,4 @@
-"""Tracking a collocation stride with the reflex controller (issue 20's warm start).
+"""Tracking a collocation stride with the reflex controller (the reflex optimisation's warm start).
 
 A reflex controller found by CMA-ES from SCONE's parameters has to discover a gait by itself;
 a collocation stride (:mod:`bladelab.predict.collocation`) of the same runner at the same speed
@@ -34,6 +34,8 @@ from pathlib import Path
 import numpy as np
 
 from bladelab.errors import InputFileError
+from bladelab.predict import defaults
+from bladelab.predict.collocation.solution import CollocationSolution
 
 #: Phase points per stride at which the angles are compared.
 PHASES = 50
@@ -44,7 +46,7 @@ TOUCHDOWN_BW = 0.1
 #: Default weight of the tracking term [1/rad²] (``bladelab predict --track-weight``): 10° of
 #: rms error costs 30, as much as running 30 % of the simulation outside the speed window
 #: (w_gait = 100).
-DEFAULT_WEIGHT = 1000.0
+DEFAULT_WEIGHT = defaults.TRACK_WEIGHT_PER_RAD2
 #: Coordinates never tracked.
 UNTRACKED = ("pelvis_tx", "pelvis_tz", "socket_angle_r")
 
@@ -105,8 +107,6 @@ class GaitReference:
     def read(cls, path: str | Path) -> GaitReference:
         """The reference of a collocation solution file (``solution.json``, ``speed-4.json``);
         refused when the solve did not converge."""
-        from bladelab.predict.collocation.solution import CollocationSolution
-
         sol = CollocationSolution.read(path)
         if not sol.converged:
             raise InputFileError("the collocation solve did not converge", file=path,

@@ -11,9 +11,16 @@ import numpy as np
 
 from bladelab._io import read_json
 from bladelab.errors import SpecError
+from bladelab.predict.reflex.controller import read_parameters
 from bladelab.predict.reflex.objective import PUSH_AFTER, ObjectiveSettings, simulate_controlled
 from bladelab.predict.reflex.optimize import runner_and_layout, stored_settings
 from bladelab.predict.reflex.robust import VERIFY_JITTER_SEED, jittered_parameters
+from bladelab.runner.analyses import (
+    CONTACT_THRESHOLD_N,
+    power_balance_residual_pct,
+    step_touchdowns,
+    swing_contacts,
+)
 
 __all__ = ["verify_solution"]
 
@@ -61,8 +68,8 @@ def verify_solution(
     the copies do not change when the controller layout grows):
     a gait that survives only on one floating-point path (another
     CPU, compiler or library version) is not a solution. With ``initial_speed_change`` c > 0
-    they must also hold from an initial speed [m/s] (1 + c) and (1 − c) times the file's (issue
-    20: ±5 %). With ``push_change`` p > 0 they must hold after a push (forward speed times
+    they must also hold from an initial speed [m/s] (1 + c) and (1 − c) times the file's (the
+    stable-gait acceptance: ±5 %). With ``push_change`` p > 0 they must hold after a push (forward speed times
     1 + p and 1 − p) at each of ``push_phases`` times spread over the second after
     :data:`~bladelab.predict.reflex.objective.PUSH_AFTER` (the stride's phases; the basin of
     the gait, not of its start). With ``refined_step`` = n > 0 (True: 1) they must also hold
@@ -76,8 +83,6 @@ def verify_solution(
     falls, judged at the prescribed one), ``nominal_ok`` (the nominal run alone) and ``ok``
     (every run).
     """
-
-    from bladelab.predict.reflex.controller import read_parameters
 
     data = read_json(path, what="parameter file")
     model = model or data.get("model", "able")
@@ -138,13 +143,6 @@ def verify_solution(
 
 def _check_gait(runner, layout, x, settings: ObjectiveSettings, limits: tuple) -> dict:
     """Simulate ``x`` and measure the shipped-solution criteria (:func:`verify_solution`)."""
-    from bladelab.runner.analyses import (
-        CONTACT_THRESHOLD_N,
-        power_balance_residual_pct,
-        step_touchdowns,
-        swing_contacts,
-    )
-
     ev, res = simulate_controlled(runner, x, layout=layout, settings=settings, record_every=2)
     leg = res.model.contact_params[:, 6]
     forces = np.stack([res.contacts[:, leg == i, 1].sum(axis=1) for i in (0, 1)], axis=1)

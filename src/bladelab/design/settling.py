@@ -1,0 +1,185 @@
+"""Settling passes over a predicted-gait design study, and their record ``settling.json``.
+
+A settling pass solves each design's stride again from its nearest neighbours' strides and keeps
+the lowest objective (:func:`bladelab.design.collocation_evaluator.settle_strides`); the run
+files of the designs whose stride changed are removed, so that the study reads their new
+responses back (:func:`settle_study` returns whether it must). ``bladelab design --evaluator
+collocation --settle K`` runs up to K passes.
+
+A pass takes hours on two cores, so it is recorded design by design: ``settling.json`` (in the
+study's folder) is rewritten atomically as each design finishes, with ``"complete": false``
+until the pass ends, and a run stopped mid-pass (Ctrl-C, SIGTERM, a lost machine) resumes that
+pass where it stopped, skipping the designs it had settled. The record::
+
+    {"settled_below": 0.01,
+     "passes": [{"pass": 1, "complete": true, "largest_objective_drop": 0.004, "improved": 3,
+                 "designs": [{"run": 1, "point": {...}, "before": ..., "after": ...,
+                              "from": "<neighbour's stride>" | null, ...}, ...]}, ...]}
+
+:func:`bladelab.design.start_spread.start_spread` reads it back.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+from bladelab._io import read_json, write_json
+from bladelab.design import collocation_evaluator, defaults
+from bladelab.design.study import DesignStudyResult, run_design, run_file
+from bladelab.errors import InputFileError
+
+__all__ = ["RECORD_NAME", "SETTLED_REL", "SettlingOutcome", "read_settling_record",
+           "run_settled_design", "settle_study"]
+
+#: A pass that lowers no design's objective by more than this fraction [-] has settled.
+SETTLED_REL = defaults.SETTLED_REL
+#: The record of the settling passes in a study's folder.
+RECORD_NAME = "settling.json"
+
+
+@dataclass(frozen=True)
+class SettlingOutcome:
+    """What :func:`settle_study` did.
+
+    Attributes
+    ----------
+    changed
+        A design's stride changed: the study must be read again (its run files were removed).
+    settled
+        The last pass lowered no objective by more than :data:`SETTLED_REL`.
+    passes
+        Passes run (or finished, when resumed) by this call.
+    largest_objective_drop
+        Largest relative objective drop of the last pass [-]; NaN when no pass ran.
+    """
+
+    changed: bool
+    settled: bool
+    passes: int
+    largest_objective_drop: float
+
+
+def _drop(row: dict) -> float:
+    """Relative objective drop of one design's settling [-]."""
+    return (row["before"] - row["after"]) / abs(row["before"])
+
+
+def read_settling_record(out: str | Path, points: Sequence[dict] | None = None) -> list[dict]:
+    """The passes recorded in the study folder ``out`` (``settling.json``; none: ``[]``).
+
+    With ``points`` (the study's design points, run 1 first), every recorded design must be
+    the study's run of the same point.
+
+    Raises
+    ------
+    InputFileError
+        A recorded design is not the study's run of that number.
+    """
+    path = Path(out) / RECORD_NAME
+    if not path.is_file():
+        return []
+    record = read_json(path, what="settling record").get("passes", [])
+    if points is None:
+        return record
+    stems = [collocation_evaluator.point_file_stem(p) for p in points]
+    for rec in record:
+        for row in rec.get("designs", []):
+            run = row.get("run")
+            if not (isinstance(run, int) and 1 <= run <= len(points)
+                    and collocation_evaluator.point_file_stem(row["point"]) == stems[run - 1]):
+                raise InputFileError(
+                    f"a settled design ({row.get('point')}) is not run {run} of this study",
+                    file=path, hint="settle in the study's own folder, or remove the file")
+    return record
+
+
+def _run_pass(evaluator, points, current: dict, out: Path, *, jobs: int, save,
+              failed=frozenset()) -> bool:
+    """Settle the designs of pass ``current`` not yet in it (nor the ``failed`` run indices,
+    which have no stride), recording each as it finishes; True if a stride changed."""
+    changed = False
+
+    def done(i: int, row: dict) -> None:
+        nonlocal changed
+        current["designs"].append({"run": i + 1, **row})
+        if row["from"] is not None:
+            changed = True
+            run_file(out, i).unlink(missing_ok=True)
+        save()
+
+    collocation_evaluator.settle_strides(
+        evaluator, points, jobs=jobs, on_design=done,
+        skip=[r["run"] - 1 for r in current["designs"]] + sorted(failed))
+    return changed
+
+
+def settle_study(evaluator, result, *, passes: int, jobs: int = 1,
+                 progress: Callable[[str], None] | None = None) -> SettlingOutcome:
+    """Run up to ``passes`` settling passes over the designs of a study ``result``
+    (:class:`~bladelab.design.study.DesignStudyResult`) with its collocation ``evaluator``,
+    resuming an incomplete pass first, ``jobs`` designs at a time; record them in the study's
+    ``settling.json`` (module docstring). Stops at the first pass that settles (no objective
+    lowered by more than :data:`SETTLED_REL`). ``progress`` receives one line per pass.
+
+    Raises
+    ------
+    InputFileError
+        The folder's record belongs to other designs.
+    """
+    space, design, out = result.space, result.design, Path(result.out_dir)
+    points = [space.point(c) for c in design.coded]
+    failed = frozenset(run - 1 for run in result.failed)  # no stride to settle
+    record = read_settling_record(out, points)
+    say = progress or (lambda line: None)
+    changed_any = False
+    ran = 0
+    worst = float("nan")
+
+    def save() -> None:
+        write_json(out / RECORD_NAME, {"settled_below": SETTLED_REL, "passes": record})
+
+    for _ in range(passes):
+        if record and not record[-1]["complete"]:
+            current = record[-1]
+            say(f"resuming settling pass {current['pass']}: {len(current['designs'])} of "
+                f"{len(points)} designs already settled")
+        else:
+            current = {"pass": len(record) + 1, "complete": False, "designs": []}
+            record.append(current)
+            save()
+        changed_any |= _run_pass(evaluator, points, current, out, jobs=jobs, save=save,
+                                 failed=failed)
+        worst = max(_drop(r) for r in current["designs"])
+        current.update(complete=True, largest_objective_drop=worst,
+                       improved=sum(r["from"] is not None for r in current["designs"]))
+        save()
+        ran += 1
+        say(f"settling pass {current['pass']}: {current['improved']} of "
+            f"{len(points) - len(failed)} designs improved, largest objective drop "
+            f"{100 * worst:.2f} %")
+        if worst <= SETTLED_REL:
+            return SettlingOutcome(changed_any, True, ran, worst)
+    return SettlingOutcome(changed_any, False, ran, worst)
+
+
+def run_settled_design(space, *, evaluator, out_dir: str | Path, settle_passes: int = 0,
+                       jobs: int = 1, progress: Callable[[str], None] | None = None,
+                       **options) -> tuple[DesignStudyResult, SettlingOutcome | None]:
+    """:func:`~bladelab.design.study.run_design` of ``space`` with ``evaluator`` into
+    ``out_dir`` (``jobs`` and the other ``options`` are its own), then up to
+    ``settle_passes`` settling passes over its designs (:func:`settle_study`); when a stride
+    changed, the study again (the settled strides' responses read back, not solved). Returns
+    the study's result and the settling's outcome (None without settling passes)."""
+    def study() -> DesignStudyResult:
+        return run_design(space, evaluator=evaluator, out_dir=out_dir, jobs=jobs, **options)
+
+    result = study()
+    if settle_passes <= 0:
+        return result, None
+    outcome = settle_study(evaluator, result, passes=settle_passes, jobs=jobs,
+                           progress=progress)
+    if outcome.changed:
+        result = study()
+    return result, outcome

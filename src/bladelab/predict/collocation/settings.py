@@ -1,0 +1,301 @@
+"""The settings of one stride solve: :class:`CollocationSettings` (mesh, speed, objective
+weights, constraints, reference term and IPOPT options), checked when made and stored with each
+solution (:meth:`CollocationSettings.to_dict`)."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass, fields
+from pathlib import Path
+
+import numpy as np
+
+from bladelab.errors import SpecError
+from bladelab.predict import defaults
+from bladelab.predict.collocation.dynamics import COORDINATE_BOUNDS_DEG
+from bladelab.predict.collocation.transcription import StrideWeights
+
+__all__ = ["HESSIANS", "CollocationSettings"]
+
+#: IPOPT Hessian options (:meth:`~bladelab.predict.collocation.transcription.StrideNLP.solve`).
+HESSIANS = ("limited-memory", "exact")
+
+
+def _weights_from_dict(data, where: str) -> StrideWeights:
+    if isinstance(data, StrideWeights):
+        return data
+    if not isinstance(data, dict):
+        raise SpecError(f"expected a mapping of objective weights, got {type(data).__name__}",
+                        where=where)
+    known = {f.name for f in fields(StrideWeights)}
+    unknown = sorted(set(data) - known)
+    if unknown:
+        raise SpecError(f"unknown objective weight(s) {', '.join(unknown)}", where=where,
+                        hint=f"known: {', '.join(sorted(known))}")
+    try:
+        return StrideWeights(**{k: float(v) for k, v in data.items()})
+    except (TypeError, ValueError):
+        raise SpecError("objective weights must be numbers", where=where) from None
+
+
+@dataclass(frozen=True)
+class CollocationSettings:
+    """Settings of one stride solve.
+
+    Attributes
+    ----------
+    mesh_intervals
+        Mesh intervals n of the stride (trapezoidal collocation, n + 1 nodes).
+    speed_m_per_s
+        Prescribed mean speed [m/s]; None: the maximum-speed problem.
+    weights
+        Objective weights of the predictive stage (:class:`StrideWeights`); None: cost of
+        transport 1, activation 1, acceleration 0.1 at a prescribed speed; speed 1,
+        activation 1, acceleration 0.1 and no metabolic term for the maximum speed.
+    tracking_weight
+        Weight of the joint-angle tracking term of the tracking stage [1/rad²].
+    grf_tracking_weight
+        Weight of the tracking stage's vertical-ground-force term [1/BW²], used when the guess
+        carries a force pattern (``StrideGuess.vertical_grf_bw``; every guess function gives
+        one). Measured: with angles alone the stage met the Fukuchi angles with a one-legged
+        hop and the template with 20-BW bounds; with the force pattern, alternating stances.
+    track_first
+        Run the tracking stage before the predictive one (module docstring).
+    hessian
+        IPOPT's Hessian: ``"limited-memory"`` (L-BFGS, adaptive barrier) or ``"exact"``.
+    tol
+        IPOPT's convergence tolerance [-].
+    max_iter
+        IPOPT's iteration limit per stage.
+    warm_start_mu
+        IPOPT's initial barrier parameter when the predictive stage starts from a collocation
+        solution (a warm start: speed continuation, maximum speed, ``--guess solution.json``),
+        with ``bound_push`` = ``bound_frac`` = 1e-8 so that the start is not pushed away from
+        the bounds it sits on; None (default): IPOPT's defaults (mu_init 0.1, bound_push and
+        bound_frac 0.01). Neither is better everywhere (measured 2026-11-25, mesh 50): amputee
+        Cat6 4 → 4.2 m/s reached objective 2.708 with 1e-4 and 3.323 with the defaults; Cat5
+        4 → 5 m/s reached a cost of transport of 3.33 with 1e-4 and 2.89 with the defaults,
+        and the maximum speeds of Cat4/Cat5 were 6.99/7.32 m/s with 1e-4 against 7.53/7.71
+        m/s. The landscape has local optima 15–25 % apart along a continuation; the two
+        settings are two starts (docs/collocation.md).
+    swing_clearance_m
+        Keep every swinging foot or blade at least this high above the ground [m]: a path
+        constraint on each contact while it moves forward faster than the pelvis
+        (:func:`~bladelab.predict.collocation.dynamics.swing_clearance`); 0 (default): none.
+        The "toe clearance as a constraint" setting (the transfemoral runner's blade
+        grazed the ground in swing without it).
+    knee_moment_min_nm
+        Keep the external extension moment of the prosthetic contacts' ground forces about the
+        prosthetic knee at or above this [N·m] at every node (seed 002's knee-buckling
+        constraint, :func:`~bladelab.predict.collocation.dynamics.knee_extension_moment`;
+        at most 0, since the moment is 0 in swing); None (default): no constraint. Transfemoral
+        runner only.
+    knee_flexion_max_loaded_deg
+        Keep the prosthetic knee within this flexion [deg] of straight while its blade
+        carries load (a path constraint weighted by the blade's vertical force,
+        :func:`~bladelab.predict.collocation.dynamics.knee_straight_while_loaded`): the
+        straight stance from which ``knee_moment_min_nm`` at 0 becomes reachable
+        (docs/design.md); None (default): no constraint. Transfemoral runner only.
+    blade_backward_euler
+        Transcribe a multi-link blade's joints by backward Euler instead of the trapezoidal
+        rule (``StrideDynamics.backward_euler_dofs``): its links' modes (about 300 Hz) are
+        resolved by no mesh, and with the trapezoidal rule they ring from node to node
+        (measured 2026-11-26 on the transfemoral design stride: blade-joint accelerations
+        alternating ±1500 rad/s², sole friction forces and the knee moment alternating in
+        sign from node to node). Backward Euler damps them: first-order accurate, it lags and
+        damps the blade's own motion by O(h) (docs/design.md). No effect without such a blade.
+    pelvis_tilt_range_deg
+        (lo, hi) [deg]: keep the pelvis tilt inside this range at every node (bounds; forward
+        lean negative), e.g. seed 001's window (-16, -2) the reflex gaits' acceptance asks for;
+        None (default): the coordinate's own bounds (-60, 30). A stride the reflex
+        controller tracks (``bladelab predict --track``) passes its lean on: the Cat6 4 m/s
+        stride without it leans -17.8° on average (docs/collocation.md).
+    reference, reference_weight, reference_dofs
+        A collocation solution file of the same runner whose joint angles the predictive
+        stage stays near: ``reference_weight`` [1/rad²] × the time-averaged mean squared
+        deviation of the coordinates ``reference_dofs`` (None: pelvis tilt and every joint)
+        from the reference's, on the normalised stride, plus the same weight × ln(T/T_ref)²
+        of the stride time T against the reference's (the cadence: measured 2026-11-26, with
+        the angles alone the design strides split into 0.51 s and 0.59 s strides, both
+        within 7° of the reference's angles). Weight 0 (default): none, the gait
+        is predicted freely. The design study's "athlete keeps their technique" setting
+        (docs/design.md): without it the optimum's split of the horizontal impulse between
+        the legs is barely determined and depends on the start. The problem's identity
+        (:meth:`same_problem`) holds the reference's file name, not its folder.
+    """
+
+    mesh_intervals: int = defaults.MESH_INTERVALS
+    speed_m_per_s: float | None = defaults.SPEED_M_PER_S
+    weights: StrideWeights | None = None
+    tracking_weight: float = 100.0
+    grf_tracking_weight: float = 10.0
+    track_first: bool = True
+    hessian: str = "limited-memory"
+    tol: float = 1e-4
+    max_iter: int = defaults.MAX_ITER
+    warm_start_mu: float | None = None
+    swing_clearance_m: float = 0.0
+    knee_moment_min_nm: float | None = None
+    knee_flexion_max_loaded_deg: float | None = None
+    blade_backward_euler: bool = False
+    pelvis_tilt_range_deg: tuple[float, float] | None = None
+    reference: str | None = None
+    reference_weight: float = 0.0
+    reference_dofs: tuple[str, ...] | None = None
+
+    def __post_init__(self) -> None:
+        n = self.mesh_intervals
+        if isinstance(n, bool) or not isinstance(n, int | np.integer) or n < 4:
+            raise SpecError(f"need an integer of at least 4 mesh intervals, got {n!r}",
+                            where="mesh_intervals")
+        object.__setattr__(self, "mesh_intervals", int(n))
+        v = self.speed_m_per_s
+        if v is not None:
+            if isinstance(v, bool) or not isinstance(v, int | float) or not (
+                    math.isfinite(v) and v > 0):
+                raise SpecError(f"speed must be > 0 m/s or None (maximum speed), got {v!r}",
+                                where="speed_m_per_s")
+            object.__setattr__(self, "speed_m_per_s", float(v))
+        if self.weights is None:
+            w = (StrideWeights(metabolic=1.0, activation=1.0, acceleration=0.1)
+                 if v is not None else
+                 StrideWeights(metabolic=0.0, activation=1.0, acceleration=0.1, speed=1.0))
+        else:
+            w = _weights_from_dict(self.weights, "weights")
+        object.__setattr__(self, "weights", w)
+        self._check_weight("tracking_weight", "tracking weight")
+        self._check_weight("grf_tracking_weight", "force tracking weight")
+        if not isinstance(self.track_first, bool):
+            raise SpecError(f"expected true or false, got {self.track_first!r}",
+                            where="track_first")
+        if self.hessian not in HESSIANS:
+            raise SpecError(f"unknown Hessian option {self.hessian!r}", where="hessian",
+                            hint=" or ".join(HESSIANS))
+        if isinstance(self.tol, bool) or not isinstance(self.tol, int | float) or not (
+                math.isfinite(self.tol) and self.tol > 0):
+            raise SpecError(f"tolerance must be > 0, got {self.tol!r}", where="tol")
+        object.__setattr__(self, "tol", float(self.tol))
+        mi = self.max_iter
+        if isinstance(mi, bool) or not isinstance(mi, int | np.integer) or mi < 1:
+            raise SpecError(f"need at least 1 iteration, got {mi!r}", where="max_iter")
+        object.__setattr__(self, "max_iter", int(mi))
+        mu = self.warm_start_mu
+        if mu is not None:
+            if isinstance(mu, bool) or not isinstance(mu, int | float) or not (
+                    math.isfinite(mu) and mu > 0):
+                raise SpecError(f"the warm-start barrier must be > 0 or None, got {mu!r}",
+                                where="warm_start_mu")
+            object.__setattr__(self, "warm_start_mu", float(mu))
+
+        sc = self.swing_clearance_m
+        if isinstance(sc, bool) or not isinstance(sc, int | float) or not (
+                math.isfinite(sc) and 0 <= sc < 0.5):
+            raise SpecError(f"swing clearance must be within [0, 0.5) m, got {sc!r}",
+                            where="swing_clearance_m")
+        object.__setattr__(self, "swing_clearance_m", float(sc))
+        km = self.knee_moment_min_nm
+        if km is not None:
+            if isinstance(km, bool) or not isinstance(km, int | float) or not (
+                    math.isfinite(km) and km <= 0):
+                raise SpecError(f"the knee moment minimum must be <= 0 N·m or None, got {km!r}",
+                                where="knee_moment_min_nm",
+                                hint="the moment is 0 while the prosthesis is off the ground")
+            object.__setattr__(self, "knee_moment_min_nm", float(km))
+        kf = self.knee_flexion_max_loaded_deg
+        if kf is not None:
+            if isinstance(kf, bool) or not isinstance(kf, int | float) or not (
+                    math.isfinite(kf) and 0 <= kf <= 90):
+                raise SpecError(f"the loaded knee's flexion limit must be within [0, 90] deg "
+                                f"or None, got {kf!r}", where="knee_flexion_max_loaded_deg")
+            object.__setattr__(self, "knee_flexion_max_loaded_deg", float(kf))
+        if not isinstance(self.blade_backward_euler, bool):
+            raise SpecError(f"expected true or false, got {self.blade_backward_euler!r}",
+                            where="blade_backward_euler")
+        self._check_tilt_range()
+        self._check_reference()
+
+    def _check_tilt_range(self) -> None:
+        """``pelvis_tilt_range_deg``: None or (lo, hi) [deg] with lo < hi inside the pelvis
+        tilt's own bounds, stored as a tuple of floats."""
+        tr = self.pelvis_tilt_range_deg
+        if tr is None:
+            return
+        lo_all, hi_all = COORDINATE_BOUNDS_DEG["pelvis_tilt"]
+        ok = (not isinstance(tr, str | bytes) and len(tr) == 2
+              and all(isinstance(v, int | float) and not isinstance(v, bool)
+                      and math.isfinite(v) for v in tr)
+              and lo_all <= tr[0] < tr[1] <= hi_all)
+        if not ok:
+            raise SpecError(f"the pelvis tilt range must be (lo, hi) [deg] with {lo_all:g} <= "
+                            f"lo < hi <= {hi_all:g}, got {tr!r}", where="pelvis_tilt_range_deg",
+                            hint="seed 001's window is -16, -2 (forward lean negative)")
+        object.__setattr__(self, "pelvis_tilt_range_deg", (float(tr[0]), float(tr[1])))
+
+    def _check_weight(self, name: str, what: str) -> None:
+        """A weight field: a finite number >= 0, stored as float."""
+        w = getattr(self, name)
+        if isinstance(w, bool) or not isinstance(w, int | float) or not (
+                math.isfinite(w) and w >= 0):
+            raise SpecError(f"{what} must be >= 0, got {w!r}", where=name)
+        object.__setattr__(self, name, float(w))
+
+    def _check_reference(self) -> None:
+        self._check_weight("reference_weight", "the reference weight")
+        rw = self.reference_weight
+        if self.reference is not None:
+            object.__setattr__(self, "reference", str(self.reference))
+        if rw > 0 and self.reference is None:
+            raise SpecError("a reference weight needs a reference solution", where="reference",
+                            hint="give the solution file whose joint angles to stay near")
+        dofs = self.reference_dofs
+        if dofs is not None:
+            if isinstance(dofs, str) or not all(isinstance(d, str) for d in dofs) or not dofs:
+                raise SpecError(f"expected a list of coordinate names, got {dofs!r}",
+                                where="reference_dofs")
+            object.__setattr__(self, "reference_dofs", tuple(dofs))
+
+    @property
+    def max_speed(self) -> bool:
+        """True for the maximum-speed problem."""
+        return self.speed_m_per_s is None
+
+    def to_dict(self) -> dict:
+        out = asdict(self)
+        out["weights"] = self.weights.to_dict()
+        if self.reference_dofs is not None:
+            out["reference_dofs"] = list(self.reference_dofs)
+        if self.pelvis_tilt_range_deg is not None:
+            out["pelvis_tilt_range_deg"] = list(self.pelvis_tilt_range_deg)
+        return out
+
+    @classmethod
+    def from_dict(cls, data: dict) -> CollocationSettings:
+        """Settings from :meth:`to_dict`'s mapping; an unknown key raises SpecError naming it
+        (missing keys take their defaults)."""
+        if not isinstance(data, dict):
+            raise SpecError(f"expected a mapping of settings, got {type(data).__name__}",
+                            where="settings")
+        known = {f.name for f in fields(cls)}
+        unknown = sorted(set(data) - known)
+        if unknown:
+            raise SpecError(f"unknown setting(s) {', '.join(unknown)}", where="settings",
+                            hint=f"known: {', '.join(sorted(known))}")
+        return cls(**data)
+
+    def same_problem(self, other: CollocationSettings) -> bool:
+        """True if ``other`` poses the same NLP (mesh, speed, weights, swing clearance, knee
+        moment bound, loaded knee's flexion limit, blade transcription, pelvis tilt range);
+        solver options
+        (Hessian, tolerance, iterations) and the tracking stage may differ."""
+        return self._problem() == other._problem()
+
+    def _problem(self) -> tuple:
+        return (self.mesh_intervals, self.speed_m_per_s, self.weights, self.swing_clearance_m,
+                self.knee_moment_min_nm, self.knee_flexion_max_loaded_deg,
+                self.blade_backward_euler, self.pelvis_tilt_range_deg) + self.reference_key()
+
+    def reference_key(self) -> tuple:
+        """(reference file name, weight, coordinates), or () without a reference term."""
+        if not self.reference_weight:
+            return ()
+        return (Path(self.reference).name, self.reference_weight, self.reference_dofs)

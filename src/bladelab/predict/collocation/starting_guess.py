@@ -1,0 +1,117 @@
+"""The initial guess of a stride named by a word or a file.
+
+``template`` (:func:`~bladelab.predict.collocation.guess.template_guess` at the prescribed
+speed), ``trial`` (the measured running trial shipped with bladelab,
+:func:`~bladelab.predict.collocation.guess.guess_from_trial`), or the path of a file: a
+collocation solution or best iterate (``solution.json``, ``best_iterate.json``; a stride of the
+other amputee kind is mapped onto the runner) or a reflex controller's parameter file
+(``bladelab predict`` writes ``best.json``). ``bladelab predict --guess`` and
+``bladelab sweep --guess`` name their guess this way.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from bladelab._io import read_json
+from bladelab.errors import InputFileError, SpecError
+from bladelab.predict.collocation.guess import (
+    MEASURED_STATIC,
+    MEASURED_TRIAL,
+    MEASURED_TRIAL_SPEED_M_PER_S,
+    guess_from_reflex,
+    guess_from_trial,
+    prosthetic_stride_on,
+    template_guess,
+)
+from bladelab.predict.collocation.solution import CollocationSolution
+from bladelab.runner.params import PROSTHETIC_KINDS
+
+__all__ = ["GUESS_WORDS", "MAX_SPEED_TEMPLATE_M_PER_S", "guess_file_kind", "make_guess",
+           "resolve_guess"]
+
+#: The guesses named by a word; anything else is the path of a file.
+GUESS_WORDS = ("template", "trial")
+#: Speed [m/s] of the template guess of a maximum-speed problem (no prescribed speed).
+MAX_SPEED_TEMPLATE_M_PER_S = 4.0
+
+_NEITHER_HINT = ("template, trial, or the path of a solution.json, best_iterate.json or reflex "
+                 "parameter JSON file")
+
+
+def make_guess(runner, guess: str, *, n: int, speed: float | None, where: str = "guess"):
+    """The initial guess named by ``guess`` on ``n`` mesh intervals (module docstring).
+
+    Parameters
+    ----------
+    runner
+        The runner model (:class:`bladelab.runner.RunnerModel`).
+    guess
+        ``"template"``, ``"trial"`` or the path of a file.
+    n
+        Mesh intervals of the stride.
+    speed
+        Prescribed speed [m/s] of the template; None (a maximum-speed problem):
+        :data:`MAX_SPEED_TEMPLATE_M_PER_S`.
+    where
+        What errors name as the source of ``guess`` (the command line: ``--guess``).
+
+    Raises
+    ------
+    InputFileError
+        ``trial`` without the packaged trial; a file that is neither kind of guess.
+    SpecError
+        A name that is neither a word nor a file; a solution of an unrelated model.
+    """
+    if guess == "template":
+        return template_guess(runner, speed=speed or MAX_SPEED_TEMPLATE_M_PER_S, n=n)
+    if guess == "trial":
+        if not MEASURED_TRIAL.is_file():
+            raise InputFileError("the measured running trial is not there", file=MEASURED_TRIAL,
+                                 where=f"{where} trial",
+                                 hint="bladelab's installation lacks its packaged data: "
+                                      f"reinstall bladelab, or use {where} template")
+        static = MEASURED_STATIC if MEASURED_STATIC.is_file() else None
+        return guess_from_trial(runner, MEASURED_TRIAL, static=static, n=n,
+                                speed=MEASURED_TRIAL_SPEED_M_PER_S)
+    path = Path(guess)
+    if guess_file_kind(path, where=where) == "collocation":
+        sol = CollocationSolution.read(path)
+        stride = sol.to_guess(f"collocation solution {path.name} ({sol.guess_source})")
+        if sol.model_spec["model"] == runner.kind:  # another body of the same kind is mapped
+            return stride
+        if {sol.model_spec["model"], runner.kind} <= set(PROSTHETIC_KINDS):
+            return prosthetic_stride_on(runner, stride)
+        raise SpecError("the guess is a solution of another model", file=path,
+                        where=where, hint=f"it is of {sol.model_spec}; an amputee runner's "
+                                          "stride starts the other amputee kind")
+    return guess_from_reflex(path, n=n)
+
+
+def guess_file_kind(path: str | Path, *, where: str = "guess") -> str:
+    """``"collocation"`` (a solution or best iterate) or ``"reflex"`` (a reflex controller's
+    parameter file) for a guess file; errors name ``where``."""
+    path = Path(path)
+    if not path.is_file():
+        raise SpecError(f"{str(path)!r} is neither template, trial nor a file", where=where,
+                        hint=_NEITHER_HINT)
+    data = read_json(path, what=f"{where} file")
+    if isinstance(data, dict) and str(data.get("kind", "")).startswith("collocation-"):
+        return "collocation"
+    if isinstance(data, dict) and isinstance(data.get("parameters"), dict):
+        return "reflex"
+    raise InputFileError("not a collocation solution nor a reflex parameter file", file=path,
+                         where=where, hint="a solution.json, best_iterate.json or a "
+                                           "'bladelab predict' parameter JSON file")
+
+
+def resolve_guess(guess: str, *, where: str = "guess") -> str:
+    """``guess`` checked before any solve: a word as it is, a file as its absolute path (worker
+    processes may start in another folder)."""
+    if guess in GUESS_WORDS:
+        return guess
+    path = Path(guess)
+    if not path.is_file():
+        raise SpecError(f"{guess!r} is neither template, trial nor a file", where=where,
+                        hint=_NEITHER_HINT)
+    return str(path.resolve())

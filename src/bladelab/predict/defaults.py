@@ -1,0 +1,98 @@
+"""Defaults of the predict wing's settings, in a module that imports nothing.
+
+The settings objects of :mod:`bladelab.predict.reflex` (``ObjectiveSettings``,
+``optimize_controller``, ``run_sweep``, the tracking weight) and of
+:mod:`bladelab.predict.collocation` (``CollocationSettings``) take their defaults from here,
+and the command line shows the same values in ``bladelab predict --help`` and
+``bladelab sweep --help`` without loading numba, MuJoCo or CasADi.
+"""
+
+from __future__ import annotations
+
+__all__ = [
+    "BODY",
+    "CHECKPOINT_EVERY",
+    "DURATION_S",
+    "GENERATIONS",
+    "GUESS",
+    "INITIAL_STEP",
+    "INTEGRATOR",
+    "LEAN_WEIGHT_PER_DEG",
+    "MAX_ITER",
+    "MESH_INTERVALS",
+    "POPULATION_SIZE",
+    "RECIPE_SEEDS",
+    "REFLEX_BLADE",
+    "ROBUST_DIRECTIONS",
+    "ROBUST_JITTER",
+    "ROBUST_SAMPLES",
+    "SEED",
+    "SPEED_M_PER_S",
+    "STARTS",
+    "STRIKE_LIMIT_BW",
+    "SWEEP_CATEGORIES",
+    "SWEEP_SPEEDS_M_PER_S",
+    "TIME_STEP_S",
+    "TRACK_WEIGHT_PER_RAD2",
+]
+
+# -- a predicted gait, either method -------------------------------------------------------
+#: Prescribed mean speed of a predicted gait [m/s] (``ObjectiveSettings.speed``,
+#: ``CollocationSettings.speed_m_per_s``).
+SPEED_M_PER_S = 3.5
+
+# -- the reflex controller and its objective (predict.reflex) ------------------------------
+#: Blade category of the reflex controller's amputee runner (seed 001's shipped solutions).
+REFLEX_BLADE = "Cat6"
+#: Simulated time of one candidate [s] (``ObjectiveSettings.duration``).
+DURATION_S = 10.0
+#: Time step of the closed-loop simulation [s]: the runner model's own step
+#: (``bladelab.runner.model.DEFAULT_DT``; a test checks that they agree).
+TIME_STEP_S = 2.5e-4
+#: Simulations per candidate: the nominal one only (``ObjectiveSettings.robust_samples``).
+ROBUST_SAMPLES = 1
+#: Relative parameter jitter of a candidate's robust copies [-].
+ROBUST_JITTER = 1e-6
+#: How the robust copies' jitter directions are drawn: once per run.
+ROBUST_DIRECTIONS = "fixed"
+#: Peak force of a swinging foot's strike at which a step loses all its credit [body weights].
+STRIKE_LIMIT_BW = 1.0
+#: Weight of the pelvis tilt outside its window [1/deg] (seed 001's 0.1 per degree).
+LEAN_WEIGHT_PER_DEG = 0.1
+#: Integrator of the closed loop: the explicit scheme at :data:`TIME_STEP_S`.
+INTEGRATOR = "explicit"
+#: Weight of the term that tracks a collocation stride [1/rad²]: 10° of rms error costs 30,
+#: as much as running 30 % of the simulation outside the speed window.
+TRACK_WEIGHT_PER_RAD2 = 1000.0
+
+# -- CMA-ES (predict.reflex.optimize, predict.reflex.sweep) --------------------------------
+#: Generations of one optimisation.
+GENERATIONS = 100
+#: Candidates per generation.
+POPULATION_SIZE = 16
+#: Initial step [× each parameter's scale].
+INITIAL_STEP = 1.0
+#: Seed of CMA-ES's random draws.
+SEED = 1
+#: Generations between two checkpoints.
+CHECKPOINT_EVERY = 5
+
+# -- the reflex sweeps ----------------------------------------------------------------------
+#: Blade categories of the category × speed sweep (seed 001 Table 3.1).
+SWEEP_CATEGORIES = ("Cat4", "Cat5", "Cat6", "Cat6High", "Cat7")
+#: Speeds of the sweep's grid [m/s], rising.
+SWEEP_SPEEDS_M_PER_S = (3.5, 4.0, 4.5, 5.0)
+#: CMA-ES seeds per category of a recipe sweep.
+RECIPE_SEEDS = (1, 2, 3)
+
+# -- collocation (predict.collocation) -----------------------------------------------------
+#: Mesh intervals of the stride (``CollocationSettings.mesh_intervals``).
+MESH_INTERVALS = 50
+#: IPOPT's iteration limit per stage (``CollocationSettings.max_iter``).
+MAX_ITER = 3000
+#: The runner's body: seed 001's model (``toes``: a toe segment and compliant Achilles tendons).
+BODY = "seed001"
+#: Initial guess of a stride: the template gait at the prescribed speed.
+GUESS = "template"
+#: Starts per problem of a collocation sweep (the best solve is kept).
+STARTS = 1
