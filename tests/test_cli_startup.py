@@ -92,3 +92,52 @@ def test_the_cli_shows_the_library_defaults():
     assert default(["sweep"], "--mesh") == coll.mesh_intervals
     assert default(["blade", "test"], "--body-mass") == BladeEvaluator().body_mass_kg
     assert default(["blade", "test"], "--max-displacement") == dd.COMPRESSION_MAX_DISPLACEMENT_M
+
+
+# (command, option, the library function the command calls, its parameter): the CLI's literal
+# default must be the library's own, so that the library owns every default the CLI shows.
+_CHARACTERISE_DEFAULTS = [
+    (["trial", "stances"], "--threshold", "bladelab.trial.events:detect_stances", "threshold"),
+    (["trial", "stances"], "--min-duration", "bladelab.trial.events:detect_stances",
+     "min_duration"),
+    (["trial", "extract"], "--rate", "bladelab.trial.kinematics:extract_stance", "rate"),
+    (["trial", "extract"], "--margin", "bladelab.trial.kinematics:extract_stance", "margin"),
+    (["trial", "extract"], "--threshold", "bladelab.trial.kinematics:extract_stance",
+     "threshold"),
+    (["identify"], "--max-evals", "bladelab.identify:identify_stance", "max_evals"),
+    (["simulate"], "--dt", "bladelab.sim:prepare", "dt"),
+    (["blade", "segment"], "--max-error", "bladelab.blade.segmentation:segment_profile",
+     "max_error_mm2_per_mm"),
+    (["example", "make"], "--seed", "bladelab.example.study:make_example_study", "seed"),
+    (["example", "make"], "--jobs", "bladelab.example.study:make_example_study", "jobs"),
+    (["runner", "simulate"], "--duration", "bladelab.runner:simulate_runner", "duration"),
+    (["runner", "simulate"], "--speed", "bladelab.runner:simulate_runner", "initial_speed"),
+    (["runner", "simulate"], "--initial-state", "bladelab.runner:simulate_runner",
+     "initial_state"),
+    (["runner", "simulate"], "--integrator", "bladelab.runner:simulate_runner", "integrator"),
+    (["design", "gait-cycle"], "--samples", "bladelab.design.gait_cycle:gait_cycles_from_trial",
+     "n"),
+    (["design", "gait-cycle"], "--cutoff", "bladelab.design.gait_cycle:gait_cycles_from_trial",
+     "cutoff_hz"),
+]
+
+
+@pytest.mark.parametrize(("command", "option", "function", "parameter"), _CHARACTERISE_DEFAULTS,
+                         ids=[" ".join(c) + " " + o for c, o, _, _ in _CHARACTERISE_DEFAULTS])
+def test_the_other_commands_show_the_library_defaults(command, option, function, parameter):
+    import importlib
+    import inspect
+
+    import typer.main
+
+    from bladelab.cli import app
+
+    cmd = typer.main.get_command(app)
+    for name in command:
+        cmd = cmd.commands[name]
+    shown = next(p.default for p in cmd.params if option in p.opts)
+    module, name = function.split(":")
+    library = inspect.signature(getattr(importlib.import_module(module), name)).parameters
+    assert shown == library[parameter].default, (
+        f"bladelab {' '.join(command)} {option} defaults to {shown!r}, the library's {name}"
+        f"({parameter}=...) to {library[parameter].default!r}")
