@@ -158,8 +158,8 @@ TREND_REASONS: dict[tuple[str, str], str] = {
         _SCATTER + "The knee moment minimum falls at touch-down, where the load line passes "
         "behind the knee before the toe's lever acts."),
     ("collocation", "longer_toe_lowers_clearance"): (
-        _SCATTER + "The 2 cm swing-clearance constraint binds in 11 of its 25 strides, which "
-        "caps the response the trend is read from."),
+        _SCATTER + "The 2 cm swing-clearance constraint binds (within 0.5 mm) in 9 of the free "
+        "study's 25 strides, which caps the response the trend is read from."),
 }
 
 #: Reason given when no known mechanism of the evaluator explains a trend that does not hold.
