@@ -12,6 +12,7 @@ from bladelab.design.gait_cycle import (
     average_gait_cycle,
     gait_cycle_from_trial,
     gait_cycles_from_trial,
+    measured_gait_cycle,
     read_gait_csv,
 )
 from bladelab.errors import DataError, SpecError
@@ -104,6 +105,22 @@ def test_cli_writes_the_gait_csv(tmp_path, capsys):
     stride, _, _ = _stride_and_stance(run)
     assert cyc.period == pytest.approx(stride, abs=2 / 300)
     assert np.degrees(cyc.angles["knee_prosthetic"]).max() > 80
+
+
+def test_measured_gait_cycle_is_the_mean_of_the_trials_cycles(tmp_path, cycles):
+    res = measured_gait_cycle(RUN, static_file=STATIC, leg="right", out=tmp_path / "c.csv")
+    assert res.zeroed_at_standing and len(res.cycles) == len(cycles)
+    for k in ANGLE_NAMES:  # the same cycles, averaged sample by sample
+        mean_k = np.mean([c.angles[k] for c in cycles], axis=0)
+        assert np.allclose(res.mean.angles[k], mean_k, atol=1e-12)
+        lo, hi, sd = res.angle_ranges_deg()[k]
+        assert (lo, hi) == pytest.approx((np.degrees(mean_k).min(), np.degrees(mean_k).max()))
+        spread = np.degrees(np.std([c.angles[k] for c in cycles], axis=0)).mean()
+        assert sd == pytest.approx(spread)
+    # the CSV holds times to 1 µs
+    assert read_gait_csv(res.path).period == pytest.approx(np.mean(res.periods_s), abs=2e-6)
+    with pytest.raises(SpecError, match="at least 8 samples"):
+        measured_gait_cycle(RUN, n=4)
 
 
 def test_cli_errors(tmp_path, capsys):

@@ -24,7 +24,7 @@ from bladelab._io import figure_format
 from bladelab.cli.blade import blade_app
 from bladelab.cli.panels import Panel, PanelGroup, refuse_other_methods, renamed
 from bladelab.design import defaults
-from bladelab.errors import BladelabError, InputFileError, SpecError
+from bladelab.errors import BladelabError, SpecError
 
 __all__ = ["DESIGN_PANELS", "OPTIONS", "register"]
 
@@ -315,42 +315,20 @@ def _gait_cycle(
     up: str = typer.Option("auto", "--up", help="File axis that is up."),
 ) -> None:
     """Mean gait cycle of a measured trial (joint angles from markers) as a gait-cycle CSV."""
-    import numpy as np  # deferred: keeps bladelab --help fast
-
-    from bladelab.design import gait_cycle  # deferred: keeps bladelab --help fast
-    from bladelab.trial import read_c3d  # deferred: keeps bladelab --help fast
-
-    # deferred: keeps bladelab --help fast
-    from bladelab.trial.joint_angles import load_joint_marker_map
+    from bladelab.design.gait_cycle import measured_gait_cycle  # deferred: keeps --help fast
 
     if samples < 8:
         raise SpecError(f"--samples must be >= 8, got {samples}", where="--samples")
-    for f in (trial_file, static):
-        if f is not None and not f.is_file():
-            raise InputFileError("no such file", file=f)
-    mmap = load_joint_marker_map(markers) if markers is not None else None
-    trial = read_c3d(trial_file, forward=forward, up=up)
-    ax = trial.metadata.get("axes", {})
-    st = None
-    if static is not None:
-        st = read_c3d(static, forward=ax.get("forward", forward), up=ax.get("up", up))
-    cycles = gait_cycle.gait_cycles_from_trial(trial, leg=leg, markers=mmap, static=st,
-                                               cutoff_hz=cutoff if cutoff > 0 else None,
-                                               n=samples)
-    mean = gait_cycle.average_gait_cycle(
-        cycles, source=f"{trial_file}: mean of {len(cycles)} {leg}-leg cycles")
-    gait_cycle.write_gait_csv(mean, out)
-    periods = np.array([c.period for c in cycles])
-    a = {k: np.degrees(v) for k, v in mean.angles.items()}
-    sd = {k: float(np.mean(np.degrees(np.std([c.angles[k] for c in cycles], axis=0))))
-          for k in mean.angles}
-    typer.echo(f"{len(cycles)} cycles of the {leg} leg: period {periods.mean():.4f} ± "
+    res = measured_gait_cycle(trial_file, leg=leg, static_file=static, markers_file=markers,
+                              n=samples, cutoff_hz=cutoff if cutoff > 0 else None,
+                              forward=forward, up=up, out=out)
+    periods = res.periods_s
+    typer.echo(f"{len(res.cycles)} cycles of the {leg} leg: period {periods.mean():.4f} ± "
                f"{periods.std():.4f} s")
-    for k in a:
-        typer.echo(f"  {k:16s} {a[k].min():7.1f} .. {a[k].max():7.1f} deg  "
-                   f"(between-cycle SD {sd[k]:.1f} deg)")
-    typer.echo(f"wrote {out}")
-    if st is None:
+    for k, (lo, hi, sd) in res.angle_ranges_deg().items():
+        typer.echo(f"  {k:16s} {lo:7.1f} .. {hi:7.1f} deg  (between-cycle SD {sd:.1f} deg)")
+    typer.echo(f"wrote {res.path}")
+    if not res.zeroed_at_standing:
         typer.echo("note: no --static trial: the angles are those of the marker axes, not zero "
                    "at standing", err=True)
 

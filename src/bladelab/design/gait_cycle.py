@@ -48,7 +48,9 @@ from scipy.interpolate import CubicSpline
 
 from bladelab._io import atomic_path
 from bladelab.errors import DataError, InputFileError, SpecError
+from bladelab.trial.c3d import read_c3d
 from bladelab.trial.cycles import joint_angle_cycles
+from bladelab.trial.joint_angles import load_joint_marker_map
 
 __all__ = [
     "ANGLE_NAMES",
@@ -58,6 +60,8 @@ __all__ = [
     "gait_cycle_from_runner",
     "gait_cycle_from_trial",
     "gait_cycles_from_trial",
+    "MeasuredGaitCycle",
+    "measured_gait_cycle",
     "read_gait_csv",
     "write_gait_csv",
 ]
@@ -345,3 +349,72 @@ def gait_cycle_from_trial(trial, *, leg: str = "right", markers=None, static=Non
                                     cutoff_hz=cutoff_hz, n=n, max_period_s=max_period_s)
     src = trial.source or "trial"
     return average_gait_cycle(cycles, source=f"{src}: mean of {len(cycles)} {leg}-leg cycles")
+
+
+@dataclass(frozen=True)
+class MeasuredGaitCycle:
+    """The mean gait cycle of a measured trial and the cycles behind it.
+
+    Attributes
+    ----------
+    mean
+        The time-normalised mean cycle (:func:`average_gait_cycle`).
+    cycles
+        The trial's cycles of the chosen leg.
+    zeroed_at_standing
+        Whether a standing trial set the angles' zeros (else they are the marker axes' angles).
+    path
+        The gait-cycle CSV written, or None.
+    """
+
+    mean: GaitCycle
+    cycles: tuple[GaitCycle, ...]
+    zeroed_at_standing: bool
+    path: Path | None = None
+
+    @property
+    def periods_s(self) -> np.ndarray:
+        """The cycles' periods [s]."""
+        return np.array([c.period for c in self.cycles])
+
+    def angle_ranges_deg(self) -> dict[str, tuple[float, float, float]]:
+        """Angle name -> (min, max) of the mean cycle [deg] and the between-cycle standard
+        deviation, averaged over the cycle [deg]."""
+        out = {}
+        for k, a in self.mean.angles.items():
+            deg = np.degrees(a)
+            sd = np.mean(np.degrees(np.std([c.angles[k] for c in self.cycles], axis=0)))
+            out[k] = (float(deg.min()), float(deg.max()), float(sd))
+        return out
+
+
+def measured_gait_cycle(trial_file: str | Path, *, leg: str = "right",
+                        static_file: str | Path | None = None,
+                        markers_file: str | Path | None = None, n: int = 100,
+                        cutoff_hz: float | None = 20.0, forward: str = "auto", up: str = "auto",
+                        out: str | Path | None = None) -> MeasuredGaitCycle:
+    """Read a C3D trial (and its standing trial), find the cycles of ``leg`` and their mean
+    (:func:`gait_cycles_from_trial`), and write the mean as a gait-cycle CSV to ``out``.
+
+    ``n`` samples per cycle (at least 8); ``cutoff_hz`` the marker low-pass [Hz] (None: none);
+    ``markers_file`` a YAML joint marker map (None: the Fukuchi set); the standing trial is read
+    with the axes found in the running trial.
+    """
+    if n < 8:
+        raise SpecError(f"needs at least 8 samples per cycle, got {n}", where="samples")
+    for f in (trial_file, static_file):
+        if f is not None and not Path(f).is_file():
+            raise InputFileError("no such file", file=f)
+    markers = load_joint_marker_map(markers_file) if markers_file is not None else None
+    trial = read_c3d(trial_file, forward=forward, up=up)
+    axes = trial.metadata.get("axes", {})
+    static = None
+    if static_file is not None:
+        static = read_c3d(static_file, forward=axes.get("forward", forward),
+                          up=axes.get("up", up))
+    cycles = gait_cycles_from_trial(trial, leg=leg, markers=markers, static=static,
+                                    cutoff_hz=cutoff_hz, n=n)
+    mean = average_gait_cycle(cycles,
+                              source=f"{trial_file}: mean of {len(cycles)} {leg}-leg cycles")
+    path = write_gait_csv(mean, out) if out is not None else None
+    return MeasuredGaitCycle(mean, tuple(cycles), static is not None, path)
