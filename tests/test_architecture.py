@@ -310,3 +310,31 @@ def test_the_reason_check_sees_an_unexplained_local_import(source, unexplained):
 ])
 def test_the_private_check_sees_imports_and_uses_through_imported_names(source, private):
     assert len(_private_uses(SRC / "cli" / "probe.py", source)) == private
+
+
+_WRITERS = {"atomic_path", "atomic_open", "write_json"}
+
+
+def _cli_writers(sources: dict[Path, str] | None = None) -> list[str]:
+    """file:line of every file writer of ``bladelab._io`` that a CLI module imports."""
+    found = []
+    for path in sources or sorted((SRC / "cli").rglob("*.py")):
+        for target, name, line, _ in _imports(path, (sources or {}).get(path)):
+            if target == "bladelab._io" and name in _WRITERS:
+                found.append(f"{path.relative_to(SRC.parent)}:{line}: {name}")
+    return found
+
+
+def test_the_cli_writes_no_file_format_itself():
+    """A command's output files are written by the library function that defines their format
+    (docs/architecture.md), so no CLI module imports the atomic writers."""
+    assert (SRC / "cli").is_dir()
+    bad = _cli_writers()
+    assert not bad, "the CLI writes files itself; move the writer into the library:\n" + "\n".join(bad)
+
+
+def test_the_cli_writer_check_flags_a_writer():
+    path = SRC / "cli" / "example.py"
+    assert _cli_writers({path: "from bladelab._io import atomic_open, read_json\n"}) == [
+        "bladelab/cli/example.py:1: atomic_open"]
+    assert _cli_writers({path: "from bladelab._io import read_json\n"}) == []

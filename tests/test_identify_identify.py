@@ -163,6 +163,11 @@ def test_cli_stance_and_study(stances, tmp_path, capsys):
     assert main(["results", str(tmp_path), "--csv"]) == 0
     lines = capsys.readouterr().out.strip().splitlines()
     assert len(lines) == 3 and "K_Nm_per_deg" in lines[0]
+    exported = tmp_path / "export" / "results.csv"
+    exported.parent.mkdir()
+    assert main(["results", str(tmp_path), "--output", str(exported)]) == 0
+    assert "(2 rows)" in capsys.readouterr().err
+    assert exported.read_text().strip().splitlines() == lines
     assert main(["results", str(tmp_path / "nowhere")]) == 2
 
 

@@ -158,8 +158,9 @@ def _lab_perm(axes):
 
 
 def test_motionmonitor_type4_y_up_takes_the_vertical_sense_from_the_data(tmp_path):
-    """The MotionMonitor sample: type-4 plates in a y-up lab whose corners put the plate z axis
-    up. ezc3d's platform module shows a normal loading along +y; the vertical must be +y."""
+    """Type-4 plates in a y-up lab whose corners put the plate z axis up (the real MotionMonitor
+    sample's corners do not: tests/test_trial_c3d_samples.py). The markers stand along +y and
+    ezc3d's platform module shows a normal loading along +y; the vertical must be +y."""
     rate, arate, n = 100.0, 1000.0, 1300
     t = np.arange(n) / arate
     tm = np.arange(n // 10) / rate

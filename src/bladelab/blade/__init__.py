@@ -6,7 +6,7 @@ consume; ``list_blades()`` names the built-ins; ``docs/blade-spec.md`` documents
 
 from bladelab.blade.catalogue import blade_catalogue, list_blades, load_blade, multilink_blade
 from bladelab.blade.model import BladeModel, CompliantJoint, ContactModel, SoleEllipse
-from bladelab.blade.plot import plot_blade
+from bladelab.blade.plot import plot_blade, save_blade_figure
 from bladelab.blade.profile import (
     Profile,
     ProfileElement,
@@ -14,7 +14,12 @@ from bladelab.blade.profile import (
     profile_from_elements,
     read_profile_csv,
 )
-from bladelab.blade.segmentation import Segmentation, segment_profile, segmentation_error
+from bladelab.blade.segmentation import (
+    Segmentation,
+    segment_profile,
+    segmentation_error,
+    write_segmentation_json,
+)
 from bladelab.blade.spec import BladeSpec, read_blade_spec, segment_mass_properties
 
 __all__ = [
@@ -35,7 +40,9 @@ __all__ = [
     "profile_from_elements",
     "read_blade_spec",
     "read_profile_csv",
+    "save_blade_figure",
     "segment_mass_properties",
     "segment_profile",
     "segmentation_error",
+    "write_segmentation_json",
 ]

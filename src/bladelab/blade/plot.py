@@ -2,12 +2,15 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 
+from bladelab._io import atomic_path, figure_format
 from bladelab.blade.model import BladeModel
 from bladelab.blade.profile import Profile
 
-__all__ = ["plot_blade"]
+__all__ = ["plot_blade", "save_blade_figure"]
 
 
 def plot_blade(
@@ -91,3 +94,22 @@ def _ellipse_lowest_z(sole) -> float:
     # Ellipse axes in the clamp frame: e_x = (cos a, -sin a), e_z = (sin a, cos a).
     a = sole.angle
     return float(sole.center[1] - np.hypot(sole.semi_axis_x * np.sin(a), sole.semi_axis_z * np.cos(a)))
+
+
+def save_blade_figure(model: BladeModel, path: str | Path, *,
+                      profile: Profile | None = None) -> Path:
+    """Draw a blade (:func:`plot_blade`) into an image file, atomically; the format follows the
+    file's extension (png, svg, pdf...; an unknown one is refused before any drawing)."""
+    fmt = figure_format(path)
+    import matplotlib  # deferred: matplotlib takes about 0.5 s to import
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(4.5, 5.5))
+    plot_blade(model, ax, profile=profile)
+    fig.tight_layout()
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, format=fmt, dpi=150)
+    plt.close(fig)
+    return Path(path)

@@ -19,13 +19,15 @@ of radius R cut into pieces of length s, Aᵢ/sᵢ ≈ s²/(12R): the error fall
 from __future__ import annotations
 
 import dataclasses
+from pathlib import Path
 
 import numpy as np
 
+from bladelab._io import write_json
 from bladelab.blade.profile import Profile, find_self_intersections
 from bladelab.errors import ModelError
 
-__all__ = ["Segmentation", "segment_profile", "segmentation_error"]
+__all__ = ["Segmentation", "segment_profile", "segmentation_error", "write_segmentation_json"]
 
 _MAX_SEGMENTS = 200
 
@@ -211,3 +213,11 @@ def segment_profile(
                 f"the segmented blade intersects itself (segments {i + 1} and {j + 1} of {seg.n})",
                 where=prof.name, hint="use more segments or a lower error threshold")
     return seg
+
+
+def write_segmentation_json(segmentation: Segmentation, path: str | Path, *,
+                            profile: str | Path = "") -> Path:
+    """Write a segmentation (:meth:`Segmentation.to_dict`, lengths in m) as JSON, atomically,
+    with the profile file it came from under ``profile``."""
+    write_json(path, {"profile": str(profile), **segmentation.to_dict()})
+    return Path(path)

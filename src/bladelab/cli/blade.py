@@ -7,7 +7,7 @@ from pathlib import Path
 
 import typer
 
-from bladelab._io import atomic_path, figure_format, write_json
+from bladelab._io import figure_format
 from bladelab.parameters import JOINT_PARAMETERS
 
 __all__ = ["register"]
@@ -41,7 +41,8 @@ def _show(
     plot: Path | None = typer.Option(None, "--plot", help="Also draw the blade to this image file."),
 ) -> None:
     """Show a blade: dimensions, segmentation, joints (K in N·m/deg), soles, contact."""
-    from bladelab.blade import load_blade  # deferred: keeps bladelab --help fast
+    # deferred: keeps bladelab --help fast
+    from bladelab.blade import load_blade, save_blade_figure
 
     if plot is not None:
         figure_format(plot)  # refuse an unknown image format before any work
@@ -55,7 +56,7 @@ def _show(
         else:
             typer.echo(_format_summary(summary))
     if plot is not None:
-        _save_plot(spec, plot)
+        save_blade_figure(spec.build(), plot, profile=spec.profile_geometry())
         typer.echo(f"wrote {plot}", err=True)
 
 
@@ -68,7 +69,7 @@ def _segment(
 ) -> None:
     """Segment a profile polyline: smallest N whose error is below --max-error."""
     # deferred: keeps bladelab --help fast
-    from bladelab.blade import read_profile_csv, segment_profile
+    from bladelab.blade import read_profile_csv, segment_profile, write_segmentation_json
 
     prof = read_profile_csv(profile)
     seg = segment_profile(prof, max_error_mm2_per_mm=max_error, n_segments=n_segments)
@@ -83,7 +84,7 @@ def _segment(
         typer.echo(f"{i + 1:4d} {x0:7.1f} {z0:8.1f} {x1:8.1f} {z1:8.1f} "
                    f"{seg.chord_lengths[i] * 1e3:9.1f} {seg.segment_errors[i]:12.3f}")
     if out is not None:
-        write_json(out, {"profile": str(profile), **seg.to_dict()})
+        write_segmentation_json(seg, out, profile=profile)
         typer.echo(f"wrote {out}", err=True)
 
 
@@ -112,23 +113,6 @@ def _format_summary(s: dict) -> str:
         cats = ", ".join(f"{k}: K = {v}" for k, v in s["categories"].items())
         lines.append(f"  categories (K in N·m/deg): {cats}; selected: {s['category']}")
     return "\n".join(lines)
-
-
-def _save_plot(spec, path: Path) -> None:
-    fmt = figure_format(path)
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    from bladelab.blade import plot_blade  # deferred: keeps bladelab --help fast
-
-    fig, ax = plt.subplots(figsize=(4.5, 5.5))
-    plot_blade(spec.build(), ax, profile=spec.profile_geometry())
-    fig.tight_layout()
-    with atomic_path(path) as tmp:
-        fig.savefig(tmp, format=fmt, dpi=150)
-    plt.close(fig)
 
 
 def register(app: typer.Typer) -> None:

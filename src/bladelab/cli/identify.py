@@ -7,7 +7,6 @@ from pathlib import Path
 
 import typer
 
-from bladelab._io import atomic_open
 from bladelab.errors import InputFileError, SpecError
 from bladelab.parameters import JOINT_PARAMETERS
 
@@ -134,14 +133,14 @@ def _results(
     output: Path | None = typer.Option(None, "--output", "-o", help="Write the CSV to this file."),
 ) -> None:
     """Print (or export as CSV) the results table of a study."""
-    from bladelab.study.store import open_results  # deferred: keeps bladelab --help fast
+    # deferred: keeps bladelab --help fast
+    from bladelab.study.store import export_results_csv, open_results
 
-    df = open_results(study_dir)
     if output is not None:
-        with atomic_open(output, "w", encoding="utf-8", newline="") as fh:
-            df.to_csv(fh, index=False)
-        typer.echo(f"wrote {output} ({len(df)} rows)", err=True)
+        rows = export_results_csv(study_dir, output)
+        typer.echo(f"wrote {output} ({rows} rows)", err=True)
         return
+    df = open_results(study_dir)
     if as_csv:
         typer.echo(df.to_csv(index=False), nl=False)
         return

@@ -7,7 +7,6 @@ from pathlib import Path
 import numpy as np
 import typer
 
-from bladelab._io import atomic_open
 from bladelab.errors import ModelError
 from bladelab.parameters import JOINT_PARAMETERS
 
@@ -46,7 +45,9 @@ def _simulate(
 ) -> None:
     """Simulate a blade driven by the clamp motion of a stance; write GRF, distance, deflection."""
     from bladelab.blade import load_blade  # deferred: keeps bladelab --help fast
-    from bladelab.sim import prepare, simulate  # deferred: keeps bladelab --help fast
+
+    # deferred: keeps bladelab --help fast
+    from bladelab.sim import prepare, simulate, write_simulation_csv
     from bladelab.trial.stance import read_stance_csv  # deferred: keeps bladelab --help fast
 
     if engine not in ("kernel", "mujoco"):
@@ -62,19 +63,9 @@ def _simulate(
         stiffness=None if k_deg is None else JOINT_PARAMETERS["K"].from_edge(k_deg),
         damping=None if d_deg is None else JOINT_PARAMETERS["D"].from_edge(d_deg),
     )
-    frame = result.to_frame()
-    with atomic_open(out, "w", encoding="utf-8", newline="\n") as fh:
-        k_used = np.atleast_1d(JOINT_PARAMETERS["K"].to_edge(result.stiffness))
-        d_used = np.atleast_1d(JOINT_PARAMETERS["D"].to_edge(result.damping))
-        fh.write("# bladelab simulation\n")
-        fh.write(f"# blade: {model.name}\n# stance: {stance}\n# engine: {result.engine}\n")
-        fh.write(f"# dt_s: {result.dt:.6g}\n")
-        for key, used in ((JOINT_PARAMETERS["K"].edge_key, k_used),
-                          (JOINT_PARAMETERS["D"].edge_key, d_used)):
-            fh.write(f"# {key}: " + ",".join(f"{v:.6g}" for v in used) + "\n")
-        frame.to_csv(fh, index=False, float_format="%.9g")
+    write_simulation_csv(result, out, blade=model.name, stance=stance)
     typer.echo(
-        f"wrote {out}: {len(frame)} samples, peak GRF z {result.grf_z.max():.1f} N, "
+        f"wrote {out}: {len(result.time)} samples, peak GRF z {result.grf_z.max():.1f} N, "
         f"min distance {result.distance.min():.4f} m",
         err=True,
     )

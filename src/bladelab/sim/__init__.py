@@ -20,7 +20,7 @@ from bladelab.sim.api import (
 from bladelab.sim.chain import Chain, build_chain
 from bladelab.sim.kernel import ENERGY_TERMS
 from bladelab.sim.motion import ClampMotion
-from bladelab.sim.result import BatchResult, SimResult
+from bladelab.sim.result import BatchResult, SimResult, write_simulation_csv
 from bladelab.sim.synthetic import generate_stance
 
 __all__ = [
@@ -38,4 +38,5 @@ __all__ = [
     "simulate",
     "simulate_batch",
     "utilised_friction_ratio",
+    "write_simulation_csv",
 ]

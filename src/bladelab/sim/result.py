@@ -4,14 +4,17 @@
 from __future__ import annotations
 
 import dataclasses
+from pathlib import Path
 from typing import Any
 
 import numpy as np
 import pandas as pd
 
 from bladelab import units
+from bladelab._io import atomic_open
+from bladelab.parameters import JOINT_PARAMETERS
 
-__all__ = ["BatchResult", "SimResult"]
+__all__ = ["BatchResult", "SimResult", "write_simulation_csv"]
 
 
 @dataclasses.dataclass(frozen=True, eq=False)
@@ -106,6 +109,26 @@ class SimResult:
         for name, values in self.energy.items():
             cols[f"energy_{name}_J"] = values
         return pd.DataFrame(cols)
+
+
+def write_simulation_csv(result: SimResult, path: str | Path, *, blade: str = "",
+                         stance: str | Path = "") -> Path:
+    """Write a simulation as CSV (atomically): ``#`` header lines (blade, stance, engine, time
+    step [s], the joints' K* [N·m/deg] and D* [N·m·s/deg]) and one row per sample
+    (:meth:`SimResult.to_frame`, units in the column names). Read it back with
+    ``pandas.read_csv(path, comment="#")``."""
+    path = Path(path)
+    k_used = np.atleast_1d(JOINT_PARAMETERS["K"].to_edge(result.stiffness))
+    d_used = np.atleast_1d(JOINT_PARAMETERS["D"].to_edge(result.damping))
+    with atomic_open(path, "w", encoding="utf-8", newline="\n") as fh:
+        fh.write("# bladelab simulation\n")
+        fh.write(f"# blade: {blade}\n# stance: {stance}\n# engine: {result.engine}\n")
+        fh.write(f"# dt_s: {result.dt:.6g}\n")
+        for key, used in ((JOINT_PARAMETERS["K"].edge_key, k_used),
+                          (JOINT_PARAMETERS["D"].edge_key, d_used)):
+            fh.write(f"# {key}: " + ",".join(f"{v:.6g}" for v in used) + "\n")
+        result.to_frame().to_csv(fh, index=False, float_format="%.9g")
+    return path
 
 
 @dataclasses.dataclass(frozen=True, eq=False)

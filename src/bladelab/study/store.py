@@ -22,6 +22,7 @@ from typing import Any
 
 import pandas as pd
 
+from bladelab._io import atomic_open
 from bladelab.errors import InputFileError
 from bladelab.identify.quality import QUALITY_COLUMNS
 
@@ -200,3 +201,12 @@ def open_results(study_dir: str | Path) -> pd.DataFrame:
                              hint=f"run `bladelab identify {study_dir} --blade ...` first")
     with ResultsStore(path) as store:
         return store.table()
+
+
+def export_results_csv(study_dir: str | Path, path: str | Path) -> int:
+    """Write a study's results table (every column, units in the names) as CSV to ``path``,
+    atomically; returns the number of rows."""
+    df = open_results(study_dir)
+    with atomic_open(path, "w", encoding="utf-8", newline="") as fh:
+        df.to_csv(fh, index=False)
+    return len(df)

@@ -18,8 +18,9 @@ The lab frame
     bladelab's lab frame is x forward, y lateral, z up. Files differ (the Fukuchi treadmill files
     have y up), so the reader maps the file's axes onto the lab frame with a signed permutation:
     ``up`` defaults to the normal of the first force platform (else the file's +z), its sense
-    taken from the data (the ground reaction force on a loaded plate points up; a warning says
-    when the corners say otherwise); ``forward`` to the direction of overground progression of
+    taken from the markers when they lie clearly above one side of the plate's surface, else
+    from the data (the ground reaction force on a loaded plate points up); a warning says when
+    the corners say otherwise; ``forward`` to the direction of overground progression of
     the markers, or on a treadmill to the direction in which the horizontal force changes from
     braking to propulsion during contact. Both can be given explicitly ("+x", "-y", ...). The
     mapping used is stored in ``trial.metadata["axes"]``.
@@ -132,7 +133,7 @@ def read_c3d(
     )
 
     # file axes -> lab axes
-    up_vec = _choose_up(up, plates_file, path, log)
+    up_vec = _choose_up(up, plates_file, points, path, log)
     fwd_vec = _choose_forward(forward, up_vec, points, plates_file, analog_rate, path)
     lat_vec = np.cross(up_vec, fwd_vec)
     rot = np.vstack([fwd_vec, lat_vec, up_vec])  # lab = rot @ file
@@ -203,18 +204,34 @@ def _snap(v: np.ndarray) -> np.ndarray:
     return out
 
 
-def _choose_up(up: str, plates: list[FilePlate], path, log: WarningLog) -> np.ndarray:
+def _choose_up(up: str, plates: list[FilePlate], points, path, log: WarningLog) -> np.ndarray:
     """The lab's up in file axes; plates whose loaded force points down are inverted.
 
-    Auto: the axis is the first plate's normal (else the file's +z); its sense comes from the
-    data: the ground reaction force on a loaded plate points up (a foot pushes a plate down).
-    The plates with unloaded periods vote (those that never unload when none has any); a tie
-    keeps the corners' sense.
+    Auto: the axis is the first plate's normal (else the file's +z). Its sense comes from the
+    markers when they lie clearly on one side of the plate's surface (median height beyond
+    ``MARKER_SIDE_M``): a subject stands above the plates. Without such markers it comes from
+    the data: the ground reaction force on a loaded plate points up (a foot pushes a plate
+    down); the plates with unloaded periods vote (those that never unload when none has any); a
+    tie keeps the corners' sense.
     """
     if up != "auto":
         up_vec = _axis_vec(up, "up", path)
     elif plates:
         up_vec = _snap(-plates[0].rot[:, 2])  # plate z points down into the plate
+        height = _marker_height(points, plates[0].corners.mean(axis=0), up_vec)
+        if height is not None and abs(height) > MARKER_SIDE_M:
+            if height < 0:
+                p = plates[0]
+                log.warn(
+                    f"its CORNERS make file {_axis_name(_snap(p.rot[:, 2]))} the plate's z axis "
+                    f"(into the plate, i.e. down), but the markers lie along file "
+                    f"{_axis_name(-up_vec)} of its surface (median {abs(height):.2f} m): taking "
+                    f"file {_axis_name(-up_vec)} as up, as the markers say",
+                    file=path, where=p.name,
+                    hint="check the corner order (C3D: z into the plate), or give the up axis (--up)",
+                )
+                up_vec = -up_vec
+            return _invert_downward(plates, up_vec, path, log)
         voters = [p for p in plates if p.loading.status == "unloads"] or [
             p for p in plates if p.loading.sense != 0
         ]
@@ -232,6 +249,25 @@ def _choose_up(up: str, plates: list[FilePlate], path, log: WarningLog) -> np.nd
             up_vec = -up_vec
     else:
         return np.array([0.0, 0.0, 1.0])
+    return _invert_downward(plates, up_vec, path, log)
+
+
+#: Markers whose median height lies farther than this [m] from the first plate's surface give
+#: the vertical sense (a subject stands above the plates).
+MARKER_SIDE_M = 0.1
+
+
+def _marker_height(points: np.ndarray, surface: np.ndarray, up_vec: np.ndarray) -> float | None:
+    """Median height [m] of all marker samples above ``surface`` along ``up_vec`` (None: none)."""
+    if points.size == 0:
+        return None
+    h = np.tensordot(up_vec, points - surface[:, None, None], axes=1).ravel()
+    h = h[np.isfinite(h)]
+    return float(np.median(h)) if h.size else None
+
+
+def _invert_downward(plates: list[FilePlate], up_vec, path, log: WarningLog) -> np.ndarray:
+    """Invert the plates whose loaded vertical force points down along ``up_vec``."""
     for p in plates:
         if p.loading.sense != 0 and _sense_along(p, up_vec) < 0:
             log.warn(

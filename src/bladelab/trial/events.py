@@ -206,12 +206,15 @@ def detect_stances(
     groups = _merge_contacts(trial, contacts, merge_distance)
 
     events: list[StanceEvent] = []
+    partial: list[tuple[tuple[int, ...], int, int]] = []  # dropped contacts at the ends
     for group in groups:
         plates = tuple(sorted({c[0] for c in group}))
         s = min(c[1] for c in group)
         e = max(c[2] for c in group)
         complete = s > 0 and e < n
         if not complete and not include_partial:
+            if s > 0 or e < n:  # a load all along is a zero problem, not a cut contact
+                partial.append((plates, s, e))
             continue
         force, _ = combined_grf(trial, plates)
         fz_f = np.sum([fz_filtered[i] for i in plates], axis=0)
@@ -228,12 +231,26 @@ def detect_stances(
             )
         )
     if not events:
-        raise _no_stance(trial, fz_filtered, threshold, min_duration)
+        raise _no_stance(trial, fz_filtered, threshold, min_duration, partial, rate)
     return events
 
 
-def _no_stance(trial: Trial, fz_filtered: dict[int, np.ndarray], threshold, min_duration) -> DataError:
+def _no_stance(
+    trial: Trial, fz_filtered: dict[int, np.ndarray], threshold, min_duration, partial=(), rate=1.0
+) -> DataError:
     """The error for a trial without stances; its hint follows what the forces look like."""
+    if partial:  # contacts were found, but each touches the start or end of the recording
+        spans = "; ".join(
+            f"platform{'s' if len(pl) > 1 else ''} {', '.join(map(str, pl))}: "
+            f"{s / rate:.2f}–{e / rate:.2f} s" for pl, s, e in partial
+        )
+        return DataError(
+            f"no complete stance: every contact touches the start or end of the recording "
+            f"({spans}, recording 0–{trial.platforms[0].n_samples / rate:.2f} s)",
+            file=trial.source,
+            where="platforms " + ", ".join(str(p.index) for p in trial.platforms),
+            hint="include_partial=True keeps incomplete contacts; or record the whole contact",
+        )
     peak = max(float(np.max(v)) for v in fz_filtered.values())
     low = min(float(np.min(v)) for v in fz_filtered.values())
     message = (

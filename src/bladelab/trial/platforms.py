@@ -24,6 +24,11 @@ Loading, zero offset (``analyse_loading``)
       default) an offset larger than ``ZERO_TOLERANCE_N`` (5 N) is removed from every force and
       moment channel (their medians over the unloaded periods); smaller ones are kept, so a
       zeroed file reads exactly as its acquisition software and ezc3d give it.
+    - *light load*: the candidate unloaded stretches are not steady (their robust spread exceeds
+      max(3 × noise, ``ZERO_TOLERANCE_N``)): something rests on the plate there (the Peak
+      Performance sample FP1 reads 13–50 N before and after its main contact, spread 15 N, noise
+      0.1 N, with the same share on each of its four sensors as at the peak); nothing is removed
+      and a warning names the plate.
     - *never unloads*: no such stretch, or its level lies on the loaded side of zero by more
       than half the load range (a treadmill walker, a plate loaded all along): nothing is
       removed and a warning names the plate.
@@ -77,6 +82,12 @@ class Loading:
     mask: np.ndarray | None
     peak: float
     noise: float
+    spread: float = 0.0  # robust spread (1.4826 · MAD) of the unloaded samples [N]
+
+    @property
+    def steady(self) -> bool:
+        """Whether the unloaded samples stay within ``max(3 × noise, ZERO_TOLERANCE_N)``."""
+        return self.spread <= max(3.0 * self.noise, ZERO_TOLERANCE_N)
 
 
 def _runs(mask: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -124,10 +135,11 @@ def analyse_loading(v: np.ndarray, rate: float) -> Loading:
     if not mask.any():
         mask = candidate
     level = float(np.median(v[mask]))
+    spread = float(1.4826 * np.median(np.abs(v[mask] - level)))
     peak = float(hi if sense > 0 else lo)
     if sense * level > 0.5 * abs(peak - level):  # its "unloaded" level is itself a load
         return _never(finite, noise, level=level)
-    return Loading("unloads", sense, level, mask, peak, noise)
+    return Loading("unloads", sense, level, mask, peak, noise, spread)
 
 
 def _never(finite: np.ndarray, noise: float, level: float | None = None) -> Loading:
@@ -238,6 +250,7 @@ def read_platforms(
             )
         raw = analogs[chans]  # (n_ch, n)
         ch_labels = tuple(labels[c] for c in chans)
+        _warn_clipped(params, analogs, chans, labels, rate, path, where, log)
         ch_units = [units[c] if c < len(units) else "" for c in chans]
         cnr = corners[:, :, k].T * point_scale  # (4, 3) file axes [m]
         rot = plate_rotation(cnr, path, where)
@@ -258,6 +271,48 @@ def read_platforms(
             cop = cnr.mean(axis=0) + (rot @ cop_p).T
         plates.append(FilePlate(index, ptype, force, cop, tz, cnr, rot, ch_labels, rate, loading, removed))
     return plates
+
+
+#: A platform channel at its converter's full scale for at least this many samples is clipped.
+CLIPPED_MIN_SAMPLES = 3
+
+
+def _warn_clipped(params, analogs, chans, labels, rate, path, where, log: WarningLog) -> None:
+    """Warn when a platform channel sits at its converter's full scale (``ANALOG:BITS``).
+
+    The stored count is ``value / (SCALE · GEN_SCALE) + OFFSET``; a signed ``b``-bit converter
+    spans −2^(b−1) … 2^(b−1) − 1 counts, an unsigned one 0 … 2^b − 1. Files without
+    ``ANALOG:BITS`` are not checked.
+    """
+    bits = np.asarray(_param(params, "ANALOG", "BITS", []), dtype=float).ravel()
+    if not bits.size or not 2 <= bits[0] <= 32:
+        return
+    b = int(bits[0])
+    fmt = _param(params, "ANALOG", "FORMAT", [])
+    unsigned = bool(len(fmt)) and str(fmt[0]).strip().upper().startswith("UNSIGNED")
+    lo, hi = (0.0, 2.0**b - 1) if unsigned else (-(2.0 ** (b - 1)), 2.0 ** (b - 1) - 1)
+    scale = np.asarray(_param(params, "ANALOG", "SCALE", []), dtype=float).ravel()
+    offset = np.asarray(_param(params, "ANALOG", "OFFSET", []), dtype=float).ravel()
+    gen = np.asarray(_param(params, "ANALOG", "GEN_SCALE", [1.0]), dtype=float).ravel()
+    gen_scale = float(gen[0]) if gen.size else 1.0
+    for c in chans:
+        sc = (scale[c] if c < scale.size else 1.0) * gen_scale
+        if sc == 0:
+            continue
+        counts = analogs[c] / sc + (offset[c] if c < offset.size else 0.0)
+        with np.errstate(invalid="ignore"):
+            at = np.flatnonzero((counts >= hi - 0.5) | (counts <= lo + 0.5))
+        if at.size < CLIPPED_MIN_SAMPLES:
+            continue
+        full = hi if counts[at[0]] >= hi - 0.5 else lo
+        log.warn(
+            f"analog channel {c + 1} ({labels[c]!r}) sits at the converter's full scale "
+            f"({full:.0f} counts of a {b}-bit converter, ANALOG:BITS) for {at.size} samples "
+            f"({at[0] / rate:.3f}–{at[-1] / rate:.3f} s): the signal is clipped there and the "
+            "platform's forces are lower bounds",
+            file=path, where=where,
+            hint="record with a lower amplifier gain or a wider converter range",
+        )
 
 
 def _remove_offset(raw, ptype, loading: Loading, zero_offset, path, where, log: WarningLog):
@@ -282,6 +337,15 @@ def _remove_offset(raw, ptype, loading: Loading, zero_offset, path, where, log: 
     if abs(loading.level) <= ZERO_TOLERANCE_N or loading.mask is None or not loading.mask.any():
         return raw, 0.0
     if not zero_offset:
+        return raw, 0.0
+    if not loading.steady:
+        log.warn(
+            f"its lowest stretches ({abs(loading.level):.0f} N) wander by {loading.spread:.0f} N "
+            f"(robust spread) against a sample noise of {loading.noise:.1f} N: a light load, not "
+            "an unloaded plate, so no zero offset is removed; its forces are used as the file "
+            "gives them", file=path, where=where,
+            hint="if the plate was not zeroed, zero it in the capture software and re-export",
+        )
         return raw, 0.0
     zeroable = [0, 1, 2, 5] if ptype == 1 else list(range(raw.shape[0]))
     raw = raw.copy()
