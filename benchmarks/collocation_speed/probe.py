@@ -18,7 +18,9 @@ Commands (run from the repository root with ``.venv/bin/python``):
     split of its own time (factorisation, back solves, quasi-Newton update, ...).
     ``--save-tracking`` keeps the tracking stage's solution vector; ``--from-tracking`` starts
     the predictive stage from such a file (no tracking stage), so that predictive-stage
-    variants share one start.
+    variants share one start. ``--ipopt NAME=VALUE`` (repeatable) sets an IPOPT option over
+    the library's own for both stages (``mu_strategy``, ``limited_memory_max_history``,
+    ``mumps_pivtol``, ``mumps_pivot_order``, ...); the record keeps them.
 ``evals``
     Time per call of the NLP functions IPOPT calls (objective, gradient, constraints,
     Jacobian, Hessian of the Lagrangian) as the solver builds them: with ``expand`` (SX
@@ -124,11 +126,28 @@ def _parse_ipopt(text: str) -> dict:
     return out
 
 
+def _ipopt_options(pairs: list[str] | None) -> dict:
+    """``NAME=VALUE`` pairs as CasADi IPOPT options (``ipopt.NAME``), over the library's own;
+    a value is an int, else a float, else a string."""
+    out = {}
+    for pair in pairs or []:
+        name, _, text = pair.partition("=")
+        for kind in (int, float, str):
+            try:
+                out[f"ipopt.{name.strip()}"] = kind(text.strip())
+                break
+            except ValueError:
+                continue
+    return out
+
+
 def _stage(nlp, x0, stage: str, hessian: str, args) -> tuple[dict, object]:
     """Solve one stage with IPOPT's timing statistics written to a file; the stage's record."""
     log = Path(tempfile.gettempdir()) / f"probe-{os.getpid()}-{stage}.ipopt.txt"
     options = {"ipopt.print_timing_statistics": "yes", "ipopt.output_file": str(log),
                "ipopt.file_print_level": 3, "ipopt.max_wall_time": float(args.max_wall_s)}
+    extra = _ipopt_options(args.ipopt)
+    options |= extra
     t0 = time.perf_counter()
     sol = nlp.solve(x0, max_iter=args.max_iter, tol=1e-4, hessian=hessian, options=options,
                     speed=args.speed)
@@ -138,7 +157,7 @@ def _stage(nlp, x0, stage: str, hessian: str, args) -> tuple[dict, object]:
            "iterations": sol.iterations, "wall_s": wall, "build_s": sol.timings.get("build_s"),
            "solve_s": wall - sol.timings.get("build_s", 0.0), "objective": sol.objective,
            "max_violation": sol.max_violation, "maxrss_mb": _maxrss_mb(),
-           "n_vars": nlp.n_vars, "n_cons": nlp.n_cons}
+           "n_vars": nlp.n_vars, "n_cons": nlp.n_cons, "ipopt_options": extra}
     for f in FUNCS:
         key = f.removeprefix("nlp_")
         calls, secs = sol.timings.get(f"calls_{f}", 0.0), sol.timings.get(f"{f}_s", 0.0)
@@ -332,6 +351,8 @@ def main(argv=None) -> int:
                    help="IPOPT's wall-time limit per stage [s]")
     p.add_argument("--save-tracking", type=Path)
     p.add_argument("--from-tracking", type=Path)
+    p.add_argument("--ipopt", action="append", metavar="NAME=VALUE",
+                   help="an IPOPT option for the solves, over the library's (repeatable)")
     p.add_argument("--tracking-only", action="store_true", help="solve the tracking stage only")
     p.add_argument("--stage", default="predictive", choices=("tracking", "predictive"))
     p.add_argument("--expand", action=argparse.BooleanOptionalAction, default=True)
