@@ -221,15 +221,11 @@ def _choose_up(up: str, plates: list[FilePlate], points, path, log: WarningLog) 
         height = _marker_height(points, plates[0].corners.mean(axis=0), up_vec)
         if height is not None and abs(height) > MARKER_SIDE_M:
             if height < 0:
-                p = plates[0]
-                log.warn(
-                    f"its CORNERS make file {_axis_name(_snap(p.rot[:, 2]))} the plate's z axis "
-                    f"(into the plate, i.e. down), but the markers lie along file "
-                    f"{_axis_name(-up_vec)} of its surface (median {abs(height):.2f} m): taking "
-                    f"file {_axis_name(-up_vec)} as up, as the markers say",
-                    file=path, where=p.name,
-                    hint="check the corner order (C3D: z into the plate), or give the up axis (--up)",
-                )
+                _warn_up_flipped(
+                    log, path, plates[0], up_vec,
+                    f"the markers lie along file {_axis_name(-up_vec)} of its surface (median "
+                    f"{abs(height):.2f} m): taking file {_axis_name(-up_vec)} as up, as the "
+                    f"markers say")
                 up_vec = -up_vec
             return _invert_downward(plates, up_vec, path, log)
         voters = [p for p in plates if p.loading.status == "unloads"] or [
@@ -238,18 +234,25 @@ def _choose_up(up: str, plates: list[FilePlate], points, path, log: WarningLog) 
         against = [p for p in voters if _sense_along(p, up_vec) < 0]
         if 2 * len(against) > len(voters):
             p = against[0]
-            log.warn(
-                f"its CORNERS make file {_axis_name(_snap(p.rot[:, 2]))} the plate's z axis (into "
-                f"the plate, i.e. down), but under load its ground reaction force points along "
-                f"file {_axis_name(-up_vec)} (peak {abs(p.loading.peak):.0f} N): taking file "
-                f"{_axis_name(-up_vec)} as up, as the data say (the ground pushes a foot up)",
-                file=path, where=p.name,
-                hint="check the corner order (C3D: z into the plate), or give the up axis (--up)",
-            )
+            _warn_up_flipped(
+                log, path, p, up_vec,
+                f"under load its ground reaction force points along file {_axis_name(-up_vec)} "
+                f"(peak {abs(p.loading.peak):.0f} N): taking file {_axis_name(-up_vec)} as up, "
+                f"as the data say (the ground pushes a foot up)")
             up_vec = -up_vec
     else:
         return np.array([0.0, 0.0, 1.0])
     return _invert_downward(plates, up_vec, path, log)
+
+
+def _warn_up_flipped(log, path, plate, up_vec: np.ndarray, evidence: str) -> None:
+    """Warn that the plate's CORNERS say one up axis and ``evidence`` the other."""
+    log.warn(
+        f"its CORNERS make file {_axis_name(_snap(plate.rot[:, 2]))} the plate's z axis (into the "
+        f"plate, i.e. down), but {evidence}",
+        file=path, where=plate.name,
+        hint="check the corner order (C3D: z into the plate), or give the up axis (--up)",
+    )
 
 
 #: Markers whose median height lies farther than this [m] from the first plate's surface give
