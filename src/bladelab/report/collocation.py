@@ -23,13 +23,9 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from bladelab.datasets import MEASURED_TRIAL_SPEED_M_PER_S
 from bladelab.errors import BladelabError, InputFileError
-from bladelab.predict.collocation.guess import (
-    MEASURED_STATIC,
-    MEASURED_TRIAL,
-    MEASURED_TRIAL_SPEED_M_PER_S,
-    guess_from_trial,
-)
+from bladelab.predict.collocation.guess import measured_trial_guess
 from bladelab.predict.collocation.model import build_collocation_model
 from bladelab.predict.collocation.solution import (
     BEST_ITERATE_KIND,
@@ -156,14 +152,11 @@ def _measured_trial(runner, sol):
     """The measured 3.5 m/s trial's mean stride on ``runner``'s coordinates (a StrideGuess),
     or None where it does not apply (another speed, the trial file absent) or cannot be read."""
     speed = sol.mean_speed_mps
-    if (not MEASURED_TRIAL.is_file()
-            or abs(speed - MEASURED_TRIAL_SPEED_M_PER_S) > TRIAL_SPEED_WINDOW_M_PER_S):
+    if abs(speed - MEASURED_TRIAL_SPEED_M_PER_S) > TRIAL_SPEED_WINDOW_M_PER_S:
         return None
     try:
-        return guess_from_trial(runner, MEASURED_TRIAL, n=100,
-                                static=MEASURED_STATIC if MEASURED_STATIC.is_file() else None,
-                                speed=MEASURED_TRIAL_SPEED_M_PER_S)
-    except BladelabError:
+        return measured_trial_guess(runner, n=100)
+    except BladelabError:  # the trial missing from the installation, or unreadable
         return None
 
 

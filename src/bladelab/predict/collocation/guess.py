@@ -30,8 +30,11 @@ from pathlib import Path
 import numpy as np
 
 from bladelab._io import read_json
-from bladelab.datasets import MEASURED_TRIAL_SPEED_M_PER_S as DATASET_TRIAL_SPEED_M_PER_S
-from bladelab.datasets import measured_running_trial, measured_static_trial
+from bladelab.datasets import (
+    MEASURED_TRIAL_SPEED_M_PER_S,
+    measured_running_trial,
+    measured_static_trial,
+)
 from bladelab.errors import DataError, SpecError
 from bladelab.predict.collocation.stride_guess import StrideGuess, periodic_derivative
 from bladelab.predict.reflex.controller import read_parameters
@@ -49,6 +52,7 @@ __all__ = [
     "guess_from_reflex",
     "guess_from_result",
     "guess_from_trial",
+    "measured_trial_guess",
     "template_guess",
     "template_vertical_grf",
 ]
@@ -155,12 +159,6 @@ def template_vertical_grf(phase: np.ndarray, *, duty: float = 0.34) -> np.ndarra
     return out
 
 
-#: The measured running trial of ``--guess trial`` (Fukuchi et al. 2017, subject RBDS001 at
-#: 3.5 m/s on a treadmill), its standing trial and its speed [m/s]: package data
-#: (:mod:`bladelab.datasets`).
-MEASURED_TRIAL = measured_running_trial()
-MEASURED_STATIC = measured_static_trial()
-MEASURED_TRIAL_SPEED_M_PER_S = DATASET_TRIAL_SPEED_M_PER_S
 
 
 def guess_from_trial(model: RunnerModel, path: str | Path, *, static: str | Path | None = None,
@@ -193,6 +191,15 @@ def guess_from_trial(model: RunnerModel, path: str | Path, *, static: str | Path
     return StrideGuess(f"{Path(path).name}: mean of {len(good)} left-leg cycles at {speed:g} m/s",
                        period, q, periodic_derivative(q, period),
                        vertical_grf_bw=_measured_vertical_grf(trial, good, frac))
+
+
+def measured_trial_guess(model: RunnerModel, *, n: int = 50) -> StrideGuess:
+    """:func:`guess_from_trial` of the measured running trial shipped with bladelab (Fukuchi et
+    al. 2017, subject RBDS001 on a treadmill at
+    :data:`~bladelab.datasets.MEASURED_TRIAL_SPEED_M_PER_S` m/s, its standing trial as the zero
+    posture; :mod:`bladelab.datasets`, which names a missing file) on ``n`` intervals."""
+    return guess_from_trial(model, measured_running_trial(), static=measured_static_trial(),
+                            n=n, speed=MEASURED_TRIAL_SPEED_M_PER_S)
 
 
 def _measured_vertical_grf(trial, cycles, frac: np.ndarray) -> np.ndarray | None:

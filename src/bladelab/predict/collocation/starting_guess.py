@@ -16,11 +16,8 @@ from pathlib import Path
 from bladelab._io import read_json
 from bladelab.errors import InputFileError, SpecError
 from bladelab.predict.collocation.guess import (
-    MEASURED_STATIC,
-    MEASURED_TRIAL,
-    MEASURED_TRIAL_SPEED_M_PER_S,
     guess_from_reflex,
-    guess_from_trial,
+    measured_trial_guess,
     prosthetic_stride_on,
     template_guess,
 )
@@ -59,21 +56,15 @@ def make_guess(runner, guess: str, *, n: int, speed: float | None, where: str = 
     Raises
     ------
     InputFileError
-        ``trial`` without the packaged trial; a file that is neither kind of guess.
+        ``trial`` in an installation that lacks its packaged trial
+        (:mod:`bladelab.datasets` names the file); a file that is neither kind of guess.
     SpecError
         A name that is neither a word nor a file; a solution of an unrelated model.
     """
     if guess == "template":
         return template_guess(runner, speed=speed or MAX_SPEED_TEMPLATE_M_PER_S, n=n)
     if guess == "trial":
-        if not MEASURED_TRIAL.is_file():
-            raise InputFileError("the measured running trial is not there", file=MEASURED_TRIAL,
-                                 where=f"{where} trial",
-                                 hint="bladelab's installation lacks its packaged data: "
-                                      f"reinstall bladelab, or use {where} template")
-        static = MEASURED_STATIC if MEASURED_STATIC.is_file() else None
-        return guess_from_trial(runner, MEASURED_TRIAL, static=static, n=n,
-                                speed=MEASURED_TRIAL_SPEED_M_PER_S)
+        return measured_trial_guess(runner, n=n)
     path = Path(guess)
     if guess_file_kind(path, where=where) == "collocation":
         sol = CollocationSolution.read(path)
