@@ -22,6 +22,7 @@ import typer
 
 from bladelab.cli.collocation import StageProgress
 from bladelab.cli.panels import renamed
+from bladelab.cli.values import parse_list
 from bladelab.errors import BladelabError, SpecError
 from bladelab.predict.collocation.named_runs import sweep_named_models
 
@@ -58,13 +59,8 @@ class SweepProgress:
 
 
 def _speeds(text: str) -> list[float]:
-    try:
-        speeds = [float(t) for t in text.split(",") if t.strip()]
-    except ValueError:
-        raise SpecError(f"cannot read the speeds {text!r}", where="--speeds",
-                        hint="comma-separated speeds in m/s, e.g. 3,3.5,4") from None
-    if not speeds:
-        raise SpecError("no speed given", where="--speeds")
+    speeds = parse_list(text, "--speeds", float,
+                        hint="comma-separated speeds in m/s, e.g. 3,3.5,4")
     bad = [v for v in speeds if not (math.isfinite(v) and v > 0)]
     if bad:
         raise SpecError(f"speeds must be > 0 m/s, got {bad[0]:g}", where="--speeds")
@@ -111,7 +107,7 @@ def run_collocation_sweep(
     """Run ``bladelab sweep --method collocation``; returns the exit status (0 every solve
     converged, 2 some model failed)."""
     speed_list = _speeds(speeds)
-    cats = [c.strip() for c in categories.split(",") if c.strip()]
+    cats = parse_list(categories, "--categories")
     try:
         result = sweep_named_models(
             out, categories=cats, speeds=speed_list, able=able, body=body, guess=guess,

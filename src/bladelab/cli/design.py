@@ -23,6 +23,7 @@ import typer
 from bladelab._io import figure_format
 from bladelab.cli.blade import blade_app
 from bladelab.cli.panels import Panel, PanelGroup, refuse_other_methods, renamed
+from bladelab.cli.values import parse_list
 from bladelab.design import defaults
 from bladelab.errors import BladelabError, SpecError
 
@@ -48,12 +49,8 @@ _FACTORS = ",".join(f"{name}={low:g}:{high:g}" for name, low, high, *_ in defaul
 
 
 def _parse_floats(text: str, what: str) -> list[float]:
-    try:
-        vals = [float(v) for v in text.split(",") if v.strip()]
-    except ValueError:
-        raise SpecError(f"cannot read {text!r} as comma-separated numbers", where=what,
-                        hint="e.g. --alignment 0,-8,8") from None
-    if not vals or not all(math.isfinite(v) for v in vals):
+    vals = parse_list(text, what, float, hint="comma-separated numbers, e.g. --alignment 0,-8,8")
+    if not all(math.isfinite(v) for v in vals):
         raise SpecError(f"no finite numbers in {text!r}", where=what)
     return vals
 

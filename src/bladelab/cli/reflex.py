@@ -14,6 +14,7 @@ from pathlib import Path
 import typer
 
 from bladelab.cli.panels import renamed
+from bladelab.cli.values import parse_list
 from bladelab.errors import BladelabError, SpecError
 from bladelab.predict.reflex.named_runs import (
     check_run_settings,
@@ -23,7 +24,7 @@ from bladelab.predict.reflex.named_runs import (
 from bladelab.predict.reflex.objective import ObjectiveSettings, check_robust_copies
 from bladelab.predict.reflex.sweep import run_sweep
 
-__all__ = ["OPTIONS", "parse_list", "run_recipe_sweep", "run_reflex", "run_reflex_sweep"]
+__all__ = ["OPTIONS", "run_recipe_sweep", "run_reflex", "run_reflex_sweep"]
 
 #: Library argument or ``ObjectiveSettings`` field -> the option that sets it.
 OPTIONS = {
@@ -36,19 +37,6 @@ OPTIONS = {
 }
 _ROBUST_OPTIONS = ("--robust-directions", "--robust-speed-change", "--robust-push",
                    "--duration", "--robust-half-step", "--robust-samples")
-
-
-def parse_list(text: str, what: str, conv=str) -> list:
-    """A comma-separated option value as a list of ``conv`` values; errors name ``what``."""
-    try:
-        items = [conv(t.strip()) for t in text.split(",") if t.strip()]
-    except ValueError:
-        raise SpecError(
-            f"cannot read {what} {text!r}", where=what, hint="comma-separated"
-        ) from None
-    if not items:
-        raise SpecError(f"no {what} given", where=what)
-    return items
 
 
 def run_reflex(*, out: Path, model: str, blade: str | None, speed: float, init: Path | None,
