@@ -35,7 +35,7 @@ from bladelab.design import BladeEvaluator, default_design_space, run_design
 from bladelab.design.plots import write_design_figures
 from bladelab.design.trends import evaluate_trends
 from bladelab.errors import BladelabError
-from bladelab.example.study import make_example_study
+from bladelab.example.study import default_example_dir, make_example_study
 from bladelab.report.design import build_design_report
 from bladelab.report.study import build_study_report
 from bladelab.study import run_study
@@ -173,7 +173,7 @@ def run_example_pipeline(
     ----------
     folder
         Study folder (default ``examples/sprint-study`` under the current folder,
-        :func:`examples_dir`).
+        :func:`~bladelab.example.study.default_example_dir`).
     seed
         Study seed.
     jobs
@@ -186,7 +186,7 @@ def run_example_pipeline(
         Where the step lines go.
     """
     t0 = time.perf_counter()
-    folder = examples_dir() / "sprint-study" if folder is None else Path(folder)
+    folder = default_example_dir() if folder is None else Path(folder)
     made = make_example_study(folder, seed=seed, jobs=jobs, n_trials=n_trials, progress=progress)
     t1 = time.perf_counter()
     echo(f"[1/3] example study {'generated' if made.generated else 'reused'}: {made.folder} "
