@@ -55,8 +55,10 @@ from bladelab.runner.muscle import (
 )
 
 N_STATES = 20
-KINDS = ("able", "amputee-Cat6", "able-toes", "transfemoral")
-MUSCLE_KINDS = ("able", "able-toes")  # the toe body's Achilles tendons are twice as compliant
+KINDS = ("able", "amputee-Cat6", "able-toes", "transfemoral", "able-human", "amputee-human")
+# the toe body's Achilles tendons are twice as compliant; the human body's tendons differ per
+# muscle and its strengths come from a table
+MUSCLE_KINDS = ("able", "able-toes", "able-human")
 SM = Smoothing()
 
 
@@ -68,7 +70,9 @@ def models():
         runner = {"able": lambda: build_runner("able"),
                   "able-toes": lambda: build_runner("able", body="toes"),
                   "amputee-Cat6": lambda: build_runner("amputee", blade="Cat6"),
-                  "transfemoral": lambda: build_runner("transfemoral")}[kind]()
+                  "transfemoral": lambda: build_runner("transfemoral"),
+                  "able-human": lambda: build_runner("able", body="human"),
+                  "amputee-human": lambda: build_runner("amputee", body="human")}[kind]()
         out[kind] = (runner, build_collocation_model(runner))
     return out
 
@@ -396,7 +400,9 @@ def test_fibre_state_and_residual_match_forward_in_motion(models, kind):
         # the tendon curve's softplus changes the tendon compliance by e^{−s/w}/(1 − e^{−s/w})
         v_t = v_mt - v_ce / cos_a
         r = np.exp(-mp[:, MP_TSTRAIN] * np.sqrt(ft) / SM.tendon_strain)
-        np.testing.assert_array_less(np.abs(v_m - v_ce), 1.01 * r / (1 - r) * np.abs(v_t) + 1e-9)
+        # plus 5e-8 m/s: the central difference of dF̃_T/dt above (h = 1e-6) carries round-off
+        # of about that size into the fibre velocity of the stiffest tendons
+        np.testing.assert_array_less(np.abs(v_m - v_ce), 1.01 * r / (1 - r) * np.abs(v_t) + 5e-8)
         # residual of the forward state: forward fibre force minus F̃_T, up to the fits
         forward = np.array([_fibre_force(a[i], ln[i], vn[i], cos_a[i]) for i in range(nm)])
         expected = forward - ft

@@ -19,6 +19,7 @@ from bladelab.runner import (
     contact_heights,
     default_runner_params,
     load_runner_params,
+    runner_params_from_dict,
 )
 
 G = 9.81
@@ -117,8 +118,6 @@ def test_muscle_fmax_equals_table(amputee):
 def test_athlete_scaling():
     data = default_runner_params("amputee").model_dump()
     data["athlete"] = {"body_mass_kg": 70.0, "height_m": 1.70}
-    from bladelab.runner import runner_params_from_dict
-
     r = build_runner(runner_params_from_dict(data))
     assert r.total_mass == pytest.approx(70.0)
     # eq. 2.1 scaled: volume ∝ mass, l_opt ∝ height
@@ -285,3 +284,74 @@ def test_toe_body_keeps_the_mass_and_adds_a_toe_hinge(able):
 def test_unknown_body_is_a_clear_error():
     with pytest.raises(SpecError, match="unknown body 'toe'"):
         build_runner("able", body="toe")
+
+
+# SCONE's H0918 model (tests/data/scone-h0918/H0918.hfd), typed from the file: segment masses
+# [kg] and the leg muscles' maximum isometric forces [N].
+H0918_MASS = {"torso": 34.2366, "pelvis": 11.777, "femur": 9.3014, "tibia": 3.7075, "calcn": 1.25}
+H0918_FMAX = {"hamstrings": 2594, "bifemsh": 804, "glut_max": 1944, "iliopsoas": 2342,
+              "rect_fem": 1169, "vasti": 4530, "gastroc": 2241, "soleus": 3549, "tib_ant": 1759}
+
+
+def test_human_body_is_h0918_scaled_to_a_75_kg_runner():
+    """The ``human`` body: H0918's segment masses and muscle forces scaled to 75 kg and 1.80 m
+    (masses and forces by 75 / 74.53: the height is the table's), a toe segment, compliant
+    Achilles tendons, the knee flexing to 140°."""
+    runner = build_runner("able", body="human")
+    table = H0918_MASS["torso"] + H0918_MASS["pelvis"] + 2 * sum(
+        H0918_MASS[s] for s in ("femur", "tibia", "calcn"))
+    ratio = 75.0 / table
+    assert runner.total_mass == pytest.approx(75.0, rel=1e-12)
+    assert runner.segment_mass("femur_l") == pytest.approx(H0918_MASS["femur"] * ratio)
+    fmax = dict(zip(runner.muscle_names, runner.muscle_params[:, 0], strict=True))
+    for name, force in H0918_FMAX.items():
+        assert fmax[f"{name}_l"] == pytest.approx(force * ratio, rel=1e-12), name
+    strain = dict(zip(runner.muscle_names, runner.muscle_params[:, 4], strict=True))
+    assert strain["soleus_l"] == strain["gastroc_r"] == 0.08
+    assert strain["vasti_l"] == 0.049
+    assert "mtp_angle_l" in runner.dof_names and "toetip_r" in runner.contact_names
+    knee = runner.joint_params[runner.dof("knee_angle_l")]
+    assert math.degrees(knee[0]) == pytest.approx(-140.0)
+
+
+def test_human_body_scales_forces_by_mass_over_height():
+    """Eq. 2.1's scaling holds for table forces too: Fmax ∝ m/h (volume ∝ mass, fibre length
+    ∝ height)."""
+    data = yaml.safe_load(default_runner_params("able", body="human").model_dump_json())
+    data["athlete"] = {"body_mass_kg": 90.0, "height_m": 1.95}
+    runner = build_runner(runner_params_from_dict(data))
+    ref = build_runner("able", body="human")
+    i = runner.muscle_names.index("vasti_l")
+    expected = ref.muscle_params[i, 0] * (90.0 / 75.0) / (1.95 / 1.80)
+    assert runner.muscle_params[i, 0] == pytest.approx(expected, rel=1e-12)
+    assert runner.total_mass == pytest.approx(90.0, rel=1e-12)
+
+
+@pytest.mark.parametrize("kind", ["amputee", "transfemoral"])
+def test_human_body_builds_every_kind(kind):
+    runner = build_runner(kind, body="human")
+    assert "toetip_l" in runner.contact_names and "toetip_r" not in runner.contact_names
+    assert runner.params.knee_flexion_limit_deg == 140.0
+    h = contact_heights(runner, runner.stand_qpos)
+    assert h.min() == pytest.approx(0.0, abs=1e-9)
+
+
+def test_muscle_needs_exactly_one_strength(tmp_path):
+    data = yaml.safe_load(default_runner_params("able").model_dump_json())
+    data["muscle_types"]["vasti"]["max_isometric_force_N"] = 4000.0
+    path = tmp_path / "both.yaml"
+    path.write_text(yaml.safe_dump(data))
+    with pytest.raises(SpecError, match="exactly one of volume_fraction and max_isometric"):
+        load_runner_params(path)
+
+
+def test_foot_contact_law_reaches_the_contact_spheres():
+    """A parameter set's foot law is the one the contact rows carry (Hertz k = 4/3·E·√R)."""
+    data = yaml.safe_load(default_runner_params("able").model_dump_json())
+    data["foot_contact"] = {"plane_strain_modulus_N_per_m2": 1.0e6, "dissipation_s_per_m": 2.0,
+                            "friction": 0.8}
+    runner = build_runner(runner_params_from_dict(data))
+    row = runner.contact_params[runner.contact_names.index("heel_l")]
+    radius = row[2]
+    assert row[3] == pytest.approx(4.0 / 3.0 * 1.0e6 * math.sqrt(radius), rel=1e-12)
+    assert (row[4], row[5]) == (2.0, 0.8)

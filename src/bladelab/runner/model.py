@@ -47,9 +47,6 @@ from bladelab.runner.params import (
     BLADE_OFFSET_A_M,
     BLADE_OFFSET_B_M,
     BLADE_RADIUS_M,
-    FOOT_DISSIPATION_S_PER_M,
-    FOOT_FRICTION,
-    FOOT_PLANE_STRAIN_MODULUS,
     PROSTHETIC_KINDS,
     RunnerParams,
     blade_contact_modulus,
@@ -62,7 +59,8 @@ from bladelab.runner.params import (
 
 # Ligaments (joint-limit springs–dampers): (lower, upper) [deg], stiffness [N·m/rad],
 # damping [N·m·s/rad]. Hip and ankle ranges and the knee's stiffness/damping from H0918; the knee
-# range (−90°, 0°) and the soft lumbar limit at 0° from seed 001 §2.1.
+# range (−90°, 0°) and the soft lumbar limit at 0° from seed 001 §2.1 (the knee's flexion limit
+# is the parameter set's ``knee_flexion_limit_deg``).
 LIGAMENTS: dict[str, tuple[float, float, float, float]] = {
     "hip_flexion": (-40.0, 120.0, 500.0, 5.0),
     "knee_angle": (-90.0, 0.0, 114.592, 2.86479),
@@ -255,8 +253,8 @@ def build_runner(
         and D*) instead of the category's contact sphere (amputee only; see
         :mod:`bladelab.runner.multilink`; needs a step of about 1e-4 s).
     body
-        The body of a built-in parameter set named by ``params``: ``"seed001"`` or ``"toes"``
-        (:data:`bladelab.runner.params.BODIES`).
+        The body of a built-in parameter set named by ``params``: ``"seed001"``, ``"toes"``
+        or ``"human"`` (:data:`bladelab.runner.params.BODIES`).
     """
     if isinstance(params, str):
         params = default_runner_params(params, blade=blade, body=body)
@@ -432,12 +430,12 @@ def build_runner(
     for side, leg in (("l", 0), ("r", 1)):
         if side == "r" and prosthetic:
             continue
+        law = params.foot_contact
+        foot_law = (law.plane_strain_modulus_N_per_m2, law.dissipation_s_per_m, law.friction)
         for sph in geo.FOOT_SPHERES:
-            sphere(f"{sph}_{side}", geo.FOOT_SPHERE_RADIUS_M * s, FOOT_PLANE_STRAIN_MODULUS,
-                   FOOT_DISSIPATION_S_PER_M, FOOT_FRICTION, leg, 0)
+            sphere(f"{sph}_{side}", geo.FOOT_SPHERE_RADIUS_M * s, *foot_law, leg, 0)
         if params.foot == "toes":
-            sphere(f"toetip_{side}", TOETIP_RADIUS_M * s, FOOT_PLANE_STRAIN_MODULUS,
-                   FOOT_DISSIPATION_S_PER_M, FOOT_FRICTION, leg, 0)
+            sphere(f"toetip_{side}", TOETIP_RADIUS_M * s, *foot_law, leg, 0)
     e_blade = math.nan
     if prosthetic and blade_model is not None:
         for i, row in enumerate(multilink_contact_rows(model, blade_model)):
@@ -455,6 +453,8 @@ def build_runner(
         base = dn[:-2] if dn.endswith(("_l", "_r")) else dn
         if base in LIGAMENTS:
             lo, hi, k, d = LIGAMENTS[base]
+            if base == "knee_angle":
+                lo = -params.knee_flexion_limit_deg
             jp[i, :4] = (math.radians(lo), math.radians(hi), k, d)
         if base == "mtp_angle":
             jp[i, JP_SK:] = (MTP_STIFFNESS, 0.0, MTP_DAMPING, MTP_DAMPING)

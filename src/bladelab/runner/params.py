@@ -18,7 +18,14 @@ from pathlib import Path
 from typing import Literal
 
 import yaml
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
+from pydantic import (
+    BaseModel,
+    ConfigDict,
+    Field,
+    ValidationError,
+    field_validator,
+    model_validator,
+)
 
 from bladelab._io import read_yaml
 from bladelab.contact import hertz_sphere_stiffness
@@ -73,15 +80,39 @@ class Segment(_Strict):
 
 
 class MuscleType(_Strict):
-    """Muscle–tendon parameters of seed 001 Table 2.2 (lengths in m, pennation in rad)."""
+    """Muscle–tendon parameters of one muscle type (lengths in m, pennation in rad).
 
-    volume_fraction: float = Field(gt=0, lt=1)
+    The strength is either a share of the total muscle volume (``volume_fraction``, seed 001
+    eq. 2.1 with the set's specific tension) or the maximum isometric force of a published
+    model (``max_isometric_force_N``, for the parameter set's own segment table; scaled to the
+    athlete as eq. 2.1 scales: by the mass ratio over the length ratio). Exactly one is given.
+    """
+
+    volume_fraction: float | None = Field(default=None, gt=0, lt=1)
+    max_isometric_force_N: float | None = Field(default=None, gt=0)
     optimal_fiber_length_m: float = Field(gt=0)
     tendon_slack_length_m: float = Field(gt=0)
     pennation_rad: float = Field(ge=0, lt=1.2)
     #: Tendon strain at Fmax [-] (the tendon curve is ``(ε/ε_ref)²``). Default: Geyer & Herr
     #: (2010)'s 4 %, which seed 001's model uses for every muscle.
     tendon_strain_at_fmax: float = Field(default=0.04, gt=0.005, lt=0.2)
+
+    @model_validator(mode="after")
+    def _one_strength(self) -> MuscleType:
+        if (self.volume_fraction is None) == (self.max_isometric_force_N is None):
+            raise ValueError("give exactly one of volume_fraction and max_isometric_force_N")
+        return self
+
+
+class FootContact(_Strict):
+    """The Hunt–Crossley law of the foot's contact spheres (heel, ball, toe tip)."""
+
+    #: Plane-strain modulus E [N/m²] of the Hertz law ``F = 4/3·E·√R·δ^1.5``.
+    plane_strain_modulus_N_per_m2: float = Field(default=FOOT_PLANE_STRAIN_MODULUS, gt=0)
+    #: Hunt–Crossley dissipation c [s/m].
+    dissipation_s_per_m: float = Field(default=FOOT_DISSIPATION_S_PER_M, ge=0)
+    #: Friction coefficient [-].
+    friction: float = Field(default=FOOT_FRICTION, gt=0)
 
 
 #: The model kinds: seed 001's able-bodied and transtibial ("amputee") runners, and the
@@ -119,6 +150,11 @@ class RunnerParams(_Strict):
     #: ``"toes"`` (a toe segment on a passive metatarsophalangeal hinge, with a toe-tip sphere;
     #: docs/runner-model.md, "The toe segment"). Changes the model's coordinates.
     foot: Literal["rigid", "toes"] = "rigid"
+    #: The foot's contact law.
+    foot_contact: FootContact = Field(default_factory=FootContact)
+    #: Flexion [deg] at which the knee ligament engages: seed 001's 90°; people flex the knee
+    #: to about 140° (the swing of sprinting comes close to it).
+    knee_flexion_limit_deg: float = Field(default=90.0, gt=30.0, le=170.0)
     #: The prosthetic knee of the transfemoral runner (ignored by the other kinds).
     prosthetic_knee: ProstheticKnee = Field(default_factory=ProstheticKnee)
 
@@ -205,9 +241,12 @@ def blade_modulus(
 
 
 def muscle_max_force(params: RunnerParams, muscle_type: str) -> float:
-    """Fmax [N] of a muscle type by seed 001 eq. 2.1, for the (scaled) athlete."""
+    """Fmax [N] of a muscle type for the (scaled) athlete: seed 001 eq. 2.1 from its volume
+    fraction, or its table force times the mass ratio over the length ratio."""
     mt = params.muscle_types[muscle_type]
     mass_ratio, length_ratio = scale_ratios(params)
+    if mt.max_isometric_force_N is not None:
+        return mt.max_isometric_force_N * mass_ratio / length_ratio
     volume = params.total_muscle_volume_cm3 * mass_ratio
     l_opt_cm = mt.optimal_fiber_length_m * length_ratio * 100.0
     return params.specific_tension_N_per_cm2 * mt.volume_fraction * volume / l_opt_cm
@@ -286,11 +325,14 @@ def load_runner_params(path: str | Path) -> RunnerParams:
     return runner_params_from_dict(data, source=str(path))
 
 
-#: Named bodies of the built-in parameter sets. ``seed001``: seed 001's model as published
-#: (rigid foot, every tendon at 4 % strain at Fmax). ``toes``: the same body with a toe segment
-#: on a passive metatarsophalangeal hinge and triceps-surae (Achilles) tendons at 8 % strain at
-#: Fmax (docs/runner-model.md, "The toe segment and the Achilles tendon").
-BODIES = ("seed001", "toes")
+#: Named bodies of the built-in parameter sets. ``human``: segments and leg
+#: muscles of SCONE's H0918 gait model (gait10dof18musc), tendons as compliant as people's, a
+#: toe segment, the knee flexing to 140° (``bladelab/data/runner/human/``;
+#: docs/runner-model.md, "The human body"). ``seed001``: seed 001's model as published (rigid
+#: foot, every tendon at 4 % strain at Fmax). ``toes``: seed 001's body with a toe segment on a
+#: passive metatarsophalangeal hinge and triceps-surae (Achilles) tendons at 8 % strain at Fmax
+#: (docs/runner-model.md, "The toe segment and the Achilles tendon").
+BODIES = ("human", "seed001", "toes")
 #: Tendon strain at Fmax [-] of the ``toes`` body, per muscle type (others keep 4 %).
 TOES_BODY_TENDON_STRAIN = {"soleus": 0.08, "gastroc": 0.08}
 
@@ -298,15 +340,15 @@ TOES_BODY_TENDON_STRAIN = {"soleus": 0.08, "gastroc": 0.08}
 def default_runner_params(
     kind: str = "amputee", *, blade: str | None = None, body: str = "seed001"
 ) -> RunnerParams:
-    """The built-in parameter set ``able`` or ``amputee`` (seed 001) or ``transfemoral`` (seed
-    002's athlete), optionally another blade and another body (:data:`BODIES`)."""
+    """The built-in parameter set of a model kind (``able``, ``amputee`` or ``transfemoral``)
+    with a body of :data:`BODIES`, optionally wearing another blade category."""
     if kind not in KINDS:
         raise SpecError(f"unknown model {kind!r}", where="model",
                         hint="use " + ", ".join(repr(k) for k in KINDS))
     if body not in BODIES:
         raise SpecError(f"unknown body {body!r}", where="body", hint=" or ".join(BODIES))
-    text = (RUNNER_DATA_DIR / f"{kind}.yaml").read_text()
-    data = yaml.safe_load(text)
+    folder = RUNNER_DATA_DIR / "human" if body == "human" else RUNNER_DATA_DIR
+    data = yaml.safe_load((folder / f"{kind}.yaml").read_text())
     if blade is not None:
         data["blade"] = blade
     if body == "toes":
@@ -331,6 +373,7 @@ def hertz_compression(force_n: float, modulus: float, radius: float) -> float:
 
 __all__ = [
     "BODIES",
+    "FootContact",
     "KINDS",
     "PROSTHETIC_KINDS",
     "RUNNER_DATA_DIR",

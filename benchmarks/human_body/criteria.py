@@ -1,0 +1,45 @@
+"""Print a stored stride against measured human running, criterion by criterion.
+
+Usage (repository root): ``.venv/bin/python benchmarks/human_body/criteria.py FOLDER...``; each
+FOLDER holds a ``solution.json`` (or ``best_iterate.json``) of ``bladelab predict --method
+collocation``. One block per folder, then one JSON line (``--json``) per folder.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+
+from bladelab.predict.collocation.human_running import human_running_criteria
+from bladelab.predict.collocation.solution import CollocationSolution
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser()
+    ap.add_argument("folders", nargs="+", type=Path)
+    ap.add_argument("--json", action="store_true")
+    args = ap.parse_args()
+    for folder in args.folders:
+        path = folder / "solution.json"
+        if not path.is_file():
+            path = folder / "best_iterate.json"
+        sol = CollocationSolution.read(path)
+        crit = human_running_criteria(sol)
+        s = sol.summary()
+        if args.json:
+            print(json.dumps({"folder": str(folder), "summary": s,
+                              "criteria": [c.to_dict() for c in crit]}))
+            continue
+        print(f"== {folder} ({path.name}): converged {s['converged']}, "
+              f"{s['mean_speed_mps']:.2f} m/s, residual {s['dynamics_residual_pct']:.2f} %, "
+              f"{s['iterations']} iterations, {s['wall_s']:.0f} s, "
+              f"{sum(c.met for c in crit)}/{len(crit)} criteria met")
+        for c in crit:
+            print("  " + c.line())
+        if s["warnings"]:
+            print("  warnings: " + s["warnings"])
+
+
+if __name__ == "__main__":
+    main()
