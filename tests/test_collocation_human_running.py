@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 from bladelab.predict.collocation.human_running import (
+    angle_agreement,
     human_running_criteria,
     reference_band,
 )
@@ -23,10 +24,10 @@ def _stride(*, speed=3.5, contact=(0.24, 0.24), peak_bw=(2.5, 2.5), period=0.70,
     """A stand-in for a CollocationSolution with the numbers the criteria read."""
     weight = 75.0 * 9.81
     legs = ("left", "right") if model == "able" else ("intact", "prosthetic")
-    q = np.zeros((len(DOFS), 51))
-    q[DOFS.index("pelvis_tilt")] = math.radians(tilt_deg)
-    q[DOFS.index("knee_angle_l"), 20] = -math.radians(knee_deg[0])
-    q[DOFS.index("knee_angle_r"), 40] = -math.radians(knee_deg[1])
+    q = np.zeros((51, len(DOFS)))  # (nodes, coordinates)
+    q[:, DOFS.index("pelvis_tilt")] = math.radians(tilt_deg)
+    q[20, DOFS.index("knee_angle_l")] = -math.radians(knee_deg[0])
+    q[40, DOFS.index("knee_angle_r")] = -math.radians(knee_deg[1])
     phases = {"legs": {leg: {"contact_time_s": c, "contacts": n,
                              "peak_vertical_grf_N": p * weight}
                        for leg, c, n, p in zip(legs, contact, contacts, peak_bw, strict=True)},
@@ -84,3 +85,35 @@ def test_fast_strides_have_no_cost_band_and_say_when_a_band_is_held():
                                           period=0.45, knee_deg=(120, 120)))
     assert "gross cost of transport" not in {c.name for c in crit}
     assert "band held from 9 m/s" in next(c for c in crit if c.name == "stride time").line()
+
+
+def test_angle_agreement_is_zero_for_the_measured_stride_and_sees_an_offset():
+    """The stride rolled to its left touch-down against the same angles: RMSE 0, knee r = 1;
+    the knee 20° more flexed: RMSE 20° (outside 15°), correlation still 1."""
+    n = 50
+    pct = np.linspace(0.0, 1.0, n + 1)
+    measured = np.zeros((n + 1, len(DOFS)))
+    for name, amp in (("hip_flexion_l", 30.0), ("knee_angle_l", -50.0), ("hip_flexion_r", 30.0),
+                      ("knee_angle_r", -50.0)):
+        phase = 0.0 if name.endswith("_l") else 0.5
+        measured[:, DOFS.index(name)] = np.radians(amp * (1 - np.cos(2 * np.pi * (pct - phase))))
+    shift = 10  # the left leg lands at node 10 of the solved stride
+    q = np.vstack([np.roll(measured[:-1], shift, axis=0)] * 1)
+    q = np.vstack([q, q[:1]])
+    fz = np.zeros((n + 1, 2))
+    fz[shift:shift + 12, 0] = 1000.0
+    sol = _stride()
+    sol.nlp.q = q
+    sol.leg_vertical_force = lambda: fz
+    crit = {c.name: c for c in angle_agreement(sol, measured, 20.0)}
+    assert crit["knee flexion RMSE against the measured stride, left leg"].value == pytest.approx(
+        0.0, abs=1e-9)
+    assert crit["knee flexion correlation with the measured stride, left leg"].value == (
+        pytest.approx(1.0))
+    sol.nlp.q = q.copy()
+    sol.nlp.q[:, DOFS.index("knee_angle_l")] -= np.radians(20.0)
+    crit = {c.name: c for c in angle_agreement(sol, measured, 20.0)}
+    knee = crit["knee flexion RMSE against the measured stride, left leg"]
+    assert knee.value == pytest.approx(20.0) and not knee.met
+    assert crit["knee flexion correlation with the measured stride, left leg"].met
+    assert "ankle dorsiflexion RMSE against the measured stride, left leg" not in crit  # no ankle

@@ -334,9 +334,10 @@ def test_activation_rate_matches_forward(models):
         np.testing.assert_allclose(smooth, forward, rtol=0, atol=ADOT_ERROR + 1e-6)
 
 
-def _fibre_force(a, ln, vn, cos_a):
-    """The forward model's normalised fibre force along the tendon."""
-    return (a * force_length(ln) * force_velocity(vn) + passive_force(ln)
+def _fibre_force(a, ln, vn, cos_a, strength=1.0):
+    """The forward model's normalised fibre force along the tendon (``strength``: the
+    muscle's active strength)."""
+    return (strength * a * force_length(ln) * force_velocity(vn) + passive_force(ln)
             + FIBER_DAMPING * vn) * cos_a
 
 
@@ -356,13 +357,13 @@ def test_static_equilibrium_tendon_force_matches_forward(models, kind):
     for _ in range(N_STATES):
         a, ln = rng.uniform(0.1, 1.0, nm), rng.uniform(0.6, 1.5, nm)
         l_mt = np.zeros(nm)
-        for i, (_, l_opt, l_ts, penn, eref) in enumerate(mp):
+        for i, (_, l_opt, l_ts, penn, eref, _) in enumerate(mp):
             cos_a = np.sqrt(1.0 - (np.sin(penn) / ln[i]) ** 2)
-            f = _fibre_force(a[i], ln[i], 0.0, cos_a)
+            f = _fibre_force(a[i], ln[i], 0.0, cos_a, mp[i, 5])
             l_mt[i] = ln[i] * l_opt * cos_a + l_ts * (1.0 + eref * np.sqrt(f))
         forward = np.array([
             tendon_force_of_state(l_mt[i], equilibrium_fiber_length(l_mt[i], a[i], *mp[i, 1:]),
-                                  *mp[i]) / mp[i, 0] for i in range(nm)])
+                                  *mp[i, :5]) / mp[i, 0] for i in range(nm)])
         dg = _np(solve(forward, np.concatenate([a, l_mt]))).ravel()
         assert np.abs(_np(cm.muscle_residual(a, dg, 0.0, l_mt, 0.0))).max() < 1e-10
         excess = np.abs(dg - forward) - (EQ_ERROR[0] * forward + EQ_ERROR[1])
@@ -384,15 +385,15 @@ def test_fibre_state_and_residual_match_forward_in_motion(models, kind):
         vn = rng.uniform(-0.9, 0.9, nm)
         v_mt = rng.uniform(-0.5, 0.5, nm)
         l_ce, v_ce, l_mt, ft, dft, cos_a = (np.zeros(nm) for _ in range(6))
-        for i, (fmax, l_opt, l_ts, penn, eref) in enumerate(mp):
+        for i, (fmax, l_opt, l_ts, penn, eref, _) in enumerate(mp):
             cos_a[i] = np.sqrt(1.0 - (np.sin(penn) / ln[i]) ** 2)
-            f = max(_fibre_force(a[i], ln[i], vn[i], cos_a[i]), 0.05)  # a taut tendon
+            f = max(_fibre_force(a[i], ln[i], vn[i], cos_a[i], mp[i, 5]), 0.05)  # taut tendon
             l_ce[i], v_ce[i] = ln[i] * l_opt, vn[i] * 10.0 * l_opt
             l_mt[i] = l_ce[i] * cos_a[i] + l_ts * (1.0 + eref * np.sqrt(f))
-            ft[i] = tendon_force_of_state(l_mt[i], l_ce[i], *mp[i]) / fmax
+            ft[i] = tendon_force_of_state(l_mt[i], l_ce[i], *mp[i, :5]) / fmax
             h = 1e-6
-            hi = tendon_force_of_state(l_mt[i] + h * v_mt[i], l_ce[i] + h * v_ce[i], *mp[i])
-            lo = tendon_force_of_state(l_mt[i] - h * v_mt[i], l_ce[i] - h * v_ce[i], *mp[i])
+            hi = tendon_force_of_state(l_mt[i] + h * v_mt[i], l_ce[i] + h * v_ce[i], *mp[i, :5])
+            lo = tendon_force_of_state(l_mt[i] - h * v_mt[i], l_ce[i] - h * v_ce[i], *mp[i, :5])
             dft[i] = (hi - lo) / (2 * h * fmax)
         l_m, v_m, cos_m = (_np(x).ravel() for x in cm.fiber(l_mt, v_mt, ft, dft))
         np.testing.assert_allclose(l_m, l_ce, rtol=1e-5)
@@ -404,10 +405,11 @@ def test_fibre_state_and_residual_match_forward_in_motion(models, kind):
         # of about that size into the fibre velocity of the stiffest tendons
         np.testing.assert_array_less(np.abs(v_m - v_ce), 1.01 * r / (1 - r) * np.abs(v_t) + 5e-8)
         # residual of the forward state: forward fibre force minus F̃_T, up to the fits
-        forward = np.array([_fibre_force(a[i], ln[i], vn[i], cos_a[i]) for i in range(nm)])
+        forward = np.array([_fibre_force(a[i], ln[i], vn[i], cos_a[i], mp[i, 5])
+                            for i in range(nm)])
         expected = forward - ft
         res = _np(cm.muscle_residual(a, ft, dft, l_mt, v_mt)).ravel()
-        bound = a * FV_ERROR + FP_ERROR + 1e-4
+        bound = mp[:, 5] * a * FV_ERROR + FP_ERROR + 1e-4  # the fit error of the active force
         assert np.all(np.abs(res - expected) <= bound), np.abs(res - expected).max()
 
 

@@ -295,8 +295,8 @@ H0918_FMAX = {"hamstrings": 2594, "bifemsh": 804, "glut_max": 1944, "iliopsoas":
 
 def test_human_body_is_h0918_scaled_to_a_75_kg_runner():
     """The ``human`` body: H0918's segment masses and muscle forces scaled to 75 kg and 1.80 m
-    (masses and forces by 75 / 74.53: the height is the table's), a toe segment, compliant
-    Achilles tendons, the knee flexing to 140°."""
+    (masses and forces by 75 / 74.53: the height is the table's), a stronger active force, a
+    toe segment, compliant Achilles tendons, the knee flexing to 140°."""
     runner = build_runner("able", body="human")
     table = H0918_MASS["torso"] + H0918_MASS["pelvis"] + 2 * sum(
         H0918_MASS[s] for s in ("femur", "tibia", "calcn"))
@@ -309,6 +309,9 @@ def test_human_body_is_h0918_scaled_to_a_75_kg_runner():
     strain = dict(zip(runner.muscle_names, runner.muscle_params[:, 4], strict=True))
     assert strain["soleus_l"] == strain["gastroc_r"] == 0.08
     assert strain["vasti_l"] == 0.049
+    # active force at Rajagopal et al. 2016's 60 N/cm² over the table's 25 N/cm²
+    np.testing.assert_allclose(runner.muscle_params[:, 5], 60.0 / 25.0, rtol=1e-15)
+    assert set(build_runner("able").muscle_params[:, 5]) == {1.0}  # seed 001: none
     assert "mtp_angle_l" in runner.dof_names and "toetip_r" in runner.contact_names
     knee = runner.joint_params[runner.dof("knee_angle_l")]
     assert math.degrees(knee[0]) == pytest.approx(-140.0)

@@ -38,12 +38,38 @@ def test_isometric_maximal_force_is_fmax_cos_pennation():
     assert tendon_force_of_state(l_mtu, l_ce, fmax, l_opt, l_ts, penn) == pytest.approx(
         fmax * math.cos(penn), rel=1e-3
     )
-    mp = np.array([[fmax, l_opt, l_ts, penn, 0.04]])
+    mp = np.array([[fmax, l_opt, l_ts, penn, 0.04, 1.0]])
     ms = np.array([[1.0, l_ce, 0.0, 0.0]])
     for _ in range(200):  # held isometric: stays in equilibrium
         muscle_step(mp, ms, np.array([l_mtu]), np.array([1.0]), 5e-4)
     assert ms[0, 3] == pytest.approx(fmax * math.cos(penn), rel=1e-3)
     assert abs(ms[0, 2]) < 1e-6
+
+
+def test_active_strength_scales_the_active_force_only():
+    """With active strength 2.5, activation 0.4 holds the fibre at l_opt against the same
+    tendon force as activation 1 at strength 1; the passive and tendon curves are unchanged
+    (an inactive, stretched muscle carries the same force at either strength)."""
+    fmax, l_opt, l_ts, penn, strength = 3000.0, 0.06, 0.39, 0.3, 2.5
+    strain = 0.04 * math.sqrt(math.cos(penn))
+    l_mtu = l_opt * math.cos(penn) + l_ts * (1 + strain)
+    l_ce = equilibrium_fiber_length(l_mtu, 1.0 / strength, l_opt, l_ts, penn, 0.04, strength)
+    assert l_ce == pytest.approx(l_opt, rel=1e-4)
+    forces = []
+    for s in (1.0, strength):
+        mp = np.array([[fmax, l_opt, l_ts, penn, 0.04, s]])
+        ms = np.array([[0.4, l_ce, 0.0, 0.0]])
+        for _ in range(400):
+            muscle_step(mp, ms, np.array([l_mtu]), np.array([0.4]), 5e-4)
+        forces.append(ms[0, 3])
+    assert forces[1] == pytest.approx(fmax * math.cos(penn), rel=1e-3)  # 2.5 x 0.4 = 1
+    assert forces[0] < 0.6 * forces[1]
+    stretched = l_opt * 1.3 * math.cos(penn) + l_ts  # a slack-ish tendon, fibre stretched
+    passive = [equilibrium_fiber_length(stretched, 0.01, l_opt, l_ts, penn, 0.04, s)
+               for s in (1.0, 50.0)]
+    assert passive[1] < passive[0]  # stronger active part at a = 0.01: shorter fibre
+    assert equilibrium_fiber_length(stretched, 0.0, l_opt, l_ts, penn, 0.04, 50.0) == (
+        pytest.approx(equilibrium_fiber_length(stretched, 0.0, l_opt, l_ts, penn, 0.04, 1.0)))
 
 
 def test_force_velocity_shape():

@@ -199,8 +199,9 @@ def register(app: typer.Typer) -> None:
             help="Print the summary as one JSON object."),
         body: str = typer.Option(
             defaults.BODY, "--body", rich_help_panel=COLLOCATION,
-            help="seed001 (seed 001's model) | toes (a toe segment and compliant Achilles "
-                 "tendons; docs/runner-model.md)."),
+            help="human (H0918's segments and muscles, compliant Achilles, toes, soft heel "
+                 "pad) | seed001 (seed 001's model) | toes (seed 001's with a toe segment and "
+                 "compliant Achilles tendons); docs/runner-model.md."),
         swing_clearance: float = typer.Option(
             0.0, "--swing-clearance", rich_help_panel=COLLOCATION,
             help="Keep every swinging foot or blade this high above the ground [m] (0: no "
@@ -341,8 +342,9 @@ def register(app: typer.Typer) -> None:
                  "template, previous-but-one solution) and keep the best."),
         body: str = typer.Option(
             defaults.BODY, "--body", rich_help_panel=COLLOCATION,
-            help="seed001 (seed 001's model) | toes (a toe segment and compliant Achilles "
-                 "tendons)."),
+            help="human (H0918's segments and muscles, compliant Achilles, toes, soft heel "
+                 "pad) | seed001 (seed 001's model) | toes (seed 001's with a toe segment and "
+                 "compliant Achilles tendons)."),
     ) -> None:
         """Category × speed grid: warm-started optimisations, maximum speed, cost at 4 m/s,
         200 m and 400 m times, contact times (seed 001 §2.2.2 B–C, Table 3.1). Running it again

@@ -26,6 +26,12 @@ import pandas as pd
 from bladelab.datasets import MEASURED_TRIAL_SPEED_M_PER_S
 from bladelab.errors import BladelabError, InputFileError
 from bladelab.predict.collocation.guess import measured_trial_guess
+from bladelab.predict.collocation.human_running import (
+    COMPARED_JOINTS,
+    angle_agreement,
+    human_running_criteria,
+    stride_from_left_touchdown,
+)
 from bladelab.predict.collocation.model import build_collocation_model
 from bladelab.predict.collocation.solution import (
     BEST_ITERATE_KIND,
@@ -100,20 +106,8 @@ def _grf_figure(sol):
     return fig
 
 
-#: Joints of the comparison with the measured trial: (coordinate base, label, sign) — the
-#: knee drawn as flexion (positive), as gait plots show it.
-TRIAL_JOINTS = (("hip_flexion", "hip flexion", 1.0), ("knee_angle", "knee flexion", -1.0),
-                ("ankle_angle", "ankle dorsiflexion", 1.0))
 #: Speeds [m/s] within which the measured 3.5 m/s trial is drawn beside a solution.
 TRIAL_SPEED_WINDOW_M_PER_S = 0.51
-
-
-def _from_left_touchdown(sol) -> int:
-    """Node index of the left/intact leg's touch-down (first loaded node after an unloaded one)
-    in the periodic stride; 0 if the leg is never unloaded."""
-    loaded = sol.leg_vertical_force()[:-1, 0] > CONTACT_THRESHOLD_N
-    starts = np.flatnonzero(loaded & ~np.roll(loaded, 1))
-    return int(starts[0]) if starts.size else 0
 
 
 def _trial_figure(sol, runner, trial):
@@ -122,14 +116,12 @@ def _trial_figure(sol, runner, trial):
     import matplotlib.pyplot as plt
 
     n = sol.nlp.q.shape[0] - 1
-    k0 = _from_left_touchdown(sol)
-    rolled = np.roll(sol.nlp.q[:-1], -k0, axis=0)
-    q_sol = np.vstack([rolled, rolled[:1]])  # periodic: the last node is the first
+    q_sol = stride_from_left_touchdown(sol, CONTACT_THRESHOLD_N)
     pct_sol = np.linspace(0.0, 100.0, n + 1)
     pct_trial = np.linspace(0.0, 100.0, trial.q.shape[0])
     fig, axes = plt.subplots(2, 3, figsize=(10, 5.2), sharex=True)
     for row, (side, leg) in enumerate((("l", sol.leg_names[0]), ("r", sol.leg_names[1]))):
-        for col, (base, label, sign) in enumerate(TRIAL_JOINTS):
+        for col, (base, label, sign) in enumerate(COMPARED_JOINTS):
             ax = axes[row, col]
             name = f"{base}_{side}"
             ax.set_title(f"{leg} leg: {label}", fontsize=9)
@@ -158,6 +150,33 @@ def _measured_trial(runner, sol):
         return measured_trial_guess(runner, n=100)
     except BladelabError:  # the trial missing from the installation, or unreadable
         return None
+
+
+def _add_human_running_section(report, sol, trial) -> None:
+    """The stride against measured human running, criterion by criterion (the report's first
+    words about a gait)."""
+    crit = human_running_criteria(sol)
+    if trial is not None:
+        crit += angle_agreement(sol, trial.q, CONTACT_THRESHOLD_N)
+    outside = [c for c in crit if not c.met]
+    verdict = (f"This stride is outside measured human running on {len(outside)} of "
+               f"{len(crit)} criteria: " + "; ".join(
+                   f"{c.name} {c.value_text()} (people: {c.band_text()})" for c in outside)
+               + "."
+               if outside else f"This stride is within measured human running on all "
+               f"{len(crit)} criteria.")
+    table = pd.DataFrame([{"criterion": c.name, "value": c.value, "unit": c.unit,
+                           "people": c.band_text(), "met": "yes" if c.met else "NO",
+                           "note": c.note} for c in crit])
+    report.add_section(
+        "Against measured human running",
+        text=(verdict + " Bands: people at this speed (bladelab.predict.collocation."
+              "human_running: the Fukuchi et al. 2017 trial at 3.5 m/s, Weyand et al. 2000 and "
+              "Nummela et al. 2007 at 9 m/s, interpolated in speed between them)"
+              + ("; joint angles against the measured 3.5 m/s stride." if trial is not None
+                 else ".")),
+        tables=[("The stride against people running at its speed", table)],
+    )
 
 
 def collocation_sections(report, path: str | Path) -> tuple[dict, object]:
@@ -203,6 +222,8 @@ def collocation_sections(report, path: str | Path) -> tuple[dict, object]:
     ])
     import matplotlib.pyplot as plt
 
+    trial = _measured_trial(runner, sol)
+    _add_human_running_section(report, sol, trial)
     fig = _grf_figure(sol)
     report.add_section(
         "Collocation solution",
@@ -236,7 +257,6 @@ def collocation_sections(report, path: str | Path) -> tuple[dict, object]:
                 ("Settings", settings)],
     )
     plt.close(fig)
-    trial = _measured_trial(runner, sol)
     if trial is not None:
         fig = _trial_figure(sol, runner, trial)
         report.add_section(

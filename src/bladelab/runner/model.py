@@ -49,6 +49,7 @@ from bladelab.runner.params import (
     BLADE_RADIUS_M,
     PROSTHETIC_KINDS,
     RunnerParams,
+    active_strength,
     blade_contact_modulus,
     default_runner_params,
     muscle_max_force,
@@ -120,7 +121,8 @@ class RunnerModel:
     dof_names, muscle_names, segment_names, contact_names
         Names in array order.
     muscle_params
-        (n_muscles, 4): Fmax [N], l_opt [m], l_ts [m], pennation [rad].
+        (n_muscles, 6): Fmax [N], l_opt [m], l_ts [m], pennation [rad], tendon strain at Fmax
+        [-], active strength [-] (:mod:`bladelab.runner.muscle`'s ``MP_*`` columns).
     path_points, path_start
         Muscle path points as (site id, body id) rows; muscle i uses rows
         ``path_start[i]:path_start[i+1]`` (origin to insertion).
@@ -371,7 +373,8 @@ def build_runner(
 
     # muscles: sites on bodies, spatial tendons, tendon actuators (ctrl = −tendon force)
     names = muscle_names(params.kind)
-    mp = np.zeros((len(names), 5))
+    mp = np.zeros((len(names), 6))
+    strength = active_strength(params)
     path_sites: list[str] = []
     path_start = [0]
     tendons, actuators = [], []
@@ -399,6 +402,7 @@ def build_runner(
             mt.tendon_slack_length_m * s,
             mt.pennation_rad,
             mt.tendon_strain_at_fmax,
+            strength,
         )
 
     analysis_model = spec.compile()

@@ -15,7 +15,12 @@ velocity ``v_max = 10·l_opt/s``:
   ``MP_TSTRAIN``; Geyer 2010's 4 % unless the parameter set says otherwise);
 - pennation at constant fibre height ``l_ce·sin α = l_opt·sin α₀``.
 
-Equilibrium ``(a·f_l·f_v + f_p + β·ṽ)·cos α = f_t`` is solved for the fibre velocity each step,
+The active force can be stronger than the force that normalises the tendon and passive curves:
+``s·a·f_l·f_v`` with the muscle's active strength ``s`` (column ``MP_ACTIVE``, 1 unless the
+parameter set gives an active specific tension), so that a literature specific tension raises
+what the fibre can do without stiffening the tendon or the passive tissue.
+
+Equilibrium ``(s·a·f_l·f_v + f_p + β·ṽ)·cos α = f_t`` is solved for the fibre velocity each step,
 implicitly (backward Euler in the fibre length, Newton), so the fibre stays stable at any
 activation with the explicit multibody step. The tendon force is a function of the state
 (``l_mtu``, ``l_ce``); the muscle power is ``F_t·v_mtu`` (seed 001 eq. 2.12).
@@ -50,8 +55,11 @@ _LN_005 = math.log(0.05)
 # muscle_step: ``_nrt=False``, no reference counting per step (bladelab.runner.kernel); the
 # functions it calls inherit it.
 
-# Columns of the muscle parameter array ``mp`` (one row per muscle).
-MP_FMAX, MP_LOPT, MP_LTS, MP_PENN, MP_TSTRAIN = 0, 1, 2, 3, 4
+# Columns of the muscle parameter array ``mp`` (one row per muscle): Fmax [N] (the force that
+# normalises the tendon curve and the passive fibre force), l_opt [m], l_ts [m], pennation
+# [rad], tendon strain at Fmax [-], active strength [-] (the active fibre force is
+# a·f_l·f_v·Fmax times it; bladelab.runner.params.RunnerParams.active_specific_tension).
+MP_FMAX, MP_LOPT, MP_LTS, MP_PENN, MP_TSTRAIN, MP_ACTIVE = 0, 1, 2, 3, 4, 5
 # Columns of the muscle state array ``ms``.
 MS_ACT, MS_LCE, MS_VCE, MS_FORCE = 0, 1, 2, 3
 
@@ -151,8 +159,10 @@ def equilibrium_fiber_length(
     l_ts: float,
     penn0: float,
     ref_strain: float = TENDON_REF_STRAIN,
+    active: float = 1.0,
 ) -> float:
-    """Fibre length [m] in static equilibrium (ṽ = 0) at activation ``act`` (bisection)."""
+    """Fibre length [m] in static equilibrium (ṽ = 0) at activation ``act`` (bisection);
+    ``active``: the muscle's active strength (:data:`MP_ACTIVE`)."""
     lo = 0.3 * l_opt
     hi = min(2.0 * l_opt, max(l_mtu - 0.5 * l_ts, 0.31 * l_opt))
     if hi <= lo:
@@ -161,7 +171,7 @@ def equilibrium_fiber_length(
         mid = 0.5 * (lo + hi)
         c = _cos_pennation(mid, l_opt, penn0)
         ln = mid / l_opt
-        f_fib = (act * force_length(ln) + passive_force(ln)) * c
+        f_fib = (active * act * force_length(ln) + passive_force(ln)) * c
         f_ten = tendon_force((l_mtu - mid * c - l_ts) / l_ts, ref_strain)
         if f_fib > f_ten:
             hi = mid
@@ -184,8 +194,8 @@ def muscle_step(
 ) -> None:
     """Advance all muscles by one step and store their tendon forces.
 
-    ``mp`` (n, 5): Fmax [N], l_opt [m], l_ts [m], pennation α₀ [rad], tendon strain at Fmax
-    [-]. ``ms`` (n, 4) in/out:
+    ``mp`` (n, 6): Fmax [N], l_opt [m], l_ts [m], pennation α₀ [rad], tendon strain at Fmax
+    [-], active strength [-] (:data:`MP_ACTIVE`). ``ms`` (n, 4) in/out:
     activation, fibre length [m], fibre velocity [m/s], tendon force [N] (the force to apply
     during this step, computed from the state at the step's start). ``l_mtu`` [m], ``u`` [-]
     excitations in [0, 1]. ``tol``: the Newton iteration on the normalised fibre velocity stops
@@ -200,8 +210,8 @@ def muscle_step(
     at the step's end, ``l_mtu + dt·v_mtu`` [m, m/s]. Without them: implicit Euler against
     the step's start length (first order).
     """
-    if mp.shape[1] <= MP_TSTRAIN:
-        raise ValueError("muscle parameters need 5 columns (the last: tendon strain at Fmax)")
+    if mp.shape[1] <= MP_ACTIVE:
+        raise ValueError("muscle parameters need 6 columns (the last: active strength)")
     n = mp.shape[0]
     for i in range(n):
         fmax = mp[i, MP_FMAX]
@@ -209,6 +219,7 @@ def muscle_step(
         l_ts = mp[i, MP_LTS]
         penn0 = mp[i, MP_PENN]
         eref = mp[i, MP_TSTRAIN]
+        active = mp[i, MP_ACTIVE]
         act = ms[i, MS_ACT]
         l_ce = ms[i, MS_LCE]
         lm = l_mtu[i]
@@ -238,11 +249,12 @@ def muscle_step(
             fl = force_length(ln)
             strain = (lm - l_new * c - l_ts) / l_ts
             g = (
-                act * fl * force_velocity(v) + passive_force(ln) + FIBER_DAMPING * v
+                active * act * fl * force_velocity(v) + passive_force(ln) + FIBER_DAMPING * v
             ) * c - tendon_force(strain, eref)
             dft = 2.0 * strain / (eref * eref) if strain > 0.0 else 0.0
             dfp = 2.0 * (ln - 1.0) / (PASSIVE_STRAIN * PASSIVE_STRAIN) if ln > 1.0 else 0.0
-            dg = (act * fl * _force_velocity_slope(v) + FIBER_DAMPING) * c + step_dt * vscale * (
+            dg = (active * act * fl * _force_velocity_slope(v) + FIBER_DAMPING) * c + (
+                step_dt * vscale) * (
                 dfp * c / l_opt + dft * c * c / l_ts
             )
             step = g / dg

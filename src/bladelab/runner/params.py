@@ -134,6 +134,12 @@ class RunnerParams(_Strict):
     athlete: Athlete
     specific_tension_N_per_cm2: float = Field(gt=0)
     total_muscle_volume_cm3: float = Field(gt=0)
+    #: Specific tension of the fibres' active force [N/cm²]; None: ``specific_tension``. The
+    #: muscles' Fmax (eq. 2.1 or the table's forces, at ``specific_tension``) normalises their
+    #: tendon and passive curves; the active force is stronger by the ratio of the two
+    #: (:func:`active_strength`), so that a literature specific tension does not stiffen the
+    #: tendons or the passive tissue.
+    active_specific_tension_N_per_cm2: float | None = Field(default=None, gt=0)
     segments: dict[str, Segment]
     muscle_types: dict[str, MuscleType]
     #: Gravity of this model [m/s²]: 9.81, the value the seed-001 runner and its shipped reflex
@@ -250,6 +256,13 @@ def muscle_max_force(params: RunnerParams, muscle_type: str) -> float:
     volume = params.total_muscle_volume_cm3 * mass_ratio
     l_opt_cm = mt.optimal_fiber_length_m * length_ratio * 100.0
     return params.specific_tension_N_per_cm2 * mt.volume_fraction * volume / l_opt_cm
+
+
+def active_strength(params: RunnerParams) -> float:
+    """The active force over Fmax [-]: the active over the set's specific tension (1 when the
+    set gives no active specific tension)."""
+    active = params.active_specific_tension_N_per_cm2
+    return 1.0 if active is None else active / params.specific_tension_N_per_cm2
 
 
 def scale_ratios(params: RunnerParams) -> tuple[float, float]:
@@ -378,6 +391,7 @@ __all__ = [
     "PROSTHETIC_KINDS",
     "RUNNER_DATA_DIR",
     "Athlete",
+    "active_strength",
     "BladeCategory",
     "RunnerParams",
     "blade_catalogue",

@@ -27,7 +27,7 @@ from bladelab.predict.collocation.multibody import body_frames, point_position
 from bladelab.predict.collocation.smooth import sigmoid
 from bladelab.predict.collocation.transcription import StrideDynamics
 from bladelab.runner.layout import CP_LEG
-from bladelab.runner.muscle import MP_LOPT, V_MAX_OPT_PER_S
+from bladelab.runner.muscle import MP_ACTIVE, MP_LOPT, V_MAX_OPT_PER_S
 
 __all__ = ["COORDINATE_BOUNDS_DEG", "stride_dynamics"]
 
@@ -191,6 +191,7 @@ def stride_dynamics(cm: CollocationModel, *, metabolic: MetabolicSmoothing | Non
                                      np.tile([MIN_FIBER_ALONG, MAX_FIBER_ALONG], (nm, 1)),
                                      np.tile([0.0, np.inf], (int(clearance.numel()), 1))]),
         static_tendon_force=lambda q_nodes, a_nodes: static_tendon_forces(cm, q_nodes, a_nodes),
+        active_strength=np.array(runner.muscle_params[:, MP_ACTIVE]),
         vertical_grf=ca.Function("vertical_grf", [q, qd],
                                  [ca.sum1(cm.contacts(q, qd)[0][:, 1])]),
         backward_euler_dofs=tuple(n for n in runner.dof_names if n.startswith("blade_joint"))

@@ -31,7 +31,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["REFERENCE_BANDS", "Criterion", "human_running_criteria", "reference_band"]
+__all__ = [
+    "COMPARED_JOINTS",
+    "REFERENCE_BANDS",
+    "Criterion",
+    "angle_agreement",
+    "human_running_criteria",
+    "reference_band",
+    "stride_from_left_touchdown",
+]
 
 #: Anchor speeds [m/s] of the reference bands (the cost band is given up to
 #: :data:`COST_BAND_MAX_SPEED_MPS` only).
@@ -48,6 +56,10 @@ REFERENCE_BANDS: dict[str, tuple[str, tuple, tuple]] = {
 }
 #: The lower contact-time bound of a prosthetic leg [s] (module docstring).
 PROSTHETIC_CONTACT_MIN_S = 0.15
+#: Least flight [% of the stride] that counts as a flight phase.
+FLIGHT_MIN_PCT = 1.0
+#: A stride this close to an anchor speed [m/s] is at it (no "band held" note).
+SPEED_TOLERANCE_MPS = 0.01
 #: Above this speed [m/s] no cost-of-transport band is given.
 COST_BAND_MAX_SPEED_MPS = 5.0
 
@@ -72,18 +84,27 @@ class Criterion:
                 and (self.high is None or self.value <= self.high))
 
     def band_text(self) -> str:
+        unit = f" {self.unit}" if self.unit else ""
+        if self.low is not None and self.low == self.high:
+            return f"{self.low:.3g}{unit}"
         if self.low is not None and self.high is not None:
-            return f"{self.low:g}–{self.high:g} {self.unit}"
+            sep = " to " if self.low < 0 else "–"
+            return f"{self.low:.3g}{sep}{self.high:.3g}{unit}"
         if self.low is not None:
-            return f"≥ {self.low:g} {self.unit}"
-        return f"≤ {self.high:g} {self.unit}"
+            return f"≥ {self.low:.3g}{unit}"
+        return f"≤ {self.high:.3g}{unit}"
+
+    def value_text(self) -> str:
+        """The value with its unit (``"0.106 s"``)."""
+        if not math.isfinite(self.value):
+            return "none"
+        return f"{self.value:.3g} {self.unit}".rstrip()
 
     def line(self) -> str:
-        """``"contact time, left leg: 0.11 s (people: 0.20–0.30 s): outside"``."""
-        value = f"{self.value:.3g} {self.unit}" if math.isfinite(self.value) else "none"
+        """``"contact time, left leg: 0.106 s (people: 0.2–0.3 s): OUTSIDE"``."""
         verdict = "within" if self.met else "OUTSIDE"
         note = f"; {self.note}" if self.note else ""
-        return f"{self.name}: {value} (people: {self.band_text()}{note}): {verdict}"
+        return f"{self.name}: {self.value_text()} (people: {self.band_text()}{note}): {verdict}"
 
     def to_dict(self) -> dict:
         return {"name": self.name, "value": self.value, "unit": self.unit, "low": self.low,
@@ -108,7 +129,9 @@ def human_running_criteria(solution) -> list[Criterion]:
     order; speed [m/s] is the stride's mean speed."""
     speed = solution.mean_speed_mps
     v0, v1 = ANCHOR_SPEEDS_MPS
-    note = "" if v0 <= speed <= v1 else f"band held from {v0 if speed < v0 else v1:g} m/s"
+    tol = SPEED_TOLERANCE_MPS
+    note = ("" if v0 - tol <= speed <= v1 + tol
+            else f"band held from {v0 if speed < v0 else v1:g} m/s")
     phases = solution.contact_phases()
     prosthetic = solution.model_spec.get("model") in ("amputee", "transfemoral")
     out = []
@@ -123,20 +146,20 @@ def human_running_criteria(solution) -> list[Criterion]:
         out.append(Criterion(f"peak vertical ground force, {leg} leg", peak, unit, lo, hi, note))
     lo, hi, unit = reference_band("stride time", speed)
     out.append(Criterion("stride time", solution.period_s, unit, lo, hi, note))
-    q = np.asarray(solution.nlp.q)
+    q = np.asarray(solution.nlp.q)  # (nodes, coordinates)
     lo, hi, unit = reference_band("peak swing knee flexion", speed)
     for side, leg in zip(("l", "r"), solution.leg_names, strict=True):
         name = f"knee_angle_{side}"
         if name not in solution.dof_names or (prosthetic and side == "r"
                                               and solution.model_spec["model"] == "transfemoral"):
             continue
-        flexion = -math.degrees(float(q[solution.dof_names.index(name)].min()))
+        flexion = -math.degrees(float(q[:, solution.dof_names.index(name)].min()))
         out.append(Criterion(f"peak swing knee flexion, {leg} leg", flexion, unit, lo, hi, note))
     lo, hi, unit = reference_band("mean pelvis tilt", speed)
-    tilt = math.degrees(float(np.mean(q[solution.dof_names.index("pelvis_tilt")][:-1])))
+    tilt = math.degrees(float(np.mean(q[:-1, solution.dof_names.index("pelvis_tilt")])))
     out.append(Criterion("mean pelvis tilt", tilt, unit, lo, hi, "forward lean negative"))
     out.append(Criterion("flight phase", 100.0 * phases["flight_fraction"], "% of the stride",
-                         1e-9, None, "running has one"))
+                         FLIGHT_MIN_PCT, None, "running has one"))
     for leg in solution.leg_names:
         out.append(Criterion(f"ground contacts per stride, {leg} leg",
                              float(phases["legs"][leg]["contacts"]), "", 1.0, 1.0,
@@ -145,4 +168,52 @@ def human_running_criteria(solution) -> list[Criterion]:
         lo, hi, unit = reference_band("gross cost of transport", speed)
         out.append(Criterion("gross cost of transport", solution.cost_of_transport_J_per_kg_m,
                              unit, lo, hi, ""))
+    return out
+
+
+#: Joints compared with a measured stride: (coordinate base, label, sign); the knee as flexion.
+COMPARED_JOINTS = (("hip_flexion", "hip flexion", 1.0), ("knee_angle", "knee flexion", -1.0),
+                   ("ankle_angle", "ankle dorsiflexion", 1.0))
+#: Largest joint-angle RMSE [deg] and smallest knee correlation [-] against a measured stride.
+ANGLE_RMSE_MAX_DEG = 15.0
+KNEE_CORRELATION_MIN = 0.9
+
+
+def stride_from_left_touchdown(solution, threshold_n: float) -> np.ndarray:
+    """The stride's node values of q (n + 1, coordinates), rolled to start at the left (intact)
+    leg's touch-down: the first node loaded above ``threshold_n`` [N] after an unloaded one
+    (no roll if the leg is never unloaded); the last node repeats the first (periodic)."""
+    q = np.asarray(solution.nlp.q)
+    loaded = solution.leg_vertical_force()[:-1, 0] > threshold_n
+    starts = np.flatnonzero(loaded & ~np.roll(loaded, 1))
+    rolled = np.roll(q[:-1], -(int(starts[0]) if starts.size else 0), axis=0)
+    return np.vstack([rolled, rolled[:1]])
+
+
+def angle_agreement(solution, measured_q: np.ndarray, threshold_n: float) -> list[Criterion]:
+    """Hip, knee and ankle angles of the stride against a measured stride ``measured_q``
+    (samples, coordinates) [rad] on the same coordinates, starting at the left touch-down:
+    the RMSE [deg] per joint and leg (≤ :data:`ANGLE_RMSE_MAX_DEG`) and the knee's
+    correlation (≥ :data:`KNEE_CORRELATION_MIN`), the measured stride interpolated onto the
+    stride's nodes over % of the stride. Joints a leg does not have (a prosthesis) are left
+    out."""
+    q = stride_from_left_touchdown(solution, threshold_n)
+    pct = np.linspace(0.0, 1.0, q.shape[0])
+    pct_m = np.linspace(0.0, 1.0, measured_q.shape[0])
+    out = []
+    for side, leg in zip(("l", "r"), solution.leg_names, strict=True):
+        for base, label, sign in COMPARED_JOINTS:
+            name = f"{base}_{side}"
+            if name not in solution.dof_names:
+                continue
+            j = solution.dof_names.index(name)
+            model = sign * np.degrees(q[:, j])
+            measured = sign * np.degrees(np.interp(pct, pct_m, measured_q[:, j]))
+            rmse = float(np.sqrt(np.mean((model - measured)[:-1] ** 2)))
+            out.append(Criterion(f"{label} RMSE against the measured stride, {leg} leg", rmse,
+                                 "deg", None, ANGLE_RMSE_MAX_DEG))
+            if base == "knee_angle":
+                r = float(np.corrcoef(model[:-1], measured[:-1])[0, 1])
+                out.append(Criterion(f"knee flexion correlation with the measured stride, "
+                                     f"{leg} leg", r, "", KNEE_CORRELATION_MIN, None))
     return out

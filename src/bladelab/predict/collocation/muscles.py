@@ -36,6 +36,7 @@ from bladelab.runner.muscle import (
     FV_ECCENTRIC,
     FV_LENGTHENING,
     FV_SHORTENING,
+    MP_ACTIVE,
     MP_FMAX,
     MP_LOPT,
     MP_LTS,
@@ -111,13 +112,15 @@ def fiber_kinematics(mp: np.ndarray, l_mt, v_mt, ft, dft, smoothing: Smoothing):
 def equilibrium_residual(mp: np.ndarray, a, ft, dft, l_mt, v_mt, smoothing: Smoothing):
     """Fibre–tendon equilibrium residual [-] (n,), zero on a consistent trajectory.
 
-    ``(a·f_l·f_v + f_p + β·ṽ)·cos α − F̃_T`` with the fibre state of :func:`fiber_kinematics`;
-    ``a`` activation [-], other arguments as there.
+    ``(s·a·f_l·f_v + f_p + β·ṽ)·cos α − F̃_T`` with the fibre state of :func:`fiber_kinematics`
+    and the active strength s (``MP_ACTIVE``); ``a`` activation [-], other arguments as there.
     """
     l_opt = ca.DM(mp[:, MP_LOPT])
+    strength = ca.DM(mp[:, MP_ACTIVE])
     l_m, v_m, cos_a = fiber_kinematics(mp, l_mt, v_mt, ft, dft, smoothing)
     ln, vn = l_m / l_opt, v_m / (V_MAX_OPT_PER_S * l_opt)
-    fibre = a * force_length(ln) * force_velocity(vn, smoothing) + passive_force(ln, smoothing)
+    fibre = (strength * a * force_length(ln) * force_velocity(vn, smoothing)
+             + passive_force(ln, smoothing))
     return (fibre + FIBER_DAMPING * vn) * cos_a - ft
 
 

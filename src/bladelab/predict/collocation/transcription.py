@@ -97,6 +97,9 @@ class StrideDynamics:
         alternate from node to node (a stance contact sliding ±1 mm each node, the
         trapezoidal rule's period-2 mode, its friction saturating ±μ·F_n) while the
         momentum balance integrates only their interval means.
+    active_strength
+        (n_muscles,) active strength of each muscle [-] (``MP_ACTIVE``); the upper bound of its
+        normalised tendon force is ``max_tendon_force`` times it. None: 1 for every muscle.
     """
 
     dof_names: tuple[str, ...]
@@ -116,6 +119,7 @@ class StrideDynamics:
     muscle_metabolic_rates: ca.Function | None = None
     backward_euler_dofs: tuple[str, ...] = ()
     interval_mean_inequalities: tuple[int, ...] = ()
+    active_strength: np.ndarray | None = None
 
     @property
     def nq(self) -> int:
@@ -478,8 +482,9 @@ class StrideNLP:
         itx = d.dof_names.index("pelvis_tx")
         lx = np.concatenate([d.q_bounds[:, 0], d.qd_bounds[:, 0], np.full(nm, self.min_activation),
                              np.full(nm, self.min_tendon_force)])
+        strength = np.ones(nm) if d.active_strength is None else d.active_strength
         ux = np.concatenate([d.q_bounds[:, 1], d.qd_bounds[:, 1], np.ones(nm),
-                             np.full(nm, self.max_tendon_force)])
+                             self.max_tendon_force * strength])
         lX = np.tile((lx / self.sx)[:, None], (1, n + 1))
         uX = np.tile((ux / self.sx)[:, None], (1, n + 1))
         lX[itx, :], uX[itx, :] = -np.inf, np.inf
