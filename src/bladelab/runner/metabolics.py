@@ -34,7 +34,7 @@ import numpy as np
 from numba import njit
 
 from bladelab.numba_cache import refresh_stale_caches
-from bladelab.runner.muscle import V_MAX_OPT_PER_S, force_length
+from bladelab.runner.muscle import MP_ACTIVE, MP_FMAX, MP_LOPT, V_MAX_OPT_PER_S, force_length
 
 MUSCLE_DENSITY = 1059.7  # kg/m^3
 BASAL_RATE_W_PER_KG = 1.51
@@ -60,7 +60,10 @@ MB_MASS, MB_FT = 0, 1
 def metabolic_params(model, *, specific_tension_pa: float | None = None) -> np.ndarray:
     """(n_muscles, 2): muscle mass [kg] and fast-twitch percentage of a runner model.
 
-    ``specific_tension_pa`` [Pa] defaults to the model's (``params.specific_tension_N_per_cm2``).
+    The mass is the muscle's strongest isometric force (Fmax times its active strength,
+    ``MP_ACTIVE``) over ``specific_tension_pa`` [Pa], times l_opt and the density, as Uchida et
+    al. (2016), PredSim and SCONE compute it from a model's maximum isometric force;
+    ``specific_tension_pa`` defaults to the model's (``params.specific_tension_N_per_cm2``).
     """
     if specific_tension_pa is None:
         specific_tension_pa = model.params.specific_tension_N_per_cm2 * 1e4
@@ -68,7 +71,8 @@ def metabolic_params(model, *, specific_tension_pa: float | None = None) -> np.n
     out = np.zeros((mp.shape[0], 2))
     for i, name in enumerate(model.muscle_names):
         base = name.rsplit("_", 1)[0]
-        out[i, MB_MASS] = MUSCLE_DENSITY * mp[i, 0] * mp[i, 1] / specific_tension_pa
+        out[i, MB_MASS] = (MUSCLE_DENSITY * mp[i, MP_FMAX] * mp[i, MP_ACTIVE] * mp[i, MP_LOPT]
+                           / specific_tension_pa)
         out[i, MB_FT] = FAST_TWITCH_PERCENT.get(base, 50.0)
     return out
 
