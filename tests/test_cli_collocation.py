@@ -20,8 +20,9 @@ def solved():
 
 
 def _predict(out, *extra):
-    return main(["predict", "--method", "collocation", "--model", "able", "--out", str(out),
-                 *extra])
+    """The command on seed 001's body (the fake solution's)."""
+    return main(["predict", "--method", "collocation", "--model", "able", "--body", "seed001",
+                 "--out", str(out), *extra])
 
 
 def test_a_solve_that_does_not_converge_exits_2_and_keeps_only_the_best_iterate(tmp_path, capsys):
@@ -99,8 +100,8 @@ def test_bad_options_are_refused_naming_the_option(args, where, tmp_path, capsys
 
 
 def test_the_transfemoral_runner_is_solved_with_its_own_blade(tmp_path, capsys):
-    """``--model transfemoral`` runs end to end: its default blade (Cat4) goes into
-    the file, and the legs are named intact and prosthetic."""
+    """``--model transfemoral`` runs end to end: its default blade (Cat4) and the default
+    (human) body go into the file, and the legs are named intact and prosthetic."""
     out = tmp_path / "tf"
     code = main(["predict", "--method", "collocation", "--model", "transfemoral", "--out",
                  str(out), "--speed", "4", "--mesh", "6", "--max-iter", "2", "--json"])
@@ -108,7 +109,7 @@ def test_the_transfemoral_runner_is_solved_with_its_own_blade(tmp_path, capsys):
     summary = json.loads(capsys.readouterr().out)
     assert "contact_time_prosthetic_s" in summary and "contact_time_intact_s" in summary
     stored = json.loads((out / "best_iterate.json").read_text())
-    assert stored["model"] == {"model": "transfemoral", "blade": "Cat4"}
+    assert stored["model"] == {"model": "transfemoral", "blade": "Cat4", "body": "human"}
 
 
 def test_a_transtibial_stride_starts_the_transfemoral_runner(tmp_path, capsys):

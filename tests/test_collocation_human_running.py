@@ -117,3 +117,21 @@ def test_angle_agreement_is_zero_for_the_measured_stride_and_sees_an_offset():
     assert knee.value == pytest.approx(20.0) and not knee.met
     assert crit["knee flexion correlation with the measured stride, left leg"].met
     assert "ankle dorsiflexion RMSE against the measured stride, left leg" not in crit  # no ankle
+
+
+def test_the_shipped_human_body_stride_is_the_demo_start_and_meets_its_criteria():
+    """The demo's predict example starts from a converged amputee Cat6 stride at 4 m/s on the
+    human body; its contacts, prosthetic peak, cost and posture are within people's bands."""
+    from bladelab.demo import PREDICT_EXAMPLE_STRIDE
+    from bladelab.predict.collocation.solution import CollocationSolution
+
+    sol = CollocationSolution.read(PREDICT_EXAMPLE_STRIDE)
+    assert sol.converged and sol.model_spec == {"model": "amputee", "blade": "Cat6",
+                                                "body": "human"}
+    assert sol.mean_speed_mps == pytest.approx(4.0)
+    met = {c.name: c.met for c in human_running_criteria(sol)}
+    for name in ("contact time, intact leg", "contact time, prosthetic leg",
+                 "peak vertical ground force, prosthetic leg", "mean pelvis tilt",
+                 "gross cost of transport", "ground contacts per stride, prosthetic leg"):
+        assert met[name], name
+    assert sol.gait_warnings() == []

@@ -36,8 +36,14 @@ from bladelab.design.plots import write_design_figures
 from bladelab.design.trends import evaluate_trends
 from bladelab.errors import BladelabError
 from bladelab.example.study import default_example_dir, make_example_study
+from bladelab.predict.collocation.human_running import human_running_criteria
+from bladelab.predict.collocation.named_runs import solve_named_stride
+from bladelab.predict.collocation.settings import CollocationSettings
+from bladelab.predict.collocation.solve import SOLUTION_FILE
+from bladelab.report.predictive import build_predictive_report
 from bladelab.report.design import build_design_report
 from bladelab.report.study import build_study_report
+from bladelab.runner.params import RUNNER_DATA_DIR
 from bladelab.study import run_study
 from bladelab.trial import detect_stances, read_c3d
 from bladelab.units import body_weight
@@ -123,6 +129,43 @@ def design_example(out_dir: str | Path | None = None, *, seed: int = 0) -> tuple
     lines.append("  seed 002 trends: " + "; ".join(f"{v.statement}: {v.verdict}"
                                                    for v in verdicts))
     return report, lines
+
+
+#: The shipped stride the predict example starts from: the amputee runner on the human body
+#: wearing a Cat6 blade at 4 m/s (benchmarks/human_body/README.md).
+PREDICT_EXAMPLE_STRIDE = RUNNER_DATA_DIR / "collocation" / "amputee-Cat6-4-human.json"
+
+
+def predict_example(out_dir: str | Path | None = None) -> tuple[Path, list[str]]:
+    """Solve (or read back) one amputee stride at 4 m/s on the human body in ``out_dir``
+    (default ``examples/predict-amputee-Cat6-4`` under the current folder), warm-started from
+    :data:`PREDICT_EXAMPLE_STRIDE`, and write its report; returns (report, summary lines), the
+    lines saying criterion by criterion where the stride lies against people."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+
+    out_dir = examples_dir() / "predict-amputee-Cat6-4" if out_dir is None else Path(out_dir)
+    t0 = time.perf_counter()
+    res = solve_named_stride(
+        out_dir, model="amputee", blade="Cat6", body="human",
+        settings=CollocationSettings(speed_m_per_s=4.0), guess=str(PREDICT_EXAMPLE_STRIDE),
+        resume=(out_dir / SOLUTION_FILE).is_file())
+    sol = res.solution
+    report = build_predictive_report(res.path, progress=False, robustness=False)
+    s = sol.summary()
+    how = "solved" if res.solved else "read back"
+    lines = [f"predict example: amputee Cat6, human body, 4 m/s, {how} in "
+             f"{time.perf_counter() - t0:.0f} s ({s['iterations']} IPOPT iterations, warm start "
+             f"from the shipped stride) -> {out_dir}",
+             f"  converged {s['converged']}, stride {s['stride_time_s']:.3f} s, cost of "
+             f"transport {s['cost_of_transport_J_per_kg_m']:.2f} J/(kg·m), dynamics residual "
+             f"{s['dynamics_residual_pct']:.2f} %"]
+    crit = human_running_criteria(sol)
+    lines.append(f"  against people running at 4 m/s: {sum(c.met for c in crit)} of {len(crit)} "
+                 "criteria met")
+    lines += [f"    {c.line()}" for c in crit if not c.met]
+    return Path(report.index), lines
 
 
 @dataclasses.dataclass(frozen=True)
@@ -248,12 +291,16 @@ def main() -> int:
         print("\nbladelab demo: the design workflow (seed 002, docs/design.md)", flush=True)
         design_report, design_lines = design_example()
         print("\n".join(design_lines))
+        print("\nbladelab demo: the predict workflow (docs/guide-predict.md)", flush=True)
+        predict_report, predict_lines = predict_example()
+        print("\n".join(predict_lines))
     except BladelabError as err:
         print(f"error: {err}", file=sys.stderr)
         return 2
     print(f"\ndemo finished in {time.perf_counter() - t0:.0f} s")
     print(f"report: {res.report}")
     print(f"design report: {design_report}")
+    print(f"predict report: {predict_report}")
     print(f"open them with: xdg-open {res.report}   (or any browser; they work offline)")
     return 0
 

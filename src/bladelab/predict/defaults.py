@@ -90,9 +90,13 @@ RECIPE_SEEDS = (1, 2, 3)
 MESH_INTERVALS = 50
 #: IPOPT's iteration limit per stage (``CollocationSettings.max_iter``).
 MAX_ITER = 3000
-#: The runner's body: seed 001's model (``toes``: a toe segment and compliant Achilles tendons).
-BODY = "seed001"
-#: Initial guess of a stride: the template gait at the prescribed speed.
-GUESS = "template"
+#: The runner's body: ``human`` (published gait-model properties, docs/runner-model.md, "The
+#: human body"); ``seed001`` reproduces seed 001's model, ``toes`` is it with a toe segment and
+#: compliant Achilles tendons.
+BODY = "human"
+#: Initial guess of a stride: the measured 3.5 m/s trial's mean stride, scaled to the
+#: prescribed speed (on the human body the template's tracking stage stalled: objective 280
+#: after 1,050 iterations, measured; from the trial it converges).
+GUESS = "trial"
 #: Starts per problem of a collocation sweep (the best solve is kept).
 STARTS = 1
