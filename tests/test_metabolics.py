@@ -74,7 +74,7 @@ def test_muscle_masses_are_the_seed_volumes():
 
 
 def test_total_rate_is_basal_plus_muscles():
-    mp = np.array([[1000.0, 0.1, 0.2, 0.0, 0.04]])
+    mp = np.array([[1000.0, 0.1, 0.2, 0.0, 0.04, 1.0, 0.6]])
     mb = np.array([[1.0, 50.0]])
     ms = np.array([[0.5, 0.1, 0.0, 300.0]])  # isometric at optimal length
     u = np.array([0.5])

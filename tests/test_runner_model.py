@@ -312,6 +312,8 @@ def test_human_body_is_h0918_scaled_to_a_75_kg_runner():
     # active force at Rajagopal et al. 2016's 60 N/cm² over the table's 25 N/cm²
     np.testing.assert_allclose(runner.muscle_params[:, 5], 60.0 / 25.0, rtol=1e-15)
     assert set(build_runner("able").muscle_params[:, 5]) == {1.0}  # seed 001: none
+    e0 = dict(zip(runner.muscle_names, runner.muscle_params[:, 6], strict=True))
+    assert e0["vasti_l"] == e0["hamstrings_r"] == 1.2 and e0["erect_sp_l"] == 0.6
     assert "mtp_angle_l" in runner.dof_names and "toetip_r" in runner.contact_names
     knee = runner.joint_params[runner.dof("knee_angle_l")]
     assert math.degrees(knee[0]) == pytest.approx(-140.0)

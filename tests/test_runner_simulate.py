@@ -38,7 +38,7 @@ def test_isometric_maximal_force_is_fmax_cos_pennation():
     assert tendon_force_of_state(l_mtu, l_ce, fmax, l_opt, l_ts, penn) == pytest.approx(
         fmax * math.cos(penn), rel=1e-3
     )
-    mp = np.array([[fmax, l_opt, l_ts, penn, 0.04, 1.0]])
+    mp = np.array([[fmax, l_opt, l_ts, penn, 0.04, 1.0, 0.6]])
     ms = np.array([[1.0, l_ce, 0.0, 0.0]])
     for _ in range(200):  # held isometric: stays in equilibrium
         muscle_step(mp, ms, np.array([l_mtu]), np.array([1.0]), 5e-4)
@@ -57,7 +57,7 @@ def test_active_strength_scales_the_active_force_only():
     assert l_ce == pytest.approx(l_opt, rel=1e-4)
     forces = []
     for s in (1.0, strength):
-        mp = np.array([[fmax, l_opt, l_ts, penn, 0.04, s]])
+        mp = np.array([[fmax, l_opt, l_ts, penn, 0.04, s, 0.6]])
         ms = np.array([[0.4, l_ce, 0.0, 0.0]])
         for _ in range(400):
             muscle_step(mp, ms, np.array([l_mtu]), np.array([0.4]), 5e-4)
@@ -82,7 +82,7 @@ def test_force_velocity_shape():
 
 def test_activation_dynamics_first_order():
     """u = 1 from a = 0.01: a(t) = 1 − 0.99·exp(−100 t) (rate 100 /s), Euler-discretised."""
-    mp = np.array([[1000.0, 0.1, 0.2, 0.0, 0.04]])
+    mp = np.array([[1000.0, 0.1, 0.2, 0.0, 0.04, 1.0, 0.6]])
     ms = np.array([[0.01, 0.1, 0.0, 0.0]])
     dt = 1e-4
     for _ in range(200):
@@ -95,7 +95,7 @@ def test_quick_release_shortens_fibre_with_a_compliant_tendon():
     fmax, l_opt, l_ts, penn = 3000.0, 0.1, 0.2, 0.0
     l_mtu = l_opt + l_ts * 1.04
     l_ce = equilibrium_fiber_length(l_mtu, 1.0, l_opt, l_ts, penn)
-    mp = np.array([[fmax, l_opt, l_ts, penn, 0.04]])
+    mp = np.array([[fmax, l_opt, l_ts, penn, 0.04, 1.0, 0.6]])
     ms = np.array([[1.0, l_ce, 0.0, 0.0]])
     muscle_step(mp, ms, np.array([l_mtu - 0.004]), np.array([1.0]), 5e-4)
     f_after = tendon_force_of_state(l_mtu - 0.004, ms[0, 1], fmax, l_opt, l_ts, penn)

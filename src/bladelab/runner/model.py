@@ -121,8 +121,9 @@ class RunnerModel:
     dof_names, muscle_names, segment_names, contact_names
         Names in array order.
     muscle_params
-        (n_muscles, 6): Fmax [N], l_opt [m], l_ts [m], pennation [rad], tendon strain at Fmax
-        [-], active strength [-] (:mod:`bladelab.runner.muscle`'s ``MP_*`` columns).
+        (n_muscles, 7): Fmax [N], l_opt [m], l_ts [m], pennation [rad], tendon strain at Fmax
+        [-], active strength [-], passive strain at Fmax [-] (:mod:`bladelab.runner.muscle`'s
+        ``MP_*`` columns).
     path_points, path_start
         Muscle path points as (site id, body id) rows; muscle i uses rows
         ``path_start[i]:path_start[i+1]`` (origin to insertion).
@@ -373,7 +374,7 @@ def build_runner(
 
     # muscles: sites on bodies, spatial tendons, tendon actuators (ctrl = −tendon force)
     names = muscle_names(params.kind)
-    mp = np.zeros((len(names), 6))
+    mp = np.zeros((len(names), 7))
     strength = active_strength(params)
     path_sites: list[str] = []
     path_start = [0]
@@ -403,6 +404,7 @@ def build_runner(
             mt.pennation_rad,
             mt.tendon_strain_at_fmax,
             strength,
+            mt.passive_strain_at_fmax,
         )
 
     analysis_model = spec.compile()

@@ -10,7 +10,8 @@ velocity ``v_max = 10·l_opt/s``:
 - force–velocity, ``ṽ = v/v_max`` (> 0 lengthening): ``(1 + ṽ)/(1 − 4ṽ)`` when shortening
   (Hill, a/F0 = 0.25; 0 at ṽ = −1), ``1.5 − 0.5/(1 + 10ṽ)`` when lengthening (1.5·Fmax eccentric
   plateau, slope continuous at 0);
-- passive fibre ``f_p = ((l̃ − 1)/0.6)²`` for l̃ > 1; fibre damping ``β·ṽ`` with β = 0.1 (Millard);
+- passive fibre ``f_p = ((l̃ − 1)/e₀)²`` for l̃ > 1 (e₀ = 0.6 unless the parameter set says
+  otherwise, column ``MP_PSTRAIN``); fibre damping ``β·ṽ`` with β = 0.1 (Millard);
 - tendon ``f_t = (ε/ε_ref)²`` for strain ε > 0, ε_ref the strain at Fmax per muscle (column
   ``MP_TSTRAIN``; Geyer 2010's 4 % unless the parameter set says otherwise);
 - pennation at constant fibre height ``l_ce·sin α = l_opt·sin α₀``.
@@ -58,8 +59,9 @@ _LN_005 = math.log(0.05)
 # Columns of the muscle parameter array ``mp`` (one row per muscle): Fmax [N] (the force that
 # normalises the tendon curve and the passive fibre force), l_opt [m], l_ts [m], pennation
 # [rad], tendon strain at Fmax [-], active strength [-] (the active fibre force is
-# a·f_l·f_v·Fmax times it; bladelab.runner.params.RunnerParams.active_specific_tension).
-MP_FMAX, MP_LOPT, MP_LTS, MP_PENN, MP_TSTRAIN, MP_ACTIVE = 0, 1, 2, 3, 4, 5
+# a·f_l·f_v·Fmax times it; bladelab.runner.params.RunnerParams.active_specific_tension),
+# passive fibre strain at Fmax [-] (the passive curve's e₀).
+MP_FMAX, MP_LOPT, MP_LTS, MP_PENN, MP_TSTRAIN, MP_ACTIVE, MP_PSTRAIN = 0, 1, 2, 3, 4, 5, 6
 # Columns of the muscle state array ``ms``.
 MS_ACT, MS_LCE, MS_VCE, MS_FORCE = 0, 1, 2, 3
 
@@ -93,11 +95,12 @@ def _force_velocity_slope(v_norm: float) -> float:
 
 
 @njit(cache=True, error_model="numpy")
-def passive_force(l_norm: float) -> float:
-    """Passive fibre force f_p [-] of the normalised fibre length."""
+def passive_force(l_norm: float, strain: float = PASSIVE_STRAIN) -> float:
+    """Passive fibre force f_p [-] of the normalised fibre length; ``strain``: the fibre
+    strain at which it reaches Fmax (e₀)."""
     if l_norm <= 1.0:
         return 0.0
-    x = (l_norm - 1.0) / PASSIVE_STRAIN
+    x = (l_norm - 1.0) / strain
     return x * x
 
 
@@ -160,9 +163,11 @@ def equilibrium_fiber_length(
     penn0: float,
     ref_strain: float = TENDON_REF_STRAIN,
     active: float = 1.0,
+    passive_strain: float = PASSIVE_STRAIN,
 ) -> float:
     """Fibre length [m] in static equilibrium (ṽ = 0) at activation ``act`` (bisection);
-    ``active``: the muscle's active strength (:data:`MP_ACTIVE`)."""
+    ``active``: the muscle's active strength (:data:`MP_ACTIVE`), ``passive_strain`` its
+    passive curve's e₀ (:data:`MP_PSTRAIN`)."""
     lo = 0.3 * l_opt
     hi = min(2.0 * l_opt, max(l_mtu - 0.5 * l_ts, 0.31 * l_opt))
     if hi <= lo:
@@ -171,7 +176,7 @@ def equilibrium_fiber_length(
         mid = 0.5 * (lo + hi)
         c = _cos_pennation(mid, l_opt, penn0)
         ln = mid / l_opt
-        f_fib = (active * act * force_length(ln) + passive_force(ln)) * c
+        f_fib = (active * act * force_length(ln) + passive_force(ln, passive_strain)) * c
         f_ten = tendon_force((l_mtu - mid * c - l_ts) / l_ts, ref_strain)
         if f_fib > f_ten:
             hi = mid
@@ -194,8 +199,9 @@ def muscle_step(
 ) -> None:
     """Advance all muscles by one step and store their tendon forces.
 
-    ``mp`` (n, 6): Fmax [N], l_opt [m], l_ts [m], pennation α₀ [rad], tendon strain at Fmax
-    [-], active strength [-] (:data:`MP_ACTIVE`). ``ms`` (n, 4) in/out:
+    ``mp`` (n, 7): Fmax [N], l_opt [m], l_ts [m], pennation α₀ [rad], tendon strain at Fmax
+    [-], active strength [-] (:data:`MP_ACTIVE`), passive strain at Fmax [-]
+    (:data:`MP_PSTRAIN`). ``ms`` (n, 4) in/out:
     activation, fibre length [m], fibre velocity [m/s], tendon force [N] (the force to apply
     during this step, computed from the state at the step's start). ``l_mtu`` [m], ``u`` [-]
     excitations in [0, 1]. ``tol``: the Newton iteration on the normalised fibre velocity stops
@@ -210,8 +216,9 @@ def muscle_step(
     at the step's end, ``l_mtu + dt·v_mtu`` [m, m/s]. Without them: implicit Euler against
     the step's start length (first order).
     """
-    if mp.shape[1] <= MP_ACTIVE:
-        raise ValueError("muscle parameters need 6 columns (the last: active strength)")
+    if mp.shape[1] <= MP_PSTRAIN:
+        raise ValueError("muscle parameters need 7 columns (the last two: active strength, "
+                         "passive strain at Fmax)")
     n = mp.shape[0]
     for i in range(n):
         fmax = mp[i, MP_FMAX]
@@ -220,6 +227,7 @@ def muscle_step(
         penn0 = mp[i, MP_PENN]
         eref = mp[i, MP_TSTRAIN]
         active = mp[i, MP_ACTIVE]
+        e0 = mp[i, MP_PSTRAIN]
         act = ms[i, MS_ACT]
         l_ce = ms[i, MS_LCE]
         lm = l_mtu[i]
@@ -249,10 +257,10 @@ def muscle_step(
             fl = force_length(ln)
             strain = (lm - l_new * c - l_ts) / l_ts
             g = (
-                active * act * fl * force_velocity(v) + passive_force(ln) + FIBER_DAMPING * v
+                active * act * fl * force_velocity(v) + passive_force(ln, e0) + FIBER_DAMPING * v
             ) * c - tendon_force(strain, eref)
             dft = 2.0 * strain / (eref * eref) if strain > 0.0 else 0.0
-            dfp = 2.0 * (ln - 1.0) / (PASSIVE_STRAIN * PASSIVE_STRAIN) if ln > 1.0 else 0.0
+            dfp = 2.0 * (ln - 1.0) / (e0 * e0) if ln > 1.0 else 0.0
             dg = (active * act * fl * _force_velocity_slope(v) + FIBER_DAMPING) * c + (
                 step_dt * vscale) * (
                 dfp * c / l_opt + dft * c * c / l_ts

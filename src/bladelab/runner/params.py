@@ -96,6 +96,9 @@ class MuscleType(_Strict):
     #: Tendon strain at Fmax [-] (the tendon curve is ``(ε/ε_ref)²``). Default: Geyer & Herr
     #: (2010)'s 4 %, which seed 001's model uses for every muscle.
     tendon_strain_at_fmax: float = Field(default=0.04, gt=0.005, lt=0.2)
+    #: Fibre strain at which the passive fibre force reaches Fmax [-] (e₀ of the curve
+    #: ``((l̃ − 1)/e₀)²``). Default: 0.6, the curve of seed 001's model.
+    passive_strain_at_fmax: float = Field(default=0.6, gt=0.1, le=3.0)
 
     @model_validator(mode="after")
     def _one_strength(self) -> MuscleType:

@@ -35,7 +35,7 @@ from bladelab.runner.metabolics import (
     MIN_HEAT_RATE_W_PER_KG,
     metabolic_params,
 )
-from bladelab.runner.muscle import MP_FMAX, MP_LOPT, V_MAX_OPT_PER_S
+from bladelab.runner.muscle import MP_FMAX, MP_LOPT, MP_PSTRAIN, V_MAX_OPT_PER_S
 
 __all__ = ["MetabolicSmoothing", "metabolic_rate", "muscle_metabolic_rates", "whole_body_rate"]
 
@@ -120,7 +120,8 @@ def muscle_metabolic_rates(runner, u, a, ft, dft, l_mt, v_mt, smoothing: Smoothi
     heat = h_am + (1.0 - lengthening) * h_short + lengthening * h_long
     heat = MIN_HEAT_RATE_W_PER_KG + softplus(heat - MIN_HEAT_RATE_W_PER_KG, w.heat_w_per_kg)
     # active fibre force, not below 0 (the forward model's clamp; off equilibrium only)
-    f_ce = smooth_max0(fmax * ft / cos_a - muscles.passive_force(ln, smoothing) * fmax, 1.0)
+    e0 = ca.DM(mp[:, MP_PSTRAIN])
+    f_ce = smooth_max0(fmax * ft / cos_a - muscles.passive_force(ln, smoothing, e0) * fmax, 1.0)
     work = -f_ce * v_m / mass
     total = softplus(heat + work, w.total_w_per_kg)
     return total * mass

@@ -41,6 +41,7 @@ from bladelab.runner.muscle import (
     MP_LOPT,
     MP_LTS,
     MP_PENN,
+    MP_PSTRAIN,
     MP_TSTRAIN,
     PASSIVE_STRAIN,
     TENDON_REF_STRAIN,
@@ -79,9 +80,10 @@ def force_velocity(v_norm, smoothing: Smoothing):
     return num / den
 
 
-def passive_force(l_norm, smoothing: Smoothing):
-    """Passive fibre force [-]: ``(softplus(l̃ − 1)/0.6)²``."""
-    return (softplus(l_norm - 1.0, smoothing.passive_length) / PASSIVE_STRAIN) ** 2
+def passive_force(l_norm, smoothing: Smoothing, strain=PASSIVE_STRAIN):
+    """Passive fibre force [-]: ``(softplus(l̃ − 1)/e₀)²``, e₀ = ``strain`` (a number or one
+    per muscle)."""
+    return (softplus(l_norm - 1.0, smoothing.passive_length) / strain) ** 2
 
 
 def fiber_kinematics(mp: np.ndarray, l_mt, v_mt, ft, dft, smoothing: Smoothing):
@@ -112,15 +114,17 @@ def fiber_kinematics(mp: np.ndarray, l_mt, v_mt, ft, dft, smoothing: Smoothing):
 def equilibrium_residual(mp: np.ndarray, a, ft, dft, l_mt, v_mt, smoothing: Smoothing):
     """Fibre–tendon equilibrium residual [-] (n,), zero on a consistent trajectory.
 
-    ``(s·a·f_l·f_v + f_p + β·ṽ)·cos α − F̃_T`` with the fibre state of :func:`fiber_kinematics`
-    and the active strength s (``MP_ACTIVE``); ``a`` activation [-], other arguments as there.
+    ``(s·a·f_l·f_v + f_p + β·ṽ)·cos α − F̃_T`` with the fibre state of :func:`fiber_kinematics`,
+    the active strength s (``MP_ACTIVE``) and the passive curve's e₀ (``MP_PSTRAIN``); ``a``
+    activation [-], other arguments as there.
     """
     l_opt = ca.DM(mp[:, MP_LOPT])
     strength = ca.DM(mp[:, MP_ACTIVE])
+    e0 = ca.DM(mp[:, MP_PSTRAIN])
     l_m, v_m, cos_a = fiber_kinematics(mp, l_mt, v_mt, ft, dft, smoothing)
     ln, vn = l_m / l_opt, v_m / (V_MAX_OPT_PER_S * l_opt)
     fibre = (strength * a * force_length(ln) * force_velocity(vn, smoothing)
-             + passive_force(ln, smoothing))
+             + passive_force(ln, smoothing, e0))
     return (fibre + FIBER_DAMPING * vn) * cos_a - ft
 
 

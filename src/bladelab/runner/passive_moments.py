@@ -1,0 +1,80 @@
+"""Passive joint moments of the runner's muscles, and people's (Riener & Edrich 1999).
+
+The passive moment of a pose: every leg muscle at zero activation in static equilibrium
+(:func:`~bladelab.runner.muscle.equilibrium_fiber_length`, its tendon force) times its moment
+arm, the MTU length's derivative by the coordinate (MuJoCo's spatial tendons of
+``RunnerModel.mj_analysis_model``). Joint ligaments are left out: they act only beyond the
+joint limits.
+
+Riener & Edrich (1999) fitted the passive moments of all structures measured on people, with
+angles in degrees (knee flexion K, hip flexion H, ankle dorsiflexion A); Miller et al. (2012)
+used them in their sprinting model. They are the reference the human body's passive fibre
+curve is calibrated to (docs/runner-model.md, "The human body").
+"""
+
+from __future__ import annotations
+
+import math
+
+import mujoco
+import numpy as np
+
+from bladelab.runner.geometry import LEG_MUSCLES
+from bladelab.runner.muscle import MP_LOPT, equilibrium_fiber_length, tendon_force_of_state
+
+__all__ = ["passive_flexion_moment", "riener_edrich_hip_moment", "riener_edrich_knee_moment"]
+
+#: Step [rad] of the central difference of the MTU lengths.
+_STEP_RAD = 1e-6
+
+
+def riener_edrich_knee_moment(knee_deg: float, hip_deg: float, ankle_deg: float = 0.0) -> float:
+    """People's passive knee flexion moment [N·m] at knee flexion, hip flexion and ankle
+    dorsiflexion [deg]: ``exp(1.800 + 0.0460A − 0.0352K + 0.0217H) − exp(−3.971 + 0.0004A +
+    0.0495K − 0.0128H) − 4.820 + exp(2.220 − 1.50K)``."""
+    k, h, a = knee_deg, hip_deg, ankle_deg
+    return (math.exp(1.800 + 0.0460 * a - 0.0352 * k + 0.0217 * h)
+            - math.exp(-3.971 + 0.0004 * a + 0.0495 * k - 0.0128 * h)
+            - 4.820 + math.exp(2.220 - 1.50 * k))
+
+
+def riener_edrich_hip_moment(knee_deg: float, hip_deg: float) -> float:
+    """People's passive hip flexion moment [N·m] at knee and hip flexion [deg]:
+    ``exp(1.4655 − 0.0034K − 0.0750H) − exp(1.3403 − 0.0226K + 0.0305H) + 8.072``."""
+    k, h = knee_deg, hip_deg
+    return (math.exp(1.4655 - 0.0034 * k - 0.0750 * h)
+            - math.exp(1.3403 - 0.0226 * k + 0.0305 * h) + 8.072)
+
+
+def passive_flexion_moment(runner, joint: str, *, knee_deg: float, hip_deg: float,
+                           side: str = "l") -> float:
+    """The muscles' passive flexion moment [N·m] about ``joint`` (``"knee"`` or ``"hip"``) of
+    the leg ``side`` at knee and hip flexion [deg], the other coordinates of the standing
+    pose (module docstring)."""
+    if joint not in ("knee", "hip"):
+        raise ValueError(f"joint must be 'knee' or 'hip', got {joint!r}")
+    model = runner.mj_analysis_model
+    data = mujoco.MjData(model)
+    knee, hip = runner.dof(f"knee_angle_{side}"), runner.dof(f"hip_flexion_{side}")
+    dof, sign = (knee, 1.0) if joint == "knee" else (hip, -1.0)  # knee_angle = −flexion
+    muscles = [runner.muscle_names.index(f"{m}_{side}") for m in LEG_MUSCLES
+               if f"{m}_{side}" in runner.muscle_names]
+
+    def lengths(q: np.ndarray) -> np.ndarray:
+        data.qpos[:] = q
+        mujoco.mj_forward(model, data)
+        return data.ten_length.copy()
+
+    q = runner.stand_qpos.copy()
+    q[knee], q[hip] = -math.radians(knee_deg), math.radians(hip_deg)
+    qp, qm = q.copy(), q.copy()
+    qp[dof] += _STEP_RAD
+    qm[dof] -= _STEP_RAD
+    d_length = (lengths(qp) - lengths(qm)) / (2.0 * _STEP_RAD)
+    length = lengths(q)
+    total = 0.0
+    for i in muscles:
+        mp = runner.muscle_params[i]
+        fibre = equilibrium_fiber_length(length[i], 0.0, *mp[MP_LOPT:])
+        total += tendon_force_of_state(length[i], fibre, *mp[:5]) * d_length[i]
+    return sign * total
