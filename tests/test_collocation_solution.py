@@ -461,6 +461,9 @@ def test_the_predictive_report_renders_a_collocation_solution(able, tmp_path):
     assert "Collocation solution" in html and "Joint angles per leg" in html
     # at the measured trial's speed its joint angles are drawn beside the solution's
     assert "Joint angles against the measured trial" in html
+    # the report opens with the stride against people, criterion by criterion
+    assert html.index("Against measured human running") < html.index("Collocation solution")
+    assert "contact time, left leg" in html and "knee flexion RMSE against the measured" in html
     # the 'bladelab predict --method collocation' folder itself, as the CLI's help offers
     rep = build_predictive_report(path.parent, tmp_path / "report2", progress=False,
                                   animate=False)
