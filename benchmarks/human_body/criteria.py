@@ -1,8 +1,9 @@
 """Print a stored stride against measured human running, criterion by criterion.
 
-Usage (repository root): ``.venv/bin/python benchmarks/human_body/criteria.py FOLDER...``; each
-FOLDER holds a ``solution.json`` (or ``best_iterate.json``) of ``bladelab predict --method
-collocation``. One block per folder, then one JSON line (``--json``) per folder.
+Usage (repository root): ``.venv/bin/python benchmarks/human_body/criteria.py PATH...``; each
+PATH is a solution file or a folder holding a ``solution.json`` (or ``best_iterate.json``) of
+``bladelab predict --method collocation``. One block per path, or one JSON line each
+(``--json``).
 """
 
 from __future__ import annotations
@@ -17,11 +18,11 @@ from bladelab.predict.collocation.solution import CollocationSolution
 
 def main() -> None:
     ap = argparse.ArgumentParser()
-    ap.add_argument("folders", nargs="+", type=Path)
+    ap.add_argument("paths", nargs="+", type=Path)
     ap.add_argument("--json", action="store_true")
     args = ap.parse_args()
-    for folder in args.folders:
-        path = folder / "solution.json"
+    for folder in args.paths:
+        path = folder if folder.is_file() else folder / "solution.json"
         if not path.is_file():
             path = folder / "best_iterate.json"
         sol = CollocationSolution.read(path)
