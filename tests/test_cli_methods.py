@@ -202,14 +202,14 @@ def test_predict_collocation_passes_the_same_settings(tmp_path, monkeypatch):
         mesh_intervals=8, speed_m_per_s=4.0, max_iter=7, swing_clearance_m=0.02,
         knee_moment_min_nm=0.0, knee_flexion_max_loaded_deg=10.0,
         pelvis_tilt_range_deg=(-16.0, -2.0))
-    assert seen["model_spec"] == {"model": "transfemoral", "blade": "Cat4"}
+    assert seen["model_spec"] == {"model": "transfemoral", "blade": "Cat4", "body": "human"}
     assert seen["runner"] == ("runner", seen["model_spec"])
     assert (seen["out"], seen["resume"], seen["force"]) == (tmp_path, True, False)
     seen.clear()
     with pytest.raises(_Called):
         main(["predict", "--method", "collocation", "--max-speed", "--out", str(tmp_path)])
     assert seen["settings"] == CollocationSettings(speed_m_per_s=None)
-    assert seen["model_spec"] == {"model": "able", "blade": None}
+    assert seen["model_spec"] == {"model": "able", "blade": None, "body": "human"}
 
 
 def test_sweep_collocation_passes_the_same_settings(tmp_path, monkeypatch):
@@ -233,7 +233,7 @@ def test_sweep_collocation_passes_the_same_settings(tmp_path, monkeypatch):
     assert seen["settings"] == CollocationSettings(mesh_intervals=12, speed_m_per_s=3.5,
                                                    max_iter=9)
     assert isinstance(seen["guess"], functools.partial) and seen["guess"].func is make_guess
-    assert seen["guess"].keywords == {"guess": "template"}
+    assert seen["guess"].keywords == {"guess": "trial"}  # the default guess
     assert (seen["jobs"], seen["executor"], seen["starts"], seen["resume"], seen["force"]) == (
         2, "local", 2, False, False)
 

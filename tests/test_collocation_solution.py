@@ -485,5 +485,8 @@ def test_model_spec_names_the_body_only_when_it_is_not_seed_001s():
     toes = check_model_spec({"model": "amputee", "blade": "Cat6", "body": "toes"})
     assert toes != check_model_spec({"model": "amputee", "blade": "Cat6"})
     assert model_label(toes) == "amputee Cat6 (toes body)"
+    human = check_model_spec({"model": "able", "body": "human"})
+    assert human == {"model": "able", "blade": None, "body": "human"}
+    assert model_label(human) == "able (human body)"
     with pytest.raises(SpecError, match="unknown body"):
-        check_model_spec({"model": "able", "body": "human"})
+        check_model_spec({"model": "able", "body": "robot"})

@@ -17,8 +17,9 @@ N = 12  # mesh intervals: the fake solutions' (conftest.FAKE_MESH)
 
 
 def _sweep(out, *extra):
+    """The sweep on seed 001's body from the template (the fake solutions')."""
     return main(["sweep", "--method", "collocation", "--out", str(out), "--mesh", str(N),
-                 "--max-iter", "1", *extra])
+                 "--max-iter", "1", "--body", "seed001", "--guess", "template", *extra])
 
 
 def _csv(path):
@@ -222,7 +223,7 @@ def test_several_starts_keep_the_best_per_problem_and_every_file(fake_solve, mon
     (("--able",), "--able"),
     (("--starts", "2"), "--starts"),
     (("--body", "toes"), "--body"),
-    (("--method", "collocation", "--able", "--body", "human"), "--body"),
+    (("--method", "collocation", "--able", "--body", "robot"), "--body"),
     (("--method", "shooting"), "--method"),
 ])
 def test_bad_sweep_options_are_refused_naming_the_option(args, where, tmp_path, capsys):
