@@ -40,8 +40,8 @@ from bladelab.predict.collocation.human_running import human_running_criteria
 from bladelab.predict.collocation.named_runs import solve_named_stride
 from bladelab.predict.collocation.settings import CollocationSettings
 from bladelab.predict.collocation.solve import SOLUTION_FILE
-from bladelab.report.predictive import build_predictive_report
 from bladelab.report.design import build_design_report
+from bladelab.report.predictive import build_predictive_report
 from bladelab.report.study import build_study_report
 from bladelab.runner.params import RUNNER_DATA_DIR
 from bladelab.study import run_study
