@@ -35,7 +35,6 @@ from bladelab.predict.collocation.human_running import (
 from bladelab.predict.collocation.model import build_collocation_model
 from bladelab.predict.collocation.solution import (
     BEST_ITERATE_KIND,
-    CONTACT_THRESHOLD_N,
     SOLUTION_KIND,
     CollocationSolution,
 )
@@ -116,7 +115,7 @@ def _trial_figure(sol, runner, trial):
     import matplotlib.pyplot as plt
 
     n = sol.nlp.q.shape[0] - 1
-    q_sol = stride_from_left_touchdown(sol, CONTACT_THRESHOLD_N)
+    q_sol = stride_from_left_touchdown(sol)
     pct_sol = np.linspace(0.0, 100.0, n + 1)
     pct_trial = np.linspace(0.0, 100.0, trial.q.shape[0])
     fig, axes = plt.subplots(2, 3, figsize=(10, 5.2), sharex=True)
@@ -157,7 +156,7 @@ def _add_human_running_section(report, sol, trial) -> None:
     words about a gait)."""
     crit = human_running_criteria(sol)
     if trial is not None:
-        crit += angle_agreement(sol, trial.q, CONTACT_THRESHOLD_N)
+        crit += angle_agreement(sol, trial.q)
     outside = [c for c in crit if not c.met]
     verdict = (f"This stride is outside measured human running on {len(outside)} of "
                f"{len(crit)} criteria: " + "; ".join(

@@ -41,6 +41,7 @@ from bladelab.runner.muscle import (
     MP_PSTRAIN,
     V_MAX_OPT_PER_S,
     force_length,
+    passive_force,
 )
 
 MUSCLE_DENSITY = 1059.7  # kg/m^3
@@ -146,7 +147,7 @@ def total_metabolic_rate(u, ms, mp, mb, body_mass):
         h = lopt * math.sin(mp[i, 3])
         s = min(h / max(ms[i, 1], 1e-6), 0.99)
         cosp = math.sqrt(1.0 - s * s)
-        fp = ((ln - 1.0) / mp[i, MP_PSTRAIN]) ** 2 if ln > 1.0 else 0.0
+        fp = passive_force(ln, mp[i, MP_PSTRAIN])
         f_ce = max(ms[i, 3] / cosp - fp * mp[i, 0], 0.0)
         total += muscle_metabolic_rate(
             u[i], a, ln, ms[i, 2] / lopt, f_ce, ms[i, 2], mb[i, 0], mb[i, 1]

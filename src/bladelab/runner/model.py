@@ -433,11 +433,11 @@ def build_runner(
                      hertz_sphere_stiffness(radius, modulus), dissipation, friction, leg, blade,
                      radius, LAW_HUNT_CROSSLEY, 1.5, 0.0, 0.0))
 
+    law = params.foot_contact
+    foot_law = (law.plane_strain_modulus_N_per_m2, law.dissipation_s_per_m, law.friction)
     for side, leg in (("l", 0), ("r", 1)):
         if side == "r" and prosthetic:
             continue
-        law = params.foot_contact
-        foot_law = (law.plane_strain_modulus_N_per_m2, law.dissipation_s_per_m, law.friction)
         for sph in geo.FOOT_SPHERES:
             sphere(f"{sph}_{side}", geo.FOOT_SPHERE_RADIUS_M * s, *foot_law, leg, 0)
         if params.foot == "toes":

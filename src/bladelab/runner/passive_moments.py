@@ -20,7 +20,12 @@ import mujoco
 import numpy as np
 
 from bladelab.runner.geometry import LEG_MUSCLES
-from bladelab.runner.muscle import MP_LOPT, equilibrium_fiber_length, tendon_force_of_state
+from bladelab.runner.muscle import (
+    MP_ACTIVE,
+    MP_LOPT,
+    equilibrium_fiber_length,
+    tendon_force_of_state,
+)
 
 __all__ = ["passive_flexion_moment", "riener_edrich_hip_moment", "riener_edrich_knee_moment"]
 
@@ -76,5 +81,5 @@ def passive_flexion_moment(runner, joint: str, *, knee_deg: float, hip_deg: floa
     for i in muscles:
         mp = runner.muscle_params[i]
         fibre = equilibrium_fiber_length(length[i], 0.0, *mp[MP_LOPT:])
-        total += tendon_force_of_state(length[i], fibre, *mp[:5]) * d_length[i]
+        total += tendon_force_of_state(length[i], fibre, *mp[:MP_ACTIVE]) * d_length[i]
     return sign * total

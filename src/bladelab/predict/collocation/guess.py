@@ -159,8 +159,6 @@ def template_vertical_grf(phase: np.ndarray, *, duty: float = 0.34) -> np.ndarra
     return out
 
 
-
-
 def guess_from_trial(model: RunnerModel, path: str | Path, *, static: str | Path | None = None,
                      n: int = 50, speed: float | None = None, markers=None) -> StrideGuess:
     """The mean left-leg stride of a measured running trial (C3D with markers and force

@@ -31,6 +31,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from bladelab.predict.collocation.solution import CONTACT_THRESHOLD_N
+
 __all__ = [
     "COMPARED_JOINTS",
     "REFERENCE_BANDS",
@@ -179,7 +181,7 @@ ANGLE_RMSE_MAX_DEG = 15.0
 KNEE_CORRELATION_MIN = 0.9
 
 
-def stride_from_left_touchdown(solution, threshold_n: float) -> np.ndarray:
+def stride_from_left_touchdown(solution, threshold_n: float = CONTACT_THRESHOLD_N) -> np.ndarray:
     """The stride's node values of q (n + 1, coordinates), rolled to start at the left (intact)
     leg's touch-down: the first node loaded above ``threshold_n`` [N] after an unloaded one
     (no roll if the leg is never unloaded); the last node repeats the first (periodic)."""
@@ -190,7 +192,8 @@ def stride_from_left_touchdown(solution, threshold_n: float) -> np.ndarray:
     return np.vstack([rolled, rolled[:1]])
 
 
-def angle_agreement(solution, measured_q: np.ndarray, threshold_n: float) -> list[Criterion]:
+def angle_agreement(solution, measured_q: np.ndarray,
+                    threshold_n: float = CONTACT_THRESHOLD_N) -> list[Criterion]:
     """Hip, knee and ankle angles of the stride against a measured stride ``measured_q``
     (samples, coordinates) [rad] on the same coordinates, starting at the left touch-down:
     the RMSE [deg] per joint and leg (≤ :data:`ANGLE_RMSE_MAX_DEG`) and the knee's
