@@ -23,9 +23,9 @@ from bladelab.cli import main
     (["predict", "--method", "collocation", "--integrator", "newmark"], "--integrator",
      "--method reflex"),
     (["predict", "--method", "collocation", "--seeds", "1,2"], "--seeds", "--method reflex"),
-    (["predict", "--mesh", "30"], "--mesh", "--method collocation"),
+    (["predict", "--method", "reflex", "--mesh", "30"], "--mesh", "--method collocation"),
     (["predict", "--method", "reflex", "--json"], "--json", "--method collocation"),
-    (["predict", "--max-speed"], "--max-speed", "--method collocation"),
+    (["predict", "--method", "reflex", "--max-speed"], "--max-speed", "--method collocation"),
     (["sweep", "--method", "collocation", "--sigma", "0.1"], "--sigma", "--method reflex"),
     (["sweep", "--method", "collocation", "--chain-from", "Cat6"], "--chain-from",
      "--method reflex"),
@@ -54,7 +54,7 @@ def test_an_option_of_the_chosen_method_given_its_default_is_accepted(tmp_path, 
 
     seen = {}
     monkeypatch.setattr(reflex, "run_reflex", lambda **kw: seen.update(kw))
-    assert main(["predict", "--integrator", "explicit", "--seeds", "1", "--out",
+    assert main(["predict", "--method", "reflex", "--integrator", "explicit", "--seeds", "1", "--out",
                  str(tmp_path)]) == 0
     assert seen["integrator"] == "explicit" and seen["seeds"] == "1"
 
@@ -147,7 +147,7 @@ def test_predict_reflex_passes_the_same_settings(tmp_path, monkeypatch, capsys):
         return [types.SimpleNamespace(best_cost=1.0, to_dict=lambda: {"best_cost": 1.0})]
 
     monkeypatch.setattr(named, "optimize_seeds", optimize_seeds)
-    assert main(["predict", "--model", "amputee", "--blade", "Cat5", "--speed", "4",
+    assert main(["predict", "--method", "reflex", "--model", "amputee", "--blade", "Cat5", "--speed", "4",
                  "--generations", "3", "--popsize", "6", "--sigma", "0.5", "--seeds", "1,2",
                  "--duration", "4", "--dt", "5e-4", "--robust-samples", "3",
                  "--robust-jitter", "1e-5", "--robust-speed-change", "0.05",
@@ -175,7 +175,7 @@ def test_predict_reflex_defaults_are_the_settings_defaults(tmp_path, monkeypatch
     seen = {}
     monkeypatch.setattr(named, "optimize_seeds", lambda model, **kw: seen.update(kw) or [
         types.SimpleNamespace(best_cost=1.0, to_dict=dict)])
-    assert main(["predict", "--out", str(tmp_path)]) == 0
+    assert main(["predict", "--method", "reflex", "--out", str(tmp_path)]) == 0
     assert seen["settings"] == ObjectiveSettings()
     assert (seen["generations"], seen["popsize"], seen["sigma"], seen["checkpoint_every"],
             seen["blade"], seen["seeds"]) == (100, 16, 1.0, 5, "Cat6", [1])
@@ -209,6 +209,11 @@ def test_predict_collocation_passes_the_same_settings(tmp_path, monkeypatch):
     with pytest.raises(_Called):
         main(["predict", "--method", "collocation", "--max-speed", "--out", str(tmp_path)])
     assert seen["settings"] == CollocationSettings(speed_m_per_s=None)
+    assert seen["model_spec"] == {"model": "able", "blade": None, "body": "human"}
+    seen.clear()
+    with pytest.raises(_Called):  # without --method: collocation on the human body
+        main(["predict", "--out", str(tmp_path)])
+    assert seen["settings"] == CollocationSettings()
     assert seen["model_spec"] == {"model": "able", "blade": None, "body": "human"}
 
 

@@ -136,6 +136,8 @@ def test_cli_predict_and_errors(tmp_path, capsys):
     code = main(
         [
             "predict",
+            "--method",
+            "reflex",
             "--model",
             "able",
             "--generations",
@@ -162,6 +164,8 @@ def test_cli_predict_and_errors(tmp_path, capsys):
     code = main(
         [
             "predict",
+            "--method",
+            "reflex",
             "--model",
             "able",
             "--generations",
@@ -178,9 +182,9 @@ def test_cli_predict_and_errors(tmp_path, capsys):
     assert code == 0
     assert json.loads((tmp_path / "p" / "best.json").read_text())["generation"] == 3
     capsys.readouterr()
-    assert main(["predict", "--model", "robot", "--out", str(tmp_path / "x")]) == 2
+    assert main(["predict", "--method", "reflex", "--model", "robot", "--out", str(tmp_path / "x")]) == 2
     assert "robot" in capsys.readouterr().err
-    assert main(["predict", "--init", str(tmp_path / "missing.json"), "--out", str(tmp_path)]) == 2
+    assert main(["predict", "--method", "reflex", "--init", str(tmp_path / "missing.json"), "--out", str(tmp_path)]) == 2
     assert "not found" in capsys.readouterr().err
 
 
@@ -322,7 +326,7 @@ def test_a_folder_holding_a_run_is_refused_unless_resumed_or_forced(tmp_path, ca
     with pytest.raises(InputFileError, match="holds a run"):
         optimize_controller("able", out=tmp_path, **args)
     assert (tmp_path / "history.csv").read_text() == history  # nothing erased
-    code = main(["predict", "--model", "able", "--generations", "1", "--popsize", "4",
+    code = main(["predict", "--method", "reflex", "--model", "able", "--generations", "1", "--popsize", "4",
                  "--duration", "0.2", "--out", str(tmp_path)])
     assert code == 2 and "--resume continues it" in capsys.readouterr().err
     assert (tmp_path / "history.csv").read_text() == history
@@ -472,7 +476,7 @@ def test_verify_solution_after_pushes():
     ("--lean-weight", "nan", "--lean-weight"),
 ])
 def test_cli_refuses_bad_robust_copies(tmp_path, capsys, option, value, named):
-    args = ["predict", option, value, "--out", str(tmp_path / "x")]
+    args = ["predict", "--method", "reflex", option, value, "--out", str(tmp_path / "x")]
     if named == "--duration":
         args += ["--duration", "4"]
     assert main(args) == 2
@@ -481,6 +485,6 @@ def test_cli_refuses_bad_robust_copies(tmp_path, capsys, option, value, named):
 
 
 def test_cli_refuses_a_half_step_copy_without_copies(tmp_path, capsys):
-    assert main(["predict", "--robust-half-step", "--out", str(tmp_path / "x")]) == 2
+    assert main(["predict", "--method", "reflex", "--robust-half-step", "--out", str(tmp_path / "x")]) == 2
     assert "--robust-half-step" in capsys.readouterr().err
     assert not (tmp_path / "x").exists()

@@ -78,7 +78,7 @@ def register(app: typer.Typer) -> None:
             help="Output folder: the reflex run's checkpoint and best.json, or the collocation "
                  "solve's solution.json."),
         method: str = typer.Option(
-            "reflex", "--method", rich_help_panel=COMMON,
+            defaults.METHOD, "--method", rich_help_panel=COMMON,
             help=_METHOD_HELP.format(what="one periodic stride")),
         model: str = typer.Option(
             "able", "--model", rich_help_panel=COMMON,
@@ -219,10 +219,11 @@ def register(app: typer.Typer) -> None:
             help="Keep the pelvis tilt within LO,HI [deg] at every node (forward lean "
                  "negative), e.g. --tilt-range=-16,-2 (seed 001's window)."),
     ) -> None:
-        """Predict a running gait: optimise the reflex controller of the runner with CMA-ES
-        (seed 001 eq. 2.4), or with --method collocation solve one periodic stride by direct
+        """Predict a running gait: solve one periodic stride of the human body by direct
         collocation (writes DIR/solution.json; exit status 2 and DIR/best_iterate.json if
-        IPOPT does not converge). An option of the other method is refused."""
+        IPOPT does not converge), or with --method reflex optimise seed 001's reflex
+        controller with CMA-ES (seed 001 eq. 2.4). An option of the other method is
+        refused."""
         method = _method(method)
         refuse_other_methods(ctx, method, PREDICT_PANELS, labels=LABELS, hints=PREDICT_HINTS)
         if method == "collocation":

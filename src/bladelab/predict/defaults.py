@@ -20,6 +20,7 @@ __all__ = [
     "LEAN_WEIGHT_PER_DEG",
     "MAX_ITER",
     "MESH_INTERVALS",
+    "METHOD",
     "POPULATION_SIZE",
     "RECIPE_SEEDS",
     "REFLEX_BLADE",
@@ -37,6 +38,10 @@ __all__ = [
 ]
 
 # -- a predicted gait, either method -------------------------------------------------------
+#: Method of ``bladelab predict``: direct collocation of one periodic stride on the human body
+#: (the reflex controller, seed 001's method, is ``--method reflex``). ``bladelab sweep`` keeps
+#: the reflex grid as its default: its grid and recipe options belong to that method.
+METHOD = "collocation"
 #: Prescribed mean speed of a predicted gait [m/s] (``ObjectiveSettings.speed``,
 #: ``CollocationSettings.speed_m_per_s``).
 SPEED_M_PER_S = 3.5
