@@ -4,6 +4,8 @@ its smooth approximations (bladelab.predict.collocation.bounds, docs/collocation
 
 from __future__ import annotations
 
+import math
+
 import casadi as ca
 import mujoco
 import numpy as np
@@ -234,6 +236,30 @@ def test_ligament_and_socket_torques_match_forward(models, kind):
             assert abs(tau[j] - lig[j]) <= bound + 1e-9, (j, tau[j], lig[j])
             checked += 1
     assert checked >= 3 * N_STATES
+
+
+@pytest.mark.parametrize("kind", ["able-human", "amputee-human"])
+def test_hip_capsule_moment_is_riener_and_edrichs_extension_term(models, kind):
+    """Within the hip's range (no ligament), both twins' passive hip torque is the capsule's
+    3.91·exp(−0.075·H) N·m (H in degrees, flexing), the parameter file's numbers; the
+    knee and ankle carry none."""
+    runner, cm = models[kind]
+    m = runner.mj_model
+    d = mujoco.MjData(m)
+    for hip_deg in (-25.0, -10.0, 0.0, 30.0):
+        q = runner.stand_qpos.copy()
+        for side in ("l", "r"):
+            q[runner.dof(f"hip_flexion_{side}")] = math.radians(hip_deg)
+        d.qpos[:], d.qvel[:] = q, 0.0
+        mujoco.mj_forward(m, d)
+        _, lig = _forward_forces(runner, d)
+        tau = _np(cm.passive(q, np.zeros(m.nv))).ravel()
+        expected = 3.91 * math.exp(-0.075 * hip_deg)
+        for side in ("l", "r"):
+            j = runner.dof(f"hip_flexion_{side}")
+            assert lig[j] == pytest.approx(expected, rel=1e-12)
+            assert tau[j] == pytest.approx(expected, rel=1e-12)
+        assert lig[runner.dof("knee_angle_l")] == 0.0 == lig[runner.dof("ankle_angle_l")]
 
 
 @pytest.mark.parametrize("kind", ["amputee", "transfemoral"])

@@ -121,6 +121,21 @@ def test_implicit_step_hands_its_acceleration_to_mujoco_and_tends_to_explicit(am
         assert (np.abs(solved - explicit).max() < 1e-6 * scale) == close
 
 
+def test_hip_capsule_torque_and_its_stiffness_in_the_implicit_terms():
+    """The human body's hip capsule, τ = 3.91·exp(−0.075·H) N·m (H in degrees): the implicit
+    scheme linearises it with its stiffness −dτ/dq = 0.075·(180/π)·τ (the torque itself at
+    the step's start is the explicit kernel's, tested against the collocation twin; the
+    recorded one is the step's effective torque)."""
+    human = build_runner("able", body="human")
+    m, d, arrays, root, imp = _state(human)
+    implicit_forces(mujoco_views(d), arrays, imp, root, 1e-3)
+    lkd = imp[17]
+    for side in ("l", "r"):
+        j = human.dof(f"hip_flexion_{side}")
+        tau = 3.91 * math.exp(-0.075 * math.degrees(d.qpos[j]))
+        assert lkd[j, 0] == pytest.approx(0.075 * 180.0 / math.pi * tau, rel=1e-12)
+
+
 @pytest.mark.parametrize("integrator", ["implicit", "newmark"])
 def test_compiled_loop_equals_python_loop(amputee, integrator):
     """The compiled loop's own update (mj_step1/mj_step2 replaced by the stages the scheme
@@ -285,11 +300,14 @@ def test_newmark_accuracy_against_a_fine_step(amputee):
     assert angle_half < 0.5 * angle_1
 
 
-@pytest.mark.parametrize("kind,u", [("amputee", 0.05), ("amputee", 0.4), ("able", 0.2)])
+@pytest.mark.parametrize("kind,u", [("amputee", 0.05), ("amputee", 0.4), ("able", 0.2),
+                                    ("able-human", 0.2)])
 def test_newmark_power_balance_at_1ms(kind, u):
     """Constant excitations, 2 s with ground contact: Newmark at 1 ms keeps the power balance
-    within 0.1 % (measured 0.02–0.05 %; the first-order scheme 0.31–0.35 %)."""
-    runner = build_runner(kind)
+    within 0.1 % (measured 0.02–0.05 %; the first-order scheme 0.31–0.35 %). The human body
+    adds the toe hinge and the hip capsule's exponential moment to the linearised terms."""
+    runner = (build_runner("able", body="human") if kind == "able-human"
+              else build_runner(kind))
     res = simulate_runner(runner, duration=2.0, excitations=u, record_every=1,
                           fall_height=-math.inf, dt=1e-3, integrator="newmark")
     assert power_balance_residual_pct(res) <= 0.1

@@ -21,6 +21,7 @@ from bladelab.runner import (
     load_runner_params,
     runner_params_from_dict,
 )
+from bladelab.runner.layout import JP_EA, JP_EB
 
 G = 9.81
 
@@ -360,3 +361,17 @@ def test_foot_contact_law_reaches_the_contact_spheres():
     radius = row[2]
     assert row[3] == pytest.approx(4.0 / 3.0 * 1.0e6 * math.sqrt(radius), rel=1e-12)
     assert (row[4], row[5]) == (2.0, 0.8)
+
+
+def test_capsule_moments_name_known_coordinates_and_default_to_none():
+    """Seed 001's body has no capsule moment; a parameter set may give one per leg coordinate,
+    and an unknown coordinate is refused naming it."""
+    assert not build_runner("able").joint_params[:, JP_EA].any()
+    data = yaml.safe_load(default_runner_params("able").model_dump_json())
+    data["capsule_moments"] = {"knee_angle": {"moment_at_zero_Nm": -2.0, "rate_per_deg": 0.05}}
+    runner = build_runner(runner_params_from_dict(data))
+    row = runner.joint_params[runner.dof("knee_angle_r")]
+    assert (row[JP_EA], row[JP_EB]) == (-2.0, pytest.approx(0.05 * 180.0 / math.pi))
+    data["capsule_moments"] = {"elbow": {"moment_at_zero_Nm": 1.0, "rate_per_deg": 0.0}}
+    with pytest.raises(SpecError, match="elbow"):
+        runner_params_from_dict(data)

@@ -9,7 +9,7 @@ The JSON variant says what differs from the built-in human parameter set of ``ki
 ``force_factor`` ({muscle type or "all": factor} on the table's maximum isometric forces; the
 tendon and passive curves follow them), ``muscle`` ({muscle type: {field: value}}), ``set``
 (top-level parameter fields), ``weights`` (``StrideWeights`` fields) and ``guess`` (a word or a
-solution file; default the measured trial). Writes ``OUT/solution.json`` (or
+solution file; default the measured trial) and ``mesh`` (mesh intervals, default 50). Writes ``OUT/solution.json`` (or
 ``best_iterate.json``) and ``OUT/variant.json``, and prints the summary and the wall time [s].
 The rows of README.md made with it: every force doubled (``{"force_factor": {"all": 2.0}}``),
 the acceleration weight 0.01, the vasti tendon slack length 0.146 m.
@@ -45,7 +45,8 @@ def main() -> None:
     runner = build_runner(runner_params_from_dict(data))
     weights = variant.get("weights")
     settings = CollocationSettings(speed_m_per_s=speed,
-                                   weights=StrideWeights(**weights) if weights else None)
+                                   weights=StrideWeights(**weights) if weights else None,
+                                   mesh_intervals=variant.get("mesh", 50))
     guess = make_guess(runner, variant.get("guess", "trial"), n=settings.mesh_intervals,
                        speed=speed)
     t0 = time.perf_counter()

@@ -68,6 +68,8 @@ from bladelab.runner.layout import (
     CP_MU,
     CP_WIDTH,
     JP_D,
+    JP_EA,
+    JP_EB,
     JP_HI,
     JP_K,
     JP_LO,
@@ -319,6 +321,10 @@ def implicit_forces(mj, arrays, imp, root_com, dt):
             tau -= jp[j, JP_SK] * q + jp[j, JP_SK2] * q * abs(q) + damping * qd
             kj += jp[j, JP_SK] + 2.0 * jp[j, JP_SK2] * abs(q)
             dj += damping
+        if jp[j, JP_EA] != 0.0:  # the capsule's passive moment within the range
+            capsule = jp[j, JP_EA] * math.exp(jp[j, JP_EB] * q)
+            tau += capsule
+            kj -= jp[j, JP_EB] * capsule
         lig[j] = tau
         lkd[j, 0] = kj
         lkd[j, 1] = dj

@@ -32,6 +32,8 @@ from bladelab.runner.layout import (
     CP_MU,
     CP_WIDTH,
     JP_D,
+    JP_EA,
+    JP_EB,
     JP_HI,
     JP_K,
     JP_LO,
@@ -156,6 +158,8 @@ def forces(mj, arrays, root_com, dt):
         if jp[j, JP_SK] != 0.0 or jp[j, JP_SD] != 0.0 or jp[j, JP_SDX] != 0.0:
             damping = jp[j, JP_SD] if qd < 0.0 else jp[j, JP_SDX]
             tau -= jp[j, JP_SK] * q + jp[j, JP_SK2] * q * abs(q) + damping * qd
+        if jp[j, JP_EA] != 0.0:  # the capsule's passive moment within the range
+            tau += jp[j, JP_EA] * math.exp(jp[j, JP_EB] * q)
         qfrc[j] = tau
         lig[j] = tau
     # ground contacts: sphere or ellipse (semi-axes ax, az in the site's x-z plane)

@@ -34,6 +34,9 @@ from bladelab.runner.layout import (
     CP_BLADE,
     CP_RADIUS,
     CP_SITE,
+    JP_COLUMNS,
+    JP_EA,
+    JP_EB,
     JP_HI,
     JP_LO,
     JP_SK,
@@ -453,7 +456,7 @@ def build_runner(
                BLADE_FRICTION, 1, 1)
     cp = np.array(rows, dtype=np.float64)
 
-    jp = np.zeros((len(dof_names), 8))
+    jp = np.zeros((len(dof_names), JP_COLUMNS))
     jp[:, JP_LO], jp[:, JP_HI] = -np.inf, np.inf
     for i, dn in enumerate(dof_names):
         base = dn[:-2] if dn.endswith(("_l", "_r")) else dn
@@ -462,16 +465,20 @@ def build_runner(
             if base == "knee_angle":
                 lo = -params.knee_flexion_limit_deg
             jp[i, :4] = (math.radians(lo), math.radians(hi), k, d)
+        capsule = params.capsule_moments.get(base)
+        if capsule is not None:
+            jp[i, JP_EA] = capsule.moment_at_zero_Nm
+            jp[i, JP_EB] = math.degrees(capsule.rate_per_deg)  # 1/deg → 1/rad
         if base == "mtp_angle":
-            jp[i, JP_SK:] = (MTP_STIFFNESS, 0.0, MTP_DAMPING, MTP_DAMPING)
+            jp[i, JP_SK:JP_EA] = (MTP_STIFFNESS, 0.0, MTP_DAMPING, MTP_DAMPING)
         if dn == "socket_angle_r":
-            jp[i, JP_SK:] = (SOCKET_STIFFNESS, SOCKET_STIFFNESS_QUADRATIC, SOCKET_DAMPING,
+            jp[i, JP_SK:JP_EA] = (SOCKET_STIFFNESS, SOCKET_STIFFNESS_QUADRATIC, SOCKET_DAMPING,
                              SOCKET_DAMPING)
         if dn == "knee_angle_r" and transfemoral:
             jp[i] = params.prosthetic_knee.joint_row()
         if dn.startswith("blade_joint") and blade_model is not None:
             j = blade_model.joints[int(dn.removeprefix("blade_joint"))]
-            jp[i, JP_SK:] = (j.stiffness, j.stiffness_quadratic, j.damping, j.damping)
+            jp[i, JP_SK:JP_EA] = (j.stiffness, j.stiffness_quadratic, j.damping, j.damping)
 
     # the implicit scheme's model: no sites either (MuJoCo's site kinematics was ~1/6 of its
     # step); bladelab places the sites from mj_model's site_bodyid, site_pos and site_quat

@@ -118,6 +118,21 @@ class FootContact(_Strict):
     friction: float = Field(default=FOOT_FRICTION, gt=0)
 
 
+class CapsuleMoment(_Strict):
+    """A joint's passive moment within its range, ``M(q) = M₀·exp(r·q)`` [N·m] (q in degrees):
+    the capsule and ligaments, which the muscles' passive fibre forces do not include (e.g.
+    the hip capsule that resists extension; Riener & Edrich 1999)."""
+
+    #: Moment at q = 0 [N·m], positive along the coordinate.
+    moment_at_zero_Nm: float
+    #: Rate r [1/deg] (negative: growing as q decreases, i.e. into extension for a hip).
+    rate_per_deg: float = Field(ge=-0.5, le=0.5)
+
+
+#: Coordinates (both legs) that may carry a capsule moment.
+CAPSULE_COORDINATES = ("hip_flexion", "knee_angle", "ankle_angle")
+
+
 #: The model kinds: seed 001's able-bodied and transtibial ("amputee") runners, and the
 #: transfemoral runner (docs/runner-model.md, "The transfemoral runner").
 KINDS = ("able", "amputee", "transfemoral")
@@ -164,8 +179,19 @@ class RunnerParams(_Strict):
     #: Flexion [deg] at which the knee ligament engages: seed 001's 90°; people flex the knee
     #: to about 140° (the swing of sprinting comes close to it).
     knee_flexion_limit_deg: float = Field(default=90.0, gt=30.0, le=170.0)
+    #: Passive capsule moments by coordinate (:data:`CAPSULE_COORDINATES`, both legs; not on
+    #: a prosthetic joint); none by default (seed 001's model).
+    capsule_moments: dict[str, CapsuleMoment] = Field(default_factory=dict)
     #: The prosthetic knee of the transfemoral runner (ignored by the other kinds).
     prosthetic_knee: ProstheticKnee = Field(default_factory=ProstheticKnee)
+
+    @model_validator(mode="after")
+    def _known_capsules(self) -> RunnerParams:
+        unknown = sorted(set(self.capsule_moments) - set(CAPSULE_COORDINATES))
+        if unknown:
+            raise ValueError(f"capsule_moments: unknown coordinate(s) {', '.join(unknown)}; "
+                             f"known: {', '.join(CAPSULE_COORDINATES)}")
+        return self
 
 
 @dataclass(frozen=True)

@@ -3,8 +3,9 @@
 The passive moment of a pose: every leg muscle at zero activation in static equilibrium
 (:func:`~bladelab.runner.muscle.equilibrium_fiber_length`, its tendon force) times its moment
 arm, the MTU length's derivative by the coordinate (MuJoCo's spatial tendons of
-``RunnerModel.mj_analysis_model``). Joint ligaments are left out: they act only beyond the
-joint limits.
+``RunnerModel.mj_analysis_model``), plus the joint's capsule moment where the parameter set
+has one (``RunnerParams.capsule_moments``). Joint ligaments are left out: they act only beyond
+the joint limits.
 
 Riener & Edrich (1999) fitted the passive moments of all structures measured on people, with
 angles in degrees (knee flexion K, hip flexion H, ankle dorsiflexion A); Miller et al. (2012)
@@ -20,6 +21,7 @@ import mujoco
 import numpy as np
 
 from bladelab.runner.geometry import LEG_MUSCLES
+from bladelab.runner.layout import JP_EA, JP_EB
 from bladelab.runner.muscle import (
     MP_ACTIVE,
     MP_LOPT,
@@ -53,9 +55,9 @@ def riener_edrich_hip_moment(knee_deg: float, hip_deg: float) -> float:
 
 def passive_flexion_moment(runner, joint: str, *, knee_deg: float, hip_deg: float,
                            side: str = "l") -> float:
-    """The muscles' passive flexion moment [N·m] about ``joint`` (``"knee"`` or ``"hip"``) of
-    the leg ``side`` at knee and hip flexion [deg], the other coordinates of the standing
-    pose (module docstring)."""
+    """The passive flexion moment [N·m] of the muscles and the capsule about ``joint``
+    (``"knee"`` or ``"hip"``) of the leg ``side`` at knee and hip flexion [deg], the other
+    coordinates of the standing pose (module docstring)."""
     if joint not in ("knee", "hip"):
         raise ValueError(f"joint must be 'knee' or 'hip', got {joint!r}")
     model = runner.mj_analysis_model
@@ -82,4 +84,6 @@ def passive_flexion_moment(runner, joint: str, *, knee_deg: float, hip_deg: floa
         mp = runner.muscle_params[i]
         fibre = equilibrium_fiber_length(length[i], 0.0, *mp[MP_LOPT:])
         total += tendon_force_of_state(length[i], fibre, *mp[:MP_ACTIVE]) * d_length[i]
-    return sign * total
+    row = runner.joint_params[dof]
+    capsule = row[JP_EA] * math.exp(row[JP_EB] * q[dof])  # along the coordinate
+    return sign * total - sign * capsule

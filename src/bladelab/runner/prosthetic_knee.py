@@ -94,7 +94,7 @@ class ProstheticKnee:
                             where="prosthetic knee: assist_rest_angle")
         return np.array([-self.flexion_limit, -self.stop_angle, self.stop_stiffness,
                          self.stop_damping, self.assist_stiffness, 0.0, self.flexion_damping,
-                         self.extension_damping])
+                         self.extension_damping, 0.0, 0.0])
 
 
 @njit(cache=True)

@@ -42,6 +42,8 @@ from bladelab.runner.layout import (
     CP_SITE,
     CP_WIDTH,
     JP_D,
+    JP_EA,
+    JP_EB,
     JP_HI,
     JP_K,
     JP_LO,
@@ -155,5 +157,7 @@ def passive_torques(q: ca.SX, qd: ca.SX, joint_params: np.ndarray, smoothing: Sm
             else:  # a hydraulic knee: one damping flexing, another extending
                 gate = sigmoid(qd[j], smoothing.damping_switch_rad_s)
                 tau -= (d_neg + (d_pos - d_neg) * gate) * qd[j]
+        if row[JP_EA] != 0.0:  # the capsule's passive moment within the range (smooth as is)
+            tau += float(row[JP_EA]) * ca.exp(float(row[JP_EB]) * q[j])
         out.append(tau)
     return ca.vertcat(*out)

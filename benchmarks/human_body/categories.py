@@ -1,0 +1,150 @@
+"""The amputee on the human body at 4 m/s with each blade category, from several starts.
+
+Usage (repository root)::
+
+    .venv/bin/python benchmarks/human_body/categories.py [OUT] [--jobs 2] [--speed 4]
+
+Per category (Cat4, Cat5, Cat6, Cat6High, Cat7), three starts: ``trial`` (the measured 3.5 m/s
+stride scaled to the speed, through the tracking stage: the command's default), ``shipped``
+(the packaged Cat6 stride at 4 m/s, ``data/runner/collocation/amputee-Cat6-4-human.json``,
+with IPOPT's barrier started at 1e-4) and ``neighbour`` (the kept stride of the next stiffer
+category, or of Cat6 for Cat7, barrier 1e-4), the last once the first two have run everywhere.
+Each start writes ``OUT/<category>.<start>.json`` (``.best_iterate.json`` if IPOPT did not
+converge); a file already there is kept (re-run to continue). ``OUT/categories.csv`` has one
+row per category: the kept start (the lowest objective among converged solves), every start's
+objective and their spread [%], the kept stride's summary, its criteria against people's running
+and its stride analyses (K_leg, joint powers). Default OUT: ``benchmarks/human_body/categories``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import json
+import sys
+import time
+from concurrent.futures import ProcessPoolExecutor
+from pathlib import Path
+
+CATEGORIES = ("Cat4", "Cat5", "Cat6", "Cat6High", "Cat7")
+STARTS = ("trial", "shipped", "neighbour")
+SHIPPED = "amputee-Cat6-4-human.json"
+# the next stiffer category's kept stride starts the neighbour solve
+NEIGHBOUR = {"Cat4": "Cat5", "Cat5": "Cat6", "Cat6": "Cat6High", "Cat6High": "Cat7",
+             "Cat7": "Cat6"}
+
+
+def _path(out: Path, category: str, start: str) -> Path | None:
+    for suffix in (".json", ".best_iterate.json"):
+        p = out / f"{category}.{start}{suffix}"
+        if p.is_file():
+            return p
+    return None
+
+
+def _solve(out: str, category: str, start: str, guess: str, speed: float) -> str:
+    from bladelab.predict.collocation.settings import CollocationSettings
+    from bladelab.predict.collocation.solve import predict_stride
+    from bladelab.predict.collocation.starting_guess import make_guess
+    from bladelab.runner import build_runner
+
+    runner = build_runner("amputee", blade=category, body="human")
+    settings = CollocationSettings(speed_m_per_s=speed,
+                                   warm_start_mu=None if start == "trial" else 1e-4)
+    t0 = time.perf_counter()
+    sol = predict_stride(runner, settings,
+                         make_guess(runner, guess, n=settings.mesh_intervals, speed=speed),
+                         model_spec={"model": "amputee", "blade": category, "body": "human"})
+    name = f"{category}.{start}" + (".json" if sol.converged else ".best_iterate.json")
+    sol.write(Path(out) / name)
+    return (f"{name}: converged {sol.converged}, objective {sol.nlp.objective:.4f}, "
+            f"{time.perf_counter() - t0:.0f} s")
+
+
+def _kept(out: Path, category: str):
+    from bladelab.predict.collocation.solution import CollocationSolution
+
+    best = None
+    for start in STARTS:
+        p = _path(out, category, start)
+        if p is None or not p.name.endswith(f"{start}.json"):
+            continue
+        sol = CollocationSolution.read(p)
+        if best is None or sol.nlp.objective < best[1].nlp.objective:
+            best = (start, sol)
+    return best
+
+
+def _run(jobs: list[tuple], workers: int, out: Path, speed: float) -> None:
+    with ProcessPoolExecutor(max_workers=workers) as pool:
+        futures = [pool.submit(_solve, str(out), c, s, g, speed) for c, s, g in jobs]
+        for f in futures:
+            print(f.result(), flush=True)
+
+
+def _table(out: Path) -> None:
+    from bladelab.predict.collocation.analyses import stride_analyses
+    from bladelab.predict.collocation.human_running import human_running_criteria
+    from bladelab.predict.collocation.solution import CollocationSolution
+
+    rows = []
+    for category in CATEGORIES:
+        kept = _kept(out, category)
+        if kept is None:
+            continue
+        start, sol = kept
+        row = {"category": category, "kept_start": start}
+        objectives = {}
+        for s in STARTS:
+            p = _path(out, category, s)
+            ok = p is not None and p.name.endswith(f"{s}.json")
+            objectives[s] = CollocationSolution.read(p).nlp.objective if ok else None
+            row[f"objective_{s}"] = objectives[s]
+        done = [v for v in objectives.values() if v is not None]
+        row["spread_pct"] = (100 * (max(done) - min(done)) / min(done)) if len(done) > 1 else None
+        row.update(sol.summary())
+        crit = human_running_criteria(sol)
+        row["criteria_met"] = f"{sum(c.met for c in crit)}/{len(crit)}"
+        row["criteria_missed"] = "; ".join(f"{c.name} {c.value_text()}" for c in crit
+                                           if not c.met)
+        row.update(stride_analyses(sol))
+        rows.append(row)
+    if rows:
+        keys = list(dict.fromkeys(k for r in rows for k in r))
+        with open(out / "categories.csv", "w", newline="") as f:
+            w = csv.DictWriter(f, fieldnames=keys)
+            w.writeheader()
+            w.writerows(rows)
+        print(json.dumps([{k: r[k] for k in ("category", "kept_start", "spread_pct",
+                                            "criteria_met")} for r in rows], indent=1))
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser()
+    ap.add_argument("out", nargs="?", default="benchmarks/human_body/categories", type=Path)
+    ap.add_argument("--jobs", type=int, default=2)
+    ap.add_argument("--speed", type=float, default=4.0)
+    ap.add_argument("--table-only", action="store_true")
+    args = ap.parse_args(argv)
+    out = args.out
+    out.mkdir(parents=True, exist_ok=True)
+    shipped = str(Path(__file__).resolve().parents[2] / "src" / "bladelab" / "data" / "runner"
+                  / "collocation" / SHIPPED)
+    if not args.table_only:
+        first = [(c, s, g) for c in CATEGORIES for s, g in (("trial", "trial"),
+                                                            ("shipped", shipped))
+                 if _path(out, c, s) is None]
+        _run(first, args.jobs, out, args.speed)
+        second = []
+        for c in CATEGORIES:
+            kept = _kept(out, NEIGHBOUR[c])
+            if _path(out, c, "neighbour") is None and kept is not None:
+                p = _path(out, NEIGHBOUR[c], kept[0])
+                second.append((c, "neighbour", str(p)))
+        _run(second, args.jobs, out, args.speed)
+    _table(out)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
