@@ -238,7 +238,7 @@ def test_sweep_collocation_passes_the_same_settings(tmp_path, monkeypatch):
     assert seen["settings"] == CollocationSettings(mesh_intervals=12, speed_m_per_s=3.5,
                                                    max_iter=9)
     assert isinstance(seen["guess"], functools.partial) and seen["guess"].func is make_guess
-    assert seen["guess"].keywords == {"guess": "trial"}  # the default guess
+    assert seen["guess"].keywords == {"guess": "stored"}  # the default guess
     assert (seen["jobs"], seen["executor"], seen["starts"], seen["resume"], seen["force"]) == (
         2, "local", 2, False, False)
 

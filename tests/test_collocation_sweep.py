@@ -22,6 +22,17 @@ def _sweep(out, *extra):
                  "--max-iter", "1", "--body", "seed001", "--guess", "template", *extra])
 
 
+def test_able_alone_with_empty_categories(fake_solve, tmp_path):
+    """``--able --categories ''`` sweeps the able model alone; without --able an empty list is
+    refused naming the option."""
+    out = tmp_path / "sweep"
+    assert _sweep(out, "--able", "--categories", "", "--speeds", "3.5") == 0
+    assert sorted(p.name for p in out.iterdir()) == ["able", "collocation-sweep.csv"]
+    assert {c["label"] for c in fake_solve.calls} == {"able"}
+    assert _sweep(tmp_path / "none", "--categories", "", "--speeds", "3.5") == 2
+    assert not (tmp_path / "none").exists()
+
+
 def _csv(path):
     with open(path, newline="", encoding="utf-8") as fh:
         return list(csv.DictReader(fh))

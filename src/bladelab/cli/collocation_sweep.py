@@ -107,7 +107,8 @@ def run_collocation_sweep(
     """Run ``bladelab sweep --method collocation``; returns the exit status (0 every solve
     converged, 2 some model failed)."""
     speed_list = _speeds(speeds)
-    cats = parse_list(categories, "--categories")
+    # --able --categories "": the able model alone
+    cats = parse_list(categories, "--categories") if categories.strip() or not able else []
     try:
         result = sweep_named_models(
             out, categories=cats, speeds=speed_list, able=able, body=body, guess=guess,

@@ -189,7 +189,8 @@ def register(app: typer.Typer) -> None:
             help="Mesh intervals of the stride."),
         guess: str = typer.Option(
             defaults.GUESS, "--guess", rich_help_panel=COLLOCATION,
-            help="Initial guess: template | trial (the Fukuchi 3.5 m/s trial) | FILE "
+            help="Initial guess: stored (the shipped stride of the model on the human body; "
+                 "else the trial) | trial (the Fukuchi 3.5 m/s trial) | template | FILE "
                  "(solution.json, best_iterate.json or reflex JSON)."),
         max_iter: int = typer.Option(
             defaults.MAX_ITER, "--max-iter", rich_help_panel=COLLOCATION,
@@ -321,12 +322,14 @@ def register(app: typer.Typer) -> None:
                  "(amputee-<category>/speed-<v>.json)."),
         # -- collocation -------------------------------------------------------------------
         able: bool = typer.Option(False, "--able", rich_help_panel=COLLOCATION,
-                                  help="Sweep the able model too (first)."),
+                                  help="Sweep the able model too (first); with "
+                                       "--categories '' the able model alone."),
         mesh: int = typer.Option(defaults.MESH_INTERVALS, "--mesh", rich_help_panel=COLLOCATION,
                                  help="Mesh intervals of the stride."),
         guess: str = typer.Option(
             defaults.GUESS, "--guess", rich_help_panel=COLLOCATION,
-            help="Initial guess of each model's first speed: template | trial | FILE."),
+            help="Initial guess of each model's first speed: stored | trial | template | "
+                 "FILE."),
         max_iter: int = typer.Option(defaults.MAX_ITER, "--max-iter",
                                      rich_help_panel=COLLOCATION,
                                      help="IPOPT iterations per stage."),

@@ -99,9 +99,12 @@ MAX_ITER = 3000
 #: human body"); ``seed001`` reproduces seed 001's model, ``toes`` is it with a toe segment and
 #: compliant Achilles tendons.
 BODY = "human"
-#: Initial guess of a stride: the measured 3.5 m/s trial's mean stride, scaled to the
-#: prescribed speed (on the human body the template's tracking stage stalled: objective 280
-#: after 1,050 iterations, measured; from the trial it converges).
-GUESS = "trial"
+#: Initial guess of a stride: the stride shipped for the runner's kind on the human body,
+#: scaled to the prescribed speed, where there is one; else the measured 3.5 m/s trial's mean
+#: stride (``bladelab.predict.collocation.starting_guess``). Measured on the human body: the
+#: template's tracking stage stalled (objective 280 after 1,050 iterations); from the trial
+#: the able runner at 3.5 m/s reached strides 4.7 and 7.2 of objective on two versions of
+#: the body, 50 % apart, where the stored stride re-converges to the cheaper one.
+GUESS = "stored"
 #: Starts per problem of a collocation sweep (the best solve is kept).
 STARTS = 1

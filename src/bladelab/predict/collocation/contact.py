@@ -18,6 +18,7 @@ read from ``RunnerModel.contact_params`` and ``RunnerModel.joint_params``:
   ``max(K·(lo − q) − D·q̇, 0)`` below the lower one; here the excursion is a softplus, the
   damping is gated by its derivative (a sigmoid) and the outer max is :func:`smooth_max0`.
 - **Socket and blade joints**: ``−(K·q + K2·q·|q|) − D·q̇`` with ``|q| ≈ √(q² + ε²)``.
+- **Capsule** (e.g. the hip's, within the range): ``A·exp(B·q)``, smooth as it is.
 """
 
 from __future__ import annotations
@@ -133,7 +134,8 @@ def contact_forces(
 
 
 def passive_torques(q: ca.SX, qd: ca.SX, joint_params: np.ndarray, smoothing: Smoothing) -> ca.SX:
-    """Smooth ligament and socket (blade-joint) torques (nv,) [N·m] at (q [rad], qd [rad/s])."""
+    """Smooth ligament, socket (blade-joint) and capsule torques (nv,) [N·m] at (q [rad],
+    qd [rad/s])."""
     eps_t = smoothing.ligament_torque_nm
     eps_s = smoothing.socket_angle_rad
     out = []

@@ -2,7 +2,9 @@
 
 ``template`` (:func:`~bladelab.predict.collocation.guess.template_guess` at the prescribed
 speed), ``trial`` (the measured running trial shipped with bladelab,
-:func:`~bladelab.predict.collocation.guess.guess_from_trial`), or the path of a file: a
+:func:`~bladelab.predict.collocation.guess.guess_from_trial`), ``stored`` (the stride that
+bladelab ships for the runner's kind on the human body, :data:`STORED_STRIDES`, the cheapest
+found; the trial where there is none: another kind, body or parameter set), or the path of a file: a
 collocation solution or best iterate (``solution.json``, ``best_iterate.json``; a stride of the
 other amputee kind is mapped onto the runner) or a reflex controller's parameter file
 (``bladelab predict`` writes ``best.json``). ``bladelab predict --guess`` and
@@ -11,6 +13,7 @@ other amputee kind is mapped onto the runner) or a reflex controller's parameter
 
 from __future__ import annotations
 
+import dataclasses
 from pathlib import Path
 
 from bladelab._io import read_json
@@ -22,18 +25,33 @@ from bladelab.predict.collocation.guess import (
     template_guess,
 )
 from bladelab.predict.collocation.solution import CollocationSolution
-from bladelab.runner.params import PROSTHETIC_KINDS
+from bladelab.runner.params import PROSTHETIC_KINDS, RUNNER_DATA_DIR, default_runner_params
 
-__all__ = ["GUESS_WORDS", "MAX_SPEED_TEMPLATE_M_PER_S", "guess_file_kind", "make_guess",
-           "resolve_guess"]
+__all__ = ["GUESS_WORDS", "MAX_SPEED_TEMPLATE_M_PER_S", "STORED_STRIDES", "guess_file_kind",
+           "make_guess", "resolve_guess", "stored_stride_path"]
 
 #: The guesses named by a word; anything else is the path of a file.
-GUESS_WORDS = ("template", "trial")
+GUESS_WORDS = ("template", "trial", "stored")
+#: The shipped strides of the human body by runner kind (``data/runner/collocation/``; their
+#: provenance in that folder's README): the ``stored`` guess. Any blade category starts from
+#: the amputee's Cat6 stride.
+STORED_STRIDES = {"able": "able-3.5-human.json", "amputee": "amputee-Cat6-4-human.json"}
 #: Speed [m/s] of the template guess of a maximum-speed problem (no prescribed speed).
 MAX_SPEED_TEMPLATE_M_PER_S = 4.0
 
-_NEITHER_HINT = ("template, trial, or the path of a solution.json, best_iterate.json or reflex "
-                 "parameter JSON file")
+_NEITHER_HINT = ("template, trial, stored, or the path of a solution.json, best_iterate.json or "
+                 "reflex parameter JSON file")
+
+
+def stored_stride_path(runner) -> Path | None:
+    """The shipped stride (:data:`STORED_STRIDES`) of ``runner``'s kind if ``runner`` is the
+    built-in human body of that kind (any blade category), else None."""
+    name = STORED_STRIDES.get(runner.kind)
+    path = RUNNER_DATA_DIR / "collocation" / name if name else None
+    if path is None or not path.is_file():
+        return None
+    body = default_runner_params(runner.kind, body="human").model_dump(exclude={"blade"})
+    return path if runner.params.model_dump(exclude={"blade"}) == body else None
 
 
 def make_guess(runner, guess: str, *, n: int, speed: float | None, where: str = "guess"):
@@ -44,7 +62,7 @@ def make_guess(runner, guess: str, *, n: int, speed: float | None, where: str = 
     runner
         The runner model (:class:`bladelab.runner.RunnerModel`).
     guess
-        ``"template"``, ``"trial"`` or the path of a file.
+        ``"template"``, ``"trial"``, ``"stored"`` or the path of a file.
     n
         Mesh intervals of the stride.
     speed
@@ -65,6 +83,13 @@ def make_guess(runner, guess: str, *, n: int, speed: float | None, where: str = 
         return template_guess(runner, speed=speed or MAX_SPEED_TEMPLATE_M_PER_S, n=n)
     if guess == "trial":
         return measured_trial_guess(runner, n=n)
+    if guess == "stored":
+        stored = stored_stride_path(runner)
+        if stored is None:
+            trial = measured_trial_guess(runner, n=n)
+            return dataclasses.replace(trial, source=f"measured trial {trial.source} (no "
+                                                     "stored stride of this runner)")
+        guess = str(stored)
     path = Path(guess)
     if guess_file_kind(path, where=where) == "collocation":
         sol = CollocationSolution.read(path)
@@ -84,7 +109,7 @@ def guess_file_kind(path: str | Path, *, where: str = "guess") -> str:
     parameter file) for a guess file; errors name ``where``."""
     path = Path(path)
     if not path.is_file():
-        raise SpecError(f"{str(path)!r} is neither template, trial nor a file", where=where,
+        raise SpecError(f"{str(path)!r} is neither template, trial, stored nor a file", where=where,
                         hint=_NEITHER_HINT)
     data = read_json(path, what=f"{where} file")
     if isinstance(data, dict) and str(data.get("kind", "")).startswith("collocation-"):
@@ -103,6 +128,6 @@ def resolve_guess(guess: str, *, where: str = "guess") -> str:
         return guess
     path = Path(guess)
     if not path.is_file():
-        raise SpecError(f"{guess!r} is neither template, trial nor a file", where=where,
+        raise SpecError(f"{guess!r} is neither template, trial, stored nor a file", where=where,
                         hint=_NEITHER_HINT)
     return str(path.resolve())

@@ -1,0 +1,58 @@
+"""The initial guess named by a word: the stored stride of the human body."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+import yaml
+
+from bladelab.predict.collocation.solution import CollocationSolution
+from bladelab.predict.collocation.starting_guess import (
+    STORED_STRIDES,
+    make_guess,
+    resolve_guess,
+    stored_stride_path,
+)
+from bladelab.runner import build_runner, default_runner_params, runner_params_from_dict
+from bladelab.runner.params import RUNNER_DATA_DIR
+
+N = 20
+
+
+@pytest.mark.parametrize(("kind", "blade"), [("able", None), ("amputee", "Cat6"),
+                                             ("amputee", "Cat4")])
+def test_stored_is_the_shipped_stride_of_the_human_body(kind, blade):
+    """Every kind with a stored stride starts from it on the human body, any blade category;
+    the stride is the file's own (the solver resamples it to its mesh)."""
+    runner = build_runner(kind, blade=blade, body="human")
+    path = stored_stride_path(runner)
+    assert path == RUNNER_DATA_DIR / "collocation" / STORED_STRIDES[kind]
+    stored = CollocationSolution.read(path)
+    assert stored.model_spec["model"] == kind and stored.model_spec["body"] == "human"
+    assert stored.converged
+    guess = make_guess(runner, "stored", n=N, speed=4.0)
+    assert path.name in guess.source
+    np.testing.assert_array_equal(guess.q, stored.nlp.q)
+
+
+def test_stored_falls_back_to_the_trial_elsewhere_and_says_so():
+    """Seed 001's body, the transfemoral runner and a changed parameter set have no stored
+    stride: the measured trial, its source naming the fallback."""
+    changed = yaml.safe_load(default_runner_params("able", body="human").model_dump_json())
+    changed["athlete"]["body_mass_kg"] = 80.0
+    for runner in (build_runner("able"), build_runner("transfemoral", body="human"),
+                   build_runner(runner_params_from_dict(changed))):
+        assert stored_stride_path(runner) is None
+        guess = make_guess(runner, "stored", n=N, speed=3.5)
+        assert "trial" in guess.source and "no stored stride" in guess.source
+    assert resolve_guess("stored") == "stored"
+
+
+def test_stored_strides_hold_their_provenance_in_the_folder_readme():
+    readme = (RUNNER_DATA_DIR / "collocation" / "README.md").read_text()
+    for name in STORED_STRIDES.values():
+        assert f"`{name}`" in readme
+        data = json.loads((RUNNER_DATA_DIR / "collocation" / name).read_text())
+        assert data["kind"] == "collocation-solution"
