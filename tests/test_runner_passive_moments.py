@@ -8,6 +8,7 @@ import pytest
 
 from bladelab.runner import build_runner
 from bladelab.runner.passive_moments import (
+    leg_muscle_forces,
     passive_flexion_moment,
     riener_edrich_hip_moment,
     riener_edrich_knee_moment,
@@ -42,3 +43,17 @@ def test_human_body_passive_knee_and_flexed_hip_moments_are_people_s():
 def test_passive_flexion_moment_refuses_another_joint():
     with pytest.raises(ValueError, match="joint must be 'knee' or 'hip'"):
         passive_flexion_moment(build_runner("able"), "ankle", knee_deg=0, hip_deg=0)
+
+
+def test_leg_muscle_forces_act_on_the_joints_they_cross():
+    """On the knee at 45° of flexion: the hip-only muscles act not at all, the vasti extend it
+    (knee_angle = −flexion, so a positive generalised force), more at full activation than
+    passive; the monoarticular knee flexor flexes it."""
+    runner = build_runner("able", body="human")
+    q = runner.stand_qpos.copy()
+    q[runner.dof("knee_angle_l")] = math.radians(-45.0)
+    passive = leg_muscle_forces(runner, "knee_angle_l", q, activation=0.0)
+    active = leg_muscle_forces(runner, "knee_angle_l", q, activation=1.0)
+    assert abs(active["glut_max"]) < 1e-6 and abs(active["iliopsoas"]) < 1e-6
+    assert active["vasti"] > passive["vasti"] >= 0.0 and active["vasti"] > 100.0
+    assert active["bifemsh"] < 0.0

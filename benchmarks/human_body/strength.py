@@ -4,10 +4,9 @@ Usage (repository root)::
 
     .venv/bin/python benchmarks/human_body/strength.py [ACTIVE_SPECIFIC_TENSION_N_PER_CM2]
 
-Every leg muscle of the left leg at full activation in static equilibrium (compliant tendon,
-:func:`bladelab.runner.muscle.equilibrium_fiber_length`) at a pose of the standing runner with
-one joint moved; the moment is the tendon force times the moment arm (the MTU length's
-derivative, MuJoCo's spatial tendons of ``RunnerModel.mj_analysis_model``). Printed per angle:
+Every leg muscle of the left leg at full activation in static equilibrium (compliant tendon)
+at a pose of the standing runner with one joint moved, its tendon force times its moment arm
+(:func:`bladelab.runner.passive_moments.leg_muscle_forces`). Printed per angle:
 the knee extension moment (hip 0°), the plantarflexion moment (knee 0°) and the hip extension
 moment (knee 0°) [N·m], and each muscle's share. The argument replaces the body's active
 specific tension (default: the body's own, 60 N/cm²).
@@ -19,43 +18,17 @@ import json
 import math
 import sys
 
-import mujoco
-
 from bladelab.runner import build_runner
-from bladelab.runner.muscle import (
-    MP_ACTIVE,
-    MP_LOPT,
-    equilibrium_fiber_length,
-    tendon_force_of_state,
-)
 from bladelab.runner.params import default_runner_params, runner_params_from_dict
+from bladelab.runner.passive_moments import leg_muscle_forces
 
 
 def joint_moments(runner, dof: str, pose_deg: dict[str, float]) -> dict[str, float]:
     """Each left-leg muscle's generalised force on ``dof`` [N·m] at full activation."""
-    model, data = runner.mj_analysis_model, mujoco.MjData(runner.mj_analysis_model)
-
-    def lengths(q):
-        data.qpos[:] = q
-        mujoco.mj_forward(model, data)
-        return data.ten_length.copy()
-
     q = runner.stand_qpos.copy()
     for name, value in pose_deg.items():
         q[runner.dof(name)] = math.radians(value)
-    j = runner.dof(dof)
-    qp, qm = q.copy(), q.copy()
-    qp[j] += 1e-6
-    qm[j] -= 1e-6
-    arm = (lengths(qp) - lengths(qm)) / 2e-6
-    length = lengths(q)
-    out = {}
-    for i, name in enumerate(runner.muscle_names):
-        if name.endswith("_l") and abs(arm[i]) > 1e-5:
-            mp = runner.muscle_params[i]
-            fibre = equilibrium_fiber_length(length[i], 1.0, *mp[MP_LOPT:])
-            out[name[:-2]] = -tendon_force_of_state(length[i], fibre, *mp[:MP_ACTIVE]) * arm[i]
-    return out
+    return leg_muscle_forces(runner, dof, q, activation=1.0)
 
 
 def main() -> None:
@@ -75,7 +48,7 @@ def main() -> None:
         print(title)
         for angle in angles:
             parts = {k: sign * v for k, v in joint_moments(runner, dof, pose(angle)).items()
-                     if sign * v > 0}
+                     if sign * v > 1e-3}  # the muscles that do not cross the joint: ~0
             print(f"  {angle:4d}: {sum(parts.values()):6.0f}   "
                   + ", ".join(f"{k} {v:.0f}" for k, v in parts.items()))
 

@@ -29,7 +29,8 @@ from bladelab.runner.muscle import (
     tendon_force_of_state,
 )
 
-__all__ = ["passive_flexion_moment", "riener_edrich_hip_moment", "riener_edrich_knee_moment"]
+__all__ = ["leg_muscle_forces", "passive_flexion_moment", "riener_edrich_hip_moment",
+           "riener_edrich_knee_moment"]
 
 #: Step [rad] of the central difference of the MTU lengths.
 _STEP_RAD = 1e-6
@@ -53,6 +54,36 @@ def riener_edrich_hip_moment(knee_deg: float, hip_deg: float) -> float:
             - math.exp(1.3403 - 0.0226 * k + 0.0305 * h) + 8.072)
 
 
+def leg_muscle_forces(runner, dof: str, q: np.ndarray, *, activation: float,
+                      side: str = "l") -> dict[str, float]:
+    """Each leg muscle of ``side``'s generalised force on the coordinate ``dof`` [N·m or N] at
+    the pose ``q`` (MuJoCo coordinates) and ``activation`` [-], in static equilibrium (module
+    docstring), by muscle type (``vasti``, ...)."""
+    model = runner.mj_analysis_model
+    data = mujoco.MjData(model)
+    j = runner.dof(dof)
+
+    def lengths(qpos: np.ndarray) -> np.ndarray:
+        data.qpos[:] = qpos
+        mujoco.mj_forward(model, data)
+        return data.ten_length.copy()
+
+    qp, qm = q.copy(), q.copy()
+    qp[j] += _STEP_RAD
+    qm[j] -= _STEP_RAD
+    d_length = (lengths(qp) - lengths(qm)) / (2.0 * _STEP_RAD)
+    length = lengths(q)
+    out = {}
+    for m in LEG_MUSCLES:
+        if f"{m}_{side}" not in runner.muscle_names:
+            continue
+        i = runner.muscle_names.index(f"{m}_{side}")
+        mp = runner.muscle_params[i]
+        fibre = equilibrium_fiber_length(length[i], activation, *mp[MP_LOPT:])
+        out[m] = -tendon_force_of_state(length[i], fibre, *mp[:MP_ACTIVE]) * d_length[i]
+    return out
+
+
 def passive_flexion_moment(runner, joint: str, *, knee_deg: float, hip_deg: float,
                            side: str = "l") -> float:
     """The passive flexion moment [N·m] of the muscles and the capsule about ``joint``
@@ -60,30 +91,11 @@ def passive_flexion_moment(runner, joint: str, *, knee_deg: float, hip_deg: floa
     coordinates of the standing pose (module docstring)."""
     if joint not in ("knee", "hip"):
         raise ValueError(f"joint must be 'knee' or 'hip', got {joint!r}")
-    model = runner.mj_analysis_model
-    data = mujoco.MjData(model)
-    knee, hip = runner.dof(f"knee_angle_{side}"), runner.dof(f"hip_flexion_{side}")
+    knee, hip = f"knee_angle_{side}", f"hip_flexion_{side}"
     dof, sign = (knee, 1.0) if joint == "knee" else (hip, -1.0)  # knee_angle = −flexion
-    muscles = [runner.muscle_names.index(f"{m}_{side}") for m in LEG_MUSCLES
-               if f"{m}_{side}" in runner.muscle_names]
-
-    def lengths(q: np.ndarray) -> np.ndarray:
-        data.qpos[:] = q
-        mujoco.mj_forward(model, data)
-        return data.ten_length.copy()
-
     q = runner.stand_qpos.copy()
-    q[knee], q[hip] = -math.radians(knee_deg), math.radians(hip_deg)
-    qp, qm = q.copy(), q.copy()
-    qp[dof] += _STEP_RAD
-    qm[dof] -= _STEP_RAD
-    d_length = (lengths(qp) - lengths(qm)) / (2.0 * _STEP_RAD)
-    length = lengths(q)
-    total = 0.0
-    for i in muscles:
-        mp = runner.muscle_params[i]
-        fibre = equilibrium_fiber_length(length[i], 0.0, *mp[MP_LOPT:])
-        total += tendon_force_of_state(length[i], fibre, *mp[:MP_ACTIVE]) * d_length[i]
-    row = runner.joint_params[dof]
-    capsule = row[JP_EA] * math.exp(row[JP_EB] * q[dof])  # along the coordinate
-    return sign * total - sign * capsule
+    q[runner.dof(knee)], q[runner.dof(hip)] = -math.radians(knee_deg), math.radians(hip_deg)
+    forces = leg_muscle_forces(runner, dof, q, activation=0.0, side=side)
+    row = runner.joint_params[runner.dof(dof)]
+    capsule = row[JP_EA] * math.exp(row[JP_EB] * q[runner.dof(dof)])  # along the coordinate
+    return -sign * (sum(forces.values()) + capsule)
