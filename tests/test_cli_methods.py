@@ -54,7 +54,8 @@ def test_an_option_of_the_chosen_method_given_its_default_is_accepted(tmp_path, 
 
     seen = {}
     monkeypatch.setattr(reflex, "run_reflex", lambda **kw: seen.update(kw))
-    assert main(["predict", "--method", "reflex", "--integrator", "explicit", "--seeds", "1", "--out",
+    assert main(["predict", "--method", "reflex",
+                 "--integrator", "explicit", "--seeds", "1", "--out",
                  str(tmp_path)]) == 0
     assert seen["integrator"] == "explicit" and seen["seeds"] == "1"
 
@@ -147,7 +148,8 @@ def test_predict_reflex_passes_the_same_settings(tmp_path, monkeypatch, capsys):
         return [types.SimpleNamespace(best_cost=1.0, to_dict=lambda: {"best_cost": 1.0})]
 
     monkeypatch.setattr(named, "optimize_seeds", optimize_seeds)
-    assert main(["predict", "--method", "reflex", "--model", "amputee", "--blade", "Cat5", "--speed", "4",
+    assert main(["predict", "--method", "reflex",
+                 "--model", "amputee", "--blade", "Cat5", "--speed", "4",
                  "--generations", "3", "--popsize", "6", "--sigma", "0.5", "--seeds", "1,2",
                  "--duration", "4", "--dt", "5e-4", "--robust-samples", "3",
                  "--robust-jitter", "1e-5", "--robust-speed-change", "0.05",

@@ -154,7 +154,8 @@ def test_report_of_predict_folders(tmp_path, capsys):
         _units_everywhere(_table(tables, part))
     capsys.readouterr()
     seeds = tmp_path / "seeds"
-    assert main(["predict", "--method", "reflex", "--generations", "2", "--popsize", "4", "--duration", "0.5",
+    assert main(["predict", "--method", "reflex",
+                 "--generations", "2", "--popsize", "4", "--duration", "0.5",
                  "--seeds", "1,2", "--out", str(seeds)]) == 0
     assert predictive_kind(seeds) == "runs"
     capsys.readouterr()

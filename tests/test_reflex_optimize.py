@@ -182,9 +182,11 @@ def test_cli_predict_and_errors(tmp_path, capsys):
     assert code == 0
     assert json.loads((tmp_path / "p" / "best.json").read_text())["generation"] == 3
     capsys.readouterr()
-    assert main(["predict", "--method", "reflex", "--model", "robot", "--out", str(tmp_path / "x")]) == 2
+    assert main(["predict", "--method", "reflex",
+                 "--model", "robot", "--out", str(tmp_path / "x")]) == 2
     assert "robot" in capsys.readouterr().err
-    assert main(["predict", "--method", "reflex", "--init", str(tmp_path / "missing.json"), "--out", str(tmp_path)]) == 2
+    assert main(["predict", "--method", "reflex",
+                 "--init", str(tmp_path / "missing.json"), "--out", str(tmp_path)]) == 2
     assert "not found" in capsys.readouterr().err
 
 
@@ -326,7 +328,8 @@ def test_a_folder_holding_a_run_is_refused_unless_resumed_or_forced(tmp_path, ca
     with pytest.raises(InputFileError, match="holds a run"):
         optimize_controller("able", out=tmp_path, **args)
     assert (tmp_path / "history.csv").read_text() == history  # nothing erased
-    code = main(["predict", "--method", "reflex", "--model", "able", "--generations", "1", "--popsize", "4",
+    code = main(["predict", "--method", "reflex",
+                 "--model", "able", "--generations", "1", "--popsize", "4",
                  "--duration", "0.2", "--out", str(tmp_path)])
     assert code == 2 and "--resume continues it" in capsys.readouterr().err
     assert (tmp_path / "history.csv").read_text() == history
@@ -485,6 +488,7 @@ def test_cli_refuses_bad_robust_copies(tmp_path, capsys, option, value, named):
 
 
 def test_cli_refuses_a_half_step_copy_without_copies(tmp_path, capsys):
-    assert main(["predict", "--method", "reflex", "--robust-half-step", "--out", str(tmp_path / "x")]) == 2
+    assert main(["predict", "--method", "reflex",
+                 "--robust-half-step", "--out", str(tmp_path / "x")]) == 2
     assert "--robust-half-step" in capsys.readouterr().err
     assert not (tmp_path / "x").exists()

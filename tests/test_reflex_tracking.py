@@ -151,17 +151,20 @@ def test_tracking_term_adds_to_the_cost_and_leaves_the_gait_alone():
 
 def test_cli_track_errors(tmp_path, capsys):
     out = tmp_path / "run"
-    code = main(["predict", "--method", "reflex", "--model", "amputee", "--blade", "Cat4", "--track", str(CAT6_4),
+    code = main(["predict", "--method", "reflex",
+                 "--model", "amputee", "--blade", "Cat4", "--track", str(CAT6_4),
                  "--out", str(out), "--generations", "1"])
     err = capsys.readouterr().err
     assert code == 2 and "--track" in err and "same runner" in err and not out.exists()
-    code = main(["predict", "--method", "reflex", "--model", "able", "--track", str(ABLE_4), "--track-weight", "0",
+    code = main(["predict", "--method", "reflex",
+                 "--model", "able", "--track", str(ABLE_4), "--track-weight", "0",
                  "--out", str(out)])
     assert code == 2 and "--track-weight" in capsys.readouterr().err
     code = main(["predict", "--method", "collocation", "--track", str(CAT6_4),
                  "--out", str(out)])
     assert code == 2 and "only with --method reflex" in capsys.readouterr().err
-    code = main(["predict", "--method", "reflex", "--model", "able", "--integrator", "rk4", "--out", str(out)])
+    code = main(["predict", "--method", "reflex",
+                 "--model", "able", "--integrator", "rk4", "--out", str(out)])
     assert code == 2 and "--integrator" in capsys.readouterr().err
 
 
@@ -171,7 +174,8 @@ def test_a_tracked_run_and_its_report(tmp_path, capsys):
     import pandas as pd
 
     run = tmp_path / "run"
-    assert main(["predict", "--method", "reflex", "--model", "amputee", "--blade", "Cat6", "--speed", "4",
+    assert main(["predict", "--method", "reflex",
+                 "--model", "amputee", "--blade", "Cat6", "--speed", "4",
                  "--init", str(SHIPPED), "--track", str(CAT6_4), "--integrator", "implicit",
                  "--dt", "1e-3", "--duration", "2", "--generations", "2", "--popsize", "4",
                  "--sigma", "0.05", "--out", str(run)]) == 0

@@ -8,9 +8,9 @@ The JSON variant says what differs from the built-in human parameter set of ``ki
 (``able``/``amputee``, default able; ``blade``; ``speed`` [m/s], default 3.5):
 ``force_factor`` ({muscle type or "all": factor} on the table's maximum isometric forces; the
 tendon and passive curves follow them), ``muscle`` ({muscle type: {field: value}}), ``set``
-(top-level parameter fields), ``weights`` (``StrideWeights`` fields) and ``guess`` (a word or a
-solution file; default the measured trial) and ``mesh`` (mesh intervals, default 50). Writes ``OUT/solution.json`` (or
-``best_iterate.json``) and ``OUT/variant.json``, and prints the summary and the wall time [s].
+(top-level parameter fields), ``weights`` (``StrideWeights`` fields), ``guess`` (a word or a
+solution file; default the measured trial) and ``mesh`` (mesh intervals, default 50). Writes
+``OUT/solution.json`` (or ``best_iterate.json``) and ``OUT/variant.json``, and prints the summary and the wall time [s].
 The rows of README.md made with it: every force doubled (``{"force_factor": {"all": 2.0}}``),
 the acceleration weight 0.01, the vasti tendon slack length 0.146 m.
 """

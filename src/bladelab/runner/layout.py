@@ -30,4 +30,4 @@ LAW_HUNT_CROSSLEY, LAW_SPRING_DAMPER = 0, 1
 # Columns of RunnerModel.joint_params (one row per dof).
 JP_LO, JP_HI, JP_K, JP_D, JP_SK, JP_SK2, JP_SD, JP_SDX, JP_EA, JP_EB = range(10)
 #: Columns of RunnerModel.joint_params.
-JP_COLUMNS = 10
+JP_COLUMNS = JP_EB + 1

@@ -472,8 +472,8 @@ def build_runner(
         if base == "mtp_angle":
             jp[i, JP_SK:JP_EA] = (MTP_STIFFNESS, 0.0, MTP_DAMPING, MTP_DAMPING)
         if dn == "socket_angle_r":
-            jp[i, JP_SK:JP_EA] = (SOCKET_STIFFNESS, SOCKET_STIFFNESS_QUADRATIC, SOCKET_DAMPING,
-                             SOCKET_DAMPING)
+            jp[i, JP_SK:JP_EA] = (SOCKET_STIFFNESS, SOCKET_STIFFNESS_QUADRATIC,
+                                  SOCKET_DAMPING, SOCKET_DAMPING)
         if dn == "knee_angle_r" and transfemoral:
             jp[i] = params.prosthetic_knee.joint_row()
         if dn.startswith("blade_joint") and blade_model is not None:

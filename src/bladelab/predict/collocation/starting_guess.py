@@ -4,8 +4,8 @@
 speed), ``trial`` (the measured running trial shipped with bladelab,
 :func:`~bladelab.predict.collocation.guess.guess_from_trial`), ``stored`` (the stride that
 bladelab ships for the runner's kind on the human body, :data:`STORED_STRIDES`, the cheapest
-found; the trial where there is none: another kind, body or parameter set), or the path of a file: a
-collocation solution or best iterate (``solution.json``, ``best_iterate.json``; a stride of the
+found; the trial where there is none: another kind, body or parameter set), or the path of a
+file: a collocation solution or best iterate (``solution.json``, ``best_iterate.json``; a stride of the
 other amputee kind is mapped onto the runner) or a reflex controller's parameter file
 (``bladelab predict`` writes ``best.json``). ``bladelab predict --guess`` and
 ``bladelab sweep --guess`` name their guess this way.
@@ -109,8 +109,8 @@ def guess_file_kind(path: str | Path, *, where: str = "guess") -> str:
     parameter file) for a guess file; errors name ``where``."""
     path = Path(path)
     if not path.is_file():
-        raise SpecError(f"{str(path)!r} is neither template, trial, stored nor a file", where=where,
-                        hint=_NEITHER_HINT)
+        raise SpecError(f"{str(path)!r} is neither template, trial, stored nor a file",
+                        where=where, hint=_NEITHER_HINT)
     data = read_json(path, what=f"{where} file")
     if isinstance(data, dict) and str(data.get("kind", "")).startswith("collocation-"):
         return "collocation"
@@ -128,6 +128,6 @@ def resolve_guess(guess: str, *, where: str = "guess") -> str:
         return guess
     path = Path(guess)
     if not path.is_file():
-        raise SpecError(f"{guess!r} is neither template, trial, stored nor a file", where=where,
-                        hint=_NEITHER_HINT)
+        raise SpecError(f"{guess!r} is neither template, trial, stored nor a file",
+                        where=where, hint=_NEITHER_HINT)
     return str(path.resolve())
