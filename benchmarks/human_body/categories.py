@@ -63,18 +63,22 @@ def _solve(out: str, category: str, start: str, guess: str, speed: float) -> str
             f"{time.perf_counter() - t0:.0f} s")
 
 
-def _kept(out: Path, category: str):
+def _converged(out: Path, category: str) -> dict:
+    """The converged solves of ``category`` by start (a best iterate is not one)."""
     from bladelab.predict.collocation.solution import CollocationSolution
 
-    best = None
-    for start in STARTS:
-        p = _path(out, category, start)
-        if p is None or not p.name.endswith(f"{start}.json"):
-            continue
-        sol = CollocationSolution.read(p)
-        if best is None or sol.nlp.objective < best[1].nlp.objective:
-            best = (start, sol)
-    return best
+    return {start: CollocationSolution.read(p) for start in STARTS
+            if (p := _path(out, category, start)) is not None
+            and p.name.endswith(f"{start}.json")}
+
+
+def _kept(out: Path, category: str, solves: dict | None = None):
+    """(start, solution) of the lowest objective among ``category``'s converged solves."""
+    solves = _converged(out, category) if solves is None else solves
+    if not solves:
+        return None
+    start = min(solves, key=lambda s: solves[s].nlp.objective)
+    return start, solves[start]
 
 
 def _run(jobs: list[tuple], workers: int, out: Path, speed: float) -> None:
@@ -87,22 +91,18 @@ def _run(jobs: list[tuple], workers: int, out: Path, speed: float) -> None:
 def _table(out: Path) -> None:
     from bladelab.predict.collocation.analyses import stride_analyses
     from bladelab.predict.collocation.human_running import human_running_criteria
-    from bladelab.predict.collocation.solution import CollocationSolution
 
     rows = []
     for category in CATEGORIES:
-        kept = _kept(out, category)
+        solves = _converged(out, category)
+        kept = _kept(out, category, solves)
         if kept is None:
             continue
         start, sol = kept
         row = {"category": category, "kept_start": start}
-        objectives = {}
         for s in STARTS:
-            p = _path(out, category, s)
-            ok = p is not None and p.name.endswith(f"{s}.json")
-            objectives[s] = CollocationSolution.read(p).nlp.objective if ok else None
-            row[f"objective_{s}"] = objectives[s]
-        done = [v for v in objectives.values() if v is not None]
+            row[f"objective_{s}"] = solves[s].nlp.objective if s in solves else None
+        done = [v.nlp.objective for v in solves.values()]
         row["spread_pct"] = (100 * (max(done) - min(done)) / min(done)) if len(done) > 1 else None
         row.update(sol.summary())
         crit = human_running_criteria(sol)
