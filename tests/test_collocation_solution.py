@@ -137,6 +137,32 @@ def test_a_non_converged_solve_is_a_best_iterate(able, tmp_path):
         CollocationSolution.read(tmp_path / "liar.json")
 
 
+def test_multipliers_round_trip_and_bad_ones_are_named(able, tmp_path):
+    _, _, sol = able
+    assert sol.nlp.multipliers is None
+    assert CollocationSolution.read(sol.write(tmp_path / "none.json")).nlp.multipliers is None
+    rng = np.random.default_rng(7)
+    lam = (rng.normal(size=40), rng.normal(size=30))
+    with_lam = replace(sol, nlp=replace(sol.nlp, multipliers=lam))
+    back = CollocationSolution.read(with_lam.write(tmp_path / "solution.json"))
+    for a, b in zip(back.nlp.multipliers, lam, strict=True):
+        np.testing.assert_array_equal(a, b)
+    guess = back.to_guess()
+    assert guess.multipliers is not None
+    np.testing.assert_array_equal(guess.qdd, sol.nlp.qdd)  # the solution's own controls
+    np.testing.assert_array_equal(guess.excitation, sol.nlp.excitation)
+    good = with_lam.to_dict()
+    for i, (value, where) in enumerate([
+            ({"bounds": [1.0]}, "multipliers.constraints"),
+            ({"bounds": [[1.0]], "constraints": [1.0]}, "multipliers.bounds"),
+            ([1.0, 2.0], "multipliers")]):
+        path = tmp_path / f"bad{i}.json"
+        path.write_text(json.dumps({**good, "multipliers": value}))
+        with pytest.raises(DataError) as err:
+            CollocationSolution.read(path)
+        assert err.value.where == where and err.value.file == str(path), err.value
+
+
 def test_read_errors_name_the_file_and_the_field(able, tmp_path):
     _, _, sol = able
     good = sol.to_dict()
@@ -444,6 +470,37 @@ def test_warm_start_mu_sets_the_barrier_of_a_warm_start_only(able, monkeypatch):
     predict_stride(runner, dataclasses.replace(settings, warm_start_mu=None), sol.to_guess(),
                    model_spec={"model": "able"})
     assert "ipopt.mu_init" not in seen[-1]
+
+
+def test_a_guess_with_fitting_multipliers_starts_from_its_duals(able, monkeypatch):
+    from bladelab.predict.collocation.transcription import StrideNLP
+
+    runner, _, sol = able
+    seen = []
+    solve = StrideNLP.solve
+
+    def spy(self, x0, **kw):
+        seen.append((self.n_vars, self.n_cons, kw.get("multipliers"),
+                     dict(kw.get("options") or {})))
+        return solve(self, x0, **kw)
+
+    monkeypatch.setattr(StrideNLP, "solve", spy)
+    # on the solution's own mesh (another mesh drops the multipliers)
+    settings = CollocationSettings(mesh_intervals=sol.nlp.q.shape[0] - 1, speed_m_per_s=SPEED,
+                                   max_iter=2)
+    nlp = predict_stride(runner, settings, sol.to_guess(), model_spec={"model": "able"}).nlp
+    n_vars, n_cons, lam, _ = seen[-1]
+    assert lam is None  # the fake solution has none
+    fitting = (np.zeros(n_vars), np.zeros(n_cons))
+    guess = replace(sol.to_guess(), multipliers=fitting)
+    predict_stride(runner, dataclasses.replace(settings, warm_start_mu=1e-5), guess,
+                   model_spec={"model": "able"})
+    _, _, lam, options = seen[-1]
+    assert lam is not None and options == {"ipopt.mu_init": 1e-5}
+    assert nlp.multipliers is not None and nlp.multipliers[0].shape == (n_vars,)
+    wrong = replace(sol.to_guess(), multipliers=(np.zeros(n_vars + 1), np.zeros(n_cons)))
+    predict_stride(runner, settings, wrong, model_spec={"model": "able"})
+    assert seen[-1][2] is None
 
 
 # ---------------------------------------------------------------- report

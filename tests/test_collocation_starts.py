@@ -10,12 +10,14 @@ import importlib.util
 import math
 from pathlib import Path
 
+import numpy as np
 import pandas as pd
 import pytest
 
 from bladelab.errors import SpecError
 from bladelab.predict.collocation import starts as st
 from bladelab.predict.collocation.settings import CollocationSettings
+from bladelab.predict.collocation.stride_guess import StrideGuess
 
 MERGE = Path(__file__).resolve().parents[1] / "benchmarks" / "collocation" / "merge_starts.py"
 
@@ -86,7 +88,7 @@ def test_the_starts_come_in_a_fixed_order_and_only_where_they_apply():
     plan = st.plan_starts(4, warm, warm_source=warm_source, template=template, previous=prev)
     assert [s.label for s in plan] == ["warm", "warm-mu-1e-4", "template",
                                        "previous-but-one"]
-    assert plan[1].settings.warm_start_mu == st.BARRIER_MU and plan[1].guess is warm.guess
+    assert plan[1].settings.warm_start_mu == st.BARRIER_MU
     assert plan[1].settings.same_problem(warm.settings)
     assert [s.label for s in st.plan_starts(3, warm, warm_source=warm_source, template=template,
                                             previous=prev)][-1] == "template"
@@ -98,6 +100,18 @@ def test_the_starts_come_in_a_fixed_order_and_only_where_they_apply():
     # settings that already use the barrier start: the alternative is IPOPT's default
     other = st.barrier_start(_start(mu=st.BARRIER_MU))
     assert other.label == "warm-mu-default" and other.settings.warm_start_mu is None
+
+
+def test_the_barrier_start_drops_the_warm_starts_multipliers():
+    """Otherwise it would start from the same primal and dual values as the warm start."""
+    lam = (np.ones(3), np.ones(2))
+    guess = StrideGuess("collocation solution", 0.7, np.zeros((5, 2)), np.zeros((5, 2)),
+                        multipliers=lam)
+    warm = st.Start("warm", CollocationSettings(mesh_intervals=4, speed_m_per_s=4.0),
+                    lambda: guess)
+    barrier = st.barrier_start(warm)
+    assert warm.guess().multipliers is lam and barrier.guess().multipliers is None
+    np.testing.assert_array_equal(barrier.guess().q, guess.q)
 
 
 def test_each_start_has_its_own_files_and_the_warm_start_the_one_start_names(tmp_path):

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import dataclasses
+
 import casadi as ca
 import numpy as np
 import pytest
@@ -267,3 +269,32 @@ def test_period_tracking_term_is_the_squared_log_ratio_of_the_stride_times():
                                                                    rel=1e-9)
     with pytest.raises(SpecError, match="reference stride time"):
         StrideNLP(_toy(), n=n, speed=speed, period_tracking=(0.0, 3.0))
+
+
+def test_a_solution_restarted_from_its_multipliers_ends_at_once():
+    """A solution solved again from its primal and dual values (IPOPT's warm start, at the
+    library's tolerance) ends in at most two iterations at the same point; from its primal
+    values alone IPOPT's barrier starts again and takes longer. Multipliers that do not fit
+    the NLP are not used."""
+    n = 16
+    nlp = StrideNLP(_toy(), n=n, speed=2.0)
+    cold = nlp.solve(nlp.initial_vector(_bouncing_guess(n, 2.0)), hessian="exact")
+    assert cold.success and cold.multipliers is not None
+    lam_x, lam_g = cold.multipliers
+    assert lam_x.shape == (nlp.n_vars,) and lam_g.shape == (nlp.n_cons,)
+    guess = cold.to_guess()
+    lam = nlp.initial_multipliers(guess)
+    assert lam is not None
+    warm = nlp.solve(nlp.initial_vector(guess), hessian="exact", multipliers=lam)
+    primal = nlp.solve(nlp.initial_vector(guess), hessian="exact")
+    assert warm.success and warm.iterations <= 2 < primal.iterations
+    assert warm.objective == pytest.approx(cold.objective, rel=1e-6)
+    np.testing.assert_allclose(warm.q, cold.q, atol=1e-5)
+    # kept by a change of speed, dropped by another mesh; the wrong size or a NaN is refused
+    assert nlp.initial_multipliers(guess.with_speed(2.2)) is not None
+    assert guess.resample(8).multipliers is None
+    assert nlp.initial_multipliers(_bouncing_guess(n, 2.0)) is None
+    short = dataclasses.replace(guess, multipliers=(lam_x[:-1], lam_g))
+    assert nlp.initial_multipliers(short) is None
+    bad = dataclasses.replace(guess, multipliers=(lam_x, np.full_like(lam_g, np.nan)))
+    assert nlp.initial_multipliers(bad) is None

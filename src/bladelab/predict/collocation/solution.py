@@ -436,6 +436,8 @@ class CollocationSolution:
             "body_weight_N": _num(self.body_weight_N),
             "metabolic_energy_J": _num(self.metabolic_energy_J),
             "consistency": _jsonable(self.residual),
+            "multipliers": None if s.multipliers is None else {
+                "bounds": _array(s.multipliers[0]), "constraints": _array(s.multipliers[1])},
         }
 
     def write(self, path: str | Path) -> Path:
@@ -531,6 +533,7 @@ class CollocationSolution:
         if not (nlp.period > 0):
             raise DataError(f"stride time must be > 0 s, got {nlp.period}", file=file,
                             where="period_s")
+        nlp = replace(nlp, multipliers=_read_multipliers(data.get("multipliers"), file))
         if kind == SOLUTION_KIND and not (nlp.success and stage == "predictive"):
             raise DataError("marked as a solution but did not converge", file=file,
                             where="kind")
@@ -543,6 +546,20 @@ class CollocationSolution:
             metabolic_energy_J=r.number("metabolic_energy_J"),
             residual=r.get("consistency", dict),
         )
+
+
+def _read_multipliers(value, file) -> tuple[np.ndarray, np.ndarray] | None:
+    """The optional ``multipliers`` field: ``{"bounds": [...], "constraints": [...]}``."""
+    if value is None:
+        return None
+    if not isinstance(value, dict):
+        raise DataError("expected an object or null", file=file, where="multipliers")
+    r = FieldReader(value, file)
+    try:
+        return r.array("bounds", 1), r.array("constraints", 1)
+    except DataError as err:
+        raise DataError(err.message, file=file, where=f"multipliers.{err.where}",
+                        hint=err.hint) from None
 
 
 def _float(v) -> float:

@@ -17,6 +17,11 @@ vertical velocity defects after 513 iterations) and converged in 574 more from t
 restarts its barrier and its L-BFGS memory). The stage's ``tracking`` record then counts both
 solves and names the first one's status (``restarted_after``).
 
+A guess that is a solution of the same problem layout (mesh, model) and carries its
+multipliers starts the predictive stage from its primal and dual values (IPOPT's warm start,
+:data:`~bladelab.predict.collocation.transcription.DUAL_WARM_START_OPTIONS`): a solution
+solved again ends at once, a continuation step stays on its start's branch.
+
 The tracking stage is skipped when ``track_first`` is False or the guess is itself a
 collocation solution (its ``source`` starts with :data:`COLLOCATION_SOURCE`, as
 :meth:`~bladelab.predict.collocation.solution.CollocationSolution.to_guess` and
@@ -155,12 +160,18 @@ def warm_start_options(settings: CollocationSettings) -> dict:
 
 def _solve_stage(nlp, x0: np.ndarray, settings: CollocationSettings, stage: str,
                  progress: Callable[[SolveProgress], None] | None, *, warm: bool = False,
-                 speed: float | None = None):
+                 speed: float | None = None, multipliers=None):
     """Solve one NLP with the settings' IPOPT options (:func:`warm_start_options` when
-    ``warm``), reporting progress; an interrupt (Ctrl-C, SIGTERM) raises KeyboardInterrupt
-    after IPOPT returns."""
+    ``warm``; with ``multipliers``, the primal-dual warm start of
+    :meth:`~bladelab.predict.collocation.transcription.StrideNLP.solve`, its barrier start
+    :attr:`CollocationSettings.warm_start_mu` where set), reporting progress; an interrupt
+    (Ctrl-C, SIGTERM) raises KeyboardInterrupt after IPOPT returns."""
     t0 = time.perf_counter()
-    options = warm_start_options(settings) if warm else {}
+    if multipliers is not None:
+        options = ({} if settings.warm_start_mu is None
+                   else {"ipopt.mu_init": settings.warm_start_mu})
+    else:
+        options = warm_start_options(settings) if warm else {}
     report = None
     if progress is not None:
         progress(SolveProgress(stage, "start", message=f"{nlp.n_vars} variables, "
@@ -172,7 +183,7 @@ def _solve_stage(nlp, x0: np.ndarray, settings: CollocationSettings, stage: str,
     with _interrupts_recorded():
         sol = nlp.solve(x0, max_iter=settings.max_iter, tol=settings.tol,
                         hessian=settings.hessian, options=options, speed=speed,
-                        progress=report)
+                        progress=report, multipliers=multipliers)
     if progress is not None:
         progress(SolveProgress(stage, "end", sol.iterations, sol.objective, sol.max_violation,
                                time.perf_counter() - t0, sol.status))
@@ -335,8 +346,11 @@ def predict_stride(runner, settings: CollocationSettings, guess, *, model_spec: 
                 metabolic_energy_J=nlp_t.energy_and_distance(sol_t)[0], **common)
         start = sol_t.to_guess(f"{COLLOCATION_SOURCE} (tracking stage)")
     nlp_p = _predictive_nlp(runner, dyn, settings)
+    warm_predictive = warm and not tracking_stage
     sol = _solve_stage(nlp_p, nlp_p.initial_vector(start), settings, "predictive", progress,
-                       warm=warm and not tracking_stage, speed=speed)
+                       warm=warm_predictive, speed=speed,
+                       multipliers=nlp_p.initial_multipliers(start) if warm_predictive
+                       else None)
     return CollocationSolution.from_nlp(
         runner, sol, stage="predictive", tracking=tracking,
         metabolic_energy_J=nlp_p.energy_and_distance(sol)[0], **common)

@@ -10,9 +10,11 @@ keep one. The starts, in this fixed order (:data:`START_ORDER`), the first K tha
    guess at the first speed, the fastest kept speed for the maximum speed), with the
    settings' :attr:`~bladelab.predict.collocation.settings.CollocationSettings.warm_start_mu`
    (the only start of K = 1: today's sweep);
-2. ``warm-mu-1e-4`` (the barrier start): the same warm start with ``warm_start_mu`` 1e-4
-   (:data:`BARRIER_MU`); ``warm-mu-default`` (IPOPT's defaults) when the settings already use
-   1e-4. Only when the warm start is a collocation solution (a template or trial guess goes
+2. ``warm-mu-1e-4`` (the barrier start): the same warm start from its primal values alone
+   (its multipliers dropped) with ``warm_start_mu`` 1e-4 (:data:`BARRIER_MU`);
+   ``warm-mu-default`` (IPOPT's defaults) when the settings already use 1e-4. The warm start
+   itself starts from the solution's multipliers where it carries them
+   (docs/collocation.md, "Warm starts"), which stays on its branch; this one leaves it. Only when the warm start is a collocation solution (a template or trial guess goes
    through the tracking stage, where the barrier start does not apply);
 3. ``template``: the template guess at the problem's speed (at the warm start's speed for the
    maximum speed), through the tracking stage: a start that no path of the continuation
@@ -120,12 +122,17 @@ class Start:
 
 
 def barrier_start(warm: Start) -> Start:
-    """The barrier start of a warm start (module docstring, start 2)."""
+    """The barrier start of a warm start (module docstring, start 2): its primal values alone
+    (the multipliers dropped, which would start it where the warm start starts)."""
     mu = None if warm.settings.warm_start_mu == BARRIER_MU else BARRIER_MU
     label = "warm-mu-default" if mu is None else "warm-mu-1e-4"
-    text = (warm.text or "the same warm start") + (
+    text = (warm.text or "the same warm start") + ", primal values" + (
         ", IPOPT's default barrier start" if mu is None else ", barrier start 1e-4")
-    return Start(label, dataclasses.replace(warm.settings, warm_start_mu=mu), warm.guess, text)
+
+    def guess():
+        return dataclasses.replace(warm.guess(), multipliers=None)
+
+    return Start(label, dataclasses.replace(warm.settings, warm_start_mu=mu), guess, text)
 
 
 def plan_starts(k: int, warm: Start, *, warm_source: str, template: Start | None,

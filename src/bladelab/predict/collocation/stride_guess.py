@@ -64,6 +64,19 @@ class StrideGuess:
         The names of the columns of ``q``/``qd`` and of the muscle arrays, where the guess
         comes from another model (e.g. a seed-001 solution as the start of the toe body);
         None: the target model's own. :meth:`on_model` matches them by name.
+    qdd, excitation, tendon_force_rate
+        (n + 1, ·) the controls of a collocation solution (accelerations [m/s², rad/s²],
+        excitations [-], normalised tendon-force rates [1/s]), or None: derived from the
+        states by :meth:`~bladelab.predict.collocation.transcription.StrideNLP.
+        initial_vector`. With them (and the states) a solution's own point is restored
+        exactly. Kept by :meth:`with_speed` (pelvis_tx's acceleration scaled), dropped by
+        :meth:`resample` to another mesh and by :meth:`on_model` when it moves columns.
+    multipliers
+        IPOPT's multipliers (variable bounds, constraints) of the stride NLP this guess solves,
+        or None: the dual half of a warm start
+        (:meth:`~bladelab.predict.collocation.transcription.StrideNLP.initial_multipliers`
+        takes them only if they fit the NLP). Kept by :meth:`with_speed`; dropped by
+        :meth:`resample` to another mesh and by :meth:`on_model` when it moves columns.
     """
 
     source: str
@@ -75,6 +88,10 @@ class StrideGuess:
     vertical_grf_bw: np.ndarray | None = None
     dof_names: tuple[str, ...] | None = None
     muscle_names: tuple[str, ...] | None = None
+    qdd: np.ndarray | None = None
+    excitation: np.ndarray | None = None
+    tendon_force_rate: np.ndarray | None = None
+    multipliers: tuple[np.ndarray, np.ndarray] | None = None
 
     def on_model(self, model: RunnerModel) -> StrideGuess:
         """This guess on ``model``'s coordinates and muscles, matched by name: coordinates
@@ -118,7 +135,8 @@ class StrideGuess:
             activation=cols(self.activation, self.muscle_names, muscles, 0.05),
             tendon_force=cols(self.tendon_force, self.muscle_names, muscles, 0.0)
             if keep_muscles else None,
-            dof_names=None, muscle_names=None,
+            dof_names=None, muscle_names=None, multipliers=None, qdd=None, excitation=None,
+            tendon_force_rate=None,
             source=f"{self.source}, on the {model.kind} model's coordinates")
 
     @property
@@ -148,6 +166,7 @@ class StrideGuess:
             else _resample(self.tendon_force, old, new),
             vertical_grf_bw=None if self.vertical_grf_bw is None
             else _resample(self.vertical_grf_bw[:, None], old, new)[:, 0],
+            qdd=None, excitation=None, tendon_force_rate=None, multipliers=None,
         )
 
     def with_speed(self, speed: float) -> StrideGuess:
@@ -159,7 +178,11 @@ class StrideGuess:
         scale = speed / self.speed
         q[:, 0] = q[0, 0] + (q[:, 0] - q[0, 0]) * scale
         qd[:, 0] *= scale
-        return replace(self, q=q, qd=qd, source=f"{self.source}, scaled to {speed:g} m/s")
+        qdd = None if self.qdd is None else self.qdd.copy()
+        if qdd is not None:
+            qdd[:, 0] *= scale
+        return replace(self, q=q, qd=qd, qdd=qdd,
+                       source=f"{self.source}, scaled to {speed:g} m/s")
 
 
 def _resample(y: np.ndarray, old: np.ndarray, new: np.ndarray,

@@ -29,7 +29,7 @@ from __future__ import annotations
 import math
 import time
 from collections.abc import Callable
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, replace
 
 import casadi as ca
 import numpy as np
@@ -192,6 +192,8 @@ class NLPSolution:
     """The solution (or the last iterate) of a stride NLP.
 
     Arrays have n + 1 rows (nodes at ``time``); ``tendon_force`` is normalised by F_max.
+    ``multipliers``: IPOPT's multipliers of the variable bounds and of the constraints of the
+    scaled NLP at this point (None where unknown), the dual half of a warm start.
     """
 
     time: np.ndarray
@@ -212,6 +214,7 @@ class NLPSolution:
     timings: dict[str, float] = field(default_factory=dict)
     max_violation: float = math.nan
     worst_constraints: tuple[tuple[str, float], ...] = ()
+    multipliers: tuple[np.ndarray, np.ndarray] | None = None
 
     @property
     def speed(self) -> float:
@@ -222,7 +225,9 @@ class NLPSolution:
         """This solution as an initial guess (:class:`~bladelab.predict.collocation.stride_guess.
         StrideGuess`, muscle states included): a warm start for another problem or mesh."""
         return StrideGuess(source, self.period, self.q, self.qd, self.activation,
-                           self.tendon_force)
+                           self.tendon_force, qdd=self.qdd, excitation=self.excitation,
+                           tendon_force_rate=self.tendon_force_rate,
+                           multipliers=self.multipliers)
 
 
 def _node_pairs(values):
@@ -235,6 +240,21 @@ def _node_pairs(values):
 FORCE_RATE_SCALE = 100.0
 #: Scale of :attr:`StrideWeights.metabolic_squared` [(W/kg)²·s/m].
 METABOLIC_SQUARED_SCALE = 10.0
+
+#: IPOPT options of a solve started from a solution's primal and dual values (its
+#: multipliers): the barrier starts small and the point stays where it is, so that a solve
+#: at the start's own speed ends at once and a continuation step stays on the start's branch
+#: (measured, benchmarks/RESULTS.md: the amputee Cat6 stride at 4 m/s again in 0 iterations
+#: instead of 613; 4 -> 4.2 m/s in 197 instead of 574).
+DUAL_WARM_START_OPTIONS = {
+    "ipopt.warm_start_init_point": "yes",
+    "ipopt.mu_init": 1e-4,
+    "ipopt.warm_start_bound_push": 1e-9,
+    "ipopt.warm_start_bound_frac": 1e-9,
+    "ipopt.warm_start_slack_bound_push": 1e-9,
+    "ipopt.warm_start_slack_bound_frac": 1e-9,
+    "ipopt.warm_start_mult_bound_push": 1e-9,
+}
 
 #: Bounds of the free stride time [s] (a running stride at 3–10 m/s lies well inside).
 PERIOD_BOUNDS_S = (0.4, 1.2)
@@ -509,8 +529,9 @@ class StrideNLP:
     def initial_vector(self, guess) -> np.ndarray:
         """The scaled NLP vector of a :class:`~bladelab.predict.collocation.stride_guess.
         StrideGuess` (resampled to the mesh; where the guess has no muscle states, activations
-        0.05 and the tendon forces of static equilibrium, else 0.05; accelerations by
-        differentiating the speeds)."""
+        0.05 and the tendon forces of static equilibrium, else 0.05; where it has no
+        controls, accelerations and tendon-force rates by differentiating the speeds and
+        forces, excitations equal to the activations)."""
         d, n = self.dyn, self.n
         g = guess.resample(n)
         act = g.activation if g.activation is not None else np.full((n + 1, d.nm), 0.05)
@@ -522,18 +543,36 @@ class StrideNLP:
             ften = np.full((n + 1, d.nm), 0.05)
         act = np.clip(act, self.min_activation, 1.0)
         ften = np.clip(ften, self.min_tendon_force, self.max_tendon_force)
-        qdd = periodic_derivative(np.vstack([g.qd[:-1], g.qd[:1]]), g.period)
-        dft = periodic_derivative(np.vstack([ften[:-1], ften[:1]]), g.period)
+        qdd = (g.qdd if g.qdd is not None
+               else periodic_derivative(np.vstack([g.qd[:-1], g.qd[:1]]), g.period))
+        exc = act if g.excitation is None else g.excitation
+        dft = (g.tendon_force_rate if g.tendon_force_rate is not None
+               else periodic_derivative(np.vstack([ften[:-1], ften[:1]]), g.period))
         X = np.hstack([g.q, g.qd, act, ften]).T / self.sx[:, None]
-        U = np.hstack([qdd, act, dft]).T / self.su[:, None]
+        U = np.hstack([qdd, exc, dft]).T / self.su[:, None]
         return np.concatenate([X.ravel(order="F"), U.ravel(order="F"),
                                [g.period / self.scales.period]])
+
+    def initial_multipliers(self, guess) -> tuple[np.ndarray, np.ndarray] | None:
+        """The multipliers a guess carries (:attr:`~bladelab.predict.collocation.stride_guess.
+        StrideGuess.multipliers`) if they fit this NLP's variables and constraints, else
+        None."""
+        lam = getattr(guess, "multipliers", None)
+        if lam is None:
+            return None
+        lam_x, lam_g = (np.asarray(v, float).ravel() for v in lam)
+        if lam_x.size != self.n_vars or lam_g.size != self.n_cons:
+            return None
+        if not (np.isfinite(lam_x).all() and np.isfinite(lam_g).all()):
+            return None
+        return lam_x, lam_g
 
     # -- solve --------------------------------------------------------------------------
     def solve(self, x0: np.ndarray, *, max_iter: int = 3000, tol: float = 1e-4,
               hessian: str = "limited-memory", print_level: int = 0,
               options: dict | None = None, speed: float | None = None,
-              progress: Callable[[int, float, float], None] | None = None) -> NLPSolution:
+              progress: Callable[[int, float, float], None] | None = None,
+              multipliers: tuple[np.ndarray, np.ndarray] | None = None) -> NLPSolution:
         """Solve with IPOPT: MUMPS with METIS ordering; ``hessian`` ``"limited-memory"``
         (L-BFGS with the adaptive barrier, as PredSim solves muscle-driven gaits; measured:
         the muscle-driven tracking stride converged in 671 iterations, while the exact Hessian
@@ -545,6 +584,9 @@ class StrideNLP:
         objective, violation)`` is called after every IPOPT iteration. The IPOPT solver is
         built (expanded to SX, 14–20 s at mesh 50) on the first solve with these options and
         reused by every later one, at any speed (``NLPSolution.timings["build_s"]`` is 0 then).
+
+        ``multipliers`` (bounds, constraints; :meth:`initial_multipliers`): start from ``x0``
+        and these duals with :data:`DUAL_WARM_START_OPTIONS` (under ``options``).
         """
         if hessian not in ("limited-memory", "exact"):
             raise SpecError(f"unknown Hessian option {hessian!r}", where="hessian",
@@ -565,6 +607,8 @@ class StrideNLP:
             "expand": True,  # SX graph: about 10x faster iterations than MX (measured)
             "print_time": False,
         }
+        if multipliers is not None:
+            opts.update(DUAL_WARM_START_OPTIONS)
         opts.update(options or {})
         t0 = time.perf_counter()
         solver, relay = self._solver(opts)
@@ -573,13 +617,17 @@ class StrideNLP:
         p = float(speed if speed is not None else (self.speed or 0.0))
         relay.calls, relay.target = 0, progress
         try:
-            res = solver(x0=x0, p=p, lbx=lbx, ubx=ubx, lbg=lbg, ubg=ubg)
+            duals = {} if multipliers is None else {"lam_x0": multipliers[0],
+                                                    "lam_g0": multipliers[1]}
+            res = solver(x0=x0, p=p, lbx=lbx, ubx=ubx, lbg=lbg, ubg=ubg, **duals)
         finally:
             relay.target = None
         wall = time.perf_counter() - t0
         stats = solver.stats()
-        return self.unpack(np.asarray(res["x"]).ravel(), stats, wall, t_build, lbg, ubg,
-                           np.asarray(res["g"]).ravel(), speed=p)
+        sol = self.unpack(np.asarray(res["x"]).ravel(), stats, wall, t_build, lbg, ubg,
+                          np.asarray(res["g"]).ravel(), speed=p)
+        return replace(sol, multipliers=(np.asarray(res["lam_x"], float).ravel(),
+                                         np.asarray(res["lam_g"], float).ravel()))
 
     #: Solvers kept per NLP (each holds the expanded graph: about 0.3 GB at mesh 50).
     MAX_SOLVERS = 2

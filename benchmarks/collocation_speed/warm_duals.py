@@ -1,0 +1,116 @@
+"""Warm starts with the multipliers: a measuring probe (changes nothing in src).
+
+Usage (repository root)::
+
+    .venv/bin/python benchmarks/collocation_speed/warm_duals.py VARIANT [--kind amputee]
+        [--blade Cat6] [--from 4.0] [--to 4.2] [--hessian limited-memory]
+
+Solves the predictive stride NLP at ``--from`` from the shipped stride of the runner's kind
+(recording the solution's primal and dual values), then at ``--to`` from that solution with
+the start named by VARIANT:
+
+- ``primal``: the primal point only, the library's options (as a speed continuation does now);
+- ``duals-MU``: primal and multipliers (``warm_start_init_point`` yes) with ``mu_init`` MU
+  and the warm-start pushes at 1e-9.
+
+Appends one JSON record per solve to ``benchmarks/collocation_speed/warm_records.jsonl``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import resource
+import time
+from pathlib import Path
+
+import numpy as np
+
+from bladelab.predict.collocation.settings import CollocationSettings
+from bladelab.predict.collocation.solve import _model_functions
+from bladelab.predict.collocation.starting_guess import make_guess
+from bladelab.predict.collocation.transcription import StrideNLP
+from bladelab.runner import build_runner
+from bladelab.runner.params import default_runner_params
+
+RECORDS = Path(__file__).with_name("warm_records.jsonl")
+BASE = {
+    "ipopt.max_iter": 3000, "ipopt.tol": 1e-4, "ipopt.constr_viol_tol": 1e-6,
+    "ipopt.print_level": 0, "ipopt.linear_solver": "mumps", "ipopt.mumps_pivot_order": 5,
+    "ipopt.nlp_scaling_method": "gradient-based", "ipopt.sb": "yes", "expand": True,
+    "print_time": False,
+}
+
+
+def options(variant: str, hessian: str) -> dict:
+    opts = dict(BASE, **{"ipopt.hessian_approximation": hessian,
+                         "ipopt.mu_strategy": "adaptive" if hessian == "limited-memory"
+                         else "monotone"})
+    if variant.startswith("duals-"):
+        mu = float(variant.split("-", 1)[1])
+        opts.update({"ipopt.warm_start_init_point": "yes", "ipopt.mu_init": mu,
+                     "ipopt.warm_start_bound_push": 1e-9, "ipopt.warm_start_bound_frac": 1e-9,
+                     "ipopt.warm_start_slack_bound_push": 1e-9,
+                     "ipopt.warm_start_slack_bound_frac": 1e-9,
+                     "ipopt.warm_start_mult_bound_push": 1e-9})
+    return opts
+
+
+def solve(nlp, opts, x0, speed, lam=None):
+    t0 = time.perf_counter()
+    solver, _ = nlp._solver(opts)
+    t_build = time.perf_counter() - t0
+    lbx, ubx, lbg, ubg = nlp.bounds()
+    kw = {} if lam is None else {"lam_x0": lam[0], "lam_g0": lam[1]}
+    res = solver(x0=x0, p=speed, lbx=lbx, ubx=ubx, lbg=lbg, ubg=ubg, **kw)
+    st = solver.stats()
+    x = np.asarray(res["x"]).ravel()
+    sol = nlp.unpack(x, st, time.perf_counter() - t0, t_build, lbg, ubg,
+                     np.asarray(res["g"]).ravel(), speed=speed)
+    return sol, (x, np.asarray(res["lam_x"]).ravel(), np.asarray(res["lam_g"]).ravel())
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser()
+    ap.add_argument("variant")
+    ap.add_argument("--kind", default="amputee")
+    ap.add_argument("--blade", default="Cat6")
+    ap.add_argument("--from", dest="v0", type=float, default=4.0)
+    ap.add_argument("--to", dest="v1", type=float, default=4.2)
+    ap.add_argument("--hessian", default="limited-memory")
+    a = ap.parse_args()
+    blade = a.blade if a.kind == "amputee" else None
+    runner = build_runner(default_runner_params(a.kind, body="human", blade=blade))
+    settings = CollocationSettings(speed_m_per_s=a.v0)
+    _, dyn = _model_functions(runner)
+    nlp = StrideNLP(dyn, n=settings.mesh_intervals, speed=a.v0, weights=settings.weights)
+    guess = make_guess(runner, "stored", n=nlp.n, speed=a.v0)
+    cache = Path(f"/tmp/warm_duals/{a.kind}-{blade}-{a.v0}.npz")
+    if cache.is_file():  # the first solve of an earlier run (same body, speed, options)
+        z = np.load(cache)
+        point, first = (z["x"], z["lam_x"], z["lam_g"]), json.loads(str(z["first"]))
+    else:
+        sol0, point = solve(nlp, options("primal", "limited-memory"),
+                            nlp.initial_vector(guess), a.v0)
+        first = {"iterations": sol0.iterations, "wall_s": round(sol0.wall_s, 1),
+                 "objective": sol0.objective, "status": sol0.status}
+        cache.parent.mkdir(exist_ok=True)
+        np.savez(cache, x=point[0], lam_x=point[1], lam_g=point[2], first=json.dumps(first))
+    sol1, _ = solve(nlp, options(a.variant, a.hessian),
+                    point[0], a.v1, None if a.variant == "primal" else point[1:])
+    rec = {"date": time.strftime("%Y-%m-%d %H:%M"), "kind": a.kind, "blade": blade,
+           "from": a.v0, "to": a.v1, "variant": a.variant, "hessian": a.hessian,
+           "first": first,
+           "second": {"iterations": sol1.iterations, "wall_s": round(sol1.wall_s, 1),
+                      "build_s": round(sol1.timings["build_s"], 1),
+                      "objective": sol1.objective, "status": sol1.status,
+                      "speed": round(sol1.speed, 6), "period_s": round(sol1.period, 4),
+                      "violation": sol1.max_violation},
+           "maxrss_MB": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss // 1024}
+    with RECORDS.open("a") as fh:
+        fh.write(json.dumps(rec) + "\n")
+    print(json.dumps(rec))
+
+
+if __name__ == "__main__":
+    main()
