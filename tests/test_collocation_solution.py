@@ -472,6 +472,14 @@ def test_warm_start_mu_sets_the_barrier_of_a_warm_start_only(able, monkeypatch):
     assert "ipopt.mu_init" not in seen[-1]
 
 
+def nlp_x_index(n_vars: int, sol, node: int) -> int:
+    """Index of pelvis_tx (row 0, scale 1) at ``node`` in the scaled NLP vector (states
+    column-major first)."""
+    n1 = sol.nlp.q.shape[0]
+    nx = 2 * len(sol.dof_names) + 2 * len(sol.muscle_names)
+    return nx * (node % n1)
+
+
 def test_a_guess_with_fitting_multipliers_starts_from_its_duals(able, monkeypatch):
     from bladelab.predict.collocation.transcription import StrideNLP
 
@@ -481,7 +489,7 @@ def test_a_guess_with_fitting_multipliers_starts_from_its_duals(able, monkeypatc
 
     def spy(self, x0, **kw):
         seen.append((self.n_vars, self.n_cons, kw.get("multipliers"),
-                     dict(kw.get("options") or {})))
+                     dict(kw.get("options") or {}), np.array(x0)))
         return solve(self, x0, **kw)
 
     monkeypatch.setattr(StrideNLP, "solve", spy)
@@ -489,18 +497,27 @@ def test_a_guess_with_fitting_multipliers_starts_from_its_duals(able, monkeypatc
     settings = CollocationSettings(mesh_intervals=sol.nlp.q.shape[0] - 1, speed_m_per_s=SPEED,
                                    max_iter=2)
     nlp = predict_stride(runner, settings, sol.to_guess(), model_spec={"model": "able"}).nlp
-    n_vars, n_cons, lam, _ = seen[-1]
+    n_vars, n_cons, lam, _, _ = seen[-1]
     assert lam is None  # the fake solution has none
     fitting = (np.zeros(n_vars), np.zeros(n_cons))
     guess = replace(sol.to_guess(), multipliers=fitting)
     predict_stride(runner, dataclasses.replace(settings, warm_start_mu=1e-5), guess,
                    model_spec={"model": "able"})
-    _, _, lam, options = seen[-1]
+    _, _, lam, options, _ = seen[-1]
     assert lam is not None and options == {"ipopt.mu_init": 1e-5}
     assert nlp.multipliers is not None and nlp.multipliers[0].shape == (n_vars,)
     wrong = replace(sol.to_guess(), multipliers=(np.zeros(n_vars + 1), np.zeros(n_cons)))
     predict_stride(runner, settings, wrong, model_spec={"model": "able"})
     assert seen[-1][2] is None
+    # at another speed the primal-dual start keeps the solution's own point (the speed the
+    # one violated constraint); a primal start is scaled to the speed
+    faster = dataclasses.replace(settings, speed_m_per_s=1.1 * SPEED)
+    for start, scaled in ((guess, False), (sol.to_guess(), True)):
+        predict_stride(runner, faster, start, model_spec={"model": "able"})
+        x0 = seen[-1][4]
+        distance = (x0[nlp_x_index(n_vars, sol, -1)] - x0[nlp_x_index(n_vars, sol, 0)])
+        expected = sol.stride_length_m * (1.1 if scaled else 1.0)
+        assert distance == pytest.approx(expected, rel=1e-9), scaled
 
 
 # ---------------------------------------------------------------- report

@@ -211,6 +211,31 @@ def test_good_parameter_file_loads(tmp_path):
     assert load_runner_params(path).kind == "amputee"
 
 
+def test_a_parameter_file_extends_another_by_replacing_its_top_level_keys(tmp_path):
+    """A variant states only what differs: its keys replace the base file's, the rest is the
+    base's; a missing base file, a loop and a non-name are named errors."""
+    base = _write(tmp_path, lambda d: None)
+    (tmp_path / "heavier.yaml").write_text(
+        "extends: params.yaml\nathlete: {body_mass_kg: 90.0, height_m: 1.9}\n")
+    heavy, plain = load_runner_params(tmp_path / "heavier.yaml"), load_runner_params(base)
+    assert heavy.athlete.body_mass_kg == 90.0 and heavy.athlete.height_m == 1.9
+    assert heavy.muscle_types == plain.muscle_types and heavy.segments == plain.segments
+    (tmp_path / "twice.yaml").write_text("extends: heavier.yaml\nblade: Cat4\n")
+    twice = load_runner_params(tmp_path / "twice.yaml")
+    assert twice.blade == "Cat4" and twice.athlete.body_mass_kg == 90.0
+    (tmp_path / "orphan.yaml").write_text("extends: nowhere.yaml\n")
+    with pytest.raises(BladelabError, match="nowhere.yaml"):
+        load_runner_params(tmp_path / "orphan.yaml")
+    (tmp_path / "a.yaml").write_text("extends: b.yaml\n")
+    (tmp_path / "b.yaml").write_text("extends: a.yaml\n")
+    with pytest.raises(SpecError, match="loop"):
+        load_runner_params(tmp_path / "a.yaml")
+    (tmp_path / "bad.yaml").write_text("extends: [1, 2]\n")
+    with pytest.raises(SpecError) as err:
+        load_runner_params(tmp_path / "bad.yaml")
+    assert err.value.where == "extends"
+
+
 def test_unknown_category_is_a_clear_error(tmp_path):
     path = _write(tmp_path, lambda d: d.update(blade="Cat9"))
     with pytest.raises(SpecError) as err:

@@ -11,7 +11,9 @@ the start named by VARIANT:
 
 - ``primal``: the primal point only, the library's options (as a speed continuation does now);
 - ``duals-MU``: primal and multipliers (``warm_start_init_point`` yes) with ``mu_init`` MU
-  and the warm-start pushes at 1e-9.
+  and the warm-start pushes at 1e-9;
+- ``scaled-`` before either: the start scaled to the new speed first (``StrideGuess.with_speed``,
+  as ``predict_stride`` does), instead of the solution's own point.
 
 Appends one JSON record per solve to ``benchmarks/collocation_speed/warm_records.jsonl``.
 """
@@ -96,8 +98,14 @@ def main() -> None:
                  "objective": sol0.objective, "status": sol0.status}
         cache.parent.mkdir(exist_ok=True)
         np.savez(cache, x=point[0], lam_x=point[1], lam_g=point[2], first=json.dumps(first))
-    sol1, _ = solve(nlp, options(a.variant, a.hessian),
-                    point[0], a.v1, None if a.variant == "primal" else point[1:])
+    variant = a.variant.removeprefix("scaled-")
+    x0 = point[0]
+    if a.variant.startswith("scaled-"):  # as predict_stride does: the start scaled to the speed
+        lbx, ubx, lbg, ubg = nlp.bounds()
+        start = nlp.unpack(x0, {}, 0.0, 0.0, lbg, ubg, np.zeros(lbg.size)).to_guess()
+        x0 = nlp.initial_vector(start.with_speed(a.v1))
+    sol1, _ = solve(nlp, options(variant, a.hessian),
+                    x0, a.v1, None if variant == "primal" else point[1:])
     rec = {"date": time.strftime("%Y-%m-%d %H:%M"), "kind": a.kind, "blade": blade,
            "from": a.v0, "to": a.v1, "variant": a.variant, "hessian": a.hessian,
            "first": first,

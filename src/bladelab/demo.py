@@ -132,14 +132,11 @@ def design_example(out_dir: str | Path | None = None, *, seed: int = 0) -> tuple
 
 
 #: The shipped stride the predict example starts from: the amputee runner on the human body
-#: wearing a Cat6 blade at 4 m/s (benchmarks/human_body/README.md).
+#: wearing a Cat6 blade at 4 m/s (benchmarks/human_body/README.md). It carries its multipliers,
+#: so the solve starts from its primal and dual values and ends at once (docs/collocation.md,
+#: "Warm starts"); from its primal values alone IPOPT's default barrier start wandered for
+#: 946 iterations (measured).
 PREDICT_EXAMPLE_STRIDE = RUNNER_DATA_DIR / "collocation" / "amputee-Cat6-4-human.json"
-
-
-#: IPOPT's initial barrier parameter of the predict example's warm start: from the shipped
-#: optimum itself the default (0.1, with bounds pushed 1 %) wandered for 946 iterations
-#: (measured); 1e-4 keeps the start (CollocationSettings.warm_start_mu).
-PREDICT_EXAMPLE_MU = 1e-4
 
 
 def predict_example(out_dir: str | Path | None = None) -> tuple[Path, list[str]]:
@@ -155,7 +152,7 @@ def predict_example(out_dir: str | Path | None = None) -> tuple[Path, list[str]]
     t0 = time.perf_counter()
     res = solve_named_stride(
         out_dir, model="amputee", blade="Cat6", body="human",
-        settings=CollocationSettings(speed_m_per_s=4.0, warm_start_mu=PREDICT_EXAMPLE_MU),
+        settings=CollocationSettings(speed_m_per_s=4.0),
         guess=str(PREDICT_EXAMPLE_STRIDE),
         resume=(out_dir / SOLUTION_FILE).is_file())
     sol = res.solution

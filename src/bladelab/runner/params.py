@@ -358,13 +358,35 @@ def runner_params_from_dict(data: dict, *, source: str | None = None) -> RunnerP
     return _check(params, source)
 
 
-def load_runner_params(path: str | Path) -> RunnerParams:
-    """Read and validate a runner parameter YAML file."""
+def read_runner_yaml(path: str | Path, *, _seen: tuple[Path, ...] = ()) -> dict:
+    """A runner parameter YAML file as a dictionary, ``extends`` resolved: a file that names
+    another (``extends: able.yaml``, a path relative to its own folder) is that file's
+    parameters with this file's top-level keys replacing the other's (so a variant states only
+    what differs: e.g. the amputee's athlete and segments; its muscles are the able runner's)."""
     path = Path(path)
     data = read_yaml(path, what="runner parameter file")
     if not isinstance(data, dict):
         raise InputFileError("expected a mapping of parameters", file=path)
-    return runner_params_from_dict(data, source=str(path))
+    base = data.pop("extends", None)
+    if base is None:
+        return data
+    if not isinstance(base, str) or not base:
+        raise SpecError("expected the name of another parameter file", file=str(path),
+                        where="extends", hint="e.g. extends: able.yaml (beside this file)")
+    target = (path.parent / base).resolve()
+    if target in _seen or target == path.resolve():
+        raise SpecError(f"{base} extends this file again (a loop)", file=str(path),
+                        where="extends")
+    if not target.is_file():
+        raise InputFileError(f"the file it extends, {base}, does not exist", file=path,
+                             hint="name a parameter file beside this one")
+    return {**read_runner_yaml(target, _seen=(*_seen, path.resolve())), **data}
+
+
+def load_runner_params(path: str | Path) -> RunnerParams:
+    """Read and validate a runner parameter YAML file (``extends`` resolved:
+    :func:`read_runner_yaml`)."""
+    return runner_params_from_dict(read_runner_yaml(path), source=str(path))
 
 
 #: Named bodies of the built-in parameter sets. ``human``: segments and leg
@@ -390,7 +412,7 @@ def default_runner_params(
     if body not in BODIES:
         raise SpecError(f"unknown body {body!r}", where="body", hint=" or ".join(BODIES))
     folder = RUNNER_DATA_DIR / "human" if body == "human" else RUNNER_DATA_DIR
-    data = yaml.safe_load((folder / f"{kind}.yaml").read_text())
+    data = read_runner_yaml(folder / f"{kind}.yaml")
     if blade is not None:
         data["blade"] = blade
     if body == "toes":
@@ -430,6 +452,7 @@ __all__ = [
     "default_runner_params",
     "hertz_compression",
     "load_runner_params",
+    "read_runner_yaml",
     "muscle_max_force",
     "muscle_names",
     "runner_params_from_dict",
