@@ -51,7 +51,7 @@ def run() -> str:
                  stored)]
     if stored.converged:
         warm_settings = dataclasses.replace(settings, speed_m_per_s=WARM_SPEED_MPS)
-        start = stored.to_guess().with_speed(WARM_SPEED_MPS)
+        start = stored.to_guess()  # predict_stride keeps its point or scales it
         warm = predict_stride(runner, warm_settings, start, model_spec=spec)
         rows.append(_row(f"warm start from {SPEED_MPS:g} → {WARM_SPEED_MPS:g} m/s (primal and "
                          f"dual values): objective {warm.nlp.objective:.4f}", warm))

@@ -1,9 +1,10 @@
 """The whole collocation category study, from its stored files.
 
 Six models (able, amputee Cat4, Cat5, Cat6, Cat6High, Cat7) × speed continuation (4, 5 m/s)
-+ maximum speed, from the measured trial's guess, 2 workers: once with one start per problem,
++ maximum speed, 2 workers: on the human body from the shipped strides with one start per
+problem; on seed 001's body from the measured trial's guess, once with one start per problem,
 once with three (``--starts 3``: the warm start, the barrier start and the template). Target:
-≤ 30 min on 2 cores. The studies take 20–50 min of both cores, so ``make bench`` does not run
+≤ 10 min on 2 cores with three starts. The studies take 20–50 min of both cores, so ``make bench`` does not run
 them again: it reads the solve times each recorded (its ``collocation-sweep.csv``) and the wall
 time from ``timing.json`` beside it. To measure anew, run the ``command`` of a study's
 ``timing.json`` and write the wall time, date and host into it (keys ``wall_s``, ``date``,
@@ -17,16 +18,22 @@ from pathlib import Path
 
 HERE = Path(__file__).resolve().parent / "collocation"
 #: (folder, what differs) of each timed study.
-STUDIES = (("study-timed-2026-11-26", "one start per problem"),
-           ("study-starts3-timed-2026-11-26", "three starts per problem (`--starts 3`)"))
+STUDIES = (("study-human-2026-11-29", "the human body, one start per problem, from the shipped "
+            "strides (`--guess stored`, the default), each later speed from the previous "
+            "solution's primal and dual values"),
+           ("study-timed-2026-11-26", "seed 001's body, one start per problem, from the "
+            "measured trial's guess"),
+           ("study-starts3-timed-2026-11-26", "seed 001's body, three starts per problem "
+            "(`--starts 3`), from the measured trial's guess"))
 
 
 def run() -> str:
     parts = [
         "## Collocation: the whole category study",
         "",
-        "Six models × speed continuation (4, 5 m/s) + maximum speed, mesh 50, from the "
-        "Fukuchi trial's guess, `--jobs 2`. Target: ≤ 30 min on 2 cores. Times are those the "
+        "Six models × speed continuation (4, 5 m/s) + maximum speed, mesh 50, `--jobs 2`; the "
+        "body and first guess per study below. Target: ≤ 10 min on 2 cores with three starts "
+        "per problem. Times are those the "
         "studies recorded (`collocation-sweep.csv`, `timing.json`), not measured again by "
         "`make bench`; a solve that does not converge is tried again from an intermediate "
         "speed (its row counts). ✓ converged, ⚠ converged but flagged by the gait checks (a "

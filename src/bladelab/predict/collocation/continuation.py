@@ -3,9 +3,10 @@
 Two drivers on top of :func:`~bladelab.predict.collocation.solve.predict_stride`:
 
 - :func:`speed_continuation` solves the stride at a sequence of prescribed speeds [m/s], in the
-  order given, each warm-started from the previous converged solution
-  (``solution.to_guess().with_speed(v)``: same period and joint curves, pelvis_tx and its
-  speed scaled to the new mean speed; a collocation guess skips the tracking stage). The
+  order given, each warm-started from the previous converged solution (from its primal and
+  dual values at its own point where it carries its multipliers, else scaled to the new mean
+  speed: same period and joint curves, pelvis_tx and its speed scaled; a collocation guess
+  skips the tracking stage; docs/collocation.md, "Warm starts"). The
   first speed starts from ``first_guess`` (template, trial, reflex solution, or a collocation
   solution), through the tracking stage unless it is a collocation solution.
 - :func:`max_speed` solves the maximum-speed problem (``CollocationSettings(speed_m_per_s=
@@ -485,11 +486,11 @@ def speed_continuation(runner, speeds: Sequence[float], settings: CollocationSet
                 starts, warm, warm_source=str(first_start().source), template=template,
                 previous=None)
         else:
-            warm = Start("warm", s_v, functools.partial(warm_guess, prev, v),
+            warm = Start("warm", s_v, functools.partial(warm_guess, prev),
                          f"warm start from the {prev.settings.speed_m_per_s:g} m/s solution")
             previous = None if prev2 is None else Start(
                 "previous-but-one", s_v,
-                functools.partial(warm_guess, prev2, v, " (the previous but one)"),
+                functools.partial(warm_guess, prev2, " (the previous but one)"),
                 f"warm start from the {prev2.settings.speed_m_per_s:g} m/s solution (the "
                 "previous but one)")
             plan = plan_starts(starts, warm, warm_source=COLLOCATION_SOURCE, template=template,
@@ -572,7 +573,7 @@ def max_speed(runner, settings: CollocationSettings, guess, *, model_spec: dict,
 
     get_runner = LazyRunner(runner, spec)
     if isinstance(guess, CollocationSolution):
-        warm = Start("warm", settings, functools.partial(warm_guess, guess, None))
+        warm = Start("warm", settings, functools.partial(warm_guess, guess))
     else:
         warm = Start("warm", settings, lambda: guess)
     plan = [warm]
@@ -581,7 +582,7 @@ def max_speed(runner, settings: CollocationSettings, guess, *, model_spec: dict,
             get_runner, warm.guess().speed, settings.mesh_intervals))
         prev = None if previous is None else Start(
             "previous-but-one", settings,
-            functools.partial(warm_guess, previous, None, " (the previous but one)"))
+            functools.partial(warm_guess, previous, " (the previous but one)"))
         source = COLLOCATION_SOURCE if isinstance(guess, CollocationSolution) else guess.source
         plan = plan_starts(starts, warm, warm_source=str(source), template=template,
                            previous=prev)

@@ -311,10 +311,10 @@ def solve_starts(plan: Sequence[Start], *, ok: Path, best: Path, read, solve,
     return kept, tuple(outcomes)
 
 
-def warm_guess(solution, speed: float | None, note: str = ""):
+def warm_guess(solution, note: str = ""):
     """A solution as a warm start, its source naming its speed (``collocation solution at
-    4 m/s`` + ``note``), scaled to ``speed`` [m/s] unless None."""
+    4 m/s`` + ``note``); :func:`~bladelab.predict.collocation.solve.predict_stride` scales it to
+    the problem's speed unless it starts from the solution's multipliers."""
     v = solution.settings.speed_m_per_s
-    g = solution.to_guess(f"{COLLOCATION_SOURCE} at "
-                          + (f"{v:g} m/s" if v else "maximum speed") + note)
-    return g if speed is None else g.with_speed(speed)
+    return solution.to_guess(f"{COLLOCATION_SOURCE} at "
+                             + (f"{v:g} m/s" if v else "maximum speed") + note)
