@@ -29,8 +29,8 @@ from bladelab.runner.muscle import (
     tendon_force_of_state,
 )
 
-__all__ = ["leg_muscle_forces", "passive_flexion_moment", "riener_edrich_hip_moment",
-           "riener_edrich_knee_moment"]
+__all__ = ["equilibrium_tendon_force", "leg_muscle_forces", "muscle_lengths_and_arms",
+           "passive_flexion_moment", "riener_edrich_hip_moment", "riener_edrich_knee_moment"]
 
 #: Step [rad] of the central difference of the MTU lengths.
 _STEP_RAD = 1e-6
@@ -54,11 +54,11 @@ def riener_edrich_hip_moment(knee_deg: float, hip_deg: float) -> float:
             - math.exp(1.3403 - 0.0226 * k + 0.0305 * h) + 8.072)
 
 
-def leg_muscle_forces(runner, dof: str, q: np.ndarray, *, activation: float,
-                      side: str = "l") -> dict[str, float]:
-    """Each leg muscle of ``side``'s generalised force on the coordinate ``dof`` [N·m or N] at
-    the pose ``q`` (MuJoCo coordinates) and ``activation`` [-], in static equilibrium (module
-    docstring), by muscle type (``vasti``, ...)."""
+def muscle_lengths_and_arms(runner, dof: str, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Every muscle's MTU length [m] at the pose ``q`` (MuJoCo coordinates) and its derivative
+    by the coordinate ``dof`` [m/rad or m/m] (MuJoCo's spatial tendons of
+    ``RunnerModel.mj_analysis_model``, a central difference), in ``runner.muscle_names``
+    order."""
     model = runner.mj_analysis_model
     data = mujoco.MjData(model)
     j = runner.dof(dof)
@@ -71,16 +71,30 @@ def leg_muscle_forces(runner, dof: str, q: np.ndarray, *, activation: float,
     qp, qm = q.copy(), q.copy()
     qp[j] += _STEP_RAD
     qm[j] -= _STEP_RAD
-    d_length = (lengths(qp) - lengths(qm)) / (2.0 * _STEP_RAD)
-    length = lengths(q)
+    return lengths(q), (lengths(qp) - lengths(qm)) / (2.0 * _STEP_RAD)
+
+
+def equilibrium_tendon_force(muscle_params: np.ndarray, mtu_length: float,
+                             activation: float) -> float:
+    """Tendon force [N] of one muscle (its ``muscle_params`` row) at an MTU length [m] and
+    activation [-], the fibre in static equilibrium with its compliant tendon."""
+    fibre = equilibrium_fiber_length(mtu_length, activation, *muscle_params[MP_LOPT:])
+    return tendon_force_of_state(mtu_length, fibre, *muscle_params[:MP_ACTIVE])
+
+
+def leg_muscle_forces(runner, dof: str, q: np.ndarray, *, activation: float,
+                      side: str = "l") -> dict[str, float]:
+    """Each leg muscle of ``side``'s generalised force on the coordinate ``dof`` [N·m or N] at
+    the pose ``q`` (MuJoCo coordinates) and ``activation`` [-], in static equilibrium (module
+    docstring), by muscle type (``vasti``, ...)."""
+    length, d_length = muscle_lengths_and_arms(runner, dof, q)
     out = {}
     for m in LEG_MUSCLES:
         if f"{m}_{side}" not in runner.muscle_names:
             continue
         i = runner.muscle_names.index(f"{m}_{side}")
-        mp = runner.muscle_params[i]
-        fibre = equilibrium_fiber_length(length[i], activation, *mp[MP_LOPT:])
-        out[m] = -tendon_force_of_state(length[i], fibre, *mp[:MP_ACTIVE]) * d_length[i]
+        out[m] = -equilibrium_tendon_force(runner.muscle_params[i], length[i],
+                                           activation) * d_length[i]
     return out
 
 

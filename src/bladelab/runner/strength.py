@@ -6,7 +6,7 @@ leg at a fixed posture, one joint moved through its range. The model's **active*
 angle is, over the muscles that act in the exertion's direction (the antagonists are taken as
 silent), the tendon force at full activation minus the same at zero activation, each muscle in
 static equilibrium with its compliant tendon, times its moment arm (the MTU length's
-derivative by the coordinate, MuJoCo's spatial tendons of ``RunnerModel.mj_analysis_model``).
+derivative by the coordinate: :func:`~bladelab.runner.passive_moments.muscle_lengths_and_arms`).
 
 People's maximal voluntary active moment (Anderson et al. 2007, J Biomech 40:3105, Table 3,
 men aged 18–25) is ``c1·m·g·h·cos(c2·(θ − c3))``, θ in radians with hip and knee flexion and
@@ -27,16 +27,10 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
-import mujoco
 import numpy as np
 
 from bladelab.runner.geometry import LEG_MUSCLES
-from bladelab.runner.muscle import (
-    MP_ACTIVE,
-    MP_LOPT,
-    equilibrium_fiber_length,
-    tendon_force_of_state,
-)
+from bladelab.runner.passive_moments import equilibrium_tendon_force, muscle_lengths_and_arms
 
 __all__ = ["ANDERSON_2007", "EXERTIONS", "Exertion", "active_moments", "exertion_geometry",
            "people_moments", "shape_difference"]
@@ -50,10 +44,6 @@ ANDERSON_2007 = {
     "plantarflexion": (0.095, 1.391, 0.408),
     "dorsiflexion": (0.033, 1.510, -0.187),
 }
-
-#: Step [rad] of the central difference of the MTU lengths.
-_STEP_RAD = 1e-6
-
 
 @dataclass(frozen=True)
 class Exertion:
@@ -102,26 +92,16 @@ def exertion_geometry(runner, exertion: Exertion, *, side: str = "l"):
     (n_angles, n_muscles)."""
     rows = [runner.muscle_names.index(f"{m}_{side}") for m in LEG_MUSCLES
             if f"{m}_{side}" in runner.muscle_names]
-    model = runner.mj_analysis_model
-    data = mujoco.MjData(model)
-    j = runner.dof(f"{exertion.joint}_{side}")
-
-    def lengths(q: np.ndarray) -> np.ndarray:
-        data.qpos[:] = q
-        mujoco.mj_forward(model, data)
-        return data.ten_length[rows].copy()
-
+    dof = f"{exertion.joint}_{side}"
     length, arm = [], []
     for angle in exertion.angles_deg:
         q = runner.stand_qpos.copy()
         for name, value in exertion.posture_deg.items():
             q[runner.dof(f"{name}_{side}")] = math.radians(value)
-        q[j] = math.radians(exertion.coordinate_per_angle * angle)
-        qp, qm = q.copy(), q.copy()
-        qp[j] += _STEP_RAD
-        qm[j] -= _STEP_RAD
-        length.append(lengths(q))
-        arm.append((lengths(qp) - lengths(qm)) / (2.0 * _STEP_RAD))
+        q[runner.dof(dof)] = math.radians(exertion.coordinate_per_angle * angle)
+        lengths, arms = muscle_lengths_and_arms(runner, dof, q)
+        length.append(lengths[rows])
+        arm.append(arms[rows])
     return rows, np.array(length), np.array(arm)
 
 
@@ -133,11 +113,9 @@ def active_moments(muscle_params: np.ndarray, length: np.ndarray, arm: np.ndarra
     out = np.zeros(length.shape[0])
     for k in range(length.shape[0]):
         for i, mp in enumerate(muscle_params):
-            force = []
-            for act in (1.0, 0.0):
-                fibre = equilibrium_fiber_length(length[k, i], act, *mp[MP_LOPT:])
-                force.append(tendon_force_of_state(length[k, i], fibre, *mp[:MP_ACTIVE]))
-            out[k] += max(0.0, -moment_sign * (force[0] - force[1]) * arm[k, i])
+            active = (equilibrium_tendon_force(mp, length[k, i], 1.0)
+                      - equilibrium_tendon_force(mp, length[k, i], 0.0))
+            out[k] += max(0.0, -moment_sign * active * arm[k, i])
     return out
 
 
