@@ -9,11 +9,12 @@ Solves the predictive stride NLP at ``--from`` from the shipped stride of the ru
 (recording the solution's primal and dual values), then at ``--to`` from that solution with
 the start named by VARIANT:
 
-- ``primal``: the primal point only, the library's options (as a speed continuation does now);
-- ``duals-MU``: primal and multipliers (``warm_start_init_point`` yes) with ``mu_init`` MU
-  and the warm-start pushes at 1e-9;
+- ``primal``: the primal point only, the library's options (a start without multipliers);
+- ``duals-MU``: primal and multipliers (``StrideNLP.solve``'s primal-dual warm start,
+  ``DUAL_WARM_START_OPTIONS``: the warm-start pushes at 1e-9) with ``mu_init`` MU;
 - ``scaled-`` before either: the start scaled to the new speed first (``StrideGuess.with_speed``,
-  as ``predict_stride`` does), instead of the solution's own point.
+  as ``predict_stride`` scales a start without multipliers), instead of the solution's own
+  point.
 
 Appends one JSON record per solve to ``benchmarks/collocation_speed/warm_records.jsonl``.
 """
@@ -28,48 +29,28 @@ from pathlib import Path
 
 import numpy as np
 
+from bladelab.predict.collocation.dynamics import stride_dynamics
+from bladelab.predict.collocation.model import build_collocation_model
 from bladelab.predict.collocation.settings import CollocationSettings
-from bladelab.predict.collocation.solve import _model_functions
 from bladelab.predict.collocation.starting_guess import make_guess
 from bladelab.predict.collocation.transcription import StrideNLP
 from bladelab.runner import build_runner
 from bladelab.runner.params import default_runner_params
 
 RECORDS = Path(__file__).with_name("warm_records.jsonl")
-BASE = {
-    "ipopt.max_iter": 3000, "ipopt.tol": 1e-4, "ipopt.constr_viol_tol": 1e-6,
-    "ipopt.print_level": 0, "ipopt.linear_solver": "mumps", "ipopt.mumps_pivot_order": 5,
-    "ipopt.nlp_scaling_method": "gradient-based", "ipopt.sb": "yes", "expand": True,
-    "print_time": False,
-}
 
 
-def options(variant: str, hessian: str) -> dict:
-    opts = dict(BASE, **{"ipopt.hessian_approximation": hessian,
-                         "ipopt.mu_strategy": "adaptive" if hessian == "limited-memory"
-                         else "monotone"})
-    if variant.startswith("duals-"):
+def solve(nlp, x0, speed, variant="primal", hessian="limited-memory", lam=None):
+    """``StrideNLP.solve`` as the variant says: ``primal`` with the library's options,
+    ``duals-MU`` from ``lam`` (its primal-dual warm start) with the barrier starting at MU;
+    returns (solution, its scaled NLP vector and multipliers)."""
+    if variant == "primal":
+        sol = nlp.solve(x0, speed=speed, hessian=hessian)
+    else:
         mu = float(variant.split("-", 1)[1])
-        opts.update({"ipopt.warm_start_init_point": "yes", "ipopt.mu_init": mu,
-                     "ipopt.warm_start_bound_push": 1e-9, "ipopt.warm_start_bound_frac": 1e-9,
-                     "ipopt.warm_start_slack_bound_push": 1e-9,
-                     "ipopt.warm_start_slack_bound_frac": 1e-9,
-                     "ipopt.warm_start_mult_bound_push": 1e-9})
-    return opts
-
-
-def solve(nlp, opts, x0, speed, lam=None):
-    t0 = time.perf_counter()
-    solver, _ = nlp._solver(opts)
-    t_build = time.perf_counter() - t0
-    lbx, ubx, lbg, ubg = nlp.bounds()
-    kw = {} if lam is None else {"lam_x0": lam[0], "lam_g0": lam[1]}
-    res = solver(x0=x0, p=speed, lbx=lbx, ubx=ubx, lbg=lbg, ubg=ubg, **kw)
-    st = solver.stats()
-    x = np.asarray(res["x"]).ravel()
-    sol = nlp.unpack(x, st, time.perf_counter() - t0, t_build, lbg, ubg,
-                     np.asarray(res["g"]).ravel(), speed=speed)
-    return sol, (x, np.asarray(res["lam_x"]).ravel(), np.asarray(res["lam_g"]).ravel())
+        sol = nlp.solve(x0, speed=speed, hessian=hessian, multipliers=lam,
+                        options={"ipopt.mu_init": mu})
+    return sol, (nlp.initial_vector(sol.to_guess()), *sol.multipliers)
 
 
 def main() -> None:
@@ -84,7 +65,7 @@ def main() -> None:
     blade = a.blade if a.kind == "amputee" else None
     runner = build_runner(default_runner_params(a.kind, body="human", blade=blade))
     settings = CollocationSettings(speed_m_per_s=a.v0)
-    _, dyn = _model_functions(runner)
+    dyn = stride_dynamics(build_collocation_model(runner))
     nlp = StrideNLP(dyn, n=settings.mesh_intervals, speed=a.v0, weights=settings.weights)
     guess = make_guess(runner, "stored", n=nlp.n, speed=a.v0)
     cache = Path(f"/tmp/warm_duals/{a.kind}-{blade}-{a.v0}.npz")
@@ -92,8 +73,7 @@ def main() -> None:
         z = np.load(cache)
         point, first = (z["x"], z["lam_x"], z["lam_g"]), json.loads(str(z["first"]))
     else:
-        sol0, point = solve(nlp, options("primal", "limited-memory"),
-                            nlp.initial_vector(guess), a.v0)
+        sol0, point = solve(nlp, nlp.initial_vector(guess), a.v0)
         first = {"iterations": sol0.iterations, "wall_s": round(sol0.wall_s, 1),
                  "objective": sol0.objective, "status": sol0.status}
         cache.parent.mkdir(exist_ok=True)
@@ -104,8 +84,7 @@ def main() -> None:
         lbx, ubx, lbg, ubg = nlp.bounds()
         start = nlp.unpack(x0, {}, 0.0, 0.0, lbg, ubg, np.zeros(lbg.size)).to_guess()
         x0 = nlp.initial_vector(start.with_speed(a.v1))
-    sol1, _ = solve(nlp, options(variant, a.hessian),
-                    x0, a.v1, None if variant == "primal" else point[1:])
+    sol1, _ = solve(nlp, x0, a.v1, variant, a.hessian, lam=point[1:])
     rec = {"date": time.strftime("%Y-%m-%d %H:%M"), "kind": a.kind, "blade": blade,
            "from": a.v0, "to": a.v1, "variant": a.variant, "hessian": a.hessian,
            "first": first,
