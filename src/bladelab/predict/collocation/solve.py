@@ -318,9 +318,9 @@ def predict_stride(runner, settings: CollocationSettings, guess, *, model_spec: 
     speed = settings.speed_m_per_s
     warm = str(guess.source).startswith(COLLOCATION_SOURCE)
     tracking_stage = (settings.track_first and not warm) if track is None else bool(track)
-    nlp_p = _predictive_nlp(runner, dyn, settings)
     warm_predictive = warm and not tracking_stage
-    duals = nlp_p.initial_multipliers(g) if warm_predictive else None
+    duals = (_predictive_nlp(runner, dyn, settings).initial_multipliers(g) if warm_predictive
+             else None)
     # a primal-dual start stays at the solution's own point, whose one violated constraint is
     # then the speed: scaled to the speed it starts off its branch (measured: 843 iterations
     # and a stride 18 % dearer against 224, docs/collocation.md "Warm starts")
@@ -352,6 +352,7 @@ def predict_stride(runner, settings: CollocationSettings, guess, *, model_spec: 
                 runner, sol_t, stage="tracking", tracking=tracking,
                 metabolic_energy_J=nlp_t.energy_and_distance(sol_t)[0], **common)
         start = sol_t.to_guess(f"{COLLOCATION_SOURCE} (tracking stage)")
+    nlp_p = _predictive_nlp(runner, dyn, settings)  # built once per runner, then looked up
     sol = _solve_stage(nlp_p, nlp_p.initial_vector(start), settings, "predictive", progress,
                        warm=warm_predictive, speed=speed, multipliers=duals)
     return CollocationSolution.from_nlp(

@@ -424,7 +424,7 @@ class StrideNLP:
         """The multipliers a guess carries (:attr:`~bladelab.predict.collocation.stride_guess.
         StrideGuess.multipliers`) if they fit this NLP's variables and constraints, else
         None."""
-        lam = getattr(guess, "multipliers", None)
+        lam = guess.multipliers
         if lam is None:
             return None
         lam_x, lam_g = (np.asarray(v, float).ravel() for v in lam)
