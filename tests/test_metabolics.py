@@ -1,4 +1,4 @@
-"""Uchida 2016 / Umberger 2003 metabolic model against hand-computed cases."""
+"""The metabolic models (Uchida 2016 / Umberger 2003; Bhargava 2004) against hand-computed cases."""
 
 from __future__ import annotations
 
@@ -10,6 +10,9 @@ import pytest
 from bladelab.runner import build_runner
 from bladelab.runner.metabolics import (
     BASAL_RATE_W_PER_KG,
+    MB_MODEL,
+    METABOLIC_MODELS,
+    bhargava_muscle_rate,
     metabolic_params,
     muscle_metabolic_rate,
     total_metabolic_rate,
@@ -81,3 +84,59 @@ def test_total_rate_is_basal_plus_muscles():
     expected = BASAL_RATE_W_PER_KG * 70.0 + 89.0 * 0.5**0.6 * 1.5
     assert total_metabolic_rate(u, ms, mp, mb, 70.0) == pytest.approx(expected)
     assert total_metabolic_rate(u[:0], ms[:0], mp[:0], mb[:0], 70.0) == pytest.approx(1.51 * 70)
+
+
+def test_bhargava_isometric_heat_at_full_excitation():
+    # half slow-twitch, 1 kg, optimal length, isometric: activation 40/2 + 133/2 and
+    # maintenance 74/2 + 111/2 W (Bhargava et al. 2004's constants)
+    got = bhargava_muscle_rate(1.0, 1.0, 1.0, 0.0, 1000.0, 0.0, 1000.0, 1.0, 50.0)
+    assert got == pytest.approx(86.5 + 92.5)
+
+
+def test_bhargava_shortening_heat_grows_with_force():
+    # shortening at 0.1 m/s: α = 0.16·F_iso + 0.18·F_fibre, heat α·|v|, work F_ce·|v|
+    base = 86.5 + 92.5
+    got = bhargava_muscle_rate(1.0, 1.0, 1.0, -0.1, 800.0, 0.0, 1000.0, 1.0, 50.0)
+    assert got == pytest.approx(base + (160.0 + 144.0) * 0.1 + 80.0)
+    stronger = bhargava_muscle_rate(1.0, 1.0, 1.0, -0.1, 1600.0, 0.0, 2000.0, 1.0, 50.0)
+    assert stronger - base == pytest.approx(2.0 * (got - base))
+
+
+def test_bhargava_lengthening_is_not_credited_below_the_floors():
+    # lengthening: heat −0.157·F·v (negative), no work; with little excitation the total
+    # would be negative: raised to 0, then the heat floor of 1 W/kg
+    got = bhargava_muscle_rate(0.5, 0.5, 1.0, 0.1, 1000.0, 0.0, 500.0, 2.0, 50.0)
+    s = math.sin(math.pi / 4)
+    f = 1.0 - math.cos(math.pi / 4)
+    heat = 2.0 * (20.0 * s + 66.5 * f) + 2.0 * (37.0 * s + 55.5 * f) - 15.7
+    assert got == pytest.approx(heat)
+    assert bhargava_muscle_rate(0.01, 0.01, 1.0, 0.5, 5000.0, 0.0, 50.0, 2.0, 50.0) == \
+        pytest.approx(2.0)
+
+
+@pytest.mark.parametrize(("l_norm", "factor"), [(0.3, 0.5), (0.75, 0.75), (1.25, 0.5),
+                                                (1.6, 0.0)])
+def test_bhargava_maintenance_heat_length_dependence(l_norm, factor):
+    act = 86.5
+    got = bhargava_muscle_rate(1.0, 1.0, l_norm, 0.0, 0.0, 0.0, 0.0, 1.0, 50.0)
+    assert got == pytest.approx(act + factor * 92.5)
+
+
+def test_total_rate_dispatches_on_the_model_column():
+    mp = np.array([[1000.0, 0.1, 0.2, 0.0, 0.04, 1.0, 0.6]])
+    ms = np.array([[0.5, 0.1, 0.0, 300.0]])  # isometric at optimal length
+    u = np.array([1.0])
+    uchida = total_metabolic_rate(u, ms, mp, np.array([[1.0, 50.0, 0.0]]), 70.0)
+    bhargava = total_metabolic_rate(u, ms, mp, np.array([[1.0, 50.0, 1.0]]), 70.0)
+    assert uchida == pytest.approx(BASAL_RATE_W_PER_KG * 70.0 + 89.0 * 1.5)
+    assert bhargava == pytest.approx(BASAL_RATE_W_PER_KG * 70.0 + 86.5 + 92.5)
+
+
+def test_metabolic_model_is_read_from_the_parameter_set():
+    from bladelab.runner.params import default_runner_params
+
+    params = default_runner_params("able", body="human").model_copy(
+        update={"metabolic_model": "bhargava2004"})
+    mb = metabolic_params(build_runner(params))
+    assert np.all(mb[:, MB_MODEL] == METABOLIC_MODELS.index("bhargava2004"))
+    assert np.all(metabolic_params(build_runner("able"))[:, MB_MODEL] == 0.0)

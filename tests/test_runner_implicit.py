@@ -300,17 +300,26 @@ def test_newmark_accuracy_against_a_fine_step(amputee):
     assert angle_half < 0.5 * angle_1
 
 
-@pytest.mark.parametrize("kind,u", [("amputee", 0.05), ("amputee", 0.4), ("able", 0.2),
-                                    ("able-human", 0.2)])
+@pytest.mark.parametrize("kind,u", [("amputee", 0.05), ("amputee", 0.4), ("able", 0.2)])
 def test_newmark_power_balance_at_1ms(kind, u):
     """Constant excitations, 2 s with ground contact: Newmark at 1 ms keeps the power balance
-    within 0.1 % (measured 0.02–0.05 %; the first-order scheme 0.31–0.35 %). The human body
-    adds the toe hinge and the hip capsule's exponential moment to the linearised terms."""
-    runner = (build_runner("able", body="human") if kind == "able-human"
-              else build_runner(kind))
-    res = simulate_runner(runner, duration=2.0, excitations=u, record_every=1,
+    within 0.1 % (measured 0.02–0.05 %; the first-order scheme 0.31–0.35 %)."""
+    res = simulate_runner(build_runner(kind), duration=2.0, excitations=u, record_every=1,
                           fall_height=-math.inf, dt=1e-3, integrator="newmark")
     assert power_balance_residual_pct(res) <= 0.1
+
+
+def test_newmark_power_balance_converges_on_the_human_body():
+    """The human body (toe hinge, hip capsule's exponential moment in the linearised terms)
+    collapsing under constant excitations 0.2 for 2 s: the power balance within 0.15 % at 1 ms
+    (measured 0.11 %) and halved or better at 0.5 ms (measured 0.054 %): the residual is the
+    scheme's step-size error, not a missing term."""
+    runner = build_runner("able", body="human")
+    residual = [power_balance_residual_pct(simulate_runner(
+        runner, duration=2.0, excitations=0.2, record_every=1, fall_height=-math.inf, dt=dt,
+        integrator="newmark")) for dt in (1e-3, 5e-4)]
+    assert residual[0] <= 0.15
+    assert residual[1] <= 0.5 * residual[0]
 
 
 def test_newmark_starts_exactly_and_records_synchronous_velocities(amputee):

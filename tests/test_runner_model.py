@@ -335,8 +335,8 @@ def test_human_body_is_h0918_scaled_to_a_75_kg_runner():
     strain = dict(zip(runner.muscle_names, runner.muscle_params[:, 4], strict=True))
     assert strain["soleus_l"] == strain["gastroc_r"] == 0.08
     assert strain["vasti_l"] == 0.049
-    # active force at Rajagopal et al. 2016's 60 N/cm² over the table's 25 N/cm²
-    np.testing.assert_allclose(runner.muscle_params[:, 5], 60.0 / 25.0, rtol=1e-15)
+    # active force at 30 N/cm² (people's strength, runner.strength) over the table's 25 N/cm²
+    np.testing.assert_allclose(runner.muscle_params[:, 5], 30.0 / 25.0, rtol=1e-15)
     assert set(build_runner("able").muscle_params[:, 5]) == {1.0}  # seed 001: none
     e0 = dict(zip(runner.muscle_names, runner.muscle_params[:, 6], strict=True))
     assert e0["vasti_l"] == e0["hamstrings_r"] == 1.2 and e0["erect_sp_l"] == 0.6

@@ -9,7 +9,8 @@ The JSON variant says what differs from the built-in human parameter set of ``ki
 ``force_factor`` ({muscle type or "all": factor} on the table's maximum isometric forces; the
 tendon and passive curves follow them), ``muscle`` ({muscle type: {field: value}}), ``set``
 (top-level parameter fields), ``weights`` (``StrideWeights`` fields), ``guess`` (a word or a
-solution file; default the measured trial) and ``mesh`` (mesh intervals, default 50). Writes
+solution file; default the measured trial), ``track`` (true: a tracking stage of the guess
+first, as for a guess that is no collocation solution) and ``mesh`` (mesh intervals, default 50). Writes
 ``OUT/solution.json`` (or ``best_iterate.json``) and ``OUT/variant.json``, and prints the summary and the wall time [s].
 The rows of README.md made with it: every force doubled (``{"force_factor": {"all": 2.0}}``),
 the acceleration weight 0.01, the vasti tendon slack length 0.146 m.
@@ -51,7 +52,8 @@ def main() -> None:
                        speed=speed)
     t0 = time.perf_counter()
     sol = predict_stride(runner, settings, guess,
-                         model_spec={"model": kind, "blade": blade, "body": "human"})
+                         model_spec={"model": kind, "blade": blade, "body": "human"},
+                         track=variant.get("track"))
     out.mkdir(parents=True, exist_ok=True)
     sol.write(out / ("solution.json" if sol.converged else "best_iterate.json"))
     (out / "variant.json").write_text(json.dumps(variant))

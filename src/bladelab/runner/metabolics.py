@@ -24,6 +24,23 @@ Per muscle, rates per kilogram of muscle [W/kg] (Umberger et al. 2003; Uchida et
   tension, so V is the muscle's volume of seed 001 eq. 2.1) and ρ = 1059.7 kg/m³.
 
 Whole body: ``Ė = basal·body mass + Σ_i Ė_i`` with basal 1.51 W/kg (Umberger 2003).
+
+**Bhargava et al. (2004)**, the model of PredSim (Falisse et al. 2019), selected by a parameter
+set's ``metabolic_model: bhargava2004``; per muscle, in W, with the slow-twitch fraction
+``r = 1 − FT/100``:
+
+- recruitment by excitation: slow ``r·sin(πu/2)``, fast ``(1 − r)·(1 − cos(πu/2))`` (slow
+  fibres first: the fast fibres, dearer per kilogram, are recruited at high excitations);
+- activation heat ``m·(40·slow + 133·fast)``, maintenance heat ``m·g(l̃)·(74·slow + 111·fast)``
+  with ``g`` 0.5 below l̃ = 0.5, rising linearly to 1 at l̃ = 1, falling to 0 at l̃ = 1.5
+  (OpenSim's default curve);
+- shortening heat ``−α·v_ce`` with ``α = 0.16·F_iso + 0.18·F_fibre`` while shortening and
+  ``0.157·F_fibre`` while lengthening (a negative heat), ``F_iso = a·f_l·F_max`` (the active
+  strength's), ``F_fibre`` the active plus passive fibre force: the heat grows with the force;
+- mechanical work rate ``−F_ce·v_ce`` while shortening only (PredSim's default: absorbed work
+  is not credited);
+- the muscle's total not below 0 (its shortening heat raised), its heat not below 1 W/kg; no
+  aerobic scale.
 """
 
 from __future__ import annotations
@@ -61,12 +78,20 @@ FAST_TWITCH_PERCENT = {
     "gastroc": 50.0,
     "tib_ant": 30.0,
 }
-# Columns of the metabolic parameter array (one row per muscle).
-MB_MASS, MB_FT = 0, 1
+#: Bhargava et al. (2004)'s activation and maintenance heat constants [W/kg] of slow- and
+#: fast-twitch fibres.
+BHARGAVA_ACTIVATION_W_PER_KG = (40.0, 133.0)
+BHARGAVA_MAINTENANCE_W_PER_KG = (74.0, 111.0)
+# Columns of the metabolic parameter array (one row per muscle): mass, fast-twitch percentage,
+# model (0 Uchida 2016, 1 Bhargava 2004; a two-column array is Uchida's).
+MB_MASS, MB_FT, MB_MODEL = 0, 1, 2
+#: The models of ``RunnerParams.metabolic_model`` by their code in ``MB_MODEL``.
+METABOLIC_MODELS = ("uchida2016", "bhargava2004")
 
 
 def metabolic_params(model, *, specific_tension_pa: float | None = None) -> np.ndarray:
-    """(n_muscles, 2): muscle mass [kg] and fast-twitch percentage of a runner model.
+    """(n_muscles, 3): muscle mass [kg], fast-twitch percentage and metabolic model code
+    (:data:`METABOLIC_MODELS`) of a runner model.
 
     The mass is the muscle's strongest isometric force (Fmax times its active strength,
     ``MP_ACTIVE``) over ``specific_tension_pa`` [Pa], times l_opt and the density, as Uchida et
@@ -76,7 +101,9 @@ def metabolic_params(model, *, specific_tension_pa: float | None = None) -> np.n
     if specific_tension_pa is None:
         specific_tension_pa = model.params.specific_tension_N_per_cm2 * 1e4
     mp = model.muscle_params
-    out = np.zeros((mp.shape[0], 2))
+    out = np.zeros((mp.shape[0], 3))
+    out[:, MB_MODEL] = METABOLIC_MODELS.index(getattr(model.params, "metabolic_model",
+                                                      METABOLIC_MODELS[0]))
     for i, name in enumerate(model.muscle_names):
         base = name.rsplit("_", 1)[0]
         out[i, MB_MASS] = (MUSCLE_DENSITY * mp[i, MP_FMAX] * mp[i, MP_ACTIVE] * mp[i, MP_LOPT]
@@ -135,6 +162,55 @@ def muscle_metabolic_rate(
 
 
 @njit(cache=True)
+def bhargava_muscle_rate(
+    u: float,
+    a: float,
+    l_norm: float,
+    v_ce: float,
+    f_ce: float,
+    f_passive: float,
+    f_iso: float,
+    mass: float,
+    ft: float,
+) -> float:
+    """Metabolic rate [W] of one muscle after Bhargava et al. (2004) (module docstring).
+
+    ``u`` excitation, ``a`` activation [-] (unused: the heats follow the excitation, as
+    PredSim's); ``l_norm`` fibre length / l_opt; ``v_ce`` fibre velocity [m/s] (< 0
+    shortening); ``f_ce`` active and ``f_passive`` passive fibre force [N]; ``f_iso`` the
+    isometric force at this activation and length [N]; ``mass`` [kg]; ``ft`` fast-twitch %.
+    """
+    slow_fraction = 1.0 - ft / 100.0
+    slow = slow_fraction * math.sin(0.5 * math.pi * u)
+    fast = (1.0 - slow_fraction) * (1.0 - math.cos(0.5 * math.pi * u))
+    h_act = mass * (BHARGAVA_ACTIVATION_W_PER_KG[0] * slow
+                    + BHARGAVA_ACTIVATION_W_PER_KG[1] * fast)
+    if l_norm <= 0.5:
+        g = 0.5
+    elif l_norm <= 1.0:
+        g = l_norm
+    elif l_norm <= 1.5:
+        g = 3.0 - 2.0 * l_norm
+    else:
+        g = 0.0
+    h_main = mass * g * (BHARGAVA_MAINTENANCE_W_PER_KG[0] * slow
+                         + BHARGAVA_MAINTENANCE_W_PER_KG[1] * fast)
+    if v_ce <= 0.0:
+        alpha = 0.16 * f_iso + 0.18 * (f_ce + f_passive)
+        work = -f_ce * v_ce
+    else:
+        alpha = 0.157 * (f_ce + f_passive)
+        work = 0.0
+    h_short = -alpha * v_ce
+    heat = h_act + h_main + h_short
+    if heat + work < 0.0:  # the shortening heat is raised until the total is 0
+        heat = -work
+    if heat < MIN_HEAT_RATE_W_PER_KG * mass:
+        heat = MIN_HEAT_RATE_W_PER_KG * mass
+    return heat + work
+
+
+@njit(cache=True)
 def total_metabolic_rate(u, ms, mp, mb, body_mass):
     """Whole-body metabolic rate [W]: basal + Σ muscles, from excitations ``u``, muscle states
     ``ms`` (activation, l_ce, v_ce, F_t), muscle parameters ``mp`` and ``mb`` (:func:`metabolic_params`)."""
@@ -149,6 +225,11 @@ def total_metabolic_rate(u, ms, mp, mb, body_mass):
         cosp = math.sqrt(1.0 - s * s)
         fp = passive_force(ln, mp[i, MP_PSTRAIN])
         f_ce = max(ms[i, 3] / cosp - fp * mp[i, 0], 0.0)
+        if mb.shape[1] > MB_MODEL and mb[i, MB_MODEL] == 1.0:
+            f_iso = a * mp[i, 0] * mp[i, MP_ACTIVE] * force_length(ln)
+            total += bhargava_muscle_rate(u[i], a, ln, ms[i, 2], f_ce, fp * mp[i, 0], f_iso,
+                                          mb[i, 0], mb[i, 1])
+            continue
         total += muscle_metabolic_rate(
             u[i], a, ln, ms[i, 2] / lopt, f_ce, ms[i, 2], mb[i, 0], mb[i, 1]
         )
@@ -157,6 +238,8 @@ def total_metabolic_rate(u, ms, mp, mb, body_mass):
 
 __all__ = [
     "BASAL_RATE_W_PER_KG",
+    "METABOLIC_MODELS",
+    "bhargava_muscle_rate",
     "FAST_TWITCH_PERCENT",
     "metabolic_params",
     "muscle_metabolic_rate",

@@ -184,6 +184,10 @@ class RunnerParams(_Strict):
     capsule_moments: dict[str, CapsuleMoment] = Field(default_factory=dict)
     #: The prosthetic knee of the transfemoral runner (ignored by the other kinds).
     prosthetic_knee: ProstheticKnee = Field(default_factory=ProstheticKnee)
+    #: The muscles' metabolic energy model: ``"uchida2016"`` (seed 001 eq. 2.5: Umberger 2003
+    #: as modified by Uchida et al. 2016; :mod:`bladelab.runner.metabolics`) or
+    #: ``"bhargava2004"`` (Bhargava et al. 2004, as PredSim computes it).
+    metabolic_model: Literal["uchida2016", "bhargava2004"] = "uchida2016"
 
     @model_validator(mode="after")
     def _known_capsules(self) -> RunnerParams:

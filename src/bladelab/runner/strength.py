@@ -33,7 +33,7 @@ from bladelab.runner.geometry import LEG_MUSCLES
 from bladelab.runner.passive_moments import equilibrium_tendon_force, muscle_lengths_and_arms
 
 __all__ = ["ANDERSON_2007", "EXERTIONS", "Exertion", "active_moments", "exertion_geometry",
-           "people_moments", "shape_difference"]
+           "peak_ratio", "people_moments", "shape_difference"]
 
 #: Anderson et al. (2007) Table 3, men 18–25: exertion -> (c1 [-], c2 [-], c3 [rad]).
 ANDERSON_2007 = {
@@ -144,3 +144,12 @@ def shape_difference(runner, name: str, *, side: str = "l") -> dict:
     return {"angles_deg": angles, "model_Nm": model, "people_Nm": people,
             "model_peak_deg": float(angles[np.argmax(model)]),
             "people_peak_deg": float(math.degrees(ANDERSON_2007[name][2])), "rms": rms}
+
+
+def peak_ratio(runner, name: str, *, side: str = "l") -> float:
+    """The model's largest active moment of the exertion ``name`` over people's largest
+    voluntary one [-] (:func:`shape_difference`'s curves): how strong, where the shape says
+    where. People's voluntary activation is about 90 % of their muscles' capacity, so a ratio
+    of about 1.1 is people's maximal strength."""
+    d = shape_difference(runner, name, side=side)
+    return float(d["model_Nm"].max() / d["people_Nm"].max())

@@ -20,6 +20,7 @@ clamps it), fibre state from
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import casadi as ca
@@ -30,14 +31,17 @@ from bladelab.predict.collocation.smooth import Smoothing, sigmoid, smooth_max0,
 from bladelab.runner.metabolics import (
     AEROBIC_SCALE,
     BASAL_RATE_W_PER_KG,
+    BHARGAVA_ACTIVATION_W_PER_KG,
+    BHARGAVA_MAINTENANCE_W_PER_KG,
     MB_FT,
     MB_MASS,
     MIN_HEAT_RATE_W_PER_KG,
     metabolic_params,
 )
-from bladelab.runner.muscle import MP_FMAX, MP_LOPT, MP_PSTRAIN, V_MAX_OPT_PER_S
+from bladelab.runner.muscle import MP_ACTIVE, MP_FMAX, MP_LOPT, MP_PSTRAIN, V_MAX_OPT_PER_S
 
-__all__ = ["MetabolicSmoothing", "metabolic_rate", "muscle_metabolic_rates", "whole_body_rate"]
+__all__ = ["MetabolicSmoothing", "bhargava_muscle_rates", "metabolic_rate",
+           "muscle_metabolic_rates", "whole_body_rate"]
 
 
 @dataclass(frozen=True)
@@ -96,6 +100,8 @@ def muscle_metabolic_rates(runner, u, a, ft, dft, l_mt, v_mt, smoothing: Smoothi
     widths
         Widths of the metabolic switches (default :class:`MetabolicSmoothing`).
     """
+    if getattr(runner.params, "metabolic_model", "uchida2016") == "bhargava2004":
+        return bhargava_muscle_rates(runner, u, a, ft, dft, l_mt, v_mt, smoothing, widths)
     w = widths or MetabolicSmoothing()
     mp = runner.muscle_params
     mb = metabolic_params(runner)
@@ -125,3 +131,48 @@ def muscle_metabolic_rates(runner, u, a, ft, dft, l_mt, v_mt, smoothing: Smoothi
     work = -f_ce * v_m / mass
     total = softplus(heat + work, w.total_w_per_kg)
     return total * mass
+
+
+def _unit_ramp(x, width: float):
+    """Smooth ``clip(x, 0, 1)``."""
+    return softplus(x, width) - softplus(x - 1.0, width)
+
+
+def bhargava_muscle_rates(runner, u, a, ft, dft, l_mt, v_mt, smoothing: Smoothing,
+                          widths: MetabolicSmoothing | None = None):
+    """Metabolic rate of every muscle [W] after Bhargava et al. (2004), as PredSim computes it
+    (:mod:`bladelab.runner.metabolics`, ``bhargava_muscle_rate``, has the equations; arguments
+    as :func:`muscle_metabolic_rates`). The switches are smooth: shortening against lengthening
+    by ``sigmoid(ṽ, w_v)``, the floors by softplus, the maintenance heat's length dependence by
+    smooth ramps of width ``w_l``."""
+    w = widths or MetabolicSmoothing()
+    mp = runner.muscle_params
+    mb = metabolic_params(runner)
+    mass, slow = ca.DM(mb[:, MB_MASS]), ca.DM(1.0 - mb[:, MB_FT] / 100.0)
+    l_opt, fmax = ca.DM(mp[:, MP_LOPT]), ca.DM(mp[:, MP_FMAX])
+    strength = ca.DM(mp[:, MP_ACTIVE])
+    l_m, v_m, cos_a = muscles.fiber_kinematics(mp, l_mt, v_mt, ft, dft, smoothing)
+    ln = l_m / l_opt
+    slow_u = slow * ca.sin(0.5 * math.pi * u)
+    fast_u = (1.0 - slow) * (1.0 - ca.cos(0.5 * math.pi * u))
+    h_act = mass * (BHARGAVA_ACTIVATION_W_PER_KG[0] * slow_u
+                    + BHARGAVA_ACTIVATION_W_PER_KG[1] * fast_u)
+    g_len = (0.5 + 0.5 * _unit_ramp((ln - 0.5) / 0.5, w.length)
+             - _unit_ramp((ln - 1.0) / 0.5, w.length))
+    h_main = mass * g_len * (BHARGAVA_MAINTENANCE_W_PER_KG[0] * slow_u
+                             + BHARGAVA_MAINTENANCE_W_PER_KG[1] * fast_u)
+    e0 = ca.DM(mp[:, MP_PSTRAIN])
+    f_pas = muscles.passive_force(ln, smoothing, e0) * fmax
+    f_ce = smooth_max0(fmax * ft / cos_a - f_pas, 1.0)
+    f_iso = a * fmax * strength * muscles.force_length(ln)
+    lengthening = sigmoid(v_m / l_opt, w.velocity)
+    alpha = (1.0 - lengthening) * (0.16 * f_iso + 0.18 * (f_ce + f_pas)) \
+        + lengthening * 0.157 * (f_ce + f_pas)
+    h_short = -alpha * v_m
+    work = -(1.0 - lengthening) * f_ce * v_m  # positive work only
+    # the muscle's total not below 0 (its shortening heat raised), its heat not below 1 W/kg
+    total = mass * softplus((h_act + h_main + h_short + work) / mass, w.total_w_per_kg)
+    heat = total - work
+    heat = mass * (MIN_HEAT_RATE_W_PER_KG
+                   + softplus(heat / mass - MIN_HEAT_RATE_W_PER_KG, w.heat_w_per_kg))
+    return heat + work
