@@ -298,3 +298,23 @@ def test_a_solution_restarted_from_its_multipliers_ends_at_once():
     assert nlp.initial_multipliers(short) is None
     bad = dataclasses.replace(guess, multipliers=(lam_x, np.full_like(lam_g, np.nan)))
     assert nlp.initial_multipliers(bad) is None
+
+
+def test_the_maximum_speed_problem_keeps_at_least_the_speed_it_is_given():
+    """The maximum-speed NLP has one inequality the prescribed-speed NLP lacks: the stride's
+    mean speed at least the solve's ``speed`` parameter (distance − P·T ≥ 0); a 2 m/s stride
+    meets a 1.5 m/s floor and violates a 2.5 m/s one."""
+    from bladelab.predict.collocation.transcription import StrideWeights
+
+    fastest = StrideNLP(_toy(), n=10, speed=None,
+                        weights=StrideWeights(metabolic=0.0, speed=1.0))
+    prescribed = StrideNLP(_toy(), n=10, speed=2.0)
+    assert fastest.n_cons == prescribed.n_cons  # the speed row, an inequality now
+    _, _, lbg, ubg = fastest.bounds()
+    rows = np.flatnonzero(np.isinf(ubg))
+    assert rows.size == 1 and lbg[rows[0]] == 0.0
+    assert not np.isinf(prescribed.bounds()[3]).any()
+    g = ca.Function("g", [fastest.nlp["x"], fastest.nlp["p"]], [fastest.nlp["g"]])
+    x0 = fastest.initial_vector(_bouncing_guess(10, 2.0))
+    assert float(g(x0, 1.5)[rows[0]]) == pytest.approx(0.5 * 0.6, rel=1e-9)
+    assert float(g(x0, 2.5)[rows[0]]) < 0.0
