@@ -28,7 +28,7 @@ def _row(label: str, sol) -> str:
         calls, secs = nlp.timings.get(f"calls_{key}", 0.0), nlp.timings.get(f"{key}_s", 0.0)
         evals.append(f"{1e3 * secs / calls:.2f} ms" if calls else "–")
     build = nlp.timings.get("build_s", 0.0)
-    return (f"| {label} | {'yes' if sol.converged else 'no: ' + sol.status} | {iters} | "
+    return (f"| {label} | {'yes' if sol.converged else 'no: ' + sol.nlp.status} | {iters} | "
             f"{wall:.0f} s | {build:.1f} s | " + " | ".join(evals) + " |")
 
 
