@@ -102,8 +102,7 @@ def metabolic_params(model, *, specific_tension_pa: float | None = None) -> np.n
         specific_tension_pa = model.params.specific_tension_N_per_cm2 * 1e4
     mp = model.muscle_params
     out = np.zeros((mp.shape[0], 3))
-    out[:, MB_MODEL] = METABOLIC_MODELS.index(getattr(model.params, "metabolic_model",
-                                                      METABOLIC_MODELS[0]))
+    out[:, MB_MODEL] = METABOLIC_MODELS.index(model.params.metabolic_model)
     for i, name in enumerate(model.muscle_names):
         base = name.rsplit("_", 1)[0]
         out[i, MB_MASS] = (MUSCLE_DENSITY * mp[i, MP_FMAX] * mp[i, MP_ACTIVE] * mp[i, MP_LOPT]

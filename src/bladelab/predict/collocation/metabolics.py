@@ -100,13 +100,13 @@ def muscle_metabolic_rates(runner, u, a, ft, dft, l_mt, v_mt, smoothing: Smoothi
     widths
         Widths of the metabolic switches (default :class:`MetabolicSmoothing`).
     """
-    if getattr(runner.params, "metabolic_model", "uchida2016") == "bhargava2004":
+    if runner.params.metabolic_model == "bhargava2004":
         return bhargava_muscle_rates(runner, u, a, ft, dft, l_mt, v_mt, smoothing, widths)
     w = widths or MetabolicSmoothing()
     mp = runner.muscle_params
     mb = metabolic_params(runner)
     mass, ftp = ca.DM(mb[:, MB_MASS]), ca.DM(mb[:, MB_FT])
-    l_opt, fmax = ca.DM(mp[:, MP_LOPT]), ca.DM(mp[:, MP_FMAX])
+    l_opt = ca.DM(mp[:, MP_LOPT])
     l_m, v_m, cos_a = muscles.fiber_kinematics(mp, l_mt, v_mt, ft, dft, smoothing)
     ln = l_m / l_opt
     vn = v_m / l_opt  # optimal lengths per second (< 0 shortening)
@@ -125,12 +125,19 @@ def muscle_metabolic_rates(runner, u, a, ft, dft, l_mt, v_mt, smoothing: Smoothi
     lengthening = sigmoid(vn, w.velocity)
     heat = h_am + (1.0 - lengthening) * h_short + lengthening * h_long
     heat = MIN_HEAT_RATE_W_PER_KG + softplus(heat - MIN_HEAT_RATE_W_PER_KG, w.heat_w_per_kg)
-    # active fibre force, not below 0 (the forward model's clamp; off equilibrium only)
-    e0 = ca.DM(mp[:, MP_PSTRAIN])
-    f_ce = smooth_max0(fmax * ft / cos_a - muscles.passive_force(ln, smoothing, e0) * fmax, 1.0)
+    f_ce, _ = _fibre_forces(mp, ln, ft, cos_a, smoothing)
     work = -f_ce * v_m / mass
     total = softplus(heat + work, w.total_w_per_kg)
     return total * mass
+
+
+def _fibre_forces(mp: np.ndarray, ln, ft, cos_a, smoothing: Smoothing):
+    """(active, passive) fibre force [N] of every muscle from its normalised fibre length,
+    tendon force and cos(pennation); the active one not below 0 (the forward model's clamp,
+    reached off equilibrium only)."""
+    fmax = ca.DM(mp[:, MP_FMAX])
+    f_pas = muscles.passive_force(ln, smoothing, ca.DM(mp[:, MP_PSTRAIN])) * fmax
+    return smooth_max0(fmax * ft / cos_a - f_pas, 1.0), f_pas
 
 
 def _unit_ramp(x, width: float):
@@ -161,9 +168,7 @@ def bhargava_muscle_rates(runner, u, a, ft, dft, l_mt, v_mt, smoothing: Smoothin
              - _unit_ramp((ln - 1.0) / 0.5, w.length))
     h_main = mass * g_len * (BHARGAVA_MAINTENANCE_W_PER_KG[0] * slow_u
                              + BHARGAVA_MAINTENANCE_W_PER_KG[1] * fast_u)
-    e0 = ca.DM(mp[:, MP_PSTRAIN])
-    f_pas = muscles.passive_force(ln, smoothing, e0) * fmax
-    f_ce = smooth_max0(fmax * ft / cos_a - f_pas, 1.0)
+    f_ce, f_pas = _fibre_forces(mp, ln, ft, cos_a, smoothing)
     f_iso = a * fmax * strength * muscles.force_length(ln)
     lengthening = sigmoid(v_m / l_opt, w.velocity)
     alpha = (1.0 - lengthening) * (0.16 * f_iso + 0.18 * (f_ce + f_pas)) \

@@ -353,11 +353,11 @@ def predict_stride(runner, settings: CollocationSettings, guess, *, model_spec: 
                 metabolic_energy_J=nlp_t.energy_and_distance(sol_t)[0], **common)
         start = sol_t.to_guess(f"{COLLOCATION_SOURCE} (tracking stage)")
     nlp_p = _predictive_nlp(runner, dyn, settings)  # built once per runner, then looked up
-    # a maximum speed is at least that of a collocation stride it starts from (which exists)
-    floor = g.speed if speed is None and warm else None
+    # the prescribed speed; of a maximum speed, its floor: that of a collocation stride it
+    # starts from (a stride that exists)
+    stage_speed = speed if speed is not None else (g.speed if warm else None)
     sol = _solve_stage(nlp_p, nlp_p.initial_vector(start), settings, "predictive", progress,
-                       warm=warm_predictive, speed=speed if speed is not None else floor,
-                       multipliers=duals)
+                       warm=warm_predictive, speed=stage_speed, multipliers=duals)
     return CollocationSolution.from_nlp(
         runner, sol, stage="predictive", tracking=tracking,
         metabolic_energy_J=nlp_p.energy_and_distance(sol)[0], **common)
