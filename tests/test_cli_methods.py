@@ -200,23 +200,31 @@ def test_predict_collocation_passes_the_same_settings(tmp_path, monkeypatch):
               "--mesh", "8", "--max-iter", "7", "--swing-clearance", "0.02",
               "--knee-moment-min", "0", "--knee-flexion-max", "10", "--tilt-range=-16,-2",
               "--resume", "--out", str(tmp_path)])
+    people = {"reference": "people", "reference_weight": 10.0}  # the human body's default
     assert seen["settings"] == CollocationSettings(
         mesh_intervals=8, speed_m_per_s=4.0, max_iter=7, swing_clearance_m=0.02,
         knee_moment_min_nm=0.0, knee_flexion_max_loaded_deg=10.0,
-        pelvis_tilt_range_deg=(-16.0, -2.0))
+        pelvis_tilt_range_deg=(-16.0, -2.0), **people)
     assert seen["model_spec"] == {"model": "transfemoral", "blade": "Cat4", "body": "human"}
     assert seen["runner"] == ("runner", seen["model_spec"])
     assert (seen["out"], seen["resume"], seen["force"]) == (tmp_path, True, False)
     seen.clear()
     with pytest.raises(_Called):
         main(["predict", "--method", "collocation", "--max-speed", "--out", str(tmp_path)])
-    assert seen["settings"] == CollocationSettings(speed_m_per_s=None)
+    assert seen["settings"] == CollocationSettings(speed_m_per_s=None, **people)
     assert seen["model_spec"] == {"model": "able", "blade": None, "body": "human"}
     seen.clear()
     with pytest.raises(_Called):  # without --method: collocation on the human body
         main(["predict", "--out", str(tmp_path)])
-    assert seen["settings"] == CollocationSettings()
+    assert seen["settings"] == CollocationSettings(**people)
     assert seen["model_spec"] == {"model": "able", "blade": None, "body": "human"}
+    for args, term in ((["--people-weight", "0"], {}),  # a free prediction
+                       (["--people-weight", "20"], {**people, "reference_weight": 20.0}),
+                       (["--body", "seed001"], {})):  # the seed's body: as the seed solved it
+        seen.clear()
+        with pytest.raises(_Called):
+            main(["predict", "--out", str(tmp_path), *args])
+        assert seen["settings"] == CollocationSettings(**term), args
 
 
 def test_sweep_collocation_passes_the_same_settings(tmp_path, monkeypatch):
@@ -238,11 +246,17 @@ def test_sweep_collocation_passes_the_same_settings(tmp_path, monkeypatch):
     assert [m.get("blade") for m in seen["models"]] == [None, "Cat5", "Cat6"]
     assert seen["speeds"] == [3.5, 4.0]
     assert seen["settings"] == CollocationSettings(mesh_intervals=12, speed_m_per_s=3.5,
-                                                   max_iter=9)
+                                                   max_iter=9, reference="people",
+                                                   reference_weight=10.0)
     assert isinstance(seen["guess"], functools.partial) and seen["guess"].func is make_guess
     assert seen["guess"].keywords == {"guess": "stored"}  # the default guess
     assert (seen["jobs"], seen["executor"], seen["starts"], seen["resume"], seen["force"]) == (
         2, "local", 2, False, False)
+    seen.clear()
+    with pytest.raises(_Called):
+        main(["sweep", "--method", "collocation", "--able", "--categories", "",
+              "--people-weight", "0", "--out", str(tmp_path)])
+    assert seen["settings"].reference_weight == 0.0 and seen["settings"].reference is None
 
 
 def test_sweep_reflex_grid_passes_the_same_values(tmp_path, monkeypatch, capsys):

@@ -123,6 +123,17 @@ def test_file_round_trip_is_exact(able, tmp_path):
     assert [p.name for p in tmp_path.iterdir()] == ["solution.json"]
 
 
+def test_the_reference_phase_round_trips_into_the_next_start(able, tmp_path):
+    """A stride solved against people's angles keeps the phase it was solved with: in its
+    file, and in the guess a next solve starts from (and every resampling of it)."""
+    _, _, sol = able
+    assert sol.reference_phase is None and sol.to_guess().reference_phase is None
+    back = CollocationSolution.read(replace(sol, reference_phase=0.0325).write(
+        tmp_path / "solution.json"))
+    assert back.reference_phase == 0.0325
+    assert back.to_guess().resample(8).with_speed(4.0).reference_phase == 0.0325
+
+
 def test_a_non_converged_solve_is_a_best_iterate(able, tmp_path):
     _, _, sol = able
     bad = replace(sol, nlp=replace(sol.nlp, success=False, status="Maximum_Iterations_Exceeded"))

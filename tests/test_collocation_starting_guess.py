@@ -11,6 +11,7 @@ import yaml
 from bladelab.predict.collocation.solution import CollocationSolution
 from bladelab.predict.collocation.starting_guess import (
     STORED_STRIDES,
+    first_origin,
     make_guess,
     resolve_guess,
     stored_stride_path,
@@ -56,3 +57,12 @@ def test_stored_strides_hold_their_provenance_in_the_folder_readme():
         assert f"`{name}`" in readme
         data = json.loads((RUNNER_DATA_DIR / "collocation" / name).read_text())
         assert data["kind"] == "collocation-solution"
+
+
+def test_a_guess_names_the_first_origin_of_a_chain_of_solutions():
+    chain = ("collocation solution b.json (collocation solution a.json (RBDS001runT35.c3d: "
+             "mean of 41 left-leg cycles at 3.5 m/s)), stride ≥ 0.4 s)")
+    assert first_origin(chain) == "RBDS001runT35.c3d: mean of 41 left-leg cycles at 3.5 m/s"
+    once = "collocation solution c.json (first started from template stride at 4 m/s)"
+    assert first_origin(once) == "template stride at 4 m/s"
+    assert first_origin("the trial") == "the trial"

@@ -28,6 +28,7 @@ __all__ = [
     "measured_running_trial",
     "measured_static_trial",
     "measured_subject_table",
+    "people_joint_angles_table",
 ]
 
 #: Mass [kg] of subject RBDS001, the runner of :func:`measured_running_trial` (``RBDSinfo.txt``).
@@ -87,3 +88,13 @@ def measured_subject_table() -> Path:
     """``RBDSinfo.txt``: the dataset's tab-separated subject table (columns include ``Subject``,
     ``FileName``, ``Age`` [years], ``Height`` [cm], ``Mass`` [kg])."""
     return measured_file("RBDSinfo.txt")
+
+
+def people_joint_angles_table() -> Path:
+    """``people-3.5mps-joint-angles.csv``: two other subjects of the dataset (RBDS002, 80 kg,
+    183 cm; RBDS003, 65.4 kg, 177 cm) running at 3.5 m/s, each one leg's mean pattern over 30 s
+    (as processed by BioMAC-Sim-Toolbox, Apache-2.0): hip flexion, knee flexion and ankle
+    dorsiflexion [deg] and vertical ground force [BW] over 100 samples of the stride from its
+    heel strike; comma-separated with a header row (``stride_pct``, ``RBDS002_hip_flexion_deg``,
+    ...)."""
+    return measured_file("people-3.5mps-joint-angles.csv")

@@ -36,9 +36,10 @@ from bladelab.design.plots import write_design_figures
 from bladelab.design.trends import evaluate_trends
 from bladelab.errors import BladelabError
 from bladelab.example.study import default_example_dir, make_example_study
+from bladelab.predict import defaults
 from bladelab.predict.collocation.human_running import human_running_criteria
 from bladelab.predict.collocation.named_runs import solve_named_stride
-from bladelab.predict.collocation.settings import CollocationSettings
+from bladelab.predict.collocation.settings import CollocationSettings, people_term
 from bladelab.predict.collocation.solve import SOLUTION_FILE
 from bladelab.report.design import build_design_report
 from bladelab.report.predictive import build_predictive_report
@@ -152,7 +153,8 @@ def predict_example(out_dir: str | Path | None = None) -> tuple[Path, list[str]]
     t0 = time.perf_counter()
     res = solve_named_stride(
         out_dir, model="amputee", blade="Cat6", body="human",
-        settings=CollocationSettings(speed_m_per_s=4.0),
+        settings=CollocationSettings(speed_m_per_s=4.0,
+                                     **people_term(defaults.PEOPLE_WEIGHT_PER_RAD2)),
         guess=str(PREDICT_EXAMPLE_STRIDE),
         resume=(out_dir / SOLUTION_FILE).is_file())
     sol = res.solution

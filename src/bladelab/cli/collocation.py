@@ -21,8 +21,9 @@ import typer
 
 from bladelab.cli.panels import renamed
 from bladelab.errors import BladelabError, SpecError
+from bladelab.predict import defaults
 from bladelab.predict.collocation.named_runs import solve_named_stride
-from bladelab.predict.collocation.settings import CollocationSettings
+from bladelab.predict.collocation.settings import CollocationSettings, people_term
 
 __all__ = ["OPTIONS", "PROGRESS_EVERY_S", "StageProgress", "run_collocation"]
 
@@ -34,7 +35,7 @@ OPTIONS = {
     "mesh_intervals": "--mesh", "speed_m_per_s": "--speed", "max_iter": "--max-iter",
     "swing_clearance_m": "--swing-clearance", "knee_moment_min_nm": "--knee-moment-min",
     "knee_flexion_max_loaded_deg": "--knee-flexion-max",
-    "pelvis_tilt_range_deg": "--tilt-range",
+    "pelvis_tilt_range_deg": "--tilt-range", "reference_weight": "--people-weight",
 }
 
 
@@ -107,6 +108,7 @@ def run_collocation(
     knee_moment_min: float | None,
     knee_flexion_max: float | None,
     tilt_range: str | None,
+    people_weight: float | None = None,
 ) -> int:
     """Run ``bladelab predict --method collocation``; returns the exit status (0 converged,
     2 not converged)."""
@@ -116,7 +118,9 @@ def run_collocation(
             mesh_intervals=mesh, speed_m_per_s=None if max_speed else float(speed),
             max_iter=max_iter, swing_clearance_m=swing_clearance,
             knee_moment_min_nm=knee_moment_min, knee_flexion_max_loaded_deg=knee_flexion_max,
-            pelvis_tilt_range_deg=tilt)
+            pelvis_tilt_range_deg=tilt,
+            **people_term(defaults.people_weight_for(body) if people_weight is None
+                          else people_weight))
         result = solve_named_stride(out, model=model, blade=blade, body=body,
                                     settings=settings, guess=guess, resume=resume, force=force,
                                     progress=StageProgress())

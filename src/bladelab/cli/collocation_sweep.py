@@ -34,6 +34,7 @@ OPTIONS = {
     "categories": "--categories", "blade": "--categories", "model": "--categories",
     "body": "--body", "speeds": "--speeds", "guess": "--guess", "mesh_intervals": "--mesh",
     "max_iter": "--max-iter", "starts": "--starts", "jobs": "--jobs",
+    "people_weight": "--people-weight", "reference_weight": "--people-weight",
 }
 
 
@@ -103,6 +104,7 @@ def run_collocation_sweep(
     as_json: bool,
     starts: int,
     body: str,
+    people_weight: float | None = None,
 ) -> int:
     """Run ``bladelab sweep --method collocation``; returns the exit status (0 every solve
     converged, 2 some model failed)."""
@@ -112,7 +114,8 @@ def run_collocation_sweep(
     try:
         result = sweep_named_models(
             out, categories=cats, speeds=speed_list, able=able, body=body, guess=guess,
-            mesh_intervals=mesh, max_iter=max_iter, starts=starts, jobs=jobs,
+            mesh_intervals=mesh, max_iter=max_iter, people_weight=people_weight,
+            starts=starts, jobs=jobs,
             executor=executor, resume=resume, force=force, progress=SweepProgress())
     except BladelabError as err:
         raise renamed(err, OPTIONS) from None

@@ -219,6 +219,13 @@ def register(app: typer.Typer) -> None:
             None, "--tilt-range", rich_help_panel=COLLOCATION,
             help="Keep the pelvis tilt within LO,HI [deg] at every node (forward lean "
                  "negative), e.g. --tilt-range=-16,-2 (seed 001's window)."),
+        people_weight: float | None = typer.Option(
+            None, "--people-weight", rich_help_panel=COLLOCATION, show_default=False,
+            help="Weight [1/rad²] of people's measured hip, knee and ankle angles at 3.5 m/s "
+                 "in the objective (a tracking term of measured running, reported as such; "
+                 "docs/collocation.md). Default: "
+                 f"{defaults.PEOPLE_WEIGHT_PER_RAD2:g} on the human body, 0 on the others; "
+                 "0: the gait is predicted freely."),
     ) -> None:
         """Predict a running gait: solve one periodic stride of the human body by direct
         collocation (writes DIR/solution.json; exit status 2 and DIR/best_iterate.json if
@@ -235,7 +242,8 @@ def register(app: typer.Typer) -> None:
                 out=out, model=model, blade=blade, speed=speed, max_speed=max_speed, mesh=mesh,
                 guess=guess, max_iter=max_iter, resume=resume, force=force, as_json=as_json,
                 body=body, swing_clearance=swing_clearance, knee_moment_min=knee_moment_min,
-                knee_flexion_max=knee_flexion_max, tilt_range=tilt_range))
+                knee_flexion_max=knee_flexion_max, tilt_range=tilt_range,
+                people_weight=people_weight))
         from bladelab.cli.reflex import run_reflex  # deferred: keeps bladelab --help fast
 
         run_reflex(
@@ -349,6 +357,13 @@ def register(app: typer.Typer) -> None:
             help="human (H0918's segments and muscles, compliant Achilles, toes, soft heel "
                  "pad) | seed001 (seed 001's model) | toes (seed 001's with a toe segment and "
                  "compliant Achilles tendons)."),
+        people_weight: float | None = typer.Option(
+            None, "--people-weight", rich_help_panel=COLLOCATION, show_default=False,
+            help="Weight [1/rad²] of people's measured hip, knee and ankle angles at 3.5 m/s "
+                 "in the objective (a tracking term of measured running, reported as such; "
+                 "docs/collocation.md). Default: "
+                 f"{defaults.PEOPLE_WEIGHT_PER_RAD2:g} on the human body, 0 on the others; "
+                 "0: the gait is predicted freely."),
     ) -> None:
         """Category × speed grid: warm-started optimisations, maximum speed, cost at 4 m/s,
         200 m and 400 m times, contact times (seed 001 §2.2.2 B–C, Table 3.1). Running it again
@@ -379,7 +394,8 @@ def register(app: typer.Typer) -> None:
             raise typer.Exit(run_collocation_sweep(
                 out=out, categories=categories, able=able, speeds=speeds, mesh=mesh,
                 guess=guess, max_iter=max_iter, jobs=jobs, executor=executor, resume=resume,
-                force=force, as_json=as_json, starts=starts, body=body))
+                force=force, as_json=as_json, starts=starts, body=body,
+                people_weight=people_weight))
         from bladelab.cli import reflex  # deferred: keeps bladelab --help fast
 
         if mode == "recipe":

@@ -33,6 +33,7 @@ from bladelab.predict.collocation.human_running import (
     stride_from_left_touchdown,
 )
 from bladelab.predict.collocation.model import build_collocation_model
+from bladelab.predict.collocation.settings import PEOPLE_REFERENCE
 from bladelab.predict.collocation.solution import (
     BEST_ITERATE_KIND,
     SOLUTION_KIND,
@@ -151,6 +152,25 @@ def _measured_trial(runner, sol):
         return None
 
 
+def _reference_term_text(sol) -> str:
+    """What the objective held besides the predictive terms: people's measured joint angles
+    (a tracking term of measured running) or another solution's; empty without one."""
+    settings = sol.settings
+    if not settings.reference_weight:
+        return ""
+    value = sol.nlp.objective_terms.get("tracking")
+    share = (f", {value:.3g} of the objective's {sol.nlp.objective:.4g}"
+             if value is not None else "")
+    if settings.reference == PEOPLE_REFERENCE:
+        return (f" Not a free prediction: the objective held people's measured hip, knee and "
+                f"ankle angles at 3.5 m/s (Fukuchi et al. 2017, subjects RBDS002 and RBDS003, "
+                f"not the trial compared below), weight {settings.reference_weight:g} 1/rad²"
+                f"{share}.")
+    return (f" Not a free prediction: the objective held the joint angles and stride time of "
+            f"{Path(settings.reference).name}, weight {settings.reference_weight:g} 1/rad²"
+            f"{share}.")
+
+
 def _add_human_running_section(report, sol, trial) -> None:
     """The stride against measured human running, criterion by criterion (the report's first
     words about a gait)."""
@@ -169,7 +189,7 @@ def _add_human_running_section(report, sol, trial) -> None:
                            "note": c.note} for c in crit])
     report.add_section(
         "Against measured human running",
-        text=(verdict + " Bands: people at this speed (bladelab.predict.collocation."
+        text=(verdict + _reference_term_text(sol) + " Bands: people at this speed (bladelab.predict.collocation."
               "human_running: the Fukuchi et al. 2017 trial at 3.5 m/s, Weyand et al. 2000 and "
               "Nummela et al. 2007 at 9 m/s, interpolated in speed between them)"
               + ("; joint angles against the measured 3.5 m/s stride." if trial is not None

@@ -23,7 +23,7 @@ from typing import TYPE_CHECKING
 
 from bladelab.errors import SpecError
 from bladelab.predict import defaults
-from bladelab.predict.collocation.settings import CollocationSettings
+from bladelab.predict.collocation.settings import CollocationSettings, people_term
 from bladelab.predict.collocation.solve import predict_stride_in_folder
 from bladelab.predict.collocation.starting_guess import make_guess, resolve_guess
 from bladelab.predict.collocation.starts import check_starts
@@ -97,6 +97,7 @@ def sweep_named_models(
     guess: str = defaults.GUESS,
     mesh_intervals: int = defaults.MESH_INTERVALS,
     max_iter: int = defaults.MAX_ITER,
+    people_weight: float | None = None,
     starts: int = defaults.STARTS,
     jobs: int = 1,
     executor: str = "local",
@@ -112,7 +113,9 @@ def sweep_named_models(
 
     Each model's first speed starts from ``guess`` (module docstring); ``mesh_intervals`` and
     ``max_iter`` (IPOPT's iterations per stage) set its :class:`CollocationSettings`;
-    ``starts``: starts per problem, the best kept
+    ``people_weight`` [1/rad²]: the weight of people's joint angles in the objective
+    (:mod:`~bladelab.predict.collocation.people`; 0: none; None: the body's default,
+    :func:`bladelab.predict.defaults.people_weight_for`); ``starts``: starts per problem, the best kept
     (:mod:`~bladelab.predict.collocation.starts`); ``jobs`` models at a time on ``executor``.
 
     Raises
@@ -124,7 +127,9 @@ def sweep_named_models(
     if len(speeds) == 0:
         raise SpecError("no speed given", where="speeds")
     settings = CollocationSettings(mesh_intervals=mesh_intervals, speed_m_per_s=speeds[0],
-                                   max_iter=max_iter)
+                                   max_iter=max_iter, **people_term(
+                                       defaults.people_weight_for(body) if people_weight is None
+                                       else people_weight))
     if isinstance(jobs, bool) or not isinstance(jobs, int) or jobs < 1:
         raise SpecError(f"need at least 1 job, got {jobs}", where="jobs")
     check_starts(starts)

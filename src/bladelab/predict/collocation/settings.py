@@ -15,10 +15,12 @@ from bladelab.predict import defaults
 from bladelab.predict.collocation.dynamics import COORDINATE_BOUNDS_DEG
 from bladelab.predict.collocation.transcription import StrideWeights
 
-__all__ = ["HESSIANS", "CollocationSettings"]
+__all__ = ["HESSIANS", "PEOPLE_REFERENCE", "CollocationSettings", "people_term"]
 
 #: IPOPT Hessian options (:meth:`~bladelab.predict.collocation.transcription.StrideNLP.solve`).
 HESSIANS = ("limited-memory", "exact")
+#: ``CollocationSettings.reference`` naming people's measured joint angles, not a file.
+PEOPLE_REFERENCE = "people"
 
 
 def _weights_from_dict(data, where: str) -> StrideWeights:
@@ -111,8 +113,11 @@ class CollocationSettings:
         controller tracks (``bladelab predict --track``) passes its lean on: the Cat6 4 m/s
         stride without it leans -17.8° on average (docs/collocation.md).
     reference, reference_weight, reference_dofs
-        A collocation solution file of the same runner whose joint angles the predictive
-        stage stays near: ``reference_weight`` [1/rad²] × the time-averaged mean squared
+        ``"people"`` (:data:`PEOPLE_REFERENCE`): people's measured hip, knee and ankle angles
+        at 3.5 m/s (:mod:`bladelab.predict.collocation.people`), ``reference_weight``
+        [1/rad²] × their time-averaged mean squared deviation, no stride-time term; the
+        human body's gait term (docs/predictive.md). Or a collocation solution file of the
+        same runner whose joint angles the predictive stage stays near: ``reference_weight`` [1/rad²] × the time-averaged mean squared
         deviation of the coordinates ``reference_dofs`` (None: pelvis tilt and every joint)
         from the reference's, on the normalised stride, plus the same weight × ln(T/T_ref)²
         of the stride time T against the reference's (the cadence: measured 2026-11-26, with
@@ -246,7 +251,8 @@ class CollocationSettings:
             object.__setattr__(self, "reference", str(self.reference))
         if rw > 0 and self.reference is None:
             raise SpecError("a reference weight needs a reference solution", where="reference",
-                            hint="give the solution file whose joint angles to stay near")
+                            hint="give the solution file whose joint angles to stay near, "
+                                 f"or '{PEOPLE_REFERENCE}' for people's measured angles")
         dofs = self.reference_dofs
         if dofs is not None:
             if isinstance(dofs, str) or not all(isinstance(d, str) for d in dofs) or not dofs:
@@ -299,3 +305,9 @@ class CollocationSettings:
         if not self.reference_weight:
             return ()
         return (Path(self.reference).name, self.reference_weight, self.reference_dofs)
+
+
+def people_term(weight: float) -> dict:
+    """The :class:`CollocationSettings` fields of people's joint-angle term at ``weight``
+    [1/rad²] (none at 0)."""
+    return {"reference": PEOPLE_REFERENCE, "reference_weight": weight} if weight else {}

@@ -152,12 +152,14 @@ class CollocationSolution:
     body_weight_N: float
     metabolic_energy_J: float
     residual: dict = field(default_factory=dict)
+    reference_phase: float | None = None
 
     # -- construction ---------------------------------------------------------------------
     @classmethod
     def from_nlp(cls, runner, nlp, *, settings: CollocationSettings, model_spec: dict,
                  guess_source: str, stage: str = "predictive", tracking: dict | None = None,
-                 metabolic_energy_J: float | None = None, cm=None) -> CollocationSolution:
+                 metabolic_energy_J: float | None = None, cm=None,
+                 reference_phase: float | None = None) -> CollocationSolution:
         """A solution from an :class:`NLPSolution` of ``runner``: evaluates the contact forces
         and the dynamic consistency at the nodes (and the metabolic energy over the stride [J],
         :meth:`StrideNLP.energy_and_distance` on the solution's mesh, when not given)."""
@@ -189,6 +191,7 @@ class CollocationSolution:
             leg_names=leg_names(runner),
             body_mass_kg=float(runner.total_mass), body_weight_N=float(runner.body_weight),
             metabolic_energy_J=float(metabolic_energy_J), residual=res,
+            reference_phase=None if reference_phase is None else float(reference_phase),
         )
 
     # -- derived numbers ------------------------------------------------------------------
@@ -331,7 +334,7 @@ class CollocationSolution:
         if not text.startswith(COLLOCATION_SOURCE):
             text = f"{COLLOCATION_SOURCE}: {text}"
         return replace(self.nlp.to_guess(text), dof_names=self.dof_names,
-                       muscle_names=self.muscle_names)
+                       muscle_names=self.muscle_names, reference_phase=self.reference_phase)
 
     def to_runner_result(self, n_strides: int = 3, *, refine: int = 1, runner=None, cm=None):
         """The stride repeated ``n_strides`` times as a :class:`~bladelab.runner.RunnerResult`
@@ -421,6 +424,7 @@ class CollocationSolution:
             "max_violation": _num(s.max_violation),
             "worst_constraints": [[name, _num(v)] for name, v in s.worst_constraints],
             "timings": {k: _num(v) for k, v in s.timings.items()},
+            "reference_phase": self.reference_phase,
             "tracking": None if self.tracking is None else {
                 k: (_num(v) if isinstance(v, float) else v) for k, v in self.tracking.items()},
             "summary": self.summary(),
@@ -545,6 +549,8 @@ class CollocationSolution:
             body_weight_N=r.number("body_weight_N"),
             metabolic_energy_J=r.number("metabolic_energy_J"),
             residual=r.get("consistency", dict),
+            reference_phase=(None if data.get("reference_phase") is None
+                             else r.number("reference_phase")),
         )
 
 

@@ -57,7 +57,8 @@ import numpy as np
 from bladelab.errors import InputFileError, SpecError
 from bladelab.predict.collocation.dynamics import stride_dynamics
 from bladelab.predict.collocation.model import build_collocation_model
-from bladelab.predict.collocation.settings import CollocationSettings
+from bladelab.predict.collocation.people import PROSTHETIC_JOINTS, people_reference
+from bladelab.predict.collocation.settings import PEOPLE_REFERENCE, CollocationSettings
 from bladelab.predict.collocation.solution import CollocationSolution
 from bladelab.predict.collocation.stored import check_model_spec, describe_problem
 from bladelab.predict.collocation.stride_guess import COLLOCATION_SOURCE
@@ -234,34 +235,44 @@ def _model_functions(runner, swing_clearance_m: float = 0.0,
     return built["cm"], built["dyn"][narrowed]
 
 
-def _reference_tracking(runner, settings: CollocationSettings) -> tuple:
+def _reference_tracking(runner, settings: CollocationSettings, start) -> tuple:
     """The predictive stage's reference terms (:attr:`CollocationSettings.reference`):
-    ``((q_ref, weight, dofs) on the mesh, (T_ref, weight))``, or (None, None)."""
+    ``((q_ref, weight, dofs) on the mesh, (T_ref, weight) or None, phase)``, or
+    ``(None, None, None)``. People's angles (``reference="people"``) are shifted to the phase
+    of ``start`` (the guess on the mesh) and have no stride-time term; ``phase`` [fraction
+    of the stride] is theirs, None for a solution file: the start's own
+    (``StrideGuess.reference_phase``, a stride solved against people's angles) or the phase
+    that fits the start best."""
     if not settings.reference_weight:
-        return None, None
+        return None, None, None
+    if settings.reference == PEOPLE_REFERENCE:
+        q, dofs, phase = people_reference(runner.dof_names, start.q, settings.reference_dofs,
+                                          exclude=PROSTHETIC_JOINTS.get(runner.kind, ()),
+                                          phase=start.reference_phase)
+        return (q, settings.reference_weight, dofs), None, phase
     path = Path(settings.reference)
     if not path.is_file():
         raise InputFileError("no such reference solution", file=path,
                              hint="the collocation solution whose joint angles the gait stays "
-                                  "near (settings: reference)")
+                                  f"near (settings: reference), or '{PEOPLE_REFERENCE}'")
     ref = CollocationSolution.read(path).to_guess(f"{COLLOCATION_SOURCE} {path.name}")
     q = ref.on_model(runner).resample(settings.mesh_intervals).q
     return (q, settings.reference_weight, settings.reference_dofs), (
-        ref.period, settings.reference_weight)
+        ref.period, settings.reference_weight), None
 
 
-def _predictive_nlp(runner, dyn, settings: CollocationSettings):
+def _predictive_nlp(runner, dyn, settings: CollocationSettings, reference: tuple):
     """The predictive :class:`~bladelab.predict.collocation.transcription.StrideNLP` of the
-    settings' mesh, problem (prescribed speed, or maximum speed), weights and reference term,
-    built once per runner (the reference file is read only then); the speed itself is a
-    parameter of each solve."""
+    settings' mesh, problem (prescribed speed, or maximum speed), weights and ``reference``
+    terms (:func:`_reference_tracking`), built once per runner and reference (people's, once
+    per phase); the speed itself is a parameter of each solve."""
     n, speed = settings.mesh_intervals, settings.speed_m_per_s
     nlps = _BUILT[runner]["nlps"]
-    key = (n, speed is None, settings.weights, id(dyn), settings.reference_key())
+    tracking, period_tracking, phase = reference
+    key = (n, speed is None, settings.weights, id(dyn), settings.reference_key(), phase)
     if key not in nlps:
         while len(nlps) >= MAX_NLPS_PER_RUNNER:
             nlps.pop(next(iter(nlps)))
-        tracking, period_tracking = _reference_tracking(runner, settings)
         nlps[key] = StrideNLP(dyn, n=n, speed=speed, weights=settings.weights,
                               tracking=tracking, period_tracking=period_tracking)
     else:
@@ -319,8 +330,9 @@ def predict_stride(runner, settings: CollocationSettings, guess, *, model_spec: 
     warm = str(guess.source).startswith(COLLOCATION_SOURCE)
     tracking_stage = (settings.track_first and not warm) if track is None else bool(track)
     warm_predictive = warm and not tracking_stage
-    duals = (_predictive_nlp(runner, dyn, settings).initial_multipliers(g) if warm_predictive
-             else None)
+    reference = _reference_tracking(runner, settings, g)  # the stored file read once per solve
+    duals = (_predictive_nlp(runner, dyn, settings, reference).initial_multipliers(g)
+             if warm_predictive else None)
     # a primal-dual start stays at the solution's own point, whose one violated constraint is
     # then the speed: scaled to the speed it starts off its branch (measured: 843 iterations
     # and a stride 18 % dearer against 224, docs/collocation.md "Warm starts")
@@ -352,7 +364,7 @@ def predict_stride(runner, settings: CollocationSettings, guess, *, model_spec: 
                 runner, sol_t, stage="tracking", tracking=tracking,
                 metabolic_energy_J=nlp_t.energy_and_distance(sol_t)[0], **common)
         start = sol_t.to_guess(f"{COLLOCATION_SOURCE} (tracking stage)")
-    nlp_p = _predictive_nlp(runner, dyn, settings)  # built once per runner, then looked up
+    nlp_p = _predictive_nlp(runner, dyn, settings, reference)  # built once, then looked up
     # the prescribed speed; of a maximum speed, its floor: that of a collocation stride it
     # starts from (a stride that exists)
     stage_speed = speed if speed is not None else (g.speed if warm else None)
@@ -360,7 +372,8 @@ def predict_stride(runner, settings: CollocationSettings, guess, *, model_spec: 
                        warm=warm_predictive, speed=stage_speed, multipliers=duals)
     return CollocationSolution.from_nlp(
         runner, sol, stage="predictive", tracking=tracking,
-        metabolic_energy_J=nlp_p.energy_and_distance(sol)[0], **common)
+        metabolic_energy_J=nlp_p.energy_and_distance(sol)[0], reference_phase=reference[2],
+        **common)
 
 
 def read_stored(ok: Path, best: Path, spec: dict, settings: CollocationSettings):

@@ -27,8 +27,8 @@ from bladelab.predict.collocation.guess import (
 from bladelab.predict.collocation.solution import CollocationSolution
 from bladelab.runner.params import PROSTHETIC_KINDS, RUNNER_DATA_DIR, default_runner_params
 
-__all__ = ["GUESS_WORDS", "MAX_SPEED_TEMPLATE_M_PER_S", "STORED_STRIDES", "guess_file_kind",
-           "make_guess", "resolve_guess", "stored_stride_path"]
+__all__ = ["GUESS_WORDS", "MAX_SPEED_TEMPLATE_M_PER_S", "STORED_STRIDES", "first_origin",
+           "guess_file_kind", "make_guess", "resolve_guess", "stored_stride_path"]
 
 #: The guesses named by a word; anything else is the path of a file.
 GUESS_WORDS = ("template", "trial", "stored")
@@ -52,6 +52,26 @@ def stored_stride_path(runner) -> Path | None:
         return None
     body = default_runner_params(runner.kind, body="human").model_dump(exclude={"blade"})
     return path if runner.params.model_dump(exclude={"blade"}) == body else None
+
+
+def first_origin(source: str) -> str:
+    """The origin at the bottom of a guess's provenance: a solution started from a solution
+    started from ... a trial names the trial (``"collocation solution a.json (collocation
+    solution b.json (the trial), stride ≥ 0.4 s)"`` -> ``"the trial"``), so that a stride
+    carried through many solves does not carry a growing chain."""
+    text = source.strip()
+    while text.startswith("collocation solution") and "(" in text:
+        start, depth = text.index("("), 0
+        for end in range(start, len(text)):
+            depth += {"(": 1, ")": -1}.get(text[end], 0)
+            if depth == 0:
+                break
+        else:  # unclosed: to the end
+            end = len(text)
+        text = text[start + 1:end].strip()
+        if text.startswith("first started from "):
+            text = text[len("first started from "):]
+    return text
 
 
 def make_guess(runner, guess: str, *, n: int, speed: float | None, where: str = "guess"):
@@ -93,7 +113,8 @@ def make_guess(runner, guess: str, *, n: int, speed: float | None, where: str = 
     path = Path(guess)
     if guess_file_kind(path, where=where) == "collocation":
         sol = CollocationSolution.read(path)
-        stride = sol.to_guess(f"collocation solution {path.name} ({sol.guess_source})")
+        stride = sol.to_guess(f"collocation solution {path.name} (first started from "
+                              f"{first_origin(sol.guess_source)})")
         if sol.model_spec["model"] == runner.kind:  # another body of the same kind is mapped
             return stride
         if {sol.model_spec["model"], runner.kind} <= set(PROSTHETIC_KINDS):

@@ -77,6 +77,10 @@ class StrideGuess:
         (:meth:`~bladelab.predict.collocation.transcription.StrideNLP.initial_multipliers`
         takes them only if they fit the NLP). Kept by :meth:`with_speed`; dropped by
         :meth:`resample` to another mesh and by :meth:`on_model` when it moves columns.
+    reference_phase
+        The phase [fraction of the stride] of people's joint angles that the stride was solved
+        against (:mod:`~bladelab.predict.collocation.people`), or None: a solve from it with
+        people's reference keeps that phase, so that a solution is its own optimum again.
     """
 
     source: str
@@ -92,6 +96,7 @@ class StrideGuess:
     excitation: np.ndarray | None = None
     tendon_force_rate: np.ndarray | None = None
     multipliers: tuple[np.ndarray, np.ndarray] | None = None
+    reference_phase: float | None = None
 
     def on_model(self, model: RunnerModel) -> StrideGuess:
         """This guess on ``model``'s coordinates and muscles, matched by name: coordinates
