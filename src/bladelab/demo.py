@@ -163,7 +163,8 @@ def predict_example(out_dir: str | Path | None = None) -> tuple[Path, list[str]]
     how = "solved" if res.solved else "read back"
     lines = [f"predict example: amputee Cat6, human body, 4 m/s, {how} in "
              f"{time.perf_counter() - t0:.0f} s ({s['iterations']} IPOPT iterations, warm start "
-             f"from the shipped stride) -> {out_dir}",
+             f"from the shipped stride; people's measured joint angles in the objective at "
+             f"{defaults.PEOPLE_WEIGHT_PER_RAD2:g} 1/rad², docs/collocation.md) -> {out_dir}",
              f"  converged {s['converged']}, stride {s['stride_time_s']:.3f} s, cost of "
              f"transport {s['cost_of_transport_J_per_kg_m']:.2f} J/(kg·m), dynamics residual "
              f"{s['dynamics_residual_pct']:.2f} %"]

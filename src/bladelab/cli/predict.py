@@ -68,6 +68,16 @@ def _csv(values) -> str:
     return ",".join(str(v) for v in values)
 
 
+def _people_weight_option():
+    """``--people-weight``, the same on ``predict`` and ``sweep`` (collocation)."""
+    return typer.Option(
+        None, "--people-weight", rich_help_panel=COLLOCATION, show_default=False,
+        help="Weight [1/rad²] of people's measured hip, knee and ankle angles at 3.5 m/s in "
+             "the objective (a tracking term of measured running, reported as such; "
+             f"docs/collocation.md). Default: {defaults.PEOPLE_WEIGHT_PER_RAD2:g} on the human "
+             "body, 0 on the others; 0: the gait is predicted freely.")
+
+
 def register(app: typer.Typer) -> None:
     @app.command("predict", cls=PanelCommand)
     def predict(
@@ -219,13 +229,7 @@ def register(app: typer.Typer) -> None:
             None, "--tilt-range", rich_help_panel=COLLOCATION,
             help="Keep the pelvis tilt within LO,HI [deg] at every node (forward lean "
                  "negative), e.g. --tilt-range=-16,-2 (seed 001's window)."),
-        people_weight: float | None = typer.Option(
-            None, "--people-weight", rich_help_panel=COLLOCATION, show_default=False,
-            help="Weight [1/rad²] of people's measured hip, knee and ankle angles at 3.5 m/s "
-                 "in the objective (a tracking term of measured running, reported as such; "
-                 "docs/collocation.md). Default: "
-                 f"{defaults.PEOPLE_WEIGHT_PER_RAD2:g} on the human body, 0 on the others; "
-                 "0: the gait is predicted freely."),
+        people_weight: float | None = _people_weight_option(),
     ) -> None:
         """Predict a running gait: solve one periodic stride of the human body by direct
         collocation (writes DIR/solution.json; exit status 2 and DIR/best_iterate.json if
@@ -357,13 +361,7 @@ def register(app: typer.Typer) -> None:
             help="human (H0918's segments and muscles, compliant Achilles, toes, soft heel "
                  "pad) | seed001 (seed 001's model) | toes (seed 001's with a toe segment and "
                  "compliant Achilles tendons)."),
-        people_weight: float | None = typer.Option(
-            None, "--people-weight", rich_help_panel=COLLOCATION, show_default=False,
-            help="Weight [1/rad²] of people's measured hip, knee and ankle angles at 3.5 m/s "
-                 "in the objective (a tracking term of measured running, reported as such; "
-                 "docs/collocation.md). Default: "
-                 f"{defaults.PEOPLE_WEIGHT_PER_RAD2:g} on the human body, 0 on the others; "
-                 "0: the gait is predicted freely."),
+        people_weight: float | None = _people_weight_option(),
     ) -> None:
         """Category × speed grid: warm-started optimisations, maximum speed, cost at 4 m/s,
         200 m and 400 m times, contact times (seed 001 §2.2.2 B–C, Table 3.1). Running it again
