@@ -18,7 +18,12 @@ import pytest
 
 from bladelab.errors import SpecError
 from bladelab.predict.collocation import build_collocation_model
-from bladelab.predict.collocation.analyses import stride_analyses
+from bladelab.predict.collocation.analyses import (
+    SCONE_BASAL_W_PER_KG,
+    SCONE_SPECIFIC_TENSION_PA,
+    cost_of_transport,
+    stride_analyses,
+)
 from bladelab.predict.collocation.solution import CollocationSolution
 from bladelab.predict.collocation.stored import runner_from_spec
 from bladelab.runner.layout import CP_BLADE, CP_BODY, CP_EXP, CP_K
@@ -107,7 +112,7 @@ def _middle_stance(loaded: np.ndarray, n: int) -> tuple[int, int]:
 
 def test_keys_name_the_legs_joints_and_units(at_nodes, refined):
     assert at_nodes.keys() == refined.keys()
-    units = ("_kN_per_m", "_W_per_kg", "_J", "_pct")
+    units = ("_kN_per_m", "_W_per_kg", "_J", "_pct", "_J_per_kg_m")
     assert all(k.endswith(units) for k in refined), [k for k in refined if not k.endswith(units)]
     assert not any("left" in k or "right" in k for k in refined)
     for joint, leg in [*JOINTS.values(), ("rsp", "prosthetic")]:
@@ -242,3 +247,24 @@ def test_blade_stores_at_least_its_elastic_energy_and_returns_less(case, nodes, 
     assert 0.0 < returned < stored
     assert refined["blade_hysteresis_J"] == pytest.approx(stored - returned)
     assert refined["blade_recoil_pct"] == pytest.approx(100 * returned / stored)
+
+
+def test_the_cost_of_transport_is_the_solution_s_own_and_scone_s_differs_by_mass_and_basal(
+        case):
+    """:func:`cost_of_transport` at the model's own muscle masses and basal rate is the cost
+    the NLP integrated (another path through the same smooth model); SCONE's accounting
+    changes the basal term by exactly (1.51 − 1.2) W/kg over the stride, and on seed 001's
+    body (masses from 60 N/cm²) adds muscle cost: SCONE counts 2.4 times the muscle mass."""
+    sol, runner, cm = case
+    mass = float(runner.total_mass)
+    j = list(sol.dof_names).index("pelvis_tx")
+    distance = float(sol.nlp.q[-1, j] - sol.nlp.q[0, j])
+    own = cost_of_transport(sol, runner, cm=cm)
+    assert own == pytest.approx(sol.metabolic_energy_J / (mass * distance), rel=1e-9)
+    basal_only = cost_of_transport(sol, runner, basal_w_per_kg=SCONE_BASAL_W_PER_KG, cm=cm)
+    assert own - basal_only == pytest.approx(
+        (1.51 - SCONE_BASAL_W_PER_KG) * sol.period_s / distance, rel=1e-9)
+    scone = cost_of_transport(sol, runner, specific_tension_pa=SCONE_SPECIFIC_TENSION_PA,
+                              basal_w_per_kg=SCONE_BASAL_W_PER_KG, cm=cm)
+    assert runner.params.specific_tension_N_per_cm2 == 60.0  # seed 001's body
+    assert scone > 1.3 * basal_only

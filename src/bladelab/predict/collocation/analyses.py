@@ -20,6 +20,9 @@ Keys (units in the names; ``<leg>``: ``intact``/``prosthetic`` or ``left``/``rig
 - ``leg_energy_stored_<leg>_J``, ``leg_energy_generated_<leg>_J``, ``leg_hysteresis_<leg>_J``,
   ``leg_recoil_<leg>_pct``: the GRF–vertical COM displacement loop of the leg's stance
   (Table 3.3), and ``leg_energy_generated_total_J`` (both legs);
+- ``cost_of_transport_scone_J_per_kg_m``: the cost of transport as SCONE (seed 001's tool)
+  counts it, :func:`cost_of_transport` with muscle masses from their strongest force over
+  :data:`SCONE_SPECIFIC_TENSION_PA` and a basal rate of :data:`SCONE_BASAL_W_PER_KG`;
 - amputee only: ``blade_energy_stored_J``, ``blade_energy_returned_J``,
   ``blade_hysteresis_J``, ``blade_recoil_pct`` (Table D.1, the compression being the contact's
   penetration).
@@ -32,14 +35,24 @@ from __future__ import annotations
 
 import math
 
+import casadi as ca
 import numpy as np
 
 from bladelab.errors import SpecError
+from bladelab.predict.collocation.metabolics import muscle_metabolic_rates
+from bladelab.predict.collocation.model import build_collocation_model
 from bladelab.predict.collocation.stored import runner_from_spec
 from bladelab.runner import analyses as an
+from bladelab.runner.metabolics import BASAL_RATE_W_PER_KG
 from bladelab.runner.params import PROSTHETIC_KINDS
 
-__all__ = ["JOINT_LABELS", "N_STRIDES", "REFINE", "stride_analyses"]
+__all__ = ["JOINT_LABELS", "N_STRIDES", "REFINE", "SCONE_BASAL_W_PER_KG",
+           "SCONE_SPECIFIC_TENSION_PA", "cost_of_transport", "stride_analyses"]
+
+#: SCONE's specific tension [Pa] for muscle mass (its default, 0.25 MPa; seed 001 §2.1.3).
+SCONE_SPECIFIC_TENSION_PA = 0.25e6
+#: SCONE's basal metabolic rate [W/kg] in its Uchida measure (seed 001 eq. 2.5).
+SCONE_BASAL_W_PER_KG = 1.2
 
 #: Strides of the record that the analyses see; the middle one is reported.
 N_STRIDES = 3
@@ -52,6 +65,37 @@ REFINE = 16
 #: Joint coordinate (without its side) -> the joint's name in the keys.
 JOINT_LABELS = {"hip_flexion": "hip", "knee_angle": "knee", "ankle_angle": "ankle",
                 "socket_angle": "socket", "blade": "rsp"}
+
+
+def cost_of_transport(solution, runner=None, *, specific_tension_pa: float | None = None,
+                      basal_w_per_kg: float = BASAL_RATE_W_PER_KG, cm=None) -> float:
+    """Gross cost of transport [J/(kg·m)] of a collocation stride, its metabolic rate (the
+    collocation twin's, :func:`~bladelab.predict.collocation.metabolics.
+    muscle_metabolic_rates`) integrated over the nodes by the trapezoidal rule, per body mass
+    and stride length, with muscle masses from their strongest force over
+    ``specific_tension_pa`` [Pa] (None: the model's) and a basal rate of
+    ``basal_w_per_kg`` [W/kg]. With the defaults it is the solution's own cost; seed 001's
+    SCONE counts muscle mass at :data:`SCONE_SPECIFIC_TENSION_PA` and basal
+    :data:`SCONE_BASAL_W_PER_KG`."""
+    runner = runner if runner is not None else runner_from_spec(solution.model_spec)
+    cm = cm if cm is not None else build_collocation_model(runner)
+    nv, nm = cm.nv, cm.n_muscles
+    q, qd = ca.SX.sym("q", nv), ca.SX.sym("qd", nv)
+    a, ft, dft, u = (ca.SX.sym(n, nm) for n in ("a", "ft", "dft", "u"))
+    l_mt, v_mt = cm.mtu(q, qd)
+    rate = ca.sum1(muscle_metabolic_rates(runner, u, a, ft, dft, l_mt, v_mt, cm.smoothing,
+                                          specific_tension_pa=specific_tension_pa))
+    f = ca.Function("muscle_rate", [q, qd, a, ft, dft, u], [rate]).map(
+        solution.nlp.q.shape[0])
+    s = solution.nlp
+    muscles = np.asarray(f(s.q.T, s.qd.T, s.activation.T, s.tendon_force.T,
+                           s.tendon_force_rate.T, s.excitation.T), float).ravel()
+    mass = float(runner.total_mass)
+    total = muscles + basal_w_per_kg * mass
+    h = solution.period_s / (total.size - 1)
+    energy = 0.5 * h * float(np.sum(total[:-1] + total[1:]))
+    j = list(solution.dof_names).index("pelvis_tx")
+    return energy / (mass * float(s.q[-1, j] - s.q[0, j]))
 
 
 def _middle(df, column: str, period: float, leg: str):
@@ -124,6 +168,9 @@ def stride_analyses(solution, runner=None, *, refine: int = REFINE, cm=None) -> 
         out[f"negative_power_{leg}_W_per_kg"] = totals[leg][1]
     out["positive_power_total_W_per_kg"] = sum(v[0] for v in totals.values())
     out["negative_power_total_W_per_kg"] = sum(v[1] for v in totals.values())
+    out["cost_of_transport_scone_J_per_kg_m"] = cost_of_transport(
+        solution, runner, specific_tension_pa=SCONE_SPECIFIC_TENSION_PA,
+        basal_w_per_kg=SCONE_BASAL_W_PER_KG, cm=cm)
 
     e = an.leg_energy(res)
     generated = 0.0

@@ -84,7 +84,8 @@ def whole_body_rate(runner, rates):
 
 
 def muscle_metabolic_rates(runner, u, a, ft, dft, l_mt, v_mt, smoothing: Smoothing,
-                           widths: MetabolicSmoothing | None = None):
+                           widths: MetabolicSmoothing | None = None, *,
+                           specific_tension_pa: float | None = None):
     """Metabolic rate of every muscle [W] (n_muscles,) as a CasADi expression.
 
     Parameters
@@ -99,12 +100,16 @@ def muscle_metabolic_rates(runner, u, a, ft, dft, l_mt, v_mt, smoothing: Smoothi
         The model's smoothing (fibre kinematics, passive curve).
     widths
         Widths of the metabolic switches (default :class:`MetabolicSmoothing`).
+    specific_tension_pa
+        The specific tension [Pa] that turns the strongest force into muscle mass
+        (:func:`bladelab.runner.metabolics.metabolic_params`); None: the model's.
     """
     if runner.params.metabolic_model == "bhargava2004":
-        return bhargava_muscle_rates(runner, u, a, ft, dft, l_mt, v_mt, smoothing, widths)
+        return bhargava_muscle_rates(runner, u, a, ft, dft, l_mt, v_mt, smoothing, widths,
+                                     specific_tension_pa=specific_tension_pa)
     w = widths or MetabolicSmoothing()
     mp = runner.muscle_params
-    mb = metabolic_params(runner)
+    mb = metabolic_params(runner, specific_tension_pa=specific_tension_pa)
     mass, ftp = ca.DM(mb[:, MB_MASS]), ca.DM(mb[:, MB_FT])
     l_opt = ca.DM(mp[:, MP_LOPT])
     l_m, v_m, cos_a = muscles.fiber_kinematics(mp, l_mt, v_mt, ft, dft, smoothing)
@@ -146,7 +151,8 @@ def _unit_ramp(x, width: float):
 
 
 def bhargava_muscle_rates(runner, u, a, ft, dft, l_mt, v_mt, smoothing: Smoothing,
-                          widths: MetabolicSmoothing | None = None):
+                          widths: MetabolicSmoothing | None = None, *,
+                          specific_tension_pa: float | None = None):
     """Metabolic rate of every muscle [W] after Bhargava et al. (2004), as PredSim computes it
     (:mod:`bladelab.runner.metabolics`, ``bhargava_muscle_rate``, has the equations; arguments
     as :func:`muscle_metabolic_rates`). The switches are smooth: shortening against lengthening
@@ -154,7 +160,7 @@ def bhargava_muscle_rates(runner, u, a, ft, dft, l_mt, v_mt, smoothing: Smoothin
     smooth ramps of width ``w_l``."""
     w = widths or MetabolicSmoothing()
     mp = runner.muscle_params
-    mb = metabolic_params(runner)
+    mb = metabolic_params(runner, specific_tension_pa=specific_tension_pa)
     mass, slow = ca.DM(mb[:, MB_MASS]), ca.DM(1.0 - mb[:, MB_FT] / 100.0)
     l_opt, fmax = ca.DM(mp[:, MP_LOPT]), ca.DM(mp[:, MP_FMAX])
     strength = ca.DM(mp[:, MP_ACTIVE])
