@@ -19,7 +19,7 @@ from bladelab.predict.collocation.consistency import (
     inverse_dynamics,
 )
 from bladelab.predict.collocation.guess import template_guess
-from bladelab.predict.collocation.settings import CollocationSettings
+from bladelab.predict.collocation.settings import CollocationSettings, people_term
 from bladelab.predict.collocation.solution import (
     BEST_ITERATE_KIND,
     CONTACT_THRESHOLD_N,
@@ -549,6 +549,17 @@ def test_the_predictive_report_renders_a_collocation_solution(able, tmp_path):
     # the report opens with the stride against people, criterion by criterion
     assert html.index("Against measured human running") < html.index("Collocation solution")
     assert "contact time, left leg" in html and "knee flexion RMSE against the measured" in html
+    assert "Not a free prediction" not in html  # the fake solve held no reference term
+    # a stride solved with people's angles in its objective says so in its first lines
+    people = replace(sol, settings=CollocationSettings(**people_term(10.0)),
+                     nlp=replace(sol.nlp, objective_terms={**sol.nlp.objective_terms,
+                                                           "tracking": 0.25}))
+    build_predictive_report(people.write(tmp_path / "people.json"), tmp_path / "report3",
+                            progress=False, animate=False)
+    html = (tmp_path / "report3" / "index.html").read_text()
+    first = html[html.index("This stride is"):html.index("The stride against people")]
+    assert "Not a free prediction" in first and "weight 10 1/rad²" in first
+    assert "RBDS002" in first and "0.25 of the objective" in first
     # the 'bladelab predict --method collocation' folder itself, as the CLI's help offers
     rep = build_predictive_report(path.parent, tmp_path / "report2", progress=False,
                                   animate=False)

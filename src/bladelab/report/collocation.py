@@ -42,7 +42,8 @@ from bladelab.predict.collocation.solution import (
 from bladelab.predict.collocation.solve import SOLUTION_FILE
 from bladelab.predict.collocation.stored import runner_from_spec
 
-__all__ = ["N_STRIDES", "REFINE", "collocation_sections", "collocation_solution_file"]
+__all__ = ["N_STRIDES", "REFINE", "collocation_sections", "collocation_solution_file",
+           "reference_term_text"]
 
 #: Strides in the trajectory handed to the gait-cycle analyses.
 N_STRIDES = 3
@@ -152,20 +153,26 @@ def _measured_trial(runner, sol):
         return None
 
 
-def _reference_term_text(sol) -> str:
-    """What the objective held besides the predictive terms: people's measured joint angles
-    (a tracking term of measured running) or another solution's; empty without one."""
-    settings = sol.settings
-    if not settings.reference_weight:
-        return ""
+def _objective_share_text(sol) -> str:
+    """:func:`reference_term_text` of a solution, with the term's share of its objective."""
     value = sol.nlp.objective_terms.get("tracking")
     share = (f", {value:.3g} of the objective's {sol.nlp.objective:.4g}"
              if value is not None else "")
+    return reference_term_text(sol.settings, share)
+
+
+def reference_term_text(settings, share: str = "") -> str:
+    """The sentence saying what an objective held besides the predictive terms (a
+    :class:`~bladelab.predict.collocation.settings.CollocationSettings`): people's measured
+    joint angles (a tracking term of measured running) or another solution's, with ``share``
+    (e.g. ", 0.35 of the objective's 5.1") after the weight; empty without a reference."""
+    if not settings.reference_weight:
+        return ""
     if settings.reference == PEOPLE_REFERENCE:
         return (f" Not a free prediction: the objective held people's measured hip, knee and "
                 f"ankle angles at 3.5 m/s (Fukuchi et al. 2017, subjects RBDS002 and RBDS003, "
-                f"not the trial compared below), weight {settings.reference_weight:g} 1/rad²"
-                f"{share}.")
+                f"not the trial that strides are compared with), weight "
+                f"{settings.reference_weight:g} 1/rad²{share}.")
     return (f" Not a free prediction: the objective held the joint angles and stride time of "
             f"{Path(settings.reference).name}, weight {settings.reference_weight:g} 1/rad²"
             f"{share}.")
@@ -189,7 +196,7 @@ def _add_human_running_section(report, sol, trial) -> None:
                            "note": c.note} for c in crit])
     report.add_section(
         "Against measured human running",
-        text=(verdict + _reference_term_text(sol) + " Bands: people at this speed (bladelab.predict.collocation."
+        text=(verdict + _objective_share_text(sol) + " Bands: people at this speed (bladelab.predict.collocation."
               "human_running: the Fukuchi et al. 2017 trial at 3.5 m/s, Weyand et al. 2000 and "
               "Nummela et al. 2007 at 9 m/s, interpolated in speed between them)"
               + ("; joint angles against the measured 3.5 m/s stride." if trial is not None

@@ -38,6 +38,7 @@ from bladelab.predict.collocation.model import build_collocation_model
 from bladelab.predict.collocation.solution import CollocationSolution
 from bladelab.predict.collocation.stored import runner_from_spec
 from bladelab.predict.collocation.sweep import SWEEP_TABLE
+from bladelab.report.collocation import reference_term_text
 
 __all__ = ["collocation_sweep_sections", "is_collocation_sweep", "starts_table",
            "sweep_summary"]
@@ -218,6 +219,9 @@ def collocation_sweep_sections(report, folder: str | Path) -> tuple[dict, pd.Dat
                  "the previous converged speed; the maximum speed (star) from the fastest.")
     text += (" Curves and the category table use converged solves without gait warnings "
              "only.")
+    terms = {reference_term_text(sol.settings) for sol in solutions.values()}
+    text += " ".join(sorted(terms)).replace("Not a free prediction: the objective held",
+                                             "Not free predictions: every objective held")
     flagged = table[table.flagged]
     if len(flagged):
         text += (" Converged but flagged by the gait checks (drawn as crosses, left out of the "
