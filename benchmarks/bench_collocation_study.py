@@ -18,9 +18,13 @@ from pathlib import Path
 
 HERE = Path(__file__).resolve().parent / "collocation"
 #: (folder, what differs) of each timed study.
-STUDIES = (("study-human-2026-11-29", "the human body, one start per problem, from the shipped "
-            "strides (`--guess stored`, the default), each later speed from the previous "
-            "solution's primal and dual values"),
+STUDIES = (("study-human-people10-2026-11-29", "the human body with people's joint angles in "
+            "the objective at weight 10 1/rad² (the default), one start per problem, from the "
+            "shipped strides, each later speed from the previous solution's primal and dual "
+            "values"),
+           ("study-human-2026-11-29", "the human body, one start per problem, from the shipped "
+            "free strides of the time (`--guess stored`), each later speed from the previous "
+            "solution's primal and dual values, no people's angles (`--people-weight 0`)"),
            ("study-timed-2026-11-26", "seed 001's body, one start per problem, from the "
             "measured trial's guess"),
            ("study-starts3-timed-2026-11-26", "seed 001's body, three starts per problem "
