@@ -35,15 +35,17 @@ def _row(label: str, sol) -> str:
 def run() -> str:
     import dataclasses
 
+    from bladelab.predict import defaults
     from bladelab.predict.collocation.guess import template_guess
-    from bladelab.predict.collocation.settings import CollocationSettings
+    from bladelab.predict.collocation.settings import CollocationSettings, people_term
     from bladelab.predict.collocation.solve import predict_stride
     from bladelab.predict.collocation.starting_guess import make_guess
     from bladelab.runner import build_runner
 
     spec = {"model": "amputee", "blade": "Cat6", "body": "human"}
     runner = build_runner("amputee", blade="Cat6", body="human")
-    settings = CollocationSettings(mesh_intervals=MESH, speed_m_per_s=SPEED_MPS)
+    people = people_term(defaults.people_weight_for("human"))  # as the command line solves
+    settings = CollocationSettings(mesh_intervals=MESH, speed_m_per_s=SPEED_MPS, **people)
     stored = predict_stride(runner, settings,
                             make_guess(runner, "stored", n=MESH, speed=SPEED_MPS),
                             model_spec=spec)
@@ -60,7 +62,8 @@ def run() -> str:
         rows.append(_row(f"the same from the primal values alone: objective "
                          f"{primal.nlp.objective:.4f}", primal))
     able = build_runner("able", body="human")
-    cold = predict_stride(able, CollocationSettings(mesh_intervals=MESH, speed_m_per_s=3.5),
+    cold = predict_stride(able, CollocationSettings(mesh_intervals=MESH, speed_m_per_s=3.5,
+                                                    **people),
                           template_guess(able, speed=3.5, n=MESH),
                           model_spec={"model": "able", "body": "human"})
     rows.append(_row("able, the template guess → 3.5 m/s (tracking, then predictive): "
@@ -68,8 +71,8 @@ def run() -> str:
     return "\n".join([
         "## Collocation: one stride",
         "",
-        f"The human body, mesh {MESH} intervals, one core (`OMP_NUM_THREADS=1`), L-BFGS, tol "
-        "1e-4. Targets: the amputee from the default guess ≤ 60 s, warm-started at 4.2 m/s "
+        f"The human body with people's joint angles in the objective (the default weight), "
+        f"mesh {MESH} intervals, one core (`OMP_NUM_THREADS=1`), L-BFGS, tol 1e-4. Targets: the amputee from the default guess ≤ 60 s, warm-started at 4.2 m/s "
         "≤ 10 s, the able runner from the template ≤ 60 s. A warm start from a solution "
         "restores its controls and multipliers (IPOPT's primal-dual warm start, its own "
         "solver options, so its solver is built once); the primal-only row drops the "
