@@ -230,3 +230,25 @@ def test_an_older_table_is_judged_by_today_s_gait_checks(tmp_path):
     assert "flagged by the gait checks" in text and "amputee Cat4 speed 5.0" in text
     assert "amputee Cat4 speed 4.0" not in text
     assert math.isfinite(summary.iloc[0].cot_4)
+
+
+def test_a_sweep_with_people_s_angles_in_its_objective_says_so(tmp_path, monkeypatch):
+    """A study solved with people's joint angles in the objective is no free prediction, and
+    its report says so beside the solves; a free study says nothing of it."""
+    import bladelab.report.predictive_sections as sections
+
+    monkeypatch.setattr(sections, "_gait_sections", lambda report, results, cycles: None)
+    people = STUDY.parent / "study-human-people10-2026-11-29"
+    out = tmp_path / "people"
+    out.mkdir()
+    table = pd.read_csv(people / "collocation-sweep.csv")
+    table = table[table.blade == "Cat6"]
+    shutil.copytree(people / "amputee-Cat6-human", out / "amputee-Cat6-human")
+    table.to_csv(out / "collocation-sweep.csv", index=False)
+    rep = build_predictive_report(out, tmp_path / "report", progress=False, animate=False)
+    html = Path(rep.index).read_text(encoding="utf-8")
+    assert "Not free predictions: every objective held people&#39;s measured hip, knee" in html
+    assert "weight 10 1/rad²" in html
+    free = build_predictive_report(_subset(tmp_path, ["Cat6"]), tmp_path / "free",
+                                   progress=False, animate=False)
+    assert "Not free predictions" not in Path(free.index).read_text(encoding="utf-8")
