@@ -77,8 +77,8 @@ def read_sweep_table(folder: str | Path) -> pd.DataFrame:
                              file=path, hint="rewrite it with 'bladelab sweep --method "
                                              "collocation --resume'")
     table["converged"] = table["converged"].astype(str).str.lower().isin(["true", "1"])
-    table["warnings"] = (table["warnings"].fillna("").astype(str) if "warnings" in table
-                         else "")
+    table["warnings"] = (table["warnings"].astype(object).fillna("").astype(str)
+                         if "warnings" in table else "")
     return _flag(table)
 
 
