@@ -112,8 +112,8 @@ GUESS = "stored"
 #: of the human body (``CollocationSettings(reference="people")``, docs/collocation.md,
 #: "People's joint angles in the objective"): a tracking term of measured running, reported
 #: as such. Measured on the able runner at 3.5 m/s (weights 0, 10, 20): swing knees 75/73°,
-#: 89/91°, 92/92° (people ≥ 85°); cost of transport 4.12, 4.28, 4.39 J/(kg·m); knee RMSE
-#: against another runner's trial 18.5/15.7°, 12.4/7.7°, 11.1/7.1°. 10 is the smaller weight
+#: 89/92°, 92/92° (people ≥ 85°); cost of transport 4.12, 4.28, 4.39 J/(kg·m); knee RMSE
+#: against another runner's trial 18.5/15.7°, 12.5/7.3°, 11.1/7.1°. 10 is the smaller weight
 #: that gives people's swing, at 4 % more energy. Seed 001's body (and ``toes``) keep none.
 PEOPLE_WEIGHT_PER_RAD2 = 10.0
 #: Starts per problem of a collocation sweep (the best solve is kept).
