@@ -119,8 +119,7 @@ def run_collocation(
             max_iter=max_iter, swing_clearance_m=swing_clearance,
             knee_moment_min_nm=knee_moment_min, knee_flexion_max_loaded_deg=knee_flexion_max,
             pelvis_tilt_range_deg=tilt,
-            **people_term(defaults.people_weight_for(body) if people_weight is None
-                          else people_weight))
+            **people_term(defaults.people_weight_for(body, people_weight)))
         result = solve_named_stride(out, model=model, blade=blade, body=body,
                                     settings=settings, guess=guess, resume=resume, force=force,
                                     progress=StageProgress())

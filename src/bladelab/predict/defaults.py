@@ -21,12 +21,12 @@ __all__ = [
     "MAX_ITER",
     "MESH_INTERVALS",
     "METHOD",
+    "PEOPLE_WEIGHT_PER_RAD2",
     "POPULATION_SIZE",
     "RECIPE_SEEDS",
     "REFLEX_BLADE",
     "ROBUST_DIRECTIONS",
     "ROBUST_JITTER",
-    "PEOPLE_WEIGHT_PER_RAD2",
     "ROBUST_SAMPLES",
     "SEED",
     "SPEED_M_PER_S",
@@ -120,8 +120,10 @@ PEOPLE_WEIGHT_PER_RAD2 = 10.0
 STARTS = 1
 
 
-def people_weight_for(body: str) -> float:
-    """The default weight [1/rad²] of people's joint angles for a runner ``body``:
-    :data:`PEOPLE_WEIGHT_PER_RAD2` on the human body, 0 on the others (seed 001's is
-    reproduced as the seed solved it)."""
+def people_weight_for(body: str, weight: float | None = None) -> float:
+    """The weight [1/rad²] of people's joint angles for a runner ``body``: ``weight`` when
+    given, else the default, :data:`PEOPLE_WEIGHT_PER_RAD2` on the human body and 0 on the
+    others (seed 001's is reproduced as the seed solved it)."""
+    if weight is not None:
+        return weight
     return PEOPLE_WEIGHT_PER_RAD2 if body == "human" else 0.0

@@ -161,21 +161,21 @@ def _objective_share_text(sol) -> str:
     return reference_term_text(sol.settings, share)
 
 
-def reference_term_text(settings, share: str = "") -> str:
+def reference_term_text(settings, share: str = "", *,
+                        lead: str = "Not a free prediction: the objective held") -> str:
     """The sentence saying what an objective held besides the predictive terms (a
     :class:`~bladelab.predict.collocation.settings.CollocationSettings`): people's measured
-    joint angles (a tracking term of measured running) or another solution's, with ``share``
-    (e.g. ", 0.35 of the objective's 5.1") after the weight; empty without a reference."""
+    joint angles (a tracking term of measured running) or another solution's, opening with
+    ``lead`` and with ``share`` (e.g. ", 0.35 of the objective's 5.1") after the weight;
+    empty without a reference."""
     if not settings.reference_weight:
         return ""
     if settings.reference == PEOPLE_REFERENCE:
-        return (f" Not a free prediction: the objective held people's measured hip, knee and "
-                f"ankle angles at 3.5 m/s (Fukuchi et al. 2017, subjects RBDS002 and RBDS003, "
-                f"not the trial that strides are compared with), weight "
-                f"{settings.reference_weight:g} 1/rad²{share}.")
-    return (f" Not a free prediction: the objective held the joint angles and stride time of "
-            f"{Path(settings.reference).name}, weight {settings.reference_weight:g} 1/rad²"
-            f"{share}.")
+        return (f" {lead} people's measured hip, knee and ankle angles at 3.5 m/s (Fukuchi et "
+                f"al. 2017, subjects RBDS002 and RBDS003, not the trial that strides are "
+                f"compared with), weight {settings.reference_weight:g} 1/rad²{share}.")
+    return (f" {lead} the joint angles and stride time of {Path(settings.reference).name}, "
+            f"weight {settings.reference_weight:g} 1/rad²{share}.")
 
 
 def _add_human_running_section(report, sol, trial) -> None:
@@ -196,8 +196,9 @@ def _add_human_running_section(report, sol, trial) -> None:
                            "note": c.note} for c in crit])
     report.add_section(
         "Against measured human running",
-        text=(verdict + _objective_share_text(sol) + " Bands: people at this speed (bladelab.predict.collocation."
-              "human_running: the Fukuchi et al. 2017 trial at 3.5 m/s, Weyand et al. 2000 and "
+        text=(verdict + _objective_share_text(sol)
+              + " Bands: people at this speed (bladelab.predict.collocation.human_running: "
+              "the Fukuchi et al. 2017 trial at 3.5 m/s, Weyand et al. 2000 and "
               "Nummela et al. 2007 at 9 m/s, interpolated in speed between them)"
               + ("; joint angles against the measured 3.5 m/s stride." if trial is not None
                  else ".")),

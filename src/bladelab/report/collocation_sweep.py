@@ -219,9 +219,9 @@ def collocation_sweep_sections(report, folder: str | Path) -> tuple[dict, pd.Dat
                  "the previous converged speed; the maximum speed (star) from the fastest.")
     text += (" Curves and the category table use converged solves without gait warnings "
              "only.")
-    terms = {reference_term_text(sol.settings) for sol in solutions.values()}
-    text += " ".join(sorted(terms)).replace("Not a free prediction: the objective held",
-                                             "Not free predictions: every objective held")
+    text += "".join(sorted({reference_term_text(
+        sol.settings, lead="Not free predictions: every objective held")
+        for sol in solutions.values()}))
     flagged = table[table.flagged]
     if len(flagged):
         text += (" Converged but flagged by the gait checks (drawn as crosses, left out of the "

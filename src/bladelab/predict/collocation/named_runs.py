@@ -115,8 +115,8 @@ def sweep_named_models(
     ``max_iter`` (IPOPT's iterations per stage) set its :class:`CollocationSettings`;
     ``people_weight`` [1/rad²]: the weight of people's joint angles in the objective
     (:mod:`~bladelab.predict.collocation.people`; 0: none; None: the body's default,
-    :func:`bladelab.predict.defaults.people_weight_for`); ``starts``: starts per problem, the best kept
-    (:mod:`~bladelab.predict.collocation.starts`); ``jobs`` models at a time on ``executor``.
+    :func:`bladelab.predict.defaults.people_weight_for`); ``starts``: starts per problem,
+    the best kept (:mod:`~bladelab.predict.collocation.starts`); ``jobs`` models at a time on ``executor``.
 
     Raises
     ------
@@ -127,9 +127,8 @@ def sweep_named_models(
     if len(speeds) == 0:
         raise SpecError("no speed given", where="speeds")
     settings = CollocationSettings(mesh_intervals=mesh_intervals, speed_m_per_s=speeds[0],
-                                   max_iter=max_iter, **people_term(
-                                       defaults.people_weight_for(body) if people_weight is None
-                                       else people_weight))
+                                   max_iter=max_iter,
+                                   **people_term(defaults.people_weight_for(body, people_weight)))
     if isinstance(jobs, bool) or not isinstance(jobs, int) or jobs < 1:
         raise SpecError(f"need at least 1 job, got {jobs}", where="jobs")
     check_starts(starts)

@@ -116,10 +116,11 @@ class CollocationSettings:
         ``"people"`` (:data:`PEOPLE_REFERENCE`): people's measured hip, knee and ankle angles
         at 3.5 m/s (:mod:`bladelab.predict.collocation.people`), ``reference_weight``
         [1/rad²] × their time-averaged mean squared deviation, no stride-time term; the
-        human body's gait term (docs/predictive.md). Or a collocation solution file of the
-        same runner whose joint angles the predictive stage stays near: ``reference_weight`` [1/rad²] × the time-averaged mean squared
-        deviation of the coordinates ``reference_dofs`` (None: pelvis tilt and every joint)
-        from the reference's, on the normalised stride, plus the same weight × ln(T/T_ref)²
+        human body's gait term (docs/collocation.md). Or a collocation solution file of the
+        same runner whose joint angles the predictive stage stays near: ``reference_weight``
+        [1/rad²] × the time-averaged mean squared deviation of the coordinates
+        ``reference_dofs`` (None: pelvis tilt and every joint) from the reference's, on the
+        normalised stride, plus the same weight × ln(T/T_ref)²
         of the stride time T against the reference's (the cadence: measured 2026-11-26, with
         the angles alone the design strides split into 0.51 s and 0.59 s strides, both
         within 7° of the reference's angles). Weight 0 (default): none, the gait

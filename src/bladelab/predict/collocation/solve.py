@@ -235,21 +235,32 @@ def _model_functions(runner, swing_clearance_m: float = 0.0,
     return built["cm"], built["dyn"][narrowed]
 
 
-def _reference_tracking(runner, settings: CollocationSettings, start) -> tuple:
+def _reference_phase(runner, settings: CollocationSettings, start) -> float | None:
+    """The phase [fraction of the stride] of people's angles for a solve from ``start`` (the
+    guess on the mesh): the start's own (``StrideGuess.reference_phase``, a stride solved
+    against them), else the phase that fits the start best; None without people's
+    reference."""
+    if not settings.reference_weight or settings.reference != PEOPLE_REFERENCE:
+        return None
+    if start.reference_phase is not None:
+        return float(start.reference_phase) % 1.0
+    return people_reference(runner.dof_names, start.q, settings.reference_dofs,
+                            exclude=PROSTHETIC_JOINTS.get(runner.kind, ()))[2]
+
+
+def _reference_tracking(runner, settings: CollocationSettings, start,
+                        phase: float | None) -> tuple:
     """The predictive stage's reference terms (:attr:`CollocationSettings.reference`):
-    ``((q_ref, weight, dofs) on the mesh, (T_ref, weight) or None, phase)``, or
-    ``(None, None, None)``. People's angles (``reference="people"``) are shifted to the phase
-    of ``start`` (the guess on the mesh) and have no stride-time term; ``phase`` [fraction
-    of the stride] is theirs, None for a solution file: the start's own
-    (``StrideGuess.reference_phase``, a stride solved against people's angles) or the phase
-    that fits the start best."""
+    ``((q_ref, weight, dofs) on the mesh, (T_ref, weight) or None)``, or (None, None).
+    People's angles (``reference="people"``) at ``phase`` (:func:`_reference_phase`) have no
+    stride-time term; a solution file's have its stride time's."""
     if not settings.reference_weight:
-        return None, None, None
+        return None, None
     if settings.reference == PEOPLE_REFERENCE:
-        q, dofs, phase = people_reference(runner.dof_names, start.q, settings.reference_dofs,
-                                          exclude=PROSTHETIC_JOINTS.get(runner.kind, ()),
-                                          phase=start.reference_phase)
-        return (q, settings.reference_weight, dofs), None, phase
+        q, dofs, _ = people_reference(runner.dof_names, start.q, settings.reference_dofs,
+                                      exclude=PROSTHETIC_JOINTS.get(runner.kind, ()),
+                                      phase=phase)
+        return (q, settings.reference_weight, dofs), None
     path = Path(settings.reference)
     if not path.is_file():
         raise InputFileError("no such reference solution", file=path,
@@ -258,21 +269,22 @@ def _reference_tracking(runner, settings: CollocationSettings, start) -> tuple:
     ref = CollocationSolution.read(path).to_guess(f"{COLLOCATION_SOURCE} {path.name}")
     q = ref.on_model(runner).resample(settings.mesh_intervals).q
     return (q, settings.reference_weight, settings.reference_dofs), (
-        ref.period, settings.reference_weight), None
+        ref.period, settings.reference_weight)
 
 
-def _predictive_nlp(runner, dyn, settings: CollocationSettings, reference: tuple):
+def _predictive_nlp(runner, dyn, settings: CollocationSettings, start, phase: float | None):
     """The predictive :class:`~bladelab.predict.collocation.transcription.StrideNLP` of the
-    settings' mesh, problem (prescribed speed, or maximum speed), weights and ``reference``
-    terms (:func:`_reference_tracking`), built once per runner and reference (people's, once
-    per phase); the speed itself is a parameter of each solve."""
+    settings' mesh, problem (prescribed speed, or maximum speed), weights and reference term,
+    built once per runner and reference (the reference file is read only then; people's
+    angles once per ``phase``, :func:`_reference_phase` of the guess ``start``); the speed
+    itself is a parameter of each solve."""
     n, speed = settings.mesh_intervals, settings.speed_m_per_s
     nlps = _BUILT[runner]["nlps"]
-    tracking, period_tracking, phase = reference
     key = (n, speed is None, settings.weights, id(dyn), settings.reference_key(), phase)
     if key not in nlps:
         while len(nlps) >= MAX_NLPS_PER_RUNNER:
             nlps.pop(next(iter(nlps)))
+        tracking, period_tracking = _reference_tracking(runner, settings, start, phase)
         nlps[key] = StrideNLP(dyn, n=n, speed=speed, weights=settings.weights,
                               tracking=tracking, period_tracking=period_tracking)
     else:
@@ -330,8 +342,8 @@ def predict_stride(runner, settings: CollocationSettings, guess, *, model_spec: 
     warm = str(guess.source).startswith(COLLOCATION_SOURCE)
     tracking_stage = (settings.track_first and not warm) if track is None else bool(track)
     warm_predictive = warm and not tracking_stage
-    reference = _reference_tracking(runner, settings, g)  # the stored file read once per solve
-    duals = (_predictive_nlp(runner, dyn, settings, reference).initial_multipliers(g)
+    phase = _reference_phase(runner, settings, g)
+    duals = (_predictive_nlp(runner, dyn, settings, g, phase).initial_multipliers(g)
              if warm_predictive else None)
     # a primal-dual start stays at the solution's own point, whose one violated constraint is
     # then the speed: scaled to the speed it starts off its branch (measured: 843 iterations
@@ -364,7 +376,7 @@ def predict_stride(runner, settings: CollocationSettings, guess, *, model_spec: 
                 runner, sol_t, stage="tracking", tracking=tracking,
                 metabolic_energy_J=nlp_t.energy_and_distance(sol_t)[0], **common)
         start = sol_t.to_guess(f"{COLLOCATION_SOURCE} (tracking stage)")
-    nlp_p = _predictive_nlp(runner, dyn, settings, reference)  # built once, then looked up
+    nlp_p = _predictive_nlp(runner, dyn, settings, g, phase)  # built once, then looked up
     # the prescribed speed; of a maximum speed, its floor: that of a collocation stride it
     # starts from (a stride that exists)
     stage_speed = speed if speed is not None else (g.speed if warm else None)
@@ -372,7 +384,7 @@ def predict_stride(runner, settings: CollocationSettings, guess, *, model_spec: 
                        warm=warm_predictive, speed=stage_speed, multipliers=duals)
     return CollocationSolution.from_nlp(
         runner, sol, stage="predictive", tracking=tracking,
-        metabolic_energy_J=nlp_p.energy_and_distance(sol)[0], reference_phase=reference[2],
+        metabolic_energy_J=nlp_p.energy_and_distance(sol)[0], reference_phase=phase,
         **common)
 
 
