@@ -91,6 +91,10 @@ def test_a_failed_force_run_removes_the_old_solution(solved, tmp_path, capsys):
     (("--method", "collocation", "--tilt-range", "-16"), "--tilt-range"),
     (("--method", "collocation", "--tilt-range=-2,-16"), "--tilt-range"),  # lo >= hi
     (("--method", "reflex", "--tilt-range=-16,-2"), "--tilt-range"),  # its lean weight
+    (("--method", "collocation", "--body-mass", "-70"), "--body-mass"),
+    (("--method", "collocation", "--height", "0"), "--height"),
+    (("--method", "collocation", "--muscle-strength", "0"), "--muscle-strength"),
+    (("--method", "reflex", "--muscle-strength", "1.5"), "--muscle-strength"),
 ])
 def test_bad_options_are_refused_naming_the_option(args, where, tmp_path, capsys):
     assert main(["predict", "--out", str(tmp_path / "run"), *args]) == 2

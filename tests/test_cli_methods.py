@@ -225,6 +225,12 @@ def test_predict_collocation_passes_the_same_settings(tmp_path, monkeypatch):
         with pytest.raises(_Called):
             main(["predict", "--out", str(tmp_path), *args])
         assert seen["settings"] == CollocationSettings(**term), args
+    seen.clear()
+    with pytest.raises(_Called):  # the athlete is part of the model
+        main(["predict", "--out", str(tmp_path), "--model", "amputee", "--body-mass", "68",
+              "--height", "1.75", "--muscle-strength", "1.3"])
+    assert seen["model_spec"]["athlete"] == {"body_mass_kg": 68.0, "height_m": 1.75,
+                                             "muscle_strength": 1.3}
 
 
 def test_sweep_collocation_passes_the_same_settings(tmp_path, monkeypatch):
@@ -257,6 +263,12 @@ def test_sweep_collocation_passes_the_same_settings(tmp_path, monkeypatch):
         main(["sweep", "--method", "collocation", "--able", "--categories", "",
               "--people-weight", "0", "--out", str(tmp_path)])
     assert seen["settings"].reference_weight == 0.0 and seen["settings"].reference is None
+    assert "athlete" not in seen["models"][0]
+    seen.clear()
+    with pytest.raises(_Called):
+        main(["sweep", "--method", "collocation", "--able", "--categories", "Cat6",
+              "--muscle-strength", "1.5", "--out", str(tmp_path)])
+    assert [m["athlete"] for m in seen["models"]] == [{"muscle_strength": 1.5}] * 2
 
 
 def test_sweep_reflex_grid_passes_the_same_values(tmp_path, monkeypatch, capsys):

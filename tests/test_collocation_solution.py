@@ -586,3 +586,28 @@ def test_model_spec_names_the_body_only_when_it_is_not_seed_001s():
     assert model_label(human) == "able (human body)"
     with pytest.raises(SpecError, match="unknown body"):
         check_model_spec({"model": "able", "body": "robot"})
+
+
+def test_model_spec_carries_the_athlete_into_the_runner_the_label_and_the_file(able, tmp_path):
+    """An athlete other than the parameter set's is part of the problem: checked field by
+    field, named in the label, the runner built to it, and kept by the solution file."""
+    from bladelab.predict.collocation.stored import check_model_spec, model_label, runner_from_spec
+
+    plain = {"model": "amputee", "blade": "Cat6", "body": "human"}
+    spec = check_model_spec({**plain, "athlete": {"body_mass_kg": 68, "height_m": 1.75,
+                                                  "muscle_strength": None}})
+    assert spec["athlete"] == {"body_mass_kg": 68.0, "height_m": 1.75}
+    assert spec != check_model_spec(plain) == check_model_spec({**plain, "athlete": {}})
+    assert model_label(spec) == "amputee Cat6 (human body; 68 kg, 1.75 m)"
+    assert runner_from_spec(spec).total_mass == pytest.approx(68.0, rel=1e-12)
+    for bad, where in (({"body_mass_kg": -70}, "athlete.body_mass_kg"),
+                       ({"muscle_strength": float("nan")}, "athlete.muscle_strength"),
+                       ({"height_m": True}, "athlete.height_m"),
+                       ({"weight": 70}, "athlete"), (70, "athlete")):
+        with pytest.raises(SpecError) as err:
+            check_model_spec({**plain, "athlete": bad})
+        assert err.value.where == where
+    _, _, sol = able
+    strong = check_model_spec({"model": "able", "athlete": {"muscle_strength": 1.5}})
+    path = replace(sol, model_spec=strong).write(tmp_path / "solution.json")
+    assert CollocationSolution.read(path).model_spec == strong

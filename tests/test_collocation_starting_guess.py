@@ -38,11 +38,32 @@ def test_stored_is_the_shipped_stride_of_the_human_body(kind, blade):
     np.testing.assert_array_equal(guess.q, stored.nlp.q)
 
 
+def test_another_athlete_of_the_human_body_starts_from_its_stored_stride():
+    """Mass, height and muscle strength scale the same body: its shipped stride is the start."""
+    from bladelab.runner.params import athlete_params
+
+    params = athlete_params(default_runner_params("amputee", blade="Cat5", body="human"),
+                            body_mass_kg=64.0, height_m=1.70, muscle_strength=1.3)
+    runner = build_runner(params)
+    path = stored_stride_path(runner)
+    assert path == RUNNER_DATA_DIR / "collocation" / STORED_STRIDES["amputee"]
+    own = make_guess(build_runner("amputee", body="human"), "stored", n=N, speed=4.0)
+    scaled = make_guess(runner, "stored", n=N, speed=4.0)
+    assert own.multipliers is not None and scaled.multipliers is None  # another problem's
+    names = list(own.dof_names)
+    for name in ("pelvis_tx", "pelvis_tz"):  # the pelvis at the athlete's height
+        j = names.index(name)
+        np.testing.assert_allclose(scaled.q[:, j], own.q[:, j] * 1.70 / 1.80, rtol=1e-12)
+    j = names.index("knee_angle_l")  # angles as they were
+    np.testing.assert_array_equal(scaled.q[:, j], own.q[:, j])
+    assert "scaled to the athlete" in scaled.source
+
+
 def test_stored_falls_back_to_the_trial_elsewhere_and_says_so():
     """Seed 001's body, the transfemoral runner and a changed parameter set have no stored
     stride: the measured trial, its source naming the fallback."""
     changed = yaml.safe_load(default_runner_params("able", body="human").model_dump_json())
-    changed["athlete"]["body_mass_kg"] = 80.0
+    changed["muscle_types"]["vasti"]["tendon_slack_length_m"] = 0.146
     for runner in (build_runner("able"), build_runner("transfemoral", body="human"),
                    build_runner(runner_params_from_dict(changed))):
         assert stored_stride_path(runner) is None

@@ -235,6 +235,8 @@ def test_several_starts_keep_the_best_per_problem_and_every_file(fake_solve, mon
     (("--starts", "2"), "--starts"),
     (("--body", "toes"), "--body"),
     (("--method", "collocation", "--able", "--body", "robot"), "--body"),
+    (("--method", "collocation", "--able", "--body-mass", "-1"), "--body-mass"),
+    (("--height", "1.7"), "--height"),  # reflex grid
     (("--method", "shooting"), "--method"),
 ])
 def test_bad_sweep_options_are_refused_naming_the_option(args, where, tmp_path, capsys):

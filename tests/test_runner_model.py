@@ -400,3 +400,29 @@ def test_capsule_moments_name_known_coordinates_and_default_to_none():
     data["capsule_moments"] = {"elbow": {"moment_at_zero_Nm": 1.0, "rate_per_deg": 0.0}}
     with pytest.raises(SpecError, match="elbow"):
         runner_params_from_dict(data)
+
+
+def test_athlete_params_scale_the_body_and_strengthen_only_the_active_force():
+    """Mass and height scale segments and forces as eq. 2.1 does; the muscle strength
+    multiplies the active force (MP_ACTIVE) and leaves Fmax, which sets the tendon and passive
+    curves, alone; nothing given changes nothing."""
+    from bladelab.runner.muscle import MP_ACTIVE, MP_FMAX
+    from bladelab.runner.params import athlete_params
+
+    base = default_runner_params("able", body="human")
+    assert athlete_params(base) == base
+    ref = build_runner(base)
+    runner = build_runner(athlete_params(base, body_mass_kg=68.0, height_m=1.75,
+                                         muscle_strength=1.5))
+    assert runner.total_mass == pytest.approx(68.0, rel=1e-12)
+    np.testing.assert_allclose(runner.muscle_params[:, MP_FMAX],
+                               ref.muscle_params[:, MP_FMAX] * (68.0 / 75.0) / (1.75 / 1.80),
+                               rtol=1e-12)
+    np.testing.assert_allclose(runner.muscle_params[:, MP_ACTIVE],
+                               ref.muscle_params[:, MP_ACTIVE] * 1.5, rtol=1e-12)
+    for bad in (0.0, -1.0, float("inf")):
+        with pytest.raises(SpecError) as err:
+            athlete_params(base, muscle_strength=bad)
+        assert err.value.where == "muscle_strength"
+    with pytest.raises(SpecError):
+        athlete_params(base, body_mass_kg=-5.0)

@@ -36,6 +36,8 @@ OPTIONS = {
     "swing_clearance_m": "--swing-clearance", "knee_moment_min_nm": "--knee-moment-min",
     "knee_flexion_max_loaded_deg": "--knee-flexion-max",
     "pelvis_tilt_range_deg": "--tilt-range", "reference_weight": "--people-weight",
+    "athlete.body_mass_kg": "--body-mass", "athlete.height_m": "--height",
+    "athlete.muscle_strength": "--muscle-strength",
 }
 
 
@@ -109,9 +111,11 @@ def run_collocation(
     knee_flexion_max: float | None,
     tilt_range: str | None,
     people_weight: float | None = None,
+    athlete: dict | None = None,
 ) -> int:
     """Run ``bladelab predict --method collocation``; returns the exit status (0 converged,
-    2 not converged)."""
+    2 not converged). ``athlete``: the runner scaled to this athlete (``body_mass_kg``,
+    ``height_m``, ``muscle_strength``; None: the body's own)."""
     tilt = _tilt_range(tilt_range)
     try:
         settings = CollocationSettings(
@@ -121,8 +125,8 @@ def run_collocation(
             pelvis_tilt_range_deg=tilt,
             **people_term(defaults.people_weight_for(body, people_weight)))
         result = solve_named_stride(out, model=model, blade=blade, body=body,
-                                    settings=settings, guess=guess, resume=resume, force=force,
-                                    progress=StageProgress())
+                                    settings=settings, guess=guess, athlete=athlete,
+                                    resume=resume, force=force, progress=StageProgress())
     except BladelabError as err:
         raise renamed(err, OPTIONS) from None
     sol = result.solution

@@ -78,6 +78,35 @@ def _people_weight_option():
              "body, 0 on the others; 0: the gait is predicted freely.")
 
 
+#: The athlete's options, the same on ``predict`` and ``sweep`` (collocation):
+#: (library field, option, help).
+_ATHLETE_OPTIONS = {
+    "body_mass_kg": ("--body-mass", "The athlete's body mass [kg] (an amputee's with the "
+                     "prosthesis); segment masses, inertias and muscle forces scale with it. "
+                     "Default: the parameter set's (human body: able 75 kg, amputee 73.2 kg)."),
+    "height_m": ("--height", "The athlete's height [m] (default 1.80 m); segment lengths, "
+                 "inertias and muscle forces scale with it."),
+    "muscle_strength": ("--muscle-strength", "The muscles' active force relative to the "
+                        "body's (1: people's maximal strength; a sprinter's hip and knee "
+                        "muscles are about 1.3 times larger); tendons stay as they are."),
+}
+
+
+def _athlete_option(field: str):
+    """One of :data:`_ATHLETE_OPTIONS` as a typer option (default: the body's own)."""
+    flag, text = _ATHLETE_OPTIONS[field]
+    return typer.Option(None, flag, rich_help_panel=COLLOCATION, show_default=False,
+                        help=text)
+
+
+def _athlete(body_mass: float | None, height: float | None,
+             muscle_strength: float | None) -> dict | None:
+    """The athlete of the options (None when none is given)."""
+    athlete = {k: v for k, v in (("body_mass_kg", body_mass), ("height_m", height),
+                                 ("muscle_strength", muscle_strength)) if v is not None}
+    return athlete or None
+
+
 def register(app: typer.Typer) -> None:
     @app.command("predict", cls=PanelCommand)
     def predict(
@@ -230,6 +259,9 @@ def register(app: typer.Typer) -> None:
             help="Keep the pelvis tilt within LO,HI [deg] at every node (forward lean "
                  "negative), e.g. --tilt-range=-16,-2 (seed 001's window)."),
         people_weight: float | None = _people_weight_option(),
+        body_mass: float | None = _athlete_option("body_mass_kg"),
+        height: float | None = _athlete_option("height_m"),
+        muscle_strength: float | None = _athlete_option("muscle_strength"),
     ) -> None:
         """Predict a running gait: solve one periodic stride of the human body by direct
         collocation (writes DIR/solution.json; exit status 2 and DIR/best_iterate.json if
@@ -247,7 +279,8 @@ def register(app: typer.Typer) -> None:
                 guess=guess, max_iter=max_iter, resume=resume, force=force, as_json=as_json,
                 body=body, swing_clearance=swing_clearance, knee_moment_min=knee_moment_min,
                 knee_flexion_max=knee_flexion_max, tilt_range=tilt_range,
-                people_weight=people_weight))
+                people_weight=people_weight,
+                athlete=_athlete(body_mass, height, muscle_strength)))
         from bladelab.cli.reflex import run_reflex  # deferred: keeps bladelab --help fast
 
         run_reflex(
@@ -362,6 +395,9 @@ def register(app: typer.Typer) -> None:
                  "pad) | seed001 (seed 001's model) | toes (seed 001's with a toe segment and "
                  "compliant Achilles tendons)."),
         people_weight: float | None = _people_weight_option(),
+        body_mass: float | None = _athlete_option("body_mass_kg"),
+        height: float | None = _athlete_option("height_m"),
+        muscle_strength: float | None = _athlete_option("muscle_strength"),
     ) -> None:
         """Category × speed grid: warm-started optimisations, maximum speed, cost at 4 m/s,
         200 m and 400 m times, contact times (seed 001 §2.2.2 B–C, Table 3.1). Running it again
@@ -393,7 +429,8 @@ def register(app: typer.Typer) -> None:
                 out=out, categories=categories, able=able, speeds=speeds, mesh=mesh,
                 guess=guess, max_iter=max_iter, jobs=jobs, executor=executor, resume=resume,
                 force=force, as_json=as_json, starts=starts, body=body,
-                people_weight=people_weight))
+                people_weight=people_weight,
+                athlete=_athlete(body_mass, height, muscle_strength)))
         from bladelab.cli import reflex  # deferred: keeps bladelab --help fast
 
         if mode == "recipe":

@@ -12,6 +12,7 @@ l_opt in cm). Athlete scaling: segment masses and inertias by ``m/m_ref`` (inert
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
@@ -426,6 +427,40 @@ def default_runner_params(
     return runner_params_from_dict(data, source=f"built-in {kind} parameters ({body} body)")
 
 
+#: Fields of an athlete that :func:`athlete_params` changes, with their units.
+ATHLETE_FIELDS = {"body_mass_kg": "kg", "height_m": "m", "muscle_strength": "-"}
+
+
+def athlete_params(params: RunnerParams, *, body_mass_kg: float | None = None,
+                   height_m: float | None = None,
+                   muscle_strength: float | None = None) -> RunnerParams:
+    """The parameter set scaled to another athlete (None keeps the set's value).
+
+    ``body_mass_kg`` [kg] and ``height_m`` [m] replace :class:`Athlete`'s: segment masses
+    scale with the mass, lengths with the height over 1.80 m, inertias with mass times
+    length squared, maximum isometric forces with mass over length (seed 001 eq. 2.1's rule;
+    :func:`scale_ratios`). For an amputee the mass is the runner's with the prosthesis.
+    ``muscle_strength`` [-] multiplies the fibres' active force (the active specific tension)
+    and leaves the tendons and passive tissue as they are: 1 is the set's strength (on the
+    human body, people's voluntary maxima times about 1.1); a trained sprinter's hip and knee
+    muscles are about 1.3 times larger for their height and mass (Handsfield et al. 2017).
+    """
+    data = params.model_dump()
+    athlete = dict(data["athlete"])
+    for name, value in (("body_mass_kg", body_mass_kg), ("height_m", height_m)):
+        if value is not None:
+            athlete[name] = value
+    data["athlete"] = athlete
+    if muscle_strength is not None:
+        if not (isinstance(muscle_strength, int | float) and math.isfinite(muscle_strength)
+                and muscle_strength > 0):
+            raise SpecError(f"muscle strength must be a number > 0, got {muscle_strength!r}",
+                            where="muscle_strength", hint="1 is the body's own strength")
+        active = params.active_specific_tension_N_per_cm2 or params.specific_tension_N_per_cm2
+        data["active_specific_tension_N_per_cm2"] = active * float(muscle_strength)
+    return runner_params_from_dict(data, source="athlete")
+
+
 def blade_contact_modulus(params: RunnerParams) -> float:
     """E [N/m²] of the blade sphere for this athlete: the category's stiffness at body weight."""
     cat = blade_category(params.blade)
@@ -445,8 +480,10 @@ __all__ = [
     "KINDS",
     "PROSTHETIC_KINDS",
     "RUNNER_DATA_DIR",
+    "ATHLETE_FIELDS",
     "Athlete",
     "active_strength",
+    "athlete_params",
     "BladeCategory",
     "RunnerParams",
     "blade_catalogue",

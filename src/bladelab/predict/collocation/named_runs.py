@@ -49,13 +49,16 @@ def solve_named_stride(
     body: str = defaults.BODY,
     settings: CollocationSettings | None = None,
     guess: str = defaults.GUESS,
+    athlete: dict | None = None,
     resume: bool = False,
     force: bool = False,
     progress: Callable[[SolveProgress], None] | None = None,
 ) -> FolderResult:
     """Solve one stride of the runner ``model`` (``able``, ``amputee``, ``transfemoral``)
     wearing ``blade`` (None: the model's default blade) with the ``body`` (seed 001's, or
-    ``toes``), from the initial guess ``guess`` (module docstring), into the folder ``out``.
+    ``toes``), from the initial guess ``guess`` (module docstring), into the folder ``out``;
+    ``athlete`` (``body_mass_kg`` [kg], ``height_m`` [m], ``muscle_strength`` [-], any of them;
+    :func:`bladelab.runner.params.athlete_params`) scales the runner to another athlete.
 
     ``settings`` (default :class:`CollocationSettings`) say the problem (mesh intervals [-],
     speed [m/s] or None for the maximum speed, constraints); ``resume``, ``force`` and
@@ -65,8 +68,8 @@ def solve_named_stride(
     Raises
     ------
     SpecError
-        An unknown model, blade or body; prosthetic-knee settings for a runner without a
-        prosthetic knee; a guess that is neither a word nor a file.
+        An unknown model, blade or body; a bad athlete field; prosthetic-knee settings for a
+        runner without a prosthetic knee; a guess that is neither a word nor a file.
     """
     if model not in KINDS:
         raise SpecError(f"unknown model {model!r}", where="model", hint=" or ".join(KINDS))
@@ -78,7 +81,7 @@ def solve_named_stride(
                                 hint="a setting of the transfemoral model")
     if blade is None and model != "able":
         blade = default_runner_params(model).blade
-    spec = check_model_spec({"model": model, "blade": blade, "body": body})
+    spec = check_model_spec({"model": model, "blade": blade, "body": body, "athlete": athlete})
     runner = runner_from_spec(spec)
     return predict_stride_in_folder(
         out, runner, settings,
@@ -98,6 +101,7 @@ def sweep_named_models(
     mesh_intervals: int = defaults.MESH_INTERVALS,
     max_iter: int = defaults.MAX_ITER,
     people_weight: float | None = None,
+    athlete: dict | None = None,
     starts: int = defaults.STARTS,
     jobs: int = 1,
     executor: str = "local",
@@ -115,7 +119,8 @@ def sweep_named_models(
     ``max_iter`` (IPOPT's iterations per stage) set its :class:`CollocationSettings`;
     ``people_weight`` [1/rad²]: the weight of people's joint angles in the objective
     (:mod:`~bladelab.predict.collocation.people`; 0: none; None: the body's default,
-    :func:`bladelab.predict.defaults.people_weight_for`); ``starts``: starts per problem,
+    :func:`bladelab.predict.defaults.people_weight_for`); ``athlete``: every model scaled to
+    this athlete (as in :func:`solve_named_stride`); ``starts``: starts per problem,
     the best kept (:mod:`~bladelab.predict.collocation.starts`); ``jobs`` models at a time on ``executor``.
 
     Raises
@@ -132,7 +137,7 @@ def sweep_named_models(
     if isinstance(jobs, bool) or not isinstance(jobs, int) or jobs < 1:
         raise SpecError(f"need at least 1 job, got {jobs}", where="jobs")
     check_starts(starts)
-    models = sweep_models(categories, able=able, body=body)
+    models = sweep_models(categories, able=able, body=body, athlete=athlete)
     guess = resolve_guess(guess)
     return collocation_sweep(
         models, speeds, settings, functools.partial(make_guess, guess=guess), out=out,

@@ -25,6 +25,7 @@ from bladelab.predict.collocation.guess import (
     template_guess,
 )
 from bladelab.predict.collocation.solution import CollocationSolution
+from bladelab.predict.collocation.stride_guess import StrideGuess
 from bladelab.runner.params import PROSTHETIC_KINDS, RUNNER_DATA_DIR, default_runner_params
 
 __all__ = ["GUESS_WORDS", "MAX_SPEED_TEMPLATE_M_PER_S", "STORED_STRIDES", "first_origin",
@@ -45,13 +46,35 @@ _NEITHER_HINT = ("template, trial, stored, or the path of a solution.json, best_
 
 def stored_stride_path(runner) -> Path | None:
     """The shipped stride (:data:`STORED_STRIDES`) of ``runner``'s kind if ``runner`` is the
-    built-in human body of that kind (any blade category), else None."""
+    built-in human body of that kind (any blade category, any athlete:
+    :func:`~bladelab.runner.params.athlete_params`), else None."""
     name = STORED_STRIDES.get(runner.kind)
     path = RUNNER_DATA_DIR / "collocation" / name if name else None
     if path is None or not path.is_file():
         return None
-    body = default_runner_params(runner.kind, body="human").model_dump(exclude={"blade"})
-    return path if runner.params.model_dump(exclude={"blade"}) == body else None
+    athlete_free = {"blade", "athlete", "active_specific_tension_N_per_cm2"}
+    body = default_runner_params(runner.kind, body="human").model_dump(exclude=athlete_free)
+    return path if runner.params.model_dump(exclude=athlete_free) == body else None
+
+
+def _for_athlete(stride: StrideGuess, runner) -> StrideGuess:
+    """The stored stride as the start of another athlete of its body
+    (:func:`~bladelab.runner.params.athlete_params`): the pelvis's translations scaled by the
+    heights' ratio and the multipliers dropped, which belong to the stored athlete's problem
+    (measured: with them, a 68 kg, 1.75 m amputee's solve went to twice the stored stride's
+    objective); the stride itself for the stored athlete."""
+    body = default_runner_params(runner.kind, body="human")
+    if runner.params.model_dump(exclude={"blade"}) == body.model_dump(exclude={"blade"}):
+        return stride
+    ratio = runner.params.athlete.height_m / body.athlete.height_m
+    names = list(stride.dof_names or runner.dof_names)
+    q, qd = stride.q.copy(), stride.qd.copy()
+    qdd = None if stride.qdd is None else stride.qdd.copy()
+    for j in (names.index("pelvis_tx"), names.index("pelvis_tz")):
+        for a in (q, qd) if qdd is None else (q, qd, qdd):
+            a[:, j] *= ratio
+    return dataclasses.replace(stride, q=q, qd=qd, qdd=qdd, multipliers=None,
+                               source=f"{stride.source}, scaled to the athlete")
 
 
 def first_origin(source: str) -> str:
@@ -109,7 +132,8 @@ def make_guess(runner, guess: str, *, n: int, speed: float | None, where: str = 
             trial = measured_trial_guess(runner, n=n)
             return dataclasses.replace(trial, source=f"measured trial {trial.source} (no "
                                                      "stored stride of this runner)")
-        guess = str(stored)
+        return _for_athlete(make_guess(runner, str(stored), n=n, speed=speed, where=where),
+                            runner)
     path = Path(guess)
     if guess_file_kind(path, where=where) == "collocation":
         sol = CollocationSolution.read(path)

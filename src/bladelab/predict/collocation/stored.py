@@ -22,7 +22,13 @@ from bladelab.blade.spec import spec_from_dict
 from bladelab.errors import DataError, SpecError
 from bladelab.predict.collocation.settings import CollocationSettings
 from bladelab.runner.model import build_runner
-from bladelab.runner.params import BODIES, KINDS
+from bladelab.runner.params import (
+    ATHLETE_FIELDS,
+    BODIES,
+    KINDS,
+    athlete_params,
+    default_runner_params,
+)
 
 __all__ = [
     "FieldReader",
@@ -38,8 +44,10 @@ def check_model_spec(spec) -> dict:
     None}``, plus
     ``"body"`` where it is not seed 001's (:data:`bladelab.runner.params.BODIES`) and
     ``"blade_spec"`` where the runner wears a multi-link blade (the blade file's contents, as
-    :func:`bladelab.blade.spec.spec_from_dict` reads them; ``"blade"`` is then its name),
-    checked and normalised (the able model has no blade; the amputee needs one; files written
+    :func:`bladelab.blade.spec.spec_from_dict` reads them; ``"blade"`` is then its name), plus
+    ``"athlete"`` where the runner is scaled to another athlete than the parameter set's
+    (``{"body_mass_kg": kg, "height_m": m, "muscle_strength": factor}``, any of them;
+    :func:`bladelab.runner.params.athlete_params`), checked and normalised (the able model has no blade; the amputee needs one; files written
     before the bodies existed have no ``"body"`` and mean seed 001's)."""
     if not isinstance(spec, dict) or "model" not in spec:
         raise SpecError(f"expected {{'model': ..., 'blade': ...}}, got {spec!r}",
@@ -64,15 +72,50 @@ def check_model_spec(spec) -> dict:
             raise SpecError("blade_spec must be a multi-link blade's specification (a mapping) "
                             "of an amputee model", where="blade_spec")
         out["blade_spec"] = blade_spec
+    athlete = _check_athlete(spec.get("athlete"))
+    if athlete:
+        out["athlete"] = athlete
+    return out
+
+
+def _check_athlete(athlete) -> dict:
+    """The athlete of a model specification: known fields, each a finite number > 0 (an empty
+    dict for None)."""
+    if athlete is None:
+        return {}
+    if not isinstance(athlete, dict):
+        raise SpecError(f"athlete must be a mapping, got {athlete!r}", where="athlete",
+                        hint="e.g. {'body_mass_kg': 68, 'height_m': 1.75}")
+    out = {}
+    for name, value in athlete.items():
+        if name not in ATHLETE_FIELDS:
+            raise SpecError(f"unknown athlete field {name!r}", where="athlete",
+                            hint=" or ".join(ATHLETE_FIELDS))
+        if value is None:
+            continue
+        if (isinstance(value, bool) or not isinstance(value, int | float)
+                or not math.isfinite(value) or value <= 0):
+            raise SpecError(f"{name} must be a number > 0 [{ATHLETE_FIELDS[name]}], got "
+                            f"{value!r}", where=f"athlete.{name}")
+        out[name] = float(value)
     return out
 
 
 def model_label(spec: dict) -> str:
     """``"able"``, ``"amputee <blade>"`` or ``"transfemoral <blade>"`` for a model
-    specification."""
+    specification, with its body and athlete where they are not the defaults (e.g.
+    ``"amputee Cat6 (human body; 68 kg, 1.75 m, muscle strength ×1.5)"``)."""
     spec = check_model_spec(spec)
     label = spec["model"] if spec["blade"] is None else f"{spec['model']} {spec['blade']}"
-    return label + (f" ({spec['body']} body)" if "body" in spec else "")
+    notes = [f"{spec['body']} body"] if "body" in spec else []
+    athlete = spec.get("athlete", {})
+    parts = [f"{athlete['body_mass_kg']:g} kg"] if "body_mass_kg" in athlete else []
+    parts += [f"{athlete['height_m']:g} m"] if "height_m" in athlete else []
+    parts += ([f"muscle strength ×{athlete['muscle_strength']:g}"]
+              if "muscle_strength" in athlete else [])
+    if parts:
+        notes.append(", ".join(parts))
+    return label + (f" ({'; '.join(notes)})" if notes else "")
 
 
 def describe_problem(spec: dict, settings: CollocationSettings) -> str:
@@ -85,10 +128,17 @@ def describe_problem(spec: dict, settings: CollocationSettings) -> str:
 def runner_from_spec(spec: dict):
     """Build the forward runner of a model specification (:func:`check_model_spec`)."""
     spec = check_model_spec(spec)
-    if "blade_spec" in spec:
-        blade = spec_from_dict(spec["blade_spec"]).build()
-        return build_runner(spec["model"], blade_model=blade, body=spec.get("body", "seed001"))
-    return build_runner(spec["model"], blade=spec["blade"], body=spec.get("body", "seed001"))
+    body = spec.get("body", "seed001")
+    blade_model = (spec_from_dict(spec["blade_spec"]).build() if "blade_spec" in spec
+                   else None)
+    if "athlete" not in spec:
+        if blade_model is not None:
+            return build_runner(spec["model"], blade_model=blade_model, body=body)
+        return build_runner(spec["model"], blade=spec["blade"], body=body)
+    params = athlete_params(default_runner_params(
+        spec["model"], blade=None if blade_model is not None else spec["blade"], body=body),
+        **spec["athlete"])
+    return build_runner(params, blade_model=blade_model)
 
 
 class FieldReader:

@@ -85,24 +85,27 @@ def write_table(path: str | Path, rows: Sequence[dict]) -> Path:
 
 
 def sweep_models(categories: Sequence[str], *, able: bool = False,
-                 body: str = "seed001") -> list[dict]:
+                 body: str = "seed001", athlete: dict | None = None) -> list[dict]:
     """Model specifications of a sweep: the able model first when ``able``, then the amputee
     with each blade category (names as the catalogue spells them), all of one ``body``
-    (:data:`bladelab.runner.params.BODIES`).
+    (:data:`bladelab.runner.params.BODIES`) and ``athlete`` (None: the parameter sets';
+    :func:`~bladelab.predict.collocation.stored.check_model_spec`).
 
     Raises
     ------
     SpecError
         An unknown or repeated category, or no model at all.
     """
-    models = [check_model_spec({"model": "able", "body": body})] if able else []
+    models = ([check_model_spec({"model": "able", "body": body, "athlete": athlete})]
+              if able else [])
     seen: set[str] = set()
     for c in categories:
         name = blade_category(c).name
         if name in seen:
             raise SpecError(f"category {name} given twice", where="categories")
         seen.add(name)
-        models.append(check_model_spec({"model": "amputee", "blade": name, "body": body}))
+        models.append(check_model_spec({"model": "amputee", "blade": name, "body": body,
+                                        "athlete": athlete}))
     if not models:
         raise SpecError("no model to sweep", where="categories",
                         hint="give --categories, --able, or both")
