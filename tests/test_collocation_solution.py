@@ -599,6 +599,10 @@ def test_model_spec_carries_the_athlete_into_the_runner_the_label_and_the_file(a
     assert spec["athlete"] == {"body_mass_kg": 68.0, "height_m": 1.75}
     assert spec != check_model_spec(plain) == check_model_spec({**plain, "athlete": {}})
     assert model_label(spec) == "amputee Cat6 (human body; 68 kg, 1.75 m)"
+    from bladelab.predict.collocation.stored import athlete_label
+    assert athlete_label({**plain, "athlete": {"muscle_strength": 1.5}}) == (
+        "muscle strength ×1.5")
+    assert athlete_label(plain) == ""
     assert runner_from_spec(spec).total_mass == pytest.approx(68.0, rel=1e-12)
     for bad, where in (({"body_mass_kg": -70}, "athlete.body_mass_kg"),
                        ({"muscle_strength": float("nan")}, "athlete.muscle_strength"),

@@ -40,7 +40,7 @@ from bladelab.predict.collocation.solution import (
     CollocationSolution,
 )
 from bladelab.predict.collocation.solve import SOLUTION_FILE
-from bladelab.predict.collocation.stored import runner_from_spec
+from bladelab.predict.collocation.stored import athlete_label, runner_from_spec
 
 __all__ = ["N_STRIDES", "REFINE", "collocation_sections", "collocation_solution_file",
            "reference_term_text"]
@@ -89,7 +89,8 @@ def _label(sol) -> str:
     speed = ("maximum speed" if sol.settings.speed_m_per_s is None
              else f"{sol.settings.speed_m_per_s:g} m/s")
     body = f", {spec['body']} body" if "body" in spec else ""
-    return f"{who} {speed} (collocation{body})"
+    athlete = f"; {athlete_label(spec)}" if "athlete" in spec else ""
+    return f"{who} {speed} (collocation{body}{athlete})"
 
 
 def _grf_figure(sol):

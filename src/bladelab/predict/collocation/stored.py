@@ -32,6 +32,7 @@ from bladelab.runner.params import (
 
 __all__ = [
     "FieldReader",
+    "athlete_label",
     "check_model_spec",
     "describe_problem",
     "model_label",
@@ -108,14 +109,19 @@ def model_label(spec: dict) -> str:
     spec = check_model_spec(spec)
     label = spec["model"] if spec["blade"] is None else f"{spec['model']} {spec['blade']}"
     notes = [f"{spec['body']} body"] if "body" in spec else []
-    athlete = spec.get("athlete", {})
+    notes += [athlete_label(spec)] if "athlete" in spec else []
+    return label + (f" ({'; '.join(notes)})" if notes else "")
+
+
+def athlete_label(spec: dict) -> str:
+    """The athlete of a model specification where it is not the parameter set's, e.g.
+    ``"68 kg, 1.75 m, muscle strength ×1.5"`` (empty for the parameter set's own)."""
+    athlete = check_model_spec(spec).get("athlete", {})
     parts = [f"{athlete['body_mass_kg']:g} kg"] if "body_mass_kg" in athlete else []
     parts += [f"{athlete['height_m']:g} m"] if "height_m" in athlete else []
     parts += ([f"muscle strength ×{athlete['muscle_strength']:g}"]
               if "muscle_strength" in athlete else [])
-    if parts:
-        notes.append(", ".join(parts))
-    return label + (f" ({'; '.join(notes)})" if notes else "")
+    return ", ".join(parts)
 
 
 def describe_problem(spec: dict, settings: CollocationSettings) -> str:

@@ -1,0 +1,87 @@
+"""How fast can the body run? Prescribed-speed continuation to the speed where no stride is
+found (a measuring probe; changes nothing in src).
+
+Usage (repository root)::
+
+    .venv/bin/python benchmarks/human_body/sprint_limit.py OUT '{"kind": "able", ...}'
+
+Seed 001's definition of the maximum speed: the fastest prescribed speed at which the optimiser
+finds a stride (its §2.2 C: 4, 4.5, 5 m/s, each from the previous). Here: from ``start`` (a
+solution file, default the shipped stride of the kind) at ``speeds`` (default 4.5, 5.5, 6.0,
+6.5, … in 0.5 m/s steps to 10), each solve from the previous solution's primal and dual values,
+no people's term (``people_weight``, default 0); a speed that does not converge is tried once
+more halfway from the last converged one, then the chain stops. The variant (JSON):
+``active_tension`` [N/cm²] (the fibres' active specific tension; the body's is 30),
+``vmax`` [optimal fibre lengths/s] (every muscle's maximum shortening velocity; the body's is
+10), ``force_factor`` as in solve_variant.py. Writes ``OUT/speed-<v>.json`` per converged speed
+and ``OUT/records.jsonl`` (one line per solve: the summary, the largest activation of any muscle
+at any node, the wall time), and prints each line.
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+import bladelab.predict.collocation.dynamics as _dyn
+import bladelab.predict.collocation.metabolics as _met
+import bladelab.predict.collocation.muscles as _mus
+import bladelab.runner.muscle as _rmus
+from bladelab.predict.collocation.settings import CollocationSettings, people_term
+from bladelab.predict.collocation.solution import CollocationSolution
+from bladelab.predict.collocation.solve import predict_stride
+from bladelab.predict.collocation.starting_guess import make_guess
+from bladelab.runner import build_runner
+from bladelab.runner.params import default_runner_params, runner_params_from_dict
+
+
+def main() -> None:
+    out, variant = Path(sys.argv[1]), json.loads(sys.argv[2])
+    kind, blade = variant.get("kind", "able"), variant.get("blade")
+    if "vmax" in variant:  # the collocation twin reads the constant when its graph is built
+        for mod in (_dyn, _met, _mus, _rmus):
+            mod.V_MAX_OPT_PER_S = float(variant["vmax"])
+    data = json.loads(default_runner_params(kind, body="human", blade=blade).model_dump_json())
+    for name, factor in variant.get("force_factor", {}).items():
+        for muscle, row in data["muscle_types"].items():
+            if name in ("all", muscle) and row.get("max_isometric_force_N"):
+                row["max_isometric_force_N"] *= factor
+    if "active_tension" in variant:
+        data["active_specific_tension_N_per_cm2"] = float(variant["active_tension"])
+    runner = build_runner(runner_params_from_dict(data))
+    spec = {"model": kind, "blade": blade, "body": "human"}
+    speeds = variant.get("speeds", [4.5, 5.5] + [6.0 + 0.5 * k for k in range(9)])
+    people = people_term(float(variant.get("people_weight", 0.0)))
+    mesh = int(variant.get("mesh", 50))
+    if variant.get("start"):
+        guess = CollocationSolution.read(variant["start"]).to_guess()
+    else:
+        guess = make_guess(runner, "stored", n=mesh, speed=speeds[0])
+    out.mkdir(parents=True, exist_ok=True)
+    (out / "variant.json").write_text(json.dumps(variant))
+    last, pending = None, list(speeds)
+    while pending:
+        v = pending.pop(0)
+        settings = CollocationSettings(mesh_intervals=mesh, speed_m_per_s=v, **people)
+        t0 = time.perf_counter()
+        sol = predict_stride(runner, settings, guess, model_spec=spec)
+        rec = {"speed": v, **sol.summary(), "max_activation": float(np.max(sol.nlp.activation)),
+               "probe_wall_s": round(time.perf_counter() - t0, 1)}
+        with (out / "records.jsonl").open("a") as fh:
+            fh.write(json.dumps(rec) + "\n")
+        print(json.dumps(rec), flush=True)
+        if sol.converged:
+            sol.write(out / f"speed-{v:g}.json")
+            guess, last = sol.to_guess(), v
+        elif last is not None and v - last > 0.2:
+            pending = [round((last + v) / 2, 3)]
+        else:
+            break
+
+
+if __name__ == "__main__":
+    main()
