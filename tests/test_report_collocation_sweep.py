@@ -157,6 +157,7 @@ def test_the_report_of_a_sweep_folder_has_its_sections(tmp_path, monkeypatch):
     assert "Not converged" in html and "amputee Cat4 max-speed" in html
     assert "Blade categories: maximum speed and metabolic cost" in html
     assert "seed 001" in html
+    assert "not the fastest stride the body can run" in html  # what the column means
 
 
 def _flag(folder: Path, blade: str, problem: str, why: str = "a one-legged hop") -> None:

@@ -218,7 +218,10 @@ def collocation_sweep_sections(report, folder: str | Path) -> tuple[dict, pd.Dat
         text += ("Each model's speeds were solved in the order given, each warm-started from "
                  "the previous converged speed; the maximum speed (star) from the fastest.")
     text += (" Curves and the category table use converged solves without gait warnings "
-             "only.")
+             "only. The maximum speed is the optimum of the maximum-speed problem (speed "
+             "traded against effort, at least the fastest prescribed speed solved), not the "
+             "fastest stride the body can run, which a speed continuation to its end finds "
+             "(docs/collocation.md, 'How fast the body can run').")
     text += "".join(sorted({reference_term_text(
         sol.settings, lead="Not free predictions: every objective held")
         for sol in solutions.values()}))
