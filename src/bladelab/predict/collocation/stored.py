@@ -48,8 +48,9 @@ def check_model_spec(spec) -> dict:
     :func:`bladelab.blade.spec.spec_from_dict` reads them; ``"blade"`` is then its name), plus
     ``"athlete"`` where the runner is scaled to another athlete than the parameter set's
     (``{"body_mass_kg": kg, "height_m": m, "muscle_strength": factor}``, any of them;
-    :func:`bladelab.runner.params.athlete_params`), checked and normalised (the able model has no blade; the amputee needs one; files written
-    before the bodies existed have no ``"body"`` and mean seed 001's)."""
+    :func:`bladelab.runner.params.athlete_params`), checked and normalised (the able model has
+    no blade; the amputee needs one; files written before the bodies existed have no
+    ``"body"`` and mean seed 001's)."""
     if not isinstance(spec, dict) or "model" not in spec:
         raise SpecError(f"expected {{'model': ..., 'blade': ...}}, got {spec!r}",
                         where="model_spec")
@@ -134,16 +135,12 @@ def describe_problem(spec: dict, settings: CollocationSettings) -> str:
 def runner_from_spec(spec: dict):
     """Build the forward runner of a model specification (:func:`check_model_spec`)."""
     spec = check_model_spec(spec)
-    body = spec.get("body", "seed001")
     blade_model = (spec_from_dict(spec["blade_spec"]).build() if "blade_spec" in spec
                    else None)
-    if "athlete" not in spec:
-        if blade_model is not None:
-            return build_runner(spec["model"], blade_model=blade_model, body=body)
-        return build_runner(spec["model"], blade=spec["blade"], body=body)
-    params = athlete_params(default_runner_params(
-        spec["model"], blade=None if blade_model is not None else spec["blade"], body=body),
-        **spec["athlete"])
+    params = default_runner_params(spec["model"], body=spec.get("body", "seed001"),
+                                   blade=None if blade_model is not None else spec["blade"])
+    if "athlete" in spec:
+        params = athlete_params(params, **spec["athlete"])
     return build_runner(params, blade_model=blade_model)
 
 
