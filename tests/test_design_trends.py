@@ -9,6 +9,7 @@ import pytest
 
 from bladelab.design import central_composite, default_design_space, fit_surface, run_design
 from bladelab.design.trends import (
+    NO_RUNNER,
     NOT_EXPLAINED,
     SEED002_TRENDS,
     TREND_REASONS,
@@ -49,7 +50,7 @@ REVERSED = {  # each trend reversed
 
 
 def test_all_trends_hold_on_a_table_built_to_hold():
-    v = evaluate_trends(_surfaces(HOLD), evaluator="blade")
+    v = evaluate_trends(_surfaces(HOLD), evaluator="runner")
     assert [x.verdict for x in v] == ["holds"] * len(SEED002_TRENDS)
     assert all(x.reason == "" for x in v)
     k = _by_key(v)
@@ -57,26 +58,40 @@ def test_all_trends_hold_on_a_table_built_to_hold():
     assert k["stiffness_increases_dvx"].p_value < 1e-6
 
 
-@pytest.mark.parametrize("evaluator", ["blade", "runner", "collocation", None])
+@pytest.mark.parametrize("evaluator", ["runner", "collocation", None])
 def test_reversed_trends_do_not_hold_with_the_reason(evaluator):
     v = _by_key(evaluate_trends(_surfaces(REVERSED), evaluator=evaluator))
     for t in SEED002_TRENDS:
         assert v[t.key].verdict == "does not hold", t.key
         assert v[t.key].reason == TREND_REASONS.get((str(evaluator), t.key), NOT_EXPLAINED)
     assert "reversed" in v["stiffness_increases_dvx"].evidence
-    # the blade evaluator explains the Δv_x trends; its clearance proxy has no known reason
-    if evaluator == "blade":
-        assert "passive" in v["stiffness_increases_dvx"].reason
-        assert v["longer_toe_lowers_clearance"].reason == NOT_EXPLAINED
     if evaluator is None:
         assert all(x.reason == NOT_EXPLAINED for x in v.values())
     if evaluator == "collocation":  # the predicted strides' scatter, for every trend
         assert all("local optimum" in x.reason for x in v.values())
 
 
+@pytest.mark.parametrize("table", [HOLD, REVERSED])
+def test_an_evaluator_without_a_runner_tests_no_trend(table):
+    """The blade evaluator (no runner) draws no verdict, whatever its surfaces say: each trend
+    is "not tested", its evidence (the blade's coefficient) kept and the reason says what the
+    evaluator is, with the blade's mechanism where one is known."""
+    v = _by_key(evaluate_trends(_surfaces(table), evaluator="blade"))
+    judged = _by_key(evaluate_trends(_surfaces(table), evaluator="runner"))
+    for t in SEED002_TRENDS:
+        assert v[t.key].verdict == "not tested", t.key
+        assert v[t.key].reason.startswith(NO_RUNNER["blade"])
+        assert v[t.key].evidence.startswith(judged[t.key].evidence)
+        assert v[t.key].estimate == judged[t.key].estimate or t.key == "height_toe_matter_less"
+    sign = "has the seed's sign" if table is HOLD else "lacks the seed's sign"
+    assert all(sign in x.evidence for x in v.values())
+    assert "cannot push off" in v["stiffness_increases_dvx"].reason
+    assert v["longer_toe_lowers_clearance"].reason == NO_RUNNER["blade"]
+
+
 def test_no_significant_effect_does_not_hold():
     coef = dict(HOLD, delta_vx_m_per_s=(0.10, 0.0, 0.02, 0.01))
-    v = _by_key(evaluate_trends(_surfaces(coef, noise=0.01), evaluator="blade"))
+    v = _by_key(evaluate_trends(_surfaces(coef, noise=0.01), evaluator="runner"))
     w = v["width_increases_dvx"]
     assert w.verdict == "does not hold" and "no significant effect" in w.evidence
     assert w.p_value > 0.05
@@ -138,7 +153,7 @@ def test_report_has_the_trends_section(tmp_path):
     out = tmp_path / "ds"
     run_design(space, runs="ccd", evaluator=evaluator, out_dir=out, objective="delta_vx_m_per_s",
                progress=False)
-    (out / "evaluator.json").write_text(json.dumps({"evaluator": "blade"}))
+    (out / "evaluator.json").write_text(json.dumps({"evaluator": "runner"}))
     sections = design_report_sections(out)
     trend = [s for s in sections if s["title"] == "Seed 002 trends"]
     assert len(trend) == 1
@@ -147,27 +162,29 @@ def test_report_has_the_trends_section(tmp_path):
     index = build_design_report(out)
     html = index.read_text(encoding="utf-8")
     assert "Seed 002 trends" in html and "does not hold" in html
-    assert "a point mass on a spring leg" in html  # the blade evaluator's stiffness reason
+    assert "open-loop" in html  # the kinematics-driven runner's stiffness reason
+    # the same study from an evaluator with no runner: no verdict, and the section says why
+    (out / "evaluator.json").write_text(json.dumps({"evaluator": "blade"}))
+    section = next(s for s in design_report_sections(out) if s["title"] == "Seed 002 trends")
+    assert set(section["tables"][0][1]["verdict"]) == {"not tested"}
+    assert "has no runner" in section["text"] and "not a verdict" in section["text"]
 
 
-def test_shipped_example_trends_hold_or_are_explained(tmp_path):
-    """The demo's design example (25-run CCD, blade evaluator): every seed 002 trend holds or
-    the report gives the blade evaluator's known reason (never 'not explained')."""
+def test_shipped_example_draws_no_trend_verdict(tmp_path):
+    """The demo's design example (25-run CCD, blade evaluator: no runner) says what its
+    evaluator is and draws no verdict on seed 002's trends, in its printed lines and in its
+    report, which still gives the blade's own evidence."""
     from bladelab.demo import design_example
     from bladelab.report.design import design_report_sections
 
     report, lines = design_example(tmp_path / "design-study")
-    assert report.is_file() and "Seed 002 trends" in report.read_text(encoding="utf-8")
-    assert any("seed 002 trends" in line for line in lines)
+    text = "\n".join(lines)
+    assert "no runner" in text and "not tested" in text
+    assert not any(w in text for w in ("holds", "does not hold"))
+    assert "Seed 002 trends" in report.read_text(encoding="utf-8")
     section = next(s for s in design_report_sections(tmp_path / "design-study")
                    if s["title"] == "Seed 002 trends")
     table = section["tables"][0][1]
     assert len(table) == len(SEED002_TRENDS)
-    for _, row in table.iterrows():
-        assert row["verdict"] in ("holds", "does not hold"), row["trend"]
-        if row["verdict"] == "does not hold":
-            assert row["reason"] and row["reason"] != NOT_EXPLAINED, row["trend"]
-    # the geometric toe trends of the blade evaluator hold
-    verdicts = dict(zip(table["trend"], table["verdict"], strict=True))
-    assert verdicts["longer toe lowers swing clearance"] == "holds"
-    assert verdicts["shorter toe lowers the knee extension margin"] == "holds"
+    assert set(table["verdict"]) == {"not tested"}
+    assert all("per coded unit" in e or "main-effect ranges" in e for e in table["evidence"])

@@ -3,6 +3,7 @@
 Usage (repository root)::
 
     .venv/bin/python benchmarks/human_body/categories.py [OUT] [--jobs 2] [--speed 4]
+        [--people-weight W]
 
 Per category (Cat4, Cat5, Cat6, Cat6High, Cat7), up to four starts: ``trial`` (the measured
 3.5 m/s stride scaled to the speed, through the tracking stage), ``shipped`` (the packaged Cat6
@@ -16,6 +17,8 @@ converge); a file already there is kept (re-run to continue). ``OUT/categories.c
 row per category: the kept start (the lowest objective among converged solves), every start's
 objective and their spread [%], the kept stride's summary, its criteria against people's running
 and its stride analyses (K_leg, joint powers). Default OUT: ``benchmarks/human_body/categories``.
+The objective is the human body's default (people's joint angles at weight 10 1/rad²) unless
+``--people-weight`` says otherwise (0: the free problem).
 """
 
 from __future__ import annotations
@@ -44,15 +47,19 @@ def _path(out: Path, category: str, start: str) -> Path | None:
     return None
 
 
-def _solve(out: str, category: str, start: str, guess: str, speed: float) -> str:
-    from bladelab.predict.collocation.settings import CollocationSettings
+def _solve(out: str, category: str, start: str, guess: str, speed: float,
+           people_weight: float) -> str:
+    from bladelab.predict import defaults
+    from bladelab.predict.collocation.settings import CollocationSettings, people_term
     from bladelab.predict.collocation.solve import predict_stride
     from bladelab.predict.collocation.starting_guess import make_guess
     from bladelab.runner import build_runner
 
     runner = build_runner("amputee", blade=category, body="human")
     settings = CollocationSettings(speed_m_per_s=speed,
-                                   warm_start_mu=None if start == "trial" else 1e-4)
+                                   warm_start_mu=None if start == "trial" else 1e-4,
+                                   **people_term(defaults.people_weight_for("human",
+                                                                            people_weight)))
     t0 = time.perf_counter()
     sol = predict_stride(runner, settings,
                          make_guess(runner, guess, n=settings.mesh_intervals, speed=speed),
@@ -81,9 +88,11 @@ def _kept(out: Path, category: str, solves: dict | None = None):
     return start, solves[start]
 
 
-def _run(jobs: list[tuple], workers: int, out: Path, speed: float) -> None:
+def _run(jobs: list[tuple], workers: int, out: Path, speed: float,
+         people_weight: float | None) -> None:
     with ProcessPoolExecutor(max_workers=workers) as pool:
-        futures = [pool.submit(_solve, str(out), c, s, g, speed) for c, s, g in jobs]
+        futures = [pool.submit(_solve, str(out), c, s, g, speed, people_weight)
+                   for c, s, g in jobs]
         for f in futures:
             print(f.result(), flush=True)
 
@@ -126,6 +135,8 @@ def main(argv=None) -> int:
     ap.add_argument("out", nargs="?", default="benchmarks/human_body/categories", type=Path)
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--speed", type=float, default=4.0)
+    ap.add_argument("--people-weight", type=float, default=None,
+                    help="people's joint-angle term [1/rad²] (default: the body's, 10)")
     ap.add_argument("--table-only", action="store_true")
     args = ap.parse_args(argv)
     out = args.out
@@ -136,14 +147,14 @@ def main(argv=None) -> int:
         first = [(c, s, g) for c in CATEGORIES for s, g in (("trial", "trial"),
                                                             ("shipped", shipped))
                  if _path(out, c, s) is None]
-        _run(first, args.jobs, out, args.speed)
+        _run(first, args.jobs, out, args.speed, args.people_weight)
         second = []
         for c in CATEGORIES:
             kept = _kept(out, NEIGHBOUR[c])
             if _path(out, c, "neighbour") is None and kept is not None:
                 p = _path(out, NEIGHBOUR[c], kept[0])
                 second.append((c, "neighbour", str(p)))
-        _run(second, args.jobs, out, args.speed)
+        _run(second, args.jobs, out, args.speed, args.people_weight)
         kept = {c: _kept(out, c) for c in CATEGORIES}
         kept = {c: k for c, k in kept.items() if k is not None}
         if kept:
@@ -151,7 +162,7 @@ def main(argv=None) -> int:
             source = str(_path(out, lowest, kept[lowest][0]))
             third = [(c, "best", source) for c in CATEGORIES
                      if c != lowest and _path(out, c, "best") is None]
-            _run(third, args.jobs, out, args.speed)
+            _run(third, args.jobs, out, args.speed, args.people_weight)
     _table(out)
     return 0
 

@@ -25,6 +25,12 @@ A trend that does not hold gets a reason: the known mechanism of the evaluator t
 study (:data:`TREND_REASONS`, keyed by evaluator and trend; measured and explained in
 docs/design.md), else :data:`NOT_EXPLAINED`. A surface whose predicted R² is below 0.5 is
 flagged in the evidence.
+
+**not tested**: the study's evaluator has no runner (:data:`NO_RUNNER`, the ``blade``
+evaluator: the blade under one prescribed passive stance). Seed 002's trends are about a
+runner's stride, so such a study draws no verdict on them; the evidence (the blade's own
+coefficients) is still given, with what the evaluator is and, where known, the mechanism
+behind the blade's response.
 """
 
 from __future__ import annotations
@@ -43,6 +49,7 @@ from bladelab.errors import SpecError
 
 __all__ = [
     "NOT_EXPLAINED",
+    "NO_RUNNER",
     "SEED002_TRENDS",
     "TREND_REASONS",
     "Trend",
@@ -105,7 +112,7 @@ _SCATTER = (
 #: Why a trend does not hold, by (evaluator, trend key): see docs/design.md for the measurements.
 TREND_REASONS: dict[tuple[str, str], str] = {
     ("blade", "stiffness_increases_dvx"): (
-        "The blade evaluator's runner is passive (a point mass on a spring leg at a fixed "
+        "The blade evaluator's stance is passive (a point mass on a spring leg at a fixed "
         "touch-down angle): it cannot push off, so Δv_x < 0 in every run, and a stiffer blade "
         "gives a larger vertical impulse and more braking. Seed 002's runner follows measured "
         "joint angles whose hip extension supplies the propulsion and adapts to the blade; a "
@@ -162,6 +169,16 @@ TREND_REASONS: dict[tuple[str, str], str] = {
         "study's 25 strides, which caps the response the trend is read from."),
 }
 
+#: Evaluators with no runner, and what they are: their studies test no trend of seed 002
+#: (verdict "not tested"), which are about a runner's stride.
+NO_RUNNER: dict[str, str] = {
+    "blade": ("Not tested: the blade evaluator has no runner. It loads the blade under one "
+              "prescribed, passive stance (a point mass on a rigid pylon lands at a fixed "
+              "angle and speed), so its responses are the blade's, not a runner's stride's, "
+              "and seed 002's trends about running can be neither confirmed nor refuted by "
+              "it (use the collocation evaluator)."),
+}
+
 #: Reason given when no known mechanism of the evaluator explains a trend that does not hold.
 NOT_EXPLAINED = ("not explained: no known mechanism of this evaluator accounts for it; check the "
                  "surface fit (predicted R²), the factor ranges and the runs")
@@ -178,11 +195,12 @@ class TrendVerdict:
     test
         The test used, in words.
     verdict
-        ``"holds"``, ``"does not hold"`` or ``"not estimable"``.
+        ``"holds"``, ``"does not hold"``, ``"not estimable"`` or ``"not tested"`` (an
+        evaluator with no runner, :data:`NO_RUNNER`).
     evidence
         The numbers behind it (coefficients per coded unit with p-values, or effect ranges).
     reason
-        Why it does not hold (empty otherwise).
+        Why it does not hold, or why it is not tested (empty otherwise).
     estimate, p_value
         Linear coefficient per coded unit and its p-value (sign tests; NaN otherwise).
     """
@@ -237,7 +255,8 @@ def evaluate_trends(
     surfaces
         Response name -> fitted surface over coded factors (all over the same factors).
     evaluator
-        ``"blade"`` or ``"runner"`` (selects the reasons), or None (generic reasons).
+        ``"runner"`` or ``"collocation"`` (selects the reasons), ``"blade"`` (no runner:
+        every trend "not tested", :data:`NO_RUNNER`), or None (generic reasons).
     roles
         Role -> factor name (default the generator's: ``stiffness_kN_per_m``, ``width_m``,
         ``height_m``, ``toe_length_m``).
@@ -309,7 +328,22 @@ def evaluate_trends(
             reason = "" if holds else TREND_REASONS.get((str(evaluator), tr.key), NOT_EXPLAINED)
             out.append(TrendVerdict(**base, verdict="holds" if holds else "does not hold",
                                     evidence="main-effect ranges: " + ev, reason=reason))
+    if str(evaluator) in NO_RUNNER:
+        return [_not_tested(v, str(evaluator)) for v in out]
     return out
+
+
+def _not_tested(verdict: TrendVerdict, evaluator: str) -> TrendVerdict:
+    """``verdict`` from an evaluator without a runner: "not tested", the evidence kept, the
+    reason saying what the evaluator is (and the blade's known mechanism, if any)."""
+    if verdict.verdict == "not estimable":
+        return verdict
+    mechanism = TREND_REASONS.get((evaluator, verdict.key), "")
+    sign = {"holds": "the blade's response has the seed's sign",
+            "does not hold": "the blade's response lacks the seed's sign"}[verdict.verdict]
+    reason = NO_RUNNER[evaluator] + (f" {mechanism}" if mechanism else "")
+    return dataclasses.replace(verdict, verdict="not tested",
+                               evidence=f"{verdict.evidence} ({sign})", reason=reason)
 
 
 def trends_frame(verdicts: list[TrendVerdict]) -> pd.DataFrame:

@@ -30,7 +30,7 @@ from bladelab.design.space import DesignSpace
 from bladelab.design.start_spread import NEAR_PCT, start_spread
 from bladelab.design.surfaces import fit_surface
 from bladelab.design.terms import parse_terms
-from bladelab.design.trends import evaluate_trends, trends_frame
+from bladelab.design.trends import NO_RUNNER, evaluate_trends, trends_frame
 from bladelab.errors import InputFileError, OptimizationError
 from bladelab.predict.collocation.solution import RESIDUAL_WARNING_PCT
 from bladelab.report.builder import Report
@@ -370,6 +370,13 @@ def trends_section(surfaces, evaluator: dict | None = None) -> dict[str, Any]:
         held["knee_moment_min_Nm"] = (f"held at or above {evaluator['knee_moment_min_Nm']:g} "
                                       "N·m on every loaded interval by the solve")
     verdicts = evaluate_trends(surfaces, evaluator=kind, roles=roles, held=held)
+    if kind in NO_RUNNER:
+        return {"title": "Seed 002 trends", "text": (
+                    f"{NO_RUNNER[kind]} The table gives, for each of seed 002's trends, the "
+                    "blade's own coefficient or effect ranges on this study's surfaces: a "
+                    "description of the blade, not a verdict on the trend."),
+                "tables": [("Seed 002 trends: not tested by this evaluator",
+                            trends_frame(verdicts))]}
     counts = {v: sum(1 for x in verdicts if x.verdict == v)
               for v in ("holds", "does not hold", "not estimable")}
     text = (f"The trends seed 002 reports, checked on this study's fitted surfaces "
