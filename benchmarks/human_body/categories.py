@@ -5,11 +5,12 @@ Usage (repository root)::
     .venv/bin/python benchmarks/human_body/categories.py [OUT] [--jobs 2] [--speed 4]
         [--people-weight W]
 
-Per category (Cat4, Cat5, Cat6, Cat6High, Cat7), up to four starts: ``trial`` (the measured
-3.5 m/s stride scaled to the speed, through the tracking stage), ``shipped`` (the packaged Cat6
-stride at 4 m/s, ``data/runner/collocation/amputee-Cat6-4-human.json``, with IPOPT's barrier
-started at 1e-4), ``neighbour`` (the kept stride of the next stiffer category, or of Cat6 for
-Cat7, barrier 1e-4) once the first two have run everywhere, and ``best`` (the kept stride of
+Per category (Cat4, Cat5, Cat6, Cat6High, Cat7), up to five starts: ``trial`` (with
+``--trial``: the measured 3.5 m/s stride scaled to the speed, through the tracking stage),
+``shipped`` (the packaged Cat6 stride at 4 m/s, ``data/runner/collocation/amputee-Cat6-4-human.json``,
+with IPOPT's barrier started at 1e-4), ``fast`` (the category's own 5 m/s stride of the committed
+category study, :data:`FAST`, its primal values), ``neighbour`` (the kept stride of the next stiffer category, or of Cat6 for
+Cat7, barrier 1e-4) once the first starts have run everywhere, and ``best`` (the kept stride of
 the category whose kept objective is the lowest, barrier 1e-4) once the neighbours have run,
 for every other category.
 Each start writes ``OUT/<category>.<start>.json`` (``.best_iterate.json`` if IPOPT did not
@@ -32,8 +33,10 @@ from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 CATEGORIES = ("Cat4", "Cat5", "Cat6", "Cat6High", "Cat7")
-STARTS = ("trial", "shipped", "neighbour", "best")
+STARTS = ("trial", "shipped", "fast", "neighbour", "best")
 SHIPPED = "amputee-Cat6-4-human.json"
+#: The category's own 5 m/s stride of the committed category study, the ``fast`` start
+FAST = "benchmarks/collocation/study-human-people10-2026-11-29/amputee-{}-human/speed-5.json"
 # the next stiffer category's kept stride starts the neighbour solve
 NEIGHBOUR = {"Cat4": "Cat5", "Cat5": "Cat6", "Cat6": "Cat6High", "Cat6High": "Cat7",
              "Cat7": "Cat6"}
@@ -57,7 +60,7 @@ def _solve(out: str, category: str, start: str, guess: str, speed: float,
 
     runner = build_runner("amputee", blade=category, body="human")
     settings = CollocationSettings(speed_m_per_s=speed,
-                                   warm_start_mu=None if start == "trial" else 1e-4,
+                                   warm_start_mu=None if start in ("trial", "fast") else 1e-4,
                                    **people_term(defaults.people_weight_for("human",
                                                                             people_weight)))
     t0 = time.perf_counter()
@@ -137,6 +140,9 @@ def main(argv=None) -> int:
     ap.add_argument("--speed", type=float, default=4.0)
     ap.add_argument("--people-weight", type=float, default=None,
                     help="people's joint-angle term [1/rad²] (default: the body's, 10)")
+    ap.add_argument("--trial", action="store_true",
+                    help="also start from the measured trial (at weight 10 it lands in far "
+                         "dearer basins or fails: Cat4 56.8 after 3000 iterations, 1606 s)")
     ap.add_argument("--table-only", action="store_true")
     args = ap.parse_args(argv)
     out = args.out
@@ -144,8 +150,10 @@ def main(argv=None) -> int:
     shipped = str(Path(__file__).resolve().parents[2] / "src" / "bladelab" / "data" / "runner"
                   / "collocation" / SHIPPED)
     if not args.table_only:
-        first = [(c, s, g) for c in CATEGORIES for s, g in (("trial", "trial"),
-                                                            ("shipped", shipped))
+        root = Path(__file__).resolve().parents[2]
+        first = [(c, s, g) for c in CATEGORIES
+                 for s, g in (("shipped", shipped), ("fast", str(root / FAST.format(c))))
+                 + ((("trial", "trial"),) if args.trial else ())
                  if _path(out, c, s) is None]
         _run(first, args.jobs, out, args.speed, args.people_weight)
         second = []
