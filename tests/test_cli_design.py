@@ -155,6 +155,17 @@ def test_design_bad_input(tmp_path, capsys):
     assert main(["design", "--out", str(tmp_path / "c"), "--evaluator", "collocation",
                  "--start", str(tmp_path / "none.json")]) == 2
     assert "none.json" in capsys.readouterr().err
+    assert main(["design", "--out", str(tmp_path / "c"), "--body", "human"]) == 2
+    assert "--body: only with --evaluator collocation" in capsys.readouterr().err
+    assert main(["design", "--out", str(tmp_path / "c"), "--evaluator", "collocation",
+                 "--body", "human"]) == 2
+    err = capsys.readouterr().err
+    assert "--body: no built-in start stride of the transfemoral runner on the human body" in err
+    assert "Traceback" not in err
+    assert main(["design", "--out", str(tmp_path / "c"), "--evaluator", "collocation",
+                 "--reference-weight", "10", "--people-weight", "10"]) == 2
+    assert "--people-weight: people's joint angles and the start stride's technique" in (
+        capsys.readouterr().err)
     assert not (tmp_path / "c").exists()  # refused before any output
 
 

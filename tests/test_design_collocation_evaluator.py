@@ -63,8 +63,9 @@ def fake(monkeypatch):
 
 
 def _evaluator(tmp_path, **kw):
+    """The evaluator on seed 001's body, whose stride :data:`STRIDE` is."""
     return make_evaluator("collocation", start=str(STRIDE), solutions_dir=str(tmp_path / "s"),
-                          factor_ranges=RANGES, **kw)
+                          factor_ranges=RANGES, **{"body": "seed001", **kw})
 
 
 def test_each_design_wears_its_own_generated_blade(fake, tmp_path):
@@ -307,3 +308,37 @@ def test_a_design_tries_its_nearest_solved_neighbours_in_turn(fake, tmp_path):
         f"{ce.point_file_stem(solved[1])}.json", f"{ce.point_file_stem(solved[4])}.json"}
     assert ce.point_file_stem(CENTRE) in sources[2]
     assert STRIDE.name in sources[3] and STRIDE.name in sources[4] and calls[4]["track"]
+
+
+def test_the_human_body_with_peoples_angles(fake, tmp_path):
+    """On the human body the evaluator's model spec says so and people's joint angles are in
+    the objective at the body's weight; seed 001's body (the default) runs without them; a
+    technique reference replaces people's angles, and asking for both is refused; the human
+    body has no built-in start, so it needs one."""
+    from bladelab.predict.collocation.settings import PEOPLE_REFERENCE
+    from bladelab.predict.defaults import PEOPLE_WEIGHT_PER_RAD2
+
+    calls, _ = fake
+    human = make_evaluator("collocation", start=str(STRIDE), solutions_dir=str(tmp_path / "h"),
+                           body="human")
+    human(CENTRE)
+    assert calls[-1]["spec"]["body"] == "human"
+    assert "mtp_angle_l" in calls[-1]["dofs"]  # the human body's toe
+    assert calls[-1]["reference"][:2] == (PEOPLE_REFERENCE, PEOPLE_WEIGHT_PER_RAD2)
+    assert human.to_dict()["people_weight"] == PEOPLE_WEIGHT_PER_RAD2
+    assert ce.CollocationEvaluator().body == ce.DEFAULT_BODY == "seed001"
+    assert ce.CollocationEvaluator().start_file == ce.DEFAULT_START
+    assert ce.DEFAULT_START.is_file()
+    _evaluator(tmp_path)(CENTRE)
+    assert "body" not in calls[-1]["spec"] and calls[-1]["reference"][1] == 0.0
+    kept = _evaluator(tmp_path, body="human", reference_weight=5.0)
+    assert kept.settings().reference == str(STRIDE) and kept.people_weight_per_rad2 == 0.0
+    with pytest.raises(SpecError, match="one weight") as err:
+        _evaluator(tmp_path, body="human", reference_weight=5.0, people_weight=10.0)
+    assert err.value.where == "people_weight"
+    with pytest.raises(SpecError, match="unknown body") as err:
+        _evaluator(tmp_path, body="robot")
+    assert err.value.where == "body"
+    with pytest.raises(SpecError, match="no built-in start stride") as err:
+        make_evaluator("collocation", body="human")
+    assert err.value.where == "body"

@@ -226,3 +226,41 @@ def test_contours_cross_out_runs_without_a_result(tmp_path):
         SPACE.point(res.design.coded[0])["stiffness_kN_per_m"])
     plain = contour_plot(surface, SPACE, x="stiffness_kN_per_m", y="toe_length_m")
     assert not [ln for ln in plain.axes[0].get_lines() if "failed" in ln.get_label()]
+
+
+class _Described:
+    """A cheap evaluator with settings (as the built-in ones write to evaluator.json)."""
+
+    LEGACY_SETTINGS = {"body": "seed001"}
+
+    def __init__(self, **settings):
+        self.settings = settings
+
+    def to_dict(self):
+        return dict(self.settings)
+
+    def __call__(self, point):
+        return _evaluator(point)
+
+
+def test_a_study_resumes_only_with_the_evaluator_that_made_its_runs(tmp_path):
+    """Finished runs are reused only by the evaluator that made them: another setting is
+    refused naming it (where results are kept may change); a setting the study's file predates
+    counts as the evaluator's legacy value."""
+    run_design(SPACE, evaluator=_Described(speed_mps=4.0, solutions_dir="a", body="human"),
+               out_dir=tmp_path, progress=False)
+    with pytest.raises(SpecError, match=r"another evaluator \(speed_mps: 4.0 -> 5.0\)"):
+        run_design(SPACE, evaluator=_Described(speed_mps=5.0, solutions_dir="a", body="human"),
+                   out_dir=tmp_path, progress=False)
+    res = run_design(SPACE, evaluator=_Described(speed_mps=4.0, solutions_dir="b",
+                                                 body="human"),
+                     out_dir=tmp_path, progress=False)
+    assert res.n_resumed == res.design.n_runs
+    (tmp_path / "evaluator.json").write_text(json.dumps({"speed_mps": 4.0}))  # before bodies
+    with pytest.raises(SpecError, match="body: 'seed001' -> 'human'"):
+        run_design(SPACE, evaluator=_Described(speed_mps=4.0, body="human"), out_dir=tmp_path,
+                   progress=False)
+    (tmp_path / "evaluator.json").write_text(json.dumps({"speed_mps": 4.0}))
+    again = run_design(SPACE, evaluator=_Described(speed_mps=4.0, body="seed001"),
+                       out_dir=tmp_path, progress=False)
+    assert again.n_resumed == again.design.n_runs

@@ -43,7 +43,8 @@ OPTIONS = {
     "motion_model": "--motion-model", "start": "--start",
     "knee_moment_min_Nm": "--knee-moment-min",
     "knee_flexion_max_loaded_deg": "--knee-flexion-max",
-    "reference_weight": "--reference-weight",
+    "reference_weight": "--reference-weight", "body": "--body",
+    "people_weight": "--people-weight",
 }
 _FACTORS = ",".join(f"{name}={low:g}:{high:g}" for name, low, high, *_ in defaults.DESIGN_FACTORS)
 
@@ -197,6 +198,16 @@ def _design(
              "stride's, this weight [1/rad²] × their mean squared deviation added to the "
              "objective: every blade run with the same technique (docs/design.md; default 0: "
              "the gait predicted freely)."),
+    body: str | None = typer.Option(
+        None, "--body", rich_help_panel=COLLOCATION, show_default=False,
+        help="The runner body: seed001 (the default: seed 001's body) or human (predict's "
+             "default body; needs --start, a clean transfemoral stride of it)."),
+    people_weight: float | None = typer.Option(
+        None, "--people-weight", rich_help_panel=COLLOCATION, show_default=False,
+        help="Weight [1/rad²] of people's measured hip, knee and ankle angles in every "
+             "design's objective (the intact leg and the residual hip; a tracking term of "
+             "measured running, docs/collocation.md). Default: 10 on the human body, 0 on "
+             "seed001 and with --reference-weight; 0: the gait predicted freely."),
     settle: int = typer.Option(
         0, "--settle", rich_help_panel=COLLOCATION,
         help="After the runs, up to this many settling passes (each design solved again from "
@@ -246,7 +257,7 @@ def _design(
             kind=evaluator, speed_mps=speed, body_mass_kg=body_mass, dt_s=dt, base=base,
             gait=gait, motion=motion, motion_model=motion_model, start=start,
             knee_moment_min_Nm=knee_moment_min, knee_flexion_max_loaded_deg=knee_flexion_max,
-            reference_weight=reference_weight)
+            reference_weight=reference_weight, body=body, people_weight=people_weight)
     except BladelabError as err:
         raise renamed(err, OPTIONS) from None
     design = doe.make_design(runs, space, n_runs=n_runs, model=model, seed=seed)

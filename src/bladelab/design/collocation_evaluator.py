@@ -30,7 +30,7 @@ import time
 from collections.abc import Callable, Mapping
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, ClassVar
 
 from tqdm.auto import tqdm
 
@@ -40,13 +40,15 @@ from bladelab.design.predicted import stride_responses
 from bladelab.design.responses import PREDICTED_RESPONSE_UNITS
 from bladelab.errors import InputFileError, OptimizationError, SpecError
 from bladelab.executors import make_executor
-from bladelab.predict.collocation.settings import CollocationSettings
+from bladelab.predict import defaults as predict_defaults
+from bladelab.predict.collocation.settings import CollocationSettings, people_term
 from bladelab.predict.collocation.solution import CollocationSolution
 from bladelab.predict.collocation.solve import predict_stride
 from bladelab.predict.collocation.stored import check_model_spec, runner_from_spec
+from bladelab.runner.params import BODIES
 
-__all__ = ["CollocationEvaluator", "DEFAULT_DESIGN_SPEED_MPS", "REFERENCE_DOFS", "settle_strides",
-           "stride_checks"]
+__all__ = ["CollocationEvaluator", "DEFAULT_BODY", "DEFAULT_DESIGN_SPEED_MPS", "DEFAULT_STARTS",
+           "REFERENCE_DOFS", "settle_strides", "stride_checks"]
 
 #: Prescribed speed of a design's stride [m/s] (our choice, docs/design.md "Predicted
 #: transfemoral gaits"): the transfemoral runner's maximum speed on collocation is 5.6–5.8 m/s
@@ -54,11 +56,19 @@ __all__ = ["CollocationEvaluator", "DEFAULT_DESIGN_SPEED_MPS", "REFERENCE_DOFS",
 #: the speed of the clean multi-link stride the first design starts from (2026-11-26: the
 #: continuations to 4.5 and 5 m/s were not finished).
 DEFAULT_DESIGN_SPEED_MPS = defaults.COLLOCATION_SPEED_MPS
-#: The start of the first design: a clean transfemoral stride wearing the default box's centre
-#: blade at :data:`DEFAULT_DESIGN_SPEED_MPS`, its joints by backward Euler (how it was made:
-#: benchmarks/collocation/transfemoral-2026-11-26/multilink_centre.py).
-DEFAULT_START = Path(__file__).resolve().parents[1] / "data" / "runner" / "collocation" / (
-    "transfemoral-design-centre-4.json")
+_STRIDES = Path(__file__).resolve().parents[1] / "data" / "runner" / "collocation"
+#: The start of the first design by runner body: a clean transfemoral stride wearing the
+#: default box's centre blade at :data:`DEFAULT_DESIGN_SPEED_MPS`, its joints by backward
+#: Euler (how it was made: ``data/runner/collocation/README.md``). The human body has none
+#: yet: from five starts (seed 001's centre stride; the human transfemoral runner's clean
+#: sphere-blade stride, with and without a tracking stage, by either rule) the multi-link blade
+#: never landed (measured: benchmarks/design/README.md), so a study on it needs ``start``.
+DEFAULT_STARTS = {"seed001": _STRIDES / "transfemoral-design-centre-4.json"}
+#: The runner body of the design studies: seed 001's until the human body has a start stride
+#: (:data:`DEFAULT_STARTS`); ``body="human"`` with a ``start`` of that body runs on it.
+DEFAULT_BODY = "seed001"
+#: The start of the first design on :data:`DEFAULT_BODY`.
+DEFAULT_START = DEFAULT_STARTS[DEFAULT_BODY]
 #: Factor on the generated blade's sole contact stiffness (its damping by the square root, the
 #: damping ratio kept) in the design's runner, forward and collocation alike (our choice,
 #: measured 2026-11-26, docs/design.md): with the generator's 10⁶ N/m soles the transfemoral
@@ -102,7 +112,11 @@ class CollocationEvaluator:
         Prescribed mean speed of the stride [m/s].
     start
         A collocation solution (file) of the transfemoral runner to start the first design
-        from (any blade with the same number of links); default :data:`DEFAULT_START`.
+        from (any blade with the same number of links); default the body's
+        (:data:`DEFAULT_STARTS`).
+    body
+        The runner body: ``"seed001"`` (:data:`DEFAULT_BODY`) or ``"human"`` (predict's
+        default body; needs a ``start`` of it, :data:`DEFAULT_STARTS`).
     solutions_dir
         Folder of the designs' strides (the warm starts of the later designs); None: a
         ``strides`` folder is not kept and every design starts from ``start``.
@@ -132,6 +146,12 @@ class CollocationEvaluator:
         objective (``CollocationSettings.reference_weight``), so that every blade is run with
         the same technique and its responses are the blade's (seed 002 imposed measured
         kinematics); 0 (default): the gait is predicted freely.
+    people_weight
+        Weight [1/rad²] of people's joint angles in the objective (the intact leg's hip, knee
+        and ankle and the residual hip; ``CollocationSettings(reference="people")``,
+        docs/collocation.md); None: the body's default
+        (:func:`bladelab.predict.defaults.people_weight_for`: 10 on the human body, 0 on
+        seed 001's), 0 with a ``reference_weight`` (the two terms exclude each other).
     generator
         Options of :func:`~bladelab.design.blade_generator.generate_blade`.
     """
@@ -148,9 +168,27 @@ class CollocationEvaluator:
     blade_backward_euler: bool = True
     sole_stiffness_scale: float = DEFAULT_SOLE_STIFFNESS_SCALE
     reference_weight: float = 0.0
+    body: str = DEFAULT_BODY
+    people_weight: float | None = None
     generator: Mapping[str, Any] = field(default_factory=dict)
 
+    #: What a study's ``evaluator.json`` written before a setting existed meant by it: the
+    #: studies before the human body ran seed 001's body without people's angles.
+    LEGACY_SETTINGS: ClassVar[dict[str, Any]] = {"body": "seed001", "people_weight": 0.0}
+
     def __post_init__(self) -> None:
+        if self.body not in BODIES:
+            raise SpecError(f"unknown body {self.body!r}", where="body", hint=" or ".join(BODIES))
+        if self.start is None and self.body not in DEFAULT_STARTS:
+            raise SpecError(f"no built-in start stride of the transfemoral runner on the "
+                            f"{self.body} body", where="body",
+                            hint="give the first design's start: a clean transfemoral stride "
+                                 "of that body (a collocation solution file)")
+        if self.reference_weight and self.people_weight:
+            raise SpecError("people's joint angles and the start stride's technique are two "
+                            "references of one objective term: give one weight",
+                            where="people_weight", hint="people_weight 0 with a "
+                                                        "reference_weight")
         self.settings()  # speed, mesh, clearance, knee moment: errors name the field
         if not (self.sole_stiffness_scale > 0 and math.isfinite(self.sole_stiffness_scale)):
             raise SpecError(f"sole_stiffness_scale must be > 0, got {self.sole_stiffness_scale}",
@@ -162,8 +200,17 @@ class CollocationEvaluator:
 
     @property
     def start_file(self) -> Path:
-        """The first design's start (and the reference): ``start``, else :data:`DEFAULT_START`."""
-        return Path(self.start) if self.start is not None else DEFAULT_START
+        """The first design's start (and the reference): ``start``, else the body's
+        (:data:`DEFAULT_STARTS`)."""
+        return Path(self.start) if self.start is not None else DEFAULT_STARTS[self.body]
+
+    @property
+    def people_weight_per_rad2(self) -> float:
+        """The weight [1/rad²] of people's joint angles in every design's objective
+        (``people_weight``, else the body's default; 0 with a ``reference_weight``)."""
+        if self.reference_weight:
+            return 0.0
+        return float(predict_defaults.people_weight_for(self.body, self.people_weight))
 
     @property
     def units(self) -> dict[str, str]:
@@ -174,7 +221,9 @@ class CollocationEvaluator:
         d["generator"] = {k: str(v) if isinstance(v, Path) else v
                           for k, v in dict(self.generator).items()}
         d["factor_ranges"] = {k: list(v) for k, v in dict(self.factor_ranges).items()}
-        d["start"] = str(self.start) if self.start else f"built-in {DEFAULT_START.name}"
+        d["start"] = (str(self.start) if self.start
+                      else f"built-in {DEFAULT_STARTS[self.body].name}")
+        d["people_weight"] = self.people_weight_per_rad2
         return {"evaluator": "collocation", **d}
 
     # -- starts ---------------------------------------------------------------------------
@@ -246,7 +295,7 @@ class CollocationEvaluator:
     def settings(self):
         """The :class:`~bladelab.predict.collocation.settings.CollocationSettings` of every
         design's stride (checked when the evaluator is made)."""
-        reference = {}
+        reference = people_term(self.people_weight_per_rad2)
         if self.reference_weight:
             reference = {"reference": str(self.start_file),
                          "reference_weight": self.reference_weight,
@@ -262,7 +311,8 @@ class CollocationEvaluator:
     def _problem(self, point: Mapping[str, float]) -> tuple[dict, Any]:
         """(model specification with the design's blade, collocation settings) of a design."""
         blade = self.blade_spec(point)
-        return ({"model": "transfemoral", "blade": blade["name"], "blade_spec": blade},
+        return (check_model_spec({"model": "transfemoral", "blade": blade["name"],
+                                  "blade_spec": blade, "body": self.body}),
                 self.settings())
 
     def blade_spec(self, point: Mapping[str, float]) -> dict:

@@ -36,6 +36,8 @@ APPLIES_TO: dict[str, tuple[str, ...]] = {
     "knee_moment_min_Nm": ("collocation",),
     "knee_flexion_max_loaded_deg": ("collocation",),
     "reference_weight": ("collocation",),
+    "body": ("collocation",),
+    "people_weight": ("collocation",),
 }
 
 
@@ -67,6 +69,9 @@ class EvaluatorSettings:
         smallest extension moment [N·m], its largest flexion while loaded [deg], and the
         weight [1/rad²] that keeps the athlete's own joints near the start stride's
         (:class:`~bladelab.design.collocation_evaluator.CollocationEvaluator`).
+    body, people_weight
+        Collocation: the runner body (``"human"``, the default, or ``"seed001"``) and the
+        weight [1/rad²] of people's joint angles in the objective (default: the body's).
     """
 
     kind: str = "blade"
@@ -81,6 +86,8 @@ class EvaluatorSettings:
     knee_moment_min_Nm: float | None = None
     knee_flexion_max_loaded_deg: float | None = None
     reference_weight: float | None = None
+    body: str | None = None
+    people_weight: float | None = None
 
     def __post_init__(self) -> None:
         if self.kind not in EVALUATORS:
@@ -113,7 +120,7 @@ class EvaluatorSettings:
             if self.start is not None:
                 options["start"] = str(self.start)
             for name in ("knee_moment_min_Nm", "knee_flexion_max_loaded_deg",
-                         "reference_weight"):
+                         "reference_weight", "body", "people_weight"):
                 if getattr(self, name) is not None:
                     options[name] = getattr(self, name)
         elif self.body_mass_kg is not None:

@@ -34,7 +34,7 @@ import numpy as np
 import pandas as pd
 from tqdm.auto import tqdm
 
-from bladelab._io import atomic_path, write_json
+from bladelab._io import atomic_path, read_json, write_json
 from bladelab.design import defaults
 from bladelab.design.doe import Design, EstimabilityReport, make_design, require_estimable
 from bladelab.design.motion import check_motion_factors
@@ -152,6 +152,31 @@ def _read_run(path: Path, coded: np.ndarray) -> dict[str, float] | None:
             hint="use a new output folder, or delete its runs/ folder to start over",
         )
     return responses
+
+
+#: Evaluator settings that say where results are kept, not what they are: a resumed study
+#: may change them.
+_WHERE_NOT_WHAT = ("solutions_dir",)
+
+
+def _check_same_evaluator(out: Path, evaluator) -> None:
+    """Refuse to resume a folder whose finished runs came from another evaluator (its
+    ``evaluator.json`` differs in a setting that changes the responses). A setting the file
+    predates counts as the evaluator's ``LEGACY_SETTINGS`` value (e.g. seed 001's body)."""
+    path = out / "evaluator.json"
+    if not (hasattr(evaluator, "to_dict") and path.is_file()
+            and any((out / "runs").glob("run_*.json"))):
+        return
+    old = read_json(path, what="evaluator settings")
+    new = json.loads(json.dumps(evaluator.to_dict()))
+    legacy = getattr(evaluator, "LEGACY_SETTINGS", {})
+    differ = sorted(k for k, v in new.items() if k not in _WHERE_NOT_WHAT
+                    and (old[k] if k in old else legacy.get(k, v)) != v)
+    if differ:
+        shown = "; ".join(f"{k}: {old.get(k, legacy.get(k))!r} -> {new[k]!r}" for k in differ)
+        raise SpecError(f"the output folder holds runs of another evaluator ({shown})",
+                        file=path, hint="resume with the same settings, or use a new output "
+                                        "folder")
 
 
 def evaluate_design_run(payload: dict) -> dict:
@@ -311,6 +336,7 @@ def run_design(
         "motion": None if motion is None else "motion.json",
     }
     out.mkdir(parents=True, exist_ok=True)
+    _check_same_evaluator(out, evaluator)
     write_json(out / "study.json", meta)
     if hasattr(evaluator, "to_dict"):
         write_json(out / "evaluator.json", evaluator.to_dict())
