@@ -335,10 +335,12 @@ def evaluate_trends(
 
 def _not_tested(verdict: TrendVerdict, evaluator: str) -> TrendVerdict:
     """``verdict`` from an evaluator without a runner: "not tested", the evidence kept, the
-    reason saying what the evaluator is (and the blade's known mechanism, if any)."""
+    reason saying what the evaluator is (and, where the blade's response lacks the seed's
+    sign, the mechanism known for it)."""
     if verdict.verdict == "not estimable":
         return verdict
-    mechanism = TREND_REASONS.get((evaluator, verdict.key), "")
+    mechanism = (TREND_REASONS.get((evaluator, verdict.key), "")
+                 if verdict.verdict == "does not hold" else "")  # why it lacks the sign
     sign = {"holds": "the blade's response has the seed's sign",
             "does not hold": "the blade's response lacks the seed's sign"}[verdict.verdict]
     reason = NO_RUNNER[evaluator] + (f" {mechanism}" if mechanism else "")

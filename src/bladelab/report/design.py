@@ -370,13 +370,18 @@ def trends_section(surfaces, evaluator: dict | None = None) -> dict[str, Any]:
         held["knee_moment_min_Nm"] = (f"held at or above {evaluator['knee_moment_min_Nm']:g} "
                                       "N·m on every loaded interval by the solve")
     verdicts = evaluate_trends(surfaces, evaluator=kind, roles=roles, held=held)
-    if kind in NO_RUNNER:
+    if kind in NO_RUNNER:  # every verdict "not tested": the section says why, once
+        frame = trends_frame(verdicts)
+        frame["the blade's mechanism"] = [r.removeprefix(NO_RUNNER[kind]).strip()
+                                          for r in frame["reason"]]
         return {"title": "Seed 002 trends", "text": (
                     f"{NO_RUNNER[kind]} The table gives, for each of seed 002's trends, the "
-                    "blade's own coefficient or effect ranges on this study's surfaces: a "
-                    "description of the blade, not a verdict on the trend."),
+                    "blade's own coefficient or effect ranges on this study's surfaces (and the "
+                    "mechanism behind them where one is known): a description of the blade, "
+                    "not a verdict on the trend."),
                 "tables": [("Seed 002 trends: not tested by this evaluator",
-                            trends_frame(verdicts))]}
+                            frame[["trend", "response", "evidence",
+                                   "the blade's mechanism"]])]}
     counts = {v: sum(1 for x in verdicts if x.verdict == v)
               for v in ("holds", "does not hold", "not estimable")}
     text = (f"The trends seed 002 reports, checked on this study's fitted surfaces "
