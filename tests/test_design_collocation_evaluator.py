@@ -63,9 +63,8 @@ def fake(monkeypatch):
 
 
 def _evaluator(tmp_path, **kw):
-    """The evaluator on seed 001's body, whose stride :data:`STRIDE` is."""
     return make_evaluator("collocation", start=str(STRIDE), solutions_dir=str(tmp_path / "s"),
-                          factor_ranges=RANGES, **{"body": "seed001", **kw})
+                          factor_ranges=RANGES, **kw)
 
 
 def test_each_design_wears_its_own_generated_blade(fake, tmp_path):

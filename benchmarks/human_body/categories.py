@@ -7,9 +7,10 @@ Usage (repository root)::
 
 Per category (Cat4, Cat5, Cat6, Cat6High, Cat7), up to five starts: ``trial`` (with
 ``--trial``: the measured 3.5 m/s stride scaled to the speed, through the tracking stage),
-``shipped`` (the packaged Cat6 stride at 4 m/s, ``data/runner/collocation/amputee-Cat6-4-human.json``,
-with IPOPT's barrier started at 1e-4), ``fast`` (the category's own 5 m/s stride of the committed
-category study, :data:`FAST`, its primal values), ``neighbour`` (the kept stride of the next stiffer category, or of Cat6 for
+``shipped`` (the packaged Cat6 stride at 4 m/s,
+``data/runner/collocation/amputee-Cat6-4-human.json``, with IPOPT's barrier started at 1e-4),
+``fast`` (the category's own 5 m/s stride of the committed category study, :data:`FAST`, its
+primal values), ``neighbour`` (the kept stride of the next stiffer category, or of Cat6 for
 Cat7, barrier 1e-4) once the first starts have run everywhere, and ``best`` (the kept stride of
 the category whose kept objective is the lowest, barrier 1e-4) once the neighbours have run,
 for every other category.

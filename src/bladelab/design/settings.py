@@ -70,8 +70,9 @@ class EvaluatorSettings:
         weight [1/rad²] that keeps the athlete's own joints near the start stride's
         (:class:`~bladelab.design.collocation_evaluator.CollocationEvaluator`).
     body, people_weight
-        Collocation: the runner body (``"human"``, the default, or ``"seed001"``) and the
-        weight [1/rad²] of people's joint angles in the objective (default: the body's).
+        Collocation: the runner body (``"seed001"``, the default, or ``"human"`` with a
+        ``start`` of it) and the weight [1/rad²] of people's joint angles in the objective
+        (default: the body's).
     """
 
     kind: str = "blade"
