@@ -87,8 +87,10 @@ def test_an_evaluator_without_a_runner_tests_no_trend(table):
     assert all(sign in x.evidence for x in v.values())
     if table is REVERSED:  # the blade's mechanism where its response lacks the sign
         assert "cannot push off" in v["stiffness_increases_dvx"].reason
+        assert "cannot push off" in v["stiffness_increases_dvx"].mechanism
+        assert NO_RUNNER["blade"] not in v["stiffness_increases_dvx"].mechanism
     else:
-        assert all(x.reason == NO_RUNNER["blade"] for x in v.values())
+        assert all(x.reason == NO_RUNNER["blade"] and x.mechanism == "" for x in v.values())
     assert v["longer_toe_lowers_clearance"].reason == NO_RUNNER["blade"]
 
 
@@ -138,7 +140,8 @@ def test_roles_map_other_factor_names():
                                      "toe_length": "toe"})
     assert all(x.verdict == "holds" for x in v)
     frame = trends_frame(v)
-    assert list(frame.columns) == ["trend", "response", "verdict", "evidence", "test", "reason"]
+    assert list(frame.columns) == ["trend", "response", "verdict", "evidence", "test", "reason",
+                                   "mechanism"]
 
 
 def test_report_has_the_trends_section(tmp_path):

@@ -201,6 +201,9 @@ class TrendVerdict:
         The numbers behind it (coefficients per coded unit with p-values, or effect ranges).
     reason
         Why it does not hold, or why it is not tested (empty otherwise).
+    mechanism
+        For a trend not tested: the mechanism known for the blade's own response where it
+        lacks the seed's sign (also in ``reason``; empty otherwise).
     estimate, p_value
         Linear coefficient per coded unit and its p-value (sign tests; NaN otherwise).
     """
@@ -212,6 +215,7 @@ class TrendVerdict:
     verdict: str
     evidence: str
     reason: str = ""
+    mechanism: str = ""
     estimate: float = math.nan
     p_value: float = math.nan
 
@@ -345,11 +349,13 @@ def _not_tested(verdict: TrendVerdict, evaluator: str) -> TrendVerdict:
             "does not hold": "the blade's response lacks the seed's sign"}[verdict.verdict]
     reason = NO_RUNNER[evaluator] + (f" {mechanism}" if mechanism else "")
     return dataclasses.replace(verdict, verdict="not tested",
-                               evidence=f"{verdict.evidence} ({sign})", reason=reason)
+                               evidence=f"{verdict.evidence} ({sign})", reason=reason,
+                               mechanism=mechanism)
 
 
 def trends_frame(verdicts: list[TrendVerdict]) -> pd.DataFrame:
-    """Tidy table: trend, response, verdict, evidence, test, reason."""
+    """Tidy table: trend, response, verdict, evidence, test, reason, mechanism."""
     return pd.DataFrame([{"trend": v.statement, "response": v.response, "verdict": v.verdict,
-                          "evidence": v.evidence, "test": v.test, "reason": v.reason}
+                          "evidence": v.evidence, "test": v.test, "reason": v.reason,
+                          "mechanism": v.mechanism}
                          for v in verdicts])

@@ -371,9 +371,7 @@ def trends_section(surfaces, evaluator: dict | None = None) -> dict[str, Any]:
                                       "N·m on every loaded interval by the solve")
     verdicts = evaluate_trends(surfaces, evaluator=kind, roles=roles, held=held)
     if kind in NO_RUNNER:  # every verdict "not tested": the section says why, once
-        frame = trends_frame(verdicts)
-        frame["the blade's mechanism"] = [r.removeprefix(NO_RUNNER[kind]).strip()
-                                          for r in frame["reason"]]
+        frame = trends_frame(verdicts).rename(columns={"mechanism": "the blade's mechanism"})
         return {"title": "Seed 002 trends", "text": (
                     f"{NO_RUNNER[kind]} The table gives, for each of seed 002's trends, the "
                     "blade's own coefficient or effect ranges on this study's surfaces (and the "
@@ -392,7 +390,8 @@ def trends_section(surfaces, evaluator: dict | None = None) -> dict[str, Any]:
             "coded interval. A trend that does not hold gives the reason known for this "
             "evaluator (docs/design.md), or says it is not explained.")
     return {"title": "Seed 002 trends", "text": text,
-            "tables": [("Seed 002 trends on this study", trends_frame(verdicts))]}
+            "tables": [("Seed 002 trends on this study",
+                        trends_frame(verdicts).drop(columns="mechanism"))]}
 
 
 def build_design_report(design_dir: str | Path, out_dir: str | Path | None = None) -> Path:
