@@ -456,6 +456,55 @@ def test_a_locally_infeasible_tracking_stage_is_solved_again_from_its_iterate(ab
     assert len(calls) == 1 and "restarted_after" not in out.tracking
 
 
+def test_a_predictive_stage_stalled_at_a_feasible_point_is_polished(able, monkeypatch):
+    # the control flow: IPOPT's statuses and violations are relabelled per call
+    from bladelab.predict.collocation.transcription import StrideNLP
+
+    runner, _, sol = able
+    calls, labels = [], []
+    solve = StrideNLP.solve
+
+    def fake(self, x0, **kw):
+        out = solve(self, x0, **kw)
+        label = labels[len(calls)] if len(calls) < len(labels) else None
+        if label is not None:
+            out = dataclasses.replace(out, success=label[0] == "Solve_Succeeded",
+                                      status=label[0], max_violation=label[1])
+        calls.append((kw, out))
+        return out
+
+    monkeypatch.setattr(StrideNLP, "solve", fake)
+    settings = CollocationSettings(mesh_intervals=6, speed_m_per_s=SPEED, max_iter=3,
+                                   polish_iter=4)
+    stalled = ("Maximum_Iterations_Exceeded", 1e-9)
+    labels[:] = [stalled, ("Solve_Succeeded", 1e-9)]
+    out = predict_stride(runner, settings, sol.to_guess(), model_spec={"model": "able"})
+    assert len(calls) == 2  # the predictive stage, then the polish
+    (_, first), (kw, polished) = calls
+    assert kw["hessian"] == "exact" and kw["max_iter"] == 4
+    assert kw["multipliers"] is first.multipliers  # from the stalled iterate's duals
+    assert out.converged and out.nlp.status == "Solve_Succeeded"
+    assert out.nlp.iterations == first.iterations + polished.iterations
+    assert out.nlp.timings["polished"] == 1.0
+    assert out.nlp.timings["polish_iterations"] == polished.iterations
+    # a polish that does not converge returns the stalled iterate, the polish counted
+    calls.clear()
+    labels[:] = [stalled, ("Maximum_Iterations_Exceeded", 1e-9)]
+    out = predict_stride(runner, settings, sol.to_guess(), model_spec={"model": "able"})
+    assert len(calls) == 2 and not out.converged
+    assert out.nlp.objective == calls[0][1].objective and out.nlp.timings["polished"] == 0.0
+    # no polish: an infeasible stall, polish_iter 0, or a stage already on the exact Hessian
+    for label, changed in ((("Maximum_Iterations_Exceeded", 1e-3), {}),
+                           (stalled, {"polish_iter": 0}), (stalled, {"hessian": "exact"})):
+        calls.clear()
+        labels[:] = [label]
+        out = predict_stride(runner, dataclasses.replace(settings, **changed), sol.to_guess(),
+                             model_spec={"model": "able"})
+        assert len(calls) == 1 and "polished" not in out.nlp.timings, (label, changed)
+    with pytest.raises(SpecError, match="iterations"):
+        CollocationSettings(polish_iter=-1)
+
+
 def test_warm_start_mu_sets_the_barrier_of_a_warm_start_only(able, monkeypatch):
     from bladelab.predict.collocation.transcription import StrideNLP
 

@@ -19,6 +19,7 @@ __all__ = [
     "INTEGRATOR",
     "LEAN_WEIGHT_PER_DEG",
     "MAX_ITER",
+    "POLISH_ITER",
     "MESH_INTERVALS",
     "METHOD",
     "PEOPLE_WEIGHT_PER_RAD2",
@@ -97,6 +98,9 @@ RECIPE_SEEDS = (1, 2, 3)
 MESH_INTERVALS = 50
 #: IPOPT's iteration limit per stage (``CollocationSettings.max_iter``).
 MAX_ITER = 3000
+#: IPOPT's iteration limit of the exact-Hessian polish of a predictive stage that ran out of
+#: iterations at a feasible point (``CollocationSettings.polish_iter``; 0: no polish).
+POLISH_ITER = 500
 #: The runner's body: ``human`` (published gait-model properties, docs/runner-model.md, "The
 #: human body"); ``seed001`` reproduces seed 001's model, ``toes`` is it with a toe segment and
 #: compliant Achilles tendons.

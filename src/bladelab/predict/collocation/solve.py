@@ -22,6 +22,14 @@ multipliers starts the predictive stage from its primal and dual values (IPOPT's
 :data:`~bladelab.predict.collocation.transcription.DUAL_WARM_START_OPTIONS`): a solution
 solved again ends at once, a continuation step stays on its start's branch.
 
+A predictive stage on L-BFGS that runs out of iterations at a feasible point is **polished**:
+solved on from its last iterate and multipliers with the exact Hessian (stage ``"polish"``,
+:attr:`~bladelab.predict.collocation.settings.CollocationSettings.polish_iter` iterations), and
+the polished stride is kept if it converges. L-BFGS can stand thousands of iterations on a
+feasible stride without meeting the optimality tolerance, where the exact Hessian, useless far
+from a solution, finishes in about a hundred (measured: docs/collocation.md). The solution's
+``timings`` record the polish.
+
 The tracking stage is skipped when ``track_first`` is False or the guess is itself a
 collocation solution (its ``source`` starts with :data:`COLLOCATION_SOURCE`, as
 :meth:`~bladelab.predict.collocation.solution.CollocationSolution.to_guess` and
@@ -58,7 +66,11 @@ from bladelab.errors import InputFileError, SpecError
 from bladelab.predict.collocation.dynamics import stride_dynamics
 from bladelab.predict.collocation.model import build_collocation_model
 from bladelab.predict.collocation.people import PROSTHETIC_JOINTS, people_reference
-from bladelab.predict.collocation.settings import PEOPLE_REFERENCE, CollocationSettings
+from bladelab.predict.collocation.settings import (
+    PEOPLE_REFERENCE,
+    POLISH_MAX_VIOLATION,
+    CollocationSettings,
+)
 from bladelab.predict.collocation.solution import CollocationSolution
 from bladelab.predict.collocation.stored import check_model_spec, describe_problem
 from bladelab.predict.collocation.stride_guess import COLLOCATION_SOURCE
@@ -189,6 +201,31 @@ def _solve_stage(nlp, x0: np.ndarray, settings: CollocationSettings, stage: str,
         progress(SolveProgress(stage, "end", sol.iterations, sol.objective, sol.max_violation,
                                time.perf_counter() - t0, sol.status))
     return sol
+
+
+def _stalled(sol, settings: CollocationSettings) -> bool:
+    """True for an L-BFGS stage that ran out of iterations at a feasible point
+    (:attr:`CollocationSettings.polish_iter`)."""
+    return (settings.polish_iter > 0 and settings.hessian == "limited-memory"
+            and sol.status == "Maximum_Iterations_Exceeded"
+            and sol.max_violation <= POLISH_MAX_VIOLATION and sol.multipliers is not None)
+
+
+def _polish(nlp, sol, settings: CollocationSettings,
+            progress: Callable[[SolveProgress], None] | None, speed: float | None):
+    """Solve ``nlp`` on from a stalled stage's last iterate and multipliers with the exact
+    Hessian (stage ``"polish"``, at most ``settings.polish_iter`` iterations). Returns the
+    polished solution if it converged, else ``sol``; either way its ``timings`` count the
+    polish (``polish_iterations``, ``polish_s``, and ``polished`` 1 or 0) and its
+    ``iterations`` and ``wall_s`` are the two solves' together."""
+    exact = dataclasses.replace(settings, hessian="exact", max_iter=settings.polish_iter)
+    polished = _solve_stage(nlp, nlp.initial_vector(sol.to_guess("the stalled stage")), exact,
+                            "polish", progress, speed=speed, multipliers=sol.multipliers)
+    kept = polished if polished.success else sol
+    timings = {**kept.timings, "polish_iterations": float(polished.iterations),
+               "polish_s": float(polished.wall_s), "polished": float(polished.success)}
+    return dataclasses.replace(kept, iterations=sol.iterations + polished.iterations,
+                               wall_s=sol.wall_s + polished.wall_s, timings=timings)
 
 
 def _stage_info(sol) -> dict:
@@ -382,6 +419,8 @@ def predict_stride(runner, settings: CollocationSettings, guess, *, model_spec: 
     stage_speed = speed if speed is not None else (g.speed if warm else None)
     sol = _solve_stage(nlp_p, nlp_p.initial_vector(start), settings, "predictive", progress,
                        warm=warm_predictive, speed=stage_speed, multipliers=duals)
+    if _stalled(sol, settings):
+        sol = _polish(nlp_p, sol, settings, progress, stage_speed)
     return CollocationSolution.from_nlp(
         runner, sol, stage="predictive", tracking=tracking,
         metabolic_energy_J=nlp_p.energy_and_distance(sol)[0], reference_phase=phase,
