@@ -22,7 +22,7 @@ multipliers starts the predictive stage from its primal and dual values (IPOPT's
 :data:`~bladelab.predict.collocation.transcription.DUAL_WARM_START_OPTIONS`): a solution
 solved again ends at once, a continuation step stays on its start's branch.
 
-A predictive stage on L-BFGS that runs out of iterations at a feasible point is **polished**:
+A predictive stage on L-BFGS that runs out of iterations near a feasible point is **polished**:
 solved on from its last iterate and multipliers with the exact Hessian (stage ``"polish"``,
 :attr:`~bladelab.predict.collocation.settings.CollocationSettings.polish_iter` iterations), and
 the polished stride is kept if it converges. L-BFGS can stand thousands of iterations on a
@@ -204,8 +204,8 @@ def _solve_stage(nlp, x0: np.ndarray, settings: CollocationSettings, stage: str,
 
 
 def _stalled(sol, settings: CollocationSettings) -> bool:
-    """True for an L-BFGS stage that ran out of iterations at a feasible point
-    (:attr:`CollocationSettings.polish_iter`)."""
+    """True for an L-BFGS stage that ran out of iterations near a feasible point
+    (:attr:`CollocationSettings.polish_iter`, :data:`POLISH_MAX_VIOLATION`)."""
     return (settings.polish_iter > 0 and settings.hessian == "limited-memory"
             and sol.status == "Maximum_Iterations_Exceeded"
             and sol.max_violation <= POLISH_MAX_VIOLATION and sol.multipliers is not None)
