@@ -60,9 +60,9 @@ _STRIDES = Path(__file__).resolve().parents[1] / "data" / "runner" / "collocatio
 #: The start of the first design by runner body: a clean transfemoral stride wearing the
 #: default box's centre blade at :data:`DEFAULT_DESIGN_SPEED_MPS`, its joints by backward
 #: Euler (how it was made: ``data/runner/collocation/README.md``). The human body has none
-#: shipped: the multi-link blade landed only through a free stride, and at people's weight it
-#: bounds at 6.7 BW, as seed 001's start does (measured: benchmarks/design/README.md), so a
-#: study on it needs ``start``.
+#: shipped: its transfemoral runner's converged strides with the multi-link blade all bound
+#: (the stride time at its 0.40 s bound, 6–6.7 BW, people weights 10–100; measured:
+#: benchmarks/design/README.md), so a study on it needs ``start``.
 DEFAULT_STARTS = {"seed001": _STRIDES / "transfemoral-design-centre-4.json"}
 #: The runner body of the design studies: seed 001's until the human body has a start stride
 #: (:data:`DEFAULT_STARTS`); ``body="human"`` with a ``start`` of that body runs on it.
