@@ -416,71 +416,68 @@ def test_a_pelvis_tilt_range_bounds_every_node(able):
     assert bounded.settings.pelvis_tilt_range_deg == (lo, hi)
 
 
-def test_a_locally_infeasible_tracking_stage_is_solved_again_from_its_iterate(able, monkeypatch):
-    # the control flow of predict_stride: IPOPT's statuses are relabelled per call (a local
-    # infeasibility was seen on one host for the able template at 4 m/s)
+def _relabelled_solves(monkeypatch):
+    """Spy on every IPOPT solve of ``StrideNLP``: returns (calls, labels); each call appends
+    (nlp, x0, keywords, solution), and ``labels[i]`` (if given: ``(status, max_violation)``,
+    violation None to keep it) relabels the i-th call's solution, so a test can drive
+    predict_stride's control flow through any status."""
     from bladelab.predict.collocation.transcription import StrideNLP
 
-    runner, _, _ = able
-    calls, statuses = [], []
+    calls, labels = [], []
     solve = StrideNLP.solve
 
     def fake(self, x0, **kw):
         sol = solve(self, x0, **kw)
-        status = statuses[len(calls)] if len(calls) < len(statuses) else None
-        if status is not None:
-            sol = dataclasses.replace(sol, success=status == "Solve_Succeeded", status=status)
-        calls.append((np.asarray(x0).copy(), sol, self.initial_vector(sol.to_guess("x"))))
+        if len(calls) < len(labels):
+            status, violation = labels[len(calls)]
+            sol = dataclasses.replace(
+                sol, success=status == "Solve_Succeeded", status=status,
+                max_violation=sol.max_violation if violation is None else violation)
+        calls.append((self, np.asarray(x0).copy(), kw, sol))
         return sol
 
     monkeypatch.setattr(StrideNLP, "solve", fake)
+    return calls, labels
+
+
+def test_a_locally_infeasible_tracking_stage_is_solved_again_from_its_iterate(able, monkeypatch):
+    # the control flow of predict_stride (a local infeasibility was seen on one host for the
+    # able template at 4 m/s)
+    runner, _, _ = able
+    calls, labels = _relabelled_solves(monkeypatch)
     settings = CollocationSettings(mesh_intervals=6, speed_m_per_s=SPEED, max_iter=5)
     guess = template_guess(runner, speed=SPEED, n=6)
-    statuses[:] = ["Infeasible_Problem_Detected", "Solve_Succeeded"]
+    labels[:] = [("Infeasible_Problem_Detected", None), ("Solve_Succeeded", None)]
     out = predict_stride(runner, settings, guess, model_spec={"model": "able"})
     assert len(calls) == 3 and out.stage == "predictive"  # tracking, its restart, predictive
-    (_, first, first_iterate), (x_restart, restart, _), _ = calls
-    np.testing.assert_array_equal(x_restart, first_iterate)  # from the iterate, not the guess
+    (nlp, _, _, first), (_, x_restart, _, restart), _ = calls
+    # from the iterate, not the guess
+    np.testing.assert_array_equal(x_restart, nlp.initial_vector(first.to_guess("x")))
     assert out.tracking["restarted_after"] == "Infeasible_Problem_Detected"
     assert out.tracking["iterations"] == first.iterations + restart.iterations == 10
     # a second local infeasibility ends the solve: one restart, no loop
     calls.clear()
-    statuses[:] = ["Restoration_Failed", "Infeasible_Problem_Detected"]
+    labels[:] = [("Restoration_Failed", None), ("Infeasible_Problem_Detected", None)]
     out = predict_stride(runner, settings, guess, model_spec={"model": "able"})
     assert len(calls) == 2 and out.stage == "tracking" and not out.converged
     assert out.nlp.status == "Infeasible_Problem_Detected"
     # a tracking stage that runs out of iterations is not restarted
     calls.clear()
-    statuses[:] = ["Maximum_Iterations_Exceeded"]
+    labels[:] = [("Maximum_Iterations_Exceeded", None)]
     out = predict_stride(runner, settings, guess, model_spec={"model": "able"})
     assert len(calls) == 1 and "restarted_after" not in out.tracking
 
 
-def test_a_predictive_stage_stalled_at_a_feasible_point_is_polished(able, monkeypatch):
-    # the control flow: IPOPT's statuses and violations are relabelled per call
-    from bladelab.predict.collocation.transcription import StrideNLP
-
+def test_a_predictive_stage_stalled_near_a_feasible_point_is_polished(able, monkeypatch):
     runner, _, sol = able
-    calls, labels = [], []
-    solve = StrideNLP.solve
-
-    def fake(self, x0, **kw):
-        out = solve(self, x0, **kw)
-        label = labels[len(calls)] if len(calls) < len(labels) else None
-        if label is not None:
-            out = dataclasses.replace(out, success=label[0] == "Solve_Succeeded",
-                                      status=label[0], max_violation=label[1])
-        calls.append((kw, out))
-        return out
-
-    monkeypatch.setattr(StrideNLP, "solve", fake)
+    calls, labels = _relabelled_solves(monkeypatch)
     settings = CollocationSettings(mesh_intervals=6, speed_m_per_s=SPEED, max_iter=3,
                                    polish_iter=4)
     stalled = ("Maximum_Iterations_Exceeded", 1e-9)
     labels[:] = [stalled, ("Solve_Succeeded", 1e-9)]
     out = predict_stride(runner, settings, sol.to_guess(), model_spec={"model": "able"})
     assert len(calls) == 2  # the predictive stage, then the polish
-    (_, first), (kw, polished) = calls
+    (_, _, _, first), (_, _, kw, polished) = calls
     assert kw["hessian"] == "exact" and kw["max_iter"] == 4
     assert kw["multipliers"] is first.multipliers  # from the stalled iterate's duals
     assert out.converged and out.nlp.status == "Solve_Succeeded"
@@ -492,7 +489,7 @@ def test_a_predictive_stage_stalled_at_a_feasible_point_is_polished(able, monkey
     labels[:] = [stalled, ("Maximum_Iterations_Exceeded", 1e-9)]
     out = predict_stride(runner, settings, sol.to_guess(), model_spec={"model": "able"})
     assert len(calls) == 2 and not out.converged
-    assert out.nlp.objective == calls[0][1].objective and out.nlp.timings["polished"] == 0.0
+    assert out.nlp.objective == calls[0][3].objective and out.nlp.timings["polished"] == 0.0
     # no polish: an infeasible stall, polish_iter 0, or a stage already on the exact Hessian
     for label, changed in ((("Maximum_Iterations_Exceeded", 1e-3), {}),
                            (stalled, {"polish_iter": 0}), (stalled, {"hessian": "exact"})):
