@@ -110,7 +110,7 @@ def stride_start(lead: str) -> None:
     objective.initial_state = stride_state
     settings = objective.ObjectiveSettings(speed=4.0, initial_speed=3.5, duration=4.0,
                                            integrator="newmark", dt=1e-3)
-    print("activations at the start:", dict(zip(model.muscle_names, np.round(act, 2))))
+    print("activations at the start:", dict(zip(model.muscle_names, np.round(act, 2), strict=True)))
     for name, x in (("shipped", read_parameters(SHIPPED, layout, transfer=True)),
                     ("SCONE", layout.x0)):
         ev, res = objective.simulate_controlled(model, x, layout=layout, settings=settings,
