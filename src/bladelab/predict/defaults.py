@@ -19,10 +19,10 @@ __all__ = [
     "INTEGRATOR",
     "LEAN_WEIGHT_PER_DEG",
     "MAX_ITER",
-    "POLISH_ITER",
     "MESH_INTERVALS",
     "METHOD",
     "PEOPLE_WEIGHT_PER_RAD2",
+    "POLISH_ITER",
     "POPULATION_SIZE",
     "RECIPE_SEEDS",
     "REFLEX_BLADE",
@@ -99,7 +99,7 @@ MESH_INTERVALS = 50
 #: IPOPT's iteration limit per stage (``CollocationSettings.max_iter``).
 MAX_ITER = 3000
 #: IPOPT's iteration limit of the exact-Hessian polish of a predictive stage that ran out of
-#: iterations at a feasible point (``CollocationSettings.polish_iter``; 0: no polish).
+#: iterations near a feasible point (``CollocationSettings.polish_iter``; 0: no polish).
 POLISH_ITER = 500
 #: The runner's body: ``human`` (published gait-model properties, docs/runner-model.md, "The
 #: human body"); ``seed001`` reproduces seed 001's model, ``toes`` is it with a toe segment and
