@@ -72,6 +72,13 @@ def test_settings_round_trip_and_refuse_bad_values():
         with pytest.raises(SpecError) as err:
             CollocationSettings(pelvis_tilt_range_deg=bad)
         assert err.value.where == "pelvis_tilt_range_deg"
+    stepping = CollocationSettings(step_phase_tolerance=0.1)
+    assert not stepping.same_problem(CollocationSettings())
+    assert CollocationSettings.from_dict(json.loads(json.dumps(stepping.to_dict()))) == stepping
+    for bad in (0, 0.5, -0.1, math.nan, True, "0.1"):
+        with pytest.raises(SpecError) as err:
+            CollocationSettings(step_phase_tolerance=bad)
+        assert err.value.where == "step_phase_tolerance"
     with pytest.raises(SpecError, match="unknown setting"):
         CollocationSettings.from_dict({"mesh": 50})
     with pytest.raises(SpecError, match="unknown objective weight"):
@@ -225,7 +232,8 @@ def test_summary_has_the_issue_keys_per_model(able):
         "cost_of_transport_J_per_kg_m", "contact_time_s",
         *(f"contact_time_{leg}_s" for leg in legs),
         *(f"peak_vertical_grf_{leg}_bw" for leg in legs),
-        "flight_fraction", "dynamics_residual_pct", "iterations", "wall_s", "warnings"]
+        "flight_fraction", "step_phase", "dynamics_residual_pct", "iterations", "wall_s",
+        "warnings"]
     json.dumps(s, allow_nan=False)
     assert s["converged"] is True and s["mean_speed_mps"] == pytest.approx(SPEED)
     assert s["stride_time_s"] == pytest.approx(sol.nlp.period)
@@ -236,6 +244,7 @@ def test_summary_has_the_issue_keys_per_model(able):
     assert 0.05 < s["contact_time_left_s"] < sol.nlp.period
     assert s["contact_time_left_s"] == pytest.approx(s["contact_time_right_s"], rel=0.05)
     assert s["peak_vertical_grf_left_bw"] > 0.2 and 0.0 <= s["flight_fraction"] < 1.0
+    assert s["step_phase"] == pytest.approx(0.5, abs=0.05)
     assert s["cost_of_transport_J_per_kg_m"] > 0 and math.isfinite(s["dynamics_residual_pct"])
     fz = sol.leg_vertical_force()
     assert s["peak_vertical_grf_left_bw"] == pytest.approx(fz[:, 0].max() / runner.body_weight)

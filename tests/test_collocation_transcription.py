@@ -10,7 +10,7 @@ import pytest
 
 from bladelab.errors import SpecError
 from bladelab.predict.collocation.stride_guess import StrideGuess
-from bladelab.predict.collocation.transcription import StrideDynamics, StrideNLP
+from bladelab.predict.collocation.transcription import StrideDynamics, StrideNLP, step_phase
 
 M, G, K = 80.0, 9.81, 2.0e4  # kg, m/s², N/m
 
@@ -318,3 +318,71 @@ def test_the_maximum_speed_problem_keeps_at_least_the_speed_it_is_given():
     x0 = fastest.initial_vector(_bouncing_guess(10, 2.0))
     assert float(g(x0, 1.5)[rows[0]]) == pytest.approx(0.5 * 0.6, rel=1e-9)
     assert float(g(x0, 2.5)[rows[0]]) < 0.0
+
+
+def _two_stances(n: int, right_after: float, duty: float = 0.25) -> np.ndarray:
+    """Half-sine vertical forces [N] of two legs on n nodes: the left stance from 0, the right
+    one ``right_after`` of the stride later."""
+    t = np.arange(n) / n
+    out = np.zeros((n, 2))
+    for j, start in enumerate((0.0, right_after)):
+        s = (t - start) % 1.0
+        out[:, j] = np.where(s < duty, 1500.0 * np.sin(np.pi * s / duty), 0.0)
+    return out
+
+
+@pytest.mark.parametrize("right_after", [0.5, 0.15, 0.62, 0.9])
+def test_step_phase_is_the_delay_between_the_legs_stance_centres(right_after):
+    assert step_phase(_two_stances(200, right_after)) == pytest.approx(right_after, abs=1e-9)
+
+
+def test_alternation_constraint_admits_alternating_steps_and_rules_out_a_gallop():
+    """The constraint (≤ 0 to hold) is negative inside 0.5 ± tolerance, zero on its edges and
+    positive outside, whichever leg leads."""
+    from bladelab.predict.collocation.transcription import _alternation
+
+    n, bw, tol = 200, 700.0, 0.1
+
+    def g(right_after: float) -> float:
+        return float(_alternation(ca.DM(_two_stances(n, right_after).T), bw, tol))
+
+    assert g(0.5) < 0 and g(0.45) < 0 and g(0.58) < 0
+    assert g(0.4) == pytest.approx(0.0, abs=1e-6) and g(0.6) == pytest.approx(0.0, abs=1e-6)
+    assert g(0.15) > 0 and g(0.85) > 0 and g(0.3) > 0
+
+
+def test_the_nlp_holds_the_alternation_constraint_only_when_asked():
+    """``step_phase_tolerance`` adds one inequality on the node forces 0..n−1, bounded above
+    by 0; without it there is none; a tolerance outside (0, 0.5) or dynamics without the
+    legs' forces are refused."""
+    from bladelab.predict.collocation.transcription import _alternation
+
+    toy = _toy()
+    q, qd = ca.SX.sym("q", 3), ca.SX.sym("qd", 3)
+    spring = [K * 0.5 * (-z + ca.sqrt(z**2 + 1e-8)) for z in (q[1], q[2])]  # tilt as a 2nd leg
+    legs = dataclasses.replace(toy, leg_vertical_grf=ca.Function("legs", [q, qd],
+                                                                 [ca.vertcat(*spring)]))
+    n = 40
+    free = StrideNLP(legs, n=n, speed=2.0)
+    steps = StrideNLP(legs, n=n, speed=2.0, step_phase_tolerance=0.1)
+    assert "alternating steps" not in free._g_names
+    assert steps.n_cons == free.n_cons + 1
+    i = steps._g_names.index("alternating steps")
+    _, _, lbg, ubg = steps.bounds()
+    assert lbg[i] == -np.inf and ubg[i] == 0.0
+    g = ca.Function("g", [steps.nlp["x"], steps.nlp["p"]], [steps.nlp["g"]])
+    for lag in (0.5, 0.2):  # the 'right leg' sinks `lag` of the stride after the left
+        guess = _bouncing_guess(n, 2.0)
+        t = np.arange(n + 1) / n
+        guess.q[:, 2] = 0.05 * np.sin(2 * np.pi * (t - lag))
+        guess.q[:, 1] = 0.05 * np.sin(2 * np.pi * t)
+        x = steps.initial_vector(guess)
+        forces = np.stack([np.asarray(legs.leg_vertical_grf(qk, qk * 0)).ravel()
+                           for qk in guess.q[:n]])
+        expected = float(_alternation(ca.DM(forces.T), M * G, 0.1))
+        assert float(g(x, 2.0)[i]) == pytest.approx(expected, rel=1e-9)
+        assert (expected < 0) == (lag == 0.5)
+    with pytest.raises(SpecError, match="step phase"):
+        StrideNLP(legs, n=n, speed=2.0, step_phase_tolerance=0.5)
+    with pytest.raises(SpecError, match="vertical ground force"):
+        StrideNLP(toy, n=n, speed=2.0, step_phase_tolerance=0.1)

@@ -124,3 +124,35 @@ def test_the_transfemoral_runner_wears_a_multilink_blade_below_its_knee():
                                   ProstheticKnee(stop_damping=10.0).joint_row())
     with pytest.raises(ModelError, match="amputee"):
         build_runner("able", blade_model=blade)
+
+
+def test_a_myodesis_makes_the_hamstrings_and_rectus_femoris_hip_muscles_of_the_residual_limb():
+    """With ``myodesis``, the residual limb's hamstrings and rectus femoris end on the distal
+    femur where their tibial insertion lies with the knee straight: their lengths and hip moment
+    arms are the intact leg's with its knee straight, and the prosthetic knee moves neither."""
+    data = default_runner_params("transfemoral").model_dump()
+    data["myodesis"] = True
+    runner = build_runner(runner_params_from_dict(data))
+    right = {m for m in runner.muscle_names if m.endswith("_r")} - {
+        f"{t}_r" for t in ("rect_abd", "int_obl", "erect_sp")}
+    assert right == {"glut_max_r", "iliopsoas_r", "hamstrings_r", "rect_fem_r"}
+    m = runner.mj_analysis_model
+    d = mujoco.MjData(m)
+
+    def lengths(hip_deg: float, knee_deg: float) -> dict[str, float]:
+        d.qpos[:] = 0.0
+        for side in ("l", "r"):
+            d.qpos[m.joint(f"hip_flexion_{side}").qposadr[0]] = math.radians(hip_deg)
+        d.qpos[m.joint("knee_angle_r").qposadr[0]] = math.radians(knee_deg)
+        mujoco.mj_forward(m, d)
+        return {n: float(d.ten_length[m.tendon(n).id])
+                for n in ("hamstrings_l", "hamstrings_r", "rect_fem_l", "rect_fem_r")}
+
+    for hip in (-20.0, 0.0, 40.0, 80.0):
+        straight, bent = lengths(hip, 0.0), lengths(hip, -90.0)
+        for name in ("hamstrings", "rect_fem"):
+            assert straight[f"{name}_r"] == pytest.approx(straight[f"{name}_l"], rel=1e-12)
+            assert bent[f"{name}_r"] == pytest.approx(straight[f"{name}_r"], rel=1e-12)
+    # the hamstrings extend the hip, the rectus femoris flexes it
+    assert lengths(40.0, 0.0)["hamstrings_r"] > lengths(0.0, 0.0)["hamstrings_r"]
+    assert lengths(40.0, 0.0)["rect_fem_r"] < lengths(0.0, 0.0)["rect_fem_r"]

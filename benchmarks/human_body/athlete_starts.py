@@ -18,7 +18,6 @@ the spread of the converged objectives [%].
 from __future__ import annotations
 
 import argparse
-import dataclasses
 import json
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
@@ -37,7 +36,7 @@ STARTS = {
 def _solve(out: str, name: str, start: str) -> str:
     from bladelab.predict.collocation.settings import CollocationSettings, people_term
     from bladelab.predict.collocation.solve import predict_stride
-    from bladelab.predict.collocation.starting_guess import make_guess
+    from bladelab.predict.collocation.starting_guess import make_guess, scaled_to_athlete
     from bladelab.predict.collocation.stored import check_model_spec, runner_from_spec
     from bladelab.predict.defaults import PEOPLE_WEIGHT_PER_RAD2
 
@@ -48,13 +47,7 @@ def _solve(out: str, name: str, start: str) -> str:
                                    **people_term(PEOPLE_WEIGHT_PER_RAD2))
     guess = make_guess(runner, start, n=50, speed=4.0)
     if start != "stored":  # the stored guess is scaled by make_guess itself
-        ratio = ATHLETE["height_m"] / 1.80
-        q, qd = guess.q.copy(), guess.qd.copy()
-        names = list(guess.dof_names or runner.dof_names)
-        for j in (names.index("pelvis_tx"), names.index("pelvis_tz")):
-            q[:, j] *= ratio
-            qd[:, j] *= ratio
-        guess = dataclasses.replace(guess, q=q, qd=qd, qdd=None, multipliers=None)
+        guess = scaled_to_athlete(guess, runner)
     sol = predict_stride(runner, settings, guess, model_spec=spec, track=False)
     path = Path(out) / f"{name}{'.json' if sol.converged else '.best_iterate.json'}"
     sol.write(path)

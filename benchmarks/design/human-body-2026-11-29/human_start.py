@@ -4,7 +4,7 @@ Usage (repository root)::
 
     .venv/bin/python benchmarks/design/human-body-2026-11-29/human_start.py \\
         BLADE START PEOPLE_WEIGHT OUT.json [track|notrack] [backward|trapezoidal] [MODEL]
-        [MIN_STRIDE_S] [HESSIAN]
+        [MIN_STRIDE_S] [HESSIAN] [STEP_PHASE_TOLERANCE]
 
 BLADE ``sphere`` (the Cat4 contact sphere) or ``centre`` (the design box's centre blade, as the
 collocation evaluator generates it, 10⁵ N/m soles); START a collocation solution file (mapped
@@ -12,7 +12,8 @@ onto the runner by name); PEOPLE_WEIGHT the weight of people's joint angles [1/r
 a tracking stage of START first; the blade's joints by backward Euler (default) or the
 trapezoidal rule; MODEL ``transfemoral`` (default) or ``amputee``; MIN_STRIDE_S the stride
 time's lower bound [s] (default the library's, 0.4 s); HESSIAN ``limited-memory`` (default) or
-``exact``. The human body at 4 m/s,
+``exact``; STEP_PHASE_TOLERANCE the alternating-steps constraint's tolerance [fraction of the
+stride] (default ``none``: free). The human body at 4 m/s,
 mesh 50, swing clearance 2 cm; prints the summary, the gait's warnings, the criteria of people's
 running and seed 002's responses, and writes OUT.json.
 """
@@ -36,7 +37,7 @@ from bladelab.predict.collocation.transcription import PERIOD_BOUNDS_S, StrideNL
 
 def main(blade_kind: str, start: str, weight: str, out: str, track: str = "notrack",
          rule: str = "backward", model: str = "transfemoral", min_stride: str = "0.4",
-         hessian: str = "limited-memory") -> None:
+         hessian: str = "limited-memory", step_tol: str = "none") -> None:
     speed = 4.0
     # the stride time's bounds are the NLP's keyword default (not a setting)
     StrideNLP.__init__.__kwdefaults__["period_bounds"] = (float(min_stride), PERIOD_BOUNDS_S[1])
@@ -50,6 +51,8 @@ def main(blade_kind: str, start: str, weight: str, out: str, track: str = "notra
     runner = runner_from_spec(spec)
     settings = CollocationSettings(mesh_intervals=50, speed_m_per_s=speed,
                                    swing_clearance_m=0.02, hessian=hessian, **extra,
+                                   step_phase_tolerance=None if step_tol == "none"
+                                   else float(step_tol),
                                    **people_term(float(weight)))
     t0 = time.perf_counter()
     sol = predict_stride(runner, settings, make_guess(runner, start, n=50, speed=speed),
@@ -65,4 +68,4 @@ def main(blade_kind: str, start: str, weight: str, out: str, track: str = "notra
 
 
 if __name__ == "__main__":
-    main(*sys.argv[1:10])
+    main(*sys.argv[1:11])

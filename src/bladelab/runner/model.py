@@ -376,7 +376,7 @@ def build_runner(
     add("torso", "torso", "lumbar", "lumbar_extension", "pelvis", pp, pc)
 
     # muscles: sites on bodies, spatial tendons, tendon actuators (ctrl = −tendon force)
-    names = muscle_names(params.kind)
+    names = muscle_names(params.kind, params.myodesis)
     mp = np.zeros((len(names), 7))
     strength = active_strength(params)
     path_sites: list[str] = []
@@ -388,6 +388,10 @@ def build_runner(
         for k, (body_name, p) in enumerate(geo.muscle_path(mtype, side)):
             if body_name == "tibia_r" and amputee:
                 body_name, origin = "tibia_res_r", joint_child["tibia_res_r"]
+            elif body_name == "tibia_r" and transfemoral:
+                # a myodesis: the tibial point, with the knee straight, fixed on the femur
+                body_name, p = "femur_r", _myodesis_point(p)
+                origin = joint_child["femur_r"]
             else:
                 origin = joint_child[body_name]
             site = f"{mname}_p{k}"
@@ -531,6 +535,13 @@ def _add_toes(calcn, side: str, hinge: list[float], s: float, axis: list[float])
     toes.add_site(name=f"toetip_{side}",
                   pos=[TOETIP_CENTRE_M[0] * s, 0.0, TOETIP_CENTRE_M[1] * s],
                   size=[TOETIP_RADIUS_M * s, 0, 0])
+
+
+def _myodesis_point(p: tuple[float, float, float]) -> tuple[float, float, float]:
+    """A tibial path point (tibia COM-relative) as a point of the femur (femur COM-relative)
+    where it lies with the knee straight: a myodesis anchors the muscle there."""
+    _, knee_in_femur, knee_in_tibia = geo.JOINTS["knee_r"]
+    return _sub(knee_in_femur, _sub(knee_in_tibia, p))
 
 
 def _prosthetic_bottom(s: float, res_len: float) -> float:

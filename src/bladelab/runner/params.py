@@ -143,6 +143,9 @@ PROSTHETIC_KINDS = ("amputee", "transfemoral")
 #: attachments the amputation keeps (the biarticular hamstrings and rectus femoris lose their
 #: tibial insertion; where a surgeon re-attaches them is not modelled).
 RESIDUAL_THIGH_MUSCLES = ("glut_max", "iliopsoas")
+#: The biarticular thigh muscles that a myodesis re-attaches to the distal end of the residual
+#: femur, where they become monoarticular hip muscles (``RunnerParams.myodesis``).
+MYODESIS_MUSCLES = ("hamstrings", "rect_fem")
 
 
 class RunnerParams(_Strict):
@@ -185,6 +188,11 @@ class RunnerParams(_Strict):
     capsule_moments: dict[str, CapsuleMoment] = Field(default_factory=dict)
     #: The prosthetic knee of the transfemoral runner (ignored by the other kinds).
     prosthetic_knee: ProstheticKnee = Field(default_factory=ProstheticKnee)
+    #: The transfemoral runner's residual limb: False (the monoarticular hip muscles only,
+    #: :data:`RESIDUAL_THIGH_MUSCLES`) or True (a myodesis: the hamstrings and rectus femoris
+    #: also act at the hip, anchored on the distal femur where their tibial insertion was with
+    #: the knee straight; :data:`MYODESIS_MUSCLES`). Ignored by the other kinds.
+    myodesis: bool = False
     #: The muscles' metabolic energy model: ``"uchida2016"`` (seed 001 eq. 2.5: Umberger 2003
     #: as modified by Uchida et al. 2016; :mod:`bladelab.runner.metabolics`) or
     #: ``"bhargava2004"`` (Bhargava et al. 2004, as PredSim computes it).
@@ -227,11 +235,13 @@ def required_segments(kind: str) -> tuple[str, ...]:
     return common + ("tibia_r", "calcn_r")
 
 
-def muscle_names(kind: str) -> tuple[str, ...]:
-    """The model's muscle–tendon units in order: intact/left leg, right leg, torso."""
+def muscle_names(kind: str, myodesis: bool = False) -> tuple[str, ...]:
+    """The model's muscle–tendon units in order: intact/left leg, right leg, torso
+    (``myodesis``: see :attr:`RunnerParams.myodesis`)."""
     left = tuple(f"{m}_l" for m in LEG_MUSCLES)
     if kind == "transfemoral":
-        right_types = [m for m in LEG_MUSCLES if m in RESIDUAL_THIGH_MUSCLES]
+        residual = RESIDUAL_THIGH_MUSCLES + (MYODESIS_MUSCLES if myodesis else ())
+        right_types = [m for m in LEG_MUSCLES if m in residual]
     else:
         right_types = [m for m in LEG_MUSCLES if kind == "able" or m not in SHANK_MUSCLES]
     right = tuple(f"{m}_r" for m in right_types)

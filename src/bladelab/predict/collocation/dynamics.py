@@ -194,10 +194,21 @@ def stride_dynamics(cm: CollocationModel, *, metabolic: MetabolicSmoothing | Non
         active_strength=np.array(runner.muscle_params[:, MP_ACTIVE]),
         vertical_grf=ca.Function("vertical_grf", [q, qd],
                                  [ca.sum1(cm.contacts(q, qd)[0][:, 1])]),
+        leg_vertical_grf=_leg_vertical_grf(cm, q, qd),
         backward_euler_dofs=tuple(n for n in runner.dof_names if n.startswith("blade_joint"))
         if blade_backward_euler else (),
         interval_mean_inequalities=interval_mean,
     )
+
+
+def _leg_vertical_grf(cm: CollocationModel, q: ca.SX, qd: ca.SX) -> ca.Function:
+    """CasADi Function (q, q̇) -> the vertical ground force of each leg (2,) [N]: the left
+    (intact) leg's contacts, then the right (prosthetic) leg's."""
+    fz = cm.contacts(q, qd)[0][:, 1]
+    legs = cm.runner.contact_params[:, CP_LEG]
+    per_leg = [sum((fz[int(c)] for c in np.flatnonzero(legs == leg)), ca.SX(0.0))
+               for leg in (0, 1)]
+    return ca.Function("leg_vertical_grf", [q, qd], [ca.vertcat(*per_leg)])
 
 
 def static_tendon_forces(cm: CollocationModel, q_nodes: np.ndarray, a_nodes: np.ndarray,

@@ -124,6 +124,17 @@ class CollocationSettings:
         None (default): the coordinate's own bounds (-60, 30). A stride the reflex
         controller tracks (``bladelab predict --track``) passes its lean on: the Cat6 4 m/s
         stride without it leans -17.8° on average (docs/collocation.md).
+    step_phase_tolerance
+        Keep the steps alternating: the centre of the right (prosthetic) leg's stance at half
+        a stride ± this fraction of the stride after the left (intact) leg's (the circular
+        means of their vertical ground forces,
+        :func:`~bladelab.predict.collocation.transcription.step_phase`); a constraint of the
+        predictive stage. None (default): free. Runners with a transfemoral amputation step
+        with the same step frequency on both legs (nine athletes on running-specific
+        prostheses at 30–70 % of their maximum speed, ISBS proceedings 36, 2018) and their
+        peak forces are most symmetric at their preferred step frequency (Kobayashi et al.
+        2022, J NeuroEng Rehabil); the transfemoral runner on the human body, free, gallops
+        instead (docs/runner-model.md).
     reference, reference_weight, reference_dofs
         ``"people"`` (:data:`PEOPLE_REFERENCE`): people's measured hip, knee and ankle angles
         at 3.5 m/s (:mod:`bladelab.predict.collocation.people`), ``reference_weight``
@@ -158,6 +169,7 @@ class CollocationSettings:
     knee_flexion_max_loaded_deg: float | None = None
     blade_backward_euler: bool = False
     pelvis_tilt_range_deg: tuple[float, float] | None = None
+    step_phase_tolerance: float | None = None
     reference: str | None = None
     reference_weight: float = 0.0
     reference_dofs: tuple[str, ...] | None = None
@@ -234,6 +246,14 @@ class CollocationSettings:
         if not isinstance(self.blade_backward_euler, bool):
             raise SpecError(f"expected true or false, got {self.blade_backward_euler!r}",
                             where="blade_backward_euler")
+        sp = self.step_phase_tolerance
+        if sp is not None:
+            if isinstance(sp, bool) or not isinstance(sp, int | float) or not (
+                    math.isfinite(sp) and 0 < sp < 0.5):
+                raise SpecError(f"the step phase tolerance must be within (0, 0.5) of the "
+                                f"stride or None, got {sp!r}", where="step_phase_tolerance",
+                                hint="0.1: the other leg's stance 40-60 % of the stride later")
+            object.__setattr__(self, "step_phase_tolerance", float(sp))
         self._check_tilt_range()
         self._check_reference()
 
@@ -308,7 +328,8 @@ class CollocationSettings:
 
     def same_problem(self, other: CollocationSettings) -> bool:
         """True if ``other`` poses the same NLP (mesh, speed, weights, swing clearance, knee
-        moment bound, loaded knee's flexion limit, blade transcription, pelvis tilt range);
+        moment bound, loaded knee's flexion limit, blade transcription, pelvis tilt range,
+        alternating steps);
         solver options
         (Hessian, tolerance, iterations) and the tracking stage may differ."""
         return self._problem() == other._problem()
@@ -316,7 +337,8 @@ class CollocationSettings:
     def _problem(self) -> tuple:
         return (self.mesh_intervals, self.speed_m_per_s, self.weights, self.swing_clearance_m,
                 self.knee_moment_min_nm, self.knee_flexion_max_loaded_deg,
-                self.blade_backward_euler, self.pelvis_tilt_range_deg) + self.reference_key()
+                self.blade_backward_euler, self.pelvis_tilt_range_deg,
+                self.step_phase_tolerance) + self.reference_key()
 
     def reference_key(self) -> tuple:
         """(reference file name, weight, coordinates), or () without a reference term."""

@@ -41,6 +41,7 @@ from bladelab.predict.collocation.transcription import (
     PERIOD_BOUNDS_S,
     NLPSolution,
     StrideNLP,
+    step_phase,
 )
 from bladelab.runner.layout import CP_LEG
 from bladelab.runner.simulate import RunnerResult, leg_names
@@ -293,6 +294,9 @@ class CollocationSolution:
         ``mean_speed_mps``, ``stride_time_s``, ``cost_of_transport_J_per_kg_m``;
         ``contact_time_s`` (mean over the legs) and per leg ``contact_time_<leg>_s`` [s];
         ``peak_vertical_grf_<leg>_bw`` [body weights]; ``flight_fraction`` (of the stride);
+        ``step_phase`` (the second leg's stance centre after the first's, as a fraction of
+        the stride: 0.5 for alternating steps of equal time, near 0 or 1 for a gallop;
+        :func:`~bladelab.predict.collocation.transcription.step_phase`);
         ``dynamics_residual_pct``; ``iterations`` and ``wall_s`` [s] of both stages together
         (tracking + predictive); ``warnings`` (:meth:`gait_warnings`, joined by "; ", empty
         if none). Legs: left/right (able) or intact/prosthetic (amputee).
@@ -318,6 +322,7 @@ class CollocationSolution:
             out[f"peak_vertical_grf_{leg}_bw"] = (ph["legs"][leg]["peak_vertical_grf_N"]
                                                   / self.body_weight_N)
         out["flight_fraction"] = ph["flight_fraction"]
+        out["step_phase"] = step_phase(self.leg_vertical_force()[:-1])
         out["dynamics_residual_pct"] = self.dynamics_residual_pct
         out["iterations"] = its
         out["wall_s"] = wall

@@ -311,19 +311,22 @@ def _reference_tracking(runner, settings: CollocationSettings, start,
 
 def _predictive_nlp(runner, dyn, settings: CollocationSettings, start, phase: float | None):
     """The predictive :class:`~bladelab.predict.collocation.transcription.StrideNLP` of the
-    settings' mesh, problem (prescribed speed, or maximum speed), weights and reference term,
+    settings' mesh, problem (prescribed speed, or maximum speed), weights, reference term and
+    alternating steps,
     built once per runner and reference (the reference file is read only then; people's
     angles once per ``phase``, :func:`_reference_phase` of the guess ``start``); the speed
     itself is a parameter of each solve."""
     n, speed = settings.mesh_intervals, settings.speed_m_per_s
     nlps = _BUILT[runner]["nlps"]
-    key = (n, speed is None, settings.weights, id(dyn), settings.reference_key(), phase)
+    key = (n, speed is None, settings.weights, id(dyn), settings.reference_key(), phase,
+           settings.step_phase_tolerance)
     if key not in nlps:
         while len(nlps) >= MAX_NLPS_PER_RUNNER:
             nlps.pop(next(iter(nlps)))
         tracking, period_tracking = _reference_tracking(runner, settings, start, phase)
         nlps[key] = StrideNLP(dyn, n=n, speed=speed, weights=settings.weights,
-                              tracking=tracking, period_tracking=period_tracking)
+                              tracking=tracking, period_tracking=period_tracking,
+                              step_phase_tolerance=settings.step_phase_tolerance)
     else:
         nlps[key] = nlps.pop(key)  # most recently used last
     return nlps[key]

@@ -29,7 +29,8 @@ from bladelab.predict.collocation.stride_guess import StrideGuess
 from bladelab.runner.params import PROSTHETIC_KINDS, RUNNER_DATA_DIR, default_runner_params
 
 __all__ = ["GUESS_WORDS", "MAX_SPEED_TEMPLATE_M_PER_S", "STORED_STRIDES", "first_origin",
-           "guess_file_kind", "make_guess", "resolve_guess", "stored_stride_path"]
+           "guess_file_kind", "make_guess", "resolve_guess", "scaled_to_athlete",
+           "stored_stride_path"]
 
 #: The guesses named by a word; anything else is the path of a file.
 GUESS_WORDS = ("template", "trial", "stored")
@@ -57,12 +58,12 @@ def stored_stride_path(runner) -> Path | None:
     return path if runner.params.model_dump(exclude=athlete_free) == body else None
 
 
-def _for_athlete(stride: StrideGuess, runner) -> StrideGuess:
-    """The stored stride as the start of another athlete of its body
+def scaled_to_athlete(stride: StrideGuess, runner) -> StrideGuess:
+    """A stride of the human body as the start of another athlete of that body
     (:func:`~bladelab.runner.params.athlete_params`): the pelvis's translations scaled by the
     heights' ratio and the multipliers dropped, which belong to the stored athlete's problem
     (measured: with them, a 68 kg, 1.75 m amputee's solve still stood at twice the stored
-    stride's objective after 881 iterations); the stride itself for the stored athlete."""
+    stride's objective after 881 iterations); the stride itself for the body's own athlete."""
     body = default_runner_params(runner.kind, body="human")
     if runner.params.model_dump(exclude={"blade"}) == body.model_dump(exclude={"blade"}):
         return stride
@@ -132,7 +133,7 @@ def make_guess(runner, guess: str, *, n: int, speed: float | None, where: str = 
             trial = measured_trial_guess(runner, n=n)
             return dataclasses.replace(trial, source=f"measured trial {trial.source} (no "
                                                      "stored stride of this runner)")
-        return _for_athlete(make_guess(runner, str(stored), n=n, speed=speed, where=where),
+        return scaled_to_athlete(make_guess(runner, str(stored), n=n, speed=speed, where=where),
                             runner)
     path = Path(guess)
     if guess_file_kind(path, where=where) == "collocation":

@@ -51,6 +51,9 @@ class StrideDynamics:
     vertical_grf
         Optional CasADi Function (q, q̇) -> total vertical ground force [N] (for tracking a
         measured force).
+    leg_vertical_grf
+        Optional CasADi Function (q, q̇) -> the vertical ground force of each leg (2,) [N],
+        left (intact) then right (prosthetic) (for the alternating-steps constraint).
     muscle_metabolic_rates
         Optional CasADi Function (q, q̇, a, F̃ₜ, dF̃ₜ/dt, e) -> metabolic rate of every muscle
         [W] (for :attr:`StrideWeights.metabolic_squared`).
@@ -85,6 +88,7 @@ class StrideDynamics:
     static_tendon_force: Callable[[np.ndarray, np.ndarray], np.ndarray] | None = None
     vertical_grf: ca.Function | None = None
     muscle_metabolic_rates: ca.Function | None = None
+    leg_vertical_grf: ca.Function | None = None
     backward_euler_dofs: tuple[str, ...] = ()
     interval_mean_inequalities: tuple[int, ...] = ()
     active_strength: np.ndarray | None = None

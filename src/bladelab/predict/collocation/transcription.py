@@ -14,7 +14,11 @@ accelerations (implicit multibody dynamics), excitations, tendon-force rates (De
   the Hill equilibrium of every muscle, both from :class:`StrideDynamics`;
 - periodicity: node n equals node 0 (states and controls) except pelvis_tx, advanced by the
   stride length ``d``; pelvis_tx = 0 at node 0;
-- the speed: ``d = v·T`` (prescribed speed) or ``d`` free (maximum speed).
+- the speed: ``d = v·T`` (prescribed speed) or ``d`` free (maximum speed);
+- optionally, alternating steps (``step_phase_tolerance``): the centre of each leg's vertical
+  ground force over the stride (its circular mean, :func:`step_phase`) half a stride ± the
+  tolerance after the other leg's, which rules out a gallop (both stances close together,
+  then one long flight).
 
 Objective (a setting, :class:`StrideWeights`): prescribed speed — metabolic energy per
 distance and body mass (cost of transport [J/(kg·m)]) plus time-averaged mean cubed activation
@@ -55,6 +59,7 @@ __all__ = [
     "StrideNLP",
     "StrideWeights",
     "VariableScales",
+    "step_phase",
 ]
 
 
@@ -99,6 +104,35 @@ class NLPSolution:
                            self.tendon_force, qdd=self.qdd, excitation=self.excitation,
                            tendon_force_rate=self.tendon_force_rate,
                            multipliers=self.multipliers)
+
+
+#: Added to the squared force centroids [BW²] of :func:`_alternation` so that their norm stays
+#: differentiable at 0 (a leg without stance).
+_CENTROID_EPS = 1e-8
+
+
+def step_phase(leg_forces: np.ndarray) -> float:
+    """The right (prosthetic) leg's stance after the left (intact) leg's [fraction of the
+    stride, 0–1]: the difference of the circular means of the legs' vertical ground forces
+    ``leg_forces`` (n nodes of one period, without the repeated last node; columns left,
+    right) [N]. 0.5 for alternating steps of equal time; near 0 or 1 for a gallop."""
+    f = np.asarray(leg_forces, float)
+    ph = np.exp(2j * np.pi * np.arange(f.shape[0]) / f.shape[0])
+    c = ph @ f
+    return float(np.angle(c[1] * np.conj(c[0])) / (2 * np.pi) % 1.0)
+
+
+def _alternation(legs, body_weight: float, tolerance: float):
+    """The alternating-steps constraint (≤ 0): with the legs' force centroids
+    C_j = Σ_k F_j,k·e^{2πik/n} / (n·BW), Re(C₀·C̄₁) + cos(2π·tolerance)·|C₀|·|C₁| ≤ 0, i.e.
+    the phase between them within π ± 2π·tolerance (:func:`step_phase` within 0.5 ±
+    tolerance)."""
+    n = legs.shape[1]
+    k = 2 * np.pi * np.arange(n) / n
+    a = ca.mtimes(legs, ca.DM(np.cos(k))) / (n * body_weight)
+    b = ca.mtimes(legs, ca.DM(np.sin(k))) / (n * body_weight)
+    norm = [ca.sqrt(a[j] ** 2 + b[j] ** 2 + _CENTROID_EPS) for j in (0, 1)]
+    return a[0] * a[1] + b[0] * b[1] + math.cos(2 * math.pi * tolerance) * norm[0] * norm[1]
 
 
 def _node_pairs(values):
@@ -158,6 +192,10 @@ class StrideNLP:
     period_tracking
         ``(T_ref, weight)``: add ``weight`` × ln(T/T_ref)², the squared relative deviation of
         the stride time T from ``T_ref`` [s] (the reference's cadence).
+    step_phase_tolerance
+        Keep the legs' stances alternating: the right leg's :func:`step_phase` within
+        0.5 ± this [fraction of the stride] (needs ``StrideDynamics.leg_vertical_grf``);
+        None: free.
     """
 
     def __init__(
@@ -175,6 +213,7 @@ class StrideNLP:
         tracking: tuple | None = None,
         grf_tracking: tuple[np.ndarray, float] | None = None,
         period_tracking: tuple[float, float] | None = None,
+        step_phase_tolerance: float | None = None,
     ) -> None:
         if n < 4:
             raise SpecError(f"need at least 4 mesh intervals, got {n}", where="mesh intervals")
@@ -192,6 +231,14 @@ class StrideNLP:
         self.tracking = tracking
         self.grf_tracking = grf_tracking
         self.period_tracking = period_tracking
+        if step_phase_tolerance is not None and not 0.0 < step_phase_tolerance < 0.5:
+            raise SpecError(f"the step phase tolerance must be within (0, 0.5), got "
+                            f"{step_phase_tolerance!r}", where="step phase tolerance")
+        if step_phase_tolerance is not None and dynamics.leg_vertical_grf is None:
+            raise SpecError("alternating steps need each leg's vertical ground force",
+                            where="step phase tolerance",
+                            hint="build the dynamics with stride_dynamics")
+        self.step_phase_tolerance = step_phase_tolerance
         self._build()
 
     # -- layout -------------------------------------------------------------------------
@@ -297,6 +344,10 @@ class StrideNLP:
             self._g_names.append("minimum speed")
             if w.metabolic:
                 terms["metabolic"] = w.metabolic * energy / (d.mass * ca.fmax(distance, 1e-3))
+        if self.step_phase_tolerance is not None:
+            legs = ca.Function("legs", [xs], [d.leg_vertical_grf(q, qd)]).map(n)(X[:, :n])
+            g.append(_alternation(legs, d.mass * d.gravity, self.step_phase_tolerance))
+            self._g_names.append("alternating steps")
         if self.tracking is not None:
             q_ref, weight, *dofs = self.tracking
             q_ref = np.asarray(q_ref, float)
@@ -395,6 +446,8 @@ class StrideNLP:
         lbg, ubg = np.zeros(self.n_cons), np.zeros(self.n_cons)
         if self.speed is None:
             ubg[self._g_names.index("minimum speed")] = np.inf
+        if self.step_phase_tolerance is not None:
+            lbg[self._g_names.index("alternating steps")] = -np.inf
         if self.n_ineq:
             b = np.asarray(d.inequality_bounds, float)
             lbg[-self.n_ineq * n:] = np.tile(b[:, 0], n)
