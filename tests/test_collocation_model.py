@@ -58,7 +58,8 @@ from bladelab.runner.muscle import (
 from bladelab.runner.params import default_runner_params
 
 N_STATES = 20
-KINDS = ("able", "amputee-Cat6", "able-toes", "transfemoral", "able-human", "amputee-human")
+KINDS = ("able", "amputee-Cat6", "able-toes", "transfemoral", "able-human", "amputee-human",
+         "transfemoral-human")
 # the toe body's Achilles tendons are twice as compliant; the human body's tendons differ per
 # muscle and its strengths come from a table
 MUSCLE_KINDS = ("able", "able-toes", "able-human")
@@ -75,7 +76,10 @@ def models():
                   "amputee-Cat6": lambda: build_runner("amputee", blade="Cat6"),
                   "transfemoral": lambda: build_runner("transfemoral"),
                   "able-human": lambda: build_runner("able", body="human"),
-                  "amputee-human": lambda: build_runner("amputee", body="human")}[kind]()
+                  "amputee-human": lambda: build_runner("amputee", body="human"),
+                  # the residual limb with a myodesis: hip-only hamstrings and rectus femoris
+                  "transfemoral-human": lambda: build_runner("transfemoral", body="human"),
+                  }[kind]()
         out[kind] = (runner, build_collocation_model(runner))
     return out
 

@@ -343,12 +343,18 @@ def test_alternation_constraint_admits_alternating_steps_and_rules_out_a_gallop(
 
     n, bw, tol = 200, 700.0, 0.1
 
-    def g(right_after: float) -> float:
-        return float(_alternation(ca.DM(_two_stances(n, right_after).T), bw, tol))
+    def g(right_after: float, right_share: float = 1.0) -> np.ndarray:
+        forces = _two_stances(n, right_after) * [1.0, right_share]
+        return np.asarray(_alternation(ca.DM(forces.T), bw, tol)).ravel()
 
-    assert g(0.5) < 0 and g(0.45) < 0 and g(0.58) < 0
-    assert g(0.4) == pytest.approx(0.0, abs=1e-6) and g(0.6) == pytest.approx(0.0, abs=1e-6)
-    assert g(0.15) > 0 and g(0.85) > 0 and g(0.3) > 0
+    assert g(0.5)[0] < 0 and g(0.45)[0] < 0 and g(0.58)[0] < 0
+    assert g(0.4)[0] == pytest.approx(0.0, abs=1e-6)
+    assert g(0.6)[0] == pytest.approx(0.0, abs=1e-6)
+    assert g(0.15)[0] > 0 and g(0.85)[0] > 0 and g(0.3)[0] > 0
+    # each leg must carry a stance: a one-legged hop meets the phase only up to ε
+    assert (g(0.5)[1:] < 0).all()
+    hop = g(0.5, right_share=0.0)
+    assert hop[0] == pytest.approx(0.0, abs=1e-4) and hop[2] > 0 and hop[1] < 0
 
 
 def test_the_nlp_holds_the_alternation_constraint_only_when_asked():
@@ -366,10 +372,10 @@ def test_the_nlp_holds_the_alternation_constraint_only_when_asked():
     free = StrideNLP(legs, n=n, speed=2.0)
     steps = StrideNLP(legs, n=n, speed=2.0, step_phase_tolerance=0.1)
     assert "alternating steps" not in free._g_names
-    assert steps.n_cons == free.n_cons + 1
+    assert steps.n_cons == free.n_cons + 3
     i = steps._g_names.index("alternating steps")
     _, _, lbg, ubg = steps.bounds()
-    assert lbg[i] == -np.inf and ubg[i] == 0.0
+    assert (lbg[i:i + 3] == -np.inf).all() and (ubg[i:i + 3] == 0.0).all()
     g = ca.Function("g", [steps.nlp["x"], steps.nlp["p"]], [steps.nlp["g"]])
     for lag in (0.5, 0.2):  # the 'right leg' sinks `lag` of the stride after the left
         guess = _bouncing_guess(n, 2.0)
@@ -379,9 +385,9 @@ def test_the_nlp_holds_the_alternation_constraint_only_when_asked():
         x = steps.initial_vector(guess)
         forces = np.stack([np.asarray(legs.leg_vertical_grf(qk, qk * 0)).ravel()
                            for qk in guess.q[:n]])
-        expected = float(_alternation(ca.DM(forces.T), M * G, 0.1))
-        assert float(g(x, 2.0)[i]) == pytest.approx(expected, rel=1e-9)
-        assert (expected < 0) == (lag == 0.5)
+        expected = np.asarray(_alternation(ca.DM(forces.T), M * G, 0.1)).ravel()
+        np.testing.assert_allclose(np.asarray(g(x, 2.0)[i:i + 3]).ravel(), expected, rtol=1e-9)
+        assert (expected[0] < 0) == (lag == 0.5)
     with pytest.raises(SpecError, match="step phase"):
         StrideNLP(legs, n=n, speed=2.0, step_phase_tolerance=0.5)
     with pytest.raises(SpecError, match="vertical ground force"):

@@ -18,7 +18,7 @@ accelerations (implicit multibody dynamics), excitations, tendon-force rates (De
 - optionally, alternating steps (``step_phase_tolerance``): the centre of each leg's vertical
   ground force over the stride (its circular mean, :func:`step_phase`) half a stride ± the
   tolerance after the other leg's, which rules out a gallop (both stances close together,
-  then one long flight).
+  then one long flight), and each leg carrying a stance (a one-legged hop ruled out).
 
 Objective (a setting, :class:`StrideWeights`): prescribed speed — metabolic energy per
 distance and body mass (cost of transport [J/(kg·m)]) plus time-averaged mean cubed activation
@@ -109,6 +109,11 @@ class NLPSolution:
 #: Added to the squared force centroids [BW²] of :func:`_alternation` so that their norm stays
 #: differentiable at 0 (a leg without stance).
 _CENTROID_EPS = 1e-8
+#: The least force centroid |C_j| [BW] of each leg under the alternating-steps constraint:
+#: about a quarter of a leg's share in running (0.42–0.53 BW measured on the human body's
+#: strides), so that a one-legged hop (|C| = 0 on one leg, where the phase constraint holds
+#: up to ε) is ruled out with it.
+MIN_CENTROID_BW = 0.1
 
 
 def step_phase(leg_forces: np.ndarray) -> float:
@@ -123,16 +128,18 @@ def step_phase(leg_forces: np.ndarray) -> float:
 
 
 def _alternation(legs, body_weight: float, tolerance: float):
-    """The alternating-steps constraint (≤ 0): with the legs' force centroids
+    """The alternating-steps constraints (each ≤ 0): with the legs' force centroids
     C_j = Σ_k F_j,k·e^{2πik/n} / (n·BW), Re(C₀·C̄₁) + cos(2π·tolerance)·|C₀|·|C₁| ≤ 0, i.e.
     the phase between them within π ± 2π·tolerance (:func:`step_phase` within 0.5 ±
-    tolerance)."""
+    tolerance); and :data:`MIN_CENTROID_BW`² − |C_j|² ≤ 0 for each leg."""
     n = legs.shape[1]
     k = 2 * np.pi * np.arange(n) / n
     a = ca.mtimes(legs, ca.DM(np.cos(k))) / (n * body_weight)
     b = ca.mtimes(legs, ca.DM(np.sin(k))) / (n * body_weight)
-    norm = [ca.sqrt(a[j] ** 2 + b[j] ** 2 + _CENTROID_EPS) for j in (0, 1)]
-    return a[0] * a[1] + b[0] * b[1] + math.cos(2 * math.pi * tolerance) * norm[0] * norm[1]
+    sq = [a[j] ** 2 + b[j] ** 2 for j in (0, 1)]
+    norm = [ca.sqrt(v + _CENTROID_EPS) for v in sq]
+    phase = a[0] * a[1] + b[0] * b[1] + math.cos(2 * math.pi * tolerance) * norm[0] * norm[1]
+    return ca.vertcat(phase, MIN_CENTROID_BW**2 - sq[0], MIN_CENTROID_BW**2 - sq[1])
 
 
 def _node_pairs(values):
@@ -347,7 +354,7 @@ class StrideNLP:
         if self.step_phase_tolerance is not None:
             legs = ca.Function("legs", [xs], [d.leg_vertical_grf(q, qd)]).map(n)(X[:, :n])
             g.append(_alternation(legs, d.mass * d.gravity, self.step_phase_tolerance))
-            self._g_names.append("alternating steps")
+            self._g_names += ["alternating steps"] + [f"stance of leg {j}" for j in (0, 1)]
         if self.tracking is not None:
             q_ref, weight, *dofs = self.tracking
             q_ref = np.asarray(q_ref, float)
@@ -447,7 +454,8 @@ class StrideNLP:
         if self.speed is None:
             ubg[self._g_names.index("minimum speed")] = np.inf
         if self.step_phase_tolerance is not None:
-            lbg[self._g_names.index("alternating steps")] = -np.inf
+            i = self._g_names.index("alternating steps")
+            lbg[i:i + 3] = -np.inf
         if self.n_ineq:
             b = np.asarray(d.inequality_bounds, float)
             lbg[-self.n_ineq * n:] = np.tile(b[:, 0], n)
