@@ -20,8 +20,9 @@ DOFS = ("pelvis_tx", "pelvis_tz", "pelvis_tilt", "hip_flexion_l", "knee_angle_l"
 
 def _stride(*, speed=3.5, contact=(0.24, 0.24), peak_bw=(2.5, 2.5), period=0.70,
             knee_deg=(100.0, 95.0), tilt_deg=-8.0, flight=0.1, contacts=(1, 1), cot=4.0,
-            model="able"):
-    """A stand-in for a CollocationSolution with the numbers the criteria read."""
+            model="able", right_after=0.5):
+    """A stand-in for a CollocationSolution with the numbers the criteria read; the right
+    stance ``right_after`` of the stride after the left one."""
     weight = 75.0 * 9.81
     legs = ("left", "right") if model == "able" else ("intact", "prosthetic")
     q = np.zeros((51, len(DOFS)))  # (nodes, coordinates)
@@ -32,7 +33,11 @@ def _stride(*, speed=3.5, contact=(0.24, 0.24), peak_bw=(2.5, 2.5), period=0.70,
                              "peak_vertical_grf_N": p * weight}
                        for leg, c, n, p in zip(legs, contact, contacts, peak_bw, strict=True)},
               "flight_fraction": flight}
+    t = np.arange(51) / 50
+    force = np.stack([np.where((t - lag) % 1.0 < 0.3, 1000.0, 0.0) for lag in (0.0, right_after)],
+                     axis=1)
     return SimpleNamespace(mean_speed_mps=speed, contact_phases=lambda: phases,
+                           leg_vertical_force=lambda: force,
                            model_spec={"model": model}, leg_names=legs, body_weight_N=weight,
                            period_s=period, nlp=SimpleNamespace(q=q), dof_names=DOFS,
                            cost_of_transport_J_per_kg_m=cot)
@@ -69,6 +74,14 @@ def test_the_stiff_short_gait_fails_where_it_is_not_human():
                       "gross cost of transport"}
     line = next(c for c in crit if c.name == "contact time, left leg").line()
     assert line == "contact time, left leg: 0.106 s (people: 0.2–0.3 s): OUTSIDE"
+
+
+def test_a_gallop_fails_the_step_phase_whichever_leg_leads():
+    """Both stances close together then one long flight: outside 40–60 % of the stride."""
+    for lag, met in ((0.5, True), (0.42, True), (0.16, False), (0.84, False)):
+        crit = {c.name: c for c in human_running_criteria(_stride(right_after=lag))}
+        assert crit["step phase"].value == pytest.approx(100 * lag, abs=1e-6)
+        assert crit["step phase"].met is met
 
 
 def test_prosthetic_leg_may_touch_shorter_and_no_flight_fails():

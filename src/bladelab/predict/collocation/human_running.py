@@ -3,8 +3,9 @@
 A converged stride is a gait of the model; whether a person runs like it is a separate
 question. :func:`human_running_criteria` answers it for one collocation stride with the numbers
 people show at that speed: contact time and peak vertical ground force per leg, stride time,
-peak knee flexion in swing, mean pelvis tilt, a flight phase, one contact per leg per stride (no
-swinging foot or blade striking the ground) and, up to 5 m/s, the gross cost of transport.
+peak knee flexion in swing, mean pelvis tilt, a flight phase, alternating steps (no gallop), one
+contact per leg per stride (no swinging foot or blade striking the ground) and, up to 5 m/s, the
+gross cost of transport.
 
 The reference bands (:data:`REFERENCE_BANDS`) are given at 3.5 m/s and at 9 m/s and
 interpolated linearly in speed between them (held constant outside, where the line says the
@@ -17,6 +18,11 @@ band was extrapolated). Sources:
   stride times about 0.45–0.5 s);
 - pelvis tilt: seed 001's acceptance window of a running posture, −16…−2° (forward lean
   negative);
+- step phase: running people alternate their legs with steps of nearly equal time (the
+  Fukuchi trial's left and right stances half a stride apart), and so do runners with a
+  transfemoral amputation on running-specific prostheses (the same step frequency on both
+  legs, nine athletes at 30–70 % of their maximum speed, ISBS proceedings 36, 2018); the band
+  40–60 % of the stride is ours, wide enough for an amputee's asymmetry, and excludes a gallop;
 - cost of transport: about 4 J/(kg·m) gross for people running at 3–5 m/s (Margaria 1963;
   Kram & Taylor 1990 give the cost per distance nearly independent of speed).
 
@@ -32,6 +38,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from bladelab.predict.collocation.solution import CONTACT_THRESHOLD_N
+from bladelab.predict.collocation.transcription import step_phase
 
 __all__ = [
     "COMPARED_JOINTS",
@@ -60,6 +67,8 @@ REFERENCE_BANDS: dict[str, tuple[str, tuple, tuple]] = {
 PROSTHETIC_CONTACT_MIN_S = 0.15
 #: Least flight [% of the stride] that counts as a flight phase.
 FLIGHT_MIN_PCT = 1.0
+#: The band of the step phase [% of the stride] (module docstring).
+STEP_PHASE_BAND_PCT = (40.0, 60.0)
 #: A stride this close to an anchor speed [m/s] is at it (no "band held" note).
 SPEED_TOLERANCE_MPS = 0.01
 #: Above this speed [m/s] no cost-of-transport band is given.
@@ -162,6 +171,10 @@ def human_running_criteria(solution) -> list[Criterion]:
     out.append(Criterion("mean pelvis tilt", tilt, unit, lo, hi, "forward lean negative"))
     out.append(Criterion("flight phase", 100.0 * phases["flight_fraction"], "% of the stride",
                          FLIGHT_MIN_PCT, None, "running has one"))
+    out.append(Criterion("step phase", 100.0 * step_phase(solution.leg_vertical_force()[:-1]),
+                         "% of the stride", *STEP_PHASE_BAND_PCT,
+                         f"the {solution.leg_names[1]} leg's stance after the "
+                         f"{solution.leg_names[0]} leg's; a gallop lands both close together"))
     for leg in solution.leg_names:
         out.append(Criterion(f"ground contacts per stride, {leg} leg",
                              float(phases["legs"][leg]["contacts"]), "", 1.0, 1.0,
