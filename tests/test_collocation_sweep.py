@@ -151,7 +151,7 @@ ONE_START_HEAD = [
     "mean_speed_mps", "cost_of_transport_J_per_kg_m", "stride_time_s", "contact_time_s",
     "contact_time_intact_s", "contact_time_prosthetic_s", "contact_time_left_s",
     "contact_time_right_s", "peak_vertical_grf_intact_bw", "peak_vertical_grf_prosthetic_bw",
-    "peak_vertical_grf_left_bw", "peak_vertical_grf_right_bw", "flight_fraction",
+    "peak_vertical_grf_left_bw", "peak_vertical_grf_right_bw", "flight_fraction", "step_phase",
     "dynamics_residual_pct", "iterations", "wall_s", "mesh_intervals", "file", "warnings"]
 
 

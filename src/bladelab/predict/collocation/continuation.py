@@ -117,7 +117,8 @@ MAX_SPEED_BEST_ITERATE_FILE = "max-speed.best_iterate.json"
 TABLE_COLUMNS = (
     "model", "blade", "problem", "prescribed_speed_mps", "converged", "status",
     "mean_speed_mps", "cost_of_transport_J_per_kg_m", "stride_time_s", "contact_time_s",
-    "flight_fraction", "dynamics_residual_pct", "iterations", "wall_s", "mesh_intervals", "file",
+    "flight_fraction", "step_phase", "dynamics_residual_pct", "iterations", "wall_s",
+    "mesh_intervals", "file",
 )
 _LEGS = ("intact", "prosthetic", "left", "right")
 _PER_LEG = ("contact_time_{}_s", "peak_vertical_grf_{}_bw")
