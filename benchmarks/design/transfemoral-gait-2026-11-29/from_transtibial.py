@@ -4,7 +4,7 @@ person-like stride, its prosthetic knee made straight in stance (changes nothing
 Usage (repository root)::
 
     .venv/bin/python benchmarks/design/transfemoral-gait-2026-11-29/from_transtibial.py \\
-        OUT.json STEP_PHASE_TOLERANCE [KNEE_FIELD=VALUE ...]
+        OUT.json STEP_PHASE_TOLERANCE [KNEE_FIELD=VALUE ...] [from=START.json]
 
 The start is ``../human-body-2026-11-29/transtibial-centre-people10.json`` (the design box's
 centre blade, 4 m/s) mapped onto the transfemoral runner by coordinate name, the prosthetic
@@ -15,7 +15,9 @@ weight 10, swing clearance 2 cm, the blade by backward Euler, mesh 50, and the a
 steps at STEP_PHASE_TOLERANCE (``none``: free). KNEE_FIELD=VALUE overrides a field of the
 prosthetic knee (``bladelab.runner.prosthetic_knee.ProstheticKnee``, e.g.
 ``flexion_damping=30``) in every transfemoral parameter set the process builds (the
-solution's consistency check included). The body's own parameter file decides the myodesis.
+solution's consistency check included). ``from=START.json``: start from that collocation
+solution as it is instead, with no tracking stage. The body's own parameter file decides the
+myodesis.
 Prints the summary, the tracking stage's record and the criteria of people's running; writes
 OUT.json.
 """
@@ -60,14 +62,23 @@ def _with_knee(overrides: dict[str, float]):
     return patched
 
 
-def main(out: str, step_tol: str, *knee: str) -> None:
-    stored.default_runner_params = _with_knee({k: float(v) for k, v in
-                                               (kv.split("=") for kv in knee)})
+def main(out: str, step_tol: str, *extra: str) -> None:
+    fields = dict(kv.split("=") for kv in extra)
+    start = fields.pop("from", None)
+    stored.default_runner_params = _with_knee({k: float(v) for k, v in fields.items()})
     space = default_design_space()
     blade = CollocationEvaluator().blade_spec(space.point([0.0] * len(space.names)))
     spec = {"model": "transfemoral", "blade": blade["name"], "blade_spec": blade,
             "body": "human"}
     runner = stored.runner_from_spec(spec)
+    settings = CollocationSettings(
+        mesh_intervals=50, speed_m_per_s=4.0, swing_clearance_m=0.02, blade_backward_euler=True,
+        step_phase_tolerance=None if step_tol == "none" else float(step_tol),
+        **people_term(10.0))
+    if start is not None:
+        guess = make_guess(runner, start, n=50, speed=4.0)
+        _solve(runner, settings, guess, spec, out, track=False)
+        return
     transtibial = CollocationSolution.read(START)
     guess = make_guess(runner, str(START), n=50, speed=4.0)
     j = list(guess.dof_names or runner.dof_names).index("knee_angle_r")
@@ -79,15 +90,15 @@ def main(out: str, step_tol: str, *knee: str) -> None:
         tendon_force_rate=None, multipliers=None, activation=None, tendon_force=None,
         vertical_grf_bw=force.sum(axis=1) / transtibial.body_weight_N,
         source=f"{guess.source}, prosthetic knee straight in stance")
-    settings = CollocationSettings(
-        mesh_intervals=50, speed_m_per_s=4.0, swing_clearance_m=0.02, blade_backward_euler=True,
-        step_phase_tolerance=None if step_tol == "none" else float(step_tol),
-        **people_term(10.0))
+    _solve(runner, settings, guess, spec, out, track=True)
+
+
+def _solve(runner, settings, guess, spec: dict, out: str, *, track: bool) -> None:
     t0 = time.perf_counter()
-    sol = predict_stride(runner, settings, guess, model_spec=spec, track=True)
+    sol = predict_stride(runner, settings, guess, model_spec=spec, track=track)
     print(f"wall {time.perf_counter() - t0:.0f} s")
     print(json.dumps(sol.summary()))
-    print("tracking stage", json.dumps(sol.tracking))
+    print("objective", sol.nlp.objective, "tracking stage", json.dumps(sol.tracking))
     for c in human_running_criteria(sol):
         print(c.met, c.name, c.value_text())
     sol.write(out)
