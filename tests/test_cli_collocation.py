@@ -91,6 +91,8 @@ def test_a_failed_force_run_removes_the_old_solution(solved, tmp_path, capsys):
     (("--method", "collocation", "--tilt-range", "-16"), "--tilt-range"),
     (("--method", "collocation", "--tilt-range=-2,-16"), "--tilt-range"),  # lo >= hi
     (("--method", "reflex", "--tilt-range=-16,-2"), "--tilt-range"),  # its lean weight
+    (("--method", "collocation", "--alternating-steps", "0.5"), "--alternating-steps"),
+    (("--method", "reflex", "--alternating-steps", "0.1"), "--alternating-steps"),
     (("--method", "collocation", "--body-mass", "-70"), "--body-mass"),
     (("--method", "collocation", "--height", "0"), "--height"),
     (("--method", "collocation", "--muscle-strength", "0"), "--muscle-strength"),

@@ -36,6 +36,7 @@ OPTIONS = {
     "swing_clearance_m": "--swing-clearance", "knee_moment_min_nm": "--knee-moment-min",
     "knee_flexion_max_loaded_deg": "--knee-flexion-max",
     "pelvis_tilt_range_deg": "--tilt-range", "reference_weight": "--people-weight",
+    "step_phase_tolerance": "--alternating-steps",
     "athlete.body_mass_kg": "--body-mass", "athlete.height_m": "--height",
     "athlete.muscle_strength": "--muscle-strength",
 }
@@ -110,11 +111,13 @@ def run_collocation(
     knee_moment_min: float | None,
     knee_flexion_max: float | None,
     tilt_range: str | None,
+    alternating_steps: float | None = None,
     people_weight: float | None = None,
     athlete: dict | None = None,
 ) -> int:
     """Run ``bladelab predict --method collocation``; returns the exit status (0 converged,
-    2 not converged). ``athlete``: the runner scaled to this athlete (``body_mass_kg``,
+    2 not converged). ``alternating_steps``: ``CollocationSettings.step_phase_tolerance``.
+    ``athlete``: the runner scaled to this athlete (``body_mass_kg``,
     ``height_m``, ``muscle_strength``; None: the body's own)."""
     tilt = _tilt_range(tilt_range)
     try:
@@ -122,7 +125,7 @@ def run_collocation(
             mesh_intervals=mesh, speed_m_per_s=None if max_speed else float(speed),
             max_iter=max_iter, swing_clearance_m=swing_clearance,
             knee_moment_min_nm=knee_moment_min, knee_flexion_max_loaded_deg=knee_flexion_max,
-            pelvis_tilt_range_deg=tilt,
+            pelvis_tilt_range_deg=tilt, step_phase_tolerance=alternating_steps,
             **people_term(defaults.people_weight_for(body, people_weight)))
         result = solve_named_stride(out, model=model, blade=blade, body=body,
                                     settings=settings, guess=guess, athlete=athlete,

@@ -258,6 +258,11 @@ def register(app: typer.Typer) -> None:
             None, "--tilt-range", rich_help_panel=COLLOCATION,
             help="Keep the pelvis tilt within LO,HI [deg] at every node (forward lean "
                  "negative), e.g. --tilt-range=-16,-2 (seed 001's window)."),
+        alternating_steps: float | None = typer.Option(
+            None, "--alternating-steps", rich_help_panel=COLLOCATION,
+            help="Keep the steps alternating: the second leg's stance half a stride +- this "
+                 "fraction of the stride after the first leg's, e.g. 0.1 (rules out a "
+                 "gallop)."),
         people_weight: float | None = _people_weight_option(),
         body_mass: float | None = _athlete_option("body_mass_kg"),
         height: float | None = _athlete_option("height_m"),
@@ -279,7 +284,7 @@ def register(app: typer.Typer) -> None:
                 guess=guess, max_iter=max_iter, resume=resume, force=force, as_json=as_json,
                 body=body, swing_clearance=swing_clearance, knee_moment_min=knee_moment_min,
                 knee_flexion_max=knee_flexion_max, tilt_range=tilt_range,
-                people_weight=people_weight,
+                alternating_steps=alternating_steps, people_weight=people_weight,
                 athlete=_athlete(body_mass, height, muscle_strength)))
         from bladelab.cli.reflex import run_reflex  # deferred: keeps bladelab --help fast
 
