@@ -214,6 +214,24 @@ def test_contact_forces_match_forward_hunt_crossley(models, kind):
     assert n_in_contact >= N_STATES
 
 
+@pytest.mark.parametrize("kind", ["amputee-human", "transfemoral-human"])
+def test_each_legs_vertical_force_sums_that_legs_contacts(models, kind):
+    """``StrideDynamics.leg_vertical_grf``: the contacts' vertical forces of the intact leg,
+    then of the prosthetic leg (``CP_LEG``), which add up to ``vertical_grf``."""
+    from bladelab.predict.collocation.dynamics import stride_dynamics
+    from bladelab.runner.layout import CP_LEG
+
+    runner, cm = models[kind]
+    dyn = stride_dynamics(cm)
+    legs = runner.contact_params[:, CP_LEG]
+    for q, qd in _penetrating_states(runner, 4):
+        fz = _np(cm.contacts(q, qd)[0])[:, 1]
+        per_leg = _np(dyn.leg_vertical_grf(q, qd)).ravel()
+        np.testing.assert_allclose(per_leg, [fz[legs == 0].sum(), fz[legs == 1].sum()],
+                                   rtol=1e-12, atol=1e-9)
+        assert per_leg.sum() == pytest.approx(float(dyn.vertical_grf(q, qd)), rel=1e-12)
+
+
 @pytest.mark.parametrize("kind", KINDS)
 def test_ligament_and_socket_torques_match_forward(models, kind):
     runner, cm = models[kind]

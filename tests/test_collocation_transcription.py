@@ -10,7 +10,12 @@ import pytest
 
 from bladelab.errors import SpecError
 from bladelab.predict.collocation.stride_guess import StrideGuess
-from bladelab.predict.collocation.transcription import StrideDynamics, StrideNLP, step_phase
+from bladelab.predict.collocation.transcription import (
+    StrideDynamics,
+    StrideNLP,
+    alternation_rows,
+    step_phase,
+)
 
 M, G, K = 80.0, 9.81, 2.0e4  # kg, m/s², N/m
 
@@ -339,13 +344,11 @@ def test_step_phase_is_the_delay_between_the_legs_stance_centres(right_after):
 def test_alternation_constraint_admits_alternating_steps_and_rules_out_a_gallop():
     """The constraint (≤ 0 to hold) is negative inside 0.5 ± tolerance, zero on its edges and
     positive outside, whichever leg leads."""
-    from bladelab.predict.collocation.transcription import _alternation
-
     n, bw, tol = 200, 700.0, 0.1
 
     def g(right_after: float, right_share: float = 1.0) -> np.ndarray:
         forces = _two_stances(n, right_after) * [1.0, right_share]
-        return np.asarray(_alternation(ca.DM(forces.T), bw, tol)).ravel()
+        return np.asarray(alternation_rows(ca.DM(forces.T), bw, tol)).ravel()
 
     assert g(0.5)[0] < 0 and g(0.45)[0] < 0 and g(0.58)[0] < 0
     assert g(0.4)[0] == pytest.approx(0.0, abs=1e-6)
@@ -358,11 +361,9 @@ def test_alternation_constraint_admits_alternating_steps_and_rules_out_a_gallop(
 
 
 def test_the_nlp_holds_the_alternation_constraint_only_when_asked():
-    """``step_phase_tolerance`` adds one inequality on the node forces 0..n−1, bounded above
-    by 0; without it there is none; a tolerance outside (0, 0.5) or dynamics without the
+    """``step_phase_tolerance`` adds three inequalities on the node forces 0..n−1 (the phase
+    and a stance per leg), bounded above by 0; without it there are none; a tolerance outside (0, 0.5) or dynamics without the
     legs' forces are refused."""
-    from bladelab.predict.collocation.transcription import _alternation
-
     toy = _toy()
     q, qd = ca.SX.sym("q", 3), ca.SX.sym("qd", 3)
     spring = [K * 0.5 * (-z + ca.sqrt(z**2 + 1e-8)) for z in (q[1], q[2])]  # tilt as a 2nd leg
@@ -385,7 +386,7 @@ def test_the_nlp_holds_the_alternation_constraint_only_when_asked():
         x = steps.initial_vector(guess)
         forces = np.stack([np.asarray(legs.leg_vertical_grf(qk, qk * 0)).ravel()
                            for qk in guess.q[:n]])
-        expected = np.asarray(_alternation(ca.DM(forces.T), M * G, 0.1)).ravel()
+        expected = np.asarray(alternation_rows(ca.DM(forces.T), M * G, 0.1)).ravel()
         np.testing.assert_allclose(np.asarray(g(x, 2.0)[i:i + 3]).ravel(), expected, rtol=1e-9)
         assert (expected[0] < 0) == (lag == 0.5)
     with pytest.raises(SpecError, match="step phase"):

@@ -141,7 +141,7 @@ KINDS = ("able", "amputee", "transfemoral")
 PROSTHETIC_KINDS = ("amputee", "transfemoral")
 #: Muscles of the transfemoral runner's residual limb: the monoarticular hip muscles, whose
 #: attachments the amputation keeps (the biarticular hamstrings and rectus femoris lose their
-#: tibial insertion; where a surgeon re-attaches them is not modelled).
+#: tibial insertion; :data:`MYODESIS_MUSCLES` with ``RunnerParams.myodesis``).
 RESIDUAL_THIGH_MUSCLES = ("glut_max", "iliopsoas")
 #: The biarticular thigh muscles that a myodesis re-attaches to the distal end of the residual
 #: femur, where they become monoarticular hip muscles (``RunnerParams.myodesis``).

@@ -170,6 +170,7 @@ def stride_dynamics(cm: CollocationModel, *, metabolic: MetabolicSmoothing | Non
         clearance = ca.vertcat(clearance, knee_straight_while_loaded(
             cm, q, qd, math.radians(knee_flexion_max_loaded_deg)))
     weight = runner.total_mass * runner.gravity
+    fz = cm.contacts(q, qd)[0][:, 1]  # vertical force of every contact [N]
     scale = np.array([weight if n.startswith("pelvis_t") and n != "pelvis_tilt" else 100.0
                       for n in runner.dof_names])
     return StrideDynamics(
@@ -192,23 +193,20 @@ def stride_dynamics(cm: CollocationModel, *, metabolic: MetabolicSmoothing | Non
                                      np.tile([0.0, np.inf], (int(clearance.numel()), 1))]),
         static_tendon_force=lambda q_nodes, a_nodes: static_tendon_forces(cm, q_nodes, a_nodes),
         active_strength=np.array(runner.muscle_params[:, MP_ACTIVE]),
-        vertical_grf=ca.Function("vertical_grf", [q, qd],
-                                 [ca.sum1(cm.contacts(q, qd)[0][:, 1])]),
-        leg_vertical_grf=_leg_vertical_grf(cm, q, qd),
+        vertical_grf=ca.Function("vertical_grf", [q, qd], [ca.sum1(fz)]),
+        leg_vertical_grf=ca.Function("leg_vertical_grf", [q, qd],
+                                     [_leg_sums(fz, runner.contact_params[:, CP_LEG])]),
         backward_euler_dofs=tuple(n for n in runner.dof_names if n.startswith("blade_joint"))
         if blade_backward_euler else (),
         interval_mean_inequalities=interval_mean,
     )
 
 
-def _leg_vertical_grf(cm: CollocationModel, q: ca.SX, qd: ca.SX) -> ca.Function:
-    """CasADi Function (q, q̇) -> the vertical ground force of each leg (2,) [N]: the left
-    (intact) leg's contacts, then the right (prosthetic) leg's."""
-    fz = cm.contacts(q, qd)[0][:, 1]
-    legs = cm.runner.contact_params[:, CP_LEG]
-    per_leg = [sum((fz[int(c)] for c in np.flatnonzero(legs == leg)), ca.SX(0.0))
-               for leg in (0, 1)]
-    return ca.Function("leg_vertical_grf", [q, qd], [ca.vertcat(*per_leg)])
+def _leg_sums(values: ca.SX, legs: np.ndarray) -> ca.SX:
+    """(2,) sums of the per-contact ``values`` over the left (intact) leg's contacts, then the
+    right (prosthetic) leg's (``legs``: each contact's leg, 0 or 1)."""
+    return ca.vertcat(*[ca.sum1(values[np.flatnonzero(legs == leg).tolist()])
+                        for leg in (0, 1)])
 
 
 def static_tendon_forces(cm: CollocationModel, q_nodes: np.ndarray, a_nodes: np.ndarray,

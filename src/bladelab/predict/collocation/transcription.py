@@ -59,6 +59,7 @@ __all__ = [
     "StrideNLP",
     "StrideWeights",
     "VariableScales",
+    "alternation_rows",
     "step_phase",
 ]
 
@@ -106,7 +107,7 @@ class NLPSolution:
                            multipliers=self.multipliers)
 
 
-#: Added to the squared force centroids [BW²] of :func:`_alternation` so that their norm stays
+#: Added to the squared force centroids [BW²] of :func:`alternation_rows` so that their norm stays
 #: differentiable at 0 (a leg without stance).
 _CENTROID_EPS = 1e-8
 #: The least force centroid |C_j| [BW] of each leg under the alternating-steps constraint:
@@ -127,8 +128,9 @@ def step_phase(leg_forces: np.ndarray) -> float:
     return float(np.angle(c[1] * np.conj(c[0])) / (2 * np.pi) % 1.0)
 
 
-def _alternation(legs, body_weight: float, tolerance: float):
-    """The alternating-steps constraints (each ≤ 0): with the legs' force centroids
+def alternation_rows(legs, body_weight: float, tolerance: float):
+    """The alternating-steps constraint rows (each ≤ 0) of the legs' vertical forces ``legs``
+    (2, n nodes of one period) [N] and the body weight [N]: with the legs' force centroids
     C_j = Σ_k F_j,k·e^{2πik/n} / (n·BW), Re(C₀·C̄₁) + cos(2π·tolerance)·|C₀|·|C₁| ≤ 0, i.e.
     the phase between them within π ± 2π·tolerance (:func:`step_phase` within 0.5 ±
     tolerance); and :data:`MIN_CENTROID_BW`² − |C_j|² ≤ 0 for each leg."""
@@ -353,7 +355,7 @@ class StrideNLP:
                 terms["metabolic"] = w.metabolic * energy / (d.mass * ca.fmax(distance, 1e-3))
         if self.step_phase_tolerance is not None:
             legs = ca.Function("legs", [xs], [d.leg_vertical_grf(q, qd)]).map(n)(X[:, :n])
-            g.append(_alternation(legs, d.mass * d.gravity, self.step_phase_tolerance))
+            g.append(alternation_rows(legs, d.mass * d.gravity, self.step_phase_tolerance))
             self._g_names += ["alternating steps"] + [f"stance of leg {j}" for j in (0, 1)]
         if self.tracking is not None:
             q_ref, weight, *dofs = self.tracking
