@@ -166,6 +166,11 @@ def test_design_bad_input(tmp_path, capsys):
                  "--reference-weight", "10", "--people-weight", "10"]) == 2
     assert "--people-weight: people's joint angles and the start stride's technique" in (
         capsys.readouterr().err)
+    assert main(["design", "--out", str(tmp_path / "c"), "--alternating-steps", "0.1"]) == 2
+    assert "--alternating-steps: only with --evaluator collocation" in capsys.readouterr().err
+    assert main(["design", "--out", str(tmp_path / "c"), "--evaluator", "collocation",
+                 "--alternating-steps", "0.6"]) == 2
+    assert "--alternating-steps:" in capsys.readouterr().err
     assert not (tmp_path / "c").exists()  # refused before any output
 
 

@@ -52,6 +52,7 @@ def fake(monkeypatch):
         calls.append({"source": guess.source, "track": track, "spec": model_spec,
                       "speed": settings.speed_m_per_s, "dofs": runner.dof_names,
                       "backward_euler": settings.blade_backward_euler,
+                      "step_phase_tolerance": settings.step_phase_tolerance,
                       "reference": (settings.reference, settings.reference_weight,
                                     settings.reference_dofs),
                       "contacts": runner.contact_params.copy()})
@@ -341,3 +342,20 @@ def test_the_human_body_with_peoples_angles(fake, tmp_path):
     with pytest.raises(SpecError, match="no built-in start stride") as err:
         make_evaluator("collocation", body="human")
     assert err.value.where == "body"
+
+
+def test_alternating_steps_reach_every_designs_solve(fake, tmp_path):
+    """The alternating-steps constraint is a setting of every design's solve and of the
+    evaluator's identity (a study made free is not resumed with it); free by default."""
+    calls, _ = fake
+    _evaluator(tmp_path)(CENTRE)
+    assert calls[-1]["step_phase_tolerance"] is None
+    ev = _evaluator(tmp_path / "alt", step_phase_tolerance=0.1)
+    ev(CENTRE)
+    assert calls[-1]["step_phase_tolerance"] == 0.1
+    assert ev.to_dict()["step_phase_tolerance"] == 0.1
+    # a study's file from before the setting ran free
+    assert ce.CollocationEvaluator.LEGACY_SETTINGS["step_phase_tolerance"] is None
+    with pytest.raises(SpecError) as err:
+        _evaluator(tmp_path, step_phase_tolerance=0.7)
+    assert err.value.where == "step_phase_tolerance"

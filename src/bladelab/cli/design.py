@@ -44,7 +44,7 @@ OPTIONS = {
     "knee_moment_min_Nm": "--knee-moment-min",
     "knee_flexion_max_loaded_deg": "--knee-flexion-max",
     "reference_weight": "--reference-weight", "body": "--body",
-    "people_weight": "--people-weight",
+    "people_weight": "--people-weight", "step_phase_tolerance": "--alternating-steps",
 }
 _FACTORS = ",".join(f"{name}={low:g}:{high:g}" for name, low, high, *_ in defaults.DESIGN_FACTORS)
 
@@ -208,6 +208,11 @@ def _design(
              "design's objective (the intact leg and the residual hip; a tracking term of "
              "measured running, docs/collocation.md). Default: 10 on the human body, 0 on "
              "seed001 and with --reference-weight; 0: the gait predicted freely."),
+    alternating_steps: float | None = typer.Option(
+        None, "--alternating-steps", rich_help_panel=COLLOCATION, show_default=False,
+        help="Keep every design's steps alternating: the prosthetic leg's stance half a "
+             "stride +- this fraction of the stride after the intact leg's, e.g. 0.1 "
+             "(default: free; free transfemoral strides gallop, docs/design.md)."),
     settle: int = typer.Option(
         0, "--settle", rich_help_panel=COLLOCATION,
         help="After the runs, up to this many settling passes (each design solved again from "
@@ -257,7 +262,8 @@ def _design(
             kind=evaluator, speed_mps=speed, body_mass_kg=body_mass, dt_s=dt, base=base,
             gait=gait, motion=motion, motion_model=motion_model, start=start,
             knee_moment_min_Nm=knee_moment_min, knee_flexion_max_loaded_deg=knee_flexion_max,
-            reference_weight=reference_weight, body=body, people_weight=people_weight)
+            reference_weight=reference_weight, body=body, people_weight=people_weight,
+            step_phase_tolerance=alternating_steps)
     except BladelabError as err:
         raise renamed(err, OPTIONS) from None
     design = doe.make_design(runs, space, n_runs=n_runs, model=model, seed=seed)

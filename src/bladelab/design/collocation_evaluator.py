@@ -146,6 +146,11 @@ class CollocationEvaluator:
         objective (``CollocationSettings.reference_weight``), so that every blade is run with
         the same technique and its responses are the blade's (seed 002 imposed measured
         kinematics); 0 (default): the gait is predicted freely.
+    step_phase_tolerance
+        Keep every design's steps alternating: the prosthetic leg's stance half a stride ±
+        this fraction of the stride after the intact leg's
+        (``CollocationSettings.step_phase_tolerance``); None (default): free. Every
+        converged transfemoral stride of both bodies gallops without it (docs/design.md).
     people_weight
         Weight [1/rad²] of people's joint angles in the objective (the intact leg's hip, knee
         and ankle and the residual hip; ``CollocationSettings(reference="people")``,
@@ -170,11 +175,14 @@ class CollocationEvaluator:
     reference_weight: float = 0.0
     body: str = DEFAULT_BODY
     people_weight: float | None = None
+    step_phase_tolerance: float | None = None
     generator: Mapping[str, Any] = field(default_factory=dict)
 
     #: What a study's ``evaluator.json`` written before a setting existed meant by it: the
-    #: studies before the human body ran seed 001's body without people's angles.
-    LEGACY_SETTINGS: ClassVar[dict[str, Any]] = {"body": "seed001", "people_weight": 0.0}
+    #: studies before the human body ran seed 001's body without people's angles, and
+    #: those before the alternating-steps constraint ran free.
+    LEGACY_SETTINGS: ClassVar[dict[str, Any]] = {"body": "seed001", "people_weight": 0.0,
+                                                 "step_phase_tolerance": None}
 
     def __post_init__(self) -> None:
         if self.body not in BODIES:
@@ -306,6 +314,7 @@ class CollocationEvaluator:
                                    knee_moment_min_nm=self.knee_moment_min_Nm,
                                    knee_flexion_max_loaded_deg=self.knee_flexion_max_loaded_deg,
                                    blade_backward_euler=self.blade_backward_euler,
+                                   step_phase_tolerance=self.step_phase_tolerance,
                                    max_iter=self.max_iter, **reference)
 
     def _problem(self, point: Mapping[str, float]) -> tuple[dict, Any]:

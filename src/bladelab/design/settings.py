@@ -38,6 +38,7 @@ APPLIES_TO: dict[str, tuple[str, ...]] = {
     "reference_weight": ("collocation",),
     "body": ("collocation",),
     "people_weight": ("collocation",),
+    "step_phase_tolerance": ("collocation",),
 }
 
 
@@ -73,6 +74,9 @@ class EvaluatorSettings:
         Collocation: the runner body (``"seed001"``, the default, or ``"human"`` with a
         ``start`` of it) and the weight [1/rad²] of people's joint angles in the objective
         (default: the body's).
+    step_phase_tolerance
+        Collocation: keep every design's steps alternating within this fraction of the stride
+        of half a stride (``CollocationSettings.step_phase_tolerance``); None: free.
     """
 
     kind: str = "blade"
@@ -89,6 +93,7 @@ class EvaluatorSettings:
     reference_weight: float | None = None
     body: str | None = None
     people_weight: float | None = None
+    step_phase_tolerance: float | None = None
 
     def __post_init__(self) -> None:
         if self.kind not in EVALUATORS:
@@ -121,7 +126,8 @@ class EvaluatorSettings:
             if self.start is not None:
                 options["start"] = str(self.start)
             for name in ("knee_moment_min_Nm", "knee_flexion_max_loaded_deg",
-                         "reference_weight", "body", "people_weight"):
+                         "reference_weight", "body", "people_weight",
+                         "step_phase_tolerance"):
                 if getattr(self, name) is not None:
                     options[name] = getattr(self, name)
         elif self.body_mass_kg is not None:
