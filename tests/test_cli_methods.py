@@ -183,9 +183,10 @@ def test_predict_reflex_defaults_are_the_settings_defaults(tmp_path, monkeypatch
             seen["blade"], seen["seeds"]) == (100, 16, 1.0, 5, "Cat6", [1])
 
 
-def test_predict_collocation_passes_the_same_settings(tmp_path, monkeypatch):
+def test_predict_collocation_passes_the_same_settings(tmp_path, monkeypatch, capsys):
     import bladelab.predict.collocation.named_runs as named
     from bladelab.predict.collocation.settings import CollocationSettings
+    from bladelab.predict.defaults import ATHLETE_STARTS
 
     seen = {}
 
@@ -226,11 +227,26 @@ def test_predict_collocation_passes_the_same_settings(tmp_path, monkeypatch):
             main(["predict", "--out", str(tmp_path), *args])
         assert seen["settings"] == CollocationSettings(**term), args
     seen.clear()
-    with pytest.raises(_Called):  # the athlete is part of the model
+
+    def from_starts(out, runner, settings, make_guess, template_guess, **kw):
+        seen.update(out=out, settings=settings, **kw)
+        raise _Called
+
+    monkeypatch.setattr(named, "predict_stride_from_starts", from_starts)
+    with pytest.raises(_Called):  # the athlete is part of the model; two starts by default
         main(["predict", "--out", str(tmp_path), "--model", "amputee", "--body-mass", "68",
               "--height", "1.75", "--muscle-strength", "1.3"])
     assert seen["model_spec"]["athlete"] == {"body_mass_kg": 68.0, "height_m": 1.75,
                                              "muscle_strength": 1.3}
+    assert seen["starts"] == ATHLETE_STARTS == 2
+    for args, starts in ((["--body-mass", "68", "--starts", "1"], None),
+                         (["--starts", "3"], 3)):
+        seen.clear()
+        with pytest.raises(_Called):
+            main(["predict", "--out", str(tmp_path), "--model", "amputee", *args])
+        assert seen.get("starts") == starts, args  # None: the one-start folder solve
+    assert main(["predict", "--out", str(tmp_path), "--starts", "9"]) == 2
+    assert "--starts: need 1 to 3 starts" in capsys.readouterr().err
 
 
 def test_sweep_collocation_passes_the_same_settings(tmp_path, monkeypatch):

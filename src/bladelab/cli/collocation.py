@@ -38,7 +38,7 @@ OPTIONS = {
     "pelvis_tilt_range_deg": "--tilt-range", "reference_weight": "--people-weight",
     "step_phase_tolerance": "--alternating-steps",
     "athlete.body_mass_kg": "--body-mass", "athlete.height_m": "--height",
-    "athlete.muscle_strength": "--muscle-strength",
+    "athlete.muscle_strength": "--muscle-strength", "starts": "--starts",
 }
 
 
@@ -114,11 +114,16 @@ def run_collocation(
     alternating_steps: float | None = None,
     people_weight: float | None = None,
     athlete: dict | None = None,
+    starts: int | None = None,
 ) -> int:
     """Run ``bladelab predict --method collocation``; returns the exit status (0 converged,
     2 not converged). ``alternating_steps``: ``CollocationSettings.step_phase_tolerance``.
     ``athlete``: the runner scaled to this athlete (``body_mass_kg``,
-    ``height_m``, ``muscle_strength``; None: the body's own)."""
+    ``height_m``, ``muscle_strength``; None: the body's own). ``starts``: starts of the
+    stride, the best kept (None: :data:`~bladelab.predict.defaults.ATHLETE_STARTS` for a
+    scaled athlete, else :data:`~bladelab.predict.defaults.STARTS`)."""
+    if starts is None:
+        starts = defaults.ATHLETE_STARTS if athlete else defaults.STARTS
     tilt = _tilt_range(tilt_range)
     try:
         settings = CollocationSettings(
@@ -129,7 +134,9 @@ def run_collocation(
             **people_term(defaults.people_weight_for(body, people_weight)))
         result = solve_named_stride(out, model=model, blade=blade, body=body,
                                     settings=settings, guess=guess, athlete=athlete,
-                                    resume=resume, force=force, progress=StageProgress())
+                                    starts=starts, resume=resume, force=force,
+                                    progress=StageProgress(),
+                                    say=lambda line: typer.echo(line, err=True))
     except BladelabError as err:
         raise renamed(err, OPTIONS) from None
     sol = result.solution

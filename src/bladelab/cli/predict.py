@@ -267,6 +267,13 @@ def register(app: typer.Typer) -> None:
         body_mass: float | None = _athlete_option("body_mass_kg"),
         height: float | None = _athlete_option("height_m"),
         muscle_strength: float | None = _athlete_option("muscle_strength"),
+        starts: int | None = typer.Option(
+            None, "--starts", rich_help_panel=COLLOCATION, show_default=False,
+            help="Solve the stride from up to K starts (the guess, the guess with the "
+                 "barrier started at 1e-4, the template) and keep the best; each start's "
+                 f"solve in OUT/starts/. Default: {defaults.ATHLETE_STARTS} for an athlete "
+                 "scaled by --body-mass, --height or --muscle-strength (one start can land "
+                 f"17 % too high there), else {defaults.STARTS}."),
     ) -> None:
         """Predict a running gait: solve one periodic stride of the human body by direct
         collocation (writes DIR/solution.json; exit status 2 and DIR/best_iterate.json if
@@ -285,7 +292,7 @@ def register(app: typer.Typer) -> None:
                 body=body, swing_clearance=swing_clearance, knee_moment_min=knee_moment_min,
                 knee_flexion_max=knee_flexion_max, tilt_range=tilt_range,
                 alternating_steps=alternating_steps, people_weight=people_weight,
-                athlete=_athlete(body_mass, height, muscle_strength)))
+                athlete=_athlete(body_mass, height, muscle_strength), starts=starts))
         from bladelab.cli.reflex import run_reflex  # deferred: keeps bladelab --help fast
 
         run_reflex(

@@ -10,6 +10,7 @@ and the command line shows the same values in ``bladelab predict --help`` and
 from __future__ import annotations
 
 __all__ = [
+    "ATHLETE_STARTS",
     "BODY",
     "CHECKPOINT_EVERY",
     "DURATION_S",
@@ -120,8 +121,12 @@ GUESS = "stored"
 #: against another runner's trial 18.5/15.7°, 12.5/7.3°, 11.1/7.1°. 10 is the smaller weight
 #: that gives people's swing, at 4 % more energy. Seed 001's body (and ``toes``) keep none.
 PEOPLE_WEIGHT_PER_RAD2 = 10.0
-#: Starts per problem of a collocation sweep (the best solve is kept).
+#: Starts per problem of a collocation sweep or stride (the best solve is kept).
 STARTS = 1
+#: Starts of ``bladelab predict`` for an athlete scaled from the body's own: measured
+#: 2026-11-30, the amputee scaled to 68 kg and 1.75 m reached +17 % of the settled objective
+#: from the shipped stride's default barrier start and +0.08 % from its barrier start 1e-4.
+ATHLETE_STARTS = 2
 
 
 def people_weight_for(body: str, weight: float | None = None) -> float:

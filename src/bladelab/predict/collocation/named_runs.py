@@ -23,6 +23,10 @@ from typing import TYPE_CHECKING
 
 from bladelab.errors import SpecError
 from bladelab.predict import defaults
+from bladelab.predict.collocation.folder_starts import (
+    check_stride_starts,
+    predict_stride_from_starts,
+)
 from bladelab.predict.collocation.settings import CollocationSettings, people_term
 from bladelab.predict.collocation.solve import predict_stride_in_folder
 from bladelab.predict.collocation.starting_guess import make_guess, resolve_guess
@@ -50,9 +54,11 @@ def solve_named_stride(
     settings: CollocationSettings | None = None,
     guess: str = defaults.GUESS,
     athlete: dict | None = None,
+    starts: int = defaults.STARTS,
     resume: bool = False,
     force: bool = False,
     progress: Callable[[SolveProgress], None] | None = None,
+    say: Callable[[str], None] | None = None,
 ) -> FolderResult:
     """Solve one stride of the runner ``model`` (``able``, ``amputee``, ``transfemoral``)
     wearing ``blade`` (None: the model's default blade) with the ``body`` (seed 001's, or
@@ -63,7 +69,10 @@ def solve_named_stride(
     ``settings`` (default :class:`CollocationSettings`) say the problem (mesh intervals [-],
     speed [m/s] or None for the maximum speed, constraints); ``resume``, ``force`` and
     ``progress`` are those of :func:`predict_stride_in_folder`, which owns the folder
-    (``solution.json``, or ``best_iterate.json`` when IPOPT does not converge).
+    (``solution.json``, or ``best_iterate.json`` when IPOPT does not converge). ``starts``
+    > 1: the stride solved from that many starts, the best kept
+    (:func:`~bladelab.predict.collocation.folder_starts.predict_stride_from_starts`; ``say``
+    gets its lines about the starts).
 
     Raises
     ------
@@ -83,10 +92,14 @@ def solve_named_stride(
         blade = default_runner_params(model).blade
     spec = check_model_spec({"model": model, "blade": blade, "body": body, "athlete": athlete})
     runner = runner_from_spec(spec)
+    n, speed = settings.mesh_intervals, settings.speed_m_per_s
+    if check_stride_starts(starts) > 1:
+        return predict_stride_from_starts(
+            out, runner, settings, lambda: make_guess(runner, guess, n=n, speed=speed),
+            lambda: make_guess(runner, "template", n=n, speed=speed), starts=starts,
+            model_spec=spec, resume=resume, force=force, progress=progress, say=say)
     return predict_stride_in_folder(
-        out, runner, settings,
-        lambda: make_guess(runner, guess, n=settings.mesh_intervals,
-                           speed=settings.speed_m_per_s),
+        out, runner, settings, lambda: make_guess(runner, guess, n=n, speed=speed),
         model_spec=spec, resume=resume, force=force, progress=progress)
 
 

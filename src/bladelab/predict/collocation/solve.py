@@ -80,9 +80,11 @@ __all__ = [
     "BEST_ITERATE_FILE",
     "FolderResult",
     "SOLUTION_FILE",
+    "STARTS_DIR",
     "SolveProgress",
     "TRACKING_RESTART_STATUSES",
     "TRACKING_WEIGHTS",
+    "check_output_folder",
     "predict_stride",
     "predict_stride_in_folder",
     "read_stored",
@@ -97,6 +99,8 @@ TRACKING_RESTART_STATUSES = ("Infeasible_Problem_Detected", "Restoration_Failed"
 #: File names in a ``bladelab predict --method collocation`` folder.
 SOLUTION_FILE = "solution.json"
 BEST_ITERATE_FILE = "best_iterate.json"
+#: The folder of each start's solve when a folder's stride is solved from several starts.
+STARTS_DIR = "starts"
 
 
 @dataclass(frozen=True)
@@ -489,7 +493,29 @@ class FolderResult:
 
 
 def _held(out: Path) -> list[str]:
-    return [n for n in (SOLUTION_FILE, BEST_ITERATE_FILE) if (out / n).exists()]
+    return [n for n in (SOLUTION_FILE, BEST_ITERATE_FILE, STARTS_DIR) if (out / n).exists()]
+
+
+def check_output_folder(out: Path, *, resume: bool, force: bool) -> list[str]:
+    """The solve files that the output folder ``out`` holds (empty if none or no folder).
+
+    Raises
+    ------
+    InputFileError
+        ``out`` is a file, or holds a solve and neither ``resume`` nor ``force`` is given.
+    SpecError
+        Both ``resume`` and ``force``.
+    """
+    if out.exists() and not out.is_dir():
+        raise InputFileError("is a file, not a folder", file=out, hint="give a folder for --out")
+    held = _held(out) if out.is_dir() else []
+    if resume and force:
+        raise SpecError("give --resume or --force, not both", where="--resume/--force")
+    if held and not (resume or force):
+        raise InputFileError(
+            f"the output folder holds a collocation solve ({', '.join(held)})", file=out,
+            hint="--resume continues it, --force starts over in it, or choose another --out")
+    return held
 
 
 def predict_stride_in_folder(
@@ -529,15 +555,7 @@ def predict_stride_in_folder(
     """
     out = Path(out)
     spec = check_model_spec(model_spec)
-    if out.exists() and not out.is_dir():
-        raise InputFileError("is a file, not a folder", file=out, hint="give a folder for --out")
-    held = _held(out) if out.is_dir() else []
-    if resume and force:
-        raise SpecError("give --resume or --force, not both", where="--resume/--force")
-    if held and not (resume or force):
-        raise InputFileError(
-            f"the output folder holds a collocation solve ({', '.join(held)})", file=out,
-            hint="--resume continues it, --force starts over in it, or choose another --out")
+    held = check_output_folder(out, resume=resume, force=force)
     guess = None
     ok, best = out / SOLUTION_FILE, out / BEST_ITERATE_FILE
     if resume:
