@@ -30,7 +30,7 @@ from collections.abc import Callable
 from pathlib import Path
 
 from bladelab._io import write_json
-from bladelab.errors import InputFileError, SpecError
+from bladelab.errors import SpecError
 from bladelab.predict.collocation.settings import CollocationSettings
 from bladelab.predict.collocation.solve import (
     BEST_ITERATE_FILE,
@@ -101,11 +101,8 @@ def predict_stride_from_starts(
     """
     out = Path(out)
     spec = check_model_spec(model_spec)
-    held = check_output_folder(out, resume=resume, force=force)
+    check_output_folder(out, resume=resume, force=force)
     ok, best = out / SOLUTION_FILE, out / BEST_ITERATE_FILE
-    if resume and not held:
-        raise InputFileError("no collocation solve to resume from", file=out,
-                             hint="run without --resume first, with the same --out")
     warm_guess = _once(make_guess)
     warm = Start(START_ORDER[0], settings, warm_guess)
     template = Start("template", settings, template_guess, "from the template guess")

@@ -502,7 +502,8 @@ def check_output_folder(out: Path, *, resume: bool, force: bool) -> list[str]:
     Raises
     ------
     InputFileError
-        ``out`` is a file, or holds a solve and neither ``resume`` nor ``force`` is given.
+        ``out`` is a file, or holds a solve and neither ``resume`` nor ``force`` is given, or
+        ``resume`` is given and it holds none.
     SpecError
         Both ``resume`` and ``force``.
     """
@@ -515,6 +516,9 @@ def check_output_folder(out: Path, *, resume: bool, force: bool) -> list[str]:
         raise InputFileError(
             f"the output folder holds a collocation solve ({', '.join(held)})", file=out,
             hint="--resume continues it, --force starts over in it, or choose another --out")
+    if resume and not held:
+        raise InputFileError("no collocation solve to resume from", file=out,
+                             hint="run without --resume first, with the same --out")
     return held
 
 
@@ -555,13 +559,10 @@ def predict_stride_in_folder(
     """
     out = Path(out)
     spec = check_model_spec(model_spec)
-    held = check_output_folder(out, resume=resume, force=force)
+    check_output_folder(out, resume=resume, force=force)
     guess = None
     ok, best = out / SOLUTION_FILE, out / BEST_ITERATE_FILE
     if resume:
-        if not held:
-            raise InputFileError("no collocation solve to resume from", file=out,
-                                 hint="run without --resume first, with the same --out")
         done, iterate = read_stored(ok, best, spec, settings)
         if done is not None:
             return FolderResult(done, ok, False)
