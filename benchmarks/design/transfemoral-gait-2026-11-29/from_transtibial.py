@@ -4,7 +4,13 @@ person-like stride, its prosthetic knee made straight in stance (changes nothing
 Usage (repository root)::
 
     .venv/bin/python benchmarks/design/transfemoral-gait-2026-11-29/from_transtibial.py \\
-        OUT.json STEP_PHASE_TOLERANCE [KNEE_FIELD=VALUE ...] [from=START.json]
+        OUT.json STEP_PHASE_TOLERANCE [KNEE_FIELD=VALUE ...] [from=START.json] [raw=1] \\
+        [set:SETTING=VALUE ...]
+
+``raw=1``: the transtibial stride's knee angles as they are (not made straight in stance).
+The last two arguments were added on 2026-11-30 (``../transfemoral-gait-2026-11-30/``).
+``set:SETTING=VALUE``: a ``CollocationSettings`` field (a number, or ``none``), e.g.
+``set:swing_clearance_m=0`` or ``set:knee_flexion_max_loaded_deg=10``.
 
 The start is ``../human-body-2026-11-29/transtibial-centre-people10.json`` (the design box's
 centre blade, 4 m/s) mapped onto the transfemoral runner by coordinate name, the prosthetic
@@ -65,6 +71,11 @@ def _with_knee(overrides: dict[str, float]):
 def main(out: str, step_tol: str, *extra: str) -> None:
     fields = dict(kv.split("=") for kv in extra)
     start = fields.pop("from", None)
+    raw = fields.pop("raw", None)
+    sets = {k[4:]: (None if v == "none" else float(v))
+            for k, v in list(fields.items()) if k.startswith("set:")}
+    for k in sets:
+        fields.pop("set:" + k)
     stored.default_runner_params = _with_knee({k: float(v) for k, v in fields.items()})
     space = default_design_space()
     blade = CollocationEvaluator().blade_spec(space.point([0.0] * len(space.names)))
@@ -72,9 +83,9 @@ def main(out: str, step_tol: str, *extra: str) -> None:
             "body": "human"}
     runner = stored.runner_from_spec(spec)
     settings = CollocationSettings(
-        mesh_intervals=50, speed_m_per_s=4.0, swing_clearance_m=0.02, blade_backward_euler=True,
+        mesh_intervals=50, speed_m_per_s=4.0, blade_backward_euler=True,
         step_phase_tolerance=None if step_tol == "none" else float(step_tol),
-        **people_term(10.0))
+        **{"swing_clearance_m": 0.02, **people_term(10.0), **sets})
     if start is not None:
         guess = make_guess(runner, start, n=50, speed=4.0)
         _solve(runner, settings, guess, spec, out, track=False)
@@ -84,7 +95,8 @@ def main(out: str, step_tol: str, *extra: str) -> None:
     j = list(guess.dof_names or runner.dof_names).index("knee_angle_r")
     force = transtibial.leg_vertical_force()
     q = guess.q.copy()
-    q[:, j] = np.minimum(q[:, j] - q[force[:, 1] > 50.0, j].max(), 0.0)
+    if not raw:
+        q[:, j] = np.minimum(q[:, j] - q[force[:, 1] > 50.0, j].max(), 0.0)
     guess = dataclasses.replace(
         guess, q=q, qd=periodic_derivative(q, guess.period), qdd=None, excitation=None,
         tendon_force_rate=None, multipliers=None, activation=None, tendon_force=None,

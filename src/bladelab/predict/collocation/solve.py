@@ -496,30 +496,35 @@ def _held(out: Path) -> list[str]:
     return [n for n in (SOLUTION_FILE, BEST_ITERATE_FILE, STARTS_DIR) if (out / n).exists()]
 
 
-def check_output_folder(out: Path, *, resume: bool, force: bool) -> list[str]:
-    """The solve files that the output folder ``out`` holds (empty if none or no folder).
+def check_output_folder(out: Path, *, resume: bool, force: bool,
+                        held: Callable[[Path], list[str]] | None = None,
+                        what: str = "collocation solve") -> list[str]:
+    """The result files that the output folder ``out`` holds (``held(out)``, default a
+    stride's: ``solution.json``, ``best_iterate.json``, ``starts``; empty if none or no
+    folder); ``what`` names its kind in the errors.
 
     Raises
     ------
     InputFileError
-        ``out`` is a file, or holds a solve and neither ``resume`` nor ``force`` is given, or
+        ``out`` is a file, or holds results and neither ``resume`` nor ``force`` is given, or
         ``resume`` is given and it holds none.
     SpecError
         Both ``resume`` and ``force``.
     """
-    if out.exists() and not out.is_dir():
-        raise InputFileError("is a file, not a folder", file=out, hint="give a folder for --out")
-    held = _held(out) if out.is_dir() else []
     if resume and force:
         raise SpecError("give --resume or --force, not both", where="--resume/--force")
-    if held and not (resume or force):
+    if out.exists() and not out.is_dir():
+        raise InputFileError("is a file, not a folder", file=out, hint="give a folder for --out")
+    found = (held or _held)(out) if out.is_dir() else []
+    if found and not (resume or force):
+        shown = ", ".join(found[:3]) + (f" and {len(found) - 3} more" if len(found) > 3 else "")
         raise InputFileError(
-            f"the output folder holds a collocation solve ({', '.join(held)})", file=out,
+            f"the output folder holds a {what} ({shown})", file=out,
             hint="--resume continues it, --force starts over in it, or choose another --out")
-    if resume and not held:
-        raise InputFileError("no collocation solve to resume from", file=out,
+    if resume and not found:
+        raise InputFileError(f"no {what} to resume from", file=out,
                              hint="run without --resume first, with the same --out")
-    return held
+    return found
 
 
 def predict_stride_in_folder(

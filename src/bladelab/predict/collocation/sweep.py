@@ -33,7 +33,7 @@ from pathlib import Path
 import pandas as pd
 
 from bladelab._io import atomic_open
-from bladelab.errors import InputFileError, SpecError
+from bladelab.errors import SpecError
 from bladelab.executors import make_executor
 from bladelab.predict.collocation.analyses import stride_analyses
 from bladelab.predict.collocation.continuation import (
@@ -48,6 +48,7 @@ from bladelab.predict.collocation.continuation import (
 )
 from bladelab.predict.collocation.model import build_collocation_model
 from bladelab.predict.collocation.settings import CollocationSettings
+from bladelab.predict.collocation.solve import check_output_folder
 from bladelab.predict.collocation.starts import check_starts
 from bladelab.predict.collocation.stored import check_model_spec, model_label
 from bladelab.runner.params import blade_category
@@ -282,21 +283,9 @@ def collocation_sweep(
         raise SpecError("a model is given twice", where="models")
     if isinstance(jobs, bool) or not isinstance(jobs, int) or jobs < 1:
         raise SpecError(f"need at least 1 job, got {jobs!r}", where="jobs")
-    if resume and force:
-        raise SpecError("give --resume or --force, not both", where="--resume/--force")
-    starts = check_starts(starts)
     out = Path(out)
-    if out.exists() and not out.is_dir():
-        raise InputFileError("is a file, not a folder", file=out, hint="give a folder for --out")
-    held = _held(out)
-    if held and not (resume or force):
-        shown = ", ".join(held[:3]) + (f" and {len(held) - 3} more" if len(held) > 3 else "")
-        raise InputFileError(
-            f"the output folder holds a collocation sweep ({shown})", file=out,
-            hint="--resume continues it, --force starts over in it, or choose another --out")
-    if resume and not held:
-        raise InputFileError("no collocation sweep to resume from", file=out,
-                             hint="run without --resume first, with the same --out")
+    check_output_folder(out, resume=resume, force=force, held=_held, what="collocation sweep")
+    starts = check_starts(starts)
     out.mkdir(parents=True, exist_ok=True)
     payloads = [{"model_spec": m, "speeds": list(speeds), "settings": settings,
                  "make_guess": make_guess, "out": str(out.resolve()), "force": bool(force),
