@@ -91,8 +91,9 @@ def predict_stride_from_starts(
     ``starts`` starts (module docstring): ``make_guess`` gives the warm start's guess,
     ``template_guess`` the template's; ``resume``, ``force`` and ``progress`` as there (each
     start's stages named ``start <label>: <stage>``); ``say(line)`` gets a line as each start
-    begins or is read back, and the kept start with every start's objective. Returns the kept start's
-    :class:`~bladelab.predict.collocation.solve.FolderResult` (its path the copy in ``out``).
+    begins or is read back, and one naming the kept start with every start's objective.
+    Returns the kept start's :class:`~bladelab.predict.collocation.solve.FolderResult` (its
+    path the copy in ``out``).
 
     Raises
     ------
@@ -150,4 +151,3 @@ def _once(make: Callable[[], object]) -> Callable[[], object]:
         return box[0]
 
     return get
-
