@@ -26,6 +26,7 @@ their best iterates.
 from __future__ import annotations
 
 import dataclasses
+import functools
 from collections.abc import Callable
 from pathlib import Path
 
@@ -50,6 +51,7 @@ from bladelab.predict.collocation.starts import (
     plan_starts,
     solve_starts,
     start_columns,
+    start_files,
 )
 from bladelab.predict.collocation.stored import check_model_spec
 
@@ -104,20 +106,21 @@ def predict_stride_from_starts(
     spec = check_model_spec(model_spec)
     check_output_folder(out, resume=resume, force=force)
     ok, best = out / SOLUTION_FILE, out / BEST_ITERATE_FILE
-    warm_guess = _once(make_guess)
+    warm_guess = functools.cache(make_guess)  # built once: its source plans the starts
     warm = Start(START_ORDER[0], settings, warm_guess)
     template = Start("template", settings, template_guess, "from the template guess")
     plan = plan_starts(starts, warm, warm_source=str(warm_guess().source), template=template,
                        previous=None)
     folder = out / STARTS_DIR
     folder.mkdir(parents=True, exist_ok=True)
+    files = (folder / SOLUTION_FILE, folder / BEST_ITERATE_FILE)
+    label_of = {start_files(*files, s.label)[0]: s.label for s in plan}
 
     def read(o: Path, b: Path, s: CollocationSettings):
         return (None, None) if force else read_stored(o, b, spec, s)
 
     def solve(s: CollocationSettings, guess, o: Path, b: Path, said):
-        label = (START_ORDER[0] if o.name == SOLUTION_FILE
-                 else o.name.removeprefix("solution.").removesuffix(".json"))
+        label = label_of[o]
 
         def relay(p: SolveProgress) -> None:
             if progress is not None:
@@ -130,8 +133,7 @@ def predict_stride_from_starts(
         if say is not None and message:
             say(message)
 
-    kept, outcomes = solve_starts(plan, ok=folder / SOLUTION_FILE,
-                                  best=folder / BEST_ITERATE_FILE, read=read, solve=solve,
+    kept, outcomes = solve_starts(plan, ok=files[0], best=files[1], read=read, solve=solve,
                                   report=report, retry=True, several=True)
     cands = [candidate(x.label, x.solution) for x in outcomes]
     write_json(folder / STARTS_FILE, {
@@ -140,14 +142,3 @@ def predict_stride_from_starts(
     target = write_solve(kept.solution, ok, best)
     return FolderResult(kept.solution, target, any(x.solved for x in outcomes))
 
-
-def _once(make: Callable[[], object]) -> Callable[[], object]:
-    """``make`` called at most once: its result is kept."""
-    box: list = []
-
-    def get():
-        if not box:
-            box.append(make())
-        return box[0]
-
-    return get
