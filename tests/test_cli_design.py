@@ -171,6 +171,12 @@ def test_design_bad_input(tmp_path, capsys):
     assert main(["design", "--out", str(tmp_path / "c"), "--evaluator", "collocation",
                  "--alternating-steps", "0.6"]) == 2
     assert "--alternating-steps:" in capsys.readouterr().err
+    assert main(["design", "--out", str(tmp_path / "c"), "--prosthetic-load-max", "3"]) == 2
+    assert "--prosthetic-load-max: only with --evaluator collocation" in (
+        capsys.readouterr().err)
+    assert main(["design", "--out", str(tmp_path / "c"), "--evaluator", "collocation",
+                 "--prosthetic-load-max", "0"]) == 2
+    assert "--prosthetic-load-max: the prosthetic load limit" in capsys.readouterr().err
     assert not (tmp_path / "c").exists()  # refused before any output
 
 

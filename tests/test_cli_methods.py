@@ -200,12 +200,14 @@ def test_predict_collocation_passes_the_same_settings(tmp_path, monkeypatch, cap
         main(["predict", "--method", "collocation", "--model", "transfemoral", "--speed", "4",
               "--mesh", "8", "--max-iter", "7", "--swing-clearance", "0.02",
               "--knee-moment-min", "0", "--knee-flexion-max", "10", "--tilt-range=-16,-2",
-              "--alternating-steps", "0.1", "--resume", "--out", str(tmp_path)])
+              "--alternating-steps", "0.1", "--prosthetic-load-max", "3", "--resume",
+              "--out", str(tmp_path)])
     people = {"reference": "people", "reference_weight": 10.0}  # the human body's default
     assert seen["settings"] == CollocationSettings(
         mesh_intervals=8, speed_m_per_s=4.0, max_iter=7, swing_clearance_m=0.02,
         knee_moment_min_nm=0.0, knee_flexion_max_loaded_deg=10.0,
-        pelvis_tilt_range_deg=(-16.0, -2.0), step_phase_tolerance=0.1, **people)
+        pelvis_tilt_range_deg=(-16.0, -2.0), step_phase_tolerance=0.1,
+        prosthetic_load_max_bw=3.0, **people)
     assert seen["model_spec"] == {"model": "transfemoral", "blade": "Cat4", "body": "human"}
     assert seen["runner"] == ("runner", seen["model_spec"])
     assert (seen["out"], seen["resume"], seen["force"]) == (tmp_path, True, False)

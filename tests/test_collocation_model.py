@@ -614,3 +614,38 @@ def test_loaded_knee_flexion_limit_is_weighted_by_the_prosthetic_load(models):
     assert abs(float(fn(q, qd))) < 1e-6
     with pytest.raises(SpecError, match="no prosthetic knee"):
         knee_straight_while_loaded(models["amputee-Cat6"][1], q_s, qd_s, limit)
+
+
+@pytest.mark.parametrize("kind", ["transfemoral", "amputee-Cat6"])
+def test_prosthetic_load_limit_is_the_prosthetic_legs_vertical_force(models, kind):
+    """The socket-load path function: limit − F_z/(m·g), F_z summed by hand over the
+    prosthetic (right) leg's contacts only; the intact foot's load does not enter, and the
+    NLP's last path inequality is it, bounded below by 0."""
+    from bladelab.errors import SpecError
+    from bladelab.predict.collocation.dynamics import prosthetic_load_margin, stride_dynamics
+    from bladelab.runner.layout import CP_LEG
+
+    runner, cm = models[kind]
+    q_s, qd_s = ca.SX.sym("q", cm.nv), ca.SX.sym("qd", cm.nv)
+    fn = ca.Function("load", [q_s, qd_s], [prosthetic_load_margin(cm, q_s, qd_s, 0.5)])
+    legs = runner.contact_params[:, CP_LEG]
+    weight = runner.total_mass * runner.gravity
+    q = runner.stand_qpos.copy()
+    qd = np.zeros(cm.nv)
+    for sink in (0.01, 0.03):
+        q[runner.dof("pelvis_tz")] = runner.stand_qpos[runner.dof("pelvis_tz")] - sink
+        forces = np.asarray(cm.contacts(q, qd)[0])
+        assert forces[legs == 1, 1].sum() > 0.05 * weight < forces[legs == 0, 1].sum()
+        want = 0.5 - forces[legs == 1, 1].sum() / weight
+        assert float(fn(q, qd)) == pytest.approx(want, rel=1e-9)
+    assert float(fn(q, qd)) < 0  # sunk 3 cm: the prosthetic leg carries more than 0.5 BW
+    q[runner.dof("pelvis_tz")] += 0.3  # in the air: the whole limit is left
+    assert float(fn(q, qd)) == pytest.approx(0.5, abs=1e-6)
+    dyn = stride_dynamics(cm, prosthetic_load_max_bw=0.5)
+    nm = cm.n_muscles
+    a = ft = dft = np.full(nm, 0.1)
+    path = np.asarray(dyn.inequalities(q, qd, a, ft, dft)).ravel()
+    assert path.size == 2 * nm + 1 and path[-1] == pytest.approx(float(fn(q, qd)), rel=1e-12)
+    np.testing.assert_array_equal(dyn.inequality_bounds[-1], [0.0, np.inf])
+    with pytest.raises(SpecError, match="no prosthetic leg"):
+        prosthetic_load_margin(models["able"][1], q_s, qd_s, 0.5)

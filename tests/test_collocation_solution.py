@@ -52,6 +52,10 @@ def test_settings_round_trip_and_refuse_bad_values():
     assert straight.knee_flexion_max_loaded_deg == 5.0 and not straight.same_problem(
         CollocationSettings())
     assert CollocationSettings.from_dict(straight.to_dict()) == straight
+    socket = CollocationSettings(prosthetic_load_max_bw=3)
+    assert socket.prosthetic_load_max_bw == 3.0 and not socket.same_problem(
+        CollocationSettings())
+    assert CollocationSettings.from_dict(json.loads(json.dumps(socket.to_dict()))) == socket
     for bad, where in (({"mesh_intervals": 3}, "mesh_intervals"),
                        ({"speed_m_per_s": -1.0}, "speed_m_per_s"),
                        ({"hessian": "bfgs"}, "hessian"), ({"tol": 0.0}, "tol"),
@@ -60,7 +64,9 @@ def test_settings_round_trip_and_refuse_bad_values():
                        ({"warm_start_mu": 0.0}, "warm_start_mu"),
                        ({"knee_moment_min_nm": 5.0}, "knee_moment_min_nm"),
                        ({"knee_flexion_max_loaded_deg": -1.0}, "knee_flexion_max_loaded_deg"),
-                       ({"knee_flexion_max_loaded_deg": True}, "knee_flexion_max_loaded_deg")):
+                       ({"knee_flexion_max_loaded_deg": True}, "knee_flexion_max_loaded_deg"),
+                       ({"prosthetic_load_max_bw": 0.0}, "prosthetic_load_max_bw"),
+                       ({"prosthetic_load_max_bw": math.inf}, "prosthetic_load_max_bw")):
         with pytest.raises(SpecError) as err:
             CollocationSettings(**bad)
         assert err.value.where == where

@@ -53,6 +53,7 @@ def fake(monkeypatch):
                       "speed": settings.speed_m_per_s, "dofs": runner.dof_names,
                       "backward_euler": settings.blade_backward_euler,
                       "step_phase_tolerance": settings.step_phase_tolerance,
+                      "prosthetic_load_max_bw": settings.prosthetic_load_max_bw,
                       "reference": (settings.reference, settings.reference_weight,
                                     settings.reference_dofs),
                       "contacts": runner.contact_params.copy()})
@@ -359,3 +360,19 @@ def test_alternating_steps_reach_every_designs_solve(fake, tmp_path):
     with pytest.raises(SpecError) as err:
         _evaluator(tmp_path, step_phase_tolerance=0.7)
     assert err.value.where == "step_phase_tolerance"
+
+
+def test_the_prosthetic_load_limit_reaches_every_designs_solve(fake, tmp_path):
+    """The socket-load limit is a setting of every design's solve and of the evaluator's
+    identity (a study made without it is not resumed with it); none by default."""
+    calls, _ = fake
+    _evaluator(tmp_path)(CENTRE)
+    assert calls[-1]["prosthetic_load_max_bw"] is None
+    ev = _evaluator(tmp_path / "socket", prosthetic_load_max_bw=3)
+    ev(CENTRE)
+    assert calls[-1]["prosthetic_load_max_bw"] == 3.0
+    assert ev.to_dict()["prosthetic_load_max_bw"] == 3.0
+    assert ce.CollocationEvaluator.LEGACY_SETTINGS["prosthetic_load_max_bw"] is None
+    with pytest.raises(SpecError) as err:
+        _evaluator(tmp_path, prosthetic_load_max_bw=-1)
+    assert err.value.where == "prosthetic_load_max_bw"

@@ -37,6 +37,7 @@ OPTIONS = {
     "knee_flexion_max_loaded_deg": "--knee-flexion-max",
     "pelvis_tilt_range_deg": "--tilt-range", "reference_weight": "--people-weight",
     "step_phase_tolerance": "--alternating-steps",
+    "prosthetic_load_max_bw": "--prosthetic-load-max",
     "athlete.body_mass_kg": "--body-mass", "athlete.height_m": "--height",
     "athlete.muscle_strength": "--muscle-strength", "starts": "--starts",
 }
@@ -112,12 +113,14 @@ def run_collocation(
     knee_flexion_max: float | None,
     tilt_range: str | None,
     alternating_steps: float | None = None,
+    prosthetic_load_max: float | None = None,
     people_weight: float | None = None,
     athlete: dict | None = None,
     starts: int | None = None,
 ) -> int:
     """Run ``bladelab predict --method collocation``; returns the exit status (0 converged,
-    2 not converged). ``alternating_steps``: ``CollocationSettings.step_phase_tolerance``.
+    2 not converged). ``alternating_steps``: ``CollocationSettings.step_phase_tolerance``;
+    ``prosthetic_load_max``: ``CollocationSettings.prosthetic_load_max_bw``.
     ``athlete``: the runner scaled to this athlete (``body_mass_kg``,
     ``height_m``, ``muscle_strength``; None: the body's own). ``starts``: starts of the
     stride, the best kept (None: :data:`~bladelab.predict.defaults.ATHLETE_STARTS` for a
@@ -131,6 +134,7 @@ def run_collocation(
             max_iter=max_iter, swing_clearance_m=swing_clearance,
             knee_moment_min_nm=knee_moment_min, knee_flexion_max_loaded_deg=knee_flexion_max,
             pelvis_tilt_range_deg=tilt, step_phase_tolerance=alternating_steps,
+            prosthetic_load_max_bw=prosthetic_load_max,
             **people_term(defaults.people_weight_for(body, people_weight)))
         result = solve_named_stride(out, model=model, blade=blade, body=body,
                                     settings=settings, guess=guess, athlete=athlete,

@@ -45,6 +45,7 @@ OPTIONS = {
     "knee_flexion_max_loaded_deg": "--knee-flexion-max",
     "reference_weight": "--reference-weight", "body": "--body",
     "people_weight": "--people-weight", "step_phase_tolerance": "--alternating-steps",
+    "prosthetic_load_max_bw": "--prosthetic-load-max",
 }
 _FACTORS = ",".join(f"{name}={low:g}:{high:g}" for name, low, high, *_ in defaults.DESIGN_FACTORS)
 
@@ -213,6 +214,10 @@ def _design(
         help="Keep every design's steps alternating: the prosthetic leg's stance half a "
              "stride +- this fraction of the stride after the intact leg's, e.g. 0.1 "
              "(default: free; free transfemoral strides gallop, docs/design.md)."),
+    prosthetic_load_max: float | None = typer.Option(
+        None, "--prosthetic-load-max", rich_help_panel=COLLOCATION, show_default=False,
+        help="Keep every design's prosthetic leg's vertical ground force at or below this "
+             "many body weights (the residual limb's load in its socket; default: no limit)."),
     settle: int = typer.Option(
         0, "--settle", rich_help_panel=COLLOCATION,
         help="After the runs, up to this many settling passes (each design solved again from "
@@ -263,7 +268,8 @@ def _design(
             gait=gait, motion=motion, motion_model=motion_model, start=start,
             knee_moment_min_Nm=knee_moment_min, knee_flexion_max_loaded_deg=knee_flexion_max,
             reference_weight=reference_weight, body=body, people_weight=people_weight,
-            step_phase_tolerance=alternating_steps)
+            step_phase_tolerance=alternating_steps,
+            prosthetic_load_max_bw=prosthetic_load_max)
     except BladelabError as err:
         raise renamed(err, OPTIONS) from None
     design = doe.make_design(runs, space, n_runs=n_runs, model=model, seed=seed)

@@ -263,6 +263,11 @@ def register(app: typer.Typer) -> None:
             help="Keep the steps alternating: the second leg's stance half a stride +- this "
                  "fraction of the stride after the first leg's, e.g. 0.1 (rules out a "
                  "gallop)."),
+        prosthetic_load_max: float | None = typer.Option(
+            None, "--prosthetic-load-max", rich_help_panel=COLLOCATION, show_default=False,
+            help="Keep the prosthetic leg's vertical ground force at or below this many body "
+                 "weights (the load the residual limb takes in its socket; default: no "
+                 "limit)."),
         people_weight: float | None = _people_weight_option(),
         body_mass: float | None = _athlete_option("body_mass_kg"),
         height: float | None = _athlete_option("height_m"),
@@ -291,7 +296,8 @@ def register(app: typer.Typer) -> None:
                 guess=guess, max_iter=max_iter, resume=resume, force=force, as_json=as_json,
                 body=body, swing_clearance=swing_clearance, knee_moment_min=knee_moment_min,
                 knee_flexion_max=knee_flexion_max, tilt_range=tilt_range,
-                alternating_steps=alternating_steps, people_weight=people_weight,
+                alternating_steps=alternating_steps, prosthetic_load_max=prosthetic_load_max,
+                people_weight=people_weight,
                 athlete=_athlete(body_mass, height, muscle_strength), starts=starts))
         from bladelab.cli.reflex import run_reflex  # deferred: keeps bladelab --help fast
 

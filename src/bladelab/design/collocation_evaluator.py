@@ -151,6 +151,10 @@ class CollocationEvaluator:
         this fraction of the stride after the intact leg's
         (``CollocationSettings.step_phase_tolerance``); None (default): free. Every
         converged transfemoral stride of both bodies gallops without it (docs/design.md).
+    prosthetic_load_max_bw
+        Keep the prosthetic leg's vertical ground force at or below this many body weights
+        in every design's stride (``CollocationSettings.prosthetic_load_max_bw``: the load
+        the residual limb tolerates in its socket); None (default): no limit.
     people_weight
         Weight [1/rad²] of people's joint angles in the objective (the intact leg's hip, knee
         and ankle and the residual hip; ``CollocationSettings(reference="people")``,
@@ -176,13 +180,16 @@ class CollocationEvaluator:
     body: str = DEFAULT_BODY
     people_weight: float | None = None
     step_phase_tolerance: float | None = None
+    prosthetic_load_max_bw: float | None = None
     generator: Mapping[str, Any] = field(default_factory=dict)
 
     #: What a study's ``evaluator.json`` written before a setting existed meant by it: the
     #: studies before the human body ran seed 001's body without people's angles, and
-    #: those before the alternating-steps constraint ran free.
+    #: those before the alternating-steps constraint and the prosthetic load limit ran
+    #: without them.
     LEGACY_SETTINGS: ClassVar[dict[str, Any]] = {"body": "seed001", "people_weight": 0.0,
-                                                 "step_phase_tolerance": None}
+                                                 "step_phase_tolerance": None,
+                                                 "prosthetic_load_max_bw": None}
 
     def __post_init__(self) -> None:
         if self.body not in BODIES:
@@ -315,6 +322,7 @@ class CollocationEvaluator:
                                    knee_flexion_max_loaded_deg=self.knee_flexion_max_loaded_deg,
                                    blade_backward_euler=self.blade_backward_euler,
                                    step_phase_tolerance=self.step_phase_tolerance,
+                                   prosthetic_load_max_bw=self.prosthetic_load_max_bw,
                                    max_iter=self.max_iter, **reference)
 
     def _problem(self, point: Mapping[str, float]) -> tuple[dict, Any]:

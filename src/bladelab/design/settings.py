@@ -39,6 +39,7 @@ APPLIES_TO: dict[str, tuple[str, ...]] = {
     "body": ("collocation",),
     "people_weight": ("collocation",),
     "step_phase_tolerance": ("collocation",),
+    "prosthetic_load_max_bw": ("collocation",),
 }
 
 
@@ -77,6 +78,9 @@ class EvaluatorSettings:
     step_phase_tolerance
         Collocation: keep every design's steps alternating within this fraction of the stride
         of half a stride (``CollocationSettings.step_phase_tolerance``); None: free.
+    prosthetic_load_max_bw
+        Collocation: keep the prosthetic leg's vertical ground force at or below this many
+        body weights (``CollocationSettings.prosthetic_load_max_bw``); None: no limit.
     """
 
     kind: str = "blade"
@@ -94,6 +98,7 @@ class EvaluatorSettings:
     body: str | None = None
     people_weight: float | None = None
     step_phase_tolerance: float | None = None
+    prosthetic_load_max_bw: float | None = None
 
     def __post_init__(self) -> None:
         if self.kind not in EVALUATORS:
@@ -127,7 +132,7 @@ class EvaluatorSettings:
                 options["start"] = str(self.start)
             for name in ("knee_moment_min_Nm", "knee_flexion_max_loaded_deg",
                          "reference_weight", "body", "people_weight",
-                         "step_phase_tolerance"):
+                         "step_phase_tolerance", "prosthetic_load_max_bw"):
                 if getattr(self, name) is not None:
                     options[name] = getattr(self, name)
         elif self.body_mass_kg is not None:

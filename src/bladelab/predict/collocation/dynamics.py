@@ -114,6 +114,22 @@ def knee_extension_moment(cm: CollocationModel, q: ca.SX, qd: ca.SX) -> ca.SX:
     return moment
 
 
+def prosthetic_load_margin(cm: CollocationModel, q: ca.SX, qd: ca.SX, max_bw: float) -> ca.SX:
+    """``max_bw − F_z/(m·g)`` [body weights], ``F_z`` the prosthetic (right) leg's vertical
+    ground force: ≥ 0 keeps the load the residual limb takes through its socket at or below
+    ``max_bw`` body weights. The tolerated load a person's residual limb sets and the body's
+    rigid socket does not (docs/runner-model.md, "The transfemoral runner")."""
+    runner = cm.runner
+    if runner.kind == "able":
+        raise SpecError("the able model has no prosthetic leg", where="prosthetic_load_max_bw",
+                        hint="an amputee or transfemoral runner's setting")
+    forces, _, _ = cm.contacts(q, qd)
+    f_z = 0.0
+    for c in np.flatnonzero(runner.contact_params[:, CP_LEG] == 1):
+        f_z += forces[c, 1]
+    return float(max_bw) - f_z / (runner.total_mass * runner.gravity)
+
+
 def knee_straight_while_loaded(cm: CollocationModel, q: ca.SX, qd: ca.SX,
                                max_flexion_rad: float) -> ca.SX:
     """``(F_z / (m·g))·(q_knee + max_flexion_rad)`` [rad·body weights]: ≥ 0 keeps the
@@ -135,6 +151,7 @@ def stride_dynamics(cm: CollocationModel, *, metabolic: MetabolicSmoothing | Non
                     swing_clearance_m: float = 0.0,
                     knee_moment_min_nm: float | None = None,
                     knee_flexion_max_loaded_deg: float | None = None,
+                    prosthetic_load_max_bw: float | None = None,
                     blade_backward_euler: bool = False) -> StrideDynamics:
     """The :class:`StrideDynamics` of a collocation model (see the module docstring); with
     ``swing_clearance_m`` > 0 [m], the path inequalities also keep every swinging contact that
@@ -142,8 +159,9 @@ def stride_dynamics(cm: CollocationModel, *, metabolic: MetabolicSmoothing | Non
     prosthetic knee's :func:`knee_extension_moment` at or above it (on each mesh interval's
     mean: ``StrideDynamics.interval_mean_inequalities``); with
     ``knee_flexion_max_loaded_deg`` [deg], the prosthetic knee within that flexion while its
-    contacts carry load (:func:`knee_straight_while_loaded`); with
-    ``blade_backward_euler``, a multi-link blade's joints are transcribed by backward Euler
+    contacts carry load (:func:`knee_straight_while_loaded`); with ``prosthetic_load_max_bw``
+    [body weights], the prosthetic leg's vertical ground force at or below it
+    (:func:`prosthetic_load_margin`); with ``blade_backward_euler``, a multi-link blade's joints are transcribed by backward Euler
     (``StrideDynamics.backward_euler_dofs``)."""
     runner = cm.runner
     nv, nm = cm.nv, cm.n_muscles
@@ -169,6 +187,9 @@ def stride_dynamics(cm: CollocationModel, *, metabolic: MetabolicSmoothing | Non
     if knee_flexion_max_loaded_deg is not None:
         clearance = ca.vertcat(clearance, knee_straight_while_loaded(
             cm, q, qd, math.radians(knee_flexion_max_loaded_deg)))
+    if prosthetic_load_max_bw is not None:
+        clearance = ca.vertcat(clearance, prosthetic_load_margin(cm, q, qd,
+                                                                 prosthetic_load_max_bw))
     weight = runner.total_mass * runner.gravity
     fz = cm.contacts(q, qd)[0][:, 1]  # vertical force of every contact [N]
     scale = np.array([weight if n.startswith("pelvis_t") and n != "pelvis_tilt" else 100.0

@@ -110,6 +110,11 @@ class CollocationSettings:
         :func:`~bladelab.predict.collocation.dynamics.knee_straight_while_loaded`): the
         straight stance from which ``knee_moment_min_nm`` at 0 becomes reachable
         (docs/design.md); None (default): no constraint. Transfemoral runner only.
+    prosthetic_load_max_bw
+        Keep the prosthetic leg's vertical ground force at or below this many body weights at
+        every node (:func:`~bladelab.predict.collocation.dynamics.prosthetic_load_margin`):
+        the load a residual limb tolerates in its socket, which the body's rigid socket does
+        not price; None (default): no limit. Amputee and transfemoral runners.
     blade_backward_euler
         Transcribe a multi-link blade's joints by backward Euler instead of the trapezoidal
         rule (``StrideDynamics.backward_euler_dofs``): its links' modes (about 300 Hz) are
@@ -167,6 +172,7 @@ class CollocationSettings:
     swing_clearance_m: float = 0.0
     knee_moment_min_nm: float | None = None
     knee_flexion_max_loaded_deg: float | None = None
+    prosthetic_load_max_bw: float | None = None
     blade_backward_euler: bool = False
     pelvis_tilt_range_deg: tuple[float, float] | None = None
     step_phase_tolerance: float | None = None
@@ -243,6 +249,14 @@ class CollocationSettings:
                 raise SpecError(f"the loaded knee's flexion limit must be within [0, 90] deg "
                                 f"or None, got {kf!r}", where="knee_flexion_max_loaded_deg")
             object.__setattr__(self, "knee_flexion_max_loaded_deg", float(kf))
+        pl = self.prosthetic_load_max_bw
+        if pl is not None:
+            if isinstance(pl, bool) or not isinstance(pl, int | float) or not (
+                    math.isfinite(pl) and 0 < pl <= 20):
+                raise SpecError(f"the prosthetic load limit must be within (0, 20] body weights "
+                                f"or None, got {pl!r}", where="prosthetic_load_max_bw",
+                                hint="e.g. 3: the prosthetic leg's vertical force at most 3 BW")
+            object.__setattr__(self, "prosthetic_load_max_bw", float(pl))
         if not isinstance(self.blade_backward_euler, bool):
             raise SpecError(f"expected true or false, got {self.blade_backward_euler!r}",
                             where="blade_backward_euler")
@@ -328,7 +342,7 @@ class CollocationSettings:
 
     def same_problem(self, other: CollocationSettings) -> bool:
         """True if ``other`` poses the same NLP (mesh, speed, weights, swing clearance, knee
-        moment bound, loaded knee's flexion limit, blade transcription, pelvis tilt range,
+        moment bound, loaded knee's flexion limit, prosthetic load limit, blade transcription, pelvis tilt range,
         alternating steps);
         solver options
         (Hessian, tolerance, iterations) and the tracking stage may differ."""
@@ -337,7 +351,7 @@ class CollocationSettings:
     def _problem(self) -> tuple:
         return (self.mesh_intervals, self.speed_m_per_s, self.weights, self.swing_clearance_m,
                 self.knee_moment_min_nm, self.knee_flexion_max_loaded_deg,
-                self.blade_backward_euler, self.pelvis_tilt_range_deg,
+                self.prosthetic_load_max_bw, self.blade_backward_euler, self.pelvis_tilt_range_deg,
                 self.step_phase_tolerance) + self.reference_key()
 
     def reference_key(self) -> tuple:

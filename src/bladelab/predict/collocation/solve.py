@@ -250,20 +250,23 @@ MAX_NLPS_PER_RUNNER = 2
 def _model_functions(runner, swing_clearance_m: float = 0.0,
                      knee_moment_min_nm: float | None = None, blade_backward_euler: bool = False,
                      knee_flexion_max_loaded_deg: float | None = None,
-                     pelvis_tilt_range_deg: tuple[float, float] | None = None):
+                     pelvis_tilt_range_deg: tuple[float, float] | None = None,
+                     prosthetic_load_max_bw: float | None = None):
     """(collocation model, stride dynamics) of ``runner``, built once (per swing clearance,
-    knee moment bound, loaded knee's flexion limit and blade transcription; a pelvis tilt
-    range narrows the bounds of the dynamics built without it)."""
+    knee moment bound, loaded knee's flexion limit, prosthetic load limit and blade
+    transcription; a pelvis tilt range narrows the bounds of the dynamics built without
+    it)."""
     built = _BUILT.setdefault(runner, {"dyn": {}, "nlps": {}})
     if "cm" not in built:
         built["cm"] = build_collocation_model(runner)
     key = (swing_clearance_m, knee_moment_min_nm, blade_backward_euler,
-           knee_flexion_max_loaded_deg)
+           knee_flexion_max_loaded_deg, prosthetic_load_max_bw)
     if key not in built["dyn"]:
         built["dyn"][key] = stride_dynamics(built["cm"], swing_clearance_m=swing_clearance_m,
                                             knee_moment_min_nm=knee_moment_min_nm,
                                             knee_flexion_max_loaded_deg=(
                                                 knee_flexion_max_loaded_deg),
+                                            prosthetic_load_max_bw=prosthetic_load_max_bw,
                                             blade_backward_euler=blade_backward_euler)
     if pelvis_tilt_range_deg is None:
         return built["cm"], built["dyn"][key]
@@ -379,7 +382,8 @@ def predict_stride(runner, settings: CollocationSettings, guess, *, model_spec: 
     cm, dyn = _model_functions(runner, settings.swing_clearance_m, settings.knee_moment_min_nm,
                                settings.blade_backward_euler,
                                settings.knee_flexion_max_loaded_deg,
-                               settings.pelvis_tilt_range_deg)
+                               settings.pelvis_tilt_range_deg,
+                               settings.prosthetic_load_max_bw)
     n = settings.mesh_intervals
     g = guess.on_model(runner).resample(n)
     speed = settings.speed_m_per_s
