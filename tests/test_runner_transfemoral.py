@@ -156,3 +156,32 @@ def test_a_myodesis_makes_the_hamstrings_and_rectus_femoris_hip_muscles_of_the_r
     # the hamstrings extend the hip, the rectus femoris flexes it
     assert lengths(40.0, 0.0)["hamstrings_r"] > lengths(0.0, 0.0)["hamstrings_r"]
     assert lengths(40.0, 0.0)["rect_fem_r"] < lengths(0.0, 0.0)["rect_fem_r"]
+
+
+def test_the_residual_limbs_muscles_take_their_own_strength():
+    """``residual_muscle_strength`` scales the residual limb's Fmax by muscle type and nothing
+    else: the intact leg's same muscles, the residual muscles not named and every other
+    muscle parameter stay; the metabolic muscle mass follows Fmax. Unknown muscles and
+    factors outside (0, 2] are refused by name."""
+    from bladelab.runner.metabolics import MB_MASS, metabolic_params
+    from bladelab.runner.muscle import MP_FMAX
+
+    data = default_runner_params("transfemoral", body="human").model_dump()
+    base = build_runner(runner_params_from_dict(data))
+    data["residual_muscle_strength"] = {"hamstrings": 0.5, "glut_max": 0.85}
+    weak = build_runner(runner_params_from_dict(data))
+    assert weak.muscle_names == base.muscle_names
+    want = {"hamstrings_r": 0.5, "glut_max_r": 0.85}
+    for i, name in enumerate(base.muscle_names):
+        factor = want.get(name, 1.0)
+        assert weak.muscle_params[i, MP_FMAX] == pytest.approx(
+            factor * base.muscle_params[i, MP_FMAX], rel=1e-12), name
+        np.testing.assert_array_equal(np.delete(weak.muscle_params[i], MP_FMAX),
+                                      np.delete(base.muscle_params[i], MP_FMAX))
+        assert (metabolic_params(weak)[i, MB_MASS] / metabolic_params(base)[i, MB_MASS]
+                == pytest.approx(factor, rel=1e-12)), name
+    for bad, match in (({"soleus": 0.5}, "unknown residual limb muscle"),
+                       ({"iliopsoas": 0.0}, "within \\(0, 2\\]")):
+        data["residual_muscle_strength"] = bad
+        with pytest.raises(SpecError, match=match):
+            runner_params_from_dict(data)

@@ -5,12 +5,14 @@ Usage (repository root)::
 
     .venv/bin/python benchmarks/design/transfemoral-gait-2026-11-29/from_transtibial.py \\
         OUT.json STEP_PHASE_TOLERANCE [KNEE_FIELD=VALUE ...] [from=START.json] [raw=1] \\
-        [set:SETTING=VALUE ...]
+        [set:SETTING=VALUE ...] [body:FIELD=JSON ...]
 
 ``raw=1``: the transtibial stride's knee angles as they are (not made straight in stance).
 The last two arguments were added on 2026-11-30 (``../transfemoral-gait-2026-11-30/``).
 ``set:SETTING=VALUE``: a ``CollocationSettings`` field (a number, or ``none``), e.g.
 ``set:swing_clearance_m=0`` or ``set:knee_flexion_max_loaded_deg=10``.
+``body:FIELD=JSON`` (added on 2026-11-30, later): a field of the transfemoral parameter set, e.g.
+``body:residual_muscle_strength={"hamstrings":0.5}``.
 
 The start is ``../human-body-2026-11-29/transtibial-centre-people10.json`` (the design box's
 centre blade, 4 m/s) mapped onto the transfemoral runner by coordinate name, the prosthetic
@@ -53,30 +55,35 @@ START = (Path(__file__).resolve().parents[1] / "human-body-2026-11-29"
          / "transtibial-centre-people10.json")
 
 
-def _with_knee(overrides: dict[str, float]):
-    """``default_runner_params`` with the transfemoral knee's fields overridden."""
+def _with_knee(overrides: dict[str, float], body: dict | None = None):
+    """``default_runner_params`` with the transfemoral knee's fields and the parameter set's
+    fields ``body`` overridden."""
     original = stored.default_runner_params
 
     def patched(kind, **kw):
         params = original(kind, **kw)
-        if kind != "transfemoral" or not overrides:
+        if kind != "transfemoral" or not (overrides or body):
             return params
         data = params.model_dump()
         data["prosthetic_knee"].update(overrides)
+        data.update(body or {})
         return runner_params_from_dict(data)
 
     return patched
 
 
 def main(out: str, step_tol: str, *extra: str) -> None:
-    fields = dict(kv.split("=") for kv in extra)
+    fields = dict(kv.split("=", 1) for kv in extra)
     start = fields.pop("from", None)
     raw = fields.pop("raw", None)
     sets = {k[4:]: (None if v == "none" else float(v))
             for k, v in list(fields.items()) if k.startswith("set:")}
     for k in sets:
         fields.pop("set:" + k)
-    stored.default_runner_params = _with_knee({k: float(v) for k, v in fields.items()})
+    body = {k[5:]: json.loads(v) for k, v in list(fields.items()) if k.startswith("body:")}
+    for k in body:
+        fields.pop("body:" + k)
+    stored.default_runner_params = _with_knee({k: float(v) for k, v in fields.items()}, body)
     space = default_design_space()
     blade = CollocationEvaluator().blade_spec(space.point([0.0] * len(space.names)))
     spec = {"model": "transfemoral", "blade": blade["name"], "blade_spec": blade,

@@ -404,8 +404,10 @@ def build_runner(
         tendons.append(tendon)
         actuators.append(act)
         mt = params.muscle_types[mtype]
+        residual = params.residual_muscle_strength.get(mtype, 1.0) if (
+            transfemoral and side == "r") else 1.0
         mp[i] = (
-            muscle_max_force(params, mtype),
+            muscle_max_force(params, mtype) * residual,
             mt.optimal_fiber_length_m * s,
             mt.tendon_slack_length_m * s,
             mt.pennation_rad,

@@ -193,10 +193,30 @@ class RunnerParams(_Strict):
     #: also act at the hip, anchored on the distal femur where their tibial insertion was with
     #: the knee straight; :data:`MYODESIS_MUSCLES`). Ignored by the other kinds.
     myodesis: bool = False
+    #: The transfemoral runner's residual limb: a factor on the maximal isometric force of
+    #: each of its muscles, by type (:data:`RESIDUAL_THIGH_MUSCLES`, :data:`MYODESIS_MUSCLES`);
+    #: a type not named keeps the intact leg's force (factor 1: an upper bound for a
+    #: residual limb). Fmax scales the active, passive and tendon forces and the metabolic
+    #: muscle mass alike (an atrophied muscle has a smaller cross-section). Ignored by the
+    #: other kinds.
+    residual_muscle_strength: dict[str, float] = Field(default_factory=dict)
     #: The muscles' metabolic energy model: ``"uchida2016"`` (seed 001 eq. 2.5: Umberger 2003
     #: as modified by Uchida et al. 2016; :mod:`bladelab.runner.metabolics`) or
     #: ``"bhargava2004"`` (Bhargava et al. 2004, as PredSim computes it).
     metabolic_model: Literal["uchida2016", "bhargava2004"] = "uchida2016"
+
+    @field_validator("residual_muscle_strength")
+    @classmethod
+    def _residual_muscles(cls, value: dict[str, float]) -> dict[str, float]:
+        known = RESIDUAL_THIGH_MUSCLES + MYODESIS_MUSCLES
+        unknown = sorted(set(value) - set(known))
+        if unknown:
+            raise ValueError(f"unknown residual limb muscle(s) {', '.join(unknown)}; known: "
+                             f"{', '.join(known)}")
+        bad = {k: v for k, v in value.items() if not (math.isfinite(v) and 0 < v <= 2)}
+        if bad:
+            raise ValueError(f"a strength factor must be within (0, 2], got {bad}")
+        return value
 
     @model_validator(mode="after")
     def _known_capsules(self) -> RunnerParams:
