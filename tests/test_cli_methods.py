@@ -160,7 +160,8 @@ def test_predict_reflex_passes_the_same_settings(tmp_path, monkeypatch, capsys):
     progress = seen.pop("progress")
     assert callable(progress)
     assert seen == dict(
-        model="amputee", seeds=[1, 2], out=tmp_path, blade="Cat5", speed=4.0, x0=None,
+        model="amputee", seeds=[1, 2], out=tmp_path, blade="Cat5", body="seed001",
+        speed=4.0, x0=None,
         generations=3, popsize=6, sigma=0.5, jobs=2, executor="local", resume=False,
         force=True, checkpoint_every=7,
         settings=ObjectiveSettings(

@@ -492,3 +492,43 @@ def test_cli_refuses_a_half_step_copy_without_copies(tmp_path, capsys):
                  "--robust-half-step", "--out", str(tmp_path / "x")]) == 2
     assert "--robust-half-step" in capsys.readouterr().err
     assert not (tmp_path / "x").exists()
+
+
+def test_a_run_on_the_human_body_is_that_bodys_everywhere(tmp_path, capsys):
+    """``body="human"``: the candidates run on the human body (its toe joints: a cost that
+    differs from seed 001's for the same parameters), best.json and the checkpoint name the
+    body, a resume on another body is refused, the file is refused as seed 001's solution
+    and accepted as its warm start (``transfer``), and the CLI's ``--body`` reaches the run."""
+    from bladelab.predict.reflex.controller import read_parameters
+    from bladelab.predict.reflex.verify import verify_solution
+
+    _, seed_layout = runner_and_layout("able", None)
+    human, layout = runner_and_layout("able", None, "human")
+    assert "mtp_angle_l" in human.dof_names and layout.names == seed_layout.names
+    x = layout.x0.tolist()
+    costs = {body: evaluate_candidates({"model": "able", "body": body, "xs": [x],
+                                        "settings": SHORT.to_dict()})[0]["cost"]
+             for body in ("seed001", "human")}
+    assert costs["seed001"] != costs["human"]
+    run = _run(out=tmp_path / "h", generations=1, body="human")
+    assert run.body == "human" and run.to_dict()["body"] == "human"
+    best = json.loads((tmp_path / "h" / "best.json").read_text())
+    assert best["body"] == "human"
+    again = evaluate_candidates({"model": "able", "body": "human", "settings": SHORT.to_dict(),
+                                 "xs": [layout.vector(best["parameters"]).tolist()]})
+    assert again[0]["cost"] == pytest.approx(run.best_cost, rel=1e-12)
+    with pytest.raises(InputFileError, match="seed001 body"):
+        _run(out=tmp_path / "h", generations=2, resume=True)  # seed 001's body by default
+    with pytest.raises(InputFileError, match="human body, not the seed001 body") as err:
+        read_parameters(tmp_path / "h" / "best.json", seed_layout)
+    assert err.value.where == "body"
+    np.testing.assert_array_equal(
+        read_parameters(tmp_path / "h" / "best.json", seed_layout, transfer=True),
+        read_parameters(tmp_path / "h" / "best.json", layout, body="human"))
+    # the file's own body re-simulates it
+    report = verify_solution(tmp_path / "h" / "best.json", duration=1.0)
+    assert report["cost"] == pytest.approx(run.best_cost, rel=1e-9)
+    assert main(["predict", "--method", "reflex", "--body", "human", "--generations", "1",
+                 "--popsize", "4", "--duration", "1", "--out", str(tmp_path / "cli")]) == 0
+    assert json.loads((tmp_path / "cli" / "best.json").read_text())["body"] == "human"
+    capsys.readouterr()

@@ -42,7 +42,6 @@ LABELS = {"reflex": "--method reflex", "recipe": "--recipe",
           "collocation": "--method collocation"}
 #: Hints added to the error of an option given for another method.
 PREDICT_HINTS = {
-    "--body": "the reflex controller is tuned to seed 001's body",
     "--tilt-range": "the reflex objective's pelvis window: --lean-weight",
 }
 SWEEP_HINTS = {
@@ -237,11 +236,13 @@ def register(app: typer.Typer) -> None:
         as_json: bool = typer.Option(
             False, "--json", rich_help_panel=COLLOCATION,
             help="Print the summary as one JSON object."),
-        body: str = typer.Option(
-            defaults.BODY, "--body", rich_help_panel=COLLOCATION,
+        body: str | None = typer.Option(
+            None, "--body", rich_help_panel=COMMON, show_default=False,
             help="human (H0918's segments and muscles, compliant Achilles, toes, soft heel "
                  "pad) | seed001 (seed 001's model) | toes (seed 001's with a toe segment and "
-                 "compliant Achilles tendons); docs/runner-model.md."),
+                 f"compliant Achilles tendons); docs/runner-model.md. Default: {defaults.BODY} "
+                 f"for collocation, {defaults.REFLEX_BODY} for the reflex controller (its "
+                 "parameters and shipped solutions are that body's)."),
         swing_clearance: float = typer.Option(
             0.0, "--swing-clearance", rich_help_panel=COLLOCATION,
             help="Keep every swinging foot or blade this high above the ground [m] (0: no "
@@ -294,7 +295,7 @@ def register(app: typer.Typer) -> None:
             raise typer.Exit(run_collocation(
                 out=out, model=model, blade=blade, speed=speed, max_speed=max_speed, mesh=mesh,
                 guess=guess, max_iter=max_iter, resume=resume, force=force, as_json=as_json,
-                body=body, swing_clearance=swing_clearance, knee_moment_min=knee_moment_min,
+                body=body or defaults.BODY, swing_clearance=swing_clearance, knee_moment_min=knee_moment_min,
                 knee_flexion_max=knee_flexion_max, tilt_range=tilt_range,
                 alternating_steps=alternating_steps, prosthetic_load_max=prosthetic_load_max,
                 people_weight=people_weight,
@@ -302,7 +303,8 @@ def register(app: typer.Typer) -> None:
         from bladelab.cli.reflex import run_reflex  # deferred: keeps bladelab --help fast
 
         run_reflex(
-            out=out, model=model, blade=blade, speed=speed, init=init, seeds=seeds,
+            out=out, model=model, blade=blade, body=body or defaults.REFLEX_BODY, speed=speed,
+            init=init, seeds=seeds,
             generations=generations, popsize=popsize, sigma=sigma, jobs=jobs,
             executor=executor, resume=resume, force=force, checkpoint_every=checkpoint_every,
             duration=duration, dt=dt, robust_samples=robust_samples,

@@ -28,7 +28,8 @@ __all__ = ["OPTIONS", "run_recipe_sweep", "run_reflex", "run_reflex_sweep"]
 
 #: Library argument or ``ObjectiveSettings`` field -> the option that sets it.
 OPTIONS = {
-    "model": "--model", "blade": "--blade", "init": "--init", "recipe": "--recipe",
+    "model": "--model", "blade": "--blade", "body": "--body", "init": "--init",
+    "recipe": "--recipe",
     "speed": "--speed", "duration": "--duration", "dt": "--dt",
     "robust_samples": "--robust-samples", "robust_jitter": "--robust-jitter",
     "initial_speed": "--initial-speed", "strike_limit_bw": "--strike-limit",
@@ -39,7 +40,8 @@ _ROBUST_OPTIONS = ("--robust-directions", "--robust-speed-change", "--robust-pus
                    "--duration", "--robust-half-step", "--robust-samples")
 
 
-def run_reflex(*, out: Path, model: str, blade: str | None, speed: float, init: Path | None,
+def run_reflex(*, out: Path, model: str, blade: str | None, body: str, speed: float,
+               init: Path | None,
                seeds: str, generations: int, popsize: int, sigma: float, jobs: int,
                executor: str, resume: bool, force: bool, checkpoint_every: int,
                duration: float, dt: float, robust_samples: int, robust_jitter: float,
@@ -67,7 +69,8 @@ def run_reflex(*, out: Path, model: str, blade: str | None, speed: float, init: 
             integrator=integrator, track=None if track is None else str(track),
             w_track=0.0 if track is None else track_weight)
         results = optimize_named(
-            model, out=out, seeds=seed_list, blade=blade, init=init, settings=settings,
+            model, out=out, seeds=seed_list, blade=blade, body=body, init=init,
+            settings=settings,
             progress=show, generations=generations, popsize=popsize, sigma=sigma, jobs=jobs,
             executor=executor, resume=resume, force=force, checkpoint_every=checkpoint_every)
     except BladelabError as err:

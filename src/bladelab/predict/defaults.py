@@ -27,6 +27,7 @@ __all__ = [
     "POPULATION_SIZE",
     "RECIPE_SEEDS",
     "REFLEX_BLADE",
+    "REFLEX_BODY",
     "ROBUST_DIRECTIONS",
     "ROBUST_JITTER",
     "ROBUST_SAMPLES",
@@ -53,6 +54,9 @@ SPEED_M_PER_S = 3.5
 # -- the reflex controller and its objective (predict.reflex) ------------------------------
 #: Blade category of the reflex controller's amputee runner (seed 001's shipped solutions).
 REFLEX_BLADE = "Cat6"
+#: The reflex controller's body: seed 001's, the body its parameters, recipes and shipped
+#: solutions were found on (``--body human`` runs it on the human body).
+REFLEX_BODY = "seed001"
 #: Simulated time of one candidate [s] (``ObjectiveSettings.duration``).
 DURATION_S = 10.0
 #: Time step of the closed-loop simulation [s]: the runner model's own step

@@ -50,7 +50,7 @@ from bladelab.predict.collocation.solution import CollocationSolution
 from bladelab.predict.reflex.agreement import seed_agreement
 from bladelab.predict.reflex.controller import read_parameters
 from bladelab.predict.reflex.objective import simulate_controlled
-from bladelab.predict.reflex.optimize import runner_and_layout, stored_settings
+from bladelab.predict.reflex.optimize import runner_and_layout, stored_body, stored_settings
 from bladelab.predict.reflex.robust import robust_evaluation
 from bladelab.predict.reflex.sweep import finished_cell, summarise
 from bladelab.report.builder import Report
@@ -138,8 +138,9 @@ class _Solution:
         if kind not in ("able", "amputee"):
             raise InputFileError(f"unknown model {kind!r}", file=self.path, where="model")
         blade = self.data.get("blade") or ("Cat6" if kind == "amputee" else None)
-        self.model, self.layout = runner_and_layout(kind, blade)
-        self.x = read_parameters(self.path, self.layout)
+        body = stored_body(self.data, self.path)
+        self.model, self.layout = runner_and_layout(kind, blade, body)
+        self.x = read_parameters(self.path, self.layout, body=body)
 
     @property
     def kind(self) -> str:

@@ -39,7 +39,7 @@ from bladelab.errors import DataError, SpecError
 from bladelab.predict.collocation.stride_guess import StrideGuess, periodic_derivative
 from bladelab.predict.reflex.controller import read_parameters
 from bladelab.predict.reflex.objective import simulate_controlled
-from bladelab.predict.reflex.optimize import runner_and_layout, stored_settings
+from bladelab.predict.reflex.optimize import runner_and_layout, stored_body, stored_settings
 from bladelab.runner.analyses import step_touchdowns
 from bladelab.runner.layout import CP_LEG
 from bladelab.runner.model import RunnerModel, contact_heights
@@ -252,10 +252,12 @@ def guess_from_reflex(path: str | Path, *, n: int = 50, duration: float = 5.0) -
     """Re-simulate a reflex-controller parameter file (its own model, blade, speed and settings)
     for ``duration`` [s] and take :func:`guess_from_result` of it."""
     data = read_json(path, what="parameter file")
-    model, layout = runner_and_layout(data.get("model", "able"), data.get("blade"))
+    body = stored_body(data, path)
+    model, layout = runner_and_layout(data.get("model", "able"), data.get("blade"), body)
     settings = stored_settings(data, speed=float(data.get("speed_m_per_s", 3.5)),
                                duration=duration, nominal=True)
-    _, result = simulate_controlled(model, read_parameters(path, layout), layout=layout,
+    _, result = simulate_controlled(model, read_parameters(path, layout, body=body),
+                                    layout=layout,
                                     settings=settings, record_every=4)
     guess = guess_from_result(result, n=n)
     return replace(guess, source=f"{Path(path).name} re-simulated: {guess.source}")

@@ -358,13 +358,16 @@ def _mask_bits(mask: str) -> int:
 
 
 def read_parameters(
-    path: str | Path, layout: ControllerLayout, *, transfer: bool = False
+    path: str | Path, layout: ControllerLayout, *, transfer: bool = False,
+    body: str = "seed001",
 ) -> np.ndarray:
-    """Read a parameter JSON file (``{"parameters": {name: value}, ...}``) into a vector.
+    """Read a parameter JSON file (``{"parameters": {name: value}, ...}``) of a runner on
+    ``body`` (the file's ``"body"``, seed 001's where it names none) into a vector.
 
-    With ``transfer=True`` a file of the other model kind is accepted (warm start of the amputee
-    from an able-bodied solution, as seed 001 does): parameters the layout lacks (the prosthetic
-    side's shank reflexes) are dropped, those it has and the file lacks keep the initial guess.
+    With ``transfer=True`` a file of the other model kind or body is accepted (warm start of
+    the amputee from an able-bodied solution, as seed 001 does): parameters the layout lacks
+    (the prosthetic side's shank reflexes) are dropped, those it has and the file lacks keep
+    the initial guess.
     """
     path = Path(path)
     data = read_json(path, what="parameter file")
@@ -373,6 +376,13 @@ def read_parameters(
         raise InputFileError(
             "expected an object with a 'parameters' mapping {name: value}", file=path
         )
+    own_body = data.get("body", "seed001")
+    if own_body != body and not transfer:
+        raise InputFileError(
+            f"parameters are for the runner on the {own_body} body, not the {body} body",
+            file=path, where="body",
+            hint="use --body matching the file (a controller is tuned to its body), or "
+                 "another --init file")
     if transfer and data.get("model") not in (None, layout.kind):
         params = {k: v for k, v in params.items() if k in layout.names}
     elif data.get("model") not in (None, layout.kind):

@@ -27,6 +27,7 @@ from bladelab.predict.reflex.recipe import STABLE_GAIT_RECIPE, Recipe
 from bladelab.predict.reflex.recipe_sweep import run_recipe_sweep
 from bladelab.predict.reflex.tracking import GaitReference
 from bladelab.runner.implicit import INTEGRATORS
+from bladelab.runner.params import BODIES
 
 __all__ = ["MAX_TIME_STEP_S", "RECIPES", "REFLEX_MODELS", "check_run_settings", "named_recipe",
            "optimize_named", "recipe_sweep_named"]
@@ -76,6 +77,7 @@ def optimize_named(
     out: str | Path,
     seeds: Sequence[int] = (defaults.SEED,),
     blade: str | None = None,
+    body: str = defaults.REFLEX_BODY,
     init: str | Path | None = None,
     settings: ObjectiveSettings | None = None,
     progress: Callable[[int, int, float, float], None] | None = None,
@@ -83,7 +85,8 @@ def optimize_named(
 ) -> list[OptimizationResult]:
     """Optimise the reflex controller of the runner ``model`` (``able`` or ``amputee`` with
     ``blade``, default :data:`~bladelab.predict.defaults.REFLEX_BLADE`) once per seed into
-    ``out`` (:func:`~bladelab.predict.reflex.optimize.optimize_seeds`), from the parameter
+    ``out`` (:func:`~bladelab.predict.reflex.optimize.optimize_seeds`), on ``body``
+    (:data:`~bladelab.predict.defaults.REFLEX_BODY`: seed 001's), from the parameter
     file ``init`` (None: SCONE's parameters), with the objective ``settings``; a stride to
     track (``settings.track``) must be of the same runner. ``progress`` and ``options`` (CMA-ES
     generations, popsize, sigma, jobs, executor, resume, force, checkpoint_every) are
@@ -98,14 +101,18 @@ def optimize_named(
                        w_lean=settings.w_lean, strike_limit_bw=settings.strike_limit_bw)
     blade = blade or defaults.REFLEX_BLADE
     worn = blade if model == "amputee" else None
-    _, layout = runner_and_layout(model, worn)
+    if body not in BODIES:
+        raise SpecError(f"unknown body {body!r}", where="body", hint=" or ".join(BODIES))
+    _, layout = runner_and_layout(model, worn, body)
     if settings.track is not None:
         if not (math.isfinite(settings.w_track) and settings.w_track > 0):
             raise SpecError("must be > 0", where="w_track")
-        GaitReference.read(settings.track).check_model(model, worn, "track")
-    x0 = read_parameters(init, layout, transfer=True) if init is not None else None
+        GaitReference.read(settings.track).check_model(model, worn, "track", body=body)
+    x0 = (read_parameters(init, layout, transfer=True, body=body) if init is not None
+          else None)
     return optimize_seeds(model, seeds=list(seeds), out=out, progress=progress, blade=blade,
-                          speed=settings.speed, x0=x0, settings=settings, **options)
+                          body=body, speed=settings.speed, x0=x0, settings=settings,
+                          **options)
 
 
 def named_recipe(recipe: str | Path | Recipe) -> Recipe:

@@ -48,6 +48,7 @@ from bladelab.predict.reflex.robust import (
     robust_evaluation,
 )
 from bladelab.runner.model import RunnerModel, build_runner
+from bladelab.runner.params import BODIES
 
 CHECKPOINT_FORMAT = 1
 CHECKPOINT_NAME = "checkpoint.pkl"
@@ -58,14 +59,26 @@ RUN_FILES = (CHECKPOINT_NAME, "best.json", "history.csv")
 _MODELS: dict[tuple[str, str | None], tuple[RunnerModel, ControllerLayout]] = {}
 
 
-def runner_and_layout(kind: str, blade: str | None) -> tuple[RunnerModel, ControllerLayout]:
-    """The runner ``kind`` (``"able"``/``"amputee"``; ``blade`` category of the amputee) and its
-    controller layout, built once per process (workers evaluate many candidates of one model)."""
-    key = (kind, blade if kind == "amputee" else None)
+def runner_and_layout(kind: str, blade: str | None,
+                      body: str = defaults.REFLEX_BODY) -> tuple[RunnerModel, ControllerLayout]:
+    """The runner ``kind`` (``"able"``/``"amputee"``; ``blade`` category of the amputee) on
+    ``body`` (:data:`bladelab.runner.params.BODIES`) and its controller layout, built once per
+    process (workers evaluate many candidates of one model)."""
+    key = (kind, blade if kind == "amputee" else None, body)
     if key not in _MODELS:
-        model = build_runner(kind, blade=key[1])
+        model = build_runner(kind, blade=key[1], body=body)
         _MODELS[key] = (model, controller_layout(model))
     return _MODELS[key]
+
+
+def stored_body(data: dict, path: str | Path) -> str:
+    """The body of a parameter file's runner (``"body"``; seed 001's where the file names
+    none: every file written before the reflex route ran another body)."""
+    body = data.get("body", defaults.REFLEX_BODY)
+    if body not in BODIES:
+        raise InputFileError(f"unknown body {body!r}", file=path, where="body",
+                             hint=" or ".join(BODIES))
+    return body
 
 
 def evaluate_candidates(payload: dict) -> list[dict]:
@@ -74,7 +87,8 @@ def evaluate_candidates(payload: dict) -> list[dict]:
     ``payload``: ``model``, ``blade``, ``settings`` (ObjectiveSettings as a dict), ``xs`` (list
     of vectors). Returns one :meth:`Evaluation.to_dict` per vector.
     """
-    model, layout = runner_and_layout(payload["model"], payload.get("blade"))
+    model, layout = runner_and_layout(payload["model"], payload.get("blade"),
+                                      payload.get("body", defaults.REFLEX_BODY))
     settings = ObjectiveSettings.from_dict(payload["settings"])
     seed = payload.get("jitter_seed", OBJECTIVE_JITTER_SEED)
     out = []
@@ -196,11 +210,13 @@ class OptimizationResult:
     history: tuple[tuple[int, int, float, float, float], ...] = field(repr=False)
     out: str | None = None
     wall_time_s: float = math.nan
+    body: str = defaults.REFLEX_BODY
 
     def to_dict(self) -> dict:
         return {
             "model": self.model,
             "blade": self.blade,
+            "body": self.body,
             "speed_m_per_s": self.speed,
             "seed": self.seed,
             "generations": self.generations,
@@ -216,6 +232,7 @@ def optimize_controller(
     model: str = "able",
     *,
     blade: str | None = defaults.REFLEX_BLADE,
+    body: str = defaults.REFLEX_BODY,
     speed: float = defaults.SPEED_M_PER_S,
     x0: np.ndarray | None = None,
     generations: int = defaults.GENERATIONS,
@@ -240,6 +257,8 @@ def optimize_controller(
         ``"able"`` or ``"amputee"``.
     blade
         Blade category of the amputee (ignored for ``able``).
+    body
+        The runner's body (:data:`bladelab.runner.params.BODIES`; default seed 001's).
     speed
         Prescribed running speed [m/s] (initial speed and the centre of the step-speed band).
     x0
@@ -282,7 +301,7 @@ def optimize_controller(
     base_settings = settings or ObjectiveSettings()
     settings = ObjectiveSettings.from_dict({**base_settings.to_dict(), "speed": float(speed)})
     blade = blade if model == "amputee" else None
-    runner, layout = runner_and_layout(model, blade)
+    runner, layout = runner_and_layout(model, blade, body)
     del runner
     out_dir = Path(out) if out is not None else None
     if generations < 1 or popsize < 2:
@@ -305,11 +324,13 @@ def optimize_controller(
                 hint="run without --resume first, with the same --out",
             )
         state = load_checkpoint(ckpt)
-        if (state["model"], state["blade"], state["speed"]) != (model, blade, float(speed)):
+        own = (state["model"], state["blade"], state.get("body", defaults.REFLEX_BODY),
+               state["speed"])
+        if own != (model, blade, body, float(speed)):
             raise InputFileError(
-                f"checkpoint is for {state['model']} {state['blade']} at {state['speed']} m/s",
+                f"checkpoint is for {_run_text(*own)}, not {_run_text(model, blade, body, speed)}",
                 file=ckpt,
-                hint="resume with the same --model, --blade and --speed",
+                hint="resume with the same --model, --blade, --body and --speed",
             )
         if list(state["parameter_names"]) != list(layout.names):
             _resume_in_grown_layout(state, layout, ckpt)
@@ -360,7 +381,8 @@ def optimize_controller(
         elapsed0, elapsed = 0.0, []
     t_start = time.perf_counter()
     evaluator = _Evaluator(
-        executor, jobs, {"model": model, "blade": blade, "settings": settings.to_dict()}
+        executor, jobs, {"model": model, "blade": blade, "body": body,
+                         "settings": settings.to_dict()}
     )
     try:
         fresh = settings.robust_samples > 1 and settings.robust_directions == "per-generation"
@@ -414,6 +436,7 @@ def optimize_controller(
                     elapsed,
                     elapsed0 if not elapsed else elapsed[-1],
                     subspace,
+                    body=body,
                 )
     except BaseException:
         evaluator.close(abort=True)
@@ -423,6 +446,7 @@ def optimize_controller(
     return OptimizationResult(
         model=model,
         blade=blade,
+        body=body,
         speed=float(speed),
         seed=int(seed),
         generations=gen,
@@ -434,6 +458,12 @@ def optimize_controller(
         out=str(out_dir) if out_dir is not None else None,
         wall_time_s=elapsed[-1] if elapsed else elapsed0,
     )
+
+
+def _run_text(model: str, blade: str | None, body: str, speed: float) -> str:
+    """``"amputee with Cat6 on the seed001 body at 3.5 m/s"``."""
+    return (f"{model}" + (f" with {blade}" if blade else "")
+            + f" on the {body} body at {float(speed):g} m/s")
 
 
 def optimize_seeds(
@@ -479,6 +509,8 @@ def _save(
     elapsed,
     wall_time_s,
     subspace,
+    *,
+    body: str = defaults.REFLEX_BODY,
 ) -> None:
     import cma  # deferred: cma takes ~2 s to import (see optimize_controller)
 
@@ -488,6 +520,7 @@ def _save(
         "cma_version": cma.__version__,
         "model": model,
         "blade": blade,
+        "body": body,
         "speed": speed,
         "seed": seed,
         "settings": settings.to_dict(),
@@ -510,6 +543,7 @@ def _save(
         layout,
         best_x,
         blade=blade,
+        body=body,
         speed_m_per_s=speed,
         generation=gen,
         evaluations=evals,
@@ -578,6 +612,7 @@ def load_checkpoint(path: str | Path) -> dict:
 __all__ = [
     "OptimizationResult",
     "runner_and_layout",
+    "stored_body",
     "stored_settings",
     "evaluate_candidates",
     "load_checkpoint",

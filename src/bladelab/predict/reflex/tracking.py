@@ -113,15 +113,19 @@ class GaitReference:
                                  hint="track a converged solution, not a best iterate")
         return cls.from_solution(sol, source=str(path))
 
-    def check_model(self, kind: str, blade: str | None, where: str) -> None:
-        """Refuse a reference of another runner than (``kind``, ``blade``)."""
+    def check_model(self, kind: str, blade: str | None, where: str, *,
+                    body: str = "seed001") -> None:
+        """Refuse a reference of another runner than (``kind``, ``blade``, ``body``)."""
         spec = self.model_spec
-        same = spec.get("model") == kind and (kind != "amputee" or spec.get("blade") == blade)
+        own_body = spec.get("body", "seed001")
+        same = (spec.get("model") == kind and own_body == body
+                and (kind != "amputee" or spec.get("blade") == blade))
         if not same:
             raise InputFileError(
                 f"the stride is of the {spec.get('model')} runner"
                 + (f" with {spec.get('blade')}" if spec.get("blade") else "")
-                + f", the controller's runner is {kind}" + (f" with {blade}" if blade else ""),
+                + f" on the {own_body} body, the controller's runner is {kind}"
+                + (f" with {blade}" if blade else "") + f" on the {body} body",
                 file=self.source, where=where, hint="track a stride of the same runner")
 
 

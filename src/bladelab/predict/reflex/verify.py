@@ -13,7 +13,7 @@ from bladelab._io import read_json
 from bladelab.errors import SpecError
 from bladelab.predict.reflex.controller import read_parameters
 from bladelab.predict.reflex.objective import PUSH_AFTER, ObjectiveSettings, simulate_controlled
-from bladelab.predict.reflex.optimize import runner_and_layout, stored_settings
+from bladelab.predict.reflex.optimize import runner_and_layout, stored_body, stored_settings
 from bladelab.predict.reflex.robust import VERIFY_JITTER_SEED, jittered_parameters
 from bladelab.runner.analyses import (
     CONTACT_THRESHOLD_N,
@@ -93,8 +93,9 @@ def verify_solution(
         raise SpecError(f"speed must be a number [m/s], None or 'reached', not {speed!r}",
                         where="speed")
     speed = own_speed if speed is None or reached else float(speed)
-    runner, layout = runner_and_layout(model, blade)
-    x = read_parameters(path, layout)
+    body = stored_body(data, path)
+    runner, layout = runner_and_layout(model, blade, body)
+    x = read_parameters(path, layout, body=body)
     # the copies move the file's own parameters, each along a direction of its name: the same
     # copies whatever parameters a later layout adds (at their defaults, unmoved)
     own = np.array([name in (data.get("parameters") or {}) for name in layout.names])
