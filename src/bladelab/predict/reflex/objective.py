@@ -323,7 +323,7 @@ def simulate_controlled(
     reference = _tracked_stride(settings.track) if settings.track is not None else None
     if reference is not None:
         reference.check_model(model.kind, model.params.blade if model.kind == "amputee" else None,
-                              "track")
+                              "track", dof_names=tuple(model.dof_names))
     if record_every > 0:
         every = record_every
     elif reference is not None:

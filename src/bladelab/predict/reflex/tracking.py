@@ -114,18 +114,22 @@ class GaitReference:
         return cls.from_solution(sol, source=str(path))
 
     def check_model(self, kind: str, blade: str | None, where: str, *,
-                    body: str = "seed001") -> None:
-        """Refuse a reference of another runner than (``kind``, ``blade``, ``body``)."""
+                    body: str | None = None, dof_names: tuple[str, ...] | None = None) -> None:
+        """Refuse a reference of another runner than (``kind``, ``blade``) on ``body`` (None:
+        any body) whose tracked coordinates are not all among ``dof_names`` (None: no
+        check)."""
         spec = self.model_spec
         own_body = spec.get("body", "seed001")
-        same = (spec.get("model") == kind and own_body == body
-                and (kind != "amputee" or spec.get("blade") == blade))
+        same = (spec.get("model") == kind and (body is None or own_body == body)
+                and (kind != "amputee" or spec.get("blade") == blade)
+                and (dof_names is None or set(self.dof_names) <= set(dof_names)))
         if not same:
             raise InputFileError(
                 f"the stride is of the {spec.get('model')} runner"
                 + (f" with {spec.get('blade')}" if spec.get("blade") else "")
                 + f" on the {own_body} body, the controller's runner is {kind}"
-                + (f" with {blade}" if blade else "") + f" on the {body} body",
+                + (f" with {blade}" if blade else "")
+                + (f" on the {body} body" if body else " on a body with other coordinates"),
                 file=self.source, where=where, hint="track a stride of the same runner")
 
 
