@@ -275,6 +275,26 @@ def test_report_of_a_parameter_file(tmp_path):
     assert ((contact > 0.1) & (contact < 0.35)).all()  # running contact times (seed 001 §3.1)
 
 
+def test_a_parameter_file_of_the_human_body_is_shown_on_that_body(tmp_path):
+    """A reflex file of the human body is re-simulated on it (its toe joints: the re-simulated
+    cost is the human runner's, not seed 001's) and labelled with its body."""
+    from bladelab.predict.reflex.controller import write_parameters
+    from bladelab.predict.reflex.objective import ObjectiveSettings, simulate_controlled
+    from bladelab.predict.reflex.optimize import runner_and_layout
+
+    human, layout = runner_and_layout("able", None, "human")
+    settings = ObjectiveSettings(speed=3.5, duration=1.0)
+    path = write_parameters(tmp_path / "human.json", layout, layout.x0, body="human",
+                            speed_m_per_s=3.5, settings=settings.to_dict())
+    rep = build_predictive_report(path, tmp_path / "r", duration=1.0, progress=False)
+    resim = _table(_tables(Path(rep.index)), "re-simulations").iloc[0]
+    assert resim["solution"] == "able-bodied 3.5 m/s (human body)"
+    want = {body: simulate_controlled(runner_and_layout("able", None, body)[0], layout.x0,
+                                      settings=settings)[0].cost for body in ("human", "seed001")}
+    assert resim["cost (–)"] == pytest.approx(want["human"], rel=1e-6)
+    assert want["seed001"] != pytest.approx(want["human"], rel=1e-3)
+
+
 class _Sections:
     """Collects what a section function adds (a stand-in for the report builder)."""
 

@@ -132,15 +132,16 @@ class _Solution:
     model: object = None
     layout: object = None
     x: np.ndarray | None = None
+    body: str = "seed001"
 
     def __post_init__(self) -> None:
         kind = self.data.get("model", "able")
         if kind not in ("able", "amputee"):
             raise InputFileError(f"unknown model {kind!r}", file=self.path, where="model")
         blade = self.data.get("blade") or ("Cat6" if kind == "amputee" else None)
-        body = stored_body(self.data, self.path)
-        self.model, self.layout = runner_and_layout(kind, blade, body)
-        self.x = read_parameters(self.path, self.layout, body=body)
+        self.body = stored_body(self.data, self.path)
+        self.model, self.layout = runner_and_layout(kind, blade, self.body)
+        self.x = read_parameters(self.path, self.layout, body=self.body)
 
     @property
     def kind(self) -> str:
@@ -174,7 +175,8 @@ class _Solution:
 
     def label(self) -> str:
         who = "able-bodied" if self.kind == "able" else f"amputee {self.blade}"
-        return f"{who} {self.speed:g} m/s"
+        on = "" if self.body == "seed001" else f" ({self.body} body)"
+        return f"{who} {self.speed:g} m/s{on}"
 
 
 class _Counter:
