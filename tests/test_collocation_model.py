@@ -575,6 +575,19 @@ def test_knee_moment_is_the_prosthetic_grf_moment_about_the_knee_axis(models):
         knee_extension_moment(models["amputee-Cat6"][1], q_s, qd_s)
 
 
+def _assert_last_path_inequality(cm, q, qd, want: float, **setting) -> None:
+    """The stride dynamics built with one path-constraint ``setting`` end their path
+    inequalities with it (``want`` at the state q, qd), one row, bounded below by 0."""
+    from bladelab.predict.collocation.dynamics import stride_dynamics
+
+    dyn = stride_dynamics(cm, **setting)
+    nm = cm.n_muscles
+    a = ft = dft = np.full(nm, 0.1)
+    path = np.asarray(dyn.inequalities(q, qd, a, ft, dft)).ravel()
+    assert path.size == 2 * nm + 1 and path[-1] == pytest.approx(want, rel=1e-12)
+    np.testing.assert_array_equal(dyn.inequality_bounds[-1], [0.0, np.inf])
+
+
 def test_loaded_knee_flexion_limit_is_weighted_by_the_prosthetic_load(models):
     """The straight-stance path function: (F_z / m·g)·(q_knee + limit), F_z the prosthetic
     contacts' vertical force by hand; its sign says whether the loaded knee flexes past the
@@ -600,15 +613,7 @@ def test_loaded_knee_flexion_limit_is_weighted_by_the_prosthetic_load(models):
         value = float(fn(q, qd))
         assert value == pytest.approx(f_z / weight * (angle + limit), rel=1e-9)
         assert np.sign(value) == sign
-    # the NLP's path inequalities end with it, bounded below by 0
-    from bladelab.predict.collocation.dynamics import stride_dynamics
-
-    dyn = stride_dynamics(cm, knee_flexion_max_loaded_deg=5.0)
-    nm = cm.n_muscles
-    a = ft = dft = np.full(nm, 0.1)
-    path = np.asarray(dyn.inequalities(q, qd, a, ft, dft)).ravel()
-    assert path.size == 2 * nm + 1 and path[-1] == pytest.approx(float(fn(q, qd)), rel=1e-12)
-    np.testing.assert_array_equal(dyn.inequality_bounds[-1], [0.0, np.inf])
+    _assert_last_path_inequality(cm, q, qd, float(fn(q, qd)), knee_flexion_max_loaded_deg=5.0)
     q[runner.dof("pelvis_tz")] += 0.3  # in the air: free, even flexed 60°
     q[knee] = -np.radians(60.0)
     assert abs(float(fn(q, qd))) < 1e-6
@@ -622,7 +627,7 @@ def test_prosthetic_load_limit_is_the_prosthetic_legs_vertical_force(models, kin
     prosthetic (right) leg's contacts only; the intact foot's load does not enter, and the
     NLP's last path inequality is it, bounded below by 0."""
     from bladelab.errors import SpecError
-    from bladelab.predict.collocation.dynamics import prosthetic_load_margin, stride_dynamics
+    from bladelab.predict.collocation.dynamics import prosthetic_load_margin
     from bladelab.runner.layout import CP_LEG
 
     runner, cm = models[kind]
@@ -641,11 +646,6 @@ def test_prosthetic_load_limit_is_the_prosthetic_legs_vertical_force(models, kin
     assert float(fn(q, qd)) < 0  # sunk 3 cm: the prosthetic leg carries more than 0.5 BW
     q[runner.dof("pelvis_tz")] += 0.3  # in the air: the whole limit is left
     assert float(fn(q, qd)) == pytest.approx(0.5, abs=1e-6)
-    dyn = stride_dynamics(cm, prosthetic_load_max_bw=0.5)
-    nm = cm.n_muscles
-    a = ft = dft = np.full(nm, 0.1)
-    path = np.asarray(dyn.inequalities(q, qd, a, ft, dft)).ravel()
-    assert path.size == 2 * nm + 1 and path[-1] == pytest.approx(float(fn(q, qd)), rel=1e-12)
-    np.testing.assert_array_equal(dyn.inequality_bounds[-1], [0.0, np.inf])
+    _assert_last_path_inequality(cm, q, qd, float(fn(q, qd)), prosthetic_load_max_bw=0.5)
     with pytest.raises(SpecError, match="no prosthetic leg"):
         prosthetic_load_margin(models["able"][1], q_s, qd_s, 0.5)

@@ -345,34 +345,21 @@ def test_the_human_body_with_peoples_angles(fake, tmp_path):
     assert err.value.where == "body"
 
 
-def test_alternating_steps_reach_every_designs_solve(fake, tmp_path):
-    """The alternating-steps constraint is a setting of every design's solve and of the
-    evaluator's identity (a study made free is not resumed with it); free by default."""
+@pytest.mark.parametrize("field, value, bad", [("step_phase_tolerance", 0.1, 0.7),
+                                               ("prosthetic_load_max_bw", 3.0, -1.0)])
+def test_a_stride_constraint_reaches_every_designs_solve(fake, tmp_path, field, value, bad):
+    """The alternating-steps constraint and the socket-load limit are settings of every
+    design's solve and of the evaluator's identity (a study made without one is not resumed
+    with it: a study's file from before the setting ran without it); none by default; a bad
+    value is refused by name."""
     calls, _ = fake
     _evaluator(tmp_path)(CENTRE)
-    assert calls[-1]["step_phase_tolerance"] is None
-    ev = _evaluator(tmp_path / "alt", step_phase_tolerance=0.1)
+    assert calls[-1][field] is None
+    ev = _evaluator(tmp_path / "constrained", **{field: value})
     ev(CENTRE)
-    assert calls[-1]["step_phase_tolerance"] == 0.1
-    assert ev.to_dict()["step_phase_tolerance"] == 0.1
-    # a study's file from before the setting ran free
-    assert ce.CollocationEvaluator.LEGACY_SETTINGS["step_phase_tolerance"] is None
+    assert calls[-1][field] == value
+    assert ev.to_dict()[field] == value
+    assert ce.CollocationEvaluator.LEGACY_SETTINGS[field] is None
     with pytest.raises(SpecError) as err:
-        _evaluator(tmp_path, step_phase_tolerance=0.7)
-    assert err.value.where == "step_phase_tolerance"
-
-
-def test_the_prosthetic_load_limit_reaches_every_designs_solve(fake, tmp_path):
-    """The socket-load limit is a setting of every design's solve and of the evaluator's
-    identity (a study made without it is not resumed with it); none by default."""
-    calls, _ = fake
-    _evaluator(tmp_path)(CENTRE)
-    assert calls[-1]["prosthetic_load_max_bw"] is None
-    ev = _evaluator(tmp_path / "socket", prosthetic_load_max_bw=3)
-    ev(CENTRE)
-    assert calls[-1]["prosthetic_load_max_bw"] == 3.0
-    assert ev.to_dict()["prosthetic_load_max_bw"] == 3.0
-    assert ce.CollocationEvaluator.LEGACY_SETTINGS["prosthetic_load_max_bw"] is None
-    with pytest.raises(SpecError) as err:
-        _evaluator(tmp_path, prosthetic_load_max_bw=-1)
-    assert err.value.where == "prosthetic_load_max_bw"
+        _evaluator(tmp_path, **{field: bad})
+    assert err.value.where == field
