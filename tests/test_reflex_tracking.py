@@ -206,3 +206,40 @@ def test_a_missing_stride_names_the_setting(tmp_path):
     settings = ObjectiveSettings(duration=0.5, track=str(tmp_path / "gone.json"), w_track=1.0)
     with pytest.raises(InputFileError, match="settings.track"):
         simulate_controlled(model, layout.vector({}), layout=layout, settings=settings)
+
+
+def test_a_simulation_starts_from_a_strides_touchdown_state(tmp_path):
+    """``start_stride``: the simulation's first state is the stride's at leg 0's touch-down
+    (leg 0's vertical force crosses 0.1 BW there, interpolated by hand between the two nodes
+    around it), the pelvis at x = 0 and its forward speed shifted by the asked speed minus the
+    stride's mean; a stride of a runner with other coordinates, a missing file and a best
+    iterate are refused by name, and the CLI checks the file before any run."""
+    from bladelab.predict.reflex.objective import stride_initial_state
+
+    sol = CollocationSolution.read(CAT6_4)
+    t, q, qd = (np.asarray(a) for a in (sol.nlp.time, sol.nlp.q, sol.nlp.qd))
+    f0 = sol.leg_vertical_force()[:, 0] / sol.body_weight_N
+    k = next(i for i in range(len(t) - 1) if f0[i] <= 0.1 < f0[i + 1])
+    w = (0.1 - f0[k]) / (f0[k + 1] - f0[k])
+    model, layout = runner_and_layout("amputee", "Cat6")
+    settings = ObjectiveSettings(duration=0.05, start_stride=str(CAT6_4), speed=4.2)
+    _, res = simulate_controlled(model, layout.x0, layout=layout, settings=settings,
+                                 record_every=1)
+    for j, name in enumerate(sol.dof_names):
+        want_q = q[k, j] + w * (q[k + 1, j] - q[k, j])
+        want_v = qd[k, j] + w * (qd[k + 1, j] - qd[k, j])
+        if name == "pelvis_tx":
+            want_q, want_v = 0.0, want_v + 4.2 - sol.mean_speed_mps
+        assert res.qpos[0, model.dof(name)] == pytest.approx(want_q, abs=1e-9), name
+        assert res.qvel[0, model.dof(name)] == pytest.approx(want_v, rel=1e-9, abs=1e-9), name
+    human, _ = runner_and_layout("able", None, "human")
+    with pytest.raises(InputFileError, match="lacks mtp_angle_l, mtp_angle_r") as err:
+        stride_initial_state(human, str(ABLE_4), 3.5)
+    assert err.value.where == "settings.start_stride"
+    with pytest.raises(InputFileError, match="not there"):
+        stride_initial_state(model, str(tmp_path / "gone.json"), 4.0, where="start_stride")
+    with pytest.raises(InputFileError, match="did not converge"):
+        stride_initial_state(model, str(BEST_ITERATE), 4.0)
+    assert main(["predict", "--method", "reflex", "--model", "able", "--body", "human",
+                 "--start-stride", str(ABLE_4), "--out", str(tmp_path / "run")]) == 2
+    assert not (tmp_path / "run").exists()

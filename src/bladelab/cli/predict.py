@@ -218,6 +218,11 @@ def register(app: typer.Typer) -> None:
         track_weight: float = typer.Option(
             defaults.TRACK_WEIGHT_PER_RAD2, "--track-weight", rich_help_panel=REFLEX,
             help="Weight of the tracking term [1/rad²] (with --track)."),
+        start_stride: Path | None = typer.Option(
+            None, "--start-stride", rich_help_panel=REFLEX, show_default=False,
+            help="Start every simulation from this collocation stride's state at its first "
+                 "leg's touch-down (solution.json of the same runner), moving at "
+                 "--initial-speed or --speed, instead of SCONE's gait state."),
         # -- collocation -------------------------------------------------------------------
         max_speed: bool = typer.Option(
             False, "--max-speed", rich_help_panel=COLLOCATION,
@@ -312,7 +317,8 @@ def register(app: typer.Typer) -> None:
             robust_speed_change=robust_speed_change, robust_push=robust_push,
             robust_half_step=robust_half_step, initial_speed=initial_speed,
             strike_limit=strike_limit, lean_weight=lean_weight, run_up=run_up,
-            integrator=integrator, track=track, track_weight=track_weight)
+            integrator=integrator, track=track, track_weight=track_weight,
+            start_stride=start_stride)
 
     @app.command("sweep", cls=PanelCommand)
     def sweep(

@@ -34,7 +34,7 @@ OPTIONS = {
     "robust_samples": "--robust-samples", "robust_jitter": "--robust-jitter",
     "initial_speed": "--initial-speed", "strike_limit_bw": "--strike-limit",
     "w_lean": "--lean-weight", "integrator": "--integrator", "track": "--track",
-    "w_track": "--track-weight",
+    "w_track": "--track-weight", "start_stride": "--start-stride",
 }
 _ROBUST_OPTIONS = ("--robust-directions", "--robust-speed-change", "--robust-push",
                    "--duration", "--robust-half-step", "--robust-samples")
@@ -48,7 +48,7 @@ def run_reflex(*, out: Path, model: str, blade: str | None, body: str, speed: fl
                robust_directions: str, robust_speed_change: float, robust_push: float,
                robust_half_step: bool, initial_speed: float | None, strike_limit: float,
                lean_weight: float, run_up: bool, integrator: str, track: Path | None,
-               track_weight: float) -> None:
+               track_weight: float, start_stride: Path | None = None) -> None:
     """``bladelab predict`` (reflex): CMA-ES once per seed; prints each generation and the
     best run as JSON."""
     check_robust_copies(robust_directions, robust_speed_change, robust_push, duration,
@@ -67,7 +67,8 @@ def run_reflex(*, out: Path, model: str, blade: str | None, body: str, speed: fl
             robust_half_step=robust_half_step, initial_speed=initial_speed,
             strike_limit_bw=strike_limit, w_lean=lean_weight, run_up=run_up,
             integrator=integrator, track=None if track is None else str(track),
-            w_track=0.0 if track is None else track_weight)
+            w_track=0.0 if track is None else track_weight,
+            start_stride=None if start_stride is None else str(start_stride))
         results = optimize_named(
             model, out=out, seeds=seed_list, blade=blade, body=body, init=init,
             settings=settings,

@@ -21,7 +21,7 @@ from pathlib import Path
 from bladelab.errors import SpecError
 from bladelab.predict import defaults
 from bladelab.predict.reflex.controller import read_parameters
-from bladelab.predict.reflex.objective import ObjectiveSettings
+from bladelab.predict.reflex.objective import ObjectiveSettings, stride_initial_state
 from bladelab.predict.reflex.optimize import OptimizationResult, optimize_seeds, runner_and_layout
 from bladelab.predict.reflex.recipe import STABLE_GAIT_RECIPE, Recipe
 from bladelab.predict.reflex.recipe_sweep import run_recipe_sweep
@@ -103,7 +103,10 @@ def optimize_named(
     worn = blade if model == "amputee" else None
     if body not in BODIES:
         raise SpecError(f"unknown body {body!r}", where="body", hint=" or ".join(BODIES))
-    _, layout = runner_and_layout(model, worn, body)
+    runner, layout = runner_and_layout(model, worn, body)
+    if settings.start_stride is not None:
+        stride_initial_state(runner, settings.start_stride, settings.start_speed,
+                             where="start_stride")
     if settings.track is not None:
         if not (math.isfinite(settings.w_track) and settings.w_track > 0):
             raise SpecError("must be > 0", where="w_track")

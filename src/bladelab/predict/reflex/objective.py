@@ -62,7 +62,7 @@ from bladelab.predict.reflex.controller import (
     controller_layout,
     history_length,
 )
-from bladelab.predict.reflex.tracking import cached_reference, tracking_error
+from bladelab.predict.reflex.tracking import cached_reference, stride_start, tracking_error
 from bladelab.runner.implicit_setup import implicit_arrays, simulation_model, site_views
 from bladelab.runner.kernel import mujoco_step_addresses, path_kinematics
 from bladelab.runner.metabolics import metabolic_params
@@ -155,6 +155,7 @@ class ObjectiveSettings:
     track: str | None = None
     w_track: float = 0.0
     track_skip: float = 1.0
+    start_stride: str | None = None
 
     def __post_init__(self) -> None:
         check_robust_copies(self.robust_directions, self.robust_speed_change,
@@ -273,7 +274,10 @@ def simulate_controlled(
     m.opt.timestep = dt
     d = mujoco.MjData(m)
     v_start = settings.start_speed
-    q0, v0 = initial_state(model, layout, x, v_start)
+    if settings.start_stride is not None:
+        q0, v0 = stride_initial_state(model, settings.start_stride, v_start)
+    else:
+        q0, v0 = initial_state(model, layout, x, v_start)
     d.qpos[:] = q0
     d.qvel[:] = v0
     announce_compilation(run_closed_loop, "the reflex controller's simulation loop")
@@ -386,6 +390,36 @@ def simulate_controlled(
     return ev, (result if record_every > 0 else None)
 
 
+def stride_initial_state(model: RunnerModel, path: str, speed: float, *,
+                         where: str = "settings.start_stride") -> tuple[np.ndarray, np.ndarray]:
+    """The collocation stride ``path``'s state at leg 0's touch-down
+    (:func:`~bladelab.predict.reflex.tracking.stride_start`) as the initial (qpos, qvel) of
+    ``model``: the pelvis at x = 0, its forward speed shifted so that the stride's mean speed
+    becomes ``speed`` [m/s]; the controller's initial-state offsets do not apply. A stride of
+    a runner with other coordinates is refused (errors name ``where``)."""
+    if not Path(path).is_file():
+        raise InputFileError("the stride this run starts from is not there", file=path,
+                             where=where,
+                             hint="a collocation solution file; a relative path is read from "
+                                  "the current folder")
+    start = stride_start(str(path))
+    if set(start.dof_names) != set(model.dof_names):
+        lacks = [n for n in model.dof_names if n not in start.dof_names]
+        extra = [n for n in start.dof_names if n not in model.dof_names]
+        raise InputFileError(
+            "the stride's runner has other coordinates than the controller's"
+            + (f" (the stride lacks {', '.join(lacks)})" if lacks else "")
+            + (f" (the stride has {', '.join(extra)} too)" if extra else ""), file=path,
+            where=where, hint="start from a stride of the same runner and body")
+    q = np.zeros(model.mj_model.nq)
+    v = np.zeros(model.mj_model.nv)
+    for j, name in enumerate(start.dof_names):
+        q[model.dof(name)], v[model.dof(name)] = start.qpos[j], start.qvel[j]
+    q[model.dof("pelvis_tx")] = 0.0
+    v[model.dof("pelvis_tx")] += speed - start.speed_mps
+    return q, v
+
+
 def _tracked_stride(path: str):
     """The run's tracked stride (``settings.track``); a missing file names the setting."""
     if not Path(path).is_file():
@@ -462,5 +496,6 @@ __all__ = [
     "check_robust_copies",
     "evaluate",
     "initial_state",
+    "stride_initial_state",
     "simulate_controlled",
 ]

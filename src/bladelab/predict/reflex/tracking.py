@@ -143,6 +143,53 @@ def _periodic_rise(t: np.ndarray, f: np.ndarray, threshold: float) -> float | No
     return None
 
 
+@dataclass(frozen=True)
+class StrideStart:
+    """A collocation stride's state at leg 0's touch-down: the start of a reflex simulation
+    (``ObjectiveSettings.start_stride``).
+
+    Attributes
+    ----------
+    dof_names
+        The stride's coordinates (columns of ``qpos``/``qvel``).
+    qpos, qvel
+        Coordinates [m, rad] and speeds [m/s, rad/s] at the touch-down (the pelvis's forward
+        position as in the stride).
+    speed_mps
+        The stride's mean speed [m/s].
+    model_spec
+        ``{"model": ..., "blade": ..., "body": ...}`` of the collocation solution.
+    """
+
+    dof_names: tuple[str, ...]
+    qpos: np.ndarray
+    qvel: np.ndarray
+    speed_mps: float
+    model_spec: dict
+
+
+@lru_cache(maxsize=4)
+def stride_start(path: str) -> StrideStart:
+    """The :class:`StrideStart` of a converged collocation solution file (linear interpolation
+    between the nodes around leg 0's touch-down, :data:`TOUCHDOWN_BW`), once per process."""
+    sol = CollocationSolution.read(path)
+    if not sol.converged:
+        raise InputFileError("the collocation solve did not converge", file=path,
+                             hint="start from a converged solution, not a best iterate")
+    t = np.asarray(sol.nlp.time)
+    start = _periodic_rise(t, sol.leg_vertical_force()[:, 0], TOUCHDOWN_BW * sol.body_weight_N)
+    if start is None:
+        raise InputFileError(f"leg 0 ({sol.leg_names[0]}) never lands in the stride",
+                             file=path, hint="start from a running stride")
+
+    def at(values: np.ndarray) -> np.ndarray:
+        return np.array([np.interp(start, t, values[:, j]) for j in range(values.shape[1])])
+
+    return StrideStart(tuple(sol.dof_names), at(np.asarray(sol.nlp.q)),
+                       at(np.asarray(sol.nlp.qd)), float(sol.mean_speed_mps),
+                       dict(sol.model_spec))
+
+
 @lru_cache(maxsize=4)
 def cached_reference(path: str) -> GaitReference:
     """:meth:`GaitReference.read`, once per process (every candidate of a run tracks one file)."""
