@@ -300,7 +300,8 @@ def register(app: typer.Typer) -> None:
             raise typer.Exit(run_collocation(
                 out=out, model=model, blade=blade, speed=speed, max_speed=max_speed, mesh=mesh,
                 guess=guess, max_iter=max_iter, resume=resume, force=force, as_json=as_json,
-                body=body or defaults.BODY, swing_clearance=swing_clearance, knee_moment_min=knee_moment_min,
+                body=body or defaults.BODY, swing_clearance=swing_clearance,
+                knee_moment_min=knee_moment_min,
                 knee_flexion_max=knee_flexion_max, tilt_range=tilt_range,
                 alternating_steps=alternating_steps, prosthetic_load_max=prosthetic_load_max,
                 people_weight=people_weight,

@@ -123,11 +123,17 @@ def prosthetic_load_margin(cm: CollocationModel, q: ca.SX, qd: ca.SX, max_bw: fl
     if runner.kind == "able":
         raise SpecError("the able model has no prosthetic leg", where="prosthetic_load_max_bw",
                         hint="an amputee or transfemoral runner's setting")
+    prosthetic = np.flatnonzero(runner.contact_params[:, CP_LEG] == 1)
+    return float(max_bw) - _vertical_force_bw(cm, q, qd, prosthetic)
+
+
+def _vertical_force_bw(cm: CollocationModel, q: ca.SX, qd: ca.SX, contacts) -> ca.SX:
+    """The vertical ground force of ``contacts`` (contact rows) [body weights]."""
     forces, _, _ = cm.contacts(q, qd)
     f_z = 0.0
-    for c in np.flatnonzero(runner.contact_params[:, CP_LEG] == 1):
+    for c in contacts:
         f_z += forces[c, 1]
-    return float(max_bw) - f_z / (runner.total_mass * runner.gravity)
+    return f_z / (cm.runner.total_mass * cm.runner.gravity)
 
 
 def knee_straight_while_loaded(cm: CollocationModel, q: ca.SX, qd: ca.SX,
@@ -139,12 +145,8 @@ def knee_straight_while_loaded(cm: CollocationModel, q: ca.SX, qd: ca.SX,
     stance in which seed 002's knee-buckling moment can stay extending."""
     runner = cm.runner
     prosthetic = _prosthetic_contacts(runner, "knee_flexion_max_loaded_deg")
-    forces, _, _ = cm.contacts(q, qd)
-    f_z = 0.0
-    for c in prosthetic:
-        f_z += forces[c, 1]
-    weight = runner.total_mass * runner.gravity
-    return f_z / weight * (q[runner.dof("knee_angle_r")] + float(max_flexion_rad))
+    return (_vertical_force_bw(cm, q, qd, prosthetic)
+            * (q[runner.dof("knee_angle_r")] + float(max_flexion_rad)))
 
 
 def stride_dynamics(cm: CollocationModel, *, metabolic: MetabolicSmoothing | None = None,
@@ -161,8 +163,8 @@ def stride_dynamics(cm: CollocationModel, *, metabolic: MetabolicSmoothing | Non
     ``knee_flexion_max_loaded_deg`` [deg], the prosthetic knee within that flexion while its
     contacts carry load (:func:`knee_straight_while_loaded`); with ``prosthetic_load_max_bw``
     [body weights], the prosthetic leg's vertical ground force at or below it
-    (:func:`prosthetic_load_margin`); with ``blade_backward_euler``, a multi-link blade's joints are transcribed by backward Euler
-    (``StrideDynamics.backward_euler_dofs``)."""
+    (:func:`prosthetic_load_margin`); with ``blade_backward_euler``, a multi-link blade's
+    joints are transcribed by backward Euler (``StrideDynamics.backward_euler_dofs``)."""
     runner = cm.runner
     nv, nm = cm.nv, cm.n_muscles
     q, qd, qdd = ca.SX.sym("q", nv), ca.SX.sym("qd", nv), ca.SX.sym("qdd", nv)

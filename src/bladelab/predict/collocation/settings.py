@@ -342,8 +342,8 @@ class CollocationSettings:
 
     def same_problem(self, other: CollocationSettings) -> bool:
         """True if ``other`` poses the same NLP (mesh, speed, weights, swing clearance, knee
-        moment bound, loaded knee's flexion limit, prosthetic load limit, blade transcription, pelvis tilt range,
-        alternating steps);
+        moment bound, loaded knee's flexion limit, prosthetic load limit, blade transcription,
+        pelvis tilt range, alternating steps);
         solver options
         (Hessian, tolerance, iterations) and the tracking stage may differ."""
         return self._problem() == other._problem()
@@ -351,8 +351,8 @@ class CollocationSettings:
     def _problem(self) -> tuple:
         return (self.mesh_intervals, self.speed_m_per_s, self.weights, self.swing_clearance_m,
                 self.knee_moment_min_nm, self.knee_flexion_max_loaded_deg,
-                self.prosthetic_load_max_bw, self.blade_backward_euler, self.pelvis_tilt_range_deg,
-                self.step_phase_tolerance) + self.reference_key()
+                self.prosthetic_load_max_bw, self.blade_backward_euler,
+                self.pelvis_tilt_range_deg, self.step_phase_tolerance) + self.reference_key()
 
     def reference_key(self) -> tuple:
         """(reference file name, weight, coordinates), or () without a reference term."""

@@ -27,7 +27,6 @@ from bladelab.predict.reflex.recipe import STABLE_GAIT_RECIPE, Recipe
 from bladelab.predict.reflex.recipe_sweep import run_recipe_sweep
 from bladelab.predict.reflex.tracking import GaitReference
 from bladelab.runner.implicit import INTEGRATORS
-from bladelab.runner.params import BODIES
 
 __all__ = ["MAX_TIME_STEP_S", "RECIPES", "REFLEX_MODELS", "check_run_settings", "named_recipe",
            "optimize_named", "recipe_sweep_named"]
@@ -101,8 +100,6 @@ def optimize_named(
                        w_lean=settings.w_lean, strike_limit_bw=settings.strike_limit_bw)
     blade = blade or defaults.REFLEX_BLADE
     worn = blade if model == "amputee" else None
-    if body not in BODIES:
-        raise SpecError(f"unknown body {body!r}", where="body", hint=" or ".join(BODIES))
     runner, layout = runner_and_layout(model, worn, body)
     if settings.start_stride is not None:
         stride_initial_state(runner, settings.start_stride, settings.start_speed,

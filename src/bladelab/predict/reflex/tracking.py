@@ -91,12 +91,7 @@ class GaitReference:
         q = np.asarray(sol.nlp.q)[:, cols]            # (n + 1, k), node n == node 0
         t = np.asarray(sol.nlp.time)
         period = float(sol.period_s)
-        fz = sol.leg_vertical_force()[:, 0]
-        threshold = TOUCHDOWN_BW * sol.body_weight_N
-        start = _periodic_rise(t, fz, threshold)
-        if start is None:
-            raise InputFileError(f"leg 0 ({sol.leg_names[0]}) never lands in the stride",
-                                 file=source, hint="track a running stride")
+        start = _leg0_touchdown(sol, source, "track a running stride")
         phase_t = start + (np.arange(PHASES) + 0.5) / PHASES * period
         angles = np.column_stack([np.interp(phase_t % period, t, q[:, j], period=period)
                                   for j in range(len(dofs))])
@@ -107,10 +102,7 @@ class GaitReference:
     def read(cls, path: str | Path) -> GaitReference:
         """The reference of a collocation solution file (``solution.json``, ``speed-4.json``);
         refused when the solve did not converge."""
-        sol = CollocationSolution.read(path)
-        if not sol.converged:
-            raise InputFileError("the collocation solve did not converge", file=path,
-                                 hint="track a converged solution, not a best iterate")
+        sol = _converged_solution(path, "track a converged solution, not a best iterate")
         return cls.from_solution(sol, source=str(path))
 
     def check_model(self, kind: str, blade: str | None, where: str, *,
@@ -131,6 +123,26 @@ class GaitReference:
                 + (f" with {blade}" if blade else "")
                 + (f" on the {body} body" if body else " on a body with other coordinates"),
                 file=self.source, where=where, hint="track a stride of the same runner")
+
+
+def _converged_solution(path: str | Path, hint: str) -> CollocationSolution:
+    """The collocation solution of ``path``; InputFileError with ``hint`` if the solve did not
+    converge."""
+    sol = CollocationSolution.read(path)
+    if not sol.converged:
+        raise InputFileError("the collocation solve did not converge", file=path, hint=hint)
+    return sol
+
+
+def _leg0_touchdown(sol: CollocationSolution, source: str | Path, hint: str) -> float:
+    """Time [s] in the stride at which leg 0's vertical force rises through
+    :data:`TOUCHDOWN_BW`; InputFileError naming ``source`` with ``hint`` if it never lands."""
+    start = _periodic_rise(np.asarray(sol.nlp.time), sol.leg_vertical_force()[:, 0],
+                           TOUCHDOWN_BW * sol.body_weight_N)
+    if start is None:
+        raise InputFileError(f"leg 0 ({sol.leg_names[0]}) never lands in the stride",
+                             file=source, hint=hint)
+    return start
 
 
 def _periodic_rise(t: np.ndarray, f: np.ndarray, threshold: float) -> float | None:
@@ -172,15 +184,9 @@ class StrideStart:
 def stride_start(path: str) -> StrideStart:
     """The :class:`StrideStart` of a converged collocation solution file (linear interpolation
     between the nodes around leg 0's touch-down, :data:`TOUCHDOWN_BW`), once per process."""
-    sol = CollocationSolution.read(path)
-    if not sol.converged:
-        raise InputFileError("the collocation solve did not converge", file=path,
-                             hint="start from a converged solution, not a best iterate")
+    sol = _converged_solution(path, "start from a converged solution, not a best iterate")
     t = np.asarray(sol.nlp.time)
-    start = _periodic_rise(t, sol.leg_vertical_force()[:, 0], TOUCHDOWN_BW * sol.body_weight_N)
-    if start is None:
-        raise InputFileError(f"leg 0 ({sol.leg_names[0]}) never lands in the stride",
-                             file=path, hint="start from a running stride")
+    start = _leg0_touchdown(sol, path, "start from a running stride")
 
     def at(values: np.ndarray) -> np.ndarray:
         return np.array([np.interp(start, t, values[:, j]) for j in range(values.shape[1])])
