@@ -252,7 +252,7 @@ def test_predict_collocation_passes_the_same_settings(tmp_path, monkeypatch, cap
     assert "--starts: need 1 to 3 starts" in capsys.readouterr().err
 
 
-def test_sweep_collocation_passes_the_same_settings(tmp_path, monkeypatch):
+def test_sweep_collocation_passes_the_same_settings(tmp_path, monkeypatch, capsys):
     import bladelab.predict.collocation.named_runs as named
     from bladelab.predict.collocation.settings import CollocationSettings
     from bladelab.predict.collocation.starting_guess import make_guess
@@ -288,6 +288,16 @@ def test_sweep_collocation_passes_the_same_settings(tmp_path, monkeypatch):
         main(["sweep", "--method", "collocation", "--able", "--categories", "Cat6",
               "--muscle-strength", "1.5", "--out", str(tmp_path)])
     assert [m["athlete"] for m in seen["models"]] == [{"muscle_strength": 1.5}] * 2
+    assert seen["settings"].step_phase_tolerance is None  # free unless asked
+    seen.clear()
+    with pytest.raises(_Called):
+        main(["sweep", "--method", "collocation", "--categories", "Cat6",
+              "--alternating-steps", "0.1", "--out", str(tmp_path)])
+    assert seen["settings"].step_phase_tolerance == 0.1
+    capsys.readouterr()
+    assert main(["sweep", "--method", "collocation", "--categories", "Cat6",
+                 "--alternating-steps", "0.5", "--out", str(tmp_path)]) == 2
+    assert "--alternating-steps" in capsys.readouterr().err
 
 
 def test_sweep_reflex_grid_passes_the_same_values(tmp_path, monkeypatch, capsys):

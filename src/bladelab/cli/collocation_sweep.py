@@ -35,6 +35,7 @@ OPTIONS = {
     "body": "--body", "speeds": "--speeds", "guess": "--guess", "mesh_intervals": "--mesh",
     "max_iter": "--max-iter", "starts": "--starts", "jobs": "--jobs",
     "people_weight": "--people-weight", "reference_weight": "--people-weight",
+    "step_phase_tolerance": "--alternating-steps",
     "athlete.body_mass_kg": "--body-mass", "athlete.height_m": "--height",
     "athlete.muscle_strength": "--muscle-strength",
 }
@@ -107,11 +108,13 @@ def run_collocation_sweep(
     starts: int,
     body: str,
     people_weight: float | None = None,
+    alternating_steps: float | None = None,
     athlete: dict | None = None,
 ) -> int:
     """Run ``bladelab sweep --method collocation``; returns the exit status (0 every solve
-    converged, 2 some model failed). ``athlete``: every model scaled to this athlete (None:
-    the body's own)."""
+    converged, 2 some model failed). ``alternating_steps``:
+    ``CollocationSettings.step_phase_tolerance``; ``athlete``: every model scaled to this
+    athlete (None: the body's own)."""
     speed_list = _speeds(speeds)
     # --able --categories "": the able model alone
     cats = parse_list(categories, "--categories") if categories.strip() or not able else []
@@ -119,7 +122,7 @@ def run_collocation_sweep(
         result = sweep_named_models(
             out, categories=cats, speeds=speed_list, able=able, body=body, guess=guess,
             mesh_intervals=mesh, max_iter=max_iter, people_weight=people_weight,
-            athlete=athlete, starts=starts, jobs=jobs,
+            step_phase_tolerance=alternating_steps, athlete=athlete, starts=starts, jobs=jobs,
             executor=executor, resume=resume, force=force, progress=SweepProgress())
     except BladelabError as err:
         raise renamed(err, OPTIONS) from None

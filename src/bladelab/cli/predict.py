@@ -77,6 +77,14 @@ def _people_weight_option():
              "body, 0 on the others; 0: the gait is predicted freely.")
 
 
+def _alternating_steps_option():
+    """``--alternating-steps``, the same on ``predict`` and ``sweep`` (collocation)."""
+    return typer.Option(
+        None, "--alternating-steps", rich_help_panel=COLLOCATION, show_default=False,
+        help="Keep the steps alternating: the second leg's stance half a stride +- this "
+             "fraction of the stride after the first leg's, e.g. 0.1 (rules out a gallop).")
+
+
 #: The athlete's options, the same on ``predict`` and ``sweep`` (collocation):
 #: (library field, option, help).
 _ATHLETE_OPTIONS = {
@@ -264,11 +272,7 @@ def register(app: typer.Typer) -> None:
             None, "--tilt-range", rich_help_panel=COLLOCATION,
             help="Keep the pelvis tilt within LO,HI [deg] at every node (forward lean "
                  "negative), e.g. --tilt-range=-16,-2 (seed 001's window)."),
-        alternating_steps: float | None = typer.Option(
-            None, "--alternating-steps", rich_help_panel=COLLOCATION,
-            help="Keep the steps alternating: the second leg's stance half a stride +- this "
-                 "fraction of the stride after the first leg's, e.g. 0.1 (rules out a "
-                 "gallop)."),
+        alternating_steps: float | None = _alternating_steps_option(),
         prosthetic_load_max: float | None = typer.Option(
             None, "--prosthetic-load-max", rich_help_panel=COLLOCATION, show_default=False,
             help="Keep the prosthetic leg's vertical ground force at or below this many body "
@@ -422,6 +426,7 @@ def register(app: typer.Typer) -> None:
                  "pad) | seed001 (seed 001's model) | toes (seed 001's with a toe segment and "
                  "compliant Achilles tendons)."),
         people_weight: float | None = _people_weight_option(),
+        alternating_steps: float | None = _alternating_steps_option(),
         body_mass: float | None = _athlete_option("body_mass_kg"),
         height: float | None = _athlete_option("height_m"),
         muscle_strength: float | None = _athlete_option("muscle_strength"),
@@ -456,7 +461,7 @@ def register(app: typer.Typer) -> None:
                 out=out, categories=categories, able=able, speeds=speeds, mesh=mesh,
                 guess=guess, max_iter=max_iter, jobs=jobs, executor=executor, resume=resume,
                 force=force, as_json=as_json, starts=starts, body=body,
-                people_weight=people_weight,
+                people_weight=people_weight, alternating_steps=alternating_steps,
                 athlete=_athlete(body_mass, height, muscle_strength)))
         from bladelab.cli import reflex  # deferred: keeps bladelab --help fast
 

@@ -114,6 +114,7 @@ def sweep_named_models(
     mesh_intervals: int = defaults.MESH_INTERVALS,
     max_iter: int = defaults.MAX_ITER,
     people_weight: float | None = None,
+    step_phase_tolerance: float | None = None,
     athlete: dict | None = None,
     starts: int = defaults.STARTS,
     jobs: int = 1,
@@ -132,9 +133,12 @@ def sweep_named_models(
     ``max_iter`` (IPOPT's iterations per stage) set its :class:`CollocationSettings`;
     ``people_weight`` [1/rad²]: the weight of people's joint angles in the objective
     (:mod:`~bladelab.predict.collocation.people`; 0: none; None: the body's default,
-    :func:`bladelab.predict.defaults.people_weight_for`); ``athlete``: every model scaled to
-    this athlete (as in :func:`solve_named_stride`); ``starts``: starts per problem,
-    the best kept (:mod:`~bladelab.predict.collocation.starts`); ``jobs`` models at a time on ``executor``.
+    :func:`bladelab.predict.defaults.people_weight_for`); ``step_phase_tolerance``: every
+    stride's steps alternating within this fraction of the stride
+    (:attr:`CollocationSettings.step_phase_tolerance`; None: free); ``athlete``: every model
+    scaled to this athlete (as in :func:`solve_named_stride`); ``starts``: starts per
+    problem, the best kept (:mod:`~bladelab.predict.collocation.starts`); ``jobs`` models at
+    a time on ``executor``.
 
     Raises
     ------
@@ -145,7 +149,7 @@ def sweep_named_models(
     if len(speeds) == 0:
         raise SpecError("no speed given", where="speeds")
     settings = CollocationSettings(mesh_intervals=mesh_intervals, speed_m_per_s=speeds[0],
-                                   max_iter=max_iter,
+                                   max_iter=max_iter, step_phase_tolerance=step_phase_tolerance,
                                    **people_term(defaults.people_weight_for(body, people_weight)))
     if isinstance(jobs, bool) or not isinstance(jobs, int) or jobs < 1:
         raise SpecError(f"need at least 1 job, got {jobs}", where="jobs")
