@@ -1,0 +1,39 @@
+"""CMA-ES on the human body with the pelvis-speed (placement) reflexes held at SCONE's values.
+
+Every parameter of the rows fed by ``pelvis_tx`` (both legs, stance and swing: 24 parameters)
+is fixed through ``optimize_controller(..., fixed=...)``; the run starts from SCONE's
+parameters at the shipped human stride's touch-down with the run-up (the mean-speed reflexes
+act from the start).
+
+    .venv/bin/python benchmarks/runs/reflex-human/fixed_placement.py OUT GENERATIONS
+"""
+
+from __future__ import annotations
+
+import sys
+
+from bladelab.predict.reflex.objective import ObjectiveSettings
+from bladelab.predict.reflex.optimize import optimize_controller, runner_and_layout
+
+STRIDE = "src/bladelab/data/runner/collocation/able-3.5-human.json"
+
+
+def main(out: str, generations: int) -> None:
+    _, layout = runner_and_layout("able", None, "human")
+    fixed = [i for i, name in enumerate(layout.names) if "-pelvis_tx." in name]
+    print(f"fixed at SCONE's values: {len(fixed)} parameters")
+    settings = ObjectiveSettings(speed=3.5, duration=4.0, integrator="newmark", dt=1e-3,
+                                 run_up=True, start_stride=STRIDE)
+
+    def progress(generation, best, median):
+        if generation % 50 == 0:
+            print(generation, best, median, flush=True)
+
+    result = optimize_controller("able", body="human", speed=3.5, generations=generations,
+                                 popsize=32, sigma=0.5, seed=1, jobs=1, out=out,
+                                 settings=settings, fixed=fixed, progress=progress)
+    print(result)
+
+
+if __name__ == "__main__":
+    main(sys.argv[1], int(sys.argv[2]))
