@@ -5,14 +5,15 @@ Usage (repository root)::
 
     .venv/bin/python benchmarks/design/transfemoral-gait-2026-11-29/from_transtibial.py \\
         OUT.json STEP_PHASE_TOLERANCE [KNEE_FIELD=VALUE ...] [from=START.json] [raw=1] \\
-        [set:SETTING=VALUE ...] [body:FIELD=JSON ...]
+        [set:SETTING=VALUE ...] [body:FIELD=JSON ...] [speed=V]
 
 ``raw=1``: the transtibial stride's knee angles as they are (not made straight in stance).
 The last two arguments were added on 2026-11-30 (``../transfemoral-gait-2026-11-30/``).
 ``set:SETTING=VALUE``: a ``CollocationSettings`` field (a number, or ``none``), e.g.
 ``set:swing_clearance_m=0`` or ``set:knee_flexion_max_loaded_deg=10``.
 ``body:FIELD=JSON`` (added on 2026-11-30, later): a field of the transfemoral parameter set, e.g.
-``body:residual_muscle_strength={"hamstrings":0.5}``.
+``body:residual_muscle_strength={"hamstrings":0.5}``. ``speed=V`` (added on 2026-11-30, later
+still): the prescribed speed [m/s] (default 4).
 
 The start is ``../human-body-2026-11-29/transtibial-centre-people10.json`` (the design box's
 centre blade, 4 m/s) mapped onto the transfemoral runner by coordinate name, the prosthetic
@@ -76,6 +77,7 @@ def main(out: str, step_tol: str, *extra: str) -> None:
     fields = dict(kv.split("=", 1) for kv in extra)
     start = fields.pop("from", None)
     raw = fields.pop("raw", None)
+    speed = float(fields.pop("speed", 4.0))
     sets = {k[4:]: (None if v == "none" else float(v))
             for k, v in list(fields.items()) if k.startswith("set:")}
     for k in sets:
@@ -90,15 +92,15 @@ def main(out: str, step_tol: str, *extra: str) -> None:
             "body": "human"}
     runner = stored.runner_from_spec(spec)
     settings = CollocationSettings(
-        mesh_intervals=50, speed_m_per_s=4.0, blade_backward_euler=True,
+        mesh_intervals=50, speed_m_per_s=speed, blade_backward_euler=True,
         step_phase_tolerance=None if step_tol == "none" else float(step_tol),
         **{"swing_clearance_m": 0.02, **people_term(10.0), **sets})
     if start is not None:
-        guess = make_guess(runner, start, n=50, speed=4.0)
+        guess = make_guess(runner, start, n=50, speed=speed)
         _solve(runner, settings, guess, spec, out, track=False)
         return
     transtibial = CollocationSolution.read(START)
-    guess = make_guess(runner, str(START), n=50, speed=4.0)
+    guess = make_guess(runner, str(START), n=50, speed=speed)
     j = list(guess.dof_names or runner.dof_names).index("knee_angle_r")
     force = transtibial.leg_vertical_force()
     q = guess.q.copy()
