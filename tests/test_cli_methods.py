@@ -171,6 +171,34 @@ def test_predict_reflex_passes_the_same_settings(tmp_path, monkeypatch, capsys):
             run_up=True, integrator="newmark", track=None, w_track=0.0))
 
 
+def test_predict_reflex_hold_keeps_the_matching_parameters(tmp_path, monkeypatch, capsys):
+    """--hold turns name patterns into the indices CMA-ES leaves at their start values; a
+    pattern that matches nothing is refused, naming the option."""
+    import bladelab.predict.reflex.named_runs as named
+    from bladelab.predict.reflex.optimize import runner_and_layout
+
+    seen = {}
+    monkeypatch.setattr(named, "optimize_seeds", lambda model, **kw: seen.update(kw) or [
+        types.SimpleNamespace(best_cost=1.0, to_dict=dict)])
+    assert main(["predict", "--method", "reflex", "--model", "able",
+                 "--hold", "*-pelvis_tx.*, S11100.iliopsoas_l-hamstrings.KL",
+                 "--out", str(tmp_path)]) == 0
+    names = runner_and_layout("able", None, "seed001")[1].names
+    held = [names[i] for i in seen["fixed"]]
+    # both legs' placement rows: a gain and an offset each, in stance and swing
+    placement = [n for n in names if n.count(".") == 2 and n.split(".")[1].endswith("-pelvis_tx")]
+    assert len(placement) == 24 and set(placement) < set(held)
+    assert sorted(set(held) - set(placement)) == ["S11100.iliopsoas_l-hamstrings.KL"]
+    seen.clear()
+    assert main(["predict", "--method", "reflex", "--out", str(tmp_path)]) == 0
+    assert "fixed" not in seen  # nothing held unless asked
+    capsys.readouterr()
+    assert main(["predict", "--method", "reflex", "--hold", "*-pelvis_ty.*",
+                 "--out", str(tmp_path)]) == 2
+    err = capsys.readouterr().err
+    assert "--hold" in err and "'*-pelvis_ty.*'" in err
+
+
 def test_predict_reflex_defaults_are_the_settings_defaults(tmp_path, monkeypatch, capsys):
     import bladelab.predict.reflex.named_runs as named
     from bladelab.predict.reflex.objective import ObjectiveSettings

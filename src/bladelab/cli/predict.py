@@ -231,6 +231,11 @@ def register(app: typer.Typer) -> None:
             help="Start every simulation from this collocation stride's state at its first "
                  "leg's touch-down (solution.json of the same runner), moving at "
                  "--initial-speed or --speed, instead of SCONE's gait state."),
+        hold: str | None = typer.Option(
+            None, "--hold", rich_help_panel=REFLEX, show_default=False,
+            help="Keep the parameters whose names match these comma-separated patterns at "
+                 "their start values (names as in a parameter file; * and ? match), e.g. "
+                 "'*-pelvis_tx.*' (the foot placement) or 'S11100.iliopsoas_?-hamstrings.*'."),
         # -- collocation -------------------------------------------------------------------
         max_speed: bool = typer.Option(
             False, "--max-speed", rich_help_panel=COLLOCATION,
@@ -323,7 +328,7 @@ def register(app: typer.Typer) -> None:
             robust_half_step=robust_half_step, initial_speed=initial_speed,
             strike_limit=strike_limit, lean_weight=lean_weight, run_up=run_up,
             integrator=integrator, track=track, track_weight=track_weight,
-            start_stride=start_stride)
+            start_stride=start_stride, hold=hold)
 
     @app.command("sweep", cls=PanelCommand)
     def sweep(

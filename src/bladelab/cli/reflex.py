@@ -34,7 +34,7 @@ OPTIONS = {
     "robust_samples": "--robust-samples", "robust_jitter": "--robust-jitter",
     "initial_speed": "--initial-speed", "strike_limit_bw": "--strike-limit",
     "w_lean": "--lean-weight", "integrator": "--integrator", "track": "--track",
-    "w_track": "--track-weight", "start_stride": "--start-stride",
+    "w_track": "--track-weight", "start_stride": "--start-stride", "hold": "--hold",
 }
 _ROBUST_OPTIONS = ("--robust-directions", "--robust-speed-change", "--robust-push",
                    "--duration", "--robust-half-step", "--robust-samples")
@@ -48,9 +48,11 @@ def run_reflex(*, out: Path, model: str, blade: str | None, body: str, speed: fl
                robust_directions: str, robust_speed_change: float, robust_push: float,
                robust_half_step: bool, initial_speed: float | None, strike_limit: float,
                lean_weight: float, run_up: bool, integrator: str, track: Path | None,
-               track_weight: float, start_stride: Path | None = None) -> None:
+               track_weight: float, start_stride: Path | None = None,
+               hold: str | None = None) -> None:
     """``bladelab predict`` (reflex): CMA-ES once per seed; prints each generation and the
-    best run as JSON."""
+    best run as JSON. ``hold``: comma-separated name patterns of parameters kept at their
+    start values."""
     check_robust_copies(robust_directions, robust_speed_change, robust_push, duration,
                         half_step=robust_half_step, samples=robust_samples,
                         where=_ROBUST_OPTIONS)
@@ -71,7 +73,7 @@ def run_reflex(*, out: Path, model: str, blade: str | None, body: str, speed: fl
             start_stride=None if start_stride is None else str(start_stride))
         results = optimize_named(
             model, out=out, seeds=seed_list, blade=blade, body=body, init=init,
-            settings=settings,
+            settings=settings, hold=parse_list(hold, "--hold") if hold else (),
             progress=show, generations=generations, popsize=popsize, sigma=sigma, jobs=jobs,
             executor=executor, resume=resume, force=force, checkpoint_every=checkpoint_every)
     except BladelabError as err:

@@ -8,7 +8,7 @@ runs CMA-ES once per seed (:func:`~bladelab.predict.reflex.optimize.optimize_see
 ``bladelab sweep --recipe`` call them; :func:`check_run_settings` also checks the settings of
 ``bladelab sweep``'s speed grid.
 
-Errors name the argument concerned (``where``: ``model``, ``init``, ``recipe``, or an
+Errors name the argument concerned (``where``: ``model``, ``init``, ``recipe``, ``hold``, or an
 :class:`~bladelab.predict.reflex.objective.ObjectiveSettings` field).
 """
 
@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Sequence
+from fnmatch import fnmatch
 from pathlib import Path
 
 from bladelab.errors import SpecError
@@ -28,8 +29,8 @@ from bladelab.predict.reflex.recipe_sweep import run_recipe_sweep
 from bladelab.predict.reflex.tracking import GaitReference
 from bladelab.runner.implicit import INTEGRATORS
 
-__all__ = ["MAX_TIME_STEP_S", "RECIPES", "REFLEX_MODELS", "check_run_settings", "named_recipe",
-           "optimize_named", "recipe_sweep_named"]
+__all__ = ["MAX_TIME_STEP_S", "RECIPES", "REFLEX_MODELS", "check_run_settings",
+           "held_parameters", "named_recipe", "optimize_named", "recipe_sweep_named"]
 
 #: The runners the reflex controller drives.
 REFLEX_MODELS = ("able", "amputee")
@@ -80,6 +81,7 @@ def optimize_named(
     init: str | Path | None = None,
     settings: ObjectiveSettings | None = None,
     progress: Callable[[int, int, float, float], None] | None = None,
+    hold: Sequence[str] = (),
     **options,
 ) -> list[OptimizationResult]:
     """Optimise the reflex controller of the runner ``model`` (``able`` or ``amputee`` with
@@ -87,9 +89,10 @@ def optimize_named(
     ``out`` (:func:`~bladelab.predict.reflex.optimize.optimize_seeds`), on ``body``
     (:data:`~bladelab.predict.defaults.REFLEX_BODY`: seed 001's), from the parameter
     file ``init`` (None: SCONE's parameters), with the objective ``settings``; a stride to
-    track (``settings.track``) must be of the same runner. ``progress`` and ``options`` (CMA-ES
-    generations, popsize, sigma, jobs, executor, resume, force, checkpoint_every) are
-    :func:`optimize_seeds`'s."""
+    track (``settings.track``) must be of the same runner. ``hold``: name patterns
+    (:func:`held_parameters`) of parameters kept at their start values. ``progress`` and
+    ``options`` (CMA-ES generations, popsize, sigma, jobs, executor, resume, force,
+    checkpoint_every) are :func:`optimize_seeds`'s."""
     if model not in REFLEX_MODELS:
         raise SpecError(f"unknown model {model!r}", where="model",
                         hint=" or ".join(REFLEX_MODELS))
@@ -110,9 +113,23 @@ def optimize_named(
         GaitReference.read(settings.track).check_model(model, worn, "track", body=body)
     x0 = (read_parameters(init, layout, transfer=True, body=body) if init is not None
           else None)
+    fixed = held_parameters(layout.names, hold)
     return optimize_seeds(model, seeds=list(seeds), out=out, progress=progress, blade=blade,
                           body=body, speed=settings.speed, x0=x0, settings=settings,
-                          **options)
+                          **({"fixed": fixed} if fixed else {}), **options)
+
+
+def held_parameters(names: Sequence[str], patterns: Sequence[str]) -> list[int]:
+    """Indices of the controller parameters ``names`` that match any of the shell-style
+    ``patterns`` (``fnmatch``, e.g. ``*-pelvis_tx.*`` for the foot-placement reflexes,
+    ``S11100.iliopsoas_?-hamstrings.*`` for the hamstrings' inhibition of the swinging hip
+    flexor); SpecError naming a pattern that matches none."""
+    for pattern in patterns:
+        if not any(fnmatch(n, pattern) for n in names):
+            raise SpecError(f"no controller parameter matches {pattern!r}", where="hold",
+                            hint="a pattern of parameter names as in a parameter file, e.g. "
+                                 "'*-pelvis_tx.*'")
+    return [i for i, n in enumerate(names) if any(fnmatch(n, p) for p in patterns)]
 
 
 def named_recipe(recipe: str | Path | Recipe) -> Recipe:
