@@ -49,19 +49,27 @@ def replay(table, p, nh, muscles, mp, qpos, qvel, contacts, cp, ix, bw, thr, leg
     return out, states
 
 
+def replay_inputs(model, layout, x, dt, muscles, qpos, qvel, contacts, run_up):
+    """The arguments of :func:`replay` after its table and parameters: the recorded muscle
+    states, coordinates, speeds and contacts (one row per step of ``dt`` [s]) with the
+    gait-state thresholds of the parameter vector ``x``, as the simulation passes them."""
+    thr = np.array([x[layout.index(f"{name}{side}")] for name in
+                    ("stance_load_threshold_", "liftoff_load_margin_") for side in "lr"])
+    return (ctl.history_length(layout, dt), np.ascontiguousarray(muscles),
+            model.muscle_params, np.ascontiguousarray(qpos), np.ascontiguousarray(qvel),
+            np.ascontiguousarray(contacts), model.contact_params, model.dof("pelvis_tx"),
+            model.body_weight, thr, float(model.stand_qpos[model.dof("pelvis_tz")]),
+            float(run_up))
+
+
 def main(stride: str, out: str, prior: float = 0.1) -> None:
     model, layout = runner_and_layout("able", None, "human")
     sol = CollocationSolution.read(stride)
     n = np.asarray(sol.nlp.q).shape[0] - 1
     rec = sol.to_runner_result(3, refine=int(np.ceil(sol.period_s / n / 1e-3)), runner=model)
     x0 = layout.x0.copy()
-    thr = np.array([x0[layout.index(f"{name}{side}")] for name in
-                    ("stance_load_threshold_", "liftoff_load_margin_") for side in "lr"])
-    args = (ctl.history_length(layout, rec.dt), np.ascontiguousarray(rec.muscles),
-            model.muscle_params, np.ascontiguousarray(rec.qpos),
-            np.ascontiguousarray(rec.qvel), np.ascontiguousarray(rec.contacts),
-            model.contact_params, model.dof("pelvis_tx"), model.body_weight, thr,
-            float(model.stand_qpos[model.dof("pelvis_tz")]), 1.0)
+    args = replay_inputs(model, layout, x0, rec.dt, rec.muscles, rec.qpos, rec.qvel,
+                         rec.contacts, run_up=True)
     table = layout.table_for(rec.dt)
     last = rec.time >= 2 * sol.period_s - 1e-9
     target = rec.excitation[last]

@@ -15,17 +15,18 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
+from bladelab.predict.reflex.named_runs import held_parameters
 from bladelab.predict.reflex.objective import ObjectiveSettings
 from bladelab.predict.reflex.optimize import optimize_controller, runner_and_layout
 
 STRIDE = "src/bladelab/data/runner/collocation/able-3.5-human.json"
+#: The placement rows, then the hamstrings' inhibition of the swinging hip flexor (``--hold``).
+HELD = ("*-pelvis_tx.*", "S11100.iliopsoas_?-hamstrings.*")
 
 
 def main(out: str, generations: int, inhibition: bool = False, jobs: int = 1) -> None:
     _, layout = runner_and_layout("able", None, "human")
-    held = ("-pelvis_tx.", "iliopsoas_l-hamstrings.", "iliopsoas_r-hamstrings.")
-    fixed = [i for i, name in enumerate(layout.names)
-             if any(h in name for h in held[:3 if inhibition else 1])]
+    fixed = held_parameters(layout.names, HELD[:2 if inhibition else 1])
     print(f"fixed at SCONE's values: {len(fixed)} parameters")
     settings = ObjectiveSettings(speed=3.5, duration=4.0, integrator="newmark", dt=1e-3,
                                  run_up=True, start_stride=STRIDE)

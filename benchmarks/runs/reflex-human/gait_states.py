@@ -25,7 +25,7 @@ from bladelab.runner.layout import CP_LEG
 from bladelab.runner.model import contact_heights
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from fit_to_stride import replay  # noqa: E402
+from fit_to_stride import replay, replay_inputs  # noqa: E402
 
 EPS = 1e-3
 MUSCLES = ("glut_max_l", "iliopsoas_l")
@@ -38,18 +38,13 @@ def main(params: str, stride: str) -> None:
                                  start_stride=stride)
     ev, rec = simulate_controlled(model, x, layout=layout, settings=settings, record_every=1)
     print(f"falls {ev.fell} at {ev.duration:.3f} s")
-    thr = np.array([x[layout.index(f"{name}{side}")] for name in
-                    ("stance_load_threshold_", "liftoff_load_margin_") for side in "lr"])
     table = layout.table_for(settings.dt)
     # the controller of step k reads the muscle and contact states of step k − 1's forces
     # (recorded at k − 1) and the coordinates at the start of step k (recorded at k)
     muscles = np.concatenate([rec.muscles[:1], rec.muscles[:-1]])
     contacts = np.concatenate([np.zeros_like(rec.contacts[:1]), rec.contacts[:-1]])
-    args = (ctl.history_length(layout, settings.dt), np.ascontiguousarray(muscles),
-            model.muscle_params, np.ascontiguousarray(rec.qpos),
-            np.ascontiguousarray(rec.qvel), np.ascontiguousarray(contacts),
-            model.contact_params, model.dof("pelvis_tx"), model.body_weight, thr,
-            float(model.stand_qpos[model.dof("pelvis_tz")]), float(settings.run_up))
+    args = replay_inputs(model, layout, x, settings.dt, muscles, rec.qpos, rec.qvel, contacts,
+                         settings.run_up)
     u, states = replay(table, x, *args)
     print(f"replay against the simulation's excitations after the first step: largest "
           f"difference {np.abs(u[1:] - rec.excitation[1:]).max():.2e}")
