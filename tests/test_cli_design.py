@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import json
+import shutil
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -241,7 +243,6 @@ def _collocation_copy(study, tmp_path, residuals: dict[int, float], missing=()):
     """The blade study's folder as if its runs were collocation strides: every run's stride is
     the built-in clean transfemoral stride, run ``i``'s dynamics residual set to
     ``residuals[i]`` [%]."""
-    import shutil
 
     from bladelab.design.collocation_evaluator import DEFAULT_START, point_file_stem
 
@@ -289,6 +290,30 @@ def test_design_report_leaves_out_flagged_strides(study, tmp_path):
     assert "the gait predicted freely" in strides["text"]
 
 
+def test_design_report_says_how_many_strides_gallop(study, tmp_path):
+    """The built-in transfemoral stride gallops (both legs land within a fifth of a stride);
+    one run given the shipped alternating amputee stride: the report's first section and its
+    strides section say 8 of 9 gallop, and the strides table gives each run's step phase."""
+    from bladelab.design.collocation_evaluator import point_file_stem
+    from bladelab.report.design import design_report_sections
+
+    copy, table = _collocation_copy(study, tmp_path, {})
+    row = table.iloc[1]
+    stem = point_file_stem({n: row[n] for n in ["stiffness_kN_per_m", "toe_length_m"]})
+    alternating = Path(__file__).parents[1] / "src/bladelab/data/runner/collocation/" \
+        "amputee-Cat6-4-human.json"
+    shutil.copyfile(alternating, copy / "strides" / f"{stem}.json")
+    sections = {s["title"]: s for s in design_report_sections(copy)}
+    assert "8 of 9 strides gallop" in sections["Design study: response surfaces"]["text"]
+    strides = sections["Design study: predicted strides"]
+    assert "8 of 9 strides gallop" in strides["text"] and "40–60 %" in strides["text"]
+    shown = dict(strides["tables"])[
+        "Strides (files in the study's strides folder, named by the design point)"]
+    phases = shown.set_index("run")["step phase (% of the stride)"]
+    assert 40.0 < phases[int(row["run"])] < 60.0
+    assert ((phases.drop(int(row["run"])) < 25.0) | (phases.drop(int(row["run"])) > 75.0)).all()
+
+
 def test_design_report_says_the_technique_was_kept(study, tmp_path):
     """A study solved with a reference weight says so, with the weight and the knee bound."""
     from bladelab.report.design import design_report_sections
@@ -313,7 +338,6 @@ def test_design_report_refuses_too_few_clean_strides(study, tmp_path):
 
 
 def test_report_of_an_unfinished_design_study_says_so(study, tmp_path, capsys):
-    import shutil
 
     out, _ = study
     partial = tmp_path / "partial"

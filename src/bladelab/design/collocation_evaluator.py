@@ -45,6 +45,7 @@ from bladelab.predict.collocation.settings import CollocationSettings, people_te
 from bladelab.predict.collocation.solution import CollocationSolution
 from bladelab.predict.collocation.solve import predict_stride
 from bladelab.predict.collocation.stored import check_model_spec, runner_from_spec
+from bladelab.predict.collocation.transcription import step_phase
 from bladelab.runner.params import BODIES
 
 __all__ = ["CollocationEvaluator", "DEFAULT_BODY", "DEFAULT_DESIGN_SPEED_MPS", "DEFAULT_STARTS",
@@ -502,7 +503,9 @@ def stride_checks(design_dir: str | Path, evaluator: Mapping[str, Any],
                   points: list[Mapping[str, float]]) -> list[dict]:
     """Each run's stride of a collocation design study, checked again as it is now on disk:
     one row per point with ``stride`` (file name, or None when not found), ``converged``,
-    ``dynamics_residual_pct`` [%], ``iterations`` and ``warnings`` (its
+    ``dynamics_residual_pct`` [%], ``step_phase`` [fraction of the stride: 0.5 alternating,
+    near 0 or 1 a gallop; :func:`~bladelab.predict.collocation.transcription.step_phase`],
+    ``iterations`` and ``warnings`` (its
     :meth:`~bladelab.predict.collocation.solution.CollocationSolution.gait_warnings`, "; "
     -joined; "" when clean). A study's results may hold strides written before a check existed
     (the 5 % residual gate came after the free-gait study): the report marks those runs and
@@ -511,13 +514,14 @@ def stride_checks(design_dir: str | Path, evaluator: Mapping[str, Any],
     rows = []
     for point in points:
         row = {"stride": None, "converged": None, "dynamics_residual_pct": math.nan,
-               "iterations": None, "warnings": "stride file not found"}
+               "step_phase": math.nan, "iterations": None, "warnings": "stride file not found"}
         path = folder / f"{point_file_stem(point)}.json" if folder is not None else None
         if path is not None and path.is_file():
             sol = CollocationSolution.read(path)
             warnings = sol.gait_warnings() if sol.converged else [f"IPOPT {sol.nlp.status}"]
             row = {"stride": path.name, "converged": bool(sol.converged),
                    "dynamics_residual_pct": sol.dynamics_residual_pct,
+                   "step_phase": step_phase(sol.leg_vertical_force()[:-1]),
                    "iterations": int(sol.nlp.iterations), "warnings": "; ".join(warnings)}
         rows.append(row)
     return rows

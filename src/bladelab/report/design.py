@@ -32,6 +32,7 @@ from bladelab.design.surfaces import fit_surface
 from bladelab.design.terms import parse_terms
 from bladelab.design.trends import NO_RUNNER, evaluate_trends, trends_frame
 from bladelab.errors import InputFileError, OptimizationError
+from bladelab.predict.collocation.human_running import STEP_PHASE_BAND_PCT
 from bladelab.predict.collocation.solution import RESIDUAL_WARNING_PCT
 from bladelab.report.builder import Report
 
@@ -135,6 +136,9 @@ def design_report_sections(design_dir: str | Path) -> list[dict[str, Any]]:
                      f"{int(checks['excluded'].sum())} runs (marked in the table of runs, "
                      "listed under 'predicted strides') are left out, so the optimum can "
                      "differ from the study's optimum.json.")
+    gallops = _gallop_text(checks)
+    if gallops:
+        fit_text = gallops + " " + fit_text
     lev = next(iter(surfaces.values())).leverage
     if (lev >= 1.0 - 1e-10).any():
         n_one = int((lev >= 1.0 - 1e-10).sum())
@@ -271,13 +275,39 @@ def _strides_section(checks: pd.DataFrame, evaluator: dict) -> dict[str, Any]:
                if len(flagged) else "none carries warnings")
             + (f"; {missing} stride files were not found (their runs are kept, unchecked)"
                if missing else "") + ".")
-    shown = checks.assign(stride=checks["stride"].notna()).drop(columns=["excluded"]).rename(
-        columns={"stride": "file found", "dynamics_residual_pct": "dynamics residual (%)"})
+    gallops = _gallop_text(checks)
+    if gallops:
+        text += " " + gallops
+    shown = checks.assign(stride=checks["stride"].notna(),
+                          step_phase=100.0 * checks["step_phase"]).drop(
+        columns=["excluded"]).rename(
+        columns={"stride": "file found", "dynamics_residual_pct": "dynamics residual (%)",
+                 "step_phase": "step phase (% of the stride)"})
     tables = [("Strides (files in the study's strides folder, named by the design point)",
                shown)]
     if len(flagged):
         tables.insert(0, ("Runs left out", flagged[["run", "warnings"]]))
     return {"title": "Design study: predicted strides", "text": text, "tables": tables}
+
+
+def _gallop_text(checks: pd.DataFrame | None) -> str:
+    """One sentence naming how many of a collocation study's strides gallop (step phase
+    outside the band of measured running, :data:`~bladelab.predict.collocation.human_running.
+    STEP_PHASE_BAND_PCT`); "" when none does or there are no strides. A gallop is a converged
+    stride, not a gait warning: it stays in the surfaces, and the report says what they then
+    describe."""
+    if checks is None or "step_phase" not in checks:
+        return ""
+    pct = 100.0 * checks["step_phase"].astype(float)
+    lo, hi = STEP_PHASE_BAND_PCT
+    found = pct.notna()
+    gallop = found & ((pct < lo) | (pct > hi))
+    if not gallop.any():
+        return ""
+    return (f"{int(gallop.sum())} of {int(found.sum())} strides gallop (the second leg lands "
+            f"{pct[gallop].min():.0f}–{pct[gallop].max():.0f} % of a stride after the first; "
+            f"people running alternate at {lo:g}–{hi:g} %): the surfaces describe galloping "
+            "strides, not running as people run it.")
 
 
 def _start_spread(design_dir: Path, meta: dict, table: pd.DataFrame,
