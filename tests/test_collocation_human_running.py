@@ -84,6 +84,15 @@ def test_a_gallop_fails_the_step_phase_whichever_leg_leads():
         assert crit["step phase"].met is met
 
 
+def test_the_gallop_sentence_counts_strides_outside_the_band_and_skips_unknown_ones():
+    from bladelab.predict.collocation.human_running import gallop_sentence
+
+    text = gallop_sentence([50.0, 16.0, 84.0, float("nan"), 41.0])
+    assert text.startswith("2 of 4 strides gallop") and "16–84 %" in text
+    assert gallop_sentence([45.0, 55.0, float("nan")]) == ""
+    assert gallop_sentence([]) == ""
+
+
 def test_prosthetic_leg_may_touch_shorter_and_no_flight_fails():
     crit = human_running_criteria(_stride(speed=4.0, model="amputee", contact=(0.22, 0.16),
                                           flight=0.0))

@@ -253,3 +253,21 @@ def test_a_sweep_with_people_s_angles_in_its_objective_says_so(tmp_path, monkeyp
     free = build_predictive_report(_subset(tmp_path, ["Cat6"]), tmp_path / "free",
                                    progress=False, animate=False)
     assert "Not free predictions" not in Path(free.index).read_text(encoding="utf-8")
+
+
+def test_the_sweep_text_counts_the_strides_that_gallop(tmp_path):
+    """The committed study alternates its steps (nothing said); with one solve's file swapped
+    for the built-in transfemoral stride, which gallops, the text counts it."""
+    import types
+
+    from bladelab.design.collocation_evaluator import DEFAULT_START
+    from bladelab.report.collocation_sweep import collocation_sweep_sections
+
+    texts = []
+    report = types.SimpleNamespace(add_section=lambda title, text="", **kw: texts.append(text))
+    folder = _subset(tmp_path, ["Cat4"])
+    collocation_sweep_sections(report, folder)
+    assert "gallop" not in texts[-1]
+    shutil.copyfile(DEFAULT_START, folder / "amputee-Cat4" / "speed-4.json")
+    collocation_sweep_sections(report, folder)
+    assert "1 of 2 strides gallop" in texts[-1] and "40–60 %" in texts[-1]

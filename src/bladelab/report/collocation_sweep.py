@@ -34,10 +34,12 @@ import numpy as np
 import pandas as pd
 
 from bladelab.errors import InputFileError
+from bladelab.predict.collocation.human_running import gallop_sentence
 from bladelab.predict.collocation.model import build_collocation_model
 from bladelab.predict.collocation.solution import CollocationSolution
 from bladelab.predict.collocation.stored import runner_from_spec
 from bladelab.predict.collocation.sweep import SWEEP_TABLE
+from bladelab.predict.collocation.transcription import step_phase
 from bladelab.report.collocation import reference_term_text
 
 __all__ = ["collocation_sweep_sections", "is_collocation_sweep", "starts_table",
@@ -225,6 +227,10 @@ def collocation_sweep_sections(report, folder: str | Path) -> tuple[dict, pd.Dat
     text += "".join(sorted({reference_term_text(
         sol.settings, lead="Not free predictions: every objective held")
         for sol in solutions.values()}))
+    gallops = gallop_sentence([100.0 * step_phase(sol.leg_vertical_force()[:-1])
+                               for sol in solutions.values()])
+    if gallops:
+        text += " Converged solves: " + gallops
     flagged = table[table.flagged]
     if len(flagged):
         text += (" Converged but flagged by the gait checks (drawn as crosses, left out of the "

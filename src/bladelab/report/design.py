@@ -32,7 +32,7 @@ from bladelab.design.surfaces import fit_surface
 from bladelab.design.terms import parse_terms
 from bladelab.design.trends import NO_RUNNER, evaluate_trends, trends_frame
 from bladelab.errors import InputFileError, OptimizationError
-from bladelab.predict.collocation.human_running import STEP_PHASE_BAND_PCT
+from bladelab.predict.collocation.human_running import gallop_sentence
 from bladelab.predict.collocation.solution import RESIDUAL_WARNING_PCT
 from bladelab.report.builder import Report
 
@@ -291,23 +291,13 @@ def _strides_section(checks: pd.DataFrame, evaluator: dict) -> dict[str, Any]:
 
 
 def _gallop_text(checks: pd.DataFrame | None) -> str:
-    """One sentence naming how many of a collocation study's strides gallop (step phase
-    outside the band of measured running, :data:`~bladelab.predict.collocation.human_running.
-    STEP_PHASE_BAND_PCT`); "" when none does or there are no strides. A gallop is a converged
-    stride, not a gait warning: it stays in the surfaces, and the report says what they then
-    describe."""
+    """How many of a collocation study's strides gallop (:func:`~bladelab.predict.
+    collocation.human_running.gallop_sentence`); "" when none does or there are no strides.
+    A gallop is a converged stride, not a gait warning: it stays in the surfaces, and the
+    report says what they then describe."""
     if checks is None or "step_phase" not in checks:
         return ""
-    pct = 100.0 * checks["step_phase"].astype(float)
-    lo, hi = STEP_PHASE_BAND_PCT
-    found = pct.notna()
-    gallop = found & ((pct < lo) | (pct > hi))
-    if not gallop.any():
-        return ""
-    return (f"{int(gallop.sum())} of {int(found.sum())} strides gallop (the second leg lands "
-            f"{pct[gallop].min():.0f}–{pct[gallop].max():.0f} % of a stride after the first; "
-            f"people running alternate at {lo:g}–{hi:g} %): the surfaces describe galloping "
-            "strides, not running as people run it.")
+    return gallop_sentence(100.0 * checks["step_phase"].astype(float))
 
 
 def _start_spread(design_dir: Path, meta: dict, table: pd.DataFrame,

@@ -45,6 +45,7 @@ __all__ = [
     "REFERENCE_BANDS",
     "Criterion",
     "angle_agreement",
+    "gallop_sentence",
     "human_running_criteria",
     "reference_band",
     "stride_from_left_touchdown",
@@ -73,6 +74,22 @@ STEP_PHASE_BAND_PCT = (40.0, 60.0)
 SPEED_TOLERANCE_MPS = 0.01
 #: Above this speed [m/s] no cost-of-transport band is given.
 COST_BAND_MAX_SPEED_MPS = 5.0
+
+
+def gallop_sentence(step_phases_pct) -> str:
+    """One sentence naming how many of these strides gallop (step phase [% of the stride]
+    outside :data:`STEP_PHASE_BAND_PCT`; NaN: not known, not counted), and what a result
+    built on them then describes; "" when none does."""
+    pct = np.asarray(step_phases_pct, float)
+    known = pct[np.isfinite(pct)]
+    lo, hi = STEP_PHASE_BAND_PCT
+    gallop = known[(known < lo) | (known > hi)]
+    if not gallop.size:
+        return ""
+    return (f"{gallop.size} of {known.size} strides gallop (the second leg's stance "
+            f"{gallop.min():.0f}–{gallop.max():.0f} % of a stride after the first's; people "
+            f"running alternate at {lo:g}–{hi:g} %): what is built on them describes "
+            "galloping strides, not running as people run it.")
 
 
 @dataclass(frozen=True)
