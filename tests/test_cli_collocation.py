@@ -96,6 +96,8 @@ def test_a_failed_force_run_removes_the_old_solution(solved, tmp_path, capsys):
     (("--method", "collocation", "--body-mass", "-70"), "--body-mass"),
     (("--method", "collocation", "--height", "0"), "--height"),
     (("--method", "collocation", "--muscle-strength", "0"), "--muscle-strength"),
+    (("--method", "collocation", "--max-shortening-velocity", "40"),
+     "--max-shortening-velocity"),
     (("--method", "reflex", "--muscle-strength", "1.5"), "--muscle-strength"),
 ])
 def test_bad_options_are_refused_naming_the_option(args, where, tmp_path, capsys):

@@ -46,6 +46,7 @@ from bladelab.runner.model import build_runner, contact_heights
 from bladelab.runner.muscle import (
     FIBER_DAMPING,
     MP_TSTRAIN,
+    MP_VMAX,
     TENDON_REF_STRAIN,
     equilibrium_fiber_length,
     force_length,
@@ -62,7 +63,8 @@ KINDS = ("able", "amputee-Cat6", "able-toes", "transfemoral", "able-human", "amp
          "transfemoral-human")
 # the toe body's Achilles tendons are twice as compliant; the human body's tendons differ per
 # muscle and its strengths come from a table
-MUSCLE_KINDS = ("able", "able-toes", "able-human")
+# and a human body with faster fibres: every muscle's v_max 15 l_opt/s, not 10
+MUSCLE_KINDS = ("able", "able-toes", "able-human", "able-human-vmax15")
 SM = Smoothing()
 
 
@@ -70,8 +72,11 @@ SM = Smoothing()
 def models():
     """The forward runners and their collocation models, built once."""
     out = {}
-    for kind in KINDS:
+    for kind in KINDS + ("able-human-vmax15",):
         runner = {"able": lambda: build_runner("able"),
+                  "able-human-vmax15": lambda: build_runner(default_runner_params(
+                      "able", body="human").model_copy(
+                          update={"max_shortening_velocity_lopt_per_s": 15.0})),
                   "able-toes": lambda: build_runner("able", body="toes"),
                   "amputee-Cat6": lambda: build_runner("amputee", blade="Cat6"),
                   "transfemoral": lambda: build_runner("transfemoral"),
@@ -406,12 +411,12 @@ def test_static_equilibrium_tendon_force_matches_forward(models, kind):
     for _ in range(N_STATES):
         a, ln = rng.uniform(0.1, 1.0, nm), rng.uniform(0.6, 1.5, nm)
         l_mt = np.zeros(nm)
-        for i, (_, l_opt, l_ts, penn, eref, _, _) in enumerate(mp):
+        for i, (_, l_opt, l_ts, penn, eref, _, _, _) in enumerate(mp):
             cos_a = np.sqrt(1.0 - (np.sin(penn) / ln[i]) ** 2)
             f = _fibre_force(a[i], ln[i], 0.0, cos_a, mp[i, 5], mp[i, 6])
             l_mt[i] = ln[i] * l_opt * cos_a + l_ts * (1.0 + eref * np.sqrt(f))
         forward = np.array([
-            tendon_force_of_state(l_mt[i], equilibrium_fiber_length(l_mt[i], a[i], *mp[i, 1:]),
+            tendon_force_of_state(l_mt[i], equilibrium_fiber_length(l_mt[i], a[i], *mp[i, 1:7]),
                                   *mp[i, :5]) / mp[i, 0] for i in range(nm)])
         dg = _np(solve(forward, np.concatenate([a, l_mt]))).ravel()
         assert np.abs(_np(cm.muscle_residual(a, dg, 0.0, l_mt, 0.0))).max() < 1e-10
@@ -434,10 +439,10 @@ def test_fibre_state_and_residual_match_forward_in_motion(models, kind):
         vn = rng.uniform(-0.9, 0.9, nm)
         v_mt = rng.uniform(-0.5, 0.5, nm)
         l_ce, v_ce, l_mt, ft, dft, cos_a = (np.zeros(nm) for _ in range(6))
-        for i, (fmax, l_opt, l_ts, penn, eref, _, _) in enumerate(mp):
+        for i, (fmax, l_opt, l_ts, penn, eref, _, _, _) in enumerate(mp):
             cos_a[i] = np.sqrt(1.0 - (np.sin(penn) / ln[i]) ** 2)
             f = max(_fibre_force(a[i], ln[i], vn[i], cos_a[i], mp[i, 5], mp[i, 6]), 0.05)
-            l_ce[i], v_ce[i] = ln[i] * l_opt, vn[i] * 10.0 * l_opt
+            l_ce[i], v_ce[i] = ln[i] * l_opt, vn[i] * mp[i, MP_VMAX] * l_opt
             l_mt[i] = l_ce[i] * cos_a[i] + l_ts * (1.0 + eref * np.sqrt(f))
             ft[i] = tendon_force_of_state(l_mt[i], l_ce[i], *mp[i, :5]) / fmax
             h = 1e-6
@@ -463,19 +468,24 @@ def test_fibre_state_and_residual_match_forward_in_motion(models, kind):
         assert np.all(np.abs(res - expected) <= bound), np.abs(res - expected).max()
 
 
-@pytest.mark.parametrize("metabolic_model", ["uchida2016", "bhargava2004"])
+@pytest.mark.parametrize("metabolic_model", ["uchida2016", "uchida2016-vmax15", "bhargava2004"])
 def test_smooth_metabolic_rate_matches_forward(models, metabolic_model):
     """The collocation model's whole-body metabolic rate equals the forward model's
     (bladelab.runner.metabolics) at the same fibre states, within the smooth switches' widths:
     ≤ 0.5 % per state at random activations, excitations, fibre lengths and velocities — including
     stretched, weakly active muscles whose total rate the forward model floors at 0. Both
-    metabolic models (Bhargava's on the human body, whose active strength enters its heat)."""
+    metabolic models (Bhargava's on the human body, whose active strength enters its heat);
+    Uchida's shortening heat also with faster fibres (v_max 15 l_opt/s)."""
     from bladelab.predict.collocation.dynamics import MAX_FIBER_ALONG, MIN_FIBER_ALONG
     from bladelab.predict.collocation.metabolics import metabolic_rate
     from bladelab.runner.metabolics import metabolic_params, total_metabolic_rate
 
     if metabolic_model == "uchida2016":
         runner, cm = models["able"]
+    elif metabolic_model == "uchida2016-vmax15":
+        runner = build_runner(default_runner_params("able").model_copy(
+            update={"max_shortening_velocity_lopt_per_s": 15.0}))
+        cm = build_collocation_model(runner)
     else:
         runner = build_runner(default_runner_params("able", body="human").model_copy(
             update={"metabolic_model": metabolic_model}))

@@ -662,6 +662,9 @@ def test_model_spec_carries_the_athlete_into_the_runner_the_label_and_the_file(a
     from bladelab.predict.collocation.stored import athlete_label
     assert athlete_label({**plain, "athlete": {"muscle_strength": 1.5}}) == (
         "muscle strength ×1.5")
+    fast = check_model_spec({**plain, "athlete": {"max_shortening_velocity": 15}})
+    assert athlete_label(fast) == "fibres' maximum velocity 15 l_opt/s"
+    assert set(runner_from_spec(fast).muscle_params[:, 7]) == {15.0}
     assert athlete_label(plain) == ""
     assert runner_from_spec(spec).total_mass == pytest.approx(68.0, rel=1e-12)
     for bad, where in (({"body_mass_kg": -70}, "athlete.body_mass_kg"),

@@ -76,8 +76,19 @@ def test_muscle_masses_are_the_seed_volumes():
     assert mb[i, 1] == 45.0
 
 
+def test_shortening_heat_scales_with_the_inverse_maximum_shortening_velocity():
+    """Umberger's shortening heat coefficients are 100/v_max,ST and 153/v_max,FT: twice the
+    fibres' maximum velocity, half the heat at the same shortening speed (the maintenance heat
+    stays)."""
+    h_am = muscle_metabolic_rate(1.0, 1.0, 1.0, 0.0, 0.0, 0.0, 1.0, 50.0, 10.0)
+    slow, fast = (muscle_metabolic_rate(1.0, 1.0, 1.0, -2.0, 0.0, -0.2, 1.0, 50.0, v)
+                  for v in (10.0, 20.0))
+    assert slow > h_am and fast - h_am == pytest.approx(0.5 * (slow - h_am), rel=1e-12)
+    assert muscle_metabolic_rate(1.0, 1.0, 1.0, -2.0, 0.0, -0.2, 1.0, 50.0) == slow  # default
+
+
 def test_total_rate_is_basal_plus_muscles():
-    mp = np.array([[1000.0, 0.1, 0.2, 0.0, 0.04, 1.0, 0.6]])
+    mp = np.array([[1000.0, 0.1, 0.2, 0.0, 0.04, 1.0, 0.6, 10.0]])
     mb = np.array([[1.0, 50.0]])
     ms = np.array([[0.5, 0.1, 0.0, 300.0]])  # isometric at optimal length
     u = np.array([0.5])
@@ -123,7 +134,7 @@ def test_bhargava_maintenance_heat_length_dependence(l_norm, factor):
 
 
 def test_total_rate_dispatches_on_the_model_column():
-    mp = np.array([[1000.0, 0.1, 0.2, 0.0, 0.04, 1.0, 0.6]])
+    mp = np.array([[1000.0, 0.1, 0.2, 0.0, 0.04, 1.0, 0.6, 10.0]])
     ms = np.array([[0.5, 0.1, 0.0, 300.0]])  # isometric at optimal length
     u = np.array([1.0])
     uchida = total_metabolic_rate(u, ms, mp, np.array([[1.0, 50.0, 0.0]]), 70.0)

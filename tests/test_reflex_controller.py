@@ -45,7 +45,7 @@ def amputee():
 
 def test_delay_returns_the_value_from_d_steps_ago():
     nm, nq = 1, 2
-    mp = np.array([[1000.0, 0.1, 0.2, 0.0, 0.04, 1.0, 0.6]])
+    mp = np.array([[1000.0, 0.1, 0.2, 0.0, 0.04, 1.0, 0.6, 10.0]])
     hist = np.zeros((6, 3 * nm + 2 * nq))
     cs = np.zeros(CONTROLLER_STATE_SIZE)
     for k in range(10):
@@ -58,7 +58,7 @@ def test_delay_returns_the_value_from_d_steps_ago():
 
 
 def test_delay_before_history_is_filled_gives_the_first_sample():
-    mp = np.array([[1000.0, 0.1, 0.2, 0.0, 0.04, 1.0, 0.6]])
+    mp = np.array([[1000.0, 0.1, 0.2, 0.0, 0.04, 1.0, 0.6, 10.0]])
     hist = np.zeros((5, 3 + 2))
     cs = np.zeros(CONTROLLER_STATE_SIZE)
     push_sensors(hist, cs, np.array([[0.1, 0.07, 0.0, 0.0]]), mp, np.array([0.3]), np.zeros(1))
@@ -151,7 +151,7 @@ def test_reflex_laws_by_hand():
         ]
     )
     p = np.array([2.0, 0.9, 0.5, 1.5, 0.3])
-    mp = np.array([[1000.0, 0.1, 0.2, 0.0, 0.04, 1.0, 0.6]])
+    mp = np.array([[1000.0, 0.1, 0.2, 0.0, 0.04, 1.0, 0.6, 10.0]])
     hist = np.zeros((4, 3 + 2))
     cs = np.array([EARLY_STANCE, SWING, 0, 0], float)
     lengths = [0.10, 0.11, 0.12]

@@ -45,7 +45,7 @@ def _state(model, dt=1e-3, activation=0.3):
     root = d.subtree_com[1].copy()
     path_kinematics(d.site_xpos, d.cvel, root, model.path_points, model.path_start, mtu, seg_u)
     for i in range(nm):
-        ms[i, 1] = equilibrium_fiber_length(mtu[i, 0], ms[i, 0], *mp[i, 1:])
+        ms[i, 1] = equilibrium_fiber_length(mtu[i, 0], ms[i, 0], *mp[i, 1:7])
     cp = model.contact_params
     arrays = (mp, ms, mtu, seg_u, np.full(nm, activation), model.path_points, model.path_start,
               cp, np.zeros((cp.shape[0], 1)), model.joint_params, np.zeros((cp.shape[0], 7)),

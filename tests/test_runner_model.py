@@ -426,3 +426,21 @@ def test_athlete_params_scale_the_body_and_strengthen_only_the_active_force():
         assert err.value.where == "muscle_strength"
     with pytest.raises(SpecError):
         athlete_params(base, body_mass_kg=-5.0)
+
+
+def test_the_maximum_shortening_velocity_is_every_muscle_s_and_nothing_else():
+    """10 l_opt/s unless set (the MP_VMAX column of every muscle); an athlete's value replaces
+    it and leaves every other muscle parameter as it was; outside 2–30 l_opt/s refused."""
+    from bladelab.runner.muscle import MP_VMAX
+    from bladelab.runner.params import athlete_params
+
+    base = default_runner_params("amputee", body="human")
+    ref = build_runner(base)
+    assert set(ref.muscle_params[:, MP_VMAX]) == {10.0}
+    fast = build_runner(athlete_params(base, max_shortening_velocity=15.0))
+    assert set(fast.muscle_params[:, MP_VMAX]) == {15.0}
+    np.testing.assert_array_equal(fast.muscle_params[:, :MP_VMAX], ref.muscle_params[:, :MP_VMAX])
+    for bad in (1.0, 31.0, float("nan"), "fast"):
+        with pytest.raises(SpecError) as err:
+            athlete_params(base, max_shortening_velocity=bad)
+        assert err.value.where == "athlete.max_shortening_velocity"

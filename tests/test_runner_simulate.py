@@ -11,6 +11,7 @@ import pytest
 from bladelab.runner import build_runner, power_balance, power_balance_residual_pct, simulate_runner
 from bladelab.runner.muscle import (
     equilibrium_fiber_length,
+    force_length,
     force_velocity,
     muscle_step,
     tendon_force_of_state,
@@ -38,7 +39,7 @@ def test_isometric_maximal_force_is_fmax_cos_pennation():
     assert tendon_force_of_state(l_mtu, l_ce, fmax, l_opt, l_ts, penn) == pytest.approx(
         fmax * math.cos(penn), rel=1e-3
     )
-    mp = np.array([[fmax, l_opt, l_ts, penn, 0.04, 1.0, 0.6]])
+    mp = np.array([[fmax, l_opt, l_ts, penn, 0.04, 1.0, 0.6, 10.0]])
     ms = np.array([[1.0, l_ce, 0.0, 0.0]])
     for _ in range(200):  # held isometric: stays in equilibrium
         muscle_step(mp, ms, np.array([l_mtu]), np.array([1.0]), 5e-4)
@@ -57,7 +58,7 @@ def test_active_strength_scales_the_active_force_only():
     assert l_ce == pytest.approx(l_opt, rel=1e-4)
     forces = []
     for s in (1.0, strength):
-        mp = np.array([[fmax, l_opt, l_ts, penn, 0.04, s, 0.6]])
+        mp = np.array([[fmax, l_opt, l_ts, penn, 0.04, s, 0.6, 10.0]])
         ms = np.array([[0.4, l_ce, 0.0, 0.0]])
         for _ in range(400):
             muscle_step(mp, ms, np.array([l_mtu]), np.array([0.4]), 5e-4)
@@ -82,7 +83,7 @@ def test_force_velocity_shape():
 
 def test_activation_dynamics_first_order():
     """u = 1 from a = 0.01: a(t) = 1 − 0.99·exp(−100 t) (rate 100 /s), Euler-discretised."""
-    mp = np.array([[1000.0, 0.1, 0.2, 0.0, 0.04, 1.0, 0.6]])
+    mp = np.array([[1000.0, 0.1, 0.2, 0.0, 0.04, 1.0, 0.6, 10.0]])
     ms = np.array([[0.01, 0.1, 0.0, 0.0]])
     dt = 1e-4
     for _ in range(200):
@@ -90,12 +91,38 @@ def test_activation_dynamics_first_order():
     assert ms[0, 0] == pytest.approx(1 - 0.99 * math.exp(-100 * 0.02), rel=2e-3)
 
 
+def test_a_shortening_fibre_is_in_equilibrium_at_its_own_maximum_velocity():
+    """MTU shortening at 3 l_opt/s for 60 ms: at the end the tendon force equals the fibre's
+    (a·f_l·f_v(ṽ) + f_p + β·ṽ)·Fmax with ṽ = v_ce/(v_max·l_opt) of the muscle's own v_max
+    column; twice the maximum velocity, more force at the same shortening speed."""
+    fmax, l_opt, l_ts, penn = 3000.0, 0.1, 0.2, 0.0
+    l_mtu = l_opt + l_ts * 1.04
+    l_ce = equilibrium_fiber_length(l_mtu, 1.0, l_opt, l_ts, penn)
+    dt, speed = 1e-4, 0.3
+    forces = []
+    for vmax in (10.0, 20.0):
+        mp = np.array([[fmax, l_opt, l_ts, penn, 0.04, 1.0, 0.6, vmax]])
+        ms = np.array([[1.0, l_ce, 0.0, 0.0]])
+        length = l_mtu
+        for _ in range(600):
+            length -= speed * dt
+            muscle_step(mp, ms, np.array([length]), np.array([1.0]), dt)
+        v_norm = ms[0, 2] / (vmax * l_opt)
+        ln = ms[0, 1] / l_opt
+        fibre = (force_length(ln) * force_velocity(v_norm) + 0.1 * v_norm) * fmax
+        tendon = tendon_force_of_state(length, ms[0, 1], fmax, l_opt, l_ts, penn)
+        assert ms[0, 2] == pytest.approx(-speed, rel=0.05)  # steady: the fibre takes the speed
+        assert tendon == pytest.approx(fibre, rel=1e-3)
+        forces.append(tendon)
+    assert forces[1] > 1.5 * forces[0]
+
+
 def test_quick_release_shortens_fibre_with_a_compliant_tendon():
     """A sudden MTU shortening unloads the tendon first; the fibre then shortens (v_ce < 0)."""
     fmax, l_opt, l_ts, penn = 3000.0, 0.1, 0.2, 0.0
     l_mtu = l_opt + l_ts * 1.04
     l_ce = equilibrium_fiber_length(l_mtu, 1.0, l_opt, l_ts, penn)
-    mp = np.array([[fmax, l_opt, l_ts, penn, 0.04, 1.0, 0.6]])
+    mp = np.array([[fmax, l_opt, l_ts, penn, 0.04, 1.0, 0.6, 10.0]])
     ms = np.array([[1.0, l_ce, 0.0, 0.0]])
     muscle_step(mp, ms, np.array([l_mtu - 0.004]), np.array([1.0]), 5e-4)
     f_after = tendon_force_of_state(l_mtu - 0.004, ms[0, 1], fmax, l_opt, l_ts, penn)

@@ -27,10 +27,6 @@ from pathlib import Path
 
 import numpy as np
 
-import bladelab.predict.collocation.dynamics as _dyn
-import bladelab.predict.collocation.metabolics as _met
-import bladelab.predict.collocation.muscles as _mus
-import bladelab.runner.muscle as _rmus
 from bladelab.predict.collocation.settings import CollocationSettings, people_term
 from bladelab.predict.collocation.solution import CollocationSolution
 from bladelab.predict.collocation.solve import predict_stride
@@ -42,10 +38,9 @@ from bladelab.runner.params import default_runner_params, runner_params_from_dic
 def main() -> None:
     out, variant = Path(sys.argv[1]), json.loads(sys.argv[2])
     kind, blade = variant.get("kind", "able"), variant.get("blade")
-    if "vmax" in variant:  # the collocation twin reads the constant when its graph is built
-        for mod in (_dyn, _met, _mus, _rmus):
-            mod.V_MAX_OPT_PER_S = float(variant["vmax"])
     data = json.loads(default_runner_params(kind, body="human", blade=blade).model_dump_json())
+    if "vmax" in variant:
+        data["max_shortening_velocity_lopt_per_s"] = float(variant["vmax"])
     for name, factor in variant.get("force_factor", {}).items():
         for muscle, row in data["muscle_types"].items():
             if name in ("all", muscle) and row.get("max_isometric_force_N"):

@@ -38,6 +38,7 @@ OPTIONS = {
     "step_phase_tolerance": "--alternating-steps",
     "athlete.body_mass_kg": "--body-mass", "athlete.height_m": "--height",
     "athlete.muscle_strength": "--muscle-strength",
+    "athlete.max_shortening_velocity": "--max-shortening-velocity",
 }
 
 

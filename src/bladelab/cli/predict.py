@@ -96,6 +96,9 @@ _ATHLETE_OPTIONS = {
     "muscle_strength": ("--muscle-strength", "The muscles' active force relative to the "
                         "body's (1: people's maximal strength; a sprinter's hip and knee "
                         "muscles are about 1.3 times larger); tendons stay as they are."),
+    "max_shortening_velocity": ("--max-shortening-velocity", "Every muscle's maximum "
+                                "shortening velocity [optimal fibre lengths/s] (default 10; "
+                                "faster fibres, a larger fast-twitch share, raise it)."),
 }
 
 
@@ -106,11 +109,13 @@ def _athlete_option(field: str):
                         help=text)
 
 
-def _athlete(body_mass: float | None, height: float | None,
-             muscle_strength: float | None) -> dict | None:
+def _athlete(body_mass: float | None, height: float | None, muscle_strength: float | None,
+             max_shortening_velocity: float | None = None) -> dict | None:
     """The athlete of the options (None when none is given)."""
     athlete = {k: v for k, v in (("body_mass_kg", body_mass), ("height_m", height),
-                                 ("muscle_strength", muscle_strength)) if v is not None}
+                                 ("muscle_strength", muscle_strength),
+                                 ("max_shortening_velocity", max_shortening_velocity))
+               if v is not None}
     return athlete or None
 
 
@@ -287,12 +292,14 @@ def register(app: typer.Typer) -> None:
         body_mass: float | None = _athlete_option("body_mass_kg"),
         height: float | None = _athlete_option("height_m"),
         muscle_strength: float | None = _athlete_option("muscle_strength"),
+        max_shortening_velocity: float | None = _athlete_option("max_shortening_velocity"),
         starts: int | None = typer.Option(
             None, "--starts", rich_help_panel=COLLOCATION, show_default=False,
             help="Solve the stride from up to K starts (the guess, the guess with the "
                  "barrier started at 1e-4, the template) and keep the best; each start's "
                  f"solve in OUT/starts/. Default: {defaults.ATHLETE_STARTS} for an athlete "
-                 "scaled by --body-mass, --height or --muscle-strength (one start can land "
+                 "scaled by --body-mass, --height, --muscle-strength or "
+                 "--max-shortening-velocity (one start can land "
                  f"17 % too high there), else {defaults.STARTS}."),
     ) -> None:
         """Predict a running gait: solve one periodic stride of the human body by direct
@@ -314,7 +321,8 @@ def register(app: typer.Typer) -> None:
                 knee_flexion_max=knee_flexion_max, tilt_range=tilt_range,
                 alternating_steps=alternating_steps, prosthetic_load_max=prosthetic_load_max,
                 people_weight=people_weight,
-                athlete=_athlete(body_mass, height, muscle_strength), starts=starts))
+                athlete=_athlete(body_mass, height, muscle_strength, max_shortening_velocity),
+                starts=starts))
         from bladelab.cli.reflex import run_reflex  # deferred: keeps bladelab --help fast
 
         run_reflex(
@@ -435,6 +443,7 @@ def register(app: typer.Typer) -> None:
         body_mass: float | None = _athlete_option("body_mass_kg"),
         height: float | None = _athlete_option("height_m"),
         muscle_strength: float | None = _athlete_option("muscle_strength"),
+        max_shortening_velocity: float | None = _athlete_option("max_shortening_velocity"),
     ) -> None:
         """Category × speed grid: warm-started optimisations, maximum speed, cost at 4 m/s,
         200 m and 400 m times, contact times (seed 001 §2.2.2 B–C, Table 3.1). Running it again
@@ -467,7 +476,8 @@ def register(app: typer.Typer) -> None:
                 guess=guess, max_iter=max_iter, jobs=jobs, executor=executor, resume=resume,
                 force=force, as_json=as_json, starts=starts, body=body,
                 people_weight=people_weight, alternating_steps=alternating_steps,
-                athlete=_athlete(body_mass, height, muscle_strength)))
+                athlete=_athlete(body_mass, height, muscle_strength,
+                                 max_shortening_velocity)))
         from bladelab.cli import reflex  # deferred: keeps bladelab --help fast
 
         if mode == "recipe":

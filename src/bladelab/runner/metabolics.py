@@ -9,7 +9,7 @@ Per muscle, rates per kilogram of muscle [W/kg] (Umberger et al. 2003; Uchida et
 - shortening heat (``ṽ = v_ce/l_opt`` < 0, in optimal lengths per second)
   ``ḣ_S = (−α_ST·ṽ·(100 − FT)/100 − α_FT·ṽ·FT/100)·A²·S`` with ``α_ST = 100/v_max,ST``,
   ``α_FT = 153/v_max,FT``, ``v_max,ST = v_max/(1 + 1.5·FT/100)``, ``v_max,FT = 2.5·v_max,ST``
-  (``v_max`` = 10 l_opt/s, the muscle model's); times ``f_l`` for fibres longer than optimal;
+  (``v_max`` the muscle model's, column ``MP_VMAX``: 10 l_opt/s unless set); times ``f_l`` for fibres longer than optimal;
   lengthening heat ``ḣ_L = α_L·ṽ·A·S`` with ``α_L = 4·α_ST``;
 - total heat ``ḣ_AM + ḣ_SL`` not below 1 W/kg (Umberger's floor);
 - mechanical work rate ``ẇ = −F_ce·v_ce / m`` with the active fibre force ``F_ce`` — negative work
@@ -56,6 +56,7 @@ from bladelab.runner.muscle import (
     MP_FMAX,
     MP_LOPT,
     MP_PSTRAIN,
+    MP_VMAX,
     V_MAX_OPT_PER_S,
     force_length,
     passive_force,
@@ -121,12 +122,14 @@ def muscle_metabolic_rate(
     v_ce: float,
     mass: float,
     ft: float,
+    vmax: float = V_MAX_OPT_PER_S,
 ) -> float:
     """Metabolic rate [W] of one muscle (see module docstring).
 
     ``u`` excitation, ``a`` activation [-]; ``l_norm`` fibre length / l_opt; ``v_norm`` fibre
     velocity in l_opt/s (< 0 shortening); ``f_ce`` active fibre force [N]; ``v_ce`` fibre velocity
-    [m/s]; ``mass`` muscle mass [kg]; ``ft`` fast-twitch percentage.
+    [m/s]; ``mass`` muscle mass [kg]; ``ft`` fast-twitch percentage; ``vmax`` the muscle's
+    maximum shortening velocity [l_opt/s].
     """
     big_a = u if u > a else 0.5 * (u + a)
     if big_a < 0.0:
@@ -135,7 +138,7 @@ def muscle_metabolic_rate(
     h_am = (1.28 * ft + 25.0) * big_a**0.6 * AEROBIC_SCALE
     if l_norm > 1.0:
         h_am *= 0.4 + 0.6 * f_iso
-    vmax_st = V_MAX_OPT_PER_S / (1.0 + 1.5 * ft / 100.0)
+    vmax_st = vmax / (1.0 + 1.5 * ft / 100.0)
     vmax_ft = 2.5 * vmax_st
     alpha_st = 100.0 / vmax_st
     alpha_ft = 153.0 / vmax_ft
@@ -230,7 +233,7 @@ def total_metabolic_rate(u, ms, mp, mb, body_mass):
                                           mb[i, 0], mb[i, 1])
             continue
         total += muscle_metabolic_rate(
-            u[i], a, ln, ms[i, 2] / lopt, f_ce, ms[i, 2], mb[i, 0], mb[i, 1]
+            u[i], a, ln, ms[i, 2] / lopt, f_ce, ms[i, 2], mb[i, 0], mb[i, 1], mp[i, MP_VMAX]
         )
     return total
 

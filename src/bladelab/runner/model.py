@@ -43,6 +43,7 @@ from bladelab.runner.layout import (
     LAW_HUNT_CROSSLEY,
 )
 from bladelab.runner.multilink import add_multilink_blade, multilink_contact_rows
+from bladelab.runner.muscle import MP_COLUMNS
 from bladelab.runner.params import (
     BLADE_ALIGNMENT_DEG,
     BLADE_EXTRA_LENGTH_M,
@@ -124,9 +125,9 @@ class RunnerModel:
     dof_names, muscle_names, segment_names, contact_names
         Names in array order.
     muscle_params
-        (n_muscles, 7): Fmax [N], l_opt [m], l_ts [m], pennation [rad], tendon strain at Fmax
-        [-], active strength [-], passive strain at Fmax [-] (:mod:`bladelab.runner.muscle`'s
-        ``MP_*`` columns).
+        (n_muscles, 8): Fmax [N], l_opt [m], l_ts [m], pennation [rad], tendon strain at Fmax
+        [-], active strength [-], passive strain at Fmax [-], maximum shortening velocity
+        [l_opt/s] (:mod:`bladelab.runner.muscle`'s ``MP_*`` columns).
     path_points, path_start
         Muscle path points as (site id, body id) rows; muscle i uses rows
         ``path_start[i]:path_start[i+1]`` (origin to insertion).
@@ -377,7 +378,7 @@ def build_runner(
 
     # muscles: sites on bodies, spatial tendons, tendon actuators (ctrl = −tendon force)
     names = muscle_names(params.kind, params.myodesis)
-    mp = np.zeros((len(names), 7))
+    mp = np.zeros((len(names), MP_COLUMNS))
     strength = active_strength(params)
     path_sites: list[str] = []
     path_start = [0]
@@ -414,6 +415,7 @@ def build_runner(
             mt.tendon_strain_at_fmax,
             strength,
             mt.passive_strain_at_fmax,
+            params.max_shortening_velocity_lopt_per_s,
         )
 
     analysis_model = spec.compile()

@@ -2,7 +2,8 @@
 
 A Geyer & Herr (2010) / Millard (2012, damped equilibrium) class model, normalised by the
 maximum isometric force ``Fmax``, the optimal fibre length ``l_opt`` and the maximum contraction
-velocity ``v_max = 10·l_opt/s``:
+velocity ``v_max`` (column ``MP_VMAX``, in optimal fibre lengths per second: 10 l_opt/s unless
+the parameter set says otherwise):
 
 - activation ``da/dt = (u − a)·r`` with ``r = 100 /s`` when rising and ``25 /s`` when falling
   (SCONE's H0918 integrator settings), ``a`` kept in [0.01, 1];
@@ -36,6 +37,8 @@ from numba import njit
 
 from bladelab.numba_cache import refresh_stale_caches
 
+#: The default maximum shortening velocity [optimal fibre lengths/s] (Zajac 1989's 10; the
+#: parameter set may give another, column ``MP_VMAX``).
 V_MAX_OPT_PER_S = 10.0
 ACTIVATION_RATE = 100.0
 DEACTIVATION_RATE = 25.0
@@ -60,8 +63,12 @@ _LN_005 = math.log(0.05)
 # normalises the tendon curve and the passive fibre force), l_opt [m], l_ts [m], pennation
 # [rad], tendon strain at Fmax [-], active strength [-] (the active fibre force is
 # a·f_l·f_v·Fmax times it; bladelab.runner.params.RunnerParams.active_specific_tension),
-# passive fibre strain at Fmax [-] (the passive curve's e₀).
+# passive fibre strain at Fmax [-] (the passive curve's e₀), maximum shortening velocity
+# [l_opt/s] (bladelab.runner.params.RunnerParams.max_shortening_velocity_lopt_per_s).
 MP_FMAX, MP_LOPT, MP_LTS, MP_PENN, MP_TSTRAIN, MP_ACTIVE, MP_PSTRAIN = 0, 1, 2, 3, 4, 5, 6
+MP_VMAX = 7
+#: Columns of the muscle parameter array.
+MP_COLUMNS = 8
 # Columns of the muscle state array ``ms``.
 MS_ACT, MS_LCE, MS_VCE, MS_FORCE = 0, 1, 2, 3
 
@@ -199,9 +206,10 @@ def muscle_step(
 ) -> None:
     """Advance all muscles by one step and store their tendon forces.
 
-    ``mp`` (n, 7): Fmax [N], l_opt [m], l_ts [m], pennation α₀ [rad], tendon strain at Fmax
+    ``mp`` (n, 8): Fmax [N], l_opt [m], l_ts [m], pennation α₀ [rad], tendon strain at Fmax
     [-], active strength [-] (:data:`MP_ACTIVE`), passive strain at Fmax [-]
-    (:data:`MP_PSTRAIN`). ``ms`` (n, 4) in/out:
+    (:data:`MP_PSTRAIN`), maximum shortening velocity [l_opt/s] (:data:`MP_VMAX`). ``ms``
+    (n, 4) in/out:
     activation, fibre length [m], fibre velocity [m/s], tendon force [N] (the force to apply
     during this step, computed from the state at the step's start). ``l_mtu`` [m], ``u`` [-]
     excitations in [0, 1]. ``tol``: the Newton iteration on the normalised fibre velocity stops
@@ -216,9 +224,9 @@ def muscle_step(
     at the step's end, ``l_mtu + dt·v_mtu`` [m, m/s]. Without them: implicit Euler against
     the step's start length (first order).
     """
-    if mp.shape[1] <= MP_PSTRAIN:
-        raise ValueError("muscle parameters need 7 columns (the last two: active strength, "
-                         "passive strain at Fmax)")
+    if mp.shape[1] <= MP_VMAX:
+        raise ValueError("muscle parameters need 8 columns (the last three: active strength, "
+                         "passive strain at Fmax, maximum shortening velocity)")
     n = mp.shape[0]
     for i in range(n):
         fmax = mp[i, MP_FMAX]
@@ -246,7 +254,7 @@ def muscle_step(
                 base = (4.0 * l_ce - l_prev[i]) / 3.0
                 step_dt = dt * (2.0 / 3.0)
             l_prev[i] = l_ce
-        vscale = V_MAX_OPT_PER_S * l_opt
+        vscale = mp[i, MP_VMAX] * l_opt
         v = ms[i, MS_VCE] / vscale
         for _ in range(6):
             l_new = base + step_dt * v * vscale

@@ -32,6 +32,7 @@ from bladelab._io import read_yaml
 from bladelab.contact import hertz_sphere_stiffness
 from bladelab.errors import InputFileError, SpecError
 from bladelab.runner.geometry import LEG_MUSCLES, SHANK_MUSCLES, TORSO_MUSCLES
+from bladelab.runner.muscle import V_MAX_OPT_PER_S
 from bladelab.runner.prosthetic_knee import ProstheticKnee
 
 #: Folder of the runner models' data files (parameter sets, categories, shipped solutions).
@@ -148,6 +149,12 @@ RESIDUAL_THIGH_MUSCLES = ("glut_max", "iliopsoas")
 MYODESIS_MUSCLES = ("hamstrings", "rect_fem")
 
 
+#: The range of a muscle's maximum shortening velocity [optimal fibre lengths/s] a parameter
+#: set may give: wide enough for a sensitivity study over the physiological range (Miller,
+#: Umberger & Caldwell 2012 varied it so), around the models' usual 10.
+MAX_SHORTENING_VELOCITY_RANGE = (2.0, 30.0)
+
+
 class RunnerParams(_Strict):
     """A runner parameter set (one YAML file)."""
 
@@ -162,6 +169,12 @@ class RunnerParams(_Strict):
     #: (:func:`active_strength`), so that a literature specific tension does not stiffen the
     #: tendons or the passive tissue.
     active_specific_tension_N_per_cm2: float | None = Field(default=None, gt=0)
+    #: Every muscle's maximum shortening velocity [optimal fibre lengths/s]: the force–velocity
+    #: curve's zero and the metabolic model's velocity scale. 10 (Zajac 1989; OpenSim's
+    #: default) unless set; faster fibres (a sprinter's larger fast-twitch share) raise it.
+    max_shortening_velocity_lopt_per_s: float = Field(
+        default=V_MAX_OPT_PER_S, ge=MAX_SHORTENING_VELOCITY_RANGE[0],
+        le=MAX_SHORTENING_VELOCITY_RANGE[1])
     segments: dict[str, Segment]
     muscle_types: dict[str, MuscleType]
     #: Gravity of this model [m/s²]: 9.81, the value the seed-001 runner and its shipped reflex
@@ -458,12 +471,14 @@ def default_runner_params(
 
 
 #: Fields of an athlete that :func:`athlete_params` changes, with their units.
-ATHLETE_FIELDS = {"body_mass_kg": "kg", "height_m": "m", "muscle_strength": "-"}
+ATHLETE_FIELDS = {"body_mass_kg": "kg", "height_m": "m", "muscle_strength": "-",
+                  "max_shortening_velocity": "l_opt/s"}
 
 
 def athlete_params(params: RunnerParams, *, body_mass_kg: float | None = None,
                    height_m: float | None = None,
-                   muscle_strength: float | None = None) -> RunnerParams:
+                   muscle_strength: float | None = None,
+                   max_shortening_velocity: float | None = None) -> RunnerParams:
     """The parameter set scaled to another athlete (None keeps the set's value).
 
     ``body_mass_kg`` [kg] and ``height_m`` [m] replace :class:`Athlete`'s: segment masses
@@ -474,6 +489,9 @@ def athlete_params(params: RunnerParams, *, body_mass_kg: float | None = None,
     and leaves the tendons and passive tissue as they are: 1 is the set's strength (on the
     human body, people's voluntary maxima times about 1.1); a trained sprinter's hip and knee
     muscles are about 1.3 times larger for their height and mass (Handsfield et al. 2017).
+    ``max_shortening_velocity`` [optimal fibre lengths/s] replaces every muscle's maximum
+    shortening velocity (:attr:`RunnerParams.max_shortening_velocity_lopt_per_s`, 10 unless
+    set): the fibres' speed, which a larger fast-twitch share raises.
     """
     data = params.model_dump()
     athlete = dict(data["athlete"])
@@ -488,6 +506,15 @@ def athlete_params(params: RunnerParams, *, body_mass_kg: float | None = None,
                             where="muscle_strength", hint="1 is the body's own strength")
         active = params.active_specific_tension_N_per_cm2 or params.specific_tension_N_per_cm2
         data["active_specific_tension_N_per_cm2"] = active * float(muscle_strength)
+    if max_shortening_velocity is not None:
+        lo, hi = MAX_SHORTENING_VELOCITY_RANGE
+        if not (isinstance(max_shortening_velocity, int | float)
+                and lo <= max_shortening_velocity <= hi):
+            raise SpecError(f"the maximum shortening velocity must be within {lo:g}–{hi:g} "
+                            f"optimal fibre lengths/s, got {max_shortening_velocity!r}",
+                            where="athlete.max_shortening_velocity",
+                            hint="10 is the body's own")
+        data["max_shortening_velocity_lopt_per_s"] = float(max_shortening_velocity)
     return runner_params_from_dict(data, source="athlete")
 
 

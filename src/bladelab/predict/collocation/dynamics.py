@@ -27,7 +27,7 @@ from bladelab.predict.collocation.multibody import body_frames, point_position
 from bladelab.predict.collocation.smooth import sigmoid
 from bladelab.predict.collocation.transcription import StrideDynamics
 from bladelab.runner.layout import CP_LEG
-from bladelab.runner.muscle import MP_ACTIVE, MP_LOPT, V_MAX_OPT_PER_S
+from bladelab.runner.muscle import MP_ACTIVE, MP_LOPT, MP_VMAX
 
 __all__ = ["COORDINATE_BOUNDS_DEG", "stride_dynamics"]
 
@@ -176,7 +176,7 @@ def stride_dynamics(cm: CollocationModel, *, metabolic: MetabolicSmoothing | Non
     met = whole_body_rate(runner, rates)
     l_m, v_m, cos_a = cm.fiber(l_mt, v_mt, ft, dft)
     l_opt = ca.DM(runner.muscle_params[:, MP_LOPT])
-    v_norm = v_m / (V_MAX_OPT_PER_S * l_opt)
+    v_norm = v_m / (ca.DM(runner.muscle_params[:, MP_VMAX]) * l_opt)
     along = l_m * cos_a / l_opt  # fibre length along the tendon line [optimal lengths]
     q_b, qd_b = _bounds(runner.dof_names)
     clearance = (swing_clearance(cm, q, qd, float(swing_clearance_m))

@@ -38,7 +38,7 @@ from bladelab.runner.metabolics import (
     MIN_HEAT_RATE_W_PER_KG,
     metabolic_params,
 )
-from bladelab.runner.muscle import MP_ACTIVE, MP_FMAX, MP_LOPT, MP_PSTRAIN, V_MAX_OPT_PER_S
+from bladelab.runner.muscle import MP_ACTIVE, MP_FMAX, MP_LOPT, MP_PSTRAIN, MP_VMAX
 
 __all__ = ["MetabolicSmoothing", "bhargava_muscle_rates", "metabolic_rate",
            "muscle_metabolic_rates", "whole_body_rate"]
@@ -120,7 +120,7 @@ def muscle_metabolic_rates(runner, u, a, ft, dft, l_mt, v_mt, smoothing: Smoothi
     long = sigmoid(ln - 1.0, w.length)
     h_am = (1.28 * ftp + 25.0) * big_a**0.6 * AEROBIC_SCALE
     h_am = h_am * (1.0 + long * (0.4 + 0.6 * f_iso - 1.0))
-    vmax_st = V_MAX_OPT_PER_S / (1.0 + 1.5 * ftp / 100.0)
+    vmax_st = ca.DM(mp[:, MP_VMAX]) / (1.0 + 1.5 * ftp / 100.0)
     alpha_st = 100.0 / vmax_st
     alpha_ft = 153.0 / (2.5 * vmax_st)
     h_short = (-alpha_st * vn * (100.0 - ftp) / 100.0 - alpha_ft * vn * ftp / 100.0) \

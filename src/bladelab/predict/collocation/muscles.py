@@ -12,8 +12,8 @@ as an algebraic constraint. Curves and constants are those of the forward Hill m
 (:mod:`bladelab.runner.muscle`): Geyer's force–length (exact, C²), the Hill/eccentric
 force–velocity (its two rational branches blended smoothly), the quadratic passive and tendon
 curves (with a softplus at their onset, which makes the tendon curve invertible for F̃_T > 0),
-fibre damping β = 0.1, ``v_max = 10·l_opt/s``, and the 100 /s up, 25 /s down activation rates
-with a smooth switch. Parameters per muscle: ``RunnerModel.muscle_params`` (Fmax [N], l_opt [m],
+fibre damping β = 0.1, ``v_max`` (the column ``MP_VMAX``, 10 l_opt/s unless set), and the
+100 /s up, 25 /s down activation rates with a smooth switch. Parameters per muscle: ``RunnerModel.muscle_params`` (Fmax [N], l_opt [m],
 l_ts [m], pennation α₀ [rad]). Arrays are column vectors over the muscles.
 
 Domain (bounds for the NLP): ``F̃_T > 0`` (the inverse tendon curve diverges at 0; 1e-3 is a
@@ -43,9 +43,9 @@ from bladelab.runner.muscle import (
     MP_PENN,
     MP_PSTRAIN,
     MP_TSTRAIN,
+    MP_VMAX,
     PASSIVE_STRAIN,
     TENDON_REF_STRAIN,
-    V_MAX_OPT_PER_S,
 )
 
 
@@ -115,14 +115,15 @@ def equilibrium_residual(mp: np.ndarray, a, ft, dft, l_mt, v_mt, smoothing: Smoo
     """Fibre–tendon equilibrium residual [-] (n,), zero on a consistent trajectory.
 
     ``(s·a·f_l·f_v + f_p + β·ṽ)·cos α − F̃_T`` with the fibre state of :func:`fiber_kinematics`,
-    the active strength s (``MP_ACTIVE``) and the passive curve's e₀ (``MP_PSTRAIN``); ``a``
-    activation [-], other arguments as there.
+    the active strength s (``MP_ACTIVE``), the passive curve's e₀ (``MP_PSTRAIN``) and ṽ in
+    the muscle's maximum shortening velocity (``MP_VMAX``); ``a`` activation [-], other
+    arguments as there.
     """
     l_opt = ca.DM(mp[:, MP_LOPT])
     strength = ca.DM(mp[:, MP_ACTIVE])
     e0 = ca.DM(mp[:, MP_PSTRAIN])
     l_m, v_m, cos_a = fiber_kinematics(mp, l_mt, v_mt, ft, dft, smoothing)
-    ln, vn = l_m / l_opt, v_m / (V_MAX_OPT_PER_S * l_opt)
+    ln, vn = l_m / l_opt, v_m / (ca.DM(mp[:, MP_VMAX]) * l_opt)
     fibre = (strength * a * force_length(ln) * force_velocity(vn, smoothing)
              + passive_force(ln, smoothing, e0))
     return (fibre + FIBER_DAMPING * vn) * cos_a - ft

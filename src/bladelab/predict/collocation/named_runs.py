@@ -63,7 +63,8 @@ def solve_named_stride(
     """Solve one stride of the runner ``model`` (``able``, ``amputee``, ``transfemoral``)
     wearing ``blade`` (None: the model's default blade) with the ``body`` (seed 001's, or
     ``toes``), from the initial guess ``guess`` (module docstring), into the folder ``out``;
-    ``athlete`` (``body_mass_kg`` [kg], ``height_m`` [m], ``muscle_strength`` [-], any of them;
+    ``athlete`` (``body_mass_kg`` [kg], ``height_m`` [m], ``muscle_strength`` [-],
+    ``max_shortening_velocity`` [l_opt/s], any of them;
     :func:`bladelab.runner.params.athlete_params`) scales the runner to another athlete.
 
     ``settings`` (default :class:`CollocationSettings`) say the problem (mesh intervals [-],

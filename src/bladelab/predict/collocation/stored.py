@@ -47,7 +47,8 @@ def check_model_spec(spec) -> dict:
     ``"blade_spec"`` where the runner wears a multi-link blade (the blade file's contents, as
     :func:`bladelab.blade.spec.spec_from_dict` reads them; ``"blade"`` is then its name), plus
     ``"athlete"`` where the runner is scaled to another athlete than the parameter set's
-    (``{"body_mass_kg": kg, "height_m": m, "muscle_strength": factor}``, any of them;
+    (``{"body_mass_kg": kg, "height_m": m, "muscle_strength": factor,
+    "max_shortening_velocity": l_opt/s}``, any of them;
     :func:`bladelab.runner.params.athlete_params`), checked and normalised (the able model has
     no blade; the amputee needs one; files written before the bodies existed have no
     ``"body"`` and mean seed 001's)."""
@@ -122,6 +123,8 @@ def athlete_label(spec: dict) -> str:
     parts += [f"{athlete['height_m']:g} m"] if "height_m" in athlete else []
     parts += ([f"muscle strength ×{athlete['muscle_strength']:g}"]
               if "muscle_strength" in athlete else [])
+    parts += ([f"fibres' maximum velocity {athlete['max_shortening_velocity']:g} l_opt/s"]
+              if "max_shortening_velocity" in athlete else [])
     return ", ".join(parts)
 
 
