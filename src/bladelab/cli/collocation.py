@@ -122,9 +122,9 @@ def run_collocation(
     """Run ``bladelab predict --method collocation``; returns the exit status (0 converged,
     2 not converged). ``alternating_steps``: ``CollocationSettings.step_phase_tolerance``;
     ``prosthetic_load_max``: ``CollocationSettings.prosthetic_load_max_bw``.
-    ``athlete``: the runner scaled to this athlete (``body_mass_kg``,
-    ``height_m``, ``muscle_strength``, ``max_shortening_velocity``; None: the body's own). ``starts``: starts of the
-    stride, the best kept (None: :data:`~bladelab.predict.defaults.ATHLETE_STARTS` for a
+    ``athlete``: the runner scaled to this athlete (``body_mass_kg``, ``height_m``,
+    ``muscle_strength``, ``max_shortening_velocity``; None: the body's own). ``starts``:
+    starts of the stride, the best kept (None: :data:`~bladelab.predict.defaults.ATHLETE_STARTS` for a
     scaled athlete, else :data:`~bladelab.predict.defaults.STARTS`)."""
     if starts is None:
         starts = defaults.ATHLETE_STARTS if athlete else defaults.STARTS

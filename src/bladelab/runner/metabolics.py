@@ -9,7 +9,8 @@ Per muscle, rates per kilogram of muscle [W/kg] (Umberger et al. 2003; Uchida et
 - shortening heat (``ṽ = v_ce/l_opt`` < 0, in optimal lengths per second)
   ``ḣ_S = (−α_ST·ṽ·(100 − FT)/100 − α_FT·ṽ·FT/100)·A²·S`` with ``α_ST = 100/v_max,ST``,
   ``α_FT = 153/v_max,FT``, ``v_max,ST = v_max/(1 + 1.5·FT/100)``, ``v_max,FT = 2.5·v_max,ST``
-  (``v_max`` the muscle model's, column ``MP_VMAX``: 10 l_opt/s unless set); times ``f_l`` for fibres longer than optimal;
+  (``v_max`` the muscle model's, column ``MP_VMAX``: 10 l_opt/s unless set); times ``f_l``
+  for fibres longer than optimal;
   lengthening heat ``ḣ_L = α_L·ṽ·A·S`` with ``α_L = 4·α_ST``;
 - total heat ``ḣ_AM + ḣ_SL`` not below 1 W/kg (Umberger's floor);
 - mechanical work rate ``ẇ = −F_ce·v_ce / m`` with the active fibre force ``F_ce`` — negative work

@@ -13,8 +13,9 @@ as an algebraic constraint. Curves and constants are those of the forward Hill m
 force–velocity (its two rational branches blended smoothly), the quadratic passive and tendon
 curves (with a softplus at their onset, which makes the tendon curve invertible for F̃_T > 0),
 fibre damping β = 0.1, ``v_max`` (the column ``MP_VMAX``, 10 l_opt/s unless set), and the
-100 /s up, 25 /s down activation rates with a smooth switch. Parameters per muscle: ``RunnerModel.muscle_params`` (Fmax [N], l_opt [m],
-l_ts [m], pennation α₀ [rad]). Arrays are column vectors over the muscles.
+100 /s up, 25 /s down activation rates with a smooth switch. Parameters per muscle:
+``RunnerModel.muscle_params`` (Fmax [N], l_opt [m], l_ts [m], pennation α₀ [rad], ...).
+Arrays are column vectors over the muscles.
 
 Domain (bounds for the NLP): ``F̃_T > 0`` (the inverse tendon curve diverges at 0; 1e-3 is a
 good lower bound), ``−1 ≤ ṽ ≤ 1``, ``0.01 ≤ a ≤ 1`` and ``0 ≤ u ≤ 1`` (the forward model's).
