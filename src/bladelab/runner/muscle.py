@@ -198,6 +198,16 @@ def fibre_heights(mp: np.ndarray) -> np.ndarray:
     return np.array([row[MP_LOPT] * math.sin(row[MP_PENN]) for row in mp], dtype=float)
 
 
+def equilibrium_fiber_lengths(mp: np.ndarray, l_mtu, activation) -> np.ndarray:
+    """Fibre lengths [m] of the muscles ``mp`` (one row each) in static equilibrium
+    (:func:`equilibrium_fiber_length`) at their MTU lengths ``l_mtu`` [m] and activations
+    ``activation`` [-] (one per muscle, or one for all)."""
+    l_mtu = np.asarray(l_mtu, dtype=float)
+    act = np.broadcast_to(np.asarray(activation, dtype=float), l_mtu.shape)
+    return np.array([equilibrium_fiber_length(l_mtu[i], act[i], *mp[i, MP_LOPT:MP_VMAX])
+                     for i in range(mp.shape[0])], dtype=float)
+
+
 @njit(cache=True, error_model="numpy", _nrt=False)
 def muscle_step(
     mp: np.ndarray, ms: np.ndarray, l_mtu: np.ndarray, u: np.ndarray, dt: float,

@@ -24,9 +24,7 @@ from bladelab.runner.geometry import LEG_MUSCLES
 from bladelab.runner.layout import JP_EA, JP_EB
 from bladelab.runner.muscle import (
     MP_ACTIVE,
-    MP_LOPT,
-    MP_VMAX,
-    equilibrium_fiber_length,
+    equilibrium_fiber_lengths,
     tendon_force_of_state,
 )
 
@@ -79,7 +77,7 @@ def equilibrium_tendon_force(muscle_params: np.ndarray, mtu_length: float,
                              activation: float) -> float:
     """Tendon force [N] of one muscle (its ``muscle_params`` row) at an MTU length [m] and
     activation [-], the fibre in static equilibrium with its compliant tendon."""
-    fibre = equilibrium_fiber_length(mtu_length, activation, *muscle_params[MP_LOPT:MP_VMAX])
+    fibre = equilibrium_fiber_lengths(muscle_params[None, :], [mtu_length], activation)[0]
     return tendon_force_of_state(mtu_length, fibre, *muscle_params[:MP_ACTIVE])
 
 

@@ -37,7 +37,7 @@ from bladelab.runner.kernel import (
     step_forces,
 )
 from bladelab.runner.model import DEFAULT_DT, RunnerModel, contact_heights
-from bladelab.runner.muscle import MP_LOPT, MP_VMAX, equilibrium_fiber_length
+from bladelab.runner.muscle import equilibrium_fiber_lengths
 from bladelab.runner.params import PROSTHETIC_KINDS
 from bladelab.sim.compilation import announce_compilation
 
@@ -299,8 +299,7 @@ def simulate_runner(
     seg_u = np.zeros((path.shape[0], 3))
     path_kinematics(mj[2], d.cvel, d.subtree_com[1].copy(), path, pstart, mtu, seg_u)
     ms[:, 0] = np.clip(u, 0.01, 1.0) if initial_activation is None else initial_activation
-    for i in range(nm):
-        ms[i, 1] = equilibrium_fiber_length(mtu[i, 0], ms[i, 0], *mp[i, MP_LOPT:MP_VMAX])
+    ms[:, 1] = equilibrium_fiber_lengths(mp, mtu[:, 0], ms[:, 0])
     cp = model.contact_params
     cstate = np.zeros((cp.shape[0], 1))
     crec = np.zeros((cp.shape[0], 7))

@@ -67,7 +67,7 @@ from bladelab.runner.implicit_setup import implicit_arrays, simulation_model, si
 from bladelab.runner.kernel import mujoco_step_addresses, path_kinematics
 from bladelab.runner.metabolics import metabolic_params
 from bladelab.runner.model import RunnerModel, contact_heights
-from bladelab.runner.muscle import MP_LOPT, MP_VMAX, equilibrium_fiber_length
+from bladelab.runner.muscle import equilibrium_fiber_lengths
 from bladelab.runner.simulate import Recording, RunnerResult, initial_qpos
 from bladelab.sim.compilation import announce_compilation
 
@@ -293,8 +293,7 @@ def simulate_controlled(
     mtu = np.zeros((nm, 2))
     seg_u = np.zeros((path.shape[0], 3))
     path_kinematics(mj[2], d.cvel, d.subtree_com[1].copy(), path, pstart, mtu, seg_u)
-    for i in range(nm):
-        ms[i, 1] = equilibrium_fiber_length(mtu[i, 0], ms[i, 0], *mp[i, MP_LOPT:MP_VMAX])
+    ms[:, 1] = equilibrium_fiber_lengths(mp, mtu[:, 0], ms[:, 0])
     u = np.zeros(nm)
     table = layout.table_for(dt)
     hist = np.zeros((history_length(layout, dt), 3 * nm + 2 * m.nq))
