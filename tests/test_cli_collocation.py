@@ -98,6 +98,10 @@ def test_a_failed_force_run_removes_the_old_solution(solved, tmp_path, capsys):
     (("--method", "collocation", "--muscle-strength", "0"), "--muscle-strength"),
     (("--method", "collocation", "--max-shortening-velocity", "40"),
      "--max-shortening-velocity"),
+    (("--method", "collocation", "--model", "amputee", "--residual-limb", "0.5"),
+     "--residual-limb"),
+    (("--method", "collocation", "--model", "able", "--residual-limb", "0.2"),
+     "--residual-limb"),
     (("--method", "reflex", "--muscle-strength", "1.5"), "--muscle-strength"),
 ])
 def test_bad_options_are_refused_naming_the_option(args, where, tmp_path, capsys):

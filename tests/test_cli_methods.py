@@ -267,10 +267,11 @@ def test_predict_collocation_passes_the_same_settings(tmp_path, monkeypatch, cap
     with pytest.raises(_Called):  # the athlete is part of the model; two starts by default
         main(["predict", "--out", str(tmp_path), "--model", "amputee", "--body-mass", "68",
               "--height", "1.75", "--muscle-strength", "1.3", "--max-shortening-velocity",
-              "12.5"])
+              "12.5", "--residual-limb", "0.2"])
     assert seen["model_spec"]["athlete"] == {"body_mass_kg": 68.0, "height_m": 1.75,
                                              "muscle_strength": 1.3,
-                                             "max_shortening_velocity": 12.5}
+                                             "max_shortening_velocity": 12.5,
+                                             "residual_limb_length_m": 0.2}
     assert seen["starts"] == ATHLETE_STARTS == 2
     for args, starts in ((["--body-mass", "68", "--starts", "1"], None),
                          (["--starts", "3"], 3)):

@@ -56,11 +56,11 @@ from bladelab.runner.muscle import (
     tendon_force,
     tendon_force_of_state,
 )
-from bladelab.runner.params import default_runner_params
+from bladelab.runner.params import athlete_params, default_runner_params
 
 N_STATES = 20
 KINDS = ("able", "amputee-Cat6", "able-toes", "transfemoral", "able-human", "amputee-human",
-         "transfemoral-human")
+         "transfemoral-human", "amputee-human-short")
 # the toe body's Achilles tendons are twice as compliant; the human body's tendons differ per
 # muscle and its strengths come from a table
 # and a human body with faster fibres: every muscle's v_max 15 l_opt/s, not 10
@@ -82,6 +82,10 @@ def models():
                   "transfemoral": lambda: build_runner("transfemoral"),
                   "able-human": lambda: build_runner("able", body="human"),
                   "amputee-human": lambda: build_runner("amputee", body="human"),
+                  # a short residual limb: 12 cm of tibia (28 %), a longer prosthesis
+                  "amputee-human-short": lambda: build_runner(athlete_params(
+                      default_runner_params("amputee", body="human"),
+                      residual_limb_length_m=0.12)),
                   # the residual limb with a myodesis: hip-only hamstrings and rectus femoris
                   "transfemoral-human": lambda: build_runner("transfemoral", body="human"),
                   }[kind]()

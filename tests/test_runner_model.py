@@ -21,7 +21,7 @@ from bladelab.runner import (
     load_runner_params,
     runner_params_from_dict,
 )
-from bladelab.runner.layout import JP_EA, JP_EB
+from bladelab.runner.layout import CP_LEG, JP_EA, JP_EB
 
 G = 9.81
 
@@ -444,3 +444,52 @@ def test_the_maximum_shortening_velocity_is_every_muscle_s_and_nothing_else():
         with pytest.raises(SpecError) as err:
             athlete_params(base, max_shortening_velocity=bad)
         assert err.value.where == "athlete.max_shortening_velocity"
+
+
+def test_the_residual_limb_s_length_moves_the_socket_and_keeps_the_leg_and_the_athlete():
+    """A residual tibia of 12 or 35 cm (60 % = 25.8 cm unless set): the socket hinge sits that
+    far below the knee; the residual tibia's mass follows its length and its inertia mass ×
+    length²; the model still weighs the athlete's 73.24 kg, the straight prosthetic leg is as
+    long (knee to ground) and the muscles are the same; a runner without a residual tibia, or
+    a length outside 20–90 % of the tibia, is refused naming the field."""
+    from bladelab.runner.params import athlete_params
+
+    base = default_runner_params("amputee", body="human")
+    table = {name: seg.mass_kg for name, seg in base.segments.items()}
+
+    def measures(runner):
+        m = runner.mj_model
+        d = mujoco.MjData(m)
+        res = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, "tibia_res_r")
+        pros = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, "prosthesis_r")
+        knee = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, "knee_angle_r")
+        q = np.zeros(m.nq)
+        q[runner.dof("pelvis_tz")] = 1.0
+        heights = contact_heights(runner, q, d)  # straight legs, upright pelvis
+        lowest = heights[runner.contact_params[:, CP_LEG] == 1].min()
+        return (m.body_mass[res], m.body_inertia[res][0], -m.body_pos[pros][2],
+                d.xanchor[knee][2] - lowest)
+
+    ref = build_runner(base)
+    m_ref, i_ref, socket_ref, leg_ref = measures(ref)
+    assert socket_ref == pytest.approx(0.6 * 0.43, rel=1e-12)
+    for length in (0.12, 0.35):
+        runner = build_runner(athlete_params(base, residual_limb_length_m=length))
+        mass, inertia, socket, leg = measures(runner)
+        k = length / socket_ref
+        assert socket == pytest.approx(length, rel=1e-12)
+        assert runner.total_mass == pytest.approx(73.24, rel=1e-12)
+        # the other segments carry the difference: the athlete's mass over the table's
+        others = sum(table.values()) - table["tibia_res_r"]
+        ratio = 73.24 / (others + k * table["tibia_res_r"])
+        assert mass == pytest.approx(k * table["tibia_res_r"] * ratio, rel=1e-12)
+        assert inertia / mass == pytest.approx(k**2 * i_ref / m_ref, rel=1e-9)
+        assert leg == pytest.approx(leg_ref, abs=1e-9)
+        np.testing.assert_array_equal(runner.muscle_params, ref.muscle_params)
+        assert contact_heights(runner, runner.stand_qpos).min() == pytest.approx(0.0, abs=1e-6)
+    for bad in (0.05, 0.40, float("nan"), "long"):
+        with pytest.raises(SpecError) as err:
+            athlete_params(base, residual_limb_length_m=bad)
+        assert err.value.where == "athlete.residual_limb_length_m"
+    with pytest.raises(SpecError, match="no residual tibia"):
+        athlete_params(default_runner_params("able", body="human"), residual_limb_length_m=0.2)

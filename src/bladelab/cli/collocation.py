@@ -40,7 +40,8 @@ OPTIONS = {
     "prosthetic_load_max_bw": "--prosthetic-load-max",
     "athlete.body_mass_kg": "--body-mass", "athlete.height_m": "--height",
     "athlete.muscle_strength": "--muscle-strength",
-    "athlete.max_shortening_velocity": "--max-shortening-velocity", "starts": "--starts",
+    "athlete.max_shortening_velocity": "--max-shortening-velocity",
+    "athlete.residual_limb_length_m": "--residual-limb", "starts": "--starts",
 }
 
 
@@ -123,7 +124,8 @@ def run_collocation(
     2 not converged). ``alternating_steps``: ``CollocationSettings.step_phase_tolerance``;
     ``prosthetic_load_max``: ``CollocationSettings.prosthetic_load_max_bw``.
     ``athlete``: the runner scaled to this athlete (``body_mass_kg``, ``height_m``,
-    ``muscle_strength``, ``max_shortening_velocity``; None: the body's own). ``starts``:
+    ``muscle_strength``, ``max_shortening_velocity``, ``residual_limb_length_m``; None: the
+    body's own). ``starts``:
     starts of the stride, the best kept (None: :data:`~bladelab.predict.defaults.ATHLETE_STARTS` for a
     scaled athlete, else :data:`~bladelab.predict.defaults.STARTS`)."""
     if starts is None:

@@ -39,6 +39,7 @@ OPTIONS = {
     "athlete.body_mass_kg": "--body-mass", "athlete.height_m": "--height",
     "athlete.muscle_strength": "--muscle-strength",
     "athlete.max_shortening_velocity": "--max-shortening-velocity",
+    "athlete.residual_limb_length_m": "--residual-limb",
 }
 
 

@@ -99,6 +99,10 @@ _ATHLETE_OPTIONS = {
     "max_shortening_velocity": ("--max-shortening-velocity", "Every muscle's maximum "
                                 "shortening velocity [optimal fibre lengths/s] (default 10; "
                                 "faster fibres, a larger fast-twitch share, raise it)."),
+    "residual_limb_length_m": ("--residual-limb", "The transtibial amputee's residual limb "
+                               "[m]: the residual tibia from the knee joint to its end "
+                               "(default 60 % of the tibia, 0.258 m at 1.80 m); the "
+                               "prosthesis below it keeps the leg's length."),
 }
 
 
@@ -110,11 +114,13 @@ def _athlete_option(field: str):
 
 
 def _athlete(body_mass: float | None, height: float | None, muscle_strength: float | None,
-             max_shortening_velocity: float | None = None) -> dict | None:
+             max_shortening_velocity: float | None = None,
+             residual_limb: float | None = None) -> dict | None:
     """The athlete of the options (None when none is given)."""
     athlete = {k: v for k, v in (("body_mass_kg", body_mass), ("height_m", height),
                                  ("muscle_strength", muscle_strength),
-                                 ("max_shortening_velocity", max_shortening_velocity))
+                                 ("max_shortening_velocity", max_shortening_velocity),
+                                 ("residual_limb_length_m", residual_limb))
                if v is not None}
     return athlete or None
 
@@ -293,13 +299,14 @@ def register(app: typer.Typer) -> None:
         height: float | None = _athlete_option("height_m"),
         muscle_strength: float | None = _athlete_option("muscle_strength"),
         max_shortening_velocity: float | None = _athlete_option("max_shortening_velocity"),
+        residual_limb: float | None = _athlete_option("residual_limb_length_m"),
         starts: int | None = typer.Option(
             None, "--starts", rich_help_panel=COLLOCATION, show_default=False,
             help="Solve the stride from up to K starts (the guess, the guess with the "
                  "barrier started at 1e-4, the template) and keep the best; each start's "
                  f"solve in OUT/starts/. Default: {defaults.ATHLETE_STARTS} for an athlete "
-                 "scaled by --body-mass, --height, --muscle-strength or "
-                 "--max-shortening-velocity (one start can land "
+                 "scaled by --body-mass, --height, --muscle-strength, "
+                 "--max-shortening-velocity or --residual-limb (one start can land "
                  f"17 % too high there), else {defaults.STARTS}."),
     ) -> None:
         """Predict a running gait: solve one periodic stride of the human body by direct
@@ -321,7 +328,8 @@ def register(app: typer.Typer) -> None:
                 knee_flexion_max=knee_flexion_max, tilt_range=tilt_range,
                 alternating_steps=alternating_steps, prosthetic_load_max=prosthetic_load_max,
                 people_weight=people_weight,
-                athlete=_athlete(body_mass, height, muscle_strength, max_shortening_velocity),
+                athlete=_athlete(body_mass, height, muscle_strength, max_shortening_velocity,
+                                 residual_limb),
                 starts=starts))
         from bladelab.cli.reflex import run_reflex  # deferred: keeps bladelab --help fast
 
@@ -444,6 +452,7 @@ def register(app: typer.Typer) -> None:
         height: float | None = _athlete_option("height_m"),
         muscle_strength: float | None = _athlete_option("muscle_strength"),
         max_shortening_velocity: float | None = _athlete_option("max_shortening_velocity"),
+        residual_limb: float | None = _athlete_option("residual_limb_length_m"),
     ) -> None:
         """Category × speed grid: warm-started optimisations, maximum speed, cost at 4 m/s,
         200 m and 400 m times, contact times (seed 001 §2.2.2 B–C, Table 3.1). Running it again
@@ -477,7 +486,7 @@ def register(app: typer.Typer) -> None:
                 force=force, as_json=as_json, starts=starts, body=body,
                 people_weight=people_weight, alternating_steps=alternating_steps,
                 athlete=_athlete(body_mass, height, muscle_strength,
-                                 max_shortening_velocity)))
+                                 max_shortening_velocity, residual_limb)))
         from bladelab.cli import reflex  # deferred: keeps bladelab --help fast
 
         if mode == "recipe":

@@ -58,8 +58,10 @@ from bladelab.runner.params import (
     default_runner_params,
     muscle_max_force,
     muscle_names,
+    residual_tibia_factors,
     runner_params_from_dict,
     scale_ratios,
+    segment_mass_ratio,
 )
 
 # Ligaments (joint-limit springs–dampers): (lower, upper) [deg], stiffness [N·m/rad],
@@ -275,7 +277,8 @@ def build_runner(
     prosthetic = params.kind in PROSTHETIC_KINDS
     if blade_model is not None and not prosthetic:
         raise ModelError("only an amputee model wears a blade", where="blade_model")
-    mr, s = scale_ratios(params)
+    s = scale_ratios(params)[1]
+    mr = segment_mass_ratio(params)  # the muscles' forces scale with scale_ratios's
 
     spec = mujoco.MjSpec()
     spec.modelname = f"bladelab_runner_{params.kind}"
@@ -294,10 +297,11 @@ def build_runner(
     def inertial(body, name: str, com: list[float]) -> None:
         seg = params.segments[name]
         ixx, iyy, izz = seg.inertia_kg_m2
+        km, ki = residual_tibia_factors(params) if name == "tibia_res_r" else (1.0, 1.0)
         body.explicitinertial = True
-        body.mass = seg.mass_kg * mr
+        body.mass = seg.mass_kg * mr * km
         body.ipos = com
-        body.inertia = _lab_inertia(ixx, iyy, izz, mr * s * s)
+        body.inertia = _lab_inertia(ixx, iyy, izz, mr * s * s * ki)
 
     pelvis = spec.worldbody.add_body(name="pelvis", pos=[0, 0, 0])
     pelvis.add_joint(name="pelvis_tx", type=mujoco.mjtJoint.mjJNT_SLIDE, axis=[1, 0, 0])
@@ -334,7 +338,7 @@ def build_runner(
                 add_multilink_blade(bodies, joint_child, params, s, mr, axis, blade_model,
                                     depth, com_z=-PROSTHETIC_PYLON_COM_M, **knee)
         elif side == "r" and amputee:
-            res_len = geo.RESIDUAL_TIBIA_FRACTION * geo.TIBIA_LENGTH_M
+            res_len = params.residual_tibia_fraction * geo.TIBIA_LENGTH_M
             com = [0.0, 0.0, -0.5 * res_len * s]
             add("tibia_res_r", "tibia_res_r", "knee_r", "knee_angle_r", "femur_r", pp, pc, com=com)
             if blade_model is None:

@@ -31,7 +31,13 @@ from pydantic import (
 from bladelab._io import read_yaml
 from bladelab.contact import hertz_sphere_stiffness
 from bladelab.errors import InputFileError, SpecError
-from bladelab.runner.geometry import LEG_MUSCLES, SHANK_MUSCLES, TORSO_MUSCLES
+from bladelab.runner.geometry import (
+    LEG_MUSCLES,
+    RESIDUAL_TIBIA_FRACTION,
+    SHANK_MUSCLES,
+    TIBIA_LENGTH_M,
+    TORSO_MUSCLES,
+)
 from bladelab.runner.muscle import V_MAX_OPT_PER_S
 from bladelab.runner.prosthetic_knee import ProstheticKnee
 
@@ -154,6 +160,11 @@ MYODESIS_MUSCLES = ("hamstrings", "rect_fem")
 #: Umberger & Caldwell 2012 varied it so), around the models' usual 10.
 MAX_SHORTENING_VELOCITY_RANGE = (2.0, 30.0)
 
+#: The range of the transtibial residual tibia's length [fraction of the tibia, knee to
+#: ankle] a parameter set may give: from a short residual limb (about 9 cm at 1.80 m) to a
+#: long one that leaves the socket 4 cm above the ankle.
+RESIDUAL_TIBIA_FRACTION_RANGE = (0.2, 0.9)
+
 
 class RunnerParams(_Strict):
     """A runner parameter set (one YAML file)."""
@@ -175,6 +186,14 @@ class RunnerParams(_Strict):
     max_shortening_velocity_lopt_per_s: float = Field(
         default=V_MAX_OPT_PER_S, ge=MAX_SHORTENING_VELOCITY_RANGE[0],
         le=MAX_SHORTENING_VELOCITY_RANGE[1])
+    #: The transtibial runner's residual tibia: its length as a fraction of the tibia (knee to
+    #: ankle) [-]. 0.6 unless set (seed 001's model; the segment table's ``tibia_res_r`` is
+    #: this residual tibia). Its mass follows its length, its inertia mass × length²
+    #: (:func:`residual_tibia_factors`); the prosthesis below it keeps the leg's length.
+    #: Ignored by the other kinds.
+    residual_tibia_fraction: float = Field(
+        default=RESIDUAL_TIBIA_FRACTION, ge=RESIDUAL_TIBIA_FRACTION_RANGE[0],
+        le=RESIDUAL_TIBIA_FRACTION_RANGE[1])
     segments: dict[str, Segment]
     muscle_types: dict[str, MuscleType]
     #: Gravity of this model [m/s²]: 9.81, the value the seed-001 runner and its shipped reflex
@@ -342,10 +361,34 @@ def active_strength(params: RunnerParams) -> float:
     return 1.0 if active is None else active / params.specific_tension_N_per_cm2
 
 
+def residual_tibia_factors(params: RunnerParams) -> tuple[float, float]:
+    """(mass factor, inertia factor) [-] of the transtibial residual tibia against the
+    segment table's ``tibia_res_r`` (which is 60 % of the tibia long): its mass in proportion
+    to its length, its inertia to mass × length² (a uniform rod's rule); (1, 1) for the
+    other kinds and for the table's own length."""
+    if params.kind != "amputee":
+        return 1.0, 1.0
+    k = params.residual_tibia_fraction / RESIDUAL_TIBIA_FRACTION
+    return k, k**3
+
+
 def scale_ratios(params: RunnerParams) -> tuple[float, float]:
-    """(mass ratio, length ratio) of the athlete to the parameter set's segment tables."""
+    """(mass ratio, length ratio) of the athlete to the parameter set's segment tables: the
+    muscles' forces scale with them (:func:`muscle_max_force`)."""
     table_mass = sum(s.mass_kg for s in params.segments.values())
     return params.athlete.body_mass_kg / table_mass, params.athlete.height_m / 1.80
+
+
+def segment_mass_ratio(params: RunnerParams) -> float:
+    """The segments' mass ratio [-]: the athlete's mass over the segment table's with the
+    residual tibia at its own length (:func:`residual_tibia_factors`), so that the model
+    weighs what the athlete does; :func:`scale_ratios`'s mass ratio for the table's
+    residual tibia."""
+    table_mass = sum(s.mass_kg for s in params.segments.values())
+    if "tibia_res_r" in params.segments:
+        table_mass += ((residual_tibia_factors(params)[0] - 1.0)
+                       * params.segments["tibia_res_r"].mass_kg)
+    return params.athlete.body_mass_kg / table_mass
 
 
 def _check(params: RunnerParams, source: str | None) -> RunnerParams:
@@ -470,15 +513,21 @@ def default_runner_params(
     return runner_params_from_dict(data, source=f"built-in {kind} parameters ({body} body)")
 
 
+#: The parameter set's fields that :func:`athlete_params` changes (the same body scaled to
+#: another athlete has the same parameters but these).
+ATHLETE_PARAM_FIELDS = frozenset({"athlete", "active_specific_tension_N_per_cm2",
+                                  "max_shortening_velocity_lopt_per_s",
+                                  "residual_tibia_fraction"})
 #: Fields of an athlete that :func:`athlete_params` changes, with their units.
 ATHLETE_FIELDS = {"body_mass_kg": "kg", "height_m": "m", "muscle_strength": "-",
-                  "max_shortening_velocity": "l_opt/s"}
+                  "max_shortening_velocity": "l_opt/s", "residual_limb_length_m": "m"}
 
 
 def athlete_params(params: RunnerParams, *, body_mass_kg: float | None = None,
                    height_m: float | None = None,
                    muscle_strength: float | None = None,
-                   max_shortening_velocity: float | None = None) -> RunnerParams:
+                   max_shortening_velocity: float | None = None,
+                   residual_limb_length_m: float | None = None) -> RunnerParams:
     """The parameter set scaled to another athlete (None keeps the set's value).
 
     ``body_mass_kg`` [kg] and ``height_m`` [m] replace :class:`Athlete`'s: segment masses
@@ -492,6 +541,9 @@ def athlete_params(params: RunnerParams, *, body_mass_kg: float | None = None,
     ``max_shortening_velocity`` [optimal fibre lengths/s] replaces every muscle's maximum
     shortening velocity (:attr:`RunnerParams.max_shortening_velocity_lopt_per_s`, 10 unless
     set): the fibres' speed, which a larger fast-twitch share raises.
+    ``residual_limb_length_m`` [m] is the transtibial amputee's residual tibia, knee joint to
+    its distal end (:attr:`RunnerParams.residual_tibia_fraction` of the athlete's tibia,
+    0.258 m at 1.80 m unless set).
     """
     data = params.model_dump()
     athlete = dict(data["athlete"])
@@ -515,7 +567,30 @@ def athlete_params(params: RunnerParams, *, body_mass_kg: float | None = None,
                             where="athlete.max_shortening_velocity",
                             hint="10 is the body's own")
         data["max_shortening_velocity_lopt_per_s"] = float(max_shortening_velocity)
+    if residual_limb_length_m is not None:
+        data["residual_tibia_fraction"] = _residual_fraction(
+            params.kind, residual_limb_length_m, athlete["height_m"])
     return runner_params_from_dict(data, source="athlete")
+
+
+def _residual_fraction(kind: str, length_m, height_m: float) -> float:
+    """The residual tibia's fraction of the tibia for a residual limb ``length_m`` [m] of an
+    athlete ``height_m`` [m] tall; a clear error outside the accepted range or for a runner
+    without a residual tibia."""
+    where = "athlete.residual_limb_length_m"
+    if kind != "amputee":
+        raise SpecError(f"the {kind} runner has no residual tibia", where=where,
+                        hint="the residual limb's length is the transtibial amputee's "
+                             "(model amputee)")
+    tibia = TIBIA_LENGTH_M * height_m / 1.80
+    lo, hi = (f * tibia for f in RESIDUAL_TIBIA_FRACTION_RANGE)
+    if not (isinstance(length_m, int | float) and not isinstance(length_m, bool)
+            and lo <= length_m <= hi):
+        raise SpecError(f"the residual limb's length must be within {lo:.3f}–{hi:.3f} m "
+                        f"(20–90 % of the tibia of a {height_m:g} m athlete), got {length_m!r}",
+                        where=where, hint=f"{RESIDUAL_TIBIA_FRACTION * tibia:.3f} m is the "
+                        "body's own (60 % of the tibia)")
+    return float(length_m) / tibia
 
 
 def blade_contact_modulus(params: RunnerParams) -> float:
@@ -538,6 +613,7 @@ __all__ = [
     "PROSTHETIC_KINDS",
     "RUNNER_DATA_DIR",
     "ATHLETE_FIELDS",
+    "ATHLETE_PARAM_FIELDS",
     "Athlete",
     "active_strength",
     "athlete_params",
@@ -551,6 +627,8 @@ __all__ = [
     "hertz_compression",
     "load_runner_params",
     "read_runner_yaml",
+    "residual_tibia_factors",
+    "segment_mass_ratio",
     "muscle_max_force",
     "muscle_names",
     "runner_params_from_dict",

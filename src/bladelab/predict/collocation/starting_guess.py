@@ -26,7 +26,12 @@ from bladelab.predict.collocation.guess import (
 )
 from bladelab.predict.collocation.solution import CollocationSolution
 from bladelab.predict.collocation.stride_guess import StrideGuess
-from bladelab.runner.params import PROSTHETIC_KINDS, RUNNER_DATA_DIR, default_runner_params
+from bladelab.runner.params import (
+    ATHLETE_PARAM_FIELDS,
+    PROSTHETIC_KINDS,
+    RUNNER_DATA_DIR,
+    default_runner_params,
+)
 
 __all__ = ["GUESS_WORDS", "MAX_SPEED_TEMPLATE_M_PER_S", "STORED_STRIDES", "first_origin",
            "guess_file_kind", "make_guess", "resolve_guess", "scaled_to_athlete",
@@ -53,7 +58,7 @@ def stored_stride_path(runner) -> Path | None:
     path = RUNNER_DATA_DIR / "collocation" / name if name else None
     if path is None or not path.is_file():
         return None
-    athlete_free = {"blade", "athlete", "active_specific_tension_N_per_cm2"}
+    athlete_free = {"blade"} | ATHLETE_PARAM_FIELDS
     body = default_runner_params(runner.kind, body="human").model_dump(exclude=athlete_free)
     return path if runner.params.model_dump(exclude=athlete_free) == body else None
 

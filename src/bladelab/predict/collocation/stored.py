@@ -48,7 +48,7 @@ def check_model_spec(spec) -> dict:
     :func:`bladelab.blade.spec.spec_from_dict` reads them; ``"blade"`` is then its name), plus
     ``"athlete"`` where the runner is scaled to another athlete than the parameter set's
     (``{"body_mass_kg": kg, "height_m": m, "muscle_strength": factor,
-    "max_shortening_velocity": l_opt/s}``, any of them;
+    "max_shortening_velocity": l_opt/s, "residual_limb_length_m": m}``, any of them;
     :func:`bladelab.runner.params.athlete_params`), checked and normalised (the able model has
     no blade; the amputee needs one; files written before the bodies existed have no
     ``"body"`` and mean seed 001's)."""
@@ -125,6 +125,8 @@ def athlete_label(spec: dict) -> str:
               if "muscle_strength" in athlete else [])
     parts += ([f"fibres' maximum velocity {athlete['max_shortening_velocity']:g} l_opt/s"]
               if "max_shortening_velocity" in athlete else [])
+    parts += ([f"residual limb {athlete['residual_limb_length_m']:g} m"]
+              if "residual_limb_length_m" in athlete else [])
     return ", ".join(parts)
 
 
