@@ -12,6 +12,8 @@ the start named by VARIANT:
 - ``primal``: the primal point only, the library's options (a start without multipliers);
 - ``duals-MU``: primal and multipliers (``StrideNLP.solve``'s primal-dual warm start,
   ``DUAL_WARM_START_OPTIONS``: the warm-start pushes at 1e-9) with ``mu_init`` MU;
+- ``--ipopt NAME=VALUE`` (repeatable): another IPOPT option of a duals variant's second
+  solve, e.g. ``mu_strategy=monotone``;
 - ``scaled-`` before either: the start scaled to the new speed first (``StrideGuess.with_speed``,
   as ``predict_stride`` scales a start without multipliers), instead of the solution's own
   point.
@@ -40,7 +42,7 @@ from bladelab.runner.params import default_runner_params
 RECORDS = Path(__file__).with_name("warm_records.jsonl")
 
 
-def solve(nlp, x0, speed, variant="primal", hessian="limited-memory", lam=None):
+def solve(nlp, x0, speed, variant="primal", hessian="limited-memory", lam=None, extra=None):
     """``StrideNLP.solve`` as the variant says: ``primal`` with the library's options,
     ``duals-MU`` from ``lam`` (its primal-dual warm start) with the barrier starting at MU;
     returns (solution, its scaled NLP vector and multipliers)."""
@@ -49,7 +51,7 @@ def solve(nlp, x0, speed, variant="primal", hessian="limited-memory", lam=None):
     else:
         mu = float(variant.split("-", 1)[1])
         sol = nlp.solve(x0, speed=speed, hessian=hessian, multipliers=lam,
-                        options={"ipopt.mu_init": mu})
+                        options={"ipopt.mu_init": mu, **(extra or {})})
     return sol, (nlp.initial_vector(sol.to_guess()), *sol.multipliers)
 
 
@@ -61,7 +63,16 @@ def main() -> None:
     ap.add_argument("--from", dest="v0", type=float, default=4.0)
     ap.add_argument("--to", dest="v1", type=float, default=4.2)
     ap.add_argument("--hessian", default="limited-memory")
+    ap.add_argument("--ipopt", action="append", default=[], metavar="NAME=VALUE",
+                    help="another IPOPT option of the second solve (a duals variant)")
     a = ap.parse_args()
+    extra = {}
+    for item in a.ipopt:
+        name, value = item.split("=", 1)
+        try:
+            extra[f"ipopt.{name}"] = float(value) if "." in value or "e" in value else int(value)
+        except ValueError:
+            extra[f"ipopt.{name}"] = value
     blade = a.blade if a.kind == "amputee" else None
     runner = build_runner(default_runner_params(a.kind, body="human", blade=blade))
     settings = CollocationSettings(speed_m_per_s=a.v0)
@@ -84,9 +95,10 @@ def main() -> None:
         lbx, ubx, lbg, ubg = nlp.bounds()
         start = nlp.unpack(x0, {}, 0.0, 0.0, lbg, ubg, np.zeros(lbg.size)).to_guess()
         x0 = nlp.initial_vector(start.with_speed(a.v1))
-    sol1, _ = solve(nlp, x0, a.v1, variant, a.hessian, lam=point[1:])
+    sol1, _ = solve(nlp, x0, a.v1, variant, a.hessian, lam=point[1:], extra=extra)
     rec = {"date": time.strftime("%Y-%m-%d %H:%M"), "kind": a.kind, "blade": blade,
            "from": a.v0, "to": a.v1, "variant": a.variant, "hessian": a.hessian,
+           "ipopt": a.ipopt,
            "first": first,
            "second": {"iterations": sol1.iterations, "wall_s": round(sol1.wall_s, 1),
                       "build_s": round(sol1.timings["build_s"], 1),
