@@ -236,6 +236,11 @@ def test_several_starts_keep_the_best_per_problem_and_every_file(fake_solve, mon
     (("--body", "toes"), "--body"),
     (("--method", "collocation", "--able", "--body", "robot"), "--body"),
     (("--method", "collocation", "--able", "--body-mass", "-1"), "--body-mass"),
+    # athlete fields that only the parameter set can check: refused before anything is solved
+    (("--method", "collocation", "--able", "--categories", "", "--max-shortening-velocity",
+      "40"), "--max-shortening-velocity"),
+    (("--method", "collocation", "--categories", "Cat6", "--residual-limb", "0.5"),
+     "--residual-limb"),
     (("--height", "1.7"), "--height"),  # reflex grid
     (("--method", "shooting"), "--method"),
 ])
@@ -244,6 +249,17 @@ def test_bad_sweep_options_are_refused_naming_the_option(args, where, tmp_path, 
     err = capsys.readouterr().err
     assert err.startswith("error:") and where in err
     assert not (tmp_path / "sweep" / "collocation-sweep.csv").exists()
+
+
+def test_the_residual_limb_is_the_amputees_alone_in_a_sweep():
+    """A sweep of the able runner and an amputee with a residual limb: the amputee carries it,
+    the able runner the rest of the athlete."""
+    from bladelab.predict.collocation.sweep import sweep_models
+
+    able, amputee = sweep_models(["Cat6"], able=True, body="human", athlete={
+        "body_mass_kg": 70.0, "residual_limb_length_m": 0.15})
+    assert able["athlete"] == {"body_mass_kg": 70.0}
+    assert amputee["athlete"] == {"body_mass_kg": 70.0, "residual_limb_length_m": 0.15}
 
 
 def test_a_sweep_of_the_toe_body_has_folders_and_labels_of_its_own():

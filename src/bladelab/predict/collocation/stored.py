@@ -36,6 +36,7 @@ __all__ = [
     "check_model_spec",
     "describe_problem",
     "model_label",
+    "params_from_spec",
     "runner_from_spec",
 ]
 
@@ -137,16 +138,22 @@ def describe_problem(spec: dict, settings: CollocationSettings) -> str:
     return f"{model_label(spec)}, {speed}, {settings.mesh_intervals} mesh intervals"
 
 
+def params_from_spec(spec: dict):
+    """The runner parameter set of a model specification (:func:`check_model_spec`), scaled
+    to its athlete; a bad athlete field raises its :class:`~bladelab.errors.SpecError`
+    (``where`` ``"athlete.<field>"`` or the field's)."""
+    spec = check_model_spec(spec)
+    params = default_runner_params(spec["model"], body=spec.get("body", "seed001"),
+                                   blade=None if "blade_spec" in spec else spec["blade"])
+    return athlete_params(params, **spec["athlete"]) if "athlete" in spec else params
+
+
 def runner_from_spec(spec: dict):
     """Build the forward runner of a model specification (:func:`check_model_spec`)."""
     spec = check_model_spec(spec)
     blade_model = (spec_from_dict(spec["blade_spec"]).build() if "blade_spec" in spec
                    else None)
-    params = default_runner_params(spec["model"], body=spec.get("body", "seed001"),
-                                   blade=None if blade_model is not None else spec["blade"])
-    if "athlete" in spec:
-        params = athlete_params(params, **spec["athlete"])
-    return build_runner(params, blade_model=blade_model)
+    return build_runner(params_from_spec(spec), blade_model=blade_model)
 
 
 class FieldReader:

@@ -50,7 +50,7 @@ from bladelab.predict.collocation.model import build_collocation_model
 from bladelab.predict.collocation.settings import CollocationSettings
 from bladelab.predict.collocation.solve import check_output_folder
 from bladelab.predict.collocation.starts import check_starts
-from bladelab.predict.collocation.stored import check_model_spec, model_label
+from bladelab.predict.collocation.stored import check_model_spec, model_label, params_from_spec
 from bladelab.runner.params import blade_category
 
 __all__ = [
@@ -92,12 +92,17 @@ def sweep_models(categories: Sequence[str], *, able: bool = False,
     (:data:`bladelab.runner.params.BODIES`) and ``athlete`` (None: the parameter sets';
     :func:`~bladelab.predict.collocation.stored.check_model_spec`).
 
+    The able runner takes the athlete without its residual limb (``residual_limb_length_m``,
+    the amputee's). Every model's athlete is checked before anything is solved.
+
     Raises
     ------
     SpecError
-        An unknown or repeated category, or no model at all.
+        An unknown or repeated category, no model at all, or a bad athlete field.
     """
-    models = ([check_model_spec({"model": "able", "body": body, "athlete": athlete})]
+    able_athlete = ({k: v for k, v in athlete.items() if k != "residual_limb_length_m"}
+                    if athlete else athlete)
+    models = ([check_model_spec({"model": "able", "body": body, "athlete": able_athlete})]
               if able else [])
     seen: set[str] = set()
     for c in categories:
@@ -110,6 +115,8 @@ def sweep_models(categories: Sequence[str], *, able: bool = False,
     if not models:
         raise SpecError("no model to sweep", where="categories",
                         hint="give --categories, --able, or both")
+    for spec in models:
+        params_from_spec(spec)
     return models
 
 
