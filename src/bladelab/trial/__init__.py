@@ -1,7 +1,8 @@
 """Trial data: motion-capture trials, force platforms, stance windows and blade kinematics.
 
 ``read_c3d`` -> :class:`Trial` (lab frame, SI) -> ``detect_stances`` -> :class:`StanceEvent` ->
-``extract_stance`` -> :class:`Stance` (written/read as a stance CSV).
+``extract_stance`` -> :class:`Stance` (written/read as a stance CSV); ``segment_lengths`` of
+the legs from a static trial.
 """
 
 from bladelab.trial.c3d import C3DWarning, plate_corners, read_c3d, write_c3d
@@ -16,6 +17,7 @@ from bladelab.trial.kinematics import (
     load_marker_map,
     stance_window,
 )
+from bladelab.trial.segments import SegmentLengths, SegmentMarkerMap, segment_lengths
 from bladelab.trial.stance import STANCE_COLUMNS, Stance, read_stance_csv, write_stance_csv
 from bladelab.trial.trial import ForcePlatform, Trial
 
@@ -25,6 +27,8 @@ __all__ = [
     "C3DWarning",
     "ForcePlatform",
     "MarkerMap",
+    "SegmentLengths",
+    "SegmentMarkerMap",
     "Stance",
     "StanceEvent",
     "Trial",
@@ -40,6 +44,7 @@ __all__ = [
     "plate_corners",
     "read_c3d",
     "read_stance_csv",
+    "segment_lengths",
     "stance_window",
     "write_c3d",
     "write_stance_csv",
