@@ -9,6 +9,7 @@ import pytest
 
 from bladelab.cli import main
 from collocation_fake import SPEED, fake_solution
+from conftest import FUKUCHI_RUN
 
 N = 12
 
@@ -102,6 +103,10 @@ def test_a_failed_force_run_removes_the_old_solution(solved, tmp_path, capsys):
      "--residual-limb"),
     (("--method", "collocation", "--model", "able", "--residual-limb", "0.2"),
      "--residual-limb"),
+    (("--method", "collocation", "--thigh-length", "0.7"), "--thigh-length"),
+    (("--method", "collocation", "--shank-length", "0.2"), "--shank-length"),
+    # a running trial has no epicondyle or malleolus markers: no lengths, refused
+    (("--method", "collocation", "--static", str(FUKUCHI_RUN)), "--static"),
     (("--method", "reflex", "--muscle-strength", "1.5"), "--muscle-strength"),
 ])
 def test_bad_options_are_refused_naming_the_option(args, where, tmp_path, capsys):

@@ -273,6 +273,16 @@ def test_predict_collocation_passes_the_same_settings(tmp_path, monkeypatch, cap
                                              "max_shortening_velocity": 12.5,
                                              "residual_limb_length_m": 0.2}
     assert seen["starts"] == ATHLETE_STARTS == 2
+    # a static trial gives the thighs and shanks (both sides' mean); an option wins over it
+    from bladelab.datasets import measured_static_trial
+
+    seen.clear()
+    with pytest.raises(_Called):
+        main(["predict", "--out", str(tmp_path), "--static", str(measured_static_trial()),
+              "--shank-length", "0.44"])
+    athlete = seen["model_spec"]["athlete"]
+    assert athlete["shank_length_m"] == 0.44
+    assert athlete["thigh_length_m"] == pytest.approx((0.4653 + 0.4574) / 2, abs=2e-4)
     for args, starts in ((["--body-mass", "68", "--starts", "1"], None),
                          (["--starts", "3"], 3)):
         seen.clear()

@@ -60,7 +60,7 @@ from bladelab.runner.params import athlete_params, default_runner_params
 
 N_STATES = 20
 KINDS = ("able", "amputee-Cat6", "able-toes", "transfemoral", "able-human", "amputee-human",
-         "transfemoral-human", "amputee-human-short")
+         "transfemoral-human", "amputee-human-short", "able-human-long-thighs")
 # the toe body's Achilles tendons are twice as compliant; the human body's tendons differ per
 # muscle and its strengths come from a table
 # and a human body with faster fibres: every muscle's v_max 15 l_opt/s, not 10
@@ -82,6 +82,10 @@ def models():
                   "transfemoral": lambda: build_runner("transfemoral"),
                   "able-human": lambda: build_runner("able", body="human"),
                   "amputee-human": lambda: build_runner("amputee", body="human"),
+                  # an athlete's own thighs and shanks: segments and muscles rescaled
+                  "able-human-long-thighs": lambda: build_runner(athlete_params(
+                      default_runner_params("able", body="human"), thigh_length_m=0.46,
+                      shank_length_m=0.42)),
                   # a short residual limb: 12 cm of tibia (28 %), a longer prosthesis
                   "amputee-human-short": lambda: build_runner(athlete_params(
                       default_runner_params("amputee", body="human"),

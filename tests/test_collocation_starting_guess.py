@@ -45,7 +45,8 @@ def test_another_athlete_of_the_human_body_starts_from_its_stored_stride():
 
     params = athlete_params(default_runner_params("amputee", blade="Cat5", body="human"),
                             body_mass_kg=64.0, height_m=1.70, muscle_strength=1.3,
-                            max_shortening_velocity=12.0, residual_limb_length_m=0.15)
+                            max_shortening_velocity=12.0, residual_limb_length_m=0.15,
+                            thigh_length_m=0.42)
     runner = build_runner(params)
     path = stored_stride_path(runner)
     assert path == RUNNER_DATA_DIR / "collocation" / STORED_STRIDES["amputee"]
@@ -53,9 +54,13 @@ def test_another_athlete_of_the_human_body_starts_from_its_stored_stride():
     scaled = make_guess(runner, "stored", n=N, speed=4.0)
     assert own.multipliers is not None and scaled.multipliers is None  # another problem's
     names = list(own.dof_names)
-    for name in ("pelvis_tx", "pelvis_tz"):  # the pelvis at the athlete's height
+    # the pelvis at the athlete's height, raised by the longer thighs: hip to sole 0.42 m +
+    # 0.43 × 1.70 / 1.80 + the foot's 0.057 × 1.70 / 1.80, against the height-scaled model's
+    foot = 0.01195 + 0.015 + 0.03
+    leg = (0.42 + (0.43 + foot) * 1.70 / 1.80) / ((0.396 + 0.43 + foot) * 1.70 / 1.80)
+    for name, factor in (("pelvis_tx", 1.70 / 1.80), ("pelvis_tz", 1.70 / 1.80 * leg)):
         j = names.index(name)
-        np.testing.assert_allclose(scaled.q[:, j], own.q[:, j] * 1.70 / 1.80, rtol=1e-12)
+        np.testing.assert_allclose(scaled.q[:, j], own.q[:, j] * factor, rtol=1e-9)
     j = names.index("knee_angle_l")  # angles as they were
     np.testing.assert_array_equal(scaled.q[:, j], own.q[:, j])
     assert "scaled to the athlete" in scaled.source

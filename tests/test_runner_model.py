@@ -21,6 +21,7 @@ from bladelab.runner import (
     load_runner_params,
     runner_params_from_dict,
 )
+from bladelab.runner.geometry import TORSO_MUSCLES
 from bladelab.runner.layout import CP_LEG, JP_EA, JP_EB
 
 G = 9.81
@@ -493,3 +494,57 @@ def test_the_residual_limb_s_length_moves_the_socket_and_keeps_the_leg_and_the_a
         assert err.value.where == "athlete.residual_limb_length_m"
     with pytest.raises(SpecError, match="no residual tibia"):
         athlete_params(default_runner_params("able", body="human"), residual_limb_length_m=0.2)
+
+
+def _neutral_tendon_lengths(runner) -> np.ndarray:
+    """MuJoCo's muscle–tendon lengths [m] with every coordinate at 0 (standing straight)."""
+    m = runner.mj_analysis_model
+    d = mujoco.MjData(m)
+    mujoco.mj_forward(m, d)
+    return d.ten_length.copy()
+
+
+def test_thigh_and_shank_lengths_scale_their_segments_and_the_muscles_lengths():
+    """Thighs of 0.459 m and shanks of 0.40 m (the model's 0.396 / 0.430 m at 1.80 m): the
+    joint centres lie that far apart; segment masses stay; every muscle's optimal fibre and
+    tendon slack lengths change as its muscle–tendon length standing straight does, as MuJoCo
+    measures it (OpenSim's scaling rule); the trunk's muscles keep theirs; the amputee's
+    straight prosthetic leg stays 3 cm longer than the intact one; out of 80–130 % refused."""
+    from bladelab.runner.muscle import MP_LOPT, MP_LTS
+    from bladelab.runner.params import athlete_params
+
+    base = default_runner_params("able", body="human")
+    ref = build_runner(base)
+    runner = build_runner(athlete_params(base, thigh_length_m=0.459, shank_length_m=0.40))
+    m = runner.mj_model
+    d = mujoco.MjData(m)
+    mujoco.mj_forward(m, d)
+
+    def anchor(name):
+        return d.xanchor[mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, name)]
+
+    for side in ("l", "r"):
+        assert np.linalg.norm(anchor(f"hip_flexion_{side}") - anchor(f"knee_angle_{side}")) \
+            == pytest.approx(0.459, rel=1e-9)
+        assert np.linalg.norm(anchor(f"knee_angle_{side}") - anchor(f"ankle_angle_{side}")) \
+            == pytest.approx(0.40, rel=1e-9)
+    np.testing.assert_array_equal(m.body_mass, ref.mj_model.body_mass)
+    ratio = _neutral_tendon_lengths(runner) / _neutral_tendon_lengths(ref)
+    for col in (MP_LOPT, MP_LTS):
+        np.testing.assert_allclose(runner.muscle_params[:, col] / ref.muscle_params[:, col],
+                                   ratio, rtol=1e-9)
+    trunk = [i for i, n in enumerate(runner.muscle_names) if n[:-2] in TORSO_MUSCLES]
+    assert np.all(ratio[trunk] == pytest.approx(1.0, abs=1e-12))
+    assert abs(ratio - 1.0).max() > 0.1  # the vasti cross the longer thigh
+
+    amputee = build_runner(athlete_params(default_runner_params("amputee", body="human"),
+                                          shank_length_m=0.40))
+    q = np.zeros(amputee.mj_model.nq)
+    q[amputee.dof("pelvis_tz")] = 1.0
+    heights = contact_heights(amputee, q)
+    legs = amputee.contact_params[:, CP_LEG]
+    assert heights[legs == 0].min() - heights[legs == 1].min() == pytest.approx(0.03, abs=1e-9)
+    for field, bad in (("thigh_length_m", 0.30), ("shank_length_m", 0.60)):
+        with pytest.raises(SpecError) as err:
+            athlete_params(base, **{field: bad})
+        assert err.value.where == f"athlete.{field}"

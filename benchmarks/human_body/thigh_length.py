@@ -3,13 +3,16 @@
 Usage (repository root)::
 
     .venv/bin/python benchmarks/human_body/thigh_length.py OUT FACTOR [SPEED] [PEOPLE_WEIGHT]
+        [MASS_KG HEIGHT_M]
 
 Every femur of the human body is scaled by FACTOR about its centre of mass (the hip and knee
 joint positions, the muscle points on it; its inertia by FACTOR²; its mass as it is), and every
 muscle's optimal fibre and tendon slack lengths follow its muscle–tendon length in the neutral
 pose (OpenSim's scaling rule), as a per-segment scaling from a static trial would do. The stride
 is solved at SPEED (default 3.5 m/s) with people's joint angles at PEOPLE_WEIGHT (default 10,
-the body's default objective) from the shipped able stride, its pelvis raised by the legs'
+the body's default objective), optionally for an athlete of MASS_KG and HEIGHT_M (the
+parameter set's 75 kg and 1.80 m otherwise; FACTOR then on the height-scaled femur), from the
+shipped able stride, its pelvis raised by the legs'
 extra length, straight to the predictive stage. Writes ``OUT/solution.json`` (or
 ``best_iterate.json``) and prints the summary.
 
@@ -35,7 +38,12 @@ from bladelab.predict.collocation.settings import CollocationSettings, people_te
 from bladelab.predict.collocation.solve import predict_stride
 from bladelab.predict.collocation.starting_guess import STORED_STRIDES, make_guess
 from bladelab.runner import build_runner
-from bladelab.runner.params import RUNNER_DATA_DIR, default_runner_params, runner_params_from_dict
+from bladelab.runner.params import (
+    RUNNER_DATA_DIR,
+    athlete_params,
+    default_runner_params,
+    runner_params_from_dict,
+)
 
 FEMUR_LENGTH_M = 0.17 + 0.226  # hip to knee, 1.80 m
 
@@ -52,9 +60,13 @@ def neutral_mtu_lengths(runner) -> np.ndarray:
     return d.ten_length.copy()
 
 
-def scaled_runner(k: float):
-    """The able human runner with every femur scaled by ``k`` (module docstring)."""
-    ref = build_runner("able", body="human")
+def scaled_runner(k: float, athlete: dict | None = None):
+    """The able human runner (of ``athlete``: ``{"body_mass_kg": kg, "height_m": m}``) with
+    every femur scaled by ``k`` (module docstring)."""
+    base = default_runner_params("able", body="human")
+    if athlete:
+        base = athlete_params(base, **athlete)
+    ref = build_runner(base)
     for side in ("l", "r"):
         par, pp, pc = geo.JOINTS[f"hip_{side}"]
         geo.JOINTS[f"hip_{side}"] = (par, pp, _scale(pc, k))
@@ -64,7 +76,7 @@ def scaled_runner(k: float):
         for i, (body, p) in enumerate(points):
             if body == "femur":
                 points[i] = (body, _scale(p, k))
-    data = json.loads(default_runner_params("able", body="human").model_dump_json())
+    data = json.loads(base.model_dump_json())
     for side in ("l", "r"):
         seg = data["segments"][f"femur_{side}"]
         seg["inertia_kg_m2"] = [k * k * v for v in seg["inertia_kg_m2"]]
@@ -79,13 +91,18 @@ def main() -> None:
     out, k = Path(sys.argv[1]), float(sys.argv[2])
     speed = float(sys.argv[3]) if len(sys.argv) > 3 else 3.5
     weight = float(sys.argv[4]) if len(sys.argv) > 4 else 10.0
-    runner, ratio = scaled_runner(k)
+    athlete = ({"body_mass_kg": float(sys.argv[5]), "height_m": float(sys.argv[6])}
+               if len(sys.argv) > 6 else None)
+    runner, ratio = scaled_runner(k, athlete)
+    s = runner.params.athlete.height_m / 1.80
     settings = CollocationSettings(speed_m_per_s=speed, **people_term(weight))
     stored = RUNNER_DATA_DIR / "collocation" / STORED_STRIDES["able"]
     guess = make_guess(runner, str(stored), n=settings.mesh_intervals, speed=speed)
     q = guess.q.copy()
     names = list(guess.dof_names or runner.dof_names)
-    q[:, names.index("pelvis_tz")] += 0.95 * (k - 1.0) * FEMUR_LENGTH_M
+    q[:, names.index("pelvis_tz")] *= s
+    q[:, names.index("pelvis_tx")] *= s
+    q[:, names.index("pelvis_tz")] += 0.95 * (k - 1.0) * FEMUR_LENGTH_M * s
     guess = dataclasses.replace(guess, q=q, multipliers=None)
     t0 = time.perf_counter()
     sol = predict_stride(runner, settings, guess,
@@ -94,6 +111,7 @@ def main() -> None:
     out.mkdir(parents=True, exist_ok=True)
     sol.write(out / ("solution.json" if sol.converged else "best_iterate.json"))
     (out / "variant.json").write_text(json.dumps({"femur_factor": k, "speed": speed,
+                                                  "athlete": athlete,
                                                   "people_weight": weight,
                                                   "mtu_ratio": ratio.round(4).tolist()}))
     print(json.dumps(sol.summary()), f"{time.perf_counter() - t0:.0f} s")

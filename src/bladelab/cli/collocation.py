@@ -41,7 +41,9 @@ OPTIONS = {
     "athlete.body_mass_kg": "--body-mass", "athlete.height_m": "--height",
     "athlete.muscle_strength": "--muscle-strength",
     "athlete.max_shortening_velocity": "--max-shortening-velocity",
-    "athlete.residual_limb_length_m": "--residual-limb", "starts": "--starts",
+    "athlete.residual_limb_length_m": "--residual-limb",
+    "athlete.thigh_length_m": "--thigh-length", "athlete.shank_length_m": "--shank-length",
+    "starts": "--starts",
 }
 
 

@@ -40,6 +40,7 @@ OPTIONS = {
     "athlete.muscle_strength": "--muscle-strength",
     "athlete.max_shortening_velocity": "--max-shortening-velocity",
     "athlete.residual_limb_length_m": "--residual-limb",
+    "athlete.thigh_length_m": "--thigh-length", "athlete.shank_length_m": "--shank-length",
 }
 
 

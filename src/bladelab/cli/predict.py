@@ -12,6 +12,7 @@ another method is refused, naming the option and its method
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 import typer
@@ -103,7 +104,22 @@ _ATHLETE_OPTIONS = {
                                "[m]: the residual tibia from the knee joint to its end "
                                "(default 60 % of the tibia, 0.258 m at 1.80 m); the "
                                "prosthesis below it keeps the leg's length."),
+    "thigh_length_m": ("--thigh-length", "The athlete's thighs [m], hip to knee joint centre "
+                       "(default 0.396 m at 1.80 m, scaled with the height); the femur's "
+                       "joints and muscle points, and the muscles' fibre and tendon lengths, "
+                       "follow it."),
+    "shank_length_m": ("--shank-length", "The athlete's shanks [m], knee to ankle joint "
+                       "centre (default 0.430 m at 1.80 m, scaled with the height)."),
 }
+
+
+def _static_option():
+    """``--static``: thigh and shank lengths from a static trial."""
+    return typer.Option(None, "--static", rich_help_panel=COLLOCATION, show_default=False,
+                        help="A static (standing) C3D trial of the athlete: the thighs and "
+                             "shanks from its joint centres (Harrington's hips, epicondyles, "
+                             "malleoli; both sides' mean, the intact leg's shank for an "
+                             "amputee), unless --thigh-length or --shank-length are given.")
 
 
 def _athlete_option(field: str):
@@ -113,15 +129,26 @@ def _athlete_option(field: str):
                         help=text)
 
 
-def _athlete(body_mass: float | None, height: float | None, muscle_strength: float | None,
-             max_shortening_velocity: float | None = None,
-             residual_limb: float | None = None) -> dict | None:
-    """The athlete of the options (None when none is given)."""
-    athlete = {k: v for k, v in (("body_mass_kg", body_mass), ("height_m", height),
-                                 ("muscle_strength", muscle_strength),
-                                 ("max_shortening_velocity", max_shortening_velocity),
-                                 ("residual_limb_length_m", residual_limb))
-               if v is not None}
+def _athlete(static: Path | None = None, **fields: float | None) -> dict | None:
+    """The athlete of the options (library field -> value; None when none is given), with the
+    segment lengths of a ``static`` trial where no option gives them."""
+    athlete = {k: v for k, v in fields.items() if v is not None}
+    if static is not None:
+        from bladelab.trial import read_c3d, segment_lengths  # deferred: reads C3D
+
+        lengths = segment_lengths(read_c3d(static))
+        for name, per_side in (("thigh_length_m", lengths.thigh_m),
+                               ("shank_length_m", lengths.shank_m)):
+            known = [v for v in per_side.values() if math.isfinite(v)]
+            if name in athlete:
+                continue
+            if not known:
+                raise SpecError(f"{static}: no {name.split('_')[0]} on either side (the knee "
+                                "and ankle markers are missing)", where="--static",
+                                hint="a static trial with the epicondyle (L.Knee, "
+                                     "L.Knee.Medial) and malleolus (L.Ankle, L.Ankle.Medial) "
+                                     "markers")
+            athlete[name] = round(sum(known) / len(known), 4)
     return athlete or None
 
 
@@ -300,13 +327,17 @@ def register(app: typer.Typer) -> None:
         muscle_strength: float | None = _athlete_option("muscle_strength"),
         max_shortening_velocity: float | None = _athlete_option("max_shortening_velocity"),
         residual_limb: float | None = _athlete_option("residual_limb_length_m"),
+        thigh_length: float | None = _athlete_option("thigh_length_m"),
+        shank_length: float | None = _athlete_option("shank_length_m"),
+        static: Path | None = _static_option(),
         starts: int | None = typer.Option(
             None, "--starts", rich_help_panel=COLLOCATION, show_default=False,
             help="Solve the stride from up to K starts (the guess, the guess with the "
                  "barrier started at 1e-4, the template) and keep the best; each start's "
                  f"solve in OUT/starts/. Default: {defaults.ATHLETE_STARTS} for an athlete "
                  "scaled by --body-mass, --height, --muscle-strength, "
-                 "--max-shortening-velocity or --residual-limb (one start can land "
+                 "--max-shortening-velocity, --residual-limb, --thigh-length, "
+                 "--shank-length or --static (one start can land "
                  f"17 % too high there), else {defaults.STARTS}."),
     ) -> None:
         """Predict a running gait: solve one periodic stride of the human body by direct
@@ -328,8 +359,11 @@ def register(app: typer.Typer) -> None:
                 knee_flexion_max=knee_flexion_max, tilt_range=tilt_range,
                 alternating_steps=alternating_steps, prosthetic_load_max=prosthetic_load_max,
                 people_weight=people_weight,
-                athlete=_athlete(body_mass, height, muscle_strength, max_shortening_velocity,
-                                 residual_limb),
+                athlete=_athlete(static, body_mass_kg=body_mass, height_m=height,
+                                 muscle_strength=muscle_strength,
+                                 max_shortening_velocity=max_shortening_velocity,
+                                 residual_limb_length_m=residual_limb,
+                                 thigh_length_m=thigh_length, shank_length_m=shank_length),
                 starts=starts))
         from bladelab.cli.reflex import run_reflex  # deferred: keeps bladelab --help fast
 
@@ -453,6 +487,9 @@ def register(app: typer.Typer) -> None:
         muscle_strength: float | None = _athlete_option("muscle_strength"),
         max_shortening_velocity: float | None = _athlete_option("max_shortening_velocity"),
         residual_limb: float | None = _athlete_option("residual_limb_length_m"),
+        thigh_length: float | None = _athlete_option("thigh_length_m"),
+        shank_length: float | None = _athlete_option("shank_length_m"),
+        static: Path | None = _static_option(),
     ) -> None:
         """Category × speed grid: warm-started optimisations, maximum speed, cost at 4 m/s,
         200 m and 400 m times, contact times (seed 001 §2.2.2 B–C, Table 3.1). Running it again
@@ -485,8 +522,11 @@ def register(app: typer.Typer) -> None:
                 guess=guess, max_iter=max_iter, jobs=jobs, executor=executor, resume=resume,
                 force=force, as_json=as_json, starts=starts, body=body,
                 people_weight=people_weight, alternating_steps=alternating_steps,
-                athlete=_athlete(body_mass, height, muscle_strength,
-                                 max_shortening_velocity, residual_limb)))
+                athlete=_athlete(static, body_mass_kg=body_mass, height_m=height,
+                                 muscle_strength=muscle_strength,
+                                 max_shortening_velocity=max_shortening_velocity,
+                                 residual_limb_length_m=residual_limb,
+                                 thigh_length_m=thigh_length, shank_length_m=shank_length)))
         from bladelab.cli import reflex  # deferred: keeps bladelab --help fast
 
         if mode == "recipe":

@@ -43,7 +43,7 @@ from bladelab.runner.layout import (
     LAW_HUNT_CROSSLEY,
 )
 from bladelab.runner.multilink import add_multilink_blade, multilink_contact_rows
-from bladelab.runner.muscle import MP_COLUMNS
+from bladelab.runner.muscle import MP_COLUMNS, MP_LOPT, MP_LTS
 from bladelab.runner.params import (
     BLADE_ALIGNMENT_DEG,
     BLADE_EXTRA_LENGTH_M,
@@ -294,6 +294,10 @@ def build_runner(
     bodies: dict[str, object] = {}
     joint_child: dict[str, tuple[float, float, float]] = {}  # COM-relative joint point per body
 
+    def sb(name: str) -> float:
+        """The length scale of body ``name`` [-]: the height's, times its segment's factor."""
+        return s * _segment_factor(params, name)
+
     def inertial(body, name: str, com: list[float]) -> None:
         seg = params.segments[name]
         ixx, iyy, izz = seg.inertia_kg_m2
@@ -301,7 +305,7 @@ def build_runner(
         body.explicitinertial = True
         body.mass = seg.mass_kg * mr * km
         body.ipos = com
-        body.inertia = _lab_inertia(ixx, iyy, izz, mr * s * s * ki)
+        body.inertia = _lab_inertia(ixx, iyy, izz, mr * sb(name) * sb(name) * ki)
 
     pelvis = spec.worldbody.add_body(name="pelvis", pos=[0, 0, 0])
     pelvis.add_joint(name="pelvis_tx", type=mujoco.mjtJoint.mjJNT_SLIDE, axis=[1, 0, 0])
@@ -310,13 +314,20 @@ def build_runner(
     inertial(pelvis, "pelvis", [0, 0, 0])
     bodies["pelvis"] = pelvis
     joint_child["pelvis"] = (0.0, 0.0, 0.0)
+    # each body's joint point standing straight (OpenSim axes [m]), with the segments' length
+    # factors and without them: the muscles' neutral lengths, which scale their fibres and
+    # tendons (OpenSim's rule)
+    neutral = {"pelvis": (np.zeros(3), np.zeros(3))}
 
     def add(name: str, seg: str, joint: str, dof: str, parent: str, ppos, cpos, com=None):
         parent_origin = joint_child[parent]
-        pos = _v(_sub(ppos, parent_origin), s)
+        pos = _v(_sub(ppos, parent_origin), sb(parent))
+        offset = np.subtract(ppos, parent_origin)
+        neutral[name] = (neutral[parent][0] + offset * sb(parent),
+                         neutral[parent][1] + offset * s)
         body = bodies[parent].add_body(name=name, pos=pos)
         body.add_joint(name=dof, type=mujoco.mjtJoint.mjJNT_HINGE, axis=axis)
-        inertial(body, seg, _v(_sub((0, 0, 0), cpos), s) if com is None else com)
+        inertial(body, seg, _v(_sub((0, 0, 0), cpos), sb(name)) if com is None else com)
         bodies[name] = body
         joint_child[name] = cpos
         return body
@@ -328,9 +339,10 @@ def build_runner(
         )
         par, pp, pc = geo.JOINTS[f"knee_{side}"]
         if side == "r" and transfemoral:
-            knee = {"parent": "femur_r", "pos": _v(_sub(pp, joint_child["femur_r"]), s),
+            knee = {"parent": "femur_r", "pos": _v(_sub(pp, joint_child["femur_r"]),
+                                                   sb("femur_r")),
                     "joint": "knee_angle_r"}
-            depth = _prosthetic_bottom(s, 0.0)
+            depth = _prosthetic_bottom(s, params.shank_length_factor, 0.0)
             if blade_model is None:
                 _add_prosthesis(bodies, joint_child, params, s, mr, axis, depth=depth,
                                 com_fraction=PROSTHETIC_SHANK_COM, **knee)
@@ -338,17 +350,18 @@ def build_runner(
                 add_multilink_blade(bodies, joint_child, params, s, mr, axis, blade_model,
                                     depth, com_z=-PROSTHETIC_PYLON_COM_M, **knee)
         elif side == "r" and amputee:
-            res_len = params.residual_tibia_fraction * geo.TIBIA_LENGTH_M
-            com = [0.0, 0.0, -0.5 * res_len * s]
+            table_len = params.residual_tibia_fraction * geo.TIBIA_LENGTH_M  # at 1.80 m
+            res_len = table_len * sb("tibia_res_r")
+            com = [0.0, 0.0, -0.5 * res_len]
             add("tibia_res_r", "tibia_res_r", "knee_r", "knee_angle_r", "femur_r", pp, pc, com=com)
+            depth = _prosthetic_bottom(s, params.shank_length_factor, table_len)
             if blade_model is None:
                 _add_prosthesis(bodies, joint_child, params, s, mr, axis, parent="tibia_res_r",
-                                pos=[0.0, 0.0, -res_len * s], joint="socket_angle_r",
-                                depth=_prosthetic_bottom(s, res_len))
+                                pos=[0.0, 0.0, -res_len], joint="socket_angle_r",
+                                depth=depth)
             else:
                 add_multilink_blade(bodies, joint_child, params, s, mr, axis, blade_model,
-                                    _prosthetic_bottom(s, res_len),
-                                    pos=[0.0, 0.0, -res_len * s])
+                                    depth, pos=[0.0, 0.0, -res_len])
         else:
             add(
                 f"tibia_{side}",
@@ -387,9 +400,11 @@ def build_runner(
     path_sites: list[str] = []
     path_start = [0]
     tendons, actuators = [], []
+    neutral_length = np.zeros((len(names), 2))  # standing straight: scaled, uniform [m]
     for i, mname in enumerate(names):
         mtype, side = mname.rsplit("_", 1)
         tendon = spec.add_tendon(name=mname)
+        previous = None
         for k, (body_name, p) in enumerate(geo.muscle_path(mtype, side)):
             if body_name == "tibia_r" and amputee:
                 body_name, origin = "tibia_res_r", joint_child["tibia_res_r"]
@@ -400,7 +415,13 @@ def build_runner(
             else:
                 origin = joint_child[body_name]
             site = f"{mname}_p{k}"
-            bodies[body_name].add_site(name=site, pos=_v(_sub(p, origin), s))
+            bodies[body_name].add_site(name=site, pos=_v(_sub(p, origin), sb(body_name)))
+            local = np.subtract(p, origin)
+            point = (neutral[body_name][0] + local * sb(body_name),
+                     neutral[body_name][1] + local * s)
+            if previous is not None:
+                neutral_length[i] += [np.linalg.norm(point[j] - previous[j]) for j in (0, 1)]
+            previous = point
             tendon.wrap_site(site)
             path_sites.append(site)
         path_start.append(len(path_sites))
@@ -421,6 +442,10 @@ def build_runner(
             mt.passive_strain_at_fmax,
             params.max_shortening_velocity_lopt_per_s,
         )
+    if params.thigh_length_factor != 1.0 or params.shank_length_factor != 1.0:
+        ratio = neutral_length[:, 0] / neutral_length[:, 1]
+        mp[:, MP_LOPT] *= ratio
+        mp[:, MP_LTS] *= ratio
 
     analysis_model = spec.compile()
     # the simulation model has no tendons: bladelab computes the (straight-line, via-point) path
@@ -552,11 +577,24 @@ def _myodesis_point(p: tuple[float, float, float]) -> tuple[float, float, float]
     return _sub(knee_in_femur, _sub(knee_in_tibia, p))
 
 
-def _prosthetic_bottom(s: float, res_len: float) -> float:
-    """Depth [m] below the socket of the prosthetic leg's lowest point: the straight prosthetic
-    leg is 3 cm longer (knee to ground) than the intact one."""
-    intact = geo.TIBIA_LENGTH_M + geo.JOINTS["ankle_l"][2][1] + 0.015 + geo.FOOT_SPHERE_RADIUS_M
-    return (intact + BLADE_EXTRA_LENGTH_M) * s - res_len * s
+def _prosthetic_bottom(s: float, k_shank: float, res_len: float) -> float:
+    """Depth [m] below the socket of the prosthetic leg's lowest point, for a socket
+    ``res_len`` [m at 1.80 m, before ``k_shank``] below the knee: the straight prosthetic leg
+    is 3 cm longer (knee to ground) than the intact one, whose shank is ``k_shank`` times the
+    model's; ``s``: the height's scale."""
+    intact = (geo.TIBIA_LENGTH_M * k_shank + geo.JOINTS["ankle_l"][2][1] + 0.015
+              + geo.FOOT_SPHERE_RADIUS_M)
+    return (intact + BLADE_EXTRA_LENGTH_M) * s - res_len * k_shank * s
+
+
+def _segment_factor(params: RunnerParams, body: str) -> float:
+    """The length factor [-] of a body's segment: the thighs' and the shanks' (the residual
+    tibia's too) of the parameter set, 1 for every other body."""
+    if body.startswith("femur_"):
+        return params.thigh_length_factor
+    if body in ("tibia_l", "tibia_r", "tibia_res_r"):
+        return params.shank_length_factor
+    return 1.0
 
 
 def _add_prosthesis(bodies, joint_child, params, s, mr, axis, *, parent: str, pos,

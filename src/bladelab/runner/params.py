@@ -32,6 +32,8 @@ from bladelab._io import read_yaml
 from bladelab.contact import hertz_sphere_stiffness
 from bladelab.errors import InputFileError, SpecError
 from bladelab.runner.geometry import (
+    FOOT_SPHERE_RADIUS_M,
+    JOINTS,
     LEG_MUSCLES,
     RESIDUAL_TIBIA_FRACTION,
     SHANK_MUSCLES,
@@ -165,6 +167,12 @@ MAX_SHORTENING_VELOCITY_RANGE = (2.0, 30.0)
 #: long one that leaves the socket 4 cm above the ankle.
 RESIDUAL_TIBIA_FRACTION_RANGE = (0.2, 0.9)
 
+#: The range of a segment length factor (thigh, shank) a parameter set may give, relative to
+#: the height-scaled model's segment: people of one height differ by about ±10 % in each.
+SEGMENT_LENGTH_FACTOR_RANGE = (0.8, 1.3)
+#: The model's thigh (hip to knee joint centre) [m] at 1.80 m (SCONE's H0918).
+THIGH_LENGTH_M = 0.17 + 0.226
+
 
 class RunnerParams(_Strict):
     """A runner parameter set (one YAML file)."""
@@ -194,6 +202,16 @@ class RunnerParams(_Strict):
     residual_tibia_fraction: float = Field(
         default=RESIDUAL_TIBIA_FRACTION, ge=RESIDUAL_TIBIA_FRACTION_RANGE[0],
         le=RESIDUAL_TIBIA_FRACTION_RANGE[1])
+    #: Both thighs' length (hip to knee joint centre) over the height-scaled model's
+    #: (:data:`THIGH_LENGTH_M` at 1.80 m) [-]: the femur's joints, muscle points and inertia
+    #: scale with it (its mass stays), and every muscle's optimal fibre and tendon slack lengths
+    #: follow its muscle–tendon length standing straight (OpenSim's scaling rule).
+    thigh_length_factor: float = Field(default=1.0, ge=SEGMENT_LENGTH_FACTOR_RANGE[0],
+                                       le=SEGMENT_LENGTH_FACTOR_RANGE[1])
+    #: The same for both shanks (knee to ankle joint centre, the tibia's
+    #: ``TIBIA_LENGTH_M`` at 1.80 m; the residual tibia keeps its fraction of it) [-].
+    shank_length_factor: float = Field(default=1.0, ge=SEGMENT_LENGTH_FACTOR_RANGE[0],
+                                       le=SEGMENT_LENGTH_FACTOR_RANGE[1])
     segments: dict[str, Segment]
     muscle_types: dict[str, MuscleType]
     #: Gravity of this model [m/s²]: 9.81, the value the seed-001 runner and its shipped reflex
@@ -372,6 +390,15 @@ def residual_tibia_factors(params: RunnerParams) -> tuple[float, float]:
     return k, k**3
 
 
+def leg_length_factor(params: RunnerParams) -> float:
+    """The standing leg's length (hip joint to the sole) over the height-scaled model's [-]:
+    1 unless the thighs or shanks have their own length factors."""
+    foot = JOINTS["ankle_l"][2][1] + 0.015 + FOOT_SPHERE_RADIUS_M
+    scaled = (params.thigh_length_factor * THIGH_LENGTH_M
+              + params.shank_length_factor * TIBIA_LENGTH_M + foot)
+    return scaled / (THIGH_LENGTH_M + TIBIA_LENGTH_M + foot)
+
+
 def scale_ratios(params: RunnerParams) -> tuple[float, float]:
     """(mass ratio, length ratio) of the athlete to the parameter set's segment tables: the
     muscles' forces scale with them (:func:`muscle_max_force`)."""
@@ -517,17 +544,21 @@ def default_runner_params(
 #: another athlete has the same parameters but these).
 ATHLETE_PARAM_FIELDS = frozenset({"athlete", "active_specific_tension_N_per_cm2",
                                   "max_shortening_velocity_lopt_per_s",
-                                  "residual_tibia_fraction"})
+                                  "residual_tibia_fraction", "thigh_length_factor",
+                                  "shank_length_factor"})
 #: Fields of an athlete that :func:`athlete_params` changes, with their units.
 ATHLETE_FIELDS = {"body_mass_kg": "kg", "height_m": "m", "muscle_strength": "-",
-                  "max_shortening_velocity": "l_opt/s", "residual_limb_length_m": "m"}
+                  "max_shortening_velocity": "l_opt/s", "residual_limb_length_m": "m",
+                  "thigh_length_m": "m", "shank_length_m": "m"}
 
 
 def athlete_params(params: RunnerParams, *, body_mass_kg: float | None = None,
                    height_m: float | None = None,
                    muscle_strength: float | None = None,
                    max_shortening_velocity: float | None = None,
-                   residual_limb_length_m: float | None = None) -> RunnerParams:
+                   residual_limb_length_m: float | None = None,
+                   thigh_length_m: float | None = None,
+                   shank_length_m: float | None = None) -> RunnerParams:
     """The parameter set scaled to another athlete (None keeps the set's value).
 
     ``body_mass_kg`` [kg] and ``height_m`` [m] replace :class:`Athlete`'s: segment masses
@@ -543,7 +574,11 @@ def athlete_params(params: RunnerParams, *, body_mass_kg: float | None = None,
     set): the fibres' speed, which a larger fast-twitch share raises.
     ``residual_limb_length_m`` [m] is the transtibial amputee's residual tibia, knee joint to
     its distal end (:attr:`RunnerParams.residual_tibia_fraction` of the athlete's tibia,
-    0.258 m at 1.80 m unless set).
+    0.258 m at 1.80 m unless set). ``thigh_length_m`` and ``shank_length_m`` [m] are the
+    athlete's thighs (hip to knee joint centre) and shanks (knee to ankle joint centre), e.g.
+    from a static trial (:func:`bladelab.trial.segment_lengths`); unless set, 0.396 m and
+    0.430 m times the height over 1.80 m. The residual limb's length is a fraction of the
+    shank given here.
     """
     data = params.model_dump()
     athlete = dict(data["athlete"])
@@ -567,22 +602,42 @@ def athlete_params(params: RunnerParams, *, body_mass_kg: float | None = None,
                             where="athlete.max_shortening_velocity",
                             hint="10 is the body's own")
         data["max_shortening_velocity_lopt_per_s"] = float(max_shortening_velocity)
+    ratio = athlete["height_m"] / 1.80
+    for name, value, reference in (("thigh", thigh_length_m, THIGH_LENGTH_M),
+                                   ("shank", shank_length_m, TIBIA_LENGTH_M)):
+        if value is not None:
+            data[f"{name}_length_factor"] = _segment_factor(name, value, reference * ratio)
     if residual_limb_length_m is not None:
+        tibia = TIBIA_LENGTH_M * ratio * data["shank_length_factor"]
         data["residual_tibia_fraction"] = _residual_fraction(
-            params.kind, residual_limb_length_m, athlete["height_m"])
+            params.kind, residual_limb_length_m, tibia, athlete["height_m"])
     return runner_params_from_dict(data, source="athlete")
 
 
-def _residual_fraction(kind: str, length_m, height_m: float) -> float:
-    """The residual tibia's fraction of the tibia for a residual limb ``length_m`` [m] of an
-    athlete ``height_m`` [m] tall; a clear error outside the accepted range or for a runner
-    without a residual tibia."""
+def _segment_factor(name: str, length_m, model_m: float) -> float:
+    """The length factor of a segment ``length_m`` [m] long against the model's ``model_m``
+    [m]; a clear error outside :data:`SEGMENT_LENGTH_FACTOR_RANGE`."""
+    lo, hi = (f * model_m for f in SEGMENT_LENGTH_FACTOR_RANGE)
+    if not (isinstance(length_m, int | float) and not isinstance(length_m, bool)
+            and lo <= length_m <= hi):
+        raise SpecError(f"the {name}'s length must be within {lo:.3f}–{hi:.3f} m (80–130 % of "
+                        f"the model's {model_m:.3f} m at this height), got {length_m!r}",
+                        where=f"athlete.{name}_length_m",
+                        hint=f"the {name} from the hip to the knee joint centre"
+                        if name == "thigh" else "the shank from the knee to the ankle joint "
+                        "centre")
+    return float(length_m) / model_m
+
+
+def _residual_fraction(kind: str, length_m, tibia: float, height_m: float) -> float:
+    """The residual tibia's fraction of the athlete's ``tibia`` [m] for a residual limb
+    ``length_m`` [m] of an athlete ``height_m`` [m] tall; a clear error outside the accepted
+    range or for a runner without a residual tibia."""
     where = "athlete.residual_limb_length_m"
     if kind != "amputee":
         raise SpecError(f"the {kind} runner has no residual tibia", where=where,
                         hint="the residual limb's length is the transtibial amputee's "
                              "(model amputee)")
-    tibia = TIBIA_LENGTH_M * height_m / 1.80
     lo, hi = (f * tibia for f in RESIDUAL_TIBIA_FRACTION_RANGE)
     if not (isinstance(length_m, int | float) and not isinstance(length_m, bool)
             and lo <= length_m <= hi):
@@ -625,6 +680,7 @@ __all__ = [
     "blade_modulus",
     "default_runner_params",
     "hertz_compression",
+    "leg_length_factor",
     "load_runner_params",
     "read_runner_yaml",
     "residual_tibia_factors",

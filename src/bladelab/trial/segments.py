@@ -66,6 +66,10 @@ class SegmentLengths:
 
 
 def _mean(trial: Trial, label: str) -> np.ndarray:
+    if label not in trial.markers:
+        raise DataError(f"no marker named {label!r}", file=trial.source, where=f"marker {label}",
+                        hint="a static trial with the pelvis (ASIS, PSIS), knee (epicondyles) "
+                             "and ankle (malleoli) markers; other names: SegmentMarkerMap")
     xyz = trial.marker(label)
     if not np.isfinite(xyz).all(axis=1).any():
         raise DataError("has no valid frame", file=trial.source, where=f"marker {label}",

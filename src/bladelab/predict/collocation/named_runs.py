@@ -64,7 +64,8 @@ def solve_named_stride(
     wearing ``blade`` (None: the model's default blade) with the ``body`` (seed 001's, or
     ``toes``), from the initial guess ``guess`` (module docstring), into the folder ``out``;
     ``athlete`` (``body_mass_kg`` [kg], ``height_m`` [m], ``muscle_strength`` [-],
-    ``max_shortening_velocity`` [l_opt/s], ``residual_limb_length_m`` [m], any of them;
+    ``max_shortening_velocity`` [l_opt/s], ``residual_limb_length_m``, ``thigh_length_m``,
+    ``shank_length_m`` [m], any of them;
     :func:`bladelab.runner.params.athlete_params`) scales the runner to another athlete.
 
     ``settings`` (default :class:`CollocationSettings`) say the problem (mesh intervals [-],

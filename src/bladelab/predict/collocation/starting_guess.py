@@ -31,6 +31,7 @@ from bladelab.runner.params import (
     PROSTHETIC_KINDS,
     RUNNER_DATA_DIR,
     default_runner_params,
+    leg_length_factor,
 )
 
 __all__ = ["GUESS_WORDS", "MAX_SPEED_TEMPLATE_M_PER_S", "STORED_STRIDES", "first_origin",
@@ -66,19 +67,21 @@ def stored_stride_path(runner) -> Path | None:
 def scaled_to_athlete(stride: StrideGuess, runner) -> StrideGuess:
     """A stride of the human body as the start of another athlete of that body
     (:func:`~bladelab.runner.params.athlete_params`): the pelvis's translations scaled by the
-    heights' ratio and the multipliers dropped, which belong to the stored athlete's problem
+    heights' ratio (its height also by the legs' length, :func:`leg_length_factor`) and the
+    multipliers dropped, which belong to the stored athlete's problem
     (measured: with them, a 68 kg, 1.75 m amputee's solve still stood at twice the stored
     stride's objective after 881 iterations); the stride itself for the body's own athlete."""
     body = default_runner_params(runner.kind, body="human")
     if runner.params.model_dump(exclude={"blade"}) == body.model_dump(exclude={"blade"}):
         return stride
     ratio = runner.params.athlete.height_m / body.athlete.height_m
+    leg = leg_length_factor(runner.params) / leg_length_factor(body)
     names = list(stride.dof_names or runner.dof_names)
     q, qd = stride.q.copy(), stride.qd.copy()
     qdd = None if stride.qdd is None else stride.qdd.copy()
-    for j in (names.index("pelvis_tx"), names.index("pelvis_tz")):
+    for j, factor in ((names.index("pelvis_tx"), ratio), (names.index("pelvis_tz"), ratio * leg)):
         for a in (q, qd) if qdd is None else (q, qd, qdd):
-            a[:, j] *= ratio
+            a[:, j] *= factor
     return dataclasses.replace(stride, q=q, qd=qd, qdd=qdd, multipliers=None,
                                source=f"{stride.source}, scaled to the athlete")
 

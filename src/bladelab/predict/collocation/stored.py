@@ -49,7 +49,8 @@ def check_model_spec(spec) -> dict:
     :func:`bladelab.blade.spec.spec_from_dict` reads them; ``"blade"`` is then its name), plus
     ``"athlete"`` where the runner is scaled to another athlete than the parameter set's
     (``{"body_mass_kg": kg, "height_m": m, "muscle_strength": factor,
-    "max_shortening_velocity": l_opt/s, "residual_limb_length_m": m}``, any of them;
+    "max_shortening_velocity": l_opt/s, "residual_limb_length_m": m, "thigh_length_m": m,
+    "shank_length_m": m}``, any of them;
     :func:`bladelab.runner.params.athlete_params`), checked and normalised (the able model has
     no blade; the amputee needs one; files written before the bodies existed have no
     ``"body"`` and mean seed 001's)."""
@@ -128,6 +129,8 @@ def athlete_label(spec: dict) -> str:
               if "max_shortening_velocity" in athlete else [])
     parts += ([f"residual limb {athlete['residual_limb_length_m']:g} m"]
               if "residual_limb_length_m" in athlete else [])
+    parts += [f"{name} {athlete[f'{name}_length_m']:.3g} m" for name in ("thigh", "shank")
+              if f"{name}_length_m" in athlete]
     return ", ".join(parts)
 
 
