@@ -13,6 +13,7 @@ import trial_synth as synth
 from bladelab.cli import main
 from bladelab.trial.stance import read_stance_csv
 from conftest import FUKUCHI_RUN as FUKUCHI
+from conftest import FUKUCHI_STATIC
 
 
 @pytest.fixture(scope="module")
@@ -30,6 +31,24 @@ def test_info(capsys):
     info = json.loads(capsys.readouterr().out)
     assert info["marker_rate_Hz"] == 150.0 and info["platforms"][0]["type"] == 4
     assert info["platforms"][0]["channels"] == ["F1X", "F1Y", "F1Z", "M1X", "M1Y", "M1Z"]
+
+
+def test_segments_of_a_static_trial(capsys):
+    """``bladelab trial segments``: the static trial's thighs and shanks in metres (what
+    ``predict --static`` uses); a trial without the knee markers says so, and its JSON holds
+    null, not NaN."""
+    from bladelab.trial import read_c3d, segment_lengths
+
+    assert main(["trial", "segments", str(FUKUCHI_STATIC), "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    want = segment_lengths(read_c3d(FUKUCHI_STATIC))
+    assert data["thigh_m"] == pytest.approx(want.thigh_m) and data["shank_m"]["left"] > 0.4
+    assert main(["trial", "segments", str(FUKUCHI_STATIC)]) == 0
+    assert f"left leg:     thigh {want.thigh_m['left']:.3f} m" in capsys.readouterr().out
+    assert main(["trial", "segments", str(FUKUCHI)]) == 0
+    assert "thigh none (no epicondyle markers)" in capsys.readouterr().out
+    assert main(["trial", "segments", str(FUKUCHI), "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["thigh_m"] == {"left": None, "right": None}
 
 
 def test_stances_json(synthetic, capsys):

@@ -1,8 +1,10 @@
-"""``bladelab trial ...``: inspect C3D trials, list their stances, extract a stance CSV."""
+"""``bladelab trial ...``: inspect C3D trials, list their stances, extract a stance CSV,
+measure the legs' segments of a static trial."""
 
 from __future__ import annotations
 
 import json
+import math
 from pathlib import Path
 
 import typer
@@ -147,6 +149,36 @@ def _extract(
         f"wrote {out}: stance {stance}, {len(result.time)} samples at {rate:g} Hz, "
         f"peak GRF {result.grf_z.max():.0f} N"
     )
+
+
+@trial_app.command("segments")
+def _segments(
+    file: Path = typer.Argument(..., help="Static (standing) C3D trial."),
+    as_json: bool = typer.Option(False, "--json", help="Print JSON instead of text."),
+) -> None:
+    """Thigh and shank lengths [m] of each leg from a static trial's anatomical markers
+    (Harrington's hip joint centres, epicondyles, malleoli; docs/trial.md): what
+    `bladelab predict --static` scales the runner's legs to."""
+    from bladelab.trial.segments import segment_lengths  # deferred: keeps bladelab --help fast
+
+    lengths = segment_lengths(_read(file, "auto", "auto"))
+    if as_json:  # a side without the markers: null
+        data = lengths.to_dict()
+        for key in ("thigh_m", "shank_m"):
+            data[key] = {k: (v if math.isfinite(v) else None) for k, v in data[key].items()}
+        typer.echo(json.dumps(data, indent=2))
+        return
+
+    def text(value: float, missing: str) -> str:
+        return f"{value:.3f} m" if math.isfinite(value) else f"none ({missing})"
+
+    typer.echo(f"file:         {lengths.source}")
+    for side in lengths.thigh_m:
+        typer.echo(f"{side + ' leg:':<13} thigh "
+                   f"{text(lengths.thigh_m[side], 'no epicondyle markers')}, shank "
+                   f"{text(lengths.shank_m[side], 'no epicondyle or malleolus markers')}")
+    typer.echo(f"pelvis:       width {lengths.pelvic_width_m:.3f} m (between the ASIS), "
+               f"depth {lengths.pelvic_depth_m:.3f} m (to the PSIS)")
 
 
 def register(app: typer.Typer) -> None:
