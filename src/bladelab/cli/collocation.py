@@ -126,8 +126,8 @@ def run_collocation(
     2 not converged). ``alternating_steps``: ``CollocationSettings.step_phase_tolerance``;
     ``prosthetic_load_max``: ``CollocationSettings.prosthetic_load_max_bw``.
     ``athlete``: the runner scaled to this athlete (``body_mass_kg``, ``height_m``,
-    ``muscle_strength``, ``max_shortening_velocity``, ``residual_limb_length_m``; None: the
-    body's own). ``starts``:
+    ``muscle_strength``, ``max_shortening_velocity``, ``residual_limb_length_m``,
+    ``thigh_length_m``, ``shank_length_m``; None: the body's own). ``starts``:
     starts of the stride, the best kept (None: :data:`~bladelab.predict.defaults.ATHLETE_STARTS` for a
     scaled athlete, else :data:`~bladelab.predict.defaults.STARTS`)."""
     if starts is None:

@@ -31,6 +31,7 @@ JOINTS: dict[str, tuple[str, tuple[float, float, float], tuple[float, float, flo
 }
 
 TIBIA_LENGTH_M = 0.1867 + 0.2433  # knee to ankle
+THIGH_LENGTH_M = JOINTS["hip_l"][2][1] - JOINTS["knee_l"][1][1]  # hip to knee
 RESIDUAL_TIBIA_FRACTION = 0.6
 
 # Foot contact spheres on the calcaneus (COM-relative), radius 0.03 m.
@@ -39,6 +40,8 @@ FOOT_SPHERES: dict[str, tuple[float, float, float]] = {
     "toe": (0.085, -0.015, 0.0),
 }
 FOOT_SPHERE_RADIUS_M = 0.03
+# ankle joint to the sole of the foot standing flat (the spheres' lowest points)
+ANKLE_TO_SOLE_M = JOINTS["ankle_l"][2][1] - FOOT_SPHERES["heel"][1] + FOOT_SPHERE_RADIUS_M
 
 # Muscle paths: list of (body, point) for the right side; the left side mirrors z.
 # Leg muscles from H0918; torso muscles are ours (H0918 has none).

@@ -582,8 +582,7 @@ def _prosthetic_bottom(s: float, k_shank: float, res_len: float) -> float:
     ``res_len`` [m at 1.80 m, before ``k_shank``] below the knee: the straight prosthetic leg
     is 3 cm longer (knee to ground) than the intact one, whose shank is ``k_shank`` times the
     model's; ``s``: the height's scale."""
-    intact = (geo.TIBIA_LENGTH_M * k_shank + geo.JOINTS["ankle_l"][2][1] + 0.015
-              + geo.FOOT_SPHERE_RADIUS_M)
+    intact = geo.TIBIA_LENGTH_M * k_shank + geo.ANKLE_TO_SOLE_M
     return (intact + BLADE_EXTRA_LENGTH_M) * s - res_len * k_shank * s
 
 

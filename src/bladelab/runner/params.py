@@ -32,11 +32,11 @@ from bladelab._io import read_yaml
 from bladelab.contact import hertz_sphere_stiffness
 from bladelab.errors import InputFileError, SpecError
 from bladelab.runner.geometry import (
-    FOOT_SPHERE_RADIUS_M,
-    JOINTS,
+    ANKLE_TO_SOLE_M,
     LEG_MUSCLES,
     RESIDUAL_TIBIA_FRACTION,
     SHANK_MUSCLES,
+    THIGH_LENGTH_M,
     TIBIA_LENGTH_M,
     TORSO_MUSCLES,
 )
@@ -170,8 +170,6 @@ RESIDUAL_TIBIA_FRACTION_RANGE = (0.2, 0.9)
 #: The range of a segment length factor (thigh, shank) a parameter set may give, relative to
 #: the height-scaled model's segment: people of one height differ by about ±10 % in each.
 SEGMENT_LENGTH_FACTOR_RANGE = (0.8, 1.3)
-#: The model's thigh (hip to knee joint centre) [m] at 1.80 m (SCONE's H0918).
-THIGH_LENGTH_M = 0.17 + 0.226
 
 
 class RunnerParams(_Strict):
@@ -203,7 +201,7 @@ class RunnerParams(_Strict):
         default=RESIDUAL_TIBIA_FRACTION, ge=RESIDUAL_TIBIA_FRACTION_RANGE[0],
         le=RESIDUAL_TIBIA_FRACTION_RANGE[1])
     #: Both thighs' length (hip to knee joint centre) over the height-scaled model's
-    #: (:data:`THIGH_LENGTH_M` at 1.80 m) [-]: the femur's joints, muscle points and inertia
+    #: (``THIGH_LENGTH_M``, 0.396 m at 1.80 m) [-]: the femur's joints, muscle points and inertia
     #: scale with it (its mass stays), and every muscle's optimal fibre and tendon slack lengths
     #: follow its muscle–tendon length standing straight (OpenSim's scaling rule).
     thigh_length_factor: float = Field(default=1.0, ge=SEGMENT_LENGTH_FACTOR_RANGE[0],
@@ -393,10 +391,9 @@ def residual_tibia_factors(params: RunnerParams) -> tuple[float, float]:
 def leg_length_factor(params: RunnerParams) -> float:
     """The standing leg's length (hip joint to the sole) over the height-scaled model's [-]:
     1 unless the thighs or shanks have their own length factors."""
-    foot = JOINTS["ankle_l"][2][1] + 0.015 + FOOT_SPHERE_RADIUS_M
     scaled = (params.thigh_length_factor * THIGH_LENGTH_M
-              + params.shank_length_factor * TIBIA_LENGTH_M + foot)
-    return scaled / (THIGH_LENGTH_M + TIBIA_LENGTH_M + foot)
+              + params.shank_length_factor * TIBIA_LENGTH_M + ANKLE_TO_SOLE_M)
+    return scaled / (THIGH_LENGTH_M + TIBIA_LENGTH_M + ANKLE_TO_SOLE_M)
 
 
 def scale_ratios(params: RunnerParams) -> tuple[float, float]:
@@ -595,8 +592,7 @@ def athlete_params(params: RunnerParams, *, body_mass_kg: float | None = None,
         data["active_specific_tension_N_per_cm2"] = active * float(muscle_strength)
     if max_shortening_velocity is not None:
         lo, hi = MAX_SHORTENING_VELOCITY_RANGE
-        if not (isinstance(max_shortening_velocity, int | float)
-                and lo <= max_shortening_velocity <= hi):
+        if not _number_within(max_shortening_velocity, lo, hi):
             raise SpecError(f"the maximum shortening velocity must be within {lo:g}–{hi:g} "
                             f"optimal fibre lengths/s, got {max_shortening_velocity!r}",
                             where="athlete.max_shortening_velocity",
@@ -606,7 +602,7 @@ def athlete_params(params: RunnerParams, *, body_mass_kg: float | None = None,
     for name, value, reference in (("thigh", thigh_length_m, THIGH_LENGTH_M),
                                    ("shank", shank_length_m, TIBIA_LENGTH_M)):
         if value is not None:
-            data[f"{name}_length_factor"] = _segment_factor(name, value, reference * ratio)
+            data[f"{name}_length_factor"] = _length_factor(name, value, reference * ratio)
     if residual_limb_length_m is not None:
         tibia = TIBIA_LENGTH_M * ratio * data["shank_length_factor"]
         data["residual_tibia_fraction"] = _residual_fraction(
@@ -614,12 +610,17 @@ def athlete_params(params: RunnerParams, *, body_mass_kg: float | None = None,
     return runner_params_from_dict(data, source="athlete")
 
 
-def _segment_factor(name: str, length_m, model_m: float) -> float:
+def _number_within(value, lo: float, hi: float) -> bool:
+    """Whether ``value`` is a number (not a bool) within ``lo``–``hi`` (NaN is not)."""
+    return (isinstance(value, int | float) and not isinstance(value, bool)
+            and lo <= value <= hi)
+
+
+def _length_factor(name: str, length_m, model_m: float) -> float:
     """The length factor of a segment ``length_m`` [m] long against the model's ``model_m``
     [m]; a clear error outside :data:`SEGMENT_LENGTH_FACTOR_RANGE`."""
     lo, hi = (f * model_m for f in SEGMENT_LENGTH_FACTOR_RANGE)
-    if not (isinstance(length_m, int | float) and not isinstance(length_m, bool)
-            and lo <= length_m <= hi):
+    if not _number_within(length_m, lo, hi):
         raise SpecError(f"the {name}'s length must be within {lo:.3f}–{hi:.3f} m (80–130 % of "
                         f"the model's {model_m:.3f} m at this height), got {length_m!r}",
                         where=f"athlete.{name}_length_m",
@@ -639,8 +640,7 @@ def _residual_fraction(kind: str, length_m, tibia: float, height_m: float) -> fl
                         hint="the residual limb's length is the transtibial amputee's "
                              "(model amputee)")
     lo, hi = (f * tibia for f in RESIDUAL_TIBIA_FRACTION_RANGE)
-    if not (isinstance(length_m, int | float) and not isinstance(length_m, bool)
-            and lo <= length_m <= hi):
+    if not _number_within(length_m, lo, hi):
         raise SpecError(f"the residual limb's length must be within {lo:.3f}–{hi:.3f} m "
                         f"(20–90 % of the tibia of a {height_m:g} m athlete), got {length_m!r}",
                         where=where, hint=f"{RESIDUAL_TIBIA_FRACTION * tibia:.3f} m is the "

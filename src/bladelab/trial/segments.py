@@ -90,7 +90,7 @@ def _hip_centres(trial: Trial, names: SegmentMarkerMap) -> tuple[dict, float, fl
     back = 0.5 * (psis[0] + psis[1])
     forward = origin - back
     x = forward - np.dot(forward, z) * z
-    depth = float(np.linalg.norm(origin - back))
+    depth = float(np.linalg.norm(forward))
     x /= np.linalg.norm(x)
     y = np.cross(z, x)
     pw_mm, pd_mm = 1000.0 * width, 1000.0 * depth
