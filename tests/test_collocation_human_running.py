@@ -102,6 +102,16 @@ def test_prosthetic_leg_may_touch_shorter_and_no_flight_fails():
     assert not by_name["flight phase"].met
 
 
+def test_a_transtibial_runner_lands_softer_on_the_blade_than_on_the_intact_leg():
+    ratio = "peak vertical ground force, prosthetic / intact leg"
+    for peaks, met in (((3.0, 2.7), True), ((2.84, 2.92), False)):
+        crit = {c.name: c for c in human_running_criteria(
+            _stride(speed=4.0, model="amputee", contact=(0.22, 0.19), peak_bw=peaks))}
+        assert crit[ratio].value == pytest.approx(peaks[1] / peaks[0])
+        assert crit[ratio].met is met
+    assert ratio not in {c.name for c in human_running_criteria(_stride())}
+
+
 def test_fast_strides_have_no_cost_band_and_say_when_a_band_is_held():
     crit = human_running_criteria(_stride(speed=10.0, contact=(0.1, 0.1), peak_bw=(3.5, 3.5),
                                           period=0.45, knee_deg=(120, 120)))

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import json
 import math
+import shutil
 import time
 from pathlib import Path
 
@@ -22,8 +23,14 @@ import typer
 from bladelab.cli.panels import renamed
 from bladelab.errors import BladelabError, SpecError
 from bladelab.predict import defaults
+from bladelab.predict.collocation.mesh_check import (
+    MESH_CHECK_DIR,
+    MeshCheck,
+    mesh_check_in_folder,
+)
 from bladelab.predict.collocation.named_runs import solve_named_stride
 from bladelab.predict.collocation.settings import CollocationSettings, people_term
+from bladelab.predict.collocation.stored import runner_from_spec
 
 __all__ = ["OPTIONS", "PROGRESS_EVERY_S", "StageProgress", "run_collocation"]
 
@@ -43,7 +50,7 @@ OPTIONS = {
     "athlete.max_shortening_velocity": "--max-shortening-velocity",
     "athlete.residual_limb_length_m": "--residual-limb",
     "athlete.thigh_length_m": "--thigh-length", "athlete.shank_length_m": "--shank-length",
-    "starts": "--starts",
+    "starts": "--starts", "mesh check": "--mesh-check",
 }
 
 
@@ -78,12 +85,32 @@ def _text(summary: dict, path: Path, solved: bool) -> str:
     head = "solution" if summary["converged"] else "best iterate (not converged)"
     lines = [f"{head}: {path}" + ("" if solved else " (already solved: read back)")]
     for key, value in summary.items():
-        if key == "warnings":
+        if key in ("warnings", "mesh_check"):
             continue
         lines.append(f"  {key}: {value:.4g}" if isinstance(value, float)
                      else f"  {key}: {value}")
     lines += [f"  warning: {w}" for w in (summary.get("warnings") or "").split("; ") if w]
+    if summary.get("mesh_check"):
+        check = MeshCheck.from_dict(summary["mesh_check"])
+        lines.append(f"  {check.verdict()}")
+        lines += [f"    {q}: {a} → {b} ({c})" for q, a, b, c in check.table()]
     return "\n".join(lines)
+
+
+def _mesh_check(out: Path, sol, *, asked: bool, solved: bool, resume: bool, max_iter: int):
+    """The mesh-halving check of a converged stride in ``out`` (None if not asked or the
+    stride did not converge); a check in the folder from an earlier stride is removed when
+    the stride was solved anew, so that the report never shows a stale one."""
+    folder = Path(out) / MESH_CHECK_DIR
+    if solved and folder.exists() and not asked:
+        shutil.rmtree(folder)
+    if not asked or not sol.converged:
+        return None
+    runner = runner_from_spec(sol.model_spec)
+    check = mesh_check_in_folder(out, runner, sol, resume=resume and not solved,
+                                 max_iter=max_iter, progress=StageProgress(prefix="mesh check: "))
+    typer.echo(check.verdict(), err=True)
+    return check
 
 
 def _tilt_range(text: str | None) -> tuple[float, float] | None:
@@ -121,6 +148,7 @@ def run_collocation(
     people_weight: float | None = None,
     athlete: dict | None = None,
     starts: int | None = None,
+    mesh_check: bool = False,
 ) -> int:
     """Run ``bladelab predict --method collocation``; returns the exit status (0 converged,
     2 not converged). ``alternating_steps``: ``CollocationSettings.step_phase_tolerance``;
@@ -129,7 +157,10 @@ def run_collocation(
     ``muscle_strength``, ``max_shortening_velocity``, ``residual_limb_length_m``,
     ``thigh_length_m``, ``shank_length_m``; None: the body's own). ``starts``:
     starts of the stride, the best kept (None: :data:`~bladelab.predict.defaults.ATHLETE_STARTS` for a
-    scaled athlete, else :data:`~bladelab.predict.defaults.STARTS`)."""
+    scaled athlete, else :data:`~bladelab.predict.defaults.STARTS`). ``mesh_check``: the
+    converged stride solved again on twice the mesh intervals and compared
+    (:mod:`~bladelab.predict.collocation.mesh_check`); a check left from an earlier solve in
+    the folder is removed when the stride is solved anew."""
     if starts is None:
         starts = defaults.ATHLETE_STARTS if athlete else defaults.STARTS
     tilt = _tilt_range(tilt_range)
@@ -146,10 +177,14 @@ def run_collocation(
                                     starts=starts, resume=resume, force=force,
                                     progress=StageProgress(),
                                     say=lambda line: typer.echo(line, err=True))
+        sol = result.solution
+        check = _mesh_check(out, sol, asked=mesh_check, solved=result.solved, resume=resume,
+                            max_iter=max_iter)
     except BladelabError as err:
         raise renamed(err, OPTIONS) from None
-    sol = result.solution
     summary = sol.summary()
+    if check is not None:
+        summary["mesh_check"] = check.to_dict()
     typer.echo(json.dumps(summary) if as_json else _text(summary, result.path, result.solved))
     if sol.converged:
         return 0

@@ -339,6 +339,13 @@ def register(app: typer.Typer) -> None:
                  "--max-shortening-velocity, --residual-limb, --thigh-length, "
                  "--shank-length or --static (one start can land "
                  f"17 % too high there), else {defaults.STARTS}."),
+        mesh_check: bool = typer.Option(
+            False, "--mesh-check", rich_help_panel=COLLOCATION,
+            help="After the solve, solve the same problem on twice the mesh intervals from "
+                 "the stride and say what it moved (objective, stride time, cost of "
+                 "transport, contacts, peaks; settled: objective and stride time within 1 %); "
+                 "kept in OUT/mesh-check/, shown in the report. About 2-5 times the solve's "
+                 "time."),
     ) -> None:
         """Predict a running gait: solve one periodic stride of the human body by direct
         collocation (writes DIR/solution.json; exit status 2 and DIR/best_iterate.json if
@@ -364,7 +371,7 @@ def register(app: typer.Typer) -> None:
                                  max_shortening_velocity=max_shortening_velocity,
                                  residual_limb_length_m=residual_limb,
                                  thigh_length_m=thigh_length, shank_length_m=shank_length),
-                starts=starts))
+                starts=starts, mesh_check=mesh_check))
         from bladelab.cli.reflex import run_reflex  # deferred: keeps bladelab --help fast
 
         run_reflex(

@@ -32,6 +32,7 @@ from bladelab.predict.collocation.human_running import (
     human_running_criteria,
     stride_from_left_touchdown,
 )
+from bladelab.predict.collocation.mesh_check import read_mesh_check
 from bladelab.predict.collocation.model import build_collocation_model
 from bladelab.predict.collocation.settings import PEOPLE_REFERENCE
 from bladelab.predict.collocation.solution import (
@@ -179,9 +180,24 @@ def reference_term_text(settings, share: str = "", *,
             f"weight {settings.reference_weight:g} 1/rad²{share}.")
 
 
-def _add_human_running_section(report, sol, trial) -> None:
+def _mesh_check_of(path: Path, sol):
+    """The mesh-halving check kept beside the solution (its folder's ``mesh-check/``), or
+    None if there is none or it was made of another stride."""
+    check = read_mesh_check(path if path.is_dir() else path.parent)
+    return check if check is not None and check.describes(sol) else None
+
+
+def _mesh_check_text(check) -> str:
+    if check is None:
+        return (" Not checked on a finer mesh (bladelab predict --mesh-check solves it on "
+                "twice the mesh intervals): until then, differences of a few per cent between "
+                "strides may be the mesh's.")
+    return f" {check.verdict()}."
+
+
+def _add_human_running_section(report, sol, trial, check=None) -> None:
     """The stride against measured human running, criterion by criterion (the report's first
-    words about a gait)."""
+    words about a gait), and its mesh-halving check (``check``, or None)."""
     crit = human_running_criteria(sol)
     if trial is not None:
         crit += angle_agreement(sol, trial.q)
@@ -202,8 +218,16 @@ def _add_human_running_section(report, sol, trial) -> None:
               "the Fukuchi et al. 2017 trial at 3.5 m/s, Weyand et al. 2000 and "
               "Nummela et al. 2007 at 9 m/s, interpolated in speed between them)"
               + ("; joint angles against the measured 3.5 m/s stride." if trial is not None
-                 else ".")),
-        tables=[("The stride against people running at its speed", table)],
+                 else ".") + _mesh_check_text(check)),
+        tables=[("The stride against people running at its speed", table)]
+        + ([] if check is None else [(
+            f"Mesh-halving check: the same problem on {check.fine_intervals} mesh intervals "
+            f"against this stride's {check.coarse_intervals}"
+            + ("" if check.converged else " (the finer solve did not converge: a best "
+               "iterate's numbers)"),
+            pd.DataFrame([{"quantity": q, f"{check.coarse_intervals} intervals": a,
+                           f"{check.fine_intervals} intervals": b, "change": c}
+                          for q, a, b, c in check.table()]))]),
     )
 
 
@@ -251,7 +275,7 @@ def collocation_sections(report, path: str | Path) -> tuple[dict, object]:
     import matplotlib.pyplot as plt
 
     trial = _measured_trial(runner, sol)
-    _add_human_running_section(report, sol, trial)
+    _add_human_running_section(report, sol, trial, _mesh_check_of(Path(path), sol))
     fig = _grf_figure(sol)
     report.add_section(
         "Collocation solution",

@@ -27,7 +27,12 @@ band was extrapolated). Sources:
   Kram & Taylor 1990 give the cost per distance nearly independent of speed).
 
 The prosthetic leg of a transtibial runner is held to a wider contact band at the low end
-(0.15 s): its blade shortens the contact (Grabowski et al. 2010, Hobara et al. 2013).
+(0.15 s): its blade shortens the contact (Grabowski et al. 2010, Hobara et al. 2013). Its peak
+vertical force is held below the intact leg's: runners with a unilateral transtibial
+amputation land softer on the blade than on their intact leg at every speed measured
+(Grabowski et al. 2010, 3 m/s to maximum speed; Hobara et al. 2013, 2.5–3.5 m/s). Runners with
+a transfemoral amputation have no such criterion here (their peaks are near-symmetric at the
+preferred step frequency, Kobayashi et al. 2022).
 """
 
 from __future__ import annotations
@@ -172,6 +177,11 @@ def human_running_criteria(solution) -> list[Criterion]:
     for leg in solution.leg_names:
         peak = phases["legs"][leg]["peak_vertical_grf_N"] / solution.body_weight_N
         out.append(Criterion(f"peak vertical ground force, {leg} leg", peak, unit, lo, hi, note))
+    if solution.model_spec.get("model") == "amputee":
+        intact, blade = (phases["legs"][leg]["peak_vertical_grf_N"] for leg in solution.leg_names)
+        out.append(Criterion("peak vertical ground force, prosthetic / intact leg",
+                             blade / intact if intact > 0 else math.nan, "", None, 1.0,
+                             "runners land softer on the blade (Grabowski 2010, Hobara 2013)"))
     lo, hi, unit = reference_band("stride time", speed)
     out.append(Criterion("stride time", solution.period_s, unit, lo, hi, note))
     q = np.asarray(solution.nlp.q)  # (nodes, coordinates)

@@ -1,0 +1,279 @@
+"""The mesh-halving check of a predicted stride: the same problem on twice the mesh intervals.
+
+A collocation stride is a solution of its mesh. Whether a number read from it (the cost of
+transport, the stride time, a contact time, a force peak) belongs to the runner or to the
+discretisation shows only when the mesh is refined: :func:`check_mesh` solves the same problem
+(model, speed, weights, constraints) on ``factor`` × the intervals, started from the stride
+(its primal values resampled, no tracking stage), and :class:`MeshCheck` compares the two,
+quantity by quantity. The project's settling criterion (docs/collocation.md, "Mesh
+refinement"): halving the mesh interval moves the objective and the stride time by less than
+:data:`SETTLED_PCT` per cent.
+
+``bladelab predict --method collocation --mesh-check`` runs it after the solve and keeps both
+in the output folder (:func:`mesh_check_in_folder`): the finer stride in
+``OUT/mesh-check/solution.json`` (``best_iterate.json`` if it did not converge) and the
+comparison in ``OUT/mesh-check/mesh-check.json``, which the report shows beside the numbers.
+The answer stays the stride on the mesh asked for; the check says how far to trust it.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+
+from bladelab._io import read_json, write_json
+from bladelab.errors import InputFileError, SpecError
+from bladelab.predict.collocation.solution import CollocationSolution
+from bladelab.predict.collocation.solve import (
+    BEST_ITERATE_FILE,
+    SOLUTION_FILE,
+    SolveProgress,
+    predict_stride,
+    read_stored,
+    write_solve,
+)
+from bladelab.predict.collocation.stride_guess import COLLOCATION_SOURCE
+
+__all__ = ["MESH_CHECK_DIR", "MESH_CHECK_FILE", "SETTLED_PCT", "MeshCheck", "check_mesh",
+           "compare_meshes", "mesh_check_in_folder", "read_mesh_check"]
+
+#: The check's sub-folder of a solve's output folder.
+MESH_CHECK_DIR = "mesh-check"
+#: The comparison's file in :data:`MESH_CHECK_DIR`.
+MESH_CHECK_FILE = "mesh-check.json"
+#: Largest change [%] of the objective and of the stride time that counts as settled.
+SETTLED_PCT = 1.0
+#: The quantities that decide whether a stride has settled.
+SETTLING_KEYS = ("objective", "stride_time_s")
+_KIND = "collocation-mesh-check"
+
+
+def _rows(sol: CollocationSolution) -> dict[str, tuple[str, str, float | None]]:
+    """{key: (label, unit, value)} of the quantities compared, for one stride."""
+    s = sol.summary()
+    rows = {"objective": ("objective", "-", float(sol.nlp.objective)),
+            "stride_time_s": ("stride time", "s", s["stride_time_s"]),
+            "cost_of_transport_J_per_kg_m": ("cost of transport", "J/(kg·m)",
+                                             s["cost_of_transport_J_per_kg_m"])}
+    if sol.settings.speed_m_per_s is None:
+        rows["mean_speed_mps"] = ("mean speed", "m/s", s["mean_speed_mps"])
+    for leg in sol.leg_names:
+        rows[f"contact_time_{leg}_s"] = (f"contact time, {leg} leg", "s",
+                                         s[f"contact_time_{leg}_s"])
+    for leg in sol.leg_names:
+        rows[f"peak_vertical_grf_{leg}_bw"] = (f"peak vertical force, {leg} leg", "BW",
+                                               s[f"peak_vertical_grf_{leg}_bw"])
+    rows["flight_fraction"] = ("flight", "of the stride", s["flight_fraction"])
+    return rows
+
+
+@dataclass(frozen=True)
+class MeshCheck:
+    """A stride against the same problem solved on a finer mesh.
+
+    Attributes
+    ----------
+    coarse_intervals, fine_intervals
+        Mesh intervals of the stride and of the check [-].
+    converged
+        Whether the finer solve converged (if not, its numbers are a best iterate's).
+    quantities
+        ``{key: (label, unit, coarse value, fine value)}``: objective [-], stride time [s],
+        cost of transport [J/(kg·m)], (maximum speed: mean speed [m/s]), contact time per leg
+        [s], peak vertical ground force per leg [body weights], flight [fraction of the
+        stride].
+    fine_warnings
+        The finer stride's gait warnings (empty if none).
+    """
+
+    coarse_intervals: int
+    fine_intervals: int
+    converged: bool
+    quantities: dict[str, tuple[str, str, float | None, float | None]]
+    fine_warnings: tuple[str, ...] = ()
+
+    def change_pct(self, key: str) -> float | None:
+        """Relative change [%] of one quantity from the stride's mesh to the finer one; None
+        where a value is missing or the coarse one is 0."""
+        _, _, coarse, fine = self.quantities[key]
+        if coarse is None or fine is None or coarse == 0.0:
+            return None
+        return 100.0 * (fine - coarse) / abs(coarse)
+
+    def describes(self, sol: CollocationSolution) -> bool:
+        """True if this check was made of the stride ``sol`` (its mesh and objective), not of
+        an earlier stride in the same folder."""
+        coarse = self.quantities.get("objective", (None, None, None, None))[2]
+        return (self.coarse_intervals == sol.settings.mesh_intervals and coarse is not None
+                and math.isclose(coarse, float(sol.nlp.objective), rel_tol=1e-9))
+
+    @property
+    def settled(self) -> bool:
+        """True if the finer solve converged without gait warnings and moved the objective
+        and the stride time by less than :data:`SETTLED_PCT` per cent."""
+        changes = [self.change_pct(k) for k in SETTLING_KEYS]
+        return (self.converged and not self.fine_warnings
+                and all(c is not None and abs(c) < SETTLED_PCT for c in changes))
+
+    def verdict(self) -> str:
+        """One sentence: settled or not, and why."""
+        head = f"Mesh-halving check ({self.coarse_intervals} → {self.fine_intervals} intervals)"
+        if not self.converged:
+            return f"{head}: the finer solve did not converge, so the stride is not shown settled"
+        moved = ", ".join(f"{self.quantities[k][0]} {_signed(self.change_pct(k))}"
+                          for k in SETTLING_KEYS)
+        if self.fine_warnings:
+            return (f"{head}: {moved}; not settled: the finer stride has gait warnings "
+                    f"({'; '.join(self.fine_warnings)})")
+        if self.settled:
+            return f"{head}: {moved}: settled (both below {SETTLED_PCT:g} %)"
+        return (f"{head}: {moved}: not settled (the criterion is below {SETTLED_PCT:g} % "
+                "for both); read differences of this size between strides as the mesh's")
+
+    def table(self) -> list[tuple[str, str, str, str]]:
+        """Rows (quantity with its unit, stride's mesh, finer mesh, change) as text."""
+        out = []
+        for key, (label, unit, coarse, fine) in self.quantities.items():
+            out.append((f"{label} [{unit}]" if unit != "-" else label, _value(coarse),
+                        _value(fine), _signed(self.change_pct(key))))
+        return out
+
+    def to_dict(self) -> dict:
+        return {"kind": _KIND, "coarse_intervals": self.coarse_intervals,
+                "fine_intervals": self.fine_intervals, "converged": self.converged,
+                "settled": self.settled, "settled_below_pct": SETTLED_PCT,
+                "quantities": {k: {"label": lab, "unit": unit, "coarse": c, "fine": f,
+                                   "change_pct": self.change_pct(k)}
+                               for k, (lab, unit, c, f) in self.quantities.items()},
+                "fine_warnings": list(self.fine_warnings)}
+
+    @classmethod
+    def from_dict(cls, data: dict, *, file: Path | None = None) -> MeshCheck:
+        if not isinstance(data, dict) or data.get("kind") != _KIND:
+            raise InputFileError("is not a mesh-halving check", file=file,
+                                 hint="written by bladelab predict --mesh-check")
+        try:
+            quantities = {str(k): (str(v["label"]), str(v["unit"]), _number(v["coarse"]),
+                                   _number(v["fine"]))
+                          for k, v in data["quantities"].items()}
+            return cls(int(data["coarse_intervals"]), int(data["fine_intervals"]),
+                       bool(data["converged"]), quantities,
+                       tuple(str(w) for w in data.get("fine_warnings", ())))
+        except (KeyError, TypeError, ValueError, AttributeError) as err:
+            raise InputFileError(f"a mesh-halving check with a missing or bad field ({err})",
+                                 file=file, hint="run bladelab predict --mesh-check again "
+                                                 "(--resume keeps the solves)") from None
+
+
+def _number(v) -> float | None:
+    return None if v is None else float(v)
+
+
+def _value(v: float | None) -> str:
+    return "–" if v is None else f"{v:.4g}"
+
+
+def _signed(pct: float | None) -> str:
+    if pct is None:
+        return "–"
+    text = f"{pct:+.2f}" if abs(pct) >= 0.1 or pct == 0.0 else f"{pct:+.1g}"
+    return f"{text} %".replace("-", "−")
+
+
+def compare_meshes(coarse: CollocationSolution, fine: CollocationSolution) -> MeshCheck:
+    """The :class:`MeshCheck` of a stride (``coarse``) against the same problem solved on a
+    finer mesh (``fine``, converged or a best iterate).
+
+    Raises
+    ------
+    SpecError
+        The two are not the same problem on two meshes (model, speed, weights or
+        constraints differ, or ``fine`` has no more intervals than ``coarse``).
+    """
+    a, b = coarse.settings, fine.settings
+    if coarse.model_spec != fine.model_spec or not dataclasses.replace(
+            a, mesh_intervals=b.mesh_intervals).same_problem(b):
+        raise SpecError("the two strides are not the same problem on two meshes",
+                        where="mesh check", hint="solve the finer one with check_mesh")
+    if b.mesh_intervals <= a.mesh_intervals:
+        raise SpecError(f"the finer stride has {b.mesh_intervals} mesh intervals, the stride "
+                        f"{a.mesh_intervals}", where="mesh check")
+    rc, rf = _rows(coarse), _rows(fine)
+    quantities = {k: (lab, unit, _finite(v), _finite(rf.get(k, (None, None, None))[2]))
+                  for k, (lab, unit, v) in rc.items()}
+    return MeshCheck(a.mesh_intervals, b.mesh_intervals, fine.converged, quantities,
+                     tuple(fine.gait_warnings()))
+
+
+def _finite(v) -> float | None:
+    return float(v) if v is not None and math.isfinite(float(v)) else None
+
+
+def _finer(sol: CollocationSolution, factor: int, max_iter: int | None):
+    return dataclasses.replace(sol.settings, mesh_intervals=factor * sol.settings.mesh_intervals,
+                               **({} if max_iter is None else {"max_iter": max_iter}))
+
+
+def check_mesh(runner, sol: CollocationSolution, *, factor: int = 2,
+               max_iter: int | None = None,
+               progress: Callable[[SolveProgress], None] | None = None,
+               ) -> tuple[CollocationSolution, MeshCheck]:
+    """Solve ``sol``'s problem on ``factor`` × its mesh intervals from ``sol`` and compare
+    (module docstring); ``max_iter``: IPOPT's iterations (None: the stride's setting).
+    Returns (the finer solve, its :class:`MeshCheck`).
+
+    Raises
+    ------
+    SpecError
+        ``factor`` is not an integer ≥ 2; ``sol`` is not a converged stride (a best iterate
+        has no mesh to check).
+    """
+    if isinstance(factor, bool) or not isinstance(factor, int) or factor < 2:
+        raise SpecError(f"the finer mesh needs a whole factor ≥ 2, got {factor!r}",
+                        where="mesh check factor")
+    if not sol.converged:
+        raise SpecError("the stride did not converge: there is no solution to check",
+                        where="mesh check", hint="converge the solve first (--resume)")
+    settings = _finer(sol, factor, max_iter)
+    guess = sol.to_guess(f"{COLLOCATION_SOURCE} on {sol.settings.mesh_intervals} intervals "
+                         f"({sol.guess_source})")
+    fine = predict_stride(runner, settings, guess, model_spec=sol.model_spec, progress=progress)
+    return fine, compare_meshes(sol, fine)
+
+
+def mesh_check_in_folder(out: str | Path, runner, sol: CollocationSolution, *,
+                         resume: bool = False, max_iter: int | None = None,
+                         progress: Callable[[SolveProgress], None] | None = None) -> MeshCheck:
+    """:func:`check_mesh` (twice the intervals) of the stride ``sol`` solved in the folder
+    ``out``, written into ``out/mesh-check/`` (module docstring). With ``resume`` a converged
+    finer solve of the same problem already there is read back, and a best iterate of it is
+    the finer solve's start."""
+    folder = Path(out) / MESH_CHECK_DIR
+    folder.mkdir(parents=True, exist_ok=True)
+    ok, best = folder / SOLUTION_FILE, folder / BEST_ITERATE_FILE
+    fine_settings = _finer(sol, 2, max_iter)
+    done, iterate = (read_stored(ok, best, sol.model_spec, fine_settings) if resume
+                     else (None, None))
+    if done is not None:
+        check = compare_meshes(sol, done)
+    elif iterate is not None:
+        fine = predict_stride(runner, fine_settings, iterate.to_guess(),
+                              model_spec=sol.model_spec, progress=progress)
+        write_solve(fine, ok, best)
+        check = compare_meshes(sol, fine)
+    else:
+        fine, check = check_mesh(runner, sol, max_iter=max_iter, progress=progress)
+        write_solve(fine, ok, best)
+    write_json(folder / MESH_CHECK_FILE, check.to_dict())
+    return check
+
+
+def read_mesh_check(out: str | Path) -> MeshCheck | None:
+    """The mesh-halving check kept in a solve's folder ``out``, or None if it has none."""
+    path = Path(out) / MESH_CHECK_DIR / MESH_CHECK_FILE
+    if not path.is_file():
+        return None
+    return MeshCheck.from_dict(read_json(path, what="mesh-halving check"), file=path)
