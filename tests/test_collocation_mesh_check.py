@@ -91,17 +91,22 @@ def test_the_folder_keeps_the_finer_solve_and_resume_reads_it_back(strides, tmp_
     calls = []
 
     def solve(runner_, settings, guess, *, model_spec, progress=None):
-        calls.append((settings.mesh_intervals, settings.max_iter, guess.n_intervals))
+        calls.append((settings.mesh_intervals, settings.max_iter, settings.warm_start_mu,
+                  guess.n_intervals))
         return fine
 
     monkeypatch.setattr(mesh_check, "predict_stride", solve)
-    check = mesh_check_in_folder(tmp_path, runner, coarse, max_iter=77)
-    assert calls == [(2 * N, 77, N)]  # the stride itself, resampled by the solve
     folder = tmp_path / MESH_CHECK_DIR
+    check = mesh_check_in_folder(folder, runner, coarse, max_iter=77)
+    assert calls == [(2 * N, 77, 1e-4, N)]  # the stride itself, resampled by the solve
     assert sorted(p.name for p in folder.iterdir()) == [MESH_CHECK_FILE, "solution.json"]
-    assert read_mesh_check(tmp_path) == check
-    again = mesh_check_in_folder(tmp_path, runner, coarse, resume=True)
+    assert read_mesh_check(folder) == check
+    again = mesh_check_in_folder(folder, runner, coarse, resume=True)
     assert again == check and len(calls) == 1  # read back, not solved again
+    # a check of another stride in the folder is made anew
+    other = dataclasses.replace(coarse, nlp=dataclasses.replace(coarse.nlp, objective=1.3))
+    mesh_check_in_folder(folder, runner, other, resume=True)
+    assert len(calls) == 2 and read_mesh_check(folder).describes(other)
     assert read_mesh_check(tmp_path / "elsewhere") is None
     with pytest.raises(SpecError, match="did not converge"):
         mesh_check.check_mesh(runner, dataclasses.replace(

@@ -6,12 +6,14 @@ the fake solution at the guess's speed, marked so that each warm start can be tr
 from __future__ import annotations
 
 import csv
+import dataclasses
 import json
 
 import numpy as np
 import pytest
 
 from bladelab.cli import main
+from collocation_fake import fake_solution
 
 N = 12  # mesh intervals: the fake solutions' (conftest.FAKE_MESH)
 
@@ -99,6 +101,53 @@ def test_sweep_solves_each_model_and_writes_the_table(fake_solve, tmp_path, caps
     assert sorted(p.name for p in (out / "amputee-Cat6").iterdir()) == [
         "max-speed.json", "speed-3.5.json"]
     assert len(_csv(out / "collocation-sweep.csv")) == 2
+
+
+def test_a_mesh_check_of_every_converged_solve_joins_the_table_and_the_report(
+        fake_solve, monkeypatch, tmp_path, capsys):
+    """--mesh-check: each converged solve solved again on twice the intervals (the fake
+    solve stands in for it too), its columns in the table, read back on --resume, the report's
+    sentence and table; checks of solves no longer in the sweep go with --force."""
+    from bladelab.predict.collocation import mesh_check
+    from bladelab.report.builder import Report
+    from bladelab.report.collocation_sweep import collocation_sweep_sections
+
+    fine = fake_solution("amputee", 2 * N)[2]  # a consistent stride on twice the intervals
+    checked = []
+
+    def solve_fine(runner, settings, guess, *, model_spec, progress=None):
+        checked.append(settings.mesh_intervals)
+        return dataclasses.replace(fine, settings=settings, model_spec=model_spec)
+
+    monkeypatch.setattr(mesh_check, "predict_stride", solve_fine)
+    out = tmp_path / "sweep"
+    args = ("--categories", "Cat6", "--speeds", "3.5,4", "--mesh-check")
+    assert _sweep(out, *args) == 0
+    err = capsys.readouterr().err
+    assert "amputee Cat6, 4 m/s: mesh check: Mesh-halving check (12 → 24 intervals)" in err
+    assert checked == [2 * N] * 3 and len(fake_solve.calls) == 3
+    assert sorted(p.name for p in (out / "amputee-Cat6" / "mesh-check").iterdir()) == [
+        "max-speed", "speed-3.5", "speed-4"]
+    rows = _csv(out / "collocation-sweep.csv")
+    for row in rows:
+        assert row["mesh_check_intervals"] == str(2 * N)
+        assert row["mesh_check_settled"] in ("True", "False")
+        assert float(row["mesh_check_objective_change_pct"]) == pytest.approx(0.0)
+    fake_solve.calls.clear()
+    assert _sweep(out, *args, "--resume") == 0
+    capsys.readouterr()
+    assert fake_solve.calls == [] and len(checked) == 3  # the checks are read back too
+    rep = Report("t")
+    collocation_sweep_sections(rep, out)
+    section = rep.sections[0]
+    assert "Mesh-halving check: " in " ".join(section.text)
+    (per_solve,) = [t for t in section.tables if t.title.startswith("Mesh-halving check")]
+    assert len(per_solve.frame) == 3
+    assert _sweep(out, "--categories", "Cat6", "--speeds", "3.5", "--mesh-check",
+                  "--force") == 0
+    capsys.readouterr()
+    assert sorted(p.name for p in (out / "amputee-Cat6" / "mesh-check").iterdir()) == [
+        "max-speed", "speed-3.5"]
 
 
 def test_sweep_exits_2_naming_the_failed_models_after_finishing_the_others(

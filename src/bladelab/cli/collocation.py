@@ -107,7 +107,7 @@ def _mesh_check(out: Path, sol, *, asked: bool, solved: bool, resume: bool, max_
     if not asked or not sol.converged:
         return None
     runner = runner_from_spec(sol.model_spec)
-    check = mesh_check_in_folder(out, runner, sol, resume=resume and not solved,
+    check = mesh_check_in_folder(folder, runner, sol, resume=resume and not solved,
                                  max_iter=max_iter, progress=StageProgress(prefix="mesh check: "))
     typer.echo(check.verdict(), err=True)
     return check

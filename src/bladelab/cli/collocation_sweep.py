@@ -41,6 +41,7 @@ OPTIONS = {
     "athlete.max_shortening_velocity": "--max-shortening-velocity",
     "athlete.residual_limb_length_m": "--residual-limb",
     "athlete.thigh_length_m": "--thigh-length", "athlete.shank_length_m": "--shank-length",
+    "mesh check": "--mesh-check",
 }
 
 
@@ -82,6 +83,9 @@ def _text(result) -> str:
             "iterations", "wall_s"]
     if any("start" in row for row in result.rows):
         keep += ["start", "starts", "spread_pct"]
+    if any("mesh_check_settled" in row for row in result.rows):
+        keep += ["mesh_check_objective_change_pct", "mesh_check_stride_time_change_pct",
+                 "mesh_check_settled"]
     lines = ["  ".join(keep)]
     for row in result.rows:
         cells = []
@@ -113,11 +117,13 @@ def run_collocation_sweep(
     people_weight: float | None = None,
     alternating_steps: float | None = None,
     athlete: dict | None = None,
+    mesh_check: bool = False,
 ) -> int:
     """Run ``bladelab sweep --method collocation``; returns the exit status (0 every solve
     converged, 2 some model failed). ``alternating_steps``:
     ``CollocationSettings.step_phase_tolerance``; ``athlete``: every model scaled to this
-    athlete (None: the body's own)."""
+    athlete (None: the body's own); ``mesh_check``: every converged solve checked on twice
+    the mesh intervals."""
     speed_list = _speeds(speeds)
     # --able --categories "": the able model alone
     cats = parse_list(categories, "--categories") if categories.strip() or not able else []
@@ -126,7 +132,8 @@ def run_collocation_sweep(
             out, categories=cats, speeds=speed_list, able=able, body=body, guess=guess,
             mesh_intervals=mesh, max_iter=max_iter, people_weight=people_weight,
             step_phase_tolerance=alternating_steps, athlete=athlete, starts=starts, jobs=jobs,
-            executor=executor, resume=resume, force=force, progress=SweepProgress())
+            executor=executor, resume=resume, force=force, progress=SweepProgress(),
+            mesh_check=mesh_check)
     except BladelabError as err:
         raise renamed(err, OPTIONS) from None
     if as_json:

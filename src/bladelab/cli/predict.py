@@ -497,6 +497,12 @@ def register(app: typer.Typer) -> None:
         thigh_length: float | None = _athlete_option("thigh_length_m"),
         shank_length: float | None = _athlete_option("shank_length_m"),
         static: Path | None = _static_option(),
+        mesh_check: bool = typer.Option(
+            False, "--mesh-check", rich_help_panel=COLLOCATION,
+            help="Solve every converged problem again on twice the mesh intervals from its "
+                 "stride (DIR/<model>/mesh-check/) and add each one's changes and whether it "
+                 "settled (objective and stride time within 1 %) to the table and the "
+                 "report. About 2-5 times the sweep's time."),
     ) -> None:
         """Category × speed grid: warm-started optimisations, maximum speed, cost at 4 m/s,
         200 m and 400 m times, contact times (seed 001 §2.2.2 B–C, Table 3.1). Running it again
@@ -514,7 +520,7 @@ def register(app: typer.Typer) -> None:
         and the maximum speed; DIR/<model>/speed-<v>.json, max-speed.json and the table
         DIR/collocation-sweep.csv. A used --out needs --resume or --force; exit status 2 when a
         model failed (after the others). --starts K solves each problem from up to K starts
-        and keeps the best.
+        and keeps the best; --mesh-check adds the settling evidence of every solve.
 
         An option of another method (or of the grid with --recipe) is refused."""
         method = _method(method)
@@ -533,7 +539,8 @@ def register(app: typer.Typer) -> None:
                                  muscle_strength=muscle_strength,
                                  max_shortening_velocity=max_shortening_velocity,
                                  residual_limb_length_m=residual_limb,
-                                 thigh_length_m=thigh_length, shank_length_m=shank_length)))
+                                 thigh_length_m=thigh_length, shank_length_m=shank_length),
+                mesh_check=mesh_check))
         from bladelab.cli import reflex  # deferred: keeps bladelab --help fast
 
         if mode == "recipe":

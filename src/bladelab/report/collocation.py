@@ -32,7 +32,7 @@ from bladelab.predict.collocation.human_running import (
     human_running_criteria,
     stride_from_left_touchdown,
 )
-from bladelab.predict.collocation.mesh_check import read_mesh_check
+from bladelab.predict.collocation.mesh_check import MESH_CHECK_DIR, read_mesh_check
 from bladelab.predict.collocation.model import build_collocation_model
 from bladelab.predict.collocation.settings import PEOPLE_REFERENCE
 from bladelab.predict.collocation.solution import (
@@ -183,7 +183,7 @@ def reference_term_text(settings, share: str = "", *,
 def _mesh_check_of(path: Path, sol):
     """The mesh-halving check kept beside the solution (its folder's ``mesh-check/``), or
     None if there is none or it was made of another stride."""
-    check = read_mesh_check(path if path.is_dir() else path.parent)
+    check = read_mesh_check((path if path.is_dir() else path.parent) / MESH_CHECK_DIR)
     return check if check is not None and check.describes(sol) else None
 
 

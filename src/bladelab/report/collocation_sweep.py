@@ -146,6 +146,41 @@ def _with_current_warnings(table: pd.DataFrame, folder: Path) -> tuple[pd.DataFr
     return _flag(table), solutions
 
 
+#: The mesh-halving check's columns of a sweep table, as shown (``mesh_check_columns``).
+MESH_CHECK_COLUMNS = ("mesh_check_converged", "mesh_check_settled",
+                      "mesh_check_objective_change_pct", "mesh_check_stride_time_change_pct",
+                      "mesh_check_cot_change_pct")
+
+
+def mesh_check_table(table: pd.DataFrame) -> pd.DataFrame | None:
+    """The converged solves' mesh-halving checks (``bladelab sweep --mesh-check``): model,
+    problem, speed and the check's columns; None for a sweep without them."""
+    if "mesh_check_settled" not in table.columns:
+        return None
+    rows = table[table.converged]
+    cols = ["model", "problem", "prescribed_speed_mps", "mean_speed_mps", *MESH_CHECK_COLUMNS]
+    return rows[[c for c in cols if c in rows.columns]].reset_index(drop=True)
+
+
+def _truth(v) -> bool:
+    return str(v).strip().lower() in ("true", "1", "1.0")
+
+
+def _mesh_check_text(checks: pd.DataFrame | None) -> str:
+    if checks is None:
+        return (" No mesh-halving check ('bladelab sweep --mesh-check' solves every problem "
+                "again on twice the mesh intervals): differences of a few per cent between "
+                "solves may be the mesh's.")
+    done = checks[checks.mesh_check_settled.notna()]
+    settled = int(sum(_truth(v) for v in done.mesh_check_settled))
+    change = pd.to_numeric(done.mesh_check_objective_change_pct, errors="coerce").abs()
+    text = (f" Mesh-halving check: {settled} of {len(done)} converged solves settled "
+            "(objective and stride time within 1 % on twice the mesh intervals)")
+    if change.notna().any():
+        text += f"; objectives moved by {change.min():.2g}–{change.max():.2g} %"
+    return text + " (table 'Mesh-halving check per solve')."
+
+
 def _problem_name(row) -> str:
     """'amputee Cat4 speed 5.0' or 'able max-speed' for the text."""
     return (f"{row.model} {row.problem} "
@@ -240,6 +275,8 @@ def collocation_sweep_sections(report, folder: str | Path) -> tuple[dict, pd.Dat
         text += (" Not converged (listed in the table, left out of the figures and the "
                  "category table): " + ", ".join(_problem_name(r) for r in failed.itertuples())
                  + ".")
+    checks = mesh_check_table(table)
+    text += _mesh_check_text(checks)
     shown = table.rename(columns={"file": "solution file"})
     report.add_section(
         "Collocation sweep: speed continuation and maximum speed",
@@ -249,7 +286,10 @@ def collocation_sweep_sections(report, folder: str | Path) -> tuple[dict, pd.Dat
                   "speed)", fig)],
         tables=[("Every solve (collocation-sweep.csv)", shown)] + (
             [] if starts is None else [
-                ("Starts per problem: objectives and spread", starts)]),
+                ("Starts per problem: objectives and spread", starts)]) + (
+            [] if checks is None else [
+                ("Mesh-halving check per solve: the change [%] from the sweep's mesh to twice "
+                 "its intervals", checks)]),
     )
     plt.close(fig)
     results = {}

@@ -4,8 +4,12 @@ A collocation stride is a solution of its mesh. Whether a number read from it (t
 transport, the stride time, a contact time, a force peak) belongs to the runner or to the
 discretisation shows only when the mesh is refined: :func:`check_mesh` solves the same problem
 (model, speed, weights, constraints) on ``factor`` × the intervals, started from the stride
-(its primal values resampled, no tracking stage), and :class:`MeshCheck` compares the two,
-quantity by quantity. The project's settling criterion (docs/collocation.md, "Mesh
+(its primal values resampled, no tracking stage, IPOPT's barrier started at 1e-4 so that
+the solve stays on the stride's own branch), and :class:`MeshCheck` compares the two, quantity
+by quantity. With IPOPT's default barrier start (0.1) the finer solve can leave that branch:
+measured on the amputee with Cat5 at 4 m/s, it landed 5.7 % dearer at 100 intervals, where the
+start at 1e-4 found the stride's own optimum 0.85 % dearer
+(benchmarks/human_body/categories-people10/mesh-100/). The project's settling criterion (docs/collocation.md, "Mesh
 refinement"): halving the mesh interval moves the objective and the stride time by less than
 :data:`SETTLED_PCT` per cent.
 
@@ -35,6 +39,7 @@ from bladelab.predict.collocation.solve import (
     read_stored,
     write_solve,
 )
+from bladelab.predict.collocation.starts import BARRIER_MU
 from bladelab.predict.collocation.stride_guess import COLLOCATION_SOURCE
 
 __all__ = ["MESH_CHECK_DIR", "MESH_CHECK_FILE", "SETTLED_PCT", "MeshCheck", "check_mesh",
@@ -213,7 +218,12 @@ def _finite(v) -> float | None:
 
 
 def _finer(sol: CollocationSolution, factor: int, max_iter: int | None):
+    """The finer solve's settings: ``factor`` × the intervals, the barrier started at
+    :data:`~bladelab.predict.collocation.starts.BARRIER_MU` unless the stride's settings
+    name a start (module docstring)."""
+    mu = BARRIER_MU if sol.settings.warm_start_mu is None else sol.settings.warm_start_mu
     return dataclasses.replace(sol.settings, mesh_intervals=factor * sol.settings.mesh_intervals,
+                               warm_start_mu=mu,
                                **({} if max_iter is None else {"max_iter": max_iter}))
 
 
@@ -244,19 +254,23 @@ def check_mesh(runner, sol: CollocationSolution, *, factor: int = 2,
     return fine, compare_meshes(sol, fine)
 
 
-def mesh_check_in_folder(out: str | Path, runner, sol: CollocationSolution, *,
+def mesh_check_in_folder(folder: str | Path, runner, sol: CollocationSolution, *,
                          resume: bool = False, max_iter: int | None = None,
                          progress: Callable[[SolveProgress], None] | None = None) -> MeshCheck:
-    """:func:`check_mesh` (twice the intervals) of the stride ``sol`` solved in the folder
-    ``out``, written into ``out/mesh-check/`` (module docstring). With ``resume`` a converged
-    finer solve of the same problem already there is read back, and a best iterate of it is
-    the finer solve's start."""
-    folder = Path(out) / MESH_CHECK_DIR
+    """:func:`check_mesh` (twice the intervals) of the stride ``sol``, kept in the check's own
+    ``folder``: the finer solve as ``solution.json`` (``best_iterate.json`` if it did not
+    converge) and the comparison as :data:`MESH_CHECK_FILE` (module docstring; a solve's
+    folder keeps it in ``OUT/mesh-check/``). With ``resume``, a check already there that was
+    made of this very stride (:meth:`MeshCheck.describes`) is read back if its finer solve
+    converged, and continued from its best iterate if not; a check of another stride is made
+    anew."""
+    folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)
     ok, best = folder / SOLUTION_FILE, folder / BEST_ITERATE_FILE
     fine_settings = _finer(sol, 2, max_iter)
-    done, iterate = (read_stored(ok, best, sol.model_spec, fine_settings) if resume
-                     else (None, None))
+    previous = read_mesh_check(folder) if resume else None
+    done, iterate = ((None, None) if previous is None or not previous.describes(sol)
+                     else read_stored(ok, best, sol.model_spec, fine_settings))
     if done is not None:
         check = compare_meshes(sol, done)
     elif iterate is not None:
@@ -271,9 +285,10 @@ def mesh_check_in_folder(out: str | Path, runner, sol: CollocationSolution, *,
     return check
 
 
-def read_mesh_check(out: str | Path) -> MeshCheck | None:
-    """The mesh-halving check kept in a solve's folder ``out``, or None if it has none."""
-    path = Path(out) / MESH_CHECK_DIR / MESH_CHECK_FILE
+def read_mesh_check(folder: str | Path) -> MeshCheck | None:
+    """The mesh-halving check kept in its ``folder`` (:func:`mesh_check_in_folder`), or None
+    if there is none."""
+    path = Path(folder) / MESH_CHECK_FILE
     if not path.is_file():
         return None
     return MeshCheck.from_dict(read_json(path, what="mesh-halving check"), file=path)

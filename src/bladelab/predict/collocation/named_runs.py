@@ -119,6 +119,7 @@ def sweep_named_models(
     step_phase_tolerance: float | None = None,
     athlete: dict | None = None,
     starts: int = defaults.STARTS,
+    mesh_check: bool = False,
     jobs: int = 1,
     executor: str = "local",
     resume: bool = False,
@@ -139,8 +140,10 @@ def sweep_named_models(
     stride's steps alternating within this fraction of the stride
     (:attr:`CollocationSettings.step_phase_tolerance`; None: free); ``athlete``: every model
     scaled to this athlete (as in :func:`solve_named_stride`); ``starts``: starts per
-    problem, the best kept (:mod:`~bladelab.predict.collocation.starts`); ``jobs`` models at
-    a time on ``executor``.
+    problem, the best kept (:mod:`~bladelab.predict.collocation.starts`); ``mesh_check``:
+    every converged solve checked on twice the mesh intervals
+    (:mod:`~bladelab.predict.collocation.mesh_check`); ``jobs`` models at a time on
+    ``executor``.
 
     Raises
     ------
@@ -161,4 +164,4 @@ def sweep_named_models(
     return collocation_sweep(
         models, speeds, settings, functools.partial(make_guess, guess=guess), out=out,
         jobs=jobs, executor=executor, resume=resume, force=force, progress=progress,
-        starts=starts)
+        starts=starts, mesh_check=mesh_check)

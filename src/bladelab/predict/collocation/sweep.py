@@ -20,12 +20,19 @@ barrier start, the template, the previous-but-one solution); the continuation go
 kept solution, every start's file stays in the model folder, and a row is the kept solve's
 plus the columns ``start``, ``starts``, ``objective``, ``objective_<start>`` and
 ``spread_pct``.
+
+With ``mesh_check`` every converged solve is solved again on twice the mesh intervals from its
+stride (:mod:`bladelab.predict.collocation.mesh_check`; the finer solves in
+``<model folder>/mesh-check/<solve>/``) and its row gets :func:`mesh_check_columns`: the
+settling evidence beside each number.
 """
 
 from __future__ import annotations
 
 import csv
+import dataclasses
 import math
+import shutil
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -46,6 +53,7 @@ from bladelab.predict.collocation.continuation import (
     speed_continuation,
     table_columns,
 )
+from bladelab.predict.collocation.mesh_check import MESH_CHECK_DIR, mesh_check_in_folder
 from bladelab.predict.collocation.model import build_collocation_model
 from bladelab.predict.collocation.settings import CollocationSettings
 from bladelab.predict.collocation.solve import check_output_folder
@@ -57,6 +65,7 @@ __all__ = [
     "SWEEP_TABLE",
     "SweepResult",
     "collocation_sweep",
+    "mesh_check_columns",
     "sweep_model_task",
     "sweep_models",
     "write_table",
@@ -134,7 +143,9 @@ def sweep_model_task(payload: dict) -> dict:
 
     ``payload``: ``model_spec``, ``speeds``, ``settings`` (:class:`CollocationSettings`),
     ``make_guess`` (``make_guess(runner, n=..., speed=...)``), ``out`` (the sweep folder),
-    ``force``, ``progress`` (or None), ``starts`` (per problem; default 1). Returns ``label``, ``rows`` (module docstring) and
+    ``force``, ``progress`` (or None), ``starts`` (per problem; default 1), ``mesh_check``
+    (each converged solve checked on twice the mesh intervals; default False). Returns
+    ``label``, ``rows`` (module docstring) and
     ``failures`` (one line per solve that did not converge). With ``force``, files of the model
     folder that this run did not write are removed once the model is done.
     """
@@ -184,9 +195,55 @@ def sweep_model_task(payload: dict) -> dict:
             if p.resolve() not in keep:
                 p.unlink(missing_ok=True)
     runner = get_runner()
+    checks = (_mesh_checks(runner, records, folder, label, progress, force)
+              if payload.get("mesh_check") else {})
     cm = build_collocation_model(runner)  # once for every row's analyses
-    rows = [r.row(out) | stride_analyses(r.solution, runner, cm=cm) for r in records]
+    rows = [r.row(out) | stride_analyses(r.solution, runner, cm=cm)
+            | mesh_check_columns(checks.get(r.path)) for r in records]
     return {"label": label, "rows": rows, "failures": failures}
+
+
+def _mesh_checks(runner, records, folder: Path, label: str, progress, force: bool) -> dict:
+    """The mesh-halving check of every converged record (:mod:`.mesh_check`), each in
+    ``folder/mesh-check/<file stem>/`` (a check of the same stride there is read back; with
+    ``force``, checks of strides no longer in the sweep are removed)."""
+    root = folder / MESH_CHECK_DIR
+    checks = {}
+    for r in records:
+        if not r.converged:
+            continue
+        problem = "maximum speed" if r.speed_mps is None else f"{r.speed_mps:g} m/s"
+
+        def relay(p, problem=problem) -> None:
+            if progress is not None:
+                progress(ContinuationProgress(label, problem, "solve",
+                                              solve=dataclasses.replace(
+                                                  p, stage=f"mesh check: {p.stage}")))
+
+        checks[r.path] = mesh_check_in_folder(root / r.path.stem, runner, r.solution,
+                                              resume=True, progress=relay)
+        if progress is not None:
+            progress(ContinuationProgress(label, problem, "mesh check",
+                                          message=checks[r.path].verdict()))
+    if force and root.is_dir():
+        kept = {r.path.stem for r in records}
+        for sub in root.iterdir():
+            if sub.is_dir() and sub.name not in kept:
+                shutil.rmtree(sub)
+    return checks
+
+
+def mesh_check_columns(check) -> dict:
+    """The sweep table's columns of one solve's mesh-halving check (empty without one):
+    ``mesh_check_intervals``, ``mesh_check_converged``, ``mesh_check_settled`` and the
+    change [%] of the objective, the stride time and the cost of transport."""
+    if check is None:
+        return {}
+    return {"mesh_check_intervals": check.fine_intervals,
+            "mesh_check_converged": check.converged, "mesh_check_settled": check.settled,
+            "mesh_check_objective_change_pct": check.change_pct("objective"),
+            "mesh_check_stride_time_change_pct": check.change_pct("stride_time_s"),
+            "mesh_check_cot_change_pct": check.change_pct("cost_of_transport_J_per_kg_m")}
 
 
 @dataclass(frozen=True)
@@ -235,6 +292,7 @@ def collocation_sweep(
     force: bool = False,
     progress: Callable[[ContinuationProgress], None] | None = None,
     starts: int = 1,
+    mesh_check: bool = False,
 ) -> SweepResult:
     """For each model, the speed continuation then the maximum speed (module docstring); each
     model in ``out/<model_folder>``, the table ``out/collocation-sweep.csv`` rewritten
@@ -269,6 +327,10 @@ def collocation_sweep(
     starts
         Starts per problem, 1 to 4 (module docstring): 1 the continuation's warm start only;
         more, the best of several kept.
+    mesh_check
+        Solve every converged problem again on twice the mesh intervals from its stride
+        (:mod:`~bladelab.predict.collocation.mesh_check`, in ``<model folder>/mesh-check/``)
+        and add its columns to the table (:func:`mesh_check_columns`).
 
     Raises
     ------
@@ -296,7 +358,8 @@ def collocation_sweep(
     out.mkdir(parents=True, exist_ok=True)
     payloads = [{"model_spec": m, "speeds": list(speeds), "settings": settings,
                  "make_guess": make_guess, "out": str(out.resolve()), "force": bool(force),
-                 "progress": progress, "starts": starts} for m in models]
+                 "progress": progress, "starts": starts, "mesh_check": bool(mesh_check)}
+                for m in models]
     table = out / SWEEP_TABLE
     rows: dict[int, list[dict]] = {}
     failures: dict[int, list[str]] = {}

@@ -1,0 +1,82 @@
+"""Probe: a cold start solved on a coarse mesh, as the first step of a mesh continuation.
+
+Usage (from the repository root)::
+
+    .venv/bin/python benchmarks/collocation_speed/coarse_start.py MODEL BLADE SPEED MESH START OUT
+
+MODEL ``able`` or ``amputee``, BLADE a category or ``none``, SPEED [m/s], MESH intervals,
+START ``sine`` (the library's template guess) or ``people`` (a template from people's mean
+joint angles, ``bladelab.predict.collocation.people.people_joint_angles``: RBDS002 and
+RBDS003 of Fukuchi et al. 2017, the right leg half a stride later, the trunk 5° forward, the
+template's stride time and vertical force pattern). Solves the tracking stage and the
+predictive stage on the human body with the default objective, writes the solution to OUT and
+prints one JSON line: each stage's iterations, wall time and status, and the solve's summary.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import sys
+import time
+
+import numpy as np
+
+from bladelab.predict.collocation.guess import template_guess, template_vertical_grf
+from bladelab.predict.collocation.people import people_joint_angles
+from bladelab.predict.collocation.settings import CollocationSettings
+from bladelab.predict.collocation.solve import predict_stride
+from bladelab.predict.collocation.stride_guess import StrideGuess, periodic_derivative
+from bladelab.runner import build_runner
+from bladelab.runner.model import contact_heights
+
+
+def people_template(runner, speed: float, n: int) -> StrideGuess:
+    """People's mean angles as a template stride (module docstring)."""
+    period = 0.75 / (1.0 + 0.05 * (speed - 3.5))  # the library template's stride time
+    frac = np.linspace(0.0, 1.0, n + 1)
+    curves = people_joint_angles()
+    q = np.zeros((n + 1, len(runner.dof_names)))
+    q[:, runner.dof("pelvis_tx")] = speed * period * frac
+    q[:, runner.dof("pelvis_tilt")] = -math.radians(5.0)
+    for side, lag in (("l", 0.0), ("r", 0.5)):
+        for base, curve in curves.items():
+            name = f"{base}_{side}"
+            if name in runner.dof_names:
+                q[:, runner.dof(name)] = np.interp(np.mod(frac - lag, 1.0),
+                                                   np.arange(100) / 100.0, curve, period=1.0)
+    iz = runner.dof("pelvis_tz")
+    for k in range(n + 1):  # the lowest contact on the ground at every node
+        q[k, iz] -= contact_heights(runner, q[k]).min()
+    return StrideGuess(f"people template at {speed:g} m/s", period, q,
+                       periodic_derivative(q, period),
+                       vertical_grf_bw=template_vertical_grf(frac))
+
+
+def main(argv: list[str]) -> int:
+    model, blade, speed, n, start, out = argv
+    speed, n = float(speed), int(n)
+    blade = None if blade == "none" else blade
+    runner = build_runner(model, blade=blade, body="human")
+    guess = (template_guess(runner, speed=speed, n=n) if start == "sine"
+             else people_template(runner, speed, n))
+    stages = []
+
+    def progress(p) -> None:
+        if p.event == "end":
+            stages.append({"stage": p.stage, "iterations": p.iteration,
+                           "wall_s": round(p.elapsed_s, 1), "status": p.message})
+
+    t0 = time.perf_counter()
+    sol = predict_stride(runner, CollocationSettings(speed_m_per_s=speed, mesh_intervals=n),
+                         guess, model_spec={"model": model, "blade": blade, "body": "human"},
+                         progress=progress)
+    sol.write(out)
+    print(json.dumps({"model": model, "blade": blade, "start": start, "mesh": n,
+                      "wall_s": round(time.perf_counter() - t0, 1), "stages": stages,
+                      "summary": sol.summary()}))
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main(sys.argv[1:]))

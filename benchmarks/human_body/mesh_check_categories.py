@@ -1,0 +1,81 @@
+"""The mesh-halving check of each category's kept 4 m/s stride (``bladelab predict --mesh-check``).
+
+Usage (from the repository root)::
+
+    .venv/bin/python benchmarks/human_body/mesh_check_categories.py OUT [--mu MU] [--only Cat5,...]
+
+For each category, OUT/<category>/solution.json is the kept stride of
+``categories-people10`` (its README names the start kept) and ``bladelab predict --model
+amputee --blade <category> --speed 4 --out OUT/<category> --resume --mesh-check`` solves the
+same problem on 100 intervals from it (a finer solve already in OUT/<category>/mesh-check/ is
+read back). ``--mu`` starts IPOPT's barrier of the finer solve at MU (set as the stride's
+``warm_start_mu``; default: the check's own start, 1e-4; 0.1 is IPOPT's default start). Writes OUT/mesh-check.csv: per
+category the objective, cost of transport, stride time and peaks on both meshes and their
+changes, and the verdict.
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import dataclasses
+import shutil
+import sys
+from pathlib import Path
+
+from bladelab.cli import main
+from bladelab.predict.collocation.mesh_check import MESH_CHECK_DIR, read_mesh_check
+from bladelab.predict.collocation.solution import CollocationSolution
+
+HERE = Path(__file__).resolve().parent
+KEPT = {"Cat4": "neighbour", "Cat5": "shipped", "Cat6": "neighbour", "Cat6High": "neighbour",
+        "Cat7": "best"}
+COLUMNS = ("objective", "cost_of_transport_J_per_kg_m", "stride_time_s",
+           "peak_vertical_grf_intact_bw", "peak_vertical_grf_prosthetic_bw",
+           "contact_time_prosthetic_s")
+
+
+def main_(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("out", type=Path)
+    ap.add_argument("--mu", type=float, default=None)
+    ap.add_argument("--only", default=",".join(KEPT))
+    args = ap.parse_args(argv)
+    rows = []
+    for cat in args.only.split(","):
+        folder = args.out / cat
+        folder.mkdir(parents=True, exist_ok=True)
+        stride = HERE / "categories-people10" / f"{cat}.{KEPT[cat]}.json"
+        if args.mu is None:
+            shutil.copyfile(stride, folder / "solution.json")
+        else:
+            sol = CollocationSolution.read(stride)
+            sol = dataclasses.replace(sol, settings=dataclasses.replace(
+                sol.settings, warm_start_mu=args.mu))
+            sol.write(folder / "solution.json")
+        status = main(["predict", "--method", "collocation", "--model", "amputee", "--blade",
+                       cat, "--speed", "4", "--out", str(folder), "--resume", "--mesh-check",
+                       "--json"])
+        check = read_mesh_check(folder / MESH_CHECK_DIR)
+        if status != 0 or check is None:
+            print(f"{cat}: no check (exit status {status})", file=sys.stderr)
+            continue
+        row = {"category": cat, "kept start": KEPT[cat], "converged": check.converged,
+               "settled": check.settled}
+        for key in COLUMNS:
+            label, unit, coarse, fine = check.quantities[key]
+            row[f"{key} mesh 50"] = coarse
+            row[f"{key} mesh 100"] = fine
+            row[f"{key} change %"] = check.change_pct(key)
+        row["verdict"] = check.verdict()
+        rows.append(row)
+    if rows:
+        with open(args.out / "mesh-check.csv", "w", newline="", encoding="utf-8") as f:
+            w = csv.DictWriter(f, fieldnames=list(rows[0]))
+            w.writeheader()
+            w.writerows(rows)
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main_())
