@@ -178,9 +178,10 @@ def human_running_criteria(solution) -> list[Criterion]:
         peak = phases["legs"][leg]["peak_vertical_grf_N"] / solution.body_weight_N
         out.append(Criterion(f"peak vertical ground force, {leg} leg", peak, unit, lo, hi, note))
     if solution.model_spec.get("model") == "amputee":
-        intact, blade = (phases["legs"][leg]["peak_vertical_grf_N"] for leg in solution.leg_names)
-        out.append(Criterion("peak vertical ground force, prosthetic / intact leg",
-                             blade / intact if intact > 0 else math.nan, "", None, 1.0,
+        intact, blade = (phases["legs"][leg]["peak_vertical_grf_N"] / solution.body_weight_N
+                         for leg in solution.leg_names)
+        out.append(Criterion("peak vertical ground force, prosthetic minus intact leg",
+                             blade - intact, "BW", None, 0.0,
                              "runners land softer on the blade (Grabowski 2010, Hobara 2013)"))
     lo, hi, unit = reference_band("stride time", speed)
     out.append(Criterion("stride time", solution.period_s, unit, lo, hi, note))
