@@ -2,14 +2,15 @@
 
 Usage (from the repository root)::
 
-    .venv/bin/python benchmarks/collocation_speed/coarse_start.py MODEL BLADE SPEED MESH START OUT
+    .venv/bin/python benchmarks/collocation_speed/coarse_start.py MODEL BLADE SPEED MESH START OUT [W]
 
 MODEL ``able`` or ``amputee``, BLADE a category or ``none``, SPEED [m/s], MESH intervals,
 START ``sine`` (the library's template guess) or ``people`` (a template from people's mean
 joint angles, ``bladelab.predict.collocation.people.people_joint_angles``: RBDS002 and
 RBDS003 of Fukuchi et al. 2017, the right leg half a stride later, the trunk 5° forward, the
-template's stride time and vertical force pattern). Solves the tracking stage and the
-predictive stage on the human body with the default objective, writes the solution to OUT and
+template's stride time and vertical force pattern). W: the weight of people's joint angles in
+the objective [1/rad²] (default: the human body's, 10). Solves the tracking stage and the
+predictive stage on the human body, writes the solution to OUT and
 prints one JSON line: each stage's iterations, wall time and status, and the solve's summary.
 """
 
@@ -22,9 +23,10 @@ import time
 
 import numpy as np
 
+from bladelab.predict import defaults
 from bladelab.predict.collocation.guess import template_guess, template_vertical_grf
 from bladelab.predict.collocation.people import people_joint_angles
-from bladelab.predict.collocation.settings import CollocationSettings
+from bladelab.predict.collocation.settings import CollocationSettings, people_term
 from bladelab.predict.collocation.solve import predict_stride
 from bladelab.predict.collocation.stride_guess import StrideGuess, periodic_derivative
 from bladelab.runner import build_runner
@@ -54,8 +56,9 @@ def people_template(runner, speed: float, n: int) -> StrideGuess:
 
 
 def main(argv: list[str]) -> int:
-    model, blade, speed, n, start, out = argv
+    model, blade, speed, n, start, out = argv[:6]
     speed, n = float(speed), int(n)
+    weight = defaults.people_weight_for("human", float(argv[6]) if len(argv) > 6 else None)
     blade = None if blade == "none" else blade
     runner = build_runner(model, blade=blade, body="human")
     guess = (template_guess(runner, speed=speed, n=n) if start == "sine"
@@ -68,11 +71,12 @@ def main(argv: list[str]) -> int:
                            "wall_s": round(p.elapsed_s, 1), "status": p.message})
 
     t0 = time.perf_counter()
-    sol = predict_stride(runner, CollocationSettings(speed_m_per_s=speed, mesh_intervals=n),
-                         guess, model_spec={"model": model, "blade": blade, "body": "human"},
+    settings = CollocationSettings(speed_m_per_s=speed, mesh_intervals=n, **people_term(weight))
+    sol = predict_stride(runner, settings, guess, model_spec={"model": model, "blade": blade, "body": "human"},
                          progress=progress)
     sol.write(out)
     print(json.dumps({"model": model, "blade": blade, "start": start, "mesh": n,
+                      "people_weight": weight,
                       "wall_s": round(time.perf_counter() - t0, 1), "stages": stages,
                       "summary": sol.summary()}))
     return 0
