@@ -161,6 +161,12 @@ def test_one_built_solver_serves_every_speed():
                         tol=1e-8)
     assert first.success and again.success and alone.success
     assert first.timings["build_s"] > 10 * again.timings["build_s"]  # reused, not rebuilt
+    for sol in (first, again):  # the wall time split: build, our functions, IPOPT's own
+        t = sol.timings
+        assert t["functions_s"] == pytest.approx(sum(v for k, v in t.items()
+                                                     if k.startswith("nlp_")))
+        assert t["build_s"] + t["functions_s"] + t["ipopt_own_s"] == pytest.approx(sol.wall_s)
+        assert t["ipopt_own_s"] > 0.0 and t["peak_memory_MB"] > 50.0
     assert again.speed == pytest.approx(2.5, rel=1e-8)
     assert again.objective == pytest.approx(alone.objective, rel=1e-9)
     assert again.objective_terms["metabolic"] == pytest.approx(

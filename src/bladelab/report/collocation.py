@@ -248,9 +248,14 @@ def collocation_sections(report, path: str | Path) -> tuple[dict, object]:
                        "iterations (count)": t.get("iterations"), "wall time (s)": t.get("wall_s"),
                        "objective (–)": t.get("objective"),
                        "largest constraint violation (–)": t.get("max_violation")})
+    t = s.timings
     stages.append({"stage": sol.stage, "status": s.status, "iterations (count)": s.iterations,
                    "wall time (s)": s.wall_s, "objective (–)": s.objective,
-                   "largest constraint violation (–)": s.max_violation})
+                   "largest constraint violation (–)": s.max_violation,
+                   "of it, building the solver (s)": t.get("build_s"),
+                   "of it, our functions (s)": t.get("functions_s"),
+                   "of it, IPOPT's own (s)": t.get("ipopt_own_s"),
+                   "process peak memory (MB)": t.get("peak_memory_MB")})
     terms = pd.DataFrame([{"term": k, "value (–)": v} for k, v in s.objective_terms.items()])
     settings = pd.DataFrame([{"setting": k, "value": json.dumps(v) if isinstance(v, dict) else v}
                              for k, v in sol.settings.to_dict().items()]

@@ -31,6 +31,7 @@ Variables are scaled (:class:`VariableScales`) so that IPOPT sees numbers of ord
 from __future__ import annotations
 
 import math
+import sys
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
@@ -71,6 +72,11 @@ class NLPSolution:
     Arrays have n + 1 rows (nodes at ``time``); ``tendon_force`` is normalised by F_max.
     ``multipliers``: IPOPT's multipliers of the variable bounds and of the constraints of the
     scaled NLP at this point (None where unknown), the dual half of a warm start.
+    ``timings`` [s unless named]: ``build_s`` (building the solver; 0 when reused), each NLP
+    function's time (``nlp_f_s``, ``nlp_g_s``, ...) and calls (``calls_nlp_f``, ...), their
+    sum ``functions_s``, ``ipopt_own_s`` (the rest of ``wall_s``: IPOPT's own linear algebra
+    and line search) and ``peak_memory_MB`` (the process's peak resident memory after the
+    solve [MB], where the platform tells).
     """
 
     time: np.ndarray
@@ -115,6 +121,17 @@ _CENTROID_EPS = 1e-8
 #: strides), so that a one-legged hop (|C| = 0 on one leg, where the phase constraint holds
 #: up to ε) is ruled out with it.
 MIN_CENTROID_BW = 0.1
+
+
+def _peak_memory_mb() -> float | None:
+    """The process's peak resident memory so far [MB] (``getrusage``), None where the
+    platform does not tell; after a solve, an upper bound of that solve's peak."""
+    try:
+        import resource
+    except ImportError:  # Windows
+        return None
+    peak = float(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss)
+    return peak / 2**20 if sys.platform == "darwin" else peak / 2**10  # bytes / KiB
 
 
 def step_phase(leg_forces: np.ndarray) -> float:
@@ -611,6 +628,12 @@ class StrideNLP:
                     "n_call_nlp_hess_l"):
             if key in stats:
                 timings[key.replace("n_call_", "calls_")] = float(stats[key])
+        functions = sum(v for k, v in timings.items() if k.startswith("nlp_"))
+        timings["functions_s"] = functions
+        timings["ipopt_own_s"] = max(0.0, float(wall) - t_build - functions)
+        memory = _peak_memory_mb()
+        if memory is not None:
+            timings["peak_memory_MB"] = memory
         return NLPSolution(
             time=np.linspace(0.0, T, n + 1),
             q=X[:nq].T, qd=X[nq:2 * nq].T,
