@@ -7,17 +7,19 @@ discretisation shows only when the mesh is refined: :func:`check_mesh` solves th
 (its primal values resampled, no tracking stage, IPOPT's barrier started at 1e-4 so that
 the solve stays on the stride's own branch), and :class:`MeshCheck` compares the two, quantity
 by quantity. With IPOPT's default barrier start (0.1) the finer solve can leave that branch:
-measured on the amputee with Cat5 at 4 m/s, it landed 5.7 % dearer at 100 intervals, where the
+measured on the amputee with Cat5 at 4 m/s, it landed 5.6 % dearer at 100 intervals, where the
 start at 1e-4 found the stride's own optimum 0.85 % dearer
-(benchmarks/human_body/categories-people10/mesh-100/). The project's settling criterion (docs/collocation.md, "Mesh
-refinement"): halving the mesh interval moves the objective and the stride time by less than
-:data:`SETTLED_PCT` per cent.
+(benchmarks/human_body/categories-people10/mesh-100/). The project's settling criterion
+(docs/collocation.md, "Mesh refinement"): halving the mesh interval moves the objective and the
+stride time by less than :data:`SETTLED_PCT` per cent.
 
 ``bladelab predict --method collocation --mesh-check`` runs it after the solve and keeps both
 in the output folder (:func:`mesh_check_in_folder`): the finer stride in
 ``OUT/mesh-check/solution.json`` (``best_iterate.json`` if it did not converge) and the
-comparison in ``OUT/mesh-check/mesh-check.json``, which the report shows beside the numbers.
-The answer stays the stride on the mesh asked for; the check says how far to trust it.
+comparison in ``OUT/mesh-check/mesh-check.json``, which the report shows beside the numbers;
+``bladelab sweep --method collocation --mesh-check`` does the same for every converged solve
+(``<model>/mesh-check/<solve>/``). The answer stays the stride on the mesh asked for; the check
+says how far to trust it.
 """
 
 from __future__ import annotations
@@ -45,9 +47,9 @@ from bladelab.predict.collocation.stride_guess import COLLOCATION_SOURCE
 __all__ = ["MESH_CHECK_DIR", "MESH_CHECK_FILE", "SETTLED_PCT", "MeshCheck", "check_mesh",
            "compare_meshes", "mesh_check_in_folder", "read_mesh_check"]
 
-#: The check's sub-folder of a solve's output folder.
+#: The check's sub-folder of a ``bladelab predict`` output folder.
 MESH_CHECK_DIR = "mesh-check"
-#: The comparison's file in :data:`MESH_CHECK_DIR`.
+#: The comparison's file in a check's folder.
 MESH_CHECK_FILE = "mesh-check.json"
 #: Largest change [%] of the objective and of the stride time that counts as settled.
 SETTLED_PCT = 1.0
