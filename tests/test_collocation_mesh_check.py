@@ -90,8 +90,7 @@ def test_the_folder_keeps_the_finer_solve_and_resume_reads_it_back(strides, tmp_
     runner, coarse, fine = strides
     calls = []
 
-    def solve(runner_, settings, guess, *, model_spec, progress=None, speed_floor=True):
-        assert speed_floor is False  # a maximum speed may come out slower
+    def solve(runner_, settings, guess, *, model_spec, progress=None):
         calls.append((settings.mesh_intervals, settings.max_iter, settings.warm_start_mu,
                   guess.n_intervals))
         return fine
@@ -158,28 +157,3 @@ def test_the_reflex_method_refuses_the_option(tmp_path, capsys):
     assert main(["predict", "--method", "reflex", "--out", str(tmp_path / "r"),
                  "--mesh-check"]) == 2
     assert "--mesh-check" in capsys.readouterr().err
-
-
-class _Stop(Exception):
-    pass
-
-
-def test_a_maximum_speed_is_checked_without_its_strides_speed_as_a_floor(strides, monkeypatch):
-    """From a collocation stride a maximum-speed solve keeps at least the stride's speed; the
-    check drops that floor, so that the finer mesh may find a slower stride."""
-    from bladelab.predict.collocation import solve
-
-    runner, coarse, _ = strides
-    floors = []
-
-    def stage(nlp, x0, settings, stage, progress, *, warm=False, speed=None, multipliers=None):
-        floors.append(speed)
-        raise _Stop
-
-    monkeypatch.setattr(solve, "_solve_stage", stage)
-    settings = CollocationSettings(mesh_intervals=N, speed_m_per_s=None)
-    for floor in (True, False):
-        with pytest.raises(_Stop):
-            solve.predict_stride(runner, settings, coarse.to_guess(),
-                                 model_spec=coarse.model_spec, speed_floor=floor)
-    assert floors[0] == pytest.approx(SPEED, rel=1e-6) and floors[1] is None

@@ -115,8 +115,7 @@ def test_a_mesh_check_of_every_converged_solve_joins_the_table_and_the_report(
     fine = fake_solution("amputee", 2 * N)[2]  # a consistent stride on twice the intervals
     checked = []
 
-    def solve_fine(runner, settings, guess, *, model_spec, progress=None, speed_floor=True):
-        assert speed_floor is False
+    def solve_fine(runner, settings, guess, *, model_spec, progress=None):
         checked.append(settings.mesh_intervals)
         return dataclasses.replace(fine, settings=settings, model_spec=model_spec)
 

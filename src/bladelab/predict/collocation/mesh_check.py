@@ -5,9 +5,8 @@ transport, the stride time, a contact time, a force peak) belongs to the runner 
 discretisation shows only when the mesh is refined: :func:`check_mesh` solves the same problem
 (model, speed, weights, constraints) on ``factor`` × the intervals, started from the stride
 (its primal values resampled, no tracking stage, IPOPT's barrier started at 1e-4 so that
-the solve stays on the stride's own branch; a maximum-speed problem without the floor of the
-stride's speed, so that the finer mesh may find a slower stride), and :class:`MeshCheck`
-compares the two, quantity by quantity. With IPOPT's default barrier start (0.1) the finer solve can leave that branch:
+the solve stays on the stride's own branch), and :class:`MeshCheck` compares the two, quantity
+by quantity. With IPOPT's default barrier start (0.1) the finer solve can leave that branch:
 measured on the amputee with Cat5 at 4 m/s, it landed 5.6 % dearer at 100 intervals, where the
 start at 1e-4 found the stride's own optimum 0.85 % dearer
 (benchmarks/human_body/categories-people10/mesh-100/). The project's settling criterion
@@ -253,8 +252,7 @@ def check_mesh(runner, sol: CollocationSolution, *, factor: int = 2,
     settings = _finer(sol, factor, max_iter)
     guess = sol.to_guess(f"{COLLOCATION_SOURCE} on {sol.settings.mesh_intervals} intervals "
                          f"({sol.guess_source})")
-    fine = predict_stride(runner, settings, guess, model_spec=sol.model_spec, progress=progress,
-                          speed_floor=False)
+    fine = predict_stride(runner, settings, guess, model_spec=sol.model_spec, progress=progress)
     return fine, compare_meshes(sol, fine)
 
 
@@ -279,7 +277,7 @@ def mesh_check_in_folder(folder: str | Path, runner, sol: CollocationSolution, *
         check = compare_meshes(sol, done)
     elif iterate is not None:
         fine = predict_stride(runner, fine_settings, iterate.to_guess(),
-                              model_spec=sol.model_spec, progress=progress, speed_floor=False)
+                              model_spec=sol.model_spec, progress=progress)
         write_solve(fine, ok, best)
         check = compare_meshes(sol, fine)
     else:

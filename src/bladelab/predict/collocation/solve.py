@@ -341,7 +341,7 @@ def _predictive_nlp(runner, dyn, settings: CollocationSettings, start, phase: fl
 
 def predict_stride(runner, settings: CollocationSettings, guess, *, model_spec: dict,
                    progress: Callable[[SolveProgress], None] | None = None,
-                   track: bool | None = None, speed_floor: bool = True):
+                   track: bool | None = None):
     """Solve one periodic stride of ``runner`` (module docstring): tracking, then predictive.
 
     Parameters
@@ -365,10 +365,6 @@ def predict_stride(runner, settings: CollocationSettings, guess, *, model_spec: 
     track
         Force (True) or skip (False) the tracking stage; None: ``settings.track_first`` unless
         the guess is a collocation solution.
-    speed_floor
-        A maximum-speed problem started from a collocation solution keeps at least that
-        solution's speed (a stride that exists); False drops the floor (the mesh-halving check:
-        the finer mesh may be slower).
 
     Returns
     -------
@@ -431,7 +427,7 @@ def predict_stride(runner, settings: CollocationSettings, guess, *, model_spec: 
     nlp_p = _predictive_nlp(runner, dyn, settings, g, phase)  # built once, then looked up
     # the prescribed speed; of a maximum speed, its floor: that of a collocation stride it
     # starts from (a stride that exists)
-    stage_speed = speed if speed is not None else (g.speed if warm and speed_floor else None)
+    stage_speed = speed if speed is not None else (g.speed if warm else None)
     sol = _solve_stage(nlp_p, nlp_p.initial_vector(start), settings, "predictive", progress,
                        warm=warm_predictive, speed=stage_speed, multipliers=duals)
     if _stalled(sol, settings):
