@@ -5,8 +5,9 @@ transport, the stride time, a contact time, a force peak) belongs to the runner 
 discretisation shows only when the mesh is refined: :func:`check_mesh` solves the same problem
 (model, speed, weights, constraints) on ``factor`` × the intervals, started from the stride
 (its primal values resampled, no tracking stage, IPOPT's barrier started at 1e-4 so that
-the solve stays on the stride's own branch), and :class:`MeshCheck` compares the two, quantity
-by quantity. With IPOPT's default barrier start (0.1) the finer solve can leave that branch:
+the solve stays on the stride's own branch; a maximum-speed problem keeps its stride's speed as
+a floor, as every warm-started one does), and :class:`MeshCheck` compares the two, quantity by
+quantity. With IPOPT's default barrier start (0.1) the finer solve can leave that branch:
 measured on the amputee with Cat5 at 4 m/s, it landed 5.6 % dearer at 100 intervals, where the
 start at 1e-4 found the stride's own optimum 0.85 % dearer
 (benchmarks/human_body/categories-people10/mesh-100/). The project's settling criterion
