@@ -158,8 +158,13 @@ def mesh_check_table(table: pd.DataFrame) -> pd.DataFrame | None:
     if "mesh_check_settled" not in table.columns:
         return None
     rows = table[table.converged]
-    cols = ["model", "problem", "prescribed_speed_mps", "mean_speed_mps", *MESH_CHECK_COLUMNS]
-    return rows[[c for c in cols if c in rows.columns]].reset_index(drop=True)
+    cols = ["model", "problem", "mean_speed_mps", *MESH_CHECK_COLUMNS]
+    shown = rows[[c for c in cols if c in rows.columns]].reset_index(drop=True)
+    return shown.rename(columns={
+        "mean_speed_mps": "speed (m/s)", "mesh_check_converged": "finer solve converged",
+        "mesh_check_settled": "settled", "mesh_check_objective_change_pct": "objective (%)",
+        "mesh_check_stride_time_change_pct": "stride time (%)",
+        "mesh_check_cot_change_pct": "cost of transport (%)"})
 
 
 def _truth(v) -> bool:
@@ -171,9 +176,9 @@ def _mesh_check_text(checks: pd.DataFrame | None) -> str:
         return (" No mesh-halving check ('bladelab sweep --mesh-check' solves every problem "
                 "again on twice the mesh intervals): differences of a few per cent between "
                 "solves may be the mesh's.")
-    done = checks[checks.mesh_check_settled.notna()]
-    settled = int(sum(_truth(v) for v in done.mesh_check_settled))
-    change = pd.to_numeric(done.mesh_check_objective_change_pct, errors="coerce").abs()
+    done = checks[checks["settled"].notna()]
+    settled = int(sum(_truth(v) for v in done["settled"]))
+    change = pd.to_numeric(done["objective (%)"], errors="coerce").abs()
     text = (f" Mesh-halving check: {settled} of {len(done)} converged solves settled "
             "(objective and stride time within 1 % on twice the mesh intervals)")
     if change.notna().any():
