@@ -20,6 +20,8 @@ from bladelab.predict.collocation.mesh_check import (
     read_mesh_check,
 )
 from bladelab.predict.collocation.settings import CollocationSettings
+from bladelab.report.builder import Report
+from bladelab.report.collocation import collocation_sections
 from collocation_fake import SPEED, fake_solution
 
 N = 12
@@ -134,11 +136,15 @@ def test_the_command_solves_the_finer_mesh_and_says_so(strides, tmp_path, capsys
     assert "mesh check: predictive stage: started" in cap.err
     assert "the finer solve did not converge" in cap.err
     assert (out / MESH_CHECK_DIR / "best_iterate.json").is_file()
-    # the report names it in its first section
-    assert main(["report", str(out), "--out", str(tmp_path / "report")]) == 0
-    text = (tmp_path / "report" / "index.html").read_text(encoding="utf-8")
-    assert "Mesh-halving check: the same problem on 24 mesh intervals" in text
-    assert "the finer solve did not converge" in text
+    # the report names it in its first section (the collocation solution's own sections)
+    report = Report("t")
+    collocation_sections(report, out)
+    first = report.sections[0]
+    assert first.title == "Against measured human running"
+    assert "the finer solve did not converge" in " ".join(first.text)
+    (table,) = [t for t in first.tables if t.title.startswith("Mesh-halving check")]
+    assert "24 mesh intervals against this stride's 12" in table.title
+    assert list(table.frame.columns) == ["quantity", "12 intervals", "24 intervals", "change"]
 
 
 def test_a_new_stride_in_the_folder_drops_the_old_check(strides, tmp_path, capsys):
