@@ -57,7 +57,8 @@ def run() -> str:
         "## Collocation: the mesh-halving check of the shipped strides",
         "",
         f"Each shipped stride (human body, mesh {MESH}, people's angles at the default weight) "
-        f"solved again on {2 * MESH} intervals from itself, IPOPT's barrier started at 1e-4 "
+        f"solved again on {2 * MESH} intervals from itself, IPOPT warm-started (barrier 1e-4, "
+        "bound push 1e-8) "
         "(`bladelab predict --mesh-check`); settled: objective and stride time within 1 %.",
         "",
         "| stride | objective | stride time | cost of transport | peaks per leg | verdict | "

@@ -11,7 +11,8 @@ For each category, OUT/<category>/solution.json is the kept stride of ``categori
 --mesh-check`` solves the
 same problem on 100 intervals from it (a finer solve already in OUT/<category>/mesh-check/ is
 read back). ``--mu`` starts IPOPT's barrier of the finer solve at MU (set as the stride's
-``warm_start_mu``; default: the check's own start, 1e-4; 0.1 is IPOPT's default start). Writes OUT/mesh-check.csv: per
+``warm_start_mu``; default: the check's own start, 1e-4; the bound push stays 1e-8 either
+way, so 0.1 is not IPOPT's default start, which also pushes the start off its bounds). Writes OUT/mesh-check.csv: per
 category the objective, cost of transport, stride time and peaks on both meshes and their
 changes, and the verdict.
 """

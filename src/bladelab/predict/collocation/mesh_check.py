@@ -4,13 +4,15 @@ A collocation stride is a solution of its mesh. Whether a number read from it (t
 transport, the stride time, a contact time, a force peak) belongs to the runner or to the
 discretisation shows only when the mesh is refined: :func:`check_mesh` solves the same problem
 (model, speed, weights, constraints) on ``factor`` × the intervals, started from the stride
-(its primal values resampled, no tracking stage, IPOPT's barrier started at 1e-4 so that
-the solve stays on the stride's own branch; a maximum-speed problem keeps its stride's speed as
-a floor, as every warm-started one does), and :class:`MeshCheck` compares the two, quantity by
-quantity. With IPOPT's default barrier start (0.1) the finer solve can leave that branch:
-measured on the amputee with Cat5 at 4 m/s, it landed 5.6 % dearer at 100 intervals, where the
-start at 1e-4 found the stride's own optimum 0.85 % dearer
-(benchmarks/human_body/categories-people10/mesh-100/). The project's settling criterion
+(its primal values resampled, no tracking stage, IPOPT started as the library's warm starts
+are: barrier 1e-4, bound push and fraction 1e-8, so that the start is not pushed off its bounds
+and the solve stays on the stride's own branch; a maximum-speed problem keeps its stride's
+speed as a floor, as every warm-started one does), and :class:`MeshCheck` compares the two,
+quantity by quantity. With IPOPT's default start (barrier 0.1, bound push 0.01) the finer solve
+can leave that branch: measured on the amputee with Cat5 at 4 m/s, it landed 5.6 % dearer at
+100 intervals, where the warm start found the stride's own optimum 0.85 % dearer; with the
+bound push at 1e-8 the barrier's start made no difference (0.1 and 1e-4 gave bit-identical
+strides at 5 m/s) (benchmarks/human_body/categories-people10/mesh-100/). The project's settling criterion
 (docs/collocation.md, "Mesh refinement"): halving the mesh interval moves the objective and the
 stride time by less than :data:`SETTLED_PCT` per cent.
 
