@@ -81,17 +81,16 @@ class StageProgress:
                        f"{p.elapsed_s:.1f} s", err=True)
 
 
-def _text(summary: dict, path: Path, solved: bool) -> str:
+def _text(summary: dict, path: Path, solved: bool, check: MeshCheck | None = None) -> str:
     head = "solution" if summary["converged"] else "best iterate (not converged)"
     lines = [f"{head}: {path}" + ("" if solved else " (already solved: read back)")]
     for key, value in summary.items():
-        if key in ("warnings", "mesh_check"):
+        if key == "warnings":
             continue
         lines.append(f"  {key}: {value:.4g}" if isinstance(value, float)
                      else f"  {key}: {value}")
     lines += [f"  warning: {w}" for w in (summary.get("warnings") or "").split("; ") if w]
-    if summary.get("mesh_check"):
-        check = MeshCheck.from_dict(summary["mesh_check"])
+    if check is not None:
         lines.append(f"  {check.verdict()}")
         lines += [f"    {q}: {a} → {b} ({c})" for q, a, b, c in check.table()]
     return "\n".join(lines)
@@ -183,9 +182,11 @@ def run_collocation(
     except BladelabError as err:
         raise renamed(err, OPTIONS) from None
     summary = sol.summary()
-    if check is not None:
-        summary["mesh_check"] = check.to_dict()
-    typer.echo(json.dumps(summary) if as_json else _text(summary, result.path, result.solved))
+    if as_json:
+        typer.echo(json.dumps(summary | ({} if check is None
+                                         else {"mesh_check": check.to_dict()})))
+    else:
+        typer.echo(_text(summary, result.path, result.solved, check))
     if sol.converged:
         return 0
     worst = "; ".join(f"{name} ({value:.3g})" for name, value in sol.nlp.worst_constraints)

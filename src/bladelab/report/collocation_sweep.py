@@ -146,10 +146,13 @@ def _with_current_warnings(table: pd.DataFrame, folder: Path) -> tuple[pd.DataFr
     return _flag(table), solutions
 
 
-#: The mesh-halving check's columns of a sweep table, as shown (``mesh_check_columns``).
-MESH_CHECK_COLUMNS = ("mesh_check_converged", "mesh_check_settled",
-                      "mesh_check_objective_change_pct", "mesh_check_stride_time_change_pct",
-                      "mesh_check_cot_change_pct")
+#: The sweep table's columns shown with a solve's mesh-halving check
+#: (:func:`~bladelab.predict.collocation.sweep.mesh_check_columns`) -> their headers.
+_MESH_CHECK_SHOWN = {
+    "mean_speed_mps": "speed (m/s)", "mesh_check_converged": "finer solve converged",
+    "mesh_check_settled": "settled", "mesh_check_objective_change_pct": "objective (%)",
+    "mesh_check_stride_time_change_pct": "stride time (%)",
+    "mesh_check_cot_change_pct": "cost of transport (%)"}
 
 
 def mesh_check_table(table: pd.DataFrame) -> pd.DataFrame | None:
@@ -158,13 +161,9 @@ def mesh_check_table(table: pd.DataFrame) -> pd.DataFrame | None:
     if "mesh_check_settled" not in table.columns:
         return None
     rows = table[table.converged]
-    cols = ["model", "problem", "mean_speed_mps", *MESH_CHECK_COLUMNS]
+    cols = ["model", "problem", *_MESH_CHECK_SHOWN]
     shown = rows[[c for c in cols if c in rows.columns]].reset_index(drop=True)
-    return shown.rename(columns={
-        "mean_speed_mps": "speed (m/s)", "mesh_check_converged": "finer solve converged",
-        "mesh_check_settled": "settled", "mesh_check_objective_change_pct": "objective (%)",
-        "mesh_check_stride_time_change_pct": "stride time (%)",
-        "mesh_check_cot_change_pct": "cost of transport (%)"})
+    return shown.rename(columns=_MESH_CHECK_SHOWN)
 
 
 def _truth(v) -> bool:

@@ -174,12 +174,12 @@ def human_running_criteria(solution) -> list[Criterion]:
         out.append(Criterion(f"contact time, {leg} leg",
                              phases["legs"][leg]["contact_time_s"], unit, leg_lo, hi, note))
     lo, hi, unit = reference_band("peak vertical ground force", speed)
-    for leg in solution.leg_names:
-        peak = phases["legs"][leg]["peak_vertical_grf_N"] / solution.body_weight_N
+    peaks = [phases["legs"][leg]["peak_vertical_grf_N"] / solution.body_weight_N
+             for leg in solution.leg_names]
+    for leg, peak in zip(solution.leg_names, peaks, strict=True):
         out.append(Criterion(f"peak vertical ground force, {leg} leg", peak, unit, lo, hi, note))
     if solution.model_spec.get("model") == "amputee":
-        intact, blade = (phases["legs"][leg]["peak_vertical_grf_N"] / solution.body_weight_N
-                         for leg in solution.leg_names)
+        intact, blade = peaks
         out.append(Criterion("peak vertical ground force, prosthetic minus intact leg",
                              blade - intact, "BW", None, 0.0,
                              "runners land softer on the blade (Grabowski 2010, Hobara 2013)"))

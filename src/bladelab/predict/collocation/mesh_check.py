@@ -10,9 +10,10 @@ and the solve stays on the stride's own branch; a maximum-speed problem keeps it
 speed as a floor, as every warm-started one does), and :class:`MeshCheck` compares the two,
 quantity by quantity. With IPOPT's default start (barrier 0.1, bound push 0.01) the finer solve
 can leave that branch: measured on the amputee with Cat5 at 4 m/s, it landed 5.6 % dearer at
-100 intervals, where the warm start found the stride's own optimum 0.85 % dearer; with the
-bound push at 1e-8 the barrier's start made no difference (0.1 and 1e-4 gave bit-identical
-strides at 5 m/s) (benchmarks/human_body/categories-people10/mesh-100/). The project's settling criterion
+100 intervals, where the warm start found the stride's own optimum 0.85 % dearer
+(benchmarks/human_body/categories-people10/mesh-100/); with the bound push at 1e-8 the
+barrier's start made no difference (0.1 and 1e-4 gave bit-identical strides at 5 m/s,
+benchmarks/human_body/categories-people10-5mps/mesh-100/). The project's settling criterion
 (docs/collocation.md, "Mesh refinement"): halving the mesh interval moves the objective and the
 stride time by less than :data:`SETTLED_PCT` per cent.
 
@@ -233,11 +234,12 @@ def _finer(sol: CollocationSolution, factor: int, max_iter: int | None):
 
 
 def check_mesh(runner, sol: CollocationSolution, *, factor: int = 2,
-               max_iter: int | None = None,
+               max_iter: int | None = None, start: CollocationSolution | None = None,
                progress: Callable[[SolveProgress], None] | None = None,
                ) -> tuple[CollocationSolution, MeshCheck]:
     """Solve ``sol``'s problem on ``factor`` × its mesh intervals from ``sol`` and compare
-    (module docstring); ``max_iter``: IPOPT's iterations (None: the stride's setting).
+    (module docstring); ``max_iter``: IPOPT's iterations (None: the stride's setting);
+    ``start``: a best iterate of the finer solve to continue from instead (None: the stride).
     Returns (the finer solve, its :class:`MeshCheck`).
 
     Raises
@@ -253,8 +255,9 @@ def check_mesh(runner, sol: CollocationSolution, *, factor: int = 2,
         raise SpecError("the stride did not converge: there is no solution to check",
                         where="mesh check", hint="converge the solve first (--resume)")
     settings = _finer(sol, factor, max_iter)
-    guess = sol.to_guess(f"{COLLOCATION_SOURCE} on {sol.settings.mesh_intervals} intervals "
-                         f"({sol.guess_source})")
+    guess = (start.to_guess() if start is not None else
+             sol.to_guess(f"{COLLOCATION_SOURCE} on {sol.settings.mesh_intervals} intervals "
+                          f"({sol.guess_source})"))
     fine = predict_stride(runner, settings, guess, model_spec=sol.model_spec, progress=progress)
     return fine, compare_meshes(sol, fine)
 
@@ -278,13 +281,9 @@ def mesh_check_in_folder(folder: str | Path, runner, sol: CollocationSolution, *
                      else read_stored(ok, best, sol.model_spec, fine_settings))
     if done is not None:
         check = compare_meshes(sol, done)
-    elif iterate is not None:
-        fine = predict_stride(runner, fine_settings, iterate.to_guess(),
-                              model_spec=sol.model_spec, progress=progress)
-        write_solve(fine, ok, best)
-        check = compare_meshes(sol, fine)
     else:
-        fine, check = check_mesh(runner, sol, max_iter=max_iter, progress=progress)
+        fine, check = check_mesh(runner, sol, max_iter=max_iter, start=iterate,
+                                 progress=progress)
         write_solve(fine, ok, best)
     write_json(folder / MESH_CHECK_FILE, check.to_dict())
     return check
