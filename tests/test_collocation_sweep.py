@@ -143,6 +143,18 @@ def test_a_mesh_check_of_every_converged_solve_joins_the_table_and_the_report(
     assert "Mesh-halving check: " in " ".join(section.text)
     (per_solve,) = [t for t in section.tables if t.title.startswith("Mesh-halving check")]
     assert len(per_solve.frame) == 3
+    # the category summary says per category whether its two solves settled
+    from bladelab.report.collocation_sweep import read_sweep_table, sweep_summary
+
+    table = read_sweep_table(out)
+    table["flagged"] = False  # (the fake strides carry gait warnings)
+    assert table.mesh_check_settled.astype(str).eq("True").all()
+    table["mesh_check_settled"] = table.mesh_check_settled.astype(object)
+    table.loc[table.problem == "max-speed", "mesh_check_settled"] = False
+    assert sweep_summary(table).settled.tolist() == ["4 m/s: yes; maximum speed: no"]
+    table.loc[table.prescribed_speed_mps == 4.0, "mesh_check_settled"] = None
+    assert sweep_summary(table).settled.tolist() == ["4 m/s: not checked; maximum speed: no"]
+    assert "settled" not in sweep_summary(table.drop(columns="mesh_check_settled"))
     assert _sweep(out, "--categories", "Cat6", "--speeds", "3.5", "--mesh-check",
                   "--force") == 0
     capsys.readouterr()

@@ -96,7 +96,10 @@ def sweep_summary(table: pd.DataFrame) -> pd.DataFrame:
     maximum-speed solve), cot_4 [J/(kg·m)] (converged solve at 4 m/s), t200 and t400 [s]
     (200 m and 400 m at the maximum speed) and the contact times [s] of each leg at the maximum
     speed. NaN where the solve is missing, did not converge or is flagged by the gait checks
-    (``flagged`` of :func:`read_sweep_table`)."""
+    (``flagged`` of :func:`read_sweep_table`). A sweep with mesh-halving checks (``bladelab
+    sweep --mesh-check``) adds ``settled``: whether those two solves settled on twice the mesh
+    intervals, e.g. "4 m/s: yes; maximum speed: not checked"."""
+    checked = "mesh_check_settled" in table.columns
     rows = []
     amputee = table[table.model.astype(str).str.startswith("amputee")]
     for cat, df in amputee.groupby("blade", sort=False):
@@ -113,9 +116,24 @@ def sweep_summary(table: pd.DataFrame) -> pd.DataFrame:
             col = f"contact_time_{leg}_s"
             row[f"contact_time_{leg}"] = (float(top[col].iloc[0]) if len(top) and col in top
                                           else math.nan)
+        if checked:
+            row["settled"] = "; ".join(f"{name}: {_settled_word(solve)}" for name, solve in (
+                (f"{COST_SPEED_M_PER_S:g} m/s", at4), ("maximum speed", top)))
         rows.append(row)
     return pd.DataFrame(rows, columns=["category", "max_speed", "cot_4", "t200", "t400",
-                                       "contact_time_intact", "contact_time_prosthetic"])
+                                       "contact_time_intact", "contact_time_prosthetic"]
+                        + (["settled"] if checked else []))
+
+
+def _settled_word(solve: pd.DataFrame) -> str:
+    """'yes', 'no' or 'not checked' for the mesh-halving check of a (one-row) solve; '–'
+    without a solve."""
+    if not len(solve):
+        return "–"
+    value = solve["mesh_check_settled"].iloc[0]
+    if pd.isna(value) or str(value).strip() == "":
+        return "not checked"
+    return "yes" if _truth(value) else "no"
 
 
 def starts_table(table: pd.DataFrame) -> pd.DataFrame | None:
