@@ -43,7 +43,7 @@ OPTIONS = {
     "swing_clearance_m": "--swing-clearance", "knee_moment_min_nm": "--knee-moment-min",
     "knee_flexion_max_loaded_deg": "--knee-flexion-max",
     "pelvis_tilt_range_deg": "--tilt-range", "reference_weight": "--people-weight",
-    "step_phase_tolerance": "--alternating-steps",
+    "step_phase_tolerance": "--alternating-steps", "symmetric": "--symmetric",
     "prosthetic_load_max_bw": "--prosthetic-load-max",
     "athlete.body_mass_kg": "--body-mass", "athlete.height_m": "--height",
     "athlete.muscle_strength": "--muscle-strength",
@@ -148,9 +148,11 @@ def run_collocation(
     athlete: dict | None = None,
     starts: int | None = None,
     mesh_check: bool = False,
+    symmetric: bool = False,
 ) -> int:
     """Run ``bladelab predict --method collocation``; returns the exit status (0 converged,
     2 not converged). ``alternating_steps``: ``CollocationSettings.step_phase_tolerance``;
+    ``symmetric``: ``CollocationSettings.symmetric``;
     ``prosthetic_load_max``: ``CollocationSettings.prosthetic_load_max_bw``.
     ``athlete``: the runner scaled to this athlete (``body_mass_kg``, ``height_m``,
     ``muscle_strength``, ``max_shortening_velocity``, ``residual_limb_length_m``,
@@ -169,7 +171,7 @@ def run_collocation(
             max_iter=max_iter, swing_clearance_m=swing_clearance,
             knee_moment_min_nm=knee_moment_min, knee_flexion_max_loaded_deg=knee_flexion_max,
             pelvis_tilt_range_deg=tilt, step_phase_tolerance=alternating_steps,
-            prosthetic_load_max_bw=prosthetic_load_max,
+            prosthetic_load_max_bw=prosthetic_load_max, symmetric=symmetric,
             **people_term(defaults.people_weight_for(body, people_weight)))
         result = solve_named_stride(out, model=model, blade=blade, body=body,
                                     settings=settings, guess=guess, athlete=athlete,

@@ -316,6 +316,10 @@ def register(app: typer.Typer) -> None:
             help="Keep the pelvis tilt within LO,HI [deg] at every node (forward lean "
                  "negative), e.g. --tilt-range=-16,-2 (seed 001's window)."),
         alternating_steps: float | None = _alternating_steps_option(),
+        symmetric: bool = typer.Option(
+            False, "--symmetric", rich_help_panel=COLLOCATION,
+            help="Able runner: each leg does what the other did half a stride earlier "
+                 "(bilateral symmetry, as PredSim imposes it; an even --mesh)."),
         prosthetic_load_max: float | None = typer.Option(
             None, "--prosthetic-load-max", rich_help_panel=COLLOCATION, show_default=False,
             help="Keep the prosthetic leg's vertical ground force at or below this many body "
@@ -365,7 +369,7 @@ def register(app: typer.Typer) -> None:
                 knee_moment_min=knee_moment_min,
                 knee_flexion_max=knee_flexion_max, tilt_range=tilt_range,
                 alternating_steps=alternating_steps, prosthetic_load_max=prosthetic_load_max,
-                people_weight=people_weight,
+                people_weight=people_weight, symmetric=symmetric,
                 athlete=_athlete(static, body_mass_kg=body_mass, height_m=height,
                                  muscle_strength=muscle_strength,
                                  max_shortening_velocity=max_shortening_velocity,

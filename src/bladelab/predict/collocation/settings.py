@@ -140,6 +140,12 @@ class CollocationSettings:
         peak forces are most symmetric at their preferred step frequency (Kobayashi et al.
         2022, J NeuroEng Rehabil); the transfemoral runner on the human body, free, gallops
         instead (docs/runner-model.md).
+    symmetric
+        Each leg does what the other did half a stride earlier (bilateral symmetry, as
+        PredSim imposes it by solving half a gait cycle;
+        :mod:`~bladelab.predict.collocation.symmetry`): a constraint of the predictive
+        stage, for a runner whose legs are mirror images (the able runner) and an even
+        number of mesh intervals. False (default): each leg free.
     reference, reference_weight, reference_dofs
         ``"people"`` (:data:`PEOPLE_REFERENCE`): people's measured hip, knee and ankle angles
         at 3.5 m/s (:mod:`bladelab.predict.collocation.people`), ``reference_weight``
@@ -176,6 +182,7 @@ class CollocationSettings:
     blade_backward_euler: bool = False
     pelvis_tilt_range_deg: tuple[float, float] | None = None
     step_phase_tolerance: float | None = None
+    symmetric: bool = False
     reference: str | None = None
     reference_weight: float = 0.0
     reference_dofs: tuple[str, ...] | None = None
@@ -268,6 +275,13 @@ class CollocationSettings:
                                 f"stride or None, got {sp!r}", where="step_phase_tolerance",
                                 hint="0.1: the other leg's stance 40-60 % of the stride later")
             object.__setattr__(self, "step_phase_tolerance", float(sp))
+        if not isinstance(self.symmetric, bool):
+            raise SpecError(f"expected true or false, got {self.symmetric!r}",
+                            where="symmetric")
+        if self.symmetric and self.mesh_intervals % 2:
+            raise SpecError(f"a symmetric stride needs an even number of mesh intervals, got "
+                            f"{self.mesh_intervals}", where="mesh_intervals",
+                            hint="e.g. 50 or 100")
         self._check_tilt_range()
         self._check_reference()
 
@@ -343,7 +357,7 @@ class CollocationSettings:
     def same_problem(self, other: CollocationSettings) -> bool:
         """True if ``other`` poses the same NLP (mesh, speed, weights, swing clearance, knee
         moment bound, loaded knee's flexion limit, prosthetic load limit, blade transcription,
-        pelvis tilt range, alternating steps);
+        pelvis tilt range, alternating steps, symmetry);
         solver options
         (Hessian, tolerance, iterations) and the tracking stage may differ."""
         return self._problem() == other._problem()
@@ -352,7 +366,8 @@ class CollocationSettings:
         return (self.mesh_intervals, self.speed_m_per_s, self.weights, self.swing_clearance_m,
                 self.knee_moment_min_nm, self.knee_flexion_max_loaded_deg,
                 self.prosthetic_load_max_bw, self.blade_backward_euler,
-                self.pelvis_tilt_range_deg, self.step_phase_tolerance) + self.reference_key()
+                self.pelvis_tilt_range_deg, self.step_phase_tolerance, self.symmetric
+                ) + self.reference_key()
 
     def reference_key(self) -> tuple:
         """(reference file name, weight, coordinates), or () without a reference term."""

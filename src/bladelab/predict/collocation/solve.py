@@ -326,14 +326,15 @@ def _predictive_nlp(runner, dyn, settings: CollocationSettings, start, phase: fl
     n, speed = settings.mesh_intervals, settings.speed_m_per_s
     nlps = _BUILT[runner]["nlps"]
     key = (n, speed is None, settings.weights, id(dyn), settings.reference_key(), phase,
-           settings.step_phase_tolerance)
+           settings.step_phase_tolerance, settings.symmetric)
     if key not in nlps:
         while len(nlps) >= MAX_NLPS_PER_RUNNER:
             nlps.pop(next(iter(nlps)))
         tracking, period_tracking = _reference_tracking(runner, settings, start, phase)
         nlps[key] = StrideNLP(dyn, n=n, speed=speed, weights=settings.weights,
                               tracking=tracking, period_tracking=period_tracking,
-                              step_phase_tolerance=settings.step_phase_tolerance)
+                              step_phase_tolerance=settings.step_phase_tolerance,
+                              symmetric=settings.symmetric)
     else:
         nlps[key] = nlps.pop(key)  # most recently used last
     return nlps[key]

@@ -53,6 +53,7 @@ from bladelab.predict.collocation.stride_problem import (
     StrideWeights,
     VariableScales,
 )
+from bladelab.predict.collocation.symmetry import stride_mirror, symmetrized, symmetry_rows
 
 __all__ = [
     "NLPSolution",
@@ -222,6 +223,10 @@ class StrideNLP:
         Keep the legs' stances alternating: the right leg's :func:`step_phase` within
         0.5 ± this [fraction of the stride] (needs ``StrideDynamics.leg_vertical_grf``);
         None: free.
+    symmetric
+        Each leg does what the other did half a stride earlier
+        (:mod:`~bladelab.predict.collocation.symmetry`; an even ``n``, legs that are mirror
+        images).
     """
 
     def __init__(
@@ -240,6 +245,7 @@ class StrideNLP:
         grf_tracking: tuple[np.ndarray, float] | None = None,
         period_tracking: tuple[float, float] | None = None,
         step_phase_tolerance: float | None = None,
+        symmetric: bool = False,
     ) -> None:
         if n < 4:
             raise SpecError(f"need at least 4 mesh intervals, got {n}", where="mesh intervals")
@@ -265,6 +271,10 @@ class StrideNLP:
                             where="step phase tolerance",
                             hint="build the dynamics with stride_dynamics")
         self.step_phase_tolerance = step_phase_tolerance
+        if symmetric and n % 2:
+            raise SpecError(f"a symmetric stride needs an even number of mesh intervals, got "
+                            f"{n}", where="mesh intervals")
+        self.symmetric = bool(symmetric)
         self._build()
 
     # -- layout -------------------------------------------------------------------------
@@ -339,14 +349,22 @@ class StrideNLP:
         # torque-driven 'gait' that never touched the ground, one flight phase closed by an
         # acceleration spike at the last node)
         periodic = ca.vertcat(X[keep, n] - X[keep, 0], U[:, n] - U[:, 0])
-        g = [ca.vec(defects), ca.vec(pth[:, :n]), periodic]
+        # a symmetric stride: the second half's rows follow from the first half's (symmetry)
+        self._imposed_nodes = m = n // 2 if self.symmetric else n
+        g = [ca.vec(defects[:, :m]), ca.vec(pth[:, :m]), periodic]
         state_names = self._state_names()
         self._g_names = (
-            [f"defect {nm_}@{k}" for k in range(n) for nm_ in state_names]
-            + [f"path {nm_}@{k}" for k in range(n) for nm_ in self._path_names()]
+            [f"defect {nm_}@{k}" for k in range(m) for nm_ in state_names]
+            + [f"path {nm_}@{k}" for k in range(m) for nm_ in self._path_names()]
             + [f"periodicity {state_names[i]}" for i in keep]
             + [f"periodicity {nm_}" for nm_ in self._control_names()]
         )
+        if self.symmetric:
+            self._mirror = stride_mirror(d, node, self.sx)
+            g.append(symmetry_rows(X, U, *self._mirror, itx))
+            self._g_names += (
+                [f"symmetry {nm_}@{k}" for k in range(m, n) for nm_ in state_names]
+                + [f"symmetry {nm_}@{k}" for k in range(m, n) for nm_ in self._control_names()])
         trap = _node_pairs(eff) / 2 * h  # ∫ effort dt
         energy = _node_pairs(mets) / 2 * h  # ∫ Ė dt [J]
         terms = {"effort": trap / period}
@@ -401,13 +419,13 @@ class StrideNLP:
             dev = ((fzs - f_ref) / bw) ** 2
             terms["grf_tracking"] = float(weight) * _node_pairs(dev) / (2 * n)
         if self.n_ineq:
-            imposed = ineqs[:, :n]
+            imposed = ineqs[:, :m]
             if d.interval_mean_inequalities:
-                means = 0.5 * (ineqs[:, :n] + ineqs[:, 1:])
+                means = 0.5 * (ineqs[:, :m] + ineqs[:, 1:m + 1])
                 imposed = ca.vertcat(*[means[i, :] if i in d.interval_mean_inequalities
                                        else imposed[i, :] for i in range(self.n_ineq)])
             g.append(ca.vec(imposed))
-            self._g_names += [f"inequality {i}@{k}" for k in range(n) for i in range(self.n_ineq)]
+            self._g_names += [f"inequality {i}@{k}" for k in range(m) for i in range(self.n_ineq)]
         J = sum(terms.values())
         self._terms = ca.Function("terms", [X, U, T, P], list(terms.values()))
         self._term_names = tuple(terms)
@@ -477,8 +495,9 @@ class StrideNLP:
             lbg[i:i + 3] = -np.inf
         if self.n_ineq:
             b = np.asarray(d.inequality_bounds, float)
-            lbg[-self.n_ineq * n:] = np.tile(b[:, 0], n)
-            ubg[-self.n_ineq * n:] = np.tile(b[:, 1], n)
+            m = self._imposed_nodes
+            lbg[-self.n_ineq * m:] = np.tile(b[:, 0], m)
+            ubg[-self.n_ineq * m:] = np.tile(b[:, 1], m)
         return lbx, ubx, lbg, ubg
 
     def initial_vector(self, guess) -> np.ndarray:
@@ -505,6 +524,8 @@ class StrideNLP:
                else periodic_derivative(np.vstack([ften[:-1], ften[:1]]), g.period))
         X = np.hstack([g.q, g.qd, act, ften]).T / self.sx[:, None]
         U = np.hstack([qdd, exc, dft]).T / self.su[:, None]
+        if self.symmetric:
+            X, U = symmetrized(X, U, *self._mirror, d.dof_names.index("pelvis_tx"))
         return np.concatenate([X.ravel(order="F"), U.ravel(order="F"),
                                [g.period / self.scales.period]])
 
