@@ -94,6 +94,9 @@ def test_a_failed_force_run_removes_the_old_solution(solved, tmp_path, capsys):
     (("--method", "reflex", "--tilt-range=-16,-2"), "--tilt-range"),  # its lean weight
     (("--method", "collocation", "--alternating-steps", "0.5"), "--alternating-steps"),
     (("--method", "reflex", "--alternating-steps", "0.1"), "--alternating-steps"),
+    (("--method", "collocation", "--symmetric", "--mesh", "51"), "--mesh"),
+    (("--method", "collocation", "--model", "amputee", "--symmetric"), "--symmetric"),
+    (("--method", "reflex", "--symmetric"), "--symmetric"),
     (("--method", "collocation", "--body-mass", "-70"), "--body-mass"),
     (("--method", "collocation", "--height", "0"), "--height"),
     (("--method", "collocation", "--muscle-strength", "0"), "--muscle-strength"),

@@ -13,7 +13,8 @@ no people's term (``people_weight``, default 0); a speed that does not converge 
 more halfway from the last converged one, then the chain stops. The variant (JSON):
 ``active_tension`` [N/cm²] (the fibres' active specific tension; the body's is 30),
 ``vmax`` [optimal fibre lengths/s] (every muscle's maximum shortening velocity; the body's is
-10), ``force_factor`` as in solve_variant.py. Writes ``OUT/speed-<v>.json`` per converged speed
+10), ``force_factor`` as in solve_variant.py, ``symmetric`` (true: each leg does what the other
+did half a stride earlier, ``CollocationSettings.symmetric``; able runner). Writes ``OUT/speed-<v>.json`` per converged speed
 and ``OUT/records.jsonl`` (one line per solve: the summary, the largest activation of any muscle
 at any node, the wall time), and prints each line.
 """
@@ -61,7 +62,8 @@ def main() -> None:
     last, pending = None, list(speeds)
     while pending:
         v = pending.pop(0)
-        settings = CollocationSettings(mesh_intervals=mesh, speed_m_per_s=v, **people)
+        settings = CollocationSettings(mesh_intervals=mesh, speed_m_per_s=v, **people,
+                                       symmetric=bool(variant.get("symmetric", False)))
         t0 = time.perf_counter()
         sol = predict_stride(runner, settings, guess, model_spec=spec)
         rec = {"speed": v, **sol.summary(), "max_activation": float(np.max(sol.nlp.activation)),

@@ -74,6 +74,7 @@ from bladelab.predict.collocation.settings import (
 from bladelab.predict.collocation.solution import CollocationSolution
 from bladelab.predict.collocation.stored import check_model_spec, describe_problem
 from bladelab.predict.collocation.stride_guess import COLLOCATION_SOURCE
+from bladelab.predict.collocation.symmetry import mirror_permutation
 from bladelab.predict.collocation.transcription import StrideNLP, StrideWeights
 
 __all__ = [
@@ -380,6 +381,9 @@ def predict_stride(runner, settings: CollocationSettings, guess, *, model_spec: 
     if not isinstance(settings, CollocationSettings):
         raise SpecError(f"expected CollocationSettings, got {type(settings).__name__}",
                         where="settings")
+    if settings.symmetric:  # refused before any stage runs (the legs: when the NLP is built)
+        mirror_permutation(runner.dof_names)
+        mirror_permutation(runner.muscle_names)
     cm, dyn = _model_functions(runner, settings.swing_clearance_m, settings.knee_moment_min_nm,
                                settings.blade_backward_euler,
                                settings.knee_flexion_max_loaded_deg,

@@ -140,20 +140,25 @@ def symmetry_rows(X: ca.MX, U: ca.MX, perm_x: np.ndarray, perm_u: np.ndarray, it
 
 def symmetrized(X: np.ndarray, U: np.ndarray, perm_x: np.ndarray, perm_u: np.ndarray,
                 itx: int) -> tuple[np.ndarray, np.ndarray]:
-    """The symmetric stride nearest a stride's node values ``X`` (n_x, n + 1) and ``U``
-    (n_u, n + 1) (scaled or not; n even): each first-half node the mean of itself and the
-    mirror of its twin half a stride later, the second half their mirror (pelvis_tx, row
-    ``itx``, half the stride length ahead), node n node 0 (pelvis_tx a stride ahead)."""
+    """A symmetric stride made of a stride's node values ``X`` (n_x, n + 1) and ``U``
+    (n_u, n + 1) (scaled or not; n even): of each mirrored pair of rows the first (the left
+    leg's) as it is and the second that row half a stride later; each row without a side
+    (pelvis, trunk) the mean of itself and itself half a stride later (pelvis_tx, row ``itx``,
+    half the stride length ahead); node n is node 0 (pelvis_tx a stride ahead). A leg's
+    motion, continuous over the stride, is kept whole: a mean of the two legs would blur
+    their stances where the steps are not exactly half a stride apart."""
     X, U = np.array(X, float), np.array(U, float)
     n = X.shape[1] - 1
     half = n // 2
     length = X[itx, n] - X[itx, 0]
-    ahead = np.zeros((X.shape[0], 1))
-    ahead[itx] = length / 2
-    x = 0.5 * (X[:, :half] + (X[:, half:n] - ahead)[perm_x])
-    u = 0.5 * (U[:, :half] + U[:, half:n][perm_u])
-    X[:, :half], X[:, half:n] = x, x[perm_x] + ahead
-    U[:, :half], U[:, half:n] = u, u[perm_u]
-    X[:, n], U[:, n] = X[:, 0], U[:, 0]
-    X[itx, n] = X[itx, 0] + length
+    X[itx] -= np.arange(n + 1) * length / n  # pelvis_tx about its steady advance
+    for values, perm in ((X, perm_x), (U, perm_u)):
+        body = values[:, :n]  # one period (a view)
+        for i, j in enumerate(perm):
+            if j > i:
+                body[j] = np.roll(body[i], half)
+            elif j == i:
+                body[i] = np.tile(0.5 * (body[i, :half] + body[i, half:]), 2)
+        values[:, n] = values[:, 0]
+    X[itx] += np.arange(n + 1) * length / n
     return X, U
