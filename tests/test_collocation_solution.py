@@ -627,6 +627,12 @@ def test_the_predictive_report_renders_a_collocation_solution(able, tmp_path):
     first = html[html.index("This stride is"):html.index("The stride against people")]
     assert "Not a free prediction" in first and "weight 10 1/rad²" in first
     assert "RBDS002" in first and "0.25 of the objective" in first
+    assert "Symmetric by constraint" not in first
+    report = Report("symmetric")
+    collocation_sections(report, replace(sol, settings=CollocationSettings(
+        symmetric=True)).write(tmp_path / "symmetric.json"))
+    html = report.write(tmp_path / "report4").read_text()
+    assert "Symmetric by constraint" in html[:html.index("The stride against people")]
     bad = replace(sol, nlp=replace(sol.nlp, success=False)).write(tmp_path / "best.json")
     with pytest.raises(InputFileError, match="did not converge"):
         predictive_kind(bad)

@@ -214,6 +214,10 @@ def _add_human_running_section(report, sol, trial, check=None) -> None:
     report.add_section(
         "Against measured human running",
         text=(verdict + _objective_share_text(sol)
+              + (" Symmetric by constraint: each leg does what the other did half a stride "
+                 "earlier (bladelab predict --symmetric), so the step phase of 50 % and the "
+                 "two legs' equal numbers are imposed, not predicted."
+                 if sol.settings.symmetric else "")
               + " Bands: people at this speed (bladelab.predict.collocation.human_running: "
               "the Fukuchi et al. 2017 trial at 3.5 m/s, Weyand et al. 2000 and "
               "Nummela et al. 2007 at 9 m/s, interpolated in speed between them)"
