@@ -14,6 +14,7 @@ from bladelab.predict.collocation import mesh_check
 from bladelab.predict.collocation.mesh_check import (
     MESH_CHECK_DIR,
     MESH_CHECK_FILE,
+    ROUND_TRIP_DIR,
     MeshCheck,
     compare_meshes,
     mesh_check_in_folder,
@@ -89,32 +90,58 @@ def test_the_check_round_trips_through_its_file_and_knows_its_stride(strides, tm
 
 def test_the_folder_keeps_the_finer_solve_and_resume_reads_it_back(strides, tmp_path,
                                                                    monkeypatch):
+    """The finer solve, then the round trip (the stride's own mesh again, from the finer
+    stride) in the folder; resume reads both back; another stride gets both anew."""
     runner, coarse, fine = strides
+    back = dataclasses.replace(coarse, nlp=dataclasses.replace(coarse.nlp, objective=1.2))
     calls = []
 
     def solve(runner_, settings, guess, *, model_spec, progress=None):
         calls.append((settings.mesh_intervals, settings.max_iter, settings.warm_start_mu,
-                  guess.n_intervals))
-        return fine
+                      guess.n_intervals))
+        return fine if settings.mesh_intervals == 2 * N else back
 
     monkeypatch.setattr(mesh_check, "predict_stride", solve)
     folder = tmp_path / MESH_CHECK_DIR
     check = mesh_check_in_folder(folder, runner, coarse, max_iter=77)
-    assert calls == [(2 * N, 77, 1e-4, N)]  # the stride itself, resampled by the solve
-    assert sorted(p.name for p in folder.iterdir()) == [MESH_CHECK_FILE, "solution.json"]
+    # the stride itself (resampled by the solve), then the finer stride on the stride's mesh
+    assert calls == [(2 * N, 77, 1e-4, N), (N, 77, 1e-4, 2 * N)]
+    assert sorted(p.name for p in folder.iterdir()) == [MESH_CHECK_FILE, ROUND_TRIP_DIR,
+                                                        "solution.json"]
+    assert (folder / ROUND_TRIP_DIR / "solution.json").is_file()
     assert read_mesh_check(folder) == check
+    # 1.25 (the stride) → 1.2 (the round trip) → 1.275 (the finer stride)
+    basin, own = check.round_trip_pct("objective")
+    assert basin == pytest.approx(-4.0) and own == pytest.approx(6.25)
+    assert "a lower optimum of the stride's own mesh, which this stride is not" in (
+        check.verdict())
+    assert [row[2] for row in check.round_trip_table()][0] == "1.2"
     again = mesh_check_in_folder(folder, runner, coarse, resume=True)
-    assert again == check and len(calls) == 1  # read back, not solved again
-    # a check of another stride in the folder is made anew
+    assert again == check and len(calls) == 2  # read back, not solved again
+    # a check of another stride in the folder is made anew, its round trip too
     other = dataclasses.replace(coarse, nlp=dataclasses.replace(coarse.nlp, objective=1.3))
     mesh_check_in_folder(folder, runner, other, resume=True)
-    assert len(calls) == 2 and read_mesh_check(folder).describes(other)
+    assert len(calls) == 4 and read_mesh_check(folder).describes(other)
+    # a finer solve that does not converge has no round trip: the old one goes
+    failed = dataclasses.replace(fine, nlp=dataclasses.replace(fine.nlp, success=False))
+    monkeypatch.setattr(mesh_check, "predict_stride", lambda *a, **k: failed)
+    no_trip = mesh_check_in_folder(folder, runner, coarse)
+    assert no_trip.returned is None and not (folder / ROUND_TRIP_DIR).exists()
+    assert "round trip" not in no_trip.verdict()
     assert read_mesh_check(tmp_path / "elsewhere") is None
     with pytest.raises(SpecError, match="did not converge"):
         mesh_check.check_mesh(runner, dataclasses.replace(
             coarse, nlp=dataclasses.replace(coarse.nlp, success=False)))
     with pytest.raises(SpecError, match="whole factor"):
         mesh_check.check_mesh(runner, coarse, factor=1)
+
+
+def test_a_round_trip_to_the_same_optimum_says_so_and_keeps_its_file(strides):
+    _, coarse, fine = strides
+    check = mesh_check.with_round_trip(compare_meshes(coarse, fine), coarse)
+    assert check.round_trip_pct("objective") == (pytest.approx(0.0), pytest.approx(2.0))
+    assert "the stride's own optimum again" in check.verdict()
+    assert MeshCheck.from_dict(json.loads(json.dumps(check.to_dict()))) == check
 
 
 def _predict(out, *extra):
@@ -145,6 +172,17 @@ def test_the_command_solves_the_finer_mesh_and_says_so(strides, tmp_path, capsys
     (table,) = [t for t in first.tables if t.title.startswith("Mesh-halving check")]
     assert "24 mesh intervals against this stride's 12" in table.title
     assert list(table.frame.columns) == ["quantity", "12 intervals", "24 intervals", "change"]
+    # a check with its round trip: the verdict and the round trip's own table
+    _, _, fine = strides
+    trip = mesh_check.with_round_trip(compare_meshes(coarse, fine), dataclasses.replace(
+        coarse, nlp=dataclasses.replace(coarse.nlp, objective=1.2)))
+    (out / MESH_CHECK_DIR / MESH_CHECK_FILE).write_text(json.dumps(trip.to_dict()))
+    report = Report("t")
+    collocation_sections(report, out)
+    first = report.sections[0]
+    assert "a lower optimum of the stride's own mesh" in " ".join(first.text)
+    (table,) = [t for t in first.tables if t.title.startswith("Round trip")]
+    assert table.frame["round trip against this stride"].iloc[0] == "−4.00 %"
 
 
 def test_a_new_stride_in_the_folder_drops_the_old_check(strides, tmp_path, capsys):

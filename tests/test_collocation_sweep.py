@@ -125,7 +125,7 @@ def test_a_mesh_check_of_every_converged_solve_joins_the_table_and_the_report(
     assert _sweep(out, *args) == 0
     err = capsys.readouterr().err
     assert "amputee Cat6, 4 m/s: mesh check: Mesh-halving check (12 → 24 intervals)" in err
-    assert checked == [2 * N] * 3 and len(fake_solve.calls) == 3
+    assert checked == [2 * N, N] * 3 and len(fake_solve.calls) == 3  # finer, round trip
     assert sorted(p.name for p in (out / "amputee-Cat6" / "mesh-check").iterdir()) == [
         "max-speed", "speed-3.5", "speed-4"]
     rows = _csv(out / "collocation-sweep.csv")
@@ -136,7 +136,7 @@ def test_a_mesh_check_of_every_converged_solve_joins_the_table_and_the_report(
     fake_solve.calls.clear()
     assert _sweep(out, *args, "--resume") == 0
     capsys.readouterr()
-    assert fake_solve.calls == [] and len(checked) == 3  # the checks are read back too
+    assert fake_solve.calls == [] and len(checked) == 6  # the checks are read back too
     rep = Report("t")
     collocation_sweep_sections(rep, out)
     section = rep.sections[0]

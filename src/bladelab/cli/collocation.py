@@ -93,6 +93,11 @@ def _text(summary: dict, path: Path, solved: bool, check: MeshCheck | None = Non
     if check is not None:
         lines.append(f"  {check.verdict()}")
         lines += [f"    {q}: {a} → {b} ({c})" for q, a, b, c in check.table()]
+        if check.returned is not None:
+            lines.append(f"  round trip ({check.coarse_intervals} intervals again, from the "
+                         f"finer stride): this stride → round trip (change) → finer (change)")
+            lines += [f"    {q}: {a} → {b} ({c}) → {d} ({e})"
+                      for q, a, b, c, d, e in check.round_trip_table()]
     return "\n".join(lines)
 
 

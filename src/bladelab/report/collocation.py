@@ -231,7 +231,18 @@ def _add_human_running_section(report, sol, trial, check=None) -> None:
                "iterate's numbers)"),
             pd.DataFrame([{"quantity": q, f"{check.coarse_intervals} intervals": a,
                            f"{check.fine_intervals} intervals": b, "change": c}
-                          for q, a, b, c in check.table()]))]),
+                          for q, a, b, c in check.table()]))]
+             + ([] if check.returned is None else [(
+                 f"Round trip: the {check.coarse_intervals}-interval problem solved again from "
+                 f"the {check.fine_intervals}-interval stride (against this stride: a lower "
+                 "optimum of its own mesh; the finer against it: the mesh's own part)"
+                 + ("" if check.returned_converged else " (did not converge: a best "
+                    "iterate's numbers)"),
+                 pd.DataFrame([{"quantity": q, "this stride": a, "round trip": b,
+                                "round trip against this stride": c,
+                                f"{check.fine_intervals} intervals": d,
+                                "finer against the round trip": e}
+                               for q, a, b, c, d, e in check.round_trip_table()]))])),
     )
 
 
