@@ -5,8 +5,9 @@ body, people's joint angles at the default weight, mesh 50), each solved again o
 intervals from itself (``bladelab.predict.collocation.mesh_check.check_mesh``, as
 ``bladelab predict --mesh-check`` does). Reported per stride: the change of the objective, the
 stride time, the cost of transport and each leg's peak, the verdict (settled: objective and
-stride time within 1 %), and the finer solve's iterations, wall time (of it, IPOPT's own) and
-the process's peak memory. The target is the project's settling criterion; the measured
+stride time within 1 %), the round trip (the stride's mesh again, from the finer stride:
+its objective against the stride's, and the mesh's own part, the finer stride against it), and
+the finer solve's iterations, wall time (of it, IPOPT's own) and the process's peak memory. The target is the project's settling criterion; the measured
 answers of the category study are in benchmarks/human_body/categories-people10/mesh-100.
 """
 
@@ -21,13 +22,16 @@ MESH = 50
 
 
 def _pct(check, key: str) -> str:
-    value = check.change_pct(key)
+    return _signed(check.change_pct(key))
+
+
+def _signed(value) -> str:
     return "–" if value is None else f"{value:+.2f} %"
 
 
 def run() -> str:
     from bladelab.predict import defaults
-    from bladelab.predict.collocation.mesh_check import check_mesh
+    from bladelab.predict.collocation.mesh_check import check_mesh, round_trip, with_round_trip
     from bladelab.predict.collocation.settings import CollocationSettings, people_term
     from bladelab.predict.collocation.solve import predict_stride
     from bladelab.predict.collocation.starting_guess import make_guess
@@ -43,6 +47,8 @@ def run() -> str:
                                 make_guess(runner, "stored", n=MESH, speed=speed),
                                 model_spec=spec)
         fine, check = check_mesh(runner, stride)
+        check = with_round_trip(check, round_trip(runner, stride, fine))
+        trip = {k: check.round_trip_pct(k) for k in ("objective", "stride_time_s")}
         legs = stride.leg_names
         t = fine.nlp.timings
         rows.append(
@@ -50,7 +56,9 @@ def run() -> str:
             f"{_pct(check, 'objective')} | {_pct(check, 'stride_time_s')} | "
             f"{_pct(check, 'cost_of_transport_J_per_kg_m')} | "
             + " / ".join(_pct(check, f"peak_vertical_grf_{leg}_bw") for leg in legs)
-            + f" | {'settled' if check.settled else 'not settled'} | {fine.nlp.iterations} | "
+            + f" | {'settled' if check.settled else 'not settled'} | "
+            f"{_signed(trip['objective'][0])} | {_signed(trip['objective'][1])} / "
+            f"{_signed(trip['stride_time_s'][1])} | {fine.nlp.iterations} | "
             f"{fine.nlp.wall_s:.0f} s ({t.get('ipopt_own_s', 0.0):.0f} s) | "
             f"{t.get('peak_memory_MB', float('nan')):.0f} MB |")
     return "\n".join([
@@ -59,10 +67,15 @@ def run() -> str:
         f"Each shipped stride (human body, mesh {MESH}, people's angles at the default weight) "
         f"solved again on {2 * MESH} intervals from itself, IPOPT warm-started (barrier 1e-4, "
         "bound push 1e-8) "
-        "(`bladelab predict --mesh-check`); settled: objective and stride time within 1 %.",
+        "(`bladelab predict --mesh-check`); settled: objective and stride time within 1 %. "
+        f"Round trip: the {MESH}-interval problem solved again from the finer stride; its "
+        "objective against the stride's (below 0: a lower optimum of the stride's own mesh), "
+        "and the mesh's own part (the finer stride against the round trip's) in objective and "
+        "stride time.",
         "",
         "| stride | objective | stride time | cost of transport | peaks per leg | verdict | "
+        "round trip: objective | the mesh's own part: objective / stride time | "
         "iterations | wall (of it, IPOPT's own) | peak memory |",
-        "|---|---|---|---|---|---|---|---|---|",
+        "|---|---|---|---|---|---|---|---|---|---|---|",
         *rows,
     ])
