@@ -142,6 +142,10 @@ def test_a_round_trip_to_the_same_optimum_says_so_and_keeps_its_file(strides):
     assert check.round_trip_pct("objective") == (pytest.approx(0.0), pytest.approx(2.0))
     assert "the stride's own optimum again" in check.verdict()
     assert MeshCheck.from_dict(json.loads(json.dumps(check.to_dict()))) == check
+    # a round trip that lands higher has left the stride's basin: no split is claimed
+    higher = mesh_check.with_round_trip(compare_meshes(coarse, fine), dataclasses.replace(
+        coarse, nlp=dataclasses.replace(coarse.nlp, objective=1.3)))
+    assert "a higher optimum" in higher.verdict() and "own part" not in higher.verdict()
 
 
 def _predict(out, *extra):

@@ -72,7 +72,8 @@ MESH_CHECK_FILE = "mesh-check.json"
 ROUND_TRIP_DIR = "round-trip"
 #: Largest change [%] of the objective and of the stride time that counts as settled.
 SETTLED_PCT = 1.0
-#: A round trip's objective this much [%] below the stride's: a lower optimum of its mesh.
+#: A round trip's objective this much [%] below the stride's: a lower optimum of its mesh;
+#: this much above: a higher one (the round trip left the stride's basin).
 LOWER_PCT = 0.1
 #: The quantities that decide whether a stride has settled.
 SETTLING_KEYS = ("objective", "stride_time_s")
@@ -188,6 +189,9 @@ class MeshCheck:
         parts = {k: self.round_trip_pct(k) for k in SETTLING_KEYS}
         own = ", ".join(f"{self.quantities[k][0]} {_signed(parts[k][1])}" for k in SETTLING_KEYS)
         change = parts["objective"][0]
+        if change is not None and change > LOWER_PCT:
+            return (f"{head}: objective {_signed(change)}: a higher optimum, the round trip "
+                    "left the stride's basin and does not split the change")
         found = (f"objective {_signed(change)}: a lower optimum of the stride's own mesh, "
                  "which this stride is not" if change is not None and change < -LOWER_PCT
                  else f"objective {_signed(change)}: the stride's own optimum again")
