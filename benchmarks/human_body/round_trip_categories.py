@@ -15,9 +15,10 @@ peaks of the kept stride, the round trip and the 100-interval stride.
 from __future__ import annotations
 
 import argparse
-import csv
 import os
 from pathlib import Path
+
+import pandas as pd
 
 os.environ.setdefault("OMP_NUM_THREADS", "1")
 
@@ -58,10 +59,7 @@ def main(argv=None) -> int:
             row |= {f"{k} ({name})": v for k, v in _values(sol).items()}
         rows.append(row)
         print(row, flush=True)
-    with (args.out / "round-trip.csv").open("w", newline="") as fh:
-        writer = csv.DictWriter(fh, fieldnames=list(rows[0]))
-        writer.writeheader()
-        writer.writerows(rows)
+    pd.DataFrame(rows).to_csv(args.out / "round-trip.csv", index=False)
     return 0
 
 
