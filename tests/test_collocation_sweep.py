@@ -117,7 +117,9 @@ def test_a_mesh_check_of_every_converged_solve_joins_the_table_and_the_report(
 
     def solve_fine(runner, settings, guess, *, model_spec, progress=None):
         checked.append(settings.mesh_intervals)
-        return dataclasses.replace(fine, settings=settings, model_spec=model_spec)
+        back = settings.mesh_intervals == N  # the round trip: 2 % below the finer stride
+        nlp = dataclasses.replace(fine.nlp, objective=fine.nlp.objective * (0.98 if back else 1))
+        return dataclasses.replace(fine, settings=settings, model_spec=model_spec, nlp=nlp)
 
     monkeypatch.setattr(mesh_check, "predict_stride", solve_fine)
     out = tmp_path / "sweep"
@@ -133,6 +135,9 @@ def test_a_mesh_check_of_every_converged_solve_joins_the_table_and_the_report(
         assert row["mesh_check_intervals"] == str(2 * N)
         assert row["mesh_check_settled"] in ("True", "False")
         assert float(row["mesh_check_objective_change_pct"]) == pytest.approx(0.0)
+        # the round trip 2 % below the stride (whose objective the finer one equals)
+        assert float(row["mesh_check_round_trip_objective_pct"]) == pytest.approx(-2.0)
+        assert float(row["mesh_check_own_objective_pct"]) == pytest.approx(100 * (1 / 0.98 - 1))
     fake_solve.calls.clear()
     assert _sweep(out, *args, "--resume") == 0
     capsys.readouterr()

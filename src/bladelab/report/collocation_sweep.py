@@ -170,7 +170,10 @@ _MESH_CHECK_SHOWN = {
     "mean_speed_mps": "speed (m/s)", "mesh_check_converged": "finer solve converged",
     "mesh_check_settled": "settled", "mesh_check_objective_change_pct": "objective (%)",
     "mesh_check_stride_time_change_pct": "stride time (%)",
-    "mesh_check_cot_change_pct": "cost of transport (%)"}
+    "mesh_check_cot_change_pct": "cost of transport (%)",
+    "mesh_check_round_trip_objective_pct": "round trip: objective (%)",
+    "mesh_check_own_objective_pct": "the mesh's own part: objective (%)",
+    "mesh_check_own_stride_time_pct": "the mesh's own part: stride time (%)"}
 
 
 def mesh_check_table(table: pd.DataFrame) -> pd.DataFrame | None:

@@ -235,15 +235,22 @@ def _mesh_checks(runner, records, folder: Path, label: str, progress, force: boo
 
 def mesh_check_columns(check) -> dict:
     """The sweep table's columns of one solve's mesh-halving check (empty without one):
-    ``mesh_check_intervals``, ``mesh_check_converged``, ``mesh_check_settled`` and the
-    change [%] of the objective, the stride time and the cost of transport."""
+    ``mesh_check_intervals``, ``mesh_check_converged``, ``mesh_check_settled``, the
+    change [%] of the objective, the stride time and the cost of transport, and of its round
+    trip (``MeshCheck.round_trip_pct``; empty without one): the round trip's objective against
+    the solve's [%] and the mesh's own part of the objective and the stride time [%]."""
     if check is None:
         return {}
+    (trip, own), (_, own_time) = (check.round_trip_pct("objective"),
+                                  check.round_trip_pct("stride_time_s"))
     return {"mesh_check_intervals": check.fine_intervals,
             "mesh_check_converged": check.converged, "mesh_check_settled": check.settled,
             "mesh_check_objective_change_pct": check.change_pct("objective"),
             "mesh_check_stride_time_change_pct": check.change_pct("stride_time_s"),
-            "mesh_check_cot_change_pct": check.change_pct("cost_of_transport_J_per_kg_m")}
+            "mesh_check_cot_change_pct": check.change_pct("cost_of_transport_J_per_kg_m"),
+            "mesh_check_round_trip_objective_pct": trip,
+            "mesh_check_own_objective_pct": own,
+            "mesh_check_own_stride_time_pct": own_time}
 
 
 @dataclass(frozen=True)
