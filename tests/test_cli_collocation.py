@@ -92,6 +92,10 @@ def test_a_failed_force_run_removes_the_old_solution(solved, tmp_path, capsys):
     (("--method", "collocation", "--tilt-range", "-16"), "--tilt-range"),
     (("--method", "collocation", "--tilt-range=-2,-16"), "--tilt-range"),  # lo >= hi
     (("--method", "reflex", "--tilt-range=-16,-2"), "--tilt-range"),  # its lean weight
+    (("--method", "collocation", "--stride-time", "0.7,0.6"), "--stride-time"),  # lo > hi
+    (("--method", "collocation", "--stride-time", "0.3"), "--stride-time"),  # below 0.4 s
+    (("--method", "collocation", "--stride-time", "fast"), "--stride-time"),
+    (("--method", "reflex", "--stride-time", "0.7"), "--stride-time"),
     (("--method", "collocation", "--alternating-steps", "0.5"), "--alternating-steps"),
     (("--method", "reflex", "--alternating-steps", "0.1"), "--alternating-steps"),
     (("--method", "collocation", "--symmetric", "--mesh", "51"), "--mesh"),

@@ -20,7 +20,7 @@ DOFS = ("pelvis_tx", "pelvis_tz", "pelvis_tilt", "hip_flexion_l", "knee_angle_l"
 
 def _stride(*, speed=3.5, contact=(0.24, 0.24), peak_bw=(2.5, 2.5), period=0.70,
             knee_deg=(100.0, 95.0), tilt_deg=-8.0, flight=0.1, contacts=(1, 1), cot=4.0,
-            model="able", right_after=0.5):
+            model="able", right_after=0.5, stride_time_range=None):
     """A stand-in for a CollocationSolution with the numbers the criteria read; the right
     stance ``right_after`` of the stride after the left one."""
     weight = 75.0 * 9.81
@@ -40,7 +40,8 @@ def _stride(*, speed=3.5, contact=(0.24, 0.24), peak_bw=(2.5, 2.5), period=0.70,
                            leg_vertical_force=lambda: force,
                            model_spec={"model": model}, leg_names=legs, body_weight_N=weight,
                            period_s=period, nlp=SimpleNamespace(q=q), dof_names=DOFS,
-                           cost_of_transport_J_per_kg_m=cot)
+                           cost_of_transport_J_per_kg_m=cot,
+                           settings=SimpleNamespace(stride_time_range_s=stride_time_range))
 
 
 def test_bands_are_the_anchors_and_interpolate_between_them():
@@ -57,6 +58,17 @@ def test_a_human_stride_meets_every_criterion():
     assert {c.name for c in crit} >= {"contact time, left leg", "stride time",
                                       "peak swing knee flexion, right leg", "mean pelvis tilt",
                                       "gross cost of transport"}
+
+
+def test_a_stride_held_on_a_band_edge_by_its_bound_meets_it_and_says_it_was_imposed():
+    # IPOPT relaxes bounds by 1e-8 relative: a stride held at 0.64 s ends a hair below it
+    held = human_running_criteria(_stride(period=0.64 * (1 - 1e-8),
+                                          stride_time_range=(0.64, 0.78)))
+    stride = next(c for c in held if c.name == "stride time")
+    assert stride.met and stride.note == "imposed: 0.64–0.78 s"
+    short = next(c for c in human_running_criteria(_stride(period=0.6399))
+                 if c.name == "stride time")
+    assert not short.met and short.note == ""
 
 
 def test_the_stiff_short_gait_fails_where_it_is_not_human():

@@ -19,6 +19,7 @@ from bladelab.predict.collocation.consistency import (
     inverse_dynamics,
 )
 from bladelab.predict.collocation.guess import template_guess
+from bladelab.predict.collocation.human_running import human_running_criteria
 from bladelab.predict.collocation.settings import CollocationSettings, people_term
 from bladelab.predict.collocation.solution import (
     BEST_ITERATE_KIND,
@@ -78,6 +79,16 @@ def test_settings_round_trip_and_refuse_bad_values():
         with pytest.raises(SpecError) as err:
             CollocationSettings(pelvis_tilt_range_deg=bad)
         assert err.value.where == "pelvis_tilt_range_deg"
+    cadence = CollocationSettings(stride_time_range_s=[0.64, 0.78])
+    assert cadence.stride_time_range_s == (0.64, 0.78) == cadence.period_bounds_s
+    assert not cadence.same_problem(CollocationSettings())
+    assert CollocationSettings.from_dict(json.loads(json.dumps(cadence.to_dict()))) == cadence
+    assert CollocationSettings(stride_time_range_s=(0.7, 0.7)).period_bounds_s == (0.7, 0.7)
+    for bad in ((0.78, 0.64), (0.3, 0.7), (0.6, 1.5), (0.7,), "ab", (0.6, math.nan),
+                (True, 0.7)):
+        with pytest.raises(SpecError) as err:
+            CollocationSettings(stride_time_range_s=bad)
+        assert err.value.where == "stride_time_range_s"
     stepping = CollocationSettings(step_phase_tolerance=0.1)
     assert not stepping.same_problem(CollocationSettings())
     assert CollocationSettings.from_dict(json.loads(json.dumps(stepping.to_dict()))) == stepping
@@ -431,6 +442,25 @@ def test_a_pelvis_tilt_range_bounds_every_node(able):
     assert bounded.settings.pelvis_tilt_range_deg == (lo, hi)
 
 
+def test_a_stride_time_range_bounds_the_period_of_every_stage(able):
+    # the same few iterations with and without a range that excludes the free solve's
+    # stride time: IPOPT's iterates stay inside the bounds, in the tracking stage too
+    runner, _, _ = able
+    guess = template_guess(runner, speed=SPEED, n=6)
+    free = predict_stride(runner, CollocationSettings(mesh_intervals=6, speed_m_per_s=SPEED,
+                                                      max_iter=3), guess,
+                          model_spec={"model": "able"})
+    lo, hi = free.period_s + 0.05, free.period_s + 0.08
+    for track in (True, False):
+        bounded = predict_stride(
+            runner, CollocationSettings(mesh_intervals=6, speed_m_per_s=SPEED, max_iter=3,
+                                        stride_time_range_s=(lo, hi)),
+            guess, model_spec={"model": "able"}, track=track)
+        assert lo - 1e-9 <= bounded.period_s <= hi + 1e-9
+    stride = [c for c in human_running_criteria(bounded) if c.name == "stride time"]
+    assert f"imposed: {lo:g}–{hi:g} s" in stride[0].note
+
+
 def _relabelled_solves(monkeypatch):
     """Spy on every IPOPT solve of ``StrideNLP``: returns (calls, labels); each call appends
     (nlp, x0, keywords, solution), and ``labels[i]`` (if given: ``(status, max_violation)``,
@@ -627,12 +657,13 @@ def test_the_predictive_report_renders_a_collocation_solution(able, tmp_path):
     first = html[html.index("This stride is"):html.index("The stride against people")]
     assert "Not a free prediction" in first and "weight 10 1/rad²" in first
     assert "RBDS002" in first and "0.25 of the objective" in first
-    assert "Symmetric by constraint" not in first
+    assert "Symmetric by constraint" not in first and "Stride time imposed" not in first
     report = Report("symmetric")
     collocation_sections(report, replace(sol, settings=CollocationSettings(
-        symmetric=True)).write(tmp_path / "symmetric.json"))
+        symmetric=True, stride_time_range_s=(0.7, 0.7))).write(tmp_path / "symmetric.json"))
     html = report.write(tmp_path / "report4").read_text()
-    assert "Symmetric by constraint" in html[:html.index("The stride against people")]
+    first = html[:html.index("The stride against people")]
+    assert "Symmetric by constraint" in first and "Stride time imposed at 0.7 s" in first
     bad = replace(sol, nlp=replace(sol.nlp, success=False)).write(tmp_path / "best.json")
     with pytest.raises(InputFileError, match="did not converge"):
         predictive_kind(bad)

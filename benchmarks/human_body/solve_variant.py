@@ -10,7 +10,8 @@ The JSON variant says what differs from the built-in human parameter set of ``ki
 tendon and passive curves follow them), ``muscle`` ({muscle type: {field: value}}), ``set``
 (top-level parameter fields), ``weights`` (``StrideWeights`` fields), ``guess`` (a word or a
 solution file; default the measured trial), ``track`` (true: a tracking stage of the guess
-first, as for a guess that is no collocation solution) and ``mesh`` (mesh intervals, default 50). Writes
+first, as for a guess that is no collocation solution), ``mesh`` (mesh intervals, default 50)
+and ``stride_time`` ([lo, hi] s, ``CollocationSettings.stride_time_range_s``). Writes
 ``OUT/solution.json`` (or ``best_iterate.json``) and ``OUT/variant.json``, and prints the summary and the wall time [s].
 The rows of README.md made with it: every force doubled (``{"force_factor": {"all": 2.0}}``),
 the acceleration weight 0.01, the vasti tendon slack length 0.146 m.
@@ -47,7 +48,8 @@ def main() -> None:
     weights = variant.get("weights")
     settings = CollocationSettings(speed_m_per_s=speed,
                                    weights=StrideWeights(**weights) if weights else None,
-                                   mesh_intervals=variant.get("mesh", 50))
+                                   mesh_intervals=variant.get("mesh", 50),
+                                   stride_time_range_s=variant.get("stride_time"))
     guess = make_guess(runner, variant.get("guess", "trial"), n=settings.mesh_intervals,
                        speed=speed)
     t0 = time.perf_counter()

@@ -42,7 +42,8 @@ OPTIONS = {
     "mesh_intervals": "--mesh", "speed_m_per_s": "--speed", "max_iter": "--max-iter",
     "swing_clearance_m": "--swing-clearance", "knee_moment_min_nm": "--knee-moment-min",
     "knee_flexion_max_loaded_deg": "--knee-flexion-max",
-    "pelvis_tilt_range_deg": "--tilt-range", "reference_weight": "--people-weight",
+    "pelvis_tilt_range_deg": "--tilt-range", "stride_time_range_s": "--stride-time",
+    "reference_weight": "--people-weight",
     "step_phase_tolerance": "--alternating-steps", "symmetric": "--symmetric",
     "prosthetic_load_max_bw": "--prosthetic-load-max",
     "athlete.body_mass_kg": "--body-mass", "athlete.height_m": "--height",
@@ -129,6 +130,21 @@ def _tilt_range(text: str | None) -> tuple[float, float] | None:
     return lo, hi
 
 
+def _stride_time(text: str | None) -> tuple[float, float] | None:
+    """``--stride-time LO,HI`` or ``T`` [s] as a pair of numbers (checked by
+    CollocationSettings; T fixes the stride time)."""
+    if text is None:
+        return None
+    try:
+        values = [float(v) for v in text.split(",")]
+    except ValueError:
+        values = []
+    if len(values) not in (1, 2):
+        raise SpecError(f"expected LO,HI or T [s], got {text!r}", where="--stride-time",
+                        hint="e.g. --stride-time 0.64,0.78 (people at 3.5 m/s) or 0.70")
+    return values[0], values[-1]
+
+
 def run_collocation(
     *,
     out: Path,
@@ -147,6 +163,7 @@ def run_collocation(
     knee_moment_min: float | None,
     knee_flexion_max: float | None,
     tilt_range: str | None,
+    stride_time: str | None = None,
     alternating_steps: float | None = None,
     prosthetic_load_max: float | None = None,
     people_weight: float | None = None,
@@ -157,6 +174,7 @@ def run_collocation(
 ) -> int:
     """Run ``bladelab predict --method collocation``; returns the exit status (0 converged,
     2 not converged). ``alternating_steps``: ``CollocationSettings.step_phase_tolerance``;
+    ``stride_time``: ``LO,HI`` or ``T`` [s], ``CollocationSettings.stride_time_range_s``;
     ``symmetric``: ``CollocationSettings.symmetric``;
     ``prosthetic_load_max``: ``CollocationSettings.prosthetic_load_max_bw``.
     ``athlete``: the runner scaled to this athlete (``body_mass_kg``, ``height_m``,
@@ -170,12 +188,14 @@ def run_collocation(
     if starts is None:
         starts = defaults.ATHLETE_STARTS if athlete else defaults.STARTS
     tilt = _tilt_range(tilt_range)
+    period = _stride_time(stride_time)
     try:
         settings = CollocationSettings(
             mesh_intervals=mesh, speed_m_per_s=None if max_speed else float(speed),
             max_iter=max_iter, swing_clearance_m=swing_clearance,
             knee_moment_min_nm=knee_moment_min, knee_flexion_max_loaded_deg=knee_flexion_max,
             pelvis_tilt_range_deg=tilt, step_phase_tolerance=alternating_steps,
+            stride_time_range_s=period,
             prosthetic_load_max_bw=prosthetic_load_max, symmetric=symmetric,
             **people_term(defaults.people_weight_for(body, people_weight)))
         result = solve_named_stride(out, model=model, blade=blade, body=body,

@@ -315,6 +315,11 @@ def register(app: typer.Typer) -> None:
             None, "--tilt-range", rich_help_panel=COLLOCATION,
             help="Keep the pelvis tilt within LO,HI [deg] at every node (forward lean "
                  "negative), e.g. --tilt-range=-16,-2 (seed 001's window)."),
+        stride_time: str | None = typer.Option(
+            None, "--stride-time", rich_help_panel=COLLOCATION, show_default=False,
+            help="Keep the stride time within LO,HI [s], or at T [s] (an athlete's measured "
+                 "cadence: imposed, not predicted, and the report says so), e.g. "
+                 "--stride-time 0.64,0.78. Default: free (0.4-1.2 s)."),
         alternating_steps: float | None = _alternating_steps_option(),
         symmetric: bool = typer.Option(
             False, "--symmetric", rich_help_panel=COLLOCATION,
@@ -368,6 +373,7 @@ def register(app: typer.Typer) -> None:
                 body=body or defaults.BODY, swing_clearance=swing_clearance,
                 knee_moment_min=knee_moment_min,
                 knee_flexion_max=knee_flexion_max, tilt_range=tilt_range,
+                stride_time=stride_time,
                 alternating_steps=alternating_steps, prosthetic_load_max=prosthetic_load_max,
                 people_weight=people_weight, symmetric=symmetric,
                 athlete=_athlete(static, body_mass_kg=body_mass, height_m=height,

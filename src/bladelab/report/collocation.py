@@ -155,6 +155,16 @@ def _measured_trial(runner, sol):
         return None
 
 
+def _imposed_stride_time_text(settings) -> str:
+    """The sentence that says a stride time range was imposed (``--stride-time``), or ""."""
+    r = settings.stride_time_range_s
+    if r is None:
+        return ""
+    what = f"at {r[0]:g} s" if r[0] == r[1] else f"within {r[0]:g}–{r[1]:g} s"
+    return (f" Stride time imposed {what} (bladelab predict --stride-time): the cadence is "
+            "given, not predicted.")
+
+
 def _objective_share_text(sol) -> str:
     """:func:`reference_term_text` of a solution, with the term's share of its objective."""
     value = sol.nlp.objective_terms.get("tracking")
@@ -218,6 +228,7 @@ def _add_human_running_section(report, sol, trial, check=None) -> None:
                  "earlier (bladelab predict --symmetric), so the step phase of 50 % and the "
                  "two legs' equal numbers are imposed, not predicted."
                  if sol.settings.symmetric else "")
+              + _imposed_stride_time_text(sol.settings)
               + " Bands: people at this speed (bladelab.predict.collocation.human_running: "
               "the Fukuchi et al. 2017 trial at 3.5 m/s, Weyand et al. 2000 and "
               "Nummela et al. 2007 at 9 m/s, interpolated in speed between them)"

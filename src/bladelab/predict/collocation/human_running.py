@@ -97,6 +97,11 @@ def gallop_sentence(step_phases_pct) -> str:
             "galloping strides, not running as people run it.")
 
 
+#: Relative widening of a band's edges: a stride held on a band's edge by a bound (e.g.
+#: ``--stride-time 0.64,0.78``) sits up to IPOPT's bound relaxation (1e-8 relative) outside it.
+BAND_EDGE_TOLERANCE = 1e-6
+
+
 @dataclass(frozen=True)
 class Criterion:
     """One measure of a stride against the band people show at its speed."""
@@ -110,11 +115,14 @@ class Criterion:
 
     @property
     def met(self) -> bool:
-        """Inside the band (a nan value is not)."""
+        """Inside the band, its edges widened by :data:`BAND_EDGE_TOLERANCE` (a nan value is
+        not)."""
         if not math.isfinite(self.value):
             return False
-        return ((self.low is None or self.value >= self.low)
-                and (self.high is None or self.value <= self.high))
+        tol = BAND_EDGE_TOLERANCE
+        return ((self.low is None or self.value >= self.low - tol * max(abs(self.low), 1.0))
+                and (self.high is None
+                     or self.value <= self.high + tol * max(abs(self.high), 1.0)))
 
     def band_text(self) -> str:
         unit = f" {self.unit}" if self.unit else ""
@@ -184,7 +192,11 @@ def human_running_criteria(solution) -> list[Criterion]:
                              blade - intact, "BW", None, 0.0,
                              "runners land softer on the blade (Grabowski 2010, Hobara 2013)"))
     lo, hi, unit = reference_band("stride time", speed)
-    out.append(Criterion("stride time", solution.period_s, unit, lo, hi, note))
+    imposed = solution.settings.stride_time_range_s
+    if imposed is not None:
+        imposed = f"imposed: {imposed[0]:g}–{imposed[1]:g} s"
+    out.append(Criterion("stride time", solution.period_s, unit, lo, hi,
+                         "; ".join(t for t in (note, imposed) if t)))
     q = np.asarray(solution.nlp.q)  # (nodes, coordinates)
     lo, hi, unit = reference_band("peak swing knee flexion", speed)
     for side, leg in zip(("l", "r"), solution.leg_names, strict=True):

@@ -13,7 +13,7 @@ import numpy as np
 from bladelab.errors import SpecError
 from bladelab.predict import defaults
 from bladelab.predict.collocation.dynamics import COORDINATE_BOUNDS_DEG
-from bladelab.predict.collocation.transcription import StrideWeights
+from bladelab.predict.collocation.transcription import PERIOD_BOUNDS_S, StrideWeights
 
 __all__ = ["HESSIANS", "PEOPLE_REFERENCE", "CollocationSettings", "people_term"]
 
@@ -140,6 +140,14 @@ class CollocationSettings:
         peak forces are most symmetric at their preferred step frequency (Kobayashi et al.
         2022, J NeuroEng Rehabil); the transfemoral runner on the human body, free, gallops
         instead (docs/runner-model.md).
+    stride_time_range_s
+        (lo, hi) [s]: keep the stride time (the period) inside this range, a constraint of
+        every stage (the NLP's period bounds); lo = hi fixes it. For an athlete whose cadence
+        was measured: the stride time is then imposed, not predicted, and the report says so.
+        None (default): the NLP's own bounds
+        (:data:`~bladelab.predict.collocation.transcription.PERIOD_BOUNDS_S`), the stride
+        time free. The human body's free strides are 5–15 % quicker than people's
+        (docs/collocation.md, "The stride time").
     symmetric
         Each leg does what the other did half a stride earlier (bilateral symmetry, as
         PredSim imposes it by solving half a gait cycle;
@@ -182,6 +190,7 @@ class CollocationSettings:
     blade_backward_euler: bool = False
     pelvis_tilt_range_deg: tuple[float, float] | None = None
     step_phase_tolerance: float | None = None
+    stride_time_range_s: tuple[float, float] | None = None
     symmetric: bool = False
     reference: str | None = None
     reference_weight: float = 0.0
@@ -283,6 +292,7 @@ class CollocationSettings:
                             f"{self.mesh_intervals}", where="mesh_intervals",
                             hint="e.g. 50 or 100")
         self._check_tilt_range()
+        self._check_stride_time_range()
         self._check_reference()
 
     def _check_tilt_range(self) -> None:
@@ -301,6 +311,29 @@ class CollocationSettings:
                             f"lo < hi <= {hi_all:g}, got {tr!r}", where="pelvis_tilt_range_deg",
                             hint="seed 001's window is -16, -2 (forward lean negative)")
         object.__setattr__(self, "pelvis_tilt_range_deg", (float(tr[0]), float(tr[1])))
+
+    def _check_stride_time_range(self) -> None:
+        """``stride_time_range_s``: None or (lo, hi) [s] with lo <= hi inside the NLP's own
+        period bounds, stored as a tuple of floats."""
+        tr = self.stride_time_range_s
+        if tr is None:
+            return
+        lo_all, hi_all = PERIOD_BOUNDS_S
+        ok = (not isinstance(tr, str | bytes) and len(tr) == 2
+              and all(isinstance(v, int | float) and not isinstance(v, bool)
+                      and math.isfinite(v) for v in tr)
+              and lo_all <= tr[0] <= tr[1] <= hi_all)
+        if not ok:
+            raise SpecError(f"the stride time range must be (lo, hi) [s] with {lo_all:g} <= "
+                            f"lo <= hi <= {hi_all:g}, got {tr!r}", where="stride_time_range_s",
+                            hint="e.g. 0.64, 0.78 (people at 3.5 m/s); lo = hi fixes it")
+        object.__setattr__(self, "stride_time_range_s", (float(tr[0]), float(tr[1])))
+
+    @property
+    def period_bounds_s(self) -> tuple[float, float]:
+        """(lo, hi) [s] of the stride time in the NLP: :attr:`stride_time_range_s`, else
+        :data:`~bladelab.predict.collocation.transcription.PERIOD_BOUNDS_S`."""
+        return self.stride_time_range_s or PERIOD_BOUNDS_S
 
     def _check_weight(self, name: str, what: str) -> None:
         """A weight field: a finite number >= 0, stored as float."""
@@ -338,6 +371,8 @@ class CollocationSettings:
             out["reference_dofs"] = list(self.reference_dofs)
         if self.pelvis_tilt_range_deg is not None:
             out["pelvis_tilt_range_deg"] = list(self.pelvis_tilt_range_deg)
+        if self.stride_time_range_s is not None:
+            out["stride_time_range_s"] = list(self.stride_time_range_s)
         return out
 
     @classmethod
@@ -357,7 +392,7 @@ class CollocationSettings:
     def same_problem(self, other: CollocationSettings) -> bool:
         """True if ``other`` poses the same NLP (mesh, speed, weights, swing clearance, knee
         moment bound, loaded knee's flexion limit, prosthetic load limit, blade transcription,
-        pelvis tilt range, alternating steps, symmetry);
+        pelvis tilt range, alternating steps, stride time range, symmetry);
         solver options
         (Hessian, tolerance, iterations) and the tracking stage may differ."""
         return self._problem() == other._problem()
@@ -366,8 +401,8 @@ class CollocationSettings:
         return (self.mesh_intervals, self.speed_m_per_s, self.weights, self.swing_clearance_m,
                 self.knee_moment_min_nm, self.knee_flexion_max_loaded_deg,
                 self.prosthetic_load_max_bw, self.blade_backward_euler,
-                self.pelvis_tilt_range_deg, self.step_phase_tolerance, self.symmetric
-                ) + self.reference_key()
+                self.pelvis_tilt_range_deg, self.step_phase_tolerance, self.symmetric,
+                self.stride_time_range_s) + self.reference_key()
 
     def reference_key(self) -> tuple:
         """(reference file name, weight, coordinates), or () without a reference term."""

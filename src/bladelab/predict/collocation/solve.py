@@ -319,15 +319,15 @@ def _reference_tracking(runner, settings: CollocationSettings, start,
 
 def _predictive_nlp(runner, dyn, settings: CollocationSettings, start, phase: float | None):
     """The predictive :class:`~bladelab.predict.collocation.transcription.StrideNLP` of the
-    settings' mesh, problem (prescribed speed, or maximum speed), weights, reference term and
-    alternating steps,
+    settings' mesh, problem (prescribed speed, or maximum speed), weights, reference term,
+    alternating steps, symmetry and stride time range,
     built once per runner and reference (the reference file is read only then; people's
     angles once per ``phase``, :func:`_reference_phase` of the guess ``start``); the speed
     itself is a parameter of each solve."""
     n, speed = settings.mesh_intervals, settings.speed_m_per_s
     nlps = _BUILT[runner]["nlps"]
     key = (n, speed is None, settings.weights, id(dyn), settings.reference_key(), phase,
-           settings.step_phase_tolerance, settings.symmetric)
+           settings.step_phase_tolerance, settings.symmetric, settings.period_bounds_s)
     if key not in nlps:
         while len(nlps) >= MAX_NLPS_PER_RUNNER:
             nlps.pop(next(iter(nlps)))
@@ -335,7 +335,8 @@ def _predictive_nlp(runner, dyn, settings: CollocationSettings, start, phase: fl
         nlps[key] = StrideNLP(dyn, n=n, speed=speed, weights=settings.weights,
                               tracking=tracking, period_tracking=period_tracking,
                               step_phase_tolerance=settings.step_phase_tolerance,
-                              symmetric=settings.symmetric)
+                              symmetric=settings.symmetric,
+                              period_bounds=settings.period_bounds_s)
     else:
         nlps[key] = nlps.pop(key)  # most recently used last
     return nlps[key]
@@ -413,7 +414,7 @@ def predict_stride(runner, settings: CollocationSettings, guess, *, model_spec: 
             grf = (g.vertical_grf_bw * runner.body_weight, settings.grf_tracking_weight)
         nlp_t = StrideNLP(dyn, n=n, speed=speed if speed is not None else g.speed,
                           weights=TRACKING_WEIGHTS, tracking=(g.q, settings.tracking_weight),
-                          grf_tracking=grf)
+                          grf_tracking=grf, period_bounds=settings.period_bounds_s)
         sol_t = _solve_stage(nlp_t, nlp_t.initial_vector(g), settings, "tracking", progress)
         tracking = _stage_info(sol_t)
         if not sol_t.success and sol_t.status in TRACKING_RESTART_STATUSES:
