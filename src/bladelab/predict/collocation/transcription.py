@@ -227,6 +227,13 @@ class StrideNLP:
         Each leg does what the other did half a stride earlier
         (:mod:`~bladelab.predict.collocation.symmetry`; an even ``n``, legs that are mirror
         images).
+
+    Attributes
+    ----------
+    node
+        The SX function of one mesh node, ``(x, u) -> (ẋ scaled, path residuals, effort,
+        metabolic rate, inequalities, vertical force, squared metabolic rate, force rate)``,
+        mapped over the ``n + 1`` nodes to build the NLP.
     """
 
     def __init__(
@@ -319,6 +326,7 @@ class StrideNLP:
         frate = ca.sumsqr(dfnt) / max(nm, 1) / FORCE_RATE_SCALE
         node = ca.Function("node", [xs, us],
                            [xdot_scaled, path, effort, met, ineq, fz, met_sq, frate])
+        self.node = node  # one node's functions (SX), mapped over the mesh below
         fmap = node.map(n + 1)
 
         X = ca.MX.sym("X", self.nx, n + 1)
