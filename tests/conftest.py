@@ -7,7 +7,12 @@ The measured running dataset (Fukuchi et al. 2017) is package data, found throug
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
+
+# the collocation NLPs map the interpreted node function: compiling it (about 15 s per model and
+# setting) is tested only in test_collocation_compiled.py
+os.environ["BLADELAB_COMPILE"] = "0"
 
 import pytest
 

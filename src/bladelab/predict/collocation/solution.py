@@ -179,8 +179,8 @@ class CollocationSolution:
         ev = evaluate_nodes(cm, q, np.asarray(nlp.qd, float), np.asarray(nlp.tendon_force, float),
                        np.asarray(nlp.tendon_force_rate, float))
         if metabolic_energy_J is None:  # the NLP's own trapezoidal rule: one definition
-            metabolic_energy_J = StrideNLP(stride_dynamics(cm), n=q.shape[0] - 1,
-                                           speed=None).energy_and_distance(nlp)[0]
+            metabolic_energy_J = StrideNLP(stride_dynamics(cm), n=q.shape[0] - 1, speed=None,
+                                           compiled=False).energy_and_distance(nlp)[0]
         res = dynamics_residual(nlp, runner, cm=cm).to_dict()
         res["bristle_residual_pct"] = dynamics_residual(nlp, runner, cm=cm, friction="bristle").pct
         return cls(

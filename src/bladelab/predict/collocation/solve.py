@@ -224,6 +224,7 @@ def _polish(nlp, sol, settings: CollocationSettings,
     polish (``polish_iterations``, ``polish_s``, and ``polished`` 1 or 0) and its
     ``iterations`` and ``wall_s`` are the two solves' together."""
     exact = dataclasses.replace(settings, hessian="exact", max_iter=settings.polish_iter)
+    nlp = nlp.interpreted()  # the exact Hessian needs the interpreted node function
     polished = _solve_stage(nlp, nlp.initial_vector(sol.to_guess("the stalled stage")), exact,
                             "polish", progress, speed=speed, multipliers=sol.multipliers)
     kept = polished if polished.success else sol
@@ -317,6 +318,12 @@ def _reference_tracking(runner, settings: CollocationSettings, start,
         ref.period, settings.reference_weight)
 
 
+def _compiled(settings: CollocationSettings) -> bool | None:
+    """The NLP's ``compiled`` argument: the default (compiled unless turned off) with L-BFGS,
+    False with the exact Hessian (which needs the interpreted node function)."""
+    return False if settings.hessian == "exact" else None
+
+
 def _predictive_nlp(runner, dyn, settings: CollocationSettings, start, phase: float | None):
     """The predictive :class:`~bladelab.predict.collocation.transcription.StrideNLP` of the
     settings' mesh, problem (prescribed speed, or maximum speed), weights, reference term,
@@ -327,7 +334,8 @@ def _predictive_nlp(runner, dyn, settings: CollocationSettings, start, phase: fl
     n, speed = settings.mesh_intervals, settings.speed_m_per_s
     nlps = _BUILT[runner]["nlps"]
     key = (n, speed is None, settings.weights, id(dyn), settings.reference_key(), phase,
-           settings.step_phase_tolerance, settings.symmetric, settings.period_bounds_s)
+           settings.step_phase_tolerance, settings.symmetric, settings.period_bounds_s,
+           settings.hessian)
     if key not in nlps:
         while len(nlps) >= MAX_NLPS_PER_RUNNER:
             nlps.pop(next(iter(nlps)))
@@ -336,7 +344,8 @@ def _predictive_nlp(runner, dyn, settings: CollocationSettings, start, phase: fl
                               tracking=tracking, period_tracking=period_tracking,
                               step_phase_tolerance=settings.step_phase_tolerance,
                               symmetric=settings.symmetric,
-                              period_bounds=settings.period_bounds_s)
+                              period_bounds=settings.period_bounds_s,
+                              compiled=_compiled(settings))
     else:
         nlps[key] = nlps.pop(key)  # most recently used last
     return nlps[key]
@@ -414,7 +423,8 @@ def predict_stride(runner, settings: CollocationSettings, guess, *, model_spec: 
             grf = (g.vertical_grf_bw * runner.body_weight, settings.grf_tracking_weight)
         nlp_t = StrideNLP(dyn, n=n, speed=speed if speed is not None else g.speed,
                           weights=TRACKING_WEIGHTS, tracking=(g.q, settings.tracking_weight),
-                          grf_tracking=grf, period_bounds=settings.period_bounds_s)
+                          grf_tracking=grf, period_bounds=settings.period_bounds_s,
+                          compiled=_compiled(settings))
         sol_t = _solve_stage(nlp_t, nlp_t.initial_vector(g), settings, "tracking", progress)
         tracking = _stage_info(sol_t)
         if not sol_t.success and sol_t.status in TRACKING_RESTART_STATUSES:

@@ -40,6 +40,7 @@ import casadi as ca
 import numpy as np
 
 from bladelab.errors import SpecError
+from bladelab.predict.collocation.compiled import compiled_node, compiling_enabled
 from bladelab.predict.collocation.progress import ProgressRelay
 from bladelab.predict.collocation.stride_guess import (
     COLLOCATION_SOURCE,
@@ -227,9 +228,19 @@ class StrideNLP:
         Each leg does what the other did half a stride earlier
         (:mod:`~bladelab.predict.collocation.symmetry`; an even ``n``, legs that are mirror
         images).
+    compiled
+        Map the node function compiled to C (:mod:`~bladelab.predict.collocation.compiled`:
+        cached on disk, the solver built without expanding the graph) instead of the
+        interpreted SX function; None (default): compiled unless ``BLADELAB_COMPILE=0``. Falls
+        back to the interpreted function, with a warning, when no compiler works. The exact
+        Hessian needs the interpreted function (``compiled=False``).
 
     Attributes
     ----------
+    compiled
+        True when the NLP maps the compiled node function.
+    compile_s
+        Wall time [s] of compiling the node function, or of loading it from the cache.
     node
         The SX function of one mesh node, ``(x, u) -> (ẋ scaled, path residuals, effort,
         metabolic rate, inequalities, vertical force, squared metabolic rate, force rate)``,
@@ -253,11 +264,20 @@ class StrideNLP:
         period_tracking: tuple[float, float] | None = None,
         step_phase_tolerance: float | None = None,
         symmetric: bool = False,
+        compiled: bool | None = None,
     ) -> None:
         if n < 4:
             raise SpecError(f"need at least 4 mesh intervals, got {n}", where="mesh intervals")
         if speed is not None and not (speed > 0 and math.isfinite(speed)):
             raise SpecError(f"speed must be > 0 m/s, got {speed}", where="speed")
+        self._arguments = {  # for interpreted(): the same NLP again
+            "n": n, "speed": speed, "weights": weights, "period_bounds": period_bounds,
+            "scales": scales, "min_activation": min_activation,
+            "min_tendon_force": min_tendon_force, "max_tendon_force": max_tendon_force,
+            "tracking": tracking, "grf_tracking": grf_tracking,
+            "period_tracking": period_tracking, "step_phase_tolerance": step_phase_tolerance,
+            "symmetric": symmetric}
+        self._compile = compiling_enabled() if compiled is None else bool(compiled)
         self.dyn = dynamics
         self.n = int(n)
         self.speed = None if speed is None else float(speed)
@@ -327,7 +347,12 @@ class StrideNLP:
         node = ca.Function("node", [xs, us],
                            [xdot_scaled, path, effort, met, ineq, fz, met_sq, frate])
         self.node = node  # one node's functions (SX), mapped over the mesh below
-        fmap = node.map(n + 1)
+        t0 = time.perf_counter()
+        external = compiled_node(node) if self._compile else None
+        self.compile_s = time.perf_counter() - t0  # compiling, or loading from the cache
+        self.compiled = external is not None
+        self._interpreted: StrideNLP | None = None
+        fmap = (node if external is None else external).map(n + 1)
 
         X = ca.MX.sym("X", self.nx, n + 1)
         U = ca.MX.sym("U", self.nu, n + 1)
@@ -567,7 +592,8 @@ class StrideNLP:
         :attr:`speed`); in the maximum-speed problem, the speed the stride must at least
         reach (default 0: none). ``progress(iteration,
         objective, violation)`` is called after every IPOPT iteration. The IPOPT solver is
-        built (expanded to SX, 14–20 s at mesh 50) on the first solve with these options and
+        built (expanded to SX, 14–20 s at mesh 50; 0.3 s with the compiled node) on the first
+        solve with these options and
         reused by every later one, at any speed (``NLPSolution.timings["build_s"]`` is 0 then).
 
         ``multipliers`` (bounds, constraints; :meth:`initial_multipliers`): start from ``x0``
@@ -576,6 +602,9 @@ class StrideNLP:
         if hessian not in ("limited-memory", "exact"):
             raise SpecError(f"unknown Hessian option {hessian!r}", where="hessian",
                             hint="limited-memory or exact")
+        if hessian == "exact" and self.compiled:
+            raise SpecError("the exact Hessian needs the interpreted node function",
+                            where="hessian", hint="build the StrideNLP with compiled=False")
         if speed is not None and not (speed > 0 and math.isfinite(speed)):
             raise SpecError(f"speed must be > 0 m/s, got {speed}", where="speed")
         opts = {
@@ -589,7 +618,9 @@ class StrideNLP:
             "ipopt.mumps_pivot_order": 5,  # METIS
             "ipopt.nlp_scaling_method": "gradient-based",
             "ipopt.sb": "yes",  # no banner
-            "expand": True,  # SX graph: about 10x faster iterations than MX (measured)
+            # SX graph: about 10x faster iterations than MX (measured); a compiled node is an
+            # external, which no SX graph holds
+            "expand": not self.compiled,
             "print_time": False,
         }
         if multipliers is not None:
@@ -629,6 +660,15 @@ class StrideNLP:
             self._solvers[key] = (solver, relay)
         return self._solvers[key]
 
+    def interpreted(self) -> StrideNLP:
+        """This NLP with the interpreted node function (itself if it has it): the same
+        variables and constraints, for the exact Hessian."""
+        if not self.compiled:
+            return self
+        if self._interpreted is None:
+            self._interpreted = StrideNLP(self.dyn, **self._arguments, compiled=False)
+        return self._interpreted
+
     def unpack(self, w: np.ndarray, stats: dict, wall: float, t_build: float,
                lbg: np.ndarray, ubg: np.ndarray, gval: np.ndarray, *,
                speed: float | None = None) -> NLPSolution:
@@ -648,7 +688,7 @@ class StrideNLP:
         terms = [float(v) for v in values]
         viol = np.maximum(lbg - gval, gval - ubg)
         order = np.argsort(viol)[::-1][:5]
-        timings = {"build_s": t_build}
+        timings = {"build_s": t_build, "compile_s": self.compile_s}
         for key in ("t_wall_nlp_f", "t_wall_nlp_g", "t_wall_nlp_grad_f", "t_wall_nlp_jac_g",
                     "t_wall_nlp_hess_l"):
             if key in stats:
