@@ -59,6 +59,16 @@ def test_a_node_is_compiled_once_and_a_changed_one_again(cache):
         np.testing.assert_array_equal(np.asarray(got), np.asarray(want))
 
 
+def test_a_damaged_library_in_the_cache_is_compiled_again(cache):
+    assert compiled_node(_tiny()) is not None
+    (lib,) = _libraries(cache)
+    (cache / lib).write_bytes(b"not a shared library")
+    again = compiled_node(_tiny())
+    assert again is not None and _libraries(cache) == [lib]
+    x, u = np.array([0.2, 0.1, -0.3]), np.array([1.0, 2.0])
+    np.testing.assert_array_equal(np.asarray(again(x, u)[1]), np.asarray(_tiny()(x, u)[1]))
+
+
 def test_two_processes_compiling_the_same_node_leave_one_valid_library(cache):
     script = textwrap.dedent("""
         import casadi as ca, numpy as np, sys

@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import hashlib
 import os
+import platform
 import shutil
 import subprocess
 import sys
@@ -88,16 +89,20 @@ def compiled_node(node: ca.Function) -> ca.Function | None:
                       "interpreted (install gcc to compile them)", CompileWarning, stacklevel=2)
         return None
     path = cache_dir() / f"{NODE_NAME}-{_key(node, compiler)}.so"
-    if not path.exists():
-        try:
-            _compile(node, compiler[0], path)
-        except (OSError, subprocess.CalledProcessError, RuntimeError) as err:
-            detail = getattr(err, "stderr", None) or str(err)
-            warnings.warn(f"compiling the collocation functions with {compiler[0]} failed "
-                          f"({str(detail).strip()[:300]}): they are interpreted",
-                          CompileWarning, stacklevel=2)
-            return None
-    return ca.external(NODE_NAME, str(path))
+    try:
+        if path.exists():
+            try:
+                return ca.external(NODE_NAME, str(path))
+            except RuntimeError:  # unreadable (another machine's, damaged): compiled again
+                path.unlink(missing_ok=True)
+        _compile(node, compiler[0], path)
+        return ca.external(NODE_NAME, str(path))
+    except (OSError, subprocess.CalledProcessError, RuntimeError) as err:
+        detail = getattr(err, "stderr", None) or str(err)
+        warnings.warn(f"compiling the collocation functions with {compiler[0]} failed "
+                      f"({str(detail).strip()[:300]}): they are interpreted",
+                      CompileWarning, stacklevel=2)
+        return None
 
 
 def _compile(node: ca.Function, compiler: str, path: Path) -> None:
@@ -126,9 +131,11 @@ def _compile(node: ca.Function, compiler: str, path: Path) -> None:
 
 
 def _key(node: ca.Function, compiler: tuple[str, str]) -> str:
-    """Hash of everything that changes the library: the node's graph, CasADi, the compiler."""
+    """Hash of everything that changes the library: the node's graph, CasADi, the machine's
+    architecture and system, the compiler and its flags."""
     h = hashlib.sha256()
-    for part in (node.serialize(), ca.__version__, *compiler, *CFLAGS):
+    for part in (node.serialize(), ca.__version__, platform.machine(), platform.system(),
+                 *compiler, *CFLAGS):
         h.update(part.encode())
         h.update(b"\0")
     return h.hexdigest()[:20]
