@@ -38,6 +38,8 @@ clean: clean-cache
 	rm -rf $(VENV) build *.egg-info src/*.egg-info .pytest_cache
 
 # numba's on-disk cache of compiled functions (keyed on each function's own file; bladelab
-# flushes it by itself when a compiled source changes: bladelab/numba_cache.py)
+# flushes it by itself when a compiled source changes: bladelab/numba_cache.py), and the
+# compiled collocation node functions (keyed on their graphs: bladelab/predict/collocation/compiled.py)
 clean-cache:
 	find src -name '*.nbi' -delete -o -name '*.nbc' -delete
+	rm -f "$${BLADELAB_CACHE_DIR:-$${XDG_CACHE_HOME:-$$HOME/.cache}/bladelab/casadi}"/node-*.so
