@@ -3,7 +3,7 @@
 Usage (repository root)::
 
     .venv/bin/python benchmarks/human_body/operating_ranges.py [--hip-tests-knee DEG]
-        [--kind able]
+        [--kind able] [--keep MUSCLES] [--muscle JSON]
 
 The curves and their comparison: :mod:`bladelab.runner.strength` (Anderson et al. 2007, the
 shape of each exertion's active moment–angle curve). The unknowns are the tendon slack lengths
@@ -43,8 +43,19 @@ def main() -> None:
     ap.add_argument("--hip-tests-knee", type=float, default=None)
     ap.add_argument("--kind", default="able")
     ap.add_argument("--keep", default="", help="muscles whose length stays, comma-separated")
+    ap.add_argument("--muscle", default=None,
+                    help='JSON {muscle type: {field: value}} changed before the fit, e.g. '
+                         '\'{"soleus": {"tendon_strain_at_fmax": 0.1}}\'')
     args = ap.parse_args()
-    runner = build_runner(args.kind, body="human")
+    if args.muscle:
+        from bladelab.runner.params import default_runner_params, runner_params_from_dict
+
+        data = json.loads(default_runner_params(args.kind, body="human").model_dump_json())
+        for muscle, row in json.loads(args.muscle).items():
+            data["muscle_types"][muscle].update(row)
+        runner = build_runner(runner_params_from_dict(data))
+    else:
+        runner = build_runner(args.kind, body="human")
     athlete = runner.params.athlete
     ex = dict(EXERTIONS)
     for name in ("hip extension", "hip flexion"):
