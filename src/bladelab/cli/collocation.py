@@ -118,31 +118,31 @@ def _mesh_check(out: Path, sol, *, asked: bool, solved: bool, resume: bool, max_
     return check
 
 
-def _tilt_range(text: str | None) -> tuple[float, float] | None:
-    """``--tilt-range LO,HI`` [deg] as a pair of numbers (checked by CollocationSettings)."""
-    if text is None:
-        return None
-    try:
-        lo, hi = (float(v) for v in text.split(","))
-    except ValueError:
-        raise SpecError(f"expected two numbers LO,HI [deg], got {text!r}", where="--tilt-range",
-                        hint="e.g. --tilt-range=-16,-2 (seed 001's window)") from None
-    return lo, hi
-
-
-def _stride_time(text: str | None) -> tuple[float, float] | None:
-    """``--stride-time LO,HI`` or ``T`` [s] as a pair of numbers (checked by
-    CollocationSettings; T fixes the stride time)."""
+def _pair(text: str | None, option: str, expected: str, hint: str, *,
+          single_ok: bool = False) -> tuple[float, float] | None:
+    """``LO,HI`` (or, with ``single_ok``, one number T read as T,T) as a pair of numbers,
+    checked by CollocationSettings; None for None."""
     if text is None:
         return None
     try:
         values = [float(v) for v in text.split(",")]
     except ValueError:
         values = []
-    if len(values) not in (1, 2):
-        raise SpecError(f"expected LO,HI or T [s], got {text!r}", where="--stride-time",
-                        hint="e.g. --stride-time 0.64,0.78 (people at 3.5 m/s) or 0.70")
+    if len(values) not in ((1, 2) if single_ok else (2,)):
+        raise SpecError(f"expected {expected}, got {text!r}", where=option, hint=hint)
     return values[0], values[-1]
+
+
+def _tilt_range(text: str | None) -> tuple[float, float] | None:
+    """``--tilt-range LO,HI`` [deg]."""
+    return _pair(text, "--tilt-range", "two numbers LO,HI [deg]",
+                 "e.g. --tilt-range=-16,-2 (seed 001's window)")
+
+
+def _stride_time(text: str | None) -> tuple[float, float] | None:
+    """``--stride-time LO,HI`` or ``T`` [s] (T fixes the stride time)."""
+    return _pair(text, "--stride-time", "LO,HI or T [s]",
+                 "e.g. --stride-time 0.64,0.78 (people at 3.5 m/s) or 0.70", single_ok=True)
 
 
 def run_collocation(

@@ -297,37 +297,36 @@ class CollocationSettings:
 
     def _check_tilt_range(self) -> None:
         """``pelvis_tilt_range_deg``: None or (lo, hi) [deg] with lo < hi inside the pelvis
-        tilt's own bounds, stored as a tuple of floats."""
-        tr = self.pelvis_tilt_range_deg
-        if tr is None:
-            return
-        lo_all, hi_all = COORDINATE_BOUNDS_DEG["pelvis_tilt"]
-        ok = (not isinstance(tr, str | bytes) and len(tr) == 2
-              and all(isinstance(v, int | float) and not isinstance(v, bool)
-                      and math.isfinite(v) for v in tr)
-              and lo_all <= tr[0] < tr[1] <= hi_all)
-        if not ok:
-            raise SpecError(f"the pelvis tilt range must be (lo, hi) [deg] with {lo_all:g} <= "
-                            f"lo < hi <= {hi_all:g}, got {tr!r}", where="pelvis_tilt_range_deg",
-                            hint="seed 001's window is -16, -2 (forward lean negative)")
-        object.__setattr__(self, "pelvis_tilt_range_deg", (float(tr[0]), float(tr[1])))
+        tilt's own bounds."""
+        self._check_range("pelvis_tilt_range_deg", "the pelvis tilt range", "deg",
+                          COORDINATE_BOUNDS_DEG["pelvis_tilt"],
+                          "seed 001's window is -16, -2 (forward lean negative)")
 
     def _check_stride_time_range(self) -> None:
         """``stride_time_range_s``: None or (lo, hi) [s] with lo <= hi inside the NLP's own
-        period bounds, stored as a tuple of floats."""
-        tr = self.stride_time_range_s
+        period bounds."""
+        self._check_range("stride_time_range_s", "the stride time range", "s", PERIOD_BOUNDS_S,
+                          "e.g. 0.64, 0.78 (people at 3.5 m/s); lo = hi fixes it",
+                          equal_ok=True)
+
+    def _check_range(self, name: str, what: str, unit: str, bounds: tuple[float, float],
+                     hint: str, *, equal_ok: bool = False) -> None:
+        """A range field: None or two finite numbers (lo, hi) within ``bounds``, lo < hi (lo <=
+        hi with ``equal_ok``), stored as a tuple of floats."""
+        tr = getattr(self, name)
         if tr is None:
             return
-        lo_all, hi_all = PERIOD_BOUNDS_S
+        lo_all, hi_all = bounds
+        ordered = (lambda lo, hi: lo <= hi) if equal_ok else (lambda lo, hi: lo < hi)
         ok = (not isinstance(tr, str | bytes) and len(tr) == 2
               and all(isinstance(v, int | float) and not isinstance(v, bool)
                       and math.isfinite(v) for v in tr)
-              and lo_all <= tr[0] <= tr[1] <= hi_all)
+              and lo_all <= tr[0] and tr[1] <= hi_all and ordered(tr[0], tr[1]))
         if not ok:
-            raise SpecError(f"the stride time range must be (lo, hi) [s] with {lo_all:g} <= "
-                            f"lo <= hi <= {hi_all:g}, got {tr!r}", where="stride_time_range_s",
-                            hint="e.g. 0.64, 0.78 (people at 3.5 m/s); lo = hi fixes it")
-        object.__setattr__(self, "stride_time_range_s", (float(tr[0]), float(tr[1])))
+            op = "<=" if equal_ok else "<"
+            raise SpecError(f"{what} must be (lo, hi) [{unit}] with {lo_all:g} <= lo {op} hi <= "
+                            f"{hi_all:g}, got {tr!r}", where=name, hint=hint)
+        object.__setattr__(self, name, (float(tr[0]), float(tr[1])))
 
     @property
     def period_bounds_s(self) -> tuple[float, float]:
