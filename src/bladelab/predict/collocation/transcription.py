@@ -270,13 +270,6 @@ class StrideNLP:
             raise SpecError(f"need at least 4 mesh intervals, got {n}", where="mesh intervals")
         if speed is not None and not (speed > 0 and math.isfinite(speed)):
             raise SpecError(f"speed must be > 0 m/s, got {speed}", where="speed")
-        self._arguments = {  # for interpreted(): the same NLP again
-            "n": n, "speed": speed, "weights": weights, "period_bounds": period_bounds,
-            "scales": scales, "min_activation": min_activation,
-            "min_tendon_force": min_tendon_force, "max_tendon_force": max_tendon_force,
-            "tracking": tracking, "grf_tracking": grf_tracking,
-            "period_tracking": period_tracking, "step_phase_tolerance": step_phase_tolerance,
-            "symmetric": symmetric}
         self._compile = compiling_enabled() if compiled is None else bool(compiled)
         self.dyn = dynamics
         self.n = int(n)
@@ -666,7 +659,14 @@ class StrideNLP:
         if not self.compiled:
             return self
         if self._interpreted is None:
-            self._interpreted = StrideNLP(self.dyn, **self._arguments, compiled=False)
+            self._interpreted = StrideNLP(
+                self.dyn, n=self.n, speed=self.speed, weights=self.weights,
+                period_bounds=self.period_bounds, scales=self.scales,
+                min_activation=self.min_activation, min_tendon_force=self.min_tendon_force,
+                max_tendon_force=self.max_tendon_force, tracking=self.tracking,
+                grf_tracking=self.grf_tracking, period_tracking=self.period_tracking,
+                step_phase_tolerance=self.step_phase_tolerance, symmetric=self.symmetric,
+                compiled=False)
         return self._interpreted
 
     def unpack(self, w: np.ndarray, stats: dict, wall: float, t_build: float,
