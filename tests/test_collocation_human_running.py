@@ -13,6 +13,7 @@ from bladelab.predict.collocation.human_running import (
     human_running_criteria,
     reference_band,
 )
+from bladelab.predict.collocation.settings import CollocationSettings
 
 DOFS = ("pelvis_tx", "pelvis_tz", "pelvis_tilt", "hip_flexion_l", "knee_angle_l",
         "hip_flexion_r", "knee_angle_r")
@@ -41,7 +42,7 @@ def _stride(*, speed=3.5, contact=(0.24, 0.24), peak_bw=(2.5, 2.5), period=0.70,
                            model_spec={"model": model}, leg_names=legs, body_weight_N=weight,
                            period_s=period, nlp=SimpleNamespace(q=q), dof_names=DOFS,
                            cost_of_transport_J_per_kg_m=cot,
-                           settings=SimpleNamespace(stride_time_range_s=stride_time_range))
+                           settings=CollocationSettings(stride_time_range_s=stride_time_range))
 
 
 def test_bands_are_the_anchors_and_interpolate_between_them():

@@ -57,6 +57,10 @@ def test_settings_round_trip_and_refuse_bad_values():
     assert socket.prosthetic_load_max_bw == 3.0 and not socket.same_problem(
         CollocationSettings())
     assert CollocationSettings.from_dict(json.loads(json.dumps(socket.to_dict()))) == socket
+    assert CollocationSettings().imposed_stride_time is None
+    assert CollocationSettings(stride_time_range_s=(0.7, 0.7)).imposed_stride_time == "0.7 s"
+    assert CollocationSettings(stride_time_range_s=(0.64, 0.78)).imposed_stride_time == (
+        "0.64–0.78 s")
     for bad, where in (({"mesh_intervals": 3}, "mesh_intervals"),
                        ({"speed_m_per_s": -1.0}, "speed_m_per_s"),
                        ({"hessian": "bfgs"}, "hessian"), ({"tol": 0.0}, "tol"),

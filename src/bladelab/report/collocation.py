@@ -157,10 +157,11 @@ def _measured_trial(runner, sol):
 
 def _imposed_stride_time_text(settings) -> str:
     """The sentence that says a stride time range was imposed (``--stride-time``), or ""."""
-    r = settings.stride_time_range_s
-    if r is None:
+    imposed = settings.imposed_stride_time
+    if imposed is None:
         return ""
-    what = f"at {r[0]:g} s" if r[0] == r[1] else f"within {r[0]:g}–{r[1]:g} s"
+    r = settings.stride_time_range_s
+    what = f"{'at' if r[0] == r[1] else 'within'} {imposed}"
     return (f" Stride time imposed {what} (bladelab predict --stride-time): the cadence is "
             "given, not predicted.")
 

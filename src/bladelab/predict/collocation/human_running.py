@@ -192,9 +192,9 @@ def human_running_criteria(solution) -> list[Criterion]:
                              blade - intact, "BW", None, 0.0,
                              "runners land softer on the blade (Grabowski 2010, Hobara 2013)"))
     lo, hi, unit = reference_band("stride time", speed)
-    imposed = solution.settings.stride_time_range_s
+    imposed = solution.settings.imposed_stride_time
     if imposed is not None:
-        imposed = f"imposed: {imposed[0]:g}–{imposed[1]:g} s"
+        imposed = f"imposed: {imposed}"
     out.append(Criterion("stride time", solution.period_s, unit, lo, hi,
                          "; ".join(t for t in (note, imposed) if t)))
     q = np.asarray(solution.nlp.q)  # (nodes, coordinates)

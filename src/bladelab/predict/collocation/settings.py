@@ -334,6 +334,15 @@ class CollocationSettings:
         :data:`~bladelab.predict.collocation.transcription.PERIOD_BOUNDS_S`."""
         return self.stride_time_range_s or PERIOD_BOUNDS_S
 
+    @property
+    def imposed_stride_time(self) -> str | None:
+        """The imposed stride time as text with its unit ("0.7 s" when fixed, "0.64–0.78 s"
+        for a range), or None when the stride time is free."""
+        r = self.stride_time_range_s
+        if r is None:
+            return None
+        return f"{r[0]:g} s" if r[0] == r[1] else f"{r[0]:g}–{r[1]:g} s"
+
     def _check_weight(self, name: str, what: str) -> None:
         """A weight field: a finite number >= 0, stored as float."""
         w = getattr(self, name)
