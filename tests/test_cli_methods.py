@@ -335,6 +335,13 @@ def test_sweep_collocation_passes_the_same_settings(tmp_path, monkeypatch, capsy
         main(["sweep", "--method", "collocation", "--categories", "Cat6",
               "--alternating-steps", "0.1", "--out", str(tmp_path)])
     assert seen["settings"].step_phase_tolerance == 0.1
+    assert not seen["settings"].stride_time_people  # free unless asked
+    seen.clear()
+    with pytest.raises(_Called):
+        main(["sweep", "--method", "collocation", "--categories", "Cat6", "--speeds", "4,5",
+              "--stride-time", "people", "--out", str(tmp_path)])
+    assert seen["settings"].stride_time_people
+    assert seen["settings"].period_bounds_s == pytest.approx((0.6182, 0.7591), abs=1e-4)
     capsys.readouterr()
     assert main(["sweep", "--method", "collocation", "--categories", "Cat6",
                  "--alternating-steps", "0.5", "--out", str(tmp_path)]) == 2

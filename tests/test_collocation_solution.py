@@ -18,8 +18,10 @@ from bladelab.predict.collocation.consistency import (
     forward_generalised_forces,
     inverse_dynamics,
 )
+from bladelab.predict.collocation.continuation import max_speed_settings
 from bladelab.predict.collocation.guess import template_guess
 from bladelab.predict.collocation.human_running import human_running_criteria
+from bladelab.predict.collocation.running_bands import reference_band
 from bladelab.predict.collocation.settings import CollocationSettings, people_term
 from bladelab.predict.collocation.solution import (
     BEST_ITERATE_KIND,
@@ -61,6 +63,10 @@ def test_settings_round_trip_and_refuse_bad_values():
     assert CollocationSettings(stride_time_range_s=(0.7, 0.7)).imposed_stride_time == "0.7 s"
     assert CollocationSettings(stride_time_range_s=(0.64, 0.78)).imposed_stride_time == (
         "0.64–0.78 s")
+    people = CollocationSettings(speed_m_per_s=9.0, stride_time_people=True)
+    assert people.period_bounds_s == pytest.approx((0.40, 0.55))  # the band at 9 m/s
+    assert not people.same_problem(CollocationSettings(speed_m_per_s=9.0))
+    assert not max_speed_settings(people).stride_time_people
     for bad, where in (({"mesh_intervals": 3}, "mesh_intervals"),
                        ({"speed_m_per_s": -1.0}, "speed_m_per_s"),
                        ({"hessian": "bfgs"}, "hessian"), ({"tol": 0.0}, "tol"),
@@ -71,7 +77,12 @@ def test_settings_round_trip_and_refuse_bad_values():
                        ({"knee_flexion_max_loaded_deg": -1.0}, "knee_flexion_max_loaded_deg"),
                        ({"knee_flexion_max_loaded_deg": True}, "knee_flexion_max_loaded_deg"),
                        ({"prosthetic_load_max_bw": 0.0}, "prosthetic_load_max_bw"),
-                       ({"prosthetic_load_max_bw": math.inf}, "prosthetic_load_max_bw")):
+                       ({"prosthetic_load_max_bw": math.inf}, "prosthetic_load_max_bw"),
+                       ({"stride_time_people": 1}, "stride_time_people"),
+                       ({"stride_time_people": True, "speed_m_per_s": None},
+                        "stride_time_people"),
+                       ({"stride_time_people": True, "stride_time_range_s": (0.6, 0.7)},
+                        "stride_time_people")):
         with pytest.raises(SpecError) as err:
             CollocationSettings(**bad)
         assert err.value.where == where
@@ -463,6 +474,25 @@ def test_a_stride_time_range_bounds_the_period_of_every_stage(able):
         assert lo - 1e-9 <= bounded.period_s <= hi + 1e-9
     stride = [c for c in human_running_criteria(bounded) if c.name == "stride time"]
     assert f"imposed: {lo:g}–{hi:g} s" in stride[0].note
+
+
+def test_people_stride_time_bounds_the_period_by_their_band_at_the_speed(able):
+    # the same few iterations free and with people's band: the free solve's stride time lies
+    # outside the band, the bounded one inside it; the criterion says it was imposed
+    runner, _, _ = able
+    guess = template_guess(runner, speed=SPEED, n=6)
+    lo, hi, _ = reference_band("stride time", SPEED)
+    free = predict_stride(runner, CollocationSettings(mesh_intervals=6, speed_m_per_s=SPEED,
+                                                      max_iter=3), guess,
+                          model_spec={"model": "able"})
+    assert not lo <= free.period_s <= hi
+    people = CollocationSettings(mesh_intervals=6, speed_m_per_s=SPEED, max_iter=3,
+                                 stride_time_people=True)
+    bounded = predict_stride(runner, people, guess, model_spec={"model": "able"})
+    assert lo - 1e-6 <= bounded.period_s <= hi + 1e-6
+    stride = [c for c in human_running_criteria(bounded) if c.name == "stride time"]
+    assert f"imposed: people's band at {SPEED:g} m/s" in stride[0].note
+    assert CollocationSettings.from_dict(json.loads(json.dumps(people.to_dict()))) == people
 
 
 def _relabelled_solves(monkeypatch):

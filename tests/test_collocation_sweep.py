@@ -308,6 +308,9 @@ def test_several_starts_keep_the_best_per_problem_and_every_file(fake_solve, mon
     (("--method", "collocation", "--categories", "Cat6", "--residual-limb", "0.5"),
      "--residual-limb"),
     (("--height", "1.7"), "--height"),  # reflex grid
+    (("--method", "collocation", "--categories", "Cat6", "--stride-time", "0.6,0.7"),
+     "--stride-time"),  # one range cannot fit every speed
+    (("--stride-time", "people"), "--stride-time"),  # reflex grid
     (("--method", "shooting"), "--method"),
 ])
 def test_bad_sweep_options_are_refused_naming_the_option(args, where, tmp_path, capsys):

@@ -32,7 +32,8 @@ from bladelab.predict.collocation.named_runs import solve_named_stride
 from bladelab.predict.collocation.settings import CollocationSettings, people_term
 from bladelab.predict.collocation.stored import runner_from_spec
 
-__all__ = ["OPTIONS", "PROGRESS_EVERY_S", "StageProgress", "run_collocation"]
+__all__ = ["OPTIONS", "PEOPLE_STRIDE_TIME", "PROGRESS_EVERY_S", "StageProgress", "run_collocation",
+           "stride_time_settings"]
 
 #: Seconds between two progress lines while a stage iterates.
 PROGRESS_EVERY_S = 5.0
@@ -43,6 +44,7 @@ OPTIONS = {
     "swing_clearance_m": "--swing-clearance", "knee_moment_min_nm": "--knee-moment-min",
     "knee_flexion_max_loaded_deg": "--knee-flexion-max",
     "pelvis_tilt_range_deg": "--tilt-range", "stride_time_range_s": "--stride-time",
+    "stride_time_people": "--stride-time",
     "reference_weight": "--people-weight",
     "step_phase_tolerance": "--alternating-steps", "symmetric": "--symmetric",
     "prosthetic_load_max_bw": "--prosthetic-load-max",
@@ -139,10 +141,20 @@ def _tilt_range(text: str | None) -> tuple[float, float] | None:
                  "e.g. --tilt-range=-16,-2 (seed 001's window)")
 
 
-def _stride_time(text: str | None) -> tuple[float, float] | None:
-    """``--stride-time LO,HI`` or ``T`` [s] (T fixes the stride time)."""
-    return _pair(text, "--stride-time", "LO,HI or T [s]",
-                 "e.g. --stride-time 0.64,0.78 (people at 3.5 m/s) or 0.70", single_ok=True)
+#: ``--stride-time people``: people's band at each prescribed speed
+#: (``CollocationSettings.stride_time_people``).
+PEOPLE_STRIDE_TIME = "people"
+
+
+def stride_time_settings(text: str | None) -> dict:
+    """The ``CollocationSettings`` fields of ``--stride-time``: ``LO,HI`` or ``T`` [s] (T fixes
+    the stride time) as ``stride_time_range_s``, ``people`` as ``stride_time_people``."""
+    if text is not None and text.strip().lower() == PEOPLE_STRIDE_TIME:
+        return {"stride_time_people": True}
+    return {"stride_time_range_s": _pair(
+        text, "--stride-time", "LO,HI or T [s], or people",
+        "e.g. --stride-time 0.64,0.78 (people at 3.5 m/s), 0.70, or people (their band at "
+        "the speed)", single_ok=True)}
 
 
 def run_collocation(
@@ -174,7 +186,8 @@ def run_collocation(
 ) -> int:
     """Run ``bladelab predict --method collocation``; returns the exit status (0 converged,
     2 not converged). ``alternating_steps``: ``CollocationSettings.step_phase_tolerance``;
-    ``stride_time``: ``LO,HI`` or ``T`` [s], ``CollocationSettings.stride_time_range_s``;
+    ``stride_time``: ``LO,HI`` or ``T`` [s], ``CollocationSettings.stride_time_range_s``, or
+    ``people``, ``CollocationSettings.stride_time_people``;
     ``symmetric``: ``CollocationSettings.symmetric``;
     ``prosthetic_load_max``: ``CollocationSettings.prosthetic_load_max_bw``.
     ``athlete``: the runner scaled to this athlete (``body_mass_kg``, ``height_m``,
@@ -188,14 +201,14 @@ def run_collocation(
     if starts is None:
         starts = defaults.ATHLETE_STARTS if athlete else defaults.STARTS
     tilt = _tilt_range(tilt_range)
-    period = _stride_time(stride_time)
+    period = stride_time_settings(stride_time)
     try:
         settings = CollocationSettings(
             mesh_intervals=mesh, speed_m_per_s=None if max_speed else float(speed),
             max_iter=max_iter, swing_clearance_m=swing_clearance,
             knee_moment_min_nm=knee_moment_min, knee_flexion_max_loaded_deg=knee_flexion_max,
             pelvis_tilt_range_deg=tilt, step_phase_tolerance=alternating_steps,
-            stride_time_range_s=period,
+            **period,
             prosthetic_load_max_bw=prosthetic_load_max, symmetric=symmetric,
             **people_term(defaults.people_weight_for(body, people_weight)))
         result = solve_named_stride(out, model=model, blade=blade, body=body,

@@ -20,7 +20,7 @@ from pathlib import Path
 
 import typer
 
-from bladelab.cli.collocation import StageProgress
+from bladelab.cli.collocation import PEOPLE_STRIDE_TIME, StageProgress
 from bladelab.cli.panels import renamed
 from bladelab.cli.values import parse_list
 from bladelab.errors import BladelabError, SpecError
@@ -118,12 +118,19 @@ def run_collocation_sweep(
     alternating_steps: float | None = None,
     athlete: dict | None = None,
     mesh_check: bool = False,
+    stride_time: str | None = None,
 ) -> int:
     """Run ``bladelab sweep --method collocation``; returns the exit status (0 every solve
     converged, 2 some model failed). ``alternating_steps``:
     ``CollocationSettings.step_phase_tolerance``; ``athlete``: every model scaled to this
     athlete (None: the body's own); ``mesh_check``: every converged solve checked on twice
-    the mesh intervals."""
+    the mesh intervals; ``stride_time``: ``people`` (people's band at each prescribed speed,
+    ``CollocationSettings.stride_time_people``) or None (free)."""
+    if stride_time is not None and stride_time.strip().lower() != PEOPLE_STRIDE_TIME:
+        raise SpecError(f"a sweep imposes people's band at each speed, got {stride_time!r}",
+                        where="--stride-time",
+                        hint="--stride-time people; one range fits one speed: bladelab "
+                             "predict --stride-time LO,HI")
     speed_list = _speeds(speeds)
     # --able --categories "": the able model alone
     cats = parse_list(categories, "--categories") if categories.strip() or not able else []
@@ -131,7 +138,8 @@ def run_collocation_sweep(
         result = sweep_named_models(
             out, categories=cats, speeds=speed_list, able=able, body=body, guess=guess,
             mesh_intervals=mesh, max_iter=max_iter, people_weight=people_weight,
-            step_phase_tolerance=alternating_steps, athlete=athlete, starts=starts, jobs=jobs,
+            step_phase_tolerance=alternating_steps, stride_time_people=stride_time is not None,
+            athlete=athlete, starts=starts, jobs=jobs,
             executor=executor, resume=resume, force=force, progress=SweepProgress(),
             mesh_check=mesh_check)
     except BladelabError as err:

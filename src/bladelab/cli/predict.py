@@ -319,7 +319,8 @@ def register(app: typer.Typer) -> None:
             None, "--stride-time", rich_help_panel=COLLOCATION, show_default=False,
             help="Keep the stride time within LO,HI [s], or at T [s] (an athlete's measured "
                  "cadence: imposed, not predicted, and the report says so), e.g. "
-                 "--stride-time 0.64,0.78. Default: free (0.4-1.2 s)."),
+                 "--stride-time 0.64,0.78; or 'people': within measured runners' band at "
+                 "the speed (0.62-0.76 s at 4 m/s). Default: free (0.4-1.2 s)."),
         alternating_steps: float | None = _alternating_steps_option(),
         symmetric: bool = typer.Option(
             False, "--symmetric", rich_help_panel=COLLOCATION,
@@ -499,6 +500,11 @@ def register(app: typer.Typer) -> None:
                  "compliant Achilles tendons)."),
         people_weight: float | None = _people_weight_option(),
         alternating_steps: float | None = _alternating_steps_option(),
+        stride_time: str | None = typer.Option(
+            None, "--stride-time", rich_help_panel=COLLOCATION, show_default=False,
+            help="'people': keep every prescribed speed's stride time within measured "
+                 "runners' band at that speed (0.62-0.76 s at 4 m/s; imposed, not predicted, "
+                 "and each report says so); the maximum speed stays free. Default: free."),
         body_mass: float | None = _athlete_option("body_mass_kg"),
         height: float | None = _athlete_option("height_m"),
         muscle_strength: float | None = _athlete_option("muscle_strength"),
@@ -545,6 +551,7 @@ def register(app: typer.Typer) -> None:
                 guess=guess, max_iter=max_iter, jobs=jobs, executor=executor, resume=resume,
                 force=force, as_json=as_json, starts=starts, body=body,
                 people_weight=people_weight, alternating_steps=alternating_steps,
+                stride_time=stride_time,
                 athlete=_athlete(static, body_mass_kg=body_mass, height_m=height,
                                  muscle_strength=muscle_strength,
                                  max_shortening_velocity=max_shortening_velocity,

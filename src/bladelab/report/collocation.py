@@ -161,7 +161,7 @@ def _imposed_stride_time_text(settings) -> str:
     if imposed is None:
         return ""
     r = settings.stride_time_range_s
-    what = f"{'at' if r[0] == r[1] else 'within'} {imposed}"
+    what = f"{'at' if r is not None and r[0] == r[1] else 'within'} {imposed}"
     return (f" Stride time imposed {what} (bladelab predict --stride-time): the cadence is "
             "given, not predicted.")
 

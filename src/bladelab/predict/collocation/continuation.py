@@ -532,8 +532,11 @@ def speed_continuation(runner, speeds: Sequence[float], settings: CollocationSet
 
 def max_speed_settings(settings: CollocationSettings) -> CollocationSettings:
     """The maximum-speed problem with the mesh and solver options of ``settings``: speed None,
-    the default maximum-speed weights (speed 1, activation 1, acceleration 0.1)."""
-    return dataclasses.replace(settings, speed_m_per_s=None, weights=None)
+    the default maximum-speed weights (speed 1, activation 1, acceleration 0.1), the stride
+    time free of people's band (``stride_time_people``: the band moves with the speed, which
+    this problem predicts)."""
+    return dataclasses.replace(settings, speed_m_per_s=None, weights=None,
+                               stride_time_people=False)
 
 
 def max_speed(runner, settings: CollocationSettings, guess, *, model_spec: dict,

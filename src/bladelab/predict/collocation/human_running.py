@@ -7,24 +7,15 @@ peak knee flexion in swing, mean pelvis tilt, a flight phase, alternating steps 
 contact per leg per stride (no swinging foot or blade striking the ground) and, up to 5 m/s, the
 gross cost of transport.
 
-The reference bands (:data:`REFERENCE_BANDS`) are given at 3.5 m/s and at 9 m/s and
-interpolated linearly in speed between them (held constant outside, where the line says the
-band was extrapolated). Sources:
-
-- 3.5 m/s: the Fukuchi et al. (2017) trial shipped with bladelab (85 stances: contacts
-  0.22–0.25 s, peaks 2.3–2.6 BW, strides 0.70 s, about 100° of swing knee flexion), Novacheck
-  (1998) for the knee in swing;
-- 9 m/s: Weyand et al. (2000) and Nummela et al. (2007) (contacts 0.10–0.13 s, peaks 2.5–4 BW,
-  stride times about 0.45–0.5 s);
-- pelvis tilt: seed 001's acceptance window of a running posture, −16…−2° (forward lean
-  negative);
-- step phase: running people alternate their legs with steps of nearly equal time (the
-  Fukuchi trial's left and right stances half a stride apart), and so do runners with a
-  transfemoral amputation on running-specific prostheses (the same step frequency on both
-  legs, nine athletes at 30–70 % of their maximum speed, ISBS proceedings 36, 2018); the band
-  40–60 % of the stride is ours, wide enough for an amputee's asymmetry, and excludes a gallop;
-- cost of transport: about 4 J/(kg·m) gross for people running at 3–5 m/s (Margaria 1963;
-  Kram & Taylor 1990 give the cost per distance nearly independent of speed).
+The reference bands are those of
+:mod:`~bladelab.predict.collocation.running_bands` (people at 3.5 m/s and at 9 m/s,
+interpolated in speed; their sources there; no cost band above
+:data:`COST_BAND_MAX_SPEED_MPS`). The step phase's band is this module's: running people
+alternate their legs with steps of nearly equal time (the Fukuchi trial's left and right
+stances half a stride apart), and so do runners with a transfemoral amputation on
+running-specific prostheses (the same step frequency on both legs, nine athletes at 30–70 % of
+their maximum speed, ISBS proceedings 36, 2018); the band 40–60 % of the stride is ours, wide
+enough for an amputee's asymmetry, and excludes a gallop.
 
 The prosthetic leg of a transtibial runner is held to a wider contact band at the low end
 (0.15 s): its blade shortens the contact (Grabowski et al. 2010, Hobara et al. 2013). Its peak
@@ -42,6 +33,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from bladelab.predict.collocation.running_bands import (
+    ANCHOR_SPEEDS_MPS,
+    REFERENCE_BANDS,
+    reference_band,
+)
 from bladelab.predict.collocation.solution import CONTACT_THRESHOLD_N
 from bladelab.predict.collocation.transcription import step_phase
 
@@ -56,19 +52,6 @@ __all__ = [
     "stride_from_left_touchdown",
 ]
 
-#: Anchor speeds [m/s] of the reference bands (the cost band is given up to
-#: :data:`COST_BAND_MAX_SPEED_MPS` only).
-ANCHOR_SPEEDS_MPS = (3.5, 9.0)
-#: Reference bands of measured human running at the anchor speeds: name -> (unit, band at
-#: 3.5 m/s, band at 9 m/s); a bound of None is open.
-REFERENCE_BANDS: dict[str, tuple[str, tuple, tuple]] = {
-    "contact time": ("s", (0.20, 0.30), (0.10, 0.13)),
-    "peak vertical ground force": ("BW", (2.2, 3.0), (2.5, 4.0)),
-    "stride time": ("s", (0.64, 0.78), (0.40, 0.55)),
-    "peak swing knee flexion": ("deg", (85.0, 140.0), (105.0, 140.0)),
-    "mean pelvis tilt": ("deg", (-16.0, -2.0), (-16.0, -2.0)),
-    "gross cost of transport": ("J/(kg·m)", (3.5, 5.0), (3.5, 5.0)),
-}
 #: The lower contact-time bound of a prosthetic leg [s] (module docstring).
 PROSTHETIC_CONTACT_MIN_S = 0.15
 #: Least flight [% of the stride] that counts as a flight phase.
@@ -150,18 +133,6 @@ class Criterion:
     def to_dict(self) -> dict:
         return {"name": self.name, "value": self.value, "unit": self.unit, "low": self.low,
                 "high": self.high, "met": self.met, "note": self.note}
-
-
-def reference_band(name: str, speed_mps: float) -> tuple[float | None, float | None, str]:
-    """(low, high, unit) of a :data:`REFERENCE_BANDS` entry at ``speed_mps`` [m/s]."""
-    unit, slow, fast = REFERENCE_BANDS[name]
-    v0, v1 = ANCHOR_SPEEDS_MPS
-    w = min(max((speed_mps - v0) / (v1 - v0), 0.0), 1.0)
-
-    def mix(a, b):
-        return None if a is None or b is None else (1.0 - w) * a + w * b
-
-    return mix(slow[0], fast[0]), mix(slow[1], fast[1]), unit
 
 
 def human_running_criteria(solution) -> list[Criterion]:

@@ -117,6 +117,7 @@ def sweep_named_models(
     max_iter: int = defaults.MAX_ITER,
     people_weight: float | None = None,
     step_phase_tolerance: float | None = None,
+    stride_time_people: bool = False,
     athlete: dict | None = None,
     starts: int = defaults.STARTS,
     mesh_check: bool = False,
@@ -138,7 +139,9 @@ def sweep_named_models(
     (:mod:`~bladelab.predict.collocation.people`; 0: none; None: the body's default,
     :func:`bladelab.predict.defaults.people_weight_for`); ``step_phase_tolerance``: every
     stride's steps alternating within this fraction of the stride
-    (:attr:`CollocationSettings.step_phase_tolerance`; None: free); ``athlete``: every model
+    (:attr:`CollocationSettings.step_phase_tolerance`; None: free); ``stride_time_people``:
+    every prescribed speed's stride time within people's band at that speed
+    (:attr:`CollocationSettings.stride_time_people`; the maximum speed free); ``athlete``: every model
     scaled to this athlete (as in :func:`solve_named_stride`); ``starts``: starts per
     problem, the best kept (:mod:`~bladelab.predict.collocation.starts`); ``mesh_check``:
     every converged solve checked on twice the mesh intervals
@@ -155,6 +158,7 @@ def sweep_named_models(
         raise SpecError("no speed given", where="speeds")
     settings = CollocationSettings(mesh_intervals=mesh_intervals, speed_m_per_s=speeds[0],
                                    max_iter=max_iter, step_phase_tolerance=step_phase_tolerance,
+                                   stride_time_people=stride_time_people,
                                    **people_term(defaults.people_weight_for(body, people_weight)))
     if isinstance(jobs, bool) or not isinstance(jobs, int) or jobs < 1:
         raise SpecError(f"need at least 1 job, got {jobs}", where="jobs")

@@ -13,6 +13,7 @@ import numpy as np
 from bladelab.errors import SpecError
 from bladelab.predict import defaults
 from bladelab.predict.collocation.dynamics import COORDINATE_BOUNDS_DEG
+from bladelab.predict.collocation.running_bands import reference_band
 from bladelab.predict.collocation.transcription import PERIOD_BOUNDS_S, StrideWeights
 
 __all__ = ["HESSIANS", "PEOPLE_REFERENCE", "CollocationSettings", "people_term"]
@@ -148,6 +149,14 @@ class CollocationSettings:
         (:data:`~bladelab.predict.collocation.transcription.PERIOD_BOUNDS_S`), the stride
         time free. The human body's free strides are 5–15 % quicker than people's
         (docs/collocation.md, "The stride time").
+    stride_time_people
+        True: keep the stride time within people's band at the prescribed speed
+        (:func:`~bladelab.predict.collocation.running_bands.reference_band`, "stride time":
+        0.64–0.78 s at 3.5 m/s, 0.40–0.55 s at 9 m/s, linear between), for an athlete whose
+        cadence was not measured; imposed, not predicted, as ``stride_time_range_s``, which
+        it excludes. Each speed of a continuation gets its own band; the maximum-speed
+        problem, whose speed is the unknown, has none (:func:`~bladelab.predict.collocation.
+        continuation.max_speed_settings`). False (default): free.
     symmetric
         Each leg does what the other did half a stride earlier (bilateral symmetry, as
         PredSim imposes it by solving half a gait cycle;
@@ -191,6 +200,7 @@ class CollocationSettings:
     pelvis_tilt_range_deg: tuple[float, float] | None = None
     step_phase_tolerance: float | None = None
     stride_time_range_s: tuple[float, float] | None = None
+    stride_time_people: bool = False
     symmetric: bool = False
     reference: str | None = None
     reference_weight: float = 0.0
@@ -293,6 +303,7 @@ class CollocationSettings:
                             hint="e.g. 50 or 100")
         self._check_tilt_range()
         self._check_stride_time_range()
+        self._check_stride_time_people()
         self._check_reference()
 
     def _check_tilt_range(self) -> None:
@@ -308,6 +319,23 @@ class CollocationSettings:
         self._check_range("stride_time_range_s", "the stride time range", "s", PERIOD_BOUNDS_S,
                           "e.g. 0.64, 0.78 (people at 3.5 m/s); lo = hi fixes it",
                           equal_ok=True)
+
+    def _check_stride_time_people(self) -> None:
+        """``stride_time_people``: a bool; with a prescribed speed and no stride time range."""
+        if not isinstance(self.stride_time_people, bool):
+            raise SpecError(f"expected true or false, got {self.stride_time_people!r}",
+                            where="stride_time_people")
+        if not self.stride_time_people:
+            return
+        if self.stride_time_range_s is not None:
+            raise SpecError("people's stride time and a stride time range are two ways to "
+                            "impose one stride time: give one", where="stride_time_people",
+                            hint="drop the range, or stride_time_people false")
+        if self.speed_m_per_s is None:
+            raise SpecError("people's stride time needs a prescribed speed (their band moves "
+                            "with the speed, which the maximum-speed problem predicts)",
+                            where="stride_time_people", hint="prescribe a speed, or leave "
+                                                             "the stride time free")
 
     def _check_range(self, name: str, what: str, unit: str, bounds: tuple[float, float],
                      hint: str, *, equal_ok: bool = False) -> None:
@@ -330,14 +358,21 @@ class CollocationSettings:
 
     @property
     def period_bounds_s(self) -> tuple[float, float]:
-        """(lo, hi) [s] of the stride time in the NLP: :attr:`stride_time_range_s`, else
+        """(lo, hi) [s] of the stride time in the NLP: people's band at the speed with
+        :attr:`stride_time_people` (to 1 µs), else :attr:`stride_time_range_s`, else
         :data:`~bladelab.predict.collocation.transcription.PERIOD_BOUNDS_S`."""
+        if self.stride_time_people:
+            lo, hi, _ = reference_band("stride time", self.speed_m_per_s)
+            return round(lo, 6), round(hi, 6)
         return self.stride_time_range_s or PERIOD_BOUNDS_S
 
     @property
     def imposed_stride_time(self) -> str | None:
         """The imposed stride time as text with its unit ("0.7 s" when fixed, "0.64–0.78 s"
-        for a range), or None when the stride time is free."""
+        for a range, "people's band at 4 m/s, 0.618–0.759 s"), or None when it is free."""
+        if self.stride_time_people:
+            lo, hi = self.period_bounds_s
+            return f"people's band at {self.speed_m_per_s:g} m/s, {lo:.3g}–{hi:.3g} s"
         r = self.stride_time_range_s
         if r is None:
             return None
@@ -410,7 +445,7 @@ class CollocationSettings:
                 self.knee_moment_min_nm, self.knee_flexion_max_loaded_deg,
                 self.prosthetic_load_max_bw, self.blade_backward_euler,
                 self.pelvis_tilt_range_deg, self.step_phase_tolerance, self.symmetric,
-                self.stride_time_range_s) + self.reference_key()
+                self.stride_time_range_s, self.stride_time_people) + self.reference_key()
 
     def reference_key(self) -> tuple:
         """(reference file name, weight, coordinates), or () without a reference term."""
