@@ -27,9 +27,15 @@ HELD = ("*-pelvis_tx.*", "S11100.iliopsoas_?-hamstrings.*")
 def main(out: str, generations: int, inhibition: bool = False, jobs: int = 1) -> None:
     _, layout = runner_and_layout("able", None, "human")
     fixed = held_parameters(layout.names, HELD[:2 if inhibition else 1])
-    print(f"fixed at SCONE's values: {len(fixed)} parameters")
     settings = ObjectiveSettings(speed=3.5, duration=4.0, integrator="newmark", dt=1e-3,
                                  run_up=True, start_stride=STRIDE)
+    search(out, generations, settings, fixed, jobs)
+
+
+def search(out: str, generations: int, settings: ObjectiveSettings, fixed, jobs: int) -> None:
+    """CMA-ES of the able runner on the human body from SCONE's parameters (σ 0.5, popsize 32,
+    seed 1) with ``fixed`` parameters held; a second call with the same ``out`` continues."""
+    print(f"fixed at SCONE's values: {len(fixed)} parameters")
 
     def progress(generation, best, median):
         if generation % 50 == 0:

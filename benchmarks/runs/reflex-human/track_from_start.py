@@ -15,13 +15,13 @@ A second call with the same OUT continues the run up to GENERATIONS.
 from __future__ import annotations
 
 import sys
-from pathlib import Path
+
+from fixed_placement import STRIDE, search
 
 from bladelab.predict.reflex.named_runs import held_parameters
 from bladelab.predict.reflex.objective import ObjectiveSettings
-from bladelab.predict.reflex.optimize import optimize_controller, runner_and_layout
+from bladelab.predict.reflex.optimize import runner_and_layout
 
-STRIDE = "src/bladelab/data/runner/collocation/able-3.5-human.json"
 HELD = ("S11100.iliopsoas_?-hamstrings.*",)
 
 
@@ -29,20 +29,10 @@ def main(out: str, generations: int, w_track: float, inhibition: bool = False,
          jobs: int = 1) -> None:
     _, layout = runner_and_layout("able", None, "human")
     fixed = held_parameters(layout.names, HELD) if inhibition else ()
-    print(f"fixed at SCONE's values: {len(fixed)} parameters")
     settings = ObjectiveSettings(speed=3.5, duration=4.0, integrator="newmark", dt=1e-3,
                                  run_up=True, start_stride=STRIDE, track=STRIDE,
                                  w_track=w_track, track_skip=0.0)
-
-    def progress(generation, best, median):
-        if generation % 50 == 0:
-            print(generation, best, median, flush=True)
-
-    result = optimize_controller("able", body="human", speed=3.5, generations=generations,
-                                 popsize=32, sigma=0.5, seed=1, jobs=jobs, out=out,
-                                 settings=settings, fixed=fixed, progress=progress,
-                                 resume=(Path(out) / "checkpoint.pkl").exists())
-    print(result)
+    search(out, generations, settings, fixed, jobs)
 
 
 if __name__ == "__main__":
