@@ -2,7 +2,8 @@
 
 Six models (able, amputee Cat4, Cat5, Cat6, Cat6High, Cat7) × speed continuation (4, 5 m/s)
 + maximum speed, 2 workers: on the human body from the shipped strides with one start per
-problem; on seed 001's body from the measured trial's guess, once with one start per problem,
+problem (the stride time free, and held at people's band); on seed 001's body from the
+measured trial's guess, once with one start per problem,
 once with three (``--starts 3``: the warm start, the barrier start and the template). Target:
 ≤ 10 min on 2 cores with three starts. The studies take 20–50 min of both cores, so ``make bench`` does not run
 them again: it reads the solve times each recorded (its ``collocation-sweep.csv``) and the wall
@@ -18,7 +19,12 @@ from pathlib import Path
 
 HERE = Path(__file__).resolve().parent / "collocation"
 #: (folder, what differs) of each timed study.
-STUDIES = (("study-human-people10-2026-11-29", "the human body with people's joint angles in "
+STUDIES = (("study-human-people-cadence-2026-11-30", "the human body at people's stride time "
+            "(`--stride-time people`: every prescribed speed's stride time within measured "
+            "runners' band at that speed; the maximum speed free), people's joint angles at "
+            "weight 10 1/rad², one start per problem, from the shipped strides, the node "
+            "function compiled"),
+           ("study-human-people10-2026-11-29", "the human body with people's joint angles in "
             "the objective at weight 10 1/rad² (the default), one start per problem, from the "
             "shipped strides, each later speed from the previous solution's primal and dual "
             "values"),
