@@ -161,6 +161,7 @@ def test_report_has_the_trends_section(tmp_path):
                progress=False)
     (out / "evaluator.json").write_text(json.dumps({"evaluator": "runner"}))
     sections = design_report_sections(out)
+    assert sections[0]["text"].startswith("Each run is one transfemoral gait cycle")
     trend = [s for s in sections if s["title"] == "Seed 002 trends"]
     assert len(trend) == 1
     table = trend[0]["tables"][0][1]
@@ -193,6 +194,9 @@ def test_shipped_example_draws_no_trend_verdict(tmp_path):
     assert "Seed 002 trends" in report.read_text(encoding="utf-8")
     section = next(s for s in design_report_sections(tmp_path / "design-study")
                    if s["title"] == "Seed 002 trends")
+    first = design_report_sections(tmp_path / "design-study")[0]["text"]
+    assert first.startswith("Each run is the generated blade alone")
+    assert "a 76 kg point mass" in first and "at 8 m/s" in first and "no runner" in first
     table = section["tables"][0][1]
     assert len(table) == len(SEED002_TRENDS)
     assert "not tested" in section["tables"][0][0] and "verdict" not in table

@@ -150,9 +150,10 @@ def design_report_sections(design_dir: str | Path) -> list[dict[str, Any]]:
     runs = table if checks is None else table.assign(stride=[
         "left out (warnings)" if x else ("clean" if not w else w)
         for w, x in zip(checks["warnings"], checks["excluded"], strict=True)])
+    evaluated = _evaluator_sentence(meta.get("_evaluator") or {})
     sections: list[dict[str, Any]] = [{
         "title": "Design study: response surfaces",
-        "text": design_text + "\n\n" + fit_text,
+        "text": (evaluated + " " if evaluated else "") + design_text + "\n\n" + fit_text,
         "tables": [("Surface fits", fit), ("Runs", runs)],
     }]
     if n_failed:
@@ -239,6 +240,33 @@ def _failures_by_level(space, table: pd.DataFrame, failed: pd.DataFrame) -> pd.D
                          "value": f.mid + level * f.half_range, "unit": f.unit, "runs": n,
                          "failed": n_bad, "failed (%)": 100.0 * n_bad / n})
     return pd.DataFrame(rows)
+
+
+def _evaluator_sentence(evaluator: dict) -> str:
+    """What each run of the study is, from its ``evaluator.json`` ("" when it has none): the
+    first words of the report, so that no response is read as something it is not."""
+    kind = evaluator.get("evaluator")
+    speed = evaluator.get("speed_mps")
+    at = f" at {speed:g} m/s" if isinstance(speed, int | float) else ""
+    if kind == "blade":
+        mass = evaluator.get("body_mass_kg")
+        mass = f"a {mass:g} kg point mass" if isinstance(mass, int | float) else "a point mass"
+        return (f"Each run is the generated blade alone (the blade evaluator): {mass} on a "
+                f"rigid pylon lands on it{at}, one prescribed passive stance, no runner. Its "
+                "responses describe the blade under that stance; what an athlete would run on "
+                "it is not computed, so seed 002's conclusions about running are not tested "
+                "here.")
+    if kind == "runner":
+        return (f"Each run is one transfemoral gait cycle{at} with the generated blade, its "
+                "motion prescribed (seed 002's motion-driven evaluator: the measured or "
+                "adapted motion is imposed and the blade makes the forces, seed 002's own "
+                "definition of its responses).")
+    if kind == "collocation":
+        body = evaluator.get("body")
+        return (f"Each run is a predicted transfemoral stride{at} wearing the generated blade "
+                "(the collocation evaluator" + (f", {body} body" if body else "") + "): the "
+                "gait is the optimum of the stride problem for that blade.")
+    return ""
 
 
 def _problem_posed(evaluator: dict) -> str:
