@@ -32,8 +32,8 @@ from bladelab.predict.collocation.named_runs import solve_named_stride
 from bladelab.predict.collocation.settings import CollocationSettings, people_term
 from bladelab.predict.collocation.stored import runner_from_spec
 
-__all__ = ["OPTIONS", "PEOPLE_STRIDE_TIME", "PROGRESS_EVERY_S", "StageProgress", "run_collocation",
-           "stride_time_settings"]
+__all__ = ["OPTIONS", "PEOPLE_STRIDE_TIME", "PROGRESS_EVERY_S", "StageProgress",
+           "is_people_stride_time", "run_collocation", "stride_time_settings"]
 
 #: Seconds between two progress lines while a stage iterates.
 PROGRESS_EVERY_S = 5.0
@@ -146,10 +146,15 @@ def _tilt_range(text: str | None) -> tuple[float, float] | None:
 PEOPLE_STRIDE_TIME = "people"
 
 
+def is_people_stride_time(text: str | None) -> bool:
+    """True when ``--stride-time`` says ``people`` (any case, spaces around it allowed)."""
+    return text is not None and text.strip().lower() == PEOPLE_STRIDE_TIME
+
+
 def stride_time_settings(text: str | None) -> dict:
     """The ``CollocationSettings`` fields of ``--stride-time``: ``LO,HI`` or ``T`` [s] (T fixes
     the stride time) as ``stride_time_range_s``, ``people`` as ``stride_time_people``."""
-    if text is not None and text.strip().lower() == PEOPLE_STRIDE_TIME:
+    if is_people_stride_time(text):
         return {"stride_time_people": True}
     return {"stride_time_range_s": _pair(
         text, "--stride-time", "LO,HI or T [s], or people",

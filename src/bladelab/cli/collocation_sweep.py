@@ -20,7 +20,7 @@ from pathlib import Path
 
 import typer
 
-from bladelab.cli.collocation import PEOPLE_STRIDE_TIME, StageProgress
+from bladelab.cli.collocation import StageProgress, is_people_stride_time
 from bladelab.cli.panels import renamed
 from bladelab.cli.values import parse_list
 from bladelab.errors import BladelabError, SpecError
@@ -126,7 +126,7 @@ def run_collocation_sweep(
     athlete (None: the body's own); ``mesh_check``: every converged solve checked on twice
     the mesh intervals; ``stride_time``: ``people`` (people's band at each prescribed speed,
     ``CollocationSettings.stride_time_people``) or None (free)."""
-    if stride_time is not None and stride_time.strip().lower() != PEOPLE_STRIDE_TIME:
+    if stride_time is not None and not is_people_stride_time(stride_time):
         raise SpecError(f"a sweep imposes people's band at each speed, got {stride_time!r}",
                         where="--stride-time",
                         hint="--stride-time people; one range fits one speed: bladelab "

@@ -36,7 +36,6 @@ import pandas as pd
 from bladelab.errors import InputFileError
 from bladelab.predict.collocation.human_running import gallop_sentence
 from bladelab.predict.collocation.model import build_collocation_model
-from bladelab.predict.collocation.settings import CollocationSettings
 from bladelab.predict.collocation.solution import CollocationSolution
 from bladelab.predict.collocation.stored import runner_from_spec
 from bladelab.predict.collocation.sweep import SWEEP_TABLE
@@ -288,11 +287,12 @@ def collocation_sweep_sections(report, folder: str | Path) -> tuple[dict, pd.Dat
     text += "".join(sorted({reference_term_text(
         sol.settings, lead="Not free predictions: every objective held")
         for sol in solutions.values()}))
-    if any(sol.settings.stride_time_people for sol in solutions.values()):
+    banded = [sol.settings for sol in solutions.values() if sol.settings.stride_time_people]
+    if banded:
         text += (" The stride time of every prescribed speed is imposed within people's band "
                  "at that speed (bladelab sweep --stride-time people; e.g. "
-                 f"{CollocationSettings(speed_m_per_s=4.0, stride_time_people=True).imposed_stride_time}"
-                 "): the cadence is given, not predicted; the maximum speed's is free.")
+                 f"{banded[0].imposed_stride_time}): the cadence is given, not predicted; the "
+                 "maximum speed's is free.")
     gallops = gallop_sentence([100.0 * step_phase(sol.leg_vertical_force()[:-1])
                                for sol in solutions.values()])
     if gallops:
