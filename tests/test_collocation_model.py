@@ -56,15 +56,16 @@ from bladelab.runner.muscle import (
     tendon_force,
     tendon_force_of_state,
 )
-from bladelab.runner.params import athlete_params, default_runner_params
+from bladelab.runner.params import ArchSpring, athlete_params, default_runner_params
 
 N_STATES = 20
 KINDS = ("able", "amputee-Cat6", "able-toes", "transfemoral", "able-human", "amputee-human",
-         "transfemoral-human", "amputee-human-short", "able-human-long-thighs")
+         "transfemoral-human", "amputee-human-short", "able-human-long-thighs",
+         "able-human-arch")
 # the toe body's Achilles tendons are twice as compliant; the human body's tendons differ per
 # muscle and its strengths come from a table
 # and a human body with faster fibres: every muscle's v_max 15 l_opt/s, not 10
-MUSCLE_KINDS = ("able", "able-toes", "able-human", "able-human-vmax15")
+MUSCLE_KINDS = ("able", "able-toes", "able-human", "able-human-vmax15", "able-human-arch")
 SM = Smoothing()
 
 
@@ -81,6 +82,9 @@ def models():
                   "amputee-Cat6": lambda: build_runner("amputee", blade="Cat6"),
                   "transfemoral": lambda: build_runner("transfemoral"),
                   "able-human": lambda: build_runner("able", body="human"),
+                  # a foot with an arch: a midtarsal hinge with its spring and damper
+                  "able-human-arch": lambda: build_runner(default_runner_params(
+                      "able", body="human").model_copy(update={"arch": ArchSpring()})),
                   "amputee-human": lambda: build_runner("amputee", body="human"),
                   # an athlete's own thighs and shanks: segments and muscles rescaled
                   "able-human-long-thighs": lambda: build_runner(athlete_params(

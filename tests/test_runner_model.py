@@ -308,6 +308,44 @@ def test_toe_body_keeps_the_mass_and_adds_a_toe_hinge(able):
     assert h[toes.contact_names.index("toe_l")] == pytest.approx(0.0, abs=1e-12)
 
 
+def test_arch_adds_a_midtarsal_hinge_and_keeps_the_foot():
+    """A foot with an arch: the forefoot (ball sphere and toes) turns on a midtarsal hinge with
+    the arch's spring and damper; the foot's mass and centre of mass, the contacts standing and
+    the coordinates but the two hinges stay the human body's. Turning the forefoot up (the
+    arch compressed) lifts the heel off the ground with the ball on it."""
+    from bladelab.runner.layout import JP_SD, JP_SDX, JP_SK
+    from bladelab.runner.params import ArchSpring
+
+    human = build_runner("able", body="human")
+    params = default_runner_params("able", body="human")
+    arch = build_runner(params.model_copy(update={"arch": ArchSpring(
+        stiffness_Nm_per_rad=800.0, damping_Nms_per_rad=2.0)}))
+    assert set(arch.dof_names) - set(human.dof_names) == {"midtarsal_angle_l",
+                                                           "midtarsal_angle_r"}
+    assert arch.contact_names == human.contact_names
+    assert arch.total_mass == pytest.approx(human.total_mass, rel=1e-12)
+    centres = []
+    for runner in (human, arch):
+        d = mujoco.MjData(runner.mj_model)
+        d.qpos[:] = runner.stand_qpos
+        mujoco.mj_forward(runner.mj_model, d)
+        centres.append(d.subtree_com[0].copy())
+        assert contact_heights(runner, runner.stand_qpos) == pytest.approx(0.0, abs=1e-12)
+    np.testing.assert_allclose(centres[1], centres[0], atol=1e-12)
+    j = arch.dof("midtarsal_angle_l")
+    assert tuple(arch.joint_params[j, [JP_SK, JP_SD, JP_SDX]]) == (800.0, 2.0, 2.0)
+    ball = arch.contact_params[arch.contact_names.index("toe_l")]
+    assert arch.mj_model.body(int(ball[1])).name == "forefoot_l"
+    assert arch.mj_model.body(arch.mj_model.body("toes_l").parentid[0]).name == "forefoot_l"
+    q = arch.stand_qpos.copy()
+    q[j] = np.radians(10.0)  # the forefoot turned up about the hinge: the ball lifts
+    h = contact_heights(arch, q)
+    assert h[arch.contact_names.index("toe_l")] > 0.01
+    assert h[arch.contact_names.index("heel_l")] == pytest.approx(0.0, abs=1e-12)
+    with pytest.raises(BladelabError, match="toe segment"):
+        runner_params_from_dict(default_runner_params("able").model_dump() | {"arch": {}})
+
+
 def test_unknown_body_is_a_clear_error():
     with pytest.raises(SpecError, match="unknown body 'toe'"):
         build_runner("able", body="toe")

@@ -153,11 +153,20 @@ def test_contact_point_velocity_matches_mujoco_jacobian(amputee):
 
 
 def _runner(kind: str):
-    """``able``, ``amputee`` or ``able-toes`` (the toe body: toe segment, compliant Achilles)."""
-    return build_runner("able", body="toes") if kind == "able-toes" else build_runner(kind)
+    """``able``, ``amputee``, ``able-toes`` (the toe body: toe segment, compliant Achilles) or
+    ``able-human-arch`` (the human body with a midtarsal hinge and its arch spring)."""
+    if kind == "able-toes":
+        return build_runner("able", body="toes")
+    if kind == "able-human-arch":
+        from bladelab.runner.params import ArchSpring, default_runner_params
+
+        return build_runner(default_runner_params("able", body="human").model_copy(
+            update={"arch": ArchSpring()}))
+    return build_runner(kind)
 
 
-@pytest.mark.parametrize("kind,mass", [("able", 83.47), ("amputee", 81.43), ("able-toes", 83.47)])
+@pytest.mark.parametrize("kind,mass", [("able", 83.47), ("amputee", 81.43), ("able-toes", 83.47),
+                                       ("able-human-arch", 75.0)])
 def test_passive_drop_comes_to_rest_with_body_weight(kind, mass):
     """Dropped 5 cm with the joints held: static vertical GRF = m·g within 1 %."""
     runner = _runner(kind)
@@ -190,7 +199,8 @@ def test_blade_static_compression_in_simulation(category, k_cat):
 
 
 @pytest.mark.parametrize(
-    "kind,u", [("amputee", 0.05), ("amputee", 0.4), ("able", 0.2), ("able-toes", 0.2)]
+    "kind,u", [("amputee", 0.05), ("amputee", 0.4), ("able", 0.2), ("able-toes", 0.2),
+               ("able-human-arch", 0.2)]
 )
 def test_power_balance_with_ground_contact(kind, u):
     """2 s, constant excitations, feet/blade on the ground throughout: the RMS residual of

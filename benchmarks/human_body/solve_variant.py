@@ -11,7 +11,9 @@ tendon and passive curves follow them), ``muscle`` ({muscle type: {field: value}
 (top-level parameter fields), ``weights`` (``StrideWeights`` fields), ``guess`` (a word or a
 solution file; default the measured trial), ``track`` (true: a tracking stage of the guess
 first, as for a guess that is no collocation solution), ``mesh`` (mesh intervals, default 50)
-and ``stride_time`` ([lo, hi] s, ``CollocationSettings.stride_time_range_s``). Writes
+``stride_time`` ([lo, hi] s, ``CollocationSettings.stride_time_range_s``) and
+``people_weight`` (people's joint angles in the objective, the command line's
+``--people-weight``; default 0). Writes
 ``OUT/solution.json`` (or ``best_iterate.json``) and ``OUT/variant.json``, and prints the summary and the wall time [s].
 The rows of README.md made with it: every force doubled (``{"force_factor": {"all": 2.0}}``),
 the acceleration weight 0.01, the vasti tendon slack length 0.146 m.
@@ -24,7 +26,7 @@ import sys
 import time
 from pathlib import Path
 
-from bladelab.predict.collocation.settings import CollocationSettings
+from bladelab.predict.collocation.settings import CollocationSettings, people_term
 from bladelab.predict.collocation.solve import predict_stride
 from bladelab.predict.collocation.starting_guess import make_guess
 from bladelab.predict.collocation.transcription import StrideWeights
@@ -49,7 +51,8 @@ def main() -> None:
     settings = CollocationSettings(speed_m_per_s=speed,
                                    weights=StrideWeights(**weights) if weights else None,
                                    mesh_intervals=variant.get("mesh", 50),
-                                   stride_time_range_s=variant.get("stride_time"))
+                                   stride_time_range_s=variant.get("stride_time"),
+                                   **people_term(variant.get("people_weight", 0)))
     guess = make_guess(runner, variant.get("guess", "trial"), n=settings.mesh_intervals,
                        speed=speed)
     t0 = time.perf_counter()

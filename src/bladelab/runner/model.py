@@ -74,6 +74,7 @@ LIGAMENTS: dict[str, tuple[float, float, float, float]] = {
     "ankle_angle": (-60.0, 60.0, 500.0, 5.0),
     "lumbar_extension": (0.0, 0.0, 500.0, 5.0),
     "mtp_angle": (-30.0, 60.0, 100.0, 1.0),
+    "midtarsal_angle": (-15.0, 30.0, 500.0, 5.0),
 }
 # Socket: stiff nonlinear torsional spring τ = −(K·q + K2·q·|q|) − D·q̇ (seed 001 §2.1).
 SOCKET_STIFFNESS = 1000.0  # N·m/rad
@@ -91,6 +92,14 @@ TOES_COM_M = (0.025, -0.01)  # toes COM from the MTP hinge (forward, up) [m], re
 TOETIP_RADIUS_M = 0.02
 TOETIP_CENTRE_M = (0.05, -0.01)  # toe-tip sphere centre from the MTP hinge; its bottom is
 # level with the ball sphere's (radius 0.03) in the neutral pose; foot length 0.27 m in all
+
+# The arch of ``RunnerParams.arch`` (docs/runner-model.md, "The arch"): a midtarsal hinge
+# 4.5 cm ahead of the ankle at its height (the talonavicular joint; calcaneus COM-relative,
+# OpenSim axes [m], reference athlete), a forefoot of the cuneiforms and metatarsals carrying
+# the ball sphere and the toes.
+MIDTARSAL_HINGE_M = (-0.006, 0.012, 0.0)
+FOREFOOT_MASS_FRACTION = 0.30  # of the foot (our estimate: the bones' share ahead of the hinge)
+FOREFOOT_INERTIA_KG_M2 = 3.0e-4  # about its COM, every axis (0.38 kg over 9 cm: ≈ 2.6e-4)
 
 # The transfemoral prosthesis's COM below the knee axis, as a fraction of the knee-to-ground
 # depth: a 1.2 kg knee unit at the top and about as much pylon and blade below (our estimate).
@@ -382,14 +391,23 @@ def build_runner(
                 pp,
                 pc,
             )
+            ball = geo.FOOT_SPHERES["toe"]
+            fore, fore_origin = body, pc
+            if params.arch is not None:
+                fore = _add_forefoot(body, side, _v(_sub(MIDTARSAL_HINGE_M, pc), s),
+                                     _v(_sub(ball, pc), s), s, axis)
+                fore_origin = MIDTARSAL_HINGE_M
+            elif params.foot == "toes":
+                _add_toes(body, side, _v(_sub(ball, pc), s), s, axis,
+                          _take_mass(body, TOES_MASS_FRACTION,
+                                     _toes_com_at(_v(_sub(ball, pc), s), s)))
             for sph, p in geo.FOOT_SPHERES.items():
-                body.add_site(
+                on, origin = (fore, fore_origin) if sph == "toe" else (body, pc)
+                on.add_site(
                     name=f"{sph}_{side}",
-                    pos=_v(_sub(p, pc), s),
+                    pos=_v(_sub(p, origin), s),
                     size=[geo.FOOT_SPHERE_RADIUS_M * s, 0, 0],
                 )
-            if params.foot == "toes":
-                _add_toes(body, side, _v(_sub(geo.FOOT_SPHERES["toe"], pc), s), s, axis)
     par, pp, pc = geo.JOINTS["lumbar"]
     add("torso", "torso", "lumbar", "lumbar_extension", "pelvis", pp, pc)
 
@@ -508,6 +526,10 @@ def build_runner(
             jp[i, JP_EB] = math.degrees(capsule.rate_per_deg)  # 1/deg → 1/rad
         if base == "mtp_angle":
             jp[i, JP_SK:JP_EA] = (MTP_STIFFNESS, 0.0, MTP_DAMPING, MTP_DAMPING)
+        if base == "midtarsal_angle":
+            arch = params.arch
+            jp[i, JP_SK:JP_EA] = (arch.stiffness_Nm_per_rad, 0.0, arch.damping_Nms_per_rad,
+                                  arch.damping_Nms_per_rad)
         if dn == "socket_angle_r":
             jp[i, JP_SK:JP_EA] = (SOCKET_STIFFNESS, SOCKET_STIFFNESS_QUADRATIC,
                                   SOCKET_DAMPING, SOCKET_DAMPING)
@@ -546,28 +568,71 @@ def build_runner(
     return runner
 
 
-def _add_toes(calcn, side: str, hinge: list[float], s: float, axis: list[float]) -> None:
-    """A toe segment on a metatarsophalangeal hinge at ``hinge`` (calcaneus body frame [m]).
+def _add3(a, b) -> list[float]:
+    return [float(x + y) for x, y in zip(a, b, strict=True)]
 
-    Its mass, :data:`TOES_MASS_FRACTION` of the foot's, is taken from the calcaneus, whose
-    centre of mass moves back so that the foot's centre of mass in the neutral pose stays
-    where seed 001's is; the calcaneus keeps its inertia (the toes' share of it is < 2 %).
+
+def _toes_com_at(hinge: list[float], s: float) -> list[float]:
+    """The toes' centre of mass in the frame of the MTP ``hinge`` given [m] (in the sagittal
+    plane: its lateral coordinate is 0, which no sagittal quantity sees)."""
+    return [hinge[0] + TOES_COM_M[0] * s, 0.0, hinge[2] + TOES_COM_M[1] * s]
+
+
+def _take_mass(body, fraction: float, com: list[float]) -> float:
+    """Take ``fraction`` of ``body``'s mass away at ``com`` (its frame [m]) and return it
+    [kg]: the body keeps its inertia, and its centre of mass moves so that the mass taken and
+    the body together have the centre of mass the body had."""
+    m = body.mass
+    taken = fraction * m
+    body.mass = m - taken
+    body.ipos = [(m * c - taken * t) / (m - taken) for c, t in zip(body.ipos, com, strict=True)]
+    return taken
+
+
+def _add_toes(parent, side: str, hinge: list[float], s: float, axis: list[float],
+              mass: float) -> None:
+    """A toe segment of ``mass`` [kg] on a metatarsophalangeal hinge at ``hinge`` (the parent
+    body's frame [m]: the calcaneus, or the forefoot of a foot with an arch).
+
+    Its mass, :data:`TOES_MASS_FRACTION` of the foot's, is taken from the calcaneus
+    (:func:`_take_mass`), so that the foot's centre of mass in the neutral pose stays where
+    seed 001's is; the calcaneus keeps its inertia (the toes' share of it is < 2 %).
     """
-    m_foot = calcn.mass
-    m_toes = TOES_MASS_FRACTION * m_foot
-    com_toes = [hinge[0] + TOES_COM_M[0] * s, 0.0, hinge[2] + TOES_COM_M[1] * s]
-    calcn.mass = m_foot - m_toes
-    calcn.ipos = [(m_foot * c - m_toes * t) / (m_foot - m_toes)
-                  for c, t in zip(calcn.ipos, com_toes, strict=True)]
-    toes = calcn.add_body(name=f"toes_{side}", pos=hinge)
+    toes = parent.add_body(name=f"toes_{side}", pos=hinge)
     toes.add_joint(name=f"mtp_angle_{side}", type=mujoco.mjtJoint.mjJNT_HINGE, axis=axis)
     toes.explicitinertial = True
-    toes.mass = m_toes
+    toes.mass = mass
     toes.ipos = [TOES_COM_M[0] * s, 0.0, TOES_COM_M[1] * s]
     toes.inertia = [TOES_INERTIA_KG_M2 * s * s] * 3
     toes.add_site(name=f"toetip_{side}",
                   pos=[TOETIP_CENTRE_M[0] * s, 0.0, TOETIP_CENTRE_M[1] * s],
                   size=[TOETIP_RADIUS_M * s, 0, 0])
+
+
+def _add_forefoot(calcn, side: str, hinge: list[float], ball: list[float], s: float,
+                  axis: list[float]):
+    """The forefoot on a midtarsal hinge at ``hinge`` and the toes on its MTP hinge at
+    ``ball`` (both in the calcaneus frame [m]); returns the forefoot body.
+
+    The forefoot (:data:`FOREFOOT_MASS_FRACTION` of the foot, its centre of mass halfway
+    from the hinge to the ball) and the toes take their mass from the calcaneus
+    (:func:`_take_mass`): the foot's mass and centre of mass in the neutral pose are seed
+    001's.
+    """
+    to_ball = [b - h for b, h in zip(ball, hinge, strict=True)]
+    fore_com = [0.5 * d for d in to_ball]
+    m_foot = calcn.mass
+    m_fore = _take_mass(calcn, FOREFOOT_MASS_FRACTION, _add3(hinge, fore_com))
+    m_toes = _take_mass(calcn, TOES_MASS_FRACTION * m_foot / calcn.mass,
+                        _toes_com_at(ball, s))
+    fore = calcn.add_body(name=f"forefoot_{side}", pos=hinge)
+    fore.add_joint(name=f"midtarsal_angle_{side}", type=mujoco.mjtJoint.mjJNT_HINGE, axis=axis)
+    fore.explicitinertial = True
+    fore.mass = m_fore
+    fore.ipos = fore_com
+    fore.inertia = [FOREFOOT_INERTIA_KG_M2 * s * s] * 3
+    _add_toes(fore, side, to_ball, s, axis, m_toes)
+    return fore
 
 
 def _myodesis_point(p: tuple[float, float, float]) -> tuple[float, float, float]:

@@ -40,6 +40,7 @@ COORDINATE_BOUNDS_DEG: dict[str, tuple[float, float]] = {
     "socket_angle": (-30.0, 30.0),
     "lumbar_extension": (-30.0, 30.0),
     "mtp_angle": (-45.0, 80.0),
+    "midtarsal_angle": (-30.0, 45.0),
 }
 PELVIS_BOUNDS_M = {"pelvis_tx": (-math.inf, math.inf), "pelvis_tz": (0.4, 1.4)}
 SPEED_BOUNDS = {"pelvis_tx": (0.0, 12.0), "pelvis_tz": (-4.0, 4.0)}  # m/s

@@ -33,10 +33,10 @@ __all__ = [
 #: The guess source prefix that marks a collocation solution (no tracking stage needed).
 COLLOCATION_SOURCE = "collocation solution"
 
-#: Coordinates of a guess that another model may lack (prefixes): the toe hinges (the seed-001
+#: Coordinates of a guess that another model may lack (prefixes): the toe and arch hinges (the seed-001
 #: body has none) and the transtibial prosthesis's socket hinge (the transfemoral runner has
 #: none: its prosthesis hangs from the knee). Any other lost coordinate refuses the mapping.
-DROPPABLE_COORDINATES = ("mtp_angle", "socket_angle")
+DROPPABLE_COORDINATES = ("mtp_angle", "midtarsal_angle", "socket_angle")
 
 
 @dataclass(frozen=True)
