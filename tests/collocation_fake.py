@@ -117,11 +117,14 @@ def install_fake_solve(fakes: dict, monkeypatch) -> FakeSolve:
 def start_of(settings, guess) -> str:
     """Which start of ``bladelab.predict.collocation.starts`` a solve is, from its guess and
     settings: ``iterate`` (a stored best iterate's warm start), ``template``,
-    ``previous-but-one``, ``warm-mu-1e-4`` or ``warm``."""
+    ``previous-but-one``, ``from-<category>`` (a sweep's settling start from a neighbouring
+    category's stride), ``warm-mu-1e-4`` or ``warm``."""
     from bladelab.predict.collocation.stride_guess import COLLOCATION_SOURCE
 
     if guess.source.startswith(COLLOCATION_SOURCE + " ("):  # a stored iterate's to_guess()
         return "iterate"
+    if "(from-" in guess.source:
+        return "from-" + guess.source.split("(from-")[1].split(":")[0]
     if guess.source.startswith("template"):
         return "template"
     if "previous but one" in guess.source:

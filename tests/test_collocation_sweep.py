@@ -286,6 +286,57 @@ def test_several_starts_keep_the_best_per_problem_and_every_file(fake_solve, mon
         "max-speed.json", "speed-3.5.json", "speed-4.json"]
 
 
+def test_settling_starts_each_category_from_its_neighbours_strides(fake_solve, monkeypatch,
+                                                                   tmp_path, capsys):
+    """--settle: after every model, each amputee problem solved again from the kept strides of
+    the categories next to it by stiffness (not by the order given), the lowest kept with
+    every start's objective in the table; the able runner has no neighbour; --resume solves
+    nothing again."""
+    from collocation_fake import objectives_by_start
+
+    # Cat5's 3.5 m/s stride is the best start of Cat4's problem; Cat6's maximum speed does
+    # not converge from Cat5's stride
+    objective = {("from-Cat5", 3.5): 0.5, ("from-Cat5", None): None}
+    objectives_by_start(fake_solve, monkeypatch, lambda s, v: objective.get((s, v), 2.0))
+    out = tmp_path / "sweep"
+    args = ("--able", "--categories", "Cat4,Cat6,Cat5", "--speeds", "3.5", "--starts", "1",
+            "--settle")
+    assert _sweep(out, *args) == 0
+    err = capsys.readouterr().err
+    assert "start from-Cat5: from Cat5's stride amputee-Cat5/speed-3.5.json" in err
+    settling = [(c["label"], c["speed"], c["start"]) for c in fake_solve.calls[8:]]
+    assert [c["start"] for c in fake_solve.calls[:8]] == ["template", "warm"] * 4
+    assert sorted(settling, key=str) == sorted([
+        ("amputee Cat4", 3.5, "from-Cat5"), ("amputee Cat4", None, "from-Cat5"),
+        ("amputee Cat5", 3.5, "from-Cat4"), ("amputee Cat5", 3.5, "from-Cat6"),
+        ("amputee Cat5", None, "from-Cat4"), ("amputee Cat5", None, "from-Cat6"),
+        ("amputee Cat6", 3.5, "from-Cat5"), ("amputee Cat6", None, "from-Cat5")], key=str)
+    # each settling start from the neighbour's own stride (its primal and dual values)
+    cat4 = next(c for c in fake_solve.calls[8:] if c["label"] == "amputee Cat4"
+                and c["speed"] == 3.5)
+    cat5 = next(c for c in fake_solve.calls[:8] if c["label"] == "amputee Cat5"
+                and c["speed"] == 3.5)
+    np.testing.assert_array_equal(cat4["guess"].q[:, 3], cat5["solution"].nlp.q[:, 3])
+    assert sorted(p.name for p in (out / "amputee-Cat5").iterdir()) == [
+        "max-speed.from-Cat4.json", "max-speed.from-Cat6.json", "max-speed.json",
+        "speed-3.5.from-Cat4.json", "speed-3.5.from-Cat6.json", "speed-3.5.json"]
+    assert (out / "amputee-Cat6" / "max-speed.from-Cat5.best_iterate.json").exists()
+    rows = {(r["model"], r["problem"]): r for r in _csv(out / "collocation-sweep.csv")}
+    assert rows["able", "speed"].get("start", "") == ""  # no neighbour
+    r = rows["amputee Cat4", "speed"]
+    assert (r["start"], r["starts"], r["file"]) == ("from-Cat5", "2",
+                                                   "amputee-Cat4/speed-3.5.from-Cat5.json")
+    assert float(r["objective"]) == 0.5 and float(r["objective_warm"]) == 2.0
+    assert float(r["spread_pct"]) == pytest.approx(300.0)
+    r = rows["amputee Cat6", "max-speed"]
+    assert (r["start"], r["starts"], r["objective_from-Cat5"]) == ("warm", "1", "")
+    assert [m for m, _ in rows][:3] == ["able", "able", "amputee Cat4"]  # the order asked
+    before = (out / "collocation-sweep.csv").read_text()
+    fake_solve.calls.clear()
+    assert _sweep(out, *args, "--resume") == 0
+    assert fake_solve.calls == [] and (out / "collocation-sweep.csv").read_text() == before
+
+
 @pytest.mark.parametrize(("args", "where"), [
     (("--method", "collocation", "--init", "x.json"), "--init"),
     (("--method", "collocation", "--categories", "Cat9"), "--categories"),
@@ -311,6 +362,7 @@ def test_several_starts_keep_the_best_per_problem_and_every_file(fake_solve, mon
     (("--method", "collocation", "--categories", "Cat6", "--stride-time", "0.6,0.7"),
      "--stride-time"),  # one range cannot fit every speed
     (("--stride-time", "people"), "--stride-time"),  # reflex grid
+    (("--settle",), "--settle"),  # reflex grid
     (("--method", "shooting"), "--method"),
 ])
 def test_bad_sweep_options_are_refused_naming_the_option(args, where, tmp_path, capsys):

@@ -41,7 +41,7 @@ OPTIONS = {
     "athlete.max_shortening_velocity": "--max-shortening-velocity",
     "athlete.residual_limb_length_m": "--residual-limb",
     "athlete.thigh_length_m": "--thigh-length", "athlete.shank_length_m": "--shank-length",
-    "mesh check": "--mesh-check",
+    "mesh check": "--mesh-check", "settle": "--settle",
 }
 
 
@@ -119,13 +119,15 @@ def run_collocation_sweep(
     athlete: dict | None = None,
     mesh_check: bool = False,
     stride_time: str | None = None,
+    settle: bool = False,
 ) -> int:
     """Run ``bladelab sweep --method collocation``; returns the exit status (0 every solve
     converged, 2 some model failed). ``alternating_steps``:
     ``CollocationSettings.step_phase_tolerance``; ``athlete``: every model scaled to this
     athlete (None: the body's own); ``mesh_check``: every converged solve checked on twice
     the mesh intervals; ``stride_time``: ``people`` (people's band at each prescribed speed,
-    ``CollocationSettings.stride_time_people``) or None (free)."""
+    ``CollocationSettings.stride_time_people``) or None (free); ``settle``: a settling pass
+    from the neighbouring categories' strides."""
     if stride_time is not None and not is_people_stride_time(stride_time):
         raise SpecError(f"a sweep imposes people's band at each speed, got {stride_time!r}",
                         where="--stride-time",
@@ -141,7 +143,7 @@ def run_collocation_sweep(
             step_phase_tolerance=alternating_steps, stride_time_people=stride_time is not None,
             athlete=athlete, starts=starts, jobs=jobs,
             executor=executor, resume=resume, force=force, progress=SweepProgress(),
-            mesh_check=mesh_check)
+            mesh_check=mesh_check, settle=settle)
     except BladelabError as err:
         raise renamed(err, OPTIONS) from None
     if as_json:

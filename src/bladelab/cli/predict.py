@@ -519,6 +519,13 @@ def register(app: typer.Typer) -> None:
                  "stride (DIR/<model>/mesh-check/) and add each one's changes and whether it "
                  "settled (objective and stride time within 1 %) to the table and the "
                  "report. About 2-5 times the sweep's time."),
+        settle: bool = typer.Option(
+            False, "--settle", rich_help_panel=COLLOCATION,
+            help="After every model, solve each amputee problem again from the kept strides "
+                 "of the neighbouring categories (by stiffness) at the same speed, and keep "
+                 "the lowest (files speed-<v>.from-<category>.json; the spread in the "
+                 "table): starts that converge on the human body, where the template's "
+                 "does not."),
     ) -> None:
         """Category × speed grid: warm-started optimisations, maximum speed, cost at 4 m/s,
         200 m and 400 m times, contact times (seed 001 §2.2.2 B–C, Table 3.1). Running it again
@@ -536,7 +543,8 @@ def register(app: typer.Typer) -> None:
         and the maximum speed; DIR/<model>/speed-<v>.json, max-speed.json and the table
         DIR/collocation-sweep.csv. A used --out needs --resume or --force; exit status 2 when a
         model failed (after the others). --starts K solves each problem from up to K starts
-        and keeps the best; --mesh-check adds the settling evidence of every solve.
+        and keeps the best; --settle adds the neighbouring categories' strides as starts;
+        --mesh-check adds the settling evidence of every solve.
 
         An option of another method (or of the grid with --recipe) is refused."""
         method = _method(method)
@@ -557,7 +565,7 @@ def register(app: typer.Typer) -> None:
                                  max_shortening_velocity=max_shortening_velocity,
                                  residual_limb_length_m=residual_limb,
                                  thigh_length_m=thigh_length, shank_length_m=shank_length),
-                mesh_check=mesh_check))
+                mesh_check=mesh_check, settle=settle))
         from bladelab.cli import reflex  # deferred: keeps bladelab --help fast
 
         if mode == "recipe":

@@ -54,6 +54,12 @@ objective without gait warnings), the continuation goes on from it, and its row 
 ``start``, ``starts``, ``objective``, ``objective_<start>`` and ``spread_pct``. Resuming reads
 every start's converged file back; a start's best iterate is read back too when another start
 of the problem converged, and warm-starts that start again otherwise (as with one start).
+
+Other models' strides as starts (``extra_starts``, the sweep's settling pass): each problem
+(:func:`problem_key`) may get further starts from solution files of other models (a
+neighbouring blade category's stride at the same speed), labelled by the caller
+(``from-Cat5``), solved after the K starts from the solution's primal and dual values, and
+kept like any start.
 """
 
 from __future__ import annotations
@@ -104,6 +110,7 @@ __all__ = [
     "max_speed",
     "max_speed_settings",
     "model_folder",
+    "problem_key",
     "speed_continuation",
     "speed_file",
     "table_columns",
@@ -128,6 +135,28 @@ def speed_file(speed: float, *, converged: bool = True) -> str:
     """The file name of the solve at ``speed`` [m/s]: ``speed-<v:g>.json``, or
     ``speed-<v:g>.best_iterate.json`` when it did not converge."""
     return f"speed-{float(speed):g}" + (".json" if converged else ".best_iterate.json")
+
+
+def problem_key(speed: float | None) -> str:
+    """The key of a model's problem in ``extra_starts``: the prescribed speed as
+    ``f"{v:g}"`` [m/s], ``"max-speed"`` for the maximum speed (``speed`` None)."""
+    return "max-speed" if speed is None else f"{float(speed):g}"
+
+
+def _solution_start(label: str, settings: CollocationSettings, path: Path) -> Start:
+    """A start from the stride in solution file ``path`` (another model's), labelled
+    ``label``: its primal and dual values (:func:`warm_guess`)."""
+    def guess():
+        return warm_guess(CollocationSolution.read(path), f" ({label}: {Path(path).name})")
+
+    return Start(label, settings, guess, f"from {label.removeprefix('from-')}'s stride "
+                                         f"{Path(path).parent.name}/{Path(path).name}")
+
+
+def _extra(extra_starts, speed: float | None, settings: CollocationSettings) -> list[Start]:
+    """The ``extra_starts`` of the problem at ``speed`` (None: the maximum speed)."""
+    return [_solution_start(label, settings, Path(path))
+            for label, path in (extra_starts or {}).get(problem_key(speed), ())]
 
 
 def model_folder(spec: dict) -> str:
@@ -392,7 +421,7 @@ def speed_continuation(runner, speeds: Sequence[float], settings: CollocationSet
                        progress: Callable[[ContinuationProgress], None] | None = None,
                        force: bool = False,
                        refinements: int = DEFAULT_REFINEMENTS,
-                       starts: int = 1) -> ContinuationResult:
+                       starts: int = 1, extra_starts=None) -> ContinuationResult:
     """Solve the stride at each prescribed speed in order, each warm-started from the previous
     converged solution (module docstring); files ``out_dir/speed-<v>.json``.
 
@@ -426,6 +455,9 @@ def speed_continuation(runner, speeds: Sequence[float], settings: CollocationSet
     starts
         Starts per speed, 1 to 4 (module docstring; :mod:`~bladelab.predict.collocation.starts`):
         1 the warm start only; more, the best of several kept and continued from.
+    extra_starts
+        ``{problem_key(v): [(label, solution file), ...]}``: further starts of a speed from
+        other models' strides (module docstring); None: none.
 
     Returns
     -------
@@ -496,10 +528,12 @@ def speed_continuation(runner, speeds: Sequence[float], settings: CollocationSet
                 "previous but one)")
             plan = plan_starts(starts, warm, warm_source=COLLOCATION_SOURCE, template=template,
                                previous=previous)
+        extra = _extra(extra_starts, v, s_v)
         ok, best = out_dir / speed_file(v), out_dir / speed_file(v, converged=False)
         kept, outcomes = solve_starts(
-            plan, ok=ok, best=best, report=report, retry=f"{v:g}" not in restart,
-            several=starts > 1, read=functools.partial(_stored, spec=spec, force=force),
+            plan + extra, ok=ok, best=best, report=report, retry=f"{v:g}" not in restart,
+            several=starts > 1 or bool(extra),
+            read=functools.partial(_stored, spec=spec, force=force),
             solve=functools.partial(_solve, get_runner, spec, progress is not None))
         sol, path = kept.solution, kept.path
         solved = kept.solved or any(o.solved for o in outcomes)
@@ -542,7 +576,8 @@ def max_speed_settings(settings: CollocationSettings) -> CollocationSettings:
 def max_speed(runner, settings: CollocationSettings, guess, *, model_spec: dict,
               out_dir: str | Path,
               progress: Callable[[ContinuationProgress], None] | None = None,
-              force: bool = False, starts: int = 1, previous=None) -> SolveRecord:
+              force: bool = False, starts: int = 1, previous=None,
+              extra_starts=None) -> SolveRecord:
     """Solve the maximum-speed problem warm-started from ``guess`` (the fastest converged
     solution of :func:`speed_continuation`, a :class:`CollocationSolution` or its
     ``to_guess()``); file ``out_dir/max-speed.json`` (``max-speed.best_iterate.json`` if it
@@ -553,7 +588,8 @@ def max_speed(runner, settings: CollocationSettings, guess, *, model_spec: dict,
     :func:`max_speed_settings`). ``runner``, ``model_spec``, ``progress``, ``force`` and
     ``starts`` as :func:`speed_continuation`; with several starts the template is the template
     guess at the warm start's speed, and ``previous`` (the second-fastest converged solution,
-    a :class:`CollocationSolution`, or None) the previous-but-one start.
+    a :class:`CollocationSolution`, or None) the previous-but-one start; ``extra_starts`` as
+    :func:`speed_continuation` (key ``"max-speed"``).
     """
     spec = check_model_spec(model_spec)
     starts = check_starts(starts)
@@ -590,9 +626,10 @@ def max_speed(runner, settings: CollocationSettings, guess, *, model_spec: dict,
         source = COLLOCATION_SOURCE if isinstance(guess, CollocationSolution) else guess.source
         plan = plan_starts(starts, warm, warm_source=str(source), template=template,
                            previous=prev)
+    extra = _extra(extra_starts, None, settings)
     ok, best = out_dir / MAX_SPEED_FILE, out_dir / MAX_SPEED_BEST_ITERATE_FILE
     kept, outcomes = solve_starts(
-        plan, ok=ok, best=best, report=report, several=starts > 1,
+        plan + extra, ok=ok, best=best, report=report, several=starts > 1 or bool(extra),
         read=functools.partial(_stored, spec=spec, force=force),
         solve=functools.partial(_solve, get_runner, spec, progress is not None))
     solved = kept.solved or any(o.solved for o in outcomes)

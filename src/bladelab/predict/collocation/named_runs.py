@@ -121,6 +121,7 @@ def sweep_named_models(
     athlete: dict | None = None,
     starts: int = defaults.STARTS,
     mesh_check: bool = False,
+    settle: bool = False,
     jobs: int = 1,
     executor: str = "local",
     resume: bool = False,
@@ -145,8 +146,9 @@ def sweep_named_models(
     scaled to this athlete (as in :func:`solve_named_stride`); ``starts``: starts per
     problem, the best kept (:mod:`~bladelab.predict.collocation.starts`); ``mesh_check``:
     every converged solve checked on twice the mesh intervals
-    (:mod:`~bladelab.predict.collocation.mesh_check`); ``jobs`` models at a time on
-    ``executor``.
+    (:mod:`~bladelab.predict.collocation.mesh_check`); ``settle``: a settling pass from the
+    neighbouring categories' strides (:func:`~bladelab.predict.collocation.sweep.collocation_sweep`);
+    ``jobs`` models at a time on ``executor``.
 
     Raises
     ------
@@ -168,4 +170,4 @@ def sweep_named_models(
     return collocation_sweep(
         models, speeds, settings, functools.partial(make_guess, guess=guess), out=out,
         jobs=jobs, executor=executor, resume=resume, force=force, progress=progress,
-        starts=starts, mesh_check=mesh_check)
+        starts=starts, mesh_check=mesh_check, settle=settle)

@@ -21,6 +21,14 @@ kept solution, every start's file stays in the model folder, and a row is the ke
 plus the columns ``start``, ``starts``, ``objective``, ``objective_<start>`` and
 ``spread_pct``.
 
+With ``settle`` a settling pass follows: each amputee model's problems are solved again from
+its neighbouring blade categories' kept strides at the same problem (the categories ordered by
+stiffness, :func:`category_neighbours`; the able runner has none), from their primal and dual
+values, each as one more start (``from-<category>``, files ``speed-4.from-Cat5.json``; the
+continuation's ``extra_starts``), and the lowest kept: one pass, from the strides the first
+pass kept. Measured on the human body, such starts land within 0.1–0.5 % of each other where
+the template start does not converge (docs/collocation.md, "Several starts per problem").
+
 With ``mesh_check`` every converged solve is solved again on twice the mesh intervals from its
 stride (:mod:`bladelab.predict.collocation.mesh_check`; the finer solves in
 ``<model folder>/mesh-check/<solve>/``) and its row gets :func:`mesh_check_columns`: the
@@ -50,6 +58,7 @@ from bladelab.predict.collocation.continuation import (
     max_speed,
     max_speed_settings,
     model_folder,
+    problem_key,
     speed_continuation,
     table_columns,
 )
@@ -64,6 +73,7 @@ from bladelab.runner.params import blade_category
 __all__ = [
     "SWEEP_TABLE",
     "SweepResult",
+    "category_neighbours",
     "collocation_sweep",
     "mesh_check_columns",
     "sweep_model_task",
@@ -144,7 +154,9 @@ def sweep_model_task(payload: dict) -> dict:
     ``payload``: ``model_spec``, ``speeds``, ``settings`` (:class:`CollocationSettings`),
     ``make_guess`` (``make_guess(runner, n=..., speed=...)``), ``out`` (the sweep folder),
     ``force``, ``progress`` (or None), ``starts`` (per problem; default 1), ``mesh_check``
-    (each converged solve checked on twice the mesh intervals; default False). Returns
+    (each converged solve checked on twice the mesh intervals; default False),
+    ``extra_starts`` (the settling pass's starts from other models' strides, by
+    :func:`~bladelab.predict.collocation.continuation.problem_key`; default none). Returns
     ``label``, ``rows`` (module docstring) and
     ``failures`` (one line per solve that did not converge). With ``force``, files of the model
     folder that this run did not write are removed once the model is done.
@@ -158,12 +170,14 @@ def sweep_model_task(payload: dict) -> dict:
     force = bool(payload.get("force", False))
     progress = payload.get("progress")
     starts = int(payload.get("starts", 1))
+    extra = payload.get("extra_starts")
     label = model_label(spec)
     get_runner = LazyRunner(None, spec)
     cont = speed_continuation(
         get_runner, speeds, settings,
         lambda r: make_guess(r, n=settings.mesh_intervals, speed=float(speeds[0])),
-        model_spec=spec, out_dir=folder, progress=progress, force=force, starts=starts)
+        model_spec=spec, out_dir=folder, progress=progress, force=force, starts=starts,
+        extra_starts=extra)
     records = list(cont.records)
     failures = []
     if cont.failed is not None:
@@ -182,7 +196,7 @@ def sweep_model_task(payload: dict) -> dict:
         done = sorted((r for r in records if r.converged), key=lambda r: r.speed_mps)
         rec = max_speed(get_runner, max_speed_settings(settings), fastest.solution,
                         model_spec=spec, out_dir=folder, progress=progress, force=force,
-                        starts=starts,
+                        starts=starts, extra_starts=extra,
                         previous=done[-2].solution if len(done) > 1 else None)
         records.append(rec)
         if not rec.converged:
@@ -277,6 +291,37 @@ class SweepResult:
         return pd.DataFrame(self.rows, columns=table_columns(self.rows))
 
 
+def category_neighbours(models: Sequence[dict]) -> dict[int, list[int]]:
+    """For each amputee model of ``models`` (by index), the indices of the models whose blade
+    categories are next to its own when the categories are ordered by stiffness (Cat4 …
+    Cat7); models without a blade (the able runner) have none."""
+    bladed = sorted((i for i, m in enumerate(models) if m.get("blade")),
+                    key=lambda i: blade_category(models[i]["blade"]).stiffness_n_per_m)
+    return {i: [bladed[k] for k in (j - 1, j + 1) if 0 <= k < len(bladed)]
+            for j, i in enumerate(bladed)}
+
+
+def _settling_payloads(payloads: Sequence[dict], rows: dict[int, list[dict]],
+                       out: Path) -> dict[int, dict]:
+    """The settling pass's payload of each model with a neighbour that has a converged stride
+    of one of its problems: the first pass's payload, reading its files back
+    (``force`` off), with ``extra_starts`` from the neighbours' kept strides."""
+    models = [p["model_spec"] for p in payloads]
+    settling = {}
+    for i, near in category_neighbours(models).items():
+        extra: dict[str, list[tuple[str, str]]] = {}
+        for j in near:
+            for r in rows.get(j, []):
+                if str(r.get("converged")) != "True":
+                    continue
+                speed = None if r["problem"] == "max-speed" else r["prescribed_speed_mps"]
+                extra.setdefault(problem_key(speed), []).append(
+                    (f"from-{models[j]['blade']}", str(out / r["file"])))
+        if extra:
+            settling[i] = {**payloads[i], "force": False, "extra_starts": extra}
+    return settling
+
+
 def _held(out: Path) -> list[str]:
     if not out.is_dir():
         return []
@@ -300,6 +345,7 @@ def collocation_sweep(
     progress: Callable[[ContinuationProgress], None] | None = None,
     starts: int = 1,
     mesh_check: bool = False,
+    settle: bool = False,
 ) -> SweepResult:
     """For each model, the speed continuation then the maximum speed (module docstring); each
     model in ``out/<model_folder>``, the table ``out/collocation-sweep.csv`` rewritten
@@ -338,6 +384,9 @@ def collocation_sweep(
         Solve every converged problem again on twice the mesh intervals from its stride
         (:mod:`~bladelab.predict.collocation.mesh_check`, in ``<model folder>/mesh-check/``)
         and add its columns to the table (:func:`mesh_check_columns`).
+    settle
+        After every model, a settling pass (module docstring): each amputee model's problems
+        solved again from its neighbouring categories' kept strides, the lowest kept.
 
     Raises
     ------
@@ -370,14 +419,24 @@ def collocation_sweep(
     table = out / SWEEP_TABLE
     rows: dict[int, list[dict]] = {}
     failures: dict[int, list[str]] = {}
-    for i, status, value in make_executor(executor, jobs).run(sweep_model_task, payloads):
-        if status == "ok":
-            rows[i] = value["rows"]
-            if value["failures"]:
-                failures[i] = value["failures"]
-        else:
-            failures[i] = [f"stopped by an error: {value}"]
-        write_table(table, [r for k in sorted(rows) for r in rows[k]])
+
+    def run(tasks: dict[int, dict]) -> None:
+        keys = list(tasks)
+        for n, status, value in make_executor(executor, jobs).run(
+                sweep_model_task, [tasks[k] for k in keys]):
+            i = keys[n]
+            failures.pop(i, None)
+            if status == "ok":
+                rows[i] = value["rows"]
+                if value["failures"]:
+                    failures[i] = value["failures"]
+            else:
+                failures[i] = [f"stopped by an error: {value}"]
+            write_table(table, [r for k in sorted(rows) for r in rows[k]])
+
+    run(dict(enumerate(payloads)))
+    if settle:
+        run(_settling_payloads(payloads, rows, out.resolve()))
     all_rows = [r for k in sorted(rows) for r in rows[k]]
     if not rows:
         write_table(table, [])
