@@ -2,7 +2,8 @@
 
 Six models (able, amputee Cat4, Cat5, Cat6, Cat6High, Cat7) × speed continuation (4, 5 m/s)
 + maximum speed, 2 workers: on the human body from the shipped strides with one start per
-problem (the stride time free, and held at people's band); on seed 001's body from the
+problem (the stride time free, and held at people's band, the latter with the settling pass
+from the neighbouring categories' strides); on seed 001's body from the
 measured trial's guess, once with one start per problem,
 once with three (``--starts 3``: the warm start, the barrier start and the template). Target:
 ≤ 10 min on 2 cores with three starts. The studies take 20–50 min of both cores, so ``make bench`` does not run
@@ -23,7 +24,9 @@ STUDIES = (("study-human-people-cadence-2026-11-30", "the human body at people's
             "(`--stride-time people`: every prescribed speed's stride time within measured "
             "runners' band at that speed; the maximum speed free), people's joint angles at "
             "weight 10 1/rad², one start per problem, from the shipped strides, the node "
-            "function compiled"),
+            "function compiled, then the settling pass (`--settle`: each amputee problem "
+            "solved again from the neighbouring categories' kept strides; the rows are the "
+            "kept starts', the wall time both passes')"),
            ("study-human-people10-2026-11-29", "the human body with people's joint angles in "
             "the objective at weight 10 1/rad² (the default), one start per problem, from the "
             "shipped strides, each later speed from the previous solution's primal and dual "
@@ -68,6 +71,10 @@ def _study(study: Path, what: str) -> str:
     df.loc[df.warnings.fillna("").astype(str).str.len().gt(0), "mark"] = "⚠"
     df.loc[~converged, "mark"] = "✗"
     info = json.loads((study / "timing.json").read_text(encoding="utf-8"))
+    # every start's solve in the model folders (several starts or a settling pass)
+    walls = [json.loads(f.read_text(encoding="utf-8")).get("wall_s") or 0.0
+             for f in study.glob("*/*.json")]
+    n_files, all_walls = len(walls), sum(walls)
     residual = pd.to_numeric(df.dynamics_residual_pct, errors="coerce")
     rows = []
     for model, part in df.groupby("model", sort=False):
@@ -83,6 +90,8 @@ def _study(study: Path, what: str) -> str:
         f"{info['host']}) |",
         f"| solver time of the kept solves, both workers together | "
         f"{df.wall_s.sum() / 60:.1f} min |",
+        *([f"| solver time of every start's solve ({n_files} solves) | "
+           f"{all_walls / 60:.1f} min |"] if n_files > len(df) else []),
         f"| problems converged | {int(converged.sum())} of {len(df)} |",
         f"| … of which flagged by the gait checks | {int((df.mark == '⚠').sum())} |",
         f"| kept solves with a dynamics residual above 1 % | {int((residual > 1).sum())} "

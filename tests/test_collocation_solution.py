@@ -19,7 +19,7 @@ from bladelab.predict.collocation.consistency import (
     inverse_dynamics,
 )
 from bladelab.predict.collocation.continuation import max_speed_settings
-from bladelab.predict.collocation.guess import template_guess
+from bladelab.predict.collocation.guess import measured_trial_guess, template_guess
 from bladelab.predict.collocation.human_running import human_running_criteria
 from bladelab.predict.collocation.running_bands import reference_band
 from bladelab.predict.collocation.settings import CollocationSettings, people_term
@@ -659,6 +659,36 @@ def test_a_guess_with_fitting_multipliers_starts_from_its_duals(able, monkeypatc
 # ---------------------------------------------------------------- report
 
 
+def test_the_force_figure_starts_at_the_left_touch_down_beside_the_measured_force(able):
+    """The report's force figure: each leg's vertical force rolled to start at the left leg's
+    touch-down (loaded at the first node, unloaded just before), and with a measured stride
+    its total beside the measured total, point for point."""
+    import matplotlib.pyplot as plt
+
+    from bladelab.predict.collocation.human_running import stride_from_left_touchdown
+    from bladelab.report.collocation import _grf_figure
+
+    runner, _, sol = able
+    force = sol.leg_vertical_force()
+    rolled = stride_from_left_touchdown(sol, values=force)
+    assert rolled[0, 0] > 20.0 and rolled[-2, 0] <= 20.0
+    np.testing.assert_array_equal(rolled[-1], rolled[0])
+    np.testing.assert_allclose(np.sort(rolled[:-1].ravel()), np.sort(force[:-1].ravel()))
+    trial = measured_trial_guess(runner, n=100)
+    fig = _grf_figure(sol, trial)
+    try:
+        assert len(fig.axes) == 2
+        model, measured = fig.axes[1].get_lines()
+        np.testing.assert_allclose(model.get_ydata(), rolled.sum(axis=1) / sol.body_weight_N)
+        np.testing.assert_array_equal(measured.get_ydata(), trial.vertical_grf_bw)
+        assert 2.0 < measured.get_ydata().max() < 3.2  # people's peak at 3.5 m/s
+    finally:
+        plt.close(fig)
+    fig = _grf_figure(sol)
+    assert len(fig.axes) == 1
+    plt.close(fig)
+
+
 def test_the_predictive_report_renders_a_collocation_solution(able, tmp_path):
     from bladelab.report import Report
     from bladelab.report.collocation import collocation_sections
@@ -679,6 +709,7 @@ def test_the_predictive_report_renders_a_collocation_solution(able, tmp_path):
     # the report opens with the stride against people, criterion by criterion
     assert html.index("Against measured human running") < html.index("Collocation solution")
     assert "contact time, left leg" in html and "knee flexion RMSE against the measured" in html
+    assert "the total against the measured 3.5 m/s stride" in html  # the force's shape too
     assert "Not a free prediction" not in html  # the fake solve held no reference term
     # a stride solved with people's angles in its objective says so in its first lines
     people = replace(sol, settings=CollocationSettings(**people_term(10.0)),

@@ -91,6 +91,12 @@ def test_a_merged_folder_says_so_with_its_spread(tmp_path):
     text = " ".join(rep.sections[0].text)
     assert "solved from several starts" in text and "37 %" in text
     assert "warm-started from the previous converged speed;" not in text
+    # a spread below 1 % is not rounded away
+    table["spread_pct"] = [0.47] + [0.05] * (len(table) - 1)
+    table.to_csv(folder / "collocation-sweep.csv", index=False)
+    rep = Report("t")
+    collocation_sweep_sections(rep, folder)
+    assert "the largest spread between starts is 0.47 % of" in " ".join(rep.sections[0].text)
 
 
 def test_a_several_start_folder_shows_the_spread_of_each_problem(tmp_path):
@@ -122,6 +128,10 @@ def test_a_several_start_folder_shows_the_spread_of_each_problem(tmp_path):
     (per_problem,) = [t for t in section.tables if t.title.startswith("Starts per problem")]
     assert len(per_problem.frame) == n
     assert per_problem.frame.spread_pct.iloc[0] == 25.0
+    # objectives to five digits (starts differ by tenths of a per cent), counts as integers
+    assert per_problem.frame.objective_warm.iloc[0] == "2.5"
+    assert per_problem.frame["objective_warm-mu-1e-4"].iloc[0] == "2"
+    assert per_problem.frame.starts.iloc[0] == "3"
 
 
 def test_a_table_without_a_needed_column_is_refused_by_name(tmp_path):

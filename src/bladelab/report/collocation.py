@@ -94,17 +94,34 @@ def _label(sol) -> str:
     return f"{who} {speed} (collocation{body}{athlete})"
 
 
-def _grf_figure(sol):
+def _grf_figure(sol, trial=None):
+    """Each leg's vertical ground force over the stride from the left (intact) touch-down;
+    with ``trial`` (the measured stride, a StrideGuess with its force), the total force beside
+    the measured total in a second panel."""
     import matplotlib.pyplot as plt
 
-    fz = sol.leg_vertical_force() / sol.body_weight_N
+    fz = stride_from_left_touchdown(sol, values=sol.leg_vertical_force()) / sol.body_weight_N
     pct = np.linspace(0.0, 100.0, fz.shape[0])
-    fig, ax = plt.subplots(figsize=(7, 3.2))
+    measured = None if trial is None else trial.vertical_grf_bw
+    fig, axes = plt.subplots(1, 1 if measured is None else 2,
+                             figsize=(7 if measured is None else 11, 3.2), squeeze=False)
+    ax = axes[0, 0]
     for j, leg in enumerate(sol.leg_names):
         ax.plot(pct, fz[:, j], "o-", ms=3, label=leg)
     ax.set_xlabel("stride (% of the gait cycle, from the left/intact touch-down)")
     ax.set_ylabel("vertical GRF (body weights)")
+    ax.set_title("each leg", fontsize=9)
     ax.legend(fontsize=7)
+    if measured is not None:
+        ax = axes[0, 1]
+        ax.plot(pct, fz.sum(axis=1), "o-", ms=3, color="k", label="this stride")
+        ax.plot(np.linspace(0.0, 100.0, len(measured)), measured, "--", color="0.5",
+                label="measured 3.5 m/s stride (RBDS001, mean)")
+        ax.set_xlabel("stride (% of the gait cycle, from the left touch-down)")
+        ax.set_ylabel("total vertical GRF (body weights)")
+        ax.set_title("against the measured stride: the force's shape in stance", fontsize=9)
+        ax.set_ylim(top=1.3 * max(float(np.max(fz.sum(axis=1))), float(np.max(measured))))
+        ax.legend(fontsize=7, loc="upper center", ncol=2)
     fig.tight_layout()
     return fig
 
@@ -308,7 +325,7 @@ def collocation_sections(report, path: str | Path) -> tuple[dict, object]:
 
     trial = _measured_trial(runner, sol)
     _add_human_running_section(report, sol, trial, _mesh_check_of(Path(path), sol))
-    fig = _grf_figure(sol)
+    fig = _grf_figure(sol, trial)
     report.add_section(
         "Collocation solution",
         text=("One periodic stride solved by direct collocation (CasADi + IPOPT), "
@@ -333,7 +350,11 @@ def collocation_sections(report, path: str | Path) -> tuple[dict, object]:
               "whole stance (docs/collocation.md, 'Dynamic consistency'); the first row is the "
               "check. The component rows show where a difference comes from."),
         figures=[("Vertical ground reaction force per leg at the mesh nodes over % of the "
-                  "stride", fig)],
+                  "stride, from the left (intact) touch-down"
+                  + ("; right: the total against the measured 3.5 m/s stride's (its force "
+                     "platform, the mean of its strides), which shows where in stance the "
+                     "force peaks" if trial is not None and trial.vertical_grf_bw is not None
+                     else ""), fig)],
         tables=[("Summary (as 'bladelab predict --method collocation --json')", summary),
                 ("IPOPT per stage", pd.DataFrame(stages)),
                 ("Objective terms of the final stage", terms),

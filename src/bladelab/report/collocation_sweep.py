@@ -150,6 +150,17 @@ def starts_table(table: pd.DataFrame) -> pd.DataFrame | None:
     return table[[c for c in cols if c in table.columns]].reset_index(drop=True)
 
 
+def _starts_shown(starts: pd.DataFrame) -> pd.DataFrame:
+    """:func:`starts_table` as the report shows it: objectives to five significant digits
+    (starts differ by tenths of a per cent), the count of starts as an integer."""
+    shown = starts.copy()
+    for c in [c for c in shown.columns if c == "objective" or c.startswith("objective_")]:
+        shown[c] = [f"{v:.5g}" if pd.notna(v) else "–" for v in shown[c]]
+    if "starts" in shown:
+        shown["starts"] = [f"{v:.0f}" if pd.notna(v) else "–" for v in shown["starts"]]
+    return shown
+
+
 def _with_current_warnings(table: pd.DataFrame, folder: Path) -> tuple[pd.DataFrame, dict]:
     """(the table with ``warnings`` and ``flagged`` from today's gait checks, re-run on each
     converged solve's file (a table written before a check existed says nothing of it), {row
@@ -266,16 +277,20 @@ def collocation_sweep_sections(report, folder: str | Path) -> tuple[dict, pd.Dat
     starts = starts_table(table)
     if starts is not None:  # --starts K, or a merge of paths (merge_starts.py)
         spread = pd.to_numeric(table.get("spread_pct"), errors="coerce")
+        largest = spread.max()
         text += ("Each problem was solved from several starts (the paths of a merged folder, "
                  "or the starts of 'bladelab sweep --starts', which continues each model from "
-                 "the kept solution) and the best converged solve kept: the lowest objective, "
+                 "the kept solution, and of its settling pass '--settle', labelled "
+                 "from-<category>: the neighbouring categories' kept strides) and the best "
+                 "converged solve kept: the lowest objective, "
                  "one without gait warnings preferred (column 'start' names it, "
                  "'objective_<start>' every start's, empty where it did not converge or did not "
                  "run; 'spread_pct' the largest minus the lowest objective in % of the lowest, "
                  "among the converged starts without gait warnings; the table 'Starts per "
                  "problem' shows them)"
-                 + (f"; the largest spread between starts is {spread.max():.0f} % of the "
-                    "lowest objective." if spread.notna().any() else "."))
+                 + (f"; the largest spread between starts is "
+                    f"{largest:.2f}".rstrip("0").rstrip(".") + " % of the lowest objective."
+                    if spread.notna().any() else "."))
     else:
         text += ("Each model's speeds were solved in the order given, each warm-started from "
                  "the previous converged speed; the maximum speed (star) from the fastest.")
@@ -317,7 +332,7 @@ def collocation_sweep_sections(report, folder: str | Path) -> tuple[dict, pd.Dat
                   "speed)", fig)],
         tables=[("Every solve (collocation-sweep.csv)", shown)] + (
             [] if starts is None else [
-                ("Starts per problem: objectives and spread", starts)]) + (
+                ("Starts per problem: objectives and spread", _starts_shown(starts))]) + (
             [] if checks is None else [
                 ("Mesh-halving check per solve: the change [%] from the sweep's mesh to twice "
                  "its intervals", checks)]),

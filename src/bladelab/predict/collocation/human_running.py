@@ -205,11 +205,13 @@ ANGLE_RMSE_MAX_DEG = 15.0
 KNEE_CORRELATION_MIN = 0.9
 
 
-def stride_from_left_touchdown(solution, threshold_n: float = CONTACT_THRESHOLD_N) -> np.ndarray:
-    """The stride's node values of q (n + 1, coordinates), rolled to start at the left (intact)
-    leg's touch-down: the first node loaded above ``threshold_n`` [N] after an unloaded one
-    (no roll if the leg is never unloaded); the last node repeats the first (periodic)."""
-    q = np.asarray(solution.nlp.q)
+def stride_from_left_touchdown(solution, threshold_n: float = CONTACT_THRESHOLD_N,
+                               values=None) -> np.ndarray:
+    """The stride's node values of q (n + 1, coordinates), or of ``values`` (n + 1, ...) if
+    given, rolled to start at the left (intact) leg's touch-down: the first node loaded above
+    ``threshold_n`` [N] after an unloaded one (no roll if the leg is never unloaded); the last
+    node repeats the first (periodic)."""
+    q = np.asarray(solution.nlp.q if values is None else values)
     loaded = solution.leg_vertical_force()[:-1, 0] > threshold_n
     starts = np.flatnonzero(loaded & ~np.roll(loaded, 1))
     rolled = np.roll(q[:-1], -(int(starts[0]) if starts.size else 0), axis=0)
