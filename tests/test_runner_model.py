@@ -272,6 +272,19 @@ def test_missing_segment_and_bad_yaml(tmp_path):
         load_runner_params(tmp_path / "nope.yaml")
 
 
+def _assert_same_centre_of_mass_standing(a, b) -> None:
+    """Two runners standing have the same whole-body centre of mass, every contact on the
+    ground."""
+    centres = []
+    for runner in (a, b):
+        d = mujoco.MjData(runner.mj_model)
+        d.qpos[:] = runner.stand_qpos
+        mujoco.mj_forward(runner.mj_model, d)
+        centres.append(d.subtree_com[0].copy())
+        assert contact_heights(runner, runner.stand_qpos) == pytest.approx(0.0, abs=1e-12)
+    np.testing.assert_allclose(centres[1], centres[0], atol=1e-12)
+
+
 def test_toe_body_keeps_the_mass_and_adds_a_toe_hinge(able):
     """The ``toes`` body: same total mass and centre of mass as seed 001's (the toes' mass is
     taken from the calcaneus), a metatarsophalangeal hinge per foot with Sasaki et al. (2009)'s
@@ -284,14 +297,7 @@ def test_toe_body_keeps_the_mass_and_adds_a_toe_hinge(able):
     assert toes.total_mass == pytest.approx(able.total_mass, rel=1e-12)
     assert set(toes.dof_names) - set(able.dof_names) == {"mtp_angle_l", "mtp_angle_r"}
     assert toes.contact_names == ("heel_l", "toe_l", "toetip_l", "heel_r", "toe_r", "toetip_r")
-    centres = []
-    for runner in (able, toes):
-        d = mujoco.MjData(runner.mj_model)
-        d.qpos[:] = runner.stand_qpos
-        mujoco.mj_forward(runner.mj_model, d)
-        centres.append(d.subtree_com[0].copy())
-        assert contact_heights(runner, runner.stand_qpos) == pytest.approx(0.0, abs=1e-12)
-    np.testing.assert_allclose(centres[1], centres[0], atol=1e-12)
+    _assert_same_centre_of_mass_standing(able, toes)
     j = toes.dof("mtp_angle_l")
     assert toes.joint_params[j, JP_SK] == MTP_STIFFNESS == 25.0
     assert toes.joint_params[j, JP_SD] == MTP_DAMPING
@@ -324,14 +330,7 @@ def test_arch_adds_a_midtarsal_hinge_and_keeps_the_foot():
                                                            "midtarsal_angle_r"}
     assert arch.contact_names == human.contact_names
     assert arch.total_mass == pytest.approx(human.total_mass, rel=1e-12)
-    centres = []
-    for runner in (human, arch):
-        d = mujoco.MjData(runner.mj_model)
-        d.qpos[:] = runner.stand_qpos
-        mujoco.mj_forward(runner.mj_model, d)
-        centres.append(d.subtree_com[0].copy())
-        assert contact_heights(runner, runner.stand_qpos) == pytest.approx(0.0, abs=1e-12)
-    np.testing.assert_allclose(centres[1], centres[0], atol=1e-12)
+    _assert_same_centre_of_mass_standing(human, arch)
     j = arch.dof("midtarsal_angle_l")
     assert tuple(arch.joint_params[j, [JP_SK, JP_SD, JP_SDX]]) == (800.0, 2.0, 2.0)
     ball = arch.contact_params[arch.contact_names.index("toe_l")]
