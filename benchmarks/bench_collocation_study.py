@@ -3,7 +3,8 @@
 Six models (able, amputee Cat4, Cat5, Cat6, Cat6High, Cat7) × speed continuation (4, 5 m/s)
 + maximum speed, 2 workers: on the human body from the shipped strides with one start per
 problem (the stride time free, and held at people's band, the latter with the settling pass
-from the neighbouring categories' strides); on seed 001's body from the
+from the neighbouring categories' strides, before and after the vasti change); on seed 001's
+body from the
 measured trial's guess, once with one start per problem,
 once with three (``--starts 3``: the warm start, the barrier start and the template). Target:
 ≤ 10 min on 2 cores with three starts. The studies take 20–50 min of both cores, so ``make bench`` does not run
@@ -20,7 +21,11 @@ from pathlib import Path
 
 HERE = Path(__file__).resolve().parent / "collocation"
 #: (folder, what differs) of each timed study.
-STUDIES = (("study-human-people-cadence-2026-11-30", "the human body at people's stride time "
+STUDIES = (("study-human-settled-2026-12-01", "the human body with the vasti tendon at 8 % "
+            "(since 2026-12-01), at people's stride time, people's joint angles at weight "
+            "10 1/rad², one start per problem from the shipped strides, then the settling pass "
+            "(`--settle`); the rows are the kept starts', the wall time both passes'"),
+           ("study-human-people-cadence-2026-11-30", "the human body at people's stride time "
             "(`--stride-time people`: every prescribed speed's stride time within measured "
             "runners' band at that speed; the maximum speed free), people's joint angles at "
             "weight 10 1/rad², one start per problem, from the shipped strides, the node "
