@@ -337,6 +337,38 @@ def test_settling_starts_each_category_from_its_neighbours_strides(fake_solve, m
     assert fake_solve.calls == [] and (out / "collocation-sweep.csv").read_text() == before
 
 
+def test_settling_with_a_mesh_check_checks_only_the_kept_strides(fake_solve, monkeypatch,
+                                                                  tmp_path, capsys):
+    """--settle --mesh-check: a settled model is checked once, after the settling pass, on
+    the stride it keeps (here Cat5's start for Cat4 at 3.5 m/s); a model without neighbours
+    (the able runner) after the first pass."""
+    from bladelab.predict.collocation import mesh_check
+    from collocation_fake import objectives_by_start
+
+    objectives_by_start(fake_solve, monkeypatch,
+                        lambda s, v: {("from-Cat5", 3.5): 0.5}.get((s, v), 2.0))
+    fine = fake_solution("amputee", 2 * N)[2]
+    checked = []
+
+    def solve_fine(runner, settings, guess, *, model_spec, progress=None):
+        checked.append((model_spec["model"], model_spec.get("blade"), settings.mesh_intervals))
+        return dataclasses.replace(fine, settings=settings, model_spec=model_spec)
+
+    monkeypatch.setattr(mesh_check, "predict_stride", solve_fine)
+    out = tmp_path / "sweep"
+    assert _sweep(out, "--able", "--categories", "Cat4,Cat5", "--speeds", "3.5", "--starts",
+                  "1", "--settle", "--mesh-check") == 0
+    capsys.readouterr()
+    # two problems per model, each checked once (the finer solve and its round trip)
+    for model, blade in (("able", None), ("amputee", "Cat4"), ("amputee", "Cat5")):
+        fine_solves = [c for c in checked if c[:2] == (model, blade) and c[2] == 2 * N]
+        assert len(fine_solves) == 2, (model, blade)
+    assert sorted(p.name for p in (out / "amputee-Cat4" / "mesh-check").iterdir()) == [
+        "max-speed", "speed-3.5.from-Cat5"]
+    rows = {(r["model"], r["problem"]): r for r in _csv(out / "collocation-sweep.csv")}
+    assert rows["amputee Cat4", "speed"]["mesh_check_intervals"] == str(2 * N)
+
+
 @pytest.mark.parametrize(("args", "where"), [
     (("--method", "collocation", "--init", "x.json"), "--init"),
     (("--method", "collocation", "--categories", "Cat9"), "--categories"),

@@ -28,6 +28,8 @@ values, each as one more start (``from-<category>``, files ``speed-4.from-Cat5.j
 continuation's ``extra_starts``), and the lowest kept: one pass, from the strides the first
 pass kept. Measured on the human body, such starts land within 0.1–0.5 % of each other where
 the template start does not converge (docs/collocation.md, "Several starts per problem").
+With ``mesh_check`` as well, the settled models are checked after the settling pass only (their
+kept strides), the others after the first.
 
 With ``mesh_check`` every converged solve is solved again on twice the mesh intervals from its
 stride (:mod:`bladelab.predict.collocation.mesh_check`; the finer solves in
@@ -302,10 +304,12 @@ def category_neighbours(models: Sequence[dict]) -> dict[int, list[int]]:
 
 
 def _settling_payloads(payloads: Sequence[dict], rows: dict[int, list[dict]],
-                       out: Path) -> dict[int, dict]:
-    """The settling pass's payload of each model with a neighbour that has a converged stride
-    of one of its problems: the first pass's payload, reading its files back
-    (``force`` off), with ``extra_starts`` from the neighbours' kept strides."""
+                       out: Path, mesh_check: bool) -> dict[int, dict]:
+    """The settling pass's payload of each model with a neighbouring category: the first
+    pass's payload, reading its files back (``force`` off), with ``extra_starts`` from the
+    neighbours' converged kept strides (none where no neighbour converged) and the mesh
+    check the sweep asked for (the first pass leaves it to this one, so that only kept
+    strides are checked)."""
     models = [p["model_spec"] for p in payloads]
     settling = {}
     for i, near in category_neighbours(models).items():
@@ -317,8 +321,8 @@ def _settling_payloads(payloads: Sequence[dict], rows: dict[int, list[dict]],
                 speed = None if r["problem"] == "max-speed" else r["prescribed_speed_mps"]
                 extra.setdefault(problem_key(speed), []).append(
                     (f"from-{models[j]['blade']}", str(out / r["file"])))
-        if extra:
-            settling[i] = {**payloads[i], "force": False, "extra_starts": extra}
+        settling[i] = {**payloads[i], "force": False, "extra_starts": extra,
+                       "mesh_check": bool(mesh_check)}
     return settling
 
 
@@ -434,9 +438,12 @@ def collocation_sweep(
                 failures[i] = [f"stopped by an error: {value}"]
             write_table(table, [r for k in sorted(rows) for r in rows[k]])
 
-    run(dict(enumerate(payloads)))
+    settled = set(category_neighbours(models)) if settle else set()
+    # a model that the settling pass solves again is mesh-checked there, after it
+    run({i: {**p, "mesh_check": p["mesh_check"] and i not in settled}
+         for i, p in enumerate(payloads)})
     if settle:
-        run(_settling_payloads(payloads, rows, out.resolve()))
+        run(_settling_payloads(payloads, rows, out.resolve(), bool(mesh_check)))
     all_rows = [r for k in sorted(rows) for r in rows[k]]
     if not rows:
         write_table(table, [])
