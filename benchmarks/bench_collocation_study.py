@@ -70,7 +70,7 @@ def _study(study: Path, what: str) -> str:
         return f"{title}\n\nNo study in {study.name}: run it first (docstring)."
     import pandas as pd
 
-    df = pd.read_csv(table)
+    df = pd.read_csv(table).copy()  # one block: the columns added below
     converged = df.converged.astype(bool)
     df["mark"] = "✓"
     df.loc[df.warnings.fillna("").astype(str).str.len().gt(0), "mark"] = "⚠"

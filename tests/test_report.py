@@ -184,6 +184,27 @@ def test_report_is_self_contained_with_csv_tables_and_settings(tmp_path: Path):
     assert not [p for p in tmp_path.iterdir() if p.name.startswith(".")]  # no temp leftovers
 
 
+def test_tables_with_very_long_titles_get_short_distinct_file_names(tmp_path: Path):
+    """A table's CSV name stays far below the file system's 255 bytes however long its title
+    (a sweep's per-category table has a 250-character title), and two long titles that
+    share their first 120 characters keep apart."""
+    from bladelab.report import Report
+    from bladelab.report.builder import MAX_TABLE_NAME
+
+    report = Report("long")
+    head = "Blade categories: maximum speed and metabolic cost per category " * 3
+    frame = pd.DataFrame({"a": [1.0]})
+    report.add_section("A section with a long title as well, " * 2,
+                       tables=[(head + "first", frame), (head + "second", frame)])
+    html = report.write(tmp_path / "report").read_text(encoding="utf-8")
+    names = [n for n in re.findall(r'href="tables/([^"]+)"', html)
+             if n.startswith("a-section")]
+    assert len(set(names)) == 2
+    for name in names:
+        assert len(name) <= MAX_TABLE_NAME + len(".csv")
+        assert (tmp_path / "report" / "tables" / name).is_file()
+
+
 def test_write_is_atomic_and_replaces_an_old_report(tmp_path: Path, monkeypatch):
     out = tmp_path / "report"
     Report("first").write(out)

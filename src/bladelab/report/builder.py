@@ -16,6 +16,7 @@ import base64
 import contextlib
 import dataclasses
 import datetime as _dt
+import hashlib
 import io
 import json
 import os
@@ -107,6 +108,22 @@ class Section:
 def _slug(text: str) -> str:
     slug = re.sub(r"[^a-z0-9]+", "-", text.lower()).strip("-")
     return slug or "section"
+
+
+#: The longest table name [characters]: its CSV file name must stay well below the 255 bytes
+#: file systems allow, however long the table's title.
+MAX_TABLE_NAME = 120
+
+
+def _table_name(anchor: str, title: str) -> str:
+    """The file-safe name of a table (its CSV is ``tables/<name>.csv``): the section's anchor
+    and the title's slug, cut to :data:`MAX_TABLE_NAME` characters with a hash of the whole
+    name where it is longer (so that two long titles stay apart)."""
+    name = f"{anchor}-{_slug(title)}"
+    if len(name) <= MAX_TABLE_NAME:
+        return name
+    digest = hashlib.sha1(name.encode("utf-8")).hexdigest()[:8]
+    return f"{name[:MAX_TABLE_NAME - 9].rstrip('-')}-{digest}"
 
 
 def _format_cell(value: Any) -> str:
@@ -227,7 +244,7 @@ class Report:
                 table = item
             else:
                 ttitle, frame = item if isinstance(item, tuple) else (f"Table {k}", item)
-                table = ReportTable(ttitle, frame, f"{anchor}-{_slug(ttitle)}")
+                table = ReportTable(ttitle, frame, _table_name(anchor, ttitle))
             name, j = table.name, 2
             while name in names:
                 name, j = f"{table.name}-{j}", j + 1
