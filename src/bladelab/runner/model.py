@@ -392,15 +392,15 @@ def build_runner(
                 pc,
             )
             ball = geo.FOOT_SPHERES["toe"]
+            ball_in_calcn = _v(_sub(ball, pc), s)
             fore, fore_origin = body, pc
             if params.arch is not None:
                 fore = _add_forefoot(body, side, _v(_sub(MIDTARSAL_HINGE_M, pc), s),
-                                     _v(_sub(ball, pc), s), s, axis)
+                                     ball_in_calcn, s, axis)
                 fore_origin = MIDTARSAL_HINGE_M
             elif params.foot == "toes":
-                _add_toes(body, side, _v(_sub(ball, pc), s), s, axis,
-                          _take_mass(body, TOES_MASS_FRACTION,
-                                     _toes_com_at(_v(_sub(ball, pc), s), s)))
+                _add_toes(body, side, ball_in_calcn, s, axis,
+                          _take_mass(body, TOES_MASS_FRACTION, _toes_com_at(ball_in_calcn, s)))
             for sph, p in geo.FOOT_SPHERES.items():
                 on, origin = (fore, fore_origin) if sph == "toe" else (body, pc)
                 on.add_site(
@@ -568,10 +568,6 @@ def build_runner(
     return runner
 
 
-def _add3(a, b) -> list[float]:
-    return [float(x + y) for x, y in zip(a, b, strict=True)]
-
-
 def _toes_com_at(hinge: list[float], s: float) -> list[float]:
     """The toes' centre of mass in the frame of the MTP ``hinge`` given [m] (in the sagittal
     plane: its lateral coordinate is 0, which no sagittal quantity sees)."""
@@ -594,7 +590,7 @@ def _add_toes(parent, side: str, hinge: list[float], s: float, axis: list[float]
     """A toe segment of ``mass`` [kg] on a metatarsophalangeal hinge at ``hinge`` (the parent
     body's frame [m]: the calcaneus, or the forefoot of a foot with an arch).
 
-    Its mass, :data:`TOES_MASS_FRACTION` of the foot's, is taken from the calcaneus
+    The caller takes that mass, :data:`TOES_MASS_FRACTION` of the foot's, from the calcaneus
     (:func:`_take_mass`), so that the foot's centre of mass in the neutral pose stays where
     seed 001's is; the calcaneus keeps its inertia (the toes' share of it is < 2 %).
     """
@@ -622,7 +618,8 @@ def _add_forefoot(calcn, side: str, hinge: list[float], ball: list[float], s: fl
     to_ball = [b - h for b, h in zip(ball, hinge, strict=True)]
     fore_com = [0.5 * d for d in to_ball]
     m_foot = calcn.mass
-    m_fore = _take_mass(calcn, FOREFOOT_MASS_FRACTION, _add3(hinge, fore_com))
+    m_fore = _take_mass(calcn, FOREFOOT_MASS_FRACTION,
+                        [float(h + c) for h, c in zip(hinge, fore_com, strict=True)])
     m_toes = _take_mass(calcn, TOES_MASS_FRACTION * m_foot / calcn.mass,
                         _toes_com_at(ball, s))
     fore = calcn.add_body(name=f"forefoot_{side}", pos=hinge)

@@ -316,7 +316,7 @@ def _settling_payloads(payloads: Sequence[dict], rows: dict[int, list[dict]],
         extra: dict[str, list[tuple[str, str]]] = {}
         for j in near:
             for r in rows.get(j, []):
-                if str(r.get("converged")) != "True":
+                if not r.get("converged"):
                     continue
                 speed = None if r["problem"] == "max-speed" else r["prescribed_speed_mps"]
                 extra.setdefault(problem_key(speed), []).append(
