@@ -73,7 +73,7 @@ def _running_loads(dt: float, integrator: str) -> tuple[float, bool]:
     from bladelab.runner import power_balance_residual_pct
     from bladelab.runner.params import RUNNER_DATA_DIR
 
-    path = RUNNER_DATA_DIR / "solutions" / "amputee-Cat6-3.5.json"
+    path = RUNNER_DATA_DIR / "reflex-starts" / "amputee-Cat6-3.5.json"
     data = json.loads(path.read_text())
     runner, layout = runner_and_layout(data["model"], data["blade"])
     x = read_parameters(path, layout)

@@ -82,7 +82,7 @@ def runner() -> dict[str, str]:
     out["runner.multilink"] = _h(r.qpos, r.contacts)
     import bladelab
 
-    sol = Path(bladelab.__file__).parent / "data/runner/solutions/amputee-Cat6-3.5.json"
+    sol = Path(bladelab.__file__).parent / "data/runner/reflex-starts/amputee-Cat6-3.5.json"
     layout = controller_layout(m)
     x = read_parameters(sol, layout)
     data = json.loads(sol.read_text())

@@ -65,13 +65,13 @@ def ray_instance():
 
 @pytest.fixture(scope="session")
 def shipped_amputee_report(tmp_path_factory):
-    """The predictive report of the shipped amputee Cat6 3.5 m/s solution (3 s re-simulated,
+    """The predictive report of seed 001's amputee Cat6 3.5 m/s reflex gait (a reflex start) (3 s re-simulated,
     exported for OpenSim), written once: its tables are checked in ``test_predict_report.py``
     and its animated runner played in ``test_report_animation.py`` (a report costs ~15 s,
     mostly drawing its figures)."""
     from bladelab.report.predictive import build_predictive_report
 
-    solution = PROJECT_ROOT / "src" / "bladelab" / "data" / "runner" / "solutions"
+    solution = PROJECT_ROOT / "src" / "bladelab" / "data" / "runner" / "reflex-starts"
     return build_predictive_report(solution / "amputee-Cat6-3.5.json",
                                    tmp_path_factory.mktemp("amputee") / "r", duration=3.0,
                                    progress=False, export=True)

@@ -17,7 +17,7 @@ from bladelab.predict.collocation.guess import (
 from bladelab.runner import build_runner
 from bladelab.runner.model import contact_heights
 
-SOLUTIONS = Path(__file__).resolve().parents[1] / "src/bladelab/data/runner/solutions"
+SOLUTIONS = Path(__file__).resolve().parents[1] / "src/bladelab/data/runner/reflex-starts"
 
 
 @pytest.fixture(scope="module")
@@ -84,7 +84,7 @@ def test_guess_from_the_fukuchi_trial(able):
         guess_from_trial(able, measured_running_trial())
 
 
-def test_guess_from_the_shipped_reflex_solution():
+def test_guess_from_a_reflex_start():
     g = guess_from_reflex(SOLUTIONS / "able-3.5.json", n=30, duration=3.0)
     assert g.q.shape == (31, 10) and g.activation.shape == (31, 24)
     assert abs(g.speed - 3.5) < 0.2 and 0.6 < g.period < 0.85

@@ -21,7 +21,7 @@ from bladelab.report import Report
 from bladelab.report.predictive import build_predictive_report, predictive_kind
 from bladelab.runner import build_runner
 
-SOLUTIONS = Path(pr.__file__).resolve().parents[1] / "data" / "runner" / "solutions"
+SOLUTIONS = Path(pr.__file__).resolve().parents[1] / "data" / "runner" / "reflex-starts"
 
 
 class _FakeModel:
@@ -246,7 +246,7 @@ def test_sweep_report_opens_in_a_browser(sweep_report, tmp_path):
 
 
 def test_report_of_a_parameter_file(tmp_path):
-    src = SOLUTIONS / "able-3.5.json"  # the shipped solution
+    src = SOLUTIONS / "able-3.5.json"  # a reflex start
     rep = build_predictive_report(src, tmp_path / "r", duration=2.0, progress=False)
     # the re-simulation, then the acceptance's robustness runs: the nominal (judged at the speed it
     # reaches), 4 copies and 2 other starts (2 s has no room for a push)
@@ -378,7 +378,7 @@ def test_bad_paths_exit_2_and_write_nothing(tmp_path, capsys):
         build_predictive_report(tmp_path / "empty")
 
 
-def test_report_of_the_shipped_amputee_solution(shipped_amputee_report):
+def test_report_of_the_amputee_reflex_start(shipped_amputee_report):
     from bladelab.runner.export import read_mot
 
     rep = shipped_amputee_report  # 3 s re-simulated, exported (conftest.py)

@@ -249,7 +249,7 @@ def test_the_closed_loop_sees_the_mean_speed_placement_once_its_window_is_full()
 
     model = build_runner("able")
     layout = controller_layout(model)
-    shipped = Path(ctl.__file__).resolve().parents[2] / "data/runner/solutions/able-3.5.json"
+    shipped = Path(ctl.__file__).resolve().parents[2] / "data/runner/reflex-starts/able-3.5.json"
     x = read_parameters(shipped, layout)
     s = ObjectiveSettings(duration=1.2)
     _, a = simulate_controlled(model, x, layout=layout, settings=s, record_every=4)

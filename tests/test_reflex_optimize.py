@@ -234,7 +234,7 @@ def test_verification_copies_are_not_the_objectives(monkeypatch):
         return real(*args, **kwargs)
 
     monkeypatch.setattr(opt, "jittered_parameters", spy)
-    shipped = Path(opt.__file__).resolve().parents[2] / "data/runner/solutions/able-3.5.json"
+    shipped = Path(opt.__file__).resolve().parents[2] / "data/runner/reflex-starts/able-3.5.json"
     opt.verify_solution(shipped, duration=0.5, jittered_copies=1, jitter=1e-9)
     assert seeds == [robust.VERIFY_JITTER_SEED]
 
@@ -298,7 +298,7 @@ def test_fixed_parameters_are_held_and_a_resume_keeps_them(tmp_path):
 
 
 def test_a_warm_start_is_never_lost():
-    # from the shipped able solution a wide first step (sigma 3) scatters every candidate to a
+    # from the able reflex start a wide first step (sigma 3) scatters every candidate to a
     # worse cost; the best stays the start itself, evaluated once before the first generation
     from pathlib import Path
 
@@ -306,7 +306,7 @@ def test_a_warm_start_is_never_lost():
     from bladelab.predict.reflex.controller import read_parameters
 
     _, layout = runner_and_layout("able", None)
-    shipped = Path(bladelab.__file__).parent / "data" / "runner" / "solutions" / "able-3.5.json"
+    shipped = Path(bladelab.__file__).parent / "data" / "runner" / "reflex-starts" / "able-3.5.json"
     x0 = read_parameters(shipped, layout)
     start = evaluate_candidates(
         {"model": "able", "settings": THREE_S.to_dict(), "xs": [x0.tolist()]}
@@ -448,7 +448,7 @@ def test_per_generation_copies_are_new_every_generation_and_resume_exactly(tmp_p
 def test_verify_solution_from_changed_initial_speeds():
     import bladelab.predict.reflex.verify as opt
 
-    shipped = Path(opt.__file__).resolve().parents[2] / "data/runner/solutions/able-3.5.json"
+    shipped = Path(opt.__file__).resolve().parents[2] / "data/runner/reflex-starts/able-3.5.json"
     out = opt.verify_solution(shipped, duration=0.5, initial_speed_change=0.05)
     speeds = [c["initial_speed_m_per_s"] for c in out["initial_speed"]]
     assert speeds == pytest.approx([3.5 * 1.05, 3.5 * 0.95])
@@ -460,7 +460,7 @@ def test_verify_solution_from_changed_initial_speeds():
 def test_verify_solution_after_pushes():
     import bladelab.predict.reflex.verify as opt
 
-    shipped = Path(opt.__file__).resolve().parents[2] / "data/runner/solutions/able-3.5.json"
+    shipped = Path(opt.__file__).resolve().parents[2] / "data/runner/reflex-starts/able-3.5.json"
     out = opt.verify_solution(shipped, duration=3.0, push_change=0.3, push_phases=2)
     assert [(c["push_time_s"], c["push_change"]) for c in out["pushed"]] == [
         (2.0, 0.3), (2.0, -0.3), (2.5, 0.3), (2.5, -0.3)]

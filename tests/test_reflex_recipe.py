@@ -35,7 +35,7 @@ from bladelab.predict.reflex.recipe_sweep import summarise_levels
 from bladelab.predict.reflex.verify import verify_solution
 
 ROOT = Path(__file__).resolve().parents[1]
-SHIPPED_AMPUTEE = ROOT / "src" / "bladelab" / "data" / "runner" / "solutions" / "amputee-Cat6-3.5.json"
+SHIPPED_AMPUTEE = ROOT / "src" / "bladelab" / "data" / "runner" / "reflex-starts" / "amputee-Cat6-3.5.json"
 STUDY = ROOT / "benchmarks" / "collocation" / "study-2026-11-25"
 SETTLED_GAIT = ROOT / "benchmarks" / "runs" / "newmark-settled-2026-11-27" / "best.json"
 
@@ -104,7 +104,7 @@ def test_the_able_runner_is_a_task_like_a_category(tmp_path, monkeypatch):
     _, layout = runner_and_layout("able", None)
     start = load_checkpoint(tmp_path / "able" / "seed-1" / "1-a" / "checkpoint.pkl")
     assert start["model"] == "able" and start["blade"] is None
-    shipped = SHIPPED_AMPUTEE.with_name("able-3.5.json")  # the able model's shipped solution
+    shipped = SHIPPED_AMPUTEE.with_name("able-3.5.json")  # the able model's reflex start
     np.testing.assert_array_equal(
         np.asarray(start["es"].x0),
         np.clip(read_parameters(shipped, layout), layout.lower, layout.upper))

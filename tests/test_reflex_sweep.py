@@ -26,7 +26,7 @@ from bladelab.runner.analyses import spatiotemporal
 from processes import alive, descendants
 
 SHIPPED_AMPUTEE = (Path(__file__).resolve().parents[1] / "src" / "bladelab" / "data" / "runner"
-                   / "solutions" / "amputee-Cat6-3.5.json")
+                   / "reflex-starts" / "amputee-Cat6-3.5.json")
 TINY = {"generations": 3, "popsize": 4, "duration": 0.3, "checkpoint_every": 1}
 
 
@@ -60,7 +60,7 @@ def _without_time(df: pd.DataFrame) -> pd.DataFrame:
 
 
 def test_resume_equals_not_stopping_and_finished_cells_are_read_back(tmp_path, monkeypatch):
-    # from the shipped amputee solution: a gait whose stances complete within the 0.3 s
+    # from the amputee reflex start: a gait whose stances complete within the 0.3 s
     init = {"init": SHIPPED_AMPUTEE}
     full = _sweep(tmp_path / "full", **init)
     full_res = pd.read_csv(tmp_path / "full" / "results.csv")

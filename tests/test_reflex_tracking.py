@@ -28,7 +28,7 @@ CAT6_4 = ROOT / "benchmarks/collocation/study-2026-11-25/amputee/amputee-Cat6/sp
 ABLE_4 = ROOT / "benchmarks/collocation/study-2026-11-25/able/able/speed-4.json"
 BEST_ITERATE = (ROOT / "benchmarks/collocation/study-2026-11-25-cat6-starts/amputee-Cat6/"
                 "speed-5.template.best_iterate.json")
-SHIPPED = ROOT / "src/bladelab/data/runner/solutions/amputee-Cat6-3.5.json"
+SHIPPED = ROOT / "src/bladelab/data/runner/reflex-starts/amputee-Cat6-3.5.json"
 
 
 @pytest.fixture(scope="module")

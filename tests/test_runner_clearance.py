@@ -17,7 +17,7 @@ from bladelab.runner.clearance import swing_clearance
 from bladelab.runner.layout import CP_BLADE
 from bladelab.runner.params import RUNNER_DATA_DIR
 
-SHIPPED = RUNNER_DATA_DIR / "solutions" / "amputee-Cat6-3.5.json"
+SHIPPED = RUNNER_DATA_DIR / "reflex-starts" / "amputee-Cat6-3.5.json"
 
 
 @pytest.fixture(scope="module")

@@ -36,7 +36,7 @@ from bladelab.predict.reflex.controller import controller_layout, read_parameter
 from bladelab.runner.model import build_runner
 from bladelab.runner.params import RUNNER_DATA_DIR
 
-SHIPPED = RUNNER_DATA_DIR / "solutions" / "amputee-Cat6-3.5.json"
+SHIPPED = RUNNER_DATA_DIR / "reflex-starts" / "amputee-Cat6-3.5.json"
 HUMAN_STRIDE = RUNNER_DATA_DIR / "collocation" / "amputee-Cat6-4-human.json"
 
 

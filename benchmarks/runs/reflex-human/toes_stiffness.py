@@ -25,7 +25,7 @@ ACHILLES = ({"soleus": 0.08, "gastroc": 0.08}, {})
 
 def main() -> None:
     for kind, blade, name in GAITS:
-        path = RUNNER_DATA_DIR / "solutions" / name
+        path = RUNNER_DATA_DIR / "reflex-starts" / name
         settings = optimize.stored_settings(json.loads(path.read_text()), speed=3.5,
                                             duration=10.0, nominal=True)
         for achilles in ACHILLES:

@@ -298,7 +298,7 @@ def register(app: typer.Typer) -> None:
                  "pad) | seed001 (seed 001's model) | toes (seed 001's with a toe segment and "
                  f"compliant Achilles tendons); docs/runner-model.md. Default: {defaults.BODY} "
                  f"for collocation, {defaults.REFLEX_BODY} for the reflex controller (its "
-                 "parameters and shipped solutions are that body's)."),
+                 "parameters and reflex starts are that body's)."),
         swing_clearance: float = typer.Option(
             0.0, "--swing-clearance", rich_help_panel=COLLOCATION,
             help="Keep every swinging foot or blade this high above the ground [m] (0: no "

@@ -55,7 +55,7 @@ def robustness_section(rep, out: dict, duration: float) -> None:
               f"solution's parameters. Judged: the nominal run, {COPIES} copies with "
               f"the parameters moved by {COPY_JITTER:g} (relative, along directions no "
               f"optimiser saw) and starts at ±{100 * START_CHANGE:g} % of the initial speed. A "
-              "run meets the acceptance when it runs the whole time with the shipped-solution "
+              "run meets the acceptance when it runs the whole time with the gait "
               f"criteria (speed within 0.1 m/s of {_judged_speed(out)}, a flight phase in "
               "every stride, alternating steps, power-balance residual ≤ 2 %), no swinging "
               "foot strikes the "

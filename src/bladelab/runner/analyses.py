@@ -394,7 +394,7 @@ def power_balance_residual_pct(result: RunnerResult, *, skip_times: Sequence[flo
     compared, so the residual measures the simulation, not the sampling: comparing the central
     difference with the power at the sample itself has an error of ``h²·P''/6``, which under
     running loads sampled every 1 ms is ~0.46 % of the peak for any time step (measured on the
-    shipped amputee reflex solution, 2026-11-27; explicit 0.0625 ms: 0.46 % against 0.13 %
+    seed 001's amputee reflex gait, 2026-11-27; explicit 0.0625 ms: 0.46 % against 0.13 %
     sampled every step). Until then this was that comparison."""
     pb = power_balance(result)
     if len(pb) < 3:

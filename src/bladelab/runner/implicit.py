@@ -7,7 +7,7 @@ Hunt–Crossley contacts are the stiff term: at 2 kN a foot sphere's damping
 ``∂F/∂δ̇ = 1.5·c·k·δⁿ`` is ~3000 N·s/m on a foot whose heel–toe rotation has an effective mass
 of a few hundred grams, so an explicit 0.5 ms step already oscillates (measured: 2 ms
 sawtooth in the intact foot's contact forces and ankle velocity, 7 % power-balance residual on
-the shipped amputee solution).
+seed 001's amputee reflex gait).
 
 Here the forces of the stiff terms are taken at the *end* of the step, linearised (one
 Newton step of backward Euler in the velocities, the position taken as ``q + dt·v_new`` as

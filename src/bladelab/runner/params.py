@@ -43,7 +43,7 @@ from bladelab.runner.geometry import (
 from bladelab.runner.muscle import V_MAX_OPT_PER_S
 from bladelab.runner.prosthetic_knee import ProstheticKnee
 
-#: Folder of the runner models' data files (parameter sets, categories, shipped solutions).
+#: Folder of the runner models' data files (parameter sets, categories, stored strides, reflex starts).
 RUNNER_DATA_DIR = Path(__file__).resolve().parents[1] / "data" / "runner"
 BLADE_RADIUS_M = 0.1464
 BLADE_OFFSET_A_M = 0.069
@@ -231,7 +231,7 @@ class RunnerParams(_Strict):
     #: those fragile solutions fall).
     gravity_m_per_s2: float = Field(default=9.81, gt=0)
     #: Hunt–Crossley dissipation c [s/m] of the blade sphere. Default: seed 001's 0.2 s/m, with
-    #: which the shipped reflex solutions were optimised; the sphere then returns about 54 % of
+    #: which seed 001's reflex gaits (the reflex starts) were optimised; the sphere then returns about 54 % of
     #: the energy it stores per prosthetic stance (docs/runner-model.md, "Blade energy return").
     #: 0.02 s/m returns about 94 %, 0 s/m 100 % (an elastic blade, as seed 001's Table D.1
     #: reports). Opt-in: a change makes those fragile solutions fall.

@@ -9,7 +9,7 @@ speed is not a prediction (docs/predictive.md, "Robust evaluation"). Judged runs
 - starts at initial speeds :data:`START_CHANGE` above and below the file's.
 
 A judged run meets the acceptance (:func:`meets_acceptance`) when it runs the whole time with
-the shipped-solution criteria (speed, flight, alternating steps, power balance), no swinging
+the gait criteria of verify_solution (speed, flight, alternating steps, power balance), no swinging
 foot strikes the ground above :data:`STRIKE_LIMIT_BW` body weights, and the mean pelvis tilt
 lies inside the objective's window (seed 001: −16…−2°). Pushes (forward speed × (1 ±
 :data:`PUSH_CHANGE`) at :data:`PUSH_PHASES` phases of a stride) are simulated too, not judged:
@@ -29,7 +29,7 @@ from bladelab.predict.reflex.verify import verify_solution
 __all__ = ["COPIES", "COPY_JITTER", "PUSH_CHANGE", "PUSH_PHASES", "START_CHANGE",
            "STRIKE_LIMIT_BW", "acceptance_runs", "judged_runs", "meets_acceptance"]
 
-#: Every shipped solution survives 4 copies moved by 1e-3 ...
+#: An accepted gait survives 4 copies moved by 1e-3 ...
 COPIES = 4
 COPY_JITTER = 1e-3
 #: ... and a ±5 % change of the initial speed; no swinging foot above 0.2 body weights.

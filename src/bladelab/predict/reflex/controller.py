@@ -246,7 +246,7 @@ class ControllerLayout:
 
 def _scone_par() -> dict[str, float]:
     """SCONE's RS2 parameters (column ``best``) by name (shipped with bladelab)."""
-    path = RUNNER_DATA_DIR / "solutions" / _SCONE_PAR
+    path = RUNNER_DATA_DIR / "reflex-starts" / _SCONE_PAR
     if not path.exists():
         raise InputFileError("SCONE's reflex parameter file is missing from the installation",
                              file=path, hint="reinstall bladelab (pip install --force-reinstall)")

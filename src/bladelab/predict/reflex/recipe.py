@@ -63,7 +63,7 @@ __all__ = ["ABLE", "STABLE_GAIT_RECIPE", "Recipe", "Stage", "level_row", "maximu
 RECIPE_NAME = "recipe.json"
 LEVELS_NAME = "levels.json"
 RECIPE_FORMAT = 1
-#: The first stage's warm start unless told otherwise: the shipped solution of the model.
+#: The first stage's warm start unless told otherwise: seed 001's gait of the model (data/runner/reflex-starts).
 SHIPPED_START = {"amputee": "amputee-Cat6-3.5.json", "able": "able-3.5.json"}
 #: The pseudo-category of the able-bodied runner (its tasks sit beside the blade categories').
 ABLE = "able"
@@ -296,14 +296,14 @@ def run_recipe(
     """Run (or continue) ``recipe`` for the amputee with blade ``category`` (or the able-bodied
     runner: ``"able"``) and CMA-ES seed ``seed`` in ``out/<category>/seed-<seed>/``; returns
     the rows of ``levels.json`` (see the module docstring). ``init``: the first stage's warm
-    start (parameters JSON; default the model's shipped solution); ``track_study``: the
+    start (parameters JSON; default seed 001's gait of the model, in data/runner/reflex-starts); ``track_study``: the
     collocation study of the tracking stages (:func:`track_file`); ``progress(level, row)``
     after each finished level."""
     model, blade = model_of(category)
     folder = Path(out) / category / f"seed-{seed}"
     _, layout = runner_and_layout(model, blade)
     init = (Path(init) if init is not None
-            else RUNNER_DATA_DIR / "solutions" / SHIPPED_START[model])
+            else RUNNER_DATA_DIR / "reflex-starts" / SHIPPED_START[model])
     x = read_parameters(init, layout, transfer=True)
     track = None
     if any(s.track for s in recipe.stages):

@@ -1,4 +1,4 @@
-"""Checks of a shipped reflex solution (:func:`verify_solution`): it runs, at its speed, with
+"""Checks of a reflex gait (:func:`verify_solution`): it runs, at its speed, with
 flight and alternating steps, and so do copies of it moved along unseen directions and started
 at other initial speeds."""
 
@@ -41,7 +41,7 @@ def verify_solution(
     push_phases: int = 5,
     refined_step: int = 0,
 ) -> dict:
-    """Re-simulate a parameter file and check the shipped-solution criteria.
+    """Re-simulate a parameter file and check the gait criteria.
 
     The simulation uses the objective settings the file was optimised with (its ``settings``:
     time step, initial speed, weights; without robust sampling), at ``speed`` for ``duration``;
@@ -143,7 +143,7 @@ def verify_solution(
 
 
 def _check_gait(runner, layout, x, settings: ObjectiveSettings, limits: tuple) -> dict:
-    """Simulate ``x`` and measure the shipped-solution criteria (:func:`verify_solution`)."""
+    """Simulate ``x`` and measure the gait criteria (:func:`verify_solution`)."""
     ev, res = simulate_controlled(runner, x, layout=layout, settings=settings, record_every=2)
     leg = res.model.contact_params[:, 6]
     forces = np.stack([res.contacts[:, leg == i, 1].sum(axis=1) for i in (0, 1)], axis=1)
@@ -177,7 +177,7 @@ def _check_gait(runner, layout, x, settings: ObjectiveSettings, limits: tuple) -
 
 
 def _meets(run: dict, limits: tuple) -> bool:
-    """Whether a measured run (:func:`_check_gait`) meets the shipped-solution criteria with
+    """Whether a measured run (:func:`_check_gait`) meets the gait criteria with
     ``limits`` (duration [s], speed [m/s], speed tolerance [m/s], power residual [%])."""
     duration, speed, tolerance, max_residual = limits
     return bool(
