@@ -289,9 +289,10 @@ def test_several_starts_keep_the_best_per_problem_and_every_file(fake_solve, mon
 def test_settling_starts_each_category_from_its_neighbours_strides(fake_solve, monkeypatch,
                                                                    tmp_path, capsys):
     """--settle: after every model, each amputee problem solved again from the kept strides of
-    the categories next to it by stiffness (not by the order given), the lowest kept with
-    every start's objective in the table; the able runner has no neighbour; --resume solves
-    nothing again."""
+    the categories next to it by stiffness (not by the order given), the able runner's
+    prescribed speed from its own maximum-speed stride (its next faster problem), the lowest
+    kept with every start's objective in the table;
+    --resume solves nothing again."""
     from collocation_fake import objectives_by_start
 
     # Cat5's 3.5 m/s stride is the best start of Cat4's problem; Cat6's maximum speed does
@@ -307,7 +308,7 @@ def test_settling_starts_each_category_from_its_neighbours_strides(fake_solve, m
     settling = [(c["label"], c["speed"], c["start"]) for c in fake_solve.calls[8:]]
     assert [c["start"] for c in fake_solve.calls[:8]] == ["template", "warm"] * 4
     assert sorted(settling, key=str) == sorted([
-        ("amputee Cat4", 3.5, "from-Cat5"), ("amputee Cat4", None, "from-Cat5"),
+        ("able", 3.5, "from-max-speed"), ("amputee Cat4", 3.5, "from-Cat5"), ("amputee Cat4", None, "from-Cat5"),
         ("amputee Cat5", 3.5, "from-Cat4"), ("amputee Cat5", 3.5, "from-Cat6"),
         ("amputee Cat5", None, "from-Cat4"), ("amputee Cat5", None, "from-Cat6"),
         ("amputee Cat6", 3.5, "from-Cat5"), ("amputee Cat6", None, "from-Cat5")], key=str)
@@ -322,7 +323,8 @@ def test_settling_starts_each_category_from_its_neighbours_strides(fake_solve, m
         "speed-3.5.from-Cat4.json", "speed-3.5.from-Cat6.json", "speed-3.5.json"]
     assert (out / "amputee-Cat6" / "max-speed.from-Cat5.best_iterate.json").exists()
     rows = {(r["model"], r["problem"]): r for r in _csv(out / "collocation-sweep.csv")}
-    assert rows["able", "speed"].get("start", "") == ""  # no neighbour
+    r = rows["able", "speed"]  # a tie keeps the first start
+    assert (r["start"], r["starts"], r["objective_from-max-speed"]) == ("warm", "2", "2.0")
     r = rows["amputee Cat4", "speed"]
     assert (r["start"], r["starts"], r["file"]) == ("from-Cat5", "2",
                                                    "amputee-Cat4/speed-3.5.from-Cat5.json")
@@ -340,8 +342,8 @@ def test_settling_starts_each_category_from_its_neighbours_strides(fake_solve, m
 def test_settling_with_a_mesh_check_checks_only_the_kept_strides(fake_solve, monkeypatch,
                                                                   tmp_path, capsys):
     """--settle --mesh-check: a settled model is checked once, after the settling pass, on
-    the stride it keeps (here Cat5's start for Cat4 at 3.5 m/s); a model without neighbours
-    (the able runner) after the first pass."""
+    the stride it keeps (here Cat5's start for Cat4 at 3.5 m/s); the able runner, settled
+    from its own maximum-speed stride, the same way."""
     from bladelab.predict.collocation import mesh_check
     from collocation_fake import objectives_by_start
 
@@ -367,6 +369,24 @@ def test_settling_with_a_mesh_check_checks_only_the_kept_strides(fake_solve, mon
         "max-speed", "speed-3.5.from-Cat5"]
     rows = {(r["model"], r["problem"]): r for r in _csv(out / "collocation-sweep.csv")}
     assert rows["amputee Cat4", "speed"]["mesh_check_intervals"] == str(2 * N)
+
+
+def test_faster_neighbours_are_the_next_converged_faster_problem():
+    from bladelab.predict.collocation.sweep import faster_neighbours
+
+    def row(problem, speed, converged=True):
+        return {"problem": problem, "prescribed_speed_mps": speed, "converged": converged,
+                "file": f"m/{problem}-{speed}.json"}
+
+    rows = [row("speed", 5.0), row("speed", 4.0), row("max-speed", 5.1), row("speed", 3.0)]
+    assert faster_neighbours(rows) == {"3": ("from-speed-4", "m/speed-4.0.json"),
+                                       "4": ("from-speed-5", "m/speed-5.0.json"),
+                                       "5": ("from-max-speed", "m/max-speed-5.1.json")}
+    # a problem that did not converge is nobody's neighbour and has none
+    rows[0]["converged"] = False
+    rows[2]["converged"] = False
+    assert faster_neighbours(rows) == {"3": ("from-speed-4", "m/speed-4.0.json")}
+    assert faster_neighbours([]) == {}
 
 
 @pytest.mark.parametrize(("args", "where"), [

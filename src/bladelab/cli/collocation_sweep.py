@@ -127,7 +127,7 @@ def run_collocation_sweep(
     athlete (None: the body's own); ``mesh_check``: every converged solve checked on twice
     the mesh intervals; ``stride_time``: ``people`` (people's band at each prescribed speed,
     ``CollocationSettings.stride_time_people``) or None (free); ``settle``: a settling pass
-    from the neighbouring categories' strides."""
+    from the neighbouring categories' strides (the able runner's: its own faster ones)."""
     if stride_time is not None and not is_people_stride_time(stride_time):
         raise SpecError(f"a sweep imposes people's band at each speed, got {stride_time!r}",
                         where="--stride-time",

@@ -522,10 +522,11 @@ def register(app: typer.Typer) -> None:
         settle: bool = typer.Option(
             False, "--settle", rich_help_panel=COLLOCATION,
             help="After every model, solve each amputee problem again from the kept strides "
-                 "of the neighbouring categories (by stiffness) at the same speed, and keep "
-                 "the lowest (files speed-<v>.from-<category>.json; the spread in the "
-                 "table): starts that converge on the human body, where the template's "
-                 "does not."),
+                 "of the neighbouring categories (by stiffness) at the same speed, and each "
+                 "of the able runner's speeds from its own next faster stride; keep the "
+                 "lowest (files speed-<v>.from-<category>.json, speed-<v>.from-max-speed.json; "
+                 "the spread in the table): starts that converge on the human body, where "
+                 "the template's does not."),
     ) -> None:
         """Category × speed grid: warm-started optimisations, maximum speed, cost at 4 m/s,
         200 m and 400 m times, contact times (seed 001 §2.2.2 B–C, Table 3.1). Running it again
@@ -543,7 +544,8 @@ def register(app: typer.Typer) -> None:
         and the maximum speed; DIR/<model>/speed-<v>.json, max-speed.json and the table
         DIR/collocation-sweep.csv. A used --out needs --resume or --force; exit status 2 when a
         model failed (after the others). --starts K solves each problem from up to K starts
-        and keeps the best; --settle adds the neighbouring categories' strides as starts;
+        and keeps the best; --settle adds the neighbouring categories' strides as starts (the able
+        runner's: its next faster speed's);
         --mesh-check adds the settling evidence of every solve.
 
         An option of another method (or of the grid with --recipe) is refused."""

@@ -21,13 +21,18 @@ kept solution, every start's file stays in the model folder, and a row is the ke
 plus the columns ``start``, ``starts``, ``objective``, ``objective_<start>`` and
 ``spread_pct``.
 
-With ``settle`` a settling pass follows: each amputee model's problems are solved again from
-its neighbouring blade categories' kept strides at the same problem (the categories ordered by
-stiffness, :func:`category_neighbours`; the able runner has none), from their primal and dual
-values, each as one more start (``from-<category>``, files ``speed-4.from-Cat5.json``; the
+With ``settle`` a settling pass follows: each model's problems are solved again from its
+neighbours' kept strides, from their primal and dual values, each as one more start (the
 continuation's ``extra_starts``), and the lowest kept: one pass, from the strides the first
-pass kept. Measured on the human body, such starts land within 0.1–0.5 % of each other where
-the template start does not converge (docs/collocation.md, "Several starts per problem").
+pass kept. The neighbours of a problem: the neighbouring blade categories' strides at the same
+problem (the categories ordered by stiffness, :func:`category_neighbours`; labels
+``from-<category>``, files ``speed-4.from-Cat5.json``); for a model without a category (the
+able runner), at each prescribed speed, its own stride at its next faster problem
+(:func:`faster_neighbours`; ``from-speed-5``, ``from-max-speed``). Measured on the human body,
+the categories' starts land within 0.1–0.5 % of each other where the template start does not
+converge (docs/collocation.md, "Several starts per problem"); the able runner's 5 m/s stride
+from its maximum-speed stride lay 22 % below (in objective) the one the continuation reached
+from 4 m/s, where an amputee's faster starts landed 5–100 % above their problems' best.
 With ``mesh_check`` as well, the settled models are checked after the settling pass only (their
 kept strides), the others after the first.
 
@@ -77,6 +82,7 @@ __all__ = [
     "SweepResult",
     "category_neighbours",
     "collocation_sweep",
+    "faster_neighbours",
     "mesh_check_columns",
     "sweep_model_task",
     "sweep_models",
@@ -303,26 +309,53 @@ def category_neighbours(models: Sequence[dict]) -> dict[int, list[int]]:
             for j, i in enumerate(bladed)}
 
 
+def faster_neighbours(model_rows: Sequence[dict]) -> dict[str, tuple[str, str]]:
+    """For each prescribed speed of one model's kept solves (``model_rows``, a sweep's rows),
+    the model's own next faster converged problem: ``{problem_key: (label, file)}``, the label
+    ``from-speed-<v>`` or ``from-max-speed``, the file as the row has it. The fastest prescribed
+    speed's neighbour is the maximum speed's stride; a problem with no converged faster one has
+    none."""
+    converged = [r for r in model_rows if r.get("converged")]
+    prescribed = sorted((r for r in converged if r["problem"] != "max-speed"),
+                        key=lambda r: r["prescribed_speed_mps"])
+    fastest = [r for r in converged if r["problem"] == "max-speed"]
+    out = {}
+    for k, r in enumerate(prescribed):
+        faster = prescribed[k + 1:k + 2] or fastest
+        if faster:
+            f = faster[0]
+            label = ("from-max-speed" if f["problem"] == "max-speed"
+                     else f"from-speed-{f['prescribed_speed_mps']:g}")
+            out[problem_key(r["prescribed_speed_mps"])] = (label, f["file"])
+    return out
+
+
 def _settling_payloads(payloads: Sequence[dict], rows: dict[int, list[dict]],
                        out: Path, mesh_check: bool) -> dict[int, dict]:
-    """The settling pass's payload of each model with a neighbouring category: the first
-    pass's payload, reading its files back (``force`` off), with ``extra_starts`` from the
-    neighbours' converged kept strides (none where no neighbour converged) and the mesh
-    check the sweep asked for (the first pass leaves it to this one, so that only kept
-    strides are checked)."""
+    """The settling pass's payload of each model: the first pass's payload, reading its files
+    back (``force`` off), with ``extra_starts`` from the neighbours' converged kept strides
+    (the neighbouring categories' at the same problem, :func:`category_neighbours`; a model
+    without a category, the able runner, its own at its next faster problem,
+    :func:`faster_neighbours`; a model with none is left out) and the mesh check the sweep asked for (the first pass leaves it to this one, so
+    that only kept strides are checked)."""
     models = [p["model_spec"] for p in payloads]
+    near_categories = category_neighbours(models)
     settling = {}
-    for i, near in category_neighbours(models).items():
+    for i in range(len(models)):
         extra: dict[str, list[tuple[str, str]]] = {}
-        for j in near:
+        for j in near_categories.get(i, []):
             for r in rows.get(j, []):
                 if not r.get("converged"):
                     continue
                 speed = None if r["problem"] == "max-speed" else r["prescribed_speed_mps"]
                 extra.setdefault(problem_key(speed), []).append(
                     (f"from-{models[j]['blade']}", str(out / r["file"])))
-        settling[i] = {**payloads[i], "force": False, "extra_starts": extra,
-                       "mesh_check": bool(mesh_check)}
+        if i not in near_categories:  # the able runner: its own faster strides instead
+            for key, (label, file) in faster_neighbours(rows.get(i, [])).items():
+                extra.setdefault(key, []).append((label, str(out / file)))
+        if extra:
+            settling[i] = {**payloads[i], "force": False, "extra_starts": extra,
+                           "mesh_check": bool(mesh_check)}
     return settling
 
 
@@ -438,12 +471,15 @@ def collocation_sweep(
                 failures[i] = [f"stopped by an error: {value}"]
             write_table(table, [r for k in sorted(rows) for r in rows[k]])
 
-    settled = set(category_neighbours(models)) if settle else set()
-    # a model that the settling pass solves again is mesh-checked there, after it
-    run({i: {**p, "mesh_check": p["mesh_check"] and i not in settled}
+    # with settle every model is solved again (and mesh-checked there, after it), unless it
+    # has no neighbour at all; such a model is mesh-checked after the settling pass too
+    run({i: {**p, "mesh_check": p["mesh_check"] and not settle}
          for i, p in enumerate(payloads)})
     if settle:
-        run(_settling_payloads(payloads, rows, out.resolve(), bool(mesh_check)))
+        settling = _settling_payloads(payloads, rows, out.resolve(), bool(mesh_check))
+        unsettled = {i: {**payloads[i], "force": False} for i in range(len(payloads))
+                     if i not in settling and i in rows and mesh_check}
+        run({**settling, **unsettled})
     all_rows = [r for k in sorted(rows) for r in rows[k]]
     if not rows:
         write_table(table, [])
