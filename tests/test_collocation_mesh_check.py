@@ -118,6 +118,12 @@ def test_the_folder_keeps_the_finer_solve_and_resume_reads_it_back(strides, tmp_
     assert [row[2] for row in check.round_trip_table()][0] == "1.2"
     again = mesh_check_in_folder(folder, runner, coarse, resume=True)
     assert again == check and len(calls) == 2  # read back, not solved again
+    # a committed study keeps the comparison without the finer strides: read back alone
+    kept = tmp_path / "kept"
+    kept.mkdir()
+    (kept / MESH_CHECK_FILE).write_bytes((folder / MESH_CHECK_FILE).read_bytes())
+    assert mesh_check_in_folder(kept, runner, coarse, resume=True) == check
+    assert len(calls) == 2 and sorted(p.name for p in kept.iterdir()) == [MESH_CHECK_FILE]
     # a check of another stride in the folder is made anew, its round trip too
     other = dataclasses.replace(coarse, nlp=dataclasses.replace(coarse.nlp, objective=1.3))
     mesh_check_in_folder(folder, runner, other, resume=True)

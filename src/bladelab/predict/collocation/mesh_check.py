@@ -374,8 +374,9 @@ def mesh_check_in_folder(folder: str | Path, runner, sol: CollocationSolution, *
     converge) and the comparison as :data:`MESH_CHECK_FILE` (module docstring; a solve's
     folder keeps it in ``OUT/mesh-check/``). With ``resume``, a check already there that was
     made of this very stride (:meth:`MeshCheck.describes`) is read back if its finer solve
-    converged, and continued from its best iterate if not; a check of another stride is made
-    anew. With ``round_trip_too`` (default) and a converged finer solve, the round trip
+    converged (its comparison alone when the finer strides' files were removed, as committed
+    studies do to save space), and continued from its best iterate if not; a check of another
+    stride is made anew. With ``round_trip_too`` (default) and a converged finer solve, the round trip
     (:func:`round_trip`) as well, in :data:`ROUND_TRIP_DIR` (read back and continued the same
     way)."""
     folder = Path(folder)
@@ -383,6 +384,9 @@ def mesh_check_in_folder(folder: str | Path, runner, sol: CollocationSolution, *
     ok, best = folder / SOLUTION_FILE, folder / BEST_ITERATE_FILE
     fine_settings = _finer(sol, 2, max_iter)
     previous = read_mesh_check(folder) if resume else None
+    if (previous is not None and previous.describes(sol) and previous.converged
+            and not ok.exists() and not best.exists()):
+        return previous  # a finished check whose finer strides were removed (to save space)
     done, iterate = ((None, None) if previous is None or not previous.describes(sol)
                      else read_stored(ok, best, sol.model_spec, fine_settings))
     if done is not None:
