@@ -85,7 +85,9 @@ def read_sweep_table(folder: str | Path) -> pd.DataFrame:
 
 
 def _flag(table: pd.DataFrame) -> pd.DataFrame:
-    """Set ``flagged``: converged, with a non-empty ``warnings``."""
+    """Set ``flagged``: converged, with a non-empty ``warnings`` (on a de-fragmented copy: a
+    wide table read column by column would warn of fragmentation)."""
+    table = table.copy()
     table["flagged"] = table.converged & table.warnings.str.strip().str.len().gt(0)
     return table
 
