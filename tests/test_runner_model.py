@@ -372,7 +372,7 @@ def test_human_body_is_h0918_scaled_to_a_75_kg_runner():
         assert fmax[f"{name}_l"] == pytest.approx(force * ratio, rel=1e-12), name
     strain = dict(zip(runner.muscle_names, runner.muscle_params[:, 4], strict=True))
     assert strain["soleus_l"] == strain["gastroc_r"] == 0.08
-    assert strain["vasti_l"] == 0.08 and strain["rect_fem_l"] == strain["glut_max_r"] == 0.049
+    assert strain["vasti_l"] == 0.16 and strain["rect_fem_l"] == strain["glut_max_r"] == 0.049
     # active force at 30 N/cm² (people's strength, runner.strength) over the table's 25 N/cm²
     np.testing.assert_allclose(runner.muscle_params[:, 5], 30.0 / 25.0, rtol=1e-15)
     assert set(build_runner("able").muscle_params[:, 5]) == {1.0}  # seed 001: none
