@@ -21,8 +21,14 @@ from pathlib import Path
 
 HERE = Path(__file__).resolve().parent / "collocation"
 #: (folder, what differs) of each timed study.
-STUDIES = (("study-human-settled-2026-12-01", "the human body with the vasti tendon at 8 % "
-            "(since 2026-12-01), at people's stride time, people's joint angles at weight "
+STUDIES = (("study-human-vasti16-2026-12-01", "the human body with the vasti's series "
+            "elasticity at 16 % (since 2026-12-01), at people's stride time, people's joint "
+            "angles at weight 10 1/rad², one start per problem from the shipped strides, then "
+            "the settling pass (`--settle`: the amputees from their neighbouring categories' "
+            "strides, the able runner from its own faster ones); the rows are the kept "
+            "starts', the wall time both passes'"),
+           ("study-human-settled-2026-12-01", "the human body with the vasti tendon at 8 % "
+            "(2026-12-01), at people's stride time, people's joint angles at weight "
             "10 1/rad², one start per problem from the shipped strides, then the settling pass "
             "(`--settle`); the rows are the kept starts', the wall time both passes'"),
            ("study-human-people-cadence-2026-11-30", "the human body at people's stride time "
