@@ -376,9 +376,9 @@ def mesh_check_in_folder(folder: str | Path, runner, sol: CollocationSolution, *
     made of this very stride (:meth:`MeshCheck.describes`) is read back if its finer solve
     converged (its comparison alone when the finer strides' files were removed, as committed
     studies do to save space), and continued from its best iterate if not; a check of another
-    stride is made anew. With ``round_trip_too`` (default) and a converged finer solve, the round trip
-    (:func:`round_trip`) as well, in :data:`ROUND_TRIP_DIR` (read back and continued the same
-    way)."""
+    stride is made anew. With ``round_trip_too`` (default) and a converged finer solve, the
+    round trip (:func:`round_trip`) as well, in :data:`ROUND_TRIP_DIR` (read back and continued
+    the same way)."""
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)
     ok, best = folder / SOLUTION_FILE, folder / BEST_ITERATE_FILE

@@ -33,8 +33,8 @@ the categories' starts land within 0.1–0.5 % of each other where the template 
 converge (docs/collocation.md, "Several starts per problem"); the able runner's 5 m/s stride
 from its maximum-speed stride lay 22 % below (in objective) the one the continuation reached
 from 4 m/s, where an amputee's faster starts landed 5–100 % above their problems' best.
-With ``mesh_check`` as well, the settled models are checked after the settling pass only (their
-kept strides), the others after the first.
+With ``mesh_check`` as well, every model is checked after the settling pass only (its kept
+strides).
 
 With ``mesh_check`` every converged solve is solved again on twice the mesh intervals from its
 stride (:mod:`bladelab.predict.collocation.mesh_check`; the finer solves in
@@ -336,8 +336,8 @@ def _settling_payloads(payloads: Sequence[dict], rows: dict[int, list[dict]],
     back (``force`` off), with ``extra_starts`` from the neighbours' converged kept strides
     (the neighbouring categories' at the same problem, :func:`category_neighbours`; a model
     without a category, the able runner, its own at its next faster problem,
-    :func:`faster_neighbours`; a model with none is left out) and the mesh check the sweep asked for (the first pass leaves it to this one, so
-    that only kept strides are checked)."""
+    :func:`faster_neighbours`; a model with none is left out) and the mesh check the sweep
+    asked for (the first pass leaves it to this one, so that only kept strides are checked)."""
     models = [p["model_spec"] for p in payloads]
     near_categories = category_neighbours(models)
     settling = {}
