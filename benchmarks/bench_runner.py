@@ -71,9 +71,9 @@ def _running_loads(dt: float, integrator: str) -> tuple[float, bool]:
     from bladelab.predict.reflex.objective import simulate_controlled
     from bladelab.predict.reflex.optimize import runner_and_layout, stored_settings
     from bladelab.runner import power_balance_residual_pct
-    from bladelab.runner.params import RUNNER_DATA_DIR
+    from bladelab.runner.params import REFLEX_STARTS_DIR
 
-    path = RUNNER_DATA_DIR / "reflex-starts" / "amputee-Cat6-3.5.json"
+    path = REFLEX_STARTS_DIR / "amputee-Cat6-3.5.json"
     data = json.loads(path.read_text())
     runner, layout = runner_and_layout(data["model"], data["blade"])
     x = read_parameters(path, layout)

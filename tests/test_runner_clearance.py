@@ -15,9 +15,9 @@ from bladelab.predict.reflex.optimize import runner_and_layout, stored_settings
 from bladelab.runner.analyses import stances, swing_contacts
 from bladelab.runner.clearance import swing_clearance
 from bladelab.runner.layout import CP_BLADE
-from bladelab.runner.params import RUNNER_DATA_DIR
+from bladelab.runner.params import REFLEX_STARTS_DIR
 
-SHIPPED = RUNNER_DATA_DIR / "reflex-starts" / "amputee-Cat6-3.5.json"
+SHIPPED = REFLEX_STARTS_DIR / "amputee-Cat6-3.5.json"
 
 
 @pytest.fixture(scope="module")

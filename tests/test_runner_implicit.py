@@ -228,9 +228,9 @@ def test_running_loads_at_1ms():
     from bladelab.predict.reflex.controller import read_parameters
     from bladelab.predict.reflex.objective import simulate_controlled
     from bladelab.predict.reflex.optimize import runner_and_layout, stored_settings
-    from bladelab.runner.params import RUNNER_DATA_DIR
+    from bladelab.runner.params import REFLEX_STARTS_DIR
 
-    path = RUNNER_DATA_DIR / "reflex-starts" / "amputee-Cat6-3.5.json"
+    path = REFLEX_STARTS_DIR / "amputee-Cat6-3.5.json"
     data = json.loads(path.read_text())
     runner, layout = runner_and_layout(data["model"], data["blade"])
     x = read_parameters(path, layout)
@@ -251,9 +251,9 @@ def _shipped_amputee_run(dt, integrator, duration=0.8):
     from bladelab.predict.reflex.controller import read_parameters
     from bladelab.predict.reflex.objective import simulate_controlled
     from bladelab.predict.reflex.optimize import runner_and_layout, stored_settings
-    from bladelab.runner.params import RUNNER_DATA_DIR
+    from bladelab.runner.params import REFLEX_STARTS_DIR
 
-    path = RUNNER_DATA_DIR / "reflex-starts" / "amputee-Cat6-3.5.json"
+    path = REFLEX_STARTS_DIR / "amputee-Cat6-3.5.json"
     data = json.loads(path.read_text())
     runner, layout = runner_and_layout(data["model"], data["blade"])
     base = stored_settings(data, speed=3.5, duration=duration, nominal=True)

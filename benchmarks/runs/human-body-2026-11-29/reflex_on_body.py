@@ -34,9 +34,9 @@ import bladelab.predict.reflex.optimize as optimize
 from bladelab.predict.collocation.solution import CollocationSolution
 from bladelab.predict.reflex.controller import controller_layout, read_parameters
 from bladelab.runner.model import build_runner
-from bladelab.runner.params import RUNNER_DATA_DIR
+from bladelab.runner.params import REFLEX_STARTS_DIR, RUNNER_DATA_DIR
 
-SHIPPED = RUNNER_DATA_DIR / "reflex-starts" / "amputee-Cat6-3.5.json"
+SHIPPED = REFLEX_STARTS_DIR / "amputee-Cat6-3.5.json"
 HUMAN_STRIDE = RUNNER_DATA_DIR / "collocation" / "amputee-Cat6-4-human.json"
 
 

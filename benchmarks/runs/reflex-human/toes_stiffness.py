@@ -14,7 +14,7 @@ import bladelab.predict.reflex.optimize as optimize
 import bladelab.runner.model as runner_model
 import bladelab.runner.params as runner_params
 from bladelab.predict.reflex.controller import controller_layout, read_parameters
-from bladelab.runner.params import RUNNER_DATA_DIR
+from bladelab.runner.params import REFLEX_STARTS_DIR
 
 GAITS = (("amputee", "Cat6", "amputee-Cat6-3.5.json"), ("able", None, "able-3.5.json"))
 #: Toe-joint spring stiffnesses [N·m/rad] (the model's: 25; 1e4 and above blow up at 1 ms).
@@ -25,7 +25,7 @@ ACHILLES = ({"soleus": 0.08, "gastroc": 0.08}, {})
 
 def main() -> None:
     for kind, blade, name in GAITS:
-        path = RUNNER_DATA_DIR / "reflex-starts" / name
+        path = REFLEX_STARTS_DIR / name
         settings = optimize.stored_settings(json.loads(path.read_text()), speed=3.5,
                                             duration=10.0, nominal=True)
         for achilles in ACHILLES:

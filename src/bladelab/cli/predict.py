@@ -544,9 +544,9 @@ def register(app: typer.Typer) -> None:
         and the maximum speed; DIR/<model>/speed-<v>.json, max-speed.json and the table
         DIR/collocation-sweep.csv. A used --out needs --resume or --force; exit status 2 when a
         model failed (after the others). --starts K solves each problem from up to K starts
-        and keeps the best; --settle adds the neighbouring categories' strides as starts (the able
-        runner's: its next faster speed's);
-        --mesh-check adds the settling evidence of every solve.
+        and keeps the best; --settle adds the neighbouring categories' strides as starts
+        (the able runner's: its next faster speed's); --mesh-check adds the settling evidence
+        of every solve.
 
         An option of another method (or of the grid with --recipe) is refused."""
         method = _method(method)

@@ -54,8 +54,8 @@ SPEED_M_PER_S = 3.5
 # -- the reflex controller and its objective (predict.reflex) ------------------------------
 #: Blade category of the reflex controller's amputee runner (seed 001's reflex gaits).
 REFLEX_BLADE = "Cat6"
-#: The reflex controller's body: seed 001's, the body its parameters, recipes and shipped
-#: solutions were found on (``--body human`` runs it on the human body).
+#: The reflex controller's body: seed 001's, the body its parameters, recipes and reflex
+#: starts were found on (``--body human`` runs it on the human body).
 REFLEX_BODY = "seed001"
 #: Simulated time of one candidate [s] (``ObjectiveSettings.duration``).
 DURATION_S = 10.0

@@ -43,8 +43,12 @@ from bladelab.runner.geometry import (
 from bladelab.runner.muscle import V_MAX_OPT_PER_S
 from bladelab.runner.prosthetic_knee import ProstheticKnee
 
-#: Folder of the runner models' data files (parameter sets, categories, stored strides, reflex starts).
+#: Folder of the runner models' data files (parameter sets, categories, stored strides,
+#: reflex starts).
 RUNNER_DATA_DIR = Path(__file__).resolve().parents[1] / "data" / "runner"
+#: The reflex controller's starting points: SCONE's parameters and seed 001's two gaits (warm
+#: starts, not accepted solutions; its README).
+REFLEX_STARTS_DIR = RUNNER_DATA_DIR / "reflex-starts"
 BLADE_RADIUS_M = 0.1464
 BLADE_OFFSET_A_M = 0.069
 BLADE_OFFSET_B_M = 0.0693
@@ -691,6 +695,7 @@ __all__ = [
     "FootContact",
     "KINDS",
     "PROSTHETIC_KINDS",
+    "REFLEX_STARTS_DIR",
     "RUNNER_DATA_DIR",
     "ATHLETE_FIELDS",
     "ATHLETE_PARAM_FIELDS",

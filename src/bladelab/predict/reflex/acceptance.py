@@ -9,10 +9,11 @@ speed is not a prediction (docs/predictive.md, "Robust evaluation"). Judged runs
 - starts at initial speeds :data:`START_CHANGE` above and below the file's.
 
 A judged run meets the acceptance (:func:`meets_acceptance`) when it runs the whole time with
-the gait criteria of verify_solution (speed, flight, alternating steps, power balance), no swinging
-foot strikes the ground above :data:`STRIKE_LIMIT_BW` body weights, and the mean pelvis tilt
-lies inside the objective's window (seed 001: −16…−2°). Pushes (forward speed × (1 ±
-:data:`PUSH_CHANGE`) at :data:`PUSH_PHASES` phases of a stride) are simulated too, not judged:
+:func:`~bladelab.predict.reflex.verify.verify_solution`'s gait criteria (speed, flight,
+alternating steps, power balance), no swinging foot strikes the ground above
+:data:`STRIKE_LIMIT_BW` body weights, and the mean pelvis tilt lies inside the objective's
+window (seed 001: −16…−2°). Pushes (forward speed × (1 ± :data:`PUSH_CHANGE`) at
+:data:`PUSH_PHASES` phases of a stride) are simulated too, not judged:
 they measure the size of the gait's basin. So are the nominal runs at finer time steps
 (``refined``): reported beside the verdict, not part of it (measured 2026-11-27: no gait of the
 first-order scheme runs at half its step; the Newmark scheme's gaits are the first to be

@@ -55,7 +55,7 @@ from numba import njit
 from bladelab._io import read_json, write_json
 from bladelab.errors import InputFileError, SpecError
 from bladelab.numba_cache import refresh_stale_caches
-from bladelab.runner.params import RUNNER_DATA_DIR
+from bladelab.runner.params import REFLEX_STARTS_DIR
 
 EARLY_STANCE, LATE_STANCE, LIFTOFF, SWING, LANDING = range(5)
 STATE_NAMES = ("EarlyStance", "LateStance", "Liftoff", "Swing", "Landing")
@@ -246,7 +246,7 @@ class ControllerLayout:
 
 def _scone_par() -> dict[str, float]:
     """SCONE's RS2 parameters (column ``best``) by name (shipped with bladelab)."""
-    path = RUNNER_DATA_DIR / "reflex-starts" / _SCONE_PAR
+    path = REFLEX_STARTS_DIR / _SCONE_PAR
     if not path.exists():
         raise InputFileError("SCONE's reflex parameter file is missing from the installation",
                              file=path, hint="reinstall bladelab (pip install --force-reinstall)")

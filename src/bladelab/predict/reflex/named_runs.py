@@ -149,8 +149,8 @@ def recipe_sweep_named(categories: Sequence[str], seeds: Sequence[int], *, out: 
                        init: str | Path | None = None, **options):
     """:func:`~bladelab.predict.reflex.recipe_sweep.run_recipe_sweep` of the recipe named by
     ``recipe`` (:func:`named_recipe`) for each category × seed, from the parameter file
-    ``init`` (None: each model's reflex start, seed 001's gait); ``options`` (track_study, jobs, executor,
-    checkpoint_every) are its own. Returns its per-category summary."""
+    ``init`` (None: each model's reflex start, seed 001's gait); ``options`` (track_study,
+    jobs, executor, checkpoint_every) are its own. Returns its per-category summary."""
     chosen = named_recipe(recipe)
     if init is not None and not Path(init).is_file():
         raise SpecError("file not found", file=init, where="init")

@@ -55,7 +55,7 @@ from bladelab.predict.reflex.acceptance import acceptance_runs, judged_runs, mee
 from bladelab.predict.reflex.controller import parameter_digest, read_parameters
 from bladelab.predict.reflex.objective import ObjectiveSettings
 from bladelab.predict.reflex.optimize import CHECKPOINT_NAME, optimize_controller, runner_and_layout
-from bladelab.runner.params import RUNNER_DATA_DIR, blade_category
+from bladelab.runner.params import REFLEX_STARTS_DIR, blade_category
 
 __all__ = ["ABLE", "STABLE_GAIT_RECIPE", "Recipe", "Stage", "level_row", "maximum_speed",
            "model_of", "recipe_task", "run_recipe", "settled_speed", "track_file"]
@@ -63,8 +63,9 @@ __all__ = ["ABLE", "STABLE_GAIT_RECIPE", "Recipe", "Stage", "level_row", "maximu
 RECIPE_NAME = "recipe.json"
 LEVELS_NAME = "levels.json"
 RECIPE_FORMAT = 1
-#: The first stage's warm start unless told otherwise: seed 001's gait of the model (data/runner/reflex-starts).
-SHIPPED_START = {"amputee": "amputee-Cat6-3.5.json", "able": "able-3.5.json"}
+#: The first stage's warm start unless told otherwise: seed 001's gait of the model (a file
+#: of :data:`~bladelab.runner.params.REFLEX_STARTS_DIR`).
+REFLEX_START = {"amputee": "amputee-Cat6-3.5.json", "able": "able-3.5.json"}
 #: The pseudo-category of the able-bodied runner (its tasks sit beside the blade categories').
 ABLE = "able"
 #: The collocation stride's weight in a tracking stage [1/rad²] (docs/predictive.md).
@@ -296,14 +297,14 @@ def run_recipe(
     """Run (or continue) ``recipe`` for the amputee with blade ``category`` (or the able-bodied
     runner: ``"able"``) and CMA-ES seed ``seed`` in ``out/<category>/seed-<seed>/``; returns
     the rows of ``levels.json`` (see the module docstring). ``init``: the first stage's warm
-    start (parameters JSON; default seed 001's gait of the model, in data/runner/reflex-starts); ``track_study``: the
-    collocation study of the tracking stages (:func:`track_file`); ``progress(level, row)``
-    after each finished level."""
+    start (parameters JSON; default seed 001's gait of the model, :data:`REFLEX_START`);
+    ``track_study``: the collocation study of the tracking stages (:func:`track_file`);
+    ``progress(level, row)`` after each finished level."""
     model, blade = model_of(category)
     folder = Path(out) / category / f"seed-{seed}"
     _, layout = runner_and_layout(model, blade)
     init = (Path(init) if init is not None
-            else RUNNER_DATA_DIR / "reflex-starts" / SHIPPED_START[model])
+            else REFLEX_STARTS_DIR / REFLEX_START[model])
     x = read_parameters(init, layout, transfer=True)
     track = None
     if any(s.track for s in recipe.stages):
