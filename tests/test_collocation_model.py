@@ -302,6 +302,44 @@ def test_hip_capsule_moment_is_riener_and_edrichs_extension_term(models, kind):
         assert lig[runner.dof("knee_angle_l")] == 0.0 == lig[runner.dof("ankle_angle_l")]
 
 
+@pytest.mark.parametrize("kind", ["able-human", "amputee-human", "transfemoral-human"])
+def test_human_lumbar_spring_is_the_same_law_in_both_twins_across_zero(models, kind):
+    """The human body's lumbar joint is a linear spring–damper about 0° (500 N·m/rad,
+    5 N·m·s/rad): both twins give −500·q − 5·q̇ to round-off, also where the trunk crosses 0°
+    with speed, where seed 001's two-sided ligament's damping jumps."""
+    runner, cm = models[kind]
+    m = runner.mj_model
+    d = mujoco.MjData(m)
+    j = runner.dof("lumbar_extension")
+    for q_deg, qd in ((0.0, 2.0), (0.05, -1.5), (-0.05, 1.5), (-10.0, 0.3), (8.0, -0.7)):
+        q, v = runner.stand_qpos.copy(), np.zeros(m.nv)
+        q[j], v[j] = math.radians(q_deg), qd
+        d.qpos[:], d.qvel[:] = q, v
+        mujoco.mj_forward(m, d)
+        _, lig = _forward_forces(runner, d)
+        tau = _np(cm.passive(q, v)).ravel()
+        expected = -500.0 * q[j] - 5.0 * qd
+        assert lig[j] == pytest.approx(expected, rel=1e-12, abs=1e-12)
+        assert tau[j] == pytest.approx(expected, rel=1e-12, abs=1e-12)
+
+
+def test_seed001_lumbar_ligament_pushes_only_beyond_zero(models):
+    """Seed 001's body keeps its lumbar ligament at 0° both ways: moving out of 0° its
+    damping acts at once (−5·q̇ just beyond the limit), moving back in it never pulls."""
+    runner, _ = models["able"]
+    m = runner.mj_model
+    d = mujoco.MjData(m)
+    j = runner.dof("lumbar_extension")
+    for q_rad, qd, expected in ((1e-6, 2.0, -500.0 * 1e-6 - 10.0), (1e-6, -2.0, 0.0),
+                                (-1e-6, -2.0, 500.0 * 1e-6 + 10.0)):
+        q, v = runner.stand_qpos.copy(), np.zeros(m.nv)
+        q[j], v[j] = q_rad, qd
+        d.qpos[:], d.qvel[:] = q, v
+        mujoco.mj_forward(m, d)
+        _, lig = _forward_forces(runner, d)
+        assert lig[j] == pytest.approx(expected, rel=1e-9, abs=1e-12)
+
+
 @pytest.mark.parametrize("kind", ["amputee", "transfemoral"])
 def test_multilink_blade_model_matches_forward(kind):
     """An amputee wearing a multi-link blade (extra hinge about +y, ellipse soles turned in

@@ -520,6 +520,10 @@ def build_runner(
             if base == "knee_angle":
                 lo = -params.knee_flexion_limit_deg
             jp[i, :4] = (math.radians(lo), math.radians(hi), k, d)
+        if base == "lumbar_extension" and params.lumbar_passive == "spring":
+            lo, hi, k, d = LIGAMENTS[base]
+            jp[i, :4] = (-np.inf, np.inf, 0.0, 0.0)
+            jp[i, JP_SK:JP_EA] = (k, 0.0, d, d)
         capsule = params.capsule_moments.get(base)
         if capsule is not None:
             jp[i, JP_EA] = capsule.moment_at_zero_Nm

@@ -253,6 +253,12 @@ class RunnerParams(_Strict):
     #: Flexion [deg] at which the knee ligament engages: seed 001's 90°; people flex the knee
     #: to about 140° (the swing of sprinting comes close to it).
     knee_flexion_limit_deg: float = Field(default=90.0, gt=30.0, le=170.0)
+    #: The lumbar joint's passive torque: ``"ligament"`` (seed 001: a soft limit at 0° both
+    #: ways, 500 N·m/rad and 5 N·m·s/rad, that pushes back and never pulls, so that its damping
+    #: jumps by 5 N·m·s/rad × q̇ where the trunk crosses 0°) or ``"spring"`` (the same stiffness
+    #: and damping as a linear spring–damper about 0°: smooth, and the same law in the forward
+    #: model and the collocation twin, which has to smooth the ligament's jump).
+    lumbar_passive: Literal["ligament", "spring"] = "ligament"
     #: Passive capsule moments by coordinate (:data:`CAPSULE_COORDINATES`, both legs; not on
     #: a prosthetic joint); none by default (seed 001's model).
     capsule_moments: dict[str, CapsuleMoment] = Field(default_factory=dict)
