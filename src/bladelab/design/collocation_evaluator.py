@@ -10,8 +10,8 @@
 3. predicts one periodic stride at the prescribed speed by direct collocation
    (:func:`~bladelab.predict.collocation.solve.predict_stride`), warm-started from the
    nearest designs already solved in ``solutions_dir`` (coded distance), then from ``start``;
-   a start that does not converge to a clean alternating run (no
-   :meth:`~bladelab.predict.collocation.solution.CollocationSolution.gait_warnings`) is
+   a start that does not converge to a stride without
+   :meth:`~bladelab.predict.collocation.solution.CollocationSolution.gait_warnings` is
    followed by the next one; the last resort is ``start`` with a tracking stage first;
 4. reads seed 002's responses off the stride
    (:func:`~bladelab.design.predicted.stride_responses`).
@@ -74,8 +74,8 @@ DEFAULT_START = DEFAULT_STARTS[DEFAULT_BODY]
 #: damping ratio kept) in the design's runner, forward and collocation alike (our choice,
 #: measured 2026-11-26, docs/design.md): with the generator's 10⁶ N/m soles the transfemoral
 #: 4 m/s stride from the sphere's clean run converged to 12-BW intact-leg impacts (or, with a
-#: tracking stage, to an infeasible point); with 10⁵ N/m it converged to a clean alternating
-#: run in 154 s. 10⁵ N/m (three soles: 3·10⁵ N/m against the blade's 18–32 kN/m) adds 6–10 %
+#: tracking stage, to an infeasible point); with 10⁵ N/m it converged in 154 s to a stride
+#: without gait warnings (a gallop, as every transfemoral stride found so far). 10⁵ N/m (three soles: 3·10⁵ N/m against the blade's 18–32 kN/m) adds 6–10 %
 #: to the blade's compression at a given load.
 DEFAULT_SOLE_STIFFNESS_SCALE = 0.1
 #: The athlete's own coordinates that :attr:`CollocationEvaluator.reference_weight` keeps near

@@ -61,8 +61,7 @@ __all__ = [
 def prosthetic_stride_on(model: RunnerModel, guess: StrideGuess, *,
                          depth_m: float = 0.01) -> StrideGuess:
     """A stride of one amputee runner kind as the start of another (the transtibial runner's
-    alternating run as the transfemoral runner's: docs/design.md "Predicted transfemoral
-    gaits"): coordinates and muscles matched by name (:meth:`StrideGuess.on_model`), the
+    stride as the transfemoral runner's: docs/design.md "Predicted transfemoral gaits"): coordinates and muscles matched by name (:meth:`StrideGuess.on_model`), the
     pelvis lowered at every node until the lowest contact is ``depth_m`` [m] deep, speeds
     from the new coordinates, the vertical force pattern of :func:`template_vertical_grf`."""
     g = guess.on_model(model)
