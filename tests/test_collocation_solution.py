@@ -31,6 +31,7 @@ from bladelab.predict.collocation.solution import (
 )
 from bladelab.predict.collocation.solve import SolveProgress, predict_stride
 from bladelab.predict.collocation.transcription import StrideWeights
+from bladelab.runner.params import RUNNER_DATA_DIR
 from collocation_fake import SPEED, fake_solution
 
 N = 12
@@ -783,3 +784,19 @@ def test_model_spec_carries_the_athlete_into_the_runner_the_label_and_the_file(a
     strong = check_model_spec({"model": "able", "athlete": {"muscle_strength": 1.5}})
     path = replace(sol, model_spec=strong).write(tmp_path / "solution.json")
     assert CollocationSolution.read(path).model_spec == strong
+
+
+def test_a_force_that_zigzags_from_node_to_node_is_named_in_the_warnings():
+    """The shipped able stride's stance is resolved by its mesh (no warning); the same stride
+    with its left leg's vertical force alternating ±0.4 BW from node to node is flagged, on
+    that leg only."""
+    sol = CollocationSolution.read(RUNNER_DATA_DIR / "collocation" / "able-3.5-human.json")
+    assert sol.gait_warnings() == []
+    forces = sol.contact_forces.copy()
+    left = np.flatnonzero(sol.contact_legs == 0)
+    fz = sol.leg_vertical_force()[:, 0] / sol.body_weight_N
+    sign = (-1.0) ** np.arange(fz.size)
+    forces[:, left[0], 1] += np.where(fz > 0.5, 0.4 * sol.body_weight_N * sign, 0.0)
+    warnings = dataclasses.replace(sol, contact_forces=forces).gait_warnings()
+    assert len(warnings) == 1 and warnings[0].startswith(
+        "the left leg's vertical force zigzags from node to node")

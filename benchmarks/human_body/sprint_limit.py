@@ -14,7 +14,8 @@ more halfway from the last converged one, then the chain stops. The variant (JSO
 ``active_tension`` [N/cm²] (the fibres' active specific tension; the body's is 30),
 ``vmax`` [optimal fibre lengths/s] (every muscle's maximum shortening velocity; the body's is
 10), ``force_factor`` as in solve_variant.py, ``symmetric`` (true: each leg does what the other
-did half a stride earlier, ``CollocationSettings.symmetric``; able runner). Writes ``OUT/speed-<v>.json`` per converged speed
+did half a stride earlier, ``CollocationSettings.symmetric``; able runner), ``mesh`` (mesh
+intervals, default 50; a start on another mesh is resampled). Writes ``OUT/speed-<v>.json`` per converged speed
 and ``OUT/records.jsonl`` (one line per solve: the summary, the largest activation of any muscle
 at any node, the wall time), and prints each line.
 """

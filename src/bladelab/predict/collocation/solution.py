@@ -33,7 +33,12 @@ from bladelab.errors import DataError, SpecError
 from bladelab.predict.collocation.consistency import dynamics_residual
 from bladelab.predict.collocation.dynamics import stride_dynamics
 from bladelab.predict.collocation.model import build_collocation_model
-from bladelab.predict.collocation.nodes import evaluate_nodes, on_fine_grid, periodic_runs
+from bladelab.predict.collocation.nodes import (
+    evaluate_nodes,
+    force_zigzag_steps,
+    on_fine_grid,
+    periodic_runs,
+)
 from bladelab.predict.collocation.settings import CollocationSettings
 from bladelab.predict.collocation.stored import FieldReader, check_model_spec, runner_from_spec
 from bladelab.predict.collocation.stride_guess import COLLOCATION_SOURCE, StrideGuess
@@ -71,6 +76,16 @@ PEAK_GRF_WARNING_BW = 8.0
 #: the smooth and forward contact laws differed (a blade sole's onset, fixed on 2026-11-26)
 #: reached 9–48 %. Our decision.
 RESIDUAL_WARNING_PCT = 5.0
+#: A leg's vertical ground force that zigzags up and down by at least
+#: :data:`ZIGZAG_STEP_BW` body weights over this many consecutive node steps
+#: (:func:`~bladelab.predict.collocation.nodes.force_zigzag_steps`) is flagged by
+#: :meth:`CollocationSolution.gait_warnings`: the mesh does not resolve the stance, and its
+#: force peaks are the mesh's. Measured (benchmarks/human_body/sprint-vasti16, "Twice and four
+#: times the mesh"): runs of 1–3 on every stored stride at 2.5–5.5 m/s on 50 intervals and at
+#: 5.75–8 m/s on 100–200; 8 and 10 on the 50-interval strides at 8.25 and 5.75 m/s, whose
+#: peaks (5.6 and 2.6 BW) and objective (+75 %) moved on 100 intervals. Our decision.
+ZIGZAG_STEPS = 5
+ZIGZAG_STEP_BW = 0.25
 #: Samples per mesh interval of the linear interpolation used for contact and flight times.
 _FINE = 50
 
@@ -260,7 +275,8 @@ class CollocationSolution:
         """What makes this converged stride no running gait, in words (empty if nothing):
         a leg that never touches the ground (a one-legged hop), a leg that touches it more
         than once per stride (a swinging foot striking the ground, or a bounce), a peak
-        vertical force above :data:`PEAK_GRF_WARNING_BW`, no flight phase, a dynamics residual
+        vertical force above :data:`PEAK_GRF_WARNING_BW`, a leg's vertical force that zigzags
+        from node to node (:data:`ZIGZAG_STEPS`), no flight phase, a dynamics residual
         above :data:`RESIDUAL_WARNING_PCT`, or a stride time on a bound of the NLP
         (:data:`~bladelab.predict.collocation.transcription.PERIOD_BOUNDS_S`). Measured on 2026-11-25: the amputee Cat6 at 4 m/s
         from the Fukuchi trial's guess converged to a hop on the intact leg at the 0.4 s
@@ -281,6 +297,12 @@ class CollocationSolution:
         for bound in PERIOD_BOUNDS_S:
             if math.isclose(self.period_s, bound, rel_tol=1e-3):
                 out.append(f"the stride time sits on its bound ({bound:g} s)")
+        fz = self.leg_vertical_force()[:-1] / weight
+        out += [f"the {leg} leg's vertical force zigzags from node to node over {steps} steps "
+                "(the mesh does not resolve the stance: solve it on more intervals, e.g. "
+                "--mesh 100)"
+                for j, leg in enumerate(self.leg_names)
+                if (steps := force_zigzag_steps(fz[:, j], ZIGZAG_STEP_BW, 0.05)) >= ZIGZAG_STEPS]
         residual = self.dynamics_residual_pct
         if residual > RESIDUAL_WARNING_PCT:  # nan (not recorded) is not flagged
             out.append(f"the dynamics residual against the forward model is {residual:.1f} % "
