@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 
+import numpy as np
 import pytest
 
 from bladelab.cli import main
@@ -139,7 +140,8 @@ def test_the_transfemoral_runner_is_solved_with_its_own_blade(tmp_path, capsys):
 
 def test_a_transtibial_stride_starts_the_transfemoral_runner(tmp_path, capsys):
     """``--guess`` with the other amputee kind's solution: mapped by name (the socket hinge
-    dropped), grounded; the able model's solution is still refused."""
+    dropped), grounded when nothing is known of the source's contacts, its flights kept when
+    the source's contact heights are given; the able model's solution is still refused."""
     from bladelab.predict.collocation.guess import prosthetic_stride_on
     from bladelab.runner import build_runner
     from bladelab.runner.model import contact_heights
@@ -151,6 +153,16 @@ def test_a_transtibial_stride_starts_the_transfemoral_runner(tmp_path, capsys):
     lowest = [contact_heights(tf, q).min() for q in g.q]
     assert lowest == pytest.approx([-0.01] * len(lowest), abs=1e-9)
     assert g.q.shape[1] == len(tf.dof_names) and "grounded" in g.source
+    # with the source's own lowest contacts: the same heights on this runner, node by node
+    # where the source is on the ground, and the flights (above it) kept
+    tt = build_runner("amputee", blade="Cat6")
+    src_low = np.array([contact_heights(tt, q).min() for q in transtibial.nlp.q])
+    src_low[3:6] = [0.02, 0.03, 0.02]  # a flight
+    kept = prosthetic_stride_on(tf, transtibial.to_guess(), source_heights=src_low)
+    low = np.array([contact_heights(tf, q).min() for q in kept.q])
+    ground = src_low <= 0.0
+    assert low[ground] == pytest.approx(src_low[ground], abs=1e-9)
+    assert (low[3:6] > 0.0).all() and "flights kept" in kept.source
     out = tmp_path / "tf"
     code = main(["predict", "--method", "collocation", "--model", "transfemoral", "--out",
                  str(out), "--mesh", "6", "--max-iter", "1", "--guess", str(src),
