@@ -519,11 +519,10 @@ def build_runner(
             lo, hi, k, d = LIGAMENTS[base]
             if base == "knee_angle":
                 lo = -params.knee_flexion_limit_deg
-            jp[i, :4] = (math.radians(lo), math.radians(hi), k, d)
-        if base == "lumbar_extension" and params.lumbar_passive == "spring":
-            lo, hi, k, d = LIGAMENTS[base]
-            jp[i, :4] = (-np.inf, np.inf, 0.0, 0.0)
-            jp[i, JP_SK:JP_EA] = (k, 0.0, d, d)
+            if base == "lumbar_extension" and params.lumbar_passive == "spring":
+                jp[i, JP_SK:JP_EA] = (k, 0.0, d, d)  # the limit's K and D about 0°, no limit
+            else:
+                jp[i, :4] = (math.radians(lo), math.radians(hi), k, d)
         capsule = params.capsule_moments.get(base)
         if capsule is not None:
             jp[i, JP_EA] = capsule.moment_at_zero_Nm

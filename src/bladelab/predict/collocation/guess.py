@@ -59,56 +59,54 @@ __all__ = [
 
 
 def prosthetic_stride_on(model: RunnerModel, guess: StrideGuess, *, depth_m: float = 0.01,
-                         source_heights: np.ndarray | None = None,
+                         source: RunnerModel | None = None,
                          source_grf_bw: np.ndarray | None = None) -> StrideGuess:
     """A stride of one amputee runner kind as the start of another (the transtibial runner's
     stride as the transfemoral runner's: docs/design.md "Predicted transfemoral gaits"):
     coordinates and muscles matched by name (:meth:`StrideGuess.on_model`), then the pelvis
     moved up or down and speeds taken from the new coordinates.
 
-    With ``source_heights`` (the source stride's lowest contact height at each node [m], on its
-    own runner) the stride keeps its flights: at every node where the source is on the ground
-    the pelvis moves so that this runner's lowest contact is as deep as the source's, and the
-    shift is interpolated (periodically) through the flights; the vertical force pattern is
-    ``source_grf_bw`` [body weights] when given. Without them every node is lowered until its
-    lowest contact is ``depth_m`` deep (no flight is left) and the force pattern is
-    :func:`template_vertical_grf`. Measured on the transfemoral runner from the transtibial
-    stride: the grounded start never led to alternating steps, the start with its flights did
-    (benchmarks/design/transfemoral-gait-2026-12-01)."""
+    With ``source`` (the runner ``guess`` is a stride of) the stride keeps its flights: at every
+    node where the source's lowest contact is on the ground the pelvis moves so that this
+    runner's lowest contact is as deep, and the shift is interpolated (periodically) through
+    the flights; the vertical force pattern is ``source_grf_bw`` [body weights] when given.
+    Without it every node is lowered until its lowest contact is ``depth_m`` deep (no flight is
+    left) and the force pattern is :func:`template_vertical_grf`. Measured on the transfemoral
+    runner from the transtibial stride: the grounded start never led to alternating steps, the
+    start with its flights did (benchmarks/design/transfemoral-gait-2026-12-01)."""
     g = guess.on_model(model)
-    if source_heights is None:
+    if source is None:
         q = _grounded(model, g.q)
         q[:, model.dof("pelvis_tz")] -= depth_m
         return replace(g, q=q, qd=periodic_derivative(q, g.period),
                        vertical_grf_bw=template_vertical_grf(np.linspace(0.0, 1.0, q.shape[0])),
                        source=f"{g.source}, grounded")
-    q = g.q.copy()
-    heights = np.asarray(source_heights, float)
-    if heights.shape != (q.shape[0],):
-        raise DataError(f"{heights.size} source heights for a stride of {q.shape[0]} nodes",
-                        where="source_heights")
-    own = np.array([contact_heights(model, qk).min() for qk in q])
-    shift = heights - own
+    heights = _lowest_contacts(source, guess.q)
+    shift = heights - _lowest_contacts(model, g.q)
     ground = heights <= 0.0
     if ground.any() and not ground.all():
-        n = q.shape[0] - 1  # the last node repeats the first
+        n = shift.size - 1  # the last node repeats the first
         k = np.flatnonzero(ground[:n])
         shift[:n] = np.interp(np.arange(n), np.concatenate([k - n, k, k + n]),
                               np.tile(shift[k], 3))
         shift[n] = shift[0]
+    q = g.q.copy()
     q[:, model.dof("pelvis_tz")] += shift
     grf = g.vertical_grf_bw if source_grf_bw is None else np.asarray(source_grf_bw, float)
     return replace(g, q=q, qd=periodic_derivative(q, g.period), vertical_grf_bw=grf,
                    source=f"{g.source}, its flights kept")
 
 
+def _lowest_contacts(model: RunnerModel, q: np.ndarray) -> np.ndarray:
+    """Height [m] of the lowest contact point at each node of ``q`` (negative: penetrating)."""
+    return np.array([contact_heights(model, qk).min() for qk in q])
+
+
 def _grounded(model: RunnerModel, q: np.ndarray) -> np.ndarray:
     """``q`` with pelvis_tz lowered (or raised) at every node until the lowest contact point is
     on the ground."""
     q = q.copy()
-    iz = model.dof("pelvis_tz")
-    for k in range(q.shape[0]):
-        q[k, iz] -= contact_heights(model, q[k]).min()
+    q[:, model.dof("pelvis_tz")] -= _lowest_contacts(model, q)
     return q
 
 

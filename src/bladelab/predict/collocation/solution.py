@@ -86,6 +86,8 @@ RESIDUAL_WARNING_PCT = 5.0
 #: peaks (5.6 and 2.6 BW) and objective (+75 %) moved on 100 intervals. Our decision.
 ZIGZAG_STEPS = 5
 ZIGZAG_STEP_BW = 0.25
+#: Above this vertical force [body weights] a leg counts as loaded for the zigzag.
+ZIGZAG_LOADED_BW = 0.05
 #: Samples per mesh interval of the linear interpolation used for contact and flight times.
 _FINE = 50
 
@@ -302,7 +304,7 @@ class CollocationSolution:
                 "(the mesh does not resolve the stance: solve it on more intervals, e.g. "
                 "--mesh 100)"
                 for j, leg in enumerate(self.leg_names)
-                if (steps := force_zigzag_steps(fz[:, j], ZIGZAG_STEP_BW, 0.05)) >= ZIGZAG_STEPS]
+                if (steps := force_zigzag_steps(fz[:, j], ZIGZAG_STEP_BW, ZIGZAG_LOADED_BW)) >= ZIGZAG_STEPS]
         residual = self.dynamics_residual_pct
         if residual > RESIDUAL_WARNING_PCT:  # nan (not recorded) is not flagged
             out.append(f"the dynamics residual against the forward model is {residual:.1f} % "

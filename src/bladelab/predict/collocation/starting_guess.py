@@ -16,8 +16,6 @@ from __future__ import annotations
 import dataclasses
 from pathlib import Path
 
-import numpy as np
-
 from bladelab._io import read_json
 from bladelab.errors import InputFileError, SpecError
 from bladelab.predict.collocation.guess import (
@@ -29,7 +27,6 @@ from bladelab.predict.collocation.guess import (
 from bladelab.predict.collocation.solution import CollocationSolution
 from bladelab.predict.collocation.stored import runner_from_spec
 from bladelab.predict.collocation.stride_guess import StrideGuess
-from bladelab.runner.model import contact_heights
 from bladelab.runner.params import (
     ATHLETE_PARAM_FIELDS,
     PROSTHETIC_KINDS,
@@ -155,10 +152,8 @@ def make_guess(runner, guess: str, *, n: int, speed: float | None, where: str = 
         if sol.model_spec["model"] == runner.kind:  # another body of the same kind is mapped
             return stride
         if {sol.model_spec["model"], runner.kind} <= set(PROSTHETIC_KINDS):
-            source = runner_from_spec(sol.model_spec)
-            heights = np.array([contact_heights(source, q).min() for q in sol.nlp.q])
             grf = sol.leg_vertical_force().sum(axis=1) / sol.body_weight_N
-            return prosthetic_stride_on(runner, stride, source_heights=heights,
+            return prosthetic_stride_on(runner, stride, source=runner_from_spec(sol.model_spec),
                                         source_grf_bw=grf)
         raise SpecError("the guess is a solution of another model", file=path,
                         where=where, hint=f"it is of {sol.model_spec}; an amputee runner's "
