@@ -34,10 +34,9 @@ from bladelab.runner import build_runner
 from bladelab.runner.params import default_runner_params, runner_params_from_dict
 
 
-def main() -> None:
-    out, variant = Path(sys.argv[1]), json.loads(sys.argv[2])
+def variant_runner(variant: dict):
+    """The human runner of ``kind`` with the variant's ``force_factor``, ``muscle`` and ``set``."""
     kind, blade = variant.get("kind", "able"), variant.get("blade")
-    speed = variant.get("speed", 3.5)
     data = json.loads(default_runner_params(kind, body="human", blade=blade).model_dump_json())
     for name, factor in variant.get("force_factor", {}).items():
         for muscle, row in data["muscle_types"].items():
@@ -46,7 +45,14 @@ def main() -> None:
     for muscle, row in variant.get("muscle", {}).items():
         data["muscle_types"][muscle].update(row)
     data.update(variant.get("set", {}))
-    runner = build_runner(runner_params_from_dict(data))
+    return build_runner(runner_params_from_dict(data))
+
+
+def main() -> None:
+    out, variant = Path(sys.argv[1]), json.loads(sys.argv[2])
+    kind, blade = variant.get("kind", "able"), variant.get("blade")
+    speed = variant.get("speed", 3.5)
+    runner = variant_runner(variant)
     weights = variant.get("weights")
     settings = CollocationSettings(speed_m_per_s=speed,
                                    weights=StrideWeights(**weights) if weights else None,
