@@ -8,8 +8,9 @@ For each named muscle (default ``soleus_l,gastroc_l,vasti_l``) prints, at every 
 the stride: its leg's vertical ground force [BW], activation [-], tendon force [F_max], fibre
 length [l_opt] and fibre velocity [v_max l_opt/s, + lengthening], then the fibre length at
 the node of peak activation in stance. A ``variant.json`` beside the stride (written by
-``solve_variant.py``) rebuilds that variant's body, so that its tendon slack lengths and
-forces are the ones the stride was solved with; otherwise the stride's own model. People's
+``solve_variant.py`` or ``sprint_limit.py``) rebuilds that variant's body, so that its tendon
+slack lengths, forces and fibre speeds are the ones the stride was solved with; otherwise the
+stride's own model. People's
 soleus in running: 0.88 l_opt at peak activation (Rubenson et al. 2012, J Exp Biol 215:3539),
 0.90 ± 0.10 l_opt (Bohm et al. 2019, Proc R Soc B 286:20192560).
 """
@@ -25,6 +26,7 @@ from solve_variant import variant_runner
 
 from bladelab.predict.collocation.model import build_collocation_model
 from bladelab.predict.collocation.muscles import MP_LOPT, MP_VMAX
+from bladelab.predict.collocation.nodes import evaluate_nodes
 from bladelab.predict.collocation.solution import CONTACT_THRESHOLD_N, CollocationSolution
 from bladelab.predict.collocation.stored import runner_from_spec
 
@@ -39,18 +41,14 @@ def fibre_table(path: Path, muscles: list[str]) -> tuple[dict[str, np.ndarray], 
     cm, s, mp = build_collocation_model(runner), sol.nlp, runner.muscle_params
     names = list(runner.muscle_names)
     fz = sol.leg_vertical_force() / sol.body_weight_N
-    states = []
-    for k in range(s.q.shape[0]):
-        l_mt, v_mt = (np.asarray(x).ravel() for x in cm.mtu(s.q[k], s.qd[k]))
-        l_m, v_m, _ = cm.fiber(l_mt, v_mt, s.tendon_force[k], s.tendon_force_rate[k])
-        states.append((np.asarray(l_m).ravel(), np.asarray(v_m).ravel()))
+    fibres = evaluate_nodes(cm, s.q, s.qd, s.tendon_force, s.tendon_force_rate)
+    nodes = np.arange(s.q.shape[0])
     out = {}
     for name in muscles:
         i, leg = names.index(name), 0 if name.endswith("_l") else 1
-        out[name] = np.array([(k, fz[k, leg], s.activation[k, i], s.tendon_force[k, i],
-                               states[k][0][i] / mp[i, MP_LOPT],
-                               states[k][1][i] / (mp[i, MP_VMAX] * mp[i, MP_LOPT]))
-                              for k in range(s.q.shape[0])])
+        out[name] = np.column_stack([nodes, fz[:, leg], s.activation[:, i], s.tendon_force[:, i],
+                                     fibres["l_m"][:, i] / mp[i, MP_LOPT],
+                                     fibres["v_m"][:, i] / (mp[i, MP_VMAX] * mp[i, MP_LOPT])])
     return out, CONTACT_THRESHOLD_N / sol.body_weight_N
 
 

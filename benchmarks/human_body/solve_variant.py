@@ -35,9 +35,14 @@ from bladelab.runner.params import default_runner_params, runner_params_from_dic
 
 
 def variant_runner(variant: dict):
-    """The human runner of ``kind`` with the variant's ``force_factor``, ``muscle`` and ``set``."""
+    """The human runner of ``kind`` with the variant's ``force_factor``, ``muscle`` and ``set``,
+    and ``sprint_limit.py``'s shorthands ``vmax`` [l_opt/s] and ``active_tension`` [N/cm²]."""
     kind, blade = variant.get("kind", "able"), variant.get("blade")
     data = json.loads(default_runner_params(kind, body="human", blade=blade).model_dump_json())
+    if "vmax" in variant:
+        data["max_shortening_velocity_lopt_per_s"] = float(variant["vmax"])
+    if "active_tension" in variant:
+        data["active_specific_tension_N_per_cm2"] = float(variant["active_tension"])
     for name, factor in variant.get("force_factor", {}).items():
         for muscle, row in data["muscle_types"].items():
             if name in ("all", muscle) and row.get("max_isometric_force_N"):

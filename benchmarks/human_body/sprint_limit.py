@@ -13,7 +13,7 @@ no people's term (``people_weight``, default 0); a speed that does not converge 
 more halfway from the last converged one, then the chain stops. The variant (JSON):
 ``active_tension`` [N/cm²] (the fibres' active specific tension; the body's is 30),
 ``vmax`` [optimal fibre lengths/s] (every muscle's maximum shortening velocity; the body's is
-10), ``force_factor`` as in solve_variant.py, ``symmetric`` (true: each leg does what the other
+10), ``force_factor``, ``muscle`` and ``set`` as in solve_variant.py, ``symmetric`` (true: each leg does what the other
 did half a stride earlier, ``CollocationSettings.symmetric``; able runner), ``mesh`` (mesh
 intervals, default 50; a start on another mesh is resampled). Writes ``OUT/speed-<v>.json`` per converged speed
 and ``OUT/records.jsonl`` (one line per solve: the summary, the largest activation of any muscle
@@ -28,28 +28,18 @@ import time
 from pathlib import Path
 
 import numpy as np
+from solve_variant import variant_runner
 
 from bladelab.predict.collocation.settings import CollocationSettings, people_term
 from bladelab.predict.collocation.solution import CollocationSolution
 from bladelab.predict.collocation.solve import predict_stride
 from bladelab.predict.collocation.starting_guess import make_guess
-from bladelab.runner import build_runner
-from bladelab.runner.params import default_runner_params, runner_params_from_dict
 
 
 def main() -> None:
     out, variant = Path(sys.argv[1]), json.loads(sys.argv[2])
     kind, blade = variant.get("kind", "able"), variant.get("blade")
-    data = json.loads(default_runner_params(kind, body="human", blade=blade).model_dump_json())
-    if "vmax" in variant:
-        data["max_shortening_velocity_lopt_per_s"] = float(variant["vmax"])
-    for name, factor in variant.get("force_factor", {}).items():
-        for muscle, row in data["muscle_types"].items():
-            if name in ("all", muscle) and row.get("max_isometric_force_N"):
-                row["max_isometric_force_N"] *= factor
-    if "active_tension" in variant:
-        data["active_specific_tension_N_per_cm2"] = float(variant["active_tension"])
-    runner = build_runner(runner_params_from_dict(data))
+    runner = variant_runner(variant)
     spec = {"model": kind, "blade": blade, "body": "human"}
     speeds = variant.get("speeds", [4.5, 5.5] + [6.0 + 0.5 * k for k in range(9)])
     people = people_term(float(variant.get("people_weight", 0.0)))
