@@ -15,6 +15,7 @@ from bladelab.predict.collocation.guess import (
     template_guess,
 )
 from bladelab.runner import build_runner
+from bladelab.runner.layout import CP_BLADE, CP_LEG
 from bladelab.runner.model import contact_heights
 
 SOLUTIONS = Path(__file__).resolve().parents[1] / "src/bladelab/data/runner/reflex-starts"
@@ -25,34 +26,70 @@ def able():
     return build_runner("able")
 
 
-def _check_stride(model, g, speed):
+def _check_periodic(model, g, speed):
     assert g.speed == pytest.approx(speed, rel=1e-9)
     # periodic: the last node is the first one period later (pelvis advanced by the stride)
     advance = np.zeros(g.q.shape[1])
     advance[model.dof("pelvis_tx")] = speed * g.period
     np.testing.assert_allclose(g.q[-1], g.q[0] + advance, atol=1e-9)
     np.testing.assert_allclose(g.qd[-1], g.qd[0], atol=1e-9)
+
+
+def _check_stride(model, g, speed):
+    _check_periodic(model, g, speed)
     # the pelvis is placed so that the lowest contact point touches the ground at every node
     lowest = np.array([contact_heights(model, q).min() for q in g.q])
     np.testing.assert_allclose(lowest, 0.0, atol=1e-9)
 
 
-def test_template_is_a_periodic_grounded_stride(able):
+def _leg_heights(model, g):
+    """Lowest contact point of each leg [m] at every node, shape (n + 1, 2)."""
+    legs = model.contact_params[:, CP_LEG]
+    return np.array([[contact_heights(model, q)[legs == leg].min() for leg in (0, 1)]
+                     for q in g.q])
+
+
+@pytest.mark.parametrize("kind", ["able", "amputee", "transfemoral"])
+def test_template_runs_forwards_on_its_stance_feet(kind):
+    """The template's kinematic stances are its force pattern's: the loaded foot is on the
+    ground while its hip extends; between the stances the runner flies, no foot in the ground."""
+    model = build_runner(kind)
+    g = template_guess(model, speed=4.0, n=40)
+    _check_periodic(model, g, 4.0)
+    heights = _leg_heights(model, g)
+    f = g.vertical_grf_bw[:-1]
+    phase = np.arange(40) / 40
+    for leg, start, side in ((0, 0.0, "l"), (1, 0.5, "r")):
+        stance = (np.mod(phase - start, 1.0) < 0.3) & (f > 0)
+        assert stance.sum() >= 8
+        np.testing.assert_allclose(heights[:-1][stance, leg], 0.0, atol=1e-9)
+        hip = g.q[:-1, model.dof(f"hip_flexion_{side}")][stance]
+        assert hip[-1] < hip[0] - np.radians(30)  # the stance hip extends: running forwards
+    flight = f == 0
+    assert flight.sum() >= 4
+    assert heights[:-1][flight].min() > -1e-9
+    assert (g.q[:-1, model.dof("pelvis_tz")][flight].max()
+            > g.q[:-1, model.dof("pelvis_tz")][~flight].max())
+
+
+def test_template_is_people_running(able):
     g = template_guess(able, speed=4.0, n=40)
-    _check_stride(able, g, 4.0)
     assert g.q.shape == (41, 10) and 0.6 < g.period < 0.8
-    # swing knee flexion of running (> 80°) and the legs half a period apart
+    # swing knee flexion of running (> 80°), a nearly straight knee at touch-down, and the
+    # legs half a period apart
     knee = -np.degrees(g.q[:, able.dof("knee_angle_l")])
-    assert knee.max() > 80 and knee.min() < 25
+    assert knee.max() > 80 and knee[0] < 25
     right = -np.degrees(g.q[:, able.dof("knee_angle_r")])
     np.testing.assert_allclose(np.roll(right[:-1], -20), knee[:-1], atol=1e-9)
     with pytest.raises(SpecError, match="speed"):
         template_guess(able, speed=0.0)
-    # its force pattern: alternating half-sine stances carrying one body weight on average
+    # its force pattern: alternating half-sine stances carrying one body weight on average,
+    # shorter and higher when faster
     f = g.vertical_grf_bw
     assert f.shape == (41,) and np.trapezoid(f, dx=1 / 40) == pytest.approx(1.0, rel=0.02)
-    assert 2.2 < f.max() < 2.4 and f[0] == 0.0 and f[7] > 2.2 and f[15] == 0.0
-    assert f[27] > 2.2 and f[35] == 0.0  # the right stance, half a stride later
+    assert f[0] == 0.0 and f[20] == 0.0 and f[5] > 2.2 and f[25] > 2.2
+    slower = template_guess(able, speed=3.0, n=40)
+    assert slower.period > g.period and slower.vertical_grf_bw.max() < f.max()
 
 
 def test_resampling_keeps_the_stride(able):
@@ -139,7 +176,6 @@ def test_the_transfemoral_template_keeps_the_passive_knee_straight_in_stance():
 def test_a_sphere_stride_starts_a_multilink_blade_at_its_static_deflection():
     from bladelab.design.blade_generator import generate_blade
     from bladelab.predict.collocation.stride_guess import StrideGuess, deflected_blade
-    from bladelab.runner.layout import CP_BLADE
 
     sphere = build_runner("transfemoral")
     runner = build_runner("transfemoral", blade_model=generate_blade(

@@ -5,7 +5,8 @@ Usage (from the repository root)::
     .venv/bin/python benchmarks/collocation_speed/coarse_start.py MODEL BLADE SPEED MESH START OUT [W]
 
 MODEL ``able`` or ``amputee``, BLADE a category or ``none``, SPEED [m/s], MESH intervals,
-START ``sine`` (the library's template guess) or ``people`` (a template from people's mean
+START ``template`` (the library's template guess: a sine template until 2026-12-01, people's
+running since) or ``people`` (a template from people's mean
 joint angles, ``bladelab.predict.collocation.people.people_joint_angles``: RBDS002 and
 RBDS003 of Fukuchi et al. 2017, the right leg half a stride later, the trunk 5° forward, the
 template's stride time and vertical force pattern). W: the weight of people's joint angles in
@@ -61,7 +62,7 @@ def main(argv: list[str]) -> int:
     weight = defaults.people_weight_for("human", float(argv[6]) if len(argv) > 6 else None)
     blade = None if blade == "none" else blade
     runner = build_runner(model, blade=blade, body="human")
-    guess = (template_guess(runner, speed=speed, n=n) if start == "sine"
+    guess = (template_guess(runner, speed=speed, n=n) if start == "template"
              else people_template(runner, speed, n))
     stages = []
 

@@ -6,11 +6,11 @@ next one; a guess gives the runner's coordinates and speeds at ``n + 1`` equally
 known, muscle activations and normalised tendon forces (a
 :class:`~bladelab.predict.collocation.stride_guess.StrideGuess`). Three sources:
 
-- :func:`template_guess`: a smooth template of running kinematics (sinusoidal hip, knee and
-  ankle angles with literature-typical ranges at 3–5 m/s, the other leg half a period later;
-  the transfemoral runner's passive knee straight in stance, :func:`prosthetic_knee_template`),
-  the pelvis lowered at every node until its lowest contact point touches the ground (a guess
-  that starts near the ground converges far better than a constant-height one, DESIGN.md);
+- :func:`template_guess`: people's running as a template (people's mean hip, knee and ankle
+  angles at 3.5 m/s, time-warped to people's stance share and stride time at the speed, the
+  other leg half a period later; the transfemoral runner's passive knee straight in stance,
+  :func:`prosthetic_knee_template`), the stance foot on the ground and ballistic flights
+  between the stances;
 - :func:`guess_from_trial`: measured running (e.g. the Fukuchi et al. 2017 treadmill trial at
   3.5 m/s): sagittal angles from markers (:mod:`bladelab.trial.cycles`), averaged over the
   trial's left-leg cycles, the pelvis placed the same way; the amputee's socket held at 0;
@@ -30,12 +30,15 @@ from pathlib import Path
 import numpy as np
 
 from bladelab._io import read_json
+from bladelab.constants import STANDARD_GRAVITY
 from bladelab.datasets import (
     MEASURED_TRIAL_SPEED_M_PER_S,
     measured_running_trial,
     measured_static_trial,
 )
 from bladelab.errors import DataError, SpecError
+from bladelab.predict.collocation.people import people_joint_angles
+from bladelab.predict.collocation.running_bands import reference_band
 from bladelab.predict.collocation.stride_guess import StrideGuess, periodic_derivative
 from bladelab.predict.reflex.controller import read_parameters
 from bladelab.predict.reflex.objective import simulate_controlled
@@ -56,6 +59,11 @@ __all__ = [
     "template_guess",
     "template_vertical_grf",
 ]
+
+#: Fraction of the stride at which people's stance ends in the mean curves of
+#: :func:`~bladelab.predict.collocation.people.people_joint_angles` (the measured vertical
+#: force of RBDS002 and RBDS003 at 3.5 m/s falls to zero at 31–32 % of the stride).
+PEOPLE_TOE_OFF = 0.315
 
 
 def prosthetic_stride_on(model: RunnerModel, guess: StrideGuess, *, depth_m: float = 0.01,
@@ -127,37 +135,87 @@ def _angles_to_q(model: RunnerModel, time_frac: np.ndarray, period: float, speed
 
 def template_guess(model: RunnerModel, *, speed: float = 3.5, n: int = 50,
                    period: float | None = None) -> StrideGuess:
-    """A smooth template stride at ``speed`` [m/s] on ``n`` intervals (module docstring).
+    """People's running as a template stride at ``speed`` [m/s] on ``n`` intervals.
 
-    The period defaults to a typical stride time, 0.75 s at 3.5 m/s, shorter when faster
-    (stride frequency rising ~5 %/(m/s)).
+    The hip, knee and ankle follow people's mean angles at 3.5 m/s
+    (:func:`~bladelab.predict.collocation.people.people_joint_angles`: RBDS002 and RBDS003 of
+    Fukuchi et al. 2017), the right leg half a stride later, the trunk 5° forward, the
+    transfemoral runner's passive knee :func:`prosthetic_knee_template`. The stride time
+    defaults to the middle of people's band at ``speed``
+    (:func:`~bladelab.predict.collocation.running_bands.reference_band`: 0.71 s at 3.5 m/s);
+    each leg's stance lasts people's share of the stride at that speed (0.315 at 3.5 m/s,
+    shorter when faster, as the contact-time band) and the angles are time-warped so that
+    people's toe-off falls at its end. The force pattern is :func:`template_vertical_grf` of
+    that stance. The pelvis keeps the stance foot on the ground and flies a ballistic arc
+    between the stances (:func:`_stances_and_flights`).
     """
     if not (speed > 0 and math.isfinite(speed)):
         raise SpecError(f"speed must be > 0 m/s, got {speed}", where="speed")
-    period = float(period) if period is not None else 0.75 / (1.0 + 0.05 * (speed - 3.5))
+    stride_lo, stride_hi, _ = reference_band("stride time", speed)
+    period = float(period) if period is not None else 0.5 * (stride_lo + stride_hi)
+    if not (period > 0 and math.isfinite(period)):
+        raise SpecError(f"stride time must be > 0 s, got {period}", where="period")
+    duty = PEOPLE_TOE_OFF * _contact_share(speed) / _contact_share(MEASURED_TRIAL_SPEED_M_PER_S)
     frac = np.linspace(0.0, 1.0, n + 1)
-    deg = math.pi / 180.0
-
-    def leg(phase: np.ndarray) -> dict[str, np.ndarray]:
-        w = 2 * math.pi * phase
-        # phase 0 = touch-down: hip flexed ~30°, knee ~15° flexed; swing knee flexion peaks
-        # ~100° at 70 % of the cycle; ankle dorsiflexed in stance, plantarflexed at toe-off
-        return {
-            "hip": deg * (10.0 + 25.0 * np.cos(w - 0.15)),
-            "knee": deg * (45.0 - 35.0 * np.cos(w - 4.3) + 15.0 * np.cos(2 * w - 1.2)),
-            "ankle": deg * (-5.0 + 15.0 * np.cos(w - 0.9)),
-        }
-
-    left, right = leg(frac), leg(frac + 0.5)
+    curves = people_joint_angles()
+    q = np.zeros((n + 1, len(model.dof_names)))
+    q[:, model.dof("pelvis_tx")] = speed * period * frac
+    q[:, model.dof("pelvis_tilt")] = -math.radians(5.0)
+    for side, lag in (("l", 0.0), ("r", 0.5)):
+        phase = np.mod(frac - lag, 1.0)
+        people_phase = np.where(phase < duty, phase / duty * PEOPLE_TOE_OFF,
+                                PEOPLE_TOE_OFF + (phase - duty) / (1.0 - duty)
+                                * (1.0 - PEOPLE_TOE_OFF))
+        for base, curve in curves.items():
+            name = f"{base}_{side}"
+            if name in model.dof_names:
+                q[:, model.dof(name)] = np.interp(people_phase, np.arange(100) / 100.0, curve,
+                                                  period=1.0)
     if model.kind == "transfemoral":  # a passive knee: straight in stance, flexed in swing
-        right["knee"] = prosthetic_knee_template(frac + 0.5)
-    angles = {"trunk_pitch": np.full(frac.size, 5.0 * deg)}
-    for side, a in (("left", left), ("right", right)):
-        angles.update({f"hip_{side}": a["hip"], f"knee_{side}": a["knee"],
-                       f"ankle_{side}": a["ankle"]})
-    q = _angles_to_q(model, frac, period, speed, angles)
+        q[:, model.dof("knee_angle_r")] = -prosthetic_knee_template(frac + 0.5)
+    grf = template_vertical_grf(frac, duty=duty)
+    q = _stances_and_flights(model, q, period, duty)
     return StrideGuess(f"template at {speed:g} m/s", period, q, periodic_derivative(q, period),
-                       vertical_grf_bw=template_vertical_grf(frac))
+                       vertical_grf_bw=grf)
+
+
+def _contact_share(speed: float) -> float:
+    """People's contact time over their stride time at ``speed`` [m/s] (the bands' middles)."""
+    contact_lo, contact_hi, _ = reference_band("contact time", speed)
+    stride_lo, stride_hi, _ = reference_band("stride time", speed)
+    return (contact_lo + contact_hi) / (stride_lo + stride_hi)
+
+
+def _stances_and_flights(model: RunnerModel, q: np.ndarray, period: float,
+                         duty: float) -> np.ndarray:
+    """``q`` with the pelvis height of a running stride: during each leg's stance (the left
+    leg's from 0 to ``duty`` of the stride, the right leg's half a stride later) the pelvis
+    is moved so that that leg's lowest contact point is on the ground; between the stances it
+    flies a ballistic arc (gravity, no contact) joining the heights at their ends, raised
+    where a foot would be in the ground."""
+    q = q.copy()
+    n = q.shape[0] - 1
+    iz = model.dof("pelvis_tz")
+    legs = model.contact_params[:, CP_LEG]
+    frac = np.arange(n) / n
+    stance_leg = np.full(n, -1)
+    stance_leg[frac < duty] = 0
+    stance_leg[np.mod(frac - 0.5, 1.0) < duty] = 1
+    for k in np.flatnonzero(stance_leg >= 0):
+        q[k, iz] -= contact_heights(model, q[k])[legs == stance_leg[k]].min()
+    grounded = np.flatnonzero(stance_leg >= 0)
+    h = period / n
+    for j, a in enumerate(grounded):  # each flight: from stance node a to the next one, b
+        b = grounded[j + 1] if j + 1 < grounded.size else grounded[0] + n
+        if b - a < 2:
+            continue
+        za, zb, span = q[a, iz], q[b % n, iz], (b - a) * h
+        nodes = np.arange(a + 1, b) % n
+        t = (np.arange(a + 1, b) - a) * h
+        arc = za + (zb - za) * t / span + 0.5 * STANDARD_GRAVITY * t * (span - t)
+        q[nodes, iz] = np.maximum(arc, q[nodes, iz] - _lowest_contacts(model, q[nodes]))
+    q[n, iz] = q[0, iz]
+    return q
 
 
 def prosthetic_knee_template(phase: np.ndarray) -> np.ndarray:
