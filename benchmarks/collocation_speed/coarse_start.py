@@ -1,18 +1,21 @@
-"""Probe: a cold start solved on a coarse mesh, as the first step of a mesh continuation.
+"""Probe: a cold start on a given mesh (a coarse one: the first step of a mesh continuation).
 
 Usage (from the repository root)::
 
-    .venv/bin/python benchmarks/collocation_speed/coarse_start.py MODEL BLADE SPEED MESH START OUT [W]
+    .venv/bin/python benchmarks/collocation_speed/coarse_start.py MODEL BLADE SPEED MESH START OUT [W] [--no-track]
 
-MODEL ``able`` or ``amputee``, BLADE a category or ``none``, SPEED [m/s], MESH intervals,
+MODEL ``able``, ``amputee`` or ``transfemoral``, BLADE a category or ``none``, SPEED [m/s],
+MESH intervals,
 START ``template`` (the library's template guess: a sine template until 2026-12-01, people's
 running since) or ``people`` (a template from people's mean
 joint angles, ``bladelab.predict.collocation.people.people_joint_angles``: RBDS002 and
 RBDS003 of Fukuchi et al. 2017, the right leg half a stride later, the trunk 5° forward, the
 template's stride time and vertical force pattern). W: the weight of people's joint angles in
 the objective [1/rad²] (default: the human body's, 10). Solves the tracking stage and the
-predictive stage on the human body, writes the solution to OUT and
-prints one JSON line: each stage's iterations, wall time and status, and the solve's summary.
+predictive stage on the human body (``--no-track``: the predictive stage straight from the
+start), writes the solution to OUT and prints one JSON line: each stage's iterations, wall
+time and status, the objective, the solve's summary and the criteria against measured
+running that the stride misses.
 """
 
 from __future__ import annotations
@@ -26,6 +29,7 @@ import numpy as np
 
 from bladelab.predict import defaults
 from bladelab.predict.collocation.guess import template_guess, template_vertical_grf
+from bladelab.predict.collocation.human_running import human_running_criteria
 from bladelab.predict.collocation.people import people_joint_angles
 from bladelab.predict.collocation.settings import CollocationSettings, people_term
 from bladelab.predict.collocation.solve import predict_stride
@@ -57,6 +61,8 @@ def people_template(runner, speed: float, n: int) -> StrideGuess:
 
 
 def main(argv: list[str]) -> int:
+    track = "--no-track" not in argv
+    argv = [a for a in argv if a != "--no-track"]
     model, blade, speed, n, start, out = argv[:6]
     speed, n = float(speed), int(n)
     weight = defaults.people_weight_for("human", float(argv[6]) if len(argv) > 6 else None)
@@ -74,12 +80,14 @@ def main(argv: list[str]) -> int:
     t0 = time.perf_counter()
     settings = CollocationSettings(speed_m_per_s=speed, mesh_intervals=n, **people_term(weight))
     sol = predict_stride(runner, settings, guess, model_spec={"model": model, "blade": blade, "body": "human"},
-                         progress=progress)
+                         progress=progress, track=track)
     sol.write(out)
+    missed = [c.line() for c in human_running_criteria(sol) if not c.met]
     print(json.dumps({"model": model, "blade": blade, "start": start, "mesh": n,
-                      "people_weight": weight,
+                      "people_weight": weight, "track": track,
                       "wall_s": round(time.perf_counter() - t0, 1), "stages": stages,
-                      "summary": sol.summary()}))
+                      "objective": sol.nlp.objective, "summary": sol.summary(),
+                      "criteria_missed": missed}))
     return 0
 
 
