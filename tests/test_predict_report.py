@@ -283,7 +283,7 @@ def test_a_parameter_file_of_the_human_body_is_shown_on_that_body(tmp_path):
     from bladelab.predict.reflex.optimize import runner_and_layout
 
     human, layout = runner_and_layout("able", None, "human")
-    settings = ObjectiveSettings(speed=3.5, duration=1.0)
+    settings = ObjectiveSettings(speed=3.5, duration=1.0, integrator="newmark")
     path = write_parameters(tmp_path / "human.json", layout, layout.x0, body="human",
                             speed_m_per_s=3.5, settings=settings.to_dict())
     rep = build_predictive_report(path, tmp_path / "r", duration=1.0, progress=False)

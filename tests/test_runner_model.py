@@ -289,9 +289,9 @@ def test_toe_body_keeps_the_mass_and_adds_a_toe_hinge(able):
     """The ``toes`` body: same total mass and centre of mass as seed 001's (the toes' mass is
     taken from the calcaneus), a metatarsophalangeal hinge per foot with Sasaki et al. (2009)'s
     spring, a toe-tip sphere level with the ball sphere, and compliant Achilles tendons only."""
-    from bladelab.runner.layout import JP_SD, JP_SK
-    from bladelab.runner.model import MTP_DAMPING, MTP_STIFFNESS
+    from bladelab.runner.layout import JP_SD, JP_SDX, JP_SK
     from bladelab.runner.muscle import MP_TSTRAIN
+    from bladelab.runner.params import ToeHinge
 
     toes = build_runner("able", body="toes")
     assert toes.total_mass == pytest.approx(able.total_mass, rel=1e-12)
@@ -299,8 +299,12 @@ def test_toe_body_keeps_the_mass_and_adds_a_toe_hinge(able):
     assert toes.contact_names == ("heel_l", "toe_l", "toetip_l", "heel_r", "toe_r", "toetip_r")
     _assert_same_centre_of_mass_standing(able, toes)
     j = toes.dof("mtp_angle_l")
-    assert toes.joint_params[j, JP_SK] == MTP_STIFFNESS == 25.0
-    assert toes.joint_params[j, JP_SD] == MTP_DAMPING
+    assert toes.joint_params[j, JP_SK] == 25.0 and toes.joint_params[j, JP_SD] == 0.03
+    stiff = build_runner(default_runner_params("able", body="toes").model_copy(
+        update={"toe_hinge": ToeHinge(stiffness_Nm_per_rad=17.0, damping_Nms_per_rad=2.0)}))
+    for side in ("l", "r"):
+        row = stiff.joint_params[stiff.dof(f"mtp_angle_{side}")]
+        assert (row[JP_SK], row[JP_SD], row[JP_SDX]) == (17.0, 2.0, 2.0)
     tip = toes.contact_params[toes.contact_names.index("toetip_l")]
     assert toes.mj_model.body(int(tip[1])).name == "toes_l"
     strain = dict(zip(toes.muscle_names, toes.muscle_params[:, MP_TSTRAIN], strict=True))

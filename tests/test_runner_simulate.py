@@ -8,6 +8,7 @@ import mujoco
 import numpy as np
 import pytest
 
+from bladelab.errors import SimulationError
 from bladelab.runner import build_runner, power_balance, power_balance_residual_pct, simulate_runner
 from bladelab.runner.muscle import (
     equilibrium_fiber_length,
@@ -165,12 +166,33 @@ def _runner(kind: str):
     return build_runner(kind)
 
 
+def _integrator(kind: str) -> str:
+    """The human body's toe dampers need the Newmark scheme (the explicit one refuses them)."""
+    return "newmark" if kind.startswith("able-human") else "explicit"
+
+
+def test_explicit_scheme_refuses_the_human_toes_damper():
+    """The human body's toes (2 N·m·s/rad on about 1.5·10⁻⁴ kg·m²): an explicit run at the
+    default step is refused with the joint and the remedy named; at a step short enough, or
+    with the Newmark scheme, it runs."""
+    human = build_runner("able", body="human")
+    with pytest.raises(SimulationError, match="mtp_angle") as err:
+        simulate_runner(human, duration=0.01)
+    assert "newmark" in err.value.hint
+    limit = float(err.value.hint.rsplit("at most ", 1)[1].split()[0])
+    assert 4e-5 < limit < 1e-4
+    short = simulate_runner(human, duration=0.01, dt=0.9 * limit)
+    assert short.duration == pytest.approx(0.01, abs=limit) and np.isfinite(short.qvel).all()
+    assert simulate_runner(human, duration=0.01, integrator="newmark").duration > 0
+
+
 @pytest.mark.parametrize("kind,mass", [("able", 83.47), ("amputee", 81.43), ("able-toes", 83.47),
                                        ("able-human-arch", 75.0)])
 def test_passive_drop_comes_to_rest_with_body_weight(kind, mass):
     """Dropped 5 cm with the joints held: static vertical GRF = m·g within 1 %."""
     runner = _runner(kind)
-    res = simulate_runner(runner, duration=1.5, hold_pose=True, drop_height=0.05, record_every=5)
+    res = simulate_runner(runner, duration=1.5, hold_pose=True, drop_height=0.05, record_every=5,
+                          integrator=_integrator(kind))
     assert not res.fell
     fz = res.contacts[:, :, 1].sum(axis=1)
     assert fz[: len(fz) // 10].max() > 1.5 * mass * G  # the landing impact happened
@@ -208,7 +230,8 @@ def test_power_balance_with_ground_contact(kind, u):
     controller), so the fall stop is switched off to keep the full 2 s."""
     runner = _runner(kind)
     res = simulate_runner(
-        runner, duration=2.0, excitations=u, record_every=1, fall_height=-math.inf
+        runner, duration=2.0, excitations=u, record_every=1, fall_height=-math.inf,
+        integrator=_integrator(kind)
     )
     assert res.duration == pytest.approx(2.0)
     fz = res.contacts[:, :, 1].sum(axis=1)

@@ -11,7 +11,8 @@ tendon and passive curves follow them), ``muscle`` ({muscle type: {field: value}
 (top-level parameter fields), ``weights`` (``StrideWeights`` fields), ``guess`` (a word or a
 solution file; default the measured trial), ``track`` (true: a tracking stage of the guess
 first, as for a guess that is no collocation solution), ``mesh`` (mesh intervals, default 50)
-``stride_time`` ([lo, hi] s, ``CollocationSettings.stride_time_range_s``) and
+``stride_time`` ([lo, hi] s, ``CollocationSettings.stride_time_range_s``, or ``"people"``:
+their band at the speed) and
 ``people_weight`` (people's joint angles in the objective, the command line's
 ``--people-weight``; default 0). Writes
 ``OUT/solution.json`` (or ``best_iterate.json``) and ``OUT/variant.json``, and prints the summary and the wall time [s].
@@ -59,10 +60,12 @@ def main() -> None:
     speed = variant.get("speed", 3.5)
     runner = variant_runner(variant)
     weights = variant.get("weights")
+    stride_time = variant.get("stride_time")
+    period = ({"stride_time_people": True} if stride_time == "people"
+              else {"stride_time_range_s": stride_time})
     settings = CollocationSettings(speed_m_per_s=speed,
                                    weights=StrideWeights(**weights) if weights else None,
-                                   mesh_intervals=variant.get("mesh", 50),
-                                   stride_time_range_s=variant.get("stride_time"),
+                                   mesh_intervals=variant.get("mesh", 50), **period,
                                    **people_term(variant.get("people_weight", 0)))
     guess = make_guess(runner, variant.get("guess", "trial"), n=settings.mesh_intervals,
                        speed=speed)

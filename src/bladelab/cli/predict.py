@@ -250,12 +250,13 @@ def register(app: typer.Typer) -> None:
             help="The reflexes on the mean forward speed act from the start, as if the "
                  "runner had moved at the initial speed before it (else they wait for a full "
                  "window of the run)."),
-        integrator: str = typer.Option(
-            defaults.INTEGRATOR, "--integrator", rich_help_panel=REFLEX,
-            help="explicit (the default 0.25 ms scheme) | newmark (stiff forces linearly "
-                 "implicit, second-order rule, at --dt 1e-3 more accurate than explicit at "
-                 "0.25 ms and 4x cheaper) | implicit (its first-order predecessor, for runs "
-                 "made with it)."),
+        integrator: str | None = typer.Option(
+            None, "--integrator", rich_help_panel=REFLEX, show_default=False,
+            help="explicit (the 0.25 ms scheme; the default on seed 001's body) | newmark "
+                 "(stiff forces linearly implicit, second-order rule, at --dt 1e-3 more "
+                 "accurate than explicit at 0.25 ms and 4x cheaper; the default on the human "
+                 "body, whose toes' dampers the explicit scheme cannot integrate) | implicit "
+                 "(its first-order predecessor, for runs made with it)."),
         track: Path | None = typer.Option(
             None, "--track", rich_help_panel=REFLEX,
             help="Add a term that pulls the gait towards this collocation stride of the same "
@@ -385,8 +386,12 @@ def register(app: typer.Typer) -> None:
                 starts=starts, mesh_check=mesh_check))
         from bladelab.cli.reflex import run_reflex  # deferred: keeps bladelab --help fast
 
+        body = body or defaults.REFLEX_BODY
+        if integrator is None:
+            integrator = (defaults.HUMAN_BODY_INTEGRATOR if body == "human"
+                          else defaults.INTEGRATOR)
         run_reflex(
-            out=out, model=model, blade=blade, body=body or defaults.REFLEX_BODY, speed=speed,
+            out=out, model=model, blade=blade, body=body, speed=speed,
             init=init, seeds=seeds,
             generations=generations, popsize=popsize, sigma=sigma, jobs=jobs,
             executor=executor, resume=resume, force=force, checkpoint_every=checkpoint_every,

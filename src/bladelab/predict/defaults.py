@@ -74,6 +74,9 @@ STRIKE_LIMIT_BW = 1.0
 LEAN_WEIGHT_PER_DEG = 0.1
 #: Integrator of the closed loop: the explicit scheme at :data:`TIME_STEP_S`.
 INTEGRATOR = "explicit"
+#: The reflex route's scheme on the human body: the explicit one cannot integrate its toes'
+#: dampers (docs/runner-model.md, "Simulation").
+HUMAN_BODY_INTEGRATOR = "newmark"
 #: Weight of the term that tracks a collocation stride [1/rad²]: 10° of rms error costs 30,
 #: as much as running 30 % of the simulation outside the speed window.
 TRACK_WEIGHT_PER_RAD2 = 1000.0

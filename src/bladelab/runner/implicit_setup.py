@@ -13,7 +13,7 @@ import numpy as np
 from bladelab.errors import SimulationError
 from bladelab.runner.implicit import INTEGRATORS, site_kinematics
 from bladelab.runner.kernel import mujoco_views
-from bladelab.runner.layout import CP_SITE
+from bladelab.runner.layout import CP_SITE, JP_SD, JP_SDX
 from bladelab.runner.mjcall import mujoco_stage_addresses
 from bladelab.runner.muscle import fibre_heights
 
@@ -107,6 +107,30 @@ def simulation_model(model, integrator: str, *, compiled_loop: bool = True
     return (model.mj_dynamics_model if own_sites else model.mj_model), own_sites
 
 
+def _check_explicit_dampers(model, m: mujoco.MjModel, d: mujoco.MjData,
+                            dt: float) -> None:
+    """Refuse an explicit run whose joint spring-dampers it cannot integrate.
+
+    The explicit scheme takes a damper's torque ``−D·q̇`` at the step's start; on a light
+    segment it then reverses the joint's velocity within one step (and blows up at twice that)
+    once ``dt·D/I`` exceeds 1, with ``I = 1/(M⁻¹)ⱼⱼ`` the joint's effective inertia [kg·m²]
+    (e.g. the human body's toes: 2 N·m·s/rad on about 1.5·10⁻⁴ kg·m²)."""
+    full = np.zeros((m.nv, m.nv))
+    mujoco.mj_fullM(m, d, full)
+    inverse_inertia = np.diag(np.linalg.inv(full))
+    damping = np.maximum(model.joint_params[:, JP_SD], model.joint_params[:, JP_SDX])
+    ratio = dt * damping * inverse_inertia
+    j = int(np.argmax(ratio))
+    if ratio[j] > 1.0:
+        raise SimulationError(
+            f"the explicit scheme cannot integrate the damper of {model.dof_names[j]} "
+            f"({damping[j]:g} N·m·s/rad on an effective inertia of "
+            f"{1.0 / inverse_inertia[j]:.3g} kg·m²) at a {dt:g} s step",
+            where="integrator",
+            hint=f'use integrator="newmark" or "implicit" (CLI: --integrator newmark), or a '
+                 f"step of at most {dt / ratio[j]:.2g} s")
+
+
 def implicit_arrays(model, m: mujoco.MjModel, d: mujoco.MjData, integrator: str = "explicit",
                     own_sites: bool = False) -> tuple:
     """The ``imp`` tuple of :func:`bladelab.runner.implicit.implicit_forces` for the :class:`RunnerModel` ``model``
@@ -123,6 +147,8 @@ def implicit_arrays(model, m: mujoco.MjModel, d: mujoco.MjData, integrator: str 
     n_contacts = model.contact_params.shape[0]
     nsite = site_body.shape[0]
     nv = m.nv
+    if integrator == "explicit":
+        _check_explicit_dampers(model, m, d, m.opt.timestep)
     if integrator != "explicit" and not hinge_slide:
         raise SimulationError("the implicit scheme needs a model of hinge and slide joints only",
                               where="integrator", hint='use integrator="explicit"')

@@ -81,10 +81,8 @@ SOCKET_STIFFNESS = 1000.0  # N·m/rad
 SOCKET_STIFFNESS_QUADRATIC = 2.0e4  # N·m/rad²
 SOCKET_DAMPING = 10.0  # N·m·s/rad
 # The toe segment of ``RunnerParams.foot = "toes"`` (docs/runner-model.md, "The toe segment").
-# Metatarsophalangeal hinge at the ball sphere's centre; passive linear spring and damper of
-# Sasaki, Neptune & Kautz (2009), 25 N·m/rad and 0.03 N·m·s/rad, about the neutral pose.
-MTP_STIFFNESS = 25.0  # N·m/rad
-MTP_DAMPING = 0.03  # N·m·s/rad
+# Metatarsophalangeal hinge at the ball sphere's centre; its passive spring and damper about
+# the neutral pose: ``RunnerParams.toe_hinge``.
 # Share of the foot's mass in the toes: gait2392's toes/(calcn + toes) (0.2166/1.4666 kg).
 TOES_MASS_FRACTION = 0.148
 TOES_INERTIA_KG_M2 = 1.0e-4  # about its COM, every axis (a 0.18 kg, 6 cm segment: ≈ 0.6e-4)
@@ -528,7 +526,9 @@ def build_runner(
             jp[i, JP_EA] = capsule.moment_at_zero_Nm
             jp[i, JP_EB] = math.degrees(capsule.rate_per_deg)  # 1/deg → 1/rad
         if base == "mtp_angle":
-            jp[i, JP_SK:JP_EA] = (MTP_STIFFNESS, 0.0, MTP_DAMPING, MTP_DAMPING)
+            toe = params.toe_hinge
+            jp[i, JP_SK:JP_EA] = (toe.stiffness_Nm_per_rad, 0.0, toe.damping_Nms_per_rad,
+                                  toe.damping_Nms_per_rad)
         if base == "midtarsal_angle":
             arch = params.arch
             jp[i, JP_SK:JP_EA] = (arch.stiffness_Nm_per_rad, 0.0, arch.damping_Nms_per_rad,

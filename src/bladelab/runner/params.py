@@ -143,6 +143,19 @@ class CapsuleMoment(_Strict):
     rate_per_deg: float = Field(ge=-0.5, le=0.5)
 
 
+class ToeHinge(_Strict):
+    """The passive metatarsophalangeal hinge of ``RunnerParams.foot = "toes"``: a linear
+    spring and damper about the neutral pose, ``−K·q − D·q̇`` (docs/runner-model.md, "The toe
+    segment"). Defaults: Sasaki, Neptune & Kautz (2009), as OpenSim's gait models have it."""
+
+    #: Rotational stiffness K [N·m/rad].
+    stiffness_Nm_per_rad: float = Field(default=25.0, ge=0)
+    #: Damping D [N·m·s/rad]. 0.03 leaves the light toe segment (about 2·10⁻⁴ kg·m² about its
+    #: hinge) ringing at about 50 Hz; PredSim's passive toes (Falisse, Afschrift & De Groote
+    #: 2022) use 2.
+    damping_Nms_per_rad: float = Field(default=0.03, ge=0)
+
+
 class ArchSpring(_Strict):
     """The foot's longitudinal arch as a midtarsal hinge with a passive spring and damper
     (docs/runner-model.md, "The arch"): the calcaneus carries the heel, the forefoot the ball
@@ -248,6 +261,8 @@ class RunnerParams(_Strict):
     #: forefoot, only with ``foot = "toes"``; None (the default): the calcaneus and forefoot
     #: are one rigid segment. Changes the model's coordinates.
     arch: ArchSpring | None = None
+    #: The toes' passive hinge (:class:`ToeHinge`), only with ``foot = "toes"``.
+    toe_hinge: ToeHinge = Field(default_factory=ToeHinge)
     #: The foot's contact law.
     foot_contact: FootContact = Field(default_factory=FootContact)
     #: Flexion [deg] at which the knee ligament engages: seed 001's 90°; people flex the knee
@@ -697,6 +712,7 @@ def hertz_compression(force_n: float, modulus: float, radius: float) -> float:
 
 __all__ = [
     "ArchSpring",
+    "ToeHinge",
     "BODIES",
     "FootContact",
     "KINDS",

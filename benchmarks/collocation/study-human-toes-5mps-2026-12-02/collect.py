@@ -1,0 +1,72 @@
+"""Gather the 5 m/s solves of this record into ``records.jsonl`` and each category's best.
+
+Usage (repository root)::
+
+    .venv/bin/python benchmarks/collocation/study-human-toes-5mps-2026-12-02/collect.py RUNS_DIR
+
+RUNS_DIR holds one ``bladelab predict`` output folder per solve, named ``CAT-START`` (e.g.
+``Cat4-A``; ``-m200`` in the name: a mesh-200 solve). Appends nothing twice: ``records.jsonl``
+is written anew from the folders. Each category's lowest objective on 100 intervals is copied
+to ``CAT-best.json`` (multipliers removed), its lowest on 200 intervals to ``CAT-mesh200.json``.
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+from pathlib import Path
+
+import numpy as np
+
+from bladelab.predict.collocation.human_running import human_running_criteria
+from bladelab.predict.collocation.solution import CollocationSolution
+
+HERE = Path(__file__).parent
+
+
+def _acceleration_term(s: dict) -> float:
+    qdd = np.asarray(s["qdd"], float)[:-1, 3:]
+    return float(s["settings"]["weights"]["acceleration"] * np.mean(qdd**2) / 1e4)
+
+
+def main(runs: Path) -> int:
+    records, best = [], {}
+    for folder in sorted(p for p in runs.iterdir() if p.is_dir()):
+        path = folder / "solution.json"
+        if not path.is_file():
+            records.append({"run": folder.name, "converged": False})
+            continue
+        raw = json.loads(path.read_text(encoding="utf-8"))
+        sol = CollocationSolution.read(path)
+        crit = human_running_criteria(sol)
+        category, start = folder.name.split("-", 1)
+        rec = {"run": folder.name, "category": category, "start": start,
+               "mesh_intervals": raw["settings"]["mesh_intervals"], "objective": raw["objective"],
+               "objective_terms": raw["objective_terms"],
+               "acceleration_term": _acceleration_term(raw),
+               "criteria_met": sum(c.met for c in crit), "criteria": len(crit),
+               "criteria_missed": [c.name for c in crit if not c.met], **raw["summary"]}
+        records.append(rec)
+        key = (category, rec["mesh_intervals"])
+        if rec["converged"] and (key not in best or rec["objective"] < best[key][0]):
+            best[key] = (rec["objective"], raw)
+    with open(HERE / "records.jsonl", "w", encoding="utf-8") as f:
+        for rec in records:
+            f.write(json.dumps(rec) + "\n")
+    for (category, mesh), (_, raw) in best.items():
+        raw.pop("multipliers", None)
+        name = f"{category}-best.json" if mesh == 100 else f"{category}-mesh{mesh}.json"
+        (HERE / name).write_text(json.dumps(raw), encoding="utf-8")
+    for rec in records:
+        if "objective" in rec:
+            print(f"{rec['run']:>22} mesh {rec['mesh_intervals']:>3} obj {rec['objective']:.4f} "
+                  f"CoT {rec['cost_of_transport_J_per_kg_m']:.3f} acc {rec['acceleration_term']:.3f} "
+                  f"T {rec['stride_time_s']:.3f} {rec['criteria_met']}/{rec['criteria']} "
+                  f"{rec['criteria_missed']} it {rec['iterations']}")
+        else:
+            print(f"{rec['run']:>22} not converged")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main(Path(sys.argv[1])))
