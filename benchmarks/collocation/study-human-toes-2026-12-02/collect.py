@@ -2,11 +2,11 @@
 
 Usage (repository root)::
 
-    .venv/bin/python benchmarks/collocation/study-human-toes-5mps-2026-12-02/collect.py RUNS_DIR
+    .venv/bin/python benchmarks/collocation/study-human-toes-2026-12-02/collect.py RUNS_DIR [OUT]
 
 RUNS_DIR holds one ``bladelab predict`` output folder per solve, named ``CAT-START`` (e.g.
 ``Cat4-A``; ``-m200`` in the name: a mesh-200 solve). Appends nothing twice: ``records.jsonl``
-is written anew from the folders. Each category's lowest objective on 100 intervals is copied
+is written anew from the folders into OUT (default: this folder). Each category's lowest objective on 100 intervals is copied
 to ``CAT-best.json`` (multipliers removed), its lowest on 200 intervals to ``CAT-mesh200.json``.
 """
 
@@ -29,7 +29,7 @@ def _acceleration_term(s: dict) -> float:
     return float(s["settings"]["weights"]["acceleration"] * np.mean(qdd**2) / 1e4)
 
 
-def main(runs: Path) -> int:
+def main(runs: Path, out: Path = HERE) -> int:
     records, best = [], {}
     for folder in sorted(p for p in runs.iterdir() if p.is_dir()):
         path = folder / "solution.json"
@@ -45,18 +45,20 @@ def main(runs: Path) -> int:
                "objective_terms": raw["objective_terms"],
                "acceleration_term": _acceleration_term(raw),
                "criteria_met": sum(c.met for c in crit), "criteria": len(crit),
-               "criteria_missed": [c.name for c in crit if not c.met], **raw["summary"]}
+               "criteria_missed": [c.name for c in crit if not c.met],
+               "criteria_values": {c.name: c.value for c in crit}, **raw["summary"]}
         records.append(rec)
         key = (category, rec["mesh_intervals"])
         if rec["converged"] and (key not in best or rec["objective"] < best[key][0]):
             best[key] = (rec["objective"], raw)
-    with open(HERE / "records.jsonl", "w", encoding="utf-8") as f:
+    out.mkdir(parents=True, exist_ok=True)
+    with open(out / "records.jsonl", "w", encoding="utf-8") as f:
         for rec in records:
             f.write(json.dumps(rec) + "\n")
     for (category, mesh), (_, raw) in best.items():
         raw.pop("multipliers", None)
         name = f"{category}-best.json" if mesh == 100 else f"{category}-mesh{mesh}.json"
-        (HERE / name).write_text(json.dumps(raw), encoding="utf-8")
+        (out / name).write_text(json.dumps(raw), encoding="utf-8")
     for rec in records:
         if "objective" in rec:
             print(f"{rec['run']:>22} mesh {rec['mesh_intervals']:>3} obj {rec['objective']:.4f} "
@@ -69,4 +71,4 @@ def main(runs: Path) -> int:
 
 
 if __name__ == "__main__":
-    raise SystemExit(main(Path(sys.argv[1])))
+    raise SystemExit(main(*(Path(a) for a in sys.argv[1:3])))
