@@ -387,9 +387,6 @@ def register(app: typer.Typer) -> None:
         from bladelab.cli.reflex import run_reflex  # deferred: keeps bladelab --help fast
 
         body = body or defaults.REFLEX_BODY
-        if integrator is None:
-            integrator = (defaults.HUMAN_BODY_INTEGRATOR if body == "human"
-                          else defaults.INTEGRATOR)
         run_reflex(
             out=out, model=model, blade=blade, body=body, speed=speed,
             init=init, seeds=seeds,
@@ -400,7 +397,8 @@ def register(app: typer.Typer) -> None:
             robust_speed_change=robust_speed_change, robust_push=robust_push,
             robust_half_step=robust_half_step, initial_speed=initial_speed,
             strike_limit=strike_limit, lean_weight=lean_weight, run_up=run_up,
-            integrator=integrator, track=track, track_weight=track_weight,
+            integrator=defaults.integrator_for(body, integrator), track=track,
+            track_weight=track_weight,
             start_stride=start_stride, hold=hold)
 
     @app.command("sweep", cls=PanelCommand)

@@ -17,6 +17,7 @@ __all__ = [
     "GENERATIONS",
     "GUESS",
     "INITIAL_STEP",
+    "HUMAN_BODY_INTEGRATOR",
     "INTEGRATOR",
     "LEAN_WEIGHT_PER_DEG",
     "MAX_ITER",
@@ -39,6 +40,7 @@ __all__ = [
     "SWEEP_SPEEDS_M_PER_S",
     "TIME_STEP_S",
     "TRACK_WEIGHT_PER_RAD2",
+    "integrator_for",
     "people_weight_for",
 ]
 
@@ -134,6 +136,15 @@ STARTS = 1
 #: 2026-11-30, the amputee scaled to 68 kg and 1.75 m reached +17 % of the settled objective
 #: from the shipped stride's default barrier start and +0.08 % from its barrier start 1e-4.
 ATHLETE_STARTS = 2
+
+
+def integrator_for(body: str, integrator: str | None = None) -> str:
+    """The reflex route's forward scheme for a runner ``body``: ``integrator`` when given, else
+    :data:`HUMAN_BODY_INTEGRATOR` on the human body (whose toes' dampers the explicit scheme
+    refuses) and :data:`INTEGRATOR` on the others."""
+    if integrator is not None:
+        return integrator
+    return HUMAN_BODY_INTEGRATOR if body == "human" else INTEGRATOR
 
 
 def people_weight_for(body: str, weight: float | None = None) -> float:
