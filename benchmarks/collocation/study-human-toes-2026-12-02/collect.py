@@ -5,9 +5,12 @@ Usage (repository root)::
     .venv/bin/python benchmarks/collocation/study-human-toes-2026-12-02/collect.py RUNS_DIR [OUT]
 
 RUNS_DIR holds one ``bladelab predict`` output folder per solve, named ``CAT-START`` (e.g.
-``Cat4-A``; ``-m200`` in the name: a mesh-200 solve). Appends nothing twice: ``records.jsonl``
-is written anew from the folders into OUT (default: this folder). Each category's lowest objective on 100 intervals is copied
-to ``CAT-best.json`` (multipliers removed), its lowest on 200 intervals to ``CAT-mesh200.json``.
+``Cat4-A``; ``-m200`` in the name: a mesh-200 solve). Appends nothing twice: a run already in
+OUT's ``records.jsonl`` is replaced by its folder, the others are kept. Each category's lowest
+objective on 100 intervals (among the folders and the ``CAT-best.json`` already in OUT) is
+``CAT-best.json`` (multipliers removed), its lowest on 200 intervals ``CAT-mesh200.json``.
+``categories.csv`` has one row per category's best: its summary, criteria and stride analyses
+(K_leg, joint powers, leg and blade energies; ``bladelab.predict.collocation.analyses``).
 """
 
 from __future__ import annotations
@@ -29,9 +32,43 @@ def _acceleration_term(s: dict) -> float:
     return float(s["settings"]["weights"]["acceleration"] * np.mean(qdd**2) / 1e4)
 
 
+def _earlier(out: Path, runs: set[str]) -> tuple[list[dict], dict]:
+    """OUT's records of runs not in ``runs``, and its best strides by (category, mesh)."""
+    path = out / "records.jsonl"
+    kept = [json.loads(line) for line in path.read_text(encoding="utf-8").splitlines()
+            if line.strip()] if path.is_file() else []
+    best = {}
+    for f in out.glob("*-best.json"):
+        raw = json.loads(f.read_text(encoding="utf-8"))
+        best[(f.name.split("-")[0], 100)] = (raw["objective"], raw)
+    return [r for r in kept if r["run"] not in runs], best
+
+
+def _category_table(out: Path) -> None:
+    import csv
+
+    from bladelab.predict.collocation.analyses import stride_analyses
+
+    rows = []
+    for f in sorted(out.glob("*-best.json")):
+        sol = CollocationSolution.read(f)
+        crit = human_running_criteria(sol)
+        rows.append({"category": f.name.split("-")[0], "objective": sol.nlp.objective,
+                     **sol.summary(), "criteria_met": f"{sum(c.met for c in crit)}/{len(crit)}",
+                     "criteria_missed": "; ".join(f"{c.name} {c.value_text()}" for c in crit
+                                                  if not c.met),
+                     **stride_analyses(sol)})
+    keys = list(dict.fromkeys(k for r in rows for k in r))
+    with open(out / "categories.csv", "w", newline="", encoding="utf-8") as f:
+        w = csv.DictWriter(f, fieldnames=keys)
+        w.writeheader()
+        w.writerows(rows)
+
+
 def main(runs: Path, out: Path = HERE) -> int:
-    records, best = [], {}
-    for folder in sorted(p for p in runs.iterdir() if p.is_dir()):
+    folders = sorted(p for p in runs.iterdir() if p.is_dir())
+    records, best = _earlier(out, {p.name for p in folders})
+    for folder in folders:
         path = folder / "solution.json"
         if not path.is_file():
             records.append({"run": folder.name, "converged": False})
@@ -59,6 +96,7 @@ def main(runs: Path, out: Path = HERE) -> int:
         raw.pop("multipliers", None)
         name = f"{category}-best.json" if mesh == 100 else f"{category}-mesh{mesh}.json"
         (out / name).write_text(json.dumps(raw), encoding="utf-8")
+    _category_table(out)
     for rec in records:
         if "objective" in rec:
             print(f"{rec['run']:>22} mesh {rec['mesh_intervals']:>3} obj {rec['objective']:.4f} "
