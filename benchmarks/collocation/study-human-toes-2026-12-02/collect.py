@@ -33,7 +33,7 @@ def _acceleration_term(s: dict) -> float:
 
 
 def _earlier(out: Path, runs: set[str]) -> tuple[list[dict], dict]:
-    """OUT's records of runs not in ``runs``, and its best strides by (category, mesh)."""
+    """OUT's records of runs not in ``runs``, and its ``CAT-best.json`` strides keyed (category, 100)."""
     path = out / "records.jsonl"
     kept = [json.loads(line) for line in path.read_text(encoding="utf-8").splitlines()
             if line.strip()] if path.is_file() else []
