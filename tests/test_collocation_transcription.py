@@ -46,7 +46,7 @@ def _bouncing_guess(n: int, speed: float) -> StrideGuess:
 
 
 def test_the_toy_settles_on_its_spring_at_the_prescribed_speed():
-    nlp = StrideNLP(_toy(), n=40, speed=2.0)
+    nlp = StrideNLP(_toy(), n=40, speed=2.0, compiled=False)
     sol = nlp.solve(nlp.initial_vector(_bouncing_guess(40, 2.0)), hessian="exact", tol=1e-6)
     assert sol.success, sol.status
     assert sol.speed == pytest.approx(2.0, rel=1e-8)
@@ -79,7 +79,7 @@ def test_an_objective_of_one_term_unpacks():
     """Effort alone (metabolic weight 0): the solution still names its one term."""
     from bladelab.predict.collocation.transcription import StrideWeights
 
-    nlp = StrideNLP(_toy(), n=10, speed=2.0, weights=StrideWeights(metabolic=0.0))
+    nlp = StrideNLP(_toy(), n=10, speed=2.0, weights=StrideWeights(metabolic=0.0), compiled=False)
     sol = nlp.solve(nlp.initial_vector(_bouncing_guess(10, 2.0)), hessian="exact", max_iter=5)
     assert list(sol.objective_terms) == ["effort"]
     assert sol.objective == pytest.approx(sol.objective_terms["effort"])
@@ -151,12 +151,12 @@ def test_one_built_solver_serves_every_speed():
     """The speed is a parameter: an NLP built at 2 m/s and solved at 2.5 m/s gives the same
     solution as one built at 2.5 m/s, and its solver is built only once."""
     n = 16
-    shared = StrideNLP(_toy(), n=n, speed=2.0)
+    shared = StrideNLP(_toy(), n=n, speed=2.0, compiled=False)
     first = shared.solve(shared.initial_vector(_bouncing_guess(n, 2.0)), hessian="exact",
                          tol=1e-8)
     again = shared.solve(shared.initial_vector(_bouncing_guess(n, 2.5)), hessian="exact",
                          tol=1e-8, speed=2.5)
-    fresh = StrideNLP(_toy(), n=n, speed=2.5)
+    fresh = StrideNLP(_toy(), n=n, speed=2.5, compiled=False)
     alone = fresh.solve(fresh.initial_vector(_bouncing_guess(n, 2.5)), hessian="exact",
                         tol=1e-8)
     assert first.success and again.success and alone.success
@@ -175,7 +175,7 @@ def test_one_built_solver_serves_every_speed():
 
 
 def test_progress_is_reported_every_iteration_of_each_solve():
-    nlp = StrideNLP(_toy(), n=10, speed=2.0)
+    nlp = StrideNLP(_toy(), n=10, speed=2.0, compiled=False)
     for speed in (2.0, 2.2):
         seen: list[tuple[int, float, float]] = []
         sol = nlp.solve(nlp.initial_vector(_bouncing_guess(10, speed)), hessian="exact",
@@ -258,7 +258,7 @@ def test_tracking_term_follows_only_the_named_coordinates():
     q_ref[:, 1] += 1.0  # a translation: not followed by default
     ref = {}
     for key, dofs in (("default", ()), ("tz", (["pelvis_tz"],))):
-        nlp = StrideNLP(_toy(), n=n, speed=speed, tracking=(q_ref, 2.0, *dofs))
+        nlp = StrideNLP(_toy(), n=n, speed=speed, tracking=(q_ref, 2.0, *dofs), compiled=False)
         lbx, ubx, lbg, ubg = nlp.bounds()
         x0 = nlp.initial_vector(guess)
         ref[key] = nlp.unpack(x0, {}, 0.0, 0.0, lbg, ubg, np.zeros(lbg.size))
@@ -272,7 +272,7 @@ def test_tracking_term_follows_only_the_named_coordinates():
 def test_period_tracking_term_is_the_squared_log_ratio_of_the_stride_times():
     n, speed = 20, 2.0
     guess = _bouncing_guess(n, speed)  # a 0.6 s stride
-    nlp = StrideNLP(_toy(), n=n, speed=speed, period_tracking=(0.5, 3.0))
+    nlp = StrideNLP(_toy(), n=n, speed=speed, period_tracking=(0.5, 3.0), compiled=False)
     lbx, ubx, lbg, ubg = nlp.bounds()
     sol = nlp.unpack(nlp.initial_vector(guess), {}, 0.0, 0.0, lbg, ubg, np.zeros(lbg.size))
     assert sol.period == pytest.approx(0.6)
@@ -288,7 +288,7 @@ def test_a_solution_restarted_from_its_multipliers_ends_at_once():
     values alone IPOPT's barrier starts again and takes longer. Multipliers that do not fit
     the NLP are not used."""
     n = 16
-    nlp = StrideNLP(_toy(), n=n, speed=2.0)
+    nlp = StrideNLP(_toy(), n=n, speed=2.0, compiled=False)
     cold = nlp.solve(nlp.initial_vector(_bouncing_guess(n, 2.0)), hessian="exact")
     assert cold.success and cold.multipliers is not None
     lam_x, lam_g = cold.multipliers
@@ -319,7 +319,7 @@ def test_the_maximum_speed_problem_keeps_at_least_the_speed_it_is_given():
 
     fastest = StrideNLP(_toy(), n=10, speed=None,
                         weights=StrideWeights(metabolic=0.0, speed=1.0))
-    prescribed = StrideNLP(_toy(), n=10, speed=2.0)
+    prescribed = StrideNLP(_toy(), n=10, speed=2.0, compiled=False)
     assert fastest.n_cons == prescribed.n_cons  # the speed row, an inequality now
     _, _, lbg, ubg = fastest.bounds()
     rows = np.flatnonzero(np.isinf(ubg))

@@ -15,9 +15,14 @@ more halfway from the last converged one, then the chain stops. The variant (JSO
 ``vmax`` [optimal fibre lengths/s] (every muscle's maximum shortening velocity; the body's is
 10), ``force_factor``, ``muscle`` and ``set`` as in solve_variant.py, ``symmetric`` (true: each leg does what the other
 did half a stride earlier, ``CollocationSettings.symmetric``; able runner), ``mesh`` (mesh
-intervals, default 50; a start on another mesh is resampled). Writes ``OUT/speed-<v>.json`` per converged speed
-and ``OUT/records.jsonl`` (one line per solve: the summary, the largest activation of any muscle
-at any node, the wall time), and prints each line.
+intervals, default 50; a start on another mesh is resampled), ``stride_time`` (``"people"``:
+people's band at each speed, ``CollocationSettings.stride_time_people``; default free),
+``start_mu`` (the first solve's barrier start, ``CollocationSettings.warm_start_mu``, e.g.
+1e-4 for a start file without multipliers, which IPOPT's default barrier lets leave its
+basin; default IPOPT's), ``max_iter`` (IPOPT iterations per stage, default the settings').
+Writes ``OUT/speed-<v>.json`` per converged speed and ``OUT/records.jsonl`` (one line per
+solve: the summary, the largest activation of any muscle at any node, the human-running
+criteria met and missed, the wall time), and prints each line.
 """
 
 from __future__ import annotations
@@ -30,6 +35,7 @@ from pathlib import Path
 import numpy as np
 from solve_variant import variant_runner
 
+from bladelab.predict.collocation.human_running import human_running_criteria
 from bladelab.predict.collocation.settings import CollocationSettings, people_term
 from bladelab.predict.collocation.solution import CollocationSolution
 from bladelab.predict.collocation.solve import predict_stride
@@ -51,13 +57,21 @@ def main() -> None:
     out.mkdir(parents=True, exist_ok=True)
     (out / "variant.json").write_text(json.dumps(variant))
     last, pending = None, list(speeds)
+    mu = variant.get("start_mu")
     while pending:
         v = pending.pop(0)
-        settings = CollocationSettings(mesh_intervals=mesh, speed_m_per_s=v, **people,
-                                       symmetric=bool(variant.get("symmetric", False)))
+        settings = CollocationSettings(
+            mesh_intervals=mesh, speed_m_per_s=v, **people,
+            symmetric=bool(variant.get("symmetric", False)),
+            stride_time_people=variant.get("stride_time") == "people",
+            warm_start_mu=mu if last is None else None,
+            **({"max_iter": int(variant["max_iter"])} if "max_iter" in variant else {}))
         t0 = time.perf_counter()
         sol = predict_stride(runner, settings, guess, model_spec=spec)
+        crit = human_running_criteria(sol)
         rec = {"speed": v, **sol.summary(), "max_activation": float(np.max(sol.nlp.activation)),
+               "criteria_met": sum(c.met for c in crit), "criteria": len(crit),
+               "missed": [c.line() for c in crit if not c.met],
                "probe_wall_s": round(time.perf_counter() - t0, 1)}
         with (out / "records.jsonl").open("a") as fh:
             fh.write(json.dumps(rec) + "\n")
