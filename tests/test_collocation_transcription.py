@@ -258,7 +258,7 @@ def test_tracking_term_follows_only_the_named_coordinates():
     q_ref[:, 1] += 1.0  # a translation: not followed by default
     ref = {}
     for key, dofs in (("default", ()), ("tz", (["pelvis_tz"],))):
-        nlp = StrideNLP(_toy(), n=n, speed=speed, tracking=(q_ref, 2.0, *dofs), compiled=False)
+        nlp = StrideNLP(_toy(), n=n, speed=speed, tracking=(q_ref, 2.0, *dofs))
         lbx, ubx, lbg, ubg = nlp.bounds()
         x0 = nlp.initial_vector(guess)
         ref[key] = nlp.unpack(x0, {}, 0.0, 0.0, lbg, ubg, np.zeros(lbg.size))
@@ -272,7 +272,7 @@ def test_tracking_term_follows_only_the_named_coordinates():
 def test_period_tracking_term_is_the_squared_log_ratio_of_the_stride_times():
     n, speed = 20, 2.0
     guess = _bouncing_guess(n, speed)  # a 0.6 s stride
-    nlp = StrideNLP(_toy(), n=n, speed=speed, period_tracking=(0.5, 3.0), compiled=False)
+    nlp = StrideNLP(_toy(), n=n, speed=speed, period_tracking=(0.5, 3.0))
     lbx, ubx, lbg, ubg = nlp.bounds()
     sol = nlp.unpack(nlp.initial_vector(guess), {}, 0.0, 0.0, lbg, ubg, np.zeros(lbg.size))
     assert sol.period == pytest.approx(0.6)
@@ -319,7 +319,7 @@ def test_the_maximum_speed_problem_keeps_at_least_the_speed_it_is_given():
 
     fastest = StrideNLP(_toy(), n=10, speed=None,
                         weights=StrideWeights(metabolic=0.0, speed=1.0))
-    prescribed = StrideNLP(_toy(), n=10, speed=2.0, compiled=False)
+    prescribed = StrideNLP(_toy(), n=10, speed=2.0)
     assert fastest.n_cons == prescribed.n_cons  # the speed row, an inequality now
     _, _, lbg, ubg = fastest.bounds()
     rows = np.flatnonzero(np.isinf(ubg))
