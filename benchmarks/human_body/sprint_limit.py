@@ -69,7 +69,8 @@ def main() -> None:
         t0 = time.perf_counter()
         sol = predict_stride(runner, settings, guess, model_spec=spec)
         crit = human_running_criteria(sol)
-        rec = {"speed": v, **sol.summary(), "max_activation": float(np.max(sol.nlp.activation)),
+        rec = {"speed": v, **sol.summary(), "objective": float(sol.nlp.objective),
+               "max_activation": float(np.max(sol.nlp.activation)),
                "criteria_met": sum(c.met for c in crit), "criteria": len(crit),
                "missed": [c.line() for c in crit if not c.met],
                "probe_wall_s": round(time.perf_counter() - t0, 1)}
