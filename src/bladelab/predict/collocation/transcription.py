@@ -169,6 +169,20 @@ def _node_pairs(values):
     return ca.sum2(values[:, :-1]) + ca.sum2(values[:, 1:])
 
 
+#: IPOPT's stop at an acceptable level, on an L-BFGS warm start (with multipliers): five
+#: iterations in a row feasible to 1e-5 (scaled constraints), complementarity below 1e-3 and
+#: the objective changing by less than 1e-5 of itself per iteration. Near a solution L-BFGS's
+#: dual infeasibility wanders between 1e-2 and 1 and dips below ``tol`` only now and then, so
+#: about half of a warm solve was spent on the last 0.01 % of its objective (measured,
+#: benchmarks/collocation_speed/README.md "Stopping a warm start when the objective stalls").
+WARM_STOP_OPTIONS = {
+    "ipopt.acceptable_tol": 1.0,
+    "ipopt.acceptable_iter": 5,
+    "ipopt.acceptable_obj_change_tol": 1e-5,
+    "ipopt.acceptable_constr_viol_tol": 1e-5,
+    "ipopt.acceptable_compl_inf_tol": 1e-3,
+}
+
 #: IPOPT options of a solve started from a solution's primal and dual values (its
 #: multipliers): the barrier starts small and the point stays where it is, so that a solve
 #: at the start's own speed ends at once and a continuation step stays on the start's branch
@@ -590,7 +604,8 @@ class StrideNLP:
         reused by every later one, at any speed (``NLPSolution.timings["build_s"]`` is 0 then).
 
         ``multipliers`` (bounds, constraints; :meth:`initial_multipliers`): start from ``x0``
-        and these duals with :data:`DUAL_WARM_START_OPTIONS` (under ``options``).
+        and these duals with :data:`DUAL_WARM_START_OPTIONS` and, with L-BFGS,
+        :data:`WARM_STOP_OPTIONS` (under ``options``).
         """
         if hessian not in ("limited-memory", "exact"):
             raise SpecError(f"unknown Hessian option {hessian!r}", where="hessian",
@@ -618,6 +633,8 @@ class StrideNLP:
         }
         if multipliers is not None:
             opts.update(DUAL_WARM_START_OPTIONS)
+            if hessian == "limited-memory":
+                opts.update(WARM_STOP_OPTIONS)
         opts.update(options or {})
         t0 = time.perf_counter()
         solver, relay = self._solver(opts)

@@ -1,0 +1,81 @@
+"""Solves without a dual warm start, with and without IPOPT's stop at an acceptable level (a
+measuring probe; changes nothing in src: for the "stopped" solves it adds the library's
+``WARM_STOP_OPTIONS``, which it applies only to warm starts with multipliers, to every stage).
+
+Usage (repository root, one core)::
+
+    OMP_NUM_THREADS=1 .venv/bin/python benchmarks/collocation_speed/cold_stop.py [CASE ...]
+
+Cases: ``able-template`` (the able runner at 3.5 m/s from the template guess: the tracking
+stage, then the predictive one) and ``amputee-primal`` (the shipped amputee Cat6 stride's
+primal values at 4.2 m/s, its multipliers dropped), both mesh 50, people's angles at the
+default weight, as ``make bench`` solves them. Prints and appends to
+``cold_stop_records.jsonl`` one JSON line per case, with the fields of ``warm_stop.py``.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import sys
+from pathlib import Path
+
+import numpy as np
+from warm_stop import _row
+
+from bladelab.predict import defaults
+from bladelab.predict.collocation import transcription
+from bladelab.predict.collocation.guess import template_guess
+from bladelab.predict.collocation.settings import CollocationSettings, people_term
+from bladelab.predict.collocation.solve import predict_stride
+from bladelab.predict.collocation.starting_guess import make_guess
+from bladelab.runner import build_runner
+
+HERE = Path(__file__).parent
+_SOLVE = transcription.StrideNLP.solve
+
+
+def _with_stop(self, x0, **kw):
+    kw["options"] = {**transcription.WARM_STOP_OPTIONS, **(kw.get("options") or {})}
+    return _SOLVE(self, x0, **kw)
+
+
+def _problem(name: str):
+    people = people_term(defaults.people_weight_for("human"))
+    if name == "able-template":
+        runner = build_runner("able", body="human")
+        settings = CollocationSettings(mesh_intervals=50, speed_m_per_s=3.5, **people)
+        return runner, settings, template_guess(runner, speed=3.5, n=50), {"model": "able",
+                                                                           "body": "human"}
+    runner = build_runner("amputee", blade="Cat6", body="human")
+    spec = {"model": "amputee", "blade": "Cat6", "body": "human"}
+    settings = CollocationSettings(mesh_intervals=50, speed_m_per_s=4.0, **people)
+    stored = predict_stride(runner, settings, make_guess(runner, "stored", n=50, speed=4.0),
+                            model_spec=spec)
+    guess = dataclasses.replace(stored.to_guess(), multipliers=None)
+    return runner, dataclasses.replace(settings, speed_m_per_s=4.2), guess, spec
+
+
+def run(name: str) -> dict:
+    runner, settings, guess, spec = _problem(name)
+    full = predict_stride(runner, settings, guess, model_spec=spec)
+    transcription.StrideNLP.solve = _with_stop
+    try:
+        stopped = predict_stride(runner, settings, guess, model_spec=spec)
+    finally:
+        transcription.StrideNLP.solve = _SOLVE
+    angle = float(np.max(np.abs(np.degrees(full.nlp.q[:, 3:] - stopped.nlp.q[:, 3:]))))
+    rec = {"case": name, "full": {**_row(full), "tracking_iterations": (full.tracking or {}).get(
+               "iterations")},
+           "stopped": {**_row(stopped),
+                       "tracking_iterations": (stopped.tracking or {}).get("iterations")},
+           "objective_difference_pct": 100 * (stopped.nlp.objective / full.nlp.objective - 1),
+           "largest_angle_difference_deg": angle}
+    with open(HERE / "cold_stop_records.jsonl", "a", encoding="utf-8") as fh:
+        fh.write(json.dumps(rec) + "\n")
+    return rec
+
+
+if __name__ == "__main__":
+    for case in sys.argv[1:] or ["able-template", "amputee-primal"]:
+        print(json.dumps(run(case)), flush=True)
