@@ -1,6 +1,6 @@
 """Solves without a dual warm start, with and without IPOPT's stop at an acceptable level (a
-measuring probe; changes nothing in src: for the "stopped" solves it adds the library's
-``WARM_STOP_OPTIONS``, which it applies only to warm starts with multipliers, to every stage).
+measuring probe; changes nothing in src: it empties ``STALL_STOP_OPTIONS`` in this process for
+the "full" solves).
 
 Usage (repository root, one core)::
 
@@ -32,12 +32,6 @@ from bladelab.predict.collocation.starting_guess import make_guess
 from bladelab.runner import build_runner
 
 HERE = Path(__file__).parent
-_SOLVE = transcription.StrideNLP.solve
-
-
-def _with_stop(self, x0, **kw):
-    kw["options"] = {**transcription.WARM_STOP_OPTIONS, **(kw.get("options") or {})}
-    return _SOLVE(self, x0, **kw)
 
 
 def _problem(name: str):
@@ -58,12 +52,13 @@ def _problem(name: str):
 
 def run(name: str) -> dict:
     runner, settings, guess, spec = _problem(name)
-    full = predict_stride(runner, settings, guess, model_spec=spec)
-    transcription.StrideNLP.solve = _with_stop
+    stop = dict(transcription.STALL_STOP_OPTIONS)
+    transcription.STALL_STOP_OPTIONS.clear()
     try:
-        stopped = predict_stride(runner, settings, guess, model_spec=spec)
+        full = predict_stride(runner, settings, guess, model_spec=spec)
     finally:
-        transcription.StrideNLP.solve = _SOLVE
+        transcription.STALL_STOP_OPTIONS.update(stop)
+    stopped = predict_stride(runner, settings, guess, model_spec=spec)
     angle = float(np.max(np.abs(np.degrees(full.nlp.q[:, 3:] - stopped.nlp.q[:, 3:]))))
     rec = {"case": name, "full": {**_row(full), "tracking_iterations": (full.tracking or {}).get(
                "iterations")},

@@ -1,5 +1,6 @@
 """A warm start with and without IPOPT's stop at an acceptable level (a measuring probe;
-changes nothing in src: it empties ``WARM_STOP_OPTIONS`` in this process for the "full" solve).
+changes nothing in src: it empties ``STALL_STOP_OPTIONS`` in this process for the "full" solve;
+the own-speed solve before it keeps the library's options).
 
 Usage (repository root, one core)::
 
@@ -8,7 +9,7 @@ Usage (repository root, one core)::
 Cases (``CASES``): a stride at its own speed (the shipped stride, or a committed file solved
 again from its primal values with the barrier at 1e-4), then the next speed from its primal and
 dual values, once with IPOPT's full convergence (tol 1e-4) and once with the library's
-``WARM_STOP_OPTIONS``. Prints and appends to ``warm_stop_records.jsonl`` one JSON line per
+``STALL_STOP_OPTIONS``. Prints and appends to ``warm_stop_records.jsonl`` one JSON line per
 case: iterations, wall [s], IPOPT's own time [s], objective, cost of transport [J/(kg·m)], the
 dynamics residual [% of the peak force], the largest constraint violation, criteria met, the
 objective's relative difference [%] and the largest joint-angle difference [deg].
@@ -76,10 +77,10 @@ def run(name: str) -> dict:
     if not own.converged:
         return {"case": name, "own_speed": "not converged"}
     nxt = dataclasses.replace(settings, speed_m_per_s=target, warm_start_mu=None)
-    stop = dict(transcription.WARM_STOP_OPTIONS)
-    transcription.WARM_STOP_OPTIONS.clear()
+    stop = dict(transcription.STALL_STOP_OPTIONS)
+    transcription.STALL_STOP_OPTIONS.clear()
     full = predict_stride(runner, nxt, own.to_guess(), model_spec=spec)
-    transcription.WARM_STOP_OPTIONS.update(stop)
+    transcription.STALL_STOP_OPTIONS.update(stop)
     stopped = predict_stride(runner, nxt, own.to_guess(), model_spec=spec)
     angle = float(np.max(np.abs(np.degrees(full.nlp.q[:, 3:] - stopped.nlp.q[:, 3:]))))
     rec = {"case": name, "speed": speed, "next_speed": target, "mesh": mesh,
