@@ -20,11 +20,9 @@ import json
 import sys
 from pathlib import Path
 
-import numpy as np
-from warm_stop import _row
+from warm_stop import _row, append_record, full_and_stopped
 
 from bladelab.predict import defaults
-from bladelab.predict.collocation import transcription
 from bladelab.predict.collocation.guess import template_guess
 from bladelab.predict.collocation.settings import CollocationSettings, people_term
 from bladelab.predict.collocation.solve import predict_stride
@@ -52,24 +50,15 @@ def _problem(name: str):
 
 def run(name: str) -> dict:
     runner, settings, guess, spec = _problem(name)
-    stop = dict(transcription.STALL_STOP_OPTIONS)
-    transcription.STALL_STOP_OPTIONS.clear()
-    try:
-        full = predict_stride(runner, settings, guess, model_spec=spec)
-    finally:
-        transcription.STALL_STOP_OPTIONS.update(stop)
-    stopped = predict_stride(runner, settings, guess, model_spec=spec)
-    angle = float(np.max(np.abs(np.degrees(full.nlp.q[:, 3:] - stopped.nlp.q[:, 3:]))))
-    rec = {"case": name, "full": {**_row(full), "tracking_iterations": (full.tracking or {}).get(
-               "iterations")},
+    full, stopped, diff = full_and_stopped(
+        lambda: predict_stride(runner, settings, guess, model_spec=spec))
+    rec = {"case": name,
+           "full": {**_row(full), "tracking_iterations": (full.tracking or {}).get("iterations")},
            "stopped": {**_row(stopped),
                        "tracking_iterations": (stopped.tracking or {}).get("iterations")},
-           "objective_difference_pct": 100 * (stopped.nlp.objective / full.nlp.objective - 1),
-           "largest_angle_difference_deg": angle}
-    with open(HERE / "cold_stop_records.jsonl", "a", encoding="utf-8") as fh:
-        fh.write(json.dumps(rec) + "\n")
+           **diff}
+    append_record(HERE / "cold_stop_records.jsonl", rec)
     return rec
-
 
 if __name__ == "__main__":
     for case in sys.argv[1:] or ["able-template", "amputee-primal"]:

@@ -61,6 +61,27 @@ def _row(sol) -> dict:
             "criteria_met": f"{sum(c.met for c in crit)}/{len(crit)}"}
 
 
+def full_and_stopped(solve) -> tuple:
+    """``solve()`` with ``STALL_STOP_OPTIONS`` emptied, then with the library's; the two
+    solutions and their differences (objective [%], largest joint angle [deg])."""
+    stop = dict(transcription.STALL_STOP_OPTIONS)
+    transcription.STALL_STOP_OPTIONS.clear()
+    try:
+        full = solve()
+    finally:
+        transcription.STALL_STOP_OPTIONS.update(stop)
+    stopped = solve()
+    angle = float(np.max(np.abs(np.degrees(full.nlp.q[:, 3:] - stopped.nlp.q[:, 3:]))))
+    return full, stopped, {
+        "objective_difference_pct": 100 * (stopped.nlp.objective / full.nlp.objective - 1),
+        "largest_angle_difference_deg": angle}
+
+
+def append_record(path: Path, rec: dict) -> None:
+    with open(path, "a", encoding="utf-8") as fh:
+        fh.write(json.dumps(rec) + "\n")
+
+
 def run(name: str) -> dict:
     kind, blade, start, speed, target, mesh, people_time = CASES[name]
     spec = {"model": kind, "blade": blade, "body": "human"}
@@ -77,20 +98,13 @@ def run(name: str) -> dict:
     if not own.converged:
         return {"case": name, "own_speed": "not converged"}
     nxt = dataclasses.replace(settings, speed_m_per_s=target, warm_start_mu=None)
-    stop = dict(transcription.STALL_STOP_OPTIONS)
-    transcription.STALL_STOP_OPTIONS.clear()
-    full = predict_stride(runner, nxt, own.to_guess(), model_spec=spec)
-    transcription.STALL_STOP_OPTIONS.update(stop)
-    stopped = predict_stride(runner, nxt, own.to_guess(), model_spec=spec)
-    angle = float(np.max(np.abs(np.degrees(full.nlp.q[:, 3:] - stopped.nlp.q[:, 3:]))))
+    full, stopped, diff = full_and_stopped(
+        lambda: predict_stride(runner, nxt, own.to_guess(), model_spec=spec))
     rec = {"case": name, "speed": speed, "next_speed": target, "mesh": mesh,
            "own_iterations": own.nlp.iterations, "full": _row(full), "stopped": _row(stopped),
-           "objective_difference_pct": 100 * (stopped.nlp.objective / full.nlp.objective - 1),
-           "largest_angle_difference_deg": angle}
-    with open(HERE / "warm_stop_records.jsonl", "a", encoding="utf-8") as fh:
-        fh.write(json.dumps(rec) + "\n")
+           **diff}
+    append_record(HERE / "warm_stop_records.jsonl", rec)
     return rec
-
 
 if __name__ == "__main__":
     for case in sys.argv[1:] or list(CASES):
