@@ -20,7 +20,7 @@ import json
 import sys
 from pathlib import Path
 
-from warm_stop import _row, append_record, full_and_stopped
+from warm_stop import append_record, full_and_stopped, solve_row
 
 from bladelab.predict import defaults
 from bladelab.predict.collocation.guess import template_guess
@@ -53,12 +53,14 @@ def run(name: str) -> dict:
     full, stopped, diff = full_and_stopped(
         lambda: predict_stride(runner, settings, guess, model_spec=spec))
     rec = {"case": name,
-           "full": {**_row(full), "tracking_iterations": (full.tracking or {}).get("iterations")},
-           "stopped": {**_row(stopped),
+           "full": {**solve_row(full),
+                    "tracking_iterations": (full.tracking or {}).get("iterations")},
+           "stopped": {**solve_row(stopped),
                        "tracking_iterations": (stopped.tracking or {}).get("iterations")},
            **diff}
     append_record(HERE / "cold_stop_records.jsonl", rec)
     return rec
+
 
 if __name__ == "__main__":
     for case in sys.argv[1:] or ["able-template", "amputee-primal"]:

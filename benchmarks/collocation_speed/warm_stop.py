@@ -49,7 +49,8 @@ CASES = {
 }
 
 
-def _row(sol) -> dict:
+def solve_row(sol) -> dict:
+    """The record's fields of one solve (units in the module docstring)."""
     crit = human_running_criteria(sol)
     return {"status": sol.nlp.status, "iterations": sol.nlp.iterations,
             "wall_s": round(sol.nlp.wall_s, 1),
@@ -101,10 +102,12 @@ def run(name: str) -> dict:
     full, stopped, diff = full_and_stopped(
         lambda: predict_stride(runner, nxt, own.to_guess(), model_spec=spec))
     rec = {"case": name, "speed": speed, "next_speed": target, "mesh": mesh,
-           "own_iterations": own.nlp.iterations, "full": _row(full), "stopped": _row(stopped),
+           "own_iterations": own.nlp.iterations, "full": solve_row(full),
+           "stopped": solve_row(stopped),
            **diff}
     append_record(HERE / "warm_stop_records.jsonl", rec)
     return rec
+
 
 if __name__ == "__main__":
     for case in sys.argv[1:] or list(CASES):

@@ -29,7 +29,7 @@ CATEGORIES = ("Cat4", "Cat5", "Cat6", "Cat6High", "Cat7")
 
 def _row(path: Path, weight: float, speed: float, category: str) -> dict:
     raw = json.loads(path.read_text(encoding="utf-8"))
-    sol = CollocationSolution.read(path)
+    sol = CollocationSolution.from_dict(raw, file=path)
     crit = human_running_criteria(sol)
     return {"people_weight": weight, "speed": speed, "category": category,
             "objective": raw["objective"], **{f"term_{k}": v for k, v in
@@ -65,9 +65,10 @@ def main(runs: Path, out: Path = HERE / "people-weight") -> int:
     speeds = sorted({r["speed"] for r in rows})
     for speed in speeds:
         for category in CATEGORIES:
-            best = HERE / f"speed-{speed:g}" / f"{category}-best.json"
-            if best.is_file():
-                rows.append({**_row(best, 10.0, speed, category), "start": "the record's best"})
+            record_best = HERE / f"speed-{speed:g}" / f"{category}-best.json"
+            if record_best.is_file():
+                rows.append({**_row(record_best, 10.0, speed, category),
+                             "start": "the record's best"})
     rows.sort(key=lambda r: (r["speed"], r["people_weight"], CATEGORIES.index(r["category"])))
     with open(out / "records.jsonl", "w", encoding="utf-8") as f:
         for r in rows:
