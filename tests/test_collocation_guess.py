@@ -195,33 +195,3 @@ def test_a_sphere_stride_starts_a_multilink_blade_at_its_static_deflection():
     assert deformed[1] == pytest.approx(-0.01, abs=1e-4)  # the deflected blade: 1 cm
     assert np.all(g.q[2, joints] == 0.0) and np.any(g.q[1, joints] != 0.0)  # none in the air
     assert np.array_equal(deflected_blade(sphere, q), q)  # no multi-link blade: unchanged
-
-
-def test_the_template_toes_follow_their_passive_hinge():
-    """The toes extend in stance towards the angle that keeps them flat on the ground and
-    return in swing, through the hinge's lag D/K: with a hinge that lags little they reach the
-    flat angle (the toe tip as low as the ball) at toe-off; with the human body's damper they
-    lag behind it, peak later and lower, and the stride stays periodic."""
-    n = 50
-    toes = build_runner("able", body="toes")  # D/K = 1.2 ms: follows the flat angle
-    human = build_runner("able", body="human")  # D/K = 80 ms
-    quick, slow = (template_guess(m, speed=3.5, n=n) for m in (toes, human))
-    names = list(toes.contact_names)
-    tip, ball = names.index("toetip_l"), names.index("toe_l")
-    toe_quick = quick.q[:, toes.dof("mtp_angle_l")]
-    toe_slow = slow.q[:, human.dof("mtp_angle_l")]
-    stance = quick.vertical_grf_bw[:-1] > 0
-    stance[n // 2:] = False  # the left leg's stance
-    last = np.flatnonzero(stance)[-1]
-    assert np.degrees(toe_quick[last]) > 20  # extended at toe-off, never flexed
-    assert toe_quick.min() >= 0 and toe_slow.min() >= 0
-    h = contact_heights(toes, quick.q[last])
-    assert h[tip] == pytest.approx(h[ball], abs=2e-4)  # flat on the ground
-    assert np.degrees(toe_quick[last + 3]) < 1  # back to neutral in swing
-    assert 0.2 * toe_quick.max() < toe_slow.max() < toe_quick.max()
-    assert np.argmax(toe_slow[:-1]) >= np.argmax(toe_quick[:-1])
-    assert toe_slow[last + 3] > 0.3 * toe_slow.max()  # still returning
-    _check_periodic(human, slow, 3.5)
-    # the other foot does the same half a stride later
-    np.testing.assert_allclose(np.roll(slow.q[:-1, human.dof("mtp_angle_r")], -n // 2),
-                               toe_slow[:-1], atol=1e-9)

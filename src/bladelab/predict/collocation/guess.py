@@ -9,8 +9,8 @@ known, muscle activations and normalised tendon forces (a
 - :func:`template_guess`: people's running as a template (people's mean hip, knee and ankle
   angles at 3.5 m/s, time-warped to people's stance share and stride time at the speed, the
   other leg half a period later; the transfemoral runner's passive knee straight in stance,
-  :func:`prosthetic_knee_template`; toes, where the foot has them, moved as their passive
-  hinge moves them), the stance foot on the ground and ballistic flights between the stances;
+  :func:`prosthetic_knee_template`), the stance foot on the ground and ballistic flights
+  between the stances;
 - :func:`guess_from_trial`: measured running (e.g. the Fukuchi et al. 2017 treadmill trial at
   3.5 m/s): sagittal angles from markers (:mod:`bladelab.trial.cycles`), averaged over the
   trial's left-leg cycles, the pelvis placed the same way; the amputee's socket held at 0;
@@ -27,7 +27,6 @@ import math
 from dataclasses import replace
 from pathlib import Path
 
-import mujoco
 import numpy as np
 
 from bladelab._io import read_json
@@ -141,9 +140,7 @@ def template_guess(model: RunnerModel, *, speed: float = 3.5, n: int = 50,
     The hip, knee and ankle follow people's mean angles at 3.5 m/s
     (:func:`~bladelab.predict.collocation.people.people_joint_angles`: RBDS002 and RBDS003 of
     Fukuchi et al. 2017), the right leg half a stride later, the trunk 5° forward, the
-    transfemoral runner's passive knee :func:`prosthetic_knee_template`, the toes extending
-    in stance and returning in swing as their passive hinge moves them
-    (:func:`_toes_on_the_ground`). The stride time
+    transfemoral runner's passive knee :func:`prosthetic_knee_template`. The stride time
     defaults to the middle of people's band at ``speed``
     (:func:`~bladelab.predict.collocation.running_bands.reference_band`: 0.71 s at 3.5 m/s);
     each leg's stance lasts people's share of the stride at that speed (0.315 at 3.5 m/s,
@@ -177,77 +174,9 @@ def template_guess(model: RunnerModel, *, speed: float = 3.5, n: int = 50,
     if model.kind == "transfemoral":  # a passive knee: straight in stance, flexed in swing
         q[:, model.dof("knee_angle_r")] = -prosthetic_knee_template(frac + 0.5)
     grf = template_vertical_grf(frac, duty=duty)
-    q = _toes_on_the_ground(model, q, period, duty)
     q = _stances_and_flights(model, q, period, duty)
     return StrideGuess(f"template at {speed:g} m/s", period, q, periodic_derivative(q, period),
                        vertical_grf_bw=grf)
-
-
-def _toes_on_the_ground(model: RunnerModel, q: np.ndarray, period: float,
-                        duty: float) -> np.ndarray:
-    """``q`` with the toes of each foot that has them (``mtp_angle_<side>``) moved as their
-    passive hinge moves them: towards the angle that keeps the toes flat on the ground while
-    the heel rises in stance (the toe tip as low as the ball, never flexed) and towards neutral
-    in swing, through the hinge's first-order lag of time constant D/K
-    (``RunnerParams.toe_hinge``; the toes' inertia is negligible), periodic over the stride.
-    Toes held at neutral through a stance with the heel up press the toe tip into the ground,
-    and toes that follow the flat angle faster than the hinge can were no better start
-    (benchmarks/collocation_speed/README.md, "The template's toes")."""
-    hinge = model.params.toe_hinge
-    tau = hinge.damping_Nms_per_rad / max(hinge.stiffness_Nm_per_rad, 1e-9)  # [s]
-    names = list(model.contact_names)
-    n = q.shape[0] - 1
-    frac = np.arange(n + 1) / n
-    q = q.copy()
-    data = mujoco.MjData(model.mj_model)
-    for side, lag in (("l", 0.0), ("r", 0.5)):
-        name = f"mtp_angle_{side}"
-        if name not in model.dof_names or f"toetip_{side}" not in names:
-            continue
-        j, tip, ball = model.dof(name), names.index(f"toetip_{side}"), names.index(f"toe_{side}")
-        flat = np.zeros(n)
-        for k in np.flatnonzero(np.mod(frac[:n] - lag, 1.0) < duty):
-            flat[k] = _flat_toe_angle(model, q[k], j, tip, ball, data)
-        q[:, j] = np.append(_periodic_lag(flat, period / n, tau), 0.0)
-        q[n, j] = q[0, j]
-    return q
-
-
-def _flat_toe_angle(model: RunnerModel, qk: np.ndarray, j: int, tip: int, ball: int,
-                    data) -> float:
-    """The toe hinge's angle [rad] (coordinate ``j``, 0 to :data:`_TOE_FLAT_MAX_DEG`) that puts
-    the toe tip (contact ``tip``) as low as the ball (contact ``ball``) at pose ``qk``."""
-    qk = qk.copy()
-
-    def tip_below_ball(angle: float) -> bool:
-        qk[j] = angle
-        h = contact_heights(model, qk, data)
-        return h[tip] < h[ball]
-
-    lo, hi = 0.0, math.radians(_TOE_FLAT_MAX_DEG)
-    if not tip_below_ball(lo):
-        return lo
-    for _ in range(40):  # bisection to 1e-12 rad
-        mid = 0.5 * (lo + hi)
-        lo, hi = (mid, hi) if tip_below_ball(mid) else (lo, mid)
-    return hi
-
-
-def _periodic_lag(target: np.ndarray, h: float, tau: float) -> np.ndarray:
-    """The periodic response of ``ẋ = (target − x)/tau`` [tau in s] to ``target`` given at the
-    ``target.size`` nodes of one period (spacing ``h`` [s]): each interval exact for a target
-    held at its end value; three periods from 0 (the lag forgets its start within one)."""
-    decay = math.exp(-h / max(tau, 1e-12))
-    x, out = 0.0, np.empty(target.size)
-    for _ in range(3):
-        for k in range(target.size):
-            x = decay * x + (1.0 - decay) * target[k]
-            out[k] = x
-    return out
-
-
-#: Upper end [deg] of the search for the toes' flat angle (the hinge's ligament begins at 60°).
-_TOE_FLAT_MAX_DEG = 60.0
 
 
 def _contact_share(speed: float) -> float:
