@@ -8,7 +8,8 @@ Usage (repository root; one solve, one core)::
 ``toes``: ``"hinge"`` (the toes moved as their passive hinge moves them:
 :func:`toes_on_the_ground`), ``"neutral"`` (the library's template: held at 0), or ``[peak_deg]`` (a
 sin² rise over the second half of each stance to ``peak_deg`` at toe-off, then the hinge's
-own lag in swing). ``damping`` [N·m·s/rad]: the toes' damper (default the human body's); ``blade``: the
+own lag in swing), each set on the library's template after its pelvis is placed on the
+lowest contact (the toe tip may then be a few millimetres in the ground). ``damping`` [N·m·s/rad]: the toes' damper (default the human body's); ``blade``: the
 amputee wearing that category instead of the able runner (4 m/s instead of 3.5 m/s).
 Solves the able runner (human body) at 3.5 m/s on 50 intervals from the template, tracking
 then predictive stage, as ``bench_collocation.py``'s template row, and appends one line to
@@ -61,6 +62,8 @@ def _toes(runner, guess, toes):
     hinge = runner.params.toe_hinge
     tau = hinge.damping_Nms_per_rad / hinge.stiffness_Nm_per_rad
     for side, lag in (("l", 0.0), ("r", 0.5)):
+        if f"mtp_angle_{side}" not in runner.dof_names:  # the prosthetic leg
+            continue
         j = runner.dof(f"mtp_angle_{side}")
         peak = math.radians(float(toes[0]))
         phase = np.mod(frac - lag, 1.0)
