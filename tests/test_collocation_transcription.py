@@ -433,37 +433,3 @@ def test_an_lbfgs_solve_stops_where_its_objective_stalls_near_the_full_solution(
     exact_keys = [dict(key) for key in nlp._solvers
                   if dict(key)["ipopt.hessian_approximation"] == repr("exact")]
     assert exact_keys and not any("ipopt.acceptable_iter" in k for k in exact_keys)
-
-
-def test_the_force_tracking_term_follows_each_legs_own_pattern_when_given_per_leg():
-    """grf_tracking with an (n + 1, 2) reference: w × the time-averaged squared deviation of
-    each leg's vertical force from its own column [BW²], summed over the legs; a total
-    reference (n + 1,) compares the total. A stride whose force is on the other leg misses the
-    per-leg pattern by exactly that force."""
-    toy = _toy()
-    q, qd = ca.SX.sym("q", 3), ca.SX.sym("qd", 3)
-    spring = [K * 0.5 * (-z + ca.sqrt(z**2 + 1e-8)) for z in (q[1], q[2])]
-    legs = dataclasses.replace(toy, leg_vertical_grf=ca.Function("legs", [q, qd],
-                                                                 [ca.vertcat(*spring)]))
-    n, speed = 20, 2.0
-    guess = _bouncing_guess(n, speed)
-    guess.q[:, 2] = 0.0  # the second 'leg' never loaded
-    forces = np.stack([np.asarray(legs.leg_vertical_grf(qk, qk * 0)).ravel()
-                       for qk in guess.q])
-    swapped = forces[:, ::-1]  # the force on the other leg
-    bw = M * G
-
-    def term(reference):
-        nlp = StrideNLP(legs, n=n, speed=speed, grf_tracking=(reference, 3.0))
-        lbx, ubx, lbg, ubg = nlp.bounds()
-        sol = nlp.unpack(nlp.initial_vector(guess), {}, 0.0, 0.0, lbg, ubg, np.zeros(lbg.size))
-        return sol.objective_terms["grf_tracking"]
-
-    assert term(forces) == pytest.approx(0.0, abs=1e-12)
-    dev = ((forces - swapped) / bw) ** 2
-    per_node = dev.sum(axis=1)
-    expected = 3.0 * np.sum(per_node[1:] + per_node[:-1]) / (2 * n)
-    assert expected > 0.1
-    assert term(swapped) == pytest.approx(expected, rel=1e-9)
-    with pytest.raises(SpecError, match="per leg"):
-        term(np.zeros((n + 1, 3)))

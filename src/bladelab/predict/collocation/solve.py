@@ -208,21 +208,6 @@ def _solve_stage(nlp, x0: np.ndarray, settings: CollocationSettings, stage: str,
     return sol
 
 
-def _force_pattern(total_n: np.ndarray, dyn) -> np.ndarray:
-    """The tracking stage's force pattern [N]: per leg, shape (n + 1, 2), where the dynamics
-    give each leg's force (``StrideDynamics.leg_vertical_grf``), else the total (n + 1,).
-    A stride starts at the left leg's touch-down, so the left (intact) leg stands in its
-    first half and the right leg in its second (running: the stances do not overlap).
-    Measured: with one total pattern a tracking stage from the template could meet the
-    intact leg's missing stance with the force-tracking term alone and ended in a hop on the
-    blade (benchmarks/collocation_speed/README.md, "The template's toes")."""
-    if dyn.leg_vertical_grf is None:
-        return total_n
-    first_half = np.linspace(0.0, 1.0, total_n.size) < 0.5
-    return np.stack([np.where(first_half, total_n, 0.0), np.where(first_half, 0.0, total_n)],
-                    axis=1)
-
-
 def _stalled(sol, settings: CollocationSettings) -> bool:
     """True for an L-BFGS stage that ran out of iterations near a feasible point
     (:attr:`CollocationSettings.polish_iter`, :data:`POLISH_MAX_VIOLATION`)."""
@@ -435,8 +420,7 @@ def predict_stride(runner, settings: CollocationSettings, guess, *, model_spec: 
     if tracking_stage:
         grf = None
         if g.vertical_grf_bw is not None and settings.grf_tracking_weight > 0:
-            grf = (_force_pattern(g.vertical_grf_bw * runner.body_weight, dyn),
-                   settings.grf_tracking_weight)
+            grf = (g.vertical_grf_bw * runner.body_weight, settings.grf_tracking_weight)
         nlp_t = StrideNLP(dyn, n=n, speed=speed if speed is not None else g.speed,
                           weights=TRACKING_WEIGHTS, tracking=(g.q, settings.tracking_weight),
                           grf_tracking=grf, period_bounds=settings.period_bounds_s,

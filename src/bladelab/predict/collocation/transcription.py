@@ -452,18 +452,12 @@ class StrideNLP:
             terms["period_tracking"] = weight * ca.log(period / t_ref) ** 2
         if self.grf_tracking is not None:
             f_ref, weight = self.grf_tracking
-            f_ref = np.asarray(f_ref, float)
+            f_ref = np.asarray(f_ref, float).reshape(1, -1)
+            if f_ref.shape != (1, n + 1):
+                raise SpecError(f"force reference has {f_ref.size} values, the mesh needs "
+                                f"{n + 1}", where="force tracking")
             bw = d.mass * d.gravity
-            if f_ref.ndim == 2 and f_ref.shape == (n + 1, 2):  # each leg's own pattern
-                legs = ca.Function("legs", [xs], [d.leg_vertical_grf(q, qd)]).map(n + 1)(X)
-                dev = ca.sum1(((legs - f_ref.T) / bw) ** 2)
-            else:
-                f_ref = f_ref.reshape(1, -1)
-                if f_ref.shape != (1, n + 1):
-                    raise SpecError(f"force reference has {f_ref.size} values, the mesh "
-                                    f"needs {n + 1} (or {n + 1} × 2, per leg)",
-                                    where="force tracking")
-                dev = ((fzs - f_ref) / bw) ** 2
+            dev = ((fzs - f_ref) / bw) ** 2
             terms["grf_tracking"] = float(weight) * _node_pairs(dev) / (2 * n)
         if self.n_ineq:
             imposed = ineqs[:, :m]
