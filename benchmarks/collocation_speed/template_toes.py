@@ -6,15 +6,16 @@ Usage (repository root; one solve, one core)::
         RECORDS.jsonl '{"toes": "hinge"}'
 
 ``toes``: ``"hinge"`` (the toes moved as their passive hinge moves them:
-:func:`toes_on_the_ground`), ``"neutral"`` (the library's template: held at 0), or ``[peak_deg]`` (a
-sin² rise over the second half of each stance to ``peak_deg`` at toe-off, then the hinge's
-own lag in swing), each set on the library's template after its pelvis is placed on the
-lowest contact (the toe tip may then be a few millimetres in the ground). ``damping`` [N·m·s/rad]: the toes' damper (default the human body's); ``blade``: the
-amputee wearing that category instead of the able runner (4 m/s instead of 3.5 m/s).
-Solves the able runner (human body) at 3.5 m/s on 50 intervals from the template, tracking
-then predictive stage, as ``bench_collocation.py``'s template row, and appends one line to
-RECORDS.jsonl: iterations per stage, objective, cost of transport [J/(kg·m)], stride time
-[s], wall time [s].
+:func:`toes_on_the_ground`; the default), ``"neutral"`` (the library's template: held at 0),
+or ``[peak_deg]`` (a sin² rise over the second half of each stance to ``peak_deg`` at
+toe-off, then the hinge's own lag in swing), each set on the library's template after its
+pelvis is placed on the lowest contact (the toe tip may then be a few millimetres in the
+ground). ``damping`` [N·m·s/rad]: the toes' damper (default the human body's); ``blade``:
+the amputee wearing that category at 4 m/s instead of the able runner at 3.5 m/s.
+Solves on 50 intervals from the template, tracking then predictive stage, as
+``bench_collocation.py``'s template row, and appends one line to RECORDS.jsonl: iterations
+per stage, objective, cost of transport [J/(kg·m)], stride time [s], gait warnings, wall
+time [s].
 """
 
 from __future__ import annotations
@@ -79,7 +80,7 @@ def toes_on_the_ground(model: RunnerModel, q: np.ndarray, period: float,
     passive hinge moves them: towards the angle that keeps the toes flat on the ground while
     the heel rises in stance (the toe tip as low as the ball, never flexed) and towards neutral
     in swing, through the hinge's first-order lag of time constant D/K
-    (``RunnerParams.toe_hinge``; the toes' inertia is negligible), periodic over the stride.
+    (``RunnerParams.toe_hinge``; the toes' inertia is negligible), periodic over the stride
     (README.md, "The template's toes")."""
     hinge = model.params.toe_hinge
     tau = hinge.damping_Nms_per_rad / max(hinge.stiffness_Nm_per_rad, 1e-9)  # [s]
