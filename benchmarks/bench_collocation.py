@@ -5,7 +5,8 @@ Targets: the amputee Cat6 stride at 4 m/s from the default guess ≤ 60 s; warm-
 4.2 m/s ≤ 10 s; the able runner at 3.5 m/s from the template ≤ 60 s. Reported per
 solve: wall time, IPOPT iterations per stage, and the time per evaluation of the objective,
 constraints, objective gradient and constraint Jacobian (IPOPT's own counters, CasADi
-``stats()``). The plausibility of the gait is a separate matter (docs/collocation.md).
+``stats()``), the time inside IPOPT's own algebra, the process's peak resident memory (a
+high-water mark over the solves so far), and the compiled-library cache's size on disk. The plausibility of the gait is a separate matter (docs/collocation.md).
 """
 
 from __future__ import annotations
@@ -29,8 +30,23 @@ def _row(label: str, sol) -> str:
         evals.append(f"{1e3 * secs / calls:.2f} ms" if calls else "–")
     build = nlp.timings.get("build_s", 0.0)
     compile_s = nlp.timings.get("compile_s", 0.0)
+    own = (trk.get("ipopt_own_s", 0.0) if trk else 0.0) + nlp.timings.get("ipopt_own_s", 0.0)
+    memory = nlp.timings.get("peak_memory_MB")
     return (f"| {label} | {'yes' if sol.converged else 'no: ' + sol.nlp.status} | {iters} | "
-            f"{wall:.0f} s | {build:.1f} s | {compile_s:.1f} s | " + " | ".join(evals) + " |")
+            f"{wall:.0f} s | {own:.0f} s | {build:.1f} s | {compile_s:.1f} s | "
+            + " | ".join(evals)
+            + f" | {'–' if memory is None else f'{memory:.0f} MB'} |")
+
+
+def _cache_line() -> str:
+    """The compiled-library cache's size on disk [MB] and its number of libraries."""
+    from bladelab.predict.collocation.compiled import cache_dir
+
+    folder = cache_dir()
+    files = [f for f in folder.iterdir() if f.is_file() and not f.name.startswith(".")]
+    size = sum(f.stat().st_size for f in files) / 1e6
+    return (f"The compiled-library cache ({folder}) holds {len(files)} files, {size:.1f} MB on "
+            "disk, after these solves.")
 
 
 def run() -> str:
@@ -82,8 +98,11 @@ def run() -> str:
         "docs/collocation.md \"Compiled node functions\"): its compile (or its load from the "
         "cache) is reported in its own column, outside the solve's wall time.",
         "",
-        "| solve | converged | iterations | wall | of it, building the predictive solver | "
-        "compiling the node function (before the solve) | f | g | ∇f | ∂g |",
-        "|---|---|---|---|---|---|---|---|---|---|",
+        "| solve | converged | iterations | wall | of it, IPOPT's own | of it, building the "
+        "predictive solver | compiling the node function (before the solve) | f | g | ∇f | ∂g | "
+        "peak memory of the process so far |",
+        "|---|---|---|---|---|---|---|---|---|---|---|---|",
         *rows,
+        "",
+        _cache_line(),
     ])

@@ -535,6 +535,10 @@ def test_a_locally_infeasible_tracking_stage_is_solved_again_from_its_iterate(ab
     np.testing.assert_array_equal(x_restart, nlp.initial_vector(first.to_guess("x")))
     assert out.tracking["restarted_after"] == "Infeasible_Problem_Detected"
     assert out.tracking["iterations"] == first.iterations + restart.iterations == 10
+    # IPOPT's own time of both tracking solves, as the iterations
+    assert out.tracking["ipopt_own_s"] == pytest.approx(
+        first.timings["ipopt_own_s"] + restart.timings["ipopt_own_s"])
+    assert first.timings["ipopt_own_s"] > 0
     # a second local infeasibility ends the solve: one restart, no loop
     calls.clear()
     labels[:] = [("Restoration_Failed", None), ("Infeasible_Problem_Detected", None)]

@@ -237,7 +237,8 @@ def _polish(nlp, sol, settings: CollocationSettings,
 def _stage_info(sol) -> dict:
     return {"success": bool(sol.success), "status": sol.status, "iterations": int(sol.iterations),
             "wall_s": float(sol.wall_s), "objective": float(sol.objective),
-            "max_violation": float(sol.max_violation)}
+            "max_violation": float(sol.max_violation),
+            "ipopt_own_s": float(sol.timings.get("ipopt_own_s", 0.0))}
 
 
 #: Per runner (weakly held): its collocation model, its stride dynamics and the predictive
@@ -434,6 +435,7 @@ def predict_stride(runner, settings: CollocationSettings, guess, *, model_spec: 
             tracking = _stage_info(sol_t) | {
                 "iterations": first["iterations"] + int(sol_t.iterations),
                 "wall_s": first["wall_s"] + float(sol_t.wall_s),
+                "ipopt_own_s": first["ipopt_own_s"] + float(sol_t.timings.get("ipopt_own_s", 0.0)),
                 "restarted_after": first["status"]}
         if not sol_t.success:
             return CollocationSolution.from_nlp(
