@@ -33,7 +33,7 @@ def _row(label: str, sol) -> str:
     own = (trk.get("ipopt_own_s", 0.0) if trk else 0.0) + nlp.timings.get("ipopt_own_s", 0.0)
     memory = nlp.timings.get("peak_memory_MB")
     return (f"| {label} | {'yes' if sol.converged else 'no: ' + sol.nlp.status} | {iters} | "
-            f"{wall:.0f} s | {own:.0f} s | {build:.1f} s | {compile_s:.1f} s | "
+            f"{wall:.1f} s | {own:.1f} s | {build:.1f} s | {compile_s:.1f} s | "
             + " | ".join(evals)
             + f" | {'–' if memory is None else f'{memory:.0f} MB'} |")
 
