@@ -1,0 +1,72 @@
+"""What people's swing knee costs: a stride solved with its swing knee held at a flexion
+(a measuring probe; changes nothing in src).
+
+Usage (repository root)::
+
+    .venv/bin/python benchmarks/human_body/swing-knee/knee_bound.py OUT START SPEED [DEG]
+
+Solves the able runner (the shipped body, people's angles at the default weight, mesh and
+stride time as the start's settings) at ``SPEED`` [m/s] from the stride ``START`` (its primal
+values), with each leg's knee flexed at least ``DEG`` [deg] at the mesh node where the start's
+knee flexes most in swing (a bound on that node's knee coordinate); without ``DEG``, the
+same problem unbounded (the control). Writes ``OUT/solution.json`` (or ``best_iterate.json``)
+and prints its summary, its objective and the criteria it misses.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import math
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+from bladelab.predict import defaults
+from bladelab.predict.collocation.human_running import human_running_criteria
+from bladelab.predict.collocation.settings import CollocationSettings, people_term
+from bladelab.predict.collocation.solution import CollocationSolution
+from bladelab.predict.collocation.solve import predict_stride
+from bladelab.predict.collocation.transcription import StrideNLP
+from bladelab.runner import build_runner
+
+
+def main() -> None:
+    out, start, speed = Path(sys.argv[1]), Path(sys.argv[2]), float(sys.argv[3])
+    deg = float(sys.argv[4]) if len(sys.argv) > 4 else None
+    sol0 = CollocationSolution.read(start)
+    runner = build_runner("able", body="human")
+    guess = dataclasses.replace(sol0.to_guess(f"{start.name}, primal values"), multipliers=None)
+    names = list(sol0.dof_names)
+    knees = [names.index("knee_angle_l"), names.index("knee_angle_r")]
+    # the node of each knee's deepest flexion (knee angles are negative in flexion)
+    nodes = [int(np.argmin(sol0.nlp.q[:-1, j])) for j in knees]
+    bounds = StrideNLP.bounds
+
+    def held(self):
+        lbx, ubx, lbg, ubg = bounds(self)
+        if deg is not None:
+            nx = len(self.sx)
+            for j, k in zip(knees, nodes, strict=True):
+                ubx[k * nx + j] = min(ubx[k * nx + j], -math.radians(deg) / self.sx[j])
+        return lbx, ubx, lbg, ubg
+
+    StrideNLP.bounds = held
+    settings = CollocationSettings(mesh_intervals=sol0.nlp.q.shape[0] - 1, speed_m_per_s=speed,
+                                   **people_term(defaults.people_weight_for("human")))
+    t0 = time.perf_counter()
+    sol = predict_stride(runner, settings, guess, model_spec={"model": "able", "body": "human"},
+                         track=False)
+    out.mkdir(parents=True, exist_ok=True)
+    sol.write(out / ("solution.json" if sol.converged else "best_iterate.json"))
+    crit = human_running_criteria(sol)
+    missed = [c.line() for c in crit if not c.met]
+    print(json.dumps({"bound_deg": deg, "nodes": nodes, "objective": sol.nlp.objective,
+                      "iterations": sol.nlp.iterations, **sol.summary(), "missed": missed,
+                      "wall_s": time.perf_counter() - t0}, default=str))
+
+
+if __name__ == "__main__":
+    main()
