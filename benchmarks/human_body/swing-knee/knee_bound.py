@@ -3,13 +3,14 @@
 
 Usage (repository root)::
 
-    .venv/bin/python benchmarks/human_body/swing-knee/knee_bound.py OUT START SPEED [DEG]
+    .venv/bin/python benchmarks/human_body/swing-knee/knee_bound.py OUT START SPEED [DEG[,DEG_R]] [BLADE]
 
-Solves the able runner (the shipped body, people's angles at the default weight, mesh and
-stride time as the start's settings) at ``SPEED`` [m/s] from the stride ``START`` (its primal
-values), with each leg's knee flexed at least ``DEG`` [deg] at the mesh node where the start's
-knee flexes most in swing (a bound on that node's knee coordinate); without ``DEG``, the
-same problem unbounded (the control). Writes ``OUT/solution.json`` (or ``best_iterate.json``)
+Solves the able runner (or, with ``BLADE``, e.g. ``Cat4``, the transtibial amputee wearing it)
+on the shipped body, people's angles at the default weight, the start's mesh, the stride time
+free, at ``SPEED`` [m/s] from the stride ``START`` (its primal values), with each leg's knee
+flexed at least ``DEG`` [deg] (the right, i.e. prosthetic, leg ``DEG_R`` if given) at the mesh
+node where the start's knee flexes most in swing (a bound on that node's knee coordinate);
+``DEG`` ``-``: the same problem unbounded (the control). Writes ``OUT/solution.json`` (or ``best_iterate.json``)
 and prints its summary, its objective and the criteria it misses.
 """
 
@@ -35,9 +36,16 @@ from bladelab.runner import build_runner
 
 def main() -> None:
     out, start, speed = Path(sys.argv[1]), Path(sys.argv[2]), float(sys.argv[3])
-    deg = float(sys.argv[4]) if len(sys.argv) > 4 else None
+    arg = sys.argv[4] if len(sys.argv) > 4 else "-"
+    degs = None if arg == "-" else [float(v) for v in arg.split(",")]
+    if degs is not None and len(degs) == 1:
+        degs *= 2
+    blade = sys.argv[5] if len(sys.argv) > 5 else None
+    kind = "able" if blade is None else "amputee"
+    spec = {"model": kind, "blade": blade, "body": "human"} if blade else {"model": kind,
+                                                                             "body": "human"}
     sol0 = CollocationSolution.read(start)
-    runner = build_runner("able", body="human")
+    runner = build_runner(kind, body="human", blade=blade)
     guess = dataclasses.replace(sol0.to_guess(f"{start.name}, primal values"), multipliers=None)
     names = list(sol0.dof_names)
     knees = [names.index("knee_angle_l"), names.index("knee_angle_r")]
@@ -47,9 +55,9 @@ def main() -> None:
 
     def held(self):
         lbx, ubx, lbg, ubg = bounds(self)
-        if deg is not None:
+        if degs is not None:
             nx = len(self.sx)
-            for j, k in zip(knees, nodes, strict=True):
+            for j, k, deg in zip(knees, nodes, degs, strict=True):
                 ubx[k * nx + j] = min(ubx[k * nx + j], -math.radians(deg) / self.sx[j])
         return lbx, ubx, lbg, ubg
 
@@ -57,13 +65,12 @@ def main() -> None:
     settings = CollocationSettings(mesh_intervals=sol0.nlp.q.shape[0] - 1, speed_m_per_s=speed,
                                    **people_term(defaults.people_weight_for("human")))
     t0 = time.perf_counter()
-    sol = predict_stride(runner, settings, guess, model_spec={"model": "able", "body": "human"},
-                         track=False)
+    sol = predict_stride(runner, settings, guess, model_spec=spec, track=False)
     out.mkdir(parents=True, exist_ok=True)
     sol.write(out / ("solution.json" if sol.converged else "best_iterate.json"))
     crit = human_running_criteria(sol)
     missed = [c.line() for c in crit if not c.met]
-    print(json.dumps({"bound_deg": deg, "nodes": nodes, "objective": sol.nlp.objective,
+    print(json.dumps({"bound_deg": degs, "blade": blade, "nodes": nodes, "objective": sol.nlp.objective,
                       "iterations": sol.nlp.iterations, **sol.summary(), "missed": missed,
                       "wall_s": time.perf_counter() - t0}, default=str))
 
