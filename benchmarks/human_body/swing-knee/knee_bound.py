@@ -3,14 +3,15 @@
 
 Usage (repository root)::
 
-    .venv/bin/python benchmarks/human_body/swing-knee/knee_bound.py OUT START SPEED [DEG[,DEG_R]] [BLADE]
+    .venv/bin/python benchmarks/human_body/swing-knee/knee_bound.py OUT START SPEED [DEG[,DEG_R]] [BLADE] [people]
 
-Solves the able runner (or, with ``BLADE``, e.g. ``Cat4``, the transtibial amputee wearing it)
+Solves the able runner (or, with ``BLADE``, e.g. ``Cat4``, the transtibial amputee wearing it; ``able``: the able runner)
 on the shipped body, people's angles at the default weight, the start's mesh, the stride time
 free, at ``SPEED`` [m/s] from the stride ``START`` (its primal values), with each leg's knee
 flexed at least ``DEG`` [deg] (the right, i.e. prosthetic, leg ``DEG_R`` if given) at the mesh
 node where the start's knee flexes most in swing (a bound on that node's knee coordinate);
-``DEG`` ``-``: the same problem unbounded (the control). Writes ``OUT/solution.json`` (or ``best_iterate.json``)
+``DEG`` ``-``: the same problem unbounded (the control). A last argument ``people`` holds the
+stride time within people's band at the speed (``CollocationSettings.stride_time_people``). Writes ``OUT/solution.json`` (or ``best_iterate.json``)
 and prints its summary, its objective and the criteria it misses.
 """
 
@@ -40,7 +41,8 @@ def main() -> None:
     degs = None if arg == "-" else [float(v) for v in arg.split(",")]
     if degs is not None and len(degs) == 1:
         degs *= 2
-    blade = sys.argv[5] if len(sys.argv) > 5 else None
+    blade = sys.argv[5] if len(sys.argv) > 5 and sys.argv[5] != "able" else None
+    people_stride = len(sys.argv) > 6 and sys.argv[6] == "people"
     kind = "able" if blade is None else "amputee"
     spec = {"model": kind, "blade": blade, "body": "human"} if blade else {"model": kind,
                                                                              "body": "human"}
@@ -63,6 +65,7 @@ def main() -> None:
 
     StrideNLP.bounds = held
     settings = CollocationSettings(mesh_intervals=sol0.nlp.q.shape[0] - 1, speed_m_per_s=speed,
+                                   stride_time_people=people_stride,
                                    **people_term(defaults.people_weight_for("human")))
     t0 = time.perf_counter()
     sol = predict_stride(runner, settings, guess, model_spec=spec, track=False)
