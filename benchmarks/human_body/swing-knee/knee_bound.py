@@ -11,7 +11,8 @@ free, at ``SPEED`` [m/s] from the stride ``START`` (its primal values), with eac
 flexed at least ``DEG`` [deg] (the right, i.e. prosthetic, leg ``DEG_R`` if given) at the mesh
 node where the start's knee flexes most in swing (a bound on that node's knee coordinate);
 ``DEG`` ``-``: the same problem unbounded (the control). A last argument ``people`` holds the
-stride time within people's band at the speed (``CollocationSettings.stride_time_people``). Writes ``OUT/solution.json`` (or ``best_iterate.json``)
+stride time within people's band at the speed (``CollocationSettings.stride_time_people``);
+an argument ``mesh=N`` solves on N intervals (the start resampled, the held node scaled). Writes ``OUT/solution.json`` (or ``best_iterate.json``)
 and prints its summary, its objective and the criteria it misses.
 """
 
@@ -36,6 +37,8 @@ from bladelab.runner import build_runner
 
 
 def main() -> None:
+    mesh = next((int(a[5:]) for a in sys.argv if a.startswith("mesh=")), None)
+    sys.argv = [a for a in sys.argv if not a.startswith("mesh=")]
     out, start, speed = Path(sys.argv[1]), Path(sys.argv[2]), float(sys.argv[3])
     arg = sys.argv[4] if len(sys.argv) > 4 else "-"
     degs = None if arg == "-" else [float(v) for v in arg.split(",")]
@@ -52,7 +55,9 @@ def main() -> None:
     names = list(sol0.dof_names)
     knees = [names.index("knee_angle_l"), names.index("knee_angle_r")]
     # the node of each knee's deepest flexion (knee angles are negative in flexion)
-    nodes = [int(np.argmin(sol0.nlp.q[:-1, j])) for j in knees]
+    n0 = sol0.nlp.q.shape[0] - 1
+    n = n0 if mesh is None else mesh
+    nodes = [round(int(np.argmin(sol0.nlp.q[:-1, j])) * n / n0) for j in knees]
     bounds = StrideNLP.bounds
 
     def held(self):
@@ -64,7 +69,7 @@ def main() -> None:
         return lbx, ubx, lbg, ubg
 
     StrideNLP.bounds = held
-    settings = CollocationSettings(mesh_intervals=sol0.nlp.q.shape[0] - 1, speed_m_per_s=speed,
+    settings = CollocationSettings(mesh_intervals=n, speed_m_per_s=speed,
                                    stride_time_people=people_stride,
                                    **people_term(defaults.people_weight_for("human")))
     t0 = time.perf_counter()
