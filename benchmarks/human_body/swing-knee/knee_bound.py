@@ -3,17 +3,19 @@
 
 Usage (repository root)::
 
-    .venv/bin/python benchmarks/human_body/swing-knee/knee_bound.py OUT START SPEED [DEG[,DEG_R]] [BLADE] [people]
+    .venv/bin/python benchmarks/human_body/swing-knee/knee_bound.py OUT START SPEED \
+        [DEG[,DEG_R]] [BLADE] [people] [mesh=N]
 
-Solves the able runner (or, with ``BLADE``, e.g. ``Cat4``, the transtibial amputee wearing it; ``able``: the able runner)
-on the shipped body, people's angles at the default weight, the start's mesh, the stride time
-free, at ``SPEED`` [m/s] from the stride ``START`` (its primal values), with each leg's knee
-flexed at least ``DEG`` [deg] (the right, i.e. prosthetic, leg ``DEG_R`` if given) at the mesh
-node where the start's knee flexes most in swing (a bound on that node's knee coordinate);
-``DEG`` ``-``: the same problem unbounded (the control). A last argument ``people`` holds the
-stride time within people's band at the speed (``CollocationSettings.stride_time_people``);
-an argument ``mesh=N`` solves on N intervals (the start resampled, the held node scaled). Writes ``OUT/solution.json`` (or ``best_iterate.json``)
-and prints its summary, its objective and the criteria it misses.
+Solves the able runner (with ``BLADE``, e.g. ``Cat4``, the transtibial amputee wearing it;
+``able``: the able runner) on the shipped body, people's angles at the default weight, the
+start's mesh, the stride time free, at ``SPEED`` [m/s] from the stride ``START`` (its primal
+values), with each leg's knee flexed at least ``DEG`` [deg] (the right, i.e. prosthetic, leg
+``DEG_R`` if given) at the mesh node where the start's knee flexes most in swing (a bound on
+that node's knee coordinate); ``DEG`` ``-``: the same problem unbounded (the control). A last
+argument ``people`` holds the stride time within people's band at the speed
+(``CollocationSettings.stride_time_people``); an argument ``mesh=N`` solves on N intervals
+(the start resampled, the held node scaled). Writes ``OUT/solution.json`` (or
+``best_iterate.json``) and prints its summary, its objective and the criteria it misses.
 """
 
 from __future__ import annotations
