@@ -6,7 +6,8 @@ Targets: the amputee Cat6 stride at 4 m/s from the default guess ≤ 60 s; warm-
 solve: wall time, IPOPT iterations per stage, and the time per evaluation of the objective,
 constraints, objective gradient and constraint Jacobian (IPOPT's own counters, CasADi
 ``stats()``), the time inside IPOPT's own algebra, the process's peak resident memory (a
-high-water mark over the solves so far), and the compiled-library cache's size on disk. The plausibility of the gait is a separate matter (docs/collocation.md).
+high-water mark over the solves so far), and the compiled-library cache's size on disk. The
+plausibility of the gait is a separate matter (docs/collocation.md).
 """
 
 from __future__ import annotations

@@ -14,24 +14,20 @@ knee's flexion in early swing while it flexes the hip.
 
 from __future__ import annotations
 
-import json
 import sys
 from pathlib import Path
 
 import numpy as np
-from solve_variant import variant_runner
+from solve_variant import stride_runner
 
 from bladelab.predict.collocation.solution import CollocationSolution
-from bladelab.predict.collocation.stored import runner_from_spec
 
 
 def main() -> None:
     path = Path(sys.argv[1])
     every = int(sys.argv[2]) if len(sys.argv) > 2 else 2
     sol = CollocationSolution.read(path)
-    variant_file = path.parent / "variant.json"
-    runner = (variant_runner(json.loads(variant_file.read_text())) if variant_file.is_file()
-              else runner_from_spec(sol.model_spec))
+    runner = stride_runner(path, sol)
     names = list(runner.muscle_names)
     leg = [i for i, n in enumerate(names) if n.endswith("_l")
            and n[:-2] not in ("rect_abd", "int_obl", "erect_sp")]

@@ -17,27 +17,23 @@ soleus in running: 0.88 l_opt at peak activation (Rubenson et al. 2012, J Exp Bi
 
 from __future__ import annotations
 
-import json
 import sys
 from pathlib import Path
 
 import numpy as np
-from solve_variant import variant_runner
+from solve_variant import stride_runner
 
 from bladelab.predict.collocation.model import build_collocation_model
 from bladelab.predict.collocation.muscles import MP_LOPT, MP_VMAX
 from bladelab.predict.collocation.nodes import evaluate_nodes
 from bladelab.predict.collocation.solution import CONTACT_THRESHOLD_N, CollocationSolution
-from bladelab.predict.collocation.stored import runner_from_spec
 
 
 def fibre_table(path: Path, muscles: list[str]) -> tuple[dict[str, np.ndarray], float]:
     """({muscle: (nodes, 6) array of node, force [BW], a, F̃, l̃, ṽ}, the loaded threshold
     [BW]) of the stride in ``path``."""
     sol = CollocationSolution.read(path)
-    variant_file = path.parent / "variant.json"
-    runner = (variant_runner(json.loads(variant_file.read_text())) if variant_file.is_file()
-              else runner_from_spec(sol.model_spec))
+    runner = stride_runner(path, sol)
     cm, s, mp = build_collocation_model(runner), sol.nlp, runner.muscle_params
     names = list(runner.muscle_names)
     fz = sol.leg_vertical_force() / sol.body_weight_N

@@ -28,18 +28,19 @@ import time
 from pathlib import Path
 
 from bladelab.predict.collocation.settings import CollocationSettings, people_term
+from bladelab.predict.collocation.solution import CollocationSolution
 from bladelab.predict.collocation.solve import predict_stride
 from bladelab.predict.collocation.starting_guess import make_guess
+from bladelab.predict.collocation.stored import runner_from_spec
 from bladelab.predict.collocation.transcription import StrideWeights
 from bladelab.runner import build_runner
 from bladelab.runner.params import default_runner_params, runner_params_from_dict
 
 
-def variant_runner(variant: dict):
-    """The human runner of ``kind`` with the variant's ``force_factor``, ``muscle`` and ``set``,
-    and ``sprint_limit.py``'s shorthands ``vmax`` [l_opt/s] and ``active_tension`` [N/cm²]."""
-    kind, blade = variant.get("kind", "able"), variant.get("blade")
-    data = json.loads(default_runner_params(kind, body="human", blade=blade).model_dump_json())
+def apply_variant(data: dict, variant: dict) -> dict:
+    """``data`` (a parameter set as a dict) with the variant's ``force_factor``, ``muscle`` and
+    ``set``, and ``sprint_limit.py``'s shorthands ``vmax`` [l_opt/s] and ``active_tension``
+    [N/cm²], applied in place; returns it."""
     if "vmax" in variant:
         data["max_shortening_velocity_lopt_per_s"] = float(variant["vmax"])
     if "active_tension" in variant:
@@ -51,8 +52,24 @@ def variant_runner(variant: dict):
     for muscle, row in variant.get("muscle", {}).items():
         data["muscle_types"][muscle].update(row)
     data.update(variant.get("set", {}))
-    return build_runner(runner_params_from_dict(data))
+    return data
 
+
+def variant_runner(variant: dict):
+    """The human runner of ``kind`` (and ``blade``) with the variant applied
+    (:func:`apply_variant`)."""
+    kind, blade = variant.get("kind", "able"), variant.get("blade")
+    data = json.loads(default_runner_params(kind, body="human", blade=blade).model_dump_json())
+    return build_runner(runner_params_from_dict(apply_variant(data, variant)))
+
+
+def stride_runner(path: Path, sol: CollocationSolution):
+    """The runner the stride ``sol`` (read from ``path``) was solved on: the variant of a
+    ``variant.json`` beside it (written by this script or ``sprint_limit.py``), else the
+    stride's own model."""
+    variant_file = path.parent / "variant.json"
+    return (variant_runner(json.loads(variant_file.read_text())) if variant_file.is_file()
+            else runner_from_spec(sol.model_spec))
 
 def main() -> None:
     out, variant = Path(sys.argv[1]), json.loads(sys.argv[2])

@@ -38,6 +38,35 @@ from bladelab.predict.collocation.transcription import StrideNLP
 from bladelab.runner import build_runner
 
 
+def deepest_flexion_nodes(start: CollocationSolution, knees, mesh: int | None = None
+                          ) -> dict[str, int]:
+    """{knee coordinate: the mesh node where the stride ``start`` flexes it most}, scaled to
+    ``mesh`` intervals (default the start's); knee angles are negative in flexion."""
+    names = list(start.dof_names)
+    n0 = start.nlp.q.shape[0] - 1
+    n = n0 if mesh is None else mesh
+    return {knee: round(int(np.argmin(start.nlp.q[:-1, names.index(knee)])) * n / n0)
+            for knee in knees}
+
+
+def hold_knees(nodes: dict[str, int], degrees: dict[str, float]) -> None:
+    """Make every :class:`StrideNLP` built from now on hold each knee coordinate of
+    ``degrees`` flexed at least that many degrees at its node of ``nodes`` (a bound on that
+    node's coordinate)."""
+    bounds = StrideNLP.bounds
+
+    def with_knees_held(self):
+        lbx, ubx, lbg, ubg = bounds(self)
+        nx = len(self.sx)
+        for knee, deg in degrees.items():
+            j = self.dyn.dof_names.index(knee)
+            i = nodes[knee] * nx + j
+            ubx[i] = min(ubx[i], -math.radians(deg) / self.sx[j])
+        return lbx, ubx, lbg, ubg
+
+    StrideNLP.bounds = with_knees_held
+
+
 def main() -> None:
     mesh = next((int(a[5:]) for a in sys.argv if a.startswith("mesh=")), None)
     sys.argv = [a for a in sys.argv if not a.startswith("mesh=")]
@@ -49,28 +78,15 @@ def main() -> None:
     blade = sys.argv[5] if len(sys.argv) > 5 and sys.argv[5] != "able" else None
     people_stride = len(sys.argv) > 6 and sys.argv[6] == "people"
     kind = "able" if blade is None else "amputee"
-    spec = {"model": kind, "blade": blade, "body": "human"} if blade else {"model": kind,
-                                                                             "body": "human"}
+    spec = {"model": kind, "body": "human", **({"blade": blade} if blade else {})}
     sol0 = CollocationSolution.read(start)
     runner = build_runner(kind, body="human", blade=blade)
     guess = dataclasses.replace(sol0.to_guess(f"{start.name}, primal values"), multipliers=None)
-    names = list(sol0.dof_names)
-    knees = [names.index("knee_angle_l"), names.index("knee_angle_r")]
-    # the node of each knee's deepest flexion (knee angles are negative in flexion)
-    n0 = sol0.nlp.q.shape[0] - 1
-    n = n0 if mesh is None else mesh
-    nodes = [round(int(np.argmin(sol0.nlp.q[:-1, j])) * n / n0) for j in knees]
-    bounds = StrideNLP.bounds
-
-    def held(self):
-        lbx, ubx, lbg, ubg = bounds(self)
-        if degs is not None:
-            nx = len(self.sx)
-            for j, k, deg in zip(knees, nodes, degs, strict=True):
-                ubx[k * nx + j] = min(ubx[k * nx + j], -math.radians(deg) / self.sx[j])
-        return lbx, ubx, lbg, ubg
-
-    StrideNLP.bounds = held
+    knees = ("knee_angle_l", "knee_angle_r")
+    n = sol0.nlp.q.shape[0] - 1 if mesh is None else mesh
+    nodes = deepest_flexion_nodes(sol0, knees, n)
+    if degs is not None:
+        hold_knees(nodes, dict(zip(knees, degs, strict=True)))
     settings = CollocationSettings(mesh_intervals=n, speed_m_per_s=speed,
                                    stride_time_people=people_stride,
                                    **people_term(defaults.people_weight_for("human")))
@@ -80,8 +96,8 @@ def main() -> None:
     sol.write(out / ("solution.json" if sol.converged else "best_iterate.json"))
     crit = human_running_criteria(sol)
     missed = [c.line() for c in crit if not c.met]
-    print(json.dumps({"bound_deg": degs, "blade": blade, "nodes": nodes, "objective": sol.nlp.objective,
-                      "iterations": sol.nlp.iterations, **sol.summary(), "missed": missed,
+    print(json.dumps({"bound_deg": degs, "blade": blade, "nodes": [nodes[k] for k in knees],
+                      "objective": sol.nlp.objective, "iterations": sol.nlp.iterations, **sol.summary(), "missed": missed,
                       "wall_s": time.perf_counter() - t0}, default=str))
 
 

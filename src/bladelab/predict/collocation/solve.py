@@ -432,11 +432,9 @@ def predict_stride(runner, settings: CollocationSettings, guess, *, model_spec: 
             first = tracking
             sol_t = _solve_stage(nlp_t, nlp_t.initial_vector(sol_t.to_guess("tracking restart")),
                                  settings, "tracking", progress)
-            tracking = _stage_info(sol_t) | {
-                "iterations": first["iterations"] + int(sol_t.iterations),
-                "wall_s": first["wall_s"] + float(sol_t.wall_s),
-                "ipopt_own_s": first["ipopt_own_s"] + float(sol_t.timings.get("ipopt_own_s", 0.0)),
-                "restarted_after": first["status"]}
+            again = _stage_info(sol_t)
+            both = {key: first[key] + again[key] for key in ("iterations", "wall_s", "ipopt_own_s")}
+            tracking = again | both | {"restarted_after": first["status"]}
         if not sol_t.success:
             return CollocationSolution.from_nlp(
                 runner, sol_t, stage="tracking", tracking=tracking,
