@@ -29,7 +29,7 @@ from bladelab.predict.collocation.mesh_check import (
     mesh_check_in_folder,
 )
 from bladelab.predict.collocation.named_runs import solve_named_stride
-from bladelab.predict.collocation.settings import CollocationSettings, people_term
+from bladelab.predict.collocation.settings import CollocationSettings, people_settings
 from bladelab.predict.collocation.stored import runner_from_spec
 
 __all__ = ["OPTIONS", "PEOPLE_STRIDE_TIME", "PROGRESS_EVERY_S", "StageProgress",
@@ -45,7 +45,7 @@ OPTIONS = {
     "knee_flexion_max_loaded_deg": "--knee-flexion-max",
     "pelvis_tilt_range_deg": "--tilt-range", "stride_time_range_s": "--stride-time",
     "stride_time_people": "--stride-time",
-    "reference_weight": "--people-weight",
+    "reference_weight": "--people-weight", "swing_knee_min_deg": "--swing-knee",
     "step_phase_tolerance": "--alternating-steps", "symmetric": "--symmetric",
     "prosthetic_load_max_bw": "--prosthetic-load-max",
     "athlete.body_mass_kg": "--body-mass", "athlete.height_m": "--height",
@@ -184,6 +184,7 @@ def run_collocation(
     alternating_steps: float | None = None,
     prosthetic_load_max: float | None = None,
     people_weight: float | None = None,
+    swing_knee: float | None = None,
     athlete: dict | None = None,
     starts: int | None = None,
     mesh_check: bool = False,
@@ -194,7 +195,9 @@ def run_collocation(
     ``stride_time``: ``LO,HI`` or ``T`` [s], ``CollocationSettings.stride_time_range_s``, or
     ``people``, ``CollocationSettings.stride_time_people``;
     ``symmetric``: ``CollocationSettings.symmetric``;
-    ``prosthetic_load_max``: ``CollocationSettings.prosthetic_load_max_bw``.
+    ``prosthetic_load_max``: ``CollocationSettings.prosthetic_load_max_bw``;
+    ``swing_knee`` [deg]: ``CollocationSettings.swing_knee_min_deg`` (0: none; None: the
+    body's default).
     ``athlete``: the runner scaled to this athlete (``body_mass_kg``, ``height_m``,
     ``muscle_strength``, ``max_shortening_velocity``, ``residual_limb_length_m``,
     ``thigh_length_m``, ``shank_length_m``; None: the body's own). ``starts``:
@@ -215,7 +218,7 @@ def run_collocation(
             pelvis_tilt_range_deg=tilt, step_phase_tolerance=alternating_steps,
             **period,
             prosthetic_load_max_bw=prosthetic_load_max, symmetric=symmetric,
-            **people_term(defaults.people_weight_for(body, people_weight)))
+            **people_settings(body, people_weight, swing_knee))
         result = solve_named_stride(out, model=model, blade=blade, body=body,
                                     settings=settings, guess=guess, athlete=athlete,
                                     starts=starts, resume=resume, force=force,

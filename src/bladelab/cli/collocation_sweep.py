@@ -115,6 +115,7 @@ def run_collocation_sweep(
     starts: int,
     body: str,
     people_weight: float | None = None,
+    swing_knee: float | None = None,
     alternating_steps: float | None = None,
     athlete: dict | None = None,
     mesh_check: bool = False,
@@ -124,7 +125,9 @@ def run_collocation_sweep(
     """Run ``bladelab sweep --method collocation``; returns the exit status (0 every solve
     converged, 2 some model failed). ``alternating_steps``:
     ``CollocationSettings.step_phase_tolerance``; ``athlete``: every model scaled to this
-    athlete (None: the body's own); ``mesh_check``: every converged solve checked on twice
+    athlete (None: the body's own); ``swing_knee`` [deg]: people's swing knee
+    (``CollocationSettings.swing_knee_min_deg``; 0: none; None: the body's default);
+    ``mesh_check``: every converged solve checked on twice
     the mesh intervals; ``stride_time``: ``people`` (people's band at each prescribed speed,
     ``CollocationSettings.stride_time_people``) or None (free); ``settle``: a settling pass
     from the neighbouring categories' strides (the able runner's: its own faster ones)."""
@@ -140,6 +143,7 @@ def run_collocation_sweep(
         result = sweep_named_models(
             out, categories=cats, speeds=speed_list, able=able, body=body, guess=guess,
             mesh_intervals=mesh, max_iter=max_iter, people_weight=people_weight,
+            swing_knee_deg=swing_knee,
             step_phase_tolerance=alternating_steps, stride_time_people=stride_time is not None,
             athlete=athlete, starts=starts, jobs=jobs,
             executor=executor, resume=resume, force=force, progress=SweepProgress(),

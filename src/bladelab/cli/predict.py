@@ -78,6 +78,17 @@ def _people_weight_option():
              "body, 0 on the others; 0: the gait is predicted freely.")
 
 
+def _swing_knee_option():
+    """``--swing-knee``, the same on ``predict`` and ``sweep`` (collocation)."""
+    return typer.Option(
+        None, "--swing-knee", rich_help_panel=COLLOCATION, show_default=False,
+        help="Keep every knee that is a person's flexed at least this much [deg] at its peak "
+             "in swing (a constraint from measured running, reported as such; "
+             "docs/collocation.md). Default: people's "
+             f"{defaults.SWING_KNEE_MIN_DEG:g} on the human body, none on the others; 0: "
+             "free.")
+
+
 def _alternating_steps_option():
     """``--alternating-steps``, the same on ``predict`` and ``sweep`` (collocation)."""
     return typer.Option(
@@ -333,6 +344,7 @@ def register(app: typer.Typer) -> None:
                  "weights (the load the residual limb takes in its socket; default: no "
                  "limit)."),
         people_weight: float | None = _people_weight_option(),
+        swing_knee: float | None = _swing_knee_option(),
         body_mass: float | None = _athlete_option("body_mass_kg"),
         height: float | None = _athlete_option("height_m"),
         muscle_strength: float | None = _athlete_option("muscle_strength"),
@@ -377,7 +389,7 @@ def register(app: typer.Typer) -> None:
                 knee_flexion_max=knee_flexion_max, tilt_range=tilt_range,
                 stride_time=stride_time,
                 alternating_steps=alternating_steps, prosthetic_load_max=prosthetic_load_max,
-                people_weight=people_weight, symmetric=symmetric,
+                people_weight=people_weight, swing_knee=swing_knee, symmetric=symmetric,
                 athlete=_athlete(static, body_mass_kg=body_mass, height_m=height,
                                  muscle_strength=muscle_strength,
                                  max_shortening_velocity=max_shortening_velocity,
@@ -502,6 +514,7 @@ def register(app: typer.Typer) -> None:
                  "pad) | seed001 (seed 001's model) | toes (seed 001's with a toe segment and "
                  "compliant Achilles tendons)."),
         people_weight: float | None = _people_weight_option(),
+        swing_knee: float | None = _swing_knee_option(),
         alternating_steps: float | None = _alternating_steps_option(),
         stride_time: str | None = typer.Option(
             None, "--stride-time", rich_help_panel=COLLOCATION, show_default=False,
@@ -563,7 +576,8 @@ def register(app: typer.Typer) -> None:
                 out=out, categories=categories, able=able, speeds=speeds, mesh=mesh,
                 guess=guess, max_iter=max_iter, jobs=jobs, executor=executor, resume=resume,
                 force=force, as_json=as_json, starts=starts, body=body,
-                people_weight=people_weight, alternating_steps=alternating_steps,
+                people_weight=people_weight, swing_knee=swing_knee,
+                alternating_steps=alternating_steps,
                 stride_time=stride_time,
                 athlete=_athlete(static, body_mass_kg=body_mass, height_m=height,
                                  muscle_strength=muscle_strength,

@@ -38,10 +38,12 @@ __all__ = [
     "STRIKE_LIMIT_BW",
     "SWEEP_CATEGORIES",
     "SWEEP_SPEEDS_M_PER_S",
+    "SWING_KNEE_MIN_DEG",
     "TIME_STEP_S",
     "TRACK_WEIGHT_PER_RAD2",
     "integrator_for",
     "people_weight_for",
+    "swing_knee_for",
 ]
 
 # -- a predicted gait, either method -------------------------------------------------------
@@ -130,6 +132,13 @@ GUESS = "stored"
 #: against another runner's trial 18.5/15.7°, 12.5/7.3°, 11.1/7.1°. 10 is the smaller weight
 #: that gives people's swing, at 4 % more energy. Seed 001's body (and ``toes``) keep none.
 PEOPLE_WEIGHT_PER_RAD2 = 10.0
+#: People's peak swing knee flexion [deg] that the human body's predicted strides keep at
+#: least (``CollocationSettings.swing_knee_min_deg``): the mean of the two reference runners'
+#: at 3.5 m/s (``bladelab.predict.collocation.swing_knee.people_swing_knee_deg``, a test keeps
+#: them equal); people flex more as they run faster, so above 3.5 m/s it is a floor. Measured
+#: on the able runner at 3.5 m/s (docs/collocation.md, "People's swing knee"): without it the
+#: knees fold to 91–94° and the stride takes 0.62 s (people 0.64–0.78 s).
+SWING_KNEE_MIN_DEG = 108.5
 #: Starts per problem of a collocation sweep or stride (the best solve is kept).
 STARTS = 1
 #: Starts of ``bladelab predict`` for an athlete scaled from the body's own: measured
@@ -154,3 +163,12 @@ def people_weight_for(body: str, weight: float | None = None) -> float:
     if weight is not None:
         return weight
     return PEOPLE_WEIGHT_PER_RAD2 if body == "human" else 0.0
+
+
+def swing_knee_for(body: str, degrees: float | None = None) -> float | None:
+    """The minimum peak knee flexion [deg] of a runner ``body``'s predicted strides:
+    ``degrees`` when given (0: none), else :data:`SWING_KNEE_MIN_DEG` on the human body and
+    none (None) on seed 001's body and ``toes``."""
+    if degrees is not None:
+        return float(degrees) or None
+    return SWING_KNEE_MIN_DEG if body == "human" else None

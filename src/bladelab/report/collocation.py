@@ -196,16 +196,23 @@ def reference_term_text(settings, share: str = "", *,
     """The sentence saying what an objective held besides the predictive terms (a
     :class:`~bladelab.predict.collocation.settings.CollocationSettings`): people's measured
     joint angles (a tracking term of measured running) or another solution's, opening with
-    ``lead`` and with ``share`` (e.g. ", 0.35 of the objective's 5.1") after the weight;
-    empty without a reference."""
+    ``lead`` and with ``share`` (e.g. ", 0.35 of the objective's 5.1") after the weight; then
+    the sentence saying that the swing knee was held at people's (``swing_knee_min_deg``);
+    empty without either."""
+    knee = settings.swing_knee_min_deg
+    knee_text = ("" if knee is None else
+                 f" Swing knee imposed: every knee that is a person's flexes at least {knee:g}° "
+                 "at its peak (people's at 3.5 m/s; bladelab predict --swing-knee): the "
+                 "swing's depth is given, not predicted.")
     if not settings.reference_weight:
-        return ""
+        return knee_text
     if settings.reference == PEOPLE_REFERENCE:
         return (f" {lead} people's measured hip, knee and ankle angles at 3.5 m/s (Fukuchi et "
                 f"al. 2017, subjects RBDS002 and RBDS003, not the trial that strides are "
-                f"compared with), weight {settings.reference_weight:g} 1/rad²{share}.")
+                f"compared with), weight {settings.reference_weight:g} 1/rad²{share}."
+                + knee_text)
     return (f" {lead} the joint angles and stride time of {Path(settings.reference).name}, "
-            f"weight {settings.reference_weight:g} 1/rad²{share}.")
+            f"weight {settings.reference_weight:g} 1/rad²{share}." + knee_text)
 
 
 def _mesh_check_of(path: Path, sol):

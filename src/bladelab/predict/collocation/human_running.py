@@ -170,13 +170,16 @@ def human_running_criteria(solution) -> list[Criterion]:
                          "; ".join(t for t in (note, imposed) if t)))
     q = np.asarray(solution.nlp.q)  # (nodes, coordinates)
     lo, hi, unit = reference_band("peak swing knee flexion", speed)
+    knee_min = solution.settings.swing_knee_min_deg
+    knee_imposed = None if knee_min is None else f"imposed: at least {knee_min:g} deg"
     for side, leg in zip(("l", "r"), solution.leg_names, strict=True):
         name = f"knee_angle_{side}"
         if name not in solution.dof_names or (prosthetic and side == "r"
                                               and solution.model_spec["model"] == "transfemoral"):
             continue
         flexion = -math.degrees(float(q[:, solution.dof_names.index(name)].min()))
-        out.append(Criterion(f"peak swing knee flexion, {leg} leg", flexion, unit, lo, hi, note))
+        out.append(Criterion(f"peak swing knee flexion, {leg} leg", flexion, unit, lo, hi,
+                             "; ".join(t for t in (note, knee_imposed) if t)))
     lo, hi, unit = reference_band("mean pelvis tilt", speed)
     tilt = math.degrees(float(np.mean(q[:-1, solution.dof_names.index("pelvis_tilt")])))
     out.append(Criterion("mean pelvis tilt", tilt, unit, lo, hi, "forward lean negative"))

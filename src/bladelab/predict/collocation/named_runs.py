@@ -27,7 +27,7 @@ from bladelab.predict.collocation.folder_starts import (
     check_stride_starts,
     predict_stride_from_starts,
 )
-from bladelab.predict.collocation.settings import CollocationSettings, people_term
+from bladelab.predict.collocation.settings import CollocationSettings, people_settings
 from bladelab.predict.collocation.solve import predict_stride_in_folder
 from bladelab.predict.collocation.starting_guess import make_guess, resolve_guess
 from bladelab.predict.collocation.starts import check_starts
@@ -116,6 +116,7 @@ def sweep_named_models(
     mesh_intervals: int = defaults.MESH_INTERVALS,
     max_iter: int = defaults.MAX_ITER,
     people_weight: float | None = None,
+    swing_knee_deg: float | None = None,
     step_phase_tolerance: float | None = None,
     stride_time_people: bool = False,
     athlete: dict | None = None,
@@ -138,7 +139,9 @@ def sweep_named_models(
     ``max_iter`` (IPOPT's iterations per stage) set its :class:`CollocationSettings`;
     ``people_weight`` [1/rad²]: the weight of people's joint angles in the objective
     (:mod:`~bladelab.predict.collocation.people`; 0: none; None: the body's default,
-    :func:`bladelab.predict.defaults.people_weight_for`); ``step_phase_tolerance``: every
+    :func:`bladelab.predict.defaults.people_weight_for`); ``swing_knee_deg`` [deg]: every
+    person's knee flexed at least this much in swing (0: free; None: the body's default,
+    :func:`bladelab.predict.defaults.swing_knee_for`); ``step_phase_tolerance``: every
     stride's steps alternating within this fraction of the stride
     (:attr:`CollocationSettings.step_phase_tolerance`; None: free); ``stride_time_people``:
     every prescribed speed's stride time within people's band at that speed
@@ -161,7 +164,7 @@ def sweep_named_models(
     settings = CollocationSettings(mesh_intervals=mesh_intervals, speed_m_per_s=speeds[0],
                                    max_iter=max_iter, step_phase_tolerance=step_phase_tolerance,
                                    stride_time_people=stride_time_people,
-                                   **people_term(defaults.people_weight_for(body, people_weight)))
+                                   **people_settings(body, people_weight, swing_knee_deg))
     if isinstance(jobs, bool) or not isinstance(jobs, int) or jobs < 1:
         raise SpecError(f"need at least 1 job, got {jobs}", where="jobs")
     check_starts(starts)

@@ -29,7 +29,7 @@ from bladelab.datasets import people_joint_angles_table
 from bladelab.errors import InputFileError, SpecError
 
 __all__ = ["PEOPLE_JOINTS", "PEOPLE_SUBJECTS", "PROSTHETIC_JOINTS", "people_joint_angles",
-           "people_reference"]
+           "people_reference", "subject_joint_angles"]
 
 #: Subjects of the dataset whose mean pattern is people's reference.
 PEOPLE_SUBJECTS = ("RBDS002", "RBDS003")
@@ -49,6 +49,13 @@ def people_joint_angles() -> dict[str, np.ndarray]:
     """People's mean joint angles over the stride from the heel strike, per model coordinate
     base name (``hip_flexion``, ``knee_angle``, ``ankle_angle``) [rad, model signs: knee
     flexion negative], 100 samples at 0, 1, ..., 99 % of the stride."""
+    return {base: curves.mean(axis=1) for base, curves in subject_joint_angles().items()}
+
+
+@cache
+def subject_joint_angles() -> dict[str, np.ndarray]:
+    """Each of :data:`PEOPLE_SUBJECTS`' joint angles, per model coordinate base name: (100,
+    subjects) [rad, model signs], samples as in :func:`people_joint_angles`."""
     path = people_joint_angles_table()
     with open(path, encoding="utf-8") as f:
         header = f.readline().strip().split(",")
@@ -62,7 +69,7 @@ def people_joint_angles() -> dict[str, np.ndarray]:
                                  file=path, hint="reinstall bladelab; the packaged file is "
                                                  "written by benchmarks/human_body/people_angles.py")
         cols = [header.index(n) for n in names]
-        out[base] = sign * np.radians(data[:, cols].mean(axis=1))
+        out[base] = sign * np.radians(data[:, cols])
     return out
 
 

@@ -16,7 +16,8 @@ from bladelab.predict.collocation.dynamics import COORDINATE_BOUNDS_DEG
 from bladelab.predict.collocation.running_bands import reference_band
 from bladelab.predict.collocation.transcription import PERIOD_BOUNDS_S, StrideWeights
 
-__all__ = ["HESSIANS", "PEOPLE_REFERENCE", "CollocationSettings", "people_term"]
+__all__ = ["HESSIANS", "PEOPLE_REFERENCE", "SWING_KNEE_RANGE_DEG", "CollocationSettings",
+           "people_settings", "people_term"]
 
 #: IPOPT Hessian options (:meth:`~bladelab.predict.collocation.transcription.StrideNLP.solve`).
 HESSIANS = ("limited-memory", "exact")
@@ -26,6 +27,9 @@ HESSIANS = ("limited-memory", "exact")
 POLISH_MAX_VIOLATION = 1e-4
 #: ``CollocationSettings.reference`` naming people's measured joint angles, not a file.
 PEOPLE_REFERENCE = "people"
+#: Allowed range of ``CollocationSettings.swing_knee_min_deg`` [deg]: up to the knee's range
+#: of motion in running (the coordinate's bound is 150°).
+SWING_KNEE_RANGE_DEG = (10.0, 140.0)
 
 
 def _weights_from_dict(data, where: str) -> StrideWeights:
@@ -157,6 +161,15 @@ class CollocationSettings:
         it excludes. Each speed of a continuation gets its own band; the maximum-speed
         problem, whose speed is the unknown, has none (:func:`~bladelab.predict.collocation.
         continuation.max_speed_settings`). False (default): free.
+    swing_knee_min_deg
+        Keep the peak flexion of every knee that is a person's (not a transfemoral runner's
+        prosthetic knee) at or above this [deg] over the stride, a constraint of the
+        predictive stage (a smooth maximum over the nodes,
+        :mod:`~bladelab.predict.collocation.swing_knee`); people's value, 108.5° (two runners
+        at 3.5 m/s, :data:`bladelab.predict.defaults.SWING_KNEE_MIN_DEG`), is the human body's
+        default through ``bladelab predict``: the body's own swing is 15–20° shallower than
+        people's and its stride quicker (docs/collocation.md, "People's swing knee"). A
+        prescription from measured running, reported with every answer. None (default): free.
     symmetric
         Each leg does what the other did half a stride earlier (bilateral symmetry, as
         PredSim imposes it by solving half a gait cycle;
@@ -201,6 +214,7 @@ class CollocationSettings:
     step_phase_tolerance: float | None = None
     stride_time_range_s: tuple[float, float] | None = None
     stride_time_people: bool = False
+    swing_knee_min_deg: float | None = None
     symmetric: bool = False
     reference: str | None = None
     reference_weight: float = 0.0
@@ -294,6 +308,15 @@ class CollocationSettings:
                                 f"stride or None, got {sp!r}", where="step_phase_tolerance",
                                 hint="0.1: the other leg's stance 40-60 % of the stride later")
             object.__setattr__(self, "step_phase_tolerance", float(sp))
+        sk = self.swing_knee_min_deg
+        if sk is not None:
+            lo, hi = SWING_KNEE_RANGE_DEG
+            if isinstance(sk, bool) or not isinstance(sk, int | float) or not (
+                    math.isfinite(sk) and lo <= sk <= hi):
+                raise SpecError(f"the swing knee's minimum flexion must be within [{lo:g}, "
+                                f"{hi:g}] deg or None, got {sk!r}", where="swing_knee_min_deg",
+                                hint="people flex about 108° at 3.5 m/s; None: free")
+            object.__setattr__(self, "swing_knee_min_deg", float(sk))
         if not isinstance(self.symmetric, bool):
             raise SpecError(f"expected true or false, got {self.symmetric!r}",
                             where="symmetric")
@@ -435,7 +458,7 @@ class CollocationSettings:
     def same_problem(self, other: CollocationSettings) -> bool:
         """True if ``other`` poses the same NLP (mesh, speed, weights, swing clearance, knee
         moment bound, loaded knee's flexion limit, prosthetic load limit, blade transcription,
-        pelvis tilt range, alternating steps, stride time range, symmetry);
+        pelvis tilt range, alternating steps, stride time range, swing knee, symmetry);
         solver options
         (Hessian, tolerance, iterations) and the tracking stage may differ."""
         return self._problem() == other._problem()
@@ -445,7 +468,8 @@ class CollocationSettings:
                 self.knee_moment_min_nm, self.knee_flexion_max_loaded_deg,
                 self.prosthetic_load_max_bw, self.blade_backward_euler,
                 self.pelvis_tilt_range_deg, self.step_phase_tolerance, self.symmetric,
-                self.stride_time_range_s, self.stride_time_people) + self.reference_key()
+                self.stride_time_range_s, self.stride_time_people,
+                self.swing_knee_min_deg) + self.reference_key()
 
     def reference_key(self) -> tuple:
         """(reference file name, weight, coordinates), or () without a reference term."""
@@ -458,3 +482,14 @@ def people_term(weight: float) -> dict:
     """The :class:`CollocationSettings` fields of people's joint-angle term at ``weight``
     [1/rad²] (none at 0)."""
     return {"reference": PEOPLE_REFERENCE, "reference_weight": weight} if weight else {}
+
+
+def people_settings(body: str, people_weight: float | None = None,
+                    swing_knee_deg: float | None = None) -> dict:
+    """The :class:`CollocationSettings` fields of what a runner ``body``'s predicted strides
+    take from measured running: people's joint angles at ``people_weight`` [1/rad²]
+    (:func:`bladelab.predict.defaults.people_weight_for`) and people's swing knee at
+    ``swing_knee_deg`` [deg] (:func:`bladelab.predict.defaults.swing_knee_for`; 0: none);
+    None: the body's defaults (both on the human body, neither on seed 001's)."""
+    return {**people_term(defaults.people_weight_for(body, people_weight)),
+            "swing_knee_min_deg": defaults.swing_knee_for(body, swing_knee_deg)}

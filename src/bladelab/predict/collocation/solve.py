@@ -74,6 +74,7 @@ from bladelab.predict.collocation.settings import (
 from bladelab.predict.collocation.solution import CollocationSolution
 from bladelab.predict.collocation.stored import check_model_spec, describe_problem
 from bladelab.predict.collocation.stride_guess import COLLOCATION_SOURCE
+from bladelab.predict.collocation.swing_knee import biological_knees
 from bladelab.predict.collocation.symmetry import mirror_permutation
 from bladelab.predict.collocation.transcription import StrideNLP, StrideWeights
 
@@ -325,6 +326,15 @@ def _compiled(settings: CollocationSettings) -> bool | None:
     return False if settings.hessian == "exact" else None
 
 
+def _knee_flexion_min(runner, settings: CollocationSettings) -> dict[str, float] | None:
+    """{knee coordinate: minimum peak flexion [rad]} of the settings' swing knee on the
+    runner's biological knees, or None."""
+    if settings.swing_knee_min_deg is None:
+        return None
+    minimum = math.radians(settings.swing_knee_min_deg)
+    return {k: minimum for k in biological_knees(runner.dof_names, runner.kind)} or None
+
+
 def _predictive_nlp(runner, dyn, settings: CollocationSettings, start, phase: float | None):
     """The predictive :class:`~bladelab.predict.collocation.transcription.StrideNLP` of the
     settings' mesh, problem (prescribed speed, or maximum speed), weights, reference term,
@@ -336,7 +346,7 @@ def _predictive_nlp(runner, dyn, settings: CollocationSettings, start, phase: fl
     nlps = _BUILT[runner]["nlps"]
     key = (n, speed is None, settings.weights, id(dyn), settings.reference_key(), phase,
            settings.step_phase_tolerance, settings.symmetric, settings.period_bounds_s,
-           settings.hessian)
+           settings.swing_knee_min_deg, settings.hessian)
     if key not in nlps:
         while len(nlps) >= MAX_NLPS_PER_RUNNER:
             nlps.pop(next(iter(nlps)))
@@ -346,6 +356,7 @@ def _predictive_nlp(runner, dyn, settings: CollocationSettings, start, phase: fl
                               step_phase_tolerance=settings.step_phase_tolerance,
                               symmetric=settings.symmetric,
                               period_bounds=settings.period_bounds_s,
+                              knee_flexion_min=_knee_flexion_min(runner, settings),
                               compiled=_compiled(settings))
     else:
         nlps[key] = nlps.pop(key)  # most recently used last

@@ -54,6 +54,7 @@ from bladelab.predict.collocation.stride_problem import (
     StrideWeights,
     VariableScales,
 )
+from bladelab.predict.collocation.swing_knee import peak_flexion_rows
 from bladelab.predict.collocation.symmetry import stride_mirror, symmetrized, symmetry_rows
 
 __all__ = [
@@ -243,6 +244,9 @@ class StrideNLP:
         Each leg does what the other did half a stride earlier
         (:mod:`~bladelab.predict.collocation.symmetry`; an even ``n``, legs that are mirror
         images).
+    knee_flexion_min
+        {knee coordinate: minimum [rad]}: keep each knee's smooth peak flexion over the stride
+        at or above its minimum (:mod:`~bladelab.predict.collocation.swing_knee`); None: free.
     compiled
         Map the node function compiled to C (:mod:`~bladelab.predict.collocation.compiled`:
         cached on disk, the solver built without expanding the graph) instead of the
@@ -279,6 +283,7 @@ class StrideNLP:
         period_tracking: tuple[float, float] | None = None,
         step_phase_tolerance: float | None = None,
         symmetric: bool = False,
+        knee_flexion_min: dict[str, float] | None = None,
         compiled: bool | None = None,
     ) -> None:
         if n < 4:
@@ -310,6 +315,11 @@ class StrideNLP:
             raise SpecError(f"a symmetric stride needs an even number of mesh intervals, got "
                             f"{n}", where="mesh intervals")
         self.symmetric = bool(symmetric)
+        unknown = sorted(set(knee_flexion_min or ()) - set(dynamics.dof_names))
+        if unknown:
+            raise SpecError(f"no coordinate {', '.join(unknown)} on this model",
+                            where="knee flexion minimum")
+        self.knee_flexion_min = dict(knee_flexion_min) if knee_flexion_min else None
         self._build()
 
     # -- layout -------------------------------------------------------------------------
@@ -433,6 +443,9 @@ class StrideNLP:
             legs = ca.Function("legs", [xs], [d.leg_vertical_grf(q, qd)]).map(n)(X[:, :n])
             g.append(alternation_rows(legs, d.mass * d.gravity, self.step_phase_tolerance))
             self._g_names += ["alternating steps"] + [f"stance of leg {j}" for j in (0, 1)]
+        if self.knee_flexion_min:
+            g.append(peak_flexion_rows(X[:, :n], sx, d.dof_names, self.knee_flexion_min))
+            self._g_names += [f"peak flexion {k}" for k in self.knee_flexion_min]
         if self.tracking is not None:
             q_ref, weight, *dofs = self.tracking
             q_ref = np.asarray(q_ref, float)
@@ -534,6 +547,9 @@ class StrideNLP:
         if self.step_phase_tolerance is not None:
             i = self._g_names.index("alternating steps")
             lbg[i:i + 3] = -np.inf
+        if self.knee_flexion_min:
+            i = self._g_names.index(f"peak flexion {next(iter(self.knee_flexion_min))}")
+            ubg[i:i + len(self.knee_flexion_min)] = np.inf
         if self.n_ineq:
             b = np.asarray(d.inequality_bounds, float)
             m = self._imposed_nodes
@@ -685,7 +701,7 @@ class StrideNLP:
                 max_tendon_force=self.max_tendon_force, tracking=self.tracking,
                 grf_tracking=self.grf_tracking, period_tracking=self.period_tracking,
                 step_phase_tolerance=self.step_phase_tolerance, symmetric=self.symmetric,
-                compiled=False)
+                knee_flexion_min=self.knee_flexion_min, compiled=False)
         return self._interpreted
 
     def unpack(self, w: np.ndarray, stats: dict, wall: float, t_build: float,
