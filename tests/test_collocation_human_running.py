@@ -181,3 +181,22 @@ def test_the_shipped_human_body_stride_is_the_demo_start_and_meets_its_criteria(
                  "gross cost of transport", "ground contacts per stride, prosthetic leg"):
         assert met[name], name
     assert sol.gait_warnings() == []
+
+
+def test_the_shipped_able_stride_meets_every_criterion_with_people_s_swing_knee_imposed():
+    """The able runner's shipped 3.5 m/s stride (the default guess, found from it again in no
+    iteration) is within people's running on every criterion, and the swing knee's criterion
+    says that its depth was imposed."""
+    from bladelab.predict import defaults
+    from bladelab.predict.collocation.solution import CollocationSolution
+    from bladelab.runner.params import RUNNER_DATA_DIR
+
+    sol = CollocationSolution.read(RUNNER_DATA_DIR / "collocation" / "able-3.5-human.json")
+    assert sol.converged and sol.settings.swing_knee_min_deg == defaults.SWING_KNEE_MIN_DEG
+    crit = human_running_criteria(sol)
+    assert [c.line() for c in crit if not c.met] == []
+    knees = [c for c in crit if c.name.startswith("peak swing knee flexion")]
+    assert len(knees) == 2
+    for knee in knees:
+        assert "imposed: at least 108.5 deg" in knee.note
+        assert knee.value > defaults.SWING_KNEE_MIN_DEG - 1.0  # the smooth peak's margin

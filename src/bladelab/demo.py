@@ -39,7 +39,7 @@ from bladelab.example.study import default_example_dir, make_example_study
 from bladelab.predict import defaults
 from bladelab.predict.collocation.human_running import human_running_criteria
 from bladelab.predict.collocation.named_runs import solve_named_stride
-from bladelab.predict.collocation.settings import CollocationSettings, people_term
+from bladelab.predict.collocation.settings import CollocationSettings, people_settings
 from bladelab.predict.collocation.solve import SOLUTION_FILE
 from bladelab.report.design import build_design_report
 from bladelab.report.predictive import build_predictive_report
@@ -155,8 +155,7 @@ def predict_example(out_dir: str | Path | None = None) -> tuple[Path, list[str]]
     t0 = time.perf_counter()
     res = solve_named_stride(
         out_dir, model="amputee", blade="Cat6", body="human",
-        settings=CollocationSettings(speed_m_per_s=4.0,
-                                     **people_term(defaults.PEOPLE_WEIGHT_PER_RAD2)),
+        settings=CollocationSettings(speed_m_per_s=4.0, **people_settings("human")),
         guess=str(PREDICT_EXAMPLE_STRIDE),
         resume=(out_dir / SOLUTION_FILE).is_file())
     sol = res.solution
@@ -166,7 +165,8 @@ def predict_example(out_dir: str | Path | None = None) -> tuple[Path, list[str]]
     lines = [f"predict example: amputee Cat6, human body, 4 m/s, {how} in "
              f"{time.perf_counter() - t0:.0f} s ({s['iterations']} IPOPT iterations, warm start "
              f"from the shipped stride; people's measured joint angles in the objective at "
-             f"{defaults.PEOPLE_WEIGHT_PER_RAD2:g} 1/rad², docs/collocation.md) -> {out_dir}",
+             f"{defaults.PEOPLE_WEIGHT_PER_RAD2:g} 1/rad² and their swing knee, at least "
+             f"{defaults.SWING_KNEE_MIN_DEG:g}°, imposed: docs/collocation.md) -> {out_dir}",
              f"  converged {s['converged']}, stride {s['stride_time_s']:.3f} s, cost of "
              f"transport {s['cost_of_transport_J_per_kg_m']:.2f} J/(kg·m), dynamics residual "
              f"{s['dynamics_residual_pct']:.2f} %"]
