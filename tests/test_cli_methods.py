@@ -215,7 +215,7 @@ def test_predict_reflex_defaults_are_the_settings_defaults(tmp_path, monkeypatch
 def test_predict_collocation_passes_the_same_settings(tmp_path, monkeypatch, capsys):
     import bladelab.predict.collocation.named_runs as named
     from bladelab.predict.collocation.settings import CollocationSettings
-    from bladelab.predict.defaults import ATHLETE_STARTS
+    from bladelab.predict.defaults import ATHLETE_STARTS, SWING_KNEE_MIN_DEG
 
     seen = {}
 
@@ -231,7 +231,8 @@ def test_predict_collocation_passes_the_same_settings(tmp_path, monkeypatch, cap
               "--knee-moment-min", "0", "--knee-flexion-max", "10", "--tilt-range=-16,-2",
               "--alternating-steps", "0.1", "--prosthetic-load-max", "3", "--resume",
               "--out", str(tmp_path)])
-    people = {"reference": "people", "reference_weight": 10.0}  # the human body's default
+    # the human body's default: people's angles; no swing knee on the transfemoral runner
+    people = {"reference": "people", "reference_weight": 10.0}
     assert seen["settings"] == CollocationSettings(
         mesh_intervals=8, speed_m_per_s=4.0, max_iter=7, swing_clearance_m=0.02,
         knee_moment_min_nm=0.0, knee_flexion_max_loaded_deg=10.0,
@@ -241,6 +242,8 @@ def test_predict_collocation_passes_the_same_settings(tmp_path, monkeypatch, cap
     assert seen["runner"] == ("runner", seen["model_spec"])
     assert (seen["out"], seen["resume"], seen["force"]) == (tmp_path, True, False)
     seen.clear()
+    # the able runner: people's angles and people's swing knee
+    people |= {"swing_knee_min_deg": SWING_KNEE_MIN_DEG}
     with pytest.raises(_Called):
         main(["predict", "--method", "collocation", "--max-speed", "--out", str(tmp_path)])
     assert seen["settings"] == CollocationSettings(speed_m_per_s=None, **people)
@@ -250,8 +253,11 @@ def test_predict_collocation_passes_the_same_settings(tmp_path, monkeypatch, cap
         main(["predict", "--out", str(tmp_path)])
     assert seen["settings"] == CollocationSettings(**people)
     assert seen["model_spec"] == {"model": "able", "blade": None, "body": "human"}
-    for args, term in ((["--people-weight", "0"], {}),  # a free prediction
+    free_knee = {"reference": "people", "reference_weight": 10.0}
+    for args, term in ((["--people-weight", "0", "--swing-knee", "0"], {}),  # free
                        (["--people-weight", "20"], {**people, "reference_weight": 20.0}),
+                       (["--swing-knee", "0"], free_knee),
+                       (["--swing-knee", "95"], {**people, "swing_knee_min_deg": 95.0}),
                        (["--body", "seed001"], {})):  # the seed's body: as the seed solved it
         seen.clear()
         with pytest.raises(_Called):
@@ -295,6 +301,7 @@ def test_predict_collocation_passes_the_same_settings(tmp_path, monkeypatch, cap
 
 def test_sweep_collocation_passes_the_same_settings(tmp_path, monkeypatch, capsys):
     import bladelab.predict.collocation.named_runs as named
+    from bladelab.predict.defaults import SWING_KNEE_MIN_DEG
     from bladelab.predict.collocation.settings import CollocationSettings
     from bladelab.predict.collocation.starting_guess import make_guess
 
@@ -313,7 +320,8 @@ def test_sweep_collocation_passes_the_same_settings(tmp_path, monkeypatch, capsy
     assert seen["speeds"] == [3.5, 4.0]
     assert seen["settings"] == CollocationSettings(mesh_intervals=12, speed_m_per_s=3.5,
                                                    max_iter=9, reference="people",
-                                                   reference_weight=10.0)
+                                                   reference_weight=10.0,
+                                                   swing_knee_min_deg=SWING_KNEE_MIN_DEG)
     assert isinstance(seen["guess"], functools.partial) and seen["guess"].func is make_guess
     assert seen["guess"].keywords == {"guess": "stored"}  # the default guess
     assert (seen["jobs"], seen["executor"], seen["starts"], seen["resume"], seen["force"]) == (
@@ -321,8 +329,9 @@ def test_sweep_collocation_passes_the_same_settings(tmp_path, monkeypatch, capsy
     seen.clear()
     with pytest.raises(_Called):
         main(["sweep", "--method", "collocation", "--able", "--categories", "",
-              "--people-weight", "0", "--out", str(tmp_path)])
+              "--people-weight", "0", "--swing-knee", "0", "--out", str(tmp_path)])
     assert seen["settings"].reference_weight == 0.0 and seen["settings"].reference is None
+    assert seen["settings"].swing_knee_min_deg is None
     assert "athlete" not in seen["models"][0]
     seen.clear()
     with pytest.raises(_Called):

@@ -82,6 +82,14 @@ def test_settings_hold_the_swing_knee_by_body_and_refuse_bad_values():
     human = CollocationSettings(**people_settings("human"))
     assert human.swing_knee_min_deg == defaults.SWING_KNEE_MIN_DEG
     assert CollocationSettings(**people_settings("seed001")).swing_knee_min_deg is None
+    assert CollocationSettings(**people_settings("human", kind="amputee")
+                               ).swing_knee_min_deg == defaults.SWING_KNEE_MIN_DEG
+    # the transfemoral runner's intact knee is free unless asked for
+    assert CollocationSettings(**people_settings("human", kind="transfemoral")
+                               ).swing_knee_min_deg is None
+    assert CollocationSettings(**people_settings("human", swing_knee_deg=100,
+                                                 kind="transfemoral")
+                               ).swing_knee_min_deg == 100.0
     assert CollocationSettings(**people_settings("human", swing_knee_deg=0)
                                ).swing_knee_min_deg is None
     assert CollocationSettings(**people_settings("seed001", swing_knee_deg=95)

@@ -218,7 +218,7 @@ def run_collocation(
             pelvis_tilt_range_deg=tilt, step_phase_tolerance=alternating_steps,
             **period,
             prosthetic_load_max_bw=prosthetic_load_max, symmetric=symmetric,
-            **people_settings(body, people_weight, swing_knee))
+            **people_settings(body, people_weight, swing_knee, kind=model))
         result = solve_named_stride(out, model=model, blade=blade, body=body,
                                     settings=settings, guess=guess, athlete=athlete,
                                     starts=starts, resume=resume, force=force,

@@ -165,10 +165,14 @@ def people_weight_for(body: str, weight: float | None = None) -> float:
     return PEOPLE_WEIGHT_PER_RAD2 if body == "human" else 0.0
 
 
-def swing_knee_for(body: str, degrees: float | None = None) -> float | None:
-    """The minimum peak knee flexion [deg] of a runner ``body``'s predicted strides:
-    ``degrees`` when given (0: none), else :data:`SWING_KNEE_MIN_DEG` on the human body and
-    none (None) on seed 001's body and ``toes``."""
+def swing_knee_for(body: str, degrees: float | None = None,
+                   kind: str = "able") -> float | None:
+    """The minimum peak knee flexion [deg] of the predicted strides of a runner ``kind`` on
+    ``body``: ``degrees`` when given (0: none), else :data:`SWING_KNEE_MIN_DEG` for the able
+    and transtibial runners on the human body and none (None) on seed 001's body, ``toes``
+    and for the transfemoral runner, whose intact leg swings beside a passive prosthetic
+    knee (its stride with the intact knee held at 110° did not converge:
+    benchmarks/human_body/swing-knee/README.md)."""
     if degrees is not None:
         return float(degrees) or None
-    return SWING_KNEE_MIN_DEG if body == "human" else None
+    return SWING_KNEE_MIN_DEG if body == "human" and kind != "transfemoral" else None

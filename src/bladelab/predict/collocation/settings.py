@@ -166,8 +166,9 @@ class CollocationSettings:
         prosthetic knee) at or above this [deg] over the stride, a constraint of the
         predictive stage (a smooth maximum over the nodes,
         :mod:`~bladelab.predict.collocation.swing_knee`); people's value, 108.5° (two runners
-        at 3.5 m/s, :data:`bladelab.predict.defaults.SWING_KNEE_MIN_DEG`), is the human body's
-        default through ``bladelab predict``: the body's own swing is 15–20° shallower than
+        at 3.5 m/s, :data:`bladelab.predict.defaults.SWING_KNEE_MIN_DEG`), is the default of
+        the human body's able and transtibial runners through ``bladelab predict``
+        (:func:`people_settings`): the body's own swing is 15–20° shallower than
         people's and its stride quicker (docs/collocation.md, "People's swing knee"). A
         prescription from measured running, reported with every answer. None (default): free.
     symmetric
@@ -485,11 +486,13 @@ def people_term(weight: float) -> dict:
 
 
 def people_settings(body: str, people_weight: float | None = None,
-                    swing_knee_deg: float | None = None) -> dict:
-    """The :class:`CollocationSettings` fields of what a runner ``body``'s predicted strides
-    take from measured running: people's joint angles at ``people_weight`` [1/rad²]
-    (:func:`bladelab.predict.defaults.people_weight_for`) and people's swing knee at
-    ``swing_knee_deg`` [deg] (:func:`bladelab.predict.defaults.swing_knee_for`; 0: none);
-    None: the body's defaults (both on the human body, neither on seed 001's)."""
+                    swing_knee_deg: float | None = None, kind: str = "able") -> dict:
+    """The :class:`CollocationSettings` fields of what the predicted strides of a runner
+    ``kind`` on ``body`` take from measured running: people's joint angles at
+    ``people_weight`` [1/rad²] (:func:`bladelab.predict.defaults.people_weight_for`) and
+    people's swing knee at ``swing_knee_deg`` [deg]
+    (:func:`bladelab.predict.defaults.swing_knee_for`; 0: none); None: the defaults (both
+    on the human body, but no swing knee for the transfemoral runner; neither on seed
+    001's)."""
     return {**people_term(defaults.people_weight_for(body, people_weight)),
-            "swing_knee_min_deg": defaults.swing_knee_for(body, swing_knee_deg)}
+            "swing_knee_min_deg": defaults.swing_knee_for(body, swing_knee_deg, kind)}
