@@ -301,9 +301,9 @@ def test_predict_collocation_passes_the_same_settings(tmp_path, monkeypatch, cap
 
 def test_sweep_collocation_passes_the_same_settings(tmp_path, monkeypatch, capsys):
     import bladelab.predict.collocation.named_runs as named
-    from bladelab.predict.defaults import SWING_KNEE_MIN_DEG
     from bladelab.predict.collocation.settings import CollocationSettings
     from bladelab.predict.collocation.starting_guess import make_guess
+    from bladelab.predict.defaults import SWING_KNEE_MIN_DEG
 
     seen = {}
 
