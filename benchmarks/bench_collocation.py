@@ -55,14 +55,14 @@ def run() -> str:
 
     from bladelab.predict import defaults
     from bladelab.predict.collocation.guess import template_guess
-    from bladelab.predict.collocation.settings import CollocationSettings, people_term
+    from bladelab.predict.collocation.settings import CollocationSettings, people_settings
     from bladelab.predict.collocation.solve import predict_stride
     from bladelab.predict.collocation.starting_guess import make_guess
     from bladelab.runner import build_runner
 
     spec = {"model": "amputee", "blade": "Cat6", "body": "human"}
     runner = build_runner("amputee", blade="Cat6", body="human")
-    people = people_term(defaults.people_weight_for("human"))  # as the command line solves
+    people = people_settings("human")  # as the command line solves the able and amputee runners
     settings = CollocationSettings(mesh_intervals=MESH, speed_m_per_s=SPEED_MPS, **people)
     stored = predict_stride(runner, settings,
                             make_guess(runner, "stored", n=MESH, speed=SPEED_MPS),
@@ -89,7 +89,8 @@ def run() -> str:
     return "\n".join([
         "## Collocation: one stride",
         "",
-        f"The human body with people's joint angles in the objective (the default weight), "
+        f"The human body with people's joint angles in the objective (the default weight) "
+        f"and people's swing knee (at least {defaults.SWING_KNEE_MIN_DEG:g}°), "
         f"mesh {MESH} intervals, one core (`OMP_NUM_THREADS=1`), L-BFGS, tol 1e-4. Targets: the amputee from the default guess ≤ 60 s, warm-started at 4.2 m/s "
         "≤ 10 s, the able runner from the template ≤ 60 s. A warm start from a solution "
         "restores its controls and multipliers (IPOPT's primal-dual warm start, its own "

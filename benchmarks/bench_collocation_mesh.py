@@ -30,14 +30,13 @@ def _signed(value) -> str:
 
 
 def run() -> str:
-    from bladelab.predict import defaults
     from bladelab.predict.collocation.mesh_check import check_mesh, round_trip, with_round_trip
-    from bladelab.predict.collocation.settings import CollocationSettings, people_term
+    from bladelab.predict.collocation.settings import CollocationSettings, people_settings
     from bladelab.predict.collocation.solve import predict_stride
     from bladelab.predict.collocation.starting_guess import make_guess
     from bladelab.runner import build_runner
 
-    people = people_term(defaults.people_weight_for("human"))  # as the command line solves
+    people = people_settings("human")  # as the command line solves the able and amputee runners
     rows = []
     for model, blade, speed in STRIDES:
         spec = {"model": model, "blade": blade, "body": "human"}
