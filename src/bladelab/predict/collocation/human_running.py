@@ -172,8 +172,7 @@ def human_running_criteria(solution) -> list[Criterion]:
     lo, hi, unit = reference_band("peak swing knee flexion", speed)
     knee_min = solution.settings.swing_knee_min_deg
     knee_imposed = (None if knee_min is None else
-                    f"imposed: at least {knee_min:g} deg as a smooth peak over the nodes "
-                    "(reached to within about 1 deg)")
+                    f"imposed: at least {knee_min:g} deg (a smooth peak: within about 1 deg)")
     for side, leg in zip(("l", "r"), solution.leg_names, strict=True):
         name = f"knee_angle_{side}"
         if name not in solution.dof_names or (prosthetic and side == "r"
