@@ -18,7 +18,9 @@ accelerations (implicit multibody dynamics), excitations, tendon-force rates (De
 - optionally, alternating steps (``step_phase_tolerance``): the centre of each leg's vertical
   ground force over the stride (its circular mean, :func:`step_phase`) half a stride ± the
   tolerance after the other leg's, which rules out a gallop (both stances close together,
-  then one long flight), and each leg carrying a stance (a one-legged hop ruled out).
+  then one long flight), and each leg carrying a stance (a one-legged hop ruled out);
+- optionally, a minimum peak flexion of named knees (``knee_flexion_min``, people's swing
+  knee: :mod:`~bladelab.predict.collocation.swing_knee`), a smooth maximum over the nodes.
 
 Objective (a setting, :class:`StrideWeights`): prescribed speed — metabolic energy per
 distance and body mass (cost of transport [J/(kg·m)]) plus time-averaged mean cubed activation
