@@ -200,3 +200,14 @@ def test_the_shipped_able_stride_meets_every_criterion_with_people_s_swing_knee_
     for knee in knees:
         assert "imposed: at least 108.5 deg" in knee.note
         assert knee.value > defaults.SWING_KNEE_MIN_DEG - 1.0  # the smooth peak's margin
+
+
+def test_the_cost_band_ends_at_5_m_per_s_whatever_the_round_off():
+    """A stride prescribed at 5 m/s whose mean speed is 5 m/s to round-off keeps the cost of
+    transport's criterion; a faster one has none."""
+    def names(speed):
+        return {c.name for c in human_running_criteria(_stride(speed=speed))}
+
+    assert "gross cost of transport" in names(5.0 + 1e-12)
+    assert "gross cost of transport" in names(5.0 - 1e-12)
+    assert "gross cost of transport" not in names(5.5)

@@ -194,7 +194,7 @@ def human_running_criteria(solution) -> list[Criterion]:
         out.append(Criterion(f"ground contacts per stride, {leg} leg",
                              float(phases["legs"][leg]["contacts"]), "", 1.0, 1.0,
                              "more: a swinging foot or blade strikes the ground"))
-    if speed <= COST_BAND_MAX_SPEED_MPS:
+    if speed <= COST_BAND_MAX_SPEED_MPS + tol:  # a 5 m/s stride is 5 m/s to round-off
         lo, hi, unit = reference_band("gross cost of transport", speed)
         out.append(Criterion("gross cost of transport", solution.cost_of_transport_J_per_kg_m,
                              unit, lo, hi, ""))
