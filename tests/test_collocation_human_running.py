@@ -211,3 +211,13 @@ def test_the_cost_band_ends_at_5_m_per_s_whatever_the_round_off():
     assert "gross cost of transport" in names(5.0 + 1e-12)
     assert "gross cost of transport" in names(5.0 - 1e-12)
     assert "gross cost of transport" not in names(5.5)
+
+
+def test_a_transfemoral_runner_s_prosthetic_knee_is_not_judged_as_a_person_s():
+    def knees(model):
+        return {c.name for c in human_running_criteria(_stride(model=model))
+                if c.name.startswith("peak swing knee")}
+
+    assert knees("amputee") == {"peak swing knee flexion, intact leg",
+                                "peak swing knee flexion, prosthetic leg"}
+    assert knees("transfemoral") == {"peak swing knee flexion, intact leg"}

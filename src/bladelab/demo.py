@@ -155,7 +155,8 @@ def predict_example(out_dir: str | Path | None = None) -> tuple[Path, list[str]]
     t0 = time.perf_counter()
     res = solve_named_stride(
         out_dir, model="amputee", blade="Cat6", body="human",
-        settings=CollocationSettings(speed_m_per_s=4.0, **people_settings("human")),
+        settings=CollocationSettings(speed_m_per_s=4.0,
+                                     **people_settings("human", kind="amputee")),
         guess=str(PREDICT_EXAMPLE_STRIDE),
         resume=(out_dir / SOLUTION_FILE).is_file())
     sol = res.solution

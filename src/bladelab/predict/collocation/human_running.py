@@ -39,6 +39,7 @@ from bladelab.predict.collocation.running_bands import (
     reference_band,
 )
 from bladelab.predict.collocation.solution import CONTACT_THRESHOLD_N
+from bladelab.predict.collocation.swing_knee import biological_knees
 from bladelab.predict.collocation.transcription import step_phase
 
 __all__ = [
@@ -173,10 +174,10 @@ def human_running_criteria(solution) -> list[Criterion]:
     knee_min = solution.settings.swing_knee_min_deg
     knee_imposed = (None if knee_min is None else
                     f"imposed: at least {knee_min:g} deg (a smooth peak: within about 1 deg)")
+    knees = biological_knees(solution.dof_names, solution.model_spec.get("model"))
     for side, leg in zip(("l", "r"), solution.leg_names, strict=True):
         name = f"knee_angle_{side}"
-        if name not in solution.dof_names or (prosthetic and side == "r"
-                                              and solution.model_spec["model"] == "transfemoral"):
+        if name not in knees:  # absent, or a transfemoral runner's prosthetic knee
             continue
         flexion = -math.degrees(float(q[:, solution.dof_names.index(name)].min()))
         out.append(Criterion(f"peak swing knee flexion, {leg} leg", flexion, unit, lo, hi,
