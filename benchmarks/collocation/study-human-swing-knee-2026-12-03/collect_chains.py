@@ -19,8 +19,7 @@ import json
 import sys
 from pathlib import Path
 
-from bladelab.predict.collocation.human_running import human_running_criteria
-from bladelab.predict.collocation.solution import CollocationSolution
+from collect_records import solve_record
 
 OUT = Path(__file__).parent / "every-criterion"
 
@@ -34,15 +33,9 @@ def main(runs: Path) -> int:
         if not path.is_file():
             records.append({"runner": runner, "speed_mps": float(speed), "converged": False})
             continue
-        raw = json.loads(path.read_text(encoding="utf-8"))
-        crit = human_running_criteria(CollocationSolution.read(path))
-        met = all(c.met for c in crit)
-        records.append({"runner": runner, "speed_mps": float(speed),
-                        "objective": raw["objective"], "criteria_met": sum(c.met for c in crit),
-                        "criteria": len(crit),
-                        "criteria_missed": [c.line() for c in crit if not c.met],
-                        **raw["summary"]})
-        if met and float(speed) > fastest.get(runner, (0.0, None))[0]:
+        raw, rec = solve_record(path)
+        records.append({"runner": runner, "speed_mps": float(speed), **rec})
+        if not rec["criteria_missed"] and float(speed) > fastest.get(runner, (0.0, None))[0]:
             fastest[runner] = (float(speed), raw)
     with open(OUT / "records.jsonl", "w", encoding="utf-8") as f:
         for rec in records:

@@ -18,8 +18,7 @@ import json
 import sys
 from pathlib import Path
 
-from bladelab.predict.collocation.human_running import human_running_criteria
-from bladelab.predict.collocation.solution import CollocationSolution
+from collect_records import solve_record
 
 OUT = Path(__file__).parent / "speed-4"
 
@@ -27,15 +26,9 @@ OUT = Path(__file__).parent / "speed-4"
 def main(runs: Path) -> int:
     records = []
     for folder in sorted(p for p in runs.iterdir() if (p / "solution.json").is_file()):
-        raw = json.loads((folder / "solution.json").read_text(encoding="utf-8"))
-        sol = CollocationSolution.read(folder / "solution.json")
-        crit = human_running_criteria(sol)
+        raw, rec = solve_record(folder / "solution.json")
         category, start = folder.name.split("-from-")
-        records.append({"run": folder.name, "category": category, "start": start,
-                        "objective": raw["objective"],
-                        "criteria_met": sum(c.met for c in crit), "criteria": len(crit),
-                        "criteria_missed": [c.line() for c in crit if not c.met],
-                        **raw["summary"]})
+        records.append({"run": folder.name, "category": category, "start": start, **rec})
         target = OUT / f"{category}-mesh200.json"
         current = json.loads(target.read_text(encoding="utf-8"))["objective"] \
             if target.is_file() else float("inf")

@@ -20,6 +20,16 @@ from bladelab.predict.collocation.human_running import human_running_criteria
 from bladelab.predict.collocation.solution import CollocationSolution
 
 
+def solve_record(path: Path) -> tuple[dict, dict]:
+    """(the solution file's raw mapping, its record: objective, criteria met of how many, the
+    criteria missed as lines, the summary)."""
+    raw = json.loads(path.read_text(encoding="utf-8"))
+    crit = human_running_criteria(CollocationSolution.read(path))
+    return raw, {"objective": raw["objective"], "criteria_met": sum(c.met for c in crit),
+                 "criteria": len(crit),
+                 "criteria_missed": [c.line() for c in crit if not c.met], **raw["summary"]}
+
+
 def main(runs: Path, out: Path) -> int:
     records = []
     for folder in sorted(p for p in runs.iterdir() if p.is_dir()):
@@ -27,15 +37,10 @@ def main(runs: Path, out: Path) -> int:
         if not path.is_file():
             records.append({"run": folder.name, "converged": False})
             continue
-        raw = json.loads(path.read_text(encoding="utf-8"))
-        crit = human_running_criteria(CollocationSolution.read(path))
+        raw, rec = solve_record(path)
         records.append({"run": folder.name, "category": raw["model"].get("blade"),
                         "speed_mps": raw["settings"]["speed_m_per_s"],
-                        "swing_knee_min_deg": raw["settings"]["swing_knee_min_deg"],
-                        "objective": raw["objective"], "criteria_met": sum(c.met for c in crit),
-                        "criteria": len(crit),
-                        "criteria_missed": [c.line() for c in crit if not c.met],
-                        **raw["summary"]})
+                        "swing_knee_min_deg": raw["settings"]["swing_knee_min_deg"], **rec})
     with open(out, "w", encoding="utf-8") as f:
         for rec in records:
             f.write(json.dumps(rec) + "\n")
