@@ -19,7 +19,7 @@ from bladelab.predict.collocation.swing_knee import (
     people_swing_knee_deg,
 )
 from bladelab.predict.collocation.transcription import StrideNLP
-from test_collocation_transcription import _bouncing_guess, _toy
+from toy_stride import bouncing_guess, toy_dynamics
 
 
 def test_the_default_is_people_s_peak_from_the_packaged_curves():
@@ -59,11 +59,11 @@ def test_the_nlp_keeps_the_held_coordinate_flexed_and_leaves_it_free_otherwise()
     # stays at the guess's 0; held, every node flexes at least to the minimum less
     # ln(n)/SHARPNESS (all nodes equal: the smooth peak exceeds each by exactly that)
     n, minimum = 20, 0.3
-    guess = _bouncing_guess(n, 2.0)
-    free = StrideNLP(_toy(), n=n, speed=2.0, compiled=False)
+    guess = bouncing_guess(n, 2.0)
+    free = StrideNLP(toy_dynamics(), n=n, speed=2.0, compiled=False)
     sol = free.solve(free.initial_vector(guess), hessian="exact", tol=1e-8)
     assert sol.success and np.abs(sol.q[:, 2]).max() < 1e-6
-    held = StrideNLP(_toy(), n=n, speed=2.0, compiled=False,
+    held = StrideNLP(toy_dynamics(), n=n, speed=2.0, compiled=False,
                      knee_flexion_min={"pelvis_tilt": minimum})
     assert held.n_cons == free.n_cons + 1
     _, _, lbg, ubg = held.bounds()
@@ -74,7 +74,7 @@ def test_the_nlp_keeps_the_held_coordinate_flexed_and_leaves_it_free_otherwise()
     flexion = -sol.q[:, 2]
     assert minimum - math.log(n) / SHARPNESS - 1e-6 <= flexion.min()
     with pytest.raises(SpecError, match="knee_angle_l"):
-        StrideNLP(_toy(), n=n, speed=2.0, compiled=False,
+        StrideNLP(toy_dynamics(), n=n, speed=2.0, compiled=False,
                   knee_flexion_min={"knee_angle_l": minimum})
 
 

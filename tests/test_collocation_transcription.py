@@ -10,45 +10,17 @@ import pytest
 
 from bladelab.errors import SpecError
 from bladelab.predict.collocation import transcription
-from bladelab.predict.collocation.stride_guess import StrideGuess
 from bladelab.predict.collocation.transcription import (
-    StrideDynamics,
     StrideNLP,
     alternation_rows,
     step_phase,
 )
-
-M, G, K = 80.0, 9.81, 2.0e4  # kg, m/s², N/m
-
-
-def _toy() -> StrideDynamics:
-    """A mass on a smooth ground spring, carried forward at constant speed, with one 'muscle'
-    (force 500·F̃ₜ [N] upward, rigid: F̃ₜ = a) that costs 100·a² [W]."""
-    q, qd, qdd = (ca.SX.sym(n, 3) for n in ("q", "qd", "qdd"))
-    a, f, df, e = (ca.SX.sym(n, 1) for n in ("a", "f", "df", "e"))
-    grf = K * 0.5 * (-q[1] + ca.sqrt(q[1] ** 2 + 1e-8))
-    r_mb = ca.vertcat(M * qdd[0], M * qdd[1] + M * G - grf - 500 * f, qdd[2])
-    return StrideDynamics(
-        dof_names=("pelvis_tx", "pelvis_tz", "pelvis_tilt"), muscle_names=("push",), mass=M,
-        gravity=G,
-        residuals=ca.Function("r", [q, qd, qdd, a, f, df], [r_mb, f - a]),
-        activation_rate=ca.Function("ad", [e, a], [(e - a) * 50]),
-        metabolic_rate=ca.Function("met", [q, qd, a, f, df, e], [100 * a[0] ** 2]),
-        q_bounds=np.array([[-1, 1], [-0.5, 0.5], [-1, 1]]),
-        qd_bounds=np.array([[-10.0, 10.0]] * 3), residual_scale=np.full(3, M * G))
-
-
-def _bouncing_guess(n: int, speed: float) -> StrideGuess:
-    t = np.linspace(0, 0.6, n + 1)
-    w = 2 * np.pi / 0.6
-    q = np.stack([speed * t, 0.05 * np.sin(w * t), 0 * t], 1)
-    qd = np.stack([speed + 0 * t, 0.05 * w * np.cos(w * t), 0 * t], 1)
-    return StrideGuess("toy", 0.6, q, qd)
+from toy_stride import G, K, M, bouncing_guess, toy_dynamics
 
 
 def test_the_toy_settles_on_its_spring_at_the_prescribed_speed():
-    nlp = StrideNLP(_toy(), n=40, speed=2.0, compiled=False)
-    sol = nlp.solve(nlp.initial_vector(_bouncing_guess(40, 2.0)), hessian="exact", tol=1e-6)
+    nlp = StrideNLP(toy_dynamics(), n=40, speed=2.0, compiled=False)
+    sol = nlp.solve(nlp.initial_vector(bouncing_guess(40, 2.0)), hessian="exact", tol=1e-6)
     assert sol.success, sol.status
     assert sol.speed == pytest.approx(2.0, rel=1e-8)
     assert sol.max_violation < 1e-6
@@ -71,17 +43,17 @@ def test_the_toy_settles_on_its_spring_at_the_prescribed_speed():
 
 def test_bad_settings_are_refused():
     with pytest.raises(SpecError, match="mesh intervals"):
-        StrideNLP(_toy(), n=2)
+        StrideNLP(toy_dynamics(), n=2)
     with pytest.raises(SpecError, match="speed"):
-        StrideNLP(_toy(), speed=-1.0)
+        StrideNLP(toy_dynamics(), speed=-1.0)
 
 
 def test_an_objective_of_one_term_unpacks():
     """Effort alone (metabolic weight 0): the solution still names its one term."""
     from bladelab.predict.collocation.transcription import StrideWeights
 
-    nlp = StrideNLP(_toy(), n=10, speed=2.0, weights=StrideWeights(metabolic=0.0), compiled=False)
-    sol = nlp.solve(nlp.initial_vector(_bouncing_guess(10, 2.0)), hessian="exact", max_iter=5)
+    nlp = StrideNLP(toy_dynamics(), n=10, speed=2.0, weights=StrideWeights(metabolic=0.0), compiled=False)
+    sol = nlp.solve(nlp.initial_vector(bouncing_guess(10, 2.0)), hessian="exact", max_iter=5)
     assert list(sol.objective_terms) == ["effort"]
     assert sol.objective == pytest.approx(sol.objective_terms["effort"])
 
@@ -152,13 +124,13 @@ def test_one_built_solver_serves_every_speed():
     """The speed is a parameter: an NLP built at 2 m/s and solved at 2.5 m/s gives the same
     solution as one built at 2.5 m/s, and its solver is built only once."""
     n = 16
-    shared = StrideNLP(_toy(), n=n, speed=2.0, compiled=False)
-    first = shared.solve(shared.initial_vector(_bouncing_guess(n, 2.0)), hessian="exact",
+    shared = StrideNLP(toy_dynamics(), n=n, speed=2.0, compiled=False)
+    first = shared.solve(shared.initial_vector(bouncing_guess(n, 2.0)), hessian="exact",
                          tol=1e-8)
-    again = shared.solve(shared.initial_vector(_bouncing_guess(n, 2.5)), hessian="exact",
+    again = shared.solve(shared.initial_vector(bouncing_guess(n, 2.5)), hessian="exact",
                          tol=1e-8, speed=2.5)
-    fresh = StrideNLP(_toy(), n=n, speed=2.5, compiled=False)
-    alone = fresh.solve(fresh.initial_vector(_bouncing_guess(n, 2.5)), hessian="exact",
+    fresh = StrideNLP(toy_dynamics(), n=n, speed=2.5, compiled=False)
+    alone = fresh.solve(fresh.initial_vector(bouncing_guess(n, 2.5)), hessian="exact",
                         tol=1e-8)
     assert first.success and again.success and alone.success
     assert first.timings["build_s"] > 10 * again.timings["build_s"]  # reused, not rebuilt
@@ -176,10 +148,10 @@ def test_one_built_solver_serves_every_speed():
 
 
 def test_progress_is_reported_every_iteration_of_each_solve():
-    nlp = StrideNLP(_toy(), n=10, speed=2.0, compiled=False)
+    nlp = StrideNLP(toy_dynamics(), n=10, speed=2.0, compiled=False)
     for speed in (2.0, 2.2):
         seen: list[tuple[int, float, float]] = []
-        sol = nlp.solve(nlp.initial_vector(_bouncing_guess(10, speed)), hessian="exact",
+        sol = nlp.solve(nlp.initial_vector(bouncing_guess(10, speed)), hessian="exact",
                         speed=speed, progress=lambda it, f, v, seen=seen: seen.append((it, f, v)))
         assert [s[0] for s in seen] == list(range(sol.iterations + 1))
         assert seen[-1][1] == pytest.approx(sol.objective, rel=1e-9)
@@ -194,7 +166,7 @@ def test_backward_euler_rows_for_stiff_coordinates():
 
     n, period = 20, 0.6
     h = period / n
-    g = _bouncing_guess(n, 2.0)
+    g = bouncing_guess(n, 2.0)
     z = g.q[:, 1]
     zd = np.empty_like(z)
     zd[1:] = np.diff(z) / h  # backward differences
@@ -208,8 +180,8 @@ def test_backward_euler_rows_for_stiff_coordinates():
         rows = [i for i, name in enumerate(nlp._g_names) if name.startswith("defect q ")]
         return {name: values[i] for i, name in ((i, nlp._g_names[i]) for i in rows)}
 
-    be = z_defects(dataclasses.replace(_toy(), backward_euler_dofs=("pelvis_tz",)))
-    trap = z_defects(_toy())
+    be = z_defects(dataclasses.replace(toy_dynamics(), backward_euler_dofs=("pelvis_tz",)))
+    trap = z_defects(toy_dynamics())
     be_z = np.array([v for k, v in be.items() if "pelvis_tz" in k])
     trap_z = np.array([v for k, v in trap.items() if "pelvis_tz" in k])
     assert np.abs(be_z).max() < 1e-9  # met exactly by the backward differences
@@ -228,9 +200,9 @@ def test_interval_mean_inequalities_are_imposed_on_each_intervals_mean():
     q, qd = ca.SX.sym("q", 3), ca.SX.sym("qd", 3)
     a, f, df = (ca.SX.sym(s, 1) for s in ("a", "f", "df"))
     ineq = ca.Function("ineq", [q, qd, a, f, df], [ca.vertcat(qd[1], q[1])])
-    toy = dataclasses.replace(_toy(), inequalities=ineq,
+    toy = dataclasses.replace(toy_dynamics(), inequalities=ineq,
                               inequality_bounds=np.array([[-1.0, 1.0], [-1.0, 1.0]]))
-    g = _bouncing_guess(n, 2.0)
+    g = bouncing_guess(n, 2.0)
     ringing = dataclasses.replace(g, qd=g.qd.copy())
     ringing.qd[:, 1] = 0.3 * (-1.0) ** np.arange(n + 1)  # ±0.3 m/s from node to node
 
@@ -253,34 +225,34 @@ def test_tracking_term_follows_only_the_named_coordinates():
     coordinates only; the default follows pelvis tilt and every joint; an unknown name is
     refused with the model's coordinates in the hint."""
     n, speed = 20, 2.0
-    guess = _bouncing_guess(n, speed)
+    guess = bouncing_guess(n, speed)
     q_ref = guess.q.copy()
     q_ref[:, 2] = 0.3  # the tilt's reference is 0.3 rad off the guess's 0
     q_ref[:, 1] += 1.0  # a translation: not followed by default
     ref = {}
     for key, dofs in (("default", ()), ("tz", (["pelvis_tz"],))):
-        nlp = StrideNLP(_toy(), n=n, speed=speed, tracking=(q_ref, 2.0, *dofs))
+        nlp = StrideNLP(toy_dynamics(), n=n, speed=speed, tracking=(q_ref, 2.0, *dofs))
         lbx, ubx, lbg, ubg = nlp.bounds()
         x0 = nlp.initial_vector(guess)
         ref[key] = nlp.unpack(x0, {}, 0.0, 0.0, lbg, ubg, np.zeros(lbg.size))
     assert ref["default"].objective_terms["tracking"] == pytest.approx(2.0 * 0.3**2, rel=1e-9)
     assert ref["tz"].objective_terms["tracking"] == pytest.approx(2.0, rel=1e-9)
     with pytest.raises(SpecError, match="hip_flexion_l") as err:
-        StrideNLP(_toy(), n=n, speed=speed, tracking=(q_ref, 2.0, ["hip_flexion_l"]))
+        StrideNLP(toy_dynamics(), n=n, speed=speed, tracking=(q_ref, 2.0, ["hip_flexion_l"]))
     assert "pelvis_tilt" in err.value.hint
 
 
 def test_period_tracking_term_is_the_squared_log_ratio_of_the_stride_times():
     n, speed = 20, 2.0
-    guess = _bouncing_guess(n, speed)  # a 0.6 s stride
-    nlp = StrideNLP(_toy(), n=n, speed=speed, period_tracking=(0.5, 3.0))
+    guess = bouncing_guess(n, speed)  # a 0.6 s stride
+    nlp = StrideNLP(toy_dynamics(), n=n, speed=speed, period_tracking=(0.5, 3.0))
     lbx, ubx, lbg, ubg = nlp.bounds()
     sol = nlp.unpack(nlp.initial_vector(guess), {}, 0.0, 0.0, lbg, ubg, np.zeros(lbg.size))
     assert sol.period == pytest.approx(0.6)
     assert sol.objective_terms["period_tracking"] == pytest.approx(3.0 * np.log(1.2) ** 2,
                                                                    rel=1e-9)
     with pytest.raises(SpecError, match="reference stride time"):
-        StrideNLP(_toy(), n=n, speed=speed, period_tracking=(0.0, 3.0))
+        StrideNLP(toy_dynamics(), n=n, speed=speed, period_tracking=(0.0, 3.0))
 
 
 def test_a_solution_restarted_from_its_multipliers_ends_at_once():
@@ -289,8 +261,8 @@ def test_a_solution_restarted_from_its_multipliers_ends_at_once():
     values alone IPOPT's barrier starts again and takes longer. Multipliers that do not fit
     the NLP are not used."""
     n = 16
-    nlp = StrideNLP(_toy(), n=n, speed=2.0, compiled=False)
-    cold = nlp.solve(nlp.initial_vector(_bouncing_guess(n, 2.0)), hessian="exact")
+    nlp = StrideNLP(toy_dynamics(), n=n, speed=2.0, compiled=False)
+    cold = nlp.solve(nlp.initial_vector(bouncing_guess(n, 2.0)), hessian="exact")
     assert cold.success and cold.multipliers is not None
     lam_x, lam_g = cold.multipliers
     assert lam_x.shape == (nlp.n_vars,) and lam_g.shape == (nlp.n_cons,)
@@ -305,7 +277,7 @@ def test_a_solution_restarted_from_its_multipliers_ends_at_once():
     # kept by a change of speed, dropped by another mesh; the wrong size or a NaN is refused
     assert nlp.initial_multipliers(guess.with_speed(2.2)) is not None
     assert guess.resample(8).multipliers is None
-    assert nlp.initial_multipliers(_bouncing_guess(n, 2.0)) is None
+    assert nlp.initial_multipliers(bouncing_guess(n, 2.0)) is None
     short = dataclasses.replace(guess, multipliers=(lam_x[:-1], lam_g))
     assert nlp.initial_multipliers(short) is None
     bad = dataclasses.replace(guess, multipliers=(lam_x, np.full_like(lam_g, np.nan)))
@@ -318,16 +290,16 @@ def test_the_maximum_speed_problem_keeps_at_least_the_speed_it_is_given():
     meets a 1.5 m/s floor and violates a 2.5 m/s one."""
     from bladelab.predict.collocation.transcription import StrideWeights
 
-    fastest = StrideNLP(_toy(), n=10, speed=None,
+    fastest = StrideNLP(toy_dynamics(), n=10, speed=None,
                         weights=StrideWeights(metabolic=0.0, speed=1.0))
-    prescribed = StrideNLP(_toy(), n=10, speed=2.0)
+    prescribed = StrideNLP(toy_dynamics(), n=10, speed=2.0)
     assert fastest.n_cons == prescribed.n_cons  # the speed row, an inequality now
     _, _, lbg, ubg = fastest.bounds()
     rows = np.flatnonzero(np.isinf(ubg))
     assert rows.size == 1 and lbg[rows[0]] == 0.0
     assert not np.isinf(prescribed.bounds()[3]).any()
     g = ca.Function("g", [fastest.nlp["x"], fastest.nlp["p"]], [fastest.nlp["g"]])
-    x0 = fastest.initial_vector(_bouncing_guess(10, 2.0))
+    x0 = fastest.initial_vector(bouncing_guess(10, 2.0))
     assert float(g(x0, 1.5)[rows[0]]) == pytest.approx(0.5 * 0.6, rel=1e-9)
     assert float(g(x0, 2.5)[rows[0]]) < 0.0
 
@@ -371,7 +343,7 @@ def test_the_nlp_holds_the_alternation_constraint_only_when_asked():
     """``step_phase_tolerance`` adds three inequalities on the node forces 0..n−1 (the phase
     and a stance per leg), bounded above by 0; without it there are none; a tolerance outside (0, 0.5) or dynamics without the
     legs' forces are refused."""
-    toy = _toy()
+    toy = toy_dynamics()
     q, qd = ca.SX.sym("q", 3), ca.SX.sym("qd", 3)
     spring = [K * 0.5 * (-z + ca.sqrt(z**2 + 1e-8)) for z in (q[1], q[2])]  # tilt as a 2nd leg
     legs = dataclasses.replace(toy, leg_vertical_grf=ca.Function("legs", [q, qd],
@@ -386,7 +358,7 @@ def test_the_nlp_holds_the_alternation_constraint_only_when_asked():
     assert (lbg[i:i + 3] == -np.inf).all() and (ubg[i:i + 3] == 0.0).all()
     g = ca.Function("g", [steps.nlp["x"], steps.nlp["p"]], [steps.nlp["g"]])
     for lag in (0.5, 0.2):  # the 'right leg' sinks `lag` of the stride after the left
-        guess = _bouncing_guess(n, 2.0)
+        guess = bouncing_guess(n, 2.0)
         t = np.arange(n + 1) / n
         guess.q[:, 2] = 0.05 * np.sin(2 * np.pi * (t - lag))
         guess.q[:, 1] = 0.05 * np.sin(2 * np.pi * t)
@@ -409,8 +381,8 @@ def test_an_lbfgs_solve_stops_where_its_objective_stalls_near_the_full_solution(
     primal and dual values. (The toy converges within a few iterations, before the stop can
     act; what it saves on strides is measured in benchmarks/collocation_speed/README.md.)"""
     n = 16
-    nlp = StrideNLP(_toy(), n=n, speed=2.0, compiled=False)
-    cold = nlp.solve(nlp.initial_vector(_bouncing_guess(n, 2.0)))
+    nlp = StrideNLP(toy_dynamics(), n=n, speed=2.0, compiled=False)
+    cold = nlp.solve(nlp.initial_vector(bouncing_guess(n, 2.0)))
     assert cold.success, cold.status
     guess = cold.to_guess()
     lam = nlp.initial_multipliers(guess)
