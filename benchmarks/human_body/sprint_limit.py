@@ -19,9 +19,9 @@ intervals, default 50; a start on another mesh is resampled), ``stride_time`` (`
 people's band at each speed, ``CollocationSettings.stride_time_people``; default free),
 ``start_mu`` (the first solve's barrier start, ``CollocationSettings.warm_start_mu``, e.g.
 1e-4 for a start file without multipliers, which IPOPT's default barrier lets leave its
-basin; default IPOPT's), ``max_iter`` (IPOPT iterations per stage, default the settings'), ``swing_knee`` [deg]
-(people's swing knee held at least this flexed, ``CollocationSettings.swing_knee_min_deg``;
-default none).
+basin; default IPOPT's), ``max_iter`` (IPOPT iterations per stage, default the settings'),
+``swing_knee`` [deg] (people's swing knee held at least this flexed,
+``CollocationSettings.swing_knee_min_deg``; default none).
 Writes ``OUT/speed-<v>.json`` per converged speed and ``OUT/records.jsonl`` (one line per
 solve: the summary, the largest activation of any muscle at any node, the human-running
 criteria met and missed, the wall time), and prints each line.
