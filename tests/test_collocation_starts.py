@@ -85,9 +85,14 @@ def _start(label="warm", mu=None):
 def test_the_starts_come_in_a_fixed_order_and_only_where_they_apply():
     warm, template, prev = _start(), _start("template"), _start("previous-but-one")
     warm_source = "collocation solution at 3.5 m/s"
-    plan = st.plan_starts(4, warm, warm_source=warm_source, template=template, previous=prev)
+    plan = st.plan_starts(5, warm, warm_source=warm_source, template=template, previous=prev)
     assert [s.label for s in plan] == ["warm", "warm-mu-1e-4", "template",
-                                       "previous-but-one"]
+                                       "previous-but-one", "warm-restart"]
+    assert plan[4].settings.warm_start_mu is None and plan[4].settings.same_problem(
+        warm.settings)
+    assert [s.label for s in st.plan_starts(4, warm, warm_source=warm_source,
+                                            template=None, previous=None)] == [
+        "warm", "warm-mu-1e-4", "warm-restart"]
     assert plan[1].settings.warm_start_mu == st.BARRIER_MU
     assert plan[1].settings.same_problem(warm.settings)
     assert [s.label for s in st.plan_starts(3, warm, warm_source=warm_source, template=template,
@@ -100,6 +105,10 @@ def test_the_starts_come_in_a_fixed_order_and_only_where_they_apply():
     # settings that already use the barrier start: the alternative is IPOPT's default
     other = st.barrier_start(_start(mu=st.BARRIER_MU))
     assert other.label == "warm-mu-default" and other.settings.warm_start_mu is None
+    # ... and the restart would repeat it
+    assert [s.label for s in st.plan_starts(5, _start(mu=st.BARRIER_MU), warm_source=warm_source,
+                                            template=None, previous=None)] == [
+        "warm", "warm-mu-default"]
 
 
 def test_the_barrier_start_drops_the_warm_starts_multipliers():
@@ -112,6 +121,9 @@ def test_the_barrier_start_drops_the_warm_starts_multipliers():
     barrier = st.barrier_start(warm)
     assert warm.guess().multipliers is lam and barrier.guess().multipliers is None
     np.testing.assert_array_equal(barrier.guess().q, guess.q)
+    again = st.restart(warm)
+    assert again.guess().multipliers is None and again.settings.warm_start_mu is None
+    np.testing.assert_array_equal(again.guess().q, guess.q)
 
 
 def test_each_start_has_its_own_files_and_the_warm_start_the_one_start_names(tmp_path):
@@ -121,7 +133,7 @@ def test_each_start_has_its_own_files_and_the_warm_start_the_one_start_names(tmp
         tmp_path / "speed-4.5.template.json", tmp_path / "speed-4.5.template.best_iterate.json")
 
 
-@pytest.mark.parametrize("bad", [0, 5, 2.0, True, "3"])
+@pytest.mark.parametrize("bad", [0, 6, 2.0, True, "3"])
 def test_a_number_of_starts_out_of_range_is_refused_by_name(bad):
     with pytest.raises(SpecError, match="--starts"):
         st.check_starts(bad, where="--starts")

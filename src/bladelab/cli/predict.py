@@ -356,7 +356,8 @@ def register(app: typer.Typer) -> None:
         starts: int | None = typer.Option(
             None, "--starts", rich_help_panel=COLLOCATION, show_default=False,
             help="Solve the stride from up to K starts (the guess, the guess with the "
-                 "barrier started at 1e-4, the template) and keep the best; each start's "
+                 "barrier started at 1e-4, the template, the guess's primal values with "
+                 "IPOPT's default barrier) and keep the best; each start's "
                  f"solve in OUT/starts/. Default: {defaults.ATHLETE_STARTS} for an athlete "
                  "scaled by --body-mass, --height, --muscle-strength, "
                  "--max-shortening-velocity, --residual-limb, --thigh-length, "
@@ -507,7 +508,8 @@ def register(app: typer.Typer) -> None:
         starts: int = typer.Option(
             defaults.STARTS, "--starts", rich_help_panel=COLLOCATION,
             help="Solve each problem from up to K starts (warm start, barrier start 1e-4, "
-                 "template, previous-but-one solution) and keep the best."),
+                 "template, previous-but-one solution, restart with IPOPT's default barrier) "
+                 "and keep the best."),
         body: str = typer.Option(
             defaults.BODY, "--body", rich_help_panel=COLLOCATION,
             help="human (H0918's segments and muscles, compliant Achilles, toes, soft heel "

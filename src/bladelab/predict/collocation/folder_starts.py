@@ -10,8 +10,10 @@ started at 1e-4 (``benchmarks/human_body/athlete-68kg-1.75m``).
 :func:`predict_stride_from_starts` solves the problem from the first K starts of
 :func:`~bladelab.predict.collocation.starts.plan_starts` that apply: ``warm`` (the guess
 itself), the barrier start (``warm-mu-1e-4``: its primal values with the barrier started at
-1e-4, when the guess is a collocation solution) and ``template`` (the template guess through
-the tracking stage, when the guess is not itself the template), and keeps the lowest objective
+1e-4, when the guess is a collocation solution), ``template`` (the template guess through
+the tracking stage, when the guess is not itself the template) and the restart
+(``warm-restart``: the guess's primal values with IPOPT's default barrier start, as the barrier
+start applies), and keeps the lowest objective
 among the converged solves without gait warnings
 (:func:`~bladelab.predict.collocation.starts.pick`).
 

@@ -20,10 +20,17 @@ keep one. The starts, in this fixed order (:data:`START_ORDER`), the first K tha
    maximum speed), through the tracking stage: a start that no path of the continuation
    biases. Not when the warm start is itself a template guess;
 4. ``previous-but-one``: the kept solution of the problem before the previous one (the
-   second-fastest kept speed for the maximum speed), when there is one.
+   second-fastest kept speed for the maximum speed), when there is one;
+5. ``warm-restart`` (the restart): the warm start's primal values with IPOPT's default
+   barrier start, which may leave the warm start's branch altogether. Measured at sprint
+   speed: a continuation with dual warm starts stays on a running branch well past the speed
+   where a bounding stride is cheaper (7.75 m/s: 6.49 against 8.50), and the barrier start at
+   1e-4 stays on it too; the restart found the bound. Only when the warm start is a
+   collocation solution and the barrier start is not already IPOPT's default.
 
 So K = 3 gives, at every speed after the first, the warm start, the barrier start and the
-template; K = 4 adds the previous-but-one solution from the third speed on.
+template; K = 4 adds the previous-but-one solution from the third speed on; K = 5 the
+restart.
 
 Kept (:func:`pick`): the lowest objective among the converged solves without
 :meth:`~bladelab.predict.collocation.solution.CollocationSolution.gait_warnings`; if every
@@ -64,6 +71,7 @@ __all__ = [
     "StartOutcome",
     "barrier_start",
     "candidate",
+    "restart",
     "check_starts",
     "kept_message",
     "pick",
@@ -76,7 +84,7 @@ __all__ = [
 
 #: The starts in the order they are tried (module docstring); ``barrier`` is labelled
 #: ``warm-mu-1e-4`` (or ``warm-mu-default``).
-START_ORDER = ("warm", "barrier", "template", "previous-but-one")
+START_ORDER = ("warm", "barrier", "template", "previous-but-one", "restart")
 #: The most starts per problem.
 MAX_STARTS = len(START_ORDER)
 #: IPOPT's initial barrier parameter of the barrier start.
@@ -135,18 +143,34 @@ def barrier_start(warm: Start) -> Start:
     return Start(label, dataclasses.replace(warm.settings, warm_start_mu=mu), guess, text)
 
 
+def restart(warm: Start) -> Start:
+    """The restart of a warm start (module docstring, start 5): its primal values with
+    IPOPT's default barrier start."""
+    def guess():
+        return dataclasses.replace(warm.guess(), multipliers=None)
+
+    return Start("warm-restart", dataclasses.replace(warm.settings, warm_start_mu=None), guess,
+                 (warm.text or "the same warm start")
+                 + ", primal values, IPOPT's default barrier start")
+
+
 def plan_starts(k: int, warm: Start, *, warm_source: str, template: Start | None,
                 previous: Start | None) -> list[Start]:
     """The first ``k`` starts that apply, in :data:`START_ORDER` (module docstring):
     ``warm``; its barrier start when ``warm_source`` (the source of the warm start's guess)
     names a collocation solution; ``template`` unless None or the warm start is itself a
-    template guess; ``previous`` unless None."""
+    template guess; ``previous`` unless None; the restart when the barrier start applies and
+    is not itself IPOPT's default."""
     out = [warm]
-    if warm_source.startswith(COLLOCATION_SOURCE):
-        out.append(barrier_start(warm))
+    solution = warm_source.startswith(COLLOCATION_SOURCE)
+    barrier = barrier_start(warm) if solution else None
+    if barrier is not None:
+        out.append(barrier)
     if warm_source.startswith("template"):
         template = None
     out += [s for s in (template, previous) if s is not None]
+    if barrier is not None and barrier.settings.warm_start_mu is not None:
+        out.append(restart(warm))
     return out[:k]
 
 
