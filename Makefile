@@ -1,7 +1,7 @@
 # bladelab: two commands do all the set-up on a fresh machine (Python 3.11, pip, gcc, make).
 #   make demo   installs bladelab into .venv and runs the main job on the embedded example study
-#   make test   installs the test dependencies (pytest, pytest-xdist, statsmodels, ruff, ray) and runs
-#               the tests on two workers
+#   make test   installs the test dependencies (pytest, pytest-xdist, pytest-timeout, statsmodels,
+#               ruff, ray) and runs the tests on two workers
 PYTHON ?= python3
 VENV   := .venv
 PY     := $(VENV)/bin/python

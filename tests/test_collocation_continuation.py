@@ -377,6 +377,6 @@ def test_max_speed_from_several_starts(fakes, fake_solve, monkeypatch, tmp_path)
     assert {p.name for p in rec.files} == {
         "max-speed.template.json", "max-speed.json", "max-speed.warm-mu-1e-4.json",
         "max-speed.previous-but-one.json"}
-    with pytest.raises(SpecError, match="1 to 4 starts"):
+    with pytest.raises(SpecError, match="1 to 5 starts"):
         cont.max_speed(runner, cont.max_speed_settings(_settings()), res.fastest.solution,
-                       model_spec=ABLE, out_dir=tmp_path, starts=5)
+                       model_spec=ABLE, out_dir=tmp_path, starts=6)

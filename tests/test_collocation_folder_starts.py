@@ -8,7 +8,7 @@ import json
 
 import pytest
 
-from bladelab.errors import InputFileError
+from bladelab.errors import InputFileError, SpecError
 from bladelab.predict.collocation import folder_starts as fs
 from bladelab.predict.collocation.stride_guess import StrideGuess
 from collocation_fake import fake_solution
@@ -34,7 +34,9 @@ def fake(monkeypatch, solved):
 
     def predict_stride(runner, settings, guess, *, model_spec, progress=None):
         label = ("template" if guess.source.startswith("template")
-                 else "warm-mu-1e-4" if settings.warm_start_mu == 1e-4 else "warm")
+                 else "warm-mu-1e-4" if settings.warm_start_mu == 1e-4
+                 # the restart: the guess again with the warm start's settings
+                 else "warm-restart" if ("warm", None) in calls else "warm")
         calls.append((label, settings.warm_start_mu))
         return outcome.get(label, _with(solved, 2.0))
 
@@ -78,6 +80,18 @@ def test_the_lowest_objective_of_the_starts_is_the_folders_solution(fake, solved
     assert [c[0] for c in calls] == ["warm", "warm-mu-1e-4", "template"]
     assert forced.solution.nlp.objective == 1.2
     assert not (tmp_path / "starts" / "solution.template.best_iterate.json").exists()
+
+def test_a_fourth_start_is_the_restart_from_the_guess_s_primal_values(fake, solved, tmp_path):
+    calls, outcome = fake
+    outcome["warm-restart"] = _with(solved, 0.9)
+    res = _run(tmp_path, solved, starts=4)
+    assert calls == [("warm", None), ("warm-mu-1e-4", 1e-4), ("template", None),
+                     ("warm-restart", None)]
+    assert res.solution.nlp.objective == 0.9
+    assert (tmp_path / "starts" / "solution.warm-restart.json").exists()
+    with pytest.raises(SpecError, match="1 to 4 starts"):
+        fs.check_stride_starts(5)
+
 
 def test_with_no_converged_start_the_folder_keeps_a_best_iterate(fake, solved, tmp_path):
     calls, outcome = fake

@@ -85,14 +85,19 @@ def _start(label="warm", mu=None):
 def test_the_starts_come_in_a_fixed_order_and_only_where_they_apply():
     warm, template, prev = _start(), _start("template"), _start("previous-but-one")
     warm_source = "collocation solution at 3.5 m/s"
-    plan = st.plan_starts(5, warm, warm_source=warm_source, template=template, previous=prev)
+    plan = st.plan_starts(5, warm, warm_source=warm_source, template=template, previous=prev,
+                          restart_start=True)
     assert [s.label for s in plan] == ["warm", "warm-mu-1e-4", "template",
                                        "previous-but-one", "warm-restart"]
     assert plan[4].settings.warm_start_mu is None and plan[4].settings.same_problem(
         warm.settings)
+    assert [s.label for s in st.plan_starts(4, warm, warm_source=warm_source, template=None,
+                                            previous=None, restart_start=True)] == [
+        "warm", "warm-mu-1e-4", "warm-restart"]
+    # the restart only when asked for (the largest K): a smaller K solves what it did before
     assert [s.label for s in st.plan_starts(4, warm, warm_source=warm_source,
                                             template=None, previous=None)] == [
-        "warm", "warm-mu-1e-4", "warm-restart"]
+        "warm", "warm-mu-1e-4"]
     assert plan[1].settings.warm_start_mu == st.BARRIER_MU
     assert plan[1].settings.same_problem(warm.settings)
     assert [s.label for s in st.plan_starts(3, warm, warm_source=warm_source, template=template,
@@ -107,7 +112,8 @@ def test_the_starts_come_in_a_fixed_order_and_only_where_they_apply():
     assert other.label == "warm-mu-default" and other.settings.warm_start_mu is None
     # ... and the restart would repeat it
     assert [s.label for s in st.plan_starts(5, _start(mu=st.BARRIER_MU), warm_source=warm_source,
-                                            template=None, previous=None)] == [
+                                            template=None, previous=None,
+                                            restart_start=True)] == [
         "warm", "warm-mu-default"]
 
 

@@ -399,7 +399,7 @@ def test_faster_neighbours_are_the_next_converged_faster_problem():
     (("--method", "collocation", "--resume", "--force"), "--resume/--force"),
     (("--method", "collocation", "--resume"), "no collocation sweep to resume"),
     (("--method", "collocation", "--starts", "0"), "--starts"),
-    (("--method", "collocation", "--starts", "5"), "--starts"),
+    (("--method", "collocation", "--starts", "6"), "--starts"),
     (("--able",), "--able"),
     (("--starts", "2"), "--starts"),
     (("--body", "toes"), "--body"),

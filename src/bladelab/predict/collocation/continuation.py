@@ -84,6 +84,7 @@ from bladelab.predict.collocation.solve import (
     write_solve,
 )
 from bladelab.predict.collocation.starts import (
+    MAX_STARTS,
     START_COLUMNS,
     Start,
     StartOutcome,
@@ -453,7 +454,7 @@ def speed_continuation(runner, speeds: Sequence[float], settings: CollocationSet
         speed: the smallest step is the first step towards a prescribed speed / 2^refinements
         (0: stop at the first failure).
     starts
-        Starts per speed, 1 to 4 (module docstring; :mod:`~bladelab.predict.collocation.starts`):
+        Starts per speed, 1 to 5 (module docstring; :mod:`~bladelab.predict.collocation.starts`):
         1 the warm start only; more, the best of several kept and continued from.
     extra_starts
         ``{problem_key(v): [(label, solution file), ...]}``: further starts of a speed from
@@ -517,7 +518,7 @@ def speed_continuation(runner, speeds: Sequence[float], settings: CollocationSet
             warm = Start("warm", s_v, first_start)
             plan = [warm] if starts == 1 else plan_starts(
                 starts, warm, warm_source=str(first_start().source), template=template,
-                previous=None)
+                previous=None, restart_start=starts == MAX_STARTS)
         else:
             warm = Start("warm", s_v, functools.partial(warm_guess, prev),
                          f"warm start from the {prev.settings.speed_m_per_s:g} m/s solution")
@@ -527,7 +528,7 @@ def speed_continuation(runner, speeds: Sequence[float], settings: CollocationSet
                 f"warm start from the {prev2.settings.speed_m_per_s:g} m/s solution (the "
                 "previous but one)")
             plan = plan_starts(starts, warm, warm_source=COLLOCATION_SOURCE, template=template,
-                               previous=previous)
+                               previous=previous, restart_start=starts == MAX_STARTS)
         extra = _extra(extra_starts, v, s_v)
         ok, best = out_dir / speed_file(v), out_dir / speed_file(v, converged=False)
         kept, outcomes = solve_starts(
@@ -625,7 +626,7 @@ def max_speed(runner, settings: CollocationSettings, guess, *, model_spec: dict,
             functools.partial(warm_guess, previous, " (the previous but one)"))
         source = COLLOCATION_SOURCE if isinstance(guess, CollocationSolution) else guess.source
         plan = plan_starts(starts, warm, warm_source=str(source), template=template,
-                           previous=prev)
+                           previous=prev, restart_start=starts == MAX_STARTS)
     extra = _extra(extra_starts, None, settings)
     ok, best = out_dir / MAX_SPEED_FILE, out_dir / MAX_SPEED_BEST_ITERATE_FILE
     kept, outcomes = solve_starts(

@@ -62,8 +62,8 @@ __all__ = ["MAX_STRIDE_STARTS", "STARTS_FILE", "check_stride_starts",
 
 #: The starts' record in ``OUT/starts/``.
 STARTS_FILE = "starts.json"
-#: The most starts of one stride: the guess, its barrier start, the template.
-MAX_STRIDE_STARTS = 3
+#: The most starts of one stride: the guess, its barrier start, the template, the restart.
+MAX_STRIDE_STARTS = 4
 
 
 def check_stride_starts(starts, where: str = "starts") -> int:
@@ -112,7 +112,7 @@ def predict_stride_from_starts(
     warm = Start(START_ORDER[0], settings, warm_guess)
     template = Start("template", settings, template_guess, "from the template guess")
     plan = plan_starts(starts, warm, warm_source=str(warm_guess().source), template=template,
-                       previous=None)
+                       previous=None, restart_start=starts == MAX_STRIDE_STARTS)
     folder = out / STARTS_DIR
     folder.mkdir(parents=True, exist_ok=True)
     files = (folder / SOLUTION_FILE, folder / BEST_ITERATE_FILE)

@@ -4,7 +4,8 @@ The stride's landscape has local optima 15–25 % apart (docs/collocation.md, "L
 along a continuation"): which one a solve reaches depends on its start and on IPOPT's barrier
 start. With K > 1 the speed continuation and the maximum speed
 (:mod:`bladelab.predict.collocation.continuation`) solve each problem from up to K starts and
-keep one. The starts, in this fixed order (:data:`START_ORDER`), the first K that apply:
+keep one. The starts, in this fixed order (:data:`START_ORDER`), the first K that apply (the
+restart only with K = 5, so that K = 4 solves what it solved before the restart existed):
 
 1. ``warm``: the continuation's own warm start (the previous speed's kept solution, the first
    guess at the first speed, the fastest kept speed for the maximum speed), with the
@@ -29,8 +30,8 @@ keep one. The starts, in this fixed order (:data:`START_ORDER`), the first K tha
    collocation solution and the barrier start is not already IPOPT's default.
 
 So K = 3 gives, at every speed after the first, the warm start, the barrier start and the
-template; K = 4 adds the previous-but-one solution from the third speed on; K = 5 the
-restart.
+template; K = 4 adds the previous-but-one solution from the third speed on; K = 5 adds the
+restart at every speed after the first.
 
 Kept (:func:`pick`): the lowest objective among the converged solves without
 :meth:`~bladelab.predict.collocation.solution.CollocationSolution.gait_warnings`; if every
@@ -155,12 +156,12 @@ def restart(warm: Start) -> Start:
 
 
 def plan_starts(k: int, warm: Start, *, warm_source: str, template: Start | None,
-                previous: Start | None) -> list[Start]:
+                previous: Start | None, restart_start: bool = False) -> list[Start]:
     """The first ``k`` starts that apply, in :data:`START_ORDER` (module docstring):
     ``warm``; its barrier start when ``warm_source`` (the source of the warm start's guess)
     names a collocation solution; ``template`` unless None or the warm start is itself a
-    template guess; ``previous`` unless None; the restart when the barrier start applies and
-    is not itself IPOPT's default."""
+    template guess; ``previous`` unless None; the restart when ``restart_start`` (the caller's
+    largest K), the barrier start applies and is not itself IPOPT's default."""
     out = [warm]
     solution = warm_source.startswith(COLLOCATION_SOURCE)
     barrier = barrier_start(warm) if solution else None
@@ -169,7 +170,7 @@ def plan_starts(k: int, warm: Start, *, warm_source: str, template: Start | None
     if warm_source.startswith("template"):
         template = None
     out += [s for s in (template, previous) if s is not None]
-    if barrier is not None and barrier.settings.warm_start_mu is not None:
+    if restart_start and barrier is not None and barrier.settings.warm_start_mu is not None:
         out.append(restart(warm))
     return out[:k]
 

@@ -415,7 +415,7 @@ def collocation_sweep(
         Called with each :class:`ContinuationProgress` (in the worker process when
         ``jobs`` > 1, so it must be picklable then).
     starts
-        Starts per problem, 1 to 4 (module docstring): 1 the continuation's warm start only;
+        Starts per problem, 1 to 5 (module docstring): 1 the continuation's warm start only;
         more, the best of several kept.
     mesh_check
         Solve every converged problem again on twice the mesh intervals from its stride
