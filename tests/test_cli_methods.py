@@ -296,7 +296,7 @@ def test_predict_collocation_passes_the_same_settings(tmp_path, monkeypatch, cap
             main(["predict", "--out", str(tmp_path), "--model", "amputee", *args])
         assert seen.get("starts") == starts, args  # None: the one-start folder solve
     assert main(["predict", "--out", str(tmp_path), "--starts", "9"]) == 2
-    assert "--starts: need 1 to 3 starts" in capsys.readouterr().err
+    assert "--starts: need 1 to 4 starts" in capsys.readouterr().err
 
 
 def test_sweep_collocation_passes_the_same_settings(tmp_path, monkeypatch, capsys):

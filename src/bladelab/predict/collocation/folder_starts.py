@@ -73,7 +73,8 @@ def check_stride_starts(starts, where: str = "starts") -> int:
             1 <= starts <= MAX_STRIDE_STARTS):
         raise SpecError(f"need 1 to {MAX_STRIDE_STARTS} starts, got {starts!r}", where=where,
                         hint="1: the guess; 2: + the guess with the barrier started at 1e-4; "
-                             "3: + the template")
+                             "3: + the template; 4: + the guess's primal values with IPOPT's "
+                             "default barrier")
     return starts
 
 
