@@ -1,5 +1,6 @@
-"""The 25-run design studies on predicted transfemoral strides, from their stored
-files: the free gait, and the knee-safe one (the knee's extension moment kept at or above 0).
+"""The 25-run design studies on predicted amputee strides, from their stored files: the
+transfemoral runner's free gait and knee-safe one (the knee's extension moment kept at or
+above 0), and the transtibial runner's on the human body.
 
 The study takes about half an hour of both cores, so ``make bench`` does not run it again: it
 reads the solve times and iterations of every design's stride in the committed study folder
@@ -10,6 +11,9 @@ beside it (``bladelab design`` run as in docs/design.md). Run the study again to
     bladelab design --evaluator collocation --jobs 2 --knee-moment-min 0 \
         --start benchmarks/collocation/transfemoral-2026-11-26/knee-safe-centre-4.json \
         --out benchmarks/design/transfemoral-collocation-4mps-knee-safe
+    bladelab design --evaluator collocation --amputation transtibial --runs ccd --jobs 2 \
+        --settle 2 --skip-failed --objective cost_of_transport_J_per_kg_m --sense min \
+        --out benchmarks/design/transtibial-collocation-4mps
 """
 
 from __future__ import annotations
@@ -18,24 +22,26 @@ import json
 from pathlib import Path
 
 _DESIGN = Path(__file__).resolve().parent / "design"
-#: (folder, what distinguishes it)
+#: (folder, runner, what distinguishes it)
 STUDIES = (
-    (_DESIGN / "transfemoral-collocation-4mps", "free gait"),
-    (_DESIGN / "transfemoral-collocation-4mps-knee-safe",
+    (_DESIGN / "transfemoral-collocation-4mps", "transfemoral", "free gait"),
+    (_DESIGN / "transfemoral-collocation-4mps-knee-safe", "transfemoral",
      "knee-safe: knee moment ≥ 0 N·m on every mesh interval (`--knee-moment-min 0`)"),
+    (_DESIGN / "transtibial-collocation-4mps", "transtibial",
+     "human body, people's joint angles and swing knee (`--amputation transtibial`)"),
 )
 
 
 def run() -> str:
-    return "\n\n".join(_study(folder, what) for folder, what in STUDIES)
+    return "\n\n".join(_study(*study) for study in STUDIES)
 
 
-def _study(study: Path, what: str) -> str:
+def _study(study: Path, runner: str, what: str) -> str:
     strides = sorted((study / "strides").glob("*.json"))
     strides = [p for p in strides
                if not p.name.endswith((".best_iterate.json", ".previous.json"))]
     if not strides:
-        return (f"## Design study on predicted transfemoral strides: {what}\n\n"
+        return (f"## Design study on predicted {runner} strides: {what}\n\n"
                 f"No study in {study.relative_to(study.parents[2])}: run it first (docstring).")
     from bladelab.predict.collocation.solution import CollocationSolution
 
@@ -48,10 +54,10 @@ def _study(study: Path, what: str) -> str:
     info = json.loads(timing.read_text(encoding="utf-8")) if timing.is_file() else {}
     walls = sorted(r[1] for r in rows)
     lines = [
-        f"## Design study on predicted transfemoral strides: {what}",
+        f"## Design study on predicted {runner} strides: {what}",
         "",
         "25-run face-centred CCD over seed 002's four factors, `--evaluator collocation` "
-        "(transfemoral runner wearing each generated 6-link blade, 4 m/s, mesh 50, backward "
+        f"({runner} runner wearing each generated 6-link blade, 4 m/s, mesh 50, backward "
         "Euler for the blade's joints), `--jobs 2`. Target: the study ≤ 30 min on 2 cores. "
         "Times are those the study recorded (its stride files and `timing.json`), not measured "
         "again by `make bench`.",
@@ -77,8 +83,9 @@ def _study(study: Path, what: str) -> str:
         if rec["complete"]:
             lines.append(f"| settling pass {rec['pass']} (`--settle`, 2 solves per design) | "
                          f"{rec['improved']} of {len(rec['designs'])} designs improved, largest "
-                         f"objective drop {100 * rec['largest_objective_drop']:.1f} % "
-                         f"(settled below 1 %) |")
+                         f"objective drop {100 * rec['largest_objective_drop']:.1f} % ("
+                         + ("settled: below 1 %" if rec["largest_objective_drop"] < 0.01
+                            else "not settled: 1 % or more") + ") |")
         else:
             lines.append(f"| settling pass {rec['pass']} | stopped after "
                          f"{len(rec['designs'])} designs (resumes with `--settle`) |")

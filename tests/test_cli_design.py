@@ -164,6 +164,14 @@ def test_design_bad_input(tmp_path, capsys):
     err = capsys.readouterr().err
     assert "--body: no built-in start stride of the transfemoral runner on the human body" in err
     assert "Traceback" not in err
+    assert main(["design", "--out", str(tmp_path / "c"), "--amputation", "transtibial"]) == 2
+    assert "--amputation: only with --evaluator collocation" in capsys.readouterr().err
+    assert main(["design", "--out", str(tmp_path / "c"), "--evaluator", "collocation",
+                 "--amputation", "ankle"]) == 2
+    assert "--amputation: unknown amputation 'ankle'" in capsys.readouterr().err
+    assert main(["design", "--out", str(tmp_path / "c"), "--evaluator", "collocation",
+                 "--amputation", "transtibial", "--knee-moment-min", "0"]) == 2
+    assert "--knee-moment-min: a setting of the prosthetic knee" in capsys.readouterr().err
     assert main(["design", "--out", str(tmp_path / "c"), "--evaluator", "collocation",
                  "--reference-weight", "10", "--people-weight", "10"]) == 2
     assert "--people-weight: people's joint angles and the start stride's technique" in (

@@ -54,6 +54,7 @@ def fake(monkeypatch):
                       "backward_euler": settings.blade_backward_euler,
                       "step_phase_tolerance": settings.step_phase_tolerance,
                       "prosthetic_load_max_bw": settings.prosthetic_load_max_bw,
+                      "swing_knee": settings.swing_knee_min_deg,
                       "reference": (settings.reference, settings.reference_weight,
                                     settings.reference_dofs),
                       "contacts": runner.contact_params.copy()})
@@ -363,3 +364,41 @@ def test_a_stride_constraint_reaches_every_designs_solve(fake, tmp_path, field, 
     with pytest.raises(SpecError) as err:
         _evaluator(tmp_path, **{field: bad})
     assert err.value.where == field
+
+
+def test_the_transtibial_runner_is_predicts_amputee_wearing_the_design(fake, tmp_path):
+    """amputation "transtibial": each design's blade on predict's amputee runner, on the human
+    body by default from its built-in centre stride, with predict's swing knee and people's
+    angles of the residual knee too; the prosthetic knee's settings are refused (its knee is
+    the athlete's own) and an unknown amputation is named."""
+    from bladelab.predict.defaults import PEOPLE_WEIGHT_PER_RAD2, SWING_KNEE_MIN_DEG
+
+    calls, _ = fake
+    ev = make_evaluator("collocation", amputation="transtibial",
+                        solutions_dir=str(tmp_path / "tt"), factor_ranges=RANGES)
+    assert ev.body == "human" and ev.model == "amputee"
+    assert ev.start_file == ce.DEFAULT_STARTS[("transtibial", "human")]
+    assert ev.start_file.is_file()
+    ev({**CENTRE, "width_m": 0.05})
+    spec = calls[-1]["spec"]
+    assert spec["model"] == "amputee" and spec["body"] == "human"
+    assert spec["blade_spec"]["name"] == spec["blade"]
+    assert "knee_angle_r" in calls[-1]["dofs"] and "knee_angle_l" in calls[-1]["dofs"]
+    assert calls[-1]["swing_knee"] == SWING_KNEE_MIN_DEG
+    assert calls[-1]["reference"][1] == PEOPLE_WEIGHT_PER_RAD2
+    assert ev.to_dict()["amputation"] == "transtibial"
+    kept = make_evaluator("collocation", amputation="transtibial", reference_weight=5.0)
+    assert "knee_angle_r" in kept.settings().reference_dofs
+    # the transfemoral runner keeps its settings: no swing knee beside the passive knee
+    _evaluator(tmp_path)(CENTRE)
+    assert calls[-1]["swing_knee"] is None and calls[-1]["spec"]["model"] == "transfemoral"
+    for name, value in (("knee_moment_min_Nm", 0.0), ("knee_flexion_max_loaded_deg", 10.0)):
+        with pytest.raises(SpecError, match="residual") as err:
+            make_evaluator("collocation", amputation="transtibial", **{name: value})
+        assert err.value.where == name
+    with pytest.raises(SpecError, match="unknown amputation") as err:
+        make_evaluator("collocation", amputation="knee-disarticulation")
+    assert err.value.where == "amputation"
+    with pytest.raises(SpecError, match="no built-in start stride of the transtibial") as err:
+        make_evaluator("collocation", amputation="transtibial", body="seed001")
+    assert err.value.where == "body"

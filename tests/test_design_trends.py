@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -201,3 +202,33 @@ def test_shipped_example_draws_no_trend_verdict(tmp_path):
     assert len(table) == len(SEED002_TRENDS)
     assert "not tested" in section["tables"][0][0] and "verdict" not in table
     assert all("per coded unit" in e or "main-effect ranges" in e for e in table["evidence"])
+
+
+def _keys(statements):
+    by_statement = {t.statement: t.key for t in SEED002_TRENDS}
+    return [by_statement[s] for s in statements]
+
+
+def test_the_demo_renders_the_committed_predicted_design_study(tmp_path):
+    """The demo's predicted-gait design example rebuilds the committed transtibial study's
+    report from its files (no solve): its first section says what each run is, and every run's
+    stride file is found and checked; without the study (an installed wheel) it says so."""
+    from bladelab.demo import PREDICTED_DESIGN_STUDY, predicted_design_example
+    from bladelab.report.design import design_report_sections
+
+    study = Path(__file__).resolve().parents[1] / PREDICTED_DESIGN_STUDY
+    report, lines = predicted_design_example(tmp_path / "report", study=study)
+    assert report is not None and report.is_file() and "J/(kg·m)" in lines[1]
+    sections = design_report_sections(study)
+    assert sections[0]["text"].startswith("Each run is a predicted transtibial stride at 4 m/s")
+    strides = next(s for s in sections if s["title"] == "Design study: predicted strides")
+    assert "stride files were not found" not in strides["text"]
+    # its trends carry the transtibial runner's reasons, not the transfemoral studies'
+    trends = next(s for s in sections if s["title"] == "Seed 002 trends")
+    table = trends["tables"][0][1]
+    failed = table[table["verdict"] == "does not hold"]
+    assert len(failed) and all(
+        reason == TREND_REASONS[("collocation-transtibial", key)]
+        for reason, key in zip(failed["reason"], _keys(failed["trend"]), strict=True))
+    none, said = predicted_design_example(tmp_path / "r2", study=tmp_path / "nowhere")
+    assert none is None and "not found" in said[0]

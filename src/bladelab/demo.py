@@ -14,7 +14,10 @@ Everything is written under ``examples/`` in the current working directory (:fun
 5. Runs the design example (seed 002, ``docs/design.md``): a 25-run face-centred CCD over the
    default design space with the blade evaluator into ``examples/design-study/`` and its report
    ``examples/design-study/report/index.html`` (surfaces, optimum; the blade evaluator has no
-   runner, so seed 002's trends about running are not tested by it).
+   runner, so seed 002's trends about running are not tested by it); and, in a repository
+   checkout, the report of the committed predicted-gait design study
+   (:data:`PREDICTED_DESIGN_STUDY`: a transtibial runner's predicted stride per blade), rebuilt
+   from its files without a solve into ``examples/design-predicted/report/index.html``.
 
 A complete example study and finished identifications (and design runs) are reused, so a second
 ``make demo`` only rewrites the reports.
@@ -131,6 +134,34 @@ def design_example(out_dir: str | Path | None = None, *, seed: int = 0) -> tuple
                  f"{ev.speed_mps:g} m/s); its numbers "
                  "describe the blade, and seed 002's trends about running are not tested by it "
                  "(docs/guide-design.md)")
+    return report, lines
+
+
+#: The committed predicted-gait design study the demo renders (no solve), relative to the
+#: folder the demo runs in (``make demo``: the repository root). A wheel does not carry it
+#: (25 strides, several MB); the demo then says so and goes on.
+PREDICTED_DESIGN_STUDY = Path("benchmarks") / "design" / "transtibial-collocation-4mps"
+
+
+def predicted_design_example(out_dir: str | Path | None = None,
+                             study: str | Path | None = None) -> tuple[Path | None, list[str]]:
+    """The report of the committed predicted-gait design study ``study`` (default
+    :data:`PREDICTED_DESIGN_STUDY` under the current folder), rebuilt from its files into
+    ``out_dir`` (default ``examples/design-predicted/report``); returns (report or None when the
+    study is not there, summary lines)."""
+    study = Path.cwd() / PREDICTED_DESIGN_STUDY if study is None else Path(study)
+    if not (study / "results.csv").is_file():
+        return None, [f"predicted-gait design study: {study} not found (a repository checkout "
+                      "has it; `bladelab report` rebuilds its report there)"]
+    out_dir = examples_dir() / "design-predicted" / "report" if out_dir is None else Path(out_dir)
+    report = build_design_report(study, out_dir=out_dir)
+    results = pd.read_csv(study / "results.csv")
+    cot = results["cost_of_transport_J_per_kg_m"]
+    lines = [f"predicted-gait design study (committed, report rebuilt without a solve): "
+             f"{len(results)} blades, each on the transtibial runner's predicted stride at "
+             f"4 m/s -> {report}",
+             f"  cost of transport {cot.min():.2f}–{cot.max():.2f} J/(kg·m) across the blades "
+             "(the report: surfaces, optimum, seed 002's trends, every flagged stride)"]
     return report, lines
 
 
@@ -301,6 +332,8 @@ def main() -> int:
         print("\nbladelab demo: the design workflow (seed 002, docs/design.md)", flush=True)
         design_report, design_lines = design_example()
         print("\n".join(design_lines))
+        predicted_report, predicted_lines = predicted_design_example()
+        print("\n".join(predicted_lines))
         print("\nbladelab demo: the predict workflow (docs/guide-predict.md)", flush=True)
         predict_report, predict_lines = predict_example()
         print("\n".join(predict_lines))
@@ -310,6 +343,8 @@ def main() -> int:
     print(f"\ndemo finished in {time.perf_counter() - t0:.0f} s")
     print(f"report: {res.report}")
     print(f"design report: {design_report}")
+    if predicted_report is not None:
+        print(f"predicted-gait design report: {predicted_report}")
     print(f"predict report: {predict_report}")
     print(f"open them with: xdg-open {res.report}   (or any browser; they work offline)")
     return 0

@@ -43,7 +43,7 @@ OPTIONS = {
     "motion_model": "--motion-model", "start": "--start",
     "knee_moment_min_Nm": "--knee-moment-min",
     "knee_flexion_max_loaded_deg": "--knee-flexion-max",
-    "reference_weight": "--reference-weight", "body": "--body",
+    "reference_weight": "--reference-weight", "body": "--body", "amputation": "--amputation",
     "people_weight": "--people-weight", "step_phase_tolerance": "--alternating-steps",
     "prosthetic_load_max_bw": "--prosthetic-load-max",
 }
@@ -130,7 +130,7 @@ def _design(
     evaluator: str = typer.Option(
         "blade", "--evaluator", rich_help_panel=STUDY,
         help="blade (one passive stance), runner (a template gait cycle) or collocation (a "
-             "predicted transfemoral stride per design, docs/design.md)."),
+             "predicted amputee stride per design, docs/design.md)."),
     out: Path | None = typer.Option(None, "--out", rich_help_panel=STUDY,
                                     help="Output folder (resumes an interrupted study); required."),
     seed: int = typer.Option(defaults.SEED, "--seed", rich_help_panel=STUDY,
@@ -183,15 +183,19 @@ def _design(
     # -- collocation evaluator -------------------------------------------------------------
     start: Path | None = typer.Option(
         None, "--start", rich_help_panel=COLLOCATION,
-        help="Collocation solution of the transfemoral runner that the first design starts "
-             "from (default: the built-in centre stride)."),
+        help="Collocation solution of the runner that the first design starts from "
+             "(default: the built-in centre stride of the runner, where there is one)."),
+    amputation: str | None = typer.Option(
+        None, "--amputation", rich_help_panel=COLLOCATION, show_default=False,
+        help="The runner's amputation: transfemoral (the default: seed 002's athlete, a passive "
+             "prosthetic knee) or transtibial (the residual knee, the blade below it)."),
     knee_moment_min: float | None = typer.Option(
         None, "--knee-moment-min", rich_help_panel=COLLOCATION,
-        help="Keep the prosthetic knee's extension moment at or above this [N·m] in every "
-             "design's stride (<= 0; default: reported, not imposed)."),
+        help="Transfemoral: keep the prosthetic knee's extension moment at or above this "
+             "[N·m] in every design's stride (<= 0; default: reported, not imposed)."),
     knee_flexion_max: float | None = typer.Option(
         None, "--knee-flexion-max", rich_help_panel=COLLOCATION,
-        help="Keep the prosthetic knee within this flexion [deg] while its blade is loaded "
+        help="Transfemoral: keep the prosthetic knee within this flexion [deg] while loaded "
              "(the straight stance; default: free)."),
     reference_weight: float | None = typer.Option(
         None, "--reference-weight", rich_help_panel=COLLOCATION,
@@ -201,8 +205,9 @@ def _design(
              "the gait predicted freely)."),
     body: str | None = typer.Option(
         None, "--body", rich_help_panel=COLLOCATION, show_default=False,
-        help="The runner body: seed001 (the default: seed 001's body) or human (predict's "
-             "default body; needs --start, a clean transfemoral stride of it)."),
+        help="The runner body: seed001 or human (predict's default body). Default: seed001 "
+             "for the transfemoral runner, human for the transtibial one (the transfemoral "
+             "runner on the human body needs --start: no clean stride of it is built in)."),
     people_weight: float | None = typer.Option(
         None, "--people-weight", rich_help_panel=COLLOCATION, show_default=False,
         help="Weight [1/rad²] of people's measured hip, knee and ankle angles in every "
@@ -267,7 +272,8 @@ def _design(
             kind=evaluator, speed_mps=speed, body_mass_kg=body_mass, dt_s=dt, base=base,
             gait=gait, motion=motion, motion_model=motion_model, start=start,
             knee_moment_min_Nm=knee_moment_min, knee_flexion_max_loaded_deg=knee_flexion_max,
-            reference_weight=reference_weight, body=body, people_weight=people_weight,
+            reference_weight=reference_weight, body=body, amputation=amputation,
+            people_weight=people_weight,
             step_phase_tolerance=alternating_steps,
             prosthetic_load_max_bw=prosthetic_load_max)
     except BladelabError as err:

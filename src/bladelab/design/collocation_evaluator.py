@@ -1,12 +1,13 @@
-"""Design point -> generated blade on the transfemoral runner -> predicted stride.
+"""Design point -> generated blade on an amputee runner -> predicted stride.
 
 :class:`CollocationEvaluator` is the design study's evaluator ``"collocation"``
 (``bladelab design --evaluator collocation``): for each design point it
 
 1. generates the multi-link blade (:func:`~bladelab.design.blade_generator.generate_blade`);
-2. builds the transfemoral runner wearing it (``build_runner("transfemoral", blade_model=…)``:
-   intact leg, residual hip muscles, the passive 3S80-class knee, the blade's links, joints
-   and soles);
+2. builds the runner wearing it: the transfemoral runner (``build_runner("transfemoral",
+   blade_model=…)``: intact leg, residual hip muscles, the passive 3S80-class knee, the
+   blade's links, joints and soles) or the transtibial one (``"amputee"``: the residual knee
+   and its muscles, the blade in place of the foot), by ``amputation``;
 3. predicts one periodic stride at the prescribed speed by direct collocation
    (:func:`~bladelab.predict.collocation.solve.predict_stride`), warm-started from the
    nearest designs already solved in ``solutions_dir`` (coded distance), then from ``start``;
@@ -58,18 +59,27 @@ __all__ = ["CollocationEvaluator", "DEFAULT_BODY", "DEFAULT_DESIGN_SPEED_MPS", "
 #: continuations to 4.5 and 5 m/s were not finished).
 DEFAULT_DESIGN_SPEED_MPS = defaults.COLLOCATION_SPEED_MPS
 _STRIDES = Path(__file__).resolve().parents[1] / "data" / "runner" / "collocation"
-#: The start of the first design by runner body: a clean transfemoral stride wearing the
+#: The amputations a design's runner may have: the runner model of each
+#: (:data:`bladelab.runner.model.KINDS`).
+AMPUTATIONS = {"transfemoral": "transfemoral", "transtibial": "amputee"}
+#: The amputation of a design study's runner: seed 002's athlete (a transfemoral amputation).
+DEFAULT_AMPUTATION = "transfemoral"
+#: The start of the first design by (amputation, runner body): a clean stride wearing the
 #: default box's centre blade at :data:`DEFAULT_DESIGN_SPEED_MPS`, its joints by backward
-#: Euler (how it was made: ``data/runner/collocation/README.md``). The human body has none
-#: shipped: its transfemoral runner's converged strides with the multi-link blade all bound
-#: (the stride time at its 0.40 s bound, 6–6.7 BW, people weights 10–100; measured:
-#: benchmarks/design/README.md), so a study on it needs ``start``.
-DEFAULT_STARTS = {"seed001": _STRIDES / "transfemoral-design-centre-4.json"}
-#: The runner body of the design studies: seed 001's until the human body has a start stride
-#: (:data:`DEFAULT_STARTS`); ``body="human"`` with a ``start`` of that body runs on it.
-DEFAULT_BODY = "seed001"
+#: Euler (how each was made: ``data/runner/collocation/README.md``). The transfemoral runner
+#: on the human body has none: its converged strides gallop, or alternate only with a 10.8 BW
+#: intact-leg impact (measured: benchmarks/design/README.md), so a study of it needs
+#: ``start``.
+DEFAULT_STARTS = {("transfemoral", "seed001"): _STRIDES / "transfemoral-design-centre-4.json",
+                  ("transtibial", "human"): _STRIDES / "transtibial-design-centre-4-human.json"}
+#: The runner body of the design studies by amputation: the one with a start stride
+#: (:data:`DEFAULT_STARTS`), seed 001's for the transfemoral runner, predict's human body for
+#: the transtibial one.
+DEFAULT_BODIES = {"transfemoral": "seed001", "transtibial": "human"}
+#: The runner body of the transfemoral design studies (:data:`DEFAULT_BODIES`).
+DEFAULT_BODY = DEFAULT_BODIES[DEFAULT_AMPUTATION]
 #: The start of the first design on :data:`DEFAULT_BODY`.
-DEFAULT_START = DEFAULT_STARTS[DEFAULT_BODY]
+DEFAULT_START = DEFAULT_STARTS[(DEFAULT_AMPUTATION, DEFAULT_BODY)]
 #: Factor on the generated blade's sole contact stiffness (its damping by the square root, the
 #: damping ratio kept) in the design's runner, forward and collocation alike (our choice,
 #: measured 2026-11-26, docs/design.md): with the generator's 10⁶ N/m soles the transfemoral
@@ -83,6 +93,8 @@ DEFAULT_SOLE_STIFFNESS_SCALE = 0.1
 #: knee and the blade's joints move as the blade makes them (our choice, docs/design.md).
 REFERENCE_DOFS = ("pelvis_tilt", "lumbar_extension", "hip_flexion_l", "knee_angle_l",
                   "ankle_angle_l", "hip_flexion_r")
+#: :data:`REFERENCE_DOFS` of the transtibial runner: with the residual knee, the athlete's own.
+REFERENCE_DOFS_TRANSTIBIAL = (*REFERENCE_DOFS, "knee_angle_r")
 #: Solved designs a new design may start from, nearest first, before the study's start
 #: (a start that gives no clean stride is followed by the next; measured 2026-11-26: with the
 #: technique kept, two axial designs got a 10-BW hop or no convergence from the centre, their
@@ -105,19 +117,22 @@ def _point_from_stem(stem: str) -> dict[str, float] | None:
 
 @dataclass(frozen=True)
 class CollocationEvaluator:
-    """Design point -> predicted transfemoral stride -> seed 002's responses (module docstring).
+    """Design point -> predicted amputee stride -> seed 002's responses (module docstring).
 
     Attributes
     ----------
     speed_mps
         Prescribed mean speed of the stride [m/s].
     start
-        A collocation solution (file) of the transfemoral runner to start the first design
-        from (any blade with the same number of links); default the body's
-        (:data:`DEFAULT_STARTS`).
+        A collocation solution (file) of the runner to start the first design from (any
+        blade with the same number of links); default the runner's (:data:`DEFAULT_STARTS`).
+    amputation
+        ``"transfemoral"`` (:data:`DEFAULT_AMPUTATION`, seed 002's athlete: the passive
+        prosthetic knee) or ``"transtibial"`` (the residual knee, the blade below it).
     body
-        The runner body: ``"seed001"`` (:data:`DEFAULT_BODY`) or ``"human"`` (predict's
-        default body; needs a ``start`` of it, :data:`DEFAULT_STARTS`).
+        The runner body: ``"seed001"`` or ``"human"`` (predict's default body); None: the
+        amputation's (:data:`DEFAULT_BODIES`). A runner without a built-in start
+        (:data:`DEFAULT_STARTS`) needs ``start``.
     solutions_dir
         Folder of the designs' strides (the warm starts of the later designs); None: a
         ``strides`` folder is not kept and every design starts from ``start``.
@@ -142,7 +157,8 @@ class CollocationEvaluator:
         Factor on the generated blade's sole contact stiffness
         (:data:`DEFAULT_SOLE_STIFFNESS_SCALE`).
     reference_weight
-        Keep the athlete's own joints (:data:`REFERENCE_DOFS`) near the ``start`` stride's:
+        Keep the athlete's own joints (:data:`REFERENCE_DOFS`, the transtibial runner's
+        :data:`REFERENCE_DOFS_TRANSTIBIAL`) near the ``start`` stride's:
         this weight [1/rad²] × their time-averaged mean squared deviation is added to the
         objective (``CollocationSettings.reference_weight``), so that every blade is run with
         the same technique and its responses are the blade's (seed 002 imposed measured
@@ -158,10 +174,12 @@ class CollocationEvaluator:
         the residual limb tolerates in its socket); None (default): no limit.
     people_weight
         Weight [1/rad²] of people's joint angles in the objective (the intact leg's hip, knee
-        and ankle and the residual hip; ``CollocationSettings(reference="people")``,
+        and ankle and the residual hip (and knee); ``CollocationSettings(reference="people")``,
         docs/collocation.md); None: the body's default
         (:func:`bladelab.predict.defaults.people_weight_for`: 10 on the human body, 0 on
-        seed 001's), 0 with a ``reference_weight`` (the two terms exclude each other).
+        seed 001's), 0 with a ``reference_weight`` (the two terms exclude each other). The
+        transtibial runner on the human body also keeps predict's swing knee
+        (:func:`bladelab.predict.defaults.swing_knee_for`): its strides are predict's.
     generator
         Options of :func:`~bladelab.design.blade_generator.generate_blade`.
     """
@@ -178,7 +196,8 @@ class CollocationEvaluator:
     blade_backward_euler: bool = True
     sole_stiffness_scale: float = DEFAULT_SOLE_STIFFNESS_SCALE
     reference_weight: float = 0.0
-    body: str = DEFAULT_BODY
+    body: str | None = None
+    amputation: str = DEFAULT_AMPUTATION
     people_weight: float | None = None
     step_phase_tolerance: float | None = None
     prosthetic_load_max_bw: float | None = None
@@ -190,16 +209,29 @@ class CollocationEvaluator:
     #: without them.
     LEGACY_SETTINGS: ClassVar[dict[str, Any]] = {"body": "seed001", "people_weight": 0.0,
                                                  "step_phase_tolerance": None,
-                                                 "prosthetic_load_max_bw": None}
+                                                 "prosthetic_load_max_bw": None,
+                                                 "amputation": "transfemoral"}
 
     def __post_init__(self) -> None:
+        if self.amputation not in AMPUTATIONS:
+            raise SpecError(f"unknown amputation {self.amputation!r}", where="amputation",
+                            hint=" or ".join(AMPUTATIONS))
+        if self.body is None:
+            object.__setattr__(self, "body", DEFAULT_BODIES[self.amputation])
         if self.body not in BODIES:
             raise SpecError(f"unknown body {self.body!r}", where="body", hint=" or ".join(BODIES))
-        if self.start is None and self.body not in DEFAULT_STARTS:
-            raise SpecError(f"no built-in start stride of the transfemoral runner on the "
+        if self.start is None and (self.amputation, self.body) not in DEFAULT_STARTS:
+            raise SpecError(f"no built-in start stride of the {self.amputation} runner on the "
                             f"{self.body} body", where="body",
-                            hint="give the first design's start: a clean transfemoral stride "
-                                 "of that body (a collocation solution file)")
+                            hint=f"give the first design's start: a clean {self.amputation} "
+                                 "stride of that body (a collocation solution file)")
+        transfemoral_only = {"knee_moment_min_Nm": self.knee_moment_min_Nm,
+                             "knee_flexion_max_loaded_deg": self.knee_flexion_max_loaded_deg}
+        for name, value in transfemoral_only.items():
+            if value is not None and self.amputation != "transfemoral":
+                raise SpecError("a setting of the prosthetic knee: the transtibial runner has "
+                                "the residual (biological) knee", where=name,
+                                hint="leave it out, or amputation transfemoral")
         if self.reference_weight and self.people_weight:
             raise SpecError("people's joint angles and the start stride's technique are two "
                             "references of one objective term: give one weight",
@@ -212,13 +244,21 @@ class CollocationEvaluator:
         start = self.start_file
         if not start.is_file():
             raise InputFileError("no such collocation solution (the first design's start)",
-                                 file=start, hint="a solution.json of the transfemoral runner")
+                                 file=start,
+                                 hint=f"a solution.json of the {self.amputation} runner")
 
     @property
     def start_file(self) -> Path:
-        """The first design's start (and the reference): ``start``, else the body's
+        """The first design's start (and the reference): ``start``, else the runner's
         (:data:`DEFAULT_STARTS`)."""
-        return Path(self.start) if self.start is not None else DEFAULT_STARTS[self.body]
+        if self.start is not None:
+            return Path(self.start)
+        return DEFAULT_STARTS[(self.amputation, self.body)]
+
+    @property
+    def model(self) -> str:
+        """The runner model of the designs' strides (:data:`AMPUTATIONS`)."""
+        return AMPUTATIONS[self.amputation]
 
     @property
     def people_weight_per_rad2(self) -> float:
@@ -237,8 +277,7 @@ class CollocationEvaluator:
         d["generator"] = {k: str(v) if isinstance(v, Path) else v
                           for k, v in dict(self.generator).items()}
         d["factor_ranges"] = {k: list(v) for k, v in dict(self.factor_ranges).items()}
-        d["start"] = (str(self.start) if self.start
-                      else f"built-in {DEFAULT_STARTS[self.body].name}")
+        d["start"] = str(self.start) if self.start else f"built-in {self.start_file.name}"
         d["people_weight"] = self.people_weight_per_rad2
         return {"evaluator": "collocation", **d}
 
@@ -315,7 +354,10 @@ class CollocationEvaluator:
         if self.reference_weight:
             reference = {"reference": str(self.start_file),
                          "reference_weight": self.reference_weight,
-                         "reference_dofs": REFERENCE_DOFS}
+                         "reference_dofs": (REFERENCE_DOFS if self.amputation == "transfemoral"
+                                            else REFERENCE_DOFS_TRANSTIBIAL)}
+        reference["swing_knee_min_deg"] = predict_defaults.swing_knee_for(
+            self.body, None, self.model)
         return CollocationSettings(mesh_intervals=self.mesh_intervals,
                                    speed_m_per_s=self.speed_mps,
                                    swing_clearance_m=self.swing_clearance_m,
@@ -329,7 +371,7 @@ class CollocationEvaluator:
     def _problem(self, point: Mapping[str, float]) -> tuple[dict, Any]:
         """(model specification with the design's blade, collocation settings) of a design."""
         blade = self.blade_spec(point)
-        return (check_model_spec({"model": "transfemoral", "blade": blade["name"],
+        return (check_model_spec({"model": self.model, "blade": blade["name"],
                                   "blade_spec": blade, "body": self.body}),
                 self.settings())
 

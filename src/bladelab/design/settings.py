@@ -37,6 +37,7 @@ APPLIES_TO: dict[str, tuple[str, ...]] = {
     "knee_flexion_max_loaded_deg": ("collocation",),
     "reference_weight": ("collocation",),
     "body": ("collocation",),
+    "amputation": ("collocation",),
     "people_weight": ("collocation",),
     "step_phase_tolerance": ("collocation",),
     "prosthetic_load_max_bw": ("collocation",),
@@ -51,7 +52,7 @@ class EvaluatorSettings:
     ----------
     kind
         ``"blade"`` (one passive stance), ``"runner"`` (a template transfemoral gait cycle) or
-        ``"collocation"`` (a predicted transfemoral stride per design).
+        ``"collocation"`` (a predicted amputee stride per design).
     speed_mps
         Touch-down speed [m/s] (blade: :data:`~bladelab.design.defaults.BLADE_SPEED_MPS`,
         runner: :data:`~bladelab.design.defaults.RUNNER_SPEED_MPS`); the stride's mean speed
@@ -71,10 +72,11 @@ class EvaluatorSettings:
         smallest extension moment [N·m], its largest flexion while loaded [deg], and the
         weight [1/rad²] that keeps the athlete's own joints near the start stride's
         (:class:`~bladelab.design.collocation_evaluator.CollocationEvaluator`).
-    body, people_weight
-        Collocation: the runner body (``"seed001"``, the default, or ``"human"`` with a
-        ``start`` of it) and the weight [1/rad²] of people's joint angles in the objective
-        (default: the body's).
+    amputation, body, people_weight
+        Collocation: the runner's amputation (``"transfemoral"``, the default, or
+        ``"transtibial"``), its body (``"seed001"`` or ``"human"``; default the amputation's:
+        seed 001's for the transfemoral runner, the human body for the transtibial one) and
+        the weight [1/rad²] of people's joint angles in the objective (default: the body's).
     step_phase_tolerance
         Collocation: keep every design's steps alternating within this fraction of the stride
         of half a stride (``CollocationSettings.step_phase_tolerance``); None: free.
@@ -96,6 +98,7 @@ class EvaluatorSettings:
     knee_flexion_max_loaded_deg: float | None = None
     reference_weight: float | None = None
     body: str | None = None
+    amputation: str | None = None
     people_weight: float | None = None
     step_phase_tolerance: float | None = None
     prosthetic_load_max_bw: float | None = None
@@ -131,7 +134,7 @@ class EvaluatorSettings:
             if self.start is not None:
                 options["start"] = str(self.start)
             for name in ("knee_moment_min_Nm", "knee_flexion_max_loaded_deg",
-                         "reference_weight", "body", "people_weight",
+                         "reference_weight", "body", "amputation", "people_weight",
                          "step_phase_tolerance", "prosthetic_load_max_bw"):
                 if getattr(self, name) is not None:
                     options[name] = getattr(self, name)

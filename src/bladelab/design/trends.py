@@ -167,6 +167,20 @@ TREND_REASONS: dict[tuple[str, str], str] = {
     ("collocation", "longer_toe_lowers_clearance"): (
         _SCATTER + "The 2 cm swing-clearance constraint binds (within 0.5 mm) in 9 of the free "
         "study's 25 strides, which caps the response the trend is read from."),
+    # the transtibial runner on the human body (``--amputation transtibial``), measured on its
+    # settled 25-run study (docs/design.md, "Predicted transtibial strides")
+    ("collocation-transtibial", "width_increases_dvx"): (
+        "At a fixed target stiffness the blade generator lets width change only the blade's "
+        "mass and sole contact, and on the transtibial runner's settled strides that changes "
+        "neither Δv_x (−0.003 m/s per coded unit, p 0.67 in a first-order fit) nor the cost of "
+        "transport significantly; in seed 002 width also changed the bending-stiffness "
+        "distribution and the contact area."),
+    ("collocation-transtibial", "height_toe_matter_less"): (
+        "On the transtibial runner the blade's height raises Δv_x about as much as stiffness "
+        "(+0.019 against +0.021 m/s per coded unit, both p < 0.005 in a first-order fit): a "
+        "taller blade lengthens the prosthetic leg below the residual knee, which changes the "
+        "stance's geometry as seed 002's imposed motion did not; width has no effect (see the "
+        "width trend)."),
 }
 
 #: Evaluators with no runner, and what they are: their studies test no trend of seed 002

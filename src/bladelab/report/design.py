@@ -263,7 +263,8 @@ def _evaluator_sentence(evaluator: dict) -> str:
                 "definition of its responses).")
     if kind == "collocation":
         body = evaluator.get("body")
-        return (f"Each run is a predicted transfemoral stride{at} wearing the generated blade "
+        amputation = evaluator.get("amputation") or "transfemoral"
+        return (f"Each run is a predicted {amputation} stride{at} wearing the generated blade "
                 "(the collocation evaluator" + (f", {body} body" if body else "") + "): the "
                 "gait is the optimum of the stride problem for that blade.")
     return ""
@@ -281,6 +282,10 @@ def _problem_posed(evaluator: dict) -> str:
                  f"{weight:g} /rad² × their mean squared deviation added to the objective "
                  "(the same technique on every blade; the prosthetic knee and the blade move "
                  "freely)")
+    elif evaluator.get("people_weight"):
+        text += ("of least metabolic cost and effort, with people's measured hip, knee and "
+                 f"ankle angles at {evaluator['people_weight']:g} /rad² × their mean squared "
+                 "deviation in the objective (a small tracking term of measured running)")
     else:
         text += "of least metabolic cost and effort, the gait predicted freely"
     if evaluator.get("knee_moment_min_Nm") is not None:
@@ -412,6 +417,8 @@ def trends_section(surfaces, evaluator: dict | None = None) -> dict[str, Any]:
     the reasons; its generator ``roles`` map factors to stiffness/width/height/toe length)."""
     evaluator = evaluator or {}
     kind = evaluator.get("evaluator")
+    if kind == "collocation" and evaluator.get("amputation") == "transtibial":
+        kind = "collocation-transtibial"  # its own runner, its own reasons
     roles = (evaluator.get("generator") or {}).get("roles")
     held = {}
     if evaluator.get("knee_moment_min_Nm") is not None:
@@ -431,7 +438,8 @@ def trends_section(surfaces, evaluator: dict | None = None) -> dict[str, Any]:
     counts = {v: sum(1 for x in verdicts if x.verdict == v)
               for v in ("holds", "does not hold", "not estimable")}
     text = (f"The trends seed 002 reports, checked on this study's fitted surfaces "
-            f"(evaluator: {kind or 'unknown'}): {counts['holds']} hold, "
+            f"(evaluator: {(kind or 'unknown').replace('-', ' on the ')}"
+            f"{' runner' if '-' in (kind or '') else ''}): {counts['holds']} hold, "
             f"{counts['does not hold']} do not hold, {counts['not estimable']} not estimable. "
             "Sign trends use a two-sided t-test of the linear coefficient per coded unit "
             "(α = 0.05); 'matter less' compares the ranges of the main-effect curves over the "
