@@ -223,6 +223,14 @@ def test_the_demo_renders_the_committed_predicted_design_study(tmp_path):
     assert sections[0]["text"].startswith("Each run is a predicted transtibial stride at 4 m/s")
     strides = next(s for s in sections if s["title"] == "Design study: predicted strides")
     assert "stride files were not found" not in strides["text"]
+    # each stride against people's running: the count met and the names missed add up, and
+    # the sentence counts what the table lists
+    runs = strides["tables"][-1][1]
+    met = runs["criteria of people's running met"].str.split(" of ", expand=True).astype(int)
+    outside = runs["outside people's running"].map(lambda t: [n for n in t.split("; ") if n])
+    assert (met[0] + outside.map(len) == met[1]).all() and (met[1] == 14).all()
+    for name in {n for names in outside for n in names}:
+        assert f"{name} by {sum(name in names for names in outside)}" in strides["text"]
     # its trends carry the transtibial runner's reasons, not the transfemoral studies'
     trends = next(s for s in sections if s["title"] == "Seed 002 trends")
     table = trends["tables"][0][1]

@@ -311,16 +311,46 @@ def _strides_section(checks: pd.DataFrame, evaluator: dict) -> dict[str, Any]:
     gallops = _gallop_text(checks)
     if gallops:
         text += " " + gallops
+    people = _people_text(checks)
+    if people:
+        text += " " + people
     shown = checks.assign(stride=checks["stride"].notna(),
-                          step_phase=100.0 * checks["step_phase"]).drop(
-        columns=["excluded"]).rename(
+                          step_phase=100.0 * checks["step_phase"])
+    if "criteria" in shown:
+        shown = shown.assign(criteria_met=[
+            f"{m:.0f} of {n:.0f}" if pd.notna(n) else "–"
+            for m, n in zip(shown["criteria_met"], shown["criteria"], strict=True)]).drop(
+            columns=["criteria"])
+    shown = shown.drop(columns=["excluded"]).rename(
         columns={"stride": "file found", "dynamics_residual_pct": "dynamics residual (%)",
-                 "step_phase": "step phase (% of the stride)"})
+                 "step_phase": "step phase (% of the stride)",
+                 "criteria_met": "criteria of people's running met",
+                 "outside_people": "outside people's running"})
     tables = [("Strides (files in the study's strides folder, named by the design point)",
                shown)]
     if len(flagged):
         tables.insert(0, ("Runs left out", flagged[["run", "warnings"]]))
     return {"title": "Design study: predicted strides", "text": text, "tables": tables}
+
+
+def _people_text(checks: pd.DataFrame) -> str:
+    """How the study's strides compare with people's running: how many meet every criterion
+    (:func:`~bladelab.predict.collocation.human_running.human_running_criteria`) and which
+    criteria are missed by how many strides; "" when no stride was checked."""
+    if "criteria" not in checks or checks["criteria"].isna().all():
+        return ""
+    done = checks[checks["criteria"].notna()]
+    every = int((done["criteria_met"] == done["criteria"]).sum())
+    missed: dict[str, int] = {}
+    for names in done["outside_people"]:
+        for name in filter(None, str(names).split("; ")):
+            missed[name] = missed.get(name, 0) + 1
+    text = (f"Against people's running (the criteria of a predicted stride's own report): "
+            f"{every} of {len(done)} strides meet every criterion")
+    if missed:
+        text += "; missed: " + ", ".join(
+            f"{name} by {n}" for name, n in sorted(missed.items(), key=lambda kv: -kv[1]))
+    return text + "."
 
 
 def _gallop_text(checks: pd.DataFrame | None) -> str:
