@@ -348,7 +348,7 @@ def _people_text(checks: pd.DataFrame) -> str:
     text = (f"Against people's running (the criteria of a predicted stride's own report): "
             f"{every} of {len(done)} strides meet every criterion")
     if missed:
-        text += "; missed: " + ", ".join(
+        text += ". Missed: " + "; ".join(
             f"{name} by {n}" for name, n in sorted(missed.items(), key=lambda kv: -kv[1]))
     return text + "."
 
