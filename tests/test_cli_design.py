@@ -239,6 +239,16 @@ def test_an_interrupted_settling_pass_is_recorded_and_resumed(tmp_path, monkeypa
     settle_study(None, result, passes=1, jobs=1)  # a new pass: every design again
     assert seen[-1] == [0, 1, 2, 3]
     assert len(json.loads((tmp_path / RECORD_NAME).read_text())["passes"]) == 2
+    # that pass lowered design 4 by 10 %: not settled, so a further pass runs; once a pass
+    # lowers nothing by more than 1 %, the study is settled and --settle runs no more
+    monkeypatch.setattr(ce, "settle_strides", lambda evaluator, points, *, skip=(),
+                        on_design=None, **_: [
+                            on_design(i, {"point": points[i], "before": 1.0, "after": 0.995,
+                                          "from": "nb.json"}) for i in range(len(points))])
+    assert settle_study(None, result, passes=3, jobs=1).passes == 1
+    again = settle_study(None, result, passes=3, jobs=1)
+    assert again.settled and again.passes == 0 and not again.changed
+    assert len(json.loads((tmp_path / RECORD_NAME).read_text())["passes"]) == 3
 
     other = types.SimpleNamespace(space=space, design=types.SimpleNamespace(coded=coded[::-1]),
                                   out_dir=tmp_path, failed={})

@@ -121,7 +121,8 @@ def settle_study(evaluator, result, *, passes: int, jobs: int = 1,
     (:class:`~bladelab.design.study.DesignStudyResult`) with its collocation ``evaluator``,
     resuming an incomplete pass first, ``jobs`` designs at a time; record them in the study's
     ``settling.json`` (module docstring). Stops at the first pass that settles (no objective
-    lowered by more than :data:`SETTLED_REL`). ``progress`` receives one line per pass.
+    lowered by more than :data:`SETTLED_REL`); a study whose last recorded pass settled gets
+    none (``passes`` 0 in the outcome). ``progress`` receives one line per pass.
 
     Raises
     ------
@@ -140,6 +141,11 @@ def settle_study(evaluator, result, *, passes: int, jobs: int = 1,
     def save() -> None:
         write_json(out / RECORD_NAME, {"settled_below": SETTLED_REL, "passes": record})
 
+    last = record[-1] if record else None
+    if last is not None and last["complete"] and last["largest_objective_drop"] <= SETTLED_REL:
+        say(f"settled: pass {last['pass']} lowered no objective by more than "
+            f"{100 * SETTLED_REL:g} %; no further pass")
+        return SettlingOutcome(False, True, 0, last["largest_objective_drop"])
     for _ in range(passes):
         if record and not record[-1]["complete"]:
             current = record[-1]
