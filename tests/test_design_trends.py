@@ -240,3 +240,20 @@ def test_the_demo_renders_the_committed_predicted_design_study(tmp_path):
         for reason, key in zip(failed["reason"], _keys(failed["trend"]), strict=True))
     none, said = predicted_design_example(tmp_path / "r2", study=tmp_path / "nowhere")
     assert none is None and "not found" in said[0]
+
+
+def test_the_report_says_whether_a_study_has_settled(tmp_path):
+    """The settling sentence of a collocation study's report: no record, a last pass below
+    1 %, and an unfinished pass after it (not settled, its largest drop named)."""
+    from bladelab.report.design import _settling_text
+
+    assert _settling_text(tmp_path).startswith("Not settled: no settling pass")
+    done = {"pass": 1, "complete": True, "largest_objective_drop": 0.004, "designs": []}
+    (tmp_path / "settling.json").write_text(json.dumps({"passes": [done]}))
+    assert _settling_text(tmp_path).endswith("settled (below 1 %).")
+    later = {"pass": 2, "complete": False,
+             "designs": [{"before": 2.0, "after": 1.96}, {"before": 1.0, "after": 1.0}]}
+    (tmp_path / "settling.json").write_text(json.dumps({"passes": [done, later]}))
+    text = _settling_text(tmp_path)
+    assert "pass 2 stopped after 2 designs (largest drop 2.00 %)" in text
+    assert "not settled" in text

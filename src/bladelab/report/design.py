@@ -26,6 +26,7 @@ from bladelab.design.responses import (
     PREDICTED_RESPONSE_UNITS,
     RUNNER_RESPONSE_UNITS,
 )
+from bladelab.design.settling import RECORD_NAME, SETTLED_REL
 from bladelab.design.space import DesignSpace
 from bladelab.design.start_spread import NEAR_PCT, start_spread
 from bladelab.design.surfaces import fit_surface
@@ -139,6 +140,9 @@ def design_report_sections(design_dir: str | Path) -> list[dict[str, Any]]:
     gallops = _gallop_text(checks)
     if gallops:
         fit_text = gallops + " " + fit_text
+    settling = _settling_text(design_dir) if checks is not None else ""
+    if settling:
+        fit_text = settling + " " + fit_text
     lev = next(iter(surfaces.values())).leverage
     if (lev >= 1.0 - 1e-10).any():
         n_one = int((lev >= 1.0 - 1e-10).sum())
@@ -331,6 +335,31 @@ def _strides_section(checks: pd.DataFrame, evaluator: dict) -> dict[str, Any]:
     if len(flagged):
         tables.insert(0, ("Runs left out", flagged[["run", "warnings"]]))
     return {"title": "Design study: predicted strides", "text": text, "tables": tables}
+
+
+def _settling_text(design_dir: Path) -> str:
+    """Whether a collocation study's strides have settled, from its settling record
+    (:mod:`bladelab.design.settling`): the passes, the last one's largest drop, an unfinished
+    pass; "" without a record."""
+    path = design_dir / RECORD_NAME
+    if not path.is_file():
+        return ("Not settled: no settling pass was run (--settle); each stride is one local "
+                "optimum.")
+    passes = read_json(path, what="settling record").get("passes", [])
+    done = [p for p in passes if p.get("complete")]
+    text = f"Settling: {len(done)} complete pass{'es' if len(done) != 1 else ''}"
+    if done:
+        text += (f", the last lowering no objective by more than "
+                 f"{100 * done[-1]['largest_objective_drop']:.2f} %")
+    open_pass = next((p for p in passes if not p.get("complete")), None)
+    if open_pass is not None:
+        drops = [(r["before"] - r["after"]) / r["before"] for r in open_pass["designs"]]
+        text += (f"; pass {open_pass['pass']} stopped after {len(drops)} designs"
+                 + (f" (largest drop {100 * max(drops):.2f} %)" if drops else ""))
+    settled = (open_pass is None and bool(done)
+               and done[-1]["largest_objective_drop"] <= SETTLED_REL)
+    return text + (": settled (below 1 %)." if settled else
+                   ": not settled, the responses may still move (resume with --settle).")
 
 
 def _people_text(checks: pd.DataFrame) -> str:
