@@ -114,7 +114,7 @@ _TT_SCATTER = (
     "stride at a prescribed speed shares its horizontal impulse between the legs at almost the "
     "same cost, so clean strides of one design differ in Δv_x about as much as the designs do "
     "(the start caps its R² at about 0.3, the report's 'what the solver's start decides'; one "
-    "farther start moved the centre design's Δv_x by 0.05 m/s against an SD of 0.035 m/s "
+    "farther start moved the centre design's Δv_x by 0.05 m/s against an SD of 0.031 m/s "
     "across the box). ")
 
 #: Why a trend does not hold, by (evaluator, trend key): see docs/design.md for the measurements.
