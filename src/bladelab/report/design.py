@@ -353,8 +353,9 @@ def _settling_text(design_dir: Path) -> str:
                  f"{100 * done[-1]['largest_objective_drop']:.2f} %")
     open_pass = next((p for p in passes if not p.get("complete")), None)
     if open_pass is not None:
-        drops = [(r["before"] - r["after"]) / r["before"] for r in open_pass["designs"]]
-        text += (f"; pass {open_pass['pass']} stopped after {len(drops)} designs"
+        drops = [(r["before"] - r["after"]) / r["before"] for r in open_pass["designs"]
+                 if r.get("before") and r.get("after") is not None]
+        text += (f"; pass {open_pass['pass']} stopped after {len(open_pass['designs'])} designs"
                  + (f" (largest drop {100 * max(drops):.2f} %)" if drops else ""))
     settled = (open_pass is None and bool(done)
                and done[-1]["largest_objective_drop"] <= SETTLED_REL)
