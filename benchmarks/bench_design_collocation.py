@@ -43,6 +43,7 @@ def _study(study: Path, runner: str, what: str) -> str:
     if not strides:
         return (f"## Design study on predicted {runner} strides: {what}\n\n"
                 f"No study in {study.relative_to(study.parents[2])}: run it first (docstring).")
+    from bladelab.design.settling import is_settled, read_settling_record
     from bladelab.predict.collocation.solution import CollocationSolution
 
     rows, flagged = [], 0
@@ -77,15 +78,13 @@ def _study(study: Path, runner: str, what: str) -> str:
         f"| IPOPT iterations per design: median | "
         f"{sorted(r[2] for r in rows)[len(rows) // 2]} |",
     ]
-    settling = study / "settling.json"
-    for rec in (json.loads(settling.read_text(encoding="utf-8"))["passes"]
-                if settling.is_file() else []):
+    for rec in read_settling_record(study):
         if rec["complete"]:
             lines.append(f"| settling pass {rec['pass']} (`--settle`, 2 solves per design) | "
                          f"{rec['improved']} of {len(rec['designs'])} designs improved, largest "
                          f"objective drop {100 * rec['largest_objective_drop']:.1f} % ("
-                         + ("settled: below 1 %" if rec["largest_objective_drop"] < 0.01
-                            else "not settled: 1 % or more") + ") |")
+                         + ("settled: at most 1 %" if is_settled([rec])
+                            else "not settled: above 1 %") + ") |")
         else:
             lines.append(f"| settling pass {rec['pass']} | stopped after "
                          f"{len(rec['designs'])} designs (resumes with `--settle`) |")

@@ -552,7 +552,8 @@ def stride_checks(design_dir: str | Path, evaluator: Mapping[str, Any],
     :meth:`~bladelab.predict.collocation.solution.CollocationSolution.gait_warnings`, "; "
     -joined; "" when clean), ``criteria_met`` / ``criteria`` (how many of the criteria of
     people's running it meets, :func:`~bladelab.predict.collocation.human_running.
-    human_running_criteria`) and ``outside_people`` (the names of those it misses, "; "-joined). A study's results may hold strides written before a check existed
+    human_running_criteria`) and ``outside_people`` (the names of those it misses, "; "
+    -joined). A study's results may hold strides written before a check existed
     (the 5 % residual gate came after the free-gait study): the report marks those runs and
     leaves them out of its surfaces rather than average them in silently."""
     folder = _solutions_folder(Path(design_dir), evaluator.get("solutions_dir"))

@@ -30,8 +30,8 @@ from bladelab.design import collocation_evaluator, defaults
 from bladelab.design.study import DesignStudyResult, run_design, run_file
 from bladelab.errors import InputFileError
 
-__all__ = ["RECORD_NAME", "SETTLED_REL", "SettlingOutcome", "read_settling_record",
-           "run_settled_design", "settle_study"]
+__all__ = ["RECORD_NAME", "SETTLED_REL", "SettlingOutcome", "is_settled", "objective_drop",
+           "read_settling_record", "run_settled_design", "settle_study"]
 
 #: A pass that lowers no design's objective by more than this fraction [-] has settled.
 SETTLED_REL = defaults.SETTLED_REL
@@ -61,9 +61,16 @@ class SettlingOutcome:
     largest_objective_drop: float
 
 
-def _drop(row: dict) -> float:
+def objective_drop(row: dict) -> float:
     """Relative objective drop of one design's settling [-]."""
     return (row["before"] - row["after"]) / abs(row["before"])
+
+
+def is_settled(record: Sequence[dict]) -> bool:
+    """Whether a study's settling passes (:func:`read_settling_record`) have settled: its last
+    pass is complete and lowered no objective by more than :data:`SETTLED_REL`."""
+    return bool(record) and bool(record[-1].get("complete")) and (
+        record[-1]["largest_objective_drop"] <= SETTLED_REL)
 
 
 def read_settling_record(out: str | Path, points: Sequence[dict] | None = None) -> list[dict]:
@@ -141,11 +148,10 @@ def settle_study(evaluator, result, *, passes: int, jobs: int = 1,
     def save() -> None:
         write_json(out / RECORD_NAME, {"settled_below": SETTLED_REL, "passes": record})
 
-    last = record[-1] if record else None
-    if last is not None and last["complete"] and last["largest_objective_drop"] <= SETTLED_REL:
-        say(f"settled: pass {last['pass']} lowered no objective by more than "
+    if is_settled(record):
+        say(f"settled: pass {record[-1]['pass']} lowered no objective by more than "
             f"{100 * SETTLED_REL:g} %; no further pass")
-        return SettlingOutcome(False, True, 0, last["largest_objective_drop"])
+        return SettlingOutcome(False, True, 0, record[-1]["largest_objective_drop"])
     for _ in range(passes):
         if record and not record[-1]["complete"]:
             current = record[-1]
@@ -157,7 +163,7 @@ def settle_study(evaluator, result, *, passes: int, jobs: int = 1,
             save()
         changed_any |= _run_pass(evaluator, points, current, out, jobs=jobs, save=save,
                                  failed=failed)
-        worst = max(_drop(r) for r in current["designs"])
+        worst = max(objective_drop(r) for r in current["designs"])
         current.update(complete=True, largest_objective_drop=worst,
                        improved=sum(r["from"] is not None for r in current["designs"]))
         save()

@@ -26,7 +26,12 @@ from bladelab.design.responses import (
     PREDICTED_RESPONSE_UNITS,
     RUNNER_RESPONSE_UNITS,
 )
-from bladelab.design.settling import RECORD_NAME, SETTLED_REL
+from bladelab.design.settling import (
+    RECORD_NAME,
+    is_settled,
+    objective_drop,
+    read_settling_record,
+)
 from bladelab.design.space import DesignSpace
 from bladelab.design.start_spread import NEAR_PCT, start_spread
 from bladelab.design.surfaces import fit_surface
@@ -340,12 +345,11 @@ def _strides_section(checks: pd.DataFrame, evaluator: dict) -> dict[str, Any]:
 def _settling_text(design_dir: Path) -> str:
     """Whether a collocation study's strides have settled, from its settling record
     (:mod:`bladelab.design.settling`): the passes, the last one's largest drop, an unfinished
-    pass; "" without a record."""
-    path = design_dir / RECORD_NAME
-    if not path.is_file():
+    pass."""
+    if not (design_dir / RECORD_NAME).is_file():
         return ("Not settled: no settling pass was run (--settle); each stride is one local "
                 "optimum.")
-    passes = read_json(path, what="settling record").get("passes", [])
+    passes = read_settling_record(design_dir)
     done = [p for p in passes if p.get("complete")]
     text = f"Settling: {len(done)} complete pass{'es' if len(done) != 1 else ''}"
     if done:
@@ -353,13 +357,11 @@ def _settling_text(design_dir: Path) -> str:
                  f"{100 * done[-1]['largest_objective_drop']:.2f} %")
     open_pass = next((p for p in passes if not p.get("complete")), None)
     if open_pass is not None:
-        drops = [(r["before"] - r["after"]) / r["before"] for r in open_pass["designs"]
+        drops = [objective_drop(r) for r in open_pass["designs"]
                  if r.get("before") and r.get("after") is not None]
         text += (f"; pass {open_pass['pass']} stopped after {len(open_pass['designs'])} designs"
                  + (f" (largest drop {100 * max(drops):.2f} %)" if drops else ""))
-    settled = (open_pass is None and bool(done)
-               and done[-1]["largest_objective_drop"] <= SETTLED_REL)
-    return text + (": settled (below 1 %)." if settled else
+    return text + (": settled (below 1 %)." if is_settled(passes) else
                    ": not settled, the responses may still move (resume with --settle).")
 
 
@@ -470,6 +472,10 @@ def _motion_section(design_dir: Path, meta: dict) -> dict[str, Any] | None:
                        ("Cycles used", pd.DataFrame({"source": motion.get("sources", [])}))]}
 
 
+#: How the trends section names an evaluator whose key is not its plain name.
+_EVALUATOR_LABELS = {"collocation-transtibial": "collocation on the transtibial runner"}
+
+
 def trends_section(surfaces, evaluator: dict | None = None) -> dict[str, Any]:
     """The "Seed 002 trends" section: each trend's verdict on the study's own surfaces
     (:func:`bladelab.design.trends.evaluate_trends`), with the test used and, for a trend that
@@ -498,8 +504,8 @@ def trends_section(surfaces, evaluator: dict | None = None) -> dict[str, Any]:
     counts = {v: sum(1 for x in verdicts if x.verdict == v)
               for v in ("holds", "does not hold", "not estimable")}
     text = (f"The trends seed 002 reports, checked on this study's fitted surfaces "
-            f"(evaluator: {(kind or 'unknown').replace('-', ' on the ')}"
-            f"{' runner' if '-' in (kind or '') else ''}): {counts['holds']} hold, "
+            f"(evaluator: {_EVALUATOR_LABELS.get(kind, kind or 'unknown')}): "
+            f"{counts['holds']} hold, "
             f"{counts['does not hold']} do not hold, {counts['not estimable']} not estimable. "
             "Sign trends use a two-sided t-test of the linear coefficient per coded unit "
             "(α = 0.05); 'matter less' compares the ranges of the main-effect curves over the "
