@@ -187,6 +187,14 @@ def test_design_bad_input(tmp_path, capsys):
     assert main(["design", "--out", str(tmp_path / "c"), "--evaluator", "collocation",
                  "--prosthetic-load-max", "0"]) == 2
     assert "--prosthetic-load-max: the prosthetic load limit" in capsys.readouterr().err
+    assert main(["design", "--out", str(tmp_path / "c"), "--stride-time", "people"]) == 2
+    assert "--stride-time: only with --evaluator collocation" in capsys.readouterr().err
+    assert main(["design", "--out", str(tmp_path / "c"), "--evaluator", "collocation",
+                 "--stride-time", "fast"]) == 2
+    assert "--stride-time:" in capsys.readouterr().err
+    assert main(["design", "--out", str(tmp_path / "c"), "--evaluator", "collocation",
+                 "--stride-time", "0.6,9"]) == 2
+    assert "--stride-time: the stride time range" in capsys.readouterr().err
     assert not (tmp_path / "c").exists()  # refused before any output
 
 

@@ -54,6 +54,8 @@ def fake(monkeypatch):
                       "backward_euler": settings.blade_backward_euler,
                       "step_phase_tolerance": settings.step_phase_tolerance,
                       "prosthetic_load_max_bw": settings.prosthetic_load_max_bw,
+                      "period_bounds_s": settings.period_bounds_s,
+                      "stride_time_people": settings.stride_time_people,
                       "swing_knee": settings.swing_knee_min_deg,
                       "reference": (settings.reference, settings.reference_weight,
                                     settings.reference_dofs),
@@ -364,6 +366,33 @@ def test_a_stride_constraint_reaches_every_designs_solve(fake, tmp_path, field, 
     with pytest.raises(SpecError) as err:
         _evaluator(tmp_path, **{field: bad})
     assert err.value.where == field
+
+
+def test_the_stride_time_is_held_in_every_designs_solve(fake, tmp_path):
+    """People's stride time (or a given range) bounds every design's period; free by default;
+    it is part of the evaluator's identity (a free study is not resumed with it) and a range
+    outside the NLP's own period bounds is refused by name."""
+    from bladelab.predict.collocation.running_bands import reference_band
+    from bladelab.predict.collocation.transcription import PERIOD_BOUNDS_S
+
+    calls, _ = fake
+    _evaluator(tmp_path)(CENTRE)
+    assert calls[-1]["period_bounds_s"] == PERIOD_BOUNDS_S
+    assert not calls[-1]["stride_time_people"]
+    people = _evaluator(tmp_path / "people", speed_mps=4.0, stride_time_people=True)
+    people(CENTRE)
+    lo, hi = calls[-1]["period_bounds_s"]
+    band = reference_band("stride time", 4.0)
+    assert lo == pytest.approx(band[0], abs=1e-5) and hi == pytest.approx(band[1], abs=1e-5)
+    assert PERIOD_BOUNDS_S[0] < lo < hi < PERIOD_BOUNDS_S[1]
+    assert people.to_dict()["stride_time_people"] is True
+    assert ce.CollocationEvaluator.LEGACY_SETTINGS["stride_time_people"] is False
+    ranged = _evaluator(tmp_path / "range", stride_time_range_s=(0.62, 0.70))
+    ranged(CENTRE)
+    assert calls[-1]["period_bounds_s"] == (0.62, 0.70)
+    with pytest.raises(SpecError) as err:
+        _evaluator(tmp_path, stride_time_range_s=(0.62, 9.0))
+    assert err.value.where == "stride_time_range_s"
 
 
 def test_the_transtibial_runner_is_predicts_amputee_wearing_the_design(fake, tmp_path):

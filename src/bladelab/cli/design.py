@@ -46,6 +46,7 @@ OPTIONS = {
     "reference_weight": "--reference-weight", "body": "--body", "amputation": "--amputation",
     "people_weight": "--people-weight", "step_phase_tolerance": "--alternating-steps",
     "prosthetic_load_max_bw": "--prosthetic-load-max",
+    "stride_time_range_s": "--stride-time", "stride_time_people": "--stride-time",
 }
 _FACTORS = ",".join(f"{name}={low:g}:{high:g}" for name, low, high, *_ in defaults.DESIGN_FACTORS)
 
@@ -223,6 +224,10 @@ def _design(
         None, "--prosthetic-load-max", rich_help_panel=COLLOCATION, show_default=False,
         help="Keep every design's prosthetic leg's vertical ground force at or below this "
              "many body weights (the residual limb's load in its socket; default: no limit)."),
+    stride_time: str | None = typer.Option(
+        None, "--stride-time", rich_help_panel=COLLOCATION, show_default=False,
+        help="Keep every design's stride time at people's: 'people' (measured runners' band "
+             "at the speed), LO,HI or T [s]; imposed, not predicted (default: free)."),
     settle: int = typer.Option(
         0, "--settle", rich_help_panel=COLLOCATION,
         help="After the runs, up to this many settling passes (each design solved again from "
@@ -242,6 +247,7 @@ def _design(
         raise typer.BadParameter("missing option '--out' (the study's output folder)",
                                  param_hint="--out")
     # deferred: keeps bladelab --help fast
+    from bladelab.cli.collocation import stride_time_settings
     from bladelab.design import doe, settling, terms
 
     # deferred: keeps bladelab --help fast
@@ -275,7 +281,8 @@ def _design(
             reference_weight=reference_weight, body=body, amputation=amputation,
             people_weight=people_weight,
             step_phase_tolerance=alternating_steps,
-            prosthetic_load_max_bw=prosthetic_load_max)
+            prosthetic_load_max_bw=prosthetic_load_max,
+            **(stride_time_settings(stride_time) if stride_time is not None else {}))
     except BladelabError as err:
         raise renamed(err, OPTIONS) from None
     design = doe.make_design(runs, space, n_runs=n_runs, model=model, seed=seed)

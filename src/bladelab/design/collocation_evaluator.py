@@ -173,6 +173,12 @@ class CollocationEvaluator:
         Keep the prosthetic leg's vertical ground force at or below this many body weights
         in every design's stride (``CollocationSettings.prosthetic_load_max_bw``: the load
         the residual limb tolerates in its socket); None (default): no limit.
+    stride_time_range_s, stride_time_people
+        Keep every design's stride time inside (lo, hi) [s], or inside measured runners' band
+        at the speed (``CollocationSettings.stride_time_range_s`` /
+        ``stride_time_people``): an athlete's cadence imposed, not predicted; free by default.
+        At people's stride time a design's strides from different starts agree more closely
+        than free ones (docs/design.md).
     people_weight
         Weight [1/rad²] of people's joint angles in the objective (the intact leg's hip, knee
         and ankle and the residual hip (and knee); ``CollocationSettings(reference="people")``,
@@ -202,16 +208,20 @@ class CollocationEvaluator:
     people_weight: float | None = None
     step_phase_tolerance: float | None = None
     prosthetic_load_max_bw: float | None = None
+    stride_time_range_s: tuple[float, float] | None = None
+    stride_time_people: bool = False
     generator: Mapping[str, Any] = field(default_factory=dict)
 
     #: What a study's ``evaluator.json`` written before a setting existed meant by it: the
     #: studies before the human body ran seed 001's body without people's angles, and
     #: those before the alternating-steps constraint and the prosthetic load limit ran
-    #: without them.
+    #: without them; every study before the stride time option let it free.
     LEGACY_SETTINGS: ClassVar[dict[str, Any]] = {"body": "seed001", "people_weight": 0.0,
                                                  "step_phase_tolerance": None,
                                                  "prosthetic_load_max_bw": None,
-                                                 "amputation": "transfemoral"}
+                                                 "amputation": "transfemoral",
+                                                 "stride_time_range_s": None,
+                                                 "stride_time_people": False}
 
     def __post_init__(self) -> None:
         if self.amputation not in AMPUTATIONS:
@@ -367,6 +377,8 @@ class CollocationEvaluator:
                                    blade_backward_euler=self.blade_backward_euler,
                                    step_phase_tolerance=self.step_phase_tolerance,
                                    prosthetic_load_max_bw=self.prosthetic_load_max_bw,
+                                   stride_time_range_s=self.stride_time_range_s,
+                                   stride_time_people=self.stride_time_people,
                                    max_iter=self.max_iter, **reference)
 
     def _problem(self, point: Mapping[str, float]) -> tuple[dict, Any]:

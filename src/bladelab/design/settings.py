@@ -41,6 +41,8 @@ APPLIES_TO: dict[str, tuple[str, ...]] = {
     "people_weight": ("collocation",),
     "step_phase_tolerance": ("collocation",),
     "prosthetic_load_max_bw": ("collocation",),
+    "stride_time_range_s": ("collocation",),
+    "stride_time_people": ("collocation",),
 }
 
 
@@ -83,6 +85,9 @@ class EvaluatorSettings:
     prosthetic_load_max_bw
         Collocation: keep the prosthetic leg's vertical ground force at or below this many
         body weights (``CollocationSettings.prosthetic_load_max_bw``); None: no limit.
+    stride_time_range_s, stride_time_people
+        Collocation: keep every design's stride time inside (lo, hi) [s], or (True) inside
+        measured runners' band at the speed; None: free.
     """
 
     kind: str = "blade"
@@ -102,6 +107,8 @@ class EvaluatorSettings:
     people_weight: float | None = None
     step_phase_tolerance: float | None = None
     prosthetic_load_max_bw: float | None = None
+    stride_time_range_s: tuple[float, float] | None = None
+    stride_time_people: bool | None = None
 
     def __post_init__(self) -> None:
         if self.kind not in EVALUATORS:
@@ -135,7 +142,8 @@ class EvaluatorSettings:
                 options["start"] = str(self.start)
             for name in ("knee_moment_min_Nm", "knee_flexion_max_loaded_deg",
                          "reference_weight", "body", "amputation", "people_weight",
-                         "step_phase_tolerance", "prosthetic_load_max_bw"):
+                         "step_phase_tolerance", "prosthetic_load_max_bw",
+                         "stride_time_range_s", "stride_time_people"):
                 if getattr(self, name) is not None:
                     options[name] = getattr(self, name)
         elif self.body_mass_kg is not None:

@@ -300,6 +300,14 @@ def _problem_posed(evaluator: dict) -> str:
     if evaluator.get("knee_moment_min_Nm") is not None:
         text += (f"; the prosthetic knee's extension moment held at or above "
                  f"{evaluator['knee_moment_min_Nm']:g} N·m")
+    if evaluator.get("stride_time_people"):
+        text += ("; the stride time held within measured runners' band at the speed (an "
+                 "athlete's cadence imposed, not predicted)")
+    elif evaluator.get("stride_time_range_s"):
+        lo, hi = evaluator["stride_time_range_s"]
+        text += (f"; the stride time held within {lo:g}–{hi:g} s (imposed, not predicted)"
+                 if lo != hi else f"; the stride time fixed at {lo:g} s (imposed, not "
+                                  "predicted)")
     return text + ". "
 
 
