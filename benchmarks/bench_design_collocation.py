@@ -14,6 +14,13 @@ beside it (``bladelab design`` run as in docs/design.md). Run the study again to
     bladelab design --evaluator collocation --amputation transtibial --runs ccd --jobs 2 \
         --settle 2 --skip-failed --objective cost_of_transport_J_per_kg_m --sense min \
         --out benchmarks/design/transtibial-collocation-4mps
+    bladelab design --evaluator collocation --amputation transtibial --stride-time people \
+        --runs ccd --jobs 2 --settle 2 --skip-failed \
+        --objective cost_of_transport_J_per_kg_m --sense min \
+        --out benchmarks/design/transtibial-collocation-4mps-people-stride
+
+Studies since the study timing record write their own ``timing.json`` (each sitting of each
+stage, :mod:`bladelab.design.timing`); older ones hold their times written by hand.
 """
 
 from __future__ import annotations
@@ -29,6 +36,9 @@ STUDIES = (
      "knee-safe: knee moment ≥ 0 N·m on every mesh interval (`--knee-moment-min 0`)"),
     (_DESIGN / "transtibial-collocation-4mps", "transtibial",
      "human body, people's joint angles and swing knee (`--amputation transtibial`)"),
+    (_DESIGN / "transtibial-collocation-4mps-people-stride", "transtibial",
+     "human body, people's joint angles, swing knee and stride time (`--amputation "
+     "transtibial --stride-time people`)"),
 )
 
 
@@ -51,8 +61,15 @@ def _study(study: Path, runner: str, what: str) -> str:
         sol = CollocationSolution.read(p)
         flagged += bool(sol.gait_warnings())
         rows.append((p.stem, float(sol.nlp.wall_s), int(sol.nlp.iterations), sol.guess_source))
+    from bladelab.design.timing import RUNS_STAGE, stage_walls
+
     timing = study / "timing.json"
     info = json.loads(timing.read_text(encoding="utf-8")) if timing.is_file() else {}
+    stages = stage_walls(study)  # recorded by the study itself (older studies: by hand)
+    if RUNS_STAGE in stages:
+        info = {"wall_s": stages[RUNS_STAGE]["wall_s"],
+                "date": f"recorded by the study, {stages[RUNS_STAGE]['sittings']} sitting(s), "
+                        f"{stages[RUNS_STAGE]['jobs']} workers"}
     walls = sorted(r[1] for r in rows)
     lines = [
         f"## Design study on predicted {runner} strides: {what}",
@@ -88,7 +105,15 @@ def _study(study: Path, runner: str, what: str) -> str:
         else:
             lines.append(f"| settling pass {rec['pass']} | stopped after "
                          f"{len(rec['designs'])} designs (resumes with `--settle`) |")
-    if info.get("settle_wall_s"):
+    settle = {k: v for k, v in stages.items() if k != RUNS_STAGE}
+    for stage, w in settle.items():
+        lines.append(f"| {stage} wall time, {w['jobs']} workers (recorded) | "
+                     f"{w['wall_s'] / 60:.1f} min for {w['designs']} designs |")
+    if settle or RUNS_STAGE in stages:
+        total = sum(w["wall_s"] for w in stages.values())
+        lines.append(f"| **whole study** (runs and settling passes, recorded) | "
+                     f"**{total / 60:.1f} min** |")
+    elif info.get("settle_wall_s"):
         lines.append(f"| settling pass wall time, 2 workers | {info['settle_wall_s'] / 60:.0f} "
                      f"min ({info.get('settle_note', '')}) |")
     lines += ["", "Per-design times are those of the kept strides: after settling, a stride's "

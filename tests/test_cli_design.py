@@ -78,6 +78,10 @@ def test_design_writes_study(study):
     assert surf["swing_clearance_m"]["r2"] > 0.999
     opt = json.loads((out / "optimum.json").read_text())
     assert opt["constraints"]["swing_clearance_m"]["slack"] >= -1e-6
+    # the sitting's wall time, recorded by the study itself
+    from bladelab.design.timing import RUNS_STAGE, stage_walls
+    runs = stage_walls(out)[RUNS_STAGE]
+    assert runs["designs"] == 9 and runs["sittings"] == 1 and runs["wall_s"] > 0
 
 
 def test_design_resumes_and_draws(study, capsys):
@@ -85,6 +89,8 @@ def test_design_resumes_and_draws(study, capsys):
     args = [a for a in args if a != "--no-figures"]
     assert main(args) == 0
     assert "(0 evaluated, 9 resumed)" in capsys.readouterr().out
+    from bladelab.design.timing import read_segments
+    assert len(read_segments(out)) == 1  # a sitting that evaluated nothing is not a segment
     assert (out / "figures" / "main_effects.png").is_file()
     assert any((out / "figures").glob("contour_*.png"))
 
@@ -244,7 +250,16 @@ def test_an_interrupted_settling_pass_is_recorded_and_resumed(tmp_path, monkeypa
     assert len(record) == 1 and record[0]["complete"] and record[0]["improved"] == 2
     assert record[0]["largest_objective_drop"] == pytest.approx(0.1)
     assert [run_file(tmp_path, i).exists() for i in range(4)] == [True, False, True, False]
+    # both sittings of the pass are timed, the stopped one too
+    from bladelab.design.timing import settling_stage, stage_walls
+    first = stage_walls(tmp_path)[settling_stage(1)]
+    assert first["designs"] == 4 and first["sittings"] == 2
+    (tmp_path / "timing.json").write_text('{"note": "written by hand", "segments": []}')
     settle_study(None, result, passes=1, jobs=1)  # a new pass: every design again
+    walls = stage_walls(tmp_path)
+    assert list(walls) == [settling_stage(2)] and walls[settling_stage(2)]["designs"] == 4
+    assert json.loads((tmp_path / "timing.json").read_text())["note"] == "written by hand"
+    (tmp_path / "timing.json").unlink()
     assert seen[-1] == [0, 1, 2, 3]
     assert len(json.loads((tmp_path / RECORD_NAME).read_text())["passes"]) == 2
     # that pass lowered design 4 by 10 %: not settled, so a further pass runs; once a pass

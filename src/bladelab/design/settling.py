@@ -28,6 +28,7 @@ from pathlib import Path
 from bladelab._io import read_json, write_json
 from bladelab.design import collocation_evaluator, defaults
 from bladelab.design.study import DesignStudyResult, run_design, run_file
+from bladelab.design.timing import settling_stage, timed_stage
 from bladelab.errors import InputFileError
 
 __all__ = ["RECORD_NAME", "SETTLED_REL", "SettlingOutcome", "is_settled", "objective_drop",
@@ -105,20 +106,22 @@ def read_settling_record(out: str | Path, points: Sequence[dict] | None = None) 
 def _run_pass(evaluator, points, current: dict, out: Path, *, jobs: int, save,
               failed=frozenset()) -> bool:
     """Settle the designs of pass ``current`` not yet in it (nor the ``failed`` run indices,
-    which have no stride), recording each as it finishes; True if a stride changed."""
+    which have no stride), recording each as it finishes (and the sitting's wall time in
+    ``timing.json``); True if a stride changed."""
     changed = False
+    with timed_stage(out, settling_stage(current["pass"]), jobs=jobs) as sitting:
+        def done(i: int, row: dict) -> None:
+            nonlocal changed
+            current["designs"].append({"run": i + 1, **row})
+            sitting["designs"] += 1
+            if row["from"] is not None:
+                changed = True
+                run_file(out, i).unlink(missing_ok=True)
+            save()
 
-    def done(i: int, row: dict) -> None:
-        nonlocal changed
-        current["designs"].append({"run": i + 1, **row})
-        if row["from"] is not None:
-            changed = True
-            run_file(out, i).unlink(missing_ok=True)
-        save()
-
-    collocation_evaluator.settle_strides(
-        evaluator, points, jobs=jobs, on_design=done,
-        skip=[r["run"] - 1 for r in current["designs"]] + sorted(failed))
+        collocation_evaluator.settle_strides(
+            evaluator, points, jobs=jobs, on_design=done,
+            skip=[r["run"] - 1 for r in current["designs"]] + sorted(failed))
     return changed
 
 

@@ -42,6 +42,7 @@ from bladelab.design.optimum import OptimumResult, SurfaceConstraint, constraine
 from bladelab.design.space import DesignSpace
 from bladelab.design.surfaces import ResponseSurface, fit_surface
 from bladelab.design.terms import parse_terms
+from bladelab.design.timing import RUNS_STAGE, timed_stage
 from bladelab.errors import BladelabError, DataError, OptimizationError, SpecError
 from bladelab.executors import make_executor
 
@@ -364,27 +365,29 @@ def run_design(
     finished = _evaluate_runs(evaluator, space, design, todo, jobs=jobs, executor=executor,
                               progress=progress)
     failed_now = []
-    for i, raw, err in finished:
-        point = space.point(design.coded[i])
-        if err is not None:
-            why = err.message if isinstance(err, BladelabError) else str(err)
-            write_json(failed_run_file(out, i), {"run": i + 1, "coded": design.coded[i].tolist(),
-                                                 "point": point, "error": why})
-            failed[i] = why
-            failed_now.append(f"run {i + 1} ({_point_text(point)}): {why}")
-            if isinstance(err, BladelabError) and not skip_failed:  # serial: stop at once
-                raise type(err)(failed_now[-1], file=err.file, where=err.where,
-                                hint=err.hint) from err
-            continue
-        res = _check_responses(raw, i + 1, expected)
-        expected = expected or list(res)
-        write_json(
-            run_file(out, i),
-            {"run": i + 1, "coded": design.coded[i].tolist(), "point": point, "responses": res},
-        )
-        failed_run_file(out, i).unlink(missing_ok=True)
-        results[i] = res
-        n_evaluated += 1
+    with timed_stage(out, RUNS_STAGE, jobs=jobs) as sitting:  # timing.json
+        for i, raw, err in finished:
+            sitting["designs"] += 1
+            point = space.point(design.coded[i])
+            if err is not None:
+                why = err.message if isinstance(err, BladelabError) else str(err)
+                write_json(failed_run_file(out, i), {"run": i + 1, "coded": design.coded[i].tolist(),
+                                                     "point": point, "error": why})
+                failed[i] = why
+                failed_now.append(f"run {i + 1} ({_point_text(point)}): {why}")
+                if isinstance(err, BladelabError) and not skip_failed:  # serial: stop at once
+                    raise type(err)(failed_now[-1], file=err.file, where=err.where,
+                                    hint=err.hint) from err
+                continue
+            res = _check_responses(raw, i + 1, expected)
+            expected = expected or list(res)
+            write_json(
+                run_file(out, i),
+                {"run": i + 1, "coded": design.coded[i].tolist(), "point": point, "responses": res},
+            )
+            failed_run_file(out, i).unlink(missing_ok=True)
+            results[i] = res
+            n_evaluated += 1
     if failed_now and not skip_failed:
         raise BladelabError(
             f"{len(failed_now)} of {len(todo)} runs failed ({'; '.join(failed_now[:3])})",
