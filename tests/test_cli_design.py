@@ -225,9 +225,11 @@ def test_an_interrupted_settling_pass_is_recorded_and_resumed(tmp_path, monkeypa
         run_file(tmp_path, i).write_text("{}")
     seen = []
 
-    def settle(evaluator, points, *, skip=(), on_design=None, stop_after=None, **_):
+    def settle(evaluator, points, *, skip=(), on_design=None, stop_after=None, cheapest=None,
+               **_):
         todo = [i for i in range(len(points)) if i not in set(skip)]
         seen.append(todo)
+        assert cheapest is True  # a new pass also starts from the study's cheapest stride
         for n, i in enumerate(todo):
             if stop_after is not None and n == stop_after:
                 raise KeyboardInterrupt
@@ -240,6 +242,7 @@ def test_an_interrupted_settling_pass_is_recorded_and_resumed(tmp_path, monkeypa
         settle_study(None, result, passes=1, jobs=1)
     record = json.loads((tmp_path / RECORD_NAME).read_text())["passes"]
     assert [r["run"] for r in record[0]["designs"]] == [1, 2] and not record[0]["complete"]
+    assert record[0]["from_cheapest"] is True
     assert run_file(tmp_path, 0).is_file() and not run_file(tmp_path, 1).exists()
 
     monkeypatch.setattr(ce, "settle_strides", settle)

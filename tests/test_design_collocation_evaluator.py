@@ -242,6 +242,45 @@ def test_settling_keeps_the_lowest_objective_from_the_neighbours(fake, tmp_path,
     assert ce.point_file_stem(far) in calls[-1]["source"]
 
 
+def test_settling_also_starts_from_the_studys_cheapest_stride(fake, tmp_path, monkeypatch):
+    """With ``cheapest`` a design is also solved from the lowest-objective stride of another
+    design of this problem (after its nearest neighbours), once, whether or not it is far;
+    without it (the default of a pass recorded before) only the neighbours."""
+    import json
+
+    calls, _ = fake
+    base = CollocationSolution.read(STRIDE).settings  # every stored stride is this file
+    ev = _evaluator(tmp_path, swing_clearance_m=base.swing_clearance_m,
+                    blade_backward_euler=base.blade_backward_euler)
+    assert base.same_problem(ev.settings())
+    near = {**CENTRE, "stiffness_kN_per_m": 32.0}
+    mid = {**CENTRE, "width_m": 0.08, "height_m": 0.48}
+    cheap = {**CENTRE, "stiffness_kN_per_m": 18.0, "width_m": 0.05, "toe_length_m": 0.25}
+    for p in (CENTRE, near, mid, cheap):
+        ev(p)
+    for p, objective in ((mid, 0.5), (cheap, 0.2)):  # the far corner's stride is cheapest
+        path = ev._stride_file(p)
+        data = json.loads(path.read_text())
+        data["objective"] = objective
+        path.write_text(json.dumps(data))
+    stored = CollocationSolution.read(STRIDE)
+    monkeypatch.setattr(ce.CollocationEvaluator, "_stored",
+                        lambda self, point, spec, settings: (stored, None))
+    del calls[:]
+    row = ce.settle_strides(ev, [CENTRE], neighbours=1, cheapest=True, progress=False)[0]
+    assert [t["from"] for t in row["tries"]] == [f"{ce.point_file_stem(p)}.json"
+                                                 for p in (near, cheap)]
+    assert len(calls) == 2
+    # the cheapest among the neighbours already: not tried twice
+    row = ev.settle(CENTRE, neighbours=3, cheapest=True)
+    assert [t["from"] for t in row["tries"]].count(f"{ce.point_file_stem(cheap)}.json") == 1
+    assert len(row["tries"]) == 3
+    row = ce.settle_strides(ev, [CENTRE], neighbours=1, progress=False)[0]
+    assert [t["from"] for t in row["tries"]] == [f"{ce.point_file_stem(near)}.json"]
+    other = _evaluator(tmp_path)  # another problem: none of the stored strides is its
+    assert other._cheapest_other(CENTRE, other.settings(), []) is None
+
+
 def test_settling_records_a_failed_start_without_responses(fake, tmp_path, monkeypatch):
     """A start that does not converge is recorded with IPOPT's status and no objective or
     responses, and the stored stride stays."""

@@ -231,7 +231,8 @@ def _design(
     settle: int = typer.Option(
         0, "--settle", rich_help_panel=COLLOCATION,
         help="After the runs, up to this many settling passes (each design solved again from "
-             "its 2 nearest neighbours' strides, the lowest objective kept; stops when no "
+             "its 2 nearest neighbours' strides and the study's cheapest one, the lowest objective "
+             "kept; stops when no "
              f"objective drops by more than {100 * defaults.SETTLED_REL:g} %). Recorded design "
              "by design in settling.json: a stopped pass resumes where it stopped."),
 ) -> None:

@@ -25,6 +25,7 @@ __all__ = [
     "SEED",
     "SENSE",
     "SETTLED_REL",
+    "SETTLE_FROM_CHEAPEST",
     "SURFACE_MODEL",
 ]
 
@@ -65,6 +66,9 @@ SENSE = "max"
 #: A settling pass of a collocation study that lowers no design's objective by more than this
 #: fraction [-] has settled (:mod:`bladelab.design.settling`).
 SETTLED_REL = 0.01
+#: A settling pass also starts each design from the study's cheapest stride of another design
+#: (besides its two nearest neighbours'): neighbours alone left a cheaper branch uncarried.
+SETTLE_FROM_CHEAPEST = True
 
 #: Alignment angles of the virtual compression test [deg].
 COMPRESSION_ALIGNMENTS_DEG = (0.0, -8.0, 8.0)

@@ -1,7 +1,7 @@
 """Settling passes over a predicted-gait design study, and their record ``settling.json``.
 
-A settling pass solves each design's stride again from its nearest neighbours' strides and keeps
-the lowest objective (:func:`bladelab.design.collocation_evaluator.settle_strides`); the run
+A settling pass solves each design's stride again from its two nearest neighbours' strides and
+the study's cheapest stride of another design, and keeps the lowest objective (:func:`bladelab.design.collocation_evaluator.settle_strides`); the run
 files of the designs whose stride changed are removed, so that the study reads their new
 responses back (:func:`settle_study` returns whether it must). ``bladelab design --evaluator
 collocation --settle K`` runs up to K passes.
@@ -13,6 +13,7 @@ pass where it stopped, skipping the designs it had settled. The record::
 
     {"settled_below": 0.01,
      "passes": [{"pass": 1, "complete": true, "largest_objective_drop": 0.004, "improved": 3,
+                 "from_cheapest": true,
                  "designs": [{"run": 1, "point": {...}, "before": ..., "after": ...,
                               "from": "<neighbour's stride>" | null, ...}, ...]}, ...]}
 
@@ -31,11 +32,14 @@ from bladelab.design.study import DesignStudyResult, run_design, run_file
 from bladelab.design.timing import settling_stage, timed_stage
 from bladelab.errors import InputFileError
 
-__all__ = ["RECORD_NAME", "SETTLED_REL", "SettlingOutcome", "is_settled", "objective_drop",
+__all__ = ["RECORD_NAME", "SETTLED_REL", "SETTLE_FROM_CHEAPEST", "SettlingOutcome", "is_settled", "objective_drop",
            "read_settling_record", "run_settled_design", "settle_study"]
 
 #: A pass that lowers no design's objective by more than this fraction [-] has settled.
 SETTLED_REL = defaults.SETTLED_REL
+#: New passes also start each design from the study's cheapest stride (recorded per pass as
+#: ``"from_cheapest"``; a pass recorded without it resumes without it).
+SETTLE_FROM_CHEAPEST = defaults.SETTLE_FROM_CHEAPEST
 #: The record of the settling passes in a study's folder.
 RECORD_NAME = "settling.json"
 
@@ -121,6 +125,7 @@ def _run_pass(evaluator, points, current: dict, out: Path, *, jobs: int, save,
 
         collocation_evaluator.settle_strides(
             evaluator, points, jobs=jobs, on_design=done,
+            cheapest=bool(current.get("from_cheapest", False)),
             skip=[r["run"] - 1 for r in current["designs"]] + sorted(failed))
     return changed
 
@@ -161,7 +166,8 @@ def settle_study(evaluator, result, *, passes: int, jobs: int = 1,
             say(f"resuming settling pass {current['pass']}: {len(current['designs'])} of "
                 f"{len(points)} designs already settled")
         else:
-            current = {"pass": len(record) + 1, "complete": False, "designs": []}
+            current = {"pass": len(record) + 1, "complete": False,
+                       "from_cheapest": SETTLE_FROM_CHEAPEST, "designs": []}
             record.append(current)
             save()
         changed_any |= _run_pass(evaluator, points, current, out, jobs=jobs, save=save,
