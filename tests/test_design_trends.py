@@ -256,4 +256,15 @@ def test_the_report_says_whether_a_study_has_settled(tmp_path):
     (tmp_path / "settling.json").write_text(json.dumps({"passes": [done, later]}))
     text = _settling_text(tmp_path)
     assert "pass 2 stopped after 2 designs (largest drop 2.00 %)" in text
-    assert "not settled" in text
+    assert "not settled" in text and "cheapest" not in text and "took" not in text
+    # a pass from the study's cheapest stride says so; the recorded wall time is summed
+    later["from_cheapest"] = True
+    (tmp_path / "settling.json").write_text(json.dumps({"passes": [done, later]}))
+    (tmp_path / "timing.json").write_text(json.dumps({"segments": [
+        {"stage": "runs", "wall_s": 600.0, "designs": 25, "jobs": 2},
+        {"stage": "settling pass 1", "wall_s": 1200.0, "designs": 20, "jobs": 2},
+        {"stage": "settling pass 1", "wall_s": 300.0, "designs": 5, "jobs": 2}]}))
+    text = _settling_text(tmp_path)
+    assert "(pass 2 also from the study's cheapest stride" in text
+    assert ("took 35 min of wall time with 2 workers (runs 10 min; settling pass 1 25 min)"
+            in text)

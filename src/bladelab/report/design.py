@@ -36,6 +36,7 @@ from bladelab.design.space import DesignSpace
 from bladelab.design.start_spread import NEAR_PCT, start_spread
 from bladelab.design.surfaces import fit_surface
 from bladelab.design.terms import parse_terms
+from bladelab.design.timing import stage_walls
 from bladelab.design.trends import NO_RUNNER, evaluate_trends, trends_frame
 from bladelab.errors import InputFileError, OptimizationError
 from bladelab.predict.collocation.human_running import gallop_sentence
@@ -369,8 +370,26 @@ def _settling_text(design_dir: Path) -> str:
                  if r.get("before") and r.get("after") is not None]
         text += (f"; pass {open_pass['pass']} stopped after {len(open_pass['designs'])} designs"
                  + (f" (largest drop {100 * max(drops):.2f} %)" if drops else ""))
-    return text + (": settled (below 1 %)." if is_settled(passes) else
-                   ": not settled, the responses may still move (resume with --settle).")
+    cheapest = [str(p["pass"]) for p in passes if p.get("from_cheapest")]
+    if cheapest:
+        text += (f" (pass{'es' if len(cheapest) > 1 else ''} {', '.join(cheapest)} also from "
+                 "the study's cheapest stride, besides each design's two nearest)")
+    text += (": settled (below 1 %)." if is_settled(passes) else
+             ": not settled, the responses may still move (resume with --settle).")
+    return text + _timing_text(design_dir)
+
+
+def _timing_text(design_dir: Path) -> str:
+    """" The study took …": its recorded wall time by stage (:mod:`bladelab.design.timing`);
+    "" when it recorded none."""
+    stages = stage_walls(design_dir)
+    if not stages:
+        return ""
+    total = sum(w["wall_s"] for w in stages.values())
+    parts = "; ".join(f"{stage} {w['wall_s'] / 60:.0f} min" for stage, w in stages.items())
+    jobs = max(w["jobs"] for w in stages.values())
+    return (f" The study took {total / 60:.0f} min of wall time with {jobs} worker"
+            f"{'s' if jobs > 1 else ''} ({parts}).")
 
 
 def _people_text(checks: pd.DataFrame) -> str:
