@@ -1,0 +1,91 @@
+"""Fits of a predicted-gait design study, side by side: quadratic and first-order R²pred, the
+start spread's R² ceiling, and the first-order effects per coded unit with their p-values.
+
+Reads a study folder as committed (``results.csv``, ``settling.json``); solves nothing. The
+report gives the quadratic fits and the start spread; this adds the first-order fits that
+25 runs estimate better, for the study READMEs and docs/design.md.
+
+Usage (repository root)::
+
+    .venv/bin/python benchmarks/design/fits.py benchmarks/design/transtibial-collocation-4mps \
+        [--json OUT.json]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+from scipy import stats
+
+from bladelab.design.responses import PREDICTED_RESPONSE_UNITS
+from bladelab.design.start_spread import start_spread
+from bladelab.design.surfaces import fit_surface
+
+FACTORS = ("stiffness_kN_per_m", "width_m", "height_m", "toe_length_m")
+RESPONSES = ("cost_of_transport_J_per_kg_m", "delta_vx_m_per_s", "evaluation_E_m",
+             "impulse_z_Ns", "knee_moment_min_Nm", "swing_clearance_m",
+             "contact_time_prosthetic_s")
+
+
+def _first_order(coded: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(coefficients of the four factors per coded unit, their two-sided p-values)."""
+    x = np.column_stack([np.ones(len(y)), coded])
+    beta, *_ = np.linalg.lstsq(x, y, rcond=None)
+    dof = len(y) - x.shape[1]
+    resid = y - x @ beta
+    cov = (resid @ resid / dof) * np.linalg.inv(x.T @ x)
+    t = beta / np.sqrt(np.diag(cov))
+    return beta[1:], 2 * stats.t.sf(np.abs(t[1:]), dof)
+
+
+def study_fits(study: Path) -> dict:
+    """Per response: R², R²pred of the quadratic and first-order fits, the start ceiling, and
+    the first-order effects with p-values."""
+    table = pd.read_csv(study / "results.csv")
+    coded = table[[f"{f}_coded" for f in FACTORS]].to_numpy(float)
+    spread = start_spread(study, units=PREDICTED_RESPONSE_UNITS)
+    ceiling = dict(zip(spread["response"], spread["r2_ceiling"], strict=True))
+    out = {}
+    for name in RESPONSES:
+        if name not in table:
+            continue
+        y = table[name].to_numpy(float)
+        quad = fit_surface(coded, y, factor_names=FACTORS, model="quadratic", response=name)
+        lin = fit_surface(coded, y, factor_names=FACTORS, model="linear", response=name)
+        effects, p = _first_order(coded, y)
+        out[name] = {"unit": PREDICTED_RESPONSE_UNITS.get(name, ""),
+                     "quadratic_r2": quad.r2, "quadratic_r2_pred": quad.r2_pred,
+                     "linear_r2": lin.r2, "linear_r2_pred": lin.r2_pred,
+                     "start_ceiling": ceiling.get(name),
+                     "range": [float(y.min()), float(y.max())],
+                     "effects": {f: {"per_coded_unit": float(e), "p": float(q)}
+                                 for f, e, q in zip(FACTORS, effects, p, strict=True)}}
+    return out
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("study", type=Path)
+    ap.add_argument("--json", type=Path, default=None)
+    args = ap.parse_args()
+    fits = study_fits(args.study)
+    print("| response | range | R² / R²pred quadratic | R² / R²pred first-order | start ceiling "
+          "| stiffness | width | height | toe |")
+    print("|---|---|---|---|---|---|---|---|---|")
+    for name, f in fits.items():
+        eff = " | ".join(f"{e['per_coded_unit']:+.3g} (p {e['p']:.2g})"
+                         for e in f["effects"].values())
+        ceil = "–" if f["start_ceiling"] is None else f"{f['start_ceiling']:.2f}"
+        print(f"| {name} [{f['unit']}] | {f['range'][0]:.4g} … {f['range'][1]:.4g} | "
+              f"{f['quadratic_r2']:.2f} / {f['quadratic_r2_pred']:.2f} | "
+              f"{f['linear_r2']:.2f} / {f['linear_r2_pred']:.2f} | {ceil} | {eff} |")
+    if args.json is not None:
+        args.json.write_text(json.dumps(fits, indent=1), encoding="utf-8")
+
+
+if __name__ == "__main__":
+    main()
