@@ -223,19 +223,21 @@ def test_an_interrupted_settling_pass_is_recorded_and_resumed(tmp_path, monkeypa
     for i in range(4):
         run_file(tmp_path, i).parent.mkdir(exist_ok=True)
         run_file(tmp_path, i).write_text("{}")
-    seen = []
+    seen, knowns = [], []
 
     def settle(evaluator, points, *, skip=(), on_design=None, stop_after=None, cheapest=None,
-               **_):
+               known=None, **_):
         todo = [i for i in range(len(points)) if i not in set(skip)]
         seen.append(todo)
+        knowns.append(known)
         assert cheapest is True  # a new pass also starts from the study's cheapest stride
         for n, i in enumerate(todo):
             if stop_after is not None and n == stop_after:
                 raise KeyboardInterrupt
             improved = i % 2 == 1  # designs 2 and 4 get a better stride (10 % lower)
             on_design(i, {"point": points[i], "before": 1.0, "after": 0.9 if improved else 1.0,
-                          "from": "nb.json" if improved else None})
+                          "from": "nb.json" if improved else None,
+                          "tries": [{"from": "nb.json", "start": f"id {len(knowns)}"}]})
 
     monkeypatch.setattr(ce, "settle_strides", lambda *a, **k: settle(*a, stop_after=2, **k))
     with pytest.raises(KeyboardInterrupt):
@@ -259,6 +261,9 @@ def test_an_interrupted_settling_pass_is_recorded_and_resumed(tmp_path, monkeypa
     assert first["designs"] == 4 and first["sittings"] == 2
     (tmp_path / "timing.json").write_text('{"note": "written by hand", "segments": []}')
     settle_study(None, result, passes=1, jobs=1)  # a new pass: every design again
+    assert knowns[0] == knowns[1] == [{}, {}, {}, {}]  # the first pass knew no start
+    # the new pass knows each design's starts of the first (the resumed sitting's identity)
+    assert knowns[2] == [{"nb.json": "id 1"}] * 2 + [{"nb.json": "id 2"}] * 2
     walls = stage_walls(tmp_path)
     assert list(walls) == [settling_stage(2)] and walls[settling_stage(2)]["designs"] == 4
     assert json.loads((tmp_path / "timing.json").read_text())["note"] == "written by hand"

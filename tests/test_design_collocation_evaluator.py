@@ -3,6 +3,7 @@ stand-in (a real transfemoral solve takes minutes: docs/design.md has the measur
 
 from __future__ import annotations
 
+import dataclasses
 import json
 from pathlib import Path
 
@@ -233,7 +234,7 @@ def test_settling_keeps_the_lowest_objective_from_the_neighbours(fake, tmp_path,
     tries = rows[0].pop("tries")
     assert rows == [{"point": CENTRE, "before": 1.0, "after": 0.90,
                      "from": f"{ce.point_file_stem(far)}.json",
-                     "responses_before": {"delta_vx_m_per_s": 0.1}}]
+                     "responses_before": {"delta_vx_m_per_s": 0.1}, "unchanged": []}]
     # every start's stride is recorded, kept or not: the spread between local optima
     assert [t["from"] for t in tries] == [f"{ce.point_file_stem(p)}.json" for p in (near, far)]
     assert [t["objective"] for t in tries] == [0.95, 0.90]
@@ -281,6 +282,36 @@ def test_settling_also_starts_from_the_studys_cheapest_stride(fake, tmp_path, mo
     assert other._cheapest_other(CENTRE, other.settings(), []) is None
 
 
+def test_settling_does_not_solve_again_from_an_unchanged_start(fake, tmp_path, monkeypatch):
+    """A start whose stride is the one this design was last solved from (same identity: its
+    objective and whether it carries multipliers) is not solved again, and is listed as
+    unchanged; a changed start is solved, and each try records its start's identity."""
+    calls, _ = fake
+    ev = _evaluator(tmp_path)
+    near = {**CENTRE, "stiffness_kN_per_m": 32.0}
+    for p in (CENTRE, near):
+        ev(p)
+    stored = CollocationSolution.read(STRIDE)
+    monkeypatch.setattr(ce.CollocationEvaluator, "_stored",
+                        lambda self, point, spec, settings: (stored, None))
+    name = f"{ce.point_file_stem(near)}.json"
+    del calls[:]
+    row = ev.settle(CENTRE, neighbours=1)
+    identity = row["tries"][0]["start"]
+    assert identity == ce.start_identity(CollocationSolution.read(ev._stride_file(near)))
+    assert len(calls) == 1 and row["unchanged"] == []
+    row = ce.settle_strides(ev, [CENTRE], neighbours=1, known=[{name: identity}],
+                            progress=False)[0]
+    assert len(calls) == 1 and row["tries"] == [] and row["unchanged"] == [name]
+    assert row["after"] == row["before"] and row["from"] is None
+    row = ev.settle(CENTRE, neighbours=1, known={name: "1.0 primal"})  # it changed since
+    assert len(calls) == 2 and [t["from"] for t in row["tries"]] == [name]
+    # the same primal values with IPOPT's multipliers start elsewhere: another start
+    duals = dataclasses.replace(stored.nlp, multipliers=(np.zeros(3), np.zeros(2)))
+    with_duals = ce.start_identity(dataclasses.replace(stored, nlp=duals))
+    assert with_duals.endswith(" primal-dual") and ce.start_identity(stored).endswith(" primal")
+
+
 def test_settling_records_a_failed_start_without_responses(fake, tmp_path, monkeypatch):
     """A start that does not converge is recorded with IPOPT's status and no objective or
     responses, and the stored stride stays."""
@@ -296,9 +327,10 @@ def test_settling_records_a_failed_start_without_responses(fake, tmp_path, monke
     script.append((False, [], "Maximum_Iterations_Exceeded"))
     row = ev.settle(CENTRE, neighbours=1)
     assert row["from"] is None and row["after"] == row["before"]
-    assert row["tries"] == [{"from": f"{ce.point_file_stem(near)}.json", "converged": False,
-                             "status": "Maximum_Iterations_Exceeded", "objective": None,
-                             "warnings": [], "responses": None}]
+    start = ce.start_identity(CollocationSolution.read(ev._stride_file(near)))
+    assert row["tries"] == [{"from": f"{ce.point_file_stem(near)}.json", "start": start,
+                             "converged": False, "status": "Maximum_Iterations_Exceeded",
+                             "objective": None, "warnings": [], "responses": None}]
     assert ev._stride_file(CENTRE).read_bytes() == before
 
 

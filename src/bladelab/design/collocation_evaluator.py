@@ -340,7 +340,7 @@ class CollocationEvaluator:
         return None if best is None else best[1]
 
     def settle(self, point: Mapping[str, float], neighbours: int = 2,
-               cheapest: bool = False) -> dict:
+               cheapest: bool = False, known: Mapping[str, str] | None = None) -> dict:
         """Solve this design again from its ``neighbours`` nearest solved designs (and, with
         ``cheapest``, from the study's cheapest stride of another design, when it is not one
         of them) and keep the clean stride of lowest objective (rewriting its file). The
@@ -350,8 +350,12 @@ class CollocationEvaluator:
         "after"`` (objectives), ``"from"`` (the file that gave the kept stride, or None),
         ``"responses_before"`` (the stored stride's responses) and ``"tries"``: per start,
         ``{"from", "converged", "status", "objective", "warnings", "responses"}`` (responses
-        of a clean stride only). Every clean stride of a design is a local optimum of the same
-        problem: their spread is what the start decides (:mod:`bladelab.design.start_spread`)."""
+        of a clean stride only) and ``"start"`` (:func:`start_identity` of the start stride).
+        ``known``: start file name -> its identity when this design was last solved from it; a
+        start still the same is not solved again (IPOPT would retrace the same path) and is
+        listed under ``"unchanged"``. Every clean stride of a design is a local optimum of the
+        same problem: their spread is what the start decides
+        (:mod:`bladelab.design.start_spread`)."""
         point = {k: float(v) for k, v in point.items()}
         spec, settings = self._problem(point)
         current, _ = self._stored(point, spec, settings)
@@ -359,17 +363,22 @@ class CollocationEvaluator:
             raise SpecError("this design has no stored clean stride to settle",
                             where="settle", hint="evaluate the design first")
         runner = runner_from_spec(spec)
-        best, source, tries = current, None, []
+        best, source, tries, unchanged = current, None, [], []
         starts = self._neighbours(point)[:neighbours]
         if cheapest and (far := self._cheapest_other(point, settings, starts)) is not None:
             starts.append(far)
         for path in starts:
-            guess = CollocationSolution.read(path).to_guess(f"collocation solution {path.name}")
+            start = CollocationSolution.read(path)
+            identity = start_identity(start)
+            if (known or {}).get(path.name) == identity:
+                unchanged.append(path.name)
+                continue
+            guess = start.to_guess(f"collocation solution {path.name}")
             sol = predict_stride(runner, settings, guess, model_spec=spec, track=False)
             warnings = sol.gait_warnings() if sol.converged else []
             clean = sol.converged and not warnings
-            tries.append({"from": path.name, "converged": bool(sol.converged),
-                          "status": str(sol.nlp.status),
+            tries.append({"from": path.name, "start": identity,
+                          "converged": bool(sol.converged), "status": str(sol.nlp.status),
                           "objective": float(sol.nlp.objective) if sol.converged else None,
                           "warnings": list(warnings),
                           "responses": stride_responses(sol, runner) if clean else None})
@@ -379,7 +388,8 @@ class CollocationEvaluator:
             self._keep(best, point)
         return {"point": point, "before": float(current.nlp.objective),
                 "after": float(best.nlp.objective), "from": source,
-                "responses_before": stride_responses(current, runner), "tries": tries}
+                "responses_before": stride_responses(current, runner), "tries": tries,
+                "unchanged": unchanged}
 
     def settings(self):
         """The :class:`~bladelab.predict.collocation.settings.CollocationSettings` of every
@@ -524,14 +534,22 @@ def _continuable(solution) -> bool:
             and math.isfinite(nlp.max_violation) and nlp.max_violation < CONTINUE_MAX_VIOLATION)
 
 
+def start_identity(solution) -> str:
+    """What makes a start stride the same start: its objective to the last digit and whether
+    it carries IPOPT's multipliers (a stride stored without them starts elsewhere)."""
+    return (f"{float(solution.nlp.objective)!r} "
+            + ("primal" if solution.nlp.multipliers is None else "primal-dual"))
+
+
 def settle_design_point(payload: dict) -> dict:
     """One design's :meth:`CollocationEvaluator.settle` in a worker process."""
     return payload["evaluator"].settle(payload["point"], payload["neighbours"],
-                                       payload.get("cheapest", False))
+                                       payload.get("cheapest", False), payload.get("known"))
 
 
 def settle_strides(evaluator: CollocationEvaluator, points, *, neighbours: int = 2,
                    cheapest: bool = False, jobs: int = 1, progress: bool = True, skip=(),
+                   known: Sequence[Mapping[str, str]] | None = None,
                    on_design: Callable[[int, dict], None] | None = None) -> list[dict | None]:
     """One settling pass over a study's designs (:meth:`CollocationEvaluator.settle` for each
     point from its ``neighbours`` nearest strides and, with ``cheapest``, the study's cheapest
@@ -540,12 +558,14 @@ def settle_strides(evaluator: CollocationEvaluator, points, *, neighbours: int =
     evidence that its strides have settled (docs/design.md).
 
     ``skip``: indices of designs already settled in this pass (a resumed pass; their rows are
-    None in the result). ``on_design(i, row)`` is called in this process as each design
+    None in the result). ``known``: per point, the starts it was solved from before
+    (:meth:`CollocationEvaluator.settle`), not solved again while unchanged. ``on_design(i, row)`` is called in this process as each design
     finishes, so that a caller can record the pass as it goes."""
     skip = set(skip)
     todo = [i for i in range(len(points)) if i not in skip]
     payloads = [{"evaluator": evaluator, "point": dict(points[i]), "neighbours": int(neighbours),
-                 "cheapest": bool(cheapest)} for i in todo]
+                 "cheapest": bool(cheapest), "known": dict(known[i]) if known else None}
+                for i in todo]
     out: list[dict | None] = [None] * len(points)
     failed = []
     bar = tqdm(total=len(points), initial=len(points) - len(todo), desc="settling strides",

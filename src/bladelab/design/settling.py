@@ -15,7 +15,11 @@ pass where it stopped, skipping the designs it had settled. The record::
      "passes": [{"pass": 1, "complete": true, "largest_objective_drop": 0.004, "improved": 3,
                  "from_cheapest": true,
                  "designs": [{"run": 1, "point": {...}, "before": ..., "after": ...,
-                              "from": "<neighbour's stride>" | null, ...}, ...]}, ...]}
+                              "from": "<neighbour's stride>" | null, "tries": [...],
+                              "unchanged": [...]}, ...]}, ...]}
+
+A start a design was solved from in an earlier pass and whose stride has not changed since
+(:func:`~bladelab.design.collocation_evaluator.start_identity`) is not solved again.
 
 :func:`bladelab.design.start_spread.start_spread` reads it back.
 """
@@ -107,11 +111,25 @@ def read_settling_record(out: str | Path, points: Sequence[dict] | None = None) 
     return record
 
 
+def _known_starts(passes: Sequence[dict], n: int) -> list[dict[str, str]]:
+    """Per design (run 1 first): start file name -> the identity of that start when the
+    design was last solved from it, over the recorded ``passes`` (older records, without
+    identities, give none)."""
+    known: list[dict[str, str]] = [{} for _ in range(n)]
+    for rec in passes:
+        for row in rec.get("designs", []):
+            for t in row.get("tries", []):
+                if t.get("start") is not None:
+                    known[int(row["run"]) - 1][t["from"]] = t["start"]
+    return known
+
+
 def _run_pass(evaluator, points, current: dict, out: Path, *, jobs: int, save,
-              failed=frozenset()) -> bool:
+              failed=frozenset(), record_before: Sequence[dict] = ()) -> bool:
     """Settle the designs of pass ``current`` not yet in it (nor the ``failed`` run indices,
     which have no stride), recording each as it finishes (and the sitting's wall time in
-    ``timing.json``); True if a stride changed."""
+    ``timing.json``), skipping the starts unchanged since the passes ``record_before``; True
+    if a stride changed."""
     changed = False
     with timed_stage(out, settling_stage(current["pass"]), jobs=jobs) as sitting:
         def done(i: int, row: dict) -> None:
@@ -126,6 +144,7 @@ def _run_pass(evaluator, points, current: dict, out: Path, *, jobs: int, save,
         collocation_evaluator.settle_strides(
             evaluator, points, jobs=jobs, on_design=done,
             cheapest=bool(current.get("from_cheapest", False)),
+            known=_known_starts(record_before, len(points)),
             skip=[r["run"] - 1 for r in current["designs"]] + sorted(failed))
     return changed
 
@@ -171,7 +190,7 @@ def settle_study(evaluator, result, *, passes: int, jobs: int = 1,
             record.append(current)
             save()
         changed_any |= _run_pass(evaluator, points, current, out, jobs=jobs, save=save,
-                                 failed=failed)
+                                 failed=failed, record_before=record[:-1])
         worst = max(objective_drop(r) for r in current["designs"])
         current.update(complete=True, largest_objective_drop=worst,
                        improved=sum(r["from"] is not None for r in current["designs"]))
