@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import re
 from pathlib import Path
 
 import numpy as np
@@ -66,6 +67,11 @@ def fake(monkeypatch):
     monkeypatch.setattr(ce, "predict_stride", predict_stride)
     monkeypatch.setattr(ce, "stride_responses", lambda sol, runner: {"delta_vx_m_per_s": 0.1})
     return calls, script
+
+
+def _start_name(source: str) -> str:
+    """The stride file a solve's guess source names."""
+    return re.search(r"collocation solution (\S+\.json)", source)[1]
 
 
 def _evaluator(tmp_path, **kw):
@@ -247,8 +253,6 @@ def test_settling_also_starts_from_the_studys_cheapest_stride(fake, tmp_path, mo
     """With ``cheapest`` a design is also solved from the lowest-objective stride of another
     design of this problem (after its nearest neighbours), once, whether or not it is far;
     without it (the default of a pass recorded before) only the neighbours."""
-    import json
-
     calls, _ = fake
     base = CollocationSolution.read(STRIDE).settings  # every stored stride is this file
     ev = _evaluator(tmp_path, swing_clearance_m=base.swing_clearance_m,
@@ -306,6 +310,18 @@ def test_settling_does_not_solve_again_from_an_unchanged_start(fake, tmp_path, m
     assert row["after"] == row["before"] and row["from"] is None
     row = ev.settle(CENTRE, neighbours=1, known={name: "1.0 primal"})  # it changed since
     assert len(calls) == 2 and [t["from"] for t in row["tries"]] == [name]
+    # the design's stored stride says what it was solved from: a first pass knows that start
+    from bladelab.design.settling import _known_starts
+
+    own = ev._stride_file(CENTRE)
+    data = json.loads(own.read_text())
+    data["guess_source"] = f"collocation solution {name}, start {identity}"
+    own.write_text(json.dumps(data))
+    assert ev.solved_from(CENTRE) == {name: identity}
+    assert _known_starts([], [CENTRE, near], ev) == [{name: identity}, {}]
+    data["guess_source"] = f"collocation solution {name}, continued after 3000 iterations"
+    own.write_text(json.dumps(data))
+    assert ev.solved_from(CENTRE) == {}  # not one solve from that start as it was
     # the same primal values with IPOPT's multipliers start elsewhere: another start
     duals = dataclasses.replace(stored.nlp, multipliers=(np.zeros(3), np.zeros(2)))
     with_duals = ce.start_identity(dataclasses.replace(stored, nlp=duals))
@@ -360,7 +376,7 @@ def test_a_reference_weight_keeps_the_athletes_joints_near_the_start(fake, tmp_p
     _, script = fake
     script += [(False, [])] * 2 + [(True, [])]
     ev({**CENTRE, "width_m": 0.08})
-    assert [c["source"].split()[-1] for c in calls[-3:]] == [
+    assert [_start_name(c["source"]) for c in calls[-3:]] == [
         STRIDE.name, f"{ce.point_file_stem(CENTRE)}.json",
         f"{ce.point_file_stem({**CENTRE, 'width_m': 0.05})}.json"]
 
@@ -379,7 +395,7 @@ def test_a_design_tries_its_nearest_solved_neighbours_in_turn(fake, tmp_path):
     sources = [c["source"] for c in calls]
     assert len(sources) == ce.START_NEIGHBOURS + 2  # the neighbours, the start, tracking
     # nearest first: the two at distance 1, then the centre (1.41), never the far ones
-    assert {s.split()[-1] for s in sources[:2]} == {
+    assert {_start_name(s) for s in sources[:2]} == {
         f"{ce.point_file_stem(solved[1])}.json", f"{ce.point_file_stem(solved[4])}.json"}
     assert ce.point_file_stem(CENTRE) in sources[2]
     assert STRIDE.name in sources[3] and STRIDE.name in sources[4] and calls[4]["track"]

@@ -27,6 +27,7 @@ and the gait's defects (the study stops there with the finished runs kept: never
 from __future__ import annotations
 
 import math
+import re
 import time
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import asdict, dataclass, field
@@ -324,6 +325,16 @@ class CollocationEvaluator:
         near = self._neighbours(point)[:START_NEIGHBOURS]
         return [self.start_file, *near] if self.reference_weight else [*near, self.start_file]
 
+    def solved_from(self, point: Mapping[str, float]) -> dict[str, str]:
+        """{start file name: its identity} of the solve that gave this design's stored stride,
+        when that was one solve from another stride as it is (no tracking stage, not
+        continued); else {}."""
+        own = self._stride_file(point)
+        if own is None or not own.is_file():
+            return {}
+        match = _START_TEXT.match(CollocationSolution.read(own).guess_source or "")
+        return {match["name"]: match["id"]} if match else {}
+
     def _cheapest_other(self, point: Mapping[str, float], settings,
                         exclude: Sequence[Path]) -> Path | None:
         """The stored stride of another design of this problem with the lowest objective, not
@@ -373,7 +384,7 @@ class CollocationEvaluator:
             if (known or {}).get(path.name) == identity:
                 unchanged.append(path.name)
                 continue
-            guess = start.to_guess(f"collocation solution {path.name}")
+            guess = start.to_guess(_start_text(path, start))
             sol = predict_stride(runner, settings, guess, model_spec=spec, track=False)
             warnings = sol.gait_warnings() if sol.converged else []
             clean = sol.converged and not warnings
@@ -492,8 +503,8 @@ class CollocationEvaluator:
         t0 = time.perf_counter()
         for path, track in plan:
             source = CollocationSolution.read(path)
-            guess = source.to_guess(f"{'tracking ' if track else ''}collocation solution "
-                                    f"{path.name}")
+            guess = source.to_guess(f"tracking collocation solution {path.name}" if track
+                                    else _start_text(path, source))
             sol = predict_stride(runner, settings, guess, model_spec=spec, track=track)
             if _continuable(sol):  # one more round from where the iteration limit stopped it
                 sol = predict_stride(runner, settings, sol.to_guess(
@@ -539,6 +550,16 @@ def start_identity(solution) -> str:
     it carries IPOPT's multipliers (a stride stored without them starts elsewhere)."""
     return (f"{float(solution.nlp.objective)!r} "
             + ("primal" if solution.nlp.multipliers is None else "primal-dual"))
+
+
+#: A stride's guess source when it was solved from another stride as it is (``_start_text``).
+_START_TEXT = re.compile(r"^collocation solution (?P<name>\S+\.json), start (?P<id>.+)$")
+
+
+def _start_text(path: Path, start) -> str:
+    """The guess source of a solve from the stride ``start`` read from ``path``: its file and
+    its :func:`start_identity`, so that the solved stride says what it was solved from."""
+    return f"collocation solution {path.name}, start {start_identity(start)}"
 
 
 def settle_design_point(payload: dict) -> dict:

@@ -111,16 +111,22 @@ def read_settling_record(out: str | Path, points: Sequence[dict] | None = None) 
     return record
 
 
-def _known_starts(passes: Sequence[dict], n: int) -> list[dict[str, str]]:
+def _known_starts(passes: Sequence[dict], points: Sequence[dict],
+                  evaluator=None) -> list[dict[str, str]]:
     """Per design (run 1 first): start file name -> the identity of that start when the
     design was last solved from it, over the recorded ``passes`` (older records, without
-    identities, give none)."""
-    known: list[dict[str, str]] = [{} for _ in range(n)]
+    identities, give none) and the solve that gave its stored stride (the evaluator's
+    ``solved_from``)."""
+    known: list[dict[str, str]] = [{} for _ in points]
     for rec in passes:
         for row in rec.get("designs", []):
             for t in row.get("tries", []):
                 if t.get("start") is not None:
                     known[int(row["run"]) - 1][t["from"]] = t["start"]
+    solved_from = getattr(evaluator, "solved_from", None)
+    if solved_from is not None:
+        for i, point in enumerate(points):
+            known[i].update(solved_from(point))
     return known
 
 
@@ -144,7 +150,7 @@ def _run_pass(evaluator, points, current: dict, out: Path, *, jobs: int, save,
         collocation_evaluator.settle_strides(
             evaluator, points, jobs=jobs, on_design=done,
             cheapest=bool(current.get("from_cheapest", False)),
-            known=_known_starts(record_before, len(points)),
+            known=_known_starts(record_before, points, evaluator),
             skip=[r["run"] - 1 for r in current["designs"]] + sorted(failed))
     return changed
 
