@@ -18,7 +18,6 @@ import numpy as np
 import pandas as pd
 
 from bladelab._io import read_json
-from bladelab.design.collocation_evaluator import stride_checks
 from bladelab.design.optimum import SurfaceConstraint, constrained_optimum
 from bladelab.design.plots import contour_plot, figure_pairs, main_effects_plot
 from bladelab.design.responses import (
@@ -34,6 +33,7 @@ from bladelab.design.settling import (
 )
 from bladelab.design.space import DesignSpace
 from bladelab.design.start_spread import NEAR_PCT, start_spread
+from bladelab.design.stride_checks import stride_checks
 from bladelab.design.surfaces import fit_surface
 from bladelab.design.terms import parse_terms
 from bladelab.design.timing import stage_walls
@@ -96,7 +96,7 @@ def _load(design_dir: Path):
 def _stride_checks(design_dir: Path, evaluator: dict, space, table: pd.DataFrame
                    ) -> pd.DataFrame | None:
     """A collocation study's strides checked again (:func:`~bladelab.design.
-    collocation_evaluator.stride_checks`), one row per run, with ``excluded`` True for a run
+    stride_checks.stride_checks`), one row per run, with ``excluded`` True for a run
     whose stride carries gait warnings (a missing stride file cannot be checked: kept, and
     said); None for other evaluators."""
     if evaluator.get("evaluator") != "collocation":
