@@ -8,7 +8,9 @@ evaluated something appends one segment, rewritten atomically when it ends::
                    "wall_s": 960.2, "designs": 25, "jobs": 2}, ...]}
 
 A stage's wall time is the sum of its segments' (:func:`stage_walls`): the time the study
-held its workers, not the calendar time between its first and last sitting.
+held its workers, not the calendar time between its first and last sitting. ``designs`` counts
+what the sitting evaluated, a run read back from its stored stride included (after a settling
+pass the study reads its changed strides back: a "runs" sitting of seconds).
 """
 
 from __future__ import annotations
