@@ -249,6 +249,8 @@ def _design(
                                  param_hint="--out")
     # deferred: keeps bladelab --help fast
     from bladelab.cli.collocation import stride_time_settings
+
+    # deferred: keeps bladelab --help fast
     from bladelab.design import doe, settling, terms
 
     # deferred: keeps bladelab --help fast
