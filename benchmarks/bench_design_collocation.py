@@ -97,7 +97,9 @@ def _study(study: Path, runner: str, what: str) -> str:
     ]
     for rec in read_settling_record(study):
         if rec["complete"]:
-            lines.append(f"| settling pass {rec['pass']} (`--settle`, 2 solves per design) | "
+            starts = ("the 2 nearest strides and the cheapest" if rec.get("from_cheapest")
+                      else "the 2 nearest strides")
+            lines.append(f"| settling pass {rec['pass']} (`--settle`, from {starts}) | "
                          f"{rec['improved']} of {len(rec['designs'])} designs improved, largest "
                          f"objective drop {100 * rec['largest_objective_drop']:.1f} % ("
                          + ("settled: at most 1 %" if is_settled([rec])

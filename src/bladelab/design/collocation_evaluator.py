@@ -176,8 +176,8 @@ class CollocationEvaluator:
         Keep every design's stride time inside (lo, hi) [s], or inside measured runners' band
         at the speed (``CollocationSettings.stride_time_range_s`` /
         ``stride_time_people``): an athlete's cadence imposed, not predicted; free by default.
-        At people's stride time a design's strides from different starts agree more closely
-        than free ones (docs/design.md).
+        At people's stride time more strides meet people's criteria, but a design's strides
+        from different starts spread more than free ones (docs/design.md).
     people_weight
         Weight [1/rad²] of people's joint angles in the objective (the intact leg's hip, knee
         and ankle and the residual hip (and knee); ``CollocationSettings(reference="people")``,

@@ -178,9 +178,10 @@ TREND_REASONS: dict[tuple[str, str], str] = {
     # the transtibial runner on the human body (``--amputation transtibial``), measured on its
     # 25-run study (docs/design.md, "Predicted transtibial strides")
     ("collocation-transtibial", "stiffness_increases_dvx"): (
-        _TT_SCATTER + "Before five of its strides were replaced by cheaper ones from a farther "
-        "start, the stiffness effect had the seed's sign (+0.021 m/s per coded unit, p 0.002); "
-        "after, +0.011 (p 0.14, first-order fit): the start, not the blade, decided it."),
+        _TT_SCATTER + "In the free-stride study, before five of its strides were replaced by "
+        "cheaper ones from a farther start, the stiffness effect had the seed's sign (+0.021 m/s "
+        "per coded unit, p 0.002); after, +0.011 (p 0.14, first-order fit): the start, not the "
+        "blade, decided it. At people's stride time it is +0.004 (p 0.73)."),
     ("collocation-transtibial", "width_increases_dvx"): (
         _TT_SCATTER + "At a fixed target stiffness the blade generator lets width change only "
         "the blade's mass and sole contact; in seed 002 width also changed the "
