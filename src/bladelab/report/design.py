@@ -361,6 +361,10 @@ def _settling_text(design_dir: Path) -> str:
     passes = read_settling_record(design_dir)
     done = [p for p in passes if p.get("complete")]
     text = f"Settling: {len(done)} complete pass{'es' if len(done) != 1 else ''}"
+    cheapest = [str(p["pass"]) for p in passes if p.get("from_cheapest")]
+    if cheapest:
+        text += (f" (pass{'es' if len(cheapest) > 1 else ''} {', '.join(cheapest)} also from "
+                 "the study's cheapest stride, besides each design's two nearest)")
     if done:
         text += (f", the last lowering no objective by more than "
                  f"{100 * done[-1]['largest_objective_drop']:.2f} %")
@@ -370,10 +374,6 @@ def _settling_text(design_dir: Path) -> str:
                  if r.get("before") and r.get("after") is not None]
         text += (f"; pass {open_pass['pass']} stopped after {len(open_pass['designs'])} designs"
                  + (f" (largest drop {100 * max(drops):.2f} %)" if drops else ""))
-    cheapest = [str(p["pass"]) for p in passes if p.get("from_cheapest")]
-    if cheapest:
-        text += (f" (pass{'es' if len(cheapest) > 1 else ''} {', '.join(cheapest)} also from "
-                 "the study's cheapest stride, besides each design's two nearest)")
     text += (": settled (below 1 %)." if is_settled(passes) else
              ": not settled, the responses may still move (resume with --settle).")
     return text + _timing_text(design_dir)
