@@ -84,7 +84,8 @@ def _study(study: Path, runner: str, what: str) -> str:
         "|---|---|",
         f"| study wall time, 2 workers | {info.get('wall_s', float('nan')) / 60:.1f} min "
         f"({info.get('date', 'date not recorded')}) |",
-        f"| designs solved (strides stored; the centre is the built-in start, read back) | "
+        f"| designs solved (strides stored; a design whose problem is the built-in start's "
+        f"reads it back) | "
         f"{len(rows)} |",
         f"| … of which flagged by today's gait checks (left out of the report's surfaces) | "
         f"{flagged} |",
