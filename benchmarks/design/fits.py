@@ -73,7 +73,8 @@ def main() -> None:
     ap.add_argument("--json", type=Path, default=None)
     args = ap.parse_args()
     fits = study_fits(args.study)
-    print("| response | range | R² / R²pred quadratic | R² / R²pred first-order | start ceiling "
+    print("| response | range | R² / R²pred quadratic | R² / R²pred first-order "
+          "| start ceiling "
           "| stiffness | width | height | toe |")
     print("|---|---|---|---|---|---|---|---|---|")
     for name, f in fits.items():

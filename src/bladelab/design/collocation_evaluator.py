@@ -578,8 +578,9 @@ def settle_strides(evaluator: CollocationEvaluator, points, *, neighbours: int =
 
     ``skip``: indices of designs already settled in this pass (a resumed pass; their rows are
     None in the result). ``known``: per point, the starts it was solved from before
-    (:meth:`CollocationEvaluator.settle`), not solved again while unchanged. ``on_design(i, row)`` is called in this process as each design
-    finishes, so that a caller can record the pass as it goes."""
+    (:meth:`CollocationEvaluator.settle`), not solved again while unchanged.
+    ``on_design(i, row)`` is called in this process as each design finishes, so that a caller
+    can record the pass as it goes."""
     skip = set(skip)
     todo = [i for i in range(len(points)) if i not in skip]
     payloads = [{"evaluator": evaluator, "point": dict(points[i]), "neighbours": int(neighbours),

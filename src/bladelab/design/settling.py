@@ -1,10 +1,11 @@
 """Settling passes over a predicted-gait design study, and their record ``settling.json``.
 
 A settling pass solves each design's stride again from its two nearest neighbours' strides and
-the study's cheapest stride of another design, and keeps the lowest objective (:func:`bladelab.design.collocation_evaluator.settle_strides`); the run
-files of the designs whose stride changed are removed, so that the study reads their new
-responses back (:func:`settle_study` returns whether it must). ``bladelab design --evaluator
-collocation --settle K`` runs up to K passes.
+the study's cheapest stride of another design, and keeps the lowest objective
+(:func:`bladelab.design.collocation_evaluator.settle_strides`); the run files of the designs
+whose stride changed are removed, so that the study reads their new responses back
+(:func:`settle_study` returns whether it must). ``bladelab design --evaluator collocation
+--settle K`` runs up to K passes.
 
 A pass takes hours on two cores, so it is recorded design by design: ``settling.json`` (in the
 study's folder) is rewritten atomically as each design finishes, with ``"complete": false``
@@ -36,8 +37,8 @@ from bladelab.design.study import DesignStudyResult, run_design, run_file
 from bladelab.design.timing import settling_stage, timed_stage
 from bladelab.errors import InputFileError
 
-__all__ = ["RECORD_NAME", "SETTLED_REL", "SETTLE_FROM_CHEAPEST", "SettlingOutcome", "is_settled", "objective_drop",
-           "read_settling_record", "run_settled_design", "settle_study"]
+__all__ = ["RECORD_NAME", "SETTLED_REL", "SETTLE_FROM_CHEAPEST", "SettlingOutcome", "is_settled",
+           "objective_drop", "read_settling_record", "run_settled_design", "settle_study"]
 
 #: A pass that lowers no design's objective by more than this fraction [-] has settled.
 SETTLED_REL = defaults.SETTLED_REL

@@ -371,8 +371,9 @@ def run_design(
             point = space.point(design.coded[i])
             if err is not None:
                 why = err.message if isinstance(err, BladelabError) else str(err)
-                write_json(failed_run_file(out, i), {"run": i + 1, "coded": design.coded[i].tolist(),
-                                                     "point": point, "error": why})
+                write_json(failed_run_file(out, i),
+                           {"run": i + 1, "coded": design.coded[i].tolist(), "point": point,
+                            "error": why})
                 failed[i] = why
                 failed_now.append(f"run {i + 1} ({_point_text(point)}): {why}")
                 if isinstance(err, BladelabError) and not skip_failed:  # serial: stop at once
