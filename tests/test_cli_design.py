@@ -422,3 +422,12 @@ def test_design_report_shows_what_the_start_decides(study, tmp_path):
     fits = dict(sections["Design study: response surfaces"]["tables"])["Surface fits"]
     assert fits.set_index("response").loc["delta_vx_m_per_s",
                                           "R2 ceiling (start spread)"] == 0.0
+    assert "stride_objective" not in spread["text"]  # a study without it as a response
+    # with the objective a response of the study, the section says what its spread means
+    table.assign(stride_objective=np.linspace(1.0, 2.0, len(table))).to_csv(
+        copy / "results.csv", index=False)
+    spread = {s["title"]: s for s in design_report_sections(copy)}[
+        "Design study: what the solver's start decides"]
+    assert "stride_objective" in dict(spread["tables"])["Start spread of the responses"][
+        "response"].tolist()
+    assert "stride_objective is the value each solve minimised" in spread["text"]

@@ -36,6 +36,15 @@ def test_every_response_has_its_unit(stride):
     assert all(np.isfinite(v) for v in res.values())
 
 
+def test_the_stride_objective_is_the_solved_value_and_holds_its_energy_term(stride):
+    """The objective is the solution's own; with the metabolic weight 1 and every other term
+    a non-negative mean (effort, squared accelerations), it is at least the cost of transport."""
+    sol, _, res = stride
+    assert res["stride_objective"] == sol.nlp.objective
+    assert sol.settings.weights.metabolic == 1.0
+    assert res["stride_objective"] >= res["cost_of_transport_J_per_kg_m"]
+
+
 def test_impulses_change_the_momentum_of_the_centre_of_mass(stride):
     """Newton over the prosthetic stance: m·Δv of the centre of mass (MuJoCo's, from the
     nodes' states) equals the prosthetic impulses plus the intact leg's over the same window,

@@ -37,6 +37,8 @@ def test_design_strides_are_distinct_clean_and_sorted():
     assert [o for o, _ in strides[1]] == [1.9, 1.95, 2.0]  # 1.9 once; the unclean try left out
     assert [r["y"] for _, r in strides[1]] == [3.0, 2.0, 1.0]
     assert [r["y"] for _, r in strides[2]] == [2.0, 2.0, 5.0]
+    # the objective is a response of its own (records written before it was one lack it)
+    assert [r["stride_objective"] for _, r in strides[1]] == [1.9, 1.95, 2.0]
 
 
 def test_pooled_spread_and_ceiling(tmp_path):

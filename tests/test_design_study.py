@@ -100,6 +100,35 @@ def test_interrupted_study_resumes(tmp_path):
         run_design(SPACE, runs="ccd", evaluator=_evaluator, out_dir=tmp_path, progress=False)
 
 
+class _Named:
+    """An evaluator that names its responses; ``extra`` adds one (a newer library's)."""
+
+    def __init__(self, extra: bool):
+        self.extra, self.calls = extra, 0
+
+    @property
+    def response_names(self):
+        return tuple(_evaluator(SPACE.point(np.zeros(4)))) + (("added_m",) if self.extra else ())
+
+    def __call__(self, point):
+        self.calls += 1
+        out = _evaluator(point)
+        return {**out, "added_m": 1.0} if self.extra else out
+
+
+def test_stored_runs_without_a_newer_response_are_evaluated_again(tmp_path):
+    older = _Named(extra=False)
+    run_design(SPACE, runs="bbd", evaluator=older, out_dir=tmp_path, progress=False)
+    again = run_design(SPACE, runs="bbd", evaluator=older, out_dir=tmp_path, progress=False)
+    assert again.n_resumed == 25 and older.calls == 25  # read back, not evaluated
+    newer = _Named(extra=True)
+    res = run_design(SPACE, runs="bbd", evaluator=newer, out_dir=tmp_path, progress=False)
+    assert res.n_resumed == 0 and res.n_evaluated == 25 and newer.calls == 25
+    assert "added_m" in pd.read_csv(tmp_path / "results.csv")
+    run = json.loads((tmp_path / "runs" / "run_0001.json").read_text())
+    assert run["responses"]["added_m"] == 1.0
+
+
 def test_refusals_before_and_during_evaluation(tmp_path):
     runs = tmp_path / "nine.csv"
     rng = np.random.default_rng(0)

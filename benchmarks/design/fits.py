@@ -26,8 +26,8 @@ from bladelab.design.start_spread import start_spread
 from bladelab.design.surfaces import fit_surface
 
 FACTORS = ("stiffness_kN_per_m", "width_m", "height_m", "toe_length_m")
-RESPONSES = ("cost_of_transport_J_per_kg_m", "delta_vx_m_per_s", "evaluation_E_m",
-             "impulse_z_Ns", "knee_moment_min_Nm", "swing_clearance_m",
+RESPONSES = ("stride_objective", "cost_of_transport_J_per_kg_m", "delta_vx_m_per_s",
+             "evaluation_E_m", "impulse_z_Ns", "knee_moment_min_Nm", "swing_clearance_m",
              "contact_time_prosthetic_s")
 
 

@@ -282,6 +282,12 @@ class CollocationEvaluator:
     def units(self) -> dict[str, str]:
         return dict(PREDICTED_RESPONSE_UNITS)
 
+    @property
+    def response_names(self) -> tuple[str, ...]:
+        """The responses of a design: a stored run without all of them (an older library's)
+        is evaluated again by the study, which reads its stored stride back."""
+        return tuple(PREDICTED_RESPONSE_UNITS)
+
     def to_dict(self) -> dict:
         d = asdict(self)
         d["generator"] = {k: str(v) if isinstance(v, Path) else v

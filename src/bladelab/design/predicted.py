@@ -19,7 +19,16 @@ CollocationSolution` of the periodic stride and returns (name, unit):
                                                the middle half of its swing
 ``contact_time_prosthetic_s``       s          the stance's duration
 ``cost_of_transport_J_per_kg_m``    J/(kg·m)   the solution's metabolic cost of transport
+``stride_objective``                -          the optimum's value: the stride's objective
+                                               (energy, effort, accelerations and people's
+                                               angles, weighted; the settings' terms)
 ==================================  =========  ==============================================
+
+The stride objective is the value the solver minimised, and so, of a design's local optima, the
+response that the start moves least; every other response is a feature of the optimal stride
+(its argmin), which near-equal optima can share out differently: two strides of one blade 0.1 %
+apart in objective can differ by 1.5 % in cost of transport (docs/design.md, "What the start
+decides").
 
 The stance is the longest loaded stretch (vertical force above 20 N, the analyses' threshold)
 of the prosthetic leg's periodic force, the node values interpolated linearly on a grid 20
@@ -160,4 +169,5 @@ def stride_responses(solution, runner, *, cm=None) -> dict[str, float]:
         "swing_clearance_m": float(heights[mid].min()),
         "contact_time_prosthetic_s": float(idx.size * dt),
         "cost_of_transport_J_per_kg_m": solution.cost_of_transport_J_per_kg_m,
+        "stride_objective": float(nlp.objective),
     }

@@ -53,4 +53,5 @@ PREDICTED_RESPONSE_UNITS: dict[str, str] = {
         "impulse_z_net_Ns", "evaluation_E_m", "knee_moment_min_Nm", "swing_clearance_m")},
     "contact_time_prosthetic_s": "s",
     "cost_of_transport_J_per_kg_m": "J/(kg·m)",
+    "stride_objective": "-",
 }

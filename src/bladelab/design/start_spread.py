@@ -49,7 +49,8 @@ SAME_STRIDE_REL = 1e-9
 
 def design_strides(record: Mapping) -> dict[int, list[tuple[float, dict]]]:
     """Run number -> distinct clean strides of that design, as (objective, responses), from
-    a settling record (``settling.json``'s contents), lowest objective first."""
+    a settling record (``settling.json``'s contents), lowest objective first; the responses
+    include the objective as ``stride_objective`` (older records lack it)."""
     found: dict[int, list[tuple[float, dict]]] = {}
     for rec in record.get("passes", []):
         for row in rec.get("designs", []):
@@ -61,6 +62,7 @@ def design_strides(record: Mapping) -> dict[int, list[tuple[float, dict]]]:
                 if t.get("responses") is not None and t.get("objective") is not None:
                     cand.append((float(t["objective"]), t["responses"]))
             for obj, resp in cand:
+                resp = {**resp, "stride_objective": obj}  # records before it was a response
                 if not any(abs(obj - o) <= SAME_STRIDE_REL * max(abs(o), 1.0)
                            for o, _ in strides):
                     strides.append((obj, dict(resp)))

@@ -310,6 +310,10 @@ def run_design(
         recorded as failed before are not evaluated again, and the surfaces are fitted to the
         runs that finished (refused, naming the failed runs, if those cannot estimate the
         model); ``failed.csv`` lists them.
+
+    A stored run is read back, not evaluated again, unless the evaluator names the responses it
+    gives (``evaluator.response_names``) and the run lacks one of them (stored by an older
+    evaluator; a collocation design then reads its stored stride back).
     """
     if not callable(evaluator):
         raise SpecError("evaluator must be callable", where="evaluator")
@@ -349,8 +353,11 @@ def run_design(
     failed: dict[int, str] = {}  # run index -> reason
     n_resumed = n_evaluated = 0
     expected: list[str] | None = None
+    names = getattr(evaluator, "response_names", None)  # responses an evaluator always gives
     for i in range(design.n_runs):
         r = _read_run(run_file(out, i), design.coded[i])
+        if r is not None and names is not None and set(r) != set(names):
+            r = None  # stored by an older evaluator: evaluated again
         if r is not None:
             results[i] = r
             n_resumed += 1

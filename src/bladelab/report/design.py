@@ -459,6 +459,13 @@ def _spread_section(spread: pd.DataFrame) -> dict[str, Any]:
             "the kept stride is the best found, not a random one); r2_ceiling_near the same "
             "from within_sd_near, the ceiling if every design were solved that close to its "
             "best.")
+    if "stride_objective" in set(spread["response"]):
+        text += (" stride_objective is the value each solve minimised: the kept stride is a "
+                 "design's lowest, so its own start error is the gap to a lower optimum not "
+                 "found yet (what a settling pass measures), smaller than within_sd, which "
+                 "also pools the dearer optima. Every other response is a feature of "
+                 "whichever optimum was kept, and near-equal optima can differ in it by more "
+                 "than the designs do.")
     if n_designs < ROUGH_SPREAD_DESIGNS:
         text += (f" With {n_designs} designs the spread is a rough estimate: settle more "
                  "designs (--settle) before reading the ceilings.")
