@@ -1,5 +1,8 @@
 """Fits of a predicted-gait design study, side by side: quadratic and first-order R²pred, the
-start spread's R² ceiling, and the first-order effects per coded unit with their p-values.
+start spread's R² ceiling (all of a design's clean strides; those within 5 % of its best; for
+the stride objective also from the last complete settling pass's drops, the error of a kept
+optimum rather than the spread of every optimum found), and the first-order effects per coded
+unit with their p-values.
 
 Reads a study folder as committed (``results.csv``, ``settling.json``); solves nothing. The
 report gives the quadratic fits and the start spread; this adds the first-order fits that
@@ -42,6 +45,20 @@ def _first_order(coded: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarr
     return beta[1:], 2 * stats.t.sf(np.abs(t[1:]), dof)
 
 
+def last_pass_ceiling(study: Path, y: np.ndarray) -> float | None:
+    """R² ceiling of the stride objective from the last complete settling pass: each design's
+    kept objective is off its best by what a further pass would still lower it, estimated as
+    the RMS of that pass's drops (relative, times the mean objective) against the spread
+    across the box. None without a complete pass."""
+    record = json.loads((study / "settling.json").read_text(encoding="utf-8"))
+    done = [p for p in record.get("passes", []) if p.get("complete")]
+    if not done:
+        return None
+    drops = np.array([1.0 - r["after"] / r["before"] for r in done[-1]["designs"]])
+    sd = float(np.sqrt(np.mean(drops ** 2))) * float(np.mean(y))
+    return max(0.0, 1.0 - sd ** 2 / float(np.var(y, ddof=1)))
+
+
 def study_fits(study: Path) -> dict:
     """Per response: R², R²pred of the quadratic and first-order fits, the start ceiling, and
     the first-order effects with p-values."""
@@ -49,6 +66,7 @@ def study_fits(study: Path) -> dict:
     coded = table[[f"{f}_coded" for f in FACTORS]].to_numpy(float)
     spread = start_spread(study, units=PREDICTED_RESPONSE_UNITS)
     ceiling = dict(zip(spread["response"], spread["r2_ceiling"], strict=True))
+    near = dict(zip(spread["response"], spread["r2_ceiling_near"], strict=True))
     out = {}
     for name in RESPONSES:
         if name not in table:
@@ -61,6 +79,9 @@ def study_fits(study: Path) -> dict:
                      "quadratic_r2": quad.r2, "quadratic_r2_pred": quad.r2_pred,
                      "linear_r2": lin.r2, "linear_r2_pred": lin.r2_pred,
                      "start_ceiling": ceiling.get(name),
+                     "start_ceiling_near": near.get(name),
+                     "last_pass_ceiling": (last_pass_ceiling(study, y)
+                                           if name == "stride_objective" else None),
                      "range": [float(y.min()), float(y.max())],
                      "effects": {f: {"per_coded_unit": float(e), "p": float(q)}
                                  for f, e, q in zip(FACTORS, effects, p, strict=True)}}
@@ -74,13 +95,16 @@ def main() -> None:
     args = ap.parse_args()
     fits = study_fits(args.study)
     print("| response | range | R² / R²pred quadratic | R² / R²pred first-order "
-          "| start ceiling "
+          "| start ceiling (within 5 %; last pass) "
           "| stiffness | width | height | toe |")
     print("|---|---|---|---|---|---|---|---|---|")
     for name, f in fits.items():
         eff = " | ".join(f"{e['per_coded_unit']:+.3g} (p {e['p']:.2g})"
                          for e in f["effects"].values())
-        ceil = "–" if f["start_ceiling"] is None else f"{f['start_ceiling']:.2f}"
+        ceil = "–" if f["start_ceiling"] is None else (
+            f"{f['start_ceiling']:.2f} ({f['start_ceiling_near']:.2f}"
+            + ("" if f["last_pass_ceiling"] is None else f"; {f['last_pass_ceiling']:.2f}")
+            + ")")
         print(f"| {name} [{f['unit']}] | {f['range'][0]:.4g} … {f['range'][1]:.4g} | "
               f"{f['quadratic_r2']:.2f} / {f['quadratic_r2_pred']:.2f} | "
               f"{f['linear_r2']:.2f} / {f['linear_r2_pred']:.2f} | {ceil} | {eff} |")
