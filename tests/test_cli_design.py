@@ -211,7 +211,7 @@ def test_an_interrupted_settling_pass_is_recorded_and_resumed(tmp_path, monkeypa
 
     import numpy as np
 
-    import bladelab.design.collocation_evaluator as ce
+    from bladelab.design import settling
     from bladelab.design.settling import RECORD_NAME, settle_study
     from bladelab.design.space import default_design_space
     from bladelab.design.study import run_file
@@ -239,7 +239,7 @@ def test_an_interrupted_settling_pass_is_recorded_and_resumed(tmp_path, monkeypa
                           "from": "nb.json" if improved else None,
                           "tries": [{"from": "nb.json", "start": f"id {len(knowns)}"}]})
 
-    monkeypatch.setattr(ce, "settle_strides", lambda *a, **k: settle(*a, stop_after=2, **k))
+    monkeypatch.setattr(settling, "settle_strides", lambda *a, **k: settle(*a, stop_after=2, **k))
     with pytest.raises(KeyboardInterrupt):
         settle_study(None, result, passes=1, jobs=1)
     record = json.loads((tmp_path / RECORD_NAME).read_text())["passes"]
@@ -247,7 +247,7 @@ def test_an_interrupted_settling_pass_is_recorded_and_resumed(tmp_path, monkeypa
     assert record[0]["from_cheapest"] is True
     assert run_file(tmp_path, 0).is_file() and not run_file(tmp_path, 1).exists()
 
-    monkeypatch.setattr(ce, "settle_strides", settle)
+    monkeypatch.setattr(settling, "settle_strides", settle)
     outcome = settle_study(None, result, passes=1, jobs=1)
     assert outcome.changed and outcome.passes == 1  # design 4 changed
     assert seen[-1] == [2, 3]  # resumed: only the designs the pass had not reached
@@ -272,7 +272,7 @@ def test_an_interrupted_settling_pass_is_recorded_and_resumed(tmp_path, monkeypa
     assert len(json.loads((tmp_path / RECORD_NAME).read_text())["passes"]) == 2
     # that pass lowered design 4 by 10 %: not settled, so a further pass runs; once a pass
     # lowers nothing by more than 1 %, the study is settled and --settle runs no more
-    monkeypatch.setattr(ce, "settle_strides", lambda evaluator, points, *, skip=(),
+    monkeypatch.setattr(settling, "settle_strides", lambda evaluator, points, *, skip=(),
                         on_design=None, **_: [
                             on_design(i, {"point": points[i], "before": 1.0, "after": 0.995,
                                           "from": "nb.json"}) for i in range(len(points))])

@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 
 from bladelab.design import collocation_evaluator as ce
+from bladelab.design import settling
 from bladelab.design.evaluators import make_evaluator
 from bladelab.errors import InputFileError, OptimizationError, SpecError
 from bladelab.predict.collocation.solution import CollocationSolution
@@ -236,7 +237,7 @@ def test_settling_keeps_the_lowest_objective_from_the_neighbours(fake, tmp_path,
 
     monkeypatch.setattr(ce.CollocationEvaluator, "_stored", stored)
     monkeypatch.setattr(ce, "predict_stride", solve)
-    rows = ce.settle_strides(ev, [CENTRE], neighbours=2, progress=False)
+    rows = settling.settle_strides(ev, [CENTRE], neighbours=2, progress=False)
     tries = rows[0].pop("tries")
     assert rows == [{"point": CENTRE, "before": 1.0, "after": 0.90,
                      "from": f"{ce.point_file_stem(far)}.json",
@@ -272,7 +273,7 @@ def test_settling_also_starts_from_the_studys_cheapest_stride(fake, tmp_path, mo
     monkeypatch.setattr(ce.CollocationEvaluator, "_stored",
                         lambda self, point, spec, settings: (stored, None))
     del calls[:]
-    row = ce.settle_strides(ev, [CENTRE], neighbours=1, cheapest=True, progress=False)[0]
+    row = settling.settle_strides(ev, [CENTRE], neighbours=1, cheapest=True, progress=False)[0]
     assert [t["from"] for t in row["tries"]] == [f"{ce.point_file_stem(p)}.json"
                                                  for p in (near, cheap)]
     assert len(calls) == 2
@@ -280,7 +281,7 @@ def test_settling_also_starts_from_the_studys_cheapest_stride(fake, tmp_path, mo
     row = ev.settle(CENTRE, neighbours=3, cheapest=True)
     assert [t["from"] for t in row["tries"]].count(f"{ce.point_file_stem(cheap)}.json") == 1
     assert len(row["tries"]) == 3
-    row = ce.settle_strides(ev, [CENTRE], neighbours=1, progress=False)[0]
+    row = settling.settle_strides(ev, [CENTRE], neighbours=1, progress=False)[0]
     assert [t["from"] for t in row["tries"]] == [f"{ce.point_file_stem(near)}.json"]
     other = _evaluator(tmp_path)  # another problem: none of the stored strides is its
     assert other._cheapest_other(CENTRE, other.settings(), []) is None
@@ -304,12 +305,17 @@ def test_settling_does_not_solve_again_from_an_unchanged_start(fake, tmp_path, m
     identity = row["tries"][0]["start"]
     assert identity == ce.start_identity(CollocationSolution.read(ev._stride_file(near)))
     assert len(calls) == 1 and row["unchanged"] == []
-    row = ce.settle_strides(ev, [CENTRE], neighbours=1, known=[{name: identity}],
-                            progress=False)[0]
+    row = settling.settle_strides(ev, [CENTRE], neighbours=1, known=[{name: identity}],
+                                  progress=False)[0]
     assert len(calls) == 1 and row["tries"] == [] and row["unchanged"] == [name]
     assert row["after"] == row["before"] and row["from"] is None
-    row = ev.settle(CENTRE, neighbours=1, known={name: "1.0 primal"})  # it changed since
+    lines = []  # a line per start, skipped or solved
+    ev.settle(CENTRE, neighbours=1, known={name: identity}, say=lines.append)
+    row = ev.settle(CENTRE, neighbours=1, known={name: "1.0 primal"},  # it changed since
+                    say=lines.append)
     assert len(calls) == 2 and [t["from"] for t in row["tries"]] == [name]
+    assert len(lines) == 2 and all(f"start 1 of 1 ({name})" in line for line in lines)
+    assert "skipped" in lines[0] and "objective" in lines[1] and lines[1].endswith(" s")
     # the design's stored stride says what it was solved from: a first pass knows that start
     from bladelab.design.settling import _known_starts
 

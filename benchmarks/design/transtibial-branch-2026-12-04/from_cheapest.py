@@ -26,11 +26,8 @@ from pathlib import Path
 import pandas as pd
 
 from bladelab._io import read_json, write_json
-from bladelab.design.collocation_evaluator import (
-    CollocationEvaluator,
-    point_file_stem,
-    settle_strides,
-)
+from bladelab.design.collocation_evaluator import CollocationEvaluator, point_file_stem
+from bladelab.design.settling import settle_strides
 
 HERE = Path(__file__).resolve().parent
 STUDY = HERE.parent / "transtibial-collocation-4mps"

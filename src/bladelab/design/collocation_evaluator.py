@@ -34,14 +34,11 @@ from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any, ClassVar
 
-from tqdm.auto import tqdm
-
 from bladelab.design import defaults
 from bladelab.design.blade_generator import generate_blade
 from bladelab.design.predicted import stride_responses
 from bladelab.design.responses import PREDICTED_RESPONSE_UNITS
 from bladelab.errors import InputFileError, OptimizationError, SpecError
-from bladelab.executors import make_executor
 from bladelab.predict import defaults as predict_defaults
 from bladelab.predict.collocation.settings import CollocationSettings, people_term
 from bladelab.predict.collocation.solution import CollocationSolution
@@ -50,7 +47,7 @@ from bladelab.predict.collocation.stored import check_model_spec, runner_from_sp
 from bladelab.runner.params import BODIES
 
 __all__ = ["CollocationEvaluator", "DEFAULT_BODY", "DEFAULT_DESIGN_SPEED_MPS", "DEFAULT_STARTS",
-           "REFERENCE_DOFS", "settle_strides", "start_identity"]
+           "REFERENCE_DOFS", "start_identity"]
 
 #: Prescribed speed of a design's stride [m/s] (our choice, docs/design.md "Predicted
 #: transfemoral gaits"): the transfemoral runner's maximum speed on collocation is 5.6–5.8 m/s
@@ -355,7 +352,8 @@ class CollocationEvaluator:
         return None if best is None else best[1]
 
     def settle(self, point: Mapping[str, float], neighbours: int = 2,
-               cheapest: bool = False, known: Mapping[str, str] | None = None) -> dict:
+               cheapest: bool = False, known: Mapping[str, str] | None = None,
+               say: Callable[[str], None] | None = None) -> dict:
         """Solve this design again from its ``neighbours`` nearest solved designs (and, with
         ``cheapest``, from the study's cheapest stride of another design, when it is not one
         of them) and keep the clean stride of lowest objective (rewriting its file). The
@@ -370,7 +368,8 @@ class CollocationEvaluator:
         start still the same is not solved again (IPOPT would retrace the same path) and is
         listed under ``"unchanged"``. Every clean stride of a design is a local optimum of the
         same problem: their spread is what the start decides
-        (:mod:`bladelab.design.start_spread`)."""
+        (:mod:`bladelab.design.start_spread`). ``say(line)`` gets one line per start (its
+        outcome and wall time)."""
         point = {k: float(v) for k, v in point.items()}
         spec, settings = self._problem(point)
         current, _ = self._stored(point, spec, settings)
@@ -382,16 +381,26 @@ class CollocationEvaluator:
         starts = self._neighbours(point)[:neighbours]
         if cheapest and (far := self._cheapest_other(point, settings, starts)) is not None:
             starts.append(far)
-        for path in starts:
+        name = point_file_stem(point)
+        for k, path in enumerate(starts, 1):
             start = CollocationSolution.read(path)
             identity = start_identity(start)
+            head = f"{name}: start {k} of {len(starts)} ({path.name})"
             if (known or {}).get(path.name) == identity:
                 unchanged.append(path.name)
+                if say is not None:
+                    say(f"{head}: unchanged since this design was solved from it, skipped")
                 continue
             guess = start.to_guess(_start_text(path, start))
+            t0 = time.perf_counter()
             sol = predict_stride(runner, settings, guess, model_spec=spec, track=False)
             warnings = sol.gait_warnings() if sol.converged else []
             clean = sol.converged and not warnings
+            if say is not None:
+                said = (f"objective {sol.nlp.objective:.5g} (stored {current.nlp.objective:.5g})"
+                        if clean else f"IPOPT {sol.nlp.status}" if not sol.converged
+                        else "flagged: " + "; ".join(warnings))
+                say(f"{head}: {said}, {time.perf_counter() - t0:.0f} s")
             tries.append({"from": path.name, "start": identity,
                           "converged": bool(sol.converged), "status": str(sol.nlp.status),
                           "objective": float(sol.nlp.objective) if sol.converged else None,
@@ -564,49 +573,3 @@ def _start_text(path: Path, start) -> str:
     """The guess source of a solve from the stride ``start`` read from ``path``: its file and
     its :func:`start_identity`, so that the solved stride says what it was solved from."""
     return f"collocation solution {path.name}, start {start_identity(start)}"
-
-
-def settle_design_point(payload: dict) -> dict:
-    """One design's :meth:`CollocationEvaluator.settle` in a worker process."""
-    return payload["evaluator"].settle(payload["point"], payload["neighbours"],
-                                       payload.get("cheapest", False), payload.get("known"))
-
-
-def settle_strides(evaluator: CollocationEvaluator, points, *, neighbours: int = 2,
-                   cheapest: bool = False, jobs: int = 1, progress: bool = True, skip=(),
-                   known: Sequence[Mapping[str, str]] | None = None,
-                   on_design: Callable[[int, dict], None] | None = None) -> list[dict | None]:
-    """One settling pass over a study's designs (:meth:`CollocationEvaluator.settle` for each
-    point from its ``neighbours`` nearest strides and, with ``cheapest``, the study's cheapest
-    one; ``jobs`` worker processes). A design's stride depends on the start it was solved
-    from (local optima); a pass that lowers no objective by more than 1 % is the study's
-    evidence that its strides have settled (docs/design.md).
-
-    ``skip``: indices of designs already settled in this pass (a resumed pass; their rows are
-    None in the result). ``known``: per point, the starts it was solved from before
-    (:meth:`CollocationEvaluator.settle`), not solved again while unchanged.
-    ``on_design(i, row)`` is called in this process as each design finishes, so that a caller
-    can record the pass as it goes."""
-    skip = set(skip)
-    todo = [i for i in range(len(points)) if i not in skip]
-    payloads = [{"evaluator": evaluator, "point": dict(points[i]), "neighbours": int(neighbours),
-                 "cheapest": bool(cheapest), "known": dict(known[i]) if known else None}
-                for i in todo]
-    out: list[dict | None] = [None] * len(points)
-    failed = []
-    bar = tqdm(total=len(points), initial=len(points) - len(todo), desc="settling strides",
-               unit="design", disable=not progress)
-    for k, status, value in make_executor("local", jobs).run(
-            settle_design_point, payloads):
-        bar.update()
-        if status == "ok":
-            out[todo[k]] = value  # in the order of the points
-            if on_design is not None:
-                on_design(todo[k], value)
-        else:
-            failed.append(f"{point_file_stem(payloads[k]['point'])}: {value}")
-    bar.close()
-    if failed:
-        raise OptimizationError(f"{len(failed)} designs could not be settled "
-                                f"({'; '.join(failed[:3])})", where="settle")
-    return out

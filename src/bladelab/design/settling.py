@@ -2,7 +2,7 @@
 
 A settling pass solves each design's stride again from its two nearest neighbours' strides and
 the study's cheapest stride of another design, and keeps the lowest objective
-(:func:`bladelab.design.collocation_evaluator.settle_strides`); the run files of the designs
+(:func:`settle_strides`); the run files of the designs
 whose stride changed are removed, so that the study reads their new responses back
 (:func:`settle_study` returns whether it must). ``bladelab design --evaluator collocation
 --settle K`` runs up to K passes.
@@ -27,18 +27,23 @@ A start a design was solved from in an earlier pass and whose stride has not cha
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+import sys
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
+
+from tqdm.auto import tqdm
 
 from bladelab._io import read_json, write_json
 from bladelab.design import collocation_evaluator, defaults
 from bladelab.design.study import DesignStudyResult, run_design, run_file
 from bladelab.design.timing import settling_stage, timed_stage
-from bladelab.errors import InputFileError
+from bladelab.errors import InputFileError, OptimizationError
+from bladelab.executors import make_executor
 
 __all__ = ["RECORD_NAME", "SETTLED_REL", "SETTLE_FROM_CHEAPEST", "SettlingOutcome", "is_settled",
-           "objective_drop", "read_settling_record", "run_settled_design", "settle_study"]
+           "objective_drop", "read_settling_record", "run_settled_design", "settle_strides",
+           "settle_study"]
 
 #: A pass that lowers no design's objective by more than this fraction [-] has settled.
 SETTLED_REL = defaults.SETTLED_REL
@@ -148,7 +153,7 @@ def _run_pass(evaluator, points, current: dict, out: Path, *, jobs: int, save,
                 run_file(out, i).unlink(missing_ok=True)
             save()
 
-        collocation_evaluator.settle_strides(
+        settle_strides(
             evaluator, points, jobs=jobs, on_design=done,
             cheapest=bool(current.get("from_cheapest", False)),
             known=_known_starts(record_before, points, evaluator),
@@ -230,3 +235,57 @@ def run_settled_design(space, *, evaluator, out_dir: str | Path, settle_passes: 
     if outcome.changed:
         result = study()
     return result, outcome
+
+
+def _say_to_stderr(line: str) -> None:
+    """A worker's progress line, on standard error (above the parent's progress bar)."""
+    print(f"  {line}", file=sys.stderr, flush=True)
+
+
+def settle_design_point(payload: dict) -> dict:
+    """One design's :meth:`~bladelab.design.collocation_evaluator.CollocationEvaluator.settle`
+    in a worker process (a line per start on standard error with ``payload["progress"]``)."""
+    return payload["evaluator"].settle(payload["point"], payload["neighbours"],
+                                       payload.get("cheapest", False), payload.get("known"),
+                                       _say_to_stderr if payload.get("progress") else None)
+
+
+def settle_strides(evaluator, points, *, neighbours: int = 2,
+                   cheapest: bool = False, jobs: int = 1, progress: bool = True, skip=(),
+                   known: Sequence[Mapping[str, str]] | None = None,
+                   on_design: Callable[[int, dict], None] | None = None) -> list[dict | None]:
+    """One settling pass over a study's designs: the collocation ``evaluator``'s ``settle``
+    for each point from its ``neighbours`` nearest strides and, with ``cheapest``, the study's
+    cheapest one; ``jobs`` worker processes, each writing a line per start with ``progress``. A design's stride depends on the start it was solved
+    from (local optima); a pass that lowers no objective by more than 1 % is the study's
+    evidence that its strides have settled (docs/design.md).
+
+    ``skip``: indices of designs already settled in this pass (a resumed pass; their rows are
+    None in the result). ``known``: per point, the starts it was solved from before
+    (the evaluator's ``settle``), not solved again while unchanged.
+    ``on_design(i, row)`` is called in this process as each design finishes, so that a caller
+    can record the pass as it goes."""
+    skip = set(skip)
+    todo = [i for i in range(len(points)) if i not in skip]
+    payloads = [{"evaluator": evaluator, "point": dict(points[i]), "neighbours": int(neighbours),
+                 "cheapest": bool(cheapest), "known": dict(known[i]) if known else None,
+                 "progress": bool(progress)}
+                for i in todo]
+    out: list[dict | None] = [None] * len(points)
+    failed = []
+    bar = tqdm(total=len(points), initial=len(points) - len(todo), desc="settling strides",
+               unit="design", disable=not progress)
+    for k, status, value in make_executor("local", jobs).run(
+            settle_design_point, payloads):
+        bar.update()
+        if status == "ok":
+            out[todo[k]] = value  # in the order of the points
+            if on_design is not None:
+                on_design(todo[k], value)
+        else:
+            failed.append(f"{collocation_evaluator.point_file_stem(payloads[k]['point'])}: {value}")
+    bar.close()
+    if failed:
+        raise OptimizationError(f"{len(failed)} designs could not be settled "
+                                f"({'; '.join(failed[:3])})", where="settle")
+    return out
