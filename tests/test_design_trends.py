@@ -233,11 +233,12 @@ def test_the_demo_renders_the_committed_predicted_design_study(tmp_path):
         assert f"{name} by {sum(name in names for names in outside)}" in strides["text"]
     # its trends carry the transtibial runner's reasons, not the transfemoral studies'
     trends = next(s for s in sections if s["title"] == "Seed 002 trends")
-    table = trends["tables"][0][1]
+    table, notes = trends["tables"][0][1], trends["tables"][1][1].set_index("note")["reason"]
     failed = table[table["verdict"] == "does not hold"]
     assert len(failed) and all(
-        reason == TREND_REASONS[("collocation-transtibial", key)]
-        for reason, key in zip(failed["reason"], _keys(failed["trend"]), strict=True))
+        notes[note] == TREND_REASONS[("collocation-transtibial", key)]
+        for note, key in zip(failed["reason"], _keys(failed["trend"]), strict=True))
+    assert notes.is_unique  # a reason shared by two trends is written once
     none, said = predicted_design_example(tmp_path / "r2", study=tmp_path / "nowhere")
     assert none is None and "not found" in said[0]
 

@@ -366,8 +366,10 @@ def _settling_text(design_dir: Path) -> str:
         text += (f" (pass{'es' if len(cheapest) > 1 else ''} {', '.join(cheapest)} also from "
                  "the study's cheapest stride, besides each design's two nearest)")
     if done:
-        text += (f", the last lowering no objective by more than "
-                 f"{100 * done[-1]['largest_objective_drop']:.2f} %")
+        last = done[-1]
+        text += (f"; the last lowered {last.get('improved', 0)} objective"
+                 f"{'s' if last.get('improved', 0) != 1 else ''}, the largest by "
+                 f"{100 * last['largest_objective_drop']:.2f} %")
     open_pass = next((p for p in passes if not p.get("complete")), None)
     if open_pass is not None:
         drops = [objective_drop(r) for r in open_pass["designs"]
@@ -545,9 +547,15 @@ def trends_section(surfaces, evaluator: dict | None = None) -> dict[str, Any]:
             "(α = 0.05); 'matter less' compares the ranges of the main-effect curves over the "
             "coded interval. A trend that does not hold gives the reason known for this "
             "evaluator (docs/design.md), or says it is not explained.")
-    return {"title": "Seed 002 trends", "text": text,
-            "tables": [("Seed 002 trends on this study",
-                        trends_frame(verdicts).drop(columns="mechanism"))]}
+    frame = trends_frame(verdicts).drop(columns="mechanism")
+    tables = [("Seed 002 trends on this study", frame)]
+    reasons = list(dict.fromkeys(r for r in frame["reason"] if r))
+    if reasons:  # long paragraphs, often shared: numbered below the table, not in a cell
+        number = {r: f"note {k}" for k, r in enumerate(reasons, start=1)}
+        frame["reason"] = frame["reason"].map(lambda r: number.get(r, ""))
+        tables.append(("Why a trend does not hold", pd.DataFrame(
+            {"note": list(number.values()), "reason": reasons})))
+    return {"title": "Seed 002 trends", "text": text, "tables": tables}
 
 
 def build_design_report(design_dir: str | Path, out_dir: str | Path | None = None) -> Path:
