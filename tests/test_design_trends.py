@@ -10,9 +10,11 @@ import pytest
 
 from bladelab.design import central_composite, default_design_space, fit_surface, run_design
 from bladelab.design.trends import (
+    CEILING_MIN,
     NO_RUNNER,
     NOT_EXPLAINED,
     SEED002_TRENDS,
+    START_DECIDES,
     TREND_REASONS,
     evaluate_trends,
     trends_frame,
@@ -134,6 +136,27 @@ def test_a_response_held_by_every_solve_is_not_a_trend():
     assert _by_key(evaluate_trends(_surfaces(HOLD)))[knee.key].verdict == "holds"
 
 
+def test_a_response_the_start_decides_leaves_its_trends_undecided():
+    """Where clean strides of one design differ in Δv_x as much as the designs do (R² ceiling
+    below CEILING_MIN), a significant coefficient is no verdict: 'undecided', the test's numbers
+    kept, the evaluator's reason given; a ceiling at the limit or above leaves it judged."""
+    below = {"delta_vx_m_per_s": CEILING_MIN - 0.01, "knee_moment_min_Nm": 0.95}
+    for table, test_said in ((HOLD, "holds"), (REVERSED, "does not hold")):
+        v = _by_key(evaluate_trends(_surfaces(table), evaluator="collocation-transtibial",
+                                    ceilings=below))
+        dvx = [x for x in v.values() if x.response == "delta_vx_m_per_s"]
+        assert len(dvx) == 3 and all(x.verdict == "undecided" for x in dvx)
+        assert all(f"would say '{test_said}'" in x.evidence for x in dvx)
+        assert all(x.reason == TREND_REASONS[("collocation-transtibial", x.key)] for x in dvx)
+        assert v["shorter_toe_lowers_knee_margin"].verdict == test_said
+    at = _by_key(evaluate_trends(_surfaces(HOLD), ceilings={"delta_vx_m_per_s": CEILING_MIN}))
+    assert at["stiffness_increases_dvx"].verdict == "holds"
+    # no reason known for this evaluator and trend: the generic one
+    clear = _by_key(evaluate_trends(_surfaces(HOLD), evaluator="collocation-transtibial",
+                                    ceilings={"swing_clearance_m": 0.0}))
+    assert clear["longer_toe_lowers_clearance"].reason == START_DECIDES
+
+
 def test_roles_map_other_factor_names():
     names = ("k", "w", "h", "toe")
     surf = _surfaces(HOLD, names=names)
@@ -234,10 +257,12 @@ def test_the_demo_renders_the_committed_predicted_design_study(tmp_path):
     # its trends carry the transtibial runner's reasons, not the transfemoral studies'
     trends = next(s for s in sections if s["title"] == "Seed 002 trends")
     table, notes = trends["tables"][0][1], trends["tables"][1][1].set_index("note")["reason"]
-    failed = table[table["verdict"] == "does not hold"]
+    failed = table[table["verdict"].isin(["does not hold", "undecided"])]
     assert len(failed) and all(
         notes[note] == TREND_REASONS[("collocation-transtibial", key)]
         for note, key in zip(failed["reason"], _keys(failed["trend"]), strict=True))
+    # Δv_x is a feature of the kept optimum there (its start-spread ceiling below the limit)
+    assert set(table.loc[table["response"] == "delta_vx_m_per_s", "verdict"]) == {"undecided"}
     assert notes.is_unique  # a reason shared by two trends is written once
     none, said = predicted_design_example(tmp_path / "r2", study=tmp_path / "nowhere")
     assert none is None and "not found" in said[0]

@@ -21,9 +21,16 @@ fitted surface; holds when the height and toe-length ranges are both smaller tha
 and width ranges. **not estimable**: the response or a factor is not in the study, the term is
 not in the model, or the surface has no residual degree of freedom.
 
-A trend that does not hold gets a reason: the known mechanism of the evaluator that produced the
-study (:data:`TREND_REASONS`, keyed by evaluator and trend; measured and explained in
-docs/design.md), else :data:`NOT_EXPLAINED`. A surface whose predicted R² is below 0.5 is
+**undecided**: the study measured how far the solver's start moves the response
+(``ceilings``, the R² ceiling of its start spread, :mod:`bladelab.design.start_spread`) and
+that ceiling is below :data:`CEILING_MIN`: strides of one design differ in the response about
+as much as the designs do, so whichever test passes or fails, the start decided it, not the
+blade. The test's numbers stay in the evidence.
+
+A trend that does not hold, or is undecided, gets a reason: the known mechanism of the
+evaluator that produced the study (:data:`TREND_REASONS`, keyed by evaluator and trend;
+measured and explained in docs/design.md), else :data:`NOT_EXPLAINED` (undecided:
+:data:`START_DECIDES`). A surface whose predicted R² is below 0.5 is
 flagged in the evidence.
 
 **not tested**: the study's evaluator has no runner (:data:`NO_RUNNER`, the ``blade``
@@ -48,9 +55,11 @@ from bladelab.design.surfaces import ResponseSurface
 from bladelab.errors import SpecError
 
 __all__ = [
+    "CEILING_MIN",
     "NOT_EXPLAINED",
     "NO_RUNNER",
     "SEED002_TRENDS",
+    "START_DECIDES",
     "TREND_REASONS",
     "Trend",
     "TrendVerdict",
@@ -113,9 +122,19 @@ _TT_SCATTER = (
     "On the transtibial runner's strides Δv_x is not a property of the blade: a periodic "
     "stride at a prescribed speed shares its horizontal impulse between the legs at almost the "
     "same cost, so clean strides of one design differ in Δv_x about as much as the designs do "
-    "(the start caps its R² at about 0.3, the report's 'what the solver's start decides'; one "
+    "(the start caps its R² at about 0.3 at free stride time and at 0 at people's, the report's "
+    "'what the solver's start decides'; one "
     "farther start moved the centre design's Δv_x by 0.05 m/s against an SD of 0.031 m/s "
     "across the box). ")
+
+#: Below this R² ceiling of the start spread a trend's verdict is "undecided" (module docstring).
+CEILING_MIN = 0.5
+
+#: Why the start decides a response, where no reason of the evaluator is known.
+START_DECIDES = (
+    "Clean strides of one design differ in this response about as much as the designs do "
+    "(the report's 'what the solver's start decides'): which near-equal optimum a solve kept, "
+    "not the blade, sets it. ")
 
 #: Why a trend does not hold, by (evaluator, trend key): see docs/design.md for the measurements.
 TREND_REASONS: dict[tuple[str, str], str] = {
@@ -181,7 +200,8 @@ TREND_REASONS: dict[tuple[str, str], str] = {
         _TT_SCATTER + "In the free-stride study, before five of its strides were replaced by "
         "cheaper ones from a farther start, the stiffness effect had the seed's sign (+0.021 m/s "
         "per coded unit, p 0.002); after, +0.011 (p 0.14, first-order fit): the start, not the "
-        "blade, decided it. At people's stride time it is +0.004 (p 0.73)."),
+        "blade, decided it. At people's stride time it was +0.004 (p 0.73) after two settling "
+        "passes and +0.016 (p 0.014) after five."),
     ("collocation-transtibial", "width_increases_dvx"): (
         _TT_SCATTER + "At a fixed target stiffness the blade generator lets width change only "
         "the blade's mass and sole contact; in seed 002 width also changed the "
@@ -216,12 +236,13 @@ class TrendVerdict:
     test
         The test used, in words.
     verdict
-        ``"holds"``, ``"does not hold"``, ``"not estimable"`` or ``"not tested"`` (an
-        evaluator with no runner, :data:`NO_RUNNER`).
+        ``"holds"``, ``"does not hold"``, ``"undecided"`` (the start spread's R² ceiling
+        below :data:`CEILING_MIN`), ``"not estimable"`` or ``"not tested"`` (an evaluator with
+        no runner, :data:`NO_RUNNER`).
     evidence
         The numbers behind it (coefficients per coded unit with p-values, or effect ranges).
     reason
-        Why it does not hold, or why it is not tested (empty otherwise).
+        Why it does not hold, is undecided or is not tested (empty otherwise).
     mechanism
         For a trend not tested: the mechanism known for the blade's own response where it
         lacks the seed's sign (also in ``reason``; empty otherwise).
@@ -272,6 +293,7 @@ def evaluate_trends(
     alpha: float = 0.05,
     trends: tuple[Trend, ...] = SEED002_TRENDS,
     held: Mapping[str, str] | None = None,
+    ceilings: Mapping[str, float] | None = None,
 ) -> list[TrendVerdict]:
     """Check seed 002's trends on fitted response surfaces (see the module docstring).
 
@@ -291,6 +313,10 @@ def evaluate_trends(
         Response -> how every solve of the study held it (a constraint of each design's
         stride, e.g. the knee moment kept at or above 0 N·m): a trend on such a response is
         not estimable, since the response is a bound the solve enforced, not an outcome.
+    ceilings
+        Response -> R² ceiling of the study's start spread (of the strides that compete to be
+        kept, e.g. those within 5 % of each design's best); below :data:`CEILING_MIN` a
+        trend on that response is "undecided".
 
     Returns
     -------
@@ -355,7 +381,20 @@ def evaluate_trends(
                                     evidence="main-effect ranges: " + ev, reason=reason))
     if str(evaluator) in NO_RUNNER:
         return [_not_tested(v, str(evaluator)) for v in out]
-    return out
+    return [_undecided(v, (ceilings or {}).get(v.response), str(evaluator)) for v in out]
+
+
+def _undecided(verdict: TrendVerdict, ceiling: float | None, evaluator: str) -> TrendVerdict:
+    """``verdict`` made "undecided" where the start spread's R² ``ceiling`` of its response is
+    below :data:`CEILING_MIN` (unchanged otherwise, and when not estimable)."""
+    if (ceiling is None or not ceiling < CEILING_MIN
+            or verdict.verdict not in ("holds", "does not hold")):
+        return verdict
+    reason = TREND_REASONS.get((evaluator, verdict.key), START_DECIDES)
+    return dataclasses.replace(
+        verdict, verdict="undecided", reason=reason,
+        evidence=(f"{verdict.evidence}; the test alone would say '{verdict.verdict}', but the "
+                  f"start spread caps the R² of {verdict.response} at {ceiling:.2f}"))
 
 
 def _not_tested(verdict: TrendVerdict, evaluator: str) -> TrendVerdict:

@@ -37,7 +37,7 @@ from bladelab.design.stride_checks import stride_checks
 from bladelab.design.surfaces import fit_surface
 from bladelab.design.terms import parse_terms
 from bladelab.design.timing import stage_walls
-from bladelab.design.trends import NO_RUNNER, evaluate_trends, trends_frame
+from bladelab.design.trends import CEILING_MIN, NO_RUNNER, evaluate_trends, trends_frame
 from bladelab.errors import InputFileError, OptimizationError
 from bladelab.predict.collocation.human_running import gallop_sentence
 from bladelab.predict.collocation.solution import RESIDUAL_WARNING_PCT
@@ -218,7 +218,8 @@ def design_report_sections(design_dir: str | Path) -> list[dict[str, Any]]:
     motion = _motion_section(design_dir, meta)
     if motion is not None:
         sections.append(motion)
-    sections.append(trends_section(surfaces, meta.get("_evaluator") or {}))
+    sections.append(trends_section(surfaces, meta.get("_evaluator") or {},
+                                   ceilings=_trend_ceilings(spread)))
     if optimum is None:
         sections.append({"title": "Design study: optimum",
                          "text": f"No feasible optimum: {why}"})
@@ -512,11 +513,24 @@ def _motion_section(design_dir: Path, meta: dict) -> dict[str, Any] | None:
 _EVALUATOR_LABELS = {"collocation-transtibial": "collocation on the transtibial runner"}
 
 
-def trends_section(surfaces, evaluator: dict | None = None) -> dict[str, Any]:
+def _trend_ceilings(spread: pd.DataFrame | None) -> dict[str, float]:
+    """Response -> the start spread's R² ceiling that decides whether a trend on it can be
+    judged: that of the strides competing to be kept (within 5 % of each design's best), else
+    that of every clean stride; {} without a spread."""
+    if spread is None:
+        return {}
+    near = spread.get("r2_ceiling_near", pd.Series(np.nan, index=spread.index))
+    value = near.where(near.notna(), spread["r2_ceiling"])
+    return {r: float(v) for r, v in zip(spread["response"], value, strict=True) if np.isfinite(v)}
+
+
+def trends_section(surfaces, evaluator: dict | None = None,
+                   ceilings: dict[str, float] | None = None) -> dict[str, Any]:
     """The "Seed 002 trends" section: each trend's verdict on the study's own surfaces
     (:func:`bladelab.design.trends.evaluate_trends`), with the test used and, for a trend that
-    does not hold, the reason. ``evaluator`` is the study's ``evaluator.json`` (its kind selects
-    the reasons; its generator ``roles`` map factors to stiffness/width/height/toe length)."""
+    does not hold or is undecided, the reason. ``evaluator`` is the study's ``evaluator.json``
+    (its kind selects the reasons; its generator ``roles`` map factors to stiffness/width/
+    height/toe length); ``ceilings`` the start spread's R² ceilings (:func:`_trend_ceilings`)."""
     evaluator = evaluator or {}
     kind = evaluator.get("evaluator")
     if kind == "collocation" and evaluator.get("amputation") == "transtibial":
@@ -526,7 +540,8 @@ def trends_section(surfaces, evaluator: dict | None = None) -> dict[str, Any]:
     if evaluator.get("knee_moment_min_Nm") is not None:
         held["knee_moment_min_Nm"] = (f"held at or above {evaluator['knee_moment_min_Nm']:g} "
                                       "N·m on every loaded interval by the solve")
-    verdicts = evaluate_trends(surfaces, evaluator=kind, roles=roles, held=held)
+    verdicts = evaluate_trends(surfaces, evaluator=kind, roles=roles, held=held,
+                               ceilings=ceilings)
     if kind in NO_RUNNER:  # every verdict "not tested": the section says why, once
         frame = trends_frame(verdicts).rename(columns={"mechanism": "the blade's mechanism"})
         return {"title": "Seed 002 trends", "text": (
@@ -538,14 +553,22 @@ def trends_section(surfaces, evaluator: dict | None = None) -> dict[str, Any]:
                             frame[["trend", "response", "evidence",
                                    "the blade's mechanism"]])]}
     counts = {v: sum(1 for x in verdicts if x.verdict == v)
-              for v in ("holds", "does not hold", "not estimable")}
+              for v in ("holds", "does not hold", "undecided", "not estimable")}
     text = (f"The trends seed 002 reports, checked on this study's fitted surfaces "
             f"(evaluator: {_EVALUATOR_LABELS.get(kind, kind or 'unknown')}): "
-            f"{counts['holds']} hold, "
-            f"{counts['does not hold']} do not hold, {counts['not estimable']} not estimable. "
+            f"{counts['holds']} hold, {counts['does not hold']} do not hold, "
+            + (f"{counts['undecided']} undecided, " if counts["undecided"] else "")
+            + f"{counts['not estimable']} not estimable. "
             "Sign trends use a two-sided t-test of the linear coefficient per coded unit "
             "(α = 0.05); 'matter less' compares the ranges of the main-effect curves over the "
-            "coded interval. A trend that does not hold gives the reason known for this "
+            "coded interval. "
+            + (f"A trend is undecided where the solver's start moves its response about as "
+               f"much as the designs do (the start spread's R² ceiling below {CEILING_MIN:g}, "
+               f"from each design's strides within {NEAR_PCT:g} % of its best): the test's "
+               "numbers are "
+               "given, but the start, not the blade, decided them. " if counts["undecided"]
+               else "")
+            + "A trend that does not hold or is undecided gives the reason known for this "
             "evaluator (docs/design.md), or says it is not explained.")
     frame = trends_frame(verdicts).drop(columns="mechanism")
     tables = [("Seed 002 trends on this study", frame)]
