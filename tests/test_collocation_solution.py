@@ -758,6 +758,25 @@ def test_model_spec_names_the_body_only_when_it_is_not_seed_001s():
         check_model_spec({"model": "able", "body": "robot"})
 
 
+def test_two_model_specs_are_the_same_runner_to_round_off_not_beyond():
+    """A stored blade's numbers an ulp off a regenerated one's are the same runner; a change
+    of 1e-6 relative, another key or another string is not."""
+    from bladelab.predict.collocation.stored import same_model_spec
+
+    spec = {"model": "amputee", "blade": "b", "blade_spec": {"joints": [
+        {"K_Nm_per_deg": 6.063704033452058, "D_Nms_per_deg": 0.1179053562060122}]}}
+    joint = spec["blade_spec"]["joints"][0]
+    ulp = {**spec, "blade_spec": {"joints": [
+        {**joint, "K_Nm_per_deg": np.nextafter(joint["K_Nm_per_deg"], 0.0)}]}}
+    assert ulp != spec and same_model_spec(ulp, spec)
+    moved = {**spec, "blade_spec": {"joints": [
+        {**joint, "K_Nm_per_deg": joint["K_Nm_per_deg"] * (1 + 1e-6)}]}}
+    assert not same_model_spec(moved, spec)
+    assert not same_model_spec({**spec, "blade": "c"}, spec)
+    assert not same_model_spec({**spec, "body": "human"}, spec)
+    assert not same_model_spec({**spec, "blade_spec": {"joints": []}}, spec)
+
+
 def test_model_spec_carries_the_athlete_into_the_runner_the_label_and_the_file(able, tmp_path):
     """An athlete other than the parameter set's is part of the problem: checked field by
     field, named in the label, the runner built to it, and kept by the solution file."""

@@ -180,7 +180,9 @@ def test_the_runner_of_a_multilink_stride_is_rebuilt_from_its_file():
 
 
 def test_a_design_solved_before_is_read_back_not_solved_again(fake, tmp_path, monkeypatch):
+    import copy
     import dataclasses
+    import math
 
     calls, _ = fake
     ev = _evaluator(tmp_path)
@@ -198,6 +200,12 @@ def test_a_design_solved_before_is_read_back_not_solved_again(fake, tmp_path, mo
     dataclasses.replace(base, model_spec=spec, settings=ev.settings()).write(stored)
     monkeypatch.setattr(CollocationSolution, "gait_warnings", lambda self: [])
     assert ev(CENTRE) == {"delta_vx_m_per_s": 0.1} and len(calls) == 1  # a clean one: read
+    # its blade generated again elsewhere, a stiffness one ulp off: the same problem, read
+    ulp = copy.deepcopy(spec)
+    joint = ulp["blade_spec"]["joints"][0]
+    joint["K_Nm_per_deg"] = math.nextafter(joint["K_Nm_per_deg"], math.inf)
+    dataclasses.replace(base, model_spec=ulp, settings=ev.settings()).write(stored)
+    assert ev(CENTRE) == {"delta_vx_m_per_s": 0.1} and len(calls) == 1
     dataclasses.replace(ev, speed_mps=4.5)(CENTRE)  # another problem: solved
     assert len(calls) == 2
     start = tmp_path / "start.json"  # a start that solves this very design: read

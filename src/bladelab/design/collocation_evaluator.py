@@ -43,7 +43,7 @@ from bladelab.predict import defaults as predict_defaults
 from bladelab.predict.collocation.settings import CollocationSettings, people_term
 from bladelab.predict.collocation.solution import CollocationSolution
 from bladelab.predict.collocation.solve import predict_stride
-from bladelab.predict.collocation.stored import check_model_spec, runner_from_spec
+from bladelab.predict.collocation.stored import check_model_spec, runner_from_spec, same_model_spec
 from bladelab.runner.params import BODIES
 
 __all__ = ["CollocationEvaluator", "DEFAULT_BODY", "DEFAULT_DESIGN_SPEED_MPS", "DEFAULT_STARTS",
@@ -492,7 +492,7 @@ class CollocationEvaluator:
             if not path.is_file():
                 continue
             sol = CollocationSolution.read(path)
-            same = (sol.converged and sol.model_spec == check_model_spec(spec)
+            same = (sol.converged and same_model_spec(sol.model_spec, check_model_spec(spec))
                     and sol.settings.same_problem(settings))
             if same and not sol.gait_warnings():
                 return sol, path

@@ -54,4 +54,7 @@ PREDICTED_RESPONSE_UNITS: dict[str, str] = {
     "contact_time_prosthetic_s": "s",
     "cost_of_transport_J_per_kg_m": "J/(kg·m)",
     "stride_objective": "-",
+    "socket_force_max_N": "N",
+    "socket_moment_max_Nm": "N·m",
+    "blade_moment_max_Nm": "N·m",
 }

@@ -95,7 +95,12 @@ from bladelab.predict.collocation.starts import (
     start_columns,
     warm_guess,
 )
-from bladelab.predict.collocation.stored import check_model_spec, model_label, runner_from_spec
+from bladelab.predict.collocation.stored import (
+    check_model_spec,
+    model_label,
+    runner_from_spec,
+    same_model_spec,
+)
 from bladelab.predict.collocation.stride_guess import COLLOCATION_SOURCE
 
 __all__ = [
@@ -603,7 +608,7 @@ def max_speed(runner, settings: CollocationSettings, guess, *, model_spec: dict,
                         hint="max_speed_settings(settings) gives it")
     label = model_label(spec)
     for sol, what in ((guess, "warm start"), (previous, "previous-but-one start")):
-        if isinstance(sol, CollocationSolution) and sol.model_spec != spec:
+        if isinstance(sol, CollocationSolution) and not same_model_spec(sol.model_spec, spec):
             raise SpecError(f"the {what} is a solution of {model_label(sol.model_spec)}, not "
                             f"{label}", where="guess" if sol is guess else "previous")
     out_dir = Path(out_dir)

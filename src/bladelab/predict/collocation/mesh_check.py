@@ -58,6 +58,7 @@ from bladelab.predict.collocation.solve import (
     write_solve,
 )
 from bladelab.predict.collocation.starts import BARRIER_MU
+from bladelab.predict.collocation.stored import same_model_spec
 from bladelab.predict.collocation.stride_guess import COLLOCATION_SOURCE
 
 __all__ = ["MESH_CHECK_DIR", "MESH_CHECK_FILE", "ROUND_TRIP_DIR", "SETTLED_PCT", "MeshCheck",
@@ -286,7 +287,7 @@ def compare_meshes(coarse: CollocationSolution, fine: CollocationSolution) -> Me
         constraints differ, or ``fine`` has no more intervals than ``coarse``).
     """
     a, b = coarse.settings, fine.settings
-    if coarse.model_spec != fine.model_spec or not dataclasses.replace(
+    if not same_model_spec(coarse.model_spec, fine.model_spec) or not dataclasses.replace(
             a, mesh_intervals=b.mesh_intervals).same_problem(b):
         raise SpecError("the two strides are not the same problem on two meshes",
                         where="mesh check", hint="solve the finer one with check_mesh")

@@ -72,7 +72,7 @@ from bladelab.predict.collocation.settings import (
     CollocationSettings,
 )
 from bladelab.predict.collocation.solution import CollocationSolution
-from bladelab.predict.collocation.stored import check_model_spec, describe_problem
+from bladelab.predict.collocation.stored import check_model_spec, describe_problem, same_model_spec
 from bladelab.predict.collocation.stride_guess import COLLOCATION_SOURCE
 from bladelab.predict.collocation.swing_knee import biological_knees
 from bladelab.predict.collocation.symmetry import mirror_permutation
@@ -478,7 +478,8 @@ def read_stored(ok: Path, best: Path, spec: dict, settings: CollocationSettings)
         if not path.is_file():
             continue
         sol = CollocationSolution.read(path)
-        if sol.model_spec != check_model_spec(spec) or not sol.settings.same_problem(settings):
+        if (not same_model_spec(sol.model_spec, check_model_spec(spec))
+                or not sol.settings.same_problem(settings)):
             there, asked = describe_problem(sol.model_spec, sol.settings), describe_problem(
                 spec, settings)
             if there == asked:

@@ -38,7 +38,27 @@ __all__ = [
     "model_label",
     "params_from_spec",
     "runner_from_spec",
+    "same_model_spec",
 ]
+
+#: Relative tolerance of :func:`same_model_spec` on numbers: a blade generated again on another
+#: machine differs from its stored specification by an ulp or two (its libm's round-off).
+SPEC_REL_TOL = 1e-9
+
+
+def same_model_spec(a, b) -> bool:
+    """True if two model specifications (:func:`check_model_spec`'s form, e.g. a stored
+    solve's and a problem's) describe the same runner: equal keys and strings, numbers equal
+    to :data:`SPEC_REL_TOL` relative (not to the last bit)."""
+    if isinstance(a, dict) and isinstance(b, dict):
+        return a.keys() == b.keys() and all(same_model_spec(a[k], b[k]) for k in a)
+    if isinstance(a, (list, tuple)) and isinstance(b, (list, tuple)):
+        return len(a) == len(b) and all(same_model_spec(x, y) for x, y in zip(a, b, strict=True))
+    numbers = (int, float)
+    if (isinstance(a, numbers) and isinstance(b, numbers)
+            and not isinstance(a, bool) and not isinstance(b, bool)):
+        return math.isclose(a, b, rel_tol=SPEC_REL_TOL, abs_tol=1e-300)
+    return a == b
 
 
 def check_model_spec(spec) -> dict:
