@@ -128,9 +128,31 @@ def test_bladelab_report_dispatches_design_folder(study, tmp_path, capsys):
     assert (tmp_path / "r" / "index.html").is_file()
 
 
+def test_design_caps_a_response_from_the_command_line(study, tmp_path):
+    """``response<=maximum``: stored as {"max": v}; the optimum (the long toe, whose blade is
+    the heaviest, 0.67 kg) moves to a shorter toe to stay under a 0.65 kg cap, on it; the
+    report rebuilds it."""
+    out, args = study
+    capped = tmp_path / "capped"
+    shutil.copytree(out, capped)
+    limit = 0.65
+    argv = [a for a in args if a not in ("--constraint", "swing_clearance_m=0.07")]
+    argv[argv.index("--out") + 1] = str(capped)
+    assert main([*argv, "--constraint", f"blade_mass_kg<={limit}"]) == 0
+    meta = json.loads((capped / "study.json").read_text())
+    assert meta["constraints"] == {"blade_mass_kg": {"max": limit}}
+    optimum = json.loads((capped / "optimum.json").read_text())
+    opt = optimum["constraints"]["blade_mass_kg"]
+    assert opt["maximum"] == limit and opt["predicted"] == pytest.approx(limit, abs=1e-5)
+    assert optimum["coded"]["toe_length_m"] < 0.9
+    assert main(["report", str(capped), "--out", str(tmp_path / "r")]) == 0
+
+
 def test_design_bad_input(tmp_path, capsys):
     assert main(["design", "--out", str(tmp_path / "x"), "--constraint", "nonsense"]) == 2
     assert "--constraint" in capsys.readouterr().err
+    assert main(["design", "--out", str(tmp_path / "x"), "--constraint", "a<=b"]) == 2
+    assert "response<=maximum" in capsys.readouterr().err
     assert main(["design", "--out", str(tmp_path / "y"), "--evaluator", "fem"]) == 2
     assert main(["design", "--out", str(tmp_path / "w"), "--evaluator", "runner", "--gait",
                  str(tmp_path / "missing.csv")]) == 2

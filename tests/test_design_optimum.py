@@ -6,10 +6,15 @@ import numpy as np
 import pytest
 
 from bladelab.design.doe import central_composite
-from bladelab.design.optimum import SurfaceConstraint, constrained_optimum
+from bladelab.design.optimum import (
+    SurfaceConstraint,
+    constrained_optimum,
+    read_bound,
+    surface_constraints,
+)
 from bladelab.design.space import DesignSpace, Factor
 from bladelab.design.surfaces import fit_surface
-from bladelab.errors import OptimizationError
+from bladelab.errors import OptimizationError, SpecError
 
 NAMES = ("a", "b")
 D = central_composite(2, n_center=1).coded
@@ -73,3 +78,37 @@ def test_conservative_constraint_moves_inside():
                                    conservative=True)
     assert safe_opt.coded["a"] < mean_opt.coded["a"]
     assert safe_opt.constraints["knee"]["pi_lower"] == pytest.approx(0.0, abs=1e-5)
+
+
+def test_a_maximum_caps_the_response_and_its_conservative_form_its_upper_bound():
+    """Maximise a; a load rising with a is capped at 0.3 by ``{"max": 0.3}``: the optimum
+    sits on the cap (the load's slack 0); imposed on the prediction interval's upper end it
+    moves inside, the upper end then at the cap."""
+    rng = np.random.default_rng(5)
+    d5 = central_composite(2, n_center=5).coded
+    obj = fit_surface(d5, d5[:, 0], factor_names=NAMES, model="linear", response="speed")
+    load = fit_surface(d5, d5[:, 0] + rng.normal(0, 0.05, len(d5)), factor_names=NAMES,
+                       model="linear", response="socket_moment_max_Nm", unit="N·m")
+    cons = surface_constraints({"socket_moment_max_Nm": load},
+                               {"socket_moment_max_Nm": {"max": 0.3}})
+    assert cons[0].upper and cons[0].relation == "≤" and cons[0].margin(0.1) == pytest.approx(0.2)
+    mean_opt = constrained_optimum(obj, constraints=cons, seed=0)
+    row = mean_opt.constraints["socket_moment_max_Nm"]
+    assert row["maximum"] == 0.3 and row["slack"] == pytest.approx(0.0, abs=1e-6)
+    assert row["predicted"] == pytest.approx(0.3, abs=1e-6) and "pi_upper" in row
+    safe = constrained_optimum(obj, constraints=cons, seed=0, conservative=True)
+    assert safe.coded["a"] < mean_opt.coded["a"]
+    assert safe.constraints["socket_moment_max_Nm"]["pi_upper"] == pytest.approx(0.3, abs=1e-5)
+    # a minimum of the same surface keeps the optimum at the box's edge
+    low = constrained_optimum(obj, constraints=surface_constraints(
+        {"socket_moment_max_Nm": load}, {"socket_moment_max_Nm": 0.3}), seed=0)
+    assert low.coded["a"] == pytest.approx(1.0)
+
+
+def test_a_study_constraint_reads_as_a_minimum_or_a_maximum():
+    assert read_bound(0.5) == (0.5, False)
+    assert read_bound({"min": 2}) == (2.0, False)
+    assert read_bound({"max": 150}) == (150.0, True)
+    for bad in ({"below": 1.0}, {"max": "x"}, {"max": float("nan")}, {"min": 1, "max": 2}):
+        with pytest.raises(SpecError):
+            read_bound(bad)

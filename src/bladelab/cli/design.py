@@ -16,6 +16,7 @@ evaluator (:func:`~bladelab.cli.panels.refuse_other_methods`). The evaluator its
 from __future__ import annotations
 
 import math
+import re
 from pathlib import Path
 
 import typer
@@ -58,18 +59,24 @@ def _parse_floats(text: str, what: str) -> list[float]:
     return vals
 
 
-def _constraints(given: list[str]) -> dict[str, float]:
-    """``--constraint response=minimum`` (repeatable) as {response: minimum}."""
-    cons: dict[str, float] = {}
+def _constraints(given: list[str]) -> dict[str, float | dict[str, float]]:
+    """``--constraint`` (repeatable): ``response=minimum`` or ``response>=minimum`` as
+    {response: minimum}, ``response<=maximum`` as {response: {"max": maximum}}."""
+    cons: dict[str, float | dict[str, float]] = {}
     for c in given:
-        name, sep, value = c.partition("=")
-        try:
-            cons[name.strip()] = float(value)
-        except ValueError:
-            sep = ""
-        if not sep or not name.strip():
+        match = re.fullmatch(r"\s*([A-Za-z_][A-Za-z0-9_]*)\s*(<=|>=|=)\s*(\S+)\s*", c)
+        value = None
+        if match:
+            try:
+                value = float(match.group(3))
+            except ValueError:
+                value = None
+        if value is None or not math.isfinite(value):
             raise SpecError(f"cannot read constraint {c!r}", where="--constraint",
-                            hint="write response=minimum, e.g. knee_moment_min_Nm=0")
+                            hint="write response=minimum or response<=maximum, e.g. "
+                                 "knee_moment_min_Nm=0 or socket_moment_max_Nm<=150")
+        name, relation = match.group(1), match.group(2)
+        cons[name] = {"max": value} if relation == "<=" else value
     return cons
 
 
@@ -148,8 +155,9 @@ def _design(
                               help="max or min."),
     constraint: list[str] = typer.Option(
         [], "--constraint", rich_help_panel=STUDY,
-        help="response=minimum in the response's unit (repeatable), e.g. "
-             "knee_moment_min_Nm=0 swing_clearance_m=0.02."),
+        help="response=minimum (or >=) or response<=maximum in the response's unit "
+             "(repeatable), e.g. knee_moment_min_Nm=0 swing_clearance_m=0.02 "
+             "socket_moment_max_Nm<=150."),
     speed: float | None = typer.Option(
         None, "--speed", rich_help_panel=STUDY,
         help=f"Touch-down speed [m/s] (default {defaults.BLADE_SPEED_MPS:g} blade, "

@@ -1,16 +1,19 @@
 """The constrained optimum of response surfaces over the coded design box.
 
 Maximise (or minimise) an objective surface over c ∈ [-1, 1]^k subject to constraint surfaces
-g_i(c) ≥ margin_i (e.g. the minimum knee extension moment ≥ 0 N·m, the minimum swing clearance ≥
-0.01 m). scipy's SLSQP is started from the best run of the design, the centre and seeded random
-points; the best feasible local optimum wins. With ``conservative=True`` a constraint is imposed
-on the lower bound of its prediction interval instead of its fitted mean.
+g_i(c) ≥ bound_i or g_i(c) ≤ bound_i (e.g. the minimum knee extension moment ≥ 0 N·m, the
+minimum swing clearance ≥ 0.01 m, the peak socket moment ≤ 150 N·m). scipy's SLSQP is started
+from the best run of the design, the centre and seeded random points; the best feasible local
+optimum wins. With ``conservative=True`` a constraint is imposed on the bound of its prediction
+interval on the infeasible side (the lower bound of a minimum, the upper of a maximum) instead of
+its fitted mean.
 """
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from scipy import optimize
@@ -19,21 +22,61 @@ from bladelab.design.space import DesignSpace
 from bladelab.design.surfaces import ResponseSurface
 from bladelab.errors import OptimizationError, SpecError
 
-__all__ = ["SurfaceConstraint", "OptimumResult", "constrained_optimum"]
+__all__ = ["OptimumResult", "SurfaceConstraint", "constrained_optimum", "read_bound",
+           "surface_constraints"]
 
 _FEAS_TOL = 1e-6
 
 
 @dataclass(frozen=True, eq=False)
 class SurfaceConstraint:
-    """``surface(c) >= minimum`` (in the surface's unit)."""
+    """``surface(c) >= bound``, or ``surface(c) <= bound`` when ``upper`` (in the surface's
+    unit): a knee moment's minimum, a socket moment's maximum."""
 
     surface: ResponseSurface
-    minimum: float
+    bound: float
+    upper: bool = False
 
     @property
     def name(self) -> str:
         return self.surface.response
+
+    @property
+    def relation(self) -> str:
+        """"≤" or "≥"."""
+        return "≤" if self.upper else "≥"
+
+    def margin(self, value):
+        """How far ``value`` lies inside the constraint (negative: violated), in its unit."""
+        return self.bound - value if self.upper else value - self.bound
+
+
+def read_bound(value, *, name: str = "constraint") -> tuple[float, bool]:
+    """(bound, upper) of one entry of a study's constraints: a number is a minimum (the form
+    written before maxima existed), ``{"min": v}`` a minimum, ``{"max": v}`` a maximum."""
+    if isinstance(value, Mapping) and len(value) == 1 and next(iter(value)) in ("min", "max"):
+        kind, bound = next(iter(value.items()))
+        upper = kind == "max"
+    elif isinstance(value, Mapping):
+        raise SpecError(f"constraint {value!r} is neither {{'min': v}} nor {{'max': v}}",
+                        where=name)
+    else:
+        bound, upper = value, False
+    try:
+        bound = float(bound)
+    except (TypeError, ValueError):
+        raise SpecError(f"constraint bound {bound!r} is not a number", where=name) from None
+    if not np.isfinite(bound):
+        raise SpecError(f"constraint bound {bound!r} is not finite", where=name)
+    return bound, upper
+
+
+def surface_constraints(surfaces: Mapping[str, ResponseSurface],
+                        constraints: Mapping[str, Any]) -> list[SurfaceConstraint]:
+    """The :class:`SurfaceConstraint` of each entry of a study's ``constraints`` ({response:
+    minimum | {"min": v} | {"max": v}}, :func:`read_bound`) on its fitted ``surfaces``."""
+    return [SurfaceConstraint(surfaces[k], *read_bound(v, name=f"constraint {k}"))
+            for k, v in constraints.items()]
 
 
 @dataclass(frozen=True)
@@ -52,7 +95,9 @@ class OptimumResult:
         Predicted objective, its confidence interval (of the mean surface) and prediction
         interval (of a new run), at ``level``.
     constraints
-        Per constraint: predicted value, minimum, slack (predicted − minimum), pi_lower.
+        Per constraint: predicted value, its minimum or maximum, slack (how far inside the
+        bound the prediction lies), and the prediction bound on the infeasible side (pi_lower
+        of a minimum, pi_upper of a maximum).
     level
         Confidence level of the intervals.
     n_starts, n_feasible
@@ -90,9 +135,12 @@ class OptimumResult:
 
 
 def _constraint_value(con: SurfaceConstraint, c: np.ndarray, conservative: bool, level: float):
+    """The constraint's margin at ``c`` (≥ 0 feasible): of the fitted mean, or of the
+    prediction bound on the infeasible side when ``conservative``."""
     if conservative:
-        return float(con.surface.predict(c[None, :], level=level).pi_lower[0]) - con.minimum
-    return float(con.surface.predict_mean(c)) - con.minimum
+        pred = con.surface.predict(c[None, :], level=level)
+        return float(con.margin((pred.pi_upper if con.upper else pred.pi_lower)[0]))
+    return float(con.margin(con.surface.predict_mean(c)))
 
 
 def constrained_optimum(
@@ -170,7 +218,8 @@ def constrained_optimum(
                 {
                     "type": "ineq",
                     "fun": (lambda c, con=con: _constraint_value(con, c, False, level)),
-                    "jac": (lambda c, con=con: con.surface.gradient(c)),
+                    "jac": (lambda c, con=con: (-1.0 if con.upper else 1.0)
+                            * con.surface.gradient(c)),
                 }
             )
 
@@ -194,7 +243,7 @@ def constrained_optimum(
         name = min(worst, key=worst.get) if worst else "?"
         raise OptimizationError(
             f"no design in the box satisfies the constraints; {name} reached at best "
-            f"{worst[name]:+.4g} relative to its minimum",
+            f"{worst[name]:+.4g} inside its bound (negative: outside)",
             where=f"constraint {name}",
             hint="lower the margin, widen the factor ranges, or check the fitted surface",
         )
@@ -202,11 +251,12 @@ def constrained_optimum(
     con_out = {}
     for con in constraints:
         pc = con.surface.predict(best_c[None, :], level=level)
+        side = "upper" if con.upper else "lower"
         con_out[con.name] = {
             "predicted": float(pc.mean[0]),
-            "minimum": float(con.minimum),
-            "slack": float(pc.mean[0] - con.minimum),
-            "pi_lower": float(pc.pi_lower[0]),
+            "maximum" if con.upper else "minimum": float(con.bound),
+            "slack": float(con.margin(pc.mean[0])),
+            f"pi_{side}": float(getattr(pc, f"pi_{side}")[0]),
         }
     return OptimumResult(
         objective=objective.response,

@@ -8,12 +8,13 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from matplotlib.figure import Figure
 
 from bladelab._io import atomic_path, figure_format
-from bladelab.design.optimum import OptimumResult, SurfaceConstraint
+from bladelab.design.optimum import OptimumResult, SurfaceConstraint, surface_constraints
 from bladelab.design.space import DesignSpace
 from bladelab.design.surfaces import ResponseSurface
 from bladelab.errors import SpecError
@@ -141,12 +142,12 @@ def contour_plot(
     fig.colorbar(cf, ax=ax, label=surface.label)
     for i, con in enumerate(constraints):
         _check(con.surface, space)
-        G = np.asarray(con.surface.predict_mean(pts)).reshape(cx.shape) - con.minimum
+        G = con.margin(np.asarray(con.surface.predict_mean(pts)).reshape(cx.shape))
         if G.min() < 0 < G.max():
             ax.contour(X, Y, G, levels=[0.0], colors=f"C{(i + 1) % 10}", linewidths=2)
             ax.contourf(X, Y, G, levels=[G.min() - 1.0, 0.0], colors="none", hatches=["//"])
         ax.plot([], [], color=f"C{(i + 1) % 10}", lw=2,
-                label=f"{con.name} = {con.minimum:g} (hatched: infeasible)")
+                label=f"{con.name} {con.relation} {con.bound:g} (hatched: infeasible)")
     if show_runs:
         rx = fx.mid + surface.coded[:, ix] * fx.half_range
         ry = fy.mid + surface.coded[:, iy] * fy.half_range
@@ -190,7 +191,7 @@ def figure_pairs(names: Sequence[str]) -> list[tuple[str, str]]:
 
 
 def write_design_figures(result, out_dir: str | Path, *, objective: str,
-                         constraints: Mapping[str, float]) -> list[Path]:
+                         constraints: Mapping[str, Any]) -> list[Path]:
     """Main-effect and contour figures of a finished study
     (:class:`~bladelab.design.study.DesignStudyResult`) into ``out_dir/figures``; returns the
     paths written."""
@@ -198,7 +199,7 @@ def write_design_figures(result, out_dir: str | Path, *, objective: str,
     names = [objective, *[c for c in constraints if c != objective]]
     surfs = [result.surfaces[n] for n in names if n in result.surfaces]
     written = [save_figure(main_effects_plot(surfs, result.space), fig_dir / "main_effects.png")]
-    cons = [SurfaceConstraint(result.surfaces[k], float(v)) for k, v in constraints.items()]
+    cons = surface_constraints(result.surfaces, constraints)
     for x, y in figure_pairs(result.space.names):
         fig = contour_plot(result.surfaces[objective], result.space, x=x, y=y, constraints=cons,
                            optimum=result.optimum,

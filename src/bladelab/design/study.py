@@ -29,6 +29,7 @@ import math
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pandas as pd
@@ -38,7 +39,12 @@ from bladelab._io import atomic_path, read_json, write_json
 from bladelab.design import defaults
 from bladelab.design.doe import Design, EstimabilityReport, make_design, require_estimable
 from bladelab.design.motion import check_motion_factors
-from bladelab.design.optimum import OptimumResult, SurfaceConstraint, constrained_optimum
+from bladelab.design.optimum import (
+    OptimumResult,
+    constrained_optimum,
+    read_bound,
+    surface_constraints,
+)
 from bladelab.design.space import DesignSpace
 from bladelab.design.surfaces import ResponseSurface, fit_surface
 from bladelab.design.terms import parse_terms
@@ -258,7 +264,7 @@ def run_design(
     n_center: int = 1,
     objective: str | None = None,
     sense: str = defaults.SENSE,
-    constraints: Mapping[str, float] | None = None,
+    constraints: Mapping[str, Any] | None = None,
     units: Mapping[str, str] | None = None,
     conservative: bool = False,
     progress: bool = True,
@@ -292,11 +298,12 @@ def run_design(
     objective, sense
         Response to maximise (``"max"``) or minimise (``"min"``); no optimum if None.
     constraints
-        Response -> minimum: the optimum must satisfy surface ≥ minimum.
+        Response -> bound: a number or ``{"min": v}`` (the optimum must satisfy surface ≥ v),
+        ``{"max": v}`` (surface ≤ v); :func:`~bladelab.design.optimum.read_bound`.
     units
         Response -> unit, for tables and plots (e.g. ``{"delta_vx_m_per_s": "m/s"}``).
     conservative
-        Impose constraints on the lower prediction bound.
+        Impose constraints on the prediction bound on their infeasible side.
     progress
         Show a progress bar.
     jobs, executor
@@ -327,6 +334,8 @@ def run_design(
     else:
         motion = None
     constraints = dict(constraints or {})
+    for name, value in constraints.items():  # a bad bound fails now, not after the runs
+        read_bound(value, name=f"constraint {name}")
     units = dict(units or {})
 
     meta = {
@@ -450,7 +459,7 @@ def run_design(
                 f"unknown response(s) {unknown}", where="objective/constraints",
                 hint=f"the evaluator returned {list(responses)}",
             )
-        cons = [SurfaceConstraint(surfaces[k], float(v)) for k, v in constraints.items()]
+        cons = surface_constraints(surfaces, constraints)
         try:
             optimum = constrained_optimum(
                 surfaces[objective], sense=sense, constraints=cons, space=space, seed=seed,

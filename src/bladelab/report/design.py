@@ -18,7 +18,7 @@ import numpy as np
 import pandas as pd
 
 from bladelab._io import read_json
-from bladelab.design.optimum import SurfaceConstraint, constrained_optimum
+from bladelab.design.optimum import constrained_optimum, surface_constraints
 from bladelab.design.plots import contour_plot, figure_pairs, main_effects_plot
 from bladelab.design.responses import (
     BLADE_RESPONSE_UNITS,
@@ -117,8 +117,7 @@ def design_report_sections(design_dir: str | Path) -> list[dict[str, Any]]:
     design_dir = Path(design_dir)
     meta, space, table, surfaces = _load(design_dir)
     objective = meta.get("objective") or next(iter(surfaces))
-    constraints = {k: float(v) for k, v in (meta.get("constraints") or {}).items()
-                   if k in surfaces}
+    constraints = {k: v for k, v in (meta.get("constraints") or {}).items() if k in surfaces}
     fit = pd.DataFrame([
         {"response": r, "unit": s.unit, "R2": s.r2, "R2_adj": s.r2_adj, "R2_pred": s.r2_pred,
          "loo_rmse": s.loo_rmse} for r, s in surfaces.items()])
@@ -188,7 +187,7 @@ def design_report_sections(design_dir: str | Path) -> list[dict[str, Any]]:
         "figures": [("Main effects (others at the centre; band: 95 % CI of the mean)",
                      main_effects_plot([surfaces[r] for r in shown], space))],
     })
-    cons = [SurfaceConstraint(surfaces[k], v) for k, v in constraints.items()]
+    cons = surface_constraints(surfaces, constraints)
     optimum, why = None, ""
     try:
         optimum = constrained_optimum(surfaces[objective], sense=meta.get("sense", "max"),
