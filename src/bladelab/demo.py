@@ -140,7 +140,8 @@ def design_example(out_dir: str | Path | None = None, *, seed: int = 0) -> tuple
 #: The committed predicted-gait design study the demo renders (no solve), relative to the
 #: folder the demo runs in (``make demo``: the repository root). A wheel does not carry it
 #: (25 strides, several MB); the demo then says so and goes on.
-PREDICTED_DESIGN_STUDY = Path("benchmarks") / "design" / "transtibial-collocation-4mps"
+PREDICTED_DESIGN_STUDY = (Path("benchmarks") / "design"
+                          / "transtibial-collocation-4mps-people-stride")
 
 
 def predicted_design_example(out_dir: str | Path | None = None,
@@ -159,9 +160,13 @@ def predicted_design_example(out_dir: str | Path | None = None,
     cot = results["cost_of_transport_J_per_kg_m"]
     lines = [f"predicted-gait design study (committed, report rebuilt without a solve): "
              f"{len(results)} blades, each on the transtibial runner's predicted stride at "
-             f"4 m/s -> {report}",
+             f"4 m/s and people's stride time -> {report}",
              f"  cost of transport {cot.min():.2f}–{cot.max():.2f} J/(kg·m) across the blades "
              "(the report: surfaces, optimum, seed 002's trends, every flagged stride)"]
+    if "socket_moment_max_Nm" in results:
+        socket = results["socket_moment_max_Nm"]
+        lines.append(f"  peak socket moment {socket.min():.0f}–{socket.max():.0f} N·m "
+                     f"(the cheapest blade: {socket[cot.idxmin()]:.0f} N·m)")
     return report, lines
 
 
