@@ -11,6 +11,7 @@ study's seed (deterministic: the same as ``optimum.json``).
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
@@ -37,11 +38,11 @@ from bladelab.design.stride_checks import stride_checks
 from bladelab.design.surfaces import fit_surface
 from bladelab.design.terms import parse_terms
 from bladelab.design.timing import stage_walls
-from bladelab.design.trends import CEILING_MIN, NO_RUNNER, evaluate_trends, trends_frame
 from bladelab.errors import InputFileError, OptimizationError
 from bladelab.predict.collocation.human_running import gallop_sentence
 from bladelab.predict.collocation.solution import RESIDUAL_WARNING_PCT
 from bladelab.report.builder import Report
+from bladelab.report.design_trends import trend_ceilings, trends_section
 
 __all__ = ["build_design_report", "design_report_sections", "is_design_folder", "trends_section"]
 
@@ -180,7 +181,9 @@ def design_report_sections(design_dir: str | Path) -> list[dict[str, Any]]:
     if checks is not None:
         sections.append(_strides_section(checks, meta.get("_evaluator") or {}))
     if spread is not None:
-        sections.append(_spread_section(spread))
+        unmeasured = [r for r in surfaces if r not in set(spread["response"])
+                      and r in PREDICTED_RESPONSE_UNITS and table[r].std() > 0]
+        sections.append(_spread_section(spread, unmeasured))
     shown = [objective, *[c for c in constraints if c != objective]]
     sections.append({
         "title": "Design study: main effects",
@@ -218,7 +221,7 @@ def design_report_sections(design_dir: str | Path) -> list[dict[str, Any]]:
     if motion is not None:
         sections.append(motion)
     sections.append(trends_section(surfaces, meta.get("_evaluator") or {},
-                                   ceilings=_trend_ceilings(spread)))
+                                   ceilings=trend_ceilings(spread)))
     if optimum is None:
         sections.append({"title": "Design study: optimum",
                          "text": f"No feasible optimum: {why}"})
@@ -443,9 +446,10 @@ def _start_spread(design_dir: Path, meta: dict, table: pd.DataFrame,
 ROUGH_SPREAD_DESIGNS = 5
 
 
-def _spread_section(spread: pd.DataFrame) -> dict[str, Any]:
+def _spread_section(spread: pd.DataFrame, unmeasured: Sequence[str] = ()) -> dict[str, Any]:
     """What the solver's start decides: the responses' spread between clean strides of the
-    same design against their spread across the designs."""
+    same design against their spread across the designs; ``unmeasured``: fitted responses the
+    settling record has no values of (added to the library after its passes)."""
     low = spread[spread["r2_ceiling"] < 0.8]
     n_designs = int(spread["designs"].max())
     text = ("Each design's stride is a local optimum. The settling passes solve each design "
@@ -476,6 +480,10 @@ def _spread_section(spread: pd.DataFrame) -> dict[str, Any]:
                  f"({', '.join(low['response'])}): no surface model can predict them to "
                  "R² 0.8 from strides of this quality; each design would have to be solved to "
                  "its global optimum (more settling passes, more starts).")
+    if unmeasured:
+        text += (f" No spread of {', '.join(unmeasured)}: the settling record's strides were "
+                 "evaluated before these responses existed, and only each design's kept stride "
+                 "is stored (a new settling pass records them).")
     return {"title": "Design study: what the solver's start decides",
             "text": text, "tables": [("Start spread of the responses", spread)]}
 
@@ -506,78 +514,6 @@ def _motion_section(design_dir: Path, meta: dict) -> dict[str, Any] | None:
     return {"title": "Design study: motion adaptation", "text": text,
             "tables": [("Motion model errors", errors), ("Period model", coef),
                        ("Cycles used", pd.DataFrame({"source": motion.get("sources", [])}))]}
-
-
-#: How the trends section names an evaluator whose key is not its plain name.
-_EVALUATOR_LABELS = {"collocation-transtibial": "collocation on the transtibial runner"}
-
-
-def _trend_ceilings(spread: pd.DataFrame | None) -> dict[str, float]:
-    """Response -> the start spread's R² ceiling that decides whether a trend on it can be
-    judged: that of the strides competing to be kept (within 5 % of each design's best), else
-    that of every clean stride; {} without a spread."""
-    if spread is None:
-        return {}
-    near = spread.get("r2_ceiling_near", pd.Series(np.nan, index=spread.index))
-    value = near.where(near.notna(), spread["r2_ceiling"])
-    return {r: float(v) for r, v in zip(spread["response"], value, strict=True) if np.isfinite(v)}
-
-
-def trends_section(surfaces, evaluator: dict | None = None,
-                   ceilings: dict[str, float] | None = None) -> dict[str, Any]:
-    """The "Seed 002 trends" section: each trend's verdict on the study's own surfaces
-    (:func:`bladelab.design.trends.evaluate_trends`), with the test used and, for a trend that
-    does not hold or is undecided, the reason. ``evaluator`` is the study's ``evaluator.json``
-    (its kind selects the reasons; its generator ``roles`` map factors to stiffness/width/
-    height/toe length); ``ceilings`` the start spread's R² ceilings (:func:`_trend_ceilings`)."""
-    evaluator = evaluator or {}
-    kind = evaluator.get("evaluator")
-    if kind == "collocation" and evaluator.get("amputation") == "transtibial":
-        kind = "collocation-transtibial"  # its own runner, its own reasons
-    roles = (evaluator.get("generator") or {}).get("roles")
-    held = {}
-    if evaluator.get("knee_moment_min_Nm") is not None:
-        held["knee_moment_min_Nm"] = (f"held at or above {evaluator['knee_moment_min_Nm']:g} "
-                                      "N·m on every loaded interval by the solve")
-    verdicts = evaluate_trends(surfaces, evaluator=kind, roles=roles, held=held,
-                               ceilings=ceilings)
-    if kind in NO_RUNNER:  # every verdict "not tested": the section says why, once
-        frame = trends_frame(verdicts).rename(columns={"mechanism": "the blade's mechanism"})
-        return {"title": "Seed 002 trends", "text": (
-                    f"{NO_RUNNER[kind]} The table gives, for each of seed 002's trends, the "
-                    "blade's own coefficient or effect ranges on this study's surfaces (and the "
-                    "mechanism behind them where one is known): a description of the blade, "
-                    "not a verdict on the trend."),
-                "tables": [("Seed 002 trends: not tested by this evaluator",
-                            frame[["trend", "response", "evidence",
-                                   "the blade's mechanism"]])]}
-    counts = {v: sum(1 for x in verdicts if x.verdict == v)
-              for v in ("holds", "does not hold", "undecided", "not estimable")}
-    text = (f"The trends seed 002 reports, checked on this study's fitted surfaces "
-            f"(evaluator: {_EVALUATOR_LABELS.get(kind, kind or 'unknown')}): "
-            f"{counts['holds']} hold, {counts['does not hold']} do not hold, "
-            + (f"{counts['undecided']} undecided, " if counts["undecided"] else "")
-            + f"{counts['not estimable']} not estimable. "
-            "Sign trends use a two-sided t-test of the linear coefficient per coded unit "
-            "(α = 0.05); 'matter less' compares the ranges of the main-effect curves over the "
-            "coded interval. "
-            + (f"A trend is undecided where the solver's start moves its response about as "
-               f"much as the designs do (the start spread's R² ceiling below {CEILING_MIN:g}, "
-               f"from each design's strides within {NEAR_PCT:g} % of its best): the test's "
-               "numbers are "
-               "given, but the start, not the blade, decided them. " if counts["undecided"]
-               else "")
-            + "A trend that does not hold or is undecided gives the reason known for this "
-            "evaluator (docs/design.md), or says it is not explained.")
-    frame = trends_frame(verdicts).drop(columns="mechanism")
-    tables = [("Seed 002 trends on this study", frame)]
-    reasons = list(dict.fromkeys(r for r in frame["reason"] if r))
-    if reasons:  # long paragraphs, often shared: numbered below the table, not in a cell
-        number = {r: f"note {k}" for k, r in enumerate(reasons, start=1)}
-        frame["reason"] = frame["reason"].map(lambda r: number.get(r, ""))
-        tables.append(("Why a trend does not hold", pd.DataFrame(
-            {"note": list(number.values()), "reason": reasons})))
-    return {"title": "Seed 002 trends", "text": text, "tables": tables}
 
 
 def build_design_report(design_dir: str | Path, out_dir: str | Path | None = None) -> Path:
