@@ -112,7 +112,7 @@ def _middle_stance(loaded: np.ndarray, n: int) -> tuple[int, int]:
 
 def test_keys_name_the_legs_joints_and_units(at_nodes, refined):
     assert at_nodes.keys() == refined.keys()
-    units = ("_kN_per_m", "_W_per_kg", "_J", "_pct", "_J_per_kg_m")
+    units = ("_kN_per_m", "_W_per_kg", "_J", "_pct", "_J_per_kg_m", "_N", "_Nm")
     assert all(k.endswith(units) for k in refined), [k for k in refined if not k.endswith(units)]
     assert not any("left" in k or "right" in k for k in refined)
     for joint, leg in [*JOINTS.values(), ("rsp", "prosthetic")]:
@@ -122,7 +122,8 @@ def test_keys_name_the_legs_joints_and_units(at_nodes, refined):
     for key in ("leg_stiffness_intact_kN_per_m", "leg_energy_stored_prosthetic_J",
                 "leg_recoil_intact_pct", "leg_energy_generated_total_J",
                 "blade_energy_stored_J", "blade_energy_returned_J", "blade_hysteresis_J",
-                "blade_recoil_pct", "positive_power_total_W_per_kg"):
+                "blade_recoil_pct", "positive_power_total_W_per_kg", "socket_force_max_N",
+                "socket_moment_max_Nm"):
         assert math.isfinite(refined[key]), key
     assert all(v <= 0 for k, v in refined.items() if k.startswith("negative_power_"))
     assert all(v >= 0 for k, v in refined.items() if k.startswith("positive_power_"))

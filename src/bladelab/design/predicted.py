@@ -36,16 +36,8 @@ response that the start moves least; every other response is a feature of the op
 apart in objective can differ by 1.5 % in cost of transport (docs/design.md, "What the start
 decides").
 
-The loads are those the model transmits, over the whole stride, each a largest magnitude over
-the mesh intervals' means (node values ring, as for the knee moment below). The socket hinge is
-the joint of the prosthesis's root body (``prosthesis_r``): the transtibial runner's socket
-(``socket_angle_r``, a torsional spring on the residual tibia), the transfemoral runner's
-prosthetic knee (its socket is rigid on the residual thigh, so the knee axis is where the
-prosthesis's load enters it). A hinge carries only its own torque about its axis, so the moments
-are the hinges' passive torques (springs, dampers, stops); the force is the momentum balance of
-everything below the hinge, Σm·(a − g) minus the ground force on it, with the subtree's centre
-of mass acceleration from the stride's own accelerations (exact for this planar tree, no finite
-differences in time).
+The loads are :func:`~bladelab.predict.collocation.loads.peak_loads`' (that module: where
+they are taken and how).
 
 The stance is the longest loaded stretch (vertical force above 20 N, the analyses' threshold)
 of the prosthetic leg's periodic force, the node values interpolated linearly on a grid 20
@@ -74,10 +66,11 @@ import numpy as np
 from bladelab.design.performance import bouncing_ball
 from bladelab.errors import SpecError
 from bladelab.predict.collocation import build_collocation_model
+from bladelab.predict.collocation.loads import peak_loads
 from bladelab.predict.collocation.nodes import evaluate_nodes, on_fine_grid, periodic_runs
 from bladelab.runner.layout import CP_LEG
 
-__all__ = ["prosthesis_loads", "stride_responses"]
+__all__ = ["stride_responses"]
 
 _FINE = 20  # interpolation points per mesh interval
 _LOADED_N = 20.0  # N
@@ -101,51 +94,6 @@ def _kinematics(runner, q: np.ndarray, qd: np.ndarray) -> dict[str, np.ndarray]:
     res = {k: np.asarray(v) for k, v in out.items()}
     res["prosthetic"] = runner.contact_params[:, CP_LEG] == 1
     return res
-
-
-def _subtree_com_acceleration(runner, body: int, q, qd, qdd, eps: float = 1e-6) -> np.ndarray:
-    """Per node, the (x, z) acceleration [m/s²] of the centre of mass of ``body``'s subtree:
-    J(q)·q̈ + J̇(q)·q̇, the second term as a central difference of J(q)·q̇ along q̇ (every
-    joint of the planar runner is a hinge or a slide, so q ± ε·q̇ is a position)."""
-    m = runner.mj_model
-    d = mujoco.MjData(m)
-
-    def com_velocity(qk, vk) -> np.ndarray:
-        d.qpos[:], d.qvel[:] = qk, vk
-        mujoco.mj_forward(m, d)
-        mujoco.mj_subtreeVel(m, d)
-        return d.subtree_linvel[body, [0, 2]].copy()
-
-    return np.array([com_velocity(qk, ak) + (com_velocity(qk + eps * vk, vk)
-                                             - com_velocity(qk - eps * vk, vk)) / (2 * eps)
-                     for qk, vk, ak in zip(q, qd, qdd, strict=True)])
-
-
-def prosthesis_loads(runner, nlp, forces: np.ndarray, passive: np.ndarray,
-                     prosthetic: np.ndarray) -> dict[str, np.ndarray]:
-    """Per node, the loads the prosthesis carries (module docstring): ``socket_force`` (x, z)
-    on the prosthesis from the residual limb [N], ``socket_moment`` about its root hinge and
-    ``blade_moment`` (n + 1, n_blade_joints) about each blade joint [N·m].
-
-    ``forces`` (n + 1, n_contacts, 2) are the ground forces on the body, ``passive``
-    (n + 1, n_dof) the passive joint torques (:func:`~bladelab.predict.collocation.nodes.
-    evaluate_nodes`), ``prosthetic`` the mask of the prosthesis's contacts."""
-    m = runner.mj_model
-    root = m.body("prosthesis_r").id
-    hinge = m.joint(int(m.body_jntadr[root])).name
-    names = list(runner.dof_names)
-    blade = [i for i, n in enumerate(names) if n.startswith("blade_joint")]
-    acc = _subtree_com_acceleration(runner, root, nlp.q, nlp.qd, nlp.qdd)
-    weight = np.array([0.0, -runner.gravity])
-    ground = forces[:, prosthetic, :].sum(axis=1)
-    return {"socket_force": m.body_subtreemass[root] * (acc - weight) - ground,
-            "socket_moment": passive[:, names.index(hinge)],
-            "blade_moment": passive[:, blade]}
-
-
-def _interval_means(values: np.ndarray) -> np.ndarray:
-    """The mesh intervals' means of node values (n + 1, ...) -> (n, ...)."""
-    return 0.5 * (values[:-1] + values[1:])
 
 
 def _fine(values: np.ndarray) -> np.ndarray:
@@ -220,7 +168,7 @@ def stride_responses(solution, runner, *, cm=None) -> dict[str, float]:
     swing = (idx[-1] + 1 + np.arange(n_fine - idx.size)) % n_fine
     mid = swing[len(swing) // 4: len(swing) - len(swing) // 4]
     heights = _fine(ev["points"][:, pros, 1]).min(axis=1)  # the contacts' lowest points
-    loads = prosthesis_loads(runner, nlp, ev["forces"], ev["passive"], pros)
+    loads = peak_loads(runner, nlp, ev["forces"], ev["passive"], pros)
     return {
         "delta_vx_m_per_s": dvx,
         "avg_vx_m_per_s": solution.mean_speed_mps,
@@ -233,9 +181,5 @@ def stride_responses(solution, runner, *, cm=None) -> dict[str, float]:
         "contact_time_prosthetic_s": float(idx.size * dt),
         "cost_of_transport_J_per_kg_m": solution.cost_of_transport_J_per_kg_m,
         "stride_objective": float(nlp.objective),
-        "socket_force_max_N": float(
-            np.linalg.norm(_interval_means(loads["socket_force"]), axis=1).max()),
-        "socket_moment_max_Nm": float(np.abs(_interval_means(loads["socket_moment"])).max()),
-        "blade_moment_max_Nm": (float(np.abs(_interval_means(loads["blade_moment"])).max())
-                                if loads["blade_moment"].size else float("nan")),
+        **loads,
     }

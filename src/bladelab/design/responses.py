@@ -13,6 +13,8 @@ The evaluators' modules describe each response.
 
 from __future__ import annotations
 
+from bladelab.predict.collocation.loads import PEAK_LOAD_UNITS
+
 __all__ = ["BLADE_RESPONSE_UNITS", "PREDICTED_RESPONSE_UNITS", "RUNNER_RESPONSE_UNITS"]
 
 #: Units of the blade evaluator's responses (for tables and plots).
@@ -54,7 +56,5 @@ PREDICTED_RESPONSE_UNITS: dict[str, str] = {
     "contact_time_prosthetic_s": "s",
     "cost_of_transport_J_per_kg_m": "J/(kg·m)",
     "stride_objective": "-",
-    "socket_force_max_N": "N",
-    "socket_moment_max_Nm": "N·m",
-    "blade_moment_max_Nm": "N·m",
+    **PEAK_LOAD_UNITS,
 }

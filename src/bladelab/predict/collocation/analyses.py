@@ -25,7 +25,9 @@ Keys (units in the names; ``<leg>``: ``intact``/``prosthetic`` or ``left``/``rig
   :data:`SCONE_SPECIFIC_TENSION_PA` and a basal rate of :data:`SCONE_BASAL_W_PER_KG`;
 - amputee only: ``blade_energy_stored_J``, ``blade_energy_returned_J``,
   ``blade_hysteresis_J``, ``blade_recoil_pct`` (Table D.1, the compression being the contact's
-  penetration).
+  penetration); ``socket_force_max_N``, ``socket_moment_max_Nm``, ``blade_moment_max_Nm``: the
+  loads the prosthesis carries (:func:`~bladelab.predict.collocation.loads.peak_loads`; not in
+  seed 001).
 
 A quantity that the stride does not have (no stance of a leg in the middle stride) is NaN.
 Definitions, thresholds and the legs' names are those of :mod:`bladelab.runner.analyses`.
@@ -39,10 +41,13 @@ import casadi as ca
 import numpy as np
 
 from bladelab.errors import SpecError
+from bladelab.predict.collocation.loads import peak_loads
 from bladelab.predict.collocation.metabolics import muscle_metabolic_rates
 from bladelab.predict.collocation.model import build_collocation_model
+from bladelab.predict.collocation.nodes import evaluate_nodes
 from bladelab.predict.collocation.stored import runner_from_spec
 from bladelab.runner import analyses as an
+from bladelab.runner.layout import CP_LEG
 from bladelab.runner.metabolics import BASAL_RATE_W_PER_KG
 from bladelab.runner.params import PROSTHETIC_KINDS
 
@@ -189,4 +194,9 @@ def stride_analyses(solution, runner=None, *, refine: int = REFINE, cm=None) -> 
         out["blade_energy_returned_J"] = _mean(rows["E_returned_J"])
         out["blade_hysteresis_J"] = _mean(rows["hysteresis_J"])
         out["blade_recoil_pct"] = _mean(rows["recoil_pct"])
+        nodes = evaluate_nodes(cm or build_collocation_model(runner), solution.nlp.q,
+                               solution.nlp.qd, solution.nlp.tendon_force,
+                               solution.nlp.tendon_force_rate)
+        out.update(peak_loads(runner, solution.nlp, nodes["forces"], nodes["passive"],
+                              runner.contact_params[:, CP_LEG] == 1))
     return out
