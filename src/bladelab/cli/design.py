@@ -243,6 +243,11 @@ def _design(
              "kept; stops when no "
              f"objective drops by more than {100 * defaults.SETTLED_REL:g} %). Recorded design "
              "by design in settling.json: a stopped pass resumes where it stopped."),
+    confirm: bool = typer.Option(
+        False, "--confirm", rich_help_panel=COLLOCATION,
+        help="After the study, solve its optimum's blade as one more design (from its nearest "
+             "strides, settled from its two nearest and the cheapest) and set it beside the "
+             "surfaces' prediction: confirmation.json, the report's confirmation section."),
 ) -> None:
     """Run a design study: DOE -> evaluator per run -> surfaces, ANOVA, optimum, figures.
 
@@ -284,6 +289,9 @@ def _design(
         raise SpecError("--motion-model needs --motion", where="--motion-model")
     if settle < 0:
         raise SpecError(f"--settle must be >= 0, got {settle}", where="--settle")
+    if confirm and (evaluator != "collocation" or not objective):
+        raise SpecError("--confirm solves the optimum of a study of predicted strides",
+                        where="--confirm", hint="with --evaluator collocation and --objective")
     try:
         ev_settings = EvaluatorSettings(
             kind=evaluator, speed_mps=speed, body_mass_kg=body_mass, dt_s=dt, base=base,
@@ -326,12 +334,37 @@ def _design(
                    f"(PI {o.pi[0]:.4g} .. {o.pi[1]:.4g})")
     elif result.optimum_error:
         typer.echo(f"no optimum: {result.optimum_error}")
+    if confirm:
+        _confirm(ev, result)
     if figures:
         # deferred: matplotlib loads only when figures are written
         from bladelab.design.plots import write_design_figures
 
         for p in write_design_figures(result, out, objective=objective, constraints=cons):
             typer.echo(f"wrote {p}", err=True)
+def _confirm(evaluator, result) -> None:
+    """``--confirm``: the optimum solved (:func:`bladelab.design.confirmation.confirm_optimum`)
+    and a line per response, predicted beside solved."""
+    # deferred: keeps bladelab --help fast
+    from bladelab.design.confirmation import CONFIRMATION_FILE, confirm_optimum
+
+    try:
+        record = confirm_optimum(evaluator, result, say=typer.echo)
+    except BladelabError as err:
+        raise renamed(err, {"confirmation": "--confirm"}) from None
+    inside = sum(r["inside"] for r in record["responses"].values())
+    typer.echo(f"confirmation run ({record['wall_s']:.0f} s): {inside} of "
+               f"{len(record['responses'])} responses inside their 95 % prediction interval "
+               f"-> {Path(result.out_dir) / CONFIRMATION_FILE}")
+    for name, r in record["responses"].items():
+        typer.echo(f"  {name:28s} predicted {r['predicted']:.4g} (PI {r['pi'][0]:.4g} .. "
+                   f"{r['pi'][1]:.4g}), solved {r['solved']:.4g}"
+                   + ("" if r["inside"] else "  outside"))
+    for name, c in record["constraints"].items():
+        typer.echo(f"  constraint {name} {'<=' if c['upper'] else '>='} {c['bound']:g}: "
+                   f"solved {c['solved']:.4g}, {'met' if c['met'] else 'NOT met'}")
+
+
 def _echo_motion(mm) -> None:
     """One summary line of the motion model, and its leave-one-blade-out errors."""
     def fmt(v: float, scale: float = 1.0, digits: int = 2) -> str:

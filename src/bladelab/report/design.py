@@ -19,6 +19,7 @@ import numpy as np
 import pandas as pd
 
 from bladelab._io import read_json
+from bladelab.design.confirmation import CONFIRMATION_FILE
 from bladelab.design.optimum import constrained_optimum, surface_constraints
 from bladelab.design.plots import contour_plot, figure_pairs, main_effects_plot
 from bladelab.design.responses import (
@@ -236,7 +237,47 @@ def design_report_sections(design_dir: str | Path) -> list[dict[str, Any]]:
         if cons_rows:
             tabs.append(("Constraints at the optimum", pd.DataFrame(cons_rows)))
         sections.append({"title": "Design study: optimum", "text": text, "tables": tabs})
+    confirmed = _confirmation_section(design_dir, optimum, {r: s.unit for r, s in
+                                                            surfaces.items()})
+    if confirmed is not None:
+        sections.append(confirmed)
     return sections
+
+
+def _confirmation_section(design_dir: Path, optimum, units: dict[str, str]) -> dict | None:
+    """The optimum solved as a design (``--confirm``, :mod:`bladelab.design.confirmation`)
+    beside the surfaces' prediction; None without a confirmation run."""
+    path = design_dir / CONFIRMATION_FILE
+    if not path.is_file():
+        return None
+    rec = read_json(path, what="confirmation run")
+    rows = [{"response": name, "unit": units.get(name, ""), "predicted": r["predicted"],
+             "PI lower": r["pi"][0], "PI upper": r["pi"][1], "solved": r["solved"],
+             "inside the PI": "yes" if r["inside"] else "no"}
+            for name, r in rec["responses"].items()]
+    inside = sum(r["inside"] for r in rec["responses"].values())
+    point = ", ".join(f"{k} {v:.4g}" for k, v in rec["point"].items())
+    text = (f"The optimum's blade ({point}) solved as one more design: from its nearest "
+            f"designs' strides, then settled from its two nearest and the study's cheapest "
+            f"({len(rec['starts'])} starts, {rec['wall_s']:.0f} s; the stride: "
+            f"{rec['stride']}). {inside} of {len(rows)} responses lie inside their 95 % "
+            "prediction interval. A surface's optimum is a prediction; where the designs' "
+            "strides lie on two branches, a quadratic interpolates the kink between them, "
+            "and the solved stride says which branch the blade runs on.")
+    if optimum is not None and any(
+            abs(optimum.point[k] - v) > 1e-9 * max(1.0, abs(v)) for k, v in rec["point"].items()):
+        text += (" The optimum above (fitted to the clean strides only) differs from the one "
+                 "confirmed (the study's optimum.json).")
+    missed = [k for k, c in rec.get("constraints", {}).items() if not c["met"]]
+    if missed:
+        text += f" The solved stride violates {', '.join(missed)}."
+    tables = [("Predicted and solved at the optimum", pd.DataFrame(rows))]
+    if rec.get("constraints"):
+        tables.append(("Constraints, solved", pd.DataFrame(
+            [{"constraint": k, "relation": "≤" if c["upper"] else "≥", "bound": c["bound"],
+              "solved": c["solved"], "met": "yes" if c["met"] else "no"}
+             for k, c in rec["constraints"].items()])))
+    return {"title": "Design study: the optimum, solved", "text": text, "tables": tables}
 
 
 def _failures_by_level(space, table: pd.DataFrame, failed: pd.DataFrame) -> pd.DataFrame:
