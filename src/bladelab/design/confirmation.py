@@ -21,7 +21,8 @@ study's, not among them, so that no design of the study starts from it. It write
 ``point``, ``coded``  the optimum's blade, in the factors' units and coded
 ``objective``       the study's objective and sense
 ``from``            the start file that gave the kept stride (``null``: its first solve's)
-``starts``          per settling start: file, objective, status
+``starts``          per settling start solved: file, objective, status (the first solve's
+                    start is not solved again)
 ``stride``          the kept stride's file (under ``confirmation/strides/``)
 ``wall_s``          the run's wall time [s]
 ``responses``       per fitted response: ``predicted`` (the surface's mean), ``pi`` (its 95 %
@@ -108,7 +109,9 @@ def confirm_optimum(evaluator: CollocationEvaluator, result, *,
                        "study_strides": str(evaluator.solutions_dir)})
     t0 = time.perf_counter()
     first = ev(point)  # from its nearest design's stride, as a run of the study
-    settled = ev.settle(point, neighbours=2, cheapest=True, say=say)
+    # the start that gave the first stride is not solved again (IPOPT would retrace it)
+    settled = ev.settle(point, neighbours=2, cheapest=True, known=ev.solved_from(point),
+                        say=say)
     wall = time.perf_counter() - t0
     kept = first if settled["from"] is None else next(
         t["responses"] for t in settled["tries"] if t["from"] == settled["from"])
