@@ -37,7 +37,10 @@ def _study(tmp_path, *, cap: float | None = None):
     coded = central_composite(4).coded
     y = 0.05 * coded[:, 0] + 0.01 * np.random.default_rng(0).standard_normal(len(coded))
     surfaces = {"delta_vx_m_per_s": fit_surface(coded, y, factor_names=SPACE.names,
-                                                response="delta_vx_m_per_s", unit="m/s")}
+                                                response="delta_vx_m_per_s", unit="m/s"),
+                "avg_vx_m_per_s": fit_surface(coded, np.full(len(coded), 4.0),  # prescribed
+                                              factor_names=SPACE.names,
+                                              response="avg_vx_m_per_s", unit="m/s")}
     cons = {} if cap is None else {"delta_vx_m_per_s": {"max": cap}}
     optimum = constrained_optimum(surfaces["delta_vx_m_per_s"], sense="max", space=SPACE,
                                   constraints=surface_constraints(surfaces, cons))
@@ -58,8 +61,10 @@ def stored_own(monkeypatch):
 
 
 def test_the_optimum_is_solved_from_the_study_strides_and_kept_apart(fake, stored_own,  # noqa: F811
-                                                                      tmp_path):
+                                                                      tmp_path, monkeypatch):
     calls, _ = fake
+    monkeypatch.setattr(ce, "stride_responses",
+                        lambda sol, runner: {"delta_vx_m_per_s": 0.1, "avg_vx_m_per_s": 4.0})
     result = _study(tmp_path, cap=0.02)
     ev = _evaluator(tmp_path)
     lines = []
@@ -76,6 +81,7 @@ def test_the_optimum_is_solved_from_the_study_strides_and_kept_apart(fake, store
     assert sorted(p.name for p in (tmp_path / "s").iterdir()) == sorted(
         f"{ce.point_file_stem(p)}.json" for p in (CENTRE, {**CENTRE, "stiffness_kN_per_m": 32.0}))
     # predicted beside solved (the stand-in's Δv_x is 0.1 m/s), the cap checked on the stride
+    assert list(rec["responses"]) == ["delta_vx_m_per_s"]  # a prescribed response: none
     row = rec["responses"]["delta_vx_m_per_s"]
     assert row["solved"] == 0.1 and row["predicted"] == pytest.approx(0.02, abs=1e-6)
     assert row["inside"] == (row["pi"][0] <= 0.1 <= row["pi"][1])

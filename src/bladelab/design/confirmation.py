@@ -25,7 +25,7 @@ study's, not among them, so that no design of the study starts from it. It write
                     start is not solved again)
 ``stride``          the kept stride's file (under ``confirmation/strides/``)
 ``wall_s``          the run's wall time [s]
-``responses``       per fitted response: ``predicted`` (the surface's mean), ``pi`` (its 95 %
+``responses``       per fitted response that varies: ``predicted`` (the surface's mean), ``pi`` (its 95 %
                     prediction interval), ``solved``, ``inside`` (the solved value in the
                     interval)
 ``constraints``     per constraint of the optimum: ``bound``, ``upper`` (a maximum),
@@ -43,6 +43,8 @@ import math
 import time
 from collections.abc import Callable
 from pathlib import Path
+
+import numpy as np
 
 from bladelab._io import read_json, write_json
 from bladelab.design.collocation_evaluator import CollocationEvaluator, point_file_stem
@@ -119,8 +121,8 @@ def confirm_optimum(evaluator: CollocationEvaluator, result, *,
     responses = {}
     for name, surface in result.surfaces.items():
         value = kept.get(name)
-        if value is None or not math.isfinite(value):
-            continue
+        if value is None or not math.isfinite(value) or np.ptp(surface.y) == 0:
+            continue  # not given, or prescribed (the mean speed): nothing predicted
         pred = surface.predict([coded])
         lo, hi = float(pred.pi_lower[0]), float(pred.pi_upper[0])
         responses[name] = {"predicted": float(pred.mean[0]), "pi": [lo, hi],

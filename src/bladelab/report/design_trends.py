@@ -82,6 +82,6 @@ def trends_section(surfaces, evaluator: dict | None = None,
     if reasons:  # long paragraphs, often shared: numbered below the table, not in a cell
         number = {r: f"note {k}" for k, r in enumerate(reasons, start=1)}
         frame["reason"] = frame["reason"].map(lambda r: number.get(r, ""))
-        tables.append(("Why a trend does not hold", pd.DataFrame(
+        tables.append(("Why a trend does not hold or is undecided", pd.DataFrame(
             {"note": list(number.values()), "reason": reasons})))
     return {"title": "Seed 002 trends", "text": text, "tables": tables}
