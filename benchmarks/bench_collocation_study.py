@@ -21,7 +21,12 @@ from pathlib import Path
 
 HERE = Path(__file__).resolve().parent / "collocation"
 #: (folder, what differs) of each timed study.
-STUDIES = (("study-human-vasti16-2026-12-01", "the human body with the vasti's series "
+STUDIES = (("study-human-timed-2026-12-05", "the human body as shipped since 2026-12-03 (the "
+            "toes' damper, people's swing knee held), at people's stride time, people's joint "
+            "angles at weight 10 1/rad², one start per problem from the shipped strides, then "
+            "the settling pass (`--settle`); the rows are the kept starts', the wall time both "
+            "passes'"),
+           ("study-human-vasti16-2026-12-01", "the human body with the vasti's series "
             "elasticity at 16 % (since 2026-12-01), at people's stride time, people's joint "
             "angles at weight 10 1/rad², one start per problem from the shipped strides, then "
             "the settling pass (`--settle`: the amputees from their neighbouring categories' "
