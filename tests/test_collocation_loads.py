@@ -70,3 +70,23 @@ def test_the_socket_carries_the_blades_ground_force_and_its_moment(blade_stride)
     assert res["socket_moment_max_Nm"] >= 0.95 * abs(about_socket)
     assert 0.1 * res["socket_moment_max_Nm"] < res["blade_moment_max_Nm"] < 1e4
     assert res.keys() == PEAK_LOAD_UNITS.keys()
+
+
+def test_the_stride_report_shows_the_loads_it_computes(blade_stride, tmp_path):
+    """An amputee stride's report has a "Prosthesis loads" section whose peaks are
+    :func:`peak_loads`' own, in N, BW and N·m, with its figure."""
+    from bladelab.report import Report
+    from bladelab.report.collocation_loads import add_loads_section
+
+    sol, runner, _, peaks = blade_stride
+    report = Report("loads")
+    add_loads_section(report, sol, runner, build_collocation_model(runner))
+    (section,) = report.sections
+    assert section.title == "Prosthesis loads" and len(section.figures) == 1
+    table = section.tables[0].frame.set_index("load")
+    assert table.loc["socket force, peak", "value"] == pytest.approx(peaks["socket_force_max_N"])
+    assert table.loc["socket force, peak", "in body weights"] == pytest.approx(
+        peaks["socket_force_max_N"] / (runner.total_mass * runner.gravity))
+    assert table.loc["socket moment, peak", "unit"] == "N·m"
+    assert table.loc["blade joint moment, peak", "value"] == pytest.approx(
+        peaks["blade_moment_max_Nm"])

@@ -716,6 +716,7 @@ def test_the_predictive_report_renders_a_collocation_solution(able, tmp_path):
     assert "contact time, left leg" in html and "knee flexion RMSE against the measured" in html
     assert "the total against the measured 3.5 m/s stride" in html  # the force's shape too
     assert "Not a free prediction" not in html  # the fake solve held no reference term
+    assert "Prosthesis loads" not in html  # an able runner carries none
     # a stride solved with people's angles in its objective says so in its first lines
     people = replace(sol, settings=CollocationSettings(**people_term(10.0)),
                      nlp=replace(sol.nlp, objective_terms={**sol.nlp.objective_terms,

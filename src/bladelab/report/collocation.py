@@ -42,6 +42,7 @@ from bladelab.predict.collocation.solution import (
 )
 from bladelab.predict.collocation.solve import SOLUTION_FILE
 from bladelab.predict.collocation.stored import athlete_label, runner_from_spec
+from bladelab.report.collocation_loads import add_loads_section
 
 __all__ = ["N_STRIDES", "REFINE", "collocation_sections", "collocation_solution_file",
            "reference_term_text"]
@@ -288,8 +289,8 @@ def collocation_sections(report, path: str | Path) -> tuple[dict, object]:
     the :class:`~bladelab.predict.collocation.solution.CollocationSolution`)."""
     sol = CollocationSolution.read(collocation_solution_file(path) or path)  # file or folder
     runner = runner_from_spec(sol.model_spec)
-    result = sol.to_runner_result(N_STRIDES, refine=REFINE, runner=runner,
-                                  cm=build_collocation_model(runner))
+    cm = build_collocation_model(runner)
+    result = sol.to_runner_result(N_STRIDES, refine=REFINE, runner=runner, cm=cm)
     s = sol.nlp
     summary = pd.DataFrame([{"quantity": k, "value": v} for k, v in sol.summary().items()])
     stages = []
@@ -382,4 +383,5 @@ def collocation_sections(report, path: str | Path) -> tuple[dict, object]:
                       "stride", fig)],
         )
         plt.close(fig)
+    add_loads_section(report, sol, runner, cm)
     return {_label(sol): result}, sol
