@@ -518,9 +518,10 @@ def _spread_section(spread: pd.DataFrame, unmeasured: Sequence[str] = ()) -> dic
                  "designs (--settle) before reading the ceilings.")
     if len(low):
         text += (f" {len(low)} of {len(spread)} responses have a ceiling below 0.8 "
-                 f"({', '.join(low['response'])}): no surface model can predict them to "
-                 "R² 0.8 from strides of this quality; each design would have to be solved to "
-                 "its global optimum (more settling passes, more starts).")
+                 f"({', '.join(low['response'])}): were each run any of its clean strides, "
+                 "no surface could predict them to R² 0.8. The kept strides are each design's "
+                 "best found, which carry less of that error the more the study has settled: "
+                 "the surfaces' R²pred (the fits above) says how much less.")
     if unmeasured:
         text += (f" No spread of {', '.join(unmeasured)}: the settling record's strides were "
                  "evaluated before these responses existed, and only each design's kept stride "
