@@ -133,3 +133,14 @@ def test_the_command_line_refuses_confirm_without_a_predicted_stride_study(tmp_p
     assert main(["design", "--out", str(tmp_path / "x"), "--confirm"]) == 2
     assert "--confirm" in capsys.readouterr().err
     assert not Path(tmp_path / "x").exists()
+
+
+def test_an_optimum_at_a_design_starts_from_that_designs_stride(fake, stored_own, tmp_path):  # noqa: F811
+    """The optimum on a design of the study: its own stride is the first start (a replicate
+    from the neighbours alone can end in a dearer optimum)."""
+    calls, _ = fake
+    result = _study(tmp_path)
+    point = {k: float(v) for k, v in result.optimum.point.items()}
+    shutil.copy(STRIDE, tmp_path / "s" / f"{ce.point_file_stem(point)}.json")
+    cf.confirm_optimum(_evaluator(tmp_path), result)
+    assert f"{ce.point_file_stem(point)}.json" in calls[0]["source"]
