@@ -258,8 +258,9 @@ def _confirmation_section(design_dir: Path, optimum, units: dict[str, str]) -> d
     inside = sum(r["inside"] for r in rec["responses"].values())
     point = ", ".join(f"{k} {v:.4g}" for k, v in rec["point"].items())
     text = (f"The optimum's blade ({point}) solved as one more design: from its nearest "
-            f"designs' strides, then settled from its two nearest and the study's cheapest "
-            f"({len(rec['starts'])} starts, {rec['wall_s']:.0f} s; the stride: "
+            "designs' strides (its own first, when it is a design of the study), then settled "
+            "from its two nearest and the study's cheapest, a start already solved from "
+            f"skipped ({1 + len(rec['starts'])} solves, {rec['wall_s']:.0f} s; the stride: "
             f"{rec['stride']}). {inside} of {len(rows)} responses lie inside their 95 % "
             "prediction interval. A surface's optimum is a prediction; where the designs' "
             "strides lie on two branches, a quadratic interpolates the kink between them, "
