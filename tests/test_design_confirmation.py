@@ -4,6 +4,7 @@ benchmarks/design/transtibial-socket-cap-2026-12-05)."""
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import re
 import shutil
@@ -142,5 +143,11 @@ def test_an_optimum_at_a_design_starts_from_that_designs_stride(fake, stored_own
     result = _study(tmp_path)
     point = {k: float(v) for k, v in result.optimum.point.items()}
     shutil.copy(STRIDE, tmp_path / "s" / f"{ce.point_file_stem(point)}.json")
-    cf.confirm_optimum(_evaluator(tmp_path), result)
+    ev = _evaluator(tmp_path)
+    cf.confirm_optimum(ev, result)
     assert f"{ce.point_file_stem(point)}.json" in calls[0]["source"]
+    # once, even where the optimum's coordinates are an ulp off the file name's
+    nudged = {k: v * (1 + 1e-15) for k, v in point.items()}
+    fields = {f.name: getattr(ev, f.name) for f in dataclasses.fields(ev)}
+    starts = cf._FromStudy(**fields, study_strides=str(tmp_path / "s"))._neighbours(nudged)
+    assert [p.name for p in starts].count(f"{ce.point_file_stem(point)}.json") == 1
