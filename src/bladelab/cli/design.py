@@ -342,6 +342,8 @@ def _design(
 
         for p in write_design_figures(result, out, objective=objective, constraints=cons):
             typer.echo(f"wrote {p}", err=True)
+
+
 def _confirm(evaluator, result) -> None:
     """``--confirm``: the optimum solved (:func:`bladelab.design.confirmation.confirm_optimum`)
     and a line per response, predicted beside solved."""

@@ -4,11 +4,12 @@ about the blade's joints, over the stride (:mod:`bladelab.predict.collocation.lo
 
 from __future__ import annotations
 
+import mujoco
 import numpy as np
 import pandas as pd
 
 from bladelab.predict.collocation.human_running import stride_from_left_touchdown
-from bladelab.predict.collocation.loads import peak_loads, prosthesis_loads
+from bladelab.predict.collocation.loads import PROSTHESIS_BODY, peaks_of, prosthesis_loads
 from bladelab.predict.collocation.nodes import evaluate_nodes
 from bladelab.runner.layout import CP_LEG
 
@@ -47,7 +48,7 @@ def _figure(sol, loads: dict, ground_bw: np.ndarray, weight_n: float):
 def add_loads_section(report, sol, runner, cm) -> None:
     """Add the section for an amputee stride ``sol`` (its ``runner`` and collocation model
     ``cm``); nothing for a runner without a prosthesis."""
-    if "prosthesis_r" not in [runner.mj_model.body(b).name for b in range(runner.mj_model.nbody)]:
+    if mujoco.mj_name2id(runner.mj_model, mujoco.mjtObj.mjOBJ_BODY, PROSTHESIS_BODY) < 0:
         return
     import matplotlib.pyplot as plt
 
@@ -55,7 +56,7 @@ def add_loads_section(report, sol, runner, cm) -> None:
     nodes = evaluate_nodes(cm, nlp.q, nlp.qd, nlp.tendon_force, nlp.tendon_force_rate)
     pros = runner.contact_params[:, CP_LEG] == 1
     loads = prosthesis_loads(runner, nlp, nodes["forces"], nodes["passive"], pros)
-    peaks = peak_loads(runner, nlp, nodes["forces"], nodes["passive"], pros)
+    peaks = peaks_of(loads)
     weight = runner.total_mass * runner.gravity
     table = pd.DataFrame([
         {"load": "socket force, peak", "value": peaks["socket_force_max_N"], "unit": "N",

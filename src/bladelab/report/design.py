@@ -19,7 +19,7 @@ import numpy as np
 import pandas as pd
 
 from bladelab._io import read_json
-from bladelab.design.confirmation import CONFIRMATION_FILE
+from bladelab.design.confirmation import CONFIRMATION_FILE, same_point
 from bladelab.design.optimum import constrained_optimum, surface_constraints
 from bladelab.design.plots import contour_plot, figure_pairs, main_effects_plot
 from bladelab.design.responses import (
@@ -265,8 +265,7 @@ def _confirmation_section(design_dir: Path, optimum, units: dict[str, str]) -> d
             "prediction interval. A surface's optimum is a prediction; where the designs' "
             "strides lie on two branches, a quadratic interpolates the kink between them, "
             "and the solved stride says which branch the blade runs on.")
-    if optimum is not None and any(
-            abs(optimum.point[k] - v) > 1e-9 * max(1.0, abs(v)) for k, v in rec["point"].items()):
+    if optimum is not None and not same_point(optimum.point, rec["point"]):
         text += (" The optimum above (fitted to the clean strides only) differs from the one "
                  "confirmed (the study's optimum.json).")
     missed = [k for k, c in rec.get("constraints", {}).items() if not c["met"]]

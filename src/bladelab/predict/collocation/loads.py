@@ -1,7 +1,7 @@
 """The loads a prosthesis carries over a solved stride: the force and moment the residual limb
 passes into it at its socket hinge, and the moments about the blade's joints.
 
-The socket hinge is the joint of the prosthesis's root body (``prosthesis_r``): the
+The socket hinge is the joint of the prosthesis's root body (:data:`PROSTHESIS_BODY`): the
 transtibial runner's socket (``socket_angle_r``, a torsional spring on the residual tibia), the
 transfemoral runner's prosthetic knee (its socket is rigid on the residual thigh, so the knee
 axis is where the prosthesis's load enters it). A hinge carries only its own torque about its
@@ -27,7 +27,11 @@ from __future__ import annotations
 import mujoco
 import numpy as np
 
-__all__ = ["PEAK_LOAD_UNITS", "peak_loads", "prosthesis_loads", "subtree_com_acceleration"]
+__all__ = ["PEAK_LOAD_UNITS", "PROSTHESIS_BODY", "peak_loads", "peaks_of", "prosthesis_loads",
+           "subtree_com_acceleration"]
+
+#: The root body of every runner's prosthesis (socket, pylon and blade below it).
+PROSTHESIS_BODY = "prosthesis_r"
 
 #: The keys of :func:`peak_loads` and their units.
 PEAK_LOAD_UNITS = {"socket_force_max_N": "N", "socket_moment_max_Nm": "N·m",
@@ -62,7 +66,7 @@ def prosthesis_loads(runner, nlp, forces: np.ndarray, passive: np.ndarray,
     (n + 1, n_dof) the passive joint torques (:func:`~bladelab.predict.collocation.nodes.
     evaluate_nodes`), ``prosthetic`` the mask of the prosthesis's contacts."""
     m = runner.mj_model
-    root = m.body("prosthesis_r").id
+    root = m.body(PROSTHESIS_BODY).id
     hinge = m.joint(int(m.body_jntadr[root])).name
     names = list(runner.dof_names)
     blade = [i for i, n in enumerate(names) if n.startswith("blade_joint")]
@@ -79,12 +83,9 @@ def _interval_means(values: np.ndarray) -> np.ndarray:
     return 0.5 * (values[:-1] + values[1:])
 
 
-
-def peak_loads(runner, nlp, forces: np.ndarray, passive: np.ndarray,
-               prosthetic: np.ndarray) -> dict[str, float]:
-    """The largest loads over the stride (module docstring; units in :data:`PEAK_LOAD_UNITS`),
-    from :func:`prosthesis_loads`' arguments."""
-    loads = prosthesis_loads(runner, nlp, forces, passive, prosthetic)
+def peaks_of(loads: dict[str, np.ndarray]) -> dict[str, float]:
+    """The largest loads over the stride (module docstring; units in :data:`PEAK_LOAD_UNITS`)
+    of :func:`prosthesis_loads`' per-node loads."""
     blade = np.abs(_interval_means(loads["blade_moment"]))
     return {
         "socket_force_max_N": float(
@@ -92,3 +93,9 @@ def peak_loads(runner, nlp, forces: np.ndarray, passive: np.ndarray,
         "socket_moment_max_Nm": float(np.abs(_interval_means(loads["socket_moment"])).max()),
         "blade_moment_max_Nm": float(blade.max()) if blade.size else float("nan"),
     }
+
+
+def peak_loads(runner, nlp, forces: np.ndarray, passive: np.ndarray,
+               prosthetic: np.ndarray) -> dict[str, float]:
+    """:func:`peaks_of` the :func:`prosthesis_loads` of these arguments."""
+    return peaks_of(prosthesis_loads(runner, nlp, forces, passive, prosthetic))
