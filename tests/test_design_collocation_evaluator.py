@@ -37,6 +37,10 @@ class _Outcome:
     def to_guess(self, source):
         return type("G", (), {"source": source})()
 
+    @property
+    def mean_speed_mps(self):
+        return self._base.mean_speed_mps
+
     def gait_warnings(self):
         return list(self._defects)
 
@@ -532,3 +536,35 @@ def test_the_transtibial_runner_is_predicts_amputee_wearing_the_design(fake, tmp
     with pytest.raises(SpecError, match="no built-in start stride of the transtibial") as err:
         make_evaluator("collocation", amputation="transtibial", body="seed001")
     assert err.value.where == "body"
+
+
+def test_the_maximum_speed_problem_per_design_from_another_studys_strides(fake, tmp_path):
+    """max_speed: every design's solve poses the maximum-speed problem (no speed) and reports
+    its stride's mean speed; start_strides: a design starts from its own stride there first,
+    a design without one from its neighbours; a prescribed speed beside it and a missing
+    folder are named."""
+    from bladelab.design.settings import EvaluatorSettings
+
+    calls, _ = fake
+    other = tmp_path / "other"
+    other.mkdir()
+    own = other / f"{ce.point_file_stem(CENTRE)}.json"
+    own.write_bytes(STRIDE.read_bytes())
+    ev = _evaluator(tmp_path, max_speed=True, start_strides=str(other))
+    assert ev.speed_mps is None and "max_speed_m_per_s" in ev.response_names
+    out = ev(CENTRE)
+    base = CollocationSolution.read(STRIDE)
+    assert out["max_speed_m_per_s"] == pytest.approx(base.mean_speed_mps)
+    assert calls[0]["speed"] is None and _start_name(calls[0]["source"]) == own.name
+    assert calls[0]["source"].count(own.name) == 1
+    ev({**CENTRE, "width_m": 0.05})  # no stride of it in the other study: its neighbour
+    assert _start_name(calls[1]["source"]) == own.name  # the centre's, now this study's own
+    assert "max_speed_m_per_s" not in _evaluator(tmp_path).response_names
+    with pytest.raises(SpecError, match="exclude each other") as err:
+        EvaluatorSettings(kind="collocation", speed_mps=4.0, max_speed=True)
+    assert err.value.where == "max_speed"
+    with pytest.raises(InputFileError, match="start strides"):
+        _evaluator(tmp_path, max_speed=True, start_strides=str(tmp_path / "none"))
+    with pytest.raises(SpecError) as err:
+        _evaluator(tmp_path, max_speed=True, stride_time_people=True)
+    assert err.value.where == "stride_time_people"

@@ -48,6 +48,7 @@ OPTIONS = {
     "people_weight": "--people-weight", "step_phase_tolerance": "--alternating-steps",
     "prosthetic_load_max_bw": "--prosthetic-load-max",
     "stride_time_range_s": "--stride-time", "stride_time_people": "--stride-time",
+    "max_speed": "--max-speed", "start_strides": "--start-strides",
 }
 _FACTORS = ",".join(f"{name}={low:g}:{high:g}" for name, low, high, *_ in defaults.DESIGN_FACTORS)
 
@@ -194,6 +195,15 @@ def _design(
         None, "--start", rich_help_panel=COLLOCATION,
         help="Collocation solution of the runner that the first design starts from "
              "(default: the built-in centre stride of the runner, where there is one)."),
+    start_strides: Path | None = typer.Option(
+        None, "--start-strides", rich_help_panel=COLLOCATION, show_default=False,
+        help="A folder of strides of the same designs (another study's strides/): each design "
+             "starts from its own stride there first, e.g. the maximum-speed study from the "
+             "4 m/s study's strides."),
+    max_speed: bool = typer.Option(
+        False, "--max-speed", rich_help_panel=COLLOCATION,
+        help="Predict each design's maximum-speed stride (the speed free) instead of one at "
+             "--speed; response max_speed_m_per_s [m/s] (not with --stride-time people)."),
     amputation: str | None = typer.Option(
         None, "--amputation", rich_help_panel=COLLOCATION, show_default=False,
         help="The runner's amputation: transfemoral (the default: seed 002's athlete, a passive "
@@ -301,6 +311,7 @@ def _design(
             people_weight=people_weight,
             step_phase_tolerance=alternating_steps,
             prosthetic_load_max_bw=prosthetic_load_max,
+            max_speed=max_speed or None, start_strides=start_strides,
             **(stride_time_settings(stride_time) if stride_time is not None else {}))
     except BladelabError as err:
         raise renamed(err, OPTIONS) from None

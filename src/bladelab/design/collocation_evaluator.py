@@ -8,14 +8,18 @@
    blade_model=…)``: intact leg, residual hip muscles, the passive 3S80-class knee, the
    blade's links, joints and soles) or the transtibial one (``"amputee"``: the residual knee
    and its muscles, the blade in place of the foot), by ``amputation``;
-3. predicts one periodic stride at the prescribed speed by direct collocation
+3. predicts one periodic stride at the prescribed speed (or, with ``max_speed``, the stride
+   of the maximum-speed problem) by direct collocation
    (:func:`~bladelab.predict.collocation.solve.predict_stride`), warm-started from the
-   nearest designs already solved in ``solutions_dir`` (coded distance), then from ``start``;
+   design's own stride in ``start_strides`` (another study of the same designs) if given, then
+   from the nearest designs already solved in ``solutions_dir`` (coded distance), then from
+   ``start``;
    a start that does not converge to a stride without
    :meth:`~bladelab.predict.collocation.solution.CollocationSolution.gait_warnings` is
    followed by the next one; the last resort is ``start`` with a tracking stage first;
 4. reads seed 002's responses off the stride
-   (:func:`~bladelab.design.predicted.stride_responses`).
+   (:func:`~bladelab.design.predicted.stride_responses`), with ``max_speed`` also the
+   stride's mean speed as ``max_speed_m_per_s``.
 
 Every design's stride is written to ``solutions_dir/<point>.json`` (``bladelab report``
 renders it) and read back instead of solved again when the design is evaluated again (a
@@ -37,7 +41,7 @@ from typing import Any, ClassVar
 from bladelab.design import defaults
 from bladelab.design.blade_generator import generate_blade
 from bladelab.design.predicted import stride_responses
-from bladelab.design.responses import PREDICTED_RESPONSE_UNITS
+from bladelab.design.responses import MAX_SPEED_RESPONSE_UNITS, PREDICTED_RESPONSE_UNITS
 from bladelab.errors import InputFileError, OptimizationError, SpecError
 from bladelab.predict import defaults as predict_defaults
 from bladelab.predict.collocation.settings import CollocationSettings, people_term
@@ -119,7 +123,17 @@ class CollocationEvaluator:
     Attributes
     ----------
     speed_mps
-        Prescribed mean speed of the stride [m/s].
+        Prescribed mean speed of the stride [m/s]; None with ``max_speed``.
+    max_speed
+        Predict each design's stride of the maximum-speed problem instead (the speed free, the
+        negative mean speed plus the effort terms minimised:
+        :func:`~bladelab.predict.collocation.continuation.max_speed_settings`'s weights); its
+        mean speed is the response ``max_speed_m_per_s``. Excludes people's stride time
+        (their band moves with the speed, which this problem predicts).
+    start_strides
+        A folder of strides of the same designs (another study's ``strides``, e.g. at a
+        prescribed speed): each design starts from its own stride there first (the file named
+        by its point), then from the neighbours and ``start``. None (default): no such folder.
     start
         A collocation solution (file) of the runner to start the first design from (any
         blade with the same number of links); default the runner's (:data:`DEFAULT_STARTS`).
@@ -187,7 +201,9 @@ class CollocationEvaluator:
         Options of :func:`~bladelab.design.blade_generator.generate_blade`.
     """
 
-    speed_mps: float = DEFAULT_DESIGN_SPEED_MPS
+    speed_mps: float | None = DEFAULT_DESIGN_SPEED_MPS
+    max_speed: bool = False
+    start_strides: str | None = None
     start: str | None = None
     solutions_dir: str | None = None
     factor_ranges: Mapping[str, tuple[float, float]] = field(default_factory=dict)
@@ -217,7 +233,8 @@ class CollocationEvaluator:
                                                  "prosthetic_load_max_bw": None,
                                                  "amputation": "transfemoral",
                                                  "stride_time_range_s": None,
-                                                 "stride_time_people": False}
+                                                 "stride_time_people": False,
+                                                 "max_speed": False, "start_strides": None}
 
     def __post_init__(self) -> None:
         if self.amputation not in AMPUTATIONS:
@@ -225,6 +242,18 @@ class CollocationEvaluator:
                             hint=" or ".join(AMPUTATIONS))
         if self.body is None:
             object.__setattr__(self, "body", DEFAULT_BODIES[self.amputation])
+        if not isinstance(self.max_speed, bool):
+            raise SpecError(f"expected true or false, got {self.max_speed!r}",
+                            where="max_speed")
+        if self.max_speed:
+            object.__setattr__(self, "speed_mps", None)
+        elif self.speed_mps is None:
+            raise SpecError("no speed: prescribe one, or pose the maximum-speed problem",
+                            where="speed_mps", hint="speed_mps in m/s, or max_speed true")
+        if self.start_strides is not None and not Path(self.start_strides).is_dir():
+            raise InputFileError("no such folder of the designs' start strides",
+                                 file=self.start_strides,
+                                 hint="another study's strides folder (its designs' strides)")
         if self.body not in BODIES:
             raise SpecError(f"unknown body {self.body!r}", where="body", hint=" or ".join(BODIES))
         if self.start is None and (self.amputation, self.body) not in DEFAULT_STARTS:
@@ -277,13 +306,22 @@ class CollocationEvaluator:
 
     @property
     def units(self) -> dict[str, str]:
-        return dict(PREDICTED_RESPONSE_UNITS)
+        return {**PREDICTED_RESPONSE_UNITS, **(MAX_SPEED_RESPONSE_UNITS if self.max_speed
+                                               else {})}
 
     @property
     def response_names(self) -> tuple[str, ...]:
         """The responses of a design: a stored run without all of them (an older library's)
         is evaluated again by the study, which reads its stored stride back."""
-        return tuple(PREDICTED_RESPONSE_UNITS)
+        return tuple(self.units)
+
+    def responses(self, solution, runner) -> dict[str, float]:
+        """A design's responses (:func:`~bladelab.design.predicted.stride_responses`; with
+        ``max_speed`` also ``max_speed_m_per_s``, the stride's mean speed [m/s])."""
+        out = stride_responses(solution, runner)
+        if self.max_speed:
+            out["max_speed_m_per_s"] = float(solution.mean_speed_mps)
+        return out
 
     def to_dict(self) -> dict:
         d = asdict(self)
@@ -322,9 +360,13 @@ class CollocationEvaluator:
         nearest first, then ``start``; with a reference weight, ``start`` (the reference)
         first and the neighbours after it (every design from the same start: measured
         2026-11-26, a chain of neighbours carried a 0.59 s stride away from the reference's 0.53 s
-        into a third of the box)."""
+        into a third of the box). With ``start_strides``, the design's own stride there
+        comes first."""
         near = self._neighbours(point)[:START_NEIGHBOURS]
-        return [self.start_file, *near] if self.reference_weight else [*near, self.start_file]
+        starts = [self.start_file, *near] if self.reference_weight else [*near, self.start_file]
+        own = (Path(self.start_strides) / f"{point_file_stem(point)}.json"
+               if self.start_strides is not None else None)
+        return [own, *starts] if own is not None and own.is_file() else starts
 
     def solved_from(self, point: Mapping[str, float]) -> dict[str, str]:
         """{start file name: its identity} of the solve that gave this design's stored stride,
@@ -405,14 +447,14 @@ class CollocationEvaluator:
                           "converged": bool(sol.converged), "status": str(sol.nlp.status),
                           "objective": float(sol.nlp.objective) if sol.converged else None,
                           "warnings": list(warnings),
-                          "responses": stride_responses(sol, runner) if clean else None})
+                          "responses": self.responses(sol, runner) if clean else None})
             if clean and sol.nlp.objective < best.nlp.objective:
                 best, source = sol, path.name
         if source is not None:
             self._keep(best, point)
         return {"point": point, "before": float(current.nlp.objective),
                 "after": float(best.nlp.objective), "from": source,
-                "responses_before": stride_responses(current, runner), "tries": tries,
+                "responses_before": self.responses(current, runner), "tries": tries,
                 "unchanged": unchanged}
 
     def settings(self):
@@ -508,7 +550,7 @@ class CollocationEvaluator:
             own = self._stride_file(point)
             if own is not None and source != own:  # the start: a neighbour of the others
                 self._replace(stored, point)
-            return stride_responses(stored, runner)
+            return self.responses(stored, runner)
         # each start as it is, then the study's start with a tracking stage first
         plan = [(f, False) for f in self._starts(point)] + [
             (self.start_file, True)]
@@ -539,7 +581,7 @@ class CollocationEvaluator:
                 hint="the last iterates are in the solutions folder; widen the box's centre "
                      "towards this point, or give a --start stride nearer to it")
         self._replace(sol, point)
-        return stride_responses(sol, runner)
+        return self.responses(sol, runner)
 
 
 #: Largest constraint violation of an iteration-limited solve that is continued from its last

@@ -15,7 +15,8 @@ from __future__ import annotations
 
 from bladelab.predict.collocation.loads import PEAK_LOAD_UNITS
 
-__all__ = ["BLADE_RESPONSE_UNITS", "PREDICTED_RESPONSE_UNITS", "RUNNER_RESPONSE_UNITS"]
+__all__ = ["BLADE_RESPONSE_UNITS", "MAX_SPEED_RESPONSE_UNITS", "PREDICTED_RESPONSE_UNITS",
+           "RUNNER_RESPONSE_UNITS"]
 
 #: Units of the blade evaluator's responses (for tables and plots).
 BLADE_RESPONSE_UNITS: dict[str, str] = {
@@ -58,3 +59,7 @@ PREDICTED_RESPONSE_UNITS: dict[str, str] = {
     "stride_objective": "-",
     **PEAK_LOAD_UNITS,
 }
+
+#: The response added by the collocation evaluator's maximum-speed problem
+#: (``CollocationEvaluator(max_speed=True)``): the stride's mean speed.
+MAX_SPEED_RESPONSE_UNITS: dict[str, str] = {"max_speed_m_per_s": "m/s"}

@@ -43,6 +43,8 @@ APPLIES_TO: dict[str, tuple[str, ...]] = {
     "prosthetic_load_max_bw": ("collocation",),
     "stride_time_range_s": ("collocation",),
     "stride_time_people": ("collocation",),
+    "max_speed": ("collocation",),
+    "start_strides": ("collocation",),
 }
 
 
@@ -88,6 +90,10 @@ class EvaluatorSettings:
     stride_time_range_s, stride_time_people
         Collocation: keep every design's stride time inside (lo, hi) [s], or (True) inside
         measured runners' band at the speed; None: free.
+    max_speed, start_strides
+        Collocation: predict each design's maximum-speed stride instead of one at
+        ``speed_mps`` (which it excludes), and a folder of strides of the same designs (another
+        study's) that each design starts from first.
     """
 
     kind: str = "blade"
@@ -109,6 +115,8 @@ class EvaluatorSettings:
     prosthetic_load_max_bw: float | None = None
     stride_time_range_s: tuple[float, float] | None = None
     stride_time_people: bool | None = None
+    max_speed: bool | None = None
+    start_strides: str | Path | None = None
 
     def __post_init__(self) -> None:
         if self.kind not in EVALUATORS:
@@ -127,6 +135,9 @@ class EvaluatorSettings:
                             hint="give one of them")
         if self.motion_model is not None and self.motion is None:
             raise SpecError("a motion model needs a motion file", where="motion_model")
+        if self.max_speed and self.speed_mps is not None:
+            raise SpecError("a prescribed speed and the maximum-speed problem exclude each other",
+                            where="max_speed", hint="give one of them")
         if self.gait is not None and not Path(self.gait).is_file():
             raise InputFileError("no such gait-cycle file", file=self.gait,
                                  hint="a CSV with time_s and the joint angles (docs/design.md)")
@@ -140,10 +151,12 @@ class EvaluatorSettings:
             options["factor_ranges"] = {f.name: (f.low, f.high) for f in space.factors}
             if self.start is not None:
                 options["start"] = str(self.start)
+            if self.start_strides is not None:
+                options["start_strides"] = str(self.start_strides)
             for name in ("knee_moment_min_Nm", "knee_flexion_max_loaded_deg",
                          "reference_weight", "body", "amputation", "people_weight",
                          "step_phase_tolerance", "prosthetic_load_max_bw",
-                         "stride_time_range_s", "stride_time_people"):
+                         "stride_time_range_s", "stride_time_people", "max_speed"):
                 if getattr(self, name) is not None:
                     options[name] = getattr(self, name)
         elif self.body_mass_kg is not None:

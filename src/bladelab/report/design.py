@@ -302,6 +302,8 @@ def _evaluator_sentence(evaluator: dict) -> str:
     kind = evaluator.get("evaluator")
     speed = evaluator.get("speed_mps")
     at = f" at {speed:g} m/s" if isinstance(speed, int | float) else ""
+    if evaluator.get("max_speed"):
+        at = " at its maximum speed"
     if kind == "blade":
         mass = evaluator.get("body_mass_kg")
         mass = f"a {mass:g} kg point mass" if isinstance(mass, int | float) else "a point mass"
@@ -330,7 +332,16 @@ def _problem_posed(evaluator: dict) -> str:
     text = (f"Every design's stride is a periodic stride at {speed:g} m/s "
             if isinstance(speed, int | float) else "Every design's stride is a periodic stride ")
     weight = evaluator.get("reference_weight") or 0.0
-    if weight > 0:
+    if evaluator.get("max_speed"):
+        text = ("Every design's stride is the periodic stride of the maximum-speed problem "
+                "(its mean speed, max_speed_m_per_s, is the design's maximum speed): the "
+                "negative mean speed plus activation and acceleration effort minimised, the "
+                "stride time free")
+        if evaluator.get("people_weight"):
+            text += (f", people's measured hip, knee and ankle angles at "
+                     f"{evaluator['people_weight']:g} /rad² × their mean squared deviation in "
+                     "the objective")
+    elif weight > 0:
         text += ("of least metabolic cost and effort, with the athlete's own joints (trunk, "
                  "intact leg, residual hip) kept near the start stride's: "
                  f"{weight:g} /rad² × their mean squared deviation added to the objective "
