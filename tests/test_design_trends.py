@@ -14,6 +14,7 @@ from bladelab.design.trends import (
     NO_RUNNER,
     NOT_EXPLAINED,
     SEED002_TRENDS,
+    SPEED_TRENDS,
     START_DECIDES,
     TREND_REASONS,
     evaluate_trends,
@@ -155,6 +156,25 @@ def test_a_response_the_start_decides_leaves_its_trends_undecided():
     clear = _by_key(evaluate_trends(_surfaces(HOLD), evaluator="collocation-transtibial",
                                     ceilings={"swing_clearance_m": 0.0}))
     assert clear["longer_toe_lowers_clearance"].reason == START_DECIDES
+
+
+def test_the_performance_trends_are_read_on_the_maximum_speed_where_a_study_has_it():
+    """A maximum-speed study: seed 002's performance trends also on max_speed_m_per_s (stiffer
+    and wider faster here, height and toe smaller; the reversed width effect does not hold),
+    and the report's trends section adds those rows only where the response exists."""
+    from bladelab.report.design_trends import trends_section
+
+    speed = {"max_speed_m_per_s": (0.05, -0.04, 0.01, 0.005), **HOLD}
+    verdicts = _by_key(evaluate_trends(_surfaces(speed), evaluator="collocation",
+                                       trends=SEED002_TRENDS + SPEED_TRENDS))
+    assert verdicts["stiffness_raises_max_speed"].verdict == "holds"
+    assert verdicts["width_raises_max_speed"].verdict == "does not hold"
+    assert "reversed" in verdicts["width_raises_max_speed"].evidence
+    assert verdicts["height_toe_matter_less_speed"].verdict == "holds"
+    rows = trends_section(_surfaces(speed), {"evaluator": "collocation"})["tables"][0][1]
+    assert (rows["response"] == "max_speed_m_per_s").sum() == len(SPEED_TRENDS)
+    plain = trends_section(_surfaces(HOLD), {"evaluator": "collocation"})["tables"][0][1]
+    assert len(plain) == len(SEED002_TRENDS)
 
 
 def test_roles_map_other_factor_names():

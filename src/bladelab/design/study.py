@@ -45,8 +45,9 @@ from bladelab.design.optimum import (
     read_bound,
     surface_constraints,
 )
+from bladelab.design.reduction import REDUCED_MODEL, fit_response
 from bladelab.design.space import DesignSpace
-from bladelab.design.surfaces import ResponseSurface, fit_surface
+from bladelab.design.surfaces import ResponseSurface
 from bladelab.design.terms import parse_terms
 from bladelab.design.timing import RUNS_STAGE, timed_stage
 from bladelab.errors import BladelabError, DataError, OptimizationError, SpecError
@@ -436,9 +437,10 @@ def run_design(
         frame.to_csv(tmp, index=False)
 
     surfaces = {
-        name: fit_surface(
-            design.coded[done], frame[name].to_numpy(), factor_names=space.names, model=terms,
-            response=name, unit=units.get(name, ""),
+        name: fit_response(
+            design.coded[done], frame[name].to_numpy(), factor_names=space.names,
+            model=model if model == REDUCED_MODEL else terms, response=name,
+            unit=units.get(name, ""),
         )
         for name in responses
     }

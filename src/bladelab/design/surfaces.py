@@ -87,6 +87,10 @@ class ResponseSurface:
         PRESS and the leave-one-out RMSE sqrt(PRESS / n) [response unit].
     coded, y, fitted, leverage
         The data, fitted values and hat-matrix diagonal.
+    r2_pred_selected, selection
+        For a surface whose terms were chosen from the data
+        (:func:`~bladelab.design.reduction.fit_reduced`): the predicted R² with the choice
+        repeated without each run, and how the terms were chosen; NaN and "" otherwise.
     """
 
     response: str
@@ -111,6 +115,8 @@ class ResponseSurface:
     fitted: np.ndarray = field(repr=False)
     leverage: np.ndarray = field(repr=False)
     anova: pd.DataFrame = field(repr=False)
+    r2_pred_selected: float = float("nan")
+    selection: str = ""
 
     @property
     def term_names(self) -> tuple[str, ...]:
@@ -219,6 +225,8 @@ class ResponseSurface:
             "r2_pred": _json_float(self.r2_pred),
             "press": _json_float(self.press),
             "loo_rmse": _json_float(self.loo_rmse),
+            **({"r2_pred_selected": _json_float(self.r2_pred_selected),
+                "selection": self.selection} if self.selection else {}),
             "anova": [
                 {k: _json_float(v) if isinstance(v, float) else v for k, v in row.items()}
                 for row in self.anova.to_dict(orient="records")

@@ -6,7 +6,9 @@ name: ``"1"``, ``"A"``, ``"A*B"``, ``"A^2"`` with the factors' names.
 
 Named models: ``"linear"`` (1 + k terms), ``"interaction"`` (linear + two-factor interactions),
 ``"pure_quadratic"`` (linear + squares), ``"quadratic"`` (the full second-order model,
-1 + 2k + k(k-1)/2 terms: 15 for four factors).
+1 + 2k + k(k-1)/2 terms: 15 for four factors), ``"reduced"`` (the full quadratic's terms, which
+the design must estimate; each response's surface keeps a subset of them,
+:mod:`bladelab.design.reduction`).
 """
 
 from __future__ import annotations
@@ -22,7 +24,7 @@ __all__ = ["Term", "MODELS", "model_terms", "parse_terms", "term_name", "model_m
 
 Term = tuple[int, ...]
 
-MODELS = ("linear", "interaction", "pure_quadratic", "quadratic")
+MODELS = ("linear", "interaction", "pure_quadratic", "quadratic", "reduced")
 
 
 def model_terms(n_factors: int, model: str = "quadratic") -> tuple[Term, ...]:
@@ -37,9 +39,9 @@ def model_terms(n_factors: int, model: str = "quadratic") -> tuple[Term, ...]:
     k = int(n_factors)
     terms: list[Term] = [()]
     terms += [(i,) for i in range(k)]
-    if model in ("interaction", "quadratic"):
+    if model in ("interaction", "quadratic", "reduced"):
         terms += list(itertools.combinations(range(k), 2))
-    if model in ("pure_quadratic", "quadratic"):
+    if model in ("pure_quadratic", "quadratic", "reduced"):
         terms += [(i, i) for i in range(k)]
     return tuple(terms)
 

@@ -12,6 +12,11 @@ shorter toe lowers the knee margin    knee_moment_min_Nm  linear coefficient of 
 longer toe lowers swing clearance     swing_clearance_m   linear coefficient of toe length < 0
 ====================================  ==================  ===================================
 
+Seed 002's performance response was Δv_x over the stance. On a study that predicts each design's
+maximum speed (the collocation evaluator's maximum-speed problem), the same three performance
+trends are also read on ``max_speed_m_per_s`` (:data:`SPEED_TRENDS`): faster is what seed 002
+meant by better.
+
 Sign tests: the linear coefficient per coded unit of the fitted surface, two-sided t-test
 (α = 0.05 by default, the surface's residual degrees of freedom): **holds** when it is
 significant with the stated sign; **does not hold** when it is significant with the opposite
@@ -59,6 +64,7 @@ __all__ = [
     "NOT_EXPLAINED",
     "NO_RUNNER",
     "SEED002_TRENDS",
+    "SPEED_TRENDS",
     "START_DECIDES",
     "TREND_REASONS",
     "Trend",
@@ -108,6 +114,17 @@ SEED002_TRENDS: tuple[Trend, ...] = (
           "knee_moment_min_Nm", ("toe_length",), +1),
     Trend("longer_toe_lowers_clearance", "longer toe lowers swing clearance",
           "swing_clearance_m", ("toe_length",), -1),
+)
+
+#: Seed 002's performance trends read on the maximum speed (module docstring).
+SPEED_TRENDS: tuple[Trend, ...] = (
+    Trend("stiffness_raises_max_speed", "stiffer blades raise the maximum speed (performance)",
+          "max_speed_m_per_s", ("stiffness",), +1),
+    Trend("width_raises_max_speed", "wider blades raise the maximum speed (performance)",
+          "max_speed_m_per_s", ("width",), +1),
+    Trend("height_toe_matter_less_speed",
+          "height and toe length matter less than stiffness and width (maximum speed)",
+          "max_speed_m_per_s", ("height", "toe_length"), 0, ("stiffness", "width")),
 )
 
 _SCATTER = (

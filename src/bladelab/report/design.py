@@ -22,8 +22,10 @@ from bladelab._io import read_json
 from bladelab.design.confirmation import CONFIRMATION_FILE, same_point
 from bladelab.design.optimum import constrained_optimum, surface_constraints
 from bladelab.design.plots import contour_plot, figure_pairs, main_effects_plot
+from bladelab.design.reduction import REDUCED_MODEL, fit_response
 from bladelab.design.responses import (
     BLADE_RESPONSE_UNITS,
+    MAX_SPEED_RESPONSE_UNITS,
     PREDICTED_RESPONSE_UNITS,
     RUNNER_RESPONSE_UNITS,
 )
@@ -36,7 +38,6 @@ from bladelab.design.settling import (
 from bladelab.design.space import DesignSpace
 from bladelab.design.start_spread import NEAR_PCT, start_spread
 from bladelab.design.stride_checks import stride_checks
-from bladelab.design.surfaces import fit_surface
 from bladelab.design.terms import parse_terms
 from bladelab.design.timing import stage_walls
 from bladelab.errors import InputFileError, OptimizationError
@@ -71,7 +72,8 @@ def _load(design_dir: Path):
         evaluator = read_json(ev, what="evaluator settings")
         kind = evaluator.get("evaluator")
         units = {"runner": RUNNER_RESPONSE_UNITS,
-                 "collocation": PREDICTED_RESPONSE_UNITS}.get(kind, BLADE_RESPONSE_UNITS)
+                 "collocation": {**PREDICTED_RESPONSE_UNITS, **MAX_SPEED_RESPONSE_UNITS}
+                 }.get(kind, BLADE_RESPONSE_UNITS)
     meta = {**meta, "_evaluator": evaluator}
     coded_cols = [f"{n}_coded" for n in space.names]
     skip = {"run", *space.names, *coded_cols}
@@ -89,8 +91,10 @@ def _load(design_dir: Path):
             file=design_dir, hint="re-solve the flagged runs: delete their runs/*.json and "
             "run the same 'bladelab design' command again")
     coded = fitted[coded_cols].to_numpy(float)
-    surfaces = {r: fit_surface(coded, fitted[r].to_numpy(float), factor_names=space.names,
-                               model=terms, response=r, unit=units.get(r, ""))
+    model = meta.get("model", "quadratic")
+    surfaces = {r: fit_response(coded, fitted[r].to_numpy(float), factor_names=space.names,
+                                model=model if model == REDUCED_MODEL else terms, response=r,
+                                unit=units.get(r, ""))
                 for r in responses}
     return meta, space, table, surfaces
 
@@ -138,6 +142,15 @@ def design_report_sections(design_dir: str | Path) -> list[dict[str, Any]]:
         fit = fit.merge(spread[["response", "r2_ceiling"]].rename(
             columns={"r2_ceiling": "R2 ceiling (start spread)"}), on="response", how="left")
     fit_text = "Predicted R² comes from PRESS (leave-one-out)."
+    if meta.get("model") == REDUCED_MODEL:
+        fit["terms"] = [len(s.terms) for s in surfaces.values()]
+        fit["R2_pred (selection in each fold)"] = [s.r2_pred_selected
+                                                   for s in surfaces.values()]
+        fit_text += (" Each response's surface is reduced from the full quadratic ("
+                     + next(iter(surfaces.values())).selection + "; 'terms' counts the "
+                     "intercept). Its R2_pred is computed on the terms chosen from every run, so "
+                     "it flatters; 'R2_pred (selection in each fold)' repeats the choice "
+                     "without each run and is the one to compare with a full quadratic's.")
     if checks is not None and checks["excluded"].any():
         fit_text += (f" The surfaces, contours and optimum below are fitted to the "
                      f"{int((~checks['excluded']).sum())} runs with clean strides: "

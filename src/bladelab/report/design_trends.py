@@ -10,7 +10,14 @@ import numpy as np
 import pandas as pd
 
 from bladelab.design.start_spread import NEAR_PCT
-from bladelab.design.trends import CEILING_MIN, NO_RUNNER, evaluate_trends, trends_frame
+from bladelab.design.trends import (
+    CEILING_MIN,
+    NO_RUNNER,
+    SEED002_TRENDS,
+    SPEED_TRENDS,
+    evaluate_trends,
+    trends_frame,
+)
 
 __all__ = ["trend_ceilings", "trends_section"]
 
@@ -46,8 +53,9 @@ def trends_section(surfaces, evaluator: dict | None = None,
     if evaluator.get("knee_moment_min_Nm") is not None:
         held["knee_moment_min_Nm"] = (f"held at or above {evaluator['knee_moment_min_Nm']:g} "
                                       "N·m on every loaded interval by the solve")
+    trends = SEED002_TRENDS + (SPEED_TRENDS if "max_speed_m_per_s" in surfaces else ())
     verdicts = evaluate_trends(surfaces, evaluator=kind, roles=roles, held=held,
-                               ceilings=ceilings)
+                               ceilings=ceilings, trends=trends)
     if kind in NO_RUNNER:  # every verdict "not tested": the section says why, once
         frame = trends_frame(verdicts).rename(columns={"mechanism": "the blade's mechanism"})
         return {"title": "Seed 002 trends", "text": (
