@@ -18,9 +18,18 @@ beside it (``bladelab design`` run as in docs/design.md). Run the study again to
         --runs ccd --jobs 2 --settle 2 --skip-failed \
         --objective cost_of_transport_J_per_kg_m --sense min \
         --out benchmarks/design/transtibial-collocation-4mps-people-stride
+    bladelab design --evaluator collocation --amputation transtibial --max-speed \
+        --start-strides benchmarks/design/transtibial-collocation-4mps/strides \
+        --runs ccd --jobs 2 --settle 3 --skip-failed \
+        --objective max_speed_m_per_s --sense max \
+        --out benchmarks/design/transtibial-collocation-max-speed
 
 Studies since the study timing record write their own ``timing.json`` (each sitting of each
 stage, :mod:`bladelab.design.timing`); older ones hold their times written by hand.
+
+Each study's designer responses are fitted twice from its ``results.csv``: the full quadratic
+and the reduced one (:mod:`bladelab.design.reduction`), with the reduced surface's predicted R²
+both as usual and with the term choice repeated in each leave-one-out fold.
 """
 
 from __future__ import annotations
@@ -39,7 +48,12 @@ STUDIES = (
     (_DESIGN / "transtibial-collocation-4mps-people-stride", "transtibial",
      "human body, people's joint angles, swing knee and stride time (`--amputation "
      "transtibial --stride-time people`)"),
+    (_DESIGN / "transtibial-collocation-max-speed", "transtibial",
+     "human body, each design's maximum speed (`--amputation transtibial --max-speed`)"),
 )
+#: The responses a designer asks for, fitted in each study that has them.
+DESIGNER_RESPONSES = ("cost_of_transport_J_per_kg_m", "max_speed_m_per_s", "stride_objective",
+                      "socket_moment_max_Nm", "blade_moment_max_Nm")
 
 
 def run() -> str:
@@ -120,5 +134,31 @@ def _study(study: Path, runner: str, what: str) -> str:
         lines.append(f"| settling pass wall time, 2 workers | {info['settle_wall_s'] / 60:.0f} "
                      f"min ({info.get('settle_note', '')}) |")
     lines += ["", "Per-design times are those of the kept strides: after settling, a stride's "
-              "solve may have run on a machine shared with other work."]
+              "solve may have run on a machine shared with other work.", "",
+              *_surfaces(study)]
     return "\n".join(lines)
+
+
+def _surfaces(study: Path) -> list[str]:
+    """The designer responses' fits: full quadratic and reduced (module docstring)."""
+    import pandas as pd
+
+    from bladelab.design.reduction import fit_reduced
+    from bladelab.design.space import DesignSpace
+    from bladelab.design.surfaces import fit_surface
+
+    results = study / "results.csv"
+    if not results.is_file():
+        return []
+    table = pd.read_csv(results)
+    space = DesignSpace.from_dict(json.loads((study / "study.json").read_text())["space"])
+    coded = table[[f"{n}_coded" for n in space.names]].to_numpy(float)
+    lines = ["| response | R²pred, full quadratic (15 terms) | reduced: terms | R²pred | "
+             "R²pred, the choice repeated in each fold |", "|---|---|---|---|---|"]
+    for name in (r for r in DESIGNER_RESPONSES if r in table):
+        y = table[name].to_numpy(float)
+        full = fit_surface(coded, y, factor_names=space.names)
+        reduced = fit_reduced(coded, y, factor_names=space.names)
+        lines.append(f"| {name} | {full.r2_pred:.2f} | {len(reduced.terms)} | "
+                     f"{reduced.r2_pred:.2f} | {reduced.r2_pred_selected:.2f} |")
+    return lines
