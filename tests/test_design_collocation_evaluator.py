@@ -560,6 +560,19 @@ def test_the_maximum_speed_problem_per_design_from_another_studys_strides(fake, 
     ev({**CENTRE, "width_m": 0.05})  # no stride of it in the other study: its neighbour
     assert _start_name(calls[1]["source"]) == own.name  # the centre's, now this study's own
     assert "max_speed_m_per_s" not in _evaluator(tmp_path).response_names
+    import types
+
+    def stored(self, point, spec, settings):
+        return types.SimpleNamespace(nlp=types.SimpleNamespace(objective=-4.0),
+                                     mean_speed_mps=5.0), None
+
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(ce.CollocationEvaluator, "_stored", stored)
+        row = ev.settle(CENTRE, neighbours=1)  # the neighbour, then its own stride there
+    neighbour = f"{ce.point_file_stem({**CENTRE, 'width_m': 0.05})}.json"
+    assert [t["from"] for t in row["tries"]] == [neighbour, own.name]
+    assert _start_name(calls[-1]["source"]) == own.name and calls[-1]["speed"] is None
+    assert row["responses_before"]["max_speed_m_per_s"] == 5.0
     with pytest.raises(SpecError, match="exclude each other") as err:
         EvaluatorSettings(kind="collocation", speed_mps=4.0, max_speed=True)
     assert err.value.where == "max_speed"

@@ -162,9 +162,9 @@ def _read_run(path: Path, coded: np.ndarray) -> dict[str, float] | None:
     return responses
 
 
-#: Evaluator settings that say where results are kept, not what they are: a resumed study
-#: may change them.
-_WHERE_NOT_WHAT = ("solutions_dir",)
+#: Evaluator settings that say where results are kept or where solves start, not what they
+#: are: a resumed study may change them.
+_WHERE_NOT_WHAT = ("solutions_dir", "start_strides")
 
 
 def _check_same_evaluator(out: Path, evaluator) -> None:
