@@ -14,6 +14,7 @@ import pytest
 from bladelab.design import collocation_evaluator as ce
 from bladelab.design import settling
 from bladelab.design.evaluators import make_evaluator
+from bladelab.design.stride_files import point_from_stem, start_identity
 from bladelab.errors import InputFileError, OptimizationError, SpecError
 from bladelab.predict.collocation.solution import CollocationSolution
 
@@ -159,8 +160,8 @@ def test_a_solve_stopped_by_the_iteration_limit_near_feasibility_is_continued(fa
 def test_point_file_names_read_back():
     stem = ce.point_file_stem({"a_m": 0.065, "b": 25.0})
     assert stem == "a_m=0.065__b=25"
-    assert ce._point_from_stem(stem) == {"a_m": 0.065, "b": 25.0}
-    assert ce._point_from_stem("solution") is None
+    assert point_from_stem(stem) == {"a_m": 0.065, "b": 25.0}
+    assert point_from_stem("solution") is None
 
 
 def test_a_missing_start_is_named(tmp_path):
@@ -315,7 +316,7 @@ def test_settling_does_not_solve_again_from_an_unchanged_start(fake, tmp_path, m
     del calls[:]
     row = ev.settle(CENTRE, neighbours=1)
     identity = row["tries"][0]["start"]
-    assert identity == ce.start_identity(CollocationSolution.read(ev._stride_file(near)))
+    assert identity == start_identity(CollocationSolution.read(ev._stride_file(near)))
     assert len(calls) == 1 and row["unchanged"] == []
     row = settling.settle_strides(ev, [CENTRE], neighbours=1, known=[{name: identity}],
                                   progress=False)[0]
@@ -342,8 +343,8 @@ def test_settling_does_not_solve_again_from_an_unchanged_start(fake, tmp_path, m
     assert ev.solved_from(CENTRE) == {}  # not one solve from that start as it was
     # the same primal values with IPOPT's multipliers start elsewhere: another start
     duals = dataclasses.replace(stored.nlp, multipliers=(np.zeros(3), np.zeros(2)))
-    with_duals = ce.start_identity(dataclasses.replace(stored, nlp=duals))
-    assert with_duals.endswith(" primal-dual") and ce.start_identity(stored).endswith(" primal")
+    with_duals = start_identity(dataclasses.replace(stored, nlp=duals))
+    assert with_duals.endswith(" primal-dual") and start_identity(stored).endswith(" primal")
 
 
 def test_settling_records_a_failed_start_without_responses(fake, tmp_path, monkeypatch):
@@ -361,7 +362,7 @@ def test_settling_records_a_failed_start_without_responses(fake, tmp_path, monke
     script.append((False, [], "Maximum_Iterations_Exceeded"))
     row = ev.settle(CENTRE, neighbours=1)
     assert row["from"] is None and row["after"] == row["before"]
-    start = ce.start_identity(CollocationSolution.read(ev._stride_file(near)))
+    start = start_identity(CollocationSolution.read(ev._stride_file(near)))
     assert row["tries"] == [{"from": f"{ce.point_file_stem(near)}.json", "start": start,
                              "converged": False, "status": "Maximum_Iterations_Exceeded",
                              "objective": None, "warnings": [], "responses": None}]

@@ -26,8 +26,9 @@ from pathlib import Path
 import pandas as pd
 
 from bladelab._io import read_json, write_json
-from bladelab.design.collocation_evaluator import CollocationEvaluator, point_file_stem
+from bladelab.design.collocation_evaluator import CollocationEvaluator
 from bladelab.design.settling import settle_strides
+from bladelab.design.stride_files import point_file_stem
 
 HERE = Path(__file__).resolve().parent
 STUDY = HERE.parent / "transtibial-collocation-4mps"

@@ -23,7 +23,7 @@ from pathlib import Path
 import pandas as pd
 
 from bladelab._io import write_json
-from bladelab.design.collocation_evaluator import point_file_stem
+from bladelab.design.stride_files import point_file_stem
 from bladelab.executors import make_executor
 
 HERE = Path(__file__).resolve().parent

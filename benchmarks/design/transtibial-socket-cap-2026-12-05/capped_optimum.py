@@ -28,9 +28,10 @@ from pathlib import Path
 import pandas as pd
 
 from bladelab._io import read_json, write_json
-from bladelab.design.collocation_evaluator import CollocationEvaluator, point_file_stem
+from bladelab.design.collocation_evaluator import CollocationEvaluator
 from bladelab.design.optimum import constrained_optimum, surface_constraints
 from bladelab.design.space import DesignSpace
+from bladelab.design.stride_files import point_file_stem
 from bladelab.design.surfaces import fit_surface
 from bladelab.predict.collocation.solution import CollocationSolution
 

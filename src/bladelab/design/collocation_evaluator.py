@@ -31,7 +31,6 @@ and the gait's defects (the study stops there with the finished runs kept: never
 from __future__ import annotations
 
 import math
-import re
 import time
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import asdict, dataclass, field
@@ -42,6 +41,13 @@ from bladelab.design import defaults
 from bladelab.design.blade_generator import generate_blade
 from bladelab.design.predicted import stride_responses
 from bladelab.design.responses import MAX_SPEED_RESPONSE_UNITS, PREDICTED_RESPONSE_UNITS
+from bladelab.design.stride_files import (
+    point_file_stem,
+    point_from_stem,
+    solved_from_text,
+    start_identity,
+    start_text,
+)
 from bladelab.errors import InputFileError, OptimizationError, SpecError
 from bladelab.predict import defaults as predict_defaults
 from bladelab.predict.collocation.settings import CollocationSettings, people_term
@@ -51,7 +57,7 @@ from bladelab.predict.collocation.stored import check_model_spec, runner_from_sp
 from bladelab.runner.params import BODIES
 
 __all__ = ["CollocationEvaluator", "DEFAULT_BODY", "DEFAULT_DESIGN_SPEED_MPS", "DEFAULT_STARTS",
-           "REFERENCE_DOFS", "start_identity"]
+           "REFERENCE_DOFS"]
 
 #: Prescribed speed of a design's stride [m/s] (our choice, docs/design.md "Predicted
 #: transfemoral gaits"): the transfemoral runner's maximum speed on collocation is 5.6–5.8 m/s
@@ -101,21 +107,6 @@ REFERENCE_DOFS_TRANSTIBIAL = (*REFERENCE_DOFS, "knee_angle_r")
 #: technique kept, two axial designs got a 10-BW hop or no convergence from the centre, their
 #: only neighbour then).
 START_NEIGHBOURS = 3
-_SEP = "__"
-
-
-def point_file_stem(point: Mapping[str, float]) -> str:
-    """File name stem of a design point: ``name=value__name=value`` (values to 6 digits)."""
-    return _SEP.join(f"{k}={float(v):.6g}" for k, v in point.items())
-
-
-def _point_from_stem(stem: str) -> dict[str, float] | None:
-    try:
-        return {k: float(v) for k, v in (item.split("=", 1) for item in stem.split(_SEP))}
-    except ValueError:
-        return None
-
-
 @dataclass(frozen=True)
 class CollocationEvaluator:
     """Design point -> predicted amputee stride -> seed 002's responses (module docstring).
@@ -350,7 +341,7 @@ class CollocationEvaluator:
             for f in Path(self.solutions_dir).glob("*.json"):
                 if f.name.endswith((".best_iterate.json", ".previous.json")):
                     continue
-                p = _point_from_stem(f.stem)
+                p = point_from_stem(f.stem)
                 if p is not None and p != dict(point):
                     found.append((self._distance(point, p), f.name, f))
         return [f for _, _, f in sorted(found)]
@@ -381,8 +372,7 @@ class CollocationEvaluator:
         own = self._stride_file(point)
         if own is None or not own.is_file():
             return {}
-        match = _START_TEXT.match(CollocationSolution.read(own).guess_source or "")
-        return {match["name"]: match["id"]} if match else {}
+        return solved_from_text(CollocationSolution.read(own).guess_source)
 
     def _cheapest_other(self, point: Mapping[str, float], settings,
                         exclude: Sequence[Path]) -> Path | None:
@@ -442,7 +432,7 @@ class CollocationEvaluator:
                 if say is not None:
                     say(f"{head}: unchanged since this design was solved from it, skipped")
                 continue
-            guess = start.to_guess(_start_text(path, start))
+            guess = start.to_guess(start_text(path, start))
             t0 = time.perf_counter()
             sol = predict_stride(runner, settings, guess, model_spec=spec, track=False)
             warnings = sol.gait_warnings() if sol.converged else []
@@ -568,7 +558,7 @@ class CollocationEvaluator:
         for path, track in plan:
             source = CollocationSolution.read(path)
             guess = source.to_guess(f"tracking collocation solution {path.name}" if track
-                                    else _start_text(path, source))
+                                    else start_text(path, source))
             sol = predict_stride(runner, settings, guess, model_spec=spec, track=track)
             if _continuable(sol):  # one more round from where the iteration limit stopped it
                 sol = predict_stride(runner, settings, sol.to_guess(
@@ -607,20 +597,3 @@ def _continuable(solution) -> bool:
     return (not solution.converged and solution.stage == "predictive"
             and nlp.status == "Maximum_Iterations_Exceeded"
             and math.isfinite(nlp.max_violation) and nlp.max_violation < CONTINUE_MAX_VIOLATION)
-
-
-def start_identity(solution) -> str:
-    """What makes a start stride the same start: its objective to the last digit and whether
-    it carries IPOPT's multipliers (a stride stored without them starts elsewhere)."""
-    return (f"{float(solution.nlp.objective)!r} "
-            + ("primal" if solution.nlp.multipliers is None else "primal-dual"))
-
-
-#: A stride's guess source when it was solved from another stride as it is (``_start_text``).
-_START_TEXT = re.compile(r"^collocation solution (?P<name>\S+\.json), start (?P<id>.+)$")
-
-
-def _start_text(path: Path, start) -> str:
-    """The guess source of a solve from the stride ``start`` read from ``path``: its file and
-    its :func:`start_identity`, so that the solved stride says what it was solved from."""
-    return f"collocation solution {path.name}, start {start_identity(start)}"

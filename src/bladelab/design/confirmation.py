@@ -48,8 +48,9 @@ from pathlib import Path
 import numpy as np
 
 from bladelab._io import read_json, write_json
-from bladelab.design.collocation_evaluator import CollocationEvaluator, point_file_stem
+from bladelab.design.collocation_evaluator import CollocationEvaluator
 from bladelab.design.optimum import SurfaceConstraint
+from bladelab.design.stride_files import point_file_stem
 from bladelab.errors import SpecError
 
 __all__ = ["CONFIRMATION_DIR", "CONFIRMATION_FILE", "confirm_optimum", "same_point"]

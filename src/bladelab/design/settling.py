@@ -20,7 +20,7 @@ pass where it stopped, skipping the designs it had settled. The record::
                               "unchanged": [...]}, ...]}, ...]}
 
 A start a design was solved from in an earlier pass and whose stride has not changed since
-(:func:`~bladelab.design.collocation_evaluator.start_identity`) is not solved again.
+(:func:`~bladelab.design.stride_files.start_identity`) is not solved again.
 
 :func:`bladelab.design.start_spread.start_spread` reads it back.
 """
@@ -35,7 +35,8 @@ from pathlib import Path
 from tqdm.auto import tqdm
 
 from bladelab._io import read_json, write_json
-from bladelab.design import collocation_evaluator, defaults
+from bladelab.design import defaults
+from bladelab.design.stride_files import point_file_stem
 from bladelab.design.study import DesignStudyResult, run_design, run_file
 from bladelab.design.timing import settling_stage, timed_stage
 from bladelab.errors import InputFileError, OptimizationError
@@ -105,12 +106,12 @@ def read_settling_record(out: str | Path, points: Sequence[dict] | None = None) 
     record = read_json(path, what="settling record").get("passes", [])
     if points is None:
         return record
-    stems = [collocation_evaluator.point_file_stem(p) for p in points]
+    stems = [point_file_stem(p) for p in points]
     for rec in record:
         for row in rec.get("designs", []):
             run = row.get("run")
             if not (isinstance(run, int) and 1 <= run <= len(points)
-                    and collocation_evaluator.point_file_stem(row["point"]) == stems[run - 1]):
+                    and point_file_stem(row["point"]) == stems[run - 1]):
                 raise InputFileError(
                     f"a settled design ({row.get('point')}) is not run {run} of this study",
                     file=path, hint="settle in the study's own folder, or remove the file")
@@ -283,7 +284,7 @@ def settle_strides(evaluator, points, *, neighbours: int = 2,
             if on_design is not None:
                 on_design(todo[k], value)
         else:
-            failed.append(f"{collocation_evaluator.point_file_stem(payloads[k]['point'])}: {value}")
+            failed.append(f"{point_file_stem(payloads[k]['point'])}: {value}")
     bar.close()
     if failed:
         raise OptimizationError(f"{len(failed)} designs could not be settled "

@@ -12,7 +12,7 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
-from bladelab.design.collocation_evaluator import point_file_stem
+from bladelab.design.stride_files import point_file_stem
 from bladelab.predict.collocation.human_running import human_running_criteria
 from bladelab.predict.collocation.solution import CollocationSolution
 from bladelab.predict.collocation.transcription import step_phase
