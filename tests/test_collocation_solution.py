@@ -496,6 +496,27 @@ def test_people_stride_time_bounds_the_period_by_their_band_at_the_speed(able):
     assert CollocationSettings.from_dict(json.loads(json.dumps(people.to_dict()))) == people
 
 
+
+def test_people_stride_time_in_the_maximum_speed_problem_moves_with_the_speed():
+    """Without a prescribed speed people's band is no pair of period bounds but a band at the
+    anchor speeds, which the NLP applies at the stride's own speed; a different problem from
+    the free one, and said so."""
+    import dataclasses
+
+    from bladelab.predict.collocation.running_bands import ANCHOR_SPEEDS_MPS
+    from bladelab.predict.collocation.transcription import PERIOD_BOUNDS_S
+
+    fastest = CollocationSettings(mesh_intervals=6, speed_m_per_s=None, stride_time_people=True)
+    assert fastest.period_bounds_s == PERIOD_BOUNDS_S
+    v0, lo0, hi0, v1, lo1, hi1 = fastest.period_band
+    assert (v0, v1) == ANCHOR_SPEEDS_MPS
+    assert (lo0, hi0) == reference_band("stride time", v0)[:2]
+    assert (lo1, hi1) == reference_band("stride time", v1)[:2]
+    assert fastest.imposed_stride_time == "people's band at the stride's speed"
+    assert not fastest.same_problem(dataclasses.replace(fastest, stride_time_people=False))
+    assert CollocationSettings(speed_m_per_s=SPEED, stride_time_people=True).period_band is None
+    assert CollocationSettings(speed_m_per_s=None).period_band is None
+
 def _relabelled_solves(monkeypatch):
     """Spy on every IPOPT solve of ``StrideNLP``: returns (calls, labels); each call appends
     (nlp, x0, keywords, solution), and ``labels[i]`` (if given: ``(status, max_violation)``,

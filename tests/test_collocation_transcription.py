@@ -304,6 +304,35 @@ def test_the_maximum_speed_problem_keeps_at_least_the_speed_it_is_given():
     assert float(g(x0, 2.5)[rows[0]]) < 0.0
 
 
+
+@pytest.mark.parametrize("band, low, high", [
+    ((1.0, 0.5, 0.7, 3.0, 0.3, 0.4), 0.6 - 0.4, 0.6 - 0.55),  # 2 m/s: halfway between anchors
+    ((3.0, 0.5, 0.7, 4.0, 0.3, 0.4), 0.6 - 0.5, 0.6 - 0.7),  # below v0: the band at v0
+    ((0.5, 0.9, 1.1, 1.0, 0.5, 0.8), 0.6 - 0.5, 0.6 - 0.8)])  # above v1: the band at v1
+def test_a_stride_time_band_that_moves_with_the_speed(band, low, high):
+    """The maximum-speed NLP with a period band: rows T − lo(v) >= 0 and T − hi(v) <= 0 at the
+    stride's own speed v = d/T (linear between the anchors, constant outside); refused with a
+    prescribed speed or a malformed band."""
+    from bladelab.predict.collocation.transcription import StrideWeights
+
+    nlp = StrideNLP(toy_dynamics(), n=10, speed=None, period_band=band,
+                    weights=StrideWeights(metabolic=0.0, speed=1.0))
+    plain = StrideNLP(toy_dynamics(), n=10, speed=None,
+                      weights=StrideWeights(metabolic=0.0, speed=1.0))
+    assert nlp.n_cons == plain.n_cons + 2
+    _, _, lbg, ubg = nlp.bounds()
+    lo_row, hi_row = (nlp._g_names.index(f"stride time band ({k})") for k in ("low", "high"))
+    assert (lbg[lo_row], ubg[lo_row], lbg[hi_row], ubg[hi_row]) == (0.0, np.inf, -np.inf, 0.0)
+    g = ca.Function("g", [nlp.nlp["x"], nlp.nlp["p"]], [nlp.nlp["g"]])
+    x0 = nlp.initial_vector(bouncing_guess(10, 2.0))  # 2 m/s, 0.6 s
+    values = np.asarray(g(x0, 0.0)).ravel()
+    assert values[lo_row] == pytest.approx(low, abs=1e-9)
+    assert values[hi_row] == pytest.approx(high, abs=1e-9)
+    with pytest.raises(SpecError, match="maximum-speed problem"):
+        StrideNLP(toy_dynamics(), n=10, speed=2.0, period_band=band)
+    with pytest.raises(SpecError, match="v0 < v1"):
+        StrideNLP(toy_dynamics(), n=10, speed=None, period_band=(3.0, 0.5, 0.7, 1.0, 0.3, 0.4))
+
 def _two_stances(n: int, right_after: float, duty: float = 0.25) -> np.ndarray:
     """Half-sine vertical forces [N] of two legs on n nodes: the left stance from 0, the right
     one ``right_after`` of the stride later."""

@@ -203,7 +203,8 @@ def _design(
     max_speed: bool = typer.Option(
         False, "--max-speed", rich_help_panel=COLLOCATION,
         help="Predict each design's maximum-speed stride (the speed free) instead of one at "
-             "--speed; response max_speed_m_per_s [m/s] (not with --stride-time people)."),
+             "--speed; response max_speed_m_per_s [m/s]; with --stride-time people the stride "
+             "time is held in people's band at the stride's own speed."),
     amputation: str | None = typer.Option(
         None, "--amputation", rich_help_panel=COLLOCATION, show_default=False,
         help="The runner's amputation: transfemoral (the default: seed 002's athlete, a passive "

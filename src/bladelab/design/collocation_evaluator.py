@@ -119,8 +119,9 @@ class CollocationEvaluator:
         Predict each design's stride of the maximum-speed problem instead (the speed free, the
         negative mean speed plus the effort terms minimised:
         :func:`~bladelab.predict.collocation.continuation.max_speed_settings`'s weights); its
-        mean speed is the response ``max_speed_m_per_s``. Excludes people's stride time
-        (their band moves with the speed, which this problem predicts).
+        mean speed is the response ``max_speed_m_per_s``. With ``stride_time_people`` the
+        stride time is held in people's band at the stride's own speed
+        (``CollocationSettings.period_band``).
     start_strides
         A folder of strides of the same designs (another study's ``strides``, e.g. at a
         prescribed speed): each design starts from its own stride there first (the file named

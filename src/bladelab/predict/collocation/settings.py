@@ -13,7 +13,7 @@ import numpy as np
 from bladelab.errors import SpecError
 from bladelab.predict import defaults
 from bladelab.predict.collocation.dynamics import COORDINATE_BOUNDS_DEG
-from bladelab.predict.collocation.running_bands import reference_band
+from bladelab.predict.collocation.running_bands import ANCHOR_SPEEDS_MPS, reference_band
 from bladelab.predict.collocation.transcription import PERIOD_BOUNDS_S, StrideWeights
 
 __all__ = ["HESSIANS", "PEOPLE_REFERENCE", "SWING_KNEE_RANGE_DEG", "CollocationSettings",
@@ -158,9 +158,11 @@ class CollocationSettings:
         (:func:`~bladelab.predict.collocation.running_bands.reference_band`, "stride time":
         0.64–0.78 s at 3.5 m/s, 0.40–0.55 s at 9 m/s, linear between), for an athlete whose
         cadence was not measured; imposed, not predicted, as ``stride_time_range_s``, which
-        it excludes. Each speed of a continuation gets its own band; the maximum-speed
-        problem, whose speed is the unknown, has none (:func:`~bladelab.predict.collocation.
-        continuation.max_speed_settings`). False (default): free.
+        it excludes. Each speed of a continuation gets its own band. In the maximum-speed
+        problem, whose speed is the unknown, the band moves with the stride's speed (two
+        constraint rows, :attr:`period_band`); predict's maximum speed leaves it free
+        (:func:`~bladelab.predict.collocation.continuation.max_speed_settings`). False
+        (default): free.
     swing_knee_min_deg
         Keep the peak flexion of every knee that is a person's (not a transfemoral runner's
         prosthetic knee) at or above this [deg] over the stride, a constraint of the
@@ -355,11 +357,6 @@ class CollocationSettings:
             raise SpecError("people's stride time and a stride time range are two ways to "
                             "impose one stride time: give one", where="stride_time_people",
                             hint="drop the range, or stride_time_people false")
-        if self.speed_m_per_s is None:
-            raise SpecError("people's stride time needs a prescribed speed (their band moves "
-                            "with the speed, which the maximum-speed problem predicts)",
-                            where="stride_time_people", hint="prescribe a speed, or leave "
-                                                             "the stride time free")
 
     def _check_range(self, name: str, what: str, unit: str, bounds: tuple[float, float],
                      hint: str, *, equal_ok: bool = False) -> None:
@@ -385,15 +382,28 @@ class CollocationSettings:
         """(lo, hi) [s] of the stride time in the NLP: people's band at the speed with
         :attr:`stride_time_people` (to 1 µs), else :attr:`stride_time_range_s`, else
         :data:`~bladelab.predict.collocation.transcription.PERIOD_BOUNDS_S`."""
-        if self.stride_time_people:
+        if self.stride_time_people and self.speed_m_per_s is not None:
             lo, hi, _ = reference_band("stride time", self.speed_m_per_s)
             return round(lo, 6), round(hi, 6)
         return self.stride_time_range_s or PERIOD_BOUNDS_S
 
     @property
+    def period_band(self) -> tuple[float, ...] | None:
+        """The maximum-speed problem with :attr:`stride_time_people`: people's stride-time
+        band at the anchor speeds, ``(v0, lo0, hi0, v1, lo1, hi1)`` [m/s, s]
+        (:class:`~bladelab.predict.collocation.transcription.StrideNLP`'s ``period_band``);
+        else None."""
+        if not (self.stride_time_people and self.speed_m_per_s is None):
+            return None
+        return tuple(x for v in ANCHOR_SPEEDS_MPS
+                     for x in (v, *reference_band("stride time", v)[:2]))
+
+    @property
     def imposed_stride_time(self) -> str | None:
         """The imposed stride time as text with its unit ("0.7 s" when fixed, "0.64–0.78 s"
         for a range, "people's band at 4 m/s, 0.618–0.759 s"), or None when it is free."""
+        if self.stride_time_people and self.speed_m_per_s is None:
+            return "people's band at the stride's speed"
         if self.stride_time_people:
             lo, hi = self.period_bounds_s
             return f"people's band at {self.speed_m_per_s:g} m/s, {lo:.3g}–{hi:.3g} s"

@@ -346,7 +346,7 @@ def _predictive_nlp(runner, dyn, settings: CollocationSettings, start, phase: fl
     nlps = _BUILT[runner]["nlps"]
     key = (n, speed is None, settings.weights, id(dyn), settings.reference_key(), phase,
            settings.step_phase_tolerance, settings.symmetric, settings.period_bounds_s,
-           settings.swing_knee_min_deg, settings.hessian)
+           settings.period_band, settings.swing_knee_min_deg, settings.hessian)
     if key not in nlps:
         while len(nlps) >= MAX_NLPS_PER_RUNNER:
             nlps.pop(next(iter(nlps)))
@@ -356,6 +356,7 @@ def _predictive_nlp(runner, dyn, settings: CollocationSettings, start, phase: fl
                               step_phase_tolerance=settings.step_phase_tolerance,
                               symmetric=settings.symmetric,
                               period_bounds=settings.period_bounds_s,
+                              period_band=settings.period_band,
                               knee_flexion_min=_knee_flexion_min(runner, settings),
                               compiled=_compiled(settings))
     else:

@@ -222,6 +222,11 @@ class StrideNLP:
         Objective weights.
     period_bounds
         Bounds of the stride time [s].
+    period_band
+        The maximum-speed problem only: ``(v0, lo0, hi0, v1, lo1, hi1)``, a band of the stride
+        time [s] that moves with the stride's speed [m/s]: (lo0, hi0) at v0, (lo1, hi1) at v1,
+        linear between and constant outside; two constraint rows ``lo(v) <= T <= hi(v)`` with
+        ``v = d/T`` (people's stride time, whose speed this problem predicts). None: none.
     scales
         Variable scaling.
     min_activation
@@ -276,6 +281,7 @@ class StrideNLP:
         speed: float | None = 3.5,
         weights: StrideWeights | None = None,
         period_bounds: tuple[float, float] = PERIOD_BOUNDS_S,
+        period_band: tuple[float, ...] | None = None,
         scales: VariableScales | None = None,
         min_activation: float = 0.01,
         min_tendon_force: float = 1e-3,
@@ -299,6 +305,18 @@ class StrideNLP:
         self.weights = weights or StrideWeights(metabolic=0.0 if speed is None else 1.0)
         self.scales = scales or VariableScales()
         self.period_bounds = tuple(float(b) for b in period_bounds)
+        if period_band is not None:
+            band = tuple(float(b) for b in period_band)
+            if speed is not None:
+                raise SpecError("a stride time band that moves with the speed is for the "
+                                "maximum-speed problem", where="period band",
+                                hint="a prescribed speed's band is its period bounds")
+            if len(band) != 6 or not (0 < band[0] < band[3] and band[1] <= band[2]
+                                      and band[4] <= band[5]):
+                raise SpecError(f"expected (v0, lo0, hi0, v1, lo1, hi1) with v0 < v1 and "
+                                f"lo <= hi, got {period_band!r}", where="period band")
+            period_band = band
+        self.period_band = period_band
         self.min_activation = float(min_activation)
         self.min_tendon_force = float(min_tendon_force)
         self.max_tendon_force = float(max_tendon_force)
@@ -441,6 +459,12 @@ class StrideNLP:
             self._g_names.append("minimum speed")
             if w.metabolic:
                 terms["metabolic"] = w.metabolic * energy / (d.mass * ca.fmax(distance, 1e-3))
+            if self.period_band is not None:
+                v0, lo0, hi0, v1, lo1, hi1 = self.period_band
+                f = ca.fmin(ca.fmax((distance / period - v0) / (v1 - v0), 0.0), 1.0)
+                g.append(period - (lo0 + f * (lo1 - lo0)))
+                g.append(period - (hi0 + f * (hi1 - hi0)))
+                self._g_names += ["stride time band (low)", "stride time band (high)"]
         if self.step_phase_tolerance is not None:
             legs = ca.Function("legs", [xs], [d.leg_vertical_grf(q, qd)]).map(n)(X[:, :n])
             g.append(alternation_rows(legs, d.mass * d.gravity, self.step_phase_tolerance))
@@ -546,6 +570,9 @@ class StrideNLP:
         lbg, ubg = np.zeros(self.n_cons), np.zeros(self.n_cons)
         if self.speed is None:
             ubg[self._g_names.index("minimum speed")] = np.inf
+        if self.period_band is not None:
+            ubg[self._g_names.index("stride time band (low)")] = np.inf
+            lbg[self._g_names.index("stride time band (high)")] = -np.inf
         if self.step_phase_tolerance is not None:
             i = self._g_names.index("alternating steps")
             lbg[i:i + 3] = -np.inf
@@ -698,8 +725,8 @@ class StrideNLP:
         if self._interpreted is None:
             self._interpreted = StrideNLP(
                 self.dyn, n=self.n, speed=self.speed, weights=self.weights,
-                period_bounds=self.period_bounds, scales=self.scales,
-                min_activation=self.min_activation, min_tendon_force=self.min_tendon_force,
+                period_bounds=self.period_bounds, period_band=self.period_band,
+                scales=self.scales, min_activation=self.min_activation, min_tendon_force=self.min_tendon_force,
                 max_tendon_force=self.max_tendon_force, tracking=self.tracking,
                 grf_tracking=self.grf_tracking, period_tracking=self.period_tracking,
                 step_phase_tolerance=self.step_phase_tolerance, symmetric=self.symmetric,
