@@ -89,7 +89,7 @@ def _study(study: Path, runner: str, what: str) -> str:
         f"## Design study on predicted {runner} strides: {what}",
         "",
         "25-run face-centred CCD over seed 002's four factors, `--evaluator collocation` "
-        f"({runner} runner wearing each generated 6-link blade, 4 m/s, mesh 50, backward "
+        f"({runner} runner wearing each generated 6-link blade, {_speed(study)}, mesh 50, backward "
         "Euler for the blade's joints), `--jobs 2`. Target: the study ≤ 30 min on 2 cores. "
         "Times are those the study recorded (its stride files and `timing.json`), not measured "
         "again by `make bench`.",
@@ -137,6 +137,13 @@ def _study(study: Path, runner: str, what: str) -> str:
               "solve may have run on a machine shared with other work.", "",
               *_surfaces(study)]
     return "\n".join(lines)
+
+
+def _speed(study: Path) -> str:
+    """The study's speed in words, from its ``evaluator.json``."""
+    path = study / "evaluator.json"
+    ev = json.loads(path.read_text(encoding="utf-8")) if path.is_file() else {}
+    return "each design's maximum speed" if ev.get("max_speed") else "4 m/s"
 
 
 def _surfaces(study: Path) -> list[str]:
