@@ -98,7 +98,6 @@ def test_a_failed_force_run_removes_the_old_solution(solved, tmp_path, capsys):
     (("--method", "collocation", "--stride-time", "0.3"), "--stride-time"),  # below 0.4 s
     (("--method", "collocation", "--stride-time", "fast"), "--stride-time"),
     (("--method", "reflex", "--stride-time", "0.7"), "--stride-time"),
-    (("--method", "collocation", "--max-speed", "--stride-time", "people"), "--stride-time"),
     (("--method", "collocation", "--alternating-steps", "0.5"), "--alternating-steps"),
     (("--method", "reflex", "--alternating-steps", "0.1"), "--alternating-steps"),
     (("--method", "collocation", "--symmetric", "--mesh", "51"), "--mesh"),
