@@ -395,8 +395,8 @@ class CollocationEvaluator:
                say: Callable[[str], None] | None = None) -> dict:
         """Solve this design again from its ``neighbours`` nearest solved designs, its own
         stride in ``start_strides`` (if any) and, with ``cheapest``, the study's cheapest
-        stride of another design (when it is not one of them), and keep the clean stride of lowest objective (rewriting its file). The
-        cheapest stride reaches a branch the neighbours do not carry across the box (measured:
+        stride of another design (when it is not one of them), and keep the clean stride of
+        lowest objective (rewriting its file). The cheapest stride reaches a branch the neighbours do not carry across the box (measured:
         from it five designs of a settled study went lower, one by 2.4 %,
         docs/design.md). Returns ``{"point", "before",
         "after"`` (objectives), ``"from"`` (the file that gave the kept stride, or None),

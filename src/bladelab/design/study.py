@@ -45,7 +45,7 @@ from bladelab.design.optimum import (
     read_bound,
     surface_constraints,
 )
-from bladelab.design.reduction import REDUCED_MODEL, fit_response
+from bladelab.design.reduction import fit_response
 from bladelab.design.space import DesignSpace
 from bladelab.design.surfaces import ResponseSurface
 from bladelab.design.terms import parse_terms
@@ -438,9 +438,8 @@ def run_design(
 
     surfaces = {
         name: fit_response(
-            design.coded[done], frame[name].to_numpy(), factor_names=space.names,
-            model=model if model == REDUCED_MODEL else terms, response=name,
-            unit=units.get(name, ""),
+            design.coded[done], frame[name].to_numpy(), factor_names=space.names, model=model,
+            response=name, unit=units.get(name, ""),
         )
         for name in responses
     }

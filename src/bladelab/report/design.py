@@ -91,9 +91,8 @@ def _load(design_dir: Path):
             file=design_dir, hint="re-solve the flagged runs: delete their runs/*.json and "
             "run the same 'bladelab design' command again")
     coded = fitted[coded_cols].to_numpy(float)
-    model = meta.get("model", "quadratic")
     surfaces = {r: fit_response(coded, fitted[r].to_numpy(float), factor_names=space.names,
-                                model=model if model == REDUCED_MODEL else terms, response=r,
+                                model=meta.get("model", "quadratic"), response=r,
                                 unit=units.get(r, ""))
                 for r in responses}
     return meta, space, table, surfaces
