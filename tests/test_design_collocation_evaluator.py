@@ -556,6 +556,7 @@ def test_the_maximum_speed_problem_per_design_from_another_studys_strides(fake, 
     out = ev(CENTRE)
     base = CollocationSolution.read(STRIDE)
     assert out["max_speed_m_per_s"] == pytest.approx(base.mean_speed_mps)
+    assert "avg_vx_m_per_s" not in out and "avg_vx_m_per_s" not in ev.response_names  # once
     assert calls[0]["speed"] is None and _start_name(calls[0]["source"]) == own.name
     assert calls[0]["source"].count(own.name) == 1
     ev({**CENTRE, "width_m": 0.05})  # no stride of it in the other study: its neighbour

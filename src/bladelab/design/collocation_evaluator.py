@@ -18,8 +18,8 @@
    :meth:`~bladelab.predict.collocation.solution.CollocationSolution.gait_warnings` is
    followed by the next one; the last resort is ``start`` with a tracking stage first;
 4. reads seed 002's responses off the stride
-   (:func:`~bladelab.design.predicted.stride_responses`), with ``max_speed`` also the
-   stride's mean speed as ``max_speed_m_per_s``.
+   (:func:`~bladelab.design.predicted.stride_responses`), with ``max_speed`` the stride's
+   mean speed named ``max_speed_m_per_s``.
 
 Every design's stride is written to ``solutions_dir/<point>.json`` (``bladelab report``
 renders it) and read back instead of solved again when the design is evaluated again (a
@@ -298,8 +298,11 @@ class CollocationEvaluator:
 
     @property
     def units(self) -> dict[str, str]:
-        return {**PREDICTED_RESPONSE_UNITS, **(MAX_SPEED_RESPONSE_UNITS if self.max_speed
-                                               else {})}
+        units = dict(PREDICTED_RESPONSE_UNITS)
+        if self.max_speed:  # the mean speed under its own name
+            del units["avg_vx_m_per_s"]
+            units.update(MAX_SPEED_RESPONSE_UNITS)
+        return units
 
     @property
     def response_names(self) -> tuple[str, ...]:
@@ -309,9 +312,11 @@ class CollocationEvaluator:
 
     def responses(self, solution, runner) -> dict[str, float]:
         """A design's responses (:func:`~bladelab.design.predicted.stride_responses`; with
-        ``max_speed`` also ``max_speed_m_per_s``, the stride's mean speed [m/s])."""
+        ``max_speed`` the stride's mean speed is named ``max_speed_m_per_s`` [m/s] in place of
+        ``avg_vx_m_per_s``: one response, not the same column twice)."""
         out = stride_responses(solution, runner)
         if self.max_speed:
+            out.pop("avg_vx_m_per_s", None)
             out["max_speed_m_per_s"] = float(solution.mean_speed_mps)
         return out
 
