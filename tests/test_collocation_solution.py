@@ -435,6 +435,21 @@ def test_a_stage_that_does_not_converge_ends_the_solve_deterministically(able):
     assert warm.stage == "predictive" and warm.tracking is None
 
 
+def test_a_speed_floor_belongs_to_the_maximum_speed_problem(able):
+    """A floor [m/s] with a prescribed speed, or a negative or infinite one, is refused before
+    anything is built, naming the argument."""
+    runner, _, _ = able
+    guess = template_guess(runner, speed=SPEED, n=6)
+    for settings, floor in ((CollocationSettings(mesh_intervals=6, speed_m_per_s=SPEED), 3.0),
+                            (CollocationSettings(mesh_intervals=6, speed_m_per_s=None), -1.0),
+                            (CollocationSettings(mesh_intervals=6, speed_m_per_s=None),
+                             math.inf)):
+        with pytest.raises(SpecError, match="speed floor") as err:
+            predict_stride(runner, settings, guess, model_spec={"model": "able"},
+                           speed_floor=floor)
+        assert err.value.where == "speed_floor"
+
+
 def test_a_pelvis_tilt_range_bounds_every_node(able):
     # IPOPT's iterates stay inside the bounds: after a few iterations the tilt of every node
     # lies in the range, where the same solve without it leaves the range

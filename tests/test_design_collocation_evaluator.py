@@ -56,8 +56,10 @@ def fake(monkeypatch):
     base = CollocationSolution.read(STRIDE)
     calls, script = [], []
 
-    def predict_stride(runner, settings, guess, *, model_spec, track=None, progress=None):
+    def predict_stride(runner, settings, guess, *, model_spec, track=None, progress=None,
+                       speed_floor=None):
         calls.append({"source": guess.source, "track": track, "spec": model_spec,
+                      "floor": speed_floor,
                       "speed": settings.speed_m_per_s, "dofs": runner.dof_names,
                       "backward_euler": settings.blade_backward_euler,
                       "step_phase_tolerance": settings.step_phase_tolerance,
@@ -91,6 +93,7 @@ def test_each_design_wears_its_own_generated_blade(fake, tmp_path):
     assert ev({**CENTRE}) == {"delta_vx_m_per_s": 0.1}
     call = calls[0]
     assert call["speed"] == 4.5 and call["backward_euler"]  # the blade's links: no ringing
+    assert call["floor"] is None  # a prescribed speed has no floor
     assert call["spec"]["model"] == "transfemoral"
     blade = call["spec"]["blade_spec"]  # the generated blade travels with the stride
     assert len(blade["joints"]) == 5
@@ -242,7 +245,8 @@ def test_settling_keeps_the_lowest_objective_from_the_neighbours(fake, tmp_path,
     def stored(self, point, spec, settings):
         return types.SimpleNamespace(nlp=types.SimpleNamespace(objective=1.0)), None
 
-    def solve(runner, settings, guess, *, model_spec, track=None, progress=None):
+    def solve(runner, settings, guess, *, model_spec, track=None, progress=None,
+              speed_floor=None):
         calls.append({"source": guess.source})
         out = _Outcome(CollocationSolution.read(STRIDE), True, [])
         out.nlp = types.SimpleNamespace(objective=next(objectives), status="Solve_Succeeded")
@@ -559,8 +563,12 @@ def test_the_maximum_speed_problem_per_design_from_another_studys_strides(fake, 
     assert "avg_vx_m_per_s" not in out and "avg_vx_m_per_s" not in ev.response_names  # once
     assert calls[0]["speed"] is None and _start_name(calls[0]["source"]) == own.name
     assert calls[0]["source"].count(own.name) == 1
+    # the floor is this blade's own stride's speed, not a start's (a neighbour's would pin it)
+    assert calls[0]["floor"] == pytest.approx(base.mean_speed_mps)
+    assert f"floor {base.mean_speed_mps!r} m/s" in calls[0]["source"]
     ev({**CENTRE, "width_m": 0.05})  # no stride of it in the other study: its neighbour
     assert _start_name(calls[1]["source"]) == own.name  # the centre's, now this study's own
+    assert calls[1]["floor"] is None  # no stride of this blade anywhere: the start's speed
     assert "max_speed_m_per_s" not in _evaluator(tmp_path).response_names
     import types
 
@@ -574,6 +582,7 @@ def test_the_maximum_speed_problem_per_design_from_another_studys_strides(fake, 
     neighbour = f"{ce.point_file_stem({**CENTRE, 'width_m': 0.05})}.json"
     assert [t["from"] for t in row["tries"]] == [neighbour, own.name]
     assert _start_name(calls[-1]["source"]) == own.name and calls[-1]["speed"] is None
+    assert all(c["floor"] == pytest.approx(base.mean_speed_mps) for c in calls[2:])
     assert row["responses_before"]["max_speed_m_per_s"] == 5.0
     with pytest.raises(SpecError, match="exclude each other") as err:
         EvaluatorSettings(kind="collocation", speed_mps=4.0, max_speed=True)

@@ -364,6 +364,19 @@ class CollocationEvaluator:
         own = self._own_start(point)
         return [own, *starts] if own is not None else starts
 
+    def _speed_floor(self, point: Mapping[str, float], current=None) -> float | None:
+        """The maximum-speed problem's floor [m/s] for a design: the mean speed of its own
+        stride in ``start_strides``, else of its stored stride ``current`` (strides of this
+        blade); None (the start's own speed) without either, or with a prescribed speed. A
+        neighbour's speed as the floor would pin the design to it (measured: 7 of 25 designs
+        of a study at one neighbour's 4.972 m/s to the last digit)."""
+        if not self.max_speed:
+            return None
+        own = self._own_start(point)
+        if own is not None:
+            return float(CollocationSolution.read(own).mean_speed_mps)
+        return None if current is None else float(current.mean_speed_mps)
+
     def _own_start(self, point: Mapping[str, float]) -> Path | None:
         """The design's own stride in ``start_strides``, or None."""
         if self.start_strides is None:
@@ -429,18 +442,20 @@ class CollocationEvaluator:
         if cheapest and (far := self._cheapest_other(point, settings, starts)) is not None:
             starts.append(far)
         name = point_file_stem(point)
+        floor = self._speed_floor(point, current)
         for k, path in enumerate(starts, 1):
             start = CollocationSolution.read(path)
-            identity = start_identity(start)
+            identity = start_identity(start, floor)
             head = f"{name}: start {k} of {len(starts)} ({path.name})"
             if (known or {}).get(path.name) == identity:
                 unchanged.append(path.name)
                 if say is not None:
                     say(f"{head}: unchanged since this design was solved from it, skipped")
                 continue
-            guess = start.to_guess(start_text(path, start))
+            guess = start.to_guess(start_text(path, start, floor))
             t0 = time.perf_counter()
-            sol = predict_stride(runner, settings, guess, model_spec=spec, track=False)
+            sol = predict_stride(runner, settings, guess, model_spec=spec, track=False,
+                                 speed_floor=floor)
             warnings = sol.gait_warnings() if sol.converged else []
             clean = sol.converged and not warnings
             if say is not None:
@@ -561,15 +576,17 @@ class CollocationEvaluator:
             (self.start_file, True)]
         tried, best = [], None
         t0 = time.perf_counter()
+        floor = self._speed_floor(point)
         for path, track in plan:
             source = CollocationSolution.read(path)
             guess = source.to_guess(f"tracking collocation solution {path.name}" if track
-                                    else start_text(path, source))
-            sol = predict_stride(runner, settings, guess, model_spec=spec, track=track)
+                                    else start_text(path, source, floor))
+            sol = predict_stride(runner, settings, guess, model_spec=spec, track=track,
+                                 speed_floor=floor)
             if _continuable(sol):  # one more round from where the iteration limit stopped it
                 sol = predict_stride(runner, settings, sol.to_guess(
                     f"collocation solution {path.name}, continued after {sol.nlp.iterations} "
-                    "iterations"), model_spec=spec, track=False)
+                    "iterations"), model_spec=spec, track=False, speed_floor=floor)
             defects = sol.gait_warnings() if sol.converged else []
             if sol.converged and not defects:
                 break

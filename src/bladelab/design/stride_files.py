@@ -32,21 +32,24 @@ def point_from_stem(stem: str) -> dict[str, float] | None:
 
 
 
-def start_identity(solution) -> str:
+def start_identity(solution, speed_floor: float | None = None) -> str:
     """What makes a start stride the same start: its objective to the last digit and whether
-    it carries IPOPT's multipliers (a stride stored without them starts elsewhere)."""
-    return (f"{float(solution.nlp.objective)!r} "
-            + ("primal" if solution.nlp.multipliers is None else "primal-dual"))
+    it carries IPOPT's multipliers (a stride stored without them starts elsewhere); in a
+    maximum-speed problem also the speed floor [m/s] the solve from it was given, when one
+    was (another floor is another problem from the same start)."""
+    identity = (f"{float(solution.nlp.objective)!r} "
+                + ("primal" if solution.nlp.multipliers is None else "primal-dual"))
+    return identity if speed_floor is None else f"{identity}, floor {speed_floor!r} m/s"
 
 
 #: A stride's guess source when it was solved from another stride as it is (``start_text``).
 _START_TEXT = re.compile(r"^collocation solution (?P<name>\S+\.json), start (?P<id>.+)$")
 
 
-def start_text(path: Path, start) -> str:
+def start_text(path: Path, start, speed_floor: float | None = None) -> str:
     """The guess source of a solve from the stride ``start`` read from ``path``: its file and
     its :func:`start_identity`, so that the solved stride says what it was solved from."""
-    return f"collocation solution {path.name}, start {start_identity(start)}"
+    return f"collocation solution {path.name}, start {start_identity(start, speed_floor)}"
 
 
 def solved_from_text(source: str | None) -> dict[str, str]:

@@ -366,7 +366,7 @@ def _predictive_nlp(runner, dyn, settings: CollocationSettings, start, phase: fl
 
 def predict_stride(runner, settings: CollocationSettings, guess, *, model_spec: dict,
                    progress: Callable[[SolveProgress], None] | None = None,
-                   track: bool | None = None):
+                   track: bool | None = None, speed_floor: float | None = None):
     """Solve one periodic stride of ``runner`` (module docstring): tracking, then predictive.
 
     Parameters
@@ -390,6 +390,11 @@ def predict_stride(runner, settings: CollocationSettings, guess, *, model_spec: 
     track
         Force (True) or skip (False) the tracking stage; None: ``settings.track_first`` unless
         the guess is a collocation solution.
+    speed_floor
+        The maximum-speed problem only: the mean speed [m/s] the stride must at least reach, a
+        speed at which ``runner`` is known to have a stride. None: that of the collocation
+        stride it starts from, which holds only if that stride is of this runner (a stride
+        of another blade as the start would otherwise pin the answer to its speed).
 
     Returns
     -------
@@ -398,6 +403,11 @@ def predict_stride(runner, settings: CollocationSettings, guess, *, model_spec: 
         of the stage that did not (``stage`` names it).
     """
     spec = check_model_spec(model_spec)
+    if speed_floor is not None and (settings.speed_m_per_s is not None or not (
+            speed_floor >= 0 and math.isfinite(speed_floor))):
+        raise SpecError(f"a speed floor ({speed_floor!r} m/s) needs the maximum-speed problem "
+                        "and a finite speed >= 0", where="speed_floor",
+                        hint="leave it out with a prescribed speed")
     if runner.kind != spec["model"]:
         raise SpecError(f"the runner is the {runner.kind} model, model_spec says "
                         f"{spec['model']}", where="model_spec")
@@ -453,9 +463,10 @@ def predict_stride(runner, settings: CollocationSettings, guess, *, model_spec: 
                 metabolic_energy_J=nlp_t.energy_and_distance(sol_t)[0], **common)
         start = sol_t.to_guess(f"{COLLOCATION_SOURCE} (tracking stage)")
     nlp_p = _predictive_nlp(runner, dyn, settings, g, phase)  # built once, then looked up
-    # the prescribed speed; of a maximum speed, its floor: that of a collocation stride it
-    # starts from (a stride that exists)
-    stage_speed = speed if speed is not None else (g.speed if warm else None)
+    # the prescribed speed; of a maximum speed, its floor: the caller's, else that of a
+    # collocation stride it starts from (a stride that exists)
+    stage_speed = (speed if speed is not None else speed_floor if speed_floor is not None
+                   else g.speed if warm else None)
     sol = _solve_stage(nlp_p, nlp_p.initial_vector(start), settings, "predictive", progress,
                        warm=warm_predictive, speed=stage_speed, multipliers=duals)
     if _stalled(sol, settings):
