@@ -428,9 +428,11 @@ def test_design_report_shows_what_the_start_decides(study, tmp_path):
     copy, table = _collocation_copy(study, tmp_path, {})
     y = table["delta_vx_m_per_s"].to_numpy(float)
     big = 3.0 * float(np.std(y, ddof=1))  # the start moves it more than the designs do
-    designs = [{"run": r, "before": 1.0, "responses_before": {"delta_vx_m_per_s": y[r - 1]},
+    designs = [{"run": r, "before": 1.0,
+                "responses_before": {"delta_vx_m_per_s": y[r - 1], "max_speed_m_per_s": 5.0},
                 "tries": [{"from": "n.json", "converged": True, "objective": 1.01,
-                           "responses": {"delta_vx_m_per_s": y[r - 1] + big}}]}
+                           "responses": {"delta_vx_m_per_s": y[r - 1] + big,
+                                         "max_speed_m_per_s": 5.1}}]}
                for r in (1, 2)]
     (copy / "settling.json").write_text(json.dumps({"passes": [{"pass": 1,
                                                                 "designs": designs}]}))
@@ -446,10 +448,12 @@ def test_design_report_shows_what_the_start_decides(study, tmp_path):
                                           "R2 ceiling (start spread)"] == 0.0
     assert "stride_objective" not in spread["text"]  # a study without it as a response
     # with the objective a response of the study, the section says what its spread means
-    table.assign(stride_objective=np.linspace(1.0, 2.0, len(table))).to_csv(
+    table.assign(stride_objective=np.linspace(1.0, 2.0, len(table)),
+                 max_speed_m_per_s=np.linspace(4.8, 5.2, len(table))).to_csv(
         copy / "results.csv", index=False)
     spread = {s["title"]: s for s in design_report_sections(copy)}[
         "Design study: what the solver's start decides"]
-    assert "stride_objective" in dict(spread["tables"])["Start spread of the responses"][
-        "response"].tolist()
+    rows = dict(spread["tables"])["Start spread of the responses"].set_index("response")
+    assert "stride_objective" in rows.index
+    assert rows.loc["max_speed_m_per_s", "unit"] == "m/s"  # the maximum-speed problem's
     assert "stride_objective is the value each solve minimised" in spread["text"]

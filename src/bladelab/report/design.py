@@ -48,6 +48,9 @@ from bladelab.report.design_trends import trend_ceilings, trends_section
 
 __all__ = ["build_design_report", "design_report_sections", "is_design_folder", "trends_section"]
 
+#: The units of the collocation evaluator's responses (either problem).
+_COLLOCATION_UNITS = {**PREDICTED_RESPONSE_UNITS, **MAX_SPEED_RESPONSE_UNITS}
+
 
 def is_design_folder(path: str | Path) -> bool:
     """True when ``path`` holds a design study (``study.json`` and ``results.csv``)."""
@@ -71,8 +74,7 @@ def _load(design_dir: Path):
     if ev.is_file():
         evaluator = read_json(ev, what="evaluator settings")
         kind = evaluator.get("evaluator")
-        units = {"runner": RUNNER_RESPONSE_UNITS,
-                 "collocation": {**PREDICTED_RESPONSE_UNITS, **MAX_SPEED_RESPONSE_UNITS}
+        units = {"runner": RUNNER_RESPONSE_UNITS, "collocation": _COLLOCATION_UNITS
                  }.get(kind, BLADE_RESPONSE_UNITS)
     meta = {**meta, "_evaluator": evaluator}
     coded_cols = [f"{n}_coded" for n in space.names]
@@ -500,7 +502,7 @@ def _start_spread(design_dir: Path, meta: dict, table: pd.DataFrame,
         return None
     runs = table["run"] if checks is None else table.loc[~checks["excluded"].to_numpy(bool),
                                                          "run"]
-    spread = start_spread(design_dir, units=PREDICTED_RESPONSE_UNITS,
+    spread = start_spread(design_dir, units=_COLLOCATION_UNITS,
                           fitted_runs=[int(r) for r in runs])
     spread = spread[spread["across_sd"] > 0]  # a prescribed response (the speed) has none
     return None if spread.empty else spread.reset_index(drop=True)
