@@ -23,6 +23,12 @@ beside it (``bladelab design`` run as in docs/design.md). Run the study again to
         --runs ccd --jobs 2 --settle 3 --skip-failed \
         --objective max_speed_m_per_s --sense max \
         --out benchmarks/design/transtibial-collocation-max-speed
+    bladelab design --evaluator collocation --amputation transtibial --max-speed \
+        --stride-time people \
+        --start-strides benchmarks/design/transtibial-collocation-4mps-people-stride/strides \
+        --runs ccd --jobs 2 --settle 3 --skip-failed \
+        --objective max_speed_m_per_s --sense max \
+        --out benchmarks/design/transtibial-collocation-max-speed-people-stride
 
 Studies since the study timing record write their own ``timing.json`` (each sitting of each
 stage, :mod:`bladelab.design.timing`); older ones hold their times written by hand.
@@ -50,6 +56,9 @@ STUDIES = (
      "transtibial --stride-time people`)"),
     (_DESIGN / "transtibial-collocation-max-speed", "transtibial",
      "human body, each design's maximum speed (`--amputation transtibial --max-speed`)"),
+    (_DESIGN / "transtibial-collocation-max-speed-people-stride", "transtibial",
+     "human body, each design's maximum speed at people's stride time (`--amputation "
+     "transtibial --max-speed --stride-time people`)"),
 )
 #: The responses a designer asks for, fitted in each study that has them.
 DESIGNER_RESPONSES = ("cost_of_transport_J_per_kg_m", "max_speed_m_per_s", "stride_objective",
