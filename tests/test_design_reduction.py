@@ -75,3 +75,19 @@ def test_a_study_with_the_reduced_model_fits_each_response_its_own_terms(tmp_pat
     saved = json.loads((tmp_path / "surfaces.json").read_text())
     assert saved["knee"]["terms"] == ["1", "toe_length_m"]
     assert json.loads((tmp_path / "study.json").read_text())["model"] == "reduced"
+
+
+def test_the_elimination_and_its_press_work_on_runs_that_alias_a_term():
+    """The clean runs of a study can alias a term of the full quadratic (a CCD missing runs):
+    the elimination still chooses terms, and the nested R² is computed, where a full-quadratic
+    fit of the same runs is refused."""
+    a, b, c, d = CODED.T
+    y = 1.0 + 0.8 * a - 0.3 * d**2 + _noise(4)
+    keep = np.ones(len(y), bool)
+    keep[[0, 3, 5, 6, 9, 10, 12, 15, 18]] = False  # 16 runs: the factorial part half gone
+    with pytest.raises(Exception, match="cannot estimate"):
+        fit_surface(CODED[keep], y[keep], factor_names=NAMES, model="quadratic")
+    kept = backward_terms(CODED[keep], y[keep], 4)
+    assert (0,) in kept and (3, 3) in kept
+    surface = fit_reduced(CODED[keep], y[keep], factor_names=NAMES)
+    assert np.isfinite(surface.r2_pred_selected)

@@ -22,6 +22,7 @@ import dataclasses
 from collections.abc import Sequence
 
 import numpy as np
+from scipy import stats
 
 from bladelab.design.surfaces import ResponseSurface, fit_surface
 from bladelab.design.terms import Term, model_matrix, model_terms
@@ -45,19 +46,30 @@ def backward_terms(coded: np.ndarray, y: np.ndarray, n_factors: int, *,
     """The hierarchical backward elimination of the full quadratic (module docstring): the
     terms kept, intercept first. ``coded``: (n_runs, n_factors) in [-1, 1]; ``y``: responses."""
     terms = list(model_terms(n_factors, "quadratic"))
-    names = [f"x{i}" for i in range(n_factors)]
-    while len(terms) < len(y):  # a residual degree of freedom: p-values exist
-        p_value = fit_surface(coded, y, factor_names=names, model=terms
-                              ).coefficients()["p_value"].to_numpy()  # in the terms' order
+    y = np.asarray(y, float)
+    while True:
+        # by hand, not with fit_surface: a subset of the runs (a fold of the PRESS, the clean
+        # runs of a study) can alias terms, where fit_surface refuses and the pseudo-inverse
+        # gives the aliased terms no weight
+        x = model_matrix(coded, terms)
+        n, p = x.shape
+        if n <= p:
+            return tuple(terms)
+        coef, *_ = np.linalg.lstsq(x, y, rcond=None)
+        resid = y - x @ coef
+        sigma2 = float(resid @ resid) / (n - p)
+        se = np.sqrt(np.maximum(np.diag(np.linalg.pinv(x.T @ x)), 0.0) * sigma2)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            t = np.where(se > 0, np.abs(coef) / np.where(se > 0, se, 1.0), np.inf)
+        p_value = 2.0 * stats.t.sf(t, n - p)
         free = [k for k, term in enumerate(terms)
                 if term and not any(_holds(term, other) for other in terms)]
         if not free:
-            break
+            return tuple(terms)
         worst = max(free, key=lambda k: p_value[k])
         if p_value[worst] <= alpha:
-            break
+            return tuple(terms)
         terms.pop(worst)
-    return tuple(terms)
 
 
 def fit_reduced(coded: np.ndarray, y: np.ndarray | Sequence[float], *,
