@@ -78,7 +78,7 @@ class FakeSolve:
         self.fakes, self.fail, self.calls = fakes, set(fail), []
         self.max_step, self.last_ok_speed = max_step, None
 
-    def __call__(self, runner, settings, guess, *, model_spec, progress=None):
+    def __call__(self, runner, settings, guess, *, model_spec, progress=None, speed_floor=None):
         spec = check_model_spec(model_spec)
         base = self.fakes[spec["model"]][1]
         v = settings.speed_m_per_s
@@ -98,7 +98,8 @@ class FakeSolve:
             status="Solve_Succeeded" if ok else "Maximum_Iterations_Exceeded")
         sol = dataclasses.replace(base, nlp=nlp, settings=settings, model_spec=spec,
                                   guess_source=guess.source, stage="predictive")
-        self.calls.append({"label": label, "speed": v, "guess": guess, "solution": sol})
+        self.calls.append({"label": label, "speed": v, "guess": guess, "solution": sol,
+                           "speed_floor": speed_floor})
         return sol
 
 
@@ -138,8 +139,9 @@ def objectives_by_start(fake: FakeSolve, monkeypatch, objective) -> None:
     does not converge. Each call records its start under ``"start"``."""
     from bladelab.predict.collocation import continuation
 
-    def solve(runner, settings, guess, *, model_spec, progress=None):
-        sol = fake(runner, settings, guess, model_spec=model_spec, progress=progress)
+    def solve(runner, settings, guess, *, model_spec, progress=None, speed_floor=None):
+        sol = fake(runner, settings, guess, model_spec=model_spec, progress=progress,
+                   speed_floor=speed_floor)
         call = fake.calls[-1]
         call["start"] = start_of(settings, guess)
         obj = objective(call["start"], settings.speed_m_per_s)

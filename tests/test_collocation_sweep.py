@@ -289,10 +289,10 @@ def test_several_starts_keep_the_best_per_problem_and_every_file(fake_solve, mon
 def test_settling_starts_each_category_from_its_neighbours_strides(fake_solve, monkeypatch,
                                                                    tmp_path, capsys):
     """--settle: after every model, each amputee problem solved again from the kept strides of
-    the categories next to it by stiffness (not by the order given), the able runner's
-    prescribed speed from its own maximum-speed stride (its next faster problem), the lowest
-    kept with every start's objective in the table;
-    --resume solves nothing again."""
+    the two categories nearest it by stiffness (not by the order given; Cat4 at the end from
+    Cat5 and Cat6), the able runner's prescribed speed from its own maximum-speed stride (its
+    maximum speed has none: its continuation came from that speed), the lowest kept with every
+    start's objective in the table; --resume solves nothing again."""
     from collocation_fake import objectives_by_start
 
     # Cat5's 3.5 m/s stride is the best start of Cat4's problem; Cat6's maximum speed does
@@ -308,16 +308,25 @@ def test_settling_starts_each_category_from_its_neighbours_strides(fake_solve, m
     settling = [(c["label"], c["speed"], c["start"]) for c in fake_solve.calls[8:]]
     assert [c["start"] for c in fake_solve.calls[:8]] == ["template", "warm"] * 4
     assert sorted(settling, key=str) == sorted([
-        ("able", 3.5, "from-max-speed"), ("amputee Cat4", 3.5, "from-Cat5"), ("amputee Cat4", None, "from-Cat5"),
+        ("able", 3.5, "from-max-speed"),
+        ("amputee Cat4", 3.5, "from-Cat5"), ("amputee Cat4", 3.5, "from-Cat6"),
+        ("amputee Cat4", None, "from-Cat5"), ("amputee Cat4", None, "from-Cat6"),
         ("amputee Cat5", 3.5, "from-Cat4"), ("amputee Cat5", 3.5, "from-Cat6"),
         ("amputee Cat5", None, "from-Cat4"), ("amputee Cat5", None, "from-Cat6"),
-        ("amputee Cat6", 3.5, "from-Cat5"), ("amputee Cat6", None, "from-Cat5")], key=str)
+        ("amputee Cat6", 3.5, "from-Cat5"), ("amputee Cat6", 3.5, "from-Cat4"),
+        ("amputee Cat6", None, "from-Cat5"), ("amputee Cat6", None, "from-Cat4")], key=str)
     # each settling start from the neighbour's own stride (its primal and dual values)
     cat4 = next(c for c in fake_solve.calls[8:] if c["label"] == "amputee Cat4"
                 and c["speed"] == 3.5)
     cat5 = next(c for c in fake_solve.calls[:8] if c["label"] == "amputee Cat5"
                 and c["speed"] == 3.5)
     np.testing.assert_array_equal(cat4["guess"].q[:, 3], cat5["solution"].nlp.q[:, 3])
+    # a neighbour's maximum-speed stride is held at this model's own floor (the speed of its
+    # own fastest stride), not at the neighbour's speed; the warm start keeps the solver's rule
+    top = [c for c in fake_solve.calls if c["label"] == "amputee Cat4" and c["speed"] is None]
+    assert {c["start"]: c["speed_floor"] for c in top} == {
+        "warm": None, "from-Cat5": 3.5, "from-Cat6": 3.5}
+    assert {c["guess"].speed for c in top if c["start"] != "warm"} != {3.5}
     assert sorted(p.name for p in (out / "amputee-Cat5").iterdir()) == [
         "max-speed.from-Cat4.json", "max-speed.from-Cat6.json", "max-speed.json",
         "speed-3.5.from-Cat4.json", "speed-3.5.from-Cat6.json", "speed-3.5.json"]
@@ -326,12 +335,12 @@ def test_settling_starts_each_category_from_its_neighbours_strides(fake_solve, m
     r = rows["able", "speed"]  # a tie keeps the first start
     assert (r["start"], r["starts"], r["objective_from-max-speed"]) == ("warm", "2", "2.0")
     r = rows["amputee Cat4", "speed"]
-    assert (r["start"], r["starts"], r["file"]) == ("from-Cat5", "2",
+    assert (r["start"], r["starts"], r["file"]) == ("from-Cat5", "3",
                                                    "amputee-Cat4/speed-3.5.from-Cat5.json")
     assert float(r["objective"]) == 0.5 and float(r["objective_warm"]) == 2.0
     assert float(r["spread_pct"]) == pytest.approx(300.0)
     r = rows["amputee Cat6", "max-speed"]
-    assert (r["start"], r["starts"], r["objective_from-Cat5"]) == ("warm", "1", "")
+    assert (r["start"], r["starts"], r["objective_from-Cat5"]) == ("warm", "2", "")
     assert [m for m, _ in rows][:3] == ["able", "able", "amputee Cat4"]  # the order asked
     before = (out / "collocation-sweep.csv").read_text()
     fake_solve.calls.clear()
@@ -371,22 +380,36 @@ def test_settling_with_a_mesh_check_checks_only_the_kept_strides(fake_solve, mon
     assert rows["amputee Cat4", "speed"]["mesh_check_intervals"] == str(2 * N)
 
 
-def test_faster_neighbours_are_the_next_converged_faster_problem():
-    from bladelab.predict.collocation.sweep import faster_neighbours
+def test_own_neighbours_skip_the_continuations_origin_and_fill_with_the_stored_stride():
+    from bladelab.predict.collocation.sweep import own_neighbours
 
     def row(problem, speed, converged=True):
         return {"problem": problem, "prescribed_speed_mps": speed, "converged": converged,
                 "file": f"m/{problem}-{speed}.json"}
 
-    rows = [row("speed", 5.0), row("speed", 4.0), row("max-speed", 5.1), row("speed", 3.0)]
-    assert faster_neighbours(rows) == {"3": ("from-speed-4", "m/speed-4.0.json"),
-                                       "4": ("from-speed-5", "m/speed-5.0.json"),
-                                       "5": ("from-max-speed", "m/max-speed-5.1.json")}
-    # a problem that did not converge is nobody's neighbour and has none
+    rows = [row("speed", 5.0), row("speed", 4.0), row("max-speed", 5.1)]
+    s4, s5, top = "m/speed-4.0.json", "m/speed-5.0.json", "m/max-speed-5.1.json"
+    assert own_neighbours(rows, "stored.json") == {
+        "4": [("from-speed-5", s5), ("from-max-speed", top)],
+        "5": [("from-max-speed", top), ("from-stored", "stored.json")],
+        "max-speed": [("from-speed-4", s4), ("from-stored", "stored.json")]}
+    # without a shipped stride, fewer starts; a problem that did not converge is nobody's
     rows[0]["converged"] = False
-    rows[2]["converged"] = False
-    assert faster_neighbours(rows) == {"3": ("from-speed-4", "m/speed-4.0.json")}
-    assert faster_neighbours([]) == {}
+    assert own_neighbours(rows) == {"4": [("from-max-speed", top)]}
+    assert own_neighbours([]) == {}
+
+
+@pytest.mark.parametrize(("blades", "expected"), [
+    (["Cat4", "Cat5", "Cat6", "Cat7"], {0: [1, 2], 1: [2, 0], 2: [3, 1], 3: [2, 1]}),
+    (["Cat7", "Cat4"], {0: [1], 1: [0]}),
+])
+def test_category_neighbours_are_the_two_nearest_by_stiffness(blades, expected):
+    from bladelab.predict.collocation.sweep import category_neighbours
+
+    models = [{"model": "able", "blade": None}] + [
+        {"model": "amputee", "blade": b} for b in blades]
+    got = category_neighbours(models)
+    assert got == {i + 1: [j + 1 for j in js] for i, js in expected.items()}
 
 
 @pytest.mark.parametrize(("args", "where"), [

@@ -59,7 +59,9 @@ Other models' strides as starts (``extra_starts``, the sweep's settling pass): e
 (:func:`problem_key`) may get further starts from solution files of other models (a
 neighbouring blade category's stride at the same speed), labelled by the caller
 (``from-Cat5``), solved after the K starts from the solution's primal and dual values, and
-kept like any start.
+kept like any start. At the maximum speed such a start is held at the model's own floor (the
+speed of the stride its warm start came from), not at the other stride's speed, so that every
+start solves the same problem and a faster neighbour cannot pin the model to its speed.
 """
 
 from __future__ import annotations
@@ -366,18 +368,20 @@ def _stored(ok: Path, best: Path, settings: CollocationSettings, *, spec: dict, 
 
 
 def _solve(get_runner, spec: dict, watched: bool, settings: CollocationSettings, guess,
-           ok: Path, best: Path, report: Callable[..., None]):
+           ok: Path, best: Path, report: Callable[..., None], speed_floor=None):
     """:func:`_solve_and_write` with the runner of ``get_runner`` (for
     :func:`~bladelab.predict.collocation.starts.solve_starts`)."""
     return _solve_and_write(get_runner(), settings, guess, spec=spec, ok=ok, best=best,
-                            report=report, watched=watched)
+                            report=report, watched=watched, speed_floor=speed_floor)
 
 
 def _solve_and_write(runner, settings: CollocationSettings, guess, *, spec: dict, ok: Path,
-                     best: Path, report: Callable[..., None], watched: bool):
+                     best: Path, report: Callable[..., None], watched: bool,
+                     speed_floor: float | None = None):
     """Solve, write the solution (or best iterate) and remove the stale other file; the
-    solver's progress goes to ``report`` when ``watched``."""
-    sol = predict_stride(runner, settings, guess, model_spec=spec,
+    solver's progress goes to ``report`` when ``watched``; ``speed_floor`` [m/s] as
+    :func:`~bladelab.predict.collocation.solve.predict_stride`."""
+    sol = predict_stride(runner, settings, guess, model_spec=spec, speed_floor=speed_floor,
                          progress=(lambda p: report("solve", solve=p)) if watched else None)
     target = write_solve(sol, ok, best)
     s = sol.summary()
@@ -633,6 +637,9 @@ def max_speed(runner, settings: CollocationSettings, guess, *, model_spec: dict,
         plan = plan_starts(starts, warm, warm_source=str(source), template=template,
                            previous=prev, restart_start=starts == MAX_STARTS)
     extra = _extra(extra_starts, None, settings)
+    if extra:  # another model's stride: held at this model's own floor, not at its speed
+        own_floor = warm.guess().speed
+        extra = [dataclasses.replace(s, speed_floor=own_floor) for s in extra]
     ok, best = out_dir / MAX_SPEED_FILE, out_dir / MAX_SPEED_BEST_ITERATE_FILE
     kept, outcomes = solve_starts(
         plan + extra, ok=ok, best=best, report=report, several=starts > 1 or bool(extra),

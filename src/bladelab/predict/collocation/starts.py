@@ -122,12 +122,17 @@ class Start:
         ``guess() -> StrideGuess``, called only when the start is solved.
     text
         How the progress line names the start (empty: ``from <guess source>``).
+    speed_floor
+        Of a maximum-speed problem, the speed [m/s] its stride is held at or above, where it
+        is not the start stride's own (another model's stride: its speed would pin this
+        model's to it); None: the solver's rule.
     """
 
     label: str
     settings: object
     guess: Callable[[], object]
     text: str = ""
+    speed_floor: float | None = None
 
 
 def barrier_start(warm: Start) -> Start:
@@ -298,7 +303,8 @@ def solve_starts(plan: Sequence[Start], *, ok: Path, best: Path, read, solve,
 
     A start's converged file is read back, not solved again. Its best iterate is read back too
     when another start of the problem converged; otherwise it warm-starts that start again,
-    unless ``retry`` is False (the stored iterates are stale: a step was refined). Returns
+    unless ``retry`` is False (the stored iterates are stale: a step was refined). A start
+    with a ``speed_floor`` is solved as ``solve(..., speed_floor=floor)``. Returns
     (kept, every start's outcome in order); the outcomes are empty unless ``several`` (default:
     more than one start in ``plan``; a K > 1 sweep passes True where only one start applies,
     so that every row has the columns)."""
@@ -325,7 +331,8 @@ def solve_starts(plan: Sequence[Start], *, ok: Path, best: Path, read, solve,
         else:
             guess = s.guess()
             said("start", message=s.text or f"from {guess.source}")
-        sol, path = solve(s.settings, guess, o, b, said)
+        floor = {} if s.speed_floor is None else {"speed_floor": s.speed_floor}
+        sol, path = solve(s.settings, guess, o, b, said, **floor)
         outcomes.append(StartOutcome(s.label, sol, path, True))
     if not several:
         return outcomes[0], ()

@@ -24,15 +24,18 @@ plus the columns ``start``, ``starts``, ``objective``, ``objective_<start>`` and
 With ``settle`` a settling pass follows: each model's problems are solved again from its
 neighbours' kept strides, from their primal and dual values, each as one more start (the
 continuation's ``extra_starts``), and the lowest kept: one pass, from the strides the first
-pass kept. The neighbours of a problem: the neighbouring blade categories' strides at the same
-problem (the categories ordered by stiffness, :func:`category_neighbours`; labels
-``from-<category>``, files ``speed-4.from-Cat5.json``); for a model without a category (the
-able runner), at each prescribed speed, its own stride at its next faster problem
-(:func:`faster_neighbours`; ``from-speed-5``, ``from-max-speed``). Measured on the human body,
-the categories' starts land within 0.1–0.5 % of each other where the template start does not
-converge (docs/collocation.md, "Several starts per problem"); the able runner's 5 m/s stride
-from its maximum-speed stride lay 22 % below (in objective) the one the continuation reached
-from 4 m/s, where an amputee's faster starts landed 5–100 % above their problems' best.
+pass kept. The neighbours of a problem: the two nearest blade categories' strides at the same
+problem (the categories ordered by stiffness, one on each side, at an end of the order the next
+two: :func:`category_neighbours`; labels ``from-<category>``, files ``speed-4.from-Cat5.json``),
+so that every amputee problem of a study of three or more categories has three starts; for a
+model without a category (the able runner), two of its own other strides, the nearest problems
+other than the one its continuation came from, and where it has fewer its shipped stride
+(:func:`own_neighbours`; ``from-speed-5``, ``from-max-speed``, ``from-stored``). Measured on
+the human body, the categories' starts land within 0.1–0.5 % of each other where the template
+start does not converge (docs/collocation.md, "Several starts per problem"); the able runner's
+5 m/s stride from its maximum-speed stride lay 22 % below (in objective) the one the
+continuation reached from 4 m/s, where an amputee's faster starts landed 5–100 % above their
+problems' best.
 With ``mesh_check`` as well, every model is checked after the settling pass only (its kept
 strides).
 
@@ -72,9 +75,16 @@ from bladelab.predict.collocation.continuation import (
 from bladelab.predict.collocation.mesh_check import MESH_CHECK_DIR, mesh_check_in_folder
 from bladelab.predict.collocation.model import build_collocation_model
 from bladelab.predict.collocation.settings import CollocationSettings
+from bladelab.predict.collocation.solution import CollocationSolution
 from bladelab.predict.collocation.solve import check_output_folder
+from bladelab.predict.collocation.starting_guess import stored_stride_path
 from bladelab.predict.collocation.starts import check_starts
-from bladelab.predict.collocation.stored import check_model_spec, model_label, params_from_spec
+from bladelab.predict.collocation.stored import (
+    check_model_spec,
+    model_label,
+    params_from_spec,
+    runner_from_spec,
+)
 from bladelab.runner.params import blade_category
 
 __all__ = [
@@ -82,7 +92,7 @@ __all__ = [
     "SweepResult",
     "category_neighbours",
     "collocation_sweep",
-    "faster_neighbours",
+    "own_neighbours",
     "mesh_check_columns",
     "sweep_model_task",
     "sweep_models",
@@ -299,44 +309,74 @@ class SweepResult:
         return pd.DataFrame(self.rows, columns=table_columns(self.rows))
 
 
-def category_neighbours(models: Sequence[dict]) -> dict[int, list[int]]:
-    """For each amputee model of ``models`` (by index), the indices of the models whose blade
-    categories are next to its own when the categories are ordered by stiffness (Cat4 …
-    Cat7); models without a blade (the able runner) have none."""
+def category_neighbours(models: Sequence[dict], count: int = 2) -> dict[int, list[int]]:
+    """For each amputee model of ``models`` (by index), the indices of the ``count`` models
+    whose blade categories are nearest its own when the categories are ordered by stiffness
+    (Cat4 … Cat7): one on each side, and at either end of the order the next ones on the one
+    side it has (Cat4 from Cat5 and Cat6). Nearest first, the stiffer first at equal rank
+    distance; models without a blade (the able runner) have none."""
     bladed = sorted((i for i, m in enumerate(models) if m.get("blade")),
                     key=lambda i: blade_category(models[i]["blade"]).stiffness_n_per_m)
-    return {i: [bladed[k] for k in (j - 1, j + 1) if 0 <= k < len(bladed)]
-            for j, i in enumerate(bladed)}
-
-
-def faster_neighbours(model_rows: Sequence[dict]) -> dict[str, tuple[str, str]]:
-    """For each prescribed speed of one model's kept solves (``model_rows``, a sweep's rows),
-    the model's own next faster converged problem: ``{problem_key: (label, file)}``, the label
-    ``from-speed-<v>`` or ``from-max-speed``, the file as the row has it. The fastest prescribed
-    speed's neighbour is the maximum speed's stride; a problem with no converged faster one has
-    none."""
-    converged = [r for r in model_rows if r.get("converged")]
-    prescribed = sorted((r for r in converged if r["problem"] != "max-speed"),
-                        key=lambda r: r["prescribed_speed_mps"])
-    fastest = [r for r in converged if r["problem"] == "max-speed"]
     out = {}
-    for k, r in enumerate(prescribed):
-        faster = prescribed[k + 1:k + 2] or fastest
-        if faster:
-            f = faster[0]
-            label = ("from-max-speed" if f["problem"] == "max-speed"
-                     else f"from-speed-{f['prescribed_speed_mps']:g}")
-            out[problem_key(r["prescribed_speed_mps"])] = (label, f["file"])
+    for j, i in enumerate(bladed):
+        others = sorted((k for k in range(len(bladed)) if k != j),
+                        key=lambda k: (abs(k - j), k < j))
+        out[i] = [bladed[k] for k in others[:count]]
     return out
+
+
+def own_neighbours(model_rows: Sequence[dict], stored: str | Path | None = None,
+                   count: int = 2) -> dict[str, list[tuple[str, str]]]:
+    """For each problem of one model's kept solves (``model_rows``, a sweep's rows), up to
+    ``count`` of the model's own other converged strides as starts: ``{problem_key: [(label,
+    file), ...]}``, labels ``from-speed-<v>``, ``from-max-speed``, files as the rows have them.
+
+    The problems in the continuation's order (the prescribed speeds rising, then the maximum
+    speed); each problem's nearest others in that order, the faster first, leaving out the one
+    its continuation came from (the previous problem), which its own first start already was.
+    Where that leaves fewer than ``count``, the model's shipped stride ``stored`` (label
+    ``from-stored``) when there is one."""
+    converged = [r for r in model_rows if r.get("converged")]
+    order = sorted((r for r in converged if r["problem"] != "max-speed"),
+                   key=lambda r: r["prescribed_speed_mps"])
+    order += [r for r in converged if r["problem"] == "max-speed"]
+    out = {}
+    for k, r in enumerate(order):
+        others = sorted((m for m in range(len(order)) if m not in (k, k - 1)),
+                        key=lambda m: (abs(m - k), m < k))
+        starts = [(_own_label(order[m]), order[m]["file"]) for m in others[:count]]
+        if len(starts) < count and stored is not None:
+            starts.append(("from-stored", str(stored)))
+        if starts:
+            speed = None if r["problem"] == "max-speed" else r["prescribed_speed_mps"]
+            out[problem_key(speed)] = starts
+    return out
+
+
+def _own_label(row: dict) -> str:
+    return ("from-max-speed" if row["problem"] == "max-speed"
+            else f"from-speed-{row['prescribed_speed_mps']:g}")
+
+
+def _stored_stride(spec: dict, settings: CollocationSettings) -> str | None:
+    """The shipped stride of the model ``spec`` as a settling start, where it is the body's own
+    problem: the built-in body at its own athlete, the same mesh; else None."""
+    if spec.get("athlete"):
+        return None
+    path = stored_stride_path(runner_from_spec(spec))
+    if path is None or CollocationSolution.read(path).settings.mesh_intervals != \
+            settings.mesh_intervals:
+        return None
+    return str(path)
 
 
 def _settling_payloads(payloads: Sequence[dict], rows: dict[int, list[dict]],
                        out: Path, mesh_check: bool) -> dict[int, dict]:
     """The settling pass's payload of each model: the first pass's payload, reading its files
     back (``force`` off), with ``extra_starts`` from the neighbours' converged kept strides
-    (the neighbouring categories' at the same problem, :func:`category_neighbours`; a model
-    without a category, the able runner, its own at its next faster problem,
-    :func:`faster_neighbours`; a model with none is left out) and the mesh check the sweep
+    (the nearest categories' at the same problem, :func:`category_neighbours`; a model without
+    a category, the able runner, its own other problems' and its shipped stride,
+    :func:`own_neighbours`; a model with none is left out) and the mesh check the sweep
     asked for (the first pass leaves it to this one, so that only kept strides are checked)."""
     models = [p["model_spec"] for p in payloads]
     near_categories = category_neighbours(models)
@@ -350,9 +390,12 @@ def _settling_payloads(payloads: Sequence[dict], rows: dict[int, list[dict]],
                 speed = None if r["problem"] == "max-speed" else r["prescribed_speed_mps"]
                 extra.setdefault(problem_key(speed), []).append(
                     (f"from-{models[j]['blade']}", str(out / r["file"])))
-        if i not in near_categories:  # the able runner: its own faster strides instead
-            for key, (label, file) in faster_neighbours(rows.get(i, [])).items():
-                extra.setdefault(key, []).append((label, str(out / file)))
+        if i not in near_categories:  # the able runner: its own other strides instead
+            stored = _stored_stride(models[i], payloads[i]["settings"])
+            for key, starts in own_neighbours(rows.get(i, []), stored).items():
+                extra.setdefault(key, []).extend(
+                    (label, file if label == "from-stored" else str(out / file))
+                    for label, file in starts)
         if extra:
             settling[i] = {**payloads[i], "force": False, "extra_starts": extra,
                            "mesh_check": bool(mesh_check)}
