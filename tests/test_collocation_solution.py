@@ -172,6 +172,22 @@ def test_the_reference_phase_round_trips_into_the_next_start(able, tmp_path):
     assert back.to_guess().resample(8).with_speed(4.0).reference_phase == 0.0325
 
 
+def test_a_maximum_speed_s_floor_round_trips_and_says_whether_the_speed_is_on_it(able,
+                                                                                tmp_path):
+    from bladelab.predict.collocation.continuation import speed_floor_columns
+
+    _, _, sol = able
+    assert sol.speed_floor_mps is None
+    assert speed_floor_columns(sol) == {"speed_floor_mps": "", "on_speed_floor": False}
+    v = sol.mean_speed_mps
+    back = CollocationSolution.read(replace(sol, speed_floor_mps=v - 5e-4).write(
+        tmp_path / "solution.json"))
+    assert back.speed_floor_mps == v - 5e-4
+    assert speed_floor_columns(back) == {"speed_floor_mps": v - 5e-4, "on_speed_floor": True}
+    below = replace(back, speed_floor_mps=v - 0.05)
+    assert speed_floor_columns(below)["on_speed_floor"] is False
+
+
 def test_a_non_converged_solve_is_a_best_iterate(able, tmp_path):
     _, _, sol = able
     bad = replace(sol, nlp=replace(sol.nlp, success=False, status="Maximum_Iterations_Exceeded"))

@@ -31,6 +31,21 @@ def test_every_task_reports_once_and_a_failure_does_not_stop_the_others(executor
     assert results[1][0] == "failed" and "ValueError: negative input" in results[1][1]
 
 
+@pytest.mark.parametrize("executor", [SerialExecutor(), LocalExecutor(2)],
+                         ids=["serial", "local"])
+def test_payloads_appended_while_results_are_read_are_run(executor):
+    """A caller hands out work as earlier tasks finish: each result of x < 4 appends x + 1."""
+    payloads = [{"x": 0}, {"x": 10}]
+    seen = {}
+    for i, status, value in executor.run(_square_or_fail, payloads):
+        seen[i] = value["y"]
+        x = payloads[i]["x"]
+        if x < 4:
+            payloads.append({"x": x + 1})
+    assert len(payloads) == 6
+    assert seen == {i: p["x"] ** 2 for i, p in enumerate(payloads)}
+
+
 def test_make_executor_is_in_process_for_one_job():
     assert isinstance(make_executor("local", 1), SerialExecutor)
     assert isinstance(make_executor("local", 2), LocalExecutor)

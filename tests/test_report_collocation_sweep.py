@@ -75,6 +75,31 @@ def test_a_solve_that_did_not_converge_is_left_out_of_the_summary(tmp_path):
     assert math.isfinite(s.cot_4)
 
 
+def test_a_maximum_speed_on_its_floor_is_said_to_be_there(tmp_path):
+    """The summary compares the maximum speed with its floor: the recorded one, else (an older
+    table) the model's fastest prescribed speed; the section text names the models on it."""
+    from bladelab.report.collocation_sweep import _floor_text
+
+    folder = _subset(tmp_path, ["Cat5", "Cat6"])
+    table = pd.read_csv(folder / "collocation-sweep.csv")
+    top = table.problem == "max-speed"
+    fastest = table.loc[~top, "prescribed_speed_mps"].max()
+    table.loc[top & (table.blade == "Cat5"), "mean_speed_mps"] = fastest + 2e-4
+    table.to_csv(folder / "collocation-sweep.csv", index=False)
+    read = read_sweep_table(folder)
+    summary = sweep_summary(read).set_index("category")
+    assert summary.loc["Cat5", "max_speed_floor"] == f"on it ({fastest:g} m/s)"
+    assert summary.loc["Cat6", "max_speed_floor"] == f"above it ({fastest:g} m/s)"
+    text = _floor_text(read)
+    assert "Cat5" in text and "Cat6" not in text
+    # a recorded floor is the one compared with
+    table["speed_floor_mps"] = math.nan
+    table.loc[top, "speed_floor_mps"] = 3.0
+    table.to_csv(folder / "collocation-sweep.csv", index=False)
+    summary = sweep_summary(read_sweep_table(folder)).set_index("category")
+    assert summary.loc["Cat5", "max_speed_floor"] == "above it (3 m/s)"
+
+
 def test_a_merged_folder_says_so_with_its_spread(tmp_path):
     from bladelab.report.builder import Report
     from bladelab.report.collocation_sweep import collocation_sweep_sections

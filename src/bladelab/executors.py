@@ -3,7 +3,10 @@
 Every executor takes a *top-level* (importable, picklable) function ``task(payload) -> dict`` and
 a list of picklable payloads, and yields ``(index, status, value)`` as tasks finish, in any order:
 ``status`` is ``"ok"`` (value = the task's dict) or ``"failed"`` (value = an error message). A task
-that raises never stops the others.
+that raises never stops the others. The list may grow while the results are read: payloads
+appended to it (a list) are submitted as soon as the loop asks for the next result, so that a
+caller can hand out work that becomes ready as earlier tasks finish (no idle worker waiting for
+a whole round to end).
 
 - :class:`SerialExecutor`: in this process (``jobs=1``).
 - :class:`LocalExecutor`: ``concurrent.futures.ProcessPoolExecutor`` with the ``forkserver`` start
@@ -71,9 +74,11 @@ class SerialExecutor:
         self.jobs = 1
 
     def run(self, task: Task, payloads: Sequence[dict]) -> Iterator[tuple[int, str, Any]]:
-        for i, payload in enumerate(payloads):
-            status, value = run_task_safely(task, payload)
+        i = 0
+        while i < len(payloads):  # the list may grow (module docstring)
+            status, value = run_task_safely(task, payloads[i])
             yield i, status, value
+            i += 1
 
 
 def default_start_method() -> str:
@@ -148,17 +153,26 @@ class LocalExecutor:
         if not payloads:
             return
         with ProcessPool(min(self.jobs, len(payloads)), start_method=self.start_method) as pool:
-            pending = {pool.submit(run_task_safely, task, p): i for i, p in enumerate(payloads)}
+            pending = {}
+
+            def submit_new() -> None:  # the list may grow (module docstring)
+                for i in range(len(pending) + done, len(payloads)):
+                    pending[pool.submit(run_task_safely, task, payloads[i])] = i
+
+            done = 0
+            submit_new()
             try:
                 while pending:
                     finished, _ = wait(pending, return_when=FIRST_COMPLETED)
                     for fut in finished:
                         i = pending.pop(fut)
+                        done += 1
                         try:
                             status, value = fut.result()
                         except Exception as err:  # noqa: BLE001 - a worker died
                             status, value = "failed", f"worker failed: {type(err).__name__}: {err}"
                         yield i, status, value
+                        submit_new()
             finally:
                 if pending:  # interrupted (Ctrl-C, SIGTERM via the CLI, an error)
                     pool.close(abort=True)
@@ -187,8 +201,14 @@ class RayExecutor:
         started = start_local_ray(self.jobs)
         try:
             remote = ray.remote(num_cpus=1)(run_task_safely)
-            refs = {remote.remote(task, p): i for i, p in enumerate(payloads)}
-            while refs:
+            refs = {}
+            submitted = 0
+            while True:
+                for i in range(submitted, len(payloads)):  # the list may grow
+                    refs[remote.remote(task, payloads[i])] = i
+                submitted = len(payloads)
+                if not refs:
+                    break
                 ready, _ = ray.wait(list(refs), num_returns=1)
                 for ref in ready:
                     i = refs.pop(ref)

@@ -34,6 +34,7 @@ import numpy as np
 import pandas as pd
 
 from bladelab.errors import InputFileError
+from bladelab.predict.collocation.continuation import ON_FLOOR_TOL_MPS
 from bladelab.predict.collocation.human_running import gallop_sentence
 from bladelab.predict.collocation.model import build_collocation_model
 from bladelab.predict.collocation.solution import CollocationSolution
@@ -100,7 +101,8 @@ def sweep_summary(table: pd.DataFrame) -> pd.DataFrame:
     speed. NaN where the solve is missing, did not converge or is flagged by the gait checks
     (``flagged`` of :func:`read_sweep_table`). A sweep with mesh-halving checks (``bladelab
     sweep --mesh-check``) adds ``settled``: whether those two solves settled on twice the mesh
-    intervals, e.g. "4 m/s: yes; maximum speed: not checked"."""
+    intervals, e.g. "4 m/s: yes; maximum speed: not checked". ``max_speed_floor`` says whether
+    the maximum speed is its problem's floor (:func:`on_speed_floor`), e.g. "on it (5 m/s)"."""
     checked = "mesh_check_settled" in table.columns
     rows = []
     amputee = table[table.model.astype(str).str.startswith("amputee")]
@@ -110,7 +112,10 @@ def sweep_summary(table: pd.DataFrame) -> pd.DataFrame:
         at4 = ok[(ok.problem == "speed")
                  & np.isclose(ok.prescribed_speed_mps.astype(float), COST_SPEED_M_PER_S)]
         vmax = float(top.mean_speed_mps.iloc[0]) if len(top) else math.nan
+        floor = on_speed_floor(df, top)
         row = {"category": cat, "max_speed": vmax,
+               "max_speed_floor": "–" if floor is None else (
+                   f"{'on it' if floor[0] else 'above it'} ({floor[1]:g} m/s)"),
                "cot_4": float(at4.cost_of_transport_J_per_kg_m.iloc[0]) if len(at4) else math.nan,
                "t200": 200.0 / vmax if vmax > 0 else math.nan,
                "t400": 400.0 / vmax if vmax > 0 else math.nan}
@@ -122,9 +127,46 @@ def sweep_summary(table: pd.DataFrame) -> pd.DataFrame:
             row["settled"] = "; ".join(f"{name}: {_settled_word(solve)}" for name, solve in (
                 (f"{COST_SPEED_M_PER_S:g} m/s", at4), ("maximum speed", top)))
         rows.append(row)
-    return pd.DataFrame(rows, columns=["category", "max_speed", "cot_4", "t200", "t400",
+    return pd.DataFrame(rows, columns=["category", "max_speed", "max_speed_floor", "cot_4",
+                                       "t200", "t400",
                                        "contact_time_intact", "contact_time_prosthetic"]
                         + (["settled"] if checked else []))
+
+
+def on_speed_floor(model_rows: pd.DataFrame, top: pd.DataFrame) -> tuple[bool, float] | None:
+    """(on its floor, the floor [m/s]) of a model's converged maximum-speed solve ``top`` (one
+    row or none) among the model's rows: the floor its table records (``speed_floor_mps``),
+    else, in a table written before it did, the model's fastest prescribed speed (the floor of
+    the continuation's warm start); on it within ``ON_FLOOR_TOL_MPS``. None without a solve or
+    a floor."""
+    if not len(top):
+        return None
+    floor = (pd.to_numeric(top["speed_floor_mps"], errors="coerce").iloc[0]
+             if "speed_floor_mps" in top.columns else math.nan)
+    if not math.isfinite(floor):
+        speeds = pd.to_numeric(model_rows.loc[model_rows.problem == "speed",
+                                              "prescribed_speed_mps"], errors="coerce")
+        floor = speeds.max() if speeds.notna().any() else math.nan
+    if not math.isfinite(floor):
+        return None
+    speed = float(top.mean_speed_mps.iloc[0])
+    return speed - floor <= ON_FLOOR_TOL_MPS, float(floor)
+
+
+def _floor_text(table: pd.DataFrame) -> str:
+    """The sentence naming the models whose maximum speed is its problem's floor."""
+    on = []
+    for model, df in table.groupby("model", sort=False):
+        top = df[df.converged & ~df.flagged & (df.problem == "max-speed")]
+        floor = on_speed_floor(df, top)
+        if floor is not None and floor[0]:
+            on.append(f"{model} ({floor[1]:g} m/s)")
+    if not on:
+        return ""
+    return (" On its floor (the speed of the stride its solve started from, which the "
+            "problem holds it at or above): the maximum speed of " + ", ".join(on)
+            + "; there the objective found no faster stride worth its effort, so that "
+            "speed says only that the model runs at least that fast.")
 
 
 def _settled_word(solve: pd.DataFrame) -> str:
@@ -302,6 +344,7 @@ def collocation_sweep_sections(report, folder: str | Path) -> tuple[dict, pd.Dat
              "traded against effort, at least the fastest prescribed speed solved), not the "
              "fastest stride the body can run, which a speed continuation to its end finds "
              "(docs/collocation.md, 'How fast the body can run').")
+    text += _floor_text(table)
     text += "".join(sorted({reference_term_text(
         sol.settings, lead="Not free predictions: every objective held")
         for sol in solutions.values()}))

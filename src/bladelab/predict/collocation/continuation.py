@@ -44,7 +44,9 @@ Table rows (:meth:`SolveRecord.row`, units in the names): ``model``, ``blade``, 
 ``stride_time_s``, ``contact_time_s`` (mean of the legs), ``contact_time_<leg>_s``,
 ``peak_vertical_grf_<leg>_bw`` [body weights], ``flight_fraction``, ``dynamics_residual_pct``,
 ``iterations``, ``wall_s`` (of the solve, both stages; the stored value for a file read back),
-``mesh_intervals`` and ``file``. Legs are left/right (able) or intact/prosthetic (amputee).
+``mesh_intervals`` and ``file``; the maximum speed's also ``speed_floor_mps`` and
+``on_speed_floor`` (:func:`speed_floor_columns`: a maximum speed on its floor is the floor's,
+not the model's). Legs are left/right (able) or intact/prosthetic (amputee).
 
 Several starts (``starts`` K > 1, :mod:`bladelab.predict.collocation.starts`): each problem is
 solved from up to K starts (the warm start above, its barrier start, the template, the
@@ -261,6 +263,8 @@ class SolveRecord:
         row.update({k: v for k, v in summary.items() if k not in skip})
         row.update({"iterations": summary["iterations"], "wall_s": summary["wall_s"],
                     "mesh_intervals": sol.settings.mesh_intervals, "file": str(path)})
+        if self.problem == "max-speed":
+            row.update(speed_floor_columns(sol))
         if self.starts:
             kept = next(o.label for o in self.starts if o.path == self.path)
             row.update(start_columns([candidate(o.label, o.solution) for o in self.starts],
@@ -321,6 +325,21 @@ class ContinuationResult:
         """The rows as a pandas DataFrame, columns in :func:`table_columns` order."""
         rows = self.rows()
         return pd.DataFrame(rows, columns=table_columns(rows))
+
+
+#: A maximum speed within this of its floor [m/s] is on it (IPOPT's tolerance, not a stride).
+ON_FLOOR_TOL_MPS = 1e-3
+
+
+def speed_floor_columns(sol) -> dict:
+    """A maximum-speed solve's ``speed_floor_mps`` (:attr:`CollocationSolution.speed_floor_mps`,
+    empty where unknown) and ``on_speed_floor`` (its mean speed within
+    :data:`ON_FLOOR_TOL_MPS` of the floor: the speed is the floor's, not the model's
+    fastest)."""
+    floor = sol.speed_floor_mps
+    on = (floor is not None and sol.converged
+          and sol.mean_speed_mps - floor <= ON_FLOOR_TOL_MPS)
+    return {"speed_floor_mps": "" if floor is None else floor, "on_speed_floor": bool(on)}
 
 
 def table_columns(rows: Sequence[dict]) -> list[str]:

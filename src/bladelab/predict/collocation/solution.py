@@ -153,6 +153,12 @@ class CollocationSolution:
         (:meth:`~bladelab.predict.collocation.consistency.DynamicsResidual.to_dict`, the
         forward friction taken as ``"coulomb"``), with ``bristle_residual_pct``: the same
         residual with the forward bristle's state reconstructed along the stride [%].
+    reference_phase
+        Where people's joint angles start on the stride (fraction of the cycle), or None.
+    speed_floor_mps
+        Of a maximum-speed solve, the mean speed [m/s] its stride was held at or above (a
+        speed at which a stride of the model is known), None without one; a solve whose mean
+        speed equals it found no faster stride it preferred.
     """
 
     nlp: object
@@ -171,13 +177,15 @@ class CollocationSolution:
     metabolic_energy_J: float
     residual: dict = field(default_factory=dict)
     reference_phase: float | None = None
+    speed_floor_mps: float | None = None
 
     # -- construction ---------------------------------------------------------------------
     @classmethod
     def from_nlp(cls, runner, nlp, *, settings: CollocationSettings, model_spec: dict,
                  guess_source: str, stage: str = "predictive", tracking: dict | None = None,
                  metabolic_energy_J: float | None = None, cm=None,
-                 reference_phase: float | None = None) -> CollocationSolution:
+                 reference_phase: float | None = None,
+                 speed_floor_mps: float | None = None) -> CollocationSolution:
         """A solution from an :class:`NLPSolution` of ``runner``: evaluates the contact forces
         and the dynamic consistency at the nodes (and the metabolic energy over the stride [J],
         :meth:`StrideNLP.energy_and_distance` on the solution's mesh, when not given)."""
@@ -210,6 +218,7 @@ class CollocationSolution:
             body_mass_kg=float(runner.total_mass), body_weight_N=float(runner.body_weight),
             metabolic_energy_J=float(metabolic_energy_J), residual=res,
             reference_phase=None if reference_phase is None else float(reference_phase),
+            speed_floor_mps=None if speed_floor_mps is None else float(speed_floor_mps),
         )
 
     # -- derived numbers ------------------------------------------------------------------
@@ -454,6 +463,7 @@ class CollocationSolution:
             "worst_constraints": [[name, _num(v)] for name, v in s.worst_constraints],
             "timings": {k: _num(v) for k, v in s.timings.items()},
             "reference_phase": self.reference_phase,
+            "speed_floor_mps": self.speed_floor_mps,
             "tracking": None if self.tracking is None else {
                 k: (_num(v) if isinstance(v, float) else v) for k, v in self.tracking.items()},
             "summary": self.summary(),
@@ -580,6 +590,8 @@ class CollocationSolution:
             residual=r.get("consistency", dict),
             reference_phase=(None if data.get("reference_phase") is None
                              else r.number("reference_phase")),
+            speed_floor_mps=(None if data.get("speed_floor_mps") is None
+                             else r.number("speed_floor_mps")),
         )
 
 

@@ -474,6 +474,7 @@ def predict_stride(runner, settings: CollocationSettings, guess, *, model_spec: 
     return CollocationSolution.from_nlp(
         runner, sol, stage="predictive", tracking=tracking,
         metabolic_energy_J=nlp_p.energy_and_distance(sol)[0], reference_phase=phase,
+        speed_floor_mps=stage_speed if speed is None else None,
         **common)
 
 

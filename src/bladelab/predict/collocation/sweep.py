@@ -370,36 +370,41 @@ def _stored_stride(spec: dict, settings: CollocationSettings) -> str | None:
     return str(path)
 
 
-def _settling_payloads(payloads: Sequence[dict], rows: dict[int, list[dict]],
-                       out: Path, mesh_check: bool) -> dict[int, dict]:
-    """The settling pass's payload of each model: the first pass's payload, reading its files
+def _settling_payload(i: int, payloads: Sequence[dict], rows: dict[int, list[dict]],
+                      out: Path, mesh_check: bool) -> dict | None:
+    """The settling pass's payload of model ``i``: the first pass's payload, reading its files
     back (``force`` off), with ``extra_starts`` from the neighbours' converged kept strides
     (the nearest categories' at the same problem, :func:`category_neighbours`; a model without
     a category, the able runner, its own other problems' and its shipped stride,
-    :func:`own_neighbours`; a model with none is left out) and the mesh check the sweep
-    asked for (the first pass leaves it to this one, so that only kept strides are checked)."""
+    :func:`own_neighbours`) and the mesh check the sweep asked for (the first pass leaves it to
+    this one, so that only kept strides are checked); None for a model with no such start."""
     models = [p["model_spec"] for p in payloads]
     near_categories = category_neighbours(models)
-    settling = {}
-    for i in range(len(models)):
-        extra: dict[str, list[tuple[str, str]]] = {}
-        for j in near_categories.get(i, []):
-            for r in rows.get(j, []):
-                if not r.get("converged"):
-                    continue
-                speed = None if r["problem"] == "max-speed" else r["prescribed_speed_mps"]
-                extra.setdefault(problem_key(speed), []).append(
-                    (f"from-{models[j]['blade']}", str(out / r["file"])))
-        if i not in near_categories:  # the able runner: its own other strides instead
-            stored = _stored_stride(models[i], payloads[i]["settings"])
-            for key, starts in own_neighbours(rows.get(i, []), stored).items():
-                extra.setdefault(key, []).extend(
-                    (label, file if label == "from-stored" else str(out / file))
-                    for label, file in starts)
-        if extra:
-            settling[i] = {**payloads[i], "force": False, "extra_starts": extra,
-                           "mesh_check": bool(mesh_check)}
-    return settling
+    extra: dict[str, list[tuple[str, str]]] = {}
+    for j in near_categories.get(i, []):
+        for r in rows.get(j, []):
+            if not r.get("converged"):
+                continue
+            speed = None if r["problem"] == "max-speed" else r["prescribed_speed_mps"]
+            extra.setdefault(problem_key(speed), []).append(
+                (f"from-{models[j]['blade']}", str(out / r["file"])))
+    if i not in near_categories:  # the able runner: its own other strides instead
+        stored = _stored_stride(models[i], payloads[i]["settings"])
+        for key, starts in own_neighbours(rows.get(i, []), stored).items():
+            extra.setdefault(key, []).extend(
+                (label, file if label == "from-stored" else str(out / file))
+                for label, file in starts)
+    if not extra:
+        return None
+    return {**payloads[i], "force": False, "extra_starts": extra,
+            "mesh_check": bool(mesh_check)}
+
+
+def _settling_needs(models: Sequence[dict]) -> dict[int, set[int]]:
+    """The models whose first pass each model's settling pass needs: its own and its
+    neighbouring categories' (:func:`category_neighbours`)."""
+    near = category_neighbours(models)
+    return {i: {i, *near.get(i, [])} for i in range(len(models))}
 
 
 def _held(out: Path) -> list[str]:
@@ -500,29 +505,66 @@ def collocation_sweep(
     rows: dict[int, list[dict]] = {}
     failures: dict[int, list[str]] = {}
 
-    def run(tasks: dict[int, dict]) -> None:
-        keys = list(tasks)
-        for n, status, value in make_executor(executor, jobs).run(
-                sweep_model_task, [tasks[k] for k in keys]):
-            i = keys[n]
-            failures.pop(i, None)
-            if status == "ok":
-                rows[i] = value["rows"]
-                if value["failures"]:
-                    failures[i] = value["failures"]
-            else:
-                failures[i] = [f"stopped by an error: {value}"]
-            write_table(table, [r for k in sorted(rows) for r in rows[k]])
+    # One pool for both passes: the first passes in the order given, then each model's
+    # settling (or, with no neighbour, its mesh check) as soon as the first passes it needs
+    # are done, the first passes before them, so that no worker waits for a whole pass.
+    needs = _settling_needs(models)
+    first_queue = list(range(len(payloads)))
+    ready: list[int] = []
+    first_done: set[int] = set()
+    second_seen: set[int] = set()
+    handed: list[dict] = []
+    what: list[tuple[str, int]] = []
+    busy = 0
+    n_jobs = 1 if executor == "serial" else jobs
 
-    # with settle every model is solved again (and mesh-checked there, after it), unless it
-    # has no neighbour at all; such a model is mesh-checked after the settling pass too
-    run({i: {**p, "mesh_check": p["mesh_check"] and not settle}
-         for i, p in enumerate(payloads)})
-    if settle:
-        settling = _settling_payloads(payloads, rows, out.resolve(), bool(mesh_check))
-        unsettled = {i: {**payloads[i], "force": False} for i in range(len(payloads))
-                     if i not in settling and i in rows and mesh_check}
-        run({**settling, **unsettled})
+    def hand_out() -> None:
+        nonlocal busy
+        while busy < n_jobs and (first_queue or ready):
+            if first_queue:
+                i = first_queue.pop(0)
+                handed.append({**payloads[i], "mesh_check": payloads[i]["mesh_check"]
+                               and not settle})
+                what.append(("first", i))
+            else:
+                i = ready.pop(0)
+                handed.append(second[i])
+                what.append(("second", i))
+            busy += 1
+
+    def second_ready() -> None:
+        for i in range(len(payloads)):
+            if i in second_seen or not needs[i] <= first_done:
+                continue
+            second_seen.add(i)
+            task = _settling_payload(i, payloads, first_rows, out.resolve(), bool(mesh_check))
+            if task is None and i in rows and mesh_check:  # no neighbour: checked alone
+                task = {**payloads[i], "force": False}
+            if task is not None:
+                second[i] = task
+                ready.append(i)
+
+    second: dict[int, dict] = {}
+    first_rows: dict[int, list[dict]] = {}  # the settling starts come from the first pass
+    hand_out()
+    for n, status, value in make_executor(executor, jobs).run(sweep_model_task, handed):
+        busy -= 1
+        phase, i = what[n]
+        failures.pop(i, None)
+        if status == "ok":
+            rows[i] = value["rows"]
+            if value["failures"]:
+                failures[i] = value["failures"]
+        else:
+            failures[i] = [f"stopped by an error: {value}"]
+        write_table(table, [r for k in sorted(rows) for r in rows[k]])
+        if phase == "first":
+            first_done.add(i)
+            if i in rows:
+                first_rows[i] = rows[i]
+            if settle:
+                second_ready()
+        hand_out()
     all_rows = [r for k in sorted(rows) for r in rows[k]]
     if not rows:
         write_table(table, [])
