@@ -38,6 +38,7 @@ def test_payloads_appended_while_results_are_read_are_run(executor):
     payloads = [{"x": 0}, {"x": 10}]
     seen = {}
     for i, status, value in executor.run(_square_or_fail, payloads):
+        assert status == "ok"
         seen[i] = value["y"]
         x = payloads[i]["x"]
         if x < 4:

@@ -540,9 +540,10 @@ def register(app: typer.Typer) -> None:
         settle: bool = typer.Option(
             False, "--settle", rich_help_panel=COLLOCATION,
             help="After every model, solve each amputee problem again from the kept strides "
-                 "of the neighbouring categories (by stiffness) at the same speed, and each "
-                 "of the able runner's speeds from its own next faster stride; keep the "
-                 "lowest (files speed-<v>.from-<category>.json, speed-<v>.from-max-speed.json; "
+                 "of the two nearest categories (by stiffness) at the same problem, and each "
+                 "of the able runner's problems from two of its own other strides (else its "
+                 "shipped stride); keep the lowest (files speed-<v>.from-<category>.json, "
+                 "speed-<v>.from-max-speed.json, speed-<v>.from-stored.json; "
                  "the spread in the table): starts that converge on the human body, where "
                  "the template's does not."),
     ) -> None:
@@ -562,8 +563,8 @@ def register(app: typer.Typer) -> None:
         and the maximum speed; DIR/<model>/speed-<v>.json, max-speed.json and the table
         DIR/collocation-sweep.csv. A used --out needs --resume or --force; exit status 2 when a
         model failed (after the others). --starts K solves each problem from up to K starts
-        and keeps the best; --settle adds the neighbouring categories' strides as starts
-        (the able runner's: its next faster speed's); --mesh-check adds the settling evidence
+        and keeps the best; --settle adds the two nearest categories' strides as starts
+        (the able runner's: its own other strides'); --mesh-check adds the settling evidence
         of every solve.
 
         An option of another method (or of the grid with --recipe) is refused."""
