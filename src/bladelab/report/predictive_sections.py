@@ -276,7 +276,7 @@ def blade_energy_table(results: dict[str, RunnerResult]) -> pd.DataFrame:
 SUMMARY_LABELS = {
     "category": "category",
     "max_speed": "maximum speed (m/s)",
-    "max_speed_floor": "maximum speed against its floor",
+    "max_speed_floor": "maximum speed against its floor (on it / above it, floor m/s)",
     "cot_4": "metabolic cost at 4 m/s (J/(kg·m))",
     "t200": "200 m time (s)",
     "t400": "400 m time (s)",
