@@ -21,7 +21,17 @@ from pathlib import Path
 
 HERE = Path(__file__).resolve().parent / "collocation"
 #: (folder, what differs) of each timed study.
-STUDIES = (("study-human-timed-2026-12-05", "the human body as shipped since 2026-12-03 (the "
+STUDIES = (("study-human-three-starts-2026-12-06", "the human body as shipped, three starts for "
+            "every problem (the first pass from the shipped strides, then the settling pass: "
+            "each amputee problem from the two nearest categories' strides, the able runner "
+            "from its own other strides or its shipped one), the predictive stages' L-BFGS "
+            "update inside IPOPT's augmented system (the library's since 2026-12-06); the "
+            "rows are the kept starts', the wall time both passes'"),
+           ("study-human-three-starts-2026-12-05", "the same three starts per problem, the "
+            "L-BFGS update by IPOPT's default (Sherman-Morrison) route; the same study on "
+            "2026-12-06, bit-identical iterations and answers, took 13.6 min on the same host "
+            "(1,505 s of solver time against 1,206 s: the host's own spread)"),
+           ("study-human-timed-2026-12-05", "the human body as shipped since 2026-12-03 (the "
             "toes' damper, people's swing knee held), at people's stride time, people's joint "
             "angles at weight 10 1/rad², one start per problem from the shipped strides, then "
             "the settling pass (`--settle`); the rows are the kept starts', the wall time both "
@@ -76,7 +86,7 @@ def run() -> str:
 
 def _study(study: Path, what: str) -> str:
     table = study / "collocation-sweep.csv"
-    title = f"### {what.capitalize()}"
+    title = f"### {what[:1].upper()}{what[1:]}"
     if not table.is_file():
         return f"{title}\n\nNo study in {study.name}: run it first (docstring)."
     import pandas as pd

@@ -30,7 +30,7 @@ from bladelab.predict.collocation.solution import (
     CollocationSolution,
 )
 from bladelab.predict.collocation.solve import SolveProgress, predict_stride
-from bladelab.predict.collocation.transcription import StrideWeights
+from bladelab.predict.collocation.transcription import PREDICTIVE_LBFGS_OPTIONS, StrideWeights
 from bladelab.runner.params import RUNNER_DATA_DIR
 from collocation_fake import SPEED, fake_solution
 
@@ -636,7 +636,8 @@ def test_a_predictive_stage_stalled_near_a_feasible_point_is_polished(able, monk
         CollocationSettings(polish_iter=-1)
 
 
-def test_warm_start_mu_sets_the_barrier_of_a_warm_start_only(able, monkeypatch):
+def test_warm_start_mu_sets_the_barrier_of_a_warm_start_only_and_the_lbfgs_update_the_stage(
+        able, monkeypatch):
     from bladelab.predict.collocation.transcription import StrideNLP
 
     runner, _, sol = able
@@ -652,11 +653,15 @@ def test_warm_start_mu_sets_the_barrier_of_a_warm_start_only(able, monkeypatch):
                                    warm_start_mu=1e-4)
     predict_stride(runner, settings, sol.to_guess(), model_spec={"model": "able"})
     assert seen[-1]["ipopt.mu_init"] == 1e-4 and seen[-1]["ipopt.bound_push"] == 1e-8
+    # the predictive stage's L-BFGS update inside the augmented system
+    assert seen[-1]["ipopt.limited_memory_aug_solver"] == "extended"
     # tracking, then the predictive stage: IPOPT's defaults in both
     seen.clear()
     predict_stride(runner, dataclasses.replace(settings, max_iter=200),
                    template_guess(runner, speed=SPEED, n=6), model_spec={"model": "able"})
     assert seen and all("ipopt.mu_init" not in o for o in seen)
+    # the tracking stage keeps IPOPT's default L-BFGS update
+    assert "ipopt.limited_memory_aug_solver" not in seen[0]
     seen.clear()
     predict_stride(runner, dataclasses.replace(settings, warm_start_mu=None), sol.to_guess(),
                    model_spec={"model": "able"})
@@ -695,7 +700,7 @@ def test_a_guess_with_fitting_multipliers_starts_from_its_duals(able, monkeypatc
     predict_stride(runner, dataclasses.replace(settings, warm_start_mu=1e-5), guess,
                    model_spec={"model": "able"})
     _, _, lam, options, _ = seen[-1]
-    assert lam is not None and options == {"ipopt.mu_init": 1e-5}
+    assert lam is not None and options == {**PREDICTIVE_LBFGS_OPTIONS, "ipopt.mu_init": 1e-5}
     assert nlp.multipliers is not None and nlp.multipliers[0].shape == (n_vars,)
     wrong = replace(sol.to_guess(), multipliers=(np.zeros(n_vars + 1), np.zeros(n_cons)))
     predict_stride(runner, settings, wrong, model_spec={"model": "able"})

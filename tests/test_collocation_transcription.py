@@ -429,6 +429,11 @@ def test_an_lbfgs_solve_stops_where_its_objective_stalls_near_the_full_solution(
     assert stopped.max_violation < 1e-4
     assert stopped.iterations <= full.iterations
     assert stopped.objective == pytest.approx(full.objective, rel=1e-3)
+    # the predictive stages' L-BFGS update inside the augmented system: the same optimum
+    extended = nlp.solve(nlp.initial_vector(guess), speed=2.2, multipliers=lam,
+                         options=transcription.PREDICTIVE_LBFGS_OPTIONS)
+    assert extended.success and extended.max_violation < 1e-4
+    assert extended.objective == pytest.approx(full.objective, rel=1e-3)
     exact = nlp.solve(nlp.initial_vector(guess), speed=2.2, multipliers=lam, hessian="exact")
     assert exact.success
     exact_keys = [dict(key) for key in nlp._solvers

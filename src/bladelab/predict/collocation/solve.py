@@ -76,7 +76,11 @@ from bladelab.predict.collocation.stored import check_model_spec, describe_probl
 from bladelab.predict.collocation.stride_guess import COLLOCATION_SOURCE
 from bladelab.predict.collocation.swing_knee import biological_knees
 from bladelab.predict.collocation.symmetry import mirror_permutation
-from bladelab.predict.collocation.transcription import StrideNLP, StrideWeights
+from bladelab.predict.collocation.transcription import (
+    PREDICTIVE_LBFGS_OPTIONS,
+    StrideNLP,
+    StrideWeights,
+)
 
 __all__ = [
     "BEST_ITERATE_FILE",
@@ -191,6 +195,8 @@ def _solve_stage(nlp, x0: np.ndarray, settings: CollocationSettings, stage: str,
                    else {"ipopt.mu_init": settings.warm_start_mu})
     else:
         options = warm_start_options(settings) if warm else {}
+    if settings.hessian == "limited-memory" and stage != "tracking":
+        options = {**PREDICTIVE_LBFGS_OPTIONS, **options}
     report = None
     if progress is not None:
         progress(SolveProgress(stage, "start", message=f"{nlp.n_vars} variables, "

@@ -187,6 +187,21 @@ STALL_STOP_OPTIONS = {
     "ipopt.acceptable_compl_inf_tol": 1e-3,
 }
 
+#: IPOPT's L-BFGS Hessian of a predictive stage (:func:`~bladelab.predict.collocation.solve.
+#: predict_stride` adds these options to every L-BFGS stage but the tracking stage): the
+#: low-rank update held in the augmented system itself (``extended``: 2m more rows, one
+#: factorisation and one back solve per step) instead of IPOPT's default Sherman-Morrison
+#: route, whose 2m extra back solves per iteration were most of a solve's time; history m = 4.
+#: Measured (benchmarks/collocation_speed/README.md, "The low-rank update inside the augmented
+#: system"): three warm starts of the amputee Cat6 stride 58-61 against 88 ms per iteration,
+#: 33 s against 57 s in all, objectives within 0.1 %; the category study with three starts
+#: 932 against 1,505 s of solver time. The tracking stage keeps IPOPT's default: with these
+#: options the template's tracking stage did not converge in 3,000 iterations.
+PREDICTIVE_LBFGS_OPTIONS = {
+    "ipopt.limited_memory_aug_solver": "extended",
+    "ipopt.limited_memory_max_history": 4,
+}
+
 #: IPOPT options of a solve started from a solution's primal and dual values (its
 #: multipliers): the barrier starts small and the point stays where it is, so that a solve
 #: at the start's own speed ends at once and a continuation step stays on the start's branch
