@@ -406,3 +406,14 @@ def test_report_of_the_amputee_reflex_start(shipped_amputee_report):
     header, coords = read_mot(folder / "coordinates.mot")
     assert header["inDegrees"] == "yes" and coords.time.iloc[-1] == pytest.approx(3.0)
     assert "export/amputee-cat6-3.5-m-s/grf.mot" in html
+
+
+def test_mean_and_sd_cells_show_the_sd_to_the_mean_s_decimal_place():
+    """The repeated stances of one periodic stride differ by round-off: their SD reads 0 at
+    the mean's precision, not 1.8e-15; a real SD keeps its digits there."""
+    assert pr._pm(9.5213, 1.8e-15) == "9.52 ± 0.00"
+    assert pr._pm(9.5213, 0.234) == "9.52 ± 0.23"
+    assert pr._pm(0.17634, 2e-17) == "0.176 ± 0.000"
+    assert pr._pm(123.4, 5.67) == "123 ± 6"
+    assert pr._pm(2.4, float("nan")) == "2.4"
+    assert pr._pm(float("nan"), 1.0) == "–"
