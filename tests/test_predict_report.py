@@ -415,5 +415,7 @@ def test_mean_and_sd_cells_show_the_sd_to_the_mean_s_decimal_place():
     assert pr._pm(9.5213, 0.234) == "9.52 ± 0.23"
     assert pr._pm(0.17634, 2e-17) == "0.176 ± 0.000"
     assert pr._pm(123.4, 5.67) == "123 ± 6"
-    assert pr._pm(2.4, float("nan")) == "2.4"
+    assert pr._pm(0.26, 1e-17) == "0.260 ± 0.000"
+    assert pr._pm(1234.5, 12.0) == "1234 ± 12"
+    assert pr._pm(2.4, float("nan")) == "2.40"
     assert pr._pm(float("nan"), 1.0) == "–"

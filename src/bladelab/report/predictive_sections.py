@@ -146,17 +146,15 @@ _ENERGY_LABELS = {"E_stored": "E stored (J)", "E_generated": "E generated (J)",
 
 
 def _pm(mean: float, sd: float, digits: int = 3) -> str:
-    """``"mean ± SD"``, the mean to ``digits`` significant digits and the SD to the same
-    decimal place (an SD below it, e.g. the round-off among the repeated stances of one
-    periodic stride, reads 0 there, not 1.8e-15)."""
+    """``"mean ± SD"``, the mean to ``digits`` significant digits (trailing zeros kept) and
+    the SD to the same decimal place (an SD below it, e.g. the round-off among the repeated
+    stances of one periodic stride, reads 0 there, not 1.8e-15)."""
     if not math.isfinite(mean):
         return "–"
-    text = f"{mean:.{digits}g}"
-    if not math.isfinite(sd):
-        return text
     magnitude = math.floor(math.log10(abs(mean))) if mean != 0 else 0
     decimals = max(0, digits - 1 - magnitude)
-    return f"{text} ± {sd:.{decimals}f}"
+    text = f"{mean:.{decimals}f}"
+    return f"{text} ± {sd:.{decimals}f}" if math.isfinite(sd) else text
 
 
 def _long(frames: list[pd.DataFrame]) -> pd.DataFrame:
