@@ -91,7 +91,10 @@ def run() -> str:
         "",
         f"The human body with people's joint angles in the objective (the default weight) "
         f"and people's swing knee (at least {defaults.SWING_KNEE_MIN_DEG:g}°), "
-        f"mesh {MESH} intervals, one core (`OMP_NUM_THREADS=1`), L-BFGS, tol 1e-4. Targets: the amputee from the default guess ≤ 60 s, warm-started at 4.2 m/s "
+        f"mesh {MESH} intervals, one core (`OMP_NUM_THREADS=1`), L-BFGS (the predictive "
+        "stages' update inside IPOPT's augmented system, the tracking stage's by IPOPT's "
+        "default), tol 1e-4. Targets: the amputee from the default guess ≤ 60 s, "
+        "warm-started at 4.2 m/s "
         "≤ 10 s, the able runner from the template ≤ 60 s. A warm start from a solution "
         "restores its controls and multipliers (IPOPT's primal-dual warm start, its own "
         "solver options, so its solver is built once); the primal-only row drops the "
