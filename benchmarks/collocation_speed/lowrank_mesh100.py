@@ -5,7 +5,7 @@ values (the library's route) and writes the solution with its multipliers to OUT
 ``solve ROUTE SPEED FILE`` solves FILE's problem at SPEED [m/s] from FILE (from its primal
 and dual values where FILE carries them), ROUTE ``sm`` (IPOPT's default L-BFGS update,
 Sherman-Morrison) or ``ext`` (the library's ``PREDICTIVE_LBFGS_OPTIONS``). One JSON line per
-solve printed and appended to ``lowrank_records.jsonl``.
+solve printed and appended to ``lowrank_records.jsonl`` (``lowrank_update.record``).
 
     F=benchmarks/collocation/study-human-swing-knee-2026-12-03/speed-4/Cat6-best.json
     OMP_NUM_THREADS=1 .venv/bin/python benchmarks/collocation_speed/lowrank_mesh100.py \\
@@ -17,27 +17,26 @@ solve printed and appended to ``lowrank_records.jsonl``.
 from __future__ import annotations
 
 import dataclasses
-import json
 import sys
 import time
 from pathlib import Path
 
-from bladelab.predict.collocation import solve as solve_module
-from bladelab.predict.collocation.solution import CollocationSolution
-from bladelab.predict.collocation.stored import runner_from_spec
+from lowrank_update import per_stage, record
 
-RECORDS = Path(__file__).with_name("lowrank_records.jsonl")
+from bladelab.predict.collocation.solution import CollocationSolution
+from bladelab.predict.collocation.solve import predict_stride
+from bladelab.predict.collocation.stored import runner_from_spec
 
 
 def solve(route: str, speed: float | None, path: str) -> CollocationSolution:
     if route == "sm":
-        solve_module.PREDICTIVE_LBFGS_OPTIONS.clear()
+        per_stage({"predictive": {}})
     stored = CollocationSolution.read(path)
     settings = stored.settings if speed is None else dataclasses.replace(
         stored.settings, speed_m_per_s=speed)
     t0 = time.perf_counter()
-    sol = solve_module.predict_stride(runner_from_spec(stored.model_spec), settings,
-                                      stored.to_guess(), model_spec=stored.model_spec)
+    sol = predict_stride(runner_from_spec(stored.model_spec), settings, stored.to_guess(),
+                         model_spec=stored.model_spec)
     row = {"case": "mesh 100", "file": Path(path).name, "route": route,
            "start": "primal" if stored.nlp.multipliers is None else "primal-dual",
            "speed_mps": settings.speed_m_per_s, "mesh": settings.mesh_intervals,
@@ -45,9 +44,7 @@ def solve(route: str, speed: float | None, path: str) -> CollocationSolution:
            "wall_s": round(time.perf_counter() - t0, 1),
            "ipopt_own_s": round(sol.nlp.timings.get("ipopt_own_s", 0.0), 1),
            "objective": sol.nlp.objective, "start_objective": stored.nlp.objective}
-    print(json.dumps(row), flush=True)
-    with RECORDS.open("a", encoding="utf-8") as f:
-        f.write(json.dumps(row) + "\n")
+    record(row)
     return sol
 
 

@@ -23,36 +23,35 @@ import time
 from pathlib import Path
 
 from bladelab.predict.collocation import solve as solve_module
-from bladelab.predict.collocation import transcription
 from bladelab.predict.collocation.guess import template_guess
 from bladelab.predict.collocation.settings import CollocationSettings, people_settings
 from bladelab.predict.collocation.starting_guess import make_guess
+from bladelab.predict.collocation.transcription import PREDICTIVE_LBFGS_OPTIONS, StrideNLP
 from bladelab.runner import build_runner
 
 RECORDS = Path(__file__).with_name("lowrank_records.jsonl")
 
 
-def _per_stage(options: dict[str, dict]) -> None:
-    """Make every stage named in ``options`` solve with those L-BFGS options instead."""
-    original = solve_module._solve_stage
+def per_stage(options_by_stage: dict[str, dict]) -> None:
+    """Make every L-BFGS stage named in ``options_by_stage`` (``"tracking"``: a tracking NLP,
+    ``"predictive"``: any other) solve with those options (IPOPT's, without the ``ipopt.``
+    prefix) in place of the library's ``PREDICTIVE_LBFGS_OPTIONS``; a stage not named keeps
+    the library's."""
+    solve = StrideNLP.solve
 
-    def stage(nlp, x0, settings, name, progress, **kw):
-        if name not in options:  # the library's own
-            return original(nlp, x0, settings, name, progress, **kw)
-        chosen = {f"ipopt.{k}": v for k, v in options.get(name, {}).items()}
-        saved = dict(transcription.PREDICTIVE_LBFGS_OPTIONS)
-        solve_module.PREDICTIVE_LBFGS_OPTIONS.clear()
-        solve_module.PREDICTIVE_LBFGS_OPTIONS.update(chosen)
-        try:
-            return original(nlp, x0, settings, name, progress, **kw)
-        finally:
-            solve_module.PREDICTIVE_LBFGS_OPTIONS.clear()
-            solve_module.PREDICTIVE_LBFGS_OPTIONS.update(saved)
+    def staged(self, x0, *args, options=None, hessian="limited-memory", **kw):
+        name = "predictive" if self.tracking is None else "tracking"
+        if hessian == "limited-memory" and name in options_by_stage:
+            options = {k: v for k, v in (options or {}).items()
+                       if k not in PREDICTIVE_LBFGS_OPTIONS}
+            options.update({f"ipopt.{k}": v for k, v in options_by_stage[name].items()})
+        return solve(self, x0, *args, options=options, hessian=hessian, **kw)
 
-    solve_module._solve_stage = stage
+    StrideNLP.solve = staged
 
 
-def _record(row: dict) -> None:
+def record(row: dict) -> None:
+    """Print ``row`` as one JSON line and append it to :data:`RECORDS`."""
     line = json.dumps(row)
     print(line, flush=True)
     with RECORDS.open("a", encoding="utf-8") as f:
@@ -60,7 +59,7 @@ def _record(row: dict) -> None:
 
 
 def warm(options: dict) -> None:
-    _per_stage({"predictive": options})
+    per_stage({"predictive": options})
     spec = {"model": "amputee", "blade": "Cat6", "body": "human"}
     runner = build_runner("amputee", blade="Cat6", body="human")
     settings = CollocationSettings(mesh_intervals=50, speed_m_per_s=4.0,
@@ -73,7 +72,7 @@ def warm(options: dict) -> None:
         sol = solve_module.predict_stride(
             runner, dataclasses.replace(settings, speed_m_per_s=speed), stored.to_guess(),
             model_spec=spec)
-        _record({"case": "warm", "options": options, "speed_mps": speed,
+        record({"case": "warm", "options": options, "speed_mps": speed,
                  "converged": sol.converged, "iterations": sol.nlp.iterations,
                  "wall_s": round(time.perf_counter() - t0, 2),
                  "ipopt_own_s": round(sol.nlp.timings.get("ipopt_own_s", 0.0), 2),
@@ -81,7 +80,7 @@ def warm(options: dict) -> None:
 
 
 def template(tracking: dict, predictive: dict) -> None:
-    _per_stage({"tracking": tracking, "predictive": predictive})
+    per_stage({"tracking": tracking, "predictive": predictive})
     runner = build_runner("able", body="human")
     t0 = time.perf_counter()
     sol = solve_module.predict_stride(
@@ -89,7 +88,7 @@ def template(tracking: dict, predictive: dict) -> None:
                                     **people_settings("human")),
         template_guess(runner, speed=3.5, n=50), model_spec={"model": "able", "body": "human"})
     trk = sol.tracking or {}
-    _record({"case": "template", "tracking_options": tracking, "options": predictive,
+    record({"case": "template", "tracking_options": tracking, "options": predictive,
              "converged": sol.converged, "tracking_iterations": trk.get("iterations"),
              "tracking_s": trk.get("wall_s"), "iterations": sol.nlp.iterations,
              "predictive_s": round(sol.nlp.wall_s, 1),

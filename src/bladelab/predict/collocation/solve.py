@@ -187,7 +187,8 @@ def _solve_stage(nlp, x0: np.ndarray, settings: CollocationSettings, stage: str,
     """Solve one NLP with the settings' IPOPT options (:func:`warm_start_options` when
     ``warm``; with ``multipliers``, the primal-dual warm start of
     :meth:`~bladelab.predict.collocation.transcription.StrideNLP.solve`, its barrier start
-    :attr:`CollocationSettings.warm_start_mu` where set), reporting progress; an interrupt
+    :attr:`CollocationSettings.warm_start_mu` where set; with L-BFGS, every stage but the
+    tracking stage with ``PREDICTIVE_LBFGS_OPTIONS``), reporting progress; an interrupt
     (Ctrl-C, SIGTERM) raises KeyboardInterrupt after IPOPT returns."""
     t0 = time.perf_counter()
     if multipliers is not None:
