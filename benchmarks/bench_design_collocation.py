@@ -20,7 +20,7 @@ beside it (``bladelab design`` run as in docs/design.md). Run the study again to
         --out benchmarks/design/transtibial-collocation-4mps-people-stride
     bladelab design --evaluator collocation --amputation transtibial --max-speed \
         --start-strides benchmarks/design/transtibial-collocation-4mps/strides \
-        --runs ccd --jobs 2 --settle 3 --skip-failed \
+        --runs ccd --jobs 2 --settle 6 --skip-failed \
         --objective max_speed_m_per_s --sense max \
         --out benchmarks/design/transtibial-collocation-max-speed
     bladelab design --evaluator collocation --amputation transtibial --max-speed \
