@@ -11,7 +11,9 @@ or ``[peak_deg]`` (a sin² rise over the second half of each stance to ``peak_de
 toe-off, then the hinge's own lag in swing), each set on the library's template after its
 pelvis is placed on the lowest contact (the toe tip may then be a few millimetres in the
 ground). ``damping`` [N·m·s/rad]: the toes' damper (default the human body's); ``blade``:
-the amputee wearing that category at 4 m/s instead of the able runner at 3.5 m/s.
+the amputee wearing that category at 4 m/s instead of the able runner at 3.5 m/s;
+``swing_knee``: true to solve the library's default problem of today (people's angles and
+people's swing knee, ``people_settings``, as ``make bench``) instead of people's angles alone.
 Solves on 50 intervals from the template, tracking then predictive stage, as
 ``bench_collocation.py``'s template row, and appends one line to RECORDS.jsonl: iterations
 per stage, objective, cost of transport [J/(kg·m)], stride time [s], gait warnings, wall
@@ -31,7 +33,11 @@ import numpy as np
 
 from bladelab.predict import defaults
 from bladelab.predict.collocation.guess import template_guess
-from bladelab.predict.collocation.settings import CollocationSettings, people_term
+from bladelab.predict.collocation.settings import (
+    CollocationSettings,
+    people_settings,
+    people_term,
+)
 from bladelab.predict.collocation.solve import predict_stride
 from bladelab.predict.collocation.stride_guess import periodic_derivative
 from bladelab.runner import build_runner
@@ -144,8 +150,9 @@ def main() -> None:
     blade = variant.get("blade")
     runner = _runner(variant.get("damping"), blade)
     speed = 4.0 if blade else 3.5
-    settings = CollocationSettings(mesh_intervals=MESH, speed_m_per_s=speed,
-                                   **people_term(defaults.people_weight_for("human")))
+    people = (people_settings("human", kind=runner.kind) if variant.get("swing_knee")
+              else people_term(defaults.people_weight_for("human")))
+    settings = CollocationSettings(mesh_intervals=MESH, speed_m_per_s=speed, **people)
     guess = _toes(runner, template_guess(runner, speed=speed, n=MESH),
                   variant.get("toes", "hinge"))
     t0 = time.perf_counter()
