@@ -50,11 +50,11 @@ def per_stage(options_by_stage: dict[str, dict]) -> None:
     StrideNLP.solve = staged
 
 
-def record(row: dict) -> None:
-    """Print ``row`` as one JSON line and append it to :data:`RECORDS`."""
+def record(row: dict, records: Path = RECORDS) -> None:
+    """Print ``row`` as one JSON line and append it to ``records`` (:data:`RECORDS`)."""
     line = json.dumps(row)
     print(line, flush=True)
-    with RECORDS.open("a", encoding="utf-8") as f:
+    with records.open("a", encoding="utf-8") as f:
         f.write(line + "\n")
 
 

@@ -12,8 +12,8 @@ constraint Hessian is built, and the matrix is nearly positive semi-definite). V
 - ``objective-monotone``: the same with the monotone barrier.
 
 The able runner at 3.5 m/s from the template (mesh 50, people's angles, as ``make bench``'s
-template row), the predictive stage after it with the library's options. One JSON line per run is printed and appended to
-``objective_hessian_records.jsonl``.
+template row), the predictive stage after it with the library's options. One JSON line per
+run is printed and appended to ``objective_hessian_records.jsonl`` (``lowrank_update.record``).
 
     OMP_NUM_THREADS=1 .venv/bin/python benchmarks/collocation_speed/objective_hessian.py objective
 """
@@ -21,11 +21,11 @@ template row), the predictive stage after it with the library's options. One JSO
 from __future__ import annotations
 
 import argparse
-import json
 import time
 from pathlib import Path
 
 import casadi as ca
+from lowrank_update import record
 
 from bladelab.predict.collocation import solve as solve_module
 from bladelab.predict.collocation.guess import template_guess
@@ -97,10 +97,7 @@ def main() -> None:
            "warnings": sol.gait_warnings() if sol.converged else None}
     row = {"case": "template able 3.5", "variant": args.variant, **info, **row,
            "wall_s": round(time.perf_counter() - t0, 1)}
-    line = json.dumps(row)
-    print(line, flush=True)
-    with RECORDS.open("a", encoding="utf-8") as f:
-        f.write(line + "\n")
+    record(row, RECORDS)
 
 
 if __name__ == "__main__":
