@@ -72,6 +72,40 @@ def test_template_runs_forwards_on_its_stance_feet(kind):
             > g.q[:-1, model.dof("pelvis_tz")][~flight].max())
 
 
+def test_the_able_template_moves_its_toes_as_their_hinge_would():
+    """On a body with toe hinges the able runner's template extends the toes through each
+    stance (the toe tip rising towards the ball's height as the heel rises) and lets them fall
+    back in swing at the hinge's own time constant D/K; the stance foot stays on or just above
+    the ground (the pelvis is not moved for the toes)."""
+    model = build_runner("able", body="human")
+    n, speed = 50, 3.5
+    g = template_guess(model, speed=speed, n=n)
+    _check_periodic(model, g, speed)
+    hinge = model.params.toe_hinge
+    decay = np.exp(-g.period / n * hinge.stiffness_Nm_per_rad / hinge.damping_Nms_per_rad)
+    heights = _leg_heights(model, g)
+    f = g.vertical_grf_bw[:-1]
+    phase = np.arange(n) / n
+    for leg, start, side in ((0, 0.0, "l"), (1, 0.5, "r")):
+        toes = g.q[:-1, model.dof(f"mtp_angle_{side}")]
+        stance = (np.mod(phase - start, 1.0) < 0.3) & (f > 0)
+        assert toes.min() >= 0.0  # never flexed
+        peak = int(np.argmax(toes))
+        assert np.radians(5.0) < toes[peak] < np.radians(30.0)
+        assert stance[(peak - 1) % n] or stance[peak]  # the peak at toe-off
+        swing = [(peak + i) % n for i in range(1, 20)]
+        ratio = toes[swing[1:]] / toes[swing[:-1]]
+        np.testing.assert_allclose(ratio, decay, rtol=1e-9)  # the hinge's own lag in swing
+        assert heights[:-1][stance, leg].min() > -1e-9
+        assert heights[:-1][stance, leg].max() < 0.012
+    neutral = template_guess(model, speed=speed, n=n, toes="neutral")
+    assert not neutral.q[:, model.dof("mtp_angle_l")].any()
+    amputee = build_runner("amputee", body="human")  # its intact foot's toes stay at neutral
+    assert not template_guess(amputee, speed=4.0, n=n).q[:, amputee.dof("mtp_angle_l")].any()
+    with pytest.raises(SpecError, match="toes"):
+        template_guess(model, toes="flat")
+
+
 def test_template_is_people_running(able):
     g = template_guess(able, speed=4.0, n=40)
     assert g.q.shape == (41, 10) and 0.6 < g.period < 0.8

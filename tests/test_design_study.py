@@ -293,3 +293,31 @@ def test_a_study_resumes_only_with_the_evaluator_that_made_its_runs(tmp_path):
     again = run_design(SPACE, evaluator=_Described(speed_mps=4.0, body="seed001"),
                        out_dir=tmp_path, progress=False)
     assert again.n_resumed == again.design.n_runs
+
+
+def test_the_report_names_the_best_run_and_cautions_an_unpredictive_optimum(tmp_path):
+    """Beside the surface's optimum the report gives the best run measured, and where the
+    surface predicts its response poorly (R²pred below 0.5) it says the optimum is the fit's."""
+    from bladelab.report.design import design_report_sections
+
+    rng = np.random.default_rng(7)
+    noise = {}
+
+    def noisy(point):
+        key = tuple(point[n] for n in SPACE.names)
+        noise.setdefault(key, float(rng.normal(0.0, 0.05)))
+        return {**_evaluator(point), "noisy_m_per_s": 0.2 + noise[key]}
+
+    for objective, cautioned in (("delta_vx_m_per_s", False), ("noisy_m_per_s", True)):
+        out = tmp_path / objective
+        res = run_design(SPACE, evaluator=noisy, out_dir=out, objective=objective,
+                         units={objective: "m/s"}, progress=False)
+        assert (res.surfaces[objective].r2_pred < 0.5) == cautioned
+        table = pd.read_csv(out / "results.csv")
+        best = table.loc[table[objective].idxmax()]
+        text = {s["title"]: s for s in design_report_sections(out)}[
+            "Design study: optimum"]["text"]
+        assert text.startswith(f"Maximising {objective}: the surface predicts")
+        assert f"The best run measured: run {int(best['run'])}, {best[objective]:.4g}." in text
+        assert "  " not in text  # no unit known to the report: none printed
+        assert ("Caution: the surface predicts" in text) == cautioned

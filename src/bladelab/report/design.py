@@ -244,9 +244,7 @@ def design_report_sections(design_dir: str | Path) -> list[dict[str, Any]]:
         rows = [{"factor": k, "value": optimum.point[k], "unit": space.factor(k).unit,
                  "coded": optimum.coded[k]} for k in space.names]
         cons_rows = [{"constraint": k, **v} for k, v in optimum.constraints.items()]
-        text = (f"{optimum.sense} {objective}: predicted {optimum.predicted:.4g} "
-                f"{optimum.unit}, 95 % prediction interval {optimum.pi[0]:.4g} to "
-                f"{optimum.pi[1]:.4g}.")
+        text = _optimum_text(optimum, objective, surfaces[objective], table, checks)
         tabs = [("Optimum design", pd.DataFrame(rows))]
         if cons_rows:
             tabs.append(("Constraints at the optimum", pd.DataFrame(cons_rows)))
@@ -256,6 +254,42 @@ def design_report_sections(design_dir: str | Path) -> list[dict[str, Any]]:
     if confirmed is not None:
         sections.append(confirmed)
     return sections
+
+
+#: Below this predicted R² the report says that the optimum is the fit's, not the runs'.
+_PREDICTIVE_R2 = 0.5
+
+
+def _optimum_text(optimum, objective: str, surface, table: pd.DataFrame,
+                  checks: pd.DataFrame | None) -> str:
+    """The optimum's sentence: the surface's prediction with its interval, the best run the
+    study measured beside it, and a caution where the surface predicts poorly."""
+    verb = "Maximising" if optimum.sense == "max" else "Minimising"
+    unit = f" {optimum.unit}" if optimum.unit else ""
+    text = (f"{verb} {objective}: the surface predicts {optimum.predicted:.4g}{unit} at the "
+            f"design below, 95 % prediction interval {optimum.pi[0]:.4g} to "
+            f"{optimum.pi[1]:.4g}{unit}.")
+    runs = table if checks is None else table[~checks["excluded"].to_numpy(bool)]
+    if objective in runs and runs[objective].notna().any():
+        best = runs.loc[runs[objective].idxmax() if optimum.sense == "max"
+                        else runs[objective].idxmin()]
+        label = f"run {int(best['run'])}" if "run" in best else "the best run"
+        notes = [n for n, on in (
+            ("the optimum's own design", all(
+                abs(optimum.coded[k] - best.get(f"{k}_coded", np.nan)) < 1e-6
+                for k in optimum.coded)),
+            ("its constraints not checked", bool(optimum.constraints))) if on]
+        text += (f" The best run measured: {label}, {best[objective]:.4g}{unit}"
+                 + (f" ({'; '.join(notes)})" if notes else "") + ".")
+    r2 = surface.r2_pred
+    if not (r2 >= _PREDICTIVE_R2):
+        shown = "unknown" if not np.isfinite(r2) else f"{r2:.2f}"
+        text += (f" Caution: the surface predicts {objective} poorly (R²pred {shown}, "
+                 f"below {_PREDICTIVE_R2:g}; the surface fits table gives its ceiling from "
+                 "the start spread): this optimum is where the fitted quadratic is "
+                 f"{'highest' if optimum.sense == 'max' else 'lowest'}, not a design the runs "
+                 "have shown to be best.")
+    return text
 
 
 def _confirmation_section(design_dir: Path, optimum, units: dict[str, str]) -> dict | None:
@@ -592,7 +626,8 @@ def build_design_report(design_dir: str | Path, out_dir: str | Path | None = Non
     if (design_dir / "evaluator.json").is_file():  # e.g. the knee bound every stride was held to
         meta["evaluator"] = read_json(design_dir / "evaluator.json", what="evaluator settings")
     sections = design_report_sections(design_dir)
-    rep = Report("Blade design study", subtitle=str(design_dir), settings=meta,
+    rep = Report("Blade design study", subtitle=str(design_dir),
+                 settings={k: v for k, v in meta.items() if k != "seed"},  # its own row
                  seed=meta.get("seed"))
     for s in sections:
         rep.add_section(**s)

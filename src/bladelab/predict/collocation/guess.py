@@ -27,6 +27,7 @@ import math
 from dataclasses import replace
 from pathlib import Path
 
+import mujoco
 import numpy as np
 
 from bladelab._io import read_json
@@ -55,6 +56,7 @@ __all__ = [
     "guess_from_reflex",
     "guess_from_result",
     "guess_from_trial",
+    "hinge_toes",
     "measured_trial_guess",
     "template_guess",
     "template_vertical_grf",
@@ -134,7 +136,7 @@ def _angles_to_q(model: RunnerModel, time_frac: np.ndarray, period: float, speed
 
 
 def template_guess(model: RunnerModel, *, speed: float = 3.5, n: int = 50,
-                   period: float | None = None) -> StrideGuess:
+                   period: float | None = None, toes: str | None = None) -> StrideGuess:
     """People's running as a template stride at ``speed`` [m/s] on ``n`` intervals.
 
     The hip, knee and ankle follow people's mean angles at 3.5 m/s
@@ -148,7 +150,19 @@ def template_guess(model: RunnerModel, *, speed: float = 3.5, n: int = 50,
     people's toe-off falls at its end. The force pattern is :func:`template_vertical_grf` of
     that stance. The pelvis keeps the stance foot on the ground and flies a ballistic arc
     between the stances (:func:`_stances_and_flights`).
+
+    ``toes`` (feet with a toe hinge only): ``"hinge"`` moves them as their passive hinge
+    moves them (:func:`hinge_toes`, set after the pelvis is placed), ``"neutral"`` holds them
+    at 0. The default is per runner, as measured on cold starts
+    (benchmarks/collocation_speed/README.md, "The template's tracking stage"): the hinge's
+    toes for the able runner (its tracking stage a quarter as long, to a clean stride where
+    neutral toes end on a stride whose feet strike twice), neutral toes on an amputee's intact
+    foot (the hinge's toes gave flagged or dear strides in three of five categories).
     """
+    if toes is None:
+        toes = "hinge" if model.kind == "able" else "neutral"
+    if toes not in ("hinge", "neutral"):
+        raise SpecError(f"toes must be 'hinge' or 'neutral', got {toes!r}", where="toes")
     if not (speed > 0 and math.isfinite(speed)):
         raise SpecError(f"speed must be > 0 m/s, got {speed}", where="speed")
     stride_lo, stride_hi, _ = reference_band("stride time", speed)
@@ -175,6 +189,8 @@ def template_guess(model: RunnerModel, *, speed: float = 3.5, n: int = 50,
         q[:, model.dof("knee_angle_r")] = -prosthetic_knee_template(frac + 0.5)
     grf = template_vertical_grf(frac, duty=duty)
     q = _stances_and_flights(model, q, period, duty)
+    if toes == "hinge":
+        q = hinge_toes(model, q, period, duty)
     return StrideGuess(f"template at {speed:g} m/s", period, q, periodic_derivative(q, period),
                        vertical_grf_bw=grf)
 
@@ -216,6 +232,76 @@ def _stances_and_flights(model: RunnerModel, q: np.ndarray, period: float,
         q[nodes, iz] = np.maximum(arc, q[nodes, iz] - _lowest_contacts(model, q[nodes]))
     q[n, iz] = q[0, iz]
     return q
+
+
+def hinge_toes(model: RunnerModel, q: np.ndarray, period: float, duty: float) -> np.ndarray:
+    """``q`` (a stride on ``q.shape[0] - 1`` intervals of ``period`` [s], the left leg's stance
+    from 0 to ``duty`` of it, the right leg's half a stride later) with the toes of each foot
+    that has them (``mtp_angle_<side>``) moved as their passive hinge moves them: towards the
+    angle that keeps the toes flat on the ground while the heel rises in stance (the toe tip as
+    low as the ball, never flexed) and towards neutral in swing, through the hinge's
+    first-order lag of time constant D/K (``RunnerParams.toe_hinge``; the toes' inertia is
+    negligible), periodic over the stride. The pelvis is not moved: with the lag the toe tip
+    may sit a few millimetres in the ground late in stance."""
+    hinge = model.params.toe_hinge
+    tau = hinge.damping_Nms_per_rad / max(hinge.stiffness_Nm_per_rad, 1e-9)  # [s]
+    names = list(model.contact_names)
+    n = q.shape[0] - 1
+    frac = np.arange(n + 1) / n
+    q = q.copy()
+    data = mujoco.MjData(model.mj_model)
+    for side, lag in (("l", 0.0), ("r", 0.5)):
+        name = f"mtp_angle_{side}"
+        if name not in model.dof_names or f"toetip_{side}" not in names:
+            continue
+        j, tip, ball = model.dof(name), names.index(f"toetip_{side}"), names.index(f"toe_{side}")
+        flat = np.zeros(n)
+        for k in np.flatnonzero(np.mod(frac[:n] - lag, 1.0) < duty):
+            flat[k] = _flat_toe_angle(model, q[k], j, tip, ball, data)
+        q[:n, j] = _periodic_lag(flat, period / n, tau)
+        q[n, j] = q[0, j]
+    return q
+
+
+def _flat_toe_angle(model: RunnerModel, qk: np.ndarray, j: int, tip: int, ball: int,
+                    data) -> float:
+    """The toe hinge's angle [rad] (coordinate ``j``, 0 to :data:`_TOE_FLAT_MAX_DEG`) that puts
+    the toe tip (contact ``tip``) as low as the ball (contact ``ball``) at pose ``qk``."""
+    qk = qk.copy()
+
+    def tip_below_ball(angle: float) -> bool:
+        qk[j] = angle
+        h = contact_heights(model, qk, data)
+        return h[tip] < h[ball]
+
+    lo, hi = 0.0, math.radians(_TOE_FLAT_MAX_DEG)
+    if not tip_below_ball(lo):
+        return lo
+    for _ in range(40):  # bisection to 1e-12 rad
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if tip_below_ball(mid) else (lo, mid)
+    return hi
+
+
+def _periodic_lag(target: np.ndarray, h: float, tau: float) -> np.ndarray:
+    """The periodic response of ``ẋ = (target − x)/tau`` [tau in s] to ``target`` given at the
+    ``target.size`` nodes of one period (spacing ``h`` [s]): each interval exact for a target
+    held at its end value, started from the one state that the period returns to."""
+    decay = math.exp(-h / max(tau, 1e-12))
+
+    def one_period(x: float) -> np.ndarray:
+        out = np.empty(target.size)
+        for k in range(target.size):
+            x = decay * x + (1.0 - decay) * target[k]
+            out[k] = x
+        return out
+
+    # linear in the start: x_end = decay**n · x_0 + x_end(from 0); periodic when x_end = x_0
+    return one_period(one_period(0.0)[-1] / (1.0 - decay ** target.size))
+
+
+#: Upper end [deg] of the search for the toes' flat angle (the hinge's ligament begins at 60°).
+_TOE_FLAT_MAX_DEG = 60.0
 
 
 def prosthetic_knee_template(phase: np.ndarray) -> np.ndarray:
