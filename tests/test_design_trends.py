@@ -303,6 +303,10 @@ def test_the_report_says_whether_a_study_has_settled(tmp_path):
     done = {"pass": 1, "complete": True, "largest_objective_drop": 0.004, "designs": []}
     (tmp_path / "settling.json").write_text(json.dumps({"passes": [done]}))
     assert _settling_text(tmp_path).endswith("settled (below 1 %).")
+    assert "the last lowered no objective:" in _settling_text(tmp_path)  # "improved" absent
+    lowered = done | {"improved": 2}
+    (tmp_path / "settling.json").write_text(json.dumps({"passes": [lowered]}))
+    assert "the last lowered 2 objectives, the largest by 0.40 %" in _settling_text(tmp_path)
     later = {"pass": 2, "complete": False,
              "designs": [{"before": 2.0, "after": 1.96}, {"before": 1.0, "after": 1.0}]}
     (tmp_path / "settling.json").write_text(json.dumps({"passes": [done, later]}))

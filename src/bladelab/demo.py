@@ -209,7 +209,8 @@ def predict_example(out_dir: str | Path | None = None) -> tuple[Path, list[str]]
              f"{s['dynamics_residual_pct']:.2f} %"]
     crit = human_running_criteria(sol)
     lines.append(f"  against people running at 4 m/s: {sum(c.met for c in crit)} of {len(crit)} "
-                 "criteria met")
+                 "gait criteria met (the report adds the joint angles against the measured "
+                 "3.5 m/s trial)")
     lines += [f"    {c.line()}" for c in crit if not c.met]
     return Path(report.index), lines
 

@@ -259,7 +259,11 @@ def _add_human_running_section(report, sol, trial, check=None) -> None:
               "the Fukuchi et al. 2017 trial at 3.5 m/s, Weyand et al. 2000 and "
               "Nummela et al. 2007 at 9 m/s, interpolated in speed between them)"
               + ("; joint angles against the measured 3.5 m/s stride." if trial is not None
-                 else ".") + _mesh_check_text(check)),
+                 else ".")
+              + f" Contact times here interpolate the force between the nodes; the gait-cycle "
+              f"and leg-stiffness tables below count whole mesh intervals "
+              f"({1e3 * sol.period_s / sol.settings.mesh_intervals:.1f} ms each), so the two "
+              f"may differ by up to one interval." + _mesh_check_text(check)),
         tables=[("The stride against people running at its speed", table)]
         + ([] if check is None else [(
             f"Mesh-halving check: the same problem on {check.fine_intervals} mesh intervals "
@@ -292,7 +296,8 @@ def collocation_sections(report, path: str | Path) -> tuple[dict, object]:
     cm = build_collocation_model(runner)
     result = sol.to_runner_result(N_STRIDES, refine=REFINE, runner=runner, cm=cm)
     s = sol.nlp
-    summary = pd.DataFrame([{"quantity": k, "value": v} for k, v in sol.summary().items()])
+    summary = pd.DataFrame([{"quantity": k, "value": "none" if k == "warnings" and not v else v}
+                            for k, v in sol.summary().items()])
     stages = []
     if sol.tracking is not None:
         t = sol.tracking

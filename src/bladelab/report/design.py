@@ -470,9 +470,10 @@ def _settling_text(design_dir: Path) -> str:
                  "the study's cheapest stride, besides each design's two nearest)")
     if done:
         last = done[-1]
-        text += (f"; the last lowered {last.get('improved', 0)} objective"
-                 f"{'s' if last.get('improved', 0) != 1 else ''}, the largest by "
-                 f"{100 * last['largest_objective_drop']:.2f} %")
+        n_lowered = last.get("improved", 0)
+        text += (f"; the last lowered {n_lowered} objective{'s' if n_lowered != 1 else ''}, "
+                 f"the largest by {100 * last['largest_objective_drop']:.2f} %" if n_lowered
+                 else "; the last lowered no objective")
     open_pass = next((p for p in passes if not p.get("complete")), None)
     if open_pass is not None:
         drops = [objective_drop(r) for r in open_pass["designs"]

@@ -411,6 +411,10 @@ _STANCE_NOTE = (
     "or blade striking the ground is not a stance. Curves: mean over strides (stances for the "
     "GRF), band ±1 SD, dotted lines at each solution's mean toe-off."
 )
+_STIFFNESS_NOTE = (
+    "Stances as in the gait cycle above (touch-down to lift-off, real steps only). K_leg: the "
+    "peak vertical force over the leg's compression ΔL = Δy + L0·(1 − cos θ) (eq. 2.19–2.21)."
+)
 _BLADE_NOTE = (
     "Blade energy (Table D.1): the blade sphere's Hunt–Crossley law F = k·δ^1.5·(1 + 1.5·c·δ̇) "
     "with seed 001's dissipation c = 0.2 s/m returns about half the energy it stores at the "
@@ -543,7 +547,7 @@ def _gait_sections(report, results: dict[str, RunnerResult], cycles: dict) -> No
                                   "(seed 001 Table D.1)", blade, "table-d-1"))
     report.add_section(
         "Leg stiffness and energy",
-        text=_STANCE_NOTE + "\n\n" + _BLADE_NOTE if len(blade) else _STANCE_NOTE,
+        text=_STIFFNESS_NOTE + "\n\n" + _BLADE_NOTE if len(blade) else _STIFFNESS_NOTE,
         figures=[("Leg stiffness and the vertical GRF against the vertical displacement of the "
                   "centre of mass over the stance, per leg (Fig. 3.12; dot: touch-down)",
                   leg_stiffness_figure(cycles, {lab: leg_stiffness(r)
