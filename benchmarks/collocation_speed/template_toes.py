@@ -14,7 +14,11 @@ pelvis is placed on the lowest contact (the flattened toes then lift the stance 
 about a centimetre above the ground late in stance). ``damping`` [N·m·s/rad]: the toes' damper (default the human body's); ``blade``:
 the amputee wearing that category at 4 m/s instead of the able runner at 3.5 m/s;
 ``swing_knee``: true to solve the library's default problem of today (people's angles and
-people's swing knee, ``people_settings``, as ``make bench``) instead of people's angles alone.
+people's swing knee, ``people_settings``, as ``make bench``) instead of people's angles alone;
+``tracking_update``: a history m to solve the tracking stage too with the predictive stages'
+L-BFGS update inside IPOPT's augmented system (``extended``, m for both stages) instead of
+IPOPT's default; ``jitter``: a seed, to add N(0, (10⁻⁶ rad)²) to every joint angle of the
+template (the cold start's sensitivity to its start, measured over several seeds).
 Solves on 50 intervals from the template, tracking then predictive stage, as
 ``bench_collocation.py``'s template row, and appends one line to RECORDS.jsonl: iterations
 per stage, objective, cost of transport [J/(kg·m)], stride time [s], gait warnings, wall
@@ -77,6 +81,22 @@ def _template(runner, speed, toes):
     return dataclasses.replace(guess, q=q, qd=periodic_derivative(q, guess.period))
 
 
+def _extended_tracking(history: int) -> None:
+    """Give the tracking stage the predictive stages' IPOPT options (the library applies
+    them to every stage but the one named "tracking"), with L-BFGS history ``history``."""
+    from bladelab.predict.collocation import solve
+
+    solve.PREDICTIVE_LBFGS_OPTIONS = {**solve.PREDICTIVE_LBFGS_OPTIONS,
+                                      "ipopt.limited_memory_max_history": history}
+    stage_solve = solve._solve_stage
+
+    def extended(nlp, x0, settings, stage, progress, **kw):
+        return stage_solve(nlp, x0, settings,
+                           "tracking (extended)" if stage == "tracking" else stage, progress, **kw)
+
+    solve._solve_stage = extended
+
+
 def main() -> None:
     out, variant = sys.argv[1], json.loads(sys.argv[2])
     blade = variant.get("blade")
@@ -86,6 +106,12 @@ def main() -> None:
               else people_term(defaults.people_weight_for("human")))
     settings = CollocationSettings(mesh_intervals=MESH, speed_m_per_s=speed, **people)
     guess = _template(runner, speed, variant.get("toes", "hinge"))
+    if variant.get("jitter") is not None:
+        q = guess.q + np.random.default_rng(int(variant["jitter"])).normal(0.0, 1e-6, guess.q.shape)
+        q[-1] = q[0] + (guess.q[-1] - guess.q[0])  # periodic as the template is
+        guess = dataclasses.replace(guess, q=q, qd=periodic_derivative(q, guess.period))
+    if variant.get("tracking_update"):
+        _extended_tracking(int(variant["tracking_update"]))
     t0 = time.perf_counter()
     spec = {"model": runner.kind, "body": "human"} | ({"blade": blade} if blade else {})
     sol = predict_stride(runner, settings, guess, model_spec=spec)
