@@ -84,8 +84,10 @@ def run() -> str:
                                                     **people),
                           template_guess(able, speed=3.5, n=MESH),
                           model_spec={"model": "able", "body": "human"})
+    warnings = cold.gait_warnings()
     rows.append(_row("able, the template guess → 3.5 m/s (tracking, then predictive): "
-                     f"objective {cold.nlp.objective:.4f}", cold))
+                     f"objective {cold.nlp.objective:.4f}, "
+                     + ("no gait warning" if not warnings else "; ".join(warnings)), cold))
     return "\n".join([
         "## Collocation: one stride",
         "",
@@ -93,7 +95,7 @@ def run() -> str:
         f"and people's swing knee (at least {defaults.SWING_KNEE_MIN_DEG:g}°), "
         f"mesh {MESH} intervals, one core (`OMP_NUM_THREADS=1`), L-BFGS (the predictive "
         "stages' update inside IPOPT's augmented system, the tracking stage's by IPOPT's "
-        "default), tol 1e-4. Targets: the amputee from the default guess ≤ 60 s, "
+        "default, every swinging foot held 1 cm above the ground), tol 1e-4. Targets: the amputee from the default guess ≤ 60 s, "
         "warm-started at 4.2 m/s "
         "≤ 10 s, the able runner from the template ≤ 60 s. A warm start from a solution "
         "restores its controls and multipliers (IPOPT's primal-dual warm start, its own "

@@ -151,6 +151,18 @@ def test_guess_from_the_fukuchi_trial(able):
     f = g.vertical_grf_bw
     assert np.trapezoid(f, dx=1 / 50) == pytest.approx(1.0, rel=0.02)
     assert 2.3 < f.max() < 2.7 and (f < 0.05).sum() > 10
+    # the horizontal force: no net impulse over a stride at the treadmill's constant speed;
+    # each stance brakes first (negative) and propels last; none in flight
+    fx = g.horizontal_grf_bw
+    assert fx.shape == f.shape and abs(np.mean(fx[:-1])) < 0.02
+    stance = f > 0.3
+    first = np.flatnonzero(stance & ~np.roll(stance, 1))
+    last = np.flatnonzero(stance & ~np.roll(stance, -1))
+    assert len(first) == len(last) == 2
+    for a, b in zip(first, last, strict=True):
+        assert fx[a + 1: a + 4].mean() < -0.1 and fx[b - 3: b].mean() > 0.1
+    assert np.abs(fx[f < 0.01]).max() < 0.02
+    np.testing.assert_allclose(g.resample(100).horizontal_grf_bw[:-1:2], fx[:-1], atol=1e-12)
     with pytest.raises(SpecError, match="running speed"):
         guess_from_trial(able, measured_running_trial())
 

@@ -602,6 +602,31 @@ def test_a_locally_infeasible_tracking_stage_is_solved_again_from_its_iterate(ab
     assert len(calls) == 1 and "restarted_after" not in out.tracking
 
 
+def test_the_tracking_stage_alone_keeps_a_swinging_foot_clear_of_the_ground(able, monkeypatch):
+    """A cold start's tracking stage holds every swinging contact TRACKING_SWING_CLEARANCE_M
+    above the ground (one path inequality per contact more than the predictive stage's);
+    settings with a larger clearance of their own keep theirs in both stages."""
+    from bladelab.predict.collocation.solve import TRACKING_SWING_CLEARANCE_M
+
+    runner, _, _ = able
+    calls, labels = _relabelled_solves(monkeypatch)
+    guess = template_guess(runner, speed=SPEED, n=6)
+    rows = {}
+    for clearance in (0.0, 0.05):
+        calls.clear()
+        labels[:] = [("Solve_Succeeded", None)]  # the tracking stage goes on to the next
+        settings = CollocationSettings(mesh_intervals=6, speed_m_per_s=SPEED, max_iter=3,
+                                       swing_clearance_m=clearance)
+        predict_stride(runner, settings, guess, model_spec={"model": "able"})
+        assert len(calls) == 2  # tracking, then predictive
+        rows[clearance] = [c[0].dyn.inequalities.size1_out(0) for c in calls]
+    n_contacts = runner.contact_params.shape[0]
+    (tracking, predictive), (tracking_own, predictive_own) = rows[0.0], rows[0.05]
+    assert tracking == predictive + n_contacts
+    assert tracking_own == predictive_own == tracking
+    assert 0.0 < TRACKING_SWING_CLEARANCE_M < 0.05
+
+
 def test_a_predictive_stage_stalled_near_a_feasible_point_is_polished(able, monkeypatch):
     runner, _, sol = able
     calls, labels = _relabelled_solves(monkeypatch)
@@ -737,15 +762,20 @@ def test_the_force_figure_starts_at_the_left_touch_down_beside_the_measured_forc
     trial = measured_trial_guess(runner, n=100)
     fig = _grf_figure(sol, trial)
     try:
-        assert len(fig.axes) == 2
+        assert len(fig.axes) == 4  # vertical and horizontal; each leg, total against measured
         model, measured = fig.axes[1].get_lines()
         np.testing.assert_allclose(model.get_ydata(), rolled.sum(axis=1) / sol.body_weight_N)
         np.testing.assert_array_equal(measured.get_ydata(), trial.vertical_grf_bw)
         assert 2.0 < measured.get_ydata().max() < 3.2  # people's peak at 3.5 m/s
+        model, measured = (line for line in fig.axes[3].get_lines() if len(line.get_ydata()) > 2)
+        fx = sol.contact_forces[:, :, 0].sum(axis=1, keepdims=True)
+        np.testing.assert_allclose(
+            model.get_ydata(), stride_from_left_touchdown(sol, values=fx)[:, 0] / sol.body_weight_N)
+        np.testing.assert_array_equal(measured.get_ydata(), trial.horizontal_grf_bw)
     finally:
         plt.close(fig)
     fig = _grf_figure(sol)
-    assert len(fig.axes) == 1
+    assert len(fig.axes) == 2
     plt.close(fig)
 
 
@@ -769,7 +799,8 @@ def test_the_predictive_report_renders_a_collocation_solution(able, tmp_path):
     # the report opens with the stride against people, criterion by criterion
     assert html.index("Against measured human running") < html.index("Collocation solution")
     assert "contact time, left leg" in html and "knee flexion RMSE against the measured" in html
-    assert "the total against the measured 3.5 m/s stride" in html  # the force's shape too
+    assert "the totals against the measured 3.5 m/s stride" in html  # the force's shape too
+    assert "At touch-down the left leg" in html and "How a foot lands" in html
     assert "Not a free prediction" not in html  # the fake solve held no reference term
     assert "Prosthesis loads" not in html  # an able runner carries none
     # a stride solved with people's angles in its objective says so in its first lines

@@ -18,16 +18,23 @@ people's swing knee, ``people_settings``, as ``make bench``) instead of people's
 ``tracking_update``: a history m to solve the tracking stage too with the predictive stages'
 L-BFGS update inside IPOPT's augmented system (``extended``, m for both stages) instead of
 IPOPT's default; ``jitter``: a seed, to add N(0, (10⁻⁶ rad)²) to every joint angle of the
-template (the cold start's sensitivity to its start, measured over several seeds).
+template (the cold start's sensitivity to its start, measured over several seeds);
+``clearance``: a swing clearance [m] (``swing_clearance_m``) in both stages;
+``tracking_clearance``: the tracking stage's own swing clearance [m]
+(``solve.TRACKING_SWING_CLEARANCE_M``; records without the key were solved before the
+library had one, i.e. at 0); ``tracking_tol``: IPOPT's ``tol`` of the tracking stage alone
+(the settings' 1e-4 otherwise); ``tracking_obj_change``: the tracking stage's
+``acceptable_obj_change_tol`` (the stall stop's 1e-5 otherwise).
 Solves on 50 intervals from the template, tracking then predictive stage, as
 ``bench_collocation.py``'s template row, and appends one line to RECORDS.jsonl: iterations
 per stage, objective, cost of transport [J/(kg·m)], stride time [s], gait warnings, wall
-time [s].
+time [s], date.
 """
 
 from __future__ import annotations
 
 import dataclasses
+import datetime
 import json
 import math
 import sys
@@ -97,6 +104,36 @@ def _extended_tracking(history: int) -> None:
     solve._solve_stage = extended
 
 
+def _tracking_stop(tol: float | None, obj_change: float | None) -> None:
+    """Solve the tracking stage to IPOPT's ``tol`` = ``tol`` and with its acceptable level's
+    ``acceptable_obj_change_tol`` = ``obj_change`` (None: as set), the other stages as set."""
+    from bladelab.predict.collocation import solve
+
+    stage_solve = solve._solve_stage
+
+    def loosened(nlp, x0, settings, stage, progress, **kw):
+        if stage != "tracking":
+            return stage_solve(nlp, x0, settings, stage, progress, **kw)
+        if tol is not None:
+            settings = dataclasses.replace(settings, tol=tol)
+        if obj_change is None:
+            return stage_solve(nlp, x0, settings, stage, progress, **kw)
+        own = nlp.solve
+
+        def solve_(x, **k):
+            k["options"] = {**(k.get("options") or {}),
+                            "ipopt.acceptable_obj_change_tol": obj_change}
+            return own(x, **k)
+
+        nlp.solve = solve_
+        try:
+            return stage_solve(nlp, x0, settings, stage, progress, **kw)
+        finally:
+            del nlp.solve
+
+    solve._solve_stage = loosened
+
+
 def main() -> None:
     out, variant = sys.argv[1], json.loads(sys.argv[2])
     blade = variant.get("blade")
@@ -104,14 +141,21 @@ def main() -> None:
     speed = 4.0 if blade else 3.5
     people = (people_settings("human", kind=runner.kind) if variant.get("swing_knee")
               else people_term(defaults.people_weight_for("human")))
-    settings = CollocationSettings(mesh_intervals=MESH, speed_m_per_s=speed, **people)
+    settings = CollocationSettings(mesh_intervals=MESH, speed_m_per_s=speed,
+                                   swing_clearance_m=float(variant.get("clearance", 0.0)), **people)
     guess = _template(runner, speed, variant.get("toes", "hinge"))
     if variant.get("jitter") is not None:
         q = guess.q + np.random.default_rng(int(variant["jitter"])).normal(0.0, 1e-6, guess.q.shape)
         q[-1] = q[0] + (guess.q[-1] - guess.q[0])  # periodic as the template is
         guess = dataclasses.replace(guess, q=q, qd=periodic_derivative(q, guess.period))
+    if variant.get("tracking_clearance") is not None:
+        from bladelab.predict.collocation import solve
+
+        solve.TRACKING_SWING_CLEARANCE_M = float(variant["tracking_clearance"])
     if variant.get("tracking_update"):
         _extended_tracking(int(variant["tracking_update"]))
+    if variant.get("tracking_tol") or variant.get("tracking_obj_change"):
+        _tracking_stop(variant.get("tracking_tol"), variant.get("tracking_obj_change"))
     t0 = time.perf_counter()
     spec = {"model": runner.kind, "body": "human"} | ({"blade": blade} if blade else {})
     sol = predict_stride(runner, settings, guess, model_spec=spec)
@@ -121,7 +165,7 @@ def main() -> None:
               "objective": sol.nlp.objective,
               "cost_of_transport_J_per_kg_m": sol.cost_of_transport_J_per_kg_m,
               "stride_time_s": sol.period_s, "warnings": sol.gait_warnings(),
-              "wall_s": time.perf_counter() - t0}
+              "wall_s": time.perf_counter() - t0, "date": datetime.date.today().isoformat()}
     with open(out, "a") as f:
         f.write(json.dumps(record) + "\n")
     print(json.dumps(record))

@@ -7,8 +7,9 @@ add_predictive_sections`, the same as for a reflex solution) the stride is repea
 advanced by the stride length, :data:`REFINE` samples per mesh interval on the trapezoidal
 rule's interpolant); nothing is re-simulated. :func:`collocation_sections` adds before them the
 solve's own numbers: the summary of ``bladelab predict --method collocation --json``, IPOPT's
-report of both stages, the dynamic consistency with the forward model, and the vertical ground
-force per leg at the nodes over % of the stride.
+report of both stages, the dynamic consistency with the forward model, the vertical and horizontal
+ground force per leg at the nodes over % of the stride, and how each foot lands (its slide at
+touch-down).
 
 A file is recognised by its ``"kind": "collocation-solution"`` field
 (:func:`collocation_solution_file`); a best iterate (``"collocation-best-iterate"``) is not a
@@ -42,6 +43,7 @@ from bladelab.predict.collocation.solution import (
 )
 from bladelab.predict.collocation.solve import SOLUTION_FILE
 from bladelab.predict.collocation.stored import athlete_label, runner_from_spec
+from bladelab.predict.collocation.touchdown import touchdown_slides
 from bladelab.report.collocation_loads import add_loads_section
 
 __all__ = ["N_STRIDES", "REFINE", "collocation_sections", "collocation_solution_file",
@@ -96,32 +98,51 @@ def _label(sol) -> str:
 
 
 def _grf_figure(sol, trial=None):
-    """Each leg's vertical ground force over the stride from the left (intact) touch-down;
-    with ``trial`` (the measured stride, a StrideGuess with its force), the total force beside
-    the measured total in a second panel."""
+    """Each leg's vertical (top) and horizontal (bottom) ground force over the stride from the
+    left (intact) touch-down; with ``trial`` (the measured stride, a StrideGuess with its
+    forces), the totals beside the measured totals in a second column."""
     import matplotlib.pyplot as plt
 
-    fz = stride_from_left_touchdown(sol, values=sol.leg_vertical_force()) / sol.body_weight_N
-    pct = np.linspace(0.0, 100.0, fz.shape[0])
-    measured = None if trial is None else trial.vertical_grf_bw
-    fig, axes = plt.subplots(1, 1 if measured is None else 2,
-                             figsize=(7 if measured is None else 11, 3.2), squeeze=False)
-    ax = axes[0, 0]
-    for j, leg in enumerate(sol.leg_names):
-        ax.plot(pct, fz[:, j], "o-", ms=3, label=leg)
-    ax.set_xlabel("stride (% of the gait cycle, from the left/intact touch-down)")
-    ax.set_ylabel("vertical GRF (body weights)")
-    ax.set_title("each leg", fontsize=9)
-    ax.legend(fontsize=7)
-    if measured is not None:
-        ax = axes[0, 1]
-        ax.plot(pct, fz.sum(axis=1), "o-", ms=3, color="k", label="this stride")
-        ax.plot(np.linspace(0.0, 100.0, len(measured)), measured, "--", color="0.5",
+    contact = sol.contact_forces
+    per_leg = [np.stack([contact[:, sol.contact_legs == leg, axis].sum(axis=1) for leg in (0, 1)],
+                        axis=1) for axis in (1, 0)]
+    rows = [("vertical", stride_from_left_touchdown(sol, values=per_leg[0]) / sol.body_weight_N,
+             None if trial is None else trial.vertical_grf_bw),
+            ("horizontal", stride_from_left_touchdown(sol, values=per_leg[1]) / sol.body_weight_N,
+             None if trial is None else trial.horizontal_grf_bw)]
+    measured = any(m is not None for *_, m in rows)
+    fig, axes = plt.subplots(2, 2 if measured else 1, figsize=(11 if measured else 7, 6.2),
+                             squeeze=False)
+    for r, (name, force, meas) in enumerate(rows):
+        pct = np.linspace(0.0, 100.0, force.shape[0])
+        ax = axes[r, 0]
+        for j, leg in enumerate(sol.leg_names):
+            ax.plot(pct, force[:, j], "o-", ms=3, label=leg)
+        ax.set_xlabel("stride (% of the gait cycle, from the left/intact touch-down)")
+        ax.set_ylabel(f"{name} GRF (body weights)")
+        ax.set_title(f"each leg: {name}" + (" (forward positive)" if r else ""), fontsize=9)
+        ax.legend(fontsize=7)
+        if r:
+            ax.axhline(0.0, color="0.8", lw=0.8, zorder=0)
+        if not measured:
+            continue
+        ax = axes[r, 1]
+        if meas is None:
+            ax.text(0.5, 0.5, "not measured", ha="center", va="center", transform=ax.transAxes)
+            continue
+        total = force.sum(axis=1)
+        ax.plot(pct, total, "o-", ms=3, color="k", label="this stride")
+        ax.plot(np.linspace(0.0, 100.0, len(meas)), meas, "--", color="0.5",
                 label="measured 3.5 m/s stride (RBDS001, mean)")
         ax.set_xlabel("stride (% of the gait cycle, from the left touch-down)")
-        ax.set_ylabel("total vertical GRF (body weights)")
-        ax.set_title("against the measured stride: the force's shape in stance", fontsize=9)
-        ax.set_ylim(top=1.3 * max(float(np.max(fz.sum(axis=1))), float(np.max(measured))))
+        ax.set_ylabel(f"total {name} GRF (body weights)")
+        ax.set_title("against the measured stride: " + ("the force's shape in stance" if not r
+                     else "braking, then propulsion"), fontsize=9)
+        lo = min(float(np.min(total)), float(np.min(meas)))
+        hi = max(float(np.max(total)), float(np.max(meas)))
+        ax.set_ylim(lo - 0.05 * (hi - lo) if r else None, hi + 0.3 * (hi - lo))
+        if r:
+            ax.axhline(0.0, color="0.8", lw=0.8, zorder=0)
         ax.legend(fontsize=7, loc="upper center", ncol=2)
     fig.tight_layout()
     return fig
@@ -229,6 +250,27 @@ def _mesh_check_text(check) -> str:
                 "twice the mesh intervals): until then, differences of a few per cent between "
                 "strides may be the mesh's.")
     return f" {check.verdict()}."
+
+
+def _touchdown_text(sol, runner, cm, trial) -> str:
+    """How each leg lands (:func:`~bladelab.predict.collocation.touchdown.touchdown_slides`), in
+    words, for the ground-force figure's caption."""
+    slides, work = touchdown_slides(sol, runner, cm)
+    if not slides:
+        return ""
+    parts = [(f"the {s.leg} leg's loaded contact meets the ground at {s.speed_mps:+.2f} m/s and "
+              f"slides {s.slide_mm:.0f} mm in {s.slide_ms:.0f} ms, braking at up to "
+              f"{s.braking_bw:+.2f} BW (friction at its limit, μ times the normal force)")
+             if s.slide_ms > 0 else
+             f"the {s.leg} leg lands sticking (loaded contact at {s.speed_mps:+.2f} m/s)"
+             for s in slides]
+    return ("At touch-down " + "; ".join(parts) + "; friction takes "
+            + " and ".join(f"{w:.1f} J" for w in work.values())
+            + f" per stride from the {' and '.join(work)} leg. A rigid contact sphere takes the "
+            "foot's forward speed by sliding, where a shoe's sole and a heel pad take it in "
+            "shear (docs/collocation.md, 'How a foot lands')"
+            + ("; people land with a braking transient too (the measured stride, lower right)."
+               if trial is not None and trial.horizontal_grf_bw is not None else "."))
 
 
 def _add_human_running_section(report, sol, trial, check=None) -> None:
@@ -362,12 +404,13 @@ def collocation_sections(report, path: str | Path) -> tuple[dict, object]:
               "few mm/s, and a reconstructed bristle, stuck, stretches by that slip over the "
               "whole stance (docs/collocation.md, 'Dynamic consistency'); the first row is the "
               "check. The component rows show where a difference comes from."),
-        figures=[("Vertical ground reaction force per leg at the mesh nodes over % of the "
-                  "stride, from the left (intact) touch-down"
-                  + ("; right: the total against the measured 3.5 m/s stride's (its force "
-                     "platform, the mean of its strides), which shows where in stance the "
-                     "force peaks" if trial is not None and trial.vertical_grf_bw is not None
-                     else ""), fig)],
+        figures=[("Vertical (top) and horizontal (bottom) ground reaction force per leg at the "
+                  "mesh nodes over % of the stride, from the left (intact) touch-down"
+                  + ("; right: the totals against the measured 3.5 m/s stride's (its force "
+                     "platform, the mean of its strides), which show where in stance the "
+                     "force peaks and how braking turns into propulsion"
+                     if trial is not None and trial.vertical_grf_bw is not None else "")
+                  + ". " + _touchdown_text(sol, runner, cm, trial), fig)],
         tables=[("Summary (as 'bladelab predict --method collocation --json')", summary),
                 ("IPOPT per stage", pd.DataFrame(stages)),
                 ("Objective terms of the final stage", terms),

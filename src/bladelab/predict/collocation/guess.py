@@ -357,9 +357,11 @@ def guess_from_trial(model: RunnerModel, path: str | Path, *, static: str | Path
     closed = {k: np.append(v, v[0]) for k, v in mean.items()}  # node n = node 0 (periodic)
     frac = np.linspace(0.0, 1.0, n + 1)
     q = _angles_to_q(model, frac, period, speed, closed)
+    force = _measured_grf(trial, good, frac)
     return StrideGuess(f"{Path(path).name}: mean of {len(good)} left-leg cycles at {speed:g} m/s",
                        period, q, periodic_derivative(q, period),
-                       vertical_grf_bw=_measured_vertical_grf(trial, good, frac))
+                       vertical_grf_bw=None if force is None else force[1],
+                       horizontal_grf_bw=None if force is None else force[0])
 
 
 def measured_trial_guess(model: RunnerModel, *, n: int = 50) -> StrideGuess:
@@ -371,21 +373,22 @@ def measured_trial_guess(model: RunnerModel, *, n: int = 50) -> StrideGuess:
                             n=n, speed=MEASURED_TRIAL_SPEED_M_PER_S)
 
 
-def _measured_vertical_grf(trial, cycles, frac: np.ndarray) -> np.ndarray | None:
-    """The trial's total vertical platform force over its mean cycle [body weights: divided by
-    the cycle's mean force, which over a periodic stride is the runner's weight]; None without
-    platforms."""
+def _measured_grf(trial, cycles, frac: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
+    """The trial's total horizontal (forward) and vertical platform force over its mean cycle
+    [body weights: divided by the cycle's mean vertical force, which over a periodic stride is
+    the runner's weight]; None without platforms."""
     if not trial.platforms:
         return None
     curves = []
     for c in cycles:
         tt = c.start_s + frac * c.period
+        fx = sum(np.interp(tt, p.time, p.force[:, 0]) for p in trial.platforms)
         fz = sum(np.interp(tt, p.time, p.force[:, 2]) for p in trial.platforms)
         fine = c.start_s + np.linspace(0.0, 1.0, 401) * c.period
         mean = np.mean(sum(np.interp(fine, p.time, p.force[:, 2]) for p in trial.platforms))
         if mean > 0:
-            curves.append(fz / mean)
-    return np.mean(curves, axis=0) if curves else None
+            curves.append((fx / mean, fz / mean))
+    return tuple(np.mean(curves, axis=0)) if curves else None
 
 
 def guess_from_result(result, *, n: int = 50) -> StrideGuess:

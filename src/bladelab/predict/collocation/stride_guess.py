@@ -77,6 +77,9 @@ class StrideGuess:
         (:meth:`~bladelab.predict.collocation.transcription.StrideNLP.initial_multipliers`
         takes them only if they fit the NLP). Kept by :meth:`with_speed`; dropped by
         :meth:`resample` to another mesh and by :meth:`on_model` when it moves columns.
+    horizontal_grf_bw
+        (n + 1,) total horizontal ground force [body weights, forward positive] of a measured
+        trial, or None: drawn beside a stride's in reports, never tracked.
     reference_phase
         The phase [fraction of the stride] of people's joint angles that the stride was solved
         against (:mod:`~bladelab.predict.collocation.people`), or None: a solve from it with
@@ -97,6 +100,7 @@ class StrideGuess:
     tendon_force_rate: np.ndarray | None = None
     multipliers: tuple[np.ndarray, np.ndarray] | None = None
     reference_phase: float | None = None
+    horizontal_grf_bw: np.ndarray | None = None
 
     def on_model(self, model: RunnerModel) -> StrideGuess:
         """This guess on ``model``'s coordinates and muscles, matched by name: coordinates
@@ -171,6 +175,8 @@ class StrideGuess:
             else _resample(self.tendon_force, old, new),
             vertical_grf_bw=None if self.vertical_grf_bw is None
             else _resample(self.vertical_grf_bw[:, None], old, new)[:, 0],
+            horizontal_grf_bw=None if self.horizontal_grf_bw is None
+            else _resample(self.horizontal_grf_bw[:, None], old, new)[:, 0],
             qdd=None, excitation=None, tendon_force_rate=None, multipliers=None,
         )
 
