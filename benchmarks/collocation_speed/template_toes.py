@@ -24,7 +24,8 @@ template (the cold start's sensitivity to its start, measured over several seeds
 (``solve.TRACKING_SWING_CLEARANCE_M``; records without the key were solved before the
 library had one, i.e. at 0); ``tracking_tol``: IPOPT's ``tol`` of the tracking stage alone
 (the settings' 1e-4 otherwise); ``tracking_obj_change``: the tracking stage's
-``acceptable_obj_change_tol`` (the stall stop's 1e-5 otherwise).
+``acceptable_obj_change_tol`` (the stall stop's 1e-5 otherwise); ``speed``: the prescribed
+speed [m/s] instead of 3.5 (able) or 4 (amputee).
 Solves on 50 intervals from the template, tracking then predictive stage, as
 ``bench_collocation.py``'s template row, and appends one line to RECORDS.jsonl: iterations
 per stage, objective, cost of transport [J/(kg·m)], stride time [s], gait warnings, wall
@@ -138,7 +139,7 @@ def main() -> None:
     out, variant = sys.argv[1], json.loads(sys.argv[2])
     blade = variant.get("blade")
     runner = _runner(variant.get("damping"), blade)
-    speed = 4.0 if blade else 3.5
+    speed = float(variant.get("speed", 4.0 if blade else 3.5))
     people = (people_settings("human", kind=runner.kind) if variant.get("swing_knee")
               else people_term(defaults.people_weight_for("human")))
     settings = CollocationSettings(mesh_intervals=MESH, speed_m_per_s=speed,

@@ -260,11 +260,14 @@ def _touchdown_text(sol, runner, cm, trial) -> str:
         return ""
     parts = [(f"the {s.leg} leg's loaded contact meets the ground at {s.speed_mps:+.2f} m/s and "
               f"slides {s.slide_mm:.0f} mm in {s.slide_ms:.0f} ms, braking at up to "
-              f"{s.braking_bw:+.2f} BW (friction at its limit, μ times the normal force)")
+              f"{s.braking_bw:+.2f} BW")
              if s.slide_ms > 0 else
              f"the {s.leg} leg lands sticking (loaded contact at {s.speed_mps:+.2f} m/s)"
              for s in slides]
-    return ("At touch-down " + "; ".join(parts) + "; friction takes "
+    sliding = any(s.slide_ms > 0 for s in slides)
+    return ("At touch-down " + "; ".join(parts)
+            + (" (a sliding contact brakes at its friction limit, μ times its normal force)"
+               if sliding else "") + "; friction takes "
             + " and ".join(f"{w:.1f} J" for w in work.values())
             + f" per stride from the {' and '.join(work)} leg. A rigid contact sphere takes the "
             "foot's forward speed by sliding, where a shoe's sole and a heel pad take it in "
