@@ -24,7 +24,9 @@ template (the cold start's sensitivity to its start, measured over several seeds
 (``solve.TRACKING_SWING_CLEARANCE_M``; records without the key were solved before the
 library had one, i.e. at 0); ``tracking_tol``: IPOPT's ``tol`` of the tracking stage alone
 (the settings' 1e-4 otherwise); ``tracking_obj_change``: the tracking stage's
-``acceptable_obj_change_tol`` (the stall stop's 1e-5 otherwise); ``speed``: the prescribed
+``acceptable_obj_change_tol`` (the stall stop's 1e-5 otherwise); ``tracking_options``: IPOPT
+options of the tracking stage alone (e.g. ``{"ipopt.acceptable_constr_viol_tol": 1e-3}``);
+``speed``: the prescribed
 speed [m/s] instead of 3.5 (able) or 4 (amputee).
 Solves on 50 intervals from the template, tracking then predictive stage, as
 ``bench_collocation.py``'s template row, and appends one line to RECORDS.jsonl: iterations
@@ -105,9 +107,9 @@ def _extended_tracking(history: int) -> None:
     solve._solve_stage = extended
 
 
-def _tracking_stop(tol: float | None, obj_change: float | None) -> None:
-    """Solve the tracking stage to IPOPT's ``tol`` = ``tol`` and with its acceptable level's
-    ``acceptable_obj_change_tol`` = ``obj_change`` (None: as set), the other stages as set."""
+def _tracking_stop(tol: float | None, options: dict) -> None:
+    """Solve the tracking stage to IPOPT's ``tol`` = ``tol`` (None: as set) and with the IPOPT
+    ``options`` added (e.g. its acceptable level's), the other stages as set."""
     from bladelab.predict.collocation import solve
 
     stage_solve = solve._solve_stage
@@ -117,13 +119,12 @@ def _tracking_stop(tol: float | None, obj_change: float | None) -> None:
             return stage_solve(nlp, x0, settings, stage, progress, **kw)
         if tol is not None:
             settings = dataclasses.replace(settings, tol=tol)
-        if obj_change is None:
+        if not options:
             return stage_solve(nlp, x0, settings, stage, progress, **kw)
         own = nlp.solve
 
         def solve_(x, **k):
-            k["options"] = {**(k.get("options") or {}),
-                            "ipopt.acceptable_obj_change_tol": obj_change}
+            k["options"] = {**(k.get("options") or {}), **options}
             return own(x, **k)
 
         nlp.solve = solve_
@@ -155,8 +156,11 @@ def main() -> None:
         solve.TRACKING_SWING_CLEARANCE_M = float(variant["tracking_clearance"])
     if variant.get("tracking_update"):
         _extended_tracking(int(variant["tracking_update"]))
-    if variant.get("tracking_tol") or variant.get("tracking_obj_change"):
-        _tracking_stop(variant.get("tracking_tol"), variant.get("tracking_obj_change"))
+    options = dict(variant.get("tracking_options") or {})
+    if variant.get("tracking_obj_change"):
+        options["ipopt.acceptable_obj_change_tol"] = float(variant["tracking_obj_change"])
+    if variant.get("tracking_tol") or options:
+        _tracking_stop(variant.get("tracking_tol"), options)
     t0 = time.perf_counter()
     spec = {"model": runner.kind, "body": "human"} | ({"blade": blade} if blade else {})
     sol = predict_stride(runner, settings, guess, model_spec=spec)
