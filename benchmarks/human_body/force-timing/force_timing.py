@@ -1,0 +1,78 @@
+"""Where in stance the vertical force peaks, against the foot's contact law (a measuring probe;
+changes nothing in src).
+
+Usage (repository root)::
+
+    OMP_NUM_THREADS=1 .venv/bin/python benchmarks/human_body/force-timing/force_timing.py \\
+        RECORDS.jsonl '{"set": {"foot_contact": {...}}}'
+
+The shipped able stride (human body, 3.5 m/s, mesh 50, people's angles and swing knee) solved
+again from its primal and dual values on the human body changed by the variant
+(``../solve_variant.py``'s ``apply_variant``: ``set``, ``force_factor``, ``muscle``), with the
+stride's own settings: a continuation step from the shipped optimum to the changed body's
+nearest one. Appends one line to RECORDS.jsonl: the variant, converged, iterations, objective,
+cost of transport [J/(kg·m)], per leg the stance's peak vertical force [BW] and where it lies
+[% of the stance, node-wise], the contact time [s] and the knee's flexion at touch-down [deg],
+the gait warnings, the wall time [s] and the date.
+"""
+
+from __future__ import annotations
+
+import datetime
+import json
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+from solve_variant import variant_runner  # noqa: E402
+
+from bladelab.predict.collocation.solution import CollocationSolution  # noqa: E402
+from bladelab.predict.collocation.solve import predict_stride  # noqa: E402
+from bladelab.runner.params import RUNNER_DATA_DIR  # noqa: E402
+
+SHIPPED = RUNNER_DATA_DIR / "collocation" / "able-3.5-human.json"
+
+
+def stance_shape(sol) -> dict:
+    """Per leg: peak vertical force [BW], its place [% of the stance's nodes], the knee's
+    flexion at the first loaded node [deg]."""
+    fz = sol.leg_vertical_force()[:-1] / sol.body_weight_N
+    n = fz.shape[0]
+    out = {}
+    for j, leg in enumerate(sol.leg_names):
+        on = fz[:, j] > 20.0 / sol.body_weight_N
+        k0 = next(k for k in range(n) if on[k] and not on[k - 1])
+        length = next(k for k in range(1, n + 1) if not on[(k0 + k) % n])
+        stance = np.array([fz[(k0 + k) % n, j] for k in range(length)])
+        knee = sol.dof_names.index(f"knee_angle_{'l' if j == 0 else 'r'}")
+        out[leg] = {"peak_bw": float(stance.max()),
+                    "peak_at_pct_of_stance": float(100.0 * np.argmax(stance) / length),
+                    "knee_flexion_at_touchdown_deg": float(-np.degrees(sol.nlp.q[k0, knee]))}
+    return out
+
+
+def main() -> None:
+    out, variant = sys.argv[1], json.loads(sys.argv[2])
+    shipped = CollocationSolution.read(SHIPPED)
+    runner = variant_runner({"kind": "able", **variant})
+    t0 = time.perf_counter()
+    sol = predict_stride(runner, shipped.settings, shipped.to_guess(),
+                         model_spec={"model": "able", "body": "human"})
+    s = sol.summary()
+    record = {"variant": variant, "converged": sol.converged, "iterations": sol.nlp.iterations,
+              "objective": sol.nlp.objective,
+              "cost_of_transport_J_per_kg_m": sol.cost_of_transport_J_per_kg_m,
+              "contact_time_s": s.get("contact_time_s"), "legs": stance_shape(sol),
+              "warnings": sol.gait_warnings(), "wall_s": time.perf_counter() - t0,
+              "date": datetime.date.today().isoformat()}
+    with open(out, "a") as f:
+        f.write(json.dumps(record) + "\n")
+    print(json.dumps(record))
+
+
+if __name__ == "__main__":
+    main()
