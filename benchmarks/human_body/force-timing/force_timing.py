@@ -4,7 +4,7 @@ changes nothing in src).
 Usage (repository root)::
 
     OMP_NUM_THREADS=1 .venv/bin/python benchmarks/human_body/force-timing/force_timing.py \\
-        RECORDS.jsonl '{"set": {"foot_contact": {...}}}'
+        RECORDS.jsonl '{"set": {"foot_contact": {...}}}' [SOLUTION.json]
 
 The shipped able stride (human body, 3.5 m/s, mesh 50, people's angles and swing knee) solved
 again from its primal and dual values on the human body changed by the variant
@@ -13,7 +13,9 @@ stride's own settings: a continuation step from the shipped optimum to the chang
 nearest one. Appends one line to RECORDS.jsonl: the variant, converged, iterations, objective,
 cost of transport [J/(kg·m)], per leg the stance's peak vertical force [BW] and where it lies
 [% of the stance, node-wise], the contact time [s] and the knee's flexion at touch-down [deg],
-the gait warnings, the wall time [s] and the date.
+the gait warnings, the criteria of people's running met (the gait's and the joint angles'
+against the measured trial), the wall time [s] and the date; with SOLUTION.json, writes the
+stride there too.
 """
 
 from __future__ import annotations
@@ -30,6 +32,11 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from solve_variant import variant_runner  # noqa: E402
 
+from bladelab.predict.collocation.guess import measured_trial_guess  # noqa: E402
+from bladelab.predict.collocation.human_running import (  # noqa: E402
+    angle_agreement,
+    human_running_criteria,
+)
 from bladelab.predict.collocation.solution import CollocationSolution  # noqa: E402
 from bladelab.predict.collocation.solve import predict_stride  # noqa: E402
 from bladelab.runner.params import RUNNER_DATA_DIR  # noqa: E402
@@ -63,15 +70,22 @@ def main() -> None:
     sol = predict_stride(runner, shipped.settings, shipped.to_guess(),
                          model_spec={"model": "able", "body": "human"})
     s = sol.summary()
+    criteria = human_running_criteria(sol) + angle_agreement(sol, measured_trial_guess(runner,
+                                                                                       n=100).q)
     record = {"variant": variant, "converged": sol.converged, "iterations": sol.nlp.iterations,
               "objective": sol.nlp.objective,
               "cost_of_transport_J_per_kg_m": sol.cost_of_transport_J_per_kg_m,
               "contact_time_s": s.get("contact_time_s"), "legs": stance_shape(sol),
-              "warnings": sol.gait_warnings(), "wall_s": time.perf_counter() - t0,
+              "warnings": sol.gait_warnings(),
+              "criteria_met": f"{sum(c.met for c in criteria)} of {len(criteria)}",
+              "criteria_missed": [c.line() for c in criteria if not c.met],
+              "wall_s": time.perf_counter() - t0,
               "date": datetime.date.today().isoformat()}
     with open(out, "a") as f:
         f.write(json.dumps(record) + "\n")
     print(json.dumps(record))
+    if len(sys.argv) > 3:
+        sol.write(sys.argv[3])
 
 
 if __name__ == "__main__":
