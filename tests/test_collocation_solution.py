@@ -779,6 +779,16 @@ def test_the_force_figure_starts_at_the_left_touch_down_beside_the_measured_forc
     plt.close(fig)
 
 
+def test_where_each_stance_peaks_counts_a_stance_across_the_period_s_end():
+    from bladelab.report.collocation import _stance_peak_places
+
+    force = np.zeros(40)
+    force[5:15] = [1, 2, 3, 4, 5, 4, 3, 2, 1, 0.5]  # peaks at its 5th node of 10: 40 %
+    force[[36, 37, 38, 39, 0, 1, 2, 3]] = [1, 2, 2.5, 3, 2, 1.5, 1, 0.5]  # wraps: 3 of 8, 37.5 %
+    assert sorted(_stance_peak_places(force, 0.1)) == pytest.approx([37.5, 40.0])
+    assert _stance_peak_places(np.zeros(10), 0.1) == []
+
+
 def test_the_predictive_report_renders_a_collocation_solution(able, tmp_path):
     from bladelab.report import Report
     from bladelab.report.collocation import collocation_sections
@@ -801,6 +811,7 @@ def test_the_predictive_report_renders_a_collocation_solution(able, tmp_path):
     assert "contact time, left leg" in html and "knee flexion RMSE against the measured" in html
     assert "the totals against the measured 3.5 m/s stride" in html  # the force's shape too
     assert "At touch-down the left leg" in html and "How a foot lands" in html
+    assert "vertical force peaks at" in html and "% of its nodes here, the measured" in html
     assert "Not a free prediction" not in html  # the fake solve held no reference term
     assert "Prosthesis loads" not in html  # an able runner carries none
     # a stride solved with people's angles in its objective says so in its first lines

@@ -35,9 +35,11 @@ from bladelab.predict.collocation.human_running import (
 )
 from bladelab.predict.collocation.mesh_check import MESH_CHECK_DIR, read_mesh_check
 from bladelab.predict.collocation.model import build_collocation_model
+from bladelab.predict.collocation.nodes import periodic_runs
 from bladelab.predict.collocation.settings import PEOPLE_REFERENCE
 from bladelab.predict.collocation.solution import (
     BEST_ITERATE_KIND,
+    CONTACT_THRESHOLD_N,
     SOLUTION_KIND,
     CollocationSolution,
 )
@@ -252,6 +254,33 @@ def _mesh_check_text(check) -> str:
     return f" {check.verdict()}."
 
 
+def _stance_peak_places(force: np.ndarray, threshold: float) -> list[float]:
+    """Where each stance's force peaks [% of the stance's nodes], for the stances (runs above
+    ``threshold``) of a periodic force (n nodes of one period, without the repeated last one)."""
+    places = []
+    for start, length in periodic_runs(force > threshold):
+        stance = force[(start + np.arange(length)) % force.size]
+        places.append(100.0 * float(np.argmax(stance)) / length)
+    return places
+
+
+def _peak_place_text(sol, trial) -> str:
+    """Where in stance the vertical force peaks, this stride's against the measured stride's,
+    in words ('' without a measured force)."""
+    if trial is None or trial.vertical_grf_bw is None:
+        return ""
+    threshold = CONTACT_THRESHOLD_N / sol.body_weight_N
+    fz = sol.leg_vertical_force()[:-1] / sol.body_weight_N
+    ours = [p for j in range(fz.shape[1]) for p in _stance_peak_places(fz[:, j], threshold)]
+    measured = _stance_peak_places(np.asarray(trial.vertical_grf_bw)[:-1], threshold)
+    if not ours or not measured:
+        return ""
+    return (" Each stance's vertical force peaks at "
+            + ", ".join(f"{p:.0f}" for p in ours) + " % of its nodes here, the measured "
+            "runner's at " + ", ".join(f"{p:.0f}" for p in measured) + " % (no criterion "
+            "checks it; docs/collocation.md, 'How a foot lands').")
+
+
 def _touchdown_text(sol, runner, cm, trial) -> str:
     """How each leg lands (:func:`~bladelab.predict.collocation.touchdown.touchdown_slides`), in
     words, for the ground-force figure's caption."""
@@ -413,7 +442,8 @@ def collocation_sections(report, path: str | Path) -> tuple[dict, object]:
                      "platform, the mean of its strides), which show where in stance the "
                      "force peaks and how braking turns into propulsion"
                      if trial is not None and trial.vertical_grf_bw is not None else "")
-                  + ". " + _touchdown_text(sol, runner, cm, trial), fig)],
+                  + ". " + _touchdown_text(sol, runner, cm, trial)
+                  + _peak_place_text(sol, trial), fig)],
         tables=[("Summary (as 'bladelab predict --method collocation --json')", summary),
                 ("IPOPT per stage", pd.DataFrame(stages)),
                 ("Objective terms of the final stage", terms),
