@@ -321,3 +321,21 @@ def test_the_report_names_the_best_run_and_cautions_an_unpredictive_optimum(tmp_
         assert f"The best run measured: run {int(best['run'])}, {best[objective]:.4g}." in text
         assert "  " not in text  # no unit known to the report: none printed
         assert ("Caution: the surface predicts" in text) == cautioned
+
+
+def test_a_response_the_same_in_every_run_is_named_not_fitted():
+    import pandas as pd
+
+    from bladelab.report.design import _constant_responses
+
+    class Fit:
+        unit = "m/s"
+
+    table = pd.DataFrame({"avg_vx_m_per_s": [4.0, 4.0 + 1e-13, 4.0 - 2e-13],
+                          "delta_vx_m_per_s": [0.10, 0.12, 0.11],
+                          "missing": [1.0, float("nan"), 1.0]})
+    surfaces = {"avg_vx_m_per_s": Fit(), "delta_vx_m_per_s": Fit(), "missing": Fit(),
+                "not_in_the_table": Fit()}
+    constant = _constant_responses(table, surfaces)
+    assert list(constant) == ["avg_vx_m_per_s", "missing"]
+    assert constant["avg_vx_m_per_s"] == pytest.approx(4.0)

@@ -116,6 +116,20 @@ def _stride_checks(design_dir: Path, evaluator: dict, space, table: pd.DataFrame
     return checks
 
 
+def _constant_responses(table: pd.DataFrame, surfaces: dict) -> dict[str, float]:
+    """{response: value} of the responses that every run of ``table`` has the same to
+    round-off (e.g. the prescribed mean speed of a predicted stride): nothing to fit."""
+    out = {}
+    for r in surfaces:
+        if r not in table:
+            continue
+        v = pd.to_numeric(table[r], errors="coerce").to_numpy(float)
+        v = v[np.isfinite(v)]
+        if v.size > 1 and np.ptp(v) <= 1e-9 * max(1.0, float(np.abs(v).max())):
+            out[r] = float(v.mean())
+    return out
+
+
 def design_report_sections(design_dir: str | Path) -> list[dict[str, Any]]:
     """Keyword arguments of :meth:`bladelab.report.Report.add_section`, one dict per section."""
     import matplotlib
@@ -143,6 +157,12 @@ def design_report_sections(design_dir: str | Path) -> list[dict[str, Any]]:
         fit = fit.merge(spread[["response", "r2_ceiling"]].rename(
             columns={"r2_ceiling": "R2 ceiling (start spread)"}), on="response", how="left")
     fit_text = "Predicted R² comes from PRESS (leave-one-out)."
+    constant = _constant_responses(table, surfaces)
+    if constant:
+        fit = fit[~fit["response"].isin(constant)]
+        fit_text += (" Not fitted, the same in every run (a prescribed quantity): "
+                     + ", ".join(f"{r} = {v:.4g} {surfaces[r].unit}".rstrip()
+                                 for r, v in constant.items()) + ".")
     if meta.get("model") == REDUCED_MODEL:
         fit["terms"] = [len(s.terms) for s in surfaces.values()]
         fit["R2_pred (selection in each fold)"] = [s.r2_pred_selected
