@@ -9,7 +9,7 @@ Usage (repository root)::
 The shipped able stride (human body, 3.5 m/s, mesh 50, people's angles and swing knee) solved
 again from its primal and dual values on the human body changed by the variant
 (``../solve_variant.py``'s ``apply_variant``: ``set``, ``force_factor``, ``muscle``), with the
-stride's own settings: a continuation step from the shipped optimum to the changed body's
+stride's own settings (``settings``: fields of them changed, e.g. ``{"reference_weight": 30}``): a continuation step from the shipped optimum to the changed body's
 nearest one. Appends one line to RECORDS.jsonl: the variant, converged, iterations, objective,
 cost of transport [J/(kg·m)], per leg the stance's peak vertical force [BW] and where it lies
 [% of the stance, node-wise], the contact time [s] and the knee's flexion at touch-down [deg],
@@ -20,6 +20,7 @@ stride there too.
 
 from __future__ import annotations
 
+import dataclasses
 import datetime
 import json
 import sys
@@ -65,9 +66,11 @@ def stance_shape(sol) -> dict:
 def main() -> None:
     out, variant = sys.argv[1], json.loads(sys.argv[2])
     shipped = CollocationSolution.read(SHIPPED)
-    runner = variant_runner({"kind": "able", **variant})
+    runner = variant_runner({"kind": "able", **{k: v for k, v in variant.items()
+                                                if k != "settings"}})
     t0 = time.perf_counter()
-    sol = predict_stride(runner, shipped.settings, shipped.to_guess(),
+    settings = dataclasses.replace(shipped.settings, **variant.get("settings", {}))
+    sol = predict_stride(runner, settings, shipped.to_guess(),
                          model_spec={"model": "able", "body": "human"})
     s = sol.summary()
     criteria = human_running_criteria(sol) + angle_agreement(sol, measured_trial_guess(runner,
