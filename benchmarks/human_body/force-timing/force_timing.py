@@ -9,7 +9,8 @@ Usage (repository root)::
 The shipped able stride (human body, 3.5 m/s, mesh 50, people's angles and swing knee) solved
 again from its primal and dual values on the human body changed by the variant
 (``../solve_variant.py``'s ``apply_variant``: ``set``, ``force_factor``, ``muscle``), with the
-stride's own settings (``settings``: fields of them changed, e.g. ``{"reference_weight": 30}``;
+stride's own settings (``settings``: fields of them changed, e.g. ``{"reference_weight": 30}``,
+``{"weights": {"acceleration": 1.0}}``;
 ``lumbar``: [stiffness N·m/rad, damping N·m·s/rad] of the lumbar joint's spring–damper in place
 of the library's 500 and 5, ``bladelab.runner.model.LIGAMENTS``): a continuation step from the shipped optimum to the changed body's
 nearest one. Appends one line to RECORDS.jsonl: the variant, converged, iterations, objective,
@@ -75,7 +76,10 @@ def main() -> None:
     runner = variant_runner({"kind": "able", **{k: v for k, v in variant.items()
                                                 if k not in ("settings", "lumbar")}})
     t0 = time.perf_counter()
-    settings = dataclasses.replace(shipped.settings, **variant.get("settings", {}))
+    changes = dict(variant.get("settings", {}))
+    if "weights" in changes:  # the objective's weights: only the named ones change
+        changes["weights"] = dataclasses.replace(shipped.settings.weights, **changes["weights"])
+    settings = dataclasses.replace(shipped.settings, **changes)
     sol = predict_stride(runner, settings, shipped.to_guess(),
                          model_spec={"model": "able", "body": "human"})
     s = sol.summary()
