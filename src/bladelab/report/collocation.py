@@ -105,13 +105,12 @@ def _grf_figure(sol, trial=None):
     forces), the totals beside the measured totals in a second column."""
     import matplotlib.pyplot as plt
 
-    contact = sol.contact_forces
-    per_leg = [np.stack([contact[:, sol.contact_legs == leg, axis].sum(axis=1) for leg in (0, 1)],
-                        axis=1) for axis in (1, 0)]
-    rows = [("vertical", stride_from_left_touchdown(sol, values=per_leg[0]) / sol.body_weight_N,
-             None if trial is None else trial.vertical_grf_bw),
-            ("horizontal", stride_from_left_touchdown(sol, values=per_leg[1]) / sol.body_weight_N,
-             None if trial is None else trial.horizontal_grf_bw)]
+    rows = [(name, stride_from_left_touchdown(sol, values=force) / sol.body_weight_N, meas)
+            for name, force, meas in (
+                ("vertical", sol.leg_vertical_force(),
+                 None if trial is None else trial.vertical_grf_bw),
+                ("horizontal", sol.leg_horizontal_force(),
+                 None if trial is None else trial.horizontal_grf_bw))]
     measured = any(m is not None for *_, m in rows)
     fig, axes = plt.subplots(2, 2 if measured else 1, figsize=(11 if measured else 7, 6.2),
                              squeeze=False)

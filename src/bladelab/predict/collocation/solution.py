@@ -262,8 +262,16 @@ class CollocationSolution:
 
     def leg_vertical_force(self) -> np.ndarray:
         """(n + 1, 2) vertical ground force of legs 0 and 1 at the nodes [N]."""
-        fz = self.contact_forces[:, :, 1]
-        return np.stack([fz[:, self.contact_legs == leg].sum(axis=1) for leg in (0, 1)], axis=1)
+        return self._leg_force(1)
+
+    def leg_horizontal_force(self) -> np.ndarray:
+        """(n + 1, 2) horizontal (friction, forward positive) ground force of legs 0 and 1 at
+        the nodes [N]."""
+        return self._leg_force(0)
+
+    def _leg_force(self, axis: int) -> np.ndarray:
+        f = self.contact_forces[:, :, axis]
+        return np.stack([f[:, self.contact_legs == leg].sum(axis=1) for leg in (0, 1)], axis=1)
 
     def contact_phases(self, threshold_n: float = CONTACT_THRESHOLD_N) -> dict:
         """Per leg: stance time [s] (the longest loaded stretch of the periodic stride),

@@ -22,7 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from bladelab.predict.collocation.model import build_collocation_model
-from bladelab.predict.collocation.nodes import evaluate_nodes
+from bladelab.predict.collocation.nodes import evaluate_nodes, periodic_runs
 from bladelab.predict.collocation.solution import CONTACT_THRESHOLD_N
 from bladelab.predict.collocation.stored import runner_from_spec
 
@@ -84,24 +84,26 @@ def touchdown_slides(solution, runner=None, cm=None) -> tuple[list[TouchdownSlid
     n = nodes["forces"].shape[0] - 1  # the last node repeats the first
     forces, speed = nodes["forces"][:n], nodes["point_velocities"][:n, :, 0]
     h = solution.period_s / n
+    fx_legs = solution.leg_horizontal_force()[:n]
+    loaded_legs = solution.leg_vertical_force()[:n] > CONTACT_THRESHOLD_N
     slides, work = [], {}
     for j, leg in enumerate(solution.leg_names):
         rows = np.flatnonzero(np.asarray(solution.contact_legs) == j)
-        fx = forces[:, rows, 0].sum(axis=1)
         work[leg] = float(-h * (forces[:, rows, 0] * speed[:, rows]).sum())
-        loaded = forces[:, rows, 1].sum(axis=1) > CONTACT_THRESHOLD_N
-
-        def moving(k, rows_=rows):  # the fastest loaded contact's speed at node k [m/s]
-            c = _fastest_loaded(forces, speed, rows_, k % n)
-            return 0.0 if c < 0 else abs(float(speed[k % n, c]))
-
-        for k0 in (k for k in range(n) if loaded[k] and not loaded[k - 1]):
+        fastest = [_fastest_loaded(forces, speed, rows, k) for k in range(n)]
+        # the fastest loaded contact's speed at each node [m/s] (0 where none is loaded)
+        moving = np.array([abs(float(speed[k, c])) if c >= 0 else 0.0
+                           for k, c in enumerate(fastest)])
+        loaded = loaded_legs[:, j]
+        touchdowns = [] if loaded.all() else sorted(k for k, _ in periodic_runs(loaded))
+        for k0 in touchdowns:
             steps, dist, braking = 0, 0.0, 0.0
-            while steps < n and moving(k0 + steps) >= STICK_SPEED_MPS:
-                dist += 0.5 * h * (moving(k0 + steps) + moving(k0 + steps + 1))
-                braking = min(braking, float(fx[(k0 + steps) % n]) / solution.body_weight_N)
+            while steps < n and moving[(k0 + steps) % n] >= STICK_SPEED_MPS:
+                k = (k0 + steps) % n
+                dist += 0.5 * h * (moving[k] + moving[(k + 1) % n])
+                braking = min(braking, float(fx_legs[k, j]) / solution.body_weight_N)
                 steps += 1
-            first = _fastest_loaded(forces, speed, rows, k0)
+            first = fastest[k0]
             slides.append(TouchdownSlide(
                 leg=leg, node=int(k0), speed_mps=float(speed[k0, first]) if first >= 0 else 0.0,
                 slide_ms=1e3 * h * steps, slide_mm=1e3 * dist, braking_bw=braking))
