@@ -27,7 +27,10 @@ library had one, i.e. at 0); ``tracking_tol``: IPOPT's ``tol`` of the tracking s
 ``acceptable_obj_change_tol`` (the stall stop's 1e-5 otherwise); ``tracking_options``: IPOPT
 options of the tracking stage alone (e.g. ``{"ipopt.acceptable_constr_viol_tol": 1e-3}``);
 ``speed``: the prescribed
-speed [m/s] instead of 3.5 (able) or 4 (amputee).
+speed [m/s] instead of 3.5 (able) or 4 (amputee); ``tracking_mesh``: the tracking stage
+solved on that many intervals (the template resampled to it), its solution resampled to the
+50 intervals of the predictive stage, which starts from it cold (its primal values, no
+multipliers, the predictive stage's own options), people's reference phase taken from it.
 Solves on 50 intervals from the template, tracking then predictive stage, as
 ``bench_collocation.py``'s template row, and appends one line to RECORDS.jsonl: iterations
 per stage, objective, cost of transport [J/(kg·m)], stride time [s], gait warnings, wall
@@ -136,6 +139,39 @@ def _tracking_stop(tol: float | None, options: dict) -> None:
     solve._solve_stage = loosened
 
 
+class _Tracked(Exception):
+    pass
+
+
+def _coarse_tracking(runner, settings, guess, spec, n_track: int):
+    """The tracking stage on ``n_track`` intervals, then the predictive stage on the
+    settings' mesh from it (module docstring, ``tracking_mesh``)."""
+    from bladelab.predict.collocation import solve
+
+    stage_solve, held = solve._solve_stage, {}
+
+    def stop_after_tracking(nlp, x0, settings_, stage, progress, **kw):
+        if stage != "tracking":
+            raise _Tracked
+        held["sol"] = sol_t = stage_solve(nlp, x0, settings_, stage, progress, **kw)
+        held["info"] = solve._stage_info(sol_t)
+        return sol_t
+
+    solve._solve_stage = stop_after_tracking
+    try:
+        coarse = dataclasses.replace(settings, mesh_intervals=n_track)
+        predict_stride(runner, coarse, guess.resample(n_track), model_spec=spec)
+    except _Tracked:
+        pass
+    finally:
+        solve._solve_stage = stage_solve
+    start = dataclasses.replace(held["sol"].to_guess(f"tracking stage on {n_track} intervals"),
+                                multipliers=None)
+    sol = predict_stride(runner, settings, start.resample(settings.mesh_intervals),
+                         model_spec=spec, track=False)
+    return dataclasses.replace(sol, tracking=held["info"])
+
+
 def main() -> None:
     out, variant = sys.argv[1], json.loads(sys.argv[2])
     blade = variant.get("blade")
@@ -163,7 +199,10 @@ def main() -> None:
         _tracking_stop(variant.get("tracking_tol"), options)
     t0 = time.perf_counter()
     spec = {"model": runner.kind, "body": "human"} | ({"blade": blade} if blade else {})
-    sol = predict_stride(runner, settings, guess, model_spec=spec)
+    if variant.get("tracking_mesh"):
+        sol = _coarse_tracking(runner, settings, guess, spec, int(variant["tracking_mesh"]))
+    else:
+        sol = predict_stride(runner, settings, guess, model_spec=spec)
     record = {"variant": variant, "converged": sol.converged,
               "tracking_iterations": (sol.tracking or {}).get("iterations"),
               "predictive_iterations": sol.nlp.iterations,
