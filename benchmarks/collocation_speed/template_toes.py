@@ -30,7 +30,8 @@ options of the tracking stage alone (e.g. ``{"ipopt.acceptable_constr_viol_tol":
 speed [m/s] instead of 3.5 (able) or 4 (amputee); ``tracking_mesh``: the tracking stage
 solved on that many intervals (the template resampled to it), its solution resampled to the
 50 intervals of the predictive stage, which starts from it cold (its primal values, no
-multipliers, the predictive stage's own options), people's reference phase taken from it.
+multipliers, the predictive stage's own options), people's reference phase taken from it; ``settings``: further ``CollocationSettings`` fields
+(e.g. ``{"tracking_weight": 30}``, the tracking stage's weight of the template's angles).
 Solves on 50 intervals from the template, tracking then predictive stage, as
 ``bench_collocation.py``'s template row, and appends one line to RECORDS.jsonl: iterations
 per stage, objective, cost of transport [J/(kg·m)], stride time [s], gait warnings, wall
@@ -180,7 +181,8 @@ def main() -> None:
     people = (people_settings("human", kind=runner.kind) if variant.get("swing_knee")
               else people_term(defaults.people_weight_for("human")))
     settings = CollocationSettings(mesh_intervals=MESH, speed_m_per_s=speed,
-                                   swing_clearance_m=float(variant.get("clearance", 0.0)), **people)
+                                   swing_clearance_m=float(variant.get("clearance", 0.0)),
+                                   **people, **variant.get("settings", {}))
     guess = _template(runner, speed, variant.get("toes", "hinge"))
     if variant.get("jitter") is not None:
         q = guess.q + np.random.default_rng(int(variant["jitter"])).normal(0.0, 1e-6, guess.q.shape)

@@ -24,6 +24,12 @@ the environment: ``BL_RESERVE_W`` (weight of its mean square per 100 N·m in the
 ``BL_RESERVE_BOUND`` (|reserve| ≤ B N·m; 0: no reserve, the passive knee as it is),
 ``BL_RESERVE_ZERO_NODES`` (comma-separated mesh nodes where the bound is 0).
 
+Added on 2026-12-06 (``../transfemoral-gait-2026-12-06/``, with that folder's
+``probe.patch`` applied instead of ``reserve-homotopy.patch``): ``body:FIELD=JSON``, a field of
+the transfemoral parameter set as in from_transtibial.py; ``BL_SM_UPDATE=1`` in the
+environment solves with IPOPT's default L-BFGS update (the library's until that day) instead of
+the library's ``PREDICTIVE_LBFGS_OPTIONS``.
+
 ``measure``: one line of JSON per solution: converged, step phase, peaks, contacts, stride,
 objective and its terms, the reserve (the knee's dynamics residual of the collocation model:
 inverse dynamics − muscle − passive − contact; positive = extension, knee_angle_r being
@@ -57,6 +63,15 @@ def solve(out: str, step_tol: str, *extra: str) -> None:
             for k, v in list(fields.items()) if k.startswith("set:")}
     for k in sets:
         fields.pop("set:" + k)
+    body = {k[5:]: json.loads(v) for k, v in list(fields.items()) if k.startswith("body:")}
+    for k in body:
+        fields.pop("body:" + k)
+    if body:
+        ft.stored.default_runner_params = ft._with_knee({}, body)
+    import os
+    if os.environ.get("BL_SM_UPDATE"):  # IPOPT's default L-BFGS update
+        from bladelab.predict.collocation import solve as _solve
+        _solve.PREDICTIVE_LBFGS_OPTIONS = {}
     assert not fields, fields
     space = ft.default_design_space()
     blade = ft.CollocationEvaluator().blade_spec(space.point([0.0] * len(space.names)))
