@@ -263,21 +263,71 @@ def _stance_peak_places(force: np.ndarray, threshold: float) -> list[float]:
     return places
 
 
+#: Force peak and deepest knee flexion closer than this [% of the stance] count as together.
+KNEE_PEAK_AGREEMENT_PCT = 10.0
+
+
+def _stance_knees(force: np.ndarray, flexion: np.ndarray, threshold: float
+                  ) -> list[tuple[float, float]]:
+    """Per stance (runs of ``force`` above ``threshold``, periodic, n nodes without the repeated
+    last one): the knee's flexion at its first node [deg] and where in it the knee is most
+    flexed [% of the stance's nodes]; ``flexion`` (n,) [deg] of that stance's leg."""
+    out = []
+    for start, length in periodic_runs(force > threshold):
+        knee = flexion[(start + np.arange(length)) % force.size]
+        out.append((float(knee[0]), 100.0 * float(np.argmax(knee)) / length))
+    return out
+
+
+def _knee_flexion_deg(q: np.ndarray, dof_names, side: str) -> np.ndarray | None:
+    """The knee's flexion [deg, positive flexed] of leg ``side`` ('l' or 'r'), None without."""
+    name = f"knee_angle_{side}"
+    return None if name not in dof_names else -np.degrees(q[:, list(dof_names).index(name)])
+
+
 def _peak_place_text(sol, trial) -> str:
-    """Where in stance the vertical force peaks, this stride's against the measured stride's,
-    in words ('' without a measured force)."""
+    """Where in stance the vertical force peaks, and where the stance knee is most flexed and
+    how flexed it lands, this stride's against the measured stride's, in words ('' without a
+    measured force)."""
     if trial is None or trial.vertical_grf_bw is None:
         return ""
     threshold = CONTACT_THRESHOLD_N / sol.body_weight_N
     fz = sol.leg_vertical_force()[:-1] / sol.body_weight_N
+    total = np.asarray(trial.vertical_grf_bw)[:-1]
     ours = [p for j in range(fz.shape[1]) for p in _stance_peak_places(fz[:, j], threshold)]
-    measured = _stance_peak_places(np.asarray(trial.vertical_grf_bw)[:-1], threshold)
+    measured = _stance_peak_places(total, threshold)
     if not ours or not measured:
         return ""
-    return (" Each stance's vertical force peaks at "
+    text = (" Each stance's vertical force peaks at "
             + ", ".join(f"{p:.0f}" for p in ours) + " % of its nodes here, the measured "
             "runner's at " + ", ".join(f"{p:.0f}" for p in measured) + " % (no criterion "
-            "checks it; docs/collocation.md, 'How a foot lands').")
+            "checks it).")
+    q = np.asarray(sol.nlp.q)[:-1]
+    knees = [k for j, side in enumerate("lr")
+             if (flex := _knee_flexion_deg(q, sol.dof_names, side)) is not None
+             for k in _stance_knees(fz[:, j], flex, threshold)]
+    legs = [_knee_flexion_deg(np.asarray(trial.q)[:-1], trial.dof_names or sol.dof_names, side)
+            for side in "lr"]
+    theirs = []
+    if knees and all(leg is not None for leg in legs):
+        # the stance leg of each measured stance (total force): the one whose knee is the
+        # straighter over it (the other swings)
+        for start, length in periodic_runs(total > threshold):
+            nodes = (start + np.arange(length)) % total.size
+            leg = legs[int(np.argmin([flex[nodes].mean() for flex in legs]))]
+            theirs.append((float(leg[nodes[0]]), 100.0 * float(np.argmax(leg[nodes])) / length))
+    if knees and theirs:
+        text += (" The stance knee lands at " + ", ".join(f"{k[0]:.0f}" for k in knees)
+                 + "° of flexion and is most flexed at " + ", ".join(f"{k[1]:.0f}" for k in knees)
+                 + " % of the stance here, the measured runner's lands at "
+                 + ", ".join(f"{k[0]:.0f}" for k in theirs) + "° and is most flexed at "
+                 + ", ".join(f"{k[1]:.0f}" for k in theirs) + " %")
+        together = len(knees) == len(ours) and all(
+            abs(p - k[1]) <= KNEE_PEAK_AGREEMENT_PCT for p, k in zip(ours, knees, strict=True))
+        text += (": here as in the measured runner the force peaks about where the knee is most "
+                 "flexed, so a landing with the knee more flexed brings the peak earlier."
+                 if together else ".")
+    return text + " (docs/collocation.md, 'How a foot lands'.)"
 
 
 def _touchdown_text(sol, runner, cm, trial) -> str:
