@@ -31,7 +31,8 @@ speed [m/s] instead of 3.5 (able) or 4 (amputee); ``tracking_mesh``: the trackin
 solved on that many intervals (the template resampled to it), its solution resampled to the
 50 intervals of the predictive stage, which starts from it cold (its primal values, no
 multipliers, the predictive stage's own options), people's reference phase taken from it; ``settings``: further ``CollocationSettings`` fields
-(e.g. ``{"tracking_weight": 30}``, the tracking stage's weight of the template's angles).
+(e.g. ``{"tracking_weight": 30}``, the tracking stage's weight of the template's angles);
+``options``: IPOPT options of every stage (e.g. ``{"ipopt.nlp_scaling_max_gradient": 10}``).
 Solves on 50 intervals from the template, tracking then predictive stage, as
 ``bench_collocation.py``'s template row, and appends one line to RECORDS.jsonl: iterations
 per stage, objective, cost of transport [J/(kg·m)], stride time [s], gait warnings, wall
@@ -111,15 +112,16 @@ def _extended_tracking(history: int) -> None:
     solve._solve_stage = extended
 
 
-def _tracking_stop(tol: float | None, options: dict) -> None:
-    """Solve the tracking stage to IPOPT's ``tol`` = ``tol`` (None: as set) and with the IPOPT
-    ``options`` added (e.g. its acceptable level's), the other stages as set."""
+def _tracking_stop(tol: float | None, options: dict, every_stage: bool = False) -> None:
+    """Solve the tracking stage (``every_stage``: every stage) to IPOPT's ``tol`` = ``tol``
+    (None: as set) and with the IPOPT ``options`` added (e.g. its acceptable level's), the
+    other stages as set."""
     from bladelab.predict.collocation import solve
 
     stage_solve = solve._solve_stage
 
     def loosened(nlp, x0, settings, stage, progress, **kw):
-        if stage != "tracking":
+        if stage != "tracking" and not every_stage:
             return stage_solve(nlp, x0, settings, stage, progress, **kw)
         if tol is not None:
             settings = dataclasses.replace(settings, tol=tol)
@@ -199,6 +201,8 @@ def main() -> None:
         options["ipopt.acceptable_obj_change_tol"] = float(variant["tracking_obj_change"])
     if variant.get("tracking_tol") or options:
         _tracking_stop(variant.get("tracking_tol"), options)
+    if variant.get("options"):
+        _tracking_stop(None, dict(variant["options"]), every_stage=True)
     t0 = time.perf_counter()
     spec = {"model": runner.kind, "body": "human"} | ({"blade": blade} if blade else {})
     if variant.get("tracking_mesh"):
