@@ -10,8 +10,11 @@ Prints, per leg of the stride and per stance of the Fukuchi trial's mean stride 
 the vertical force [BW] at 0, 10, …, 100 % of the stance, where it peaks and where half the
 stance's impulse is reached [% of the stance]; the stride's left stance node by node with the
 force of each contact [BW]; and the left leg's knee, hip and ankle angles [deg] over the stance
-with where the knee flexes most. A stance: the nodes where the leg's vertical force exceeds
-0.03 BW.
+with where the knee flexes most; and per stance of both, the centre of mass's drop from
+touch-down to its lowest point [mm] (the total vertical force integrated twice over the periodic
+stride, zero mean vertical speed), where in the stance it is lowest and the vertical stiffness
+k_vert = peak force / drop [BW/m] (McMahon & Cheng 1990). A stance: the nodes where the leg's
+vertical force exceeds 0.03 BW.
 """
 
 from __future__ import annotations
@@ -27,6 +30,7 @@ from bladelab.runner.params import RUNNER_DATA_DIR
 
 SHIPPED = RUNNER_DATA_DIR / "collocation" / "able-3.5-human.json"
 DECILES = np.arange(0, 101, 10)
+GRAVITY = 9.81  # [m/s²], the runner's
 
 
 def stances(force_bw: np.ndarray, threshold: float = 0.03) -> list[list[int]]:
@@ -54,6 +58,28 @@ def force_line(name: str, force: np.ndarray) -> str:
             + " ".join(f"{v:.2f}" for v in on_deciles(force)))
 
 
+def com_height(force_bw: np.ndarray, period_s: float) -> np.ndarray:
+    """The centre of mass's vertical displacement [m] at the nodes of a periodic stride from
+    its total vertical ground force [BW] (n + 1 nodes), up to a constant."""
+    t = np.linspace(0.0, period_s, len(force_bw))
+    accel = GRAVITY * (force_bw - 1.0)
+    speed = np.concatenate([[0.0], np.cumsum(0.5 * (accel[1:] + accel[:-1]) * np.diff(t))])
+    speed -= np.trapezoid(speed, t) / period_s  # a periodic stride neither rises nor sinks
+    return np.concatenate([[0.0], np.cumsum(0.5 * (speed[1:] + speed[:-1]) * np.diff(t))])
+
+
+def com_lines(name: str, force_bw: np.ndarray, period_s: float) -> list[str]:
+    """Per stance of the total force: the centre of mass's drop, where it is lowest, k_vert."""
+    height = com_height(force_bw, period_s)
+    out = []
+    for idx in stances(force_bw):
+        drop = height[idx[0]] - height[idx].min()
+        out.append(f"{name}: peak {force_bw[idx].max():.2f} BW, centre of mass drops "
+                   f"{1000 * drop:.0f} mm, lowest at {100 * np.argmin(height[idx]) / len(idx):.0f} "
+                   f"% of the stance, k_vert {force_bw[idx].max() / drop:.0f} BW/m")
+    return out
+
+
 def main() -> None:
     sol = CollocationSolution.read(sys.argv[1] if len(sys.argv) > 1 else SHIPPED)
     runner = stored.runner_from_spec(sol.model_spec)
@@ -73,6 +99,10 @@ def main() -> None:
           + ", ".join(runner.contact_names[c] for c in left) + " [BW]")
     for k in idx:
         print(f"  {k:3d} {fz[k, 0]:.2f}  " + " ".join(f"{v:.2f}" for v in per_contact[k]))
+
+    for line in (com_lines("model", fz.sum(axis=1), sol.period_s)
+                 + com_lines("people", total, people.period)):
+        print(line)
 
     names, people_names = list(sol.dof_names), list(people.dof_names or runner.dof_names)
     # the trial's left stance: the one of its two (total force) where the left knee is the
