@@ -120,6 +120,58 @@ def test_force_rate_term_is_its_stated_integral():
     assert sol.objective_terms["force_rate"] == pytest.approx(expected, rel=1e-9)
 
 
+def test_passive_term_counts_the_body_s_joint_limits_alone():
+    """StrideWeights.passive: Σ_j τ_j² / n_j / 100 over the body's own joints' limit torques
+    (ligaments, hip capsule), integrated with the trapezoidal rule over the stride time; the
+    joint springs (the lumbar's, the toes') and a prosthesis's joints are not counted."""
+    from bladelab.predict.collocation import build_collocation_model
+    from bladelab.predict.collocation.dynamics import body_joints, stride_dynamics
+    from bladelab.predict.collocation.guess import template_guess
+    from bladelab.predict.collocation.transcription import PASSIVE_TORQUE_SCALE, StrideWeights
+    from bladelab.runner import build_runner
+    from bladelab.runner.layout import JP_EA, JP_EB
+    from bladelab.runner.params import default_runner_params
+
+    runner = build_runner(default_runner_params("able", body="human"))
+    cm = build_collocation_model(runner)
+    dyn = stride_dynamics(cm)
+    joints = body_joints(runner)
+    assert "mtp_angle_l" in joints and "lumbar_extension" in joints
+    n, speed = 8, 3.5
+    nlp = StrideNLP(dyn, n=n, speed=speed, weights=StrideWeights(passive=2.0))
+    lbx, ubx, lbg, ubg = nlp.bounds()
+    sol = nlp.unpack(nlp.initial_vector(template_guess(runner, speed=speed, n=n)), {}, 0.0, 0.0,
+                     lbg, ubg, np.zeros(lbg.size))
+    tau = np.array([np.asarray(dyn.passive_joint_torques(sol.q[k], sol.qd[k])).ravel()
+                    for k in range(n + 1)])
+    per_node = np.sum(tau**2, axis=1) / len(joints) / PASSIVE_TORQUE_SCALE
+    h = sol.period / n
+    expected = 2.0 * np.sum((per_node[:-1] + per_node[1:]) / 2 * h) / sol.period
+    assert expected > 0.0
+    assert sol.objective_terms["passive"] == pytest.approx(expected, rel=1e-9)
+    # within the hip's range the torque is the capsule's closed form a·exp(b·q)
+    hip = runner.dof("hip_flexion_l")
+    row = runner.joint_params[hip]
+    capsule = row[JP_EA] * np.exp(row[JP_EB] * sol.q[:, hip])
+    np.testing.assert_allclose(tau[:, joints.index("hip_flexion_l")], capsule, rtol=1e-6)
+    # the lumbar's spring bends the trunk back, but is not a limit: not counted
+    q = sol.q[0].copy()
+    q[runner.dof("lumbar_extension")] += 0.05
+    lumbar = runner.dof("lumbar_extension")
+    assert abs(float(np.asarray(cm.passive(q, sol.qd[0])).ravel()[lumbar])) > 10.0
+    assert abs(np.asarray(dyn.passive_joint_torques(q, sol.qd[0])).ravel()[
+        joints.index("lumbar_extension")]) < 1.0
+    # a knee hyperextended past its ligament is
+    q[runner.dof("knee_angle_l")] = 0.2
+    assert abs(np.asarray(dyn.passive_joint_torques(q, sol.qd[0])).ravel()[
+        joints.index("knee_angle_l")]) > 10.0
+    # a prosthesis's joints are devices
+    tf = build_runner(default_runner_params("transfemoral", body="human"))
+    assert "knee_angle_r" in tf.dof_names and "knee_angle_r" not in body_joints(tf)
+    tt = build_runner(default_runner_params("amputee", body="human", blade="Cat6"))
+    assert "ankle_angle_r" not in body_joints(tt) and "knee_angle_r" in body_joints(tt)
+
+
 def test_one_built_solver_serves_every_speed():
     """The speed is a parameter: an NLP built at 2 m/s and solved at 2.5 m/s gives the same
     solution as one built at 2.5 m/s, and its solver is built only once."""

@@ -133,9 +133,11 @@ def contact_forces(
     return ca.vertcat(*forces), ca.vertcat(*points), gen
 
 
-def passive_torques(q: ca.SX, qd: ca.SX, joint_params: np.ndarray, smoothing: Smoothing) -> ca.SX:
+def passive_torques(q: ca.SX, qd: ca.SX, joint_params: np.ndarray, smoothing: Smoothing,
+                    *, limits_only: bool = False) -> ca.SX:
     """Smooth ligament, socket (blade-joint) and capsule torques (nv,) [N·m] at (q [rad],
-    qd [rad/s])."""
+    qd [rad/s]); ``limits_only``: the ligaments' and the capsule's alone (the joints' limits),
+    without the joint springs and dampers."""
     eps_t = smoothing.ligament_torque_nm
     eps_s = smoothing.socket_angle_rad
     out = []
@@ -150,7 +152,7 @@ def passive_torques(q: ca.SX, qd: ca.SX, joint_params: np.ndarray, smoothing: Sm
             if math.isfinite(row[JP_LO]):
                 e = float(row[JP_LO]) - q[j]
                 tau += smooth_max0(k * softplus(e, w) - d * qd[j] * sigmoid(e, w), eps_t)
-        if row[JP_SK] != 0.0 or row[JP_SD] != 0.0 or row[JP_SDX] != 0.0:
+        if not limits_only and (row[JP_SK] != 0.0 or row[JP_SD] != 0.0 or row[JP_SDX] != 0.0):
             absq = ca.sqrt(q[j] * q[j] + eps_s * eps_s)
             tau -= float(row[JP_SK]) * q[j] + float(row[JP_SK2]) * q[j] * absq
             d_neg, d_pos = float(row[JP_SD]), float(row[JP_SDX])

@@ -16,7 +16,7 @@ import casadi as ca
 import numpy as np
 
 from bladelab.errors import SpecError
-from bladelab.predict.collocation.contact import contact_kinematics
+from bladelab.predict.collocation.contact import contact_kinematics, passive_torques
 from bladelab.predict.collocation.metabolics import (
     MetabolicSmoothing,
     muscle_metabolic_rates,
@@ -150,6 +150,22 @@ def knee_straight_while_loaded(cm: CollocationModel, q: ca.SX, qd: ca.SX,
             * (q[runner.dof("knee_angle_r")] + float(max_flexion_rad)))
 
 
+#: The body's own joints whose limit torques :attr:`StrideWeights.passive` counts.
+BODY_JOINTS = ("hip_flexion_l", "hip_flexion_r", "knee_angle_l", "knee_angle_r",
+               "ankle_angle_l", "ankle_angle_r", "mtp_angle_l", "mtp_angle_r",
+               "lumbar_extension")
+
+
+def body_joints(runner) -> list[str]:
+    """The coordinates of :data:`BODY_JOINTS` that ``runner`` has as its own joints: an
+    amputee's prosthetic ankle (its blade) and a transfemoral runner's prosthetic knee are
+    devices, not counted."""
+    names = [n for n in BODY_JOINTS if n in runner.dof_names]
+    if runner.kind == "transfemoral":
+        names.remove("knee_angle_r")
+    return names
+
+
 def stride_dynamics(cm: CollocationModel, *, metabolic: MetabolicSmoothing | None = None,
                     swing_clearance_m: float = 0.0,
                     knee_moment_min_nm: float | None = None,
@@ -207,6 +223,10 @@ def stride_dynamics(cm: CollocationModel, *, metabolic: MetabolicSmoothing | Non
         metabolic_rate=ca.Function("metabolic_rate", [q, qd, a, ft, dft, u], [met]),
         muscle_metabolic_rates=ca.Function("muscle_metabolic_rates", [q, qd, a, ft, dft, u],
                                            [rates]),
+        passive_joint_torques=ca.Function(
+            "passive_joint_torques", [q, qd],
+            [passive_torques(q, qd, runner.joint_params, cm.smoothing, limits_only=True)[
+                [runner.dof(n) for n in body_joints(runner)]]]),
         q_bounds=q_b,
         qd_bounds=qd_b,
         residual_scale=scale,

@@ -10,9 +10,12 @@ from dataclasses import asdict, dataclass
 import casadi as ca
 import numpy as np
 
-__all__ = ["FORCE_RATE_SCALE", "METABOLIC_SQUARED_SCALE", "StrideDynamics", "StrideWeights",
+__all__ = ["FORCE_RATE_SCALE", "METABOLIC_SQUARED_SCALE", "PASSIVE_TORQUE_SCALE", "StrideDynamics",
+           "StrideWeights",
            "VariableScales"]
 
+#: Scale of :attr:`StrideWeights.passive` [(N·m)²]: a joint's 10 N·m counts 1.
+PASSIVE_TORQUE_SCALE = 100.0
 #: Scale of :attr:`StrideWeights.force_rate` [(1/s)²].
 FORCE_RATE_SCALE = 100.0
 #: Scale of :attr:`StrideWeights.metabolic_squared` [(W/kg)²·s/m].
@@ -57,6 +60,9 @@ class StrideDynamics:
     muscle_metabolic_rates
         Optional CasADi Function (q, q̇, a, F̃ₜ, dF̃ₜ/dt, e) -> metabolic rate of every muscle
         [W] (for :attr:`StrideWeights.metabolic_squared`).
+    passive_joint_torques
+        Optional CasADi Function (q, q̇) -> the limit torques of the body's own joints [N·m]
+        (their ligaments and the hip capsule; for :attr:`StrideWeights.passive`).
     backward_euler_dofs
         Coordinates whose q and q̇ defects use the backward Euler rule
         ``x_{k+1} − x_k − h·ẋ_{k+1}`` instead of the trapezoidal one: stiff subsystems whose
@@ -88,6 +94,7 @@ class StrideDynamics:
     static_tendon_force: Callable[[np.ndarray, np.ndarray], np.ndarray] | None = None
     vertical_grf: ca.Function | None = None
     muscle_metabolic_rates: ca.Function | None = None
+    passive_joint_torques: ca.Function | None = None
     leg_vertical_grf: ca.Function | None = None
     backward_euler_dofs: tuple[str, ...] = ()
     interval_mean_inequalities: tuple[int, ...] = ()
@@ -134,6 +141,12 @@ class StrideWeights:
         in (1/s)² / 100 (a muscle going from 0 to F_max in 0.1 s counts 1): the cost of
         rapid force development (Doke & Kuo 2007; van der Zee & Kuo 2021), which the energy
         models leave out; PredSim keeps a small weight on the same controls as a regulariser.
+    passive
+        Time-averaged mean squared limit torque of the body's own joints (hip, knee, ankle,
+        toes, lumbar: their ligaments and the hip capsule, not the joint springs and dampers;
+        not a prosthesis's joints), in (N·m)² / 100: PredSim's passive-torque term (Falisse et
+        al. 2019, ``passMom``), which keeps the joints off their limits. Off by default
+        (docs/collocation.md, "The stride NLP").
     """
 
     metabolic: float = 1.0
@@ -143,6 +156,7 @@ class StrideWeights:
     speed: float = 1.0
     metabolic_squared: float = 0.0
     force_rate: float = 0.0
+    passive: float = 0.0
 
     def to_dict(self) -> dict[str, float]:
         return asdict(self)

@@ -52,6 +52,7 @@ from bladelab.predict.collocation.stride_guess import (
 from bladelab.predict.collocation.stride_problem import (
     FORCE_RATE_SCALE,
     METABOLIC_SQUARED_SCALE,
+    PASSIVE_TORQUE_SCALE,
     StrideDynamics,
     StrideWeights,
     VariableScales,
@@ -397,8 +398,16 @@ class StrideNLP:
         else:
             met_sq = ca.SX(0.0)
         frate = ca.sumsqr(dfnt) / max(nm, 1) / FORCE_RATE_SCALE
+        if w.passive:
+            if d.passive_joint_torques is None:
+                raise SpecError("the passive-torque term needs the joints' passive torques",
+                                where="weights", hint="build the dynamics with stride_dynamics")
+            tau_p = d.passive_joint_torques(q, qd)
+            passive = ca.sumsqr(tau_p) / max(int(tau_p.numel()), 1) / PASSIVE_TORQUE_SCALE
+        else:
+            passive = ca.SX(0.0)
         node = ca.Function("node", [xs, us],
-                           [xdot_scaled, path, effort, met, ineq, fz, met_sq, frate])
+                           [xdot_scaled, path, effort, met, ineq, fz, met_sq, frate, passive])
         self.node = node  # one node's functions (SX), mapped over the mesh below
         t0 = time.perf_counter()
         external = compiled_node(node) if self._compile else None
@@ -415,7 +424,7 @@ class StrideNLP:
         P = ca.MX.sym("speed")
         period = T * s.period
         h = period / n
-        xdot, pth, eff, mets, ineqs, fzs, met_sqs, frates = fmap(X, U)
+        xdot, pth, eff, mets, ineqs, fzs, met_sqs, frates, passives = fmap(X, U)
         # θ-rule per state: ½ trapezoidal, 1 backward Euler (StrideDynamics.backward_euler_dofs)
         theta = np.full(self.nx, 0.5)
         for name in d.backward_euler_dofs:
@@ -459,6 +468,8 @@ class StrideNLP:
             terms["metabolic_squared"] = w.metabolic_squared * sq / ca.fmax(distance, 1e-3)
         if w.force_rate:
             terms["force_rate"] = w.force_rate * _node_pairs(frates) / 2 * h / period
+        if w.passive:
+            terms["passive"] = w.passive * _node_pairs(passives) / 2 * h / period
         if self.speed is not None:
             g.append(distance - P * period)
             self._g_names.append("speed")
