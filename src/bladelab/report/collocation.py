@@ -253,14 +253,21 @@ def _mesh_check_text(check) -> str:
     return f" {check.verdict()}."
 
 
+def _stance_nodes(force: np.ndarray, threshold: float) -> list[np.ndarray]:
+    """The node indices of each stance (run above ``threshold``) of a periodic force (n nodes
+    of one period, without the repeated last one), in order, a stance across the end wrapped."""
+    return [(start + np.arange(length)) % force.size
+            for start, length in periodic_runs(force > threshold)]
+
+
+def _place_pct(values: np.ndarray) -> float:
+    """Where ``values`` (over one stance's nodes) is largest [% of the stance's nodes]."""
+    return 100.0 * float(np.argmax(values)) / len(values)
+
+
 def _stance_peak_places(force: np.ndarray, threshold: float) -> list[float]:
-    """Where each stance's force peaks [% of the stance's nodes], for the stances (runs above
-    ``threshold``) of a periodic force (n nodes of one period, without the repeated last one)."""
-    places = []
-    for start, length in periodic_runs(force > threshold):
-        stance = force[(start + np.arange(length)) % force.size]
-        places.append(100.0 * float(np.argmax(stance)) / length)
-    return places
+    """Where each stance's force peaks [% of the stance's nodes] (:func:`_stance_nodes`)."""
+    return [_place_pct(force[nodes]) for nodes in _stance_nodes(force, threshold)]
 
 
 #: Force peak and deepest knee flexion closer than this [% of the stance] count as together.
@@ -272,11 +279,8 @@ def _stance_knees(force: np.ndarray, flexion: np.ndarray, threshold: float
     """Per stance (runs of ``force`` above ``threshold``, periodic, n nodes without the repeated
     last one): the knee's flexion at its first node [deg] and where in it the knee is most
     flexed [% of the stance's nodes]; ``flexion`` (n,) [deg] of that stance's leg."""
-    out = []
-    for start, length in periodic_runs(force > threshold):
-        knee = flexion[(start + np.arange(length)) % force.size]
-        out.append((float(knee[0]), 100.0 * float(np.argmax(knee)) / length))
-    return out
+    return [(float(flexion[nodes[0]]), _place_pct(flexion[nodes]))
+            for nodes in _stance_nodes(force, threshold)]
 
 
 def _knee_flexion_deg(q: np.ndarray, dof_names, side: str) -> np.ndarray | None:
@@ -312,10 +316,9 @@ def _peak_place_text(sol, trial) -> str:
     if knees and all(leg is not None for leg in legs):
         # the stance leg of each measured stance (total force): the one whose knee is the
         # straighter over it (the other swings)
-        for start, length in periodic_runs(total > threshold):
-            nodes = (start + np.arange(length)) % total.size
+        for nodes in _stance_nodes(total, threshold):
             leg = legs[int(np.argmin([flex[nodes].mean() for flex in legs]))]
-            theirs.append((float(leg[nodes[0]]), 100.0 * float(np.argmax(leg[nodes])) / length))
+            theirs.append((float(leg[nodes[0]]), _place_pct(leg[nodes])))
     if knees and theirs:
         text += (" The stance knee lands at " + ", ".join(f"{k[0]:.0f}" for k in knees)
                  + "° of flexion and is most flexed at " + ", ".join(f"{k[1]:.0f}" for k in knees)
