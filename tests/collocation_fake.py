@@ -11,11 +11,11 @@ import numpy as np
 from bladelab.predict.collocation import build_collocation_model
 from bladelab.predict.collocation.dynamics import stride_dynamics
 from bladelab.predict.collocation.guess import template_guess
+from bladelab.predict.collocation.nlp_solution import NLPSolution
 from bladelab.predict.collocation.settings import CollocationSettings
 from bladelab.predict.collocation.solution import CollocationSolution
 from bladelab.predict.collocation.stored import check_model_spec, model_label
 from bladelab.predict.collocation.stride_guess import periodic_derivative
-from bladelab.predict.collocation.transcription import NLPSolution
 from bladelab.runner import build_runner
 
 SPEED = 3.5  # m/s

@@ -56,7 +56,8 @@ from bladelab.runner.muscle import (
     tendon_force,
     tendon_force_of_state,
 )
-from bladelab.runner.params import ArchSpring, athlete_params, default_runner_params
+from bladelab.runner.params import ArchSpring, default_runner_params
+from bladelab.runner.scaling import athlete_params
 
 N_STATES = 20
 KINDS = ("able", "amputee-Cat6", "able-toes", "transfemoral", "able-human", "amputee-human",

@@ -21,6 +21,7 @@ from bladelab.predict.collocation.consistency import (
 from bladelab.predict.collocation.continuation import max_speed_settings
 from bladelab.predict.collocation.guess import measured_trial_guess, template_guess
 from bladelab.predict.collocation.human_running import human_running_criteria
+from bladelab.predict.collocation.ipopt_options import PREDICTIVE_LBFGS_OPTIONS
 from bladelab.predict.collocation.running_bands import reference_band
 from bladelab.predict.collocation.settings import CollocationSettings, people_term
 from bladelab.predict.collocation.solution import (
@@ -30,7 +31,7 @@ from bladelab.predict.collocation.solution import (
     CollocationSolution,
 )
 from bladelab.predict.collocation.solve import SolveProgress, predict_stride
-from bladelab.predict.collocation.transcription import PREDICTIVE_LBFGS_OPTIONS, StrideWeights
+from bladelab.predict.collocation.stride_problem import StrideWeights
 from bladelab.runner.params import RUNNER_DATA_DIR
 from collocation_fake import SPEED, fake_solution
 

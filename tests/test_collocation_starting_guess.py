@@ -41,7 +41,7 @@ def test_stored_is_the_shipped_stride_of_the_human_body(kind, blade):
 def test_another_athlete_of_the_human_body_starts_from_its_stored_stride():
     """Mass, height, muscle strength, the fibres' velocity and the residual limb scale the same
     body: its shipped stride is the start."""
-    from bladelab.runner.params import athlete_params
+    from bladelab.runner.scaling import athlete_params
 
     params = athlete_params(default_runner_params("amputee", blade="Cat5", body="human"),
                             body_mass_kg=64.0, height_m=1.70, muscle_strength=1.3,

@@ -9,12 +9,9 @@ import numpy as np
 import pytest
 
 from bladelab.errors import SpecError
-from bladelab.predict.collocation import transcription
-from bladelab.predict.collocation.transcription import (
-    StrideNLP,
-    alternation_rows,
-    step_phase,
-)
+from bladelab.predict.collocation import ipopt_options
+from bladelab.predict.collocation.alternating_steps import alternation_rows, step_phase
+from bladelab.predict.collocation.transcription import StrideNLP
 from toy_stride import G, K, M, bouncing_guess, toy_dynamics
 
 
@@ -50,7 +47,7 @@ def test_bad_settings_are_refused():
 
 def test_an_objective_of_one_term_unpacks():
     """Effort alone (metabolic weight 0): the solution still names its one term."""
-    from bladelab.predict.collocation.transcription import StrideWeights
+    from bladelab.predict.collocation.stride_problem import StrideWeights
 
     nlp = StrideNLP(toy_dynamics(), n=10, speed=2.0, weights=StrideWeights(metabolic=0.0), compiled=False)
     sol = nlp.solve(nlp.initial_vector(bouncing_guess(10, 2.0)), hessian="exact", max_iter=5)
@@ -65,7 +62,7 @@ def test_squared_muscle_metabolic_rates_term_is_its_stated_integral():
     from bladelab.predict.collocation import build_collocation_model
     from bladelab.predict.collocation.dynamics import stride_dynamics
     from bladelab.predict.collocation.guess import template_guess
-    from bladelab.predict.collocation.transcription import (
+    from bladelab.predict.collocation.stride_problem import (
         METABOLIC_SQUARED_SCALE,
         StrideWeights,
     )
@@ -100,7 +97,7 @@ def test_force_rate_term_is_its_stated_integral():
     from bladelab.predict.collocation import build_collocation_model
     from bladelab.predict.collocation.dynamics import stride_dynamics
     from bladelab.predict.collocation.guess import template_guess
-    from bladelab.predict.collocation.transcription import StrideWeights
+    from bladelab.predict.collocation.stride_problem import StrideWeights
     from bladelab.runner import build_runner
 
     runner = build_runner("able")
@@ -127,7 +124,7 @@ def test_passive_term_counts_the_body_s_joint_limits_alone():
     from bladelab.predict.collocation import build_collocation_model
     from bladelab.predict.collocation.dynamics import body_joints, stride_dynamics
     from bladelab.predict.collocation.guess import template_guess
-    from bladelab.predict.collocation.transcription import PASSIVE_TORQUE_SCALE, StrideWeights
+    from bladelab.predict.collocation.stride_problem import PASSIVE_TORQUE_SCALE, StrideWeights
     from bladelab.runner import build_runner
     from bladelab.runner.layout import JP_EA, JP_EB
     from bladelab.runner.params import default_runner_params
@@ -340,7 +337,7 @@ def test_the_maximum_speed_problem_keeps_at_least_the_speed_it_is_given():
     """The maximum-speed NLP has one inequality the prescribed-speed NLP lacks: the stride's
     mean speed at least the solve's ``speed`` parameter (distance − P·T ≥ 0); a 2 m/s stride
     meets a 1.5 m/s floor and violates a 2.5 m/s one."""
-    from bladelab.predict.collocation.transcription import StrideWeights
+    from bladelab.predict.collocation.stride_problem import StrideWeights
 
     fastest = StrideNLP(toy_dynamics(), n=10, speed=None,
                         weights=StrideWeights(metabolic=0.0, speed=1.0))
@@ -365,7 +362,7 @@ def test_a_stride_time_band_that_moves_with_the_speed(band, low, high):
     """The maximum-speed NLP with a period band: rows T − lo(v) >= 0 and T − hi(v) <= 0 at the
     stride's own speed v = d/T (linear between the anchors, constant outside); refused with a
     prescribed speed or a malformed band."""
-    from bladelab.predict.collocation.transcription import StrideWeights
+    from bladelab.predict.collocation.stride_problem import StrideWeights
 
     nlp = StrideNLP(toy_dynamics(), n=10, speed=None, period_band=band,
                     weights=StrideWeights(metabolic=0.0, speed=1.0))
@@ -470,12 +467,12 @@ def test_an_lbfgs_solve_stops_where_its_objective_stalls_near_the_full_solution(
     stopped = nlp.solve(nlp.initial_vector(guess), speed=2.2, multipliers=lam)
     keys = [dict(key) for key in nlp._solvers]
     assert len(keys) == 2 and all("ipopt.acceptable_iter" in k for k in keys)
-    saved = dict(transcription.STALL_STOP_OPTIONS)
-    transcription.STALL_STOP_OPTIONS.clear()
+    saved = dict(ipopt_options.STALL_STOP_OPTIONS)
+    ipopt_options.STALL_STOP_OPTIONS.clear()
     try:
         full = nlp.solve(nlp.initial_vector(guess), speed=2.2, multipliers=lam)
     finally:
-        transcription.STALL_STOP_OPTIONS.update(saved)
+        ipopt_options.STALL_STOP_OPTIONS.update(saved)
     assert stopped.success and full.success, (stopped.status, full.status)
     assert stopped.speed == pytest.approx(2.2, rel=1e-6)
     assert stopped.max_violation < 1e-4
@@ -483,7 +480,7 @@ def test_an_lbfgs_solve_stops_where_its_objective_stalls_near_the_full_solution(
     assert stopped.objective == pytest.approx(full.objective, rel=1e-3)
     # the predictive stages' L-BFGS update inside the augmented system: the same optimum
     extended = nlp.solve(nlp.initial_vector(guess), speed=2.2, multipliers=lam,
-                         options=transcription.PREDICTIVE_LBFGS_OPTIONS)
+                         options=ipopt_options.PREDICTIVE_LBFGS_OPTIONS)
     assert extended.success and extended.max_violation < 1e-4
     assert extended.objective == pytest.approx(full.objective, rel=1e-3)
     exact = nlp.solve(nlp.initial_vector(guess), speed=2.2, multipliers=lam, hessian="exact")

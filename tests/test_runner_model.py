@@ -449,7 +449,7 @@ def test_athlete_params_scale_the_body_and_strengthen_only_the_active_force():
     multiplies the active force (MP_ACTIVE) and leaves Fmax, which sets the tendon and passive
     curves, alone; nothing given changes nothing."""
     from bladelab.runner.muscle import MP_ACTIVE, MP_FMAX
-    from bladelab.runner.params import athlete_params
+    from bladelab.runner.scaling import athlete_params
 
     base = default_runner_params("able", body="human")
     assert athlete_params(base) == base
@@ -474,7 +474,7 @@ def test_the_maximum_shortening_velocity_is_every_muscle_s_and_nothing_else():
     """10 l_opt/s unless set (the MP_VMAX column of every muscle); an athlete's value replaces
     it and leaves every other muscle parameter as it was; outside 2–30 l_opt/s refused."""
     from bladelab.runner.muscle import MP_VMAX
-    from bladelab.runner.params import athlete_params
+    from bladelab.runner.scaling import athlete_params
 
     base = default_runner_params("amputee", body="human")
     ref = build_runner(base)
@@ -494,7 +494,7 @@ def test_the_residual_limb_s_length_moves_the_socket_and_keeps_the_leg_and_the_a
     length²; the model still weighs the athlete's 73.24 kg, the straight prosthetic leg is as
     long (knee to ground) and the muscles are the same; a runner without a residual tibia, or
     a length outside 20–90 % of the tibia, is refused naming the field."""
-    from bladelab.runner.params import athlete_params
+    from bladelab.runner.scaling import athlete_params
 
     base = default_runner_params("amputee", body="human")
     table = {name: seg.mass_kg for name, seg in base.segments.items()}
@@ -552,7 +552,7 @@ def test_thigh_and_shank_lengths_scale_their_segments_and_the_muscles_lengths():
     measures it (OpenSim's scaling rule); the trunk's muscles keep theirs; the amputee's
     straight prosthetic leg stays 3 cm longer than the intact one; out of 80–130 % refused."""
     from bladelab.runner.muscle import MP_LOPT, MP_LTS
-    from bladelab.runner.params import athlete_params
+    from bladelab.runner.scaling import athlete_params
 
     base = default_runner_params("able", body="human")
     ref = build_runner(base)

@@ -8,7 +8,7 @@ import casadi as ca
 import numpy as np
 
 from bladelab.predict.collocation.stride_guess import StrideGuess
-from bladelab.predict.collocation.transcription import StrideDynamics
+from bladelab.predict.collocation.stride_problem import StrideDynamics
 
 M, G, K = 80.0, 9.81, 2.0e4  # kg, m/s², N/m
 

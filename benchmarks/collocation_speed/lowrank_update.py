@@ -24,9 +24,10 @@ from pathlib import Path
 
 from bladelab.predict.collocation import solve as solve_module
 from bladelab.predict.collocation.guess import template_guess
+from bladelab.predict.collocation.ipopt_options import PREDICTIVE_LBFGS_OPTIONS
 from bladelab.predict.collocation.settings import CollocationSettings, people_settings
 from bladelab.predict.collocation.starting_guess import make_guess
-from bladelab.predict.collocation.transcription import PREDICTIVE_LBFGS_OPTIONS, StrideNLP
+from bladelab.predict.collocation.transcription import StrideNLP
 from bladelab.runner import build_runner
 
 RECORDS = Path(__file__).with_name("lowrank_records.jsonl")

@@ -14,7 +14,7 @@ import json
 import sys
 
 from bladelab.predict import defaults
-from bladelab.predict.collocation import transcription
+from bladelab.predict.collocation import ipopt_options
 from bladelab.predict.collocation.settings import CollocationSettings, people_term
 from bladelab.predict.collocation.solve import predict_stride
 from bladelab.predict.collocation.starting_guess import make_guess
@@ -30,7 +30,7 @@ def main() -> None:
     settings = CollocationSettings(mesh_intervals=50, speed_m_per_s=4.0, **people)
     stored = predict_stride(runner, settings, make_guess(runner, "stored", n=50, speed=4.0),
                             model_spec=spec)
-    transcription.DUAL_WARM_START_OPTIONS.update(extra)
+    ipopt_options.DUAL_WARM_START_OPTIONS.update(extra)
     warm = predict_stride(runner, dataclasses.replace(settings, speed_m_per_s=target),
                           stored.to_guess(), model_spec=spec)
     s = warm.summary()

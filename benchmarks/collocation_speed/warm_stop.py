@@ -25,7 +25,7 @@ from pathlib import Path
 import numpy as np
 
 from bladelab.predict import defaults
-from bladelab.predict.collocation import transcription
+from bladelab.predict.collocation import ipopt_options
 from bladelab.predict.collocation.human_running import human_running_criteria
 from bladelab.predict.collocation.settings import CollocationSettings, people_term
 from bladelab.predict.collocation.solution import CollocationSolution
@@ -65,12 +65,12 @@ def solve_row(sol) -> dict:
 def full_and_stopped(solve) -> tuple:
     """``solve()`` with ``STALL_STOP_OPTIONS`` emptied, then with the library's; the two
     solutions and their differences (objective [%], largest joint angle [deg])."""
-    stop = dict(transcription.STALL_STOP_OPTIONS)
-    transcription.STALL_STOP_OPTIONS.clear()
+    stop = dict(ipopt_options.STALL_STOP_OPTIONS)
+    ipopt_options.STALL_STOP_OPTIONS.clear()
     try:
         full = solve()
     finally:
-        transcription.STALL_STOP_OPTIONS.update(stop)
+        ipopt_options.STALL_STOP_OPTIONS.update(stop)
     stopped = solve()
     angle = float(np.max(np.abs(np.degrees(full.nlp.q[:, 3:] - stopped.nlp.q[:, 3:]))))
     return full, stopped, {

@@ -32,7 +32,7 @@ from bladelab.predict.collocation.solution import CollocationSolution
 from bladelab.predict.collocation.solve import predict_stride
 from bladelab.predict.collocation.starting_guess import make_guess
 from bladelab.predict.collocation.stored import runner_from_spec
-from bladelab.predict.collocation.transcription import StrideWeights
+from bladelab.predict.collocation.stride_problem import StrideWeights
 from bladelab.runner import build_runner
 from bladelab.runner.params import default_runner_params, runner_params_from_dict
 

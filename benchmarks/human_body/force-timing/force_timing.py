@@ -12,7 +12,7 @@ again from its primal and dual values on the human body changed by the variant
 stride's own settings (``settings``: fields of them changed, e.g. ``{"reference_weight": 30}``,
 ``{"weights": {"acceleration": 1.0}}``;
 ``lumbar``: [stiffness N·m/rad, damping N·m·s/rad] of the lumbar joint's spring–damper in place
-of the library's 500 and 5, ``bladelab.runner.model.LIGAMENTS``): a continuation step from the shipped optimum to the changed body's
+of the library's 500 and 5, ``bladelab.runner.joints.LIGAMENTS``): a continuation step from the shipped optimum to the changed body's
 nearest one. Appends one line to RECORDS.jsonl: the variant, converged, iterations, objective,
 cost of transport [J/(kg·m)], per leg the stance's peak vertical force [BW] and where it lies
 [% of the stance, node-wise], the contact time [s] and the knee's flexion at touch-down [deg],
@@ -70,9 +70,9 @@ def main() -> None:
     out, variant = sys.argv[1], json.loads(sys.argv[2])
     shipped = CollocationSolution.read(SHIPPED)
     if "lumbar" in variant:
-        from bladelab.runner import model
+        from bladelab.runner import joints
 
-        model.LIGAMENTS["lumbar_extension"] = (0.0, 0.0, *map(float, variant["lumbar"]))
+        joints.LIGAMENTS["lumbar_extension"] = (0.0, 0.0, *map(float, variant["lumbar"]))
     runner = variant_runner({"kind": "able", **{k: v for k, v in variant.items()
                                                 if k not in ("settings", "lumbar")}})
     t0 = time.perf_counter()

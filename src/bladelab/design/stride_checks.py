@@ -13,9 +13,9 @@ from pathlib import Path
 from typing import Any
 
 from bladelab.design.stride_files import point_file_stem
+from bladelab.predict.collocation.alternating_steps import step_phase
 from bladelab.predict.collocation.human_running import human_running_criteria
 from bladelab.predict.collocation.solution import CollocationSolution
-from bladelab.predict.collocation.transcription import step_phase
 
 __all__ = ["stride_checks"]
 
@@ -38,7 +38,7 @@ def stride_checks(design_dir: str | Path, evaluator: Mapping[str, Any],
     """Each run's stride of a collocation design study, checked again as it is now on disk:
     one row per point with ``stride`` (file name, or None when not found), ``converged``,
     ``dynamics_residual_pct`` [%], ``step_phase`` [fraction of the stride: 0.5 alternating,
-    near 0 or 1 a gallop; :func:`~bladelab.predict.collocation.transcription.step_phase`],
+    near 0 or 1 a gallop; :func:`~bladelab.predict.collocation.alternating_steps.step_phase`],
     ``iterations``, ``warnings`` (its
     :meth:`~bladelab.predict.collocation.solution.CollocationSolution.gait_warnings`, "; "
     -joined; "" when clean), ``criteria_met`` / ``criteria`` (how many of the criteria of

@@ -34,13 +34,13 @@ import numpy as np
 import pandas as pd
 
 from bladelab.errors import InputFileError
+from bladelab.predict.collocation.alternating_steps import step_phase
 from bladelab.predict.collocation.continuation import ON_FLOOR_TOL_MPS
 from bladelab.predict.collocation.human_running import gallop_sentence
 from bladelab.predict.collocation.model import build_collocation_model
 from bladelab.predict.collocation.solution import CollocationSolution
 from bladelab.predict.collocation.stored import runner_from_spec
 from bladelab.predict.collocation.sweep import SWEEP_TABLE
-from bladelab.predict.collocation.transcription import step_phase
 from bladelab.report.collocation import reference_term_text
 
 __all__ = ["collocation_sweep_sections", "is_collocation_sweep", "starts_table",

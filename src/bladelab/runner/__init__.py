@@ -20,19 +20,21 @@ from bladelab.runner.analyses import (
     summary,
     swing_contacts,
 )
-from bladelab.runner.clearance import swing_clearance
-from bladelab.runner.model import RunnerModel, build_runner, contact_heights
-from bladelab.runner.params import (
+from bladelab.runner.blade_categories import (
     BladeCategory,
-    RunnerParams,
     blade_catalogue,
     blade_category,
     blade_modulus,
+)
+from bladelab.runner.clearance import swing_clearance
+from bladelab.runner.model import RunnerModel, build_runner, contact_heights
+from bladelab.runner.params import (
+    RunnerParams,
     default_runner_params,
     load_runner_params,
-    muscle_max_force,
     runner_params_from_dict,
 )
+from bladelab.runner.scaling import muscle_max_force
 from bladelab.runner.simulate import ControllerState, RunnerResult, initial_qpos, simulate_runner
 
 __all__ = [

@@ -29,82 +29,40 @@ from bladelab.blade.model import BladeModel
 from bladelab.contact import hertz_sphere_stiffness
 from bladelab.errors import ModelError
 from bladelab.runner import geometry as geo
+from bladelab.runner.blade_categories import BLADE_FRICTION, BLADE_RADIUS_M
+from bladelab.runner.feet import TOETIP_RADIUS_M, add_foot
+from bladelab.runner.frames import difference, lab_inertia, lab_vector
+from bladelab.runner.joints import joint_params
 from bladelab.runner.layout import (
     CP_AZ,
     CP_BLADE,
     CP_RADIUS,
     CP_SITE,
-    JP_COLUMNS,
-    JP_EA,
-    JP_EB,
-    JP_HI,
-    JP_LO,
-    JP_SK,
     LAW_HUNT_CROSSLEY,
 )
 from bladelab.runner.multilink import add_multilink_blade, multilink_contact_rows
 from bladelab.runner.muscle import MP_COLUMNS, MP_LOPT, MP_LTS
 from bladelab.runner.params import (
-    BLADE_ALIGNMENT_DEG,
-    BLADE_EXTRA_LENGTH_M,
-    BLADE_FRICTION,
-    BLADE_OFFSET_A_M,
-    BLADE_OFFSET_B_M,
-    BLADE_RADIUS_M,
     PROSTHETIC_KINDS,
     RunnerParams,
-    active_strength,
-    blade_contact_modulus,
     default_runner_params,
-    muscle_max_force,
     muscle_names,
-    residual_tibia_factors,
     runner_params_from_dict,
+)
+from bladelab.runner.prosthesis import (
+    PROSTHETIC_PYLON_COM_M,
+    PROSTHETIC_SHANK_COM,
+    add_prosthesis,
+    blade_contact_modulus,
+    prosthetic_bottom,
+)
+from bladelab.runner.scaling import (
+    active_strength,
+    muscle_max_force,
+    residual_tibia_factors,
     scale_ratios,
     segment_mass_ratio,
 )
-
-# Ligaments (joint-limit springs–dampers): (lower, upper) [deg], stiffness [N·m/rad],
-# damping [N·m·s/rad]. Hip and ankle ranges and the knee's stiffness/damping from H0918; the knee
-# range (−90°, 0°) and the soft lumbar limit at 0° from seed 001 §2.1 (the knee's flexion limit
-# is the parameter set's ``knee_flexion_limit_deg``).
-LIGAMENTS: dict[str, tuple[float, float, float, float]] = {
-    "hip_flexion": (-40.0, 120.0, 500.0, 5.0),
-    "knee_angle": (-90.0, 0.0, 114.592, 2.86479),
-    "ankle_angle": (-60.0, 60.0, 500.0, 5.0),
-    "lumbar_extension": (0.0, 0.0, 500.0, 5.0),
-    "mtp_angle": (-30.0, 60.0, 100.0, 1.0),
-    "midtarsal_angle": (-15.0, 30.0, 500.0, 5.0),
-}
-# Socket: stiff nonlinear torsional spring τ = −(K·q + K2·q·|q|) − D·q̇ (seed 001 §2.1).
-SOCKET_STIFFNESS = 1000.0  # N·m/rad
-SOCKET_STIFFNESS_QUADRATIC = 2.0e4  # N·m/rad²
-SOCKET_DAMPING = 10.0  # N·m·s/rad
-# The toe segment of ``RunnerParams.foot = "toes"`` (docs/runner-model.md, "The toe segment").
-# Metatarsophalangeal hinge at the ball sphere's centre; its passive spring and damper about
-# the neutral pose: ``RunnerParams.toe_hinge``.
-# Share of the foot's mass in the toes: gait2392's toes/(calcn + toes) (0.2166/1.4666 kg).
-TOES_MASS_FRACTION = 0.148
-TOES_INERTIA_KG_M2 = 1.0e-4  # about its COM, every axis (a 0.18 kg, 6 cm segment: ≈ 0.6e-4)
-TOES_COM_M = (0.025, -0.01)  # toes COM from the MTP hinge (forward, up) [m], reference athlete
-TOETIP_RADIUS_M = 0.02
-TOETIP_CENTRE_M = (0.05, -0.01)  # toe-tip sphere centre from the MTP hinge; its bottom is
-# level with the ball sphere's (radius 0.03) in the neutral pose; foot length 0.27 m in all
-
-# The arch of ``RunnerParams.arch`` (docs/runner-model.md, "The arch"): a midtarsal hinge
-# 4.5 cm ahead of the ankle at its height (the talonavicular joint; calcaneus COM-relative,
-# OpenSim axes [m], reference athlete), a forefoot of the cuneiforms and metatarsals carrying
-# the ball sphere and the toes.
-MIDTARSAL_HINGE_M = (-0.006, 0.012, 0.0)
-FOREFOOT_MASS_FRACTION = 0.30  # of the foot (our estimate: the bones' share ahead of the hinge)
-FOREFOOT_INERTIA_KG_M2 = 3.0e-4  # about its COM, every axis (0.38 kg over 9 cm: ≈ 2.6e-4)
-
-# The transfemoral prosthesis's COM below the knee axis, as a fraction of the knee-to-ground
-# depth: a 1.2 kg knee unit at the top and about as much pylon and blade below (our estimate).
-PROSTHETIC_SHANK_COM = 0.4
-# With a multi-link blade, the knee unit and pylon (the prosthesis mass minus the blade's) have
-# their COM this far below the knee axis [m, reference athlete]: mostly the knee unit.
-PROSTHETIC_PYLON_COM_M = 0.08
 
 # Tangential (friction) bristle spring and damper of every contact [N/m, N·s/m].
 FRICTION_STIFFNESS = 5.0e4
@@ -228,26 +186,6 @@ class RunnerModel:
         }
 
 
-def _v(p: tuple[float, float, float], s: float) -> list[float]:
-    return list(geo.to_lab(p, s))
-
-
-def _lab_inertia(ixx: float, iyy: float, izz: float, factor: float) -> list[float]:
-    """Principal inertias in lab axes; the sagittal one (lab y = OpenSim z) is kept exact, the
-    out-of-plane x one is raised if needed to satisfy the triangle inequality (it has no effect
-    in the planar model; the prosthesis of Table 2.1 violates it)."""
-    ix, iy, iz = ixx * factor, izz * factor, iyy * factor
-    if ix + iz < iy:
-        ix = iy - iz + 1e-6
-    return [ix, iy, iz]
-
-
-def _sub(
-    a: tuple[float, float, float], b: tuple[float, float, float]
-) -> tuple[float, float, float]:
-    return (a[0] - b[0], a[1] - b[1], a[2] - b[2])
-
-
 def build_runner(
     params: RunnerParams | str = "amputee",
     *,
@@ -312,7 +250,7 @@ def build_runner(
         body.explicitinertial = True
         body.mass = seg.mass_kg * mr * km
         body.ipos = com
-        body.inertia = _lab_inertia(ixx, iyy, izz, mr * sb(name) * sb(name) * ki)
+        body.inertia = lab_inertia(ixx, iyy, izz, mr * sb(name) * sb(name) * ki)
 
     pelvis = spec.worldbody.add_body(name="pelvis", pos=[0, 0, 0])
     pelvis.add_joint(name="pelvis_tx", type=mujoco.mjtJoint.mjJNT_SLIDE, axis=[1, 0, 0])
@@ -328,13 +266,14 @@ def build_runner(
 
     def add(name: str, seg: str, joint: str, dof: str, parent: str, ppos, cpos, com=None):
         parent_origin = joint_child[parent]
-        pos = _v(_sub(ppos, parent_origin), sb(parent))
+        pos = lab_vector(difference(ppos, parent_origin), sb(parent))
         offset = np.subtract(ppos, parent_origin)
         neutral[name] = (neutral[parent][0] + offset * sb(parent),
                          neutral[parent][1] + offset * s)
         body = bodies[parent].add_body(name=name, pos=pos)
         body.add_joint(name=dof, type=mujoco.mjtJoint.mjJNT_HINGE, axis=axis)
-        inertial(body, seg, _v(_sub((0, 0, 0), cpos), sb(name)) if com is None else com)
+        inertial(body, seg,
+                 lab_vector(difference((0, 0, 0), cpos), sb(name)) if com is None else com)
         bodies[name] = body
         joint_child[name] = cpos
         return body
@@ -346,13 +285,13 @@ def build_runner(
         )
         par, pp, pc = geo.JOINTS[f"knee_{side}"]
         if side == "r" and transfemoral:
-            knee = {"parent": "femur_r", "pos": _v(_sub(pp, joint_child["femur_r"]),
-                                                   sb("femur_r")),
+            knee = {"parent": "femur_r",
+                    "pos": lab_vector(difference(pp, joint_child["femur_r"]), sb("femur_r")),
                     "joint": "knee_angle_r"}
-            depth = _prosthetic_bottom(s, params.shank_length_factor, 0.0)
+            depth = prosthetic_bottom(s, params.shank_length_factor, 0.0)
             if blade_model is None:
-                _add_prosthesis(bodies, joint_child, params, s, mr, axis, depth=depth,
-                                com_fraction=PROSTHETIC_SHANK_COM, **knee)
+                add_prosthesis(bodies, joint_child, params, s, mr, axis, depth=depth,
+                               com_fraction=PROSTHETIC_SHANK_COM, **knee)
             else:
                 add_multilink_blade(bodies, joint_child, params, s, mr, axis, blade_model,
                                     depth, com_z=-PROSTHETIC_PYLON_COM_M, **knee)
@@ -361,11 +300,11 @@ def build_runner(
             res_len = table_len * sb("tibia_res_r")
             com = [0.0, 0.0, -0.5 * res_len]
             add("tibia_res_r", "tibia_res_r", "knee_r", "knee_angle_r", "femur_r", pp, pc, com=com)
-            depth = _prosthetic_bottom(s, params.shank_length_factor, table_len)
+            depth = prosthetic_bottom(s, params.shank_length_factor, table_len)
             if blade_model is None:
-                _add_prosthesis(bodies, joint_child, params, s, mr, axis, parent="tibia_res_r",
-                                pos=[0.0, 0.0, -res_len], joint="socket_angle_r",
-                                depth=depth)
+                add_prosthesis(bodies, joint_child, params, s, mr, axis, parent="tibia_res_r",
+                               pos=[0.0, 0.0, -res_len], joint="socket_angle_r",
+                               depth=depth)
             else:
                 add_multilink_blade(bodies, joint_child, params, s, mr, axis, blade_model,
                                     depth, pos=[0.0, 0.0, -res_len])
@@ -389,23 +328,7 @@ def build_runner(
                 pp,
                 pc,
             )
-            ball = geo.FOOT_SPHERES["toe"]
-            ball_in_calcn = _v(_sub(ball, pc), s)
-            fore, fore_origin = body, pc
-            if params.arch is not None:
-                fore = _add_forefoot(body, side, _v(_sub(MIDTARSAL_HINGE_M, pc), s),
-                                     ball_in_calcn, s, axis)
-                fore_origin = MIDTARSAL_HINGE_M
-            elif params.foot == "toes":
-                _add_toes(body, side, ball_in_calcn, s, axis,
-                          _take_mass(body, TOES_MASS_FRACTION, _toes_com_at(ball_in_calcn, s)))
-            for sph, p in geo.FOOT_SPHERES.items():
-                on, origin = (fore, fore_origin) if sph == "toe" else (body, pc)
-                on.add_site(
-                    name=f"{sph}_{side}",
-                    pos=_v(_sub(p, origin), s),
-                    size=[geo.FOOT_SPHERE_RADIUS_M * s, 0, 0],
-                )
+            add_foot(body, side, pc, s, axis, params)
     par, pp, pc = geo.JOINTS["lumbar"]
     add("torso", "torso", "lumbar", "lumbar_extension", "pelvis", pp, pc)
 
@@ -431,7 +354,8 @@ def build_runner(
             else:
                 origin = joint_child[body_name]
             site = f"{mname}_p{k}"
-            bodies[body_name].add_site(name=site, pos=_v(_sub(p, origin), sb(body_name)))
+            bodies[body_name].add_site(name=site,
+                                       pos=lab_vector(difference(p, origin), sb(body_name)))
             local = np.subtract(p, origin)
             point = (neutral[body_name][0] + local * sb(body_name),
                      neutral[body_name][1] + local * s)
@@ -509,38 +433,7 @@ def build_runner(
                BLADE_FRICTION, 1, 1)
     cp = np.array(rows, dtype=np.float64)
 
-    jp = np.zeros((len(dof_names), JP_COLUMNS))
-    jp[:, JP_LO], jp[:, JP_HI] = -np.inf, np.inf
-    for i, dn in enumerate(dof_names):
-        base = dn[:-2] if dn.endswith(("_l", "_r")) else dn
-        if base in LIGAMENTS:
-            lo, hi, k, d = LIGAMENTS[base]
-            if base == "knee_angle":
-                lo = -params.knee_flexion_limit_deg
-            if base == "lumbar_extension" and params.lumbar_passive == "spring":
-                jp[i, JP_SK:JP_EA] = (k, 0.0, d, d)  # the limit's K and D about 0°, no limit
-            else:
-                jp[i, :4] = (math.radians(lo), math.radians(hi), k, d)
-        capsule = params.capsule_moments.get(base)
-        if capsule is not None:
-            jp[i, JP_EA] = capsule.moment_at_zero_Nm
-            jp[i, JP_EB] = math.degrees(capsule.rate_per_deg)  # 1/deg → 1/rad
-        if base == "mtp_angle":
-            toe = params.toe_hinge
-            jp[i, JP_SK:JP_EA] = (toe.stiffness_Nm_per_rad, 0.0, toe.damping_Nms_per_rad,
-                                  toe.damping_Nms_per_rad)
-        if base == "midtarsal_angle":
-            arch = params.arch
-            jp[i, JP_SK:JP_EA] = (arch.stiffness_Nm_per_rad, 0.0, arch.damping_Nms_per_rad,
-                                  arch.damping_Nms_per_rad)
-        if dn == "socket_angle_r":
-            jp[i, JP_SK:JP_EA] = (SOCKET_STIFFNESS, SOCKET_STIFFNESS_QUADRATIC,
-                                  SOCKET_DAMPING, SOCKET_DAMPING)
-        if dn == "knee_angle_r" and transfemoral:
-            jp[i] = params.prosthetic_knee.joint_row()
-        if dn.startswith("blade_joint") and blade_model is not None:
-            j = blade_model.joints[int(dn.removeprefix("blade_joint"))]
-            jp[i, JP_SK:JP_EA] = (j.stiffness, j.stiffness_quadratic, j.damping, j.damping)
+    jp = joint_params(params, dof_names, blade_model)
 
     # the implicit scheme's model: no sites either (MuJoCo's site kinematics was ~1/6 of its
     # step); bladelab places the sites from mj_model's site_bodyid, site_pos and site_quat
@@ -571,84 +464,11 @@ def build_runner(
     return runner
 
 
-def _toes_com_at(hinge: list[float], s: float) -> list[float]:
-    """The toes' centre of mass in the frame of the MTP ``hinge`` given [m] (in the sagittal
-    plane: its lateral coordinate is 0, which no sagittal quantity sees)."""
-    return [hinge[0] + TOES_COM_M[0] * s, 0.0, hinge[2] + TOES_COM_M[1] * s]
-
-
-def _take_mass(body, fraction: float, com: list[float]) -> float:
-    """Take ``fraction`` of ``body``'s mass away at ``com`` (its frame [m]) and return it
-    [kg]: the body keeps its inertia, and its centre of mass moves so that the mass taken and
-    the body together have the centre of mass the body had."""
-    m = body.mass
-    taken = fraction * m
-    body.mass = m - taken
-    body.ipos = [(m * c - taken * t) / (m - taken) for c, t in zip(body.ipos, com, strict=True)]
-    return taken
-
-
-def _add_toes(parent, side: str, hinge: list[float], s: float, axis: list[float],
-              mass: float) -> None:
-    """A toe segment of ``mass`` [kg] on a metatarsophalangeal hinge at ``hinge`` (the parent
-    body's frame [m]: the calcaneus, or the forefoot of a foot with an arch).
-
-    The caller takes that mass, :data:`TOES_MASS_FRACTION` of the foot's, from the calcaneus
-    (:func:`_take_mass`), so that the foot's centre of mass in the neutral pose stays where
-    seed 001's is; the calcaneus keeps its inertia (the toes' share of it is < 2 %).
-    """
-    toes = parent.add_body(name=f"toes_{side}", pos=hinge)
-    toes.add_joint(name=f"mtp_angle_{side}", type=mujoco.mjtJoint.mjJNT_HINGE, axis=axis)
-    toes.explicitinertial = True
-    toes.mass = mass
-    toes.ipos = [TOES_COM_M[0] * s, 0.0, TOES_COM_M[1] * s]
-    toes.inertia = [TOES_INERTIA_KG_M2 * s * s] * 3
-    toes.add_site(name=f"toetip_{side}",
-                  pos=[TOETIP_CENTRE_M[0] * s, 0.0, TOETIP_CENTRE_M[1] * s],
-                  size=[TOETIP_RADIUS_M * s, 0, 0])
-
-
-def _add_forefoot(calcn, side: str, hinge: list[float], ball: list[float], s: float,
-                  axis: list[float]):
-    """The forefoot on a midtarsal hinge at ``hinge`` and the toes on its MTP hinge at
-    ``ball`` (both in the calcaneus frame [m]); returns the forefoot body.
-
-    The forefoot (:data:`FOREFOOT_MASS_FRACTION` of the foot, its centre of mass halfway
-    from the hinge to the ball) and the toes take their mass from the calcaneus
-    (:func:`_take_mass`): the foot's mass and centre of mass in the neutral pose are seed
-    001's.
-    """
-    to_ball = [b - h for b, h in zip(ball, hinge, strict=True)]
-    fore_com = [0.5 * d for d in to_ball]
-    m_foot = calcn.mass
-    m_fore = _take_mass(calcn, FOREFOOT_MASS_FRACTION,
-                        [float(h + c) for h, c in zip(hinge, fore_com, strict=True)])
-    m_toes = _take_mass(calcn, TOES_MASS_FRACTION * m_foot / calcn.mass,
-                        _toes_com_at(ball, s))
-    fore = calcn.add_body(name=f"forefoot_{side}", pos=hinge)
-    fore.add_joint(name=f"midtarsal_angle_{side}", type=mujoco.mjtJoint.mjJNT_HINGE, axis=axis)
-    fore.explicitinertial = True
-    fore.mass = m_fore
-    fore.ipos = fore_com
-    fore.inertia = [FOREFOOT_INERTIA_KG_M2 * s * s] * 3
-    _add_toes(fore, side, to_ball, s, axis, m_toes)
-    return fore
-
-
 def _myodesis_point(p: tuple[float, float, float]) -> tuple[float, float, float]:
     """A tibial path point (tibia COM-relative) as a point of the femur (femur COM-relative)
     where it lies with the knee straight: a myodesis anchors the muscle there."""
     _, knee_in_femur, knee_in_tibia = geo.JOINTS["knee_r"]
-    return _sub(knee_in_femur, _sub(knee_in_tibia, p))
-
-
-def _prosthetic_bottom(s: float, k_shank: float, res_len: float) -> float:
-    """Depth [m] below the socket of the prosthetic leg's lowest point, for a socket
-    ``res_len`` [m at 1.80 m, before ``k_shank``] below the knee: the straight prosthetic leg
-    is 3 cm longer (knee to ground) than the intact one, whose shank is ``k_shank`` times the
-    model's; ``s``: the height's scale."""
-    intact = geo.TIBIA_LENGTH_M * k_shank + geo.ANKLE_TO_SOLE_M
-    return (intact + BLADE_EXTRA_LENGTH_M) * s - res_len * k_shank * s
+    return difference(knee_in_femur, difference(knee_in_tibia, p))
 
 
 def _segment_factor(params: RunnerParams, body: str) -> float:
@@ -659,40 +479,6 @@ def _segment_factor(params: RunnerParams, body: str) -> float:
     if body in ("tibia_l", "tibia_r", "tibia_res_r"):
         return params.shank_length_factor
     return 1.0
-
-
-def _add_prosthesis(bodies, joint_child, params, s, mr, axis, *, parent: str, pos,
-                    joint: str, depth: float, com_fraction: float | None = None) -> None:
-    """The prosthesis below a hinge ``joint`` on ``parent`` at ``pos`` (parent frame [m]), with
-    the blade contact sphere: the socket, pylon and blade of the transtibial runner (on the
-    residual tibia, hinge ``socket_angle_r``) or the knee unit, pylon and blade of the
-    transfemoral runner (on the residual femur, hinge ``knee_angle_r``).
-
-    The sphere's bottom lies ``depth`` [m] below the hinge (the straight prosthetic leg 3 cm
-    longer than the intact one, knee to ground). The transtibial prosthesis's COM lies
-    a = 0.069 m behind and b = 0.0693 m above the sphere centre, that offset turned by the 9°
-    alignment (seed 001 Fig. 2.3, our reading); with ``com_fraction`` the COM lies that
-    fraction of ``depth`` straight below the hinge instead.
-    """
-    centre = (0.0, -(depth - BLADE_RADIUS_M))  # (x, z) in the hinge frame
-    if com_fraction is None:
-        ox, oz = geo.rotate_pitch(
-            BLADE_OFFSET_A_M * s, -BLADE_OFFSET_B_M * s, math.radians(BLADE_ALIGNMENT_DEG)
-        )
-        com = [centre[0] - ox, 0.0, centre[1] - oz]
-    else:
-        com = [0.0, 0.0, -com_fraction * depth]
-    body = bodies[parent].add_body(name="prosthesis_r", pos=list(pos))
-    body.add_joint(name=joint, type=mujoco.mjtJoint.mjJNT_HINGE, axis=axis)
-    seg = params.segments["prosthesis_r"]
-    ixx, iyy, izz = seg.inertia_kg_m2
-    body.explicitinertial = True
-    body.mass = seg.mass_kg * mr
-    body.ipos = com
-    body.inertia = _lab_inertia(ixx, iyy, izz, mr * s * s)
-    body.add_site(name="blade_r", pos=[centre[0], 0.0, centre[1]], size=[BLADE_RADIUS_M, 0, 0])
-    bodies["prosthesis_r"] = body
-    joint_child["prosthesis_r"] = (0.0, 0.0, 0.0)
 
 
 def contact_heights(runner: RunnerModel, qpos: np.ndarray,

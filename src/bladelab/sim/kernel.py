@@ -20,6 +20,11 @@ The sole contact (geometry, laws, friction, compliant track) is in :mod:`bladela
 functions and the helpers here are inlined at numba-IR level (``inline="always"``). Caveat of
 numba's cache: editing :mod:`bladelab.sim.sole` or :mod:`bladelab.contact` does not invalidate
 the cached kernel; touch this file (or clear ``__pycache__``) after such an edit.
+
+This module is longer than the project's other modules by design: :func:`simulate_prescribed`
+is one compiled step loop (predictor, Newton refinement, regime-change sub-steps, restarts and
+energy bookkeeping share its work arrays), kept in one numba function so that no array is
+allocated per step; its parts are marked by comments.
 """
 
 from __future__ import annotations

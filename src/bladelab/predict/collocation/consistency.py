@@ -380,7 +380,7 @@ def dynamics_residual(solution, runner: RunnerModel, *, cm=None, friction: str =
                       dt: float = DEFAULT_DT) -> DynamicsResidual:
     """MuJoCo's inverse dynamics against the forward model's applied forces at the nodes of a
     solution (:class:`~bladelab.predict.collocation.solution.CollocationSolution` or
-    :class:`~bladelab.predict.collocation.transcription.NLPSolution`), with the breakdown of
+    :class:`~bladelab.predict.collocation.nlp_solution.NLPSolution`), with the breakdown of
     :class:`DynamicsResidual`. ``cm``: the collocation model of ``runner`` (built if None);
     ``friction``: how the forward friction is taken (module docstring)."""
     s = _nodes(solution)

@@ -25,7 +25,7 @@ from bladelab.predict.collocation.metabolics import (
 from bladelab.predict.collocation.model import CollocationModel
 from bladelab.predict.collocation.multibody import body_frames, point_position
 from bladelab.predict.collocation.smooth import sigmoid
-from bladelab.predict.collocation.transcription import StrideDynamics
+from bladelab.predict.collocation.stride_problem import StrideDynamics
 from bladelab.runner.layout import CP_LEG
 from bladelab.runner.muscle import MP_ACTIVE, MP_LOPT, MP_VMAX
 

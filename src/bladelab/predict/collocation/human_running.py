@@ -33,6 +33,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from bladelab.predict.collocation.alternating_steps import step_phase
 from bladelab.predict.collocation.running_bands import (
     ANCHOR_SPEEDS_MPS,
     REFERENCE_BANDS,
@@ -40,7 +41,6 @@ from bladelab.predict.collocation.running_bands import (
 )
 from bladelab.predict.collocation.solution import CONTACT_THRESHOLD_N
 from bladelab.predict.collocation.swing_knee import biological_knees
-from bladelab.predict.collocation.transcription import step_phase
 
 __all__ = [
     "COMPARED_JOINTS",

@@ -14,7 +14,8 @@ from bladelab.errors import SpecError
 from bladelab.predict import defaults
 from bladelab.predict.collocation.dynamics import COORDINATE_BOUNDS_DEG
 from bladelab.predict.collocation.running_bands import ANCHOR_SPEEDS_MPS, reference_band
-from bladelab.predict.collocation.transcription import PERIOD_BOUNDS_S, StrideWeights
+from bladelab.predict.collocation.stride_problem import StrideWeights
+from bladelab.predict.collocation.transcription import PERIOD_BOUNDS_S
 
 __all__ = ["HESSIANS", "PEOPLE_REFERENCE", "SWING_KNEE_RANGE_DEG", "CollocationSettings",
            "people_settings", "people_term"]
@@ -138,7 +139,7 @@ class CollocationSettings:
         Keep the steps alternating: the centre of the right (prosthetic) leg's stance at half
         a stride ± this fraction of the stride after the left (intact) leg's (the circular
         means of their vertical ground forces,
-        :func:`~bladelab.predict.collocation.transcription.step_phase`); a constraint of the
+        :func:`~bladelab.predict.collocation.alternating_steps.step_phase`); a constraint of the
         predictive stage. None (default): free. Runners with a transfemoral amputation step
         with the same step frequency on both legs (nine athletes on running-specific
         prostheses at 30–70 % of their maximum speed, ISBS proceedings 36, 2018) and their

@@ -1,6 +1,6 @@
 """A collocation solution of one stride: its file, its summary and its trajectory.
 
-:class:`CollocationSolution` holds an :class:`~bladelab.predict.collocation.transcription.
+:class:`CollocationSolution` holds an :class:`~bladelab.predict.collocation.nlp_solution.
 NLPSolution` (the node values) with what is needed to read it without solving again: the
 settings, the model (``{"model": "able" | "amputee", "blade": "Cat6" | None}``), where the
 initial guess came from, the tracking stage's status, and values derived once from the model
@@ -30,9 +30,11 @@ import numpy as np
 
 from bladelab._io import read_json, write_json
 from bladelab.errors import DataError, SpecError
+from bladelab.predict.collocation.alternating_steps import step_phase
 from bladelab.predict.collocation.consistency import dynamics_residual
 from bladelab.predict.collocation.dynamics import stride_dynamics
 from bladelab.predict.collocation.model import build_collocation_model
+from bladelab.predict.collocation.nlp_solution import NLPSolution
 from bladelab.predict.collocation.nodes import (
     evaluate_nodes,
     force_zigzag_steps,
@@ -42,12 +44,7 @@ from bladelab.predict.collocation.nodes import (
 from bladelab.predict.collocation.settings import CollocationSettings
 from bladelab.predict.collocation.stored import FieldReader, check_model_spec, runner_from_spec
 from bladelab.predict.collocation.stride_guess import COLLOCATION_SOURCE, StrideGuess
-from bladelab.predict.collocation.transcription import (
-    PERIOD_BOUNDS_S,
-    NLPSolution,
-    StrideNLP,
-    step_phase,
-)
+from bladelab.predict.collocation.transcription import PERIOD_BOUNDS_S, StrideNLP
 from bladelab.runner.layout import CP_LEG
 from bladelab.runner.simulate import RunnerResult, leg_names
 
@@ -337,7 +334,7 @@ class CollocationSolution:
         ``peak_vertical_grf_<leg>_bw`` [body weights]; ``flight_fraction`` (of the stride);
         ``step_phase`` (the second leg's stance centre after the first's, as a fraction of
         the stride: 0.5 for alternating steps of equal time, near 0 or 1 for a gallop;
-        :func:`~bladelab.predict.collocation.transcription.step_phase`);
+        :func:`~bladelab.predict.collocation.alternating_steps.step_phase`);
         ``dynamics_residual_pct``; ``iterations`` and ``wall_s`` [s] of both stages together
         (tracking + predictive); ``warnings`` (:meth:`gait_warnings`, joined by "; ", empty
         if none). Legs: left/right (able) or intact/prosthetic (amputee).

@@ -19,7 +19,7 @@ solves and names the first one's status (``restarted_after``).
 
 A guess that is a solution of the same problem layout (mesh, model) and carries its
 multipliers starts the predictive stage from its primal and dual values (IPOPT's warm start,
-:data:`~bladelab.predict.collocation.transcription.DUAL_WARM_START_OPTIONS`): a solution
+:data:`~bladelab.predict.collocation.ipopt_options.DUAL_WARM_START_OPTIONS`): a solution
 solved again ends at once, a continuation step stays on its start's branch.
 
 A predictive stage on L-BFGS that runs out of iterations near a feasible point is **polished**:
@@ -41,7 +41,7 @@ NLP").
 The tracking stage is skipped when ``track_first`` is False or the guess is itself a
 collocation solution (its ``source`` starts with :data:`COLLOCATION_SOURCE`, as
 :meth:`~bladelab.predict.collocation.solution.CollocationSolution.to_guess` and
-:meth:`~bladelab.predict.collocation.transcription.NLPSolution.to_guess` write it). A stage that
+:meth:`~bladelab.predict.collocation.nlp_solution.NLPSolution.to_guess` write it). A stage that
 does not converge ends the solve: its last iterate is returned (``converged`` False) and is
 never written as a solution. An interrupt (Ctrl-C, SIGTERM) during a stage raises
 KeyboardInterrupt once IPOPT has returned: nothing is returned or written.
@@ -72,6 +72,7 @@ import numpy as np
 
 from bladelab.errors import InputFileError, SpecError
 from bladelab.predict.collocation.dynamics import stride_dynamics
+from bladelab.predict.collocation.ipopt_options import PREDICTIVE_LBFGS_OPTIONS
 from bladelab.predict.collocation.model import build_collocation_model
 from bladelab.predict.collocation.people import PROSTHETIC_JOINTS, people_reference
 from bladelab.predict.collocation.settings import (
@@ -82,13 +83,10 @@ from bladelab.predict.collocation.settings import (
 from bladelab.predict.collocation.solution import CollocationSolution
 from bladelab.predict.collocation.stored import check_model_spec, describe_problem, same_model_spec
 from bladelab.predict.collocation.stride_guess import COLLOCATION_SOURCE
+from bladelab.predict.collocation.stride_problem import StrideWeights
 from bladelab.predict.collocation.swing_knee import biological_knees
 from bladelab.predict.collocation.symmetry import mirror_permutation
-from bladelab.predict.collocation.transcription import (
-    PREDICTIVE_LBFGS_OPTIONS,
-    StrideNLP,
-    StrideWeights,
-)
+from bladelab.predict.collocation.transcription import StrideNLP
 
 __all__ = [
     "BEST_ITERATE_FILE",

@@ -27,13 +27,8 @@ from bladelab.predict.collocation.guess import (
 from bladelab.predict.collocation.solution import CollocationSolution
 from bladelab.predict.collocation.stored import runner_from_spec
 from bladelab.predict.collocation.stride_guess import StrideGuess
-from bladelab.runner.params import (
-    ATHLETE_PARAM_FIELDS,
-    PROSTHETIC_KINDS,
-    RUNNER_DATA_DIR,
-    default_runner_params,
-    leg_length_factor,
-)
+from bladelab.runner.params import PROSTHETIC_KINDS, RUNNER_DATA_DIR, default_runner_params
+from bladelab.runner.scaling import ATHLETE_PARAM_FIELDS, leg_length_factor
 
 __all__ = ["GUESS_WORDS", "MAX_SPEED_TEMPLATE_M_PER_S", "STORED_STRIDES", "first_origin",
            "guess_file_kind", "make_guess", "resolve_guess", "scaled_to_athlete",
@@ -55,7 +50,7 @@ _NEITHER_HINT = ("template, trial, stored, or the path of a solution.json, best_
 def stored_stride_path(runner) -> Path | None:
     """The shipped stride (:data:`STORED_STRIDES`) of ``runner``'s kind if ``runner`` is the
     built-in human body of that kind (any blade category, any athlete:
-    :func:`~bladelab.runner.params.athlete_params`), else None."""
+    :func:`~bladelab.runner.scaling.athlete_params`), else None."""
     name = STORED_STRIDES.get(runner.kind)
     path = RUNNER_DATA_DIR / "collocation" / name if name else None
     if path is None or not path.is_file():
@@ -67,7 +62,7 @@ def stored_stride_path(runner) -> Path | None:
 
 def scaled_to_athlete(stride: StrideGuess, runner) -> StrideGuess:
     """A stride of the human body as the start of another athlete of that body
-    (:func:`~bladelab.runner.params.athlete_params`): the pelvis's translations scaled by the
+    (:func:`~bladelab.runner.scaling.athlete_params`): the pelvis's translations scaled by the
     heights' ratio (its height also by the legs' length, :func:`leg_length_factor`) and the
     multipliers dropped, which belong to the stored athlete's problem
     (measured: with them, a 68 kg, 1.75 m amputee's solve still stood at twice the stored

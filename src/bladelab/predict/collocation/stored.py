@@ -22,13 +22,8 @@ from bladelab.blade.spec import spec_from_dict
 from bladelab.errors import DataError, SpecError
 from bladelab.predict.collocation.settings import CollocationSettings
 from bladelab.runner.model import build_runner
-from bladelab.runner.params import (
-    ATHLETE_FIELDS,
-    BODIES,
-    KINDS,
-    athlete_params,
-    default_runner_params,
-)
+from bladelab.runner.params import BODIES, KINDS, default_runner_params
+from bladelab.runner.scaling import ATHLETE_FIELDS, athlete_params
 
 __all__ = [
     "FieldReader",
@@ -71,7 +66,7 @@ def check_model_spec(spec) -> dict:
     (``{"body_mass_kg": kg, "height_m": m, "muscle_strength": factor,
     "max_shortening_velocity": l_opt/s, "residual_limb_length_m": m, "thigh_length_m": m,
     "shank_length_m": m}``, any of them;
-    :func:`bladelab.runner.params.athlete_params`), checked and normalised (the able model has
+    :func:`bladelab.runner.scaling.athlete_params`), checked and normalised (the able model has
     no blade; the amputee needs one; files written before the bodies existed have no
     ``"body"`` and mean seed 001's)."""
     if not isinstance(spec, dict) or "model" not in spec:

@@ -85,7 +85,7 @@ from bladelab.predict.collocation.stored import (
     params_from_spec,
     runner_from_spec,
 )
-from bladelab.runner.params import blade_category
+from bladelab.runner.blade_categories import blade_category
 
 __all__ = [
     "SWEEP_TABLE",

@@ -16,7 +16,8 @@ accelerations (implicit multibody dynamics), excitations, tendon-force rates (De
   stride length ``d``; pelvis_tx = 0 at node 0;
 - the speed: ``d = v·T`` (prescribed speed) or ``d`` free (maximum speed);
 - optionally, alternating steps (``step_phase_tolerance``): the centre of each leg's vertical
-  ground force over the stride (its circular mean, :func:`step_phase`) half a stride ± the
+  ground force over the stride (its circular mean,
+  :func:`~bladelab.predict.collocation.alternating_steps.step_phase`) half a stride ± the
   tolerance after the other leg's, which rules out a gallop (both stances close together,
   then one long flight), and each leg carrying a stance (a one-legged hop ruled out);
 - optionally, a minimum peak flexion of named knees (``knee_flexion_min``, people's swing
@@ -33,26 +34,34 @@ Variables are scaled (:class:`VariableScales`) so that IPOPT sees numbers of ord
 from __future__ import annotations
 
 import math
-import sys
 import time
 from collections.abc import Callable
-from dataclasses import dataclass, field, replace
+from dataclasses import replace
 
 import casadi as ca
 import numpy as np
 
 from bladelab.errors import SpecError
+from bladelab.predict.collocation.alternating_steps import alternation_rows
 from bladelab.predict.collocation.compiled import compiled_node, compiling_enabled
+from bladelab.predict.collocation.ipopt_options import solver_options
+from bladelab.predict.collocation.nlp_solution import (
+    NLPSolution,
+    constraint_violations,
+    solve_timings,
+)
 from bladelab.predict.collocation.progress import ProgressRelay
-from bladelab.predict.collocation.stride_guess import (
-    COLLOCATION_SOURCE,
-    StrideGuess,
-    periodic_derivative,
+from bladelab.predict.collocation.stride_guess import periodic_derivative
+from bladelab.predict.collocation.stride_node import (
+    control_names,
+    leg_forces_function,
+    node_bounds,
+    node_function,
+    node_scales,
+    path_names,
+    state_names,
 )
 from bladelab.predict.collocation.stride_problem import (
-    FORCE_RATE_SCALE,
-    METABOLIC_SQUARED_SCALE,
-    PASSIVE_TORQUE_SCALE,
     StrideDynamics,
     StrideWeights,
     VariableScales,
@@ -60,111 +69,7 @@ from bladelab.predict.collocation.stride_problem import (
 from bladelab.predict.collocation.swing_knee import peak_flexion_rows
 from bladelab.predict.collocation.symmetry import stride_mirror, symmetrized, symmetry_rows
 
-__all__ = [
-    "NLPSolution",
-    "StrideDynamics",
-    "StrideNLP",
-    "StrideWeights",
-    "VariableScales",
-    "alternation_rows",
-    "step_phase",
-]
-
-
-@dataclass(frozen=True)
-class NLPSolution:
-    """The solution (or the last iterate) of a stride NLP.
-
-    Arrays have n + 1 rows (nodes at ``time``); ``tendon_force`` is normalised by F_max.
-    ``multipliers``: IPOPT's multipliers of the variable bounds and of the constraints of the
-    scaled NLP at this point (None where unknown), the dual half of a warm start.
-    ``timings`` [s unless named]: ``build_s`` (building the solver; 0 when reused), each NLP
-    function's time (``nlp_f_s``, ``nlp_g_s``, ...) and calls (``calls_nlp_f``, ...), their
-    sum ``functions_s``, ``ipopt_own_s`` (the rest of ``wall_s``: IPOPT's own linear algebra
-    and line search) and ``peak_memory_MB`` (the process's peak resident memory after the
-    solve [MB], where the platform tells).
-    """
-
-    time: np.ndarray
-    q: np.ndarray
-    qd: np.ndarray
-    activation: np.ndarray
-    tendon_force: np.ndarray
-    qdd: np.ndarray
-    excitation: np.ndarray
-    tendon_force_rate: np.ndarray
-    period: float
-    objective: float
-    objective_terms: dict[str, float]
-    success: bool
-    status: str
-    iterations: int
-    wall_s: float
-    timings: dict[str, float] = field(default_factory=dict)
-    max_violation: float = math.nan
-    worst_constraints: tuple[tuple[str, float], ...] = ()
-    multipliers: tuple[np.ndarray, np.ndarray] | None = None
-
-    @property
-    def speed(self) -> float:
-        """Mean forward speed [m/s]."""
-        return float((self.q[-1, 0] - self.q[0, 0]) / self.period)
-
-    def to_guess(self, source: str = COLLOCATION_SOURCE) -> StrideGuess:
-        """This solution as an initial guess (:class:`~bladelab.predict.collocation.stride_guess.
-        StrideGuess`, muscle states included): a warm start for another problem or mesh."""
-        return StrideGuess(source, self.period, self.q, self.qd, self.activation,
-                           self.tendon_force, qdd=self.qdd, excitation=self.excitation,
-                           tendon_force_rate=self.tendon_force_rate,
-                           multipliers=self.multipliers)
-
-
-#: Added to the squared force centroids [BW²] of :func:`alternation_rows` so that their norm stays
-#: differentiable at 0 (a leg without stance).
-_CENTROID_EPS = 1e-8
-#: The least force centroid |C_j| [BW] of each leg under the alternating-steps constraint:
-#: about a quarter of a leg's share in running (0.42–0.53 BW measured on the human body's
-#: strides), so that a one-legged hop (|C| = 0 on one leg, where the phase constraint holds
-#: up to ε) is ruled out with it.
-MIN_CENTROID_BW = 0.1
-
-
-def _peak_memory_mb() -> float | None:
-    """The process's peak resident memory so far [MB] (``getrusage``), None where the
-    platform does not tell; after a solve, an upper bound of that solve's peak."""
-    try:
-        import resource
-    except ImportError:  # Windows
-        return None
-    peak = float(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss)
-    return peak / 2**20 if sys.platform == "darwin" else peak / 2**10  # bytes / KiB
-
-
-def step_phase(leg_forces: np.ndarray) -> float:
-    """The right (prosthetic) leg's stance after the left (intact) leg's [fraction of the
-    stride, 0–1]: the difference of the circular means of the legs' vertical ground forces
-    ``leg_forces`` (n nodes of one period, without the repeated last node; columns left,
-    right) [N]. 0.5 for alternating steps of equal time; near 0 or 1 for a gallop."""
-    f = np.asarray(leg_forces, float)
-    ph = np.exp(2j * np.pi * np.arange(f.shape[0]) / f.shape[0])
-    c = ph @ f
-    return float(np.angle(c[1] * np.conj(c[0])) / (2 * np.pi) % 1.0)
-
-
-def alternation_rows(legs, body_weight: float, tolerance: float):
-    """The alternating-steps constraint rows (each ≤ 0) of the legs' vertical forces ``legs``
-    (2, n nodes of one period) [N] and the body weight [N]: with the legs' force centroids
-    C_j = Σ_k F_j,k·e^{2πik/n} / (n·BW), Re(C₀·C̄₁) + cos(2π·tolerance)·|C₀|·|C₁| ≤ 0, i.e.
-    the phase between them within π ± 2π·tolerance (:func:`step_phase` within 0.5 ±
-    tolerance); and :data:`MIN_CENTROID_BW`² − |C_j|² ≤ 0 for each leg."""
-    n = legs.shape[1]
-    k = 2 * np.pi * np.arange(n) / n
-    a = ca.mtimes(legs, ca.DM(np.cos(k))) / (n * body_weight)
-    b = ca.mtimes(legs, ca.DM(np.sin(k))) / (n * body_weight)
-    sq = [a[j] ** 2 + b[j] ** 2 for j in (0, 1)]
-    norm = [ca.sqrt(v + _CENTROID_EPS) for v in sq]
-    phase = a[0] * a[1] + b[0] * b[1] + math.cos(2 * math.pi * tolerance) * norm[0] * norm[1]
-    return ca.vertcat(phase, MIN_CENTROID_BW**2 - sq[0], MIN_CENTROID_BW**2 - sq[1])
+__all__ = ["PERIOD_BOUNDS_S", "StrideNLP"]
 
 
 def _node_pairs(values):
@@ -172,52 +77,6 @@ def _node_pairs(values):
     row of node values: the trapezoidal rule's sum, times h/2 for an integral."""
     return ca.sum2(values[:, :-1]) + ca.sum2(values[:, 1:])
 
-
-#: IPOPT's stop at an acceptable level, on every L-BFGS solve: five iterations in a row
-#: feasible to 1e-5 (scaled constraints), complementarity below 1e-3 and the objective
-#: changing by less than 1e-5 of itself per iteration. Near a solution L-BFGS's dual
-#: infeasibility wanders between 1e-2 and 1 and dips below ``tol`` only now and then, so about
-#: half of a solve's iterations went on the last 0.01 % of its objective (measured on warm and
-#: cold starts: 15–55 % fewer iterations, objectives within 0.033 %;
-#: benchmarks/collocation_speed/README.md "Stopping a solve when the objective stalls").
-STALL_STOP_OPTIONS = {
-    "ipopt.acceptable_tol": 1.0,
-    "ipopt.acceptable_iter": 5,
-    "ipopt.acceptable_obj_change_tol": 1e-5,
-    "ipopt.acceptable_constr_viol_tol": 1e-5,
-    "ipopt.acceptable_compl_inf_tol": 1e-3,
-}
-
-#: IPOPT's L-BFGS Hessian of a predictive stage (:func:`~bladelab.predict.collocation.solve.
-#: predict_stride` adds these options to every L-BFGS stage but the tracking stage): the
-#: low-rank update held in the augmented system itself (``extended``: 2m more rows, one
-#: factorisation and one back solve per step) instead of IPOPT's default Sherman-Morrison
-#: route, whose 2m extra back solves per iteration were most of a solve's time; history m = 4.
-#: Measured (benchmarks/collocation_speed/README.md, "The low-rank update inside the augmented
-#: system"): three warm starts of the amputee Cat6 stride 58-61 against 88 ms per iteration,
-#: 33 s against 57 s in all, objectives within 0.1 %; the category study with three starts
-#: 932 against 1,505 s of solver time. The tracking stage keeps IPOPT's default: with these
-#: options the template's tracking stage did not converge in 3,000 iterations.
-PREDICTIVE_LBFGS_OPTIONS = {
-    "ipopt.limited_memory_aug_solver": "extended",
-    "ipopt.limited_memory_max_history": 4,
-}
-
-#: IPOPT options of a solve started from a solution's primal and dual values (its
-#: multipliers): the barrier starts small and the point stays where it is, so that a solve
-#: at the start's own speed ends at once and a continuation step stays on the start's branch
-#: (measured, benchmarks/collocation_speed/README.md: the amputee Cat6 stride at 4 m/s again in
-#: 0 iterations instead of 613; 4 -> 4.2 m/s in 197 instead of 574). mu_init 1e-3, 1e-4 and
-#: 1e-5 gave the same iterates.
-DUAL_WARM_START_OPTIONS = {
-    "ipopt.warm_start_init_point": "yes",
-    "ipopt.mu_init": 1e-4,
-    "ipopt.warm_start_bound_push": 1e-9,
-    "ipopt.warm_start_bound_frac": 1e-9,
-    "ipopt.warm_start_slack_bound_push": 1e-9,
-    "ipopt.warm_start_slack_bound_frac": 1e-9,
-    "ipopt.warm_start_mult_bound_push": 1e-9,
-}
 
 #: Bounds of the free stride time [s] (a running stride at 3–10 m/s lies well inside).
 PERIOD_BOUNDS_S = (0.4, 1.2)
@@ -260,9 +119,10 @@ class StrideNLP:
         ``(T_ref, weight)``: add ``weight`` × ln(T/T_ref)², the squared relative deviation of
         the stride time T from ``T_ref`` [s] (the reference's cadence).
     step_phase_tolerance
-        Keep the legs' stances alternating: the right leg's :func:`step_phase` within
-        0.5 ± this [fraction of the stride] (needs ``StrideDynamics.leg_vertical_grf``);
-        None: free.
+        Keep the legs' stances alternating: the right leg's
+        :func:`~bladelab.predict.collocation.alternating_steps.step_phase` within 0.5 ± this
+        [fraction of the stride] (needs ``StrideDynamics.leg_vertical_grf``;
+        :func:`~bladelab.predict.collocation.alternating_steps.alternation_rows`); None: free.
     symmetric
         Each leg does what the other did half a stride earlier
         (:mod:`~bladelab.predict.collocation.symmetry`; an even ``n``, legs that are mirror
@@ -285,8 +145,9 @@ class StrideNLP:
         Wall time [s] of compiling the node function, or of loading it from the cache.
     node
         The SX function of one mesh node, ``(x, u) -> (ẋ scaled, path residuals, effort,
-        metabolic rate, inequalities, vertical force, squared metabolic rate, force rate)``,
-        mapped over the ``n + 1`` nodes to build the NLP.
+        metabolic rate, inequalities, vertical force, squared metabolic rate, force rate)``
+        (:func:`~bladelab.predict.collocation.stride_node.node_function`), mapped over the
+        ``n + 1`` nodes to build the NLP.
     """
 
     def __init__(
@@ -364,50 +225,10 @@ class StrideNLP:
         nq, nm = d.nq, d.nm
         self.nx = 2 * nq + 2 * nm
         self.nu = nq + 2 * nm
-        sx = np.concatenate([np.full(nq, s.q), np.full(nq, s.qd), np.ones(nm), np.ones(nm)])
-        su = np.concatenate([np.full(nq, s.qdd), np.ones(nm), np.full(nm, s.tendon_force_rate)])
-        self.sx, self.su = sx, su
-
-        xs = ca.SX.sym("x", self.nx)
-        us = ca.SX.sym("u", self.nu)
-        x, u = xs * sx, us * su
-        q, qd = x[:nq], x[nq:2 * nq]
-        a, fnt = x[2 * nq:2 * nq + nm], x[2 * nq + nm:]
-        qdd, e, dfnt = u[:nq], u[nq:nq + nm], u[nq + nm:]
-        r_mb, r_hill = d.residuals(q, qd, qdd, a, fnt, dfnt)
-        adot = d.activation_rate(e, a)
-        xdot_scaled = ca.vertcat(qd, qdd, adot, dfnt) / sx
-        path = ca.vertcat(r_mb / d.residual_scale, r_hill)
+        self.sx, self.su = sx, su = node_scales(d, s)
         w = self.weights
-        pelvis_scale = np.array([10.0 if n_ in ("pelvis_tx", "pelvis_tz") else 100.0
-                                 for n_ in d.dof_names[:3]])
-        effort = (w.activation * ca.sum1(a**3) / max(nm, 1)
-                  + w.acceleration * ca.sumsqr(qdd[3:]) / max(nq - 3, 1) / 1e4
-                  + w.pelvis_acceleration * ca.sumsqr(qdd[:3] / pelvis_scale) / 3)
-        met = d.metabolic_rate(q, qd, a, fnt, dfnt, e)
-        ineq = (d.inequalities(q, qd, a, fnt, dfnt) if d.inequalities is not None
-                else ca.SX.zeros(0, 1))
-        self.n_ineq = int(ineq.numel())
-        fz = d.vertical_grf(q, qd) if d.vertical_grf is not None else ca.SX(0.0)
-        if w.metabolic_squared:
-            if d.muscle_metabolic_rates is None:
-                raise SpecError("metabolic_squared needs the muscles' metabolic rates",
-                                where="weights", hint="build the dynamics with stride_dynamics")
-            per_kg = d.muscle_metabolic_rates(q, qd, a, fnt, dfnt, e) / d.mass
-            met_sq = ca.sumsqr(per_kg) / METABOLIC_SQUARED_SCALE
-        else:
-            met_sq = ca.SX(0.0)
-        frate = ca.sumsqr(dfnt) / max(nm, 1) / FORCE_RATE_SCALE
-        if w.passive:
-            if d.passive_joint_torques is None:
-                raise SpecError("the passive-torque term needs the joints' passive torques",
-                                where="weights", hint="build the dynamics with stride_dynamics")
-            tau_p = d.passive_joint_torques(q, qd)
-            passive = ca.sumsqr(tau_p) / max(int(tau_p.numel()), 1) / PASSIVE_TORQUE_SCALE
-        else:
-            passive = ca.SX(0.0)
-        node = ca.Function("node", [xs, us],
-                           [xdot_scaled, path, effort, met, ineq, fz, met_sq, frate, passive])
+        node = node_function(d, w, sx, su)
+        self.n_ineq = int(node.numel_out(4))
         self.node = node  # one node's functions (SX), mapped over the mesh below
         t0 = time.perf_counter()
         external = compiled_node(node) if self._compile else None
@@ -447,19 +268,19 @@ class StrideNLP:
         # a symmetric stride: the second half's rows follow from the first half's (symmetry)
         self._imposed_nodes = m = n // 2 if self.symmetric else n
         g = [ca.vec(defects[:, :m]), ca.vec(pth[:, :m]), periodic]
-        state_names = self._state_names()
+        states, controls = state_names(d), control_names(d)
         self._g_names = (
-            [f"defect {nm_}@{k}" for k in range(m) for nm_ in state_names]
-            + [f"path {nm_}@{k}" for k in range(m) for nm_ in self._path_names()]
-            + [f"periodicity {state_names[i]}" for i in keep]
-            + [f"periodicity {nm_}" for nm_ in self._control_names()]
+            [f"defect {nm_}@{k}" for k in range(m) for nm_ in states]
+            + [f"path {nm_}@{k}" for k in range(m) for nm_ in path_names(d)]
+            + [f"periodicity {states[i]}" for i in keep]
+            + [f"periodicity {nm_}" for nm_ in controls]
         )
         if self.symmetric:
             self._mirror = stride_mirror(d, node, self.sx)
             g.append(symmetry_rows(X, U, *self._mirror, itx))
             self._g_names += (
-                [f"symmetry {nm_}@{k}" for k in range(m, n) for nm_ in state_names]
-                + [f"symmetry {nm_}@{k}" for k in range(m, n) for nm_ in self._control_names()])
+                [f"symmetry {nm_}@{k}" for k in range(m, n) for nm_ in states]
+                + [f"symmetry {nm_}@{k}" for k in range(m, n) for nm_ in controls])
         trap = _node_pairs(eff) / 2 * h  # ∫ effort dt
         energy = _node_pairs(mets) / 2 * h  # ∫ Ė dt [J]
         terms = {"effort": trap / period}
@@ -492,7 +313,7 @@ class StrideNLP:
                 g.append(period - (hi0 + f * (hi1 - hi0)))
                 self._g_names += ["stride time band (low)", "stride time band (high)"]
         if self.step_phase_tolerance is not None:
-            legs = ca.Function("legs", [xs], [d.leg_vertical_grf(q, qd)]).map(n)(X[:, :n])
+            legs = leg_forces_function(d, sx).map(n)(X[:, :n])
             g.append(alternation_rows(legs, d.mass * d.gravity, self.step_phase_tolerance))
             self._g_names += ["alternating steps"] + [f"stance of leg {j}" for j in (0, 1)]
         if self.knee_flexion_min:
@@ -554,41 +375,19 @@ class StrideNLP:
                             where="tracking", hint=f"coordinates: {', '.join(names)}")
         return [names.index(d) for d in dofs]
 
-    def _state_names(self) -> list[str]:
-        d = self.dyn
-        return ([f"q {n}" for n in d.dof_names] + [f"qd {n}" for n in d.dof_names]
-                + [f"a {n}" for n in d.muscle_names] + [f"Ft {n}" for n in d.muscle_names])
-
-    def _control_names(self) -> list[str]:
-        d = self.dyn
-        return ([f"qdd {n}" for n in d.dof_names] + [f"e {n}" for n in d.muscle_names]
-                + [f"dFt {n}" for n in d.muscle_names])
-
-    def _path_names(self) -> list[str]:
-        d = self.dyn
-        return [f"dynamics {n}" for n in d.dof_names] + [f"hill {n}" for n in d.muscle_names]
-
     # -- bounds and guess ---------------------------------------------------------------
     def bounds(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """(lbx, ubx, lbg, ubg) of the scaled NLP."""
         d, n = self.dyn, self.n
-        nq, nm = d.nq, d.nm
         itx = d.dof_names.index("pelvis_tx")
-        lx = np.concatenate([d.q_bounds[:, 0], d.qd_bounds[:, 0], np.full(nm, self.min_activation),
-                             np.full(nm, self.min_tendon_force)])
-        strength = np.ones(nm) if d.active_strength is None else d.active_strength
-        ux = np.concatenate([d.q_bounds[:, 1], d.qd_bounds[:, 1], np.ones(nm),
-                             self.max_tendon_force * strength])
+        lx, ux, lu, uu = node_bounds(d, self.min_activation, self.min_tendon_force,
+                                     self.max_tendon_force)
         lX = np.tile((lx / self.sx)[:, None], (1, n + 1))
         uX = np.tile((ux / self.sx)[:, None], (1, n + 1))
         lX[itx, :], uX[itx, :] = -np.inf, np.inf
         lX[itx, 0] = uX[itx, 0] = 0.0
-        qdd_max = 1e4
-        lu = np.concatenate([np.full(nq, -qdd_max), np.full(nm, self.min_activation),
-                             np.full(nm, -1e3)]) / self.su
-        uu = np.concatenate([np.full(nq, qdd_max), np.ones(nm), np.full(nm, 1e3)]) / self.su
-        lU = np.tile(lu[:, None], (1, n + 1))
-        uU = np.tile(uu[:, None], (1, n + 1))
+        lU = np.tile((lu / self.su)[:, None], (1, n + 1))
+        uU = np.tile((uu / self.su)[:, None], (1, n + 1))
         lT = self.period_bounds[0] / self.scales.period
         uT = self.period_bounds[1] / self.scales.period
         lbx = np.concatenate([lX.ravel(order="F"), lU.ravel(order="F"), [lT]])
@@ -676,9 +475,11 @@ class StrideNLP:
         reused by every later one, at any speed (``NLPSolution.timings["build_s"]`` is 0 then).
 
         ``multipliers`` (bounds, constraints; :meth:`initial_multipliers`): start from ``x0``
-        and these duals with :data:`DUAL_WARM_START_OPTIONS` (under ``options``). With
-        L-BFGS the solve ends at :data:`STALL_STOP_OPTIONS`' acceptable level where it comes
-        before ``tol`` (status ``Solved_To_Acceptable_Level``, a success).
+        and these duals with :data:`~bladelab.predict.collocation.ipopt_options.
+        DUAL_WARM_START_OPTIONS` (under ``options``). With L-BFGS the solve ends at
+        :data:`~bladelab.predict.collocation.ipopt_options.STALL_STOP_OPTIONS`' acceptable
+        level where it comes before ``tol`` (status ``Solved_To_Acceptable_Level``, a success).
+        The options: :func:`~bladelab.predict.collocation.ipopt_options.solver_options`.
         """
         if hessian not in ("limited-memory", "exact"):
             raise SpecError(f"unknown Hessian option {hessian!r}", where="hessian",
@@ -688,27 +489,9 @@ class StrideNLP:
                             where="hessian", hint="build the StrideNLP with compiled=False")
         if speed is not None and not (speed > 0 and math.isfinite(speed)):
             raise SpecError(f"speed must be > 0 m/s, got {speed}", where="speed")
-        opts = {
-            "ipopt.max_iter": int(max_iter),
-            "ipopt.tol": float(tol),
-            "ipopt.constr_viol_tol": 1e-6,
-            "ipopt.print_level": int(print_level),
-            "ipopt.hessian_approximation": hessian,
-            "ipopt.mu_strategy": "adaptive" if hessian == "limited-memory" else "monotone",
-            "ipopt.linear_solver": "mumps",
-            "ipopt.mumps_pivot_order": 5,  # METIS
-            "ipopt.nlp_scaling_method": "gradient-based",
-            "ipopt.sb": "yes",  # no banner
-            # SX graph: about 10x faster iterations than MX (measured); a compiled node is an
-            # external, which no SX graph holds
-            "expand": not self.compiled,
-            "print_time": False,
-        }
-        if hessian == "limited-memory":
-            opts.update(STALL_STOP_OPTIONS)
-        if multipliers is not None:
-            opts.update(DUAL_WARM_START_OPTIONS)
-        opts.update(options or {})
+        opts = solver_options(max_iter=max_iter, tol=tol, hessian=hessian,
+                              print_level=print_level, expand=not self.compiled,
+                              warm_duals=multipliers is not None, options=options)
         t0 = time.perf_counter()
         solver, relay = self._solver(opts)
         t_build = time.perf_counter() - t0
@@ -776,23 +559,8 @@ class StrideNLP:
         if not isinstance(values, (list, tuple)):  # a Function of one output returns it bare
             values = [values]
         terms = [float(v) for v in values]
-        viol = np.maximum(lbg - gval, gval - ubg)
-        order = np.argsort(viol)[::-1][:5]
-        timings = {"build_s": t_build, "compile_s": self.compile_s}
-        for key in ("t_wall_nlp_f", "t_wall_nlp_g", "t_wall_nlp_grad_f", "t_wall_nlp_jac_g",
-                    "t_wall_nlp_hess_l"):
-            if key in stats:
-                timings[key.replace("t_wall_", "") + "_s"] = float(stats[key])
-        for key in ("n_call_nlp_f", "n_call_nlp_g", "n_call_nlp_grad_f", "n_call_nlp_jac_g",
-                    "n_call_nlp_hess_l"):
-            if key in stats:
-                timings[key.replace("n_call_", "calls_")] = float(stats[key])
-        functions = sum(v for k, v in timings.items() if k.startswith("nlp_"))
-        timings["functions_s"] = functions
-        timings["ipopt_own_s"] = max(0.0, float(wall) - t_build - functions)
-        memory = _peak_memory_mb()
-        if memory is not None:
-            timings["peak_memory_MB"] = memory
+        max_violation, worst = constraint_violations(lbg, ubg, gval, self._g_names)
+        timings = solve_timings(stats, wall, t_build, self.compile_s)
         return NLPSolution(
             time=np.linspace(0.0, T, n + 1),
             q=X[:nq].T, qd=X[nq:2 * nq].T,
@@ -804,9 +572,7 @@ class StrideNLP:
             status=str(stats.get("return_status", "unknown")),
             iterations=int(stats.get("iter_count", -1)),
             wall_s=float(wall), timings=timings,
-            max_violation=float(viol.max()) if viol.size else 0.0,
-            worst_constraints=tuple((self._g_names[i], float(viol[i])) for i in order
-                                    if viol[i] > 0),
+            max_violation=max_violation, worst_constraints=worst,
         )
 
     def energy_and_distance(self, sol: NLPSolution) -> tuple[float, float]:

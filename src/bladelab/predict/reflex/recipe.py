@@ -55,7 +55,8 @@ from bladelab.predict.reflex.acceptance import acceptance_runs, judged_runs, mee
 from bladelab.predict.reflex.controller import parameter_digest, read_parameters
 from bladelab.predict.reflex.objective import ObjectiveSettings
 from bladelab.predict.reflex.optimize import CHECKPOINT_NAME, optimize_controller, runner_and_layout
-from bladelab.runner.params import REFLEX_STARTS_DIR, blade_category
+from bladelab.runner.blade_categories import blade_category
+from bladelab.runner.params import REFLEX_STARTS_DIR
 
 __all__ = ["ABLE", "STABLE_GAIT_RECIPE", "Recipe", "Stage", "level_row", "maximum_speed",
            "model_of", "recipe_task", "run_recipe", "settled_speed", "track_file"]

@@ -44,7 +44,7 @@ from bladelab.predict.reflex.controller import parameter_digest, read_parameters
 from bladelab.predict.reflex.objective import ObjectiveSettings, simulate_controlled
 from bladelab.predict.reflex.optimize import CHECKPOINT_NAME, optimize_controller, runner_and_layout
 from bladelab.runner.analyses import spatiotemporal
-from bladelab.runner.params import blade_catalogue, blade_category
+from bladelab.runner.blade_categories import blade_catalogue, blade_category
 
 CELL_NAME = "cell.json"
 CELL_FORMAT = 1
