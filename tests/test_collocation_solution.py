@@ -780,30 +780,6 @@ def test_the_force_figure_starts_at_the_left_touch_down_beside_the_measured_forc
     plt.close(fig)
 
 
-def test_where_each_stance_peaks_counts_a_stance_across_the_period_s_end():
-    from bladelab.report.collocation import _stance_peak_places
-
-    force = np.zeros(40)
-    force[5:15] = [1, 2, 3, 4, 5, 4, 3, 2, 1, 0.5]  # peaks at its 5th node of 10: 40 %
-    force[[36, 37, 38, 39, 0, 1, 2, 3]] = [1, 2, 2.5, 3, 2, 1.5, 1, 0.5]  # wraps: 3 of 8, 37.5 %
-    assert sorted(_stance_peak_places(force, 0.1)) == pytest.approx([37.5, 40.0])
-    assert _stance_peak_places(np.zeros(10), 0.1) == []
-
-
-def test_each_stance_s_knee_landing_and_deepest_flexion_wrap_around_the_period():
-    from bladelab.report.collocation import _stance_knees
-
-    force = np.zeros(40)
-    force[5:15] = 1.0
-    force[[36, 37, 38, 39, 0, 1, 2, 3]] = 1.0  # a stance across the period's end
-    knee = np.zeros(40)
-    knee[5:15] = [30, 40, 50, 45, 40, 35, 30, 25, 20, 15]  # lands at 30, deepest at 2 of 10
-    knee[[36, 37, 38, 39, 0, 1, 2, 3]] = [12, 20, 30, 40, 44, 35, 25, 15]  # 4 of 8: 50 %
-    got = sorted(_stance_knees(force, knee, 0.5))
-    assert got == [pytest.approx((12.0, 50.0)), pytest.approx((30.0, 20.0))]
-    assert _stance_knees(np.zeros(10), np.zeros(10), 0.5) == []
-
-
 def test_the_predictive_report_renders_a_collocation_solution(able, tmp_path):
     from bladelab.report import Report
     from bladelab.report.collocation import collocation_sections
@@ -828,6 +804,11 @@ def test_the_predictive_report_renders_a_collocation_solution(able, tmp_path):
     assert "At touch-down the left leg" in html and "How a foot lands" in html
     assert "vertical force peaks at" in html and "% of its nodes here, the measured" in html
     assert "The stance knee lands at" in html and "is most flexed at" in html
+    # and the first section puts that shape beside the criteria, in words and in a table
+    first = html[html.rindex("Against measured human running"):html.rindex("Collocation solution")]
+    assert "Beside the criteria, the shape of a stance" in first
+    assert "The shape of each stance beside the measured runner" in first
+    assert "knee flexion at touch-down, left leg" in first
     assert "Not a free prediction" not in html  # the fake solve held no reference term
     assert "Prosthesis loads" not in html  # an able runner carries none
     # a stride solved with people's angles in its objective says so in its first lines

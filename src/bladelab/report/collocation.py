@@ -35,11 +35,9 @@ from bladelab.predict.collocation.human_running import (
 )
 from bladelab.predict.collocation.mesh_check import MESH_CHECK_DIR, read_mesh_check
 from bladelab.predict.collocation.model import build_collocation_model
-from bladelab.predict.collocation.nodes import periodic_runs
 from bladelab.predict.collocation.settings import PEOPLE_REFERENCE
 from bladelab.predict.collocation.solution import (
     BEST_ITERATE_KIND,
-    CONTACT_THRESHOLD_N,
     SOLUTION_KIND,
     CollocationSolution,
 )
@@ -47,6 +45,7 @@ from bladelab.predict.collocation.solve import SOLUTION_FILE
 from bladelab.predict.collocation.stored import athlete_label, runner_from_spec
 from bladelab.predict.collocation.touchdown import touchdown_slides
 from bladelab.report.collocation_loads import add_loads_section
+from bladelab.report.stance_shape import stance_shape
 
 __all__ = ["N_STRIDES", "REFINE", "collocation_sections", "collocation_solution_file",
            "reference_term_text"]
@@ -253,86 +252,6 @@ def _mesh_check_text(check) -> str:
     return f" {check.verdict()}."
 
 
-def _stance_nodes(force: np.ndarray, threshold: float) -> list[np.ndarray]:
-    """The node indices of each stance (run above ``threshold``) of a periodic force (n nodes
-    of one period, without the repeated last one), in order, a stance across the end wrapped."""
-    return [(start + np.arange(length)) % force.size
-            for start, length in periodic_runs(force > threshold)]
-
-
-def _place_pct(values: np.ndarray) -> float:
-    """Where ``values`` (over one stance's nodes) is largest [% of the stance's nodes]."""
-    return 100.0 * float(np.argmax(values)) / len(values)
-
-
-def _stance_peak_places(force: np.ndarray, threshold: float) -> list[float]:
-    """Where each stance's force peaks [% of the stance's nodes] (:func:`_stance_nodes`)."""
-    return [_place_pct(force[nodes]) for nodes in _stance_nodes(force, threshold)]
-
-
-#: Force peak and deepest knee flexion closer than this [% of the stance] count as together.
-KNEE_PEAK_AGREEMENT_PCT = 10.0
-
-
-def _stance_knees(force: np.ndarray, flexion: np.ndarray, threshold: float
-                  ) -> list[tuple[float, float]]:
-    """Per stance (runs of ``force`` above ``threshold``, periodic, n nodes without the repeated
-    last one): the knee's flexion at its first node [deg] and where in it the knee is most
-    flexed [% of the stance's nodes]; ``flexion`` (n,) [deg] of that stance's leg."""
-    return [(float(flexion[nodes[0]]), _place_pct(flexion[nodes]))
-            for nodes in _stance_nodes(force, threshold)]
-
-
-def _knee_flexion_deg(q: np.ndarray, dof_names, side: str) -> np.ndarray | None:
-    """The knee's flexion [deg, positive flexed] of leg ``side`` ('l' or 'r'), None without."""
-    name = f"knee_angle_{side}"
-    return None if name not in dof_names else -np.degrees(q[:, list(dof_names).index(name)])
-
-
-def _peak_place_text(sol, trial) -> str:
-    """Where in stance the vertical force peaks, and where the stance knee is most flexed and
-    how flexed it lands, this stride's against the measured stride's, in words ('' without a
-    measured force)."""
-    if trial is None or trial.vertical_grf_bw is None:
-        return ""
-    threshold = CONTACT_THRESHOLD_N / sol.body_weight_N
-    fz = sol.leg_vertical_force()[:-1] / sol.body_weight_N
-    total = np.asarray(trial.vertical_grf_bw)[:-1]
-    ours = [p for j in range(fz.shape[1]) for p in _stance_peak_places(fz[:, j], threshold)]
-    measured = _stance_peak_places(total, threshold)
-    if not ours or not measured:
-        return ""
-    text = (" Each stance's vertical force peaks at "
-            + ", ".join(f"{p:.0f}" for p in ours) + " % of its nodes here, the measured "
-            "runner's at " + ", ".join(f"{p:.0f}" for p in measured) + " % (no criterion "
-            "checks it).")
-    q = np.asarray(sol.nlp.q)[:-1]
-    knees = [k for j, side in enumerate("lr")
-             if (flex := _knee_flexion_deg(q, sol.dof_names, side)) is not None
-             for k in _stance_knees(fz[:, j], flex, threshold)]
-    legs = [_knee_flexion_deg(np.asarray(trial.q)[:-1], trial.dof_names or sol.dof_names, side)
-            for side in "lr"]
-    theirs = []
-    if knees and all(leg is not None for leg in legs):
-        # the stance leg of each measured stance (total force): the one whose knee is the
-        # straighter over it (the other swings)
-        for nodes in _stance_nodes(total, threshold):
-            leg = legs[int(np.argmin([flex[nodes].mean() for flex in legs]))]
-            theirs.append((float(leg[nodes[0]]), _place_pct(leg[nodes])))
-    if knees and theirs:
-        text += (" The stance knee lands at " + ", ".join(f"{k[0]:.0f}" for k in knees)
-                 + "° of flexion and is most flexed at " + ", ".join(f"{k[1]:.0f}" for k in knees)
-                 + " % of the stance here, the measured runner's lands at "
-                 + ", ".join(f"{k[0]:.0f}" for k in theirs) + "° and is most flexed at "
-                 + ", ".join(f"{k[1]:.0f}" for k in theirs) + " %")
-        together = len(knees) == len(ours) and all(
-            abs(p - k[1]) <= KNEE_PEAK_AGREEMENT_PCT for p, k in zip(ours, knees, strict=True))
-        text += (": here as in the measured runner the force peaks about where the knee is most "
-                 "flexed, so a landing with the knee more flexed brings the peak earlier."
-                 if together else ".")
-    return text + " (docs/collocation.md, 'How a foot lands'.)"
-
-
 def _touchdown_text(sol, runner, cm, trial) -> str:
     """How each leg lands (:func:`~bladelab.predict.collocation.touchdown.touchdown_slides`), in
     words, for the ground-force figure's caption."""
@@ -357,9 +276,11 @@ def _touchdown_text(sol, runner, cm, trial) -> str:
                if trial is not None and trial.horizontal_grf_bw is not None else "."))
 
 
-def _add_human_running_section(report, sol, trial, check=None) -> None:
+def _add_human_running_section(report, sol, trial, check=None, shape=None) -> None:
     """The stride against measured human running, criterion by criterion (the report's first
-    words about a gait), and its mesh-halving check (``check``, or None)."""
+    words about a gait), the shape of its stances beside the measured runner's (``shape``, a
+    :class:`~bladelab.report.stance_shape.StanceShape`, or None) and its mesh-halving check
+    (``check``, or None)."""
     crit = human_running_criteria(sol)
     if trial is not None:
         crit += angle_agreement(sol, trial.q)
@@ -389,8 +310,12 @@ def _add_human_running_section(report, sol, trial, check=None) -> None:
               + f" Contact times here interpolate the force between the nodes; the gait-cycle "
               f"and leg-stiffness tables below count whole mesh intervals "
               f"({1e3 * sol.period_s / sol.settings.mesh_intervals:.1f} ms each), so the two "
-              f"may differ by up to one interval." + _mesh_check_text(check)),
+              f"may differ by up to one interval."
+              + (shape.summary_text() if shape is not None else "") + _mesh_check_text(check)),
         tables=[("The stride against people running at its speed", table)]
+        + ([] if shape is None else [(
+            "The shape of each stance beside the measured runner's (Fukuchi et al. 2017, "
+            "RBDS001 at 3.5 m/s, its mean stride; no criterion checks it)", shape.table())])
         + ([] if check is None else [(
             f"Mesh-halving check: the same problem on {check.fine_intervals} mesh intervals "
             f"against this stride's {check.coarse_intervals}"
@@ -463,7 +388,8 @@ def collocation_sections(report, path: str | Path) -> tuple[dict, object]:
     import matplotlib.pyplot as plt
 
     trial = _measured_trial(runner, sol)
-    _add_human_running_section(report, sol, trial, _mesh_check_of(Path(path), sol))
+    shape = stance_shape(sol, trial)
+    _add_human_running_section(report, sol, trial, _mesh_check_of(Path(path), sol), shape)
     fig = _grf_figure(sol, trial)
     report.add_section(
         "Collocation solution",
@@ -495,7 +421,7 @@ def collocation_sections(report, path: str | Path) -> tuple[dict, object]:
                      "force peaks and how braking turns into propulsion"
                      if trial is not None and trial.vertical_grf_bw is not None else "")
                   + ". " + _touchdown_text(sol, runner, cm, trial)
-                  + _peak_place_text(sol, trial), fig)],
+                  + (shape.caption_text() if shape is not None else ""), fig)],
         tables=[("Summary (as 'bladelab predict --method collocation --json')", summary),
                 ("IPOPT per stage", pd.DataFrame(stages)),
                 ("Objective terms of the final stage", terms),
