@@ -116,7 +116,6 @@ _CHARACTERISE_DEFAULTS = [
     (["runner", "simulate"], "--speed", "bladelab.runner:simulate_runner", "initial_speed"),
     (["runner", "simulate"], "--initial-state", "bladelab.runner:simulate_runner",
      "initial_state"),
-    (["runner", "simulate"], "--integrator", "bladelab.runner:simulate_runner", "integrator"),
     (["design", "gait-cycle"], "--samples", "bladelab.design.gait_cycle:gait_cycles_from_trial",
      "n"),
     (["design", "gait-cycle"], "--cutoff", "bladelab.design.gait_cycle:gait_cycles_from_trial",
@@ -143,3 +142,17 @@ def test_the_other_commands_show_the_library_defaults(command, option, function,
     assert shown == library[parameter].default, (
         f"bladelab {' '.join(command)} {option} defaults to {shown!r}, the library's {name}"
         f"({parameter}=...) to {library[parameter].default!r}")
+
+
+def test_runner_simulate_leaves_the_integrator_to_the_library_s_choice_per_body():
+    import typer.main
+
+    from bladelab.cli import app
+    from bladelab.runner import build_runner, integrator_for
+    from bladelab.runner.model import DEFAULT_DT
+
+    cmd = typer.main.get_command(app).commands["runner"].commands["simulate"]
+    assert next(p.default for p in cmd.params if "--integrator" in p.opts) is None
+    assert next(p.default for p in cmd.params if "--dt" in p.opts) is None
+    assert integrator_for(build_runner("able", body="seed001")) == ("explicit", DEFAULT_DT)
+    assert integrator_for(build_runner("able", body="human"))[0] == "newmark"

@@ -13,14 +13,15 @@ from bladelab.errors import InputFileError, SpecError
 from bladelab.predict.defaults import TIME_STEP_S
 from bladelab.units import damping_per_deg_to_per_rad, stiffness_per_deg_to_per_rad
 
-runner_app = typer.Typer(help="Planar musculoskeletal runner with a running blade (seed 001).")
+runner_app = typer.Typer(help="Planar musculoskeletal runner with a running blade: the human "
+                                "body of predict and design, or seed 001's.")
 
 
 def _read_controller(path: Path, muscle_names: tuple[str, ...]) -> list[float]:
     """Constant excitations from a controller JSON file.
 
     Format: ``{"excitations": {"glut_max_l": 0.3, ...}, "default": 0.05}``; muscles not named
-    get ``default``. (The reflex controller of the predictive-running issue will extend this.)
+    get ``default``. (Gait controllers are the reflex route's: ``bladelab predict``.)
     """
 
     data = read_json(path, what="controller file")
@@ -86,6 +87,11 @@ def _wear(name: str, links: int | None, k_deg: float | None, d_deg: float | None
 @runner_app.command("simulate")
 def simulate_cmd(
     model: str = typer.Option("amputee", "--model", help="able or amputee."),
+    body: str = typer.Option(
+        "human", "--body",
+        help="human (the default body of predict and design), seed001 (seed 001's body, which "
+        "the reflex route runs on) or toes (seed 001's with a toe segment). Ignored with "
+        "--params (the file says it)."),
     blade: str = typer.Option("Cat6", "--blade", help="Blade category (amputee): Cat4..Cat7."),
     params: Path | None = typer.Option(None, "--params", help="Runner parameter YAML file."),
     wear: str | None = typer.Option(
@@ -107,14 +113,16 @@ def simulate_cmd(
     ),
     duration: float = typer.Option(10.0, "--duration", help="Simulated time [s]."),
     dt: float | None = typer.Option(
-        None, "--dt", help=f"Time step [s] (default: the runner model's, {TIME_STEP_S:g} s; "
-                           "1e-4 s with --wear and the explicit integrator)."),
-    integrator: str = typer.Option(
-        "explicit", "--integrator",
-        help="explicit (default), newmark (contacts, ligaments and socket linearly implicit, "
+        None, "--dt", help=f"Time step [s] (default: {TIME_STEP_S:g} s with the explicit "
+                           "integrator, 1e-4 s with --wear; 1e-3 s with newmark or implicit)."),
+    integrator: str | None = typer.Option(
+        None, "--integrator",
+        help="explicit, newmark (contacts, ligaments and socket linearly implicit, "
         "second-order rule: at --dt 1e-3 more accurate than explicit at 0.25 ms, also with "
         "--wear) or implicit (its first-order predecessor, stable at 1 ms; with --wear at "
-        "5e-4).",
+        "5e-4). Default: the body's (bladelab.runner.integrator_for): explicit on seed 001's "
+        "rigid feet, newmark at 1e-3 s on a foot with a toe hinge (the human and toes bodies), "
+        "whose damper an explicit step would need below 0.1 ms for.",
     ),
     initial_state: str = typer.Option("stand", "--initial-state", help="stand or gait."),
     speed: float = typer.Option(0.0, "--speed", help="Initial forward speed [m/s]."),
@@ -127,6 +135,8 @@ def simulate_cmd(
     from bladelab.runner import analyses, build_runner, load_runner_params, simulate_runner
     from bladelab.runner.export import write_simulation  # deferred: keeps bladelab --help fast
     from bladelab.runner.model import DEFAULT_DT  # deferred: keeps bladelab --help fast
+    from bladelab.runner.params import BODIES  # deferred: keeps bladelab --help fast
+    from bladelab.runner.simulate import NEWMARK_DT, integrator_for  # deferred: as above
 
     if model not in ("able", "amputee"):
         raise SpecError(f"unknown model {model!r}", where="--model", hint="use able or amputee")
@@ -134,14 +144,13 @@ def simulate_cmd(
         raise SpecError("must be positive", where="--duration")
     if initial_state not in ("stand", "gait"):
         raise SpecError(f"unknown initial state {initial_state!r}", where="--initial-state")
+    if body not in BODIES:
+        raise SpecError(f"unknown body {body!r}", where="--body", hint="use " + ", ".join(BODIES))
     blade_model = None
     if wear is not None:
         if model != "amputee":
             raise SpecError("only the amputee model wears a blade", where="--wear")
         blade_model = _wear(wear, links, k_deg, d_deg)
-        if dt in (None, DEFAULT_DT) and integrator == "explicit":
-            dt = 1e-4  # the blade's sole contact needs a finer step
-    dt = DEFAULT_DT if dt is None else dt
     if params is not None:
         p = load_runner_params(params)
         if p.kind != model:
@@ -156,8 +165,16 @@ def simulate_cmd(
         )
     else:
         runner = build_runner(
-            model, blade=blade if model == "amputee" else None, blade_model=blade_model
+            model, blade=blade if model == "amputee" else None, blade_model=blade_model,
+            body=body,
         )
+    if integrator is None:  # the library's choice for this body's feet
+        integrator, default_dt = integrator_for(runner)
+        dt = default_dt if dt is None else dt
+    if dt is None:
+        dt = DEFAULT_DT if integrator == "explicit" else NEWMARK_DT
+    if wear is not None and dt == DEFAULT_DT and integrator == "explicit":
+        dt = 1e-4  # the blade's sole contact needs a finer step
     excitations = None
     if controller is not None:
         excitations = _read_controller(controller, runner.muscle_names)
@@ -170,15 +187,19 @@ def simulate_cmd(
         initial_speed=speed,
         integrator=integrator,
     )
+    about = {"body": "parameter file" if params is not None else body,
+             "integrator": integrator, "time_step_s": dt}
     if out is not None:
-        summary = write_simulation(result, out)
+        summary = write_simulation(result, out, about=about)
     else:
-        summary = analyses.summary(result)
+        summary = {**analyses.summary(result), **about}
     if as_json:
         typer.echo(json.dumps(summary, indent=2))
     else:
         typer.echo(
-            f"{runner.kind} ({summary['blade'] or 'no blade'}): "
+            f"{runner.kind} ({summary['blade'] or 'no blade'}; "
+            f"{'the parameter file' if params is not None else body + ' body'}, "
+            f"{integrator} at {dt:g} s): "
             f"{'fell' if summary['fell'] else 'ran'} {summary['duration_s']:.3f} s, "
             f"mean speed {summary['mean_speed_mps']:.2f} m/s, "
             f"power balance residual {summary['power_balance_residual_pct']:.2f} %"

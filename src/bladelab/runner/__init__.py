@@ -35,7 +35,13 @@ from bladelab.runner.params import (
     runner_params_from_dict,
 )
 from bladelab.runner.scaling import muscle_max_force
-from bladelab.runner.simulate import ControllerState, RunnerResult, initial_qpos, simulate_runner
+from bladelab.runner.simulate import (
+    ControllerState,
+    RunnerResult,
+    initial_qpos,
+    integrator_for,
+    simulate_runner,
+)
 
 __all__ = [
     "BladeCategory",
@@ -61,6 +67,7 @@ __all__ = [
     "power_balance",
     "power_balance_residual_pct",
     "runner_params_from_dict",
+    "integrator_for",
     "simulate_runner",
     "spatiotemporal",
     "summary",

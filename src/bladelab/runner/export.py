@@ -69,9 +69,9 @@ OPENSIM_PELVIS_ORIGIN_M = 0.0707
 _FLOAT = "%.9g"
 
 
-def write_simulation(result: RunnerResult, out: str | Path) -> dict:
+def write_simulation(result: RunnerResult, out: str | Path, *, about: dict | None = None) -> dict:
     """Write ``result``'s tables and summary into the folder ``out`` (created; each file written
-    atomically); returns the summary."""
+    atomically); returns the summary, with ``about`` (e.g. how it was simulated) added."""
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     tables = {
@@ -85,7 +85,7 @@ def write_simulation(result: RunnerResult, out: str | Path) -> dict:
     for name, df in tables.items():
         with atomic_open(out / name, "w", newline="") as fh:
             df.to_csv(fh, index=False)
-    summary = analyses.summary(result)
+    summary = {**analyses.summary(result), **(about or {})}
     write_json(out / "summary.json", summary)
     return summary
 

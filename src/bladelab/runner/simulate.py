@@ -189,6 +189,21 @@ def initial_qpos(model: RunnerModel, state: str | dict = "stand") -> tuple[np.nd
     return q, v
 
 
+#: Time step [s] of the Newmark integrator where :func:`integrator_for` chooses it.
+NEWMARK_DT = 1e-3
+
+
+def integrator_for(model: RunnerModel) -> tuple[str, float]:
+    """The integrator and time step [s] a forward simulation of ``model`` takes by default:
+    seed 001's rigid feet ``("explicit", DEFAULT_DT)``; a foot with a toe hinge (the human and
+    toes bodies) ``("newmark", NEWMARK_DT)``, since the hinge's damper on the toes' small
+    inertia would need an explicit step below 0.1 ms (:func:`simulate_runner` refuses it by
+    name)."""
+    if model.params.foot == "rigid":
+        return "explicit", DEFAULT_DT
+    return "newmark", NEWMARK_DT
+
+
 def simulate_runner(
     model: RunnerModel,
     *,
