@@ -59,6 +59,11 @@ def test_resume_reads_a_stored_solution_back(solved, tmp_path, capsys):
     args = ("--speed", str(SPEED), "--mesh", str(N), "--json")
     assert _predict(out, *args, "--resume") == 0
     assert json.loads(capsys.readouterr().out) == json.loads(json.dumps(solved.summary()))
+    # as text: where it was read from and where it started
+    assert _predict(out, *args[:-1], "--resume") == 0
+    text = capsys.readouterr().out
+    assert "(already solved: read back)" in text
+    assert f"  started from: {solved.guess_source}\n" in text
     assert _predict(out, *args) == 2
     assert "--resume continues it, --force starts over" in capsys.readouterr().err
     assert _predict(out, "--speed", "4", "--mesh", str(N), "--resume") == 2

@@ -84,9 +84,12 @@ class StageProgress:
                        f"{p.elapsed_s:.1f} s", err=True)
 
 
-def _text(summary: dict, path: Path, solved: bool, check: MeshCheck | None = None) -> str:
+def _text(summary: dict, path: Path, solved: bool, check: MeshCheck | None = None,
+          start: str | None = None) -> str:
     head = "solution" if summary["converged"] else "best iterate (not converged)"
     lines = [f"{head}: {path}" + ("" if solved else " (already solved: read back)")]
+    if start:
+        lines.append(f"  started from: {start}")
     for key, value in summary.items():
         if key == "warnings":
             continue
@@ -234,7 +237,7 @@ def run_collocation(
         typer.echo(json.dumps(summary | ({} if check is None
                                          else {"mesh_check": check.to_dict()})))
     else:
-        typer.echo(_text(summary, result.path, result.solved, check))
+        typer.echo(_text(summary, result.path, result.solved, check, start=sol.guess_source))
     if sol.converged:
         return 0
     worst = "; ".join(f"{name} ({value:.3g})" for name, value in sol.nlp.worst_constraints)
