@@ -196,7 +196,8 @@ def predict_example(out_dir: str | Path | None = None) -> tuple[Path, list[str]]
         guess=str(PREDICT_EXAMPLE_STRIDE),
         resume=(out_dir / SOLUTION_FILE).is_file())
     sol = res.solution
-    report = build_predictive_report(res.path, progress=False, robustness=False)
+    report = build_predictive_report(res.path, out_dir / "report", progress=False,
+                                     robustness=False)
     s = sol.summary()
     how = "solved" if res.solved else "read back"
     lines = [f"predict example: amputee Cat6, human body, 4 m/s, {how} in "
