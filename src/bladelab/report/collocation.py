@@ -315,7 +315,8 @@ def _add_human_running_section(report, sol, trial, check=None, shape=None) -> No
         tables=[("The stride against people running at its speed", table)]
         + ([] if shape is None else [(
             "The shape of each stance beside the measured runner's (Fukuchi et al. 2017, "
-            "RBDS001 at 3.5 m/s, its mean stride; no criterion checks it)", shape.table())])
+            "RBDS001 at 3.5 m/s, its mean stride; a second runner of that dataset, RBDS004 at "
+            "2.5 m/s, peaks at 37–44 % of 78 stances; no criterion checks it)", shape.table())])
         + ([] if check is None else [(
             f"Mesh-halving check: the same problem on {check.fine_intervals} mesh intervals "
             f"against this stride's {check.coarse_intervals}"
