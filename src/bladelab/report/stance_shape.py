@@ -59,6 +59,18 @@ def knee_flexion_deg(q: np.ndarray, dof_names, side: str) -> np.ndarray | None:
     return None if name not in dof_names else -np.degrees(q[:, list(dof_names).index(name)])
 
 
+def _listed(values) -> str:
+    """Whole numbers, comma-separated."""
+    return ", ".join(f"{v:.0f}" for v in values)
+
+
+def _span(values) -> str:
+    """The range of ``values`` as whole numbers ("a–b", "a" for one value, "–" for none)."""
+    if not values:
+        return "–"
+    return f"{min(values):.0f}–{max(values):.0f}" if len(values) > 1 else f"{values[0]:.0f}"
+
+
 @dataclass(frozen=True)
 class StanceShape:
     """Per stance, in stance order: force peak places [% of the stance], and (landing knee
@@ -83,13 +95,8 @@ class StanceShape:
     def table(self) -> pd.DataFrame:
         """One row per measure and stance: this stride's value beside the measured runner's
         range over its stances."""
-
-        def measured(values) -> str:
-            return (f"{min(values):.0f}–{max(values):.0f}" if len(values) > 1
-                    else f"{values[0]:.0f}" if values else "–")
-
         rows = [{"measure": f"vertical force peak, {leg} leg's stance", "this stride": round(p, 1),
-                 "the measured runner": measured(self.measured_peaks), "unit": "% of the stance"}
+                 "the measured runner": _span(self.measured_peaks), "unit": "% of the stance"}
                 for leg, p in zip(self.legs, self.peaks, strict=True)]
         if self.knees and self.measured_knees:
             land = [k[0] for k in self.measured_knees]
@@ -98,10 +105,10 @@ class StanceShape:
                      if len(self.legs) == len(self.knees)
                      else [f"stance {i + 1}" for i in range(len(self.knees))])
             rows += [{"measure": f"knee flexion at touch-down, {w}", "this stride": round(k[0], 1),
-                      "the measured runner": measured(land), "unit": "deg"}
+                      "the measured runner": _span(land), "unit": "deg"}
                      for w, k in zip(which, self.knees, strict=True)]
             rows += [{"measure": f"deepest stance knee flexion, {w}",
-                      "this stride": round(k[1], 1), "the measured runner": measured(deep),
+                      "this stride": round(k[1], 1), "the measured runner": _span(deep),
                       "unit": "% of the stance"}
                      for w, k in zip(which, self.knees, strict=True)]
         return pd.DataFrame(rows)
@@ -109,17 +116,17 @@ class StanceShape:
     def caption_text(self) -> str:
         """The shape in words, for the ground-force figure's caption."""
         text = (" Each stance's vertical force peaks at "
-                + ", ".join(f"{p:.0f}" for p in self.peaks) + " % of its nodes here, the measured "
-                "runner's at " + ", ".join(f"{p:.0f}" for p in self.measured_peaks)
+                + _listed(self.peaks) + " % of its nodes here, the measured "
+                "runner's at " + _listed(self.measured_peaks)
                 + " % (no criterion checks it).")
         if self.knees and self.measured_knees:
-            text += (" The stance knee lands at " + ", ".join(f"{k[0]:.0f}" for k in self.knees)
+            text += (" The stance knee lands at " + _listed(k[0] for k in self.knees)
                      + "° of flexion and is most flexed at "
-                     + ", ".join(f"{k[1]:.0f}" for k in self.knees)
+                     + _listed(k[1] for k in self.knees)
                      + " % of the stance here, the measured runner's lands at "
-                     + ", ".join(f"{k[0]:.0f}" for k in self.measured_knees)
+                     + _listed(k[0] for k in self.measured_knees)
                      + "° and is most flexed at "
-                     + ", ".join(f"{k[1]:.0f}" for k in self.measured_knees) + " %")
+                     + _listed(k[1] for k in self.measured_knees) + " %")
             text += (": here as in the measured runner the force peaks about where the knee is "
                      "most flexed, so a landing with the knee more flexed brings the peak earlier."
                      if self.together else ".")
@@ -128,19 +135,14 @@ class StanceShape:
     def summary_text(self) -> str:
         """One sentence for the report's first section: the shape beside the measured
         runner's, said to be outside no criterion."""
-
-        def span(values) -> str:
-            return (f"{min(values):.0f}–{max(values):.0f}" if len(values) > 1
-                    else f"{values[0]:.0f}")
-
         text = (" Beside the criteria, the shape of a stance (no criterion checks it; the "
                 "measured runner at 3.5 m/s): the vertical force peaks at "
-                + ", ".join(f"{p:.0f}" for p in self.peaks) + " % of the stance (the measured "
-                f"runner's {span(self.measured_peaks)} %)")
+                + _listed(self.peaks) + " % of the stance (the measured "
+                f"runner's {_span(self.measured_peaks)} %)")
         if self.knees and self.measured_knees:
             text += (" and the stance knee lands "
-                     + ", ".join(f"{k[0]:.0f}" for k in self.knees) + "° flexed (the measured "
-                     f"runner's {span([k[0] for k in self.measured_knees])}°)")
+                     + _listed(k[0] for k in self.knees) + "° flexed (the measured "
+                     f"runner's {_span([k[0] for k in self.measured_knees])}°)")
         return text + " (table below; docs/collocation.md, 'How a foot lands')."
 
 
