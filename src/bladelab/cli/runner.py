@@ -136,7 +136,7 @@ def simulate_cmd(
     from bladelab.runner.export import write_simulation  # deferred: keeps bladelab --help fast
     from bladelab.runner.model import DEFAULT_DT  # deferred: keeps bladelab --help fast
     from bladelab.runner.params import BODIES  # deferred: keeps bladelab --help fast
-    from bladelab.runner.simulate import NEWMARK_DT, integrator_for  # deferred: as above
+    from bladelab.runner.simulate import DEFAULT_TIME_STEPS, integrator_for  # deferred: --help
 
     if model not in ("able", "amputee"):
         raise SpecError(f"unknown model {model!r}", where="--model", hint="use able or amputee")
@@ -169,10 +169,9 @@ def simulate_cmd(
             body=body,
         )
     if integrator is None:  # the library's choice for this body's feet
-        integrator, default_dt = integrator_for(runner)
-        dt = default_dt if dt is None else dt
-    if dt is None:
-        dt = DEFAULT_DT if integrator == "explicit" else NEWMARK_DT
+        integrator, _ = integrator_for(runner)
+    if dt is None:  # an unknown integrator is refused by name by simulate_runner
+        dt = DEFAULT_TIME_STEPS.get(integrator, DEFAULT_DT)
     if wear is not None and dt == DEFAULT_DT and integrator == "explicit":
         dt = 1e-4  # the blade's sole contact needs a finer step
     excitations = None
@@ -187,6 +186,7 @@ def simulate_cmd(
         initial_speed=speed,
         integrator=integrator,
     )
+    origin = "the parameter file" if params is not None else f"{body} body"
     about = {"body": "parameter file" if params is not None else body,
              "integrator": integrator, "time_step_s": dt}
     if out is not None:
@@ -198,7 +198,7 @@ def simulate_cmd(
     else:
         typer.echo(
             f"{runner.kind} ({summary['blade'] or 'no blade'}; "
-            f"{'the parameter file' if params is not None else body + ' body'}, "
+            f"{origin}, "
             f"{integrator} at {dt:g} s): "
             f"{'fell' if summary['fell'] else 'ran'} {summary['duration_s']:.3f} s, "
             f"mean speed {summary['mean_speed_mps']:.2f} m/s, "
