@@ -11,8 +11,7 @@ import casadi as ca
 import numpy as np
 
 __all__ = ["FORCE_RATE_SCALE", "METABOLIC_SQUARED_SCALE", "PASSIVE_TORQUE_SCALE", "StrideDynamics",
-           "StrideWeights",
-           "VariableScales"]
+           "StrideWeights", "VariableScales"]
 
 #: Scale of :attr:`StrideWeights.passive` [(N·m)²]: a joint's 10 N·m counts 1.
 PASSIVE_TORQUE_SCALE = 100.0
