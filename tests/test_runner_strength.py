@@ -54,11 +54,12 @@ def test_exertion_geometry_moves_only_the_tested_joint_and_finds_the_agonists():
 
 def test_human_body_strength_curves_have_people_s_shape():
     """The human body's active moment–angle curves against Anderson et al. (2007)'s shapes
-    (each divided by its own peak): the ankle within 0.05 RMS, the others within 0.25; the
-    ankle's, the knee extensors' and the hip extensors' peaks within 15° of people's. Seed
-    001's body, which was never fitted to them, misses the ankle by more."""
+    (each divided by its own peak): dorsiflexion within 0.05 RMS, plantarflexion within 0.08
+    (the soleus' tendon is set by its length in running, not by this curve), the others
+    within 0.25; the ankle's, the knee extensors' and the hip extensors' peaks within 15° of
+    people's. Seed 001's body, which was never fitted to them, misses the ankle by more."""
     human = build_runner("able", body="human")
-    limits = {"plantarflexion": 0.05, "dorsiflexion": 0.05, "knee extension": 0.25,
+    limits = {"plantarflexion": 0.08, "dorsiflexion": 0.05, "knee extension": 0.25,
               "hip extension": 0.25, "knee flexion": 0.25, "hip flexion": 0.25}
     for name, limit in limits.items():
         d = shape_difference(human, name)
@@ -79,3 +80,18 @@ def test_human_body_is_as_strong_as_people_at_hip_and_knee():
         assert 1.0 <= peak_ratio(human, name) <= 1.35, name
     assert 1.0 <= peak_ratio(human, "plantarflexion") <= 2.0
     assert peak_ratio(build_runner("able"), "knee extension") > 2.0
+
+
+def test_human_body_soleus_carries_a_large_share_of_plantarflexion():
+    """At a neutral ankle with the knee extended the soleus, the largest plantarflexor, gives
+    at least 40 % of the model's isometric plantarflexion moment (people's soleus gives the
+    larger part; a soleus tendon long enough to leave it on its ascending limb gave 19 %)."""
+    runner = build_runner("able", body="human")
+    ex = EXERTIONS["plantarflexion"]
+    rows, length, arm = exertion_geometry(runner, ex)
+    k = list(ex.angles_deg).index(0.0)
+    params = np.asarray(runner.muscle_params)[rows]
+    each = [active_moments(params[[i]], length[[k]][:, [i]], arm[[k]][:, [i]], ex.moment_sign)[0]
+            for i in range(len(rows))]
+    soleus = [runner.muscle_names[i] for i in rows].index("soleus_l")
+    assert each[soleus] / sum(each) >= 0.4
