@@ -121,8 +121,8 @@ def simulate_cmd(
         "second-order rule: at --dt 1e-3 more accurate than explicit at 0.25 ms, also with "
         "--wear) or implicit (its first-order predecessor, stable at 1 ms; with --wear at "
         "5e-4). Default: the body's (bladelab.runner.integrator_for): explicit on seed 001's "
-        "rigid feet, newmark at 1e-3 s on a foot with a toe hinge (the human and toes bodies), "
-        "whose damper an explicit step would need below 0.1 ms for.",
+        "rigid feet, newmark at 1e-3 s on a foot with a toe hinge (the human and toes bodies; "
+        "the human body's toe damper would need an explicit step below 0.1 ms).",
     ),
     initial_state: str = typer.Option("stand", "--initial-state", help="stand or gait."),
     speed: float = typer.Option(0.0, "--speed", help="Initial forward speed [m/s]."),

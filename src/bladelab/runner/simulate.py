@@ -199,9 +199,10 @@ DEFAULT_TIME_STEPS = {"explicit": DEFAULT_DT, "implicit": NEWMARK_DT, "newmark":
 def integrator_for(model: RunnerModel) -> tuple[str, float]:
     """The integrator and time step [s] a forward simulation of ``model`` takes by default:
     seed 001's rigid feet ``("explicit", DEFAULT_DT)``; a foot with a toe hinge (the human and
-    toes bodies) ``("newmark", NEWMARK_DT)``, since the hinge's damper on the toes' small
-    inertia would need an explicit step below 0.1 ms (:func:`simulate_runner` refuses it by
-    name)."""
+    toes bodies) ``("newmark", NEWMARK_DT)``. The human body's hinge damper (2 N·m·s/rad on
+    the toes' small inertia) would need an explicit step below 0.1 ms (:func:`simulate_runner`
+    refuses a longer one by name); the toes body's (0.03 N·m·s/rad) would not, and its feet
+    get Newmark by the same rule."""
     name = "explicit" if model.params.foot == "rigid" else "newmark"
     return name, DEFAULT_TIME_STEPS[name]
 
