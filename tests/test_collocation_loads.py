@@ -74,7 +74,7 @@ def test_the_socket_carries_the_blades_ground_force_and_its_moment(blade_stride)
             <= 0.15 * res["socket_moment_max_Nm"]
     assert loads["blade_moment"].shape == (sol.nlp.q.shape[0], 5)
     assert res["socket_force_max_N"] >= 0.95 * ground[peak, 1]
-    assert res["socket_moment_max_Nm"] >= 0.85 * max(abs(v) for v in about_socket.values())
+    assert res["socket_moment_max_Nm"] >= 0.95 * max(abs(v) for v in about_socket.values())
     assert 0.1 * res["socket_moment_max_Nm"] < res["blade_moment_max_Nm"] < 1e4
     assert res.keys() == PEAK_LOAD_UNITS.keys()
 
