@@ -156,3 +156,4 @@ def test_runner_simulate_leaves_the_integrator_to_the_library_s_choice_per_body(
     assert next(p.default for p in cmd.params if "--dt" in p.opts) is None
     assert integrator_for(build_runner("able", body="seed001")) == ("explicit", DEFAULT_DT)
     assert integrator_for(build_runner("able", body="human"))[0] == "newmark"
+    assert integrator_for(build_runner("able", body="toes")) == ("explicit", DEFAULT_DT)

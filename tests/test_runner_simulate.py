@@ -186,6 +186,29 @@ def test_explicit_scheme_refuses_the_human_toes_damper():
     assert simulate_runner(human, duration=0.01, integrator="newmark").duration > 0
 
 
+@pytest.mark.parametrize("body", ["seed001", "toes", "human"])
+def test_default_integrator_is_explicit_exactly_where_the_explicit_step_is_allowed(body):
+    """``integrator_for`` and the reflex route's ``body_integrator`` pick the explicit scheme
+    where an explicit run at the default step is accepted, and Newmark where it is refused
+    (one rule, the dampers' step limit, for every body)."""
+    from bladelab.predict.reflex.named_runs import body_integrator
+    from bladelab.runner import integrator_for
+    from bladelab.runner.implicit_setup import explicit_step_limit
+    from bladelab.runner.model import DEFAULT_DT
+
+    runner = build_runner("amputee", body=body)
+    try:
+        simulate_runner(runner, duration=0.005)
+        explicit_runs = True
+    except SimulationError:
+        explicit_runs = False
+    assert explicit_runs == (explicit_step_limit(runner) >= DEFAULT_DT)
+    chosen = "explicit" if explicit_runs else "newmark"
+    assert integrator_for(runner)[0] == chosen
+    assert body_integrator("amputee", body) == chosen
+    assert body_integrator("able", body, "implicit") == "implicit"
+
+
 @pytest.mark.parametrize("kind,mass", [("able", 83.47), ("amputee", 81.43), ("able-toes", 83.47),
                                        ("able-human-arch", 75.0)])
 def test_passive_drop_comes_to_rest_with_body_weight(kind, mass):

@@ -263,7 +263,8 @@ def register(app: typer.Typer) -> None:
                  "window of the run)."),
         integrator: str | None = typer.Option(
             None, "--integrator", rich_help_panel=REFLEX, show_default=False,
-            help="explicit (the 0.25 ms scheme; the default on seed 001's body) | newmark "
+            help="explicit (the 0.25 ms scheme; the default on seed 001's and the toes body, "
+                 "whose joint dampers it integrates) | newmark "
                  "(stiff forces linearly implicit, second-order rule, at --dt 1e-3 more "
                  "accurate than explicit at 0.25 ms and 4x cheaper; the default on the human "
                  "body, whose toes' dampers the explicit scheme cannot integrate) | implicit "
@@ -410,7 +411,7 @@ def register(app: typer.Typer) -> None:
             robust_speed_change=robust_speed_change, robust_push=robust_push,
             robust_half_step=robust_half_step, initial_speed=initial_speed,
             strike_limit=strike_limit, lean_weight=lean_weight, run_up=run_up,
-            integrator=defaults.integrator_for(body, integrator), track=track,
+            integrator=integrator, track=track,
             track_weight=track_weight,
             start_stride=start_stride, hold=hold)
 

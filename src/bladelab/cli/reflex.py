@@ -17,6 +17,7 @@ from bladelab.cli.panels import renamed
 from bladelab.cli.values import parse_list
 from bladelab.errors import BladelabError, SpecError
 from bladelab.predict.reflex.named_runs import (
+    body_integrator,
     check_run_settings,
     optimize_named,
     recipe_sweep_named,
@@ -47,12 +48,12 @@ def run_reflex(*, out: Path, model: str, blade: str | None, body: str, speed: fl
                duration: float, dt: float, robust_samples: int, robust_jitter: float,
                robust_directions: str, robust_speed_change: float, robust_push: float,
                robust_half_step: bool, initial_speed: float | None, strike_limit: float,
-               lean_weight: float, run_up: bool, integrator: str, track: Path | None,
+               lean_weight: float, run_up: bool, integrator: str | None, track: Path | None,
                track_weight: float, start_stride: Path | None = None,
                hold: str | None = None) -> None:
     """``bladelab predict`` (reflex): CMA-ES once per seed; prints each generation and the
     best run as JSON. ``hold``: comma-separated name patterns of parameters kept at their
-    start values."""
+    start values; ``integrator`` None: the body's own (:func:`body_integrator`)."""
     check_robust_copies(robust_directions, robust_speed_change, robust_push, duration,
                         half_step=robust_half_step, samples=robust_samples,
                         where=_ROBUST_OPTIONS)
@@ -68,7 +69,8 @@ def run_reflex(*, out: Path, model: str, blade: str | None, body: str, speed: fl
             robust_speed_change=robust_speed_change, robust_push=robust_push,
             robust_half_step=robust_half_step, initial_speed=initial_speed,
             strike_limit_bw=strike_limit, w_lean=lean_weight, run_up=run_up,
-            integrator=integrator, track=None if track is None else str(track),
+            integrator=body_integrator(model, body, integrator),
+            track=None if track is None else str(track),
             w_track=0.0 if track is None else track_weight,
             start_stride=None if start_stride is None else str(start_stride))
         results = optimize_named(

@@ -17,7 +17,6 @@ __all__ = [
     "GENERATIONS",
     "GUESS",
     "INITIAL_STEP",
-    "HUMAN_BODY_INTEGRATOR",
     "INTEGRATOR",
     "LEAN_WEIGHT_PER_DEG",
     "MAX_ITER",
@@ -41,7 +40,6 @@ __all__ = [
     "SWING_KNEE_MIN_DEG",
     "TIME_STEP_S",
     "TRACK_WEIGHT_PER_RAD2",
-    "integrator_for",
     "people_weight_for",
     "swing_knee_for",
 ]
@@ -78,9 +76,6 @@ STRIKE_LIMIT_BW = 1.0
 LEAN_WEIGHT_PER_DEG = 0.1
 #: Integrator of the closed loop: the explicit scheme at :data:`TIME_STEP_S`.
 INTEGRATOR = "explicit"
-#: The reflex route's scheme on the human body: the explicit one cannot integrate its toes'
-#: dampers (docs/runner-model.md, "Simulation").
-HUMAN_BODY_INTEGRATOR = "newmark"
 #: Weight of the term that tracks a collocation stride [1/rad²]: 10° of rms error costs 30,
 #: as much as running 30 % of the simulation outside the speed window.
 TRACK_WEIGHT_PER_RAD2 = 1000.0
@@ -145,15 +140,6 @@ STARTS = 1
 #: 2026-11-30, the amputee scaled to 68 kg and 1.75 m reached +17 % of the settled objective
 #: from the shipped stride's default barrier start and +0.08 % from its barrier start 1e-4.
 ATHLETE_STARTS = 2
-
-
-def integrator_for(body: str, integrator: str | None = None) -> str:
-    """The reflex route's forward scheme for a runner ``body``: ``integrator`` when given, else
-    :data:`HUMAN_BODY_INTEGRATOR` on the human body (whose toes' dampers the explicit scheme
-    refuses) and :data:`INTEGRATOR` on the others."""
-    if integrator is not None:
-        return integrator
-    return HUMAN_BODY_INTEGRATOR if body == "human" else INTEGRATOR
 
 
 def people_weight_for(body: str, weight: float | None = None) -> float:

@@ -107,6 +107,27 @@ def simulation_model(model, integrator: str, *, compiled_loop: bool = True
     return (model.mj_dynamics_model if own_sites else model.mj_model), own_sites
 
 
+def _damper_step_ratios(model, m: mujoco.MjModel, d: mujoco.MjData) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(D·(M⁻¹)ⱼⱼ [1/s], D [N·m·s/rad], (M⁻¹)ⱼⱼ)`` per joint at ``d``'s pose: an explicit
+    step ``dt`` integrates joint j's damper while ``dt·D·(M⁻¹)ⱼⱼ ≤ 1``."""
+    full = np.zeros((m.nv, m.nv))
+    mujoco.mj_fullM(m, d, full)
+    inverse_inertia = np.diag(np.linalg.inv(full))
+    damping = np.maximum(model.joint_params[:, JP_SD], model.joint_params[:, JP_SDX])
+    return damping * inverse_inertia, damping, inverse_inertia
+
+
+def explicit_step_limit(model) -> float:
+    """The longest step [s] at which the explicit scheme integrates every joint
+    spring-damper of the :class:`RunnerModel` ``model`` (at its reference pose; ``inf`` without
+    dampers). See :func:`_check_explicit_dampers`."""
+    m = model.mj_model
+    d = mujoco.MjData(m)
+    mujoco.mj_forward(m, d)
+    rate = _damper_step_ratios(model, m, d)[0].max(initial=0.0)
+    return float(np.inf) if rate <= 0.0 else float(1.0 / rate)
+
+
 def _check_explicit_dampers(model, m: mujoco.MjModel, d: mujoco.MjData,
                             dt: float) -> None:
     """Refuse an explicit run whose joint spring-dampers it cannot integrate.
@@ -115,11 +136,8 @@ def _check_explicit_dampers(model, m: mujoco.MjModel, d: mujoco.MjData,
     segment it then reverses the joint's velocity within one step (and blows up at twice that)
     once ``dt·D/I`` exceeds 1, with ``I = 1/(M⁻¹)ⱼⱼ`` the joint's effective inertia [kg·m²]
     (e.g. the human body's toes: 2 N·m·s/rad on about 1.5·10⁻⁴ kg·m²)."""
-    full = np.zeros((m.nv, m.nv))
-    mujoco.mj_fullM(m, d, full)
-    inverse_inertia = np.diag(np.linalg.inv(full))
-    damping = np.maximum(model.joint_params[:, JP_SD], model.joint_params[:, JP_SDX])
-    ratio = dt * damping * inverse_inertia
+    rates, damping, inverse_inertia = _damper_step_ratios(model, m, d)
+    ratio = dt * rates
     j = int(np.argmax(ratio))
     if ratio[j] > 1.0:
         raise SimulationError(

@@ -28,7 +28,12 @@ import pandas as pd
 
 from bladelab.errors import SimulationError
 from bladelab.runner.implicit import INTEGRATORS, NEWMARK, implicit_advance
-from bladelab.runner.implicit_setup import implicit_arrays, simulation_model, site_views
+from bladelab.runner.implicit_setup import (
+    explicit_step_limit,
+    implicit_arrays,
+    simulation_model,
+    site_views,
+)
 from bladelab.runner.kernel import (
     mujoco_step_addresses,
     path_kinematics,
@@ -198,12 +203,11 @@ DEFAULT_TIME_STEPS = {"explicit": DEFAULT_DT, "implicit": NEWMARK_DT, "newmark":
 
 def integrator_for(model: RunnerModel) -> tuple[str, float]:
     """The integrator and time step [s] a forward simulation of ``model`` takes by default:
-    seed 001's rigid feet ``("explicit", DEFAULT_DT)``; a foot with a toe hinge (the human and
-    toes bodies) ``("newmark", NEWMARK_DT)``. The human body's hinge damper (2 N·m·s/rad on
-    the toes' small inertia) would need an explicit step below 0.1 ms (:func:`simulate_runner`
-    refuses a longer one by name); the toes body's (0.03 N·m·s/rad) would not, and its feet
-    get Newmark by the same rule."""
-    name = "explicit" if model.params.foot == "rigid" else "newmark"
+    ``("explicit", DEFAULT_DT)`` where the explicit scheme integrates every joint damper at
+    that step (:func:`~bladelab.runner.implicit_setup.explicit_step_limit`: seed 001's rigid
+    feet, the toes body's 0.03 N·m·s/rad hinge), else ``("newmark", NEWMARK_DT)`` (the human
+    body's 2 N·m·s/rad on the toes' small inertia would need a step below 0.1 ms)."""
+    name = "explicit" if explicit_step_limit(model) >= DEFAULT_DT else "newmark"
     return name, DEFAULT_TIME_STEPS[name]
 
 

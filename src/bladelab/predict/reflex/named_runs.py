@@ -28,8 +28,10 @@ from bladelab.predict.reflex.recipe import STABLE_GAIT_RECIPE, Recipe
 from bladelab.predict.reflex.recipe_sweep import run_recipe_sweep
 from bladelab.predict.reflex.tracking import GaitReference
 from bladelab.runner.implicit import INTEGRATORS
+from bladelab.runner.simulate import integrator_for
 
-__all__ = ["MAX_TIME_STEP_S", "RECIPES", "REFLEX_MODELS", "check_run_settings",
+__all__ = ["MAX_TIME_STEP_S", "RECIPES", "REFLEX_MODELS", "body_integrator",
+           "check_run_settings",
            "held_parameters", "named_recipe", "optimize_named", "recipe_sweep_named"]
 
 #: The runners the reflex controller drives.
@@ -38,6 +40,20 @@ REFLEX_MODELS = ("able", "amputee")
 MAX_TIME_STEP_S = 2e-3
 #: The built-in recipes by name.
 RECIPES: dict[str, Recipe] = {"stable-gait": STABLE_GAIT_RECIPE}
+
+
+def body_integrator(model: str, body: str = defaults.REFLEX_BODY,
+                    integrator: str | None = None) -> str:
+    """The closed loop's forward scheme for the runner ``model`` on ``body``: ``integrator``
+    when given, else the one the body's joint dampers allow at the explicit step
+    (:func:`bladelab.runner.integrator_for`: explicit on seed 001's and the toes body, Newmark
+    on the human body)."""
+    if integrator is not None:
+        return integrator
+    if model not in REFLEX_MODELS:
+        raise SpecError(f"unknown model {model!r}", where="model",
+                        hint=" or ".join(REFLEX_MODELS))
+    return integrator_for(runner_and_layout(model, defaults.REFLEX_BLADE, body)[0])[0]
 
 
 def check_run_settings(*, speed: float | None = None, duration: float | None = None,
