@@ -5,11 +5,10 @@ Usage (repository root)::
     .venv/bin/python benchmarks/human_body/every-criterion-able/collect.py NAME=RUNS [...]
 
 Each RUNS folder holds one ``bladelab predict`` output folder per solve, named ``able-SPEED``
-(e.g. ``able-4.5``). Appends to ``records.jsonl`` beside this file, per solve: the chain's NAME,
-the speed [m/s], converged, the criteria met and missed
-(:func:`~bladelab.predict.collocation.human_running.human_running_criteria`), cost of transport
-[J/(kg·m)], stride time [s], per-leg peak vertical force [BW] and contact time [s], dynamics
-residual [%], iterations and wall time [s]; and prints one line per solve.
+(e.g. ``able-4.5``). Appends to ``records.jsonl`` beside this file, per solve: the chain's NAME
+and ``../criteria.py``'s :func:`stride_record` (speed [m/s], converged, criteria met and missed,
+cost of transport [J/(kg·m)], stride time [s], per-leg peak vertical force [BW] and contact
+time [s], dynamics residual [%], iterations and wall time [s]); and prints one line per solve.
 """
 
 from __future__ import annotations
@@ -18,8 +17,10 @@ import json
 import sys
 from pathlib import Path
 
-from bladelab.predict.collocation.human_running import human_running_criteria
-from bladelab.predict.collocation.solution import CollocationSolution
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+from criteria import stride_record  # noqa: E402
+
+from bladelab.predict.collocation.solution import CollocationSolution  # noqa: E402
 
 RECORDS = Path(__file__).parent / "records.jsonl"
 
@@ -31,18 +32,8 @@ def main(args: list[str]) -> int:
             folders = sorted((p for p in Path(runs).iterdir() if (p / "solution.json").is_file()),
                              key=lambda p: float(p.name.rsplit("-", 1)[1]))
             for folder in folders:
-                sol = CollocationSolution.read(folder / "solution.json")
-                crit = human_running_criteria(sol)
-                s = sol.summary()
-                rec = {"chain": name, "speed_mps": float(folder.name.rsplit("-", 1)[1]),
-                       "converged": sol.converged, "mesh": sol.settings.mesh_intervals,
-                       "criteria_met": sum(c.met for c in crit), "criteria": len(crit),
-                       "criteria_missed": [c.line() for c in crit if not c.met],
-                       **{k: s[k] for k in ("cost_of_transport_J_per_kg_m", "stride_time_s",
-                                            "peak_vertical_grf_left_bw",
-                                            "peak_vertical_grf_right_bw", "contact_time_left_s",
-                                            "contact_time_right_s", "dynamics_residual_pct",
-                                            "iterations", "wall_s")}}
+                rec = {"chain": name,
+                       **stride_record(CollocationSolution.read(folder / "solution.json"))}
                 out.write(json.dumps(rec) + "\n")
                 print(f"{name} {rec['speed_mps']:g} m/s: {rec['criteria_met']} of "
                       f"{rec['criteria']}, CoT {rec['cost_of_transport_J_per_kg_m']:.2f}, peaks "
