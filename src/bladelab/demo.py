@@ -141,7 +141,7 @@ def design_example(out_dir: str | Path | None = None, *, seed: int = 0) -> tuple
 #: folder the demo runs in (``make demo``: the repository root). A wheel does not carry it
 #: (25 strides, several MB); the demo then says so and goes on.
 PREDICTED_DESIGN_STUDY = (Path("benchmarks") / "design"
-                          / "transtibial-collocation-4mps-people-stride")
+                          / "transtibial-people-stride-soleus-2026-12-07")
 
 
 def predicted_design_example(out_dir: str | Path | None = None,
@@ -162,9 +162,7 @@ def predicted_design_example(out_dir: str | Path | None = None,
              f"{len(results)} blades, each on the transtibial runner's predicted stride at "
              f"4 m/s and people's stride time -> {report}",
              f"  cost of transport {cot.min():.2f}–{cot.max():.2f} J/(kg·m) across the blades "
-             "(the report: surfaces, optimum, seed 002's trends, every flagged stride)",
-             "  solved on the human body before its soleus got its running length: a study run "
-             "today costs less (docs/design.md, 'Predicted transtibial strides')"]
+             "(the report: surfaces, optimum, seed 002's trends, every flagged stride)"]
     if "socket_moment_max_Nm" in results:
         socket = results["socket_moment_max_Nm"]
         lines.append(f"  peak socket moment {socket.min():.0f}–{socket.max():.0f} N·m "
