@@ -18,6 +18,7 @@ beside it (``bladelab design`` run as in docs/design.md). Run the study again to
         --runs ccd --jobs 2 --settle 2 --skip-failed \
         --objective cost_of_transport_J_per_kg_m --sense min \
         --out benchmarks/design/transtibial-collocation-4mps-people-stride
+    (the same command, --settle 3, for transtibial-people-stride-soleus-2026-12-07)
     bladelab design --evaluator collocation --amputation transtibial --max-speed \
         --start-strides benchmarks/design/transtibial-collocation-4mps/strides \
         --runs ccd --jobs 2 --settle 6 --skip-failed \
@@ -54,6 +55,9 @@ STUDIES = (
     (_DESIGN / "transtibial-collocation-4mps-people-stride", "transtibial",
      "human body, people's joint angles, swing knee and stride time (`--amputation "
      "transtibial --stride-time people`)"),
+    (_DESIGN / "transtibial-people-stride-soleus-2026-12-07", "transtibial",
+     "the human body as shipped (the soleus at its running length), people's joint angles, "
+     "swing knee and stride time (`--amputation transtibial --stride-time people`)"),
     (_DESIGN / "transtibial-collocation-max-speed", "transtibial",
      "human body, each design's maximum speed (`--amputation transtibial --max-speed`)"),
     (_DESIGN / "transtibial-collocation-max-speed-people-stride", "transtibial",
