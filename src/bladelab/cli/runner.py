@@ -120,9 +120,10 @@ def simulate_cmd(
         help="explicit, newmark (contacts, ligaments and socket linearly implicit, "
         "second-order rule: at --dt 1e-3 more accurate than explicit at 0.25 ms, also with "
         "--wear) or implicit (its first-order predecessor, stable at 1 ms; with --wear at "
-        "5e-4). Default: the body's (bladelab.runner.integrator_for): explicit on seed 001's "
-        "rigid feet, newmark at 1e-3 s on a foot with a toe hinge (the human and toes bodies; "
-        "the human body's toe damper would need an explicit step below 0.1 ms).",
+        "5e-4). Default: the body's (bladelab.runner.integrator_for): explicit where its "
+        "0.25 ms step integrates every joint damper (seed 001's and the toes body), else "
+        "newmark at 1e-3 s (the human body, whose toe damper would need an explicit step "
+        "below 0.1 ms).",
     ),
     initial_state: str = typer.Option("stand", "--initial-state", help="stand or gait."),
     speed: float = typer.Option(0.0, "--speed", help="Initial forward speed [m/s]."),
