@@ -69,7 +69,7 @@ def run_reflex(*, out: Path, model: str, blade: str | None, body: str, speed: fl
             robust_speed_change=robust_speed_change, robust_push=robust_push,
             robust_half_step=robust_half_step, initial_speed=initial_speed,
             strike_limit_bw=strike_limit, w_lean=lean_weight, run_up=run_up,
-            integrator=body_integrator(model, body, integrator),
+            integrator=body_integrator(model, body, integrator, blade),
             track=None if track is None else str(track),
             w_track=0.0 if track is None else track_weight,
             start_stride=None if start_stride is None else str(start_stride))

@@ -43,17 +43,19 @@ RECIPES: dict[str, Recipe] = {"stable-gait": STABLE_GAIT_RECIPE}
 
 
 def body_integrator(model: str, body: str = defaults.REFLEX_BODY,
-                    integrator: str | None = None) -> str:
-    """The closed loop's forward scheme for the runner ``model`` on ``body``: ``integrator``
-    when given, else the one the body's joint dampers allow at the explicit step
+                    integrator: str | None = None, blade: str | None = None) -> str:
+    """The closed loop's forward scheme for the runner ``model`` (the amputee wearing
+    ``blade``, default :data:`~bladelab.predict.defaults.REFLEX_BLADE`) on ``body``:
+    ``integrator`` when given, else the one the body's joint dampers allow at the explicit step
     (:func:`bladelab.runner.integrator_for`: explicit on seed 001's and the toes body, Newmark
-    on the human body)."""
+    on the human body). The runner is the one :func:`optimize_named` then reuses."""
     if integrator is not None:
         return integrator
     if model not in REFLEX_MODELS:
         raise SpecError(f"unknown model {model!r}", where="model",
                         hint=" or ".join(REFLEX_MODELS))
-    return integrator_for(runner_and_layout(model, defaults.REFLEX_BLADE, body)[0])[0]
+    worn = (blade or defaults.REFLEX_BLADE) if model == "amputee" else None
+    return integrator_for(runner_and_layout(model, worn, body)[0])[0]
 
 
 def check_run_settings(*, speed: float | None = None, duration: float | None = None,
