@@ -25,8 +25,8 @@ STUDIES = (("study-human-soleus-three-starts-2026-12-07", "the human body as shi
             "soleus at its running length (tendon slack length 0.25 m), three starts for every "
             "problem as in the study below; the rows are the kept starts', the wall time both "
             "passes'"),
-           ("study-human-three-starts-2026-12-06", "the human body with the soleus tendon at 0.2655 m, three starts for "
-            "every problem (the first pass from the shipped strides, then the settling pass: "
+           ("study-human-three-starts-2026-12-06", "the human body with the soleus tendon at "
+            "0.2655 m, three starts for every problem (the first pass from the shipped strides, then the settling pass: "
             "each amputee problem from the two nearest categories' strides, the able runner "
             "from its own other strides or its shipped one), the predictive stages' L-BFGS "
             "update inside IPOPT's augmented system (the library's since 2026-12-06); the "

@@ -107,7 +107,8 @@ def simulation_model(model, integrator: str, *, compiled_loop: bool = True
     return (model.mj_dynamics_model if own_sites else model.mj_model), own_sites
 
 
-def _damper_step_ratios(model, m: mujoco.MjModel, d: mujoco.MjData) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _damper_step_ratios(model, m: mujoco.MjModel, d: mujoco.MjData
+                        ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """``(D·(M⁻¹)ⱼⱼ [1/s], D [N·m·s/rad], (M⁻¹)ⱼⱼ)`` per joint at ``d``'s pose: an explicit
     step ``dt`` integrates joint j's damper while ``dt·D·(M⁻¹)ⱼⱼ ≤ 1``."""
     full = np.zeros((m.nv, m.nv))
