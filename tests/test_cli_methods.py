@@ -273,11 +273,12 @@ def test_predict_collocation_passes_the_same_settings(tmp_path, monkeypatch, cap
     with pytest.raises(_Called):  # the athlete is part of the model; two starts by default
         main(["predict", "--out", str(tmp_path), "--model", "amputee", "--body-mass", "68",
               "--height", "1.75", "--muscle-strength", "1.3", "--max-shortening-velocity",
-              "12.5", "--residual-limb", "0.2"])
+              "12.5", "--residual-limb", "0.2", "--prosthesis-extra-length", "0.05"])
     assert seen["model_spec"]["athlete"] == {"body_mass_kg": 68.0, "height_m": 1.75,
                                              "muscle_strength": 1.3,
                                              "max_shortening_velocity": 12.5,
-                                             "residual_limb_length_m": 0.2}
+                                             "residual_limb_length_m": 0.2,
+                                             "prosthesis_extra_length_m": 0.05}
     assert seen["starts"] == ATHLETE_STARTS == 2
     # a static trial gives the thighs and shanks (both sides' mean); an option wins over it
     from bladelab.datasets import measured_static_trial

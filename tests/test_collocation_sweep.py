@@ -448,14 +448,15 @@ def test_bad_sweep_options_are_refused_naming_the_option(args, where, tmp_path, 
 
 
 def test_the_residual_limb_is_the_amputees_alone_in_a_sweep():
-    """A sweep of the able runner and an amputee with a residual limb: the amputee carries it,
-    the able runner the rest of the athlete."""
+    """A sweep of the able runner and an amputee with a residual limb and a longer prosthesis:
+    the amputee carries both, the able runner the rest of the athlete."""
     from bladelab.predict.collocation.sweep import sweep_models
 
-    able, amputee = sweep_models(["Cat6"], able=True, body="human", athlete={
-        "body_mass_kg": 70.0, "residual_limb_length_m": 0.15})
+    amputee_only = {"residual_limb_length_m": 0.15, "prosthesis_extra_length_m": 0.05}
+    able, amputee = sweep_models(["Cat6"], able=True, body="human",
+                                 athlete={"body_mass_kg": 70.0} | amputee_only)
     assert able["athlete"] == {"body_mass_kg": 70.0}
-    assert amputee["athlete"] == {"body_mass_kg": 70.0, "residual_limb_length_m": 0.15}
+    assert amputee["athlete"] == {"body_mass_kg": 70.0} | amputee_only
 
 
 def test_a_sweep_of_the_toe_body_has_folders_and_labels_of_its_own():

@@ -537,6 +537,43 @@ def test_the_residual_limb_s_length_moves_the_socket_and_keeps_the_leg_and_the_a
         athlete_params(default_runner_params("able", body="human"), residual_limb_length_m=0.2)
 
 
+def test_the_prosthetic_leg_s_extra_length_lowers_the_blade_alone():
+    """The prosthetic leg set 4.5 or 8 cm longer than the intact one (3 cm unless set): the
+    straight prosthetic leg's lowest point drops by the difference, at 1.80 m and, the length
+    being the athlete's own, at 1.70 m (3 cm scaled with the height); the intact leg, the mass
+    and the muscles stay; the transfemoral runner's leg (its athlete 1.56 m) follows too; a length outside 0–10 cm (scaled with the height)
+    or the able runner is refused naming the field."""
+    from bladelab.runner.scaling import athlete_params
+
+    def lowest(runner, leg):
+        q = np.zeros(runner.mj_model.nq)
+        q[runner.dof("pelvis_tz")] = 1.0
+        heights = contact_heights(runner, q)  # straight legs, upright pelvis
+        return heights[runner.contact_params[:, CP_LEG] == leg].min()
+
+    for kind, height in (("amputee", None), ("amputee", 1.70), ("transfemoral", None)):
+        base = default_runner_params(kind, body="human")
+        if height is not None:
+            base = athlete_params(base, height_m=height)
+        ref = build_runner(base)
+        for extra in (0.045, 0.08):
+            runner = build_runner(athlete_params(base, prosthesis_extra_length_m=extra))
+            ratio = base.athlete.height_m / 1.80  # the transfemoral athlete: 1.56 m
+            assert lowest(ref, 1) - lowest(runner, 1) == pytest.approx(
+                extra - 0.03 * ratio, abs=1e-9)
+            assert lowest(runner, 0) == pytest.approx(lowest(ref, 0), abs=1e-12)
+            assert runner.total_mass == pytest.approx(ref.total_mass, rel=1e-12)
+            np.testing.assert_array_equal(runner.muscle_params, ref.muscle_params)
+    base = default_runner_params("amputee", body="human")
+    for bad in (-0.01, 0.11, float("nan"), "long"):
+        with pytest.raises(SpecError) as err:
+            athlete_params(base, prosthesis_extra_length_m=bad)
+        assert err.value.where == "athlete.prosthesis_extra_length_m"
+    with pytest.raises(SpecError, match="no prosthesis"):
+        athlete_params(default_runner_params("able", body="human"),
+                       prosthesis_extra_length_m=0.04)
+
+
 def _neutral_tendon_lengths(runner) -> np.ndarray:
     """MuJoCo's muscle–tendon lengths [m] with every coordinate at 0 (standing straight)."""
     m = runner.mj_analysis_model

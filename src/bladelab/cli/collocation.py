@@ -53,6 +53,7 @@ OPTIONS = {
     "athlete.max_shortening_velocity": "--max-shortening-velocity",
     "athlete.residual_limb_length_m": "--residual-limb",
     "athlete.thigh_length_m": "--thigh-length", "athlete.shank_length_m": "--shank-length",
+    "athlete.prosthesis_extra_length_m": "--prosthesis-extra-length",
     "starts": "--starts", "mesh check": "--mesh-check",
 }
 
@@ -203,7 +204,8 @@ def run_collocation(
     body's default).
     ``athlete``: the runner scaled to this athlete (``body_mass_kg``, ``height_m``,
     ``muscle_strength``, ``max_shortening_velocity``, ``residual_limb_length_m``,
-    ``thigh_length_m``, ``shank_length_m``; None: the body's own). ``starts``:
+    ``thigh_length_m``, ``shank_length_m``, ``prosthesis_extra_length_m``; None: the body's
+    own). ``starts``:
     starts of the stride, the best kept (None: :data:`~bladelab.predict.defaults.ATHLETE_STARTS` for a
     scaled athlete, else :data:`~bladelab.predict.defaults.STARTS`). ``mesh_check``: the
     converged stride solved again on twice the mesh intervals and compared

@@ -41,6 +41,7 @@ OPTIONS = {
     "athlete.max_shortening_velocity": "--max-shortening-velocity",
     "athlete.residual_limb_length_m": "--residual-limb",
     "athlete.thigh_length_m": "--thigh-length", "athlete.shank_length_m": "--shank-length",
+    "athlete.prosthesis_extra_length_m": "--prosthesis-extra-length",
     "mesh check": "--mesh-check", "settle": "--settle",
 }
 

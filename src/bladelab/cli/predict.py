@@ -121,6 +121,10 @@ _ATHLETE_OPTIONS = {
                        "follow it."),
     "shank_length_m": ("--shank-length", "The athlete's shanks [m], knee to ankle joint "
                        "centre (default 0.430 m at 1.80 m, scaled with the height)."),
+    "prosthesis_extra_length_m": ("--prosthesis-extra-length", "How much longer the straight "
+                                  "prosthetic leg stands than the intact one, knee to ground "
+                                  "[m]: the blade's height as set (athletes: 0.02-0.08 m; "
+                                  "default 0.03 m at 1.80 m, scaled with the height)."),
 }
 
 
@@ -353,6 +357,7 @@ def register(app: typer.Typer) -> None:
         residual_limb: float | None = _athlete_option("residual_limb_length_m"),
         thigh_length: float | None = _athlete_option("thigh_length_m"),
         shank_length: float | None = _athlete_option("shank_length_m"),
+        prosthesis_extra_length: float | None = _athlete_option("prosthesis_extra_length_m"),
         static: Path | None = _static_option(),
         starts: int | None = typer.Option(
             None, "--starts", rich_help_panel=COLLOCATION, show_default=False,
@@ -362,7 +367,7 @@ def register(app: typer.Typer) -> None:
                  f"solve in OUT/starts/. Default: {defaults.ATHLETE_STARTS} for an athlete "
                  "scaled by --body-mass, --height, --muscle-strength, "
                  "--max-shortening-velocity, --residual-limb, --thigh-length, "
-                 "--shank-length or --static (one start can land "
+                 "--shank-length, --prosthesis-extra-length or --static (one start can land "
                  f"17 % too high there), else {defaults.STARTS}."),
         mesh_check: bool = typer.Option(
             False, "--mesh-check", rich_help_panel=COLLOCATION,
@@ -396,7 +401,8 @@ def register(app: typer.Typer) -> None:
                                  muscle_strength=muscle_strength,
                                  max_shortening_velocity=max_shortening_velocity,
                                  residual_limb_length_m=residual_limb,
-                                 thigh_length_m=thigh_length, shank_length_m=shank_length),
+                                 thigh_length_m=thigh_length, shank_length_m=shank_length,
+                                 prosthesis_extra_length_m=prosthesis_extra_length),
                 starts=starts, mesh_check=mesh_check))
         from bladelab.cli.reflex import run_reflex  # deferred: keeps bladelab --help fast
 
@@ -531,6 +537,7 @@ def register(app: typer.Typer) -> None:
         residual_limb: float | None = _athlete_option("residual_limb_length_m"),
         thigh_length: float | None = _athlete_option("thigh_length_m"),
         shank_length: float | None = _athlete_option("shank_length_m"),
+        prosthesis_extra_length: float | None = _athlete_option("prosthesis_extra_length_m"),
         static: Path | None = _static_option(),
         mesh_check: bool = typer.Option(
             False, "--mesh-check", rich_help_panel=COLLOCATION,
@@ -587,7 +594,8 @@ def register(app: typer.Typer) -> None:
                                  muscle_strength=muscle_strength,
                                  max_shortening_velocity=max_shortening_velocity,
                                  residual_limb_length_m=residual_limb,
-                                 thigh_length_m=thigh_length, shank_length_m=shank_length),
+                                 thigh_length_m=thigh_length, shank_length_m=shank_length,
+                                 prosthesis_extra_length_m=prosthesis_extra_length),
                 mesh_check=mesh_check, settle=settle))
         from bladelab.cli import reflex  # deferred: keeps bladelab --help fast
 

@@ -288,7 +288,8 @@ def build_runner(
             knee = {"parent": "femur_r",
                     "pos": lab_vector(difference(pp, joint_child["femur_r"]), sb("femur_r")),
                     "joint": "knee_angle_r"}
-            depth = prosthetic_bottom(s, params.shank_length_factor, 0.0)
+            depth = prosthetic_bottom(s, params.shank_length_factor, 0.0,
+                                      params.prosthesis_extra_length_m)
             if blade_model is None:
                 add_prosthesis(bodies, joint_child, params, s, mr, axis, depth=depth,
                                com_fraction=PROSTHETIC_SHANK_COM, **knee)
@@ -300,7 +301,8 @@ def build_runner(
             res_len = table_len * sb("tibia_res_r")
             com = [0.0, 0.0, -0.5 * res_len]
             add("tibia_res_r", "tibia_res_r", "knee_r", "knee_angle_r", "femur_r", pp, pc, com=com)
-            depth = prosthetic_bottom(s, params.shank_length_factor, table_len)
+            depth = prosthetic_bottom(s, params.shank_length_factor, table_len,
+                                      params.prosthesis_extra_length_m)
             if blade_model is None:
                 add_prosthesis(bodies, joint_child, params, s, mr, axis, parent="tibia_res_r",
                                pos=[0.0, 0.0, -res_len], joint="socket_angle_r",

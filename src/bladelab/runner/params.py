@@ -26,7 +26,11 @@ from pydantic import (
 
 from bladelab._io import read_yaml
 from bladelab.errors import InputFileError, SpecError
-from bladelab.runner.blade_categories import BLADE_DISSIPATION_S_PER_M, blade_category
+from bladelab.runner.blade_categories import (
+    BLADE_DISSIPATION_S_PER_M,
+    BLADE_EXTRA_LENGTH_M,
+    blade_category,
+)
 from bladelab.runner.geometry import (
     LEG_MUSCLES,
     RESIDUAL_TIBIA_FRACTION,
@@ -188,6 +192,11 @@ RESIDUAL_TIBIA_FRACTION_RANGE = (0.2, 0.9)
 #: the height-scaled model's segment: people of one height differ by about ±10 % in each.
 SEGMENT_LENGTH_FACTOR_RANGE = (0.8, 1.3)
 
+#: The range of the prosthetic leg's extra length [m, at 1.80 m] a parameter set may give:
+#: athletes' running-specific prostheses are set so that the prosthetic leg stands 2–8 cm
+#: taller than the intact one (Taboga et al. 2020, Sci Rep 10:1763), and a little more.
+PROSTHESIS_EXTRA_LENGTH_RANGE_M = (0.0, 0.10)
+
 
 class RunnerParams(_Strict):
     """A runner parameter set (one YAML file)."""
@@ -227,6 +236,13 @@ class RunnerParams(_Strict):
     #: ``TIBIA_LENGTH_M`` at 1.80 m; the residual tibia keeps its fraction of it) [-].
     shank_length_factor: float = Field(default=1.0, ge=SEGMENT_LENGTH_FACTOR_RANGE[0],
                                        le=SEGMENT_LENGTH_FACTOR_RANGE[1])
+    #: How much longer the straight prosthetic leg is than the intact one, knee to ground
+    #: [m, at 1.80 m; scaled with the height]: the blade's height as the prosthetist sets it.
+    #: 0.03 unless set (seed 001's athlete); the transtibial and transfemoral runners'.
+    #: Ignored by the able runner.
+    prosthesis_extra_length_m: float = Field(
+        default=BLADE_EXTRA_LENGTH_M, ge=PROSTHESIS_EXTRA_LENGTH_RANGE_M[0],
+        le=PROSTHESIS_EXTRA_LENGTH_RANGE_M[1])
     segments: dict[str, Segment]
     muscle_types: dict[str, MuscleType]
     #: Gravity of this model [m/s²]: 9.81, the value the seed-001 runner and its shipped reflex

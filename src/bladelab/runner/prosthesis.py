@@ -4,7 +4,8 @@ One rigid body below a hinge: the socket, pylon and blade of the transtibial run
 residual tibia, hinge ``socket_angle_r``) or the knee unit, pylon and blade of the transfemoral
 runner (on the residual femur, hinge ``knee_angle_r``), with seed 001 Table 2.1's prosthesis mass
 and inertia and the blade as a Hertz sphere whose bottom makes the straight prosthetic leg 3 cm
-longer, knee to ground, than the intact one (seed 001 §2.1; Fig. 2.3 for the transtibial COM),
+(unless the parameter set says otherwise) longer, knee to ground, than the intact one (seed 001
+§2.1; Fig. 2.3 for the transtibial COM),
 its modulus E [N/m²] the blade category's stiffness at the athlete's body weight
 (:func:`blade_contact_modulus`; :mod:`bladelab.runner.blade_categories`). A multi-link blade
 replaces the sphere in :mod:`bladelab.runner.multilink`. Lengths [m] at the reference athlete
@@ -38,13 +39,14 @@ PROSTHETIC_SHANK_COM = 0.4
 PROSTHETIC_PYLON_COM_M = 0.08
 
 
-def prosthetic_bottom(s: float, k_shank: float, res_len: float) -> float:
+def prosthetic_bottom(s: float, k_shank: float, res_len: float,
+                      extra: float = BLADE_EXTRA_LENGTH_M) -> float:
     """Depth [m] below the socket of the prosthetic leg's lowest point, for a socket
     ``res_len`` [m at 1.80 m, before ``k_shank``] below the knee: the straight prosthetic leg
-    is 3 cm longer (knee to ground) than the intact one, whose shank is ``k_shank`` times the
-    model's; ``s``: the height's scale."""
+    is ``extra`` [m at 1.80 m] longer (knee to ground) than the intact one, whose shank is
+    ``k_shank`` times the model's; ``s``: the height's scale."""
     intact = geo.TIBIA_LENGTH_M * k_shank + geo.ANKLE_TO_SOLE_M
-    return (intact + BLADE_EXTRA_LENGTH_M) * s - res_len * k_shank * s
+    return (intact + extra) * s - res_len * k_shank * s
 
 
 def add_prosthesis(bodies, joint_child, params, s, mr, axis, *, parent: str, pos,
@@ -54,8 +56,9 @@ def add_prosthesis(bodies, joint_child, params, s, mr, axis, *, parent: str, pos
     residual tibia, hinge ``socket_angle_r``) or the knee unit, pylon and blade of the
     transfemoral runner (on the residual femur, hinge ``knee_angle_r``).
 
-    The sphere's bottom lies ``depth`` [m] below the hinge (the straight prosthetic leg 3 cm
-    longer than the intact one, knee to ground). The transtibial prosthesis's COM lies
+    The sphere's bottom lies ``depth`` [m] below the hinge (the straight prosthetic leg
+    :attr:`~bladelab.runner.params.RunnerParams.prosthesis_extra_length_m` longer than the
+    intact one, knee to ground). The transtibial prosthesis's COM lies
     a = 0.069 m behind and b = 0.0693 m above the sphere centre, that offset turned by the 9°
     alignment (seed 001 Fig. 2.3, our reading); with ``com_fraction`` the COM lies that
     fraction of ``depth`` straight below the hinge instead.

@@ -23,6 +23,7 @@ from bladelab.runner.geometry import (
 )
 from bladelab.runner.params import (
     MAX_SHORTENING_VELOCITY_RANGE,
+    PROSTHESIS_EXTRA_LENGTH_RANGE_M,
     RESIDUAL_TIBIA_FRACTION_RANGE,
     SEGMENT_LENGTH_FACTOR_RANGE,
     RunnerParams,
@@ -92,11 +93,12 @@ def segment_mass_ratio(params: RunnerParams) -> float:
 ATHLETE_PARAM_FIELDS = frozenset({"athlete", "active_specific_tension_N_per_cm2",
                                   "max_shortening_velocity_lopt_per_s",
                                   "residual_tibia_fraction", "thigh_length_factor",
-                                  "shank_length_factor"})
+                                  "shank_length_factor", "prosthesis_extra_length_m"})
 #: Fields of an athlete that :func:`athlete_params` changes, with their units.
 ATHLETE_FIELDS = {"body_mass_kg": "kg", "height_m": "m", "muscle_strength": "-",
                   "max_shortening_velocity": "l_opt/s", "residual_limb_length_m": "m",
-                  "thigh_length_m": "m", "shank_length_m": "m"}
+                  "thigh_length_m": "m", "shank_length_m": "m",
+                  "prosthesis_extra_length_m": "m"}
 
 
 def athlete_params(params: RunnerParams, *, body_mass_kg: float | None = None,
@@ -105,7 +107,8 @@ def athlete_params(params: RunnerParams, *, body_mass_kg: float | None = None,
                    max_shortening_velocity: float | None = None,
                    residual_limb_length_m: float | None = None,
                    thigh_length_m: float | None = None,
-                   shank_length_m: float | None = None) -> RunnerParams:
+                   shank_length_m: float | None = None,
+                   prosthesis_extra_length_m: float | None = None) -> RunnerParams:
     """The parameter set scaled to another athlete (None keeps the set's value).
 
     ``body_mass_kg`` [kg] and ``height_m`` [m] replace :class:`Athlete`'s: segment masses
@@ -125,7 +128,9 @@ def athlete_params(params: RunnerParams, *, body_mass_kg: float | None = None,
     athlete's thighs (hip to knee joint centre) and shanks (knee to ankle joint centre), e.g.
     from a static trial (:func:`bladelab.trial.segment_lengths`); unless set, 0.396 m and
     0.430 m times the height over 1.80 m. The residual limb's length is a fraction of the
-    shank given here.
+    shank given here. ``prosthesis_extra_length_m`` [m] is how much longer the straight
+    prosthetic leg stands than the intact one, knee to ground (the blade's height as the
+    prosthetist sets it; 3 cm at 1.80 m unless set, scaled with the height).
     """
     data = params.model_dump()
     athlete = dict(data["athlete"])
@@ -153,6 +158,9 @@ def athlete_params(params: RunnerParams, *, body_mass_kg: float | None = None,
                                    ("shank", shank_length_m, TIBIA_LENGTH_M)):
         if value is not None:
             data[f"{name}_length_factor"] = _length_factor(name, value, reference * ratio)
+    if prosthesis_extra_length_m is not None:
+        data["prosthesis_extra_length_m"] = _prosthesis_extra(
+            params.kind, prosthesis_extra_length_m, ratio)
     if residual_limb_length_m is not None:
         tibia = TIBIA_LENGTH_M * ratio * data["shank_length_factor"]
         data["residual_tibia_fraction"] = _residual_fraction(
@@ -178,6 +186,23 @@ def _length_factor(name: str, length_m, model_m: float) -> float:
                         if name == "thigh" else "the shank from the knee to the ankle joint "
                         "centre")
     return float(length_m) / model_m
+
+
+def _prosthesis_extra(kind: str, length_m, ratio: float) -> float:
+    """The prosthetic leg's extra length at 1.80 m [m] for ``length_m`` [m] on an athlete
+    ``ratio`` times 1.80 m tall; a clear error outside the accepted range or for the able
+    runner."""
+    where = "athlete.prosthesis_extra_length_m"
+    if kind == "able":
+        raise SpecError("the able runner has no prosthesis", where=where,
+                        hint="the prosthetic leg's extra length is an amputee's")
+    lo, hi = (x * ratio for x in PROSTHESIS_EXTRA_LENGTH_RANGE_M)
+    if not _number_within(length_m, lo, hi):
+        raise SpecError(f"the prosthetic leg's extra length must be within {lo:g}–{hi:.3g} m, "
+                        f"got {length_m!r}", where=where,
+                        hint="athletes' prostheses stand 0.02–0.08 m taller than the intact "
+                             "leg; 0.03 m at 1.80 m is the body's own")
+    return float(length_m) / ratio
 
 
 def _residual_fraction(kind: str, length_m, tibia: float, height_m: float) -> float:

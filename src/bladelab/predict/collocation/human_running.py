@@ -17,8 +17,14 @@ running-specific prostheses (the same step frequency on both legs, nine athletes
 their maximum speed, ISBS proceedings 36, 2018); the band 40–60 % of the stride is ours, wide
 enough for an amputee's asymmetry, and excludes a gallop.
 
-The prosthetic leg of a transtibial runner is held to a wider contact band at the low end
-(0.15 s): its blade shortens the contact (Grabowski et al. 2010, Hobara et al. 2013). Its peak
+The prosthetic leg's contact band is people's, its lower edge widened to 0.15 s where people's
+is higher (below 6.25 m/s). At top speed the blade's contact is not shorter than the intact
+leg's: six sprinters with a unilateral transtibial amputation swung their two legs for times
+that did not differ (Grabowski et al. 2010), so, sharing one stride, they stood on both about
+as long; runners with a transfemoral amputation step as often on both legs, with a longer
+contact length on the prosthetic one at their faster speeds (ISBS proceedings 36, 2018). The
+widened edge at slower speeds is ours: no measured band of the blade's contact there was in
+reach. Its peak
 vertical force is held below the intact leg's: runners with a unilateral transtibial
 amputation land softer on the blade than on their intact leg at every speed measured
 (Grabowski et al. 2010, 3 m/s to maximum speed; Hobara et al. 2013, 2.5–3.5 m/s). Runners with

@@ -65,7 +65,7 @@ def solve_named_stride(
     ``toes``), from the initial guess ``guess`` (module docstring), into the folder ``out``;
     ``athlete`` (``body_mass_kg`` [kg], ``height_m`` [m], ``muscle_strength`` [-],
     ``max_shortening_velocity`` [l_opt/s], ``residual_limb_length_m``, ``thigh_length_m``,
-    ``shank_length_m`` [m], any of them;
+    ``shank_length_m``, ``prosthesis_extra_length_m`` [m], any of them;
     :func:`bladelab.runner.scaling.athlete_params`) scales the runner to another athlete.
 
     ``settings`` (default :class:`CollocationSettings`) say the problem (mesh intervals [-],

@@ -65,7 +65,7 @@ def check_model_spec(spec) -> dict:
     ``"athlete"`` where the runner is scaled to another athlete than the parameter set's
     (``{"body_mass_kg": kg, "height_m": m, "muscle_strength": factor,
     "max_shortening_velocity": l_opt/s, "residual_limb_length_m": m, "thigh_length_m": m,
-    "shank_length_m": m}``, any of them;
+    "shank_length_m": m, "prosthesis_extra_length_m": m}``, any of them;
     :func:`bladelab.runner.scaling.athlete_params`), checked and normalised (the able model has
     no blade; the amputee needs one; files written before the bodies existed have no
     ``"body"`` and mean seed 001's)."""
@@ -99,8 +99,8 @@ def check_model_spec(spec) -> dict:
 
 
 def _check_athlete(athlete) -> dict:
-    """The athlete of a model specification: known fields, each a finite number > 0 (an empty
-    dict for None)."""
+    """The athlete of a model specification: known fields, each a finite number > 0 (the
+    prosthetic leg's extra length ≥ 0; an empty dict for None)."""
     if athlete is None:
         return {}
     if not isinstance(athlete, dict):
@@ -113,9 +113,10 @@ def _check_athlete(athlete) -> dict:
                             hint=" or ".join(ATHLETE_FIELDS))
         if value is None:
             continue
+        least = ">=" if name == "prosthesis_extra_length_m" else ">"
         if (isinstance(value, bool) or not isinstance(value, int | float)
-                or not math.isfinite(value) or value <= 0):
-            raise SpecError(f"{name} must be a number > 0 [{ATHLETE_FIELDS[name]}], got "
+                or not math.isfinite(value) or value < 0 or (least == ">" and value == 0)):
+            raise SpecError(f"{name} must be a number {least} 0 [{ATHLETE_FIELDS[name]}], got "
                             f"{value!r}", where=f"athlete.{name}")
         out[name] = float(value)
     return out
@@ -146,6 +147,8 @@ def athlete_label(spec: dict) -> str:
               if "residual_limb_length_m" in athlete else [])
     parts += [f"{name} {athlete[f'{name}_length_m']:.3g} m" for name in ("thigh", "shank")
               if f"{name}_length_m" in athlete]
+    parts += ([f"prosthetic leg {100 * athlete['prosthesis_extra_length_m']:.3g} cm longer"]
+              if "prosthesis_extra_length_m" in athlete else [])
     return ", ".join(parts)
 
 

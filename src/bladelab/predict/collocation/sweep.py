@@ -129,15 +129,16 @@ def sweep_models(categories: Sequence[str], *, able: bool = False,
     (:data:`bladelab.runner.params.BODIES`) and ``athlete`` (None: the parameter sets';
     :func:`~bladelab.predict.collocation.stored.check_model_spec`).
 
-    The able runner takes the athlete without its residual limb (``residual_limb_length_m``,
-    the amputee's). Every model's athlete is checked before anything is solved.
+    The able runner takes the athlete without its residual limb and prosthesis
+    (``residual_limb_length_m``, ``prosthesis_extra_length_m``: the amputee's). Every model's athlete is checked before anything is solved.
 
     Raises
     ------
     SpecError
         An unknown or repeated category, no model at all, or a bad athlete field.
     """
-    able_athlete = ({k: v for k, v in athlete.items() if k != "residual_limb_length_m"}
+    amputee_only = ("residual_limb_length_m", "prosthesis_extra_length_m")
+    able_athlete = ({k: v for k, v in athlete.items() if k not in amputee_only}
                     if athlete else athlete)
     models = ([check_model_spec({"model": "able", "body": body, "athlete": able_athlete})]
               if able else [])
