@@ -192,10 +192,10 @@ def test_power_balance_at_1ms(kind, u):
     assert res.duration == pytest.approx(2.0)
     assert (res.contacts[:, :, 1].sum(axis=1) > 0).mean() > 0.5
     assert power_balance_residual_pct(res) <= 0.5
-    from bladelab.runner.analyses import _forward_pass
+    from bladelab.runner.analyses import forward_pass
 
     pb = power_balance(res)
-    ek = _forward_pass(res)["ek"]
+    ek = forward_pass(res)["ek"]
     work = np.trapezoid(pb.external, pb.time)
     assert work == pytest.approx(ek[-1] - ek[0], abs=0.05 * np.ptp(ek))
 

@@ -266,9 +266,9 @@ def test_power_balance_with_ground_contact(kind, u):
     # energy: the integral of the external power equals the kinetic energy change; the gap is
     # the first-order integrator's error (∝ dt: 2.2 % of the kinetic-energy range at 0.5 ms,
     # 0.5 % at 0.1 ms, measured)
-    from bladelab.runner.analyses import _forward_pass
+    from bladelab.runner.analyses import forward_pass
 
-    ek = _forward_pass(res)["ek"]
+    ek = forward_pass(res)["ek"]
     work = np.trapezoid(pb.external, pb.time)
     assert work == pytest.approx(ek[-1] - ek[0], abs=0.05 * np.ptp(ek))
 

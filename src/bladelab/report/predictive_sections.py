@@ -39,15 +39,9 @@ from bladelab.report.predictive_figures import (
     power_balance_figure,
     spatiotemporal_figure,
 )
-from bladelab.runner.analyses import (
-    blade_energy,
-    gait_events,
-    joint_powers,
-    leg_energy,
-    leg_stiffness,
-    spatiotemporal,
-)
+from bladelab.runner.analyses import gait_events, joint_powers, spatiotemporal
 from bladelab.runner.simulate import RunnerResult, leg_names
+from bladelab.runner.stance_mechanics import blade_energy, leg_energy, leg_stiffness
 
 
 def _leg_of(joint: str, names: tuple[str, str]) -> str | None:
@@ -255,7 +249,7 @@ def energy_table_long(results: dict[str, RunnerResult]) -> pd.DataFrame:
 def blade_energy_table(results: dict[str, RunnerResult]) -> pd.DataFrame:
     """The blade's energy per prosthetic stance, mean per solution (seed 001 Table D.1 layout):
     E stored, E returned, hysteresis [J], recoil [%] from the simulated compression
-    (:func:`bladelab.runner.analyses.blade_energy`), the recoil the seed's bookkeeping gives
+    (:func:`bladelab.runner.stance_mechanics.blade_energy`), the recoil the seed's bookkeeping gives
     (compression from the force by eq. 2.3), peak compression [mm], stances (count). Solutions
     without a blade are left out."""
     rows = []

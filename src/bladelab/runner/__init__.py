@@ -11,9 +11,7 @@ from bladelab.runner.analyses import (
     gait_events,
     joint_angles,
     joint_powers,
-    leg_energy,
     leg_grf,
-    leg_stiffness,
     power_balance,
     power_balance_residual_pct,
     spatiotemporal,
@@ -42,6 +40,7 @@ from bladelab.runner.simulate import (
     integrator_for,
     simulate_runner,
 )
+from bladelab.runner.stance_mechanics import leg_energy, leg_stiffness
 
 __all__ = [
     "BladeCategory",

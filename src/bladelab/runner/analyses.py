@@ -9,8 +9,8 @@
   and the blade (power the blade contact delivers to the body);
 - :func:`power_balance`: muscle, ligament, contact, gravity and kinetic power (eq. 2.10–2.18),
   and the residual ``P_external − P_kinetic``;
-- per stance of :func:`stances`: :func:`leg_stiffness` (K_leg, eq. 2.19–2.21),
-  :func:`leg_energy` (Table 3.3) and :func:`blade_energy` (Table D.1);
+- :func:`stances`: the complete stances every per-stance analysis of
+  :mod:`bladelab.runner.stance_mechanics` (K_leg, leg and blade energy) uses;
 - :func:`summary`: the JSON summary of the CLI.
 
 Powers are positive when delivered to the body segments. All tables are tidy DataFrames.
@@ -25,11 +25,9 @@ import mujoco
 import numpy as np
 import pandas as pd
 
-from bladelab.runner.layout import CP_BLADE, CP_EXP, CP_K, CP_LEG
-from bladelab.runner.model import contact_heights
+from bladelab.runner.layout import CP_BLADE, CP_LEG
 from bladelab.runner.params import PROSTHETIC_KINDS
 from bladelab.runner.simulate import (
-    RC_DEPTH,
     RC_FX,
     RC_FZ,
     RC_VX,
@@ -45,8 +43,10 @@ MIN_GAP_S = 0.05  # unloaded gaps shorter than this inside a stance are contact 
 MIN_CONTACT_S = 0.03  # loaded stretches shorter than this are brief touches, not stances [s]
 
 
-def _forward_pass(result: RunnerResult) -> dict[str, np.ndarray]:
-    """Per sample: kinetic energy [J], COM position/velocity, muscle generalized forces."""
+def forward_pass(result: RunnerResult) -> dict[str, np.ndarray]:
+    """Per sample of ``result`` (computed once, then cached on it): ``ek`` kinetic energy [J],
+    ``com`` and ``comv`` the whole-body centre of mass's position [m] and velocity [m/s] (n, 3),
+    ``qfrc_muscle`` the muscles' generalised forces (n, nv) [N or N·m]."""
     cached = getattr(result, "_fwd_cache", None)
     if cached is not None:
         return cached
@@ -73,14 +73,15 @@ def _forward_pass(result: RunnerResult) -> dict[str, np.ndarray]:
     return out
 
 
-def _leg_fz(result: RunnerResult, leg: int) -> np.ndarray:
+def leg_vertical_force(result: RunnerResult, leg: int) -> np.ndarray:
+    """Vertical ground force of leg 0 or 1 per sample [N], its contacts summed."""
     cols = result.model.contact_params[:, CP_LEG] == leg
     return result.contacts[:, cols, RC_FZ].sum(axis=1)
 
 
 def com_trajectory(result: RunnerResult) -> pd.DataFrame:
     """Whole-body centre of mass (wide): time [s], x_m, z_m [m], vx_m_per_s, vz_m_per_s [m/s]."""
-    fwd = _forward_pass(result)
+    fwd = forward_pass(result)
     com, v = fwd["com"], fwd["comv"]
     return pd.DataFrame({"time": result.time, "x_m": com[:, 0], "z_m": com[:, 2],
                          "vx_m_per_s": v[:, 0], "vz_m_per_s": v[:, 2]})
@@ -165,7 +166,7 @@ def _contacts(
     step of :func:`step_touchdowns` starts in it) or not (a swing contact)."""
     names = leg_names(result.model)
     bw = result.model.body_weight
-    forces = np.stack([_leg_fz(result, leg) for leg in (0, 1)], axis=1)
+    forces = np.stack([leg_vertical_force(result, leg) for leg in (0, 1)], axis=1)
     steps = step_touchdowns(result.time, forces, bw)
     dt = float(result.time[1] - result.time[0]) if len(result.time) > 1 else 0.0
     out = []
@@ -313,7 +314,7 @@ def joint_angles(result: RunnerResult) -> pd.DataFrame:
 
 def _joint_torque(result: RunnerResult) -> np.ndarray:
     """(n, n_dof) muscle + ligament (and socket/blade spring) generalized force [N·m]."""
-    return _forward_pass(result)["qfrc_muscle"] + result.ligament
+    return forward_pass(result)["qfrc_muscle"] + result.ligament
 
 
 _ACTUATED = ("hip", "knee", "ankle", "socket")
@@ -361,7 +362,7 @@ def power_balance(result: RunnerResult) -> pd.DataFrame:
     at each contact, gravity power −M·g·v_com,z; the kinetic power is the time derivative of the
     kinetic energy computed by MuJoCo from the recorded states, independently of the forces.
     """
-    fwd = _forward_pass(result)
+    fwd = forward_pass(result)
     p_m = -(result.muscles[:, :, 3] * result.mtu[:, :, 1]).sum(axis=1)
     p_l = (result.ligament * result.qvel).sum(axis=1)
     c = result.contacts
@@ -429,8 +430,7 @@ def stances(
 
     Returns a DataFrame with columns leg, first, stop (sample indices: the stance is
     ``first:stop``, ``stop`` the first unloaded sample), touchdown_s, liftoff_s, contact_time_s.
-    Every per-stance analysis (:func:`leg_stiffness`, :func:`leg_energy`,
-    :func:`blade_energy`) uses these stances.
+    Every per-stance analysis of :mod:`bladelab.runner.stance_mechanics` uses these stances.
     """
     rows = [
         {
@@ -448,171 +448,6 @@ def stances(
     return pd.DataFrame(rows, columns=cols).sort_values("touchdown_s", ignore_index=True)
 
 
-def _leg_stances(result: RunnerResult, leg: int, threshold_n: float) -> list[tuple[int, int]]:
-    st = stances(result, threshold_n=threshold_n)
-    st = st[st.leg == leg_names(result.model)[leg]]
-    return list(zip(st["first"].tolist(), st["stop"].tolist(), strict=True))
-
-
-def _leg_length(result: RunnerResult, leg: int) -> float:
-    """Standing leg length L0 [m]: hip joint height in the standing pose (+3 cm prosthetic)."""
-    model = result.model
-    d = mujoco.MjData(model.mj_model)
-    q = model.stand_qpos.copy()
-    q[:] = 0.0
-    d.qpos[:] = q
-    mujoco.mj_kinematics(model.mj_model, d)
-    side = "l" if leg == 0 else "r"
-    hip = d.xanchor[model.mj_model.joint(f"hip_flexion_{side}").id, 2]
-    h = contact_heights(model, q)
-    cols = model.contact_params[:, CP_LEG] == leg
-    return float(hip - h[cols].min())
-
-
-def leg_stiffness(
-    result: RunnerResult, *, threshold_n: float = CONTACT_THRESHOLD_N
-) -> pd.DataFrame:
-    """Leg stiffness per stance of :func:`stances` (seed 001 eq. 2.19–2.21): columns leg,
-    touchdown [s], contact_time [s], F_peak [N], delta_y [m], L0 [m], theta_rad, delta_L [m],
-    K_leg [N/m]. Strikes of the swinging foot are not stances and do not count."""
-    fwd = _forward_pass(result)
-    names = leg_names(result.model)
-    rows = []
-    for leg in (0, 1):
-        l0 = _leg_length(result, leg)
-        fz = _leg_fz(result, leg)
-        for i0, i1 in _leg_stances(result, leg, threshold_n):
-            tc = result.time[i1] - result.time[i0]
-            v = float(np.mean(fwd["comv"][i0:i1, 0]))
-            dy = float(fwd["com"][i0, 2] - np.min(fwd["com"][i0:i1, 2]))
-            theta = math.asin(min(abs(v) * tc / (2 * l0), 1.0))
-            dl = dy + l0 * (1 - math.cos(theta))
-            fp = float(np.max(fz[i0:i1]))
-            rows.append(
-                {
-                    "leg": names[leg],
-                    "touchdown": float(result.time[i0]),
-                    "contact_time": tc,
-                    "F_peak": fp,
-                    "delta_y": dy,
-                    "L0": l0,
-                    "theta_rad": theta,
-                    "delta_L": dl,
-                    "K_leg": fp / dl if dl > 0 else math.nan,
-                }
-            )
-    cols = ["leg", "touchdown", "contact_time", "F_peak", "delta_y", "L0", "theta_rad",
-            "delta_L", "K_leg"]
-    return pd.DataFrame(rows, columns=cols)
-
-
-def leg_energy(result: RunnerResult, *, threshold_n: float = CONTACT_THRESHOLD_N) -> pd.DataFrame:
-    """Energy per leg and stance of :func:`stances` (strikes of the swinging foot excluded) from
-    the GRF–vertical COM displacement loop (Table 3.3 layout): columns leg, touchdown [s], E_stored [J] (work absorbed while the COM descends), E_generated
-    [J] (work returned while it rises), hysteresis [J] = |stored − generated|,
-    recoil_pct = 100·min/max."""
-    fwd = _forward_pass(result)
-    names = leg_names(result.model)
-    rows = []
-    for leg in (0, 1):
-        fz = _leg_fz(result, leg)
-        for i0, i1 in _leg_stances(result, leg, threshold_n):
-            dz = np.diff(fwd["com"][i0 : i1 + 1, 2])
-            f = 0.5 * (fz[i0:i1] + fz[i0 + 1 : i1 + 1])
-            stored = float(-np.sum(f * np.minimum(dz, 0.0)))
-            generated = float(np.sum(f * np.maximum(dz, 0.0)))
-            big = max(stored, generated)
-            rows.append(
-                {
-                    "leg": names[leg],
-                    "touchdown": float(result.time[i0]),
-                    "E_stored": stored,
-                    "E_generated": generated,
-                    "hysteresis": abs(stored - generated),
-                    "recoil_pct": 100.0 * min(stored, generated) / big if big > 0 else math.nan,
-                }
-            )
-    return pd.DataFrame(
-        rows, columns=["leg", "touchdown", "E_stored", "E_generated", "hysteresis", "recoil_pct"]
-    )
-
-
-def blade_energy(
-    result: RunnerResult,
-    *,
-    compression: str = "penetration",
-    threshold_n: float = CONTACT_THRESHOLD_N,
-) -> pd.DataFrame:
-    """Energy the blade contact stores and returns per prosthetic stance (seed 001 Table D.1).
-
-    E_stored = ∫F·dδ while the blade compresses, E_returned = −∫F·dδ while it recovers, summed
-    over the blade's contacts (the sphere, or a multi-link blade's soles), with F the contact's
-    vertical (normal) force [N] and δ its compression [m], over each stance of
-    :func:`stances` extended to the whole time the blade touches the ground.
-
-    Parameters
-    ----------
-    result
-        An amputee simulation (empty table for the able model).
-    compression
-        ``"penetration"``: δ is the simulated penetration of the contact (the energy the
-        Hunt–Crossley law really stores and returns, dissipation included); ``"hertz"``: δ is
-        computed back from the force by the elastic Hertz law ``δ = (F/k)^(1/n)`` (seed 001
-        eq. 2.3 as its eq. 2.14 uses it). The second cannot show any dissipation: F(δ) is then
-        one curve, and a loop along it encloses no area.
-    threshold_n
-        Vertical force [N] above which a leg is in contact (:func:`stances`).
-
-    Returns
-    -------
-    DataFrame
-        leg, touchdown_s, E_stored_J, E_returned_J, hysteresis_J (stored − returned),
-        recoil_pct (100·returned/stored), peak_force_N, peak_compression_m.
-    """
-    if compression not in ("penetration", "hertz"):
-        raise ValueError(f"compression must be 'penetration' or 'hertz', not {compression!r}")
-    cols = ["leg", "touchdown_s", "E_stored_J", "E_returned_J", "hysteresis_J", "recoil_pct",
-            "peak_force_N", "peak_compression_m"]
-    cp = result.model.contact_params
-    blade = np.flatnonzero(cp[:, CP_BLADE] == 1)
-    if not len(blade):
-        return pd.DataFrame(columns=cols)
-    force = result.contacts[:, blade, RC_FZ]
-    depth = result.contacts[:, blade, RC_DEPTH]
-    if compression == "hertz":
-        k, n = cp[blade, CP_K], cp[blade, CP_EXP]
-        depth = (np.maximum(force, 0.0) / k) ** (1.0 / n)
-        touching = (force > 0).any(axis=1)
-    else:
-        # penetrating; not 'force > 0': a smooth contact law (the collocation model's) pushes
-        # with a small force above the ground too, which would join every stance into one
-        # (the forward law's force is 0 without penetration: the same stances)
-        touching = (depth > 0).any(axis=1)
-    rows = []
-    name = leg_names(result.model)[1]
-    for i0, i1 in _leg_stances(result, 1, threshold_n):
-        t0 = float(result.time[i0])
-        while i0 > 0 and touching[i0 - 1]:
-            i0 -= 1
-        while i1 < len(touching) - 1 and touching[i1]:
-            i1 += 1
-        dd = np.diff(depth[i0 : i1 + 1], axis=0)
-        f = 0.5 * (force[i0:i1] + force[i0 + 1 : i1 + 1])
-        stored = float(np.sum(f * np.maximum(dd, 0.0)))
-        returned = float(-np.sum(f * np.minimum(dd, 0.0)))
-        rows.append({
-            "leg": name,
-            "touchdown_s": t0,
-            "E_stored_J": stored,
-            "E_returned_J": returned,
-            "hysteresis_J": stored - returned,
-            "recoil_pct": 100.0 * returned / stored if stored > 0 else math.nan,
-            "peak_force_N": float(force[i0 : i1 + 1].sum(axis=1).max()),
-            "peak_compression_m": float(depth[i0 : i1 + 1].max()),
-        })
-    return pd.DataFrame(rows, columns=cols)
-
-
 def _blade_name(model) -> str | None:
     if model.kind not in PROSTHETIC_KINDS:
         return None
@@ -622,7 +457,7 @@ def _blade_name(model) -> str | None:
 def summary(result: RunnerResult) -> dict:
     """The JSON summary: fell, duration_s, mean_speed_mps, contact times per leg,
     power_balance_residual_pct, and the spatiotemporal means."""
-    fwd = _forward_pass(result)
+    fwd = forward_pass(result)
     names = leg_names(result.model)
     st = spatiotemporal(result)
     dur = result.duration
@@ -642,7 +477,7 @@ def summary(result: RunnerResult) -> dict:
         f"contact_time_{names[1]}_s": _val(names[1], "contact_time"),
         "power_balance_residual_pct": power_balance_residual_pct(result),
         "peak_grf_bw": {
-            leg: float(np.max(_leg_fz(result, i)) / result.model.body_weight)
+            leg: float(np.max(leg_vertical_force(result, i)) / result.model.body_weight)
             for i, leg in enumerate(names)
         },
         "spatiotemporal_s": {

@@ -47,6 +47,7 @@ from bladelab.predict.collocation.model import build_collocation_model
 from bladelab.predict.collocation.nodes import evaluate_nodes
 from bladelab.predict.collocation.stored import runner_from_spec
 from bladelab.runner import analyses as an
+from bladelab.runner import stance_mechanics as sm
 from bladelab.runner.layout import CP_LEG
 from bladelab.runner.metabolics import BASAL_RATE_W_PER_KG
 from bladelab.runner.params import PROSTHETIC_KINDS
@@ -146,7 +147,7 @@ def stride_analyses(solution, runner=None, *, refine: int = REFINE, cm=None) -> 
     legs = tuple(solution.leg_names)
     out: dict[str, float] = {}
 
-    k = an.leg_stiffness(res)
+    k = sm.leg_stiffness(res)
     for leg in legs:
         out[f"leg_stiffness_{leg}_kN_per_m"] = _mean(
             _middle(k, "touchdown", period, leg)["K_leg"]) / 1e3
@@ -177,7 +178,7 @@ def stride_analyses(solution, runner=None, *, refine: int = REFINE, cm=None) -> 
         solution, runner, specific_tension_pa=SCONE_SPECIFIC_TENSION_PA,
         basal_w_per_kg=SCONE_BASAL_W_PER_KG, cm=cm)
 
-    e = an.leg_energy(res)
+    e = sm.leg_energy(res)
     generated = 0.0
     for leg in legs:
         rows = _middle(e, "touchdown", period, leg)
@@ -189,7 +190,7 @@ def stride_analyses(solution, runner=None, *, refine: int = REFINE, cm=None) -> 
     out["leg_energy_generated_total_J"] = generated
 
     if solution.model_spec["model"] in PROSTHETIC_KINDS:
-        rows = _middle(an.blade_energy(res), "touchdown_s", period, legs[1])
+        rows = _middle(sm.blade_energy(res), "touchdown_s", period, legs[1])
         out["blade_energy_stored_J"] = _mean(rows["E_stored_J"])
         out["blade_energy_returned_J"] = _mean(rows["E_returned_J"])
         out["blade_hysteresis_J"] = _mean(rows["hysteresis_J"])
