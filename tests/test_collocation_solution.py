@@ -175,7 +175,7 @@ def test_the_reference_phase_round_trips_into_the_next_start(able, tmp_path):
 
 def test_a_maximum_speed_s_floor_round_trips_and_says_whether_the_speed_is_on_it(able,
                                                                                 tmp_path):
-    from bladelab.predict.collocation.continuation import speed_floor_columns
+    from bladelab.predict.collocation.continuation_records import speed_floor_columns
 
     _, _, sol = able
     assert sol.speed_floor_mps is None

@@ -35,7 +35,7 @@ import pandas as pd
 
 from bladelab.errors import InputFileError
 from bladelab.predict.collocation.alternating_steps import step_phase
-from bladelab.predict.collocation.continuation import ON_FLOOR_TOL_MPS
+from bladelab.predict.collocation.continuation_records import ON_FLOOR_TOL_MPS
 from bladelab.predict.collocation.human_running import gallop_sentence
 from bladelab.predict.collocation.model import build_collocation_model
 from bladelab.predict.collocation.solution import CollocationSolution

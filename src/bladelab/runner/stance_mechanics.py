@@ -87,9 +87,9 @@ def leg_stiffness(
 
 def leg_energy(result: RunnerResult, *, threshold_n: float = CONTACT_THRESHOLD_N) -> pd.DataFrame:
     """Energy per leg and stance of :func:`stances` (strikes of the swinging foot excluded) from
-    the GRF–vertical COM displacement loop (Table 3.3 layout): columns leg, touchdown [s], E_stored [J] (work absorbed while the COM descends), E_generated
-    [J] (work returned while it rises), hysteresis [J] = |stored − generated|,
-    recoil_pct = 100·min/max."""
+    the GRF–vertical COM displacement loop (Table 3.3 layout): columns leg, touchdown [s],
+    E_stored [J] (work absorbed while the COM descends), E_generated [J] (work returned while
+    it rises), hysteresis [J] = |stored − generated|, recoil_pct = 100·min/max."""
     fwd = forward_pass(result)
     names = leg_names(result.model)
     rows = []

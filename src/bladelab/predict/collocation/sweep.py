@@ -8,7 +8,7 @@ category: :func:`sweep_models`), the speed continuation and then the maximum spe
 :data:`SWEEP_TABLE` after each model (:func:`write_table`). A model that fails does not stop
 the others.
 
-A table row is one solve: :meth:`~bladelab.predict.collocation.continuation.SolveRecord.row`
+A table row is one solve: :meth:`~bladelab.predict.collocation.continuation_records.SolveRecord.row`
 (model, problem, convergence, speed, cost of transport, stride and contact times, peak forces;
 described in the continuation module) followed by seed 001's per-stride quantities of the
 solution, :func:`~bladelab.predict.collocation.analyses.stride_analyses` (K_leg, joint powers
@@ -62,7 +62,6 @@ from bladelab.errors import SpecError
 from bladelab.executors import make_executor
 from bladelab.predict.collocation.analyses import stride_analyses
 from bladelab.predict.collocation.continuation import (
-    ContinuationProgress,
     LazyRunner,
     check_speeds,
     max_speed,
@@ -70,8 +69,8 @@ from bladelab.predict.collocation.continuation import (
     model_folder,
     problem_key,
     speed_continuation,
-    table_columns,
 )
+from bladelab.predict.collocation.continuation_records import ContinuationProgress, table_columns
 from bladelab.predict.collocation.mesh_check import MESH_CHECK_DIR, mesh_check_in_folder
 from bladelab.predict.collocation.model import build_collocation_model
 from bladelab.predict.collocation.settings import CollocationSettings
