@@ -42,8 +42,8 @@ from bladelab.example.study import default_example_dir, make_example_study
 from bladelab.predict import defaults
 from bladelab.predict.collocation.human_running import human_running_criteria
 from bladelab.predict.collocation.named_runs import solve_named_stride
+from bladelab.predict.collocation.output_folder import SOLUTION_FILE
 from bladelab.predict.collocation.settings import CollocationSettings, people_settings
-from bladelab.predict.collocation.solve import SOLUTION_FILE
 from bladelab.report.design import build_design_report
 from bladelab.report.predictive import build_predictive_report
 from bladelab.report.study import build_study_report

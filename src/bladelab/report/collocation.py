@@ -35,13 +35,13 @@ from bladelab.predict.collocation.human_running import (
 )
 from bladelab.predict.collocation.mesh_check import MESH_CHECK_DIR, read_mesh_check
 from bladelab.predict.collocation.model import build_collocation_model
+from bladelab.predict.collocation.output_folder import SOLUTION_FILE
 from bladelab.predict.collocation.settings import PEOPLE_REFERENCE
 from bladelab.predict.collocation.solution import (
     BEST_ITERATE_KIND,
     SOLUTION_KIND,
     CollocationSolution,
 )
-from bladelab.predict.collocation.solve import SOLUTION_FILE
 from bladelab.predict.collocation.stored import athlete_label, runner_from_spec
 from bladelab.predict.collocation.touchdown import touchdown_slides
 from bladelab.report.collocation_loads import add_loads_section

@@ -83,13 +83,10 @@ from bladelab.predict.collocation.continuation_records import (
     SolveRecord,
 )
 from bladelab.predict.collocation.guess import template_guess
+from bladelab.predict.collocation.output_folder import read_stored, write_solve
 from bladelab.predict.collocation.settings import CollocationSettings
 from bladelab.predict.collocation.solution import CollocationSolution
-from bladelab.predict.collocation.solve import (
-    predict_stride,
-    read_stored,
-    write_solve,
-)
+from bladelab.predict.collocation.solve import predict_stride
 from bladelab.predict.collocation.starts import (
     MAX_STARTS,
     Start,
@@ -181,7 +178,7 @@ class LazyRunner:
 
 def _stored(ok: Path, best: Path, settings: CollocationSettings, *, spec: dict, force: bool):
     """(converged solution, best iterate) in ``ok`` / ``best``
-    (:func:`~bladelab.predict.collocation.solve.read_stored`); ``force`` ignores both."""
+    (:func:`~bladelab.predict.collocation.output_folder.read_stored`); ``force`` ignores both."""
     return (None, None) if force else read_stored(ok, best, spec, settings)
 
 

@@ -34,18 +34,17 @@ from pathlib import Path
 
 from bladelab._io import write_json
 from bladelab.errors import SpecError
-from bladelab.predict.collocation.settings import CollocationSettings
-from bladelab.predict.collocation.solve import (
+from bladelab.predict.collocation.output_folder import (
     BEST_ITERATE_FILE,
     SOLUTION_FILE,
     STARTS_DIR,
     FolderResult,
-    SolveProgress,
     check_output_folder,
-    predict_stride,
     read_stored,
     write_solve,
 )
+from bladelab.predict.collocation.settings import CollocationSettings
+from bladelab.predict.collocation.solve import SolveProgress, predict_stride
 from bladelab.predict.collocation.starts import (
     START_ORDER,
     Start,
@@ -92,18 +91,18 @@ def predict_stride_from_starts(
     progress: Callable[[SolveProgress], None] | None = None,
     say: Callable[[str], None] | None = None,
 ) -> FolderResult:
-    """:func:`~bladelab.predict.collocation.solve.predict_stride_in_folder` from up to
+    """:func:`~bladelab.predict.collocation.output_folder.predict_stride_in_folder` from up to
     ``starts`` starts (module docstring): ``make_guess`` gives the warm start's guess,
     ``template_guess`` the template's; ``resume``, ``force`` and ``progress`` as there (each
     start's stages named ``start <label>: <stage>``); ``say(line)`` gets a line as each start
     begins or is read back, and one naming the kept start with every start's objective.
-    Returns the kept start's :class:`~bladelab.predict.collocation.solve.FolderResult` (its
+    Returns the kept start's :class:`~bladelab.predict.collocation.output_folder.FolderResult` (its
     path the copy in ``out``).
 
     Raises
     ------
     InputFileError
-        As :func:`~bladelab.predict.collocation.solve.predict_stride_in_folder`.
+        As :func:`~bladelab.predict.collocation.output_folder.predict_stride_in_folder`.
     """
     out = Path(out)
     spec = check_model_spec(model_spec)

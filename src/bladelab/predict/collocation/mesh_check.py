@@ -48,15 +48,14 @@ from pathlib import Path
 
 from bladelab._io import read_json, write_json
 from bladelab.errors import InputFileError, SpecError
-from bladelab.predict.collocation.solution import CollocationSolution
-from bladelab.predict.collocation.solve import (
+from bladelab.predict.collocation.output_folder import (
     BEST_ITERATE_FILE,
     SOLUTION_FILE,
-    SolveProgress,
-    predict_stride,
     read_stored,
     write_solve,
 )
+from bladelab.predict.collocation.solution import CollocationSolution
+from bladelab.predict.collocation.solve import SolveProgress, predict_stride
 from bladelab.predict.collocation.starts import BARRIER_MU
 from bladelab.predict.collocation.stored import same_model_spec
 from bladelab.predict.collocation.stride_guess import COLLOCATION_SOURCE

@@ -3,7 +3,7 @@
 :func:`solve_named_stride` builds the runner named by its model, blade and body
 (:func:`~bladelab.predict.collocation.stored.runner_from_spec`) and the initial guess named by
 a word or a file (:mod:`~bladelab.predict.collocation.starting_guess`), and solves one stride
-into a folder (:func:`~bladelab.predict.collocation.solve.predict_stride_in_folder`).
+into a folder (:func:`~bladelab.predict.collocation.output_folder.predict_stride_in_folder`).
 :func:`sweep_named_models` does the same for the speed continuation and maximum speed of the
 able runner and the amputee with each blade category
 (:func:`~bladelab.predict.collocation.sweep.collocation_sweep`). ``bladelab predict --method
@@ -27,8 +27,8 @@ from bladelab.predict.collocation.folder_starts import (
     check_stride_starts,
     predict_stride_from_starts,
 )
+from bladelab.predict.collocation.output_folder import predict_stride_in_folder
 from bladelab.predict.collocation.settings import CollocationSettings, people_settings
-from bladelab.predict.collocation.solve import predict_stride_in_folder
 from bladelab.predict.collocation.starting_guess import make_guess, resolve_guess
 from bladelab.predict.collocation.starts import check_starts
 from bladelab.predict.collocation.stored import check_model_spec, runner_from_spec
@@ -36,7 +36,8 @@ from bladelab.predict.collocation.sweep import collocation_sweep, sweep_models
 from bladelab.runner.params import KINDS, default_runner_params
 
 if TYPE_CHECKING:
-    from bladelab.predict.collocation.solve import FolderResult, SolveProgress
+    from bladelab.predict.collocation.output_folder import FolderResult
+    from bladelab.predict.collocation.solve import SolveProgress
     from bladelab.predict.collocation.sweep import SweepResult
 
 __all__ = ["PROSTHETIC_KNEE_SETTINGS", "solve_named_stride", "sweep_named_models"]

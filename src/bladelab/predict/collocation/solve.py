@@ -49,10 +49,8 @@ KeyboardInterrupt once IPOPT has returned: nothing is returned or written.
 Deterministic: IPOPT with MUMPS (METIS ordering) on one thread; the same runner, settings and
 guess give the same iterates, bit for bit.
 
-:func:`predict_stride_in_folder` adds the output folder of ``bladelab predict --method
-collocation``: ``solution.json`` only for a converged solve, ``best_iterate.json`` otherwise
-(never both: the stale one is removed once the new file is in place); files are written
-atomically, so an interruption leaves the previous state of the folder.
+The output folder of ``bladelab predict --method collocation`` is
+:mod:`bladelab.predict.collocation.output_folder`'s.
 """
 
 from __future__ import annotations
@@ -81,7 +79,7 @@ from bladelab.predict.collocation.settings import (
     CollocationSettings,
 )
 from bladelab.predict.collocation.solution import CollocationSolution
-from bladelab.predict.collocation.stored import check_model_spec, describe_problem, same_model_spec
+from bladelab.predict.collocation.stored import check_model_spec
 from bladelab.predict.collocation.stride_guess import COLLOCATION_SOURCE
 from bladelab.predict.collocation.stride_problem import StrideWeights
 from bladelab.predict.collocation.swing_knee import biological_knees
@@ -89,20 +87,12 @@ from bladelab.predict.collocation.symmetry import mirror_permutation
 from bladelab.predict.collocation.transcription import StrideNLP
 
 __all__ = [
-    "BEST_ITERATE_FILE",
-    "FolderResult",
-    "SOLUTION_FILE",
-    "STARTS_DIR",
     "SolveProgress",
     "TRACKING_RESTART_STATUSES",
     "TRACKING_SWING_CLEARANCE_M",
     "TRACKING_WEIGHTS",
-    "check_output_folder",
     "predict_stride",
-    "predict_stride_in_folder",
-    "read_stored",
     "warm_start_options",
-    "write_solve",
 ]
 
 #: Effort weights of the tracking stage (no metabolic term).
@@ -112,11 +102,6 @@ TRACKING_WEIGHTS = StrideWeights(metabolic=0.0, activation=1.0, acceleration=0.0
 TRACKING_SWING_CLEARANCE_M = 0.01
 #: IPOPT statuses of a tracking stage that is solved once more from its last iterate.
 TRACKING_RESTART_STATUSES = ("Infeasible_Problem_Detected", "Restoration_Failed")
-#: File names in a ``bladelab predict --method collocation`` folder.
-SOLUTION_FILE = "solution.json"
-BEST_ITERATE_FILE = "best_iterate.json"
-#: The folder of each start's solve when a folder's stride is solved from several starts.
-STARTS_DIR = "starts"
 
 
 @dataclass(frozen=True)
@@ -494,150 +479,3 @@ def predict_stride(runner, settings: CollocationSettings, guess, *, model_spec: 
         metabolic_energy_J=nlp_p.energy_and_distance(sol)[0], reference_phase=phase,
         speed_floor_mps=stage_speed if speed is None else None,
         **common)
-
-
-def read_stored(ok: Path, best: Path, spec: dict, settings: CollocationSettings):
-    """(converged solution, best iterate) of one problem stored as ``ok`` / ``best`` (a
-    solution file and a best-iterate file), each None if absent; the solution is preferred.
-
-    Raises
-    ------
-    InputFileError
-        A file holds another problem (model, mesh, speed or weights).
-    """
-    for path in (Path(ok), Path(best)):
-        if not path.is_file():
-            continue
-        sol = CollocationSolution.read(path)
-        if (not same_model_spec(sol.model_spec, check_model_spec(spec))
-                or not sol.settings.same_problem(settings)):
-            there, asked = describe_problem(sol.model_spec, sol.settings), describe_problem(
-                spec, settings)
-            if there == asked:
-                there, asked = (f"{there}, weights {sol.settings.weights.to_dict()}",
-                                f"weights {settings.weights.to_dict()}")
-            raise InputFileError(
-                f"holds another problem ({there}; asked: {asked})", file=path,
-                hint="resume with the same model, blade, speed and mesh, --force to start "
-                     "over, or choose another --out")
-        if path == Path(ok) and sol.converged:
-            return sol, None
-        return None, sol
-    return None, None
-
-
-def write_solve(sol: CollocationSolution, ok: Path, best: Path) -> Path:
-    """Write a solve as ``ok`` (converged) or ``best`` (best iterate), then remove the other,
-    now stale, file; returns the path written."""
-    target, stale = (Path(ok), Path(best)) if sol.converged else (Path(best), Path(ok))
-    sol.write(target)
-    stale.unlink(missing_ok=True)
-    return target
-
-
-@dataclass(frozen=True)
-class FolderResult:
-    """What :func:`predict_stride_in_folder` did.
-
-    Attributes
-    ----------
-    solution
-        The solution (or best iterate) found or read back.
-    path
-        The file it is in (``solution.json`` or ``best_iterate.json``).
-    solved
-        False when a converged solution was already in the folder (``resume``) and nothing was
-        solved.
-    """
-
-    solution: object
-    path: Path
-    solved: bool
-
-
-def _held(out: Path) -> list[str]:
-    return [n for n in (SOLUTION_FILE, BEST_ITERATE_FILE, STARTS_DIR) if (out / n).exists()]
-
-
-def check_output_folder(out: Path, *, resume: bool, force: bool,
-                        held: Callable[[Path], list[str]] | None = None,
-                        what: str = "collocation solve") -> list[str]:
-    """The result files that the output folder ``out`` holds (``held(out)``, default a
-    stride's: ``solution.json``, ``best_iterate.json``, ``starts``; empty if none or no
-    folder); ``what`` names its kind in the errors.
-
-    Raises
-    ------
-    InputFileError
-        ``out`` is a file, or holds results and neither ``resume`` nor ``force`` is given, or
-        ``resume`` is given and it holds none.
-    SpecError
-        Both ``resume`` and ``force``.
-    """
-    if resume and force:
-        raise SpecError("give --resume or --force, not both", where="--resume/--force")
-    if out.exists() and not out.is_dir():
-        raise InputFileError("is a file, not a folder", file=out, hint="give a folder for --out")
-    found = (held or _held)(out) if out.is_dir() else []
-    if found and not (resume or force):
-        shown = ", ".join(found[:3]) + (f" and {len(found) - 3} more" if len(found) > 3 else "")
-        raise InputFileError(
-            f"the output folder holds a {what} ({shown})", file=out,
-            hint="--resume continues it, --force starts over in it, or choose another --out")
-    if resume and not found:
-        raise InputFileError(f"no {what} to resume from", file=out,
-                             hint="run without --resume first, with the same --out")
-    return found
-
-
-def predict_stride_in_folder(
-    out: str | Path,
-    runner,
-    settings: CollocationSettings,
-    make_guess: Callable[[], object],
-    *,
-    model_spec: dict,
-    resume: bool = False,
-    force: bool = False,
-    progress: Callable[[SolveProgress], None] | None = None,
-) -> FolderResult:
-    """:func:`predict_stride` writing its result into the folder ``out`` (module docstring).
-
-    Parameters
-    ----------
-    out
-        Output folder (created if needed).
-    runner, settings, model_spec, progress
-        As :func:`predict_stride`.
-    make_guess
-        Returns the initial guess; not called when resuming.
-    resume
-        Continue from the folder: a converged ``solution.json`` of the same problem (model,
-        mesh, speed, weights) is returned as it is; a ``best_iterate.json`` of it is the warm
-        start of the predictive stage.
-    force
-        Start over in a folder that holds a solve (its files are replaced once the new result
-        is written).
-
-    Raises
-    ------
-    InputFileError
-        ``out`` holds a solve and neither ``resume`` nor ``force`` is given; ``resume`` without
-        a solve in the folder, or with one of another problem.
-    """
-    out = Path(out)
-    spec = check_model_spec(model_spec)
-    check_output_folder(out, resume=resume, force=force)
-    guess = None
-    ok, best = out / SOLUTION_FILE, out / BEST_ITERATE_FILE
-    if resume:
-        done, iterate = read_stored(ok, best, spec, settings)
-        if done is not None:
-            return FolderResult(done, ok, False)
-        guess = iterate.to_guess()
-    if guess is None:
-        guess = make_guess()
-    sol = predict_stride(runner, settings, guess, model_spec=spec, progress=progress)
-    target = write_solve(sol, ok, best)
-    return FolderResult(sol, target, True)
-

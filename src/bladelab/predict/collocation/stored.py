@@ -8,8 +8,8 @@ The helpers around :class:`~bladelab.predict.collocation.solution.CollocationSol
 - :class:`FieldReader`: a JSON object's fields, with errors naming the file and the field.
 
 Reading a stored solve back for a resume and writing one are
-:func:`~bladelab.predict.collocation.solve.read_stored` and
-:func:`~bladelab.predict.collocation.solve.write_solve`.
+:func:`~bladelab.predict.collocation.output_folder.read_stored` and
+:func:`~bladelab.predict.collocation.output_folder.write_solve`.
 """
 
 from __future__ import annotations

@@ -73,9 +73,9 @@ from bladelab.predict.collocation.continuation import (
 from bladelab.predict.collocation.continuation_records import ContinuationProgress, table_columns
 from bladelab.predict.collocation.mesh_check import MESH_CHECK_DIR, mesh_check_in_folder
 from bladelab.predict.collocation.model import build_collocation_model
+from bladelab.predict.collocation.output_folder import check_output_folder
 from bladelab.predict.collocation.settings import CollocationSettings
 from bladelab.predict.collocation.solution import CollocationSolution
-from bladelab.predict.collocation.solve import check_output_folder
 from bladelab.predict.collocation.starting_guess import stored_stride_path
 from bladelab.predict.collocation.starts import check_starts
 from bladelab.predict.collocation.stored import (
