@@ -30,6 +30,8 @@ beside it (``bladelab design`` run as in docs/design.md). Run the study again to
         --runs ccd --jobs 2 --settle 3 --skip-failed \
         --objective max_speed_m_per_s --sense max \
         --out benchmarks/design/transtibial-collocation-max-speed-people-stride
+    (the same command from transtibial-people-stride-soleus-2026-12-07/strides for
+    transtibial-max-speed-people-stride-soleus-2026-12-07)
 
 Studies since the study timing record write their own ``timing.json`` (each sitting of each
 stage, :mod:`bladelab.design.timing`); older ones hold their times written by hand.
@@ -63,6 +65,10 @@ STUDIES = (
     (_DESIGN / "transtibial-collocation-max-speed-people-stride", "transtibial",
      "human body, each design's maximum speed at people's stride time (`--amputation "
      "transtibial --max-speed --stride-time people`)"),
+    (_DESIGN / "transtibial-max-speed-people-stride-soleus-2026-12-07", "transtibial",
+     "the human body as shipped (the soleus at its running length), each design's maximum "
+     "speed at people's stride time (`--amputation transtibial --max-speed --stride-time "
+     "people`)"),
 )
 #: The responses a designer asks for, fitted in each study that has them.
 DESIGNER_RESPONSES = ("cost_of_transport_J_per_kg_m", "max_speed_m_per_s", "stride_objective",
