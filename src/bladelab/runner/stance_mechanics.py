@@ -27,14 +27,16 @@ from bladelab.runner.simulate import RC_DEPTH, RC_FZ, RunnerResult, leg_names
 __all__ = ["blade_energy", "leg_energy", "leg_stiffness"]
 
 
-def _leg_stances(result: RunnerResult, leg: int, threshold_n: float) -> list[tuple[int, int]]:
-    st = stances(result, threshold_n=threshold_n)
-    st = st[st.leg == leg_names(result.model)[leg]]
+def _leg_stances(st: pd.DataFrame, leg_name: str) -> list[tuple[int, int]]:
+    """The (first, stop) sample ranges of leg ``leg_name``'s stances in a :func:`stances`
+    table."""
+    st = st[st.leg == leg_name]
     return list(zip(st["first"].tolist(), st["stop"].tolist(), strict=True))
 
 
 def _leg_length(result: RunnerResult, leg: int) -> float:
-    """Standing leg length L0 [m]: hip joint height in the standing pose (+3 cm prosthetic)."""
+    """Standing leg length L0 [m]: hip joint height above the leg's lowest contact in the
+    standing pose (a prosthetic leg longer by the athlete's ``prosthesis_extra_length_m``)."""
     model = result.model
     d = mujoco.MjData(model.mj_model)
     q = model.stand_qpos.copy()
@@ -56,11 +58,12 @@ def leg_stiffness(
     K_leg [N/m]. Strikes of the swinging foot are not stances and do not count."""
     fwd = forward_pass(result)
     names = leg_names(result.model)
+    st = stances(result, threshold_n=threshold_n)
     rows = []
     for leg in (0, 1):
         l0 = _leg_length(result, leg)
         fz = leg_vertical_force(result, leg)
-        for i0, i1 in _leg_stances(result, leg, threshold_n):
+        for i0, i1 in _leg_stances(st, names[leg]):
             tc = result.time[i1] - result.time[i0]
             v = float(np.mean(fwd["comv"][i0:i1, 0]))
             dy = float(fwd["com"][i0, 2] - np.min(fwd["com"][i0:i1, 2]))
@@ -92,10 +95,11 @@ def leg_energy(result: RunnerResult, *, threshold_n: float = CONTACT_THRESHOLD_N
     it rises), hysteresis [J] = |stored − generated|, recoil_pct = 100·min/max."""
     fwd = forward_pass(result)
     names = leg_names(result.model)
+    st = stances(result, threshold_n=threshold_n)
     rows = []
     for leg in (0, 1):
         fz = leg_vertical_force(result, leg)
-        for i0, i1 in _leg_stances(result, leg, threshold_n):
+        for i0, i1 in _leg_stances(st, names[leg]):
             dz = np.diff(fwd["com"][i0 : i1 + 1, 2])
             f = 0.5 * (fz[i0:i1] + fz[i0 + 1 : i1 + 1])
             stored = float(-np.sum(f * np.minimum(dz, 0.0)))
@@ -169,7 +173,7 @@ def blade_energy(
         touching = (depth > 0).any(axis=1)
     rows = []
     name = leg_names(result.model)[1]
-    for i0, i1 in _leg_stances(result, 1, threshold_n):
+    for i0, i1 in _leg_stances(stances(result, threshold_n=threshold_n), name):
         t0 = float(result.time[i0])
         while i0 > 0 and touching[i0 - 1]:
             i0 -= 1
