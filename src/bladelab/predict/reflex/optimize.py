@@ -8,8 +8,9 @@ has fallen. Sampling uses a seeded ``numpy.random.Generator`` (never NumPy's glo
 
 Output folder (``out``):
 
-- ``checkpoint.pkl``: the full optimiser state (pickled ``cma.CMAEvolutionStrategy`` including its
-  random generator, generation, history, best), written atomically every ``checkpoint_every``
+- ``checkpoint.pkl`` (:mod:`~bladelab.predict.reflex.checkpoint`): the full optimiser state
+  (pickled ``cma.CMAEvolutionStrategy`` including its random generator, generation, history,
+  best), written atomically every ``checkpoint_every``
   generations and at the end; ``resume=True`` continues from it to the same result as an
   uninterrupted run (same settings, same seed);
 - ``best.json``: the best parameters so far (``--init`` file of a warm start), with the run's
@@ -25,10 +26,8 @@ count once, the lost ones not at all). Wall time is kept apart from
 
 from __future__ import annotations
 
-import csv
 import math
 import os
-import pickle
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field, fields
@@ -36,11 +35,17 @@ from pathlib import Path
 
 import numpy as np
 
-from bladelab._io import atomic_open, atomic_path, write_json
+from bladelab._io import write_json
 from bladelab.errors import InputFileError, OptimizationError
 from bladelab.executors import ProcessPool, RayExecutor
 from bladelab.predict import defaults
-from bladelab.predict.reflex.controller import ControllerLayout, controller_layout, write_parameters
+from bladelab.predict.reflex.checkpoint import (
+    CHECKPOINT_NAME,
+    RUN_FILES,
+    load_checkpoint,
+    write_checkpoint,
+)
+from bladelab.predict.reflex.controller import ControllerLayout, controller_layout
 from bladelab.predict.reflex.objective import Evaluation, ObjectiveSettings, simulate_controlled
 from bladelab.predict.reflex.robust import (
     OBJECTIVE_JITTER_SEED,
@@ -49,11 +54,6 @@ from bladelab.predict.reflex.robust import (
 )
 from bladelab.runner.model import RunnerModel, build_runner
 from bladelab.runner.params import BODIES
-
-CHECKPOINT_FORMAT = 1
-CHECKPOINT_NAME = "checkpoint.pkl"
-#: Files of a run folder (an ``out`` holding any of them holds a run).
-RUN_FILES = (CHECKPOINT_NAME, "best.json", "history.csv")
 
 # per-process cache of built models: (kind, blade) -> (model, layout)
 _MODELS: dict[tuple[str, str | None], tuple[RunnerModel, ControllerLayout]] = {}
@@ -418,7 +418,7 @@ def optimize_controller(
             if progress is not None:
                 progress(gen, best_f, float(np.median(fs)))
             if out_dir is not None and (gen % checkpoint_every == 0 or gen == generations):
-                _save(
+                write_checkpoint(
                     out_dir,
                     es,
                     gen,
@@ -491,73 +491,6 @@ def optimize_seeds(
     return results
 
 
-def _save(
-    out_dir,
-    es,
-    gen,
-    evals,
-    history,
-    best_x,
-    best_f,
-    best_ev,
-    layout,
-    model,
-    blade,
-    speed,
-    seed,
-    settings,
-    elapsed,
-    wall_time_s,
-    subspace,
-    *,
-    body: str = defaults.REFLEX_BODY,
-) -> None:
-    import cma  # deferred: cma takes ~2 s to import (see optimize_controller)
-
-    out_dir.mkdir(parents=True, exist_ok=True)
-    state = {
-        "format": CHECKPOINT_FORMAT,
-        "cma_version": cma.__version__,
-        "model": model,
-        "blade": blade,
-        "body": body,
-        "speed": speed,
-        "seed": seed,
-        "settings": settings.to_dict(),
-        "parameter_names": list(layout.names),
-        "es": es,
-        "generation": gen,
-        "evaluations": evals,
-        "history": history,
-        "best_x": best_x,
-        "best_f": best_f,
-        "best_eval": best_ev,
-        "elapsed": list(elapsed),
-        "elapsed_s": wall_time_s,
-        "subspace": subspace,
-    }
-    with atomic_path(out_dir / CHECKPOINT_NAME) as tmp:
-        tmp.write_bytes(pickle.dumps(state, protocol=4))
-    write_parameters(
-        out_dir / "best.json",
-        layout,
-        best_x,
-        blade=blade,
-        body=body,
-        speed_m_per_s=speed,
-        generation=gen,
-        evaluations=evals,
-        seed=seed,
-        settings=settings.to_dict(),
-        evaluation=best_ev,
-        wall_time_s=wall_time_s if math.isfinite(wall_time_s) else None,
-    )
-    with atomic_open(out_dir / "history.csv", "w", newline="") as fh:
-        w = csv.writer(fh)
-        w.writerow(["generation", "evaluations", "best", "median", "sigma", "elapsed_s"])
-        w.writerows((*row, t) for row, t in zip(history, elapsed, strict=True))
-
-
 def _resume_in_grown_layout(state: dict, layout, ckpt: Path) -> None:
     """Carry a checkpoint written before the controller layout grew into ``layout`` (in place):
     the run goes on searching the parameters it searched, the added ones held at their
@@ -585,28 +518,6 @@ def _resume_in_grown_layout(state: dict, layout, ckpt: Path) -> None:
     state["subspace"] = _Subspace(held, (), free=free)
     state["best_x"] = grown(state["best_x"])
     state["parameter_names"] = new
-
-
-def load_checkpoint(path: str | Path) -> dict:
-    """Read a checkpoint written by :func:`optimize_controller`."""
-    path = Path(path)
-    try:
-        state = pickle.loads(path.read_bytes())
-    except FileNotFoundError:
-        raise InputFileError("file not found", file=path) from None
-    except Exception as err:  # noqa: BLE001 - corrupt or incompatible pickle
-        raise InputFileError(
-            f"cannot read checkpoint ({type(err).__name__}: {err})",
-            file=path,
-            hint="warm-start a new run from best.json with --init instead",
-        ) from None
-    if not isinstance(state, dict) or state.get("format") != CHECKPOINT_FORMAT:
-        raise InputFileError(
-            "not a bladelab checkpoint of this format",
-            file=path,
-            hint="warm-start a new run from best.json with --init instead",
-        )
-    return state
 
 
 __all__ = [
