@@ -12,11 +12,19 @@ another method is refused, naming the option and its method
 
 from __future__ import annotations
 
-import math
 from pathlib import Path
 
 import typer
 
+from bladelab.cli.collocation_options import (
+    COLLOCATION,
+    alternating_steps_option,
+    athlete_from_options,
+    athlete_option,
+    people_weight_option,
+    static_option,
+    swing_knee_option,
+)
 from bladelab.cli.panels import Panel, PanelCommand, refuse_other_methods
 from bladelab.errors import SpecError
 from bladelab.predict import defaults
@@ -28,7 +36,6 @@ METHODS = ("reflex", "collocation")
 
 COMMON = "Common"
 REFLEX = "Reflex controller (CMA-ES)"
-COLLOCATION = "Collocation"
 GRID = "Reflex speed grid (without --recipe)"
 RECIPE = "Reflex recipe (with --recipe)"
 
@@ -66,105 +73,6 @@ def _method(method: str) -> str:
 
 def _csv(values) -> str:
     return ",".join(str(v) for v in values)
-
-
-def _people_weight_option():
-    """``--people-weight``, the same on ``predict`` and ``sweep`` (collocation)."""
-    return typer.Option(
-        None, "--people-weight", rich_help_panel=COLLOCATION, show_default=False,
-        help="Weight [1/rad²] of people's measured hip, knee and ankle angles at 3.5 m/s in "
-             "the objective (a tracking term of measured running, reported as such; "
-             f"docs/collocation.md). Default: {defaults.PEOPLE_WEIGHT_PER_RAD2:g} on the human "
-             "body, 0 on the others; 0: the gait is predicted freely.")
-
-
-def _swing_knee_option():
-    """``--swing-knee``, the same on ``predict`` and ``sweep`` (collocation)."""
-    return typer.Option(
-        None, "--swing-knee", rich_help_panel=COLLOCATION, show_default=False,
-        help="Keep every knee that is a person's flexed at least this much [deg] at its peak "
-             "in swing (a constraint from measured running, reported as such; "
-             "docs/collocation.md). Default: people's "
-             f"{defaults.SWING_KNEE_MIN_DEG:g} on the human body, none on the others; 0: "
-             "free.")
-
-
-def _alternating_steps_option():
-    """``--alternating-steps``, the same on ``predict`` and ``sweep`` (collocation)."""
-    return typer.Option(
-        None, "--alternating-steps", rich_help_panel=COLLOCATION, show_default=False,
-        help="Keep the steps alternating: the second leg's stance half a stride +- this "
-             "fraction of the stride after the first leg's, e.g. 0.1 (rules out a gallop).")
-
-
-#: The athlete's options, the same on ``predict`` and ``sweep`` (collocation):
-#: (library field, option, help).
-_ATHLETE_OPTIONS = {
-    "body_mass_kg": ("--body-mass", "The athlete's body mass [kg] (an amputee's with the "
-                     "prosthesis); segment masses, inertias and muscle forces scale with it. "
-                     "Default: the parameter set's (human body: able 75 kg, amputee 73.2 kg)."),
-    "height_m": ("--height", "The athlete's height [m] (default 1.80 m); segment lengths, "
-                 "inertias and muscle forces scale with it."),
-    "muscle_strength": ("--muscle-strength", "The muscles' active force relative to the "
-                        "body's (1: people's maximal strength; a sprinter's hip and knee "
-                        "muscles are about 1.3 times larger); tendons stay as they are."),
-    "max_shortening_velocity": ("--max-shortening-velocity", "Every muscle's maximum "
-                                "shortening velocity [optimal fibre lengths/s] (default 10; "
-                                "faster fibres, a larger fast-twitch share, raise it)."),
-    "residual_limb_length_m": ("--residual-limb", "The transtibial amputee's residual limb "
-                               "[m]: the residual tibia from the knee joint to its end "
-                               "(default 60 % of the tibia, 0.258 m at 1.80 m); the "
-                               "prosthesis below it keeps the leg's length."),
-    "thigh_length_m": ("--thigh-length", "The athlete's thighs [m], hip to knee joint centre "
-                       "(default 0.396 m at 1.80 m, scaled with the height); the femur's "
-                       "joints and muscle points, and the muscles' fibre and tendon lengths, "
-                       "follow it."),
-    "shank_length_m": ("--shank-length", "The athlete's shanks [m], knee to ankle joint "
-                       "centre (default 0.430 m at 1.80 m, scaled with the height)."),
-    "prosthesis_extra_length_m": ("--prosthesis-extra-length", "How much longer the straight "
-                                  "prosthetic leg stands than the intact one, knee to ground "
-                                  "[m]: the blade's height as set (athletes: 0.02-0.08 m; "
-                                  "default 0.03 m at 1.80 m, scaled with the height)."),
-}
-
-
-def _static_option():
-    """``--static``: thigh and shank lengths from a static trial."""
-    return typer.Option(None, "--static", rich_help_panel=COLLOCATION, show_default=False,
-                        help="A static (standing) C3D trial of the athlete: the thighs and "
-                             "shanks from its joint centres (Harrington's hips, epicondyles, "
-                             "malleoli; both sides' mean, the intact leg's shank for an "
-                             "amputee), unless --thigh-length or --shank-length are given.")
-
-
-def _athlete_option(field: str):
-    """One of :data:`_ATHLETE_OPTIONS` as a typer option (default: the body's own)."""
-    flag, text = _ATHLETE_OPTIONS[field]
-    return typer.Option(None, flag, rich_help_panel=COLLOCATION, show_default=False,
-                        help=text)
-
-
-def _athlete(static: Path | None = None, **fields: float | None) -> dict | None:
-    """The athlete of the options (library field -> value; None when none is given), with the
-    segment lengths of a ``static`` trial where no option gives them."""
-    athlete = {k: v for k, v in fields.items() if v is not None}
-    if static is not None:
-        from bladelab.trial import read_c3d, segment_lengths  # deferred: reads C3D
-
-        lengths = segment_lengths(read_c3d(static))
-        for name, per_side in (("thigh_length_m", lengths.thigh_m),
-                               ("shank_length_m", lengths.shank_m)):
-            known = [v for v in per_side.values() if math.isfinite(v)]
-            if name in athlete:
-                continue
-            if not known:
-                raise SpecError(f"{static}: no {name.split('_')[0]} on either side (the knee "
-                                "and ankle markers are missing)", where="--static",
-                                hint="a static trial with the epicondyle (L.Knee, "
-                                     "L.Knee.Medial) and malleolus (L.Ankle, L.Ankle.Medial) "
-                                     "markers")
-            athlete[name] = round(sum(known) / len(known), 4)
-    return athlete or None
 
 
 def register(app: typer.Typer) -> None:
@@ -338,7 +246,7 @@ def register(app: typer.Typer) -> None:
                  "cadence: imposed, not predicted, and the report says so), e.g. "
                  "--stride-time 0.64,0.78; or 'people': within measured runners' band at "
                  "the speed (0.62-0.76 s at 4 m/s). Default: free (0.4-1.2 s)."),
-        alternating_steps: float | None = _alternating_steps_option(),
+        alternating_steps: float | None = alternating_steps_option(),
         symmetric: bool = typer.Option(
             False, "--symmetric", rich_help_panel=COLLOCATION,
             help="Able runner: each leg does what the other did half a stride earlier "
@@ -348,17 +256,17 @@ def register(app: typer.Typer) -> None:
             help="Keep the prosthetic leg's vertical ground force at or below this many body "
                  "weights (the load the residual limb takes in its socket; default: no "
                  "limit)."),
-        people_weight: float | None = _people_weight_option(),
-        swing_knee: float | None = _swing_knee_option(),
-        body_mass: float | None = _athlete_option("body_mass_kg"),
-        height: float | None = _athlete_option("height_m"),
-        muscle_strength: float | None = _athlete_option("muscle_strength"),
-        max_shortening_velocity: float | None = _athlete_option("max_shortening_velocity"),
-        residual_limb: float | None = _athlete_option("residual_limb_length_m"),
-        thigh_length: float | None = _athlete_option("thigh_length_m"),
-        shank_length: float | None = _athlete_option("shank_length_m"),
-        prosthesis_extra_length: float | None = _athlete_option("prosthesis_extra_length_m"),
-        static: Path | None = _static_option(),
+        people_weight: float | None = people_weight_option(),
+        swing_knee: float | None = swing_knee_option(),
+        body_mass: float | None = athlete_option("body_mass_kg"),
+        height: float | None = athlete_option("height_m"),
+        muscle_strength: float | None = athlete_option("muscle_strength"),
+        max_shortening_velocity: float | None = athlete_option("max_shortening_velocity"),
+        residual_limb: float | None = athlete_option("residual_limb_length_m"),
+        thigh_length: float | None = athlete_option("thigh_length_m"),
+        shank_length: float | None = athlete_option("shank_length_m"),
+        prosthesis_extra_length: float | None = athlete_option("prosthesis_extra_length_m"),
+        static: Path | None = static_option(),
         starts: int | None = typer.Option(
             None, "--starts", rich_help_panel=COLLOCATION, show_default=False,
             help="Solve the stride from up to K starts (the guess, the guess with the "
@@ -397,7 +305,7 @@ def register(app: typer.Typer) -> None:
                 stride_time=stride_time,
                 alternating_steps=alternating_steps, prosthetic_load_max=prosthetic_load_max,
                 people_weight=people_weight, swing_knee=swing_knee, symmetric=symmetric,
-                athlete=_athlete(static, body_mass_kg=body_mass, height_m=height,
+                athlete=athlete_from_options(static, body_mass_kg=body_mass, height_m=height,
                                  muscle_strength=muscle_strength,
                                  max_shortening_velocity=max_shortening_velocity,
                                  residual_limb_length_m=residual_limb,
@@ -522,23 +430,23 @@ def register(app: typer.Typer) -> None:
             help="human (H0918's segments and muscles, compliant Achilles, toes, soft heel "
                  "pad) | seed001 (seed 001's model) | toes (seed 001's with a toe segment and "
                  "compliant Achilles tendons)."),
-        people_weight: float | None = _people_weight_option(),
-        swing_knee: float | None = _swing_knee_option(),
-        alternating_steps: float | None = _alternating_steps_option(),
+        people_weight: float | None = people_weight_option(),
+        swing_knee: float | None = swing_knee_option(),
+        alternating_steps: float | None = alternating_steps_option(),
         stride_time: str | None = typer.Option(
             None, "--stride-time", rich_help_panel=COLLOCATION, show_default=False,
             help="'people': keep every prescribed speed's stride time within measured "
                  "runners' band at that speed (0.62-0.76 s at 4 m/s; imposed, not predicted, "
                  "and each report says so); the maximum speed stays free. Default: free."),
-        body_mass: float | None = _athlete_option("body_mass_kg"),
-        height: float | None = _athlete_option("height_m"),
-        muscle_strength: float | None = _athlete_option("muscle_strength"),
-        max_shortening_velocity: float | None = _athlete_option("max_shortening_velocity"),
-        residual_limb: float | None = _athlete_option("residual_limb_length_m"),
-        thigh_length: float | None = _athlete_option("thigh_length_m"),
-        shank_length: float | None = _athlete_option("shank_length_m"),
-        prosthesis_extra_length: float | None = _athlete_option("prosthesis_extra_length_m"),
-        static: Path | None = _static_option(),
+        body_mass: float | None = athlete_option("body_mass_kg"),
+        height: float | None = athlete_option("height_m"),
+        muscle_strength: float | None = athlete_option("muscle_strength"),
+        max_shortening_velocity: float | None = athlete_option("max_shortening_velocity"),
+        residual_limb: float | None = athlete_option("residual_limb_length_m"),
+        thigh_length: float | None = athlete_option("thigh_length_m"),
+        shank_length: float | None = athlete_option("shank_length_m"),
+        prosthesis_extra_length: float | None = athlete_option("prosthesis_extra_length_m"),
+        static: Path | None = static_option(),
         mesh_check: bool = typer.Option(
             False, "--mesh-check", rich_help_panel=COLLOCATION,
             help="Solve every converged problem again on twice the mesh intervals from its "
@@ -590,7 +498,7 @@ def register(app: typer.Typer) -> None:
                 people_weight=people_weight, swing_knee=swing_knee,
                 alternating_steps=alternating_steps,
                 stride_time=stride_time,
-                athlete=_athlete(static, body_mass_kg=body_mass, height_m=height,
+                athlete=athlete_from_options(static, body_mass_kg=body_mass, height_m=height,
                                  muscle_strength=muscle_strength,
                                  max_shortening_velocity=max_shortening_velocity,
                                  residual_limb_length_m=residual_limb,
