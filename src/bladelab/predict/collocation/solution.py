@@ -8,11 +8,10 @@ at the nodes: contact forces of the collocation model per contact [N], the leg o
 contact, the metabolic energy over the stride [J] and the dynamic consistency with the forward
 model (:mod:`bladelab.predict.collocation.consistency`).
 
-The file (JSON, written atomically by :func:`bladelab._io.write_json`) has ``"kind":
-"collocation-solution"`` for a converged solve and ``"collocation-best-iterate"`` for the last
-iterate of one that did not converge; ``bladelab report`` renders only the former. Units are in
-the field names (``_s``, ``_m``, ``_N``, ``_J``, ``_mps``); node arrays are rows per node, in the
-order of ``dof_names`` and ``muscle_names``.
+The file (JSON, written atomically by :func:`bladelab._io.write_json`; its fields:
+:mod:`~bladelab.predict.collocation.solution_file`) has ``"kind": "collocation-solution"`` for
+a converged solve and ``"collocation-best-iterate"`` for the last iterate of one that did not
+converge; ``bladelab report`` renders only the former.
 
 :meth:`CollocationSolution.summary` gives the numbers of ``bladelab predict --method
 collocation --json``; :meth:`CollocationSolution.to_runner_result` the stride, repeated, as a
@@ -34,7 +33,6 @@ from bladelab.predict.collocation.alternating_steps import step_phase
 from bladelab.predict.collocation.consistency import dynamics_residual
 from bladelab.predict.collocation.dynamics import stride_dynamics
 from bladelab.predict.collocation.model import build_collocation_model
-from bladelab.predict.collocation.nlp_solution import NLPSolution
 from bladelab.predict.collocation.nodes import (
     evaluate_nodes,
     force_zigzag_steps,
@@ -42,7 +40,14 @@ from bladelab.predict.collocation.nodes import (
     periodic_runs,
 )
 from bladelab.predict.collocation.settings import CollocationSettings
-from bladelab.predict.collocation.stored import FieldReader, check_model_spec, runner_from_spec
+from bladelab.predict.collocation.solution_file import (
+    BEST_ITERATE_KIND,
+    FORMAT_VERSION,
+    SOLUTION_KIND,
+    solution_arguments,
+    solution_fields,
+)
+from bladelab.predict.collocation.stored import check_model_spec, runner_from_spec
 from bladelab.predict.collocation.stride_guess import COLLOCATION_SOURCE, StrideGuess
 from bladelab.predict.collocation.transcription import PERIOD_BOUNDS_S, StrideNLP
 from bladelab.runner.layout import CP_LEG
@@ -55,9 +60,6 @@ __all__ = [
     "CollocationSolution",
 ]
 
-SOLUTION_KIND = "collocation-solution"
-BEST_ITERATE_KIND = "collocation-best-iterate"
-FORMAT_VERSION = 1
 #: Vertical force of a leg above which it is in contact [N] (the forward analyses' threshold).
 CONTACT_THRESHOLD_N = 20.0
 #: A peak vertical ground force above this [body weights] is flagged by
@@ -87,30 +89,6 @@ ZIGZAG_STEP_BW = 0.25
 ZIGZAG_LOADED_BW = 0.05
 #: Samples per mesh interval of the linear interpolation used for contact and flight times.
 _FINE = 50
-
-# node arrays: (file field, NLPSolution attribute, columns: "dof" or "muscle")
-_NODE_FIELDS = (
-    ("q", "q", "dof"),
-    ("qd", "qd", "dof"),
-    ("qdd", "qdd", "dof"),
-    ("activation", "activation", "muscle"),
-    ("tendon_force_per_Fmax", "tendon_force", "muscle"),
-    ("excitation", "excitation", "muscle"),
-    ("tendon_force_rate_per_Fmax_per_s", "tendon_force_rate", "muscle"),
-)
-
-
-def _num(x) -> float | None:
-    """A float for JSON: non-finite values as null."""
-    x = float(x)
-    return x if math.isfinite(x) else None
-
-
-def _array(a: np.ndarray) -> list:
-    a = np.asarray(a, dtype=float)
-    return np.where(np.isfinite(a), a, None).tolist() if not np.all(np.isfinite(a)) \
-        else a.tolist()
-
 
 @dataclass(frozen=True, eq=False)
 class CollocationSolution:
@@ -448,45 +426,8 @@ class CollocationSolution:
 
     # -- file -----------------------------------------------------------------------------
     def to_dict(self) -> dict:
-        """The file's content (module docstring)."""
-        s = self.nlp
-        return {
-            "kind": self.kind,
-            "format_version": FORMAT_VERSION,
-            "model": dict(self.model_spec),
-            "settings": self.settings.to_dict(),
-            "guess_source": self.guess_source,
-            "stage": self.stage,
-            "converged": self.converged,
-            "status": str(s.status),
-            "success": bool(s.success),
-            "iterations": int(s.iterations),
-            "wall_s": _num(s.wall_s),
-            "objective": _num(s.objective),
-            "objective_terms": {k: _num(v) for k, v in s.objective_terms.items()},
-            "max_violation": _num(s.max_violation),
-            "worst_constraints": [[name, _num(v)] for name, v in s.worst_constraints],
-            "timings": {k: _num(v) for k, v in s.timings.items()},
-            "reference_phase": self.reference_phase,
-            "speed_floor_mps": self.speed_floor_mps,
-            "tracking": None if self.tracking is None else {
-                k: (_num(v) if isinstance(v, float) else v) for k, v in self.tracking.items()},
-            "summary": self.summary(),
-            "period_s": _num(s.period),
-            "dof_names": list(self.dof_names),
-            "muscle_names": list(self.muscle_names),
-            "time_s": _array(s.time),
-            **{name: _array(getattr(s, attr)) for name, attr, _ in _NODE_FIELDS},
-            "contact_forces_N": _array(self.contact_forces),
-            "contact_legs": [int(v) for v in self.contact_legs],
-            "leg_names": list(self.leg_names),
-            "body_mass_kg": _num(self.body_mass_kg),
-            "body_weight_N": _num(self.body_weight_N),
-            "metabolic_energy_J": _num(self.metabolic_energy_J),
-            "consistency": _jsonable(self.residual),
-            "multipliers": None if s.multipliers is None else {
-                "bounds": _array(s.multipliers[0]), "constraints": _array(s.multipliers[1])},
-        }
+        """The file's content (:mod:`~bladelab.predict.collocation.solution_file`)."""
+        return solution_fields(self)
 
     def write(self, path: str | Path) -> Path:
         """Write the solution (or best iterate) as JSON, atomically: an interruption leaves
@@ -516,116 +457,6 @@ class CollocationSolution:
     @classmethod
     def from_dict(cls, data, *, file: str | Path | None = None) -> CollocationSolution:
         """A solution from :meth:`to_dict`'s mapping; errors as :meth:`read`."""
-        if not isinstance(data, dict):
-            raise DataError("expected a JSON object", file=file)
-        r = FieldReader(data, file)
-        kind = r.get("kind", str)
-        if kind not in (SOLUTION_KIND, BEST_ITERATE_KIND):
-            raise DataError(f"not a collocation solution (kind {kind!r})", file=file,
-                            where="kind", hint=f"expected {SOLUTION_KIND!r} or "
-                                               f"{BEST_ITERATE_KIND!r}")
-        version = r.get("format_version", int)
-        if version > FORMAT_VERSION:
-            raise DataError(f"format version {version} is newer than this bladelab's "
-                            f"({FORMAT_VERSION})", file=file, where="format_version",
-                            hint="update bladelab")
-        try:
-            spec = check_model_spec(r.get("model", dict))
-            settings = CollocationSettings.from_dict(r.get("settings", dict))
-        except SpecError as err:
-            raise DataError(err.message, file=file, where=err.where, hint=err.hint) from None
-        dofs = tuple(r.names("dof_names"))
-        muscles = tuple(r.names("muscle_names"))
-        time_s = r.array("time_s", 1)
-        n1 = time_s.shape[0]
-        if n1 < 2:
-            raise DataError("need at least 2 nodes", file=file, where="time_s")
-        arrays = {}
-        for name, attr, cols in _NODE_FIELDS:
-            width = len(dofs) if cols == "dof" else len(muscles)
-            arrays[attr] = r.array(name, 2, (n1, width))
-        legs = r.get("leg_names", list)
-        if len(legs) != 2 or not all(isinstance(v, str) for v in legs):
-            raise DataError("expected two leg names", file=file, where="leg_names")
-        contact_legs = np.asarray(r.get("contact_legs", list))
-        if contact_legs.ndim != 1 or not np.isin(contact_legs, (0, 1)).all():
-            raise DataError("expected a leg index 0 or 1 per contact", file=file,
-                            where="contact_legs")
-        forces = r.array("contact_forces_N", 3, (n1, contact_legs.size, 2))
-        tracking = data.get("tracking")
-        if tracking is not None and not isinstance(tracking, dict):
-            raise DataError("expected an object or null", file=file, where="tracking")
-        stage = r.get("stage", str)
-        if stage not in ("predictive", "tracking"):
-            raise DataError(f"unknown stage {stage!r}", file=file, where="stage")
-        worst = r.get("worst_constraints", list)
-        try:
-            worst = tuple((str(a), _float(b)) for a, b in worst)
-        except (TypeError, ValueError):
-            raise DataError("expected [name, value] pairs", file=file,
-                            where="worst_constraints") from None
-        nlp = NLPSolution(
-            time=time_s, **arrays,
-            period=r.number("period_s"),
-            objective=r.number("objective"),
-            objective_terms={str(k): _float(v) for k, v in
-                             r.get("objective_terms", dict).items()},
-            success=r.get("success", bool),
-            status=r.get("status", str),
-            iterations=r.get("iterations", int),
-            wall_s=r.number("wall_s"),
-            timings={str(k): _float(v) for k, v in r.get("timings", dict).items()},
-            max_violation=r.number("max_violation"),
-            worst_constraints=worst,
-        )
-        if not (nlp.period > 0):
-            raise DataError(f"stride time must be > 0 s, got {nlp.period}", file=file,
-                            where="period_s")
-        nlp = replace(nlp, multipliers=_read_multipliers(data.get("multipliers"), file))
-        if kind == SOLUTION_KIND and not (nlp.success and stage == "predictive"):
-            raise DataError("marked as a solution but did not converge", file=file,
-                            where="kind")
-        return cls(
-            nlp=nlp, settings=settings, model_spec=spec, guess_source=r.get("guess_source", str),
-            stage=stage, tracking=tracking, dof_names=dofs, muscle_names=muscles,
-            contact_forces=forces, contact_legs=contact_legs.astype(int),
-            leg_names=(legs[0], legs[1]), body_mass_kg=r.number("body_mass_kg"),
-            body_weight_N=r.number("body_weight_N"),
-            metabolic_energy_J=r.number("metabolic_energy_J"),
-            residual=r.get("consistency", dict),
-            reference_phase=(None if data.get("reference_phase") is None
-                             else r.number("reference_phase")),
-            speed_floor_mps=(None if data.get("speed_floor_mps") is None
-                             else r.number("speed_floor_mps")),
-        )
+        return cls(**solution_arguments(data, file))
 
-
-def _read_multipliers(value, file) -> tuple[np.ndarray, np.ndarray] | None:
-    """The optional ``multipliers`` field: ``{"bounds": [...], "constraints": [...]}``."""
-    if value is None:
-        return None
-    if not isinstance(value, dict):
-        raise DataError("expected an object or null", file=file, where="multipliers")
-    r = FieldReader(value, file)
-    try:
-        return r.array("bounds", 1), r.array("constraints", 1)
-    except DataError as err:
-        raise DataError(err.message, file=file, where=f"multipliers.{err.where}",
-                        hint=err.hint) from None
-
-
-def _float(v) -> float:
-    return math.nan if v is None else float(v)
-
-
-def _jsonable(obj):
-    if isinstance(obj, dict):
-        return {str(k): _jsonable(v) for k, v in obj.items()}
-    if isinstance(obj, list | tuple):
-        return [_jsonable(v) for v in obj]
-    if isinstance(obj, float | np.floating):
-        return _num(obj)
-    if isinstance(obj, np.integer):
-        return int(obj)
-    return obj
 
