@@ -179,9 +179,22 @@ def test_design_bad_input(tmp_path, capsys):
                  "--reference-weight", "-1"]) == 2
     assert "reference weight must be >= 0" in capsys.readouterr().err
     assert main(["design", "--out", str(tmp_path / "c"), "--evaluator", "collocation",
-                 "--body-mass", "70"]) == 2
-    assert ("--body-mass: only with --evaluator blade or --evaluator runner, not with "
-            "--evaluator collocation") in capsys.readouterr().err
+                 "--amputation", "transtibial", "--body-mass", "-70"]) == 2
+    assert "--body-mass: body_mass_kg must be a number > 0 [kg]" in capsys.readouterr().err
+    assert main(["design", "--out", str(tmp_path / "c"), "--muscle-strength", "1.5"]) == 2
+    assert "--muscle-strength: only with --evaluator collocation" in capsys.readouterr().err
+    assert main(["design", "--out", str(tmp_path / "c"), "--evaluator", "collocation",
+                 "--amputation", "transtibial", "--max-shortening-velocity", "99"]) == 2
+    assert "--max-shortening-velocity: the maximum shortening velocity" in (
+        capsys.readouterr().err)
+    assert main(["design", "--out", str(tmp_path / "c"), "--evaluator", "collocation",
+                 "--prosthesis-extra-length", "0.5"]) == 2
+    assert "--prosthesis-extra-length:" in capsys.readouterr().err
+    assert main(["design", "--out", str(tmp_path / "c"), "--mesh", "100"]) == 2
+    assert "--mesh: only with --evaluator collocation" in capsys.readouterr().err
+    assert main(["design", "--out", str(tmp_path / "c"), "--evaluator", "collocation",
+                 "--mesh", "3"]) == 2
+    assert "--mesh: need an integer of at least 4 mesh intervals" in capsys.readouterr().err
     assert main(["design", "--out", str(tmp_path / "c"), "--evaluator", "collocation",
                  "--start", str(tmp_path / "none.json")]) == 2
     assert "none.json" in capsys.readouterr().err

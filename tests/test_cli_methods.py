@@ -401,8 +401,15 @@ def test_evaluator_settings_give_the_evaluators_options(tmp_path):
     assert opts["solutions_dir"] == str(tmp_path / "strides")
     assert opts["factor_ranges"]["stiffness_kN_per_m"] == (18.0, 32.0)
     assert opts["knee_moment_min_Nm"] == 0.0 and opts["reference_weight"] == 10.0
-    assert "body_mass_kg" not in opts and "start" not in opts
-    for kind, field, value in (("collocation", "body_mass_kg", 70.0),
+    assert "athlete" not in opts and "start" not in opts and "mesh_intervals" not in opts
+    # the athlete: the body mass joins the other fields; the mesh of every design's stride
+    athlete = EvaluatorSettings(kind="collocation", body_mass_kg=70.0,
+                                athlete={"height_m": 1.75}, mesh_intervals=100)
+    opts = athlete.options(space, tmp_path)
+    assert opts["athlete"] == {"height_m": 1.75, "body_mass_kg": 70.0}
+    assert opts["mesh_intervals"] == 100 and "body_mass_kg" not in opts
+    for kind, field, value in (("blade", "athlete", {"height_m": 1.75}),
+                               ("runner", "mesh_intervals", 100),
                                ("blade", "start", "x.json"), ("blade", "gait", "x.csv")):
         with pytest.raises(SpecError) as err:
             EvaluatorSettings(kind=kind, **{field: value})

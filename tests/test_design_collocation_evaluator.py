@@ -591,3 +591,39 @@ def test_the_maximum_speed_problem_per_design_from_another_studys_strides(fake, 
         _evaluator(tmp_path, max_speed=True, start_strides=str(tmp_path / "none"))
     banded = _evaluator(tmp_path, max_speed=True, stride_time_people=True).settings()
     assert banded.speed_m_per_s is None and banded.period_band is not None
+
+
+def test_every_designs_stride_is_of_the_athlete(fake, tmp_path):
+    """athlete: each design's stride is solved on the runner scaled to the athlete (its model
+    specification says so, and the study's evaluator.json); a bad field is named before any
+    solve, and a study of another athlete is not resumed."""
+    from bladelab.design.study import _check_same_evaluator
+
+    calls, _ = fake
+    athlete = {"muscle_strength": 1.5, "max_shortening_velocity": 15,
+               "prosthesis_extra_length_m": 0.045}
+    ev = make_evaluator("collocation", amputation="transtibial", athlete=athlete,
+                        solutions_dir=str(tmp_path / "s"), factor_ranges=RANGES)
+    ev(CENTRE)
+    assert calls[-1]["spec"]["athlete"] == {k: float(v) for k, v in athlete.items()}
+    assert ev.to_dict()["athlete"] == calls[-1]["spec"]["athlete"]
+    assert len(calls) == 1  # the built-in centre stride is another athlete's: solved
+    plain = make_evaluator("collocation", amputation="transtibial",
+                           solutions_dir=str(tmp_path / "p"), factor_ranges=RANGES)
+    plain(CENTRE)
+    assert len(calls) == 1 and plain.athlete is None  # the default athlete's: read back
+    plain({**CENTRE, "width_m": 0.05})
+    assert "athlete" not in calls[-1]["spec"]
+    for bad, where in (({"muscle_strength": 0}, "athlete.muscle_strength"),
+                       ({"max_shortening_velocity": 99}, "athlete.max_shortening_velocity"),
+                       ({"shoe_size": 44}, "athlete")):
+        with pytest.raises(SpecError) as err:
+            make_evaluator("collocation", amputation="transtibial", athlete=bad)
+        assert err.value.where == where
+    # a folder of this athlete's runs: resumed by the same, refused to another athlete
+    (tmp_path / "runs").mkdir()
+    (tmp_path / "runs" / "run_0001.json").write_text("{}")
+    (tmp_path / "evaluator.json").write_text(json.dumps(ev.to_dict()))
+    _check_same_evaluator(tmp_path, ev)
+    with pytest.raises(SpecError, match="athlete"):
+        _check_same_evaluator(tmp_path, plain)

@@ -292,3 +292,23 @@ def test_the_demo_renders_the_committed_predicted_design_study(tmp_path):
     assert notes.is_unique  # a reason shared by two trends is written once
     none, said = predicted_design_example(tmp_path / "r2", study=tmp_path / "nowhere")
     assert none is None and "not found" in said[0]
+
+
+def test_the_report_names_the_athlete_and_the_mesh_of_a_predicted_study(tmp_path):
+    """A study of a scaled athlete says so in its first sentence, with its mesh."""
+    import json
+    import shutil
+
+    from bladelab.demo import PREDICTED_DESIGN_STUDY
+    from bladelab.report.design import design_report_sections
+
+    study = tmp_path / "study"
+    shutil.copytree(Path(__file__).resolve().parents[1] / PREDICTED_DESIGN_STUDY, study)
+    first = design_report_sections(study)[0]["text"]
+    assert "50 mesh intervals" in first and "the athlete" not in first
+    evaluator = json.loads((study / "evaluator.json").read_text())
+    evaluator["athlete"] = {"muscle_strength": 1.5, "prosthesis_extra_length_m": 0.045}
+    (study / "evaluator.json").write_text(json.dumps(evaluator))
+    first = design_report_sections(study)[0]["text"]
+    assert ("the athlete: muscle strength ×1.5, prosthetic leg 4.5 cm longer, 50 mesh "
+            "intervals") in first

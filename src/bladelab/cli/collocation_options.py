@@ -79,20 +79,20 @@ ATHLETE_OPTIONS = {
 }
 
 
-def static_option():
-    """``--static``: thigh and shank lengths from a static trial."""
-    return typer.Option(None, "--static", rich_help_panel=COLLOCATION, show_default=False,
+def static_option(panel: str = COLLOCATION):
+    """``--static``: thigh and shank lengths from a static trial (in the help ``panel``)."""
+    return typer.Option(None, "--static", rich_help_panel=panel, show_default=False,
                         help="A static (standing) C3D trial of the athlete: the thighs and "
                              "shanks from its joint centres (Harrington's hips, epicondyles, "
                              "malleoli; both sides' mean, the intact leg's shank for an "
                              "amputee), unless --thigh-length or --shank-length are given.")
 
 
-def athlete_option(field: str):
-    """One of :data:`ATHLETE_OPTIONS` as a typer option (default: the body's own)."""
+def athlete_option(field: str, panel: str = COLLOCATION):
+    """One of :data:`ATHLETE_OPTIONS` as a typer option (default: the body's own) in the help
+    ``panel``."""
     flag, text = ATHLETE_OPTIONS[field]
-    return typer.Option(None, flag, rich_help_panel=COLLOCATION, show_default=False,
-                        help=text)
+    return typer.Option(None, flag, rich_help_panel=panel, show_default=False, help=text)
 
 
 def athlete_from_options(static: Path | None = None, **fields: float | None) -> dict | None:

@@ -23,6 +23,12 @@ import typer
 
 from bladelab._io import figure_format
 from bladelab.cli.blade import blade_app
+from bladelab.cli.collocation_options import (
+    ATHLETE_OPTIONS,
+    athlete_from_options,
+    athlete_option,
+    static_option,
+)
 from bladelab.cli.panels import Panel, PanelGroup, refuse_other_methods, renamed
 from bladelab.cli.values import parse_list
 from bladelab.design import defaults
@@ -48,7 +54,9 @@ OPTIONS = {
     "people_weight": "--people-weight", "step_phase_tolerance": "--alternating-steps",
     "prosthetic_load_max_bw": "--prosthetic-load-max",
     "stride_time_range_s": "--stride-time", "stride_time_people": "--stride-time",
-    "max_speed": "--max-speed", "start_strides": "--start-strides",
+    "max_speed": "--max-speed", "start_strides": "--start-strides", "mesh_intervals": "--mesh",
+    "athlete.body_mass_kg": "--body-mass",
+    **{f"athlete.{name}": flag for name, (flag, _) in ATHLETE_OPTIONS.items()},
 }
 _FACTORS = ",".join(f"{name}={low:g}:{high:g}" for name, low, high, *_ in defaults.DESIGN_FACTORS)
 
@@ -173,10 +181,12 @@ def _design(
              "finished (default: a failed run stops the study)."),
     figures: bool = typer.Option(True, "--figures/--no-figures", rich_help_panel=STUDY,
                                  help="Write figures."),
-    # -- blade and runner evaluators -------------------------------------------------------
     body_mass: float | None = typer.Option(
-        None, "--body-mass", rich_help_panel=BLADE_RUNNER,
-        help=f"Body mass [kg] (default {defaults.BODY_MASS_KG:g})."),
+        None, "--body-mass", rich_help_panel=STUDY,
+        help=f"Body mass [kg]: blade and runner evaluators (default "
+             f"{defaults.BODY_MASS_KG:g}); collocation: the athlete's (with the prosthesis; "
+             "default the runner body's)."),
+    # -- blade and runner evaluators -------------------------------------------------------
     dt: float | None = typer.Option(None, "--dt", rich_help_panel=BLADE_RUNNER,
                                     help="Simulation step [s] of the evaluator."),
     # -- runner evaluator ------------------------------------------------------------------
@@ -254,6 +264,20 @@ def _design(
              "kept; stops when no "
              f"objective drops by more than {100 * defaults.SETTLED_REL:g} %). Recorded design "
              "by design in settling.json: a stopped pass resumes where it stopped."),
+    mesh: int | None = typer.Option(
+        None, "--mesh", rich_help_panel=COLLOCATION, show_default=False,
+        help="Mesh intervals of every design's stride (default 50; a stride above 5 m/s wants "
+             "100, docs/collocation.md)."),
+    height: float | None = athlete_option("height_m", COLLOCATION),
+    muscle_strength: float | None = athlete_option("muscle_strength", COLLOCATION),
+    max_shortening_velocity: float | None = athlete_option("max_shortening_velocity",
+                                                           COLLOCATION),
+    residual_limb: float | None = athlete_option("residual_limb_length_m", COLLOCATION),
+    thigh_length: float | None = athlete_option("thigh_length_m", COLLOCATION),
+    shank_length: float | None = athlete_option("shank_length_m", COLLOCATION),
+    prosthesis_extra_length: float | None = athlete_option("prosthesis_extra_length_m",
+                                                           COLLOCATION),
+    static: Path | None = static_option(COLLOCATION),
     confirm: bool = typer.Option(
         False, "--confirm", rich_help_panel=COLLOCATION,
         help="After the study, solve its optimum's blade as one more design (from its nearest "
@@ -304,6 +328,11 @@ def _design(
         raise SpecError("--confirm solves the optimum of a study of predicted strides",
                         where="--confirm", hint="with --evaluator collocation and --objective")
     try:
+        athlete = athlete_from_options(
+            static, height_m=height, muscle_strength=muscle_strength,
+            max_shortening_velocity=max_shortening_velocity,
+            residual_limb_length_m=residual_limb, thigh_length_m=thigh_length,
+            shank_length_m=shank_length, prosthesis_extra_length_m=prosthesis_extra_length)
         ev_settings = EvaluatorSettings(
             kind=evaluator, speed_mps=speed, body_mass_kg=body_mass, dt_s=dt, base=base,
             gait=gait, motion=motion, motion_model=motion_model, start=start,
@@ -312,7 +341,8 @@ def _design(
             people_weight=people_weight,
             step_phase_tolerance=alternating_steps,
             prosthetic_load_max_bw=prosthetic_load_max,
-            max_speed=max_speed or None, start_strides=start_strides,
+            max_speed=max_speed or None, start_strides=start_strides, athlete=athlete,
+            mesh_intervals=mesh,
             **(stride_time_settings(stride_time) if stride_time is not None else {}))
     except BladelabError as err:
         raise renamed(err, OPTIONS) from None

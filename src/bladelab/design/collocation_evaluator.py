@@ -53,7 +53,12 @@ from bladelab.predict import defaults as predict_defaults
 from bladelab.predict.collocation.settings import CollocationSettings, people_term
 from bladelab.predict.collocation.solution import CollocationSolution
 from bladelab.predict.collocation.solve import predict_stride
-from bladelab.predict.collocation.stored import check_model_spec, runner_from_spec, same_model_spec
+from bladelab.predict.collocation.stored import (
+    check_model_spec,
+    params_from_spec,
+    runner_from_spec,
+    same_model_spec,
+)
 from bladelab.runner.params import BODIES
 
 __all__ = ["CollocationEvaluator", "DEFAULT_BODY", "DEFAULT_DESIGN_SPEED_MPS", "DEFAULT_STARTS",
@@ -189,6 +194,13 @@ class CollocationEvaluator:
         seed 001's), 0 with a ``reference_weight`` (the two terms exclude each other). The
         transtibial runner on the human body also keeps predict's swing knee
         (:func:`bladelab.predict.defaults.swing_knee_for`): its strides are predict's.
+    athlete
+        The runner scaled to this athlete: body mass [kg], height [m], muscle strength,
+        maximum shortening velocity, segment and residual-limb lengths [m], the prosthesis's
+        extra length [m] (``bladelab.runner.scaling.athlete_params``' fields, as predict's
+        ``--body-mass`` … ``--prosthesis-extra-length``); None (default): the body's own.
+        Every design's stride is of this athlete; the built-in start, of the default one, is
+        only its first guess.
     generator
         Options of :func:`~bladelab.design.blade_generator.generate_blade`.
     """
@@ -214,6 +226,7 @@ class CollocationEvaluator:
     prosthetic_load_max_bw: float | None = None
     stride_time_range_s: tuple[float, float] | None = None
     stride_time_people: bool = False
+    athlete: Mapping[str, float] | None = None
     generator: Mapping[str, Any] = field(default_factory=dict)
 
     #: What a study's ``evaluator.json`` written before a setting existed meant by it: the
@@ -226,7 +239,8 @@ class CollocationEvaluator:
                                                  "amputation": "transfemoral",
                                                  "stride_time_range_s": None,
                                                  "stride_time_people": False,
-                                                 "max_speed": False, "start_strides": None}
+                                                 "max_speed": False, "start_strides": None,
+                                                 "athlete": None}
 
     def __post_init__(self) -> None:
         if self.amputation not in AMPUTATIONS:
@@ -248,6 +262,15 @@ class CollocationEvaluator:
                                  hint="another study's strides folder (its designs' strides)")
         if self.body not in BODIES:
             raise SpecError(f"unknown body {self.body!r}", where="body", hint=" or ".join(BODIES))
+        if self.athlete is not None:
+            if not isinstance(self.athlete, Mapping):
+                raise SpecError(f"athlete must be a mapping, got {self.athlete!r}",
+                                where="athlete", hint="e.g. {'muscle_strength': 1.5}")
+            # a catalogue blade stands in for the designs' (the athlete does not depend on it)
+            spec = check_model_spec({"model": self.model, "blade": "Cat6", "body": self.body,
+                                     "athlete": dict(self.athlete)})
+            params_from_spec(spec)  # the athlete's limits: a named error now, not per design
+            object.__setattr__(self, "athlete", spec.get("athlete") or None)
         if self.start is None and (self.amputation, self.body) not in DEFAULT_STARTS:
             raise SpecError(f"no built-in start stride of the {self.amputation} runner on the "
                             f"{self.body} body", where="body",
@@ -503,9 +526,11 @@ class CollocationEvaluator:
     def _problem(self, point: Mapping[str, float]) -> tuple[dict, Any]:
         """(model specification with the design's blade, collocation settings) of a design."""
         blade = self.blade_spec(point)
-        return (check_model_spec({"model": self.model, "blade": blade["name"],
-                                  "blade_spec": blade, "body": self.body}),
-                self.settings())
+        spec = {"model": self.model, "blade": blade["name"], "blade_spec": blade,
+                "body": self.body}
+        if self.athlete:
+            spec["athlete"] = dict(self.athlete)
+        return check_model_spec(spec), self.settings()
 
     def blade_spec(self, point: Mapping[str, float]) -> dict:
         """The design's blade file contents: the generated blade, its soles' contact stiffness

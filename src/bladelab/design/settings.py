@@ -12,6 +12,7 @@ file, and builds the evaluator (:func:`~bladelab.design.evaluators.make_evaluato
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass, fields
 from pathlib import Path
 
@@ -27,7 +28,7 @@ __all__ = ["APPLIES_TO", "EVALUATORS", "EvaluatorSettings", "build_evaluator"]
 EVALUATORS = ("blade", "runner", "collocation")
 #: The evaluators each kind-specific setting of :class:`EvaluatorSettings` applies to.
 APPLIES_TO: dict[str, tuple[str, ...]] = {
-    "body_mass_kg": ("blade", "runner"),
+    "body_mass_kg": ("blade", "runner", "collocation"),
     "dt_s": ("blade", "runner"),
     "gait": ("runner",),
     "motion": ("runner",),
@@ -45,6 +46,8 @@ APPLIES_TO: dict[str, tuple[str, ...]] = {
     "stride_time_people": ("collocation",),
     "max_speed": ("collocation",),
     "start_strides": ("collocation",),
+    "athlete": ("collocation",),
+    "mesh_intervals": ("collocation",),
 }
 
 
@@ -62,7 +65,8 @@ class EvaluatorSettings:
         runner: :data:`~bladelab.design.defaults.RUNNER_SPEED_MPS`); the stride's mean speed
         (collocation: :data:`~bladelab.design.defaults.COLLOCATION_SPEED_MPS`).
     body_mass_kg
-        Body mass [kg] (blade and runner; :data:`~bladelab.design.defaults.BODY_MASS_KG`).
+        Body mass [kg] (blade and runner: :data:`~bladelab.design.defaults.BODY_MASS_KG`;
+        collocation: the athlete's, default the body's).
     dt_s
         Simulation step [s] (blade and runner).
     base
@@ -94,6 +98,13 @@ class EvaluatorSettings:
         Collocation: predict each design's maximum-speed stride instead of one at
         ``speed_mps`` (which it excludes), and a folder of strides of the same designs (another
         study's) that each design starts from first.
+    athlete
+        Collocation: the runner scaled to this athlete (height, muscle strength, maximum
+        shortening velocity, segment and residual-limb lengths, the prosthesis's extra length:
+        ``CollocationEvaluator.athlete``; the body mass is ``body_mass_kg``); None: the body's.
+    mesh_intervals
+        Collocation: mesh intervals of every design's stride (default 50; read a stride above
+        5 m/s on 100, docs/collocation.md).
     """
 
     kind: str = "blade"
@@ -117,6 +128,8 @@ class EvaluatorSettings:
     stride_time_people: bool | None = None
     max_speed: bool | None = None
     start_strides: str | Path | None = None
+    athlete: Mapping[str, float] | None = None
+    mesh_intervals: int | None = None
 
     def __post_init__(self) -> None:
         if self.kind not in EVALUATORS:
@@ -156,9 +169,15 @@ class EvaluatorSettings:
             for name in ("knee_moment_min_Nm", "knee_flexion_max_loaded_deg",
                          "reference_weight", "body", "amputation", "people_weight",
                          "step_phase_tolerance", "prosthetic_load_max_bw",
-                         "stride_time_range_s", "stride_time_people", "max_speed"):
+                         "stride_time_range_s", "stride_time_people", "max_speed",
+                         "mesh_intervals"):
                 if getattr(self, name) is not None:
                     options[name] = getattr(self, name)
+            athlete = dict(self.athlete or {})
+            if self.body_mass_kg is not None:
+                athlete["body_mass_kg"] = self.body_mass_kg
+            if athlete:
+                options["athlete"] = athlete
         elif self.body_mass_kg is not None:
             options["body_mass_kg"] = self.body_mass_kg
         if self.speed_mps is not None:

@@ -31,6 +31,7 @@ from bladelab.design.space import DesignSpace
 from bladelab.design.stride_checks import stride_checks
 from bladelab.design.terms import parse_terms
 from bladelab.errors import InputFileError, OptimizationError
+from bladelab.predict.collocation.stored import athlete_label
 from bladelab.report.builder import Report
 from bladelab.report.design_strides import (
     COLLOCATION_UNITS,
@@ -382,8 +383,16 @@ def _evaluator_sentence(evaluator: dict) -> str:
     if kind == "collocation":
         body = evaluator.get("body")
         amputation = evaluator.get("amputation") or "transfemoral"
+        notes = [f"{body} body"] if body else []
+        athlete = evaluator.get("athlete")
+        if isinstance(athlete, dict) and athlete:
+            notes.append("the athlete: " + athlete_label({"model": "amputee", "blade": "Cat6",
+                                                          "athlete": athlete}))
+        mesh = evaluator.get("mesh_intervals")
+        if isinstance(mesh, int):
+            notes.append(f"{mesh} mesh intervals")
         return (f"Each run is a predicted {amputation} stride{at} wearing the generated blade "
-                "(the collocation evaluator" + (f", {body} body" if body else "") + "): the "
+                "(the collocation evaluator" + "".join(f", {n}" for n in notes) + "): the "
                 "gait is the optimum of the stride problem for that blade.")
     return ""
 
