@@ -91,3 +91,24 @@ def test_the_elimination_and_its_press_work_on_runs_that_alias_a_term():
     assert (0,) in kept and (3, 3) in kept
     surface = fit_reduced(CODED[keep], y[keep], factor_names=NAMES)
     assert np.isfinite(surface.r2_pred_selected)
+
+
+def test_the_report_of_a_reduced_study_leaves_a_constant_response_unfitted(tmp_path):
+    """A prescribed (constant) response is left out of the fit table; each fitted response
+    keeps its own term count and its nested R²pred, to three decimals."""
+    from bladelab.report.design import design_report_sections
+
+    space = default_design_space()
+
+    def evaluator(point):
+        k, w, h, t = space.code([point[n] for n in space.names])
+        return {"speed": 5.0 + 0.1 * k - 0.05 * t**2 + 0.001 * np.sin(7 * h + 3 * w),
+                "knee": 10.0 + 25.0 * t, "prescribed": 4.0}
+
+    run_design(space, runs="ccd", evaluator=evaluator, out_dir=tmp_path, model="reduced",
+               objective="speed", sense="max", progress=False)
+    fit = design_report_sections(tmp_path)[0]["tables"][0][1]
+    assert list(fit["response"]) == ["speed", "knee"]
+    assert list(fit["terms"]) == [len(json.loads((tmp_path / "surfaces.json").read_text())[r]
+                                      ["terms"]) for r in ("speed", "knee")]
+    assert all(v == round(v, 3) for v in fit["R2_pred (selection in each fold)"])

@@ -151,6 +151,8 @@ def design_report_sections(design_dir: str | Path) -> list[dict[str, Any]]:
     if spread is not None:
         fit = fit.merge(spread[["response", "r2_ceiling"]].rename(
             columns={"r2_ceiling": "R2 ceiling (start spread)"}), on="response", how="left")
+    r2_columns = [c for c in fit.columns if c.startswith("R2")]
+    fit[r2_columns] = fit[r2_columns].astype(float).round(3)  # R² to three decimals
     fit_text = "Predicted R² comes from PRESS (leave-one-out)."
     constant = _constant_responses(table, surfaces)
     if constant:
@@ -159,9 +161,9 @@ def design_report_sections(design_dir: str | Path) -> list[dict[str, Any]]:
                      + ", ".join(f"{r} = {v:.4g} {surfaces[r].unit}".rstrip()
                                  for r, v in constant.items()) + ".")
     if meta.get("model") == REDUCED_MODEL:
-        fit["terms"] = [len(s.terms) for s in surfaces.values()]
-        fit["R2_pred (selection in each fold)"] = [s.r2_pred_selected
-                                                   for s in surfaces.values()]
+        fit["terms"] = fit["response"].map(lambda r: len(surfaces[r].terms))
+        fit["R2_pred (selection in each fold)"] = fit["response"].map(
+            lambda r: round(float(surfaces[r].r2_pred_selected), 3))
         fit_text += (" Each response's surface is reduced from the full quadratic ("
                      + next(iter(surfaces.values())).selection + "; 'terms' counts the "
                      "intercept). Its R2_pred is computed on the terms chosen from every run, so "
