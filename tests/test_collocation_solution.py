@@ -309,6 +309,15 @@ def test_a_hop_and_a_stride_on_its_bound_are_named_in_the_warnings(able):
     assert any("right leg never touches" in w for w in warnings)
     assert any("bound (0.4 s)" in w for w in warnings)
     assert "right leg never touches" in hop.summary()["warnings"]
+    # the right foot only brushing the ground (0.03 body weights, above the contact threshold)
+    brush = sol.contact_forces.copy()
+    right = sol.contact_legs == 1
+    brush[:, right, :] *= 0.03 * sol.body_weight_N / sol.leg_vertical_force()[:, 1].max()
+    brushed = dataclasses.replace(sol, contact_forces=brush)
+    assert brushed.leg_vertical_force()[:, 1].max() > CONTACT_THRESHOLD_N
+    assert brushed.gait_warnings() == [
+        "the right leg never carries the body: its peak vertical force is 0.03 body weights "
+        "(below 1: a one-legged hop, the other foot only brushing the ground)"]
     # a swinging left foot that strikes the ground mid-swing: a second loaded stretch
     strike = sol.contact_forces.copy()
     left = sol.leg_vertical_force()[:, 0]

@@ -85,6 +85,13 @@ RESIDUAL_WARNING_PCT = 5.0
 #: peaks (5.6 and 2.6 BW) and objective (+75 %) moved on 100 intervals. Our decision.
 ZIGZAG_STEPS = 5
 ZIGZAG_STEP_BW = 0.25
+#: A leg whose vertical force never reaches this [body weights] does not carry the body: the
+#: stride is a one-legged hop with the other foot brushing the ground (flagged by
+#: :meth:`CollocationSolution.gait_warnings`). Every running and walking stance peaks above
+#: it (people: 2.2-3 BW at 3.5 m/s, about 1.2 BW walking); measured on 2026-12-07: an
+#: amputee sprinter's stride from a 4 m/s start hopped on its blade at 6 BW, the intact foot
+#: brushing the ground at 0.03 BW, which the contact count alone (20 N) passed. Our decision.
+LOAD_BEARING_BW = 1.0
 #: Above this vertical force [body weights] a leg counts as loaded for the zigzag.
 ZIGZAG_LOADED_BW = 0.05
 #: Samples per mesh interval of the linear interpolation used for contact and flight times.
@@ -267,7 +274,8 @@ class CollocationSolution:
 
     def gait_warnings(self) -> list[str]:
         """What makes this converged stride no running gait, in words (empty if nothing):
-        a leg that never touches the ground (a one-legged hop), a leg that touches it more
+        a leg that never touches the ground or never carries the body
+        (:data:`LOAD_BEARING_BW`: a one-legged hop), a leg that touches it more
         than once per stride (a swinging foot striking the ground, or a bounce), a peak
         vertical force above :data:`PEAK_GRF_WARNING_BW`, a leg's vertical force that zigzags
         from node to node (:data:`ZIGZAG_STEPS`), no flight phase, a dynamics residual
@@ -276,12 +284,17 @@ class CollocationSolution:
         from the Fukuchi trial's guess converged to a hop on the intact leg at the 0.4 s
         bound."""
         ph = self.contact_phases()
+        weight = self.body_weight_N
         out = [f"the {leg} leg never touches the ground (a one-legged hop, not running)"
                for leg in self.leg_names if ph["legs"][leg]["contacts"] == 0]
+        out += [f"the {leg} leg never carries the body: its peak vertical force is "
+                f"{peak / weight:.2f} body weights (below {LOAD_BEARING_BW:g}: a one-legged "
+                "hop, the other foot only brushing the ground)"
+                for leg in self.leg_names if ph["legs"][leg]["contacts"] > 0
+                and (peak := ph["legs"][leg]["peak_vertical_grf_N"]) < LOAD_BEARING_BW * weight]
         out += [f"the {leg} leg touches the ground {ph['legs'][leg]['contacts']} times per "
                 "stride (a swinging foot strikes the ground, or the stance bounces)"
                 for leg in self.leg_names if ph["legs"][leg]["contacts"] > 1]
-        weight = self.body_weight_N
         out += [f"the {leg} leg's peak vertical force is {peak / weight:.1f} body weights "
                 f"(above {PEAK_GRF_WARNING_BW:g}: an impact no runner survives)"
                 for leg in self.leg_names
