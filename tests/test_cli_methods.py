@@ -79,7 +79,7 @@ def _sections(text: str) -> dict[str, list[str]]:
     ("sweep", {"Common": "--speeds", "Reflex controller (CMA-ES)": "--recipe",
                "Reflex speed grid (without --recipe)": "--chain-from",
                "Reflex recipe (with --recipe)": "--track-study", "Collocation": "--starts"}),
-    ("design", {"Study": "--runs", "Blade and runner evaluator": "--body-mass",
+    ("design", {"Study": "--body-mass", "Blade and runner evaluator": "--dt",
                 "Runner evaluator": "--motion", "Collocation evaluator": "--settle"}),
 ])
 def test_help_shows_the_options_by_method(command, groups, capsys):
