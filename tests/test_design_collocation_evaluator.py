@@ -597,7 +597,8 @@ def test_every_designs_stride_is_of_the_athlete(fake, tmp_path):
     """athlete: each design's stride is solved on the runner scaled to the athlete (its model
     specification says so, and the study's evaluator.json); a bad field is named before any
     solve, and a study of another athlete is not resumed."""
-    from bladelab.design.study import _check_same_evaluator
+    from bladelab.design.space import default_design_space
+    from bladelab.design.study import run_design
 
     calls, _ = fake
     athlete = {"muscle_strength": 1.5, "max_shortening_velocity": 15,
@@ -620,10 +621,12 @@ def test_every_designs_stride_is_of_the_athlete(fake, tmp_path):
         with pytest.raises(SpecError) as err:
             make_evaluator("collocation", amputation="transtibial", athlete=bad)
         assert err.value.where == where
-    # a folder of this athlete's runs: resumed by the same, refused to another athlete
-    (tmp_path / "runs").mkdir()
-    (tmp_path / "runs" / "run_0001.json").write_text("{}")
-    (tmp_path / "evaluator.json").write_text(json.dumps(ev.to_dict()))
-    _check_same_evaluator(tmp_path, ev)
-    with pytest.raises(SpecError, match="athlete"):
-        _check_same_evaluator(tmp_path, plain)
+    # a folder of this athlete's runs is not resumed for another athlete (refused before a run)
+    study = tmp_path / "study"
+    (study / "runs").mkdir(parents=True)
+    (study / "runs" / "run_0001.json").write_text("{}")
+    (study / "evaluator.json").write_text(json.dumps(ev.to_dict()))
+    solves = len(calls)
+    with pytest.raises(SpecError, match=r"another evaluator \(athlete: \{'muscle_strength'"):
+        run_design(default_design_space(), evaluator=plain, out_dir=study, progress=False)
+    assert len(calls) == solves

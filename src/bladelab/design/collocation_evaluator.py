@@ -54,12 +54,13 @@ from bladelab.predict.collocation.settings import CollocationSettings, people_te
 from bladelab.predict.collocation.solution import CollocationSolution
 from bladelab.predict.collocation.solve import predict_stride
 from bladelab.predict.collocation.stored import (
+    check_athlete,
     check_model_spec,
-    params_from_spec,
     runner_from_spec,
     same_model_spec,
 )
-from bladelab.runner.params import BODIES
+from bladelab.runner.params import BODIES, default_runner_params
+from bladelab.runner.scaling import athlete_params
 
 __all__ = ["CollocationEvaluator", "DEFAULT_BODY", "DEFAULT_DESIGN_SPEED_MPS", "DEFAULT_STARTS",
            "REFERENCE_DOFS"]
@@ -263,14 +264,11 @@ class CollocationEvaluator:
         if self.body not in BODIES:
             raise SpecError(f"unknown body {self.body!r}", where="body", hint=" or ".join(BODIES))
         if self.athlete is not None:
-            if not isinstance(self.athlete, Mapping):
-                raise SpecError(f"athlete must be a mapping, got {self.athlete!r}",
-                                where="athlete", hint="e.g. {'muscle_strength': 1.5}")
-            # a catalogue blade stands in for the designs' (the athlete does not depend on it)
-            spec = check_model_spec({"model": self.model, "blade": "Cat6", "body": self.body,
-                                     "athlete": dict(self.athlete)})
-            params_from_spec(spec)  # the athlete's limits: a named error now, not per design
-            object.__setattr__(self, "athlete", spec.get("athlete") or None)
+            athlete = check_athlete(dict(self.athlete) if isinstance(self.athlete, Mapping)
+                                    else self.athlete)
+            # the athlete's limits on this body: a named error now, not per design
+            athlete_params(default_runner_params(self.model, body=self.body), **athlete)
+            object.__setattr__(self, "athlete", athlete or None)
         if self.start is None and (self.amputation, self.body) not in DEFAULT_STARTS:
             raise SpecError(f"no built-in start stride of the {self.amputation} runner on the "
                             f"{self.body} body", where="body",

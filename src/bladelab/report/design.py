@@ -31,7 +31,7 @@ from bladelab.design.space import DesignSpace
 from bladelab.design.stride_checks import stride_checks
 from bladelab.design.terms import parse_terms
 from bladelab.errors import InputFileError, OptimizationError
-from bladelab.predict.collocation.stored import athlete_label
+from bladelab.predict.collocation.stored import athlete_text
 from bladelab.report.builder import Report
 from bladelab.report.design_strides import (
     COLLOCATION_UNITS,
@@ -388,8 +388,7 @@ def _evaluator_sentence(evaluator: dict) -> str:
         notes = [f"{body} body"] if body else []
         athlete = evaluator.get("athlete")
         if isinstance(athlete, dict) and athlete:
-            notes.append("the athlete: " + athlete_label({"model": "amputee", "blade": "Cat6",
-                                                          "athlete": athlete}))
+            notes.append("the athlete: " + athlete_text(athlete))
         mesh = evaluator.get("mesh_intervals")
         if isinstance(mesh, int):
             notes.append(f"{mesh} mesh intervals")

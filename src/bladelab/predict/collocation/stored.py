@@ -28,6 +28,8 @@ from bladelab.runner.scaling import ATHLETE_FIELDS, athlete_params
 __all__ = [
     "FieldReader",
     "athlete_label",
+    "athlete_text",
+    "check_athlete",
     "check_model_spec",
     "describe_problem",
     "model_label",
@@ -92,13 +94,13 @@ def check_model_spec(spec) -> dict:
             raise SpecError("blade_spec must be a multi-link blade's specification (a mapping) "
                             "of an amputee model", where="blade_spec")
         out["blade_spec"] = blade_spec
-    athlete = _check_athlete(spec.get("athlete"))
+    athlete = check_athlete(spec.get("athlete"))
     if athlete:
         out["athlete"] = athlete
     return out
 
 
-def _check_athlete(athlete) -> dict:
+def check_athlete(athlete) -> dict:
     """The athlete of a model specification: known fields, each a finite number > 0 (the
     prosthetic leg's extra length ≥ 0; an empty dict for None)."""
     if athlete is None:
@@ -136,7 +138,12 @@ def model_label(spec: dict) -> str:
 def athlete_label(spec: dict) -> str:
     """The athlete of a model specification where it is not the parameter set's, e.g.
     ``"68 kg, 1.75 m, muscle strength ×1.5"`` (empty for the parameter set's own)."""
-    athlete = check_model_spec(spec).get("athlete", {})
+    return athlete_text(check_model_spec(spec).get("athlete", {}))
+
+
+def athlete_text(athlete: dict) -> str:
+    """An athlete's fields (:func:`check_athlete`) in words, e.g. ``"68 kg, 1.75 m, muscle
+    strength ×1.5"`` (empty for none)."""
     parts = [f"{athlete['body_mass_kg']:g} kg"] if "body_mass_kg" in athlete else []
     parts += [f"{athlete['height_m']:g} m"] if "height_m" in athlete else []
     parts += ([f"muscle strength ×{athlete['muscle_strength']:g}"]
