@@ -61,6 +61,7 @@ def fake(monkeypatch):
         calls.append({"source": guess.source, "track": track, "spec": model_spec,
                       "floor": speed_floor,
                       "speed": settings.speed_m_per_s, "dofs": runner.dof_names,
+                      "mesh": settings.mesh_intervals,
                       "backward_euler": settings.blade_backward_euler,
                       "step_phase_tolerance": settings.step_phase_tolerance,
                       "prosthetic_load_max_bw": settings.prosthetic_load_max_bw,
@@ -630,3 +631,57 @@ def test_every_designs_stride_is_of_the_athlete(fake, tmp_path):
     with pytest.raises(SpecError, match=r"another evaluator \(athlete: \{'muscle_strength'"):
         run_design(default_design_space(), evaluator=plain, out_dir=study, progress=False)
     assert len(calls) == solves
+
+
+def test_continuation_speeds_step_to_the_studys_speed():
+    from bladelab.design.start_continuation import continuation_speeds
+
+    assert continuation_speeds(4.0, 6.0) == pytest.approx([4.0, 4.5, 5.0, 5.5, 6.0])
+    down = continuation_speeds(6.0, 4.9)  # three equal steps, none above 0.5 m/s
+    assert down == pytest.approx([6.0, 6.0 - 1.1 / 3, 6.0 - 2.2 / 3, 4.9])
+    assert continuation_speeds(4.0, 4.5) == [] and continuation_speeds(4.0, 3.6) == []
+    with pytest.raises(ValueError):
+        continuation_speeds(4.0, 6.0, step_mps=0.0)
+
+
+def test_a_study_far_from_its_starts_speed_continues_the_start_first(fake, tmp_path):
+    """prepare: the first design solved from the start (4 m/s, 50 intervals) at 4, 4.5 ... 6
+    m/s on the start's mesh, each step from the last, then on the study's 100 intervals; the
+    steps kept, the last as the design's stride, which the next design starts from."""
+    calls, _ = fake
+    ev = _evaluator(tmp_path, speed_mps=6.0, mesh_intervals=100)
+    ev.prepare(CENTRE, progress=False)
+    assert [(round(c["speed"], 9), c["mesh"]) for c in calls] == [
+        (4.0, 50), (4.5, 50), (5.0, 50), (5.5, 50), (6.0, 50), (6.0, 100)]
+    assert all(c["track"] is False for c in calls)
+    stem = ce.point_file_stem(CENTRE)
+    steps = tmp_path / "s" / "continuation"
+    assert _start_name(calls[0]["source"]) == STRIDE.name
+    assert _start_name(calls[1]["source"]) == f"{stem}-4.000mps-mesh50.json"
+    assert _start_name(calls[5]["source"]) == f"{stem}-6.000mps-mesh50.json"
+    assert (steps / f"{stem}-6.000mps-mesh100.json").is_file()
+    assert (tmp_path / "s" / f"{stem}.json").is_file()  # the design's own stride
+    ev({**CENTRE, "width_m": 0.05})
+    assert _start_name(calls[-1]["source"]) == f"{stem}.json"  # the continued centre
+
+
+def test_a_failed_continuation_step_leaves_the_start_as_it_is(fake, tmp_path):
+    calls, script = fake
+    ev = _evaluator(tmp_path, speed_mps=5.5)
+    script += [(True, []), (True, ["the prosthetic leg never carries the body"])]
+    ev.prepare(CENTRE, progress=False)
+    assert [c["speed"] for c in calls] == pytest.approx([4.0, 4.5])  # stopped at the hop
+    stem = ce.point_file_stem(CENTRE)
+    assert (tmp_path / "s" / "continuation" / f"{stem}-4.500mps-mesh50.best_iterate.json"
+            ).is_file()
+    assert not (tmp_path / "s" / f"{stem}.json").exists()
+    ev(CENTRE)
+    assert _start_name(calls[-1]["source"]) == STRIDE.name  # the start as it is
+
+
+def test_no_continuation_near_the_starts_speed_or_for_the_maximum_speed(fake, tmp_path):
+    calls, _ = fake
+    _evaluator(tmp_path, speed_mps=4.4).prepare(CENTRE, progress=False)
+    _evaluator(tmp_path / "m", max_speed=True).prepare(CENTRE, progress=False)
+    make_evaluator("collocation", start=str(STRIDE), speed_mps=6.0).prepare(CENTRE)
+    assert calls == []  # within one step; no speed to continue to; no folder to keep it in

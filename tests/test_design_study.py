@@ -167,6 +167,27 @@ def test_runs_are_evaluated_from_the_centre_outwards(tmp_path):
     assert np.allclose(np.sort(np.array(seen), axis=0), np.sort(res.design.coded, axis=0))
 
 
+class _Prepared(_Named):
+    """An evaluator with a ``prepare`` step (the collocation evaluator's start continuation)."""
+
+    def __init__(self):
+        super().__init__(extra=False)
+        self.prepared = []
+
+    def prepare(self, point, progress=True):
+        assert self.calls == 0  # before any run
+        self.prepared.append(SPACE.code([point[n] for n in SPACE.names]))
+
+
+def test_an_evaluator_is_prepared_with_the_first_run_before_the_runs(tmp_path):
+    ev = _Prepared()
+    run_design(SPACE, runs="ccd", evaluator=ev, out_dir=tmp_path, progress=False)
+    assert len(ev.prepared) == 1 and np.allclose(ev.prepared[0], 0.0)  # the centre, once
+    assert ev.calls == 25
+    run_design(SPACE, runs="ccd", evaluator=ev, out_dir=tmp_path, progress=False)
+    assert len(ev.prepared) == 1  # every run stored: nothing to prepare
+
+
 def _no_gait_at_short_toe(point):
     """The analytic evaluator, failing (as a solve with no clean stride does) at the two
     corners with the shortest toe, the lowest stiffness and the narrowest blade."""

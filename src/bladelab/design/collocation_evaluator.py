@@ -31,6 +31,7 @@ and the gait's defects (the study stops there with the finished runs kept: never
 from __future__ import annotations
 
 import math
+import sys
 import time
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import asdict, dataclass, field
@@ -41,6 +42,7 @@ from bladelab.design import defaults
 from bladelab.design.blade_generator import generate_blade
 from bladelab.design.predicted import stride_responses
 from bladelab.design.responses import MAX_SPEED_RESPONSE_UNITS, PREDICTED_RESPONSE_UNITS
+from bladelab.design.start_continuation import continue_stride
 from bladelab.design.stride_files import (
     point_file_stem,
     point_from_stem,
@@ -584,6 +586,28 @@ class CollocationEvaluator:
         return None, None
 
     # -- one design -----------------------------------------------------------------------
+    def prepare(self, point: Mapping[str, float], progress: bool = True) -> None:
+        """Before a study's runs (:func:`~bladelab.design.study.run_design` calls it with its
+        first design, the centre): at a prescribed speed more than
+        :data:`~bladelab.design.start_continuation.CONTINUATION_STEP_MPS` from the start
+        stride's, solve this design by speed continuation from the start
+        (:func:`~bladelab.design.start_continuation.continue_stride`, the steps kept in
+        ``solutions_dir/continuation``) and keep its stride, so that the other designs start
+        near their own speed. Nothing to do for a stored design, the maximum-speed problem or
+        without a solutions folder; a chain that fails leaves the start as it is. A line per
+        step on standard error with ``progress``."""
+        if self.max_speed or self.solutions_dir is None:
+            return
+        point = {k: float(v) for k, v in point.items()}
+        spec, settings = self._problem(point)
+        if self._stored(point, spec, settings)[0] is not None:
+            return
+        sol = continue_stride(runner_from_spec(spec), spec, settings, self.start_file,
+                              Path(self.solutions_dir) / "continuation", point_file_stem(point),
+                              solve=predict_stride, say=_say if progress else None)
+        if sol is not None:
+            self._replace(sol, point)
+
     def __call__(self, point: Mapping[str, float]) -> dict[str, float]:
         point = {k: float(v) for k, v in point.items()}
         spec, settings = self._problem(point)
@@ -627,6 +651,11 @@ class CollocationEvaluator:
                      "towards this point, or give a --start stride nearer to it")
         self._replace(sol, point)
         return self.responses(sol, runner)
+
+
+def _say(line: str) -> None:
+    """A progress line on standard error."""
+    print(f"  {line}", file=sys.stderr, flush=True)
 
 
 #: Largest constraint violation of an iteration-limited solve that is continued from its last

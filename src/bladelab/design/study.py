@@ -197,7 +197,12 @@ def _evaluate_runs(evaluator, space: DesignSpace, design: Design, todo: list[int
                    ) -> Iterator[tuple[int, object, BladelabError | str | None]]:
     """Yield (run index, raw responses, None) or (run index, None, the error) for the runs
     ``todo`` as they finish: in this process (``jobs`` 1; the error is the evaluator's
-    :class:`BladelabError`, others propagate) or on an executor (the error in words)."""
+    :class:`BladelabError`, others propagate) or on an executor (the error in words). An
+    evaluator with a ``prepare(point, progress=)`` method is first given the first run's point,
+    in this process (the collocation evaluator carries its start to the study's speed there)."""
+    prepare = getattr(evaluator, "prepare", None)
+    if todo and callable(prepare):
+        prepare(dict(space.point(design.coded[todo[0]])), progress=progress)
     bar = tqdm(total=len(todo), desc="design runs", unit="run", disable=not progress)
     if jobs <= 1:
         for i in todo:
