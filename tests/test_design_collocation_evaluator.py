@@ -684,4 +684,9 @@ def test_no_continuation_near_the_starts_speed_or_for_the_maximum_speed(fake, tm
     _evaluator(tmp_path, speed_mps=4.4).prepare(CENTRE, progress=False)
     _evaluator(tmp_path / "m", max_speed=True).prepare(CENTRE, progress=False)
     make_evaluator("collocation", start=str(STRIDE), speed_mps=6.0).prepare(CENTRE)
-    assert calls == []  # within one step; no speed to continue to; no folder to keep it in
+    own = tmp_path / "own"
+    own.mkdir()
+    (own / f"{ce.point_file_stem(CENTRE)}.json").write_bytes(STRIDE.read_bytes())
+    _evaluator(tmp_path / "o", speed_mps=6.0, start_strides=str(own)).prepare(CENTRE)
+    # within one step; no speed to continue to; no folder to keep it in; its own start stride
+    assert calls == []

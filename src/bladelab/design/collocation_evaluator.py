@@ -593,10 +593,11 @@ class CollocationEvaluator:
         stride's, solve this design by speed continuation from the start
         (:func:`~bladelab.design.start_continuation.continue_stride`, the steps kept in
         ``solutions_dir/continuation``) and keep its stride, so that the other designs start
-        near their own speed. Nothing to do for a stored design, the maximum-speed problem or
-        without a solutions folder; a chain that fails leaves the start as it is. A line per
-        step on standard error with ``progress``."""
-        if self.max_speed or self.solutions_dir is None:
+        near their own speed. Nothing to do for a stored design, one with its own stride in
+        ``start_strides``, the maximum-speed problem or without a solutions folder; a chain
+        that fails leaves the start as it is. A line per step on standard error with
+        ``progress``."""
+        if self.max_speed or self.solutions_dir is None or self._own_start(point) is not None:
             return
         point = {k: float(v) for k, v in point.items()}
         spec, settings = self._problem(point)
