@@ -204,7 +204,9 @@ def _design(
     start: Path | None = typer.Option(
         None, "--start", rich_help_panel=COLLOCATION,
         help="Collocation solution of the runner that the first design starts from "
-             "(default: the built-in centre stride of the runner, where there is one)."),
+             "(default: the built-in centre stride of the runner, where there is one); "
+             "carried to a --speed more than 0.5 m/s from its own in 0.5 m/s steps first "
+             "(strides/continuation/)."),
     start_strides: Path | None = typer.Option(
         None, "--start-strides", rich_help_panel=COLLOCATION, show_default=False,
         help="A folder of strides of the same designs (another study's strides/): each design "
