@@ -32,6 +32,7 @@ beside it (``bladelab design`` run as in docs/design.md). Run the study again to
         --out benchmarks/design/transtibial-collocation-max-speed-people-stride
     (the same command from transtibial-people-stride-soleus-2026-12-07/strides for
     transtibial-max-speed-people-stride-soleus-2026-12-07)
+    (transtibial-sprinter-6mps-2026-12-07: the command in its README)
 
 Studies since the study timing record write their own ``timing.json`` (each sitting of each
 stage, :mod:`bladelab.design.timing`); older ones hold their times written by hand.
@@ -69,6 +70,10 @@ STUDIES = (
      "the human body as shipped (the soleus at its running length), each design's maximum "
      "speed at people's stride time (`--amputation transtibial --max-speed --stride-time "
      "people`)"),
+    (_DESIGN / "transtibial-sprinter-6mps-2026-12-07", "transtibial",
+     "an amputee sprinter at 6 m/s, the body as shipped, people's joint angles, swing knee "
+     "and stride time (`--amputation transtibial --speed 6 --mesh 100 --stride-time people "
+     "--muscle-strength 1.5 --max-shortening-velocity 15 --prosthesis-extra-length 0.045`)"),
 )
 #: The responses a designer asks for, fitted in each study that has them.
 DESIGNER_RESPONSES = ("cost_of_transport_J_per_kg_m", "max_speed_m_per_s", "stride_objective",
@@ -108,7 +113,7 @@ def _study(study: Path, runner: str, what: str) -> str:
         f"## Design study on predicted {runner} strides: {what}",
         "",
         "25-run face-centred CCD over seed 002's four factors, `--evaluator collocation` "
-        f"({runner} runner wearing each generated 6-link blade, {_speed(study)}, mesh 50, backward "
+        f"({runner} runner wearing each generated 6-link blade, {_speed(study)}, backward "
         "Euler for the blade's joints), `--jobs 2`. Target: the study ≤ 30 min on 2 cores. "
         "Times are those the study recorded (its stride files and `timing.json`), not measured "
         "again by `make bench`.",
@@ -159,10 +164,14 @@ def _study(study: Path, runner: str, what: str) -> str:
 
 
 def _speed(study: Path) -> str:
-    """The study's speed in words, from its ``evaluator.json``."""
+    """The study's speed and mesh in words, from its ``evaluator.json``."""
     path = study / "evaluator.json"
     ev = json.loads(path.read_text(encoding="utf-8")) if path.is_file() else {}
-    return "each design's maximum speed" if ev.get("max_speed") else "4 m/s"
+    speed = ("each design's maximum speed" if ev.get("max_speed")
+             else f"{ev.get('speed_mps') or 4:g} m/s")
+    athlete = ", the athlete " + ", ".join(f"{k} {v:g}" for k, v in ev["athlete"].items()) \
+        if ev.get("athlete") else ""
+    return f"{speed}{athlete}, mesh {ev.get('mesh_intervals', 50)}"
 
 
 def _surfaces(study: Path) -> list[str]:
