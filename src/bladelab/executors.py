@@ -248,6 +248,11 @@ def make_executor(name: str, jobs: int = 1):
     raise BladelabError(f"unknown executor {name!r}", where="executor", hint="use 'local' or 'ray'")
 
 
+def say_to_stderr(line: str) -> None:
+    """A task's progress line, on standard error (above the parent's progress bar)."""
+    print(f"  {line}", file=sys.stderr, flush=True)
+
+
 __all__ = [
     "LocalExecutor",
     "ProcessPool",
@@ -256,6 +261,7 @@ __all__ = [
     "default_start_method",
     "make_executor",
     "run_task_safely",
+    "say_to_stderr",
     "start_local_ray",
     "terminate_pool",
 ]

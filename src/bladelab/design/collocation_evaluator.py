@@ -31,7 +31,6 @@ and the gait's defects (the study stops there with the finished runs kept: never
 from __future__ import annotations
 
 import math
-import sys
 import time
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import asdict, dataclass, field
@@ -42,7 +41,7 @@ from bladelab.design import defaults
 from bladelab.design.blade_generator import generate_blade
 from bladelab.design.predicted import stride_responses
 from bladelab.design.responses import MAX_SPEED_RESPONSE_UNITS, PREDICTED_RESPONSE_UNITS
-from bladelab.design.start_continuation import continue_stride
+from bladelab.design.start_continuation import continue_stride, read_clean_stride
 from bladelab.design.stride_files import (
     point_file_stem,
     point_from_stem,
@@ -51,6 +50,7 @@ from bladelab.design.stride_files import (
     start_text,
 )
 from bladelab.errors import InputFileError, OptimizationError, SpecError
+from bladelab.executors import say_to_stderr
 from bladelab.predict import defaults as predict_defaults
 from bladelab.predict.collocation.settings import CollocationSettings, people_term
 from bladelab.predict.collocation.solution import CollocationSolution
@@ -59,7 +59,6 @@ from bladelab.predict.collocation.stored import (
     check_athlete,
     check_model_spec,
     runner_from_spec,
-    same_model_spec,
 )
 from bladelab.runner.params import BODIES, default_runner_params
 from bladelab.runner.scaling import athlete_params
@@ -576,12 +575,8 @@ class CollocationEvaluator:
         own = self._stride_file(point)
         paths = [self.start_file]  # the start may be this very design's
         for path in ([own] if own is not None else []) + paths:
-            if not path.is_file():
-                continue
-            sol = CollocationSolution.read(path)
-            same = (sol.converged and same_model_spec(sol.model_spec, check_model_spec(spec))
-                    and sol.settings.same_problem(settings))
-            if same and not sol.gait_warnings():
+            sol = read_clean_stride(path, spec, settings)
+            if sol is not None:
                 return sol, path
         return None, None
 
@@ -597,15 +592,15 @@ class CollocationEvaluator:
         ``start_strides``, the maximum-speed problem or without a solutions folder; a chain
         that fails leaves the start as it is. A line per step on standard error with
         ``progress``."""
+        point = {k: float(v) for k, v in point.items()}
         if self.max_speed or self.solutions_dir is None or self._own_start(point) is not None:
             return
-        point = {k: float(v) for k, v in point.items()}
         spec, settings = self._problem(point)
         if self._stored(point, spec, settings)[0] is not None:
             return
         sol = continue_stride(runner_from_spec(spec), spec, settings, self.start_file,
                               Path(self.solutions_dir) / "continuation", point_file_stem(point),
-                              solve=predict_stride, say=_say if progress else None)
+                              solve=predict_stride, say=say_to_stderr if progress else None)
         if sol is not None:
             self._replace(sol, point)
 
@@ -652,11 +647,6 @@ class CollocationEvaluator:
                      "towards this point, or give a --start stride nearer to it")
         self._replace(sol, point)
         return self.responses(sol, runner)
-
-
-def _say(line: str) -> None:
-    """A progress line on standard error."""
-    print(f"  {line}", file=sys.stderr, flush=True)
 
 
 #: Largest constraint violation of an iteration-limited solve that is continued from its last

@@ -27,7 +27,6 @@ A start a design was solved from in an earlier pass and whose stride has not cha
 
 from __future__ import annotations
 
-import sys
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -40,7 +39,7 @@ from bladelab.design.stride_files import point_file_stem
 from bladelab.design.study import DesignStudyResult, run_design, run_file
 from bladelab.design.timing import settling_stage, timed_stage
 from bladelab.errors import InputFileError, OptimizationError
-from bladelab.executors import make_executor
+from bladelab.executors import make_executor, say_to_stderr
 
 __all__ = ["RECORD_NAME", "SETTLED_REL", "SETTLE_FROM_CHEAPEST", "SettlingOutcome", "is_settled",
            "objective_drop", "read_settling_record", "run_settled_design", "settle_strides",
@@ -238,17 +237,12 @@ def run_settled_design(space, *, evaluator, out_dir: str | Path, settle_passes: 
     return result, outcome
 
 
-def _say_to_stderr(line: str) -> None:
-    """A worker's progress line, on standard error (above the parent's progress bar)."""
-    print(f"  {line}", file=sys.stderr, flush=True)
-
-
 def settle_design_point(payload: dict) -> dict:
     """One design's :meth:`~bladelab.design.collocation_evaluator.CollocationEvaluator.settle`
     in a worker process (a line per start on standard error with ``payload["progress"]``)."""
     return payload["evaluator"].settle(payload["point"], payload["neighbours"],
                                        payload.get("cheapest", False), payload.get("known"),
-                                       _say_to_stderr if payload.get("progress") else None)
+                                       say_to_stderr if payload.get("progress") else None)
 
 
 def settle_strides(evaluator, points, *, neighbours: int = 2,

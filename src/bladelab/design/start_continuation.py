@@ -24,7 +24,8 @@ from bladelab.design.stride_files import start_text
 from bladelab.predict.collocation.solution import CollocationSolution
 from bladelab.predict.collocation.stored import check_model_spec, same_model_spec
 
-__all__ = ["CONTINUATION_STEP_MPS", "continuation_speeds", "continue_stride"]
+__all__ = ["CONTINUATION_STEP_MPS", "continuation_speeds", "continue_stride",
+           "read_clean_stride"]
 
 #: Largest speed step [m/s] of the chain (the step of the measured sprinter chain: every step
 #: gave a clean stride); a study within one step of its start's speed is solved directly.
@@ -48,13 +49,16 @@ def _clean(solution) -> bool:
     return bool(solution.converged) and not solution.gait_warnings()
 
 
-def _read_step(path: Path, spec: dict, settings):
-    """The clean stride of this step stored by an earlier sitting, or None."""
+def read_clean_stride(path: Path, spec: dict, settings):
+    """The stride stored in ``path`` if it is a clean stride (converged, no gait warning) of
+    this problem (model ``spec``: the same blade and athlete; ``settings``: the same speed,
+    mesh, weights, constraints and transcription); else None, also for a missing file."""
+    path = Path(path)
     if not path.is_file():
         return None
     sol = CollocationSolution.read(path)
-    if (_clean(sol) and same_model_spec(sol.model_spec, check_model_spec(spec))
-            and sol.settings.same_problem(settings)):
+    if (sol.converged and same_model_spec(sol.model_spec, check_model_spec(spec))
+            and sol.settings.same_problem(settings) and not sol.gait_warnings()):
         return sol
     return None
 
@@ -85,7 +89,7 @@ def continue_stride(runner, spec: dict, settings, start: Path, folder: Path, nam
         path = folder / f"{name}-{step.speed_m_per_s:.3f}mps-mesh{step.mesh_intervals}.json"
         head = (f"start continued to {step.speed_m_per_s:.3g} m/s on {step.mesh_intervals} "
                 f"intervals (step {k} of {len(steps)})")
-        sol = _read_step(path, spec, step)
+        sol = read_clean_stride(path, spec, step)
         if sol is None:
             t0 = time.perf_counter()
             sol = solve(runner, step, guess.to_guess(start_text(guess_path, guess)),
