@@ -37,17 +37,28 @@ from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any, ClassVar
 
-from bladelab.design import defaults
 from bladelab.design.blade_generator import generate_blade
 from bladelab.design.predicted import stride_responses
+from bladelab.design.predicted_runner import (
+    AMPUTATIONS,
+    DEFAULT_AMPUTATION,
+    DEFAULT_BODIES,
+    DEFAULT_BODY,
+    DEFAULT_DESIGN_SPEED_MPS,
+    DEFAULT_SOLE_STIFFNESS_SCALE,
+    DEFAULT_START,
+    DEFAULT_STARTS,
+    REFERENCE_DOFS,
+    REFERENCE_DOFS_TRANSTIBIAL,
+)
 from bladelab.design.responses import MAX_SPEED_RESPONSE_UNITS, PREDICTED_RESPONSE_UNITS
 from bladelab.design.start_continuation import continue_stride, read_clean_stride
 from bladelab.design.stride_files import (
     point_file_stem,
-    point_from_stem,
     solved_from_text,
     start_identity,
     start_text,
+    stored_neighbours,
 )
 from bladelab.errors import InputFileError, OptimizationError, SpecError
 from bladelab.executors import say_to_stderr
@@ -63,57 +74,16 @@ from bladelab.predict.collocation.stored import (
 from bladelab.runner.params import BODIES, default_runner_params
 from bladelab.runner.scaling import athlete_params
 
-__all__ = ["CollocationEvaluator", "DEFAULT_BODY", "DEFAULT_DESIGN_SPEED_MPS", "DEFAULT_STARTS",
-           "REFERENCE_DOFS"]
+__all__ = ["CollocationEvaluator", "DEFAULT_BODY", "DEFAULT_DESIGN_SPEED_MPS", "DEFAULT_START",
+           "DEFAULT_STARTS", "REFERENCE_DOFS"]
 
-#: Prescribed speed of a design's stride [m/s] (our choice, docs/design.md "Predicted
-#: transfemoral gaits"): the transfemoral runner's maximum speed on collocation is 5.6–5.8 m/s
-#: (sphere blade), so seed 002's sprint speeds (about 7 m/s) are out of its reach; 4 m/s is
-#: the speed of the clean multi-link stride the first design starts from (2026-11-26: the
-#: continuations to 4.5 and 5 m/s were not finished).
-DEFAULT_DESIGN_SPEED_MPS = defaults.COLLOCATION_SPEED_MPS
-_STRIDES = Path(__file__).resolve().parents[1] / "data" / "runner" / "collocation"
-#: The amputations a design's runner may have: the runner model of each
-#: (:data:`bladelab.runner.model.KINDS`).
-AMPUTATIONS = {"transfemoral": "transfemoral", "transtibial": "amputee"}
-#: The amputation of a design study's runner: seed 002's athlete (a transfemoral amputation).
-DEFAULT_AMPUTATION = "transfemoral"
-#: The start of the first design by (amputation, runner body): a clean stride wearing the
-#: default box's centre blade at :data:`DEFAULT_DESIGN_SPEED_MPS`, its joints by backward
-#: Euler (how each was made: ``data/runner/collocation/README.md``). The transfemoral runner
-#: on the human body has none: its converged strides gallop, or alternate only with a 10.8 BW
-#: intact-leg impact (measured: benchmarks/design/README.md), so a study of it needs
-#: ``start``.
-DEFAULT_STARTS = {("transfemoral", "seed001"): _STRIDES / "transfemoral-design-centre-4.json",
-                  ("transtibial", "human"): _STRIDES / "transtibial-design-centre-4-human.json"}
-#: The runner body of the design studies by amputation: the one with a start stride
-#: (:data:`DEFAULT_STARTS`), seed 001's for the transfemoral runner, predict's human body for
-#: the transtibial one.
-DEFAULT_BODIES = {"transfemoral": "seed001", "transtibial": "human"}
-#: The runner body of the transfemoral design studies (:data:`DEFAULT_BODIES`).
-DEFAULT_BODY = DEFAULT_BODIES[DEFAULT_AMPUTATION]
-#: The start of the first design on :data:`DEFAULT_BODY`.
-DEFAULT_START = DEFAULT_STARTS[(DEFAULT_AMPUTATION, DEFAULT_BODY)]
-#: Factor on the generated blade's sole contact stiffness (its damping by the square root, the
-#: damping ratio kept) in the design's runner, forward and collocation alike (our choice,
-#: measured 2026-11-26, docs/design.md): with the generator's 10⁶ N/m soles the transfemoral
-#: 4 m/s stride from the sphere's clean run converged to 12-BW intact-leg impacts (or, with a
-#: tracking stage, to an infeasible point); with 10⁵ N/m it converged in 154 s to a stride
-#: without gait warnings (a gallop, as every transfemoral stride found so far). 10⁵ N/m (three soles: 3·10⁵ N/m against the blade's 18–32 kN/m) adds 6–10 %
-#: to the blade's compression at a given load.
-DEFAULT_SOLE_STIFFNESS_SCALE = 0.1
-#: The athlete's own coordinates that :attr:`CollocationEvaluator.reference_weight` keeps near
-#: the start stride: trunk, pelvis tilt, the intact leg and the residual hip. The prosthetic
-#: knee and the blade's joints move as the blade makes them (our choice, docs/design.md).
-REFERENCE_DOFS = ("pelvis_tilt", "lumbar_extension", "hip_flexion_l", "knee_angle_l",
-                  "ankle_angle_l", "hip_flexion_r")
-#: :data:`REFERENCE_DOFS` of the transtibial runner: with the residual knee, the athlete's own.
-REFERENCE_DOFS_TRANSTIBIAL = (*REFERENCE_DOFS, "knee_angle_r")
 #: Solved designs a new design may start from, nearest first, before the study's start
 #: (a start that gives no clean stride is followed by the next; measured 2026-11-26: with the
 #: technique kept, two axial designs got a 10-BW hop or no convergence from the centre, their
 #: only neighbour then).
 START_NEIGHBOURS = 3
+
+
 @dataclass(frozen=True)
 class CollocationEvaluator:
     """Design point -> predicted amputee stride -> seed 002's responses (module docstring).
@@ -352,27 +322,11 @@ class CollocationEvaluator:
         return {"evaluator": "collocation", **d}
 
     # -- starts ---------------------------------------------------------------------------
-    def _distance(self, a: Mapping[str, float], b: Mapping[str, float]) -> float:
-        if set(a) != set(b):
-            return math.inf
-        total = 0.0
-        for k, v in a.items():
-            lo, hi = self.factor_ranges.get(k, (0.0, 0.0))
-            span = (hi - lo) / 2 if hi > lo else max(abs(v), 1e-12)
-            total += ((v - b[k]) / span) ** 2
-        return math.sqrt(total)
-
     def _neighbours(self, point: Mapping[str, float]) -> list[Path]:
         """Stride files of the other designs solved in ``solutions_dir``, nearest first."""
-        found = []
-        if self.solutions_dir is not None and Path(self.solutions_dir).is_dir():
-            for f in Path(self.solutions_dir).glob("*.json"):
-                if f.name.endswith((".best_iterate.json", ".previous.json")):
-                    continue
-                p = point_from_stem(f.stem)
-                if p is not None and p != dict(point):
-                    found.append((self._distance(point, p), f.name, f))
-        return [f for _, _, f in sorted(found)]
+        if self.solutions_dir is None:
+            return []
+        return stored_neighbours(self.solutions_dir, point, self.factor_ranges)
 
     def _starts(self, point: Mapping[str, float]) -> list[Path]:
         """Solution files to start from: the :data:`START_NEIGHBOURS` nearest solved designs,

@@ -2,6 +2,8 @@
 
 - :func:`point_file_stem` names a design's stride file ``name=value__name=value`` (values to 6
   digits) and :func:`point_from_stem` reads a point back from such a name;
+- :func:`stored_neighbours` lists the strides of the other designs in a folder, nearest first
+  in coded units (:func:`coded_distance`);
 - :func:`start_identity` says what makes a start stride the same start, and
   :func:`start_text` / :func:`solved_from_text` write and read the guess source that records it
   in the solved stride (so that a settling pass does not solve again from an unchanged start).
@@ -9,12 +11,13 @@
 
 from __future__ import annotations
 
+import math
 import re
 from collections.abc import Mapping
 from pathlib import Path
 
-__all__ = ["point_file_stem", "point_from_stem", "solved_from_text", "start_identity",
-           "start_text"]
+__all__ = ["coded_distance", "point_file_stem", "point_from_stem", "solved_from_text",
+           "start_identity", "start_text", "stored_neighbours"]
 
 _SEP = "__"
 
@@ -25,10 +28,44 @@ def point_file_stem(point: Mapping[str, float]) -> str:
 
 
 def point_from_stem(stem: str) -> dict[str, float] | None:
+    """The design point named by a stride file's stem (:func:`point_file_stem`); None for a
+    name that is not one."""
     try:
         return {k: float(v) for k, v in (item.split("=", 1) for item in stem.split(_SEP))}
     except ValueError:
         return None
+
+
+def coded_distance(a: Mapping[str, float], b: Mapping[str, float],
+                   factor_ranges: Mapping[str, tuple[float, float]]) -> float:
+    """Euclidean distance of two design points in coded units (each factor's half range of
+    ``factor_ranges`` is 1; a factor without a range: relative to its value in ``a``); inf for
+    points of different factors."""
+    if set(a) != set(b):
+        return math.inf
+    total = 0.0
+    for k, v in a.items():
+        lo, hi = factor_ranges.get(k, (0.0, 0.0))
+        span = (hi - lo) / 2 if hi > lo else max(abs(v), 1e-12)
+        total += ((v - b[k]) / span) ** 2
+    return math.sqrt(total)
+
+
+def stored_neighbours(folder: str | Path, point: Mapping[str, float],
+                      factor_ranges: Mapping[str, tuple[float, float]]) -> list[Path]:
+    """Stride files of the other designs in ``folder``, nearest to ``point`` first
+    (:func:`coded_distance`, ties by file name); a failed solve's last iterate
+    (``.best_iterate.json``) and a replaced stride (``.previous.json``) are not strides of a
+    design. [] for a folder that does not exist."""
+    found = []
+    if Path(folder).is_dir():
+        for f in Path(folder).glob("*.json"):
+            if f.name.endswith((".best_iterate.json", ".previous.json")):
+                continue
+            p = point_from_stem(f.stem)
+            if p is not None and p != dict(point):
+                found.append((coded_distance(point, p, factor_ranges), f.name, f))
+    return [f for _, _, f in sorted(found)]
 
 
 
