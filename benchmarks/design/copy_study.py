@@ -2,6 +2,9 @@
 strides without their IPOPT multipliers (a quarter of a 100-interval stride's size; a resumed
 pass starts from their primal values), and without the ``.previous`` and ``.best_iterate``
 strides a solve replaced or gave up on. The continuation steps of the first design are kept.
+Copied onto an earlier copy, a run or stride file the study no longer has is removed (a
+settling pass deletes a changed design's run file so that its responses are read back from
+the new stride: a stale one left behind would keep the old responses).
 
 Usage (repository root)::
 
@@ -37,6 +40,10 @@ def copy_study(src: Path, dst: Path) -> int:
             strides += 1
         else:
             shutil.copy2(path, out)
+    for folder in ("runs", "strides"):
+        for path in sorted((dst / folder).rglob("*.json")):
+            if not (src / path.relative_to(dst)).is_file():
+                path.unlink()
     return strides
 
 
