@@ -19,7 +19,7 @@ from bladelab.design import confirmation as cf
 from bladelab.design.doe import central_composite
 from bladelab.design.optimum import constrained_optimum, surface_constraints
 from bladelab.design.space import DesignSpace, Factor
-from bladelab.design.stride_files import point_from_stem
+from bladelab.design.stride_files import coded_distance, point_from_stem
 from bladelab.design.surfaces import fit_surface
 from bladelab.errors import SpecError
 from bladelab.predict.collocation.solution import CollocationSolution
@@ -74,7 +74,7 @@ def test_the_optimum_is_solved_from_the_study_strides_and_kept_apart(fake, store
     # first solve from the study's nearest design, then the settling starts: the study's two
     # designs, not the confirmation's own stride
     starts = [re.search(r"(stiffness\S+?\.json)", c["source"])[1] for c in calls]
-    study = sorted((ev._distance(rec["point"], point_from_stem(p.stem)), p.name)
+    study = sorted((coded_distance(rec["point"], point_from_stem(p.stem), RANGES), p.name)
                    for p in (tmp_path / "s").iterdir())
     assert starts[0] == study[0][1] and sorted(starts[1:]) == sorted(n for _, n in study)
     assert len(calls) == 1 + len(rec["starts"]) and len(lines) == len(rec["starts"])
