@@ -54,9 +54,10 @@ DEFAULT_START = DEFAULT_STARTS[(DEFAULT_AMPUTATION, DEFAULT_BODY)]
 #: 10⁵ N/m (three soles: 3·10⁵ N/m against the blade's 18–32 kN/m) adds 6–10 % to the
 #: blade's compression at a given load.
 DEFAULT_SOLE_STIFFNESS_SCALE = 0.1
-#: The athlete's own coordinates that :attr:`~bladelab.design.collocation_evaluator.CollocationEvaluator.reference_weight` keeps near
-#: the start stride: trunk, pelvis tilt, the intact leg and the residual hip. The prosthetic
-#: knee and the blade's joints move as the blade makes them (our choice, docs/design.md).
+#: The athlete's own coordinates that the collocation evaluator's ``reference_weight``
+#: (:class:`~bladelab.design.collocation_evaluator.CollocationEvaluator`) keeps near the start
+#: stride: trunk, pelvis tilt, the intact leg and the residual hip. The prosthetic knee and the
+#: blade's joints move as the blade makes them (our choice, docs/design.md).
 REFERENCE_DOFS = ("pelvis_tilt", "lumbar_extension", "hip_flexion_l", "knee_angle_l",
                   "ankle_angle_l", "hip_flexion_r")
 #: :data:`REFERENCE_DOFS` of the transtibial runner: with the residual knee, the athlete's own.

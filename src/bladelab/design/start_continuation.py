@@ -57,8 +57,8 @@ def read_clean_stride(path: Path, spec: dict, settings):
     if not path.is_file():
         return None
     sol = CollocationSolution.read(path)
-    if (sol.converged and same_model_spec(sol.model_spec, check_model_spec(spec))
-            and sol.settings.same_problem(settings) and not sol.gait_warnings()):
+    if (same_model_spec(sol.model_spec, check_model_spec(spec))
+            and sol.settings.same_problem(settings) and _clean(sol)):
         return sol
     return None
 

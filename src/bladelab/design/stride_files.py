@@ -68,7 +68,6 @@ def stored_neighbours(folder: str | Path, point: Mapping[str, float],
     return [f for _, _, f in sorted(found)]
 
 
-
 def start_identity(solution, speed_floor: float | None = None) -> str:
     """What makes a start stride the same start: its objective to the last digit and whether
     it carries IPOPT's multipliers (a stride stored without them starts elsewhere); in a
