@@ -23,9 +23,10 @@
 
 Every design's stride is written to ``solutions_dir/<point>.json`` (``bladelab report``
 renders it) and read back instead of solved again when the design is evaluated again (a
-resumed or re-fitted study), a failed one's best iterate to ``<point>.best_iterate.json``; a design point
-with no clean stride raises :class:`~bladelab.errors.OptimizationError` naming IPOPT's status
-and the gait's defects (the study stops there with the finished runs kept: never a NaN).
+resumed or re-fitted study), a failed one's best iterate to
+``<point>.best_iterate.json``; a design point with no clean stride raises
+:class:`~bladelab.errors.OptimizationError` naming IPOPT's status and the gait's defects
+(the study stops there with the finished runs kept: never a NaN).
 """
 
 from __future__ import annotations
@@ -390,9 +391,9 @@ class CollocationEvaluator:
         """Solve this design again from its ``neighbours`` nearest solved designs, its own
         stride in ``start_strides`` (if any) and, with ``cheapest``, the study's cheapest
         stride of another design (when it is not one of them), and keep the clean stride of
-        lowest objective (rewriting its file). The cheapest stride reaches a branch the neighbours do not carry across the box (measured:
-        from it five designs of a settled study went lower, one by 2.4 %,
-        docs/design.md). Returns ``{"point", "before",
+        lowest objective (rewriting its file). The cheapest stride reaches a branch the
+        neighbours do not carry across the box (measured: from it five designs of a settled
+        study went lower, one by 2.4 %, docs/design.md). Returns ``{"point", "before",
         "after"`` (objectives), ``"from"`` (the file that gave the kept stride, or None),
         ``"responses_before"`` (the stored stride's responses) and ``"tries"``: per start,
         ``{"from", "converged", "status", "objective", "warnings", "responses"}`` (responses
