@@ -441,11 +441,15 @@ def test_design_report_shows_what_the_start_decides(study, tmp_path):
     copy, table = _collocation_copy(study, tmp_path, {})
     y = table["delta_vx_m_per_s"].to_numpy(float)
     big = 3.0 * float(np.std(y, ddof=1))  # the start moves it more than the designs do
+    z = table["impulse_z_Ns"].to_numpy(float)
+    small = 0.2 * float(np.std(z, ddof=1))  # ... and this one less
     designs = [{"run": r, "before": 1.0,
-                "responses_before": {"delta_vx_m_per_s": y[r - 1], "max_speed_m_per_s": 5.0},
+                "responses_before": {"delta_vx_m_per_s": y[r - 1], "max_speed_m_per_s": 5.0,
+                                     "impulse_z_Ns": z[r - 1]},
                 "tries": [{"from": "n.json", "converged": True, "objective": 1.01,
                            "responses": {"delta_vx_m_per_s": y[r - 1] + big,
-                                         "max_speed_m_per_s": 5.1}}]}
+                                         "max_speed_m_per_s": 5.1,
+                                         "impulse_z_Ns": z[r - 1] + small}}]}
                for r in (1, 2)]
     (copy / "settling.json").write_text(json.dumps({"passes": [{"pass": 1,
                                                                 "designs": designs}]}))
@@ -457,8 +461,14 @@ def test_design_report_shows_what_the_start_decides(study, tmp_path):
     assert "delta_vx_m_per_s" in spread["text"] and "below 0.8" in spread["text"]
     assert "With 2 designs the spread is a rough estimate" in spread["text"]
     fits = dict(sections["Design study: response surfaces"]["tables"])["Surface fits"]
-    assert fits.set_index("response").loc["delta_vx_m_per_s",
-                                          "R2 ceiling (start spread)"] == 0.0
+    fitted = fits.set_index("response")
+    assert fitted.loc["delta_vx_m_per_s", "R2 ceiling (start spread)"] == 0.0
+    assert fitted.loc["delta_vx_m_per_s", "R2_pred ceiling (start spread)"] == 0.0
+    # a response the start moves less: the leverages put its predicted-R² ceiling below
+    # its R² ceiling
+    r2_ceiling, r2_pred_ceiling = fitted.loc["impulse_z_Ns", ["R2 ceiling (start spread)",
+                                                              "R2_pred ceiling (start spread)"]]
+    assert 0.0 < r2_pred_ceiling < r2_ceiling < 1.0
     assert "stride_objective" not in spread["text"]  # a study without it as a response
     # with the objective a response of the study, the section says what its spread means
     table.assign(stride_objective=np.linspace(1.0, 2.0, len(table)),

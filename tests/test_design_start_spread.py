@@ -70,3 +70,38 @@ def test_no_record_or_single_strides_give_an_empty_table(tmp_path):
     one = {"passes": [{"pass": 1, "designs": [_row(1, 2.0, 1.0, [(2.2, None)])]}]}
     (tmp_path / "settling.json").write_text(json.dumps(one))
     assert start_spread(tmp_path).empty
+
+
+def test_predicted_r2_ceiling_matches_a_simulated_start_error():
+    """On a 25-run face-centred design, a quadratic response plus independent noise: the
+    mean PRESS R² of the fitted quadratic equals the ceiling from the leverages, and sits
+    well below the R² ceiling (which ignores them)."""
+    from bladelab.design.doe import central_composite
+    from bladelab.design.start_spread import r2_pred_ceiling
+    from bladelab.design.surfaces import fit_surface
+
+    coded = central_composite(4).coded
+    names = ["a", "b", "c", "d"]
+    signal = 1.0 * coded[:, 0] - 0.5 * coded[:, 1] + 0.4 * coded[:, 0] ** 2
+    sigma = 0.25
+    rng = np.random.default_rng(7)
+    observed, predicted, r2_ceil = [], [], []
+    for _ in range(400):
+        y = signal + rng.normal(0.0, sigma, len(signal))
+        surface = fit_surface(coded, y, factor_names=names, model="quadratic")
+        across = float(np.std(y, ddof=1))
+        observed.append(surface.r2_pred)
+        predicted.append(r2_pred_ceiling(sigma, across, surface.leverage))
+        r2_ceil.append(1.0 - sigma ** 2 / across ** 2)
+    assert np.mean(surface.leverage) == pytest.approx(15 / 25)
+    assert np.mean(observed) == pytest.approx(np.mean(predicted), abs=0.03)
+    assert np.mean(r2_ceil) - np.mean(predicted) > 0.1  # the leverages matter
+
+
+def test_predicted_r2_ceiling_is_undefined_with_leverage_one():
+    from bladelab.design.start_spread import r2_pred_ceiling
+
+    assert math.isnan(r2_pred_ceiling(0.1, 1.0, [0.5, 1.0, 0.2]))
+    assert math.isnan(r2_pred_ceiling(0.1, 0.0, [0.5, 0.5, 0.2]))
+    # no start error: a surface of the right form predicts perfectly
+    assert r2_pred_ceiling(0.0, 1.0, [0.5, 0.5, 0.2]) == 1.0

@@ -26,6 +26,10 @@ Per response (``results.csv``'s columns; values in their units):
   the ceiling is an estimate, not a bound. ``r2_ceiling_near`` is the same from
   ``within_sd_near``: the ceiling if every design were solved to within ``near_pct`` of its
   best objective.
+
+Predicted R² (from PRESS) has a lower ceiling than R², because each left-out run is
+predicted from the others with the start error of all of them: :func:`r2_pred_ceiling`
+gives it for a fitted surface from its runs' leverages.
 """
 
 from __future__ import annotations
@@ -39,7 +43,7 @@ import pandas as pd
 from bladelab._io import read_json
 from bladelab.design.settling import RECORD_NAME
 
-__all__ = ["NEAR_PCT", "design_strides", "start_spread"]
+__all__ = ["NEAR_PCT", "design_strides", "r2_pred_ceiling", "start_spread"]
 
 #: Objective window of ``within_sd_near`` [%] (the report's).
 NEAR_PCT = 5.0
@@ -126,3 +130,26 @@ def start_spread(design_dir: str | Path, *, responses: Sequence[str] | None = No
                      "across_sd": across, "r2_ceiling": ceiling,
                      "r2_ceiling_near": ceiling_near})
     return pd.DataFrame(rows, columns=cols)
+
+
+def r2_pred_ceiling(within_sd: float, across_sd: float, leverage: Sequence[float]) -> float:
+    """The predicted R² (PRESS) a surface of the right form would reach on average if each
+    run's response carried a start error of standard deviation ``within_sd``, when the runs
+    vary by ``across_sd`` (sample SD, both in the response's unit) and have the surface's
+    ``leverage`` (hat-matrix diagonal, one per fitted run).
+
+    A left-out run's PRESS residual e_i / (1 − h_i) has variance σ² / (1 − h_i) when the
+    model is right, so E[PRESS] = σ² Σ 1 / (1 − h_i) and the ceiling is
+    1 − (within_sd / across_sd)² Σ 1 / (1 − h_i) / (n − 1). A quadratic in four factors on
+    a 25-run face-centred design has mean leverage 0.6, so its ceiling sits 2.7 times as far
+    below 1 as :func:`start_spread`'s R² ceiling. Like that one it is an estimate (the start
+    error is not independent between neighbouring designs). At least 0, as that one: 0 says
+    the start's error alone leaves the surface predicting no better than the runs' mean. NaN
+    when a run has leverage 1 (no leave-one-out prediction) or the spreads are not finite."""
+    h = np.asarray(leverage, dtype=float)
+    n = len(h)
+    if (n < 2 or not (np.isfinite(within_sd) and np.isfinite(across_sd)) or across_sd <= 0
+            or (h >= 1.0 - 1e-10).any()):
+        return float("nan")
+    share = (within_sd / across_sd) ** 2 * float(np.sum(1.0 / (1.0 - h))) / (n - 1)
+    return max(0.0, 1.0 - share)

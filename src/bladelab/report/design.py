@@ -28,6 +28,7 @@ from bladelab.design.responses import (
     RUNNER_RESPONSE_UNITS,
 )
 from bladelab.design.space import DesignSpace
+from bladelab.design.start_spread import r2_pred_ceiling
 from bladelab.design.stride_checks import stride_checks
 from bladelab.design.terms import parse_terms
 from bladelab.errors import InputFileError, OptimizationError
@@ -125,6 +126,17 @@ def _constant_responses(table: pd.DataFrame, surfaces: dict) -> dict[str, float]
     return out
 
 
+def _r2_pred_ceilings(responses: pd.Series, spread: pd.DataFrame,
+                      surfaces: dict) -> list[float]:
+    """Per fitted response, the predicted R² its surface would reach on average with the
+    start spread's error in every run (:func:`~bladelab.design.start_spread.r2_pred_ceiling`
+    from its own surface's leverages); NaN where the spread has no value."""
+    by_name = spread.set_index("response")
+    return [r2_pred_ceiling(float(by_name.loc[r, "within_sd"]),
+                            float(by_name.loc[r, "across_sd"]), surfaces[r].leverage)
+            if r in by_name.index else float("nan") for r in responses]
+
+
 def design_report_sections(design_dir: str | Path) -> list[dict[str, Any]]:
     """Keyword arguments of :meth:`bladelab.report.Report.add_section`, one dict per section."""
     import matplotlib
@@ -151,9 +163,19 @@ def design_report_sections(design_dir: str | Path) -> list[dict[str, Any]]:
     if spread is not None:
         fit = fit.merge(spread[["response", "r2_ceiling"]].rename(
             columns={"r2_ceiling": "R2 ceiling (start spread)"}), on="response", how="left")
+        fit["R2_pred ceiling (start spread)"] = _r2_pred_ceilings(fit["response"], spread,
+                                                                  surfaces)
     r2_columns = [c for c in fit.columns if c.startswith("R2")]
     fit[r2_columns] = fit[r2_columns].astype(float).round(3)  # R² to three decimals
     fit_text = "Predicted R² comes from PRESS (leave-one-out)."
+    if spread is not None:
+        fit_text += (" The ceilings say how far the solver's start lets a surface go: 'R2 "
+                     "ceiling' is the share of the runs' variance a perfect surface could "
+                     "explain if each run carried the start's error; 'R2_pred ceiling' is the "
+                     "predicted R² that a surface of the right form would reach on average "
+                     "with that error, lower because each left-out run is predicted from "
+                     "the others' errors, more so the more terms the surface has "
+                     "(1 − (within_sd/across_sd)² Σ 1/(1 − leverage) / (runs − 1)).")
     constant = _constant_responses(table, surfaces)
     if constant:
         fit = fit[~fit["response"].isin(constant)]
@@ -302,7 +324,7 @@ def _optimum_text(optimum, objective: str, surface, table: pd.DataFrame,
     if not (r2 >= _PREDICTIVE_R2):
         shown = "unknown" if not np.isfinite(r2) else f"{r2:.2f}"
         text += (f" Caution: the surface predicts {objective} poorly (R²pred {shown}, "
-                 f"below {_PREDICTIVE_R2:g}; the surface fits table gives its ceiling from "
+                 f"below {_PREDICTIVE_R2:g}; the surface fits table gives its ceilings from "
                  "the start spread): this optimum is where the fitted quadratic is "
                  f"{'highest' if optimum.sense == 'max' else 'lowest'}, not a design the runs "
                  "have shown to be best.")
