@@ -175,7 +175,11 @@ def design_report_sections(design_dir: str | Path) -> list[dict[str, Any]]:
                      "predicted R² that a surface of the right form would reach on average "
                      "with that error, lower because each left-out run is predicted from "
                      "the others' errors, more so the more terms the surface has "
-                     "(1 − (within_sd/across_sd)² Σ 1/(1 − leverage) / (runs − 1)).")
+                     "(1 − (within_sd/across_sd)² Σ 1/(1 − leverage) / (runs − 1)). Both are "
+                     "estimates: the kept stride is the best found, not a random one, and "
+                     "settling carries strides between neighbouring designs, so their start "
+                     "errors are alike and a smooth surface can fit part of them (an R2_pred "
+                     "above its ceiling is that).")
     constant = _constant_responses(table, surfaces)
     if constant:
         fit = fit[~fit["response"].isin(constant)]
