@@ -11,7 +11,9 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from bladelab.design.start_spread import design_strides, start_spread
+from bladelab.design.doe import central_composite
+from bladelab.design.start_spread import design_strides, r2_pred_ceiling, start_spread
+from bladelab.design.surfaces import fit_surface
 
 
 def _row(run, before, y_before, tries):
@@ -76,10 +78,6 @@ def test_predicted_r2_ceiling_matches_a_simulated_start_error():
     """On a 25-run face-centred design, a quadratic response plus independent noise: the
     mean PRESS R² of the fitted quadratic equals the ceiling from the leverages, and sits
     well below the R² ceiling (which ignores them)."""
-    from bladelab.design.doe import central_composite
-    from bladelab.design.start_spread import r2_pred_ceiling
-    from bladelab.design.surfaces import fit_surface
-
     coded = central_composite(4).coded
     names = ["a", "b", "c", "d"]
     signal = 1.0 * coded[:, 0] - 0.5 * coded[:, 1] + 0.4 * coded[:, 0] ** 2
@@ -99,8 +97,6 @@ def test_predicted_r2_ceiling_matches_a_simulated_start_error():
 
 
 def test_predicted_r2_ceiling_is_undefined_with_leverage_one():
-    from bladelab.design.start_spread import r2_pred_ceiling
-
     assert math.isnan(r2_pred_ceiling(0.1, 1.0, [0.5, 1.0, 0.2]))
     assert math.isnan(r2_pred_ceiling(0.1, 0.0, [0.5, 0.5, 0.2]))
     # no start error: a surface of the right form predicts perfectly
