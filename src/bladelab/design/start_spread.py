@@ -42,6 +42,7 @@ import pandas as pd
 
 from bladelab._io import read_json
 from bladelab.design.settling import RECORD_NAME
+from bladelab.design.surfaces import EXACT_FIT_LEVERAGE
 
 __all__ = ["NEAR_PCT", "design_strides", "r2_pred_ceiling", "start_spread"]
 
@@ -149,7 +150,7 @@ def r2_pred_ceiling(within_sd: float, across_sd: float, leverage: Sequence[float
     h = np.asarray(leverage, dtype=float)
     n = len(h)
     if (n < 2 or not (np.isfinite(within_sd) and np.isfinite(across_sd)) or across_sd <= 0
-            or (h >= 1.0 - 1e-10).any()):
+            or (h >= EXACT_FIT_LEVERAGE).any()):
         return float("nan")
     share = (within_sd / across_sd) ** 2 * float(np.sum(1.0 / (1.0 - h))) / (n - 1)
     return max(0.0, 1.0 - share)

@@ -25,7 +25,11 @@ from bladelab.design.doe import require_estimable
 from bladelab.design.terms import Term, model_matrix, parse_terms, term_name
 from bladelab.errors import DataError, SpecError
 
-__all__ = ["ResponseSurface", "SurfacePrediction", "fit_surface"]
+__all__ = ["EXACT_FIT_LEVERAGE", "ResponseSurface", "SurfacePrediction", "fit_surface"]
+
+#: A run with leverage h_ii at least this is fitted exactly whatever its value (h_ii = 1 to
+#: round-off): it has no leave-one-out prediction, so PRESS and R²pred are undefined.
+EXACT_FIT_LEVERAGE = 1.0 - 1e-10
 
 
 @dataclass(frozen=True, eq=False)
@@ -204,7 +208,7 @@ class ResponseSurface:
     def loo_residuals(self) -> np.ndarray:
         """Leave-one-out (deleted) residuals e_i / (1 − h_ii); NaN where h_ii = 1."""
         e = self.y - self.fitted
-        ok = self.leverage < 1.0 - 1e-10
+        ok = self.leverage < EXACT_FIT_LEVERAGE
         out = np.full_like(e, np.nan)
         out[ok] = e[ok] / (1.0 - self.leverage[ok])
         return out
@@ -373,7 +377,7 @@ def fit_surface(
         r2_adj = 1.0 - (sse / df_resid) / (sst / (n - 1))
     else:
         r2 = r2_adj = float("nan")
-    if np.all(lev < 1.0 - 1e-10):
+    if np.all(lev < EXACT_FIT_LEVERAGE):
         press = float(np.sum((resid / (1.0 - lev)) ** 2))
         r2_pred = 1.0 - press / sst if sst > _noise_floor(y) else float("nan")
         loo_rmse = float(np.sqrt(press / n))

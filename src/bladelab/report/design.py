@@ -30,6 +30,7 @@ from bladelab.design.responses import (
 from bladelab.design.space import DesignSpace
 from bladelab.design.start_spread import r2_pred_ceiling
 from bladelab.design.stride_checks import stride_checks
+from bladelab.design.surfaces import EXACT_FIT_LEVERAGE
 from bladelab.design.terms import parse_terms
 from bladelab.errors import InputFileError, OptimizationError
 from bladelab.predict.collocation.stored import athlete_text
@@ -208,8 +209,8 @@ def design_report_sections(design_dir: str | Path) -> list[dict[str, Any]]:
     if settling:
         fit_text = settling + " " + fit_text
     lev = next(iter(surfaces.values())).leverage
-    if (lev >= 1.0 - 1e-10).any():
-        n_one = int((lev >= 1.0 - 1e-10).sum())
+    n_one = int((lev >= EXACT_FIT_LEVERAGE).sum())
+    if n_one:
         fit_text += (f" Predicted R² and the leave-one-out error are blank: {n_one} of the "
                      f"{len(lev)} runs fitted {'has' if n_one == 1 else 'have'} leverage 1 "
                      "(the surface passes exactly through such a run whatever its value, as "
