@@ -24,13 +24,13 @@ import numpy as np
 import pandas as pd
 from scipy import stats
 
-from bladelab.design.responses import PREDICTED_RESPONSE_UNITS
+from bladelab.design.responses import MAX_SPEED_RESPONSE_UNITS, PREDICTED_RESPONSE_UNITS
 from bladelab.design.start_spread import start_spread
 from bladelab.design.surfaces import fit_surface
 
 FACTORS = ("stiffness_kN_per_m", "width_m", "height_m", "toe_length_m")
-RESPONSES = ("stride_objective", "cost_of_transport_J_per_kg_m", "delta_vx_m_per_s",
-             "evaluation_E_m", "impulse_z_Ns", "knee_moment_min_Nm", "swing_clearance_m",
+RESPONSES = ("stride_objective", "max_speed_m_per_s", "cost_of_transport_J_per_kg_m",
+             "delta_vx_m_per_s", "evaluation_E_m", "impulse_z_Ns", "knee_moment_min_Nm", "swing_clearance_m",
              "contact_time_prosthetic_s", "socket_force_max_N", "socket_moment_max_Nm",
              "blade_moment_max_Nm")
 
@@ -65,7 +65,8 @@ def study_fits(study: Path) -> dict:
     the first-order effects with p-values."""
     table = pd.read_csv(study / "results.csv")
     coded = table[[f"{f}_coded" for f in FACTORS]].to_numpy(float)
-    spread = start_spread(study, units=PREDICTED_RESPONSE_UNITS)
+    units = {**PREDICTED_RESPONSE_UNITS, **MAX_SPEED_RESPONSE_UNITS}
+    spread = start_spread(study, units=units)
     ceiling = dict(zip(spread["response"], spread["r2_ceiling"], strict=True))
     near = dict(zip(spread["response"], spread["r2_ceiling_near"], strict=True))
     out = {}
@@ -76,7 +77,7 @@ def study_fits(study: Path) -> dict:
         quad = fit_surface(coded, y, factor_names=FACTORS, model="quadratic", response=name)
         lin = fit_surface(coded, y, factor_names=FACTORS, model="linear", response=name)
         effects, p = _first_order(coded, y)
-        out[name] = {"unit": PREDICTED_RESPONSE_UNITS.get(name, ""),
+        out[name] = {"unit": units.get(name, ""),
                      "quadratic_r2": quad.r2, "quadratic_r2_pred": quad.r2_pred,
                      "linear_r2": lin.r2, "linear_r2_pred": lin.r2_pred,
                      "start_ceiling": ceiling.get(name),
