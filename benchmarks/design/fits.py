@@ -30,9 +30,9 @@ from bladelab.design.surfaces import fit_surface
 
 FACTORS = ("stiffness_kN_per_m", "width_m", "height_m", "toe_length_m")
 RESPONSES = ("stride_objective", "max_speed_m_per_s", "cost_of_transport_J_per_kg_m",
-             "delta_vx_m_per_s", "evaluation_E_m", "impulse_z_Ns", "knee_moment_min_Nm", "swing_clearance_m",
-             "contact_time_prosthetic_s", "socket_force_max_N", "socket_moment_max_Nm",
-             "blade_moment_max_Nm")
+             "delta_vx_m_per_s", "evaluation_E_m", "impulse_z_Ns", "knee_moment_min_Nm",
+             "swing_clearance_m", "contact_time_prosthetic_s", "socket_force_max_N",
+             "socket_moment_max_Nm", "blade_moment_max_Nm")
 
 
 def _first_order(coded: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -32,6 +32,8 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from bladelab.design.stride_files import point_from_stem
+
 
 def restart_one(study: Path, stem: str, work: Path) -> dict:
     """Solve design ``stem``'s stride of ``study`` again from itself (stall stop off); cached."""
@@ -50,19 +52,20 @@ def restart_one(study: Path, stem: str, work: Path) -> dict:
     setup.update(solutions_dir=None, start_strides=None,
                  factor_ranges={k: tuple(v) for k, v in setup["factor_ranges"].items()})
     evaluator = CollocationEvaluator(**setup)
-    point = {kv.split("=")[0]: float(kv.split("=")[1]) for kv in stem.split("__")}
-    spec, settings = evaluator._problem(point)
+    point = point_from_stem(stem)
+    spec, settings = evaluator.problem(point)
     runner = runner_from_spec(spec)
     kept = CollocationSolution.read(study / "strides" / f"{stem}.json")
     t0 = time.perf_counter()
     sol = predict_stride(runner, dataclasses.replace(settings, max_iter=3000),
                          kept.to_guess("the study's kept stride"), model_spec=spec, track=False,
-                         speed_floor=evaluator._speed_floor(point, kept))
-    clean = bool(sol.converged) and not sol.gait_warnings()
+                         speed_floor=evaluator.speed_floor(point, kept))
+    warnings = sol.gait_warnings() if sol.converged else None
+    clean = bool(sol.converged) and not warnings
     out = {"design": stem, "point": point, "kept_objective": float(kept.nlp.objective),
            "status": str(sol.nlp.status), "iterations": int(sol.nlp.iterations),
            "objective": float(sol.nlp.objective) if clean else None,
-           "warnings": sol.gait_warnings() if sol.converged else None,
+           "warnings": warnings,
            "wall_s": time.perf_counter() - t0,
            "responses_kept": evaluator.responses(kept, runner),
            "responses": evaluator.responses(sol, runner) if clean else None}
@@ -101,8 +104,9 @@ def main() -> None:
     ap.add_argument("--jobs", type=int, default=2)
     args = ap.parse_args()
     args.work.mkdir(parents=True, exist_ok=True)
-    stems = sorted(p.name[:-len(".json")] for p in (args.study / "strides").glob("*.json")
-                   if not p.name.endswith((".previous.json", ".best_iterate.json")))
+    # a design's stride only: a replaced stride or a failed solve's iterate names no point
+    stems = sorted(p.stem for p in (args.study / "strides").glob("*.json")
+                   if point_from_stem(p.stem) is not None)
     todo = [(args.study, s, args.work) for s in stems]
     with ProcessPoolExecutor(args.jobs) as pool:
         results = list(pool.map(_restart, todo))

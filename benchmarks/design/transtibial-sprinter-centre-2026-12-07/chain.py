@@ -28,7 +28,7 @@ guess_file = start
 for v in speeds:
     ev = CollocationEvaluator(amputation="transtibial", athlete=athlete, mesh_intervals=mesh,
                               speed_mps=v, stride_time_people=True)
-    spec, settings = ev._problem(centre)
+    spec, settings = ev.problem(centre)
     guess = CollocationSolution.read(guess_file).to_guess(f"chain from {guess_file}")
     t0 = time.perf_counter()
     sol = predict_stride(runner_from_spec(spec), settings, guess, model_spec=spec, track=False)

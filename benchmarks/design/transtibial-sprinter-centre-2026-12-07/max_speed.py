@@ -20,7 +20,7 @@ ev = CollocationEvaluator(amputation="transtibial", max_speed=True, mesh_interva
                           stride_time_people=True,
                           athlete={"muscle_strength": 1.5, "max_shortening_velocity": 15.0,
                                    "prosthesis_extra_length_m": 0.045})
-spec, settings = ev._problem({"stiffness_kN_per_m": 25.0, "width_m": 0.065, "height_m": 0.44,
+spec, settings = ev.problem({"stiffness_kN_per_m": 25.0, "width_m": 0.065, "height_m": 0.44,
                               "toe_length_m": 0.22})
 t0 = time.perf_counter()
 sol = predict_stride(runner_from_spec(spec), settings, CollocationSolution.read(start).to_guess(str(start)),

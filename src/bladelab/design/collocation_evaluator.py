@@ -341,7 +341,7 @@ class CollocationEvaluator:
         own = self._own_start(point)
         return [own, *starts] if own is not None else starts
 
-    def _speed_floor(self, point: Mapping[str, float], current=None) -> float | None:
+    def speed_floor(self, point: Mapping[str, float], current=None) -> float | None:
         """The maximum-speed problem's floor [m/s] for a design: the mean speed of its own
         stride in ``start_strides``, else of its stored stride ``current`` (strides of this
         blade); None (the start's own speed) without either, or with a prescribed speed. A
@@ -405,7 +405,7 @@ class CollocationEvaluator:
         (:mod:`bladelab.design.start_spread`). ``say(line)`` gets one line per start (its
         outcome and wall time)."""
         point = {k: float(v) for k, v in point.items()}
-        spec, settings = self._problem(point)
+        spec, settings = self.problem(point)
         current, _ = self._stored(point, spec, settings)
         if current is None or self.solutions_dir is None:
             raise SpecError("this design has no stored clean stride to settle",
@@ -419,7 +419,7 @@ class CollocationEvaluator:
         if cheapest and (far := self._cheapest_other(point, settings, starts)) is not None:
             starts.append(far)
         name = point_file_stem(point)
-        floor = self._speed_floor(point, current)
+        floor = self.speed_floor(point, current)
         for k, path in enumerate(starts, 1):
             start = CollocationSolution.read(path)
             identity = start_identity(start, floor)
@@ -477,8 +477,9 @@ class CollocationEvaluator:
                                    stride_time_people=self.stride_time_people,
                                    max_iter=self.max_iter, **reference)
 
-    def _problem(self, point: Mapping[str, float]) -> tuple[dict, Any]:
-        """(model specification with the design's blade, collocation settings) of a design."""
+    def problem(self, point: Mapping[str, float]) -> tuple[dict, Any]:
+        """(model specification with the design's blade, collocation settings) of a design: the
+        problem every start of this design is solved for."""
         blade = self.blade_spec(point)
         spec = {"model": self.model, "blade": blade["name"], "blade_spec": blade,
                 "body": self.body}
@@ -550,7 +551,7 @@ class CollocationEvaluator:
         point = {k: float(v) for k, v in point.items()}
         if self.max_speed or self.solutions_dir is None or self._own_start(point) is not None:
             return
-        spec, settings = self._problem(point)
+        spec, settings = self.problem(point)
         if self._stored(point, spec, settings)[0] is not None:
             return
         sol = continue_stride(runner_from_spec(spec), spec, settings, self.start_file,
@@ -561,7 +562,7 @@ class CollocationEvaluator:
 
     def __call__(self, point: Mapping[str, float]) -> dict[str, float]:
         point = {k: float(v) for k, v in point.items()}
-        spec, settings = self._problem(point)
+        spec, settings = self.problem(point)
         runner = runner_from_spec(spec)
         stored, source = self._stored(point, spec, settings)
         if stored is not None:  # solved before (an interrupted or refitted study), or the start
@@ -574,7 +575,7 @@ class CollocationEvaluator:
             (self.start_file, True)]
         tried, best = [], None
         t0 = time.perf_counter()
-        floor = self._speed_floor(point)
+        floor = self.speed_floor(point)
         for path, track in plan:
             source = CollocationSolution.read(path)
             guess = source.to_guess(f"tracking collocation solution {path.name}" if track
