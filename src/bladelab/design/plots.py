@@ -15,11 +15,13 @@ from matplotlib.figure import Figure
 
 from bladelab._io import atomic_path, figure_format
 from bladelab.design.optimum import OptimumResult, SurfaceConstraint, surface_constraints
+from bladelab.design.settling_effects import RESOLVED_P
 from bladelab.design.space import DesignSpace
 from bladelab.design.surfaces import ResponseSurface
 from bladelab.errors import SpecError
 
-__all__ = ["contour_plot", "figure_pairs", "main_effects_plot", "save_figure", "write_design_figures"]
+__all__ = ["contour_plot", "effects_by_stage_plot", "figure_pairs", "main_effects_plot", "save_figure",
+           "write_design_figures"]
 
 
 def _levels(space: DesignSpace, at: Mapping[str, float] | None) -> np.ndarray:
@@ -79,6 +81,42 @@ def main_effects_plot(
             ax.grid(True, alpha=0.3)
     fig.suptitle(f"Main effects (other factors at coded {np.round(base, 2).tolist()}; "
                  f"band: {level:.0%} CI)", fontsize="medium")
+    return fig
+
+
+def effects_by_stage_plot(effects: Mapping[str, Any], space: DesignSpace) -> Figure:
+    """Each factor's first-order effect (columns) on each response (rows) after the runs and
+    after each settling pass, with its confidence interval; a filled marker is resolved
+    (p < :data:`~bladelab.design.settling_effects.RESOLVED_P`), a hollow one not. ``effects``: response -> the table of
+    :func:`~bladelab.design.settling_effects.effects_by_stage`."""
+    if not effects:
+        raise SpecError("no effects to plot", where="plot")
+    k = space.n_factors
+    fig = Figure(figsize=(2.8 * k, 2.6 * len(effects)), layout="constrained")
+    axes = fig.subplots(len(effects), k, squeeze=False, sharey="row")
+    for r, (response, table) in enumerate(effects.items()):
+        for j, name in enumerate(space.names):
+            rows = table[table["factor"] == name]
+            x = np.arange(len(rows))
+            eff = rows["effect"].to_numpy(float)
+            err = np.vstack([eff - rows["ci_lower"].to_numpy(float),
+                             rows["ci_upper"].to_numpy(float) - eff])
+            ax = axes[r, j]
+            ax.axhline(0.0, color="0.5", lw=0.8)
+            ax.errorbar(x, eff, yerr=err, fmt="none", ecolor="C0", capsize=3)
+            resolved = rows["p_value"].to_numpy(float) < RESOLVED_P
+            ax.plot(x[resolved], eff[resolved], "o", color="C0")
+            ax.plot(x[~resolved], eff[~resolved], "o", mfc="white", color="C0")
+            ax.set_xticks(x, [s.replace(" designs)", ")") for s in rows["stage"]],
+                          rotation=30, ha="right", fontsize="small")
+            if r == 0:
+                ax.set_title(name, fontsize="medium")
+            if j == 0:
+                unit = rows["unit"].iloc[0] if len(rows) else ""
+                ax.set_ylabel(f"{response}\n[{unit}]", fontsize="small")
+            ax.grid(True, alpha=0.3)
+    fig.suptitle("First-order effects after the runs and each settling pass (bars: 95 % CI; "
+                 f"filled: p < {RESOLVED_P:g})", fontsize="medium")
     return fig
 
 

@@ -39,6 +39,7 @@ from bladelab.report.design_strides import (
     COLLOCATION_UNITS,
     collocation_start_spread,
     gallop_text,
+    settling_effects_section,
     settling_text,
     spread_section,
     strides_section,
@@ -244,6 +245,12 @@ def design_report_sections(design_dir: str | Path) -> list[dict[str, Any]]:
                       and r in PREDICTED_RESPONSE_UNITS and table[r].std() > 0]
         sections.append(spread_section(spread, unmeasured))
     shown = [objective, *[c for c in constraints if c != objective]]
+    if checks is not None:
+        fitted = table[~checks["excluded"].to_numpy(bool)]
+        passes = settling_effects_section(design_dir, fitted, space,
+                                          {r: surfaces[r].unit for r in shown})
+        if passes is not None:
+            sections.append(passes)
     sections.append({
         "title": "Design study: main effects",
         "figures": [("Main effects (others at the centre; band: 95 % CI of the mean)",

@@ -4,7 +4,8 @@
 :func:`settling_text` (whether the strides have settled, and the study's wall time),
 :func:`collocation_start_spread` and :func:`spread_section` (what the solver's start decides:
 the responses' spread between strides of one design against their spread across designs),
-:func:`gallop_text` and :func:`people_text` (the strides against people's running).
+:func:`settling_effects_section` (each factor's effect after the runs and after each settling
+pass), :func:`gallop_text` and :func:`people_text` (the strides against people's running).
 :mod:`bladelab.report.design` assembles them into the report.
 """
 
@@ -16,6 +17,7 @@ from typing import Any
 
 import pandas as pd
 
+from bladelab.design.plots import effects_by_stage_plot
 from bladelab.design.responses import MAX_SPEED_RESPONSE_UNITS, PREDICTED_RESPONSE_UNITS
 from bladelab.design.settling import (
     RECORD_NAME,
@@ -23,14 +25,20 @@ from bladelab.design.settling import (
     objective_drop,
     read_settling_record,
 )
+from bladelab.design.settling_effects import (
+    RESOLVED_P,
+    effects_by_stage,
+    effects_summary,
+    settling_stages,
+)
 from bladelab.design.start_spread import NEAR_PCT, start_spread
 from bladelab.design.timing import stage_walls
 from bladelab.predict.collocation.human_running import gallop_sentence
 from bladelab.predict.collocation.solution import RESIDUAL_WARNING_PCT
 
 __all__ = ["COLLOCATION_UNITS", "ROUGH_SPREAD_DESIGNS", "collocation_start_spread",
-           "gallop_text", "people_text", "problem_posed", "settling_text", "spread_section",
-           "strides_section", "timing_text"]
+           "gallop_text", "people_text", "problem_posed", "settling_effects_section",
+           "settling_text", "spread_section", "strides_section", "timing_text"]
 
 #: The units of the collocation evaluator's responses (either problem).
 COLLOCATION_UNITS = {**PREDICTED_RESPONSE_UNITS, **MAX_SPEED_RESPONSE_UNITS}
@@ -250,3 +258,43 @@ def spread_section(spread: pd.DataFrame, unmeasured: Sequence[str] = ()) -> dict
                  "is stored (a new settling pass records them).")
     return {"title": "Design study: what the solver's start decides",
             "text": text, "tables": [("Start spread of the responses", spread)]}
+
+
+def settling_effects_section(design_dir: Path, fitted: pd.DataFrame, space,
+                             units: dict[str, str]) -> dict[str, Any] | None:
+    """How each factor's first-order effect on each response of ``units`` ({response:
+    unit}: the objective and the constraints) moved from the runs through the settling passes
+    (:mod:`bladelab.design.settling_effects`), on the ``fitted`` runs (``results.csv``'s
+    rows the surfaces are fitted to); None without a settling pass."""
+    passes = read_settling_record(design_dir)
+    if not any(p.get("designs") for p in passes):
+        return None
+    responses = [r for r in units if r in fitted]
+    stages = settling_stages(fitted, passes, responses)
+    coded = fitted.set_index("run")[[f"{n}_coded" for n in space.names]]
+    coded.columns = list(space.names)
+    effects = {r: effects_by_stage(stages, coded, r, units[r]) for r in responses}
+    effects = {r: e for r, e in effects.items() if len(e)}
+    if not effects:
+        return None
+    first = next(iter(effects))
+    summary = effects_summary(effects[first])
+    text = (f"Each factor's effect on {first} as the study stood after its runs and after each "
+            "settling pass (a pass stopped midway is a stage of its own), from a first-order "
+            "surface (an intercept and one slope per factor, the change from a factor's centre "
+            "to its high level) fitted to the same runs at every stage: the record of each "
+            "pass (settling.json) keeps every changed design's responses before it. Where the "
+            "passes do not settle, the answer to read is an effect that keeps its sign and "
+            "size from stage to stage; an effect resolved at p < "
+            f"{RESOLVED_P:g} at one stage and not at the next, or one whose sign turns, is "
+            "the solver's start, not the blade.\n\n"
+            + " ".join(f"{name}: {line}." for name, line in summary.items()))
+    if len(stages) < len(passes) + 1:
+        text += (" The stages before "
+                 f"{stages[0].label} cannot be rebuilt: a design changed then was recorded "
+                 "without its earlier responses.")
+    table = pd.concat([e.assign(response=r) for r, e in effects.items()], ignore_index=True)
+    table = table[["response", *[c for c in table.columns if c != "response"]]]
+    return {"title": "Design study: the effects through the settling passes", "text": text,
+            "figures": [("First-order effects by stage", effects_by_stage_plot(effects, space))],
+            "tables": [("First-order effects by stage", table)]}
