@@ -10,7 +10,9 @@ Usage (repository root)::
 ``raw=1``: the transtibial stride's knee angles as they are (not made straight in stance).
 The last two arguments were added on 2026-11-30 (``../transfemoral-gait-2026-11-30/``).
 ``set:SETTING=VALUE``: a ``CollocationSettings`` field (a number, or ``none``), e.g.
-``set:swing_clearance_m=0`` or ``set:knee_flexion_max_loaded_deg=10``.
+``set:swing_clearance_m=0`` or ``set:knee_flexion_max_loaded_deg=10``; since 2026-12-08 the
+value is read as JSON, so ``set:stride_time_people=true`` and
+``set:pelvis_tilt_range_deg=[-15,5]`` work too.
 ``body:FIELD=JSON`` (added on 2026-11-30, later): a field of the transfemoral parameter set, e.g.
 ``body:residual_muscle_strength={"hamstrings":0.5}``. ``speed=V`` (added on 2026-11-30, later
 still): the prescribed speed [m/s] (default 4).
@@ -73,12 +75,18 @@ def _with_knee(overrides: dict[str, float], body: dict | None = None):
     return patched
 
 
+def _setting(text: str):
+    """A ``set:`` value read as JSON: a number, true/false, or a list (a range: a tuple)."""
+    value = json.loads(text)
+    return tuple(value) if isinstance(value, list) else value
+
+
 def main(out: str, step_tol: str, *extra: str) -> None:
     fields = dict(kv.split("=", 1) for kv in extra)
     start = fields.pop("from", None)
     raw = fields.pop("raw", None)
     speed = float(fields.pop("speed", 4.0))
-    sets = {k[4:]: (None if v == "none" else float(v))
+    sets = {k[4:]: (None if v == "none" else _setting(v))
             for k, v in list(fields.items()) if k.startswith("set:")}
     for k in sets:
         fields.pop("set:" + k)
