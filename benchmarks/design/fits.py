@@ -22,7 +22,6 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
-from scipy import stats
 
 from bladelab.design.responses import MAX_SPEED_RESPONSE_UNITS, PREDICTED_RESPONSE_UNITS
 from bladelab.design.start_spread import start_spread
@@ -33,17 +32,6 @@ RESPONSES = ("stride_objective", "max_speed_m_per_s", "cost_of_transport_J_per_k
              "delta_vx_m_per_s", "evaluation_E_m", "impulse_z_Ns", "knee_moment_min_Nm",
              "swing_clearance_m", "contact_time_prosthetic_s", "socket_force_max_N",
              "socket_moment_max_Nm", "blade_moment_max_Nm")
-
-
-def _first_order(coded: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(coefficients of the four factors per coded unit, their two-sided p-values)."""
-    x = np.column_stack([np.ones(len(y)), coded])
-    beta, *_ = np.linalg.lstsq(x, y, rcond=None)
-    dof = len(y) - x.shape[1]
-    resid = y - x @ beta
-    cov = (resid @ resid / dof) * np.linalg.inv(x.T @ x)
-    t = beta / np.sqrt(np.diag(cov))
-    return beta[1:], 2 * stats.t.sf(np.abs(t[1:]), dof)
 
 
 def last_pass_ceiling(study: Path, y: np.ndarray) -> float | None:
@@ -76,7 +64,7 @@ def study_fits(study: Path) -> dict:
         y = table[name].to_numpy(float)
         quad = fit_surface(coded, y, factor_names=FACTORS, model="quadratic", response=name)
         lin = fit_surface(coded, y, factor_names=FACTORS, model="linear", response=name)
-        effects, p = _first_order(coded, y)
+        coef = lin.coefficients().set_index("term")
         out[name] = {"unit": units.get(name, ""),
                      "quadratic_r2": quad.r2, "quadratic_r2_pred": quad.r2_pred,
                      "linear_r2": lin.r2, "linear_r2_pred": lin.r2_pred,
@@ -85,8 +73,8 @@ def study_fits(study: Path) -> dict:
                      "last_pass_ceiling": (last_pass_ceiling(study, y)
                                            if name == "stride_objective" else None),
                      "range": [float(y.min()), float(y.max())],
-                     "effects": {f: {"per_coded_unit": float(e), "p": float(q)}
-                                 for f, e, q in zip(FACTORS, effects, p, strict=True)}}
+                     "effects": {f: {"per_coded_unit": float(coef.loc[f, "estimate"]),
+                                     "p": float(coef.loc[f, "p_value"])} for f in FACTORS}}
     return out
 
 

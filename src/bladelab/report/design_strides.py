@@ -288,7 +288,7 @@ def settling_effects_section(design_dir: Path, fitted: pd.DataFrame, space,
             "size from stage to stage; an effect resolved at p < "
             f"{RESOLVED_P:g} at one stage and not at the next, or one whose sign turns, is "
             "the solver's start, not the blade.\n\n"
-            + " ".join(f"{name}: {line}." for name, line in summary.items()))
+            + "\n\n".join(f"{name}: {line}." for name, line in summary.items()))
     if len(stages) < len(passes) + 1:
         text += (" The stages before "
                  f"{stages[0].label} cannot be rebuilt: a design changed then was recorded "
