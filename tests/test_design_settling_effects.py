@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import json
 
 import numpy as np
@@ -13,6 +14,7 @@ from bladelab.design.doe import central_composite
 from bladelab.design.settling_effects import (
     effects_by_stage,
     effects_summary,
+    last_stage_moves,
     settling_stages,
 )
 from bladelab.design.space import default_design_space
@@ -114,3 +116,20 @@ def test_the_report_section_needs_a_settling_pass(tmp_path):
     (_, frame), = section["tables"]
     assert set(frame["response"]) == {"y"} and len(frame) == 2 * len(space.names)
     assert f"{space.names[0]}: -0.5" in section["text"]
+
+
+def test_the_last_stage_says_how_far_it_moved_the_answer():
+    """moved_se is the change from the stage before in standard errors; last_stage_moves
+    says whether the set of resolved effects (with their signs) changed."""
+    stages, coded = _ccd_stages(np.random.default_rng(2))
+    effects = effects_by_stage(stages, coded, "y", "m")
+    a = effects[effects["factor"] == "A"]
+    assert np.isnan(a["moved_se"].iloc[0])
+    assert a["moved_se"].iloc[1] == pytest.approx(
+        abs(a["effect"].iloc[1] - a["effect"].iloc[0]) / a["std_error"].iloc[1])
+    largest, same = last_stage_moves(effects)
+    assert largest == pytest.approx(a["moved_se"].iloc[1]) and not same  # A's sign turned
+    again = dataclasses.replace(stages[-1], label="pass 2")  # a pass that changed nothing
+    steady = effects_by_stage([stages[-1], again], coded, "y", "m")
+    assert last_stage_moves(steady) == (0.0, True)
+    assert last_stage_moves(effects_by_stage(stages[:1], coded, "y")) is None

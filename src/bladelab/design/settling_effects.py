@@ -14,7 +14,9 @@ keeps its sign and size from pass to pass. This module reads that from a study's
   :func:`~bladelab.design.surfaces.fit_surface` with ``model="linear"``) to a response at
   every stage: each factor's effect per coded unit with its 95 % confidence interval and
   p-value;
-- :func:`effects_summary` says per factor whether its effect held.
+- :func:`effects_summary` says per factor whether its effect held, and
+  :func:`last_stage_moves` what the last pass did to the answer (how many standard errors it
+  moved an effect, and whether it changed which effects are resolved).
 
 Every stage is read on the same runs (those given, e.g. the report's clean runs), so a
 change from stage to stage is the passes' alone.
@@ -31,7 +33,7 @@ import pandas as pd
 from bladelab.design.surfaces import fit_surface
 
 __all__ = ["RESOLVED_P", "SettlingStage", "effects_by_stage", "effects_summary",
-           "settling_stages"]
+           "last_stage_moves", "settling_stages"]
 
 #: An effect with a p-value below this is resolved (its sign read from the data) [-].
 RESOLVED_P = 0.05
@@ -108,12 +110,15 @@ def effects_by_stage(stages: Sequence[SettlingStage], coded: pd.DataFrame, respo
     factor: ``stage``, ``designs_changed``, ``largest_objective_drop_pct`` [%],
     ``factor``, ``effect`` [the response's unit per coded unit: the change from the
     factor's centre to its high level], ``ci_lower``/``ci_upper`` (``level`` confidence),
-    ``p_value``, ``unit``, ``R2_pred`` (the first-order surface's, the same for a stage's
-    factors). ``coded`` holds each run's coded factor levels (index: run number; one column
-    per factor, named after it). A stage where a run lacks the response is left out.
+    ``p_value``, ``std_error``, ``moved_se`` (how far the stage moved the effect from the
+    stage before, in this stage's standard errors; NaN for the first), ``unit``, ``R2_pred``
+    (the first-order surface's, the same for a stage's factors). ``coded`` holds each run's
+    coded factor levels (index: run number; one column per factor, named after it). A stage
+    where a run lacks the response is left out.
     """
     rows = []
     names = list(coded.columns)
+    previous: dict[str, float] = {}
     for stage in stages:
         y = stage.values[response].reindex(coded.index).to_numpy(float)
         if not np.all(np.isfinite(y)):
@@ -122,17 +127,38 @@ def effects_by_stage(stages: Sequence[SettlingStage], coded: pd.DataFrame, respo
                               response=response, unit=unit)
         coef = surface.coefficients(level=level).set_index("term")
         for name in names:
+            effect, se = float(coef.loc[name, "estimate"]), float(coef.loc[name, "std_error"])
             rows.append({"stage": stage.label, "designs_changed": stage.changed,
                          "largest_objective_drop_pct": 100.0 * stage.largest_drop,
-                         "factor": name, "effect": coef.loc[name, "estimate"],
+                         "factor": name, "effect": effect,
                          "ci_lower": coef.loc[name, "ci_lower"],
                          "ci_upper": coef.loc[name, "ci_upper"],
-                         "p_value": coef.loc[name, "p_value"],
+                         "p_value": coef.loc[name, "p_value"], "std_error": se,
+                         "moved_se": (abs(effect - previous[name]) / se
+                                      if name in previous and se > 0 else float("nan")),
                          "unit": f"{unit} per coded unit".strip(),
                          "R2_pred": surface.r2_pred})
+            previous[name] = effect
     return pd.DataFrame(rows, columns=[
         "stage", "designs_changed", "largest_objective_drop_pct", "factor", "effect",
-        "ci_lower", "ci_upper", "p_value", "unit", "R2_pred"])
+        "ci_lower", "ci_upper", "p_value", "std_error", "moved_se", "unit", "R2_pred"])
+
+
+def last_stage_moves(effects: pd.DataFrame) -> tuple[float, bool] | None:
+    """What the last stage of :func:`effects_by_stage` did to the answer: (the largest
+    ``moved_se`` over the factors, whether the factors resolved at p < :data:`RESOLVED_P`
+    and their signs are the stage before's); None with a single stage."""
+    labels = list(dict.fromkeys(effects["stage"]))
+    if len(labels) < 2:
+        return None
+    last = effects[effects["stage"] == labels[-1]]
+    before = effects[effects["stage"] == labels[-2]]
+
+    def resolved(rows: pd.DataFrame) -> set[tuple[str, float]]:
+        hit = rows[rows["p_value"] < RESOLVED_P]
+        return set(zip(hit["factor"], np.sign(hit["effect"]), strict=True))
+
+    return float(last["moved_se"].max()), resolved(last) == resolved(before)
 
 
 def effects_summary(effects: pd.DataFrame) -> dict[str, str]:

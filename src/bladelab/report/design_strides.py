@@ -29,6 +29,7 @@ from bladelab.design.settling_effects import (
     RESOLVED_P,
     effects_by_stage,
     effects_summary,
+    last_stage_moves,
     settling_stages,
 )
 from bladelab.design.start_spread import NEAR_PCT, start_spread
@@ -279,6 +280,12 @@ def settling_effects_section(design_dir: Path, fitted: pd.DataFrame, space,
         return None
     first = next(iter(effects))
     summary = effects_summary(effects[first])
+    moves = last_stage_moves(effects[first])
+    last_text = "" if moves is None else (
+        f" The last stage ({stages[-1].label}) moved no effect on {first} by more than "
+        f"{moves[0]:.2g} of its standard errors, and "
+        + ("left the resolved effects and their signs as they were." if moves[1] else
+           "changed which effects are resolved: read the answer after a further pass."))
     text = (f"Each factor's effect on {first} as the study stood after its runs and after each "
             "settling pass (a pass stopped midway is a stage of its own), from a first-order "
             "surface (an intercept and one slope per factor, the change from a factor's centre "
@@ -287,7 +294,7 @@ def settling_effects_section(design_dir: Path, fitted: pd.DataFrame, space,
             "passes do not settle, the answer to read is an effect that keeps its sign and "
             "size from stage to stage; an effect resolved at p < "
             f"{RESOLVED_P:g} at one stage and not at the next, or one whose sign turns, is "
-            "the solver's start, not the blade.\n\n"
+            "the solver's start, not the blade." + last_text + "\n\n"
             + "\n\n".join(f"{name}: {line}." for name, line in summary.items()))
     if len(stages) < len(passes) + 1:
         text += (" The stages before "
