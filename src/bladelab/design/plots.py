@@ -87,7 +87,8 @@ def main_effects_plot(
 def effects_by_stage_plot(effects: Mapping[str, Any], space: DesignSpace) -> Figure:
     """Each factor's first-order effect (columns) on each response (rows) after the runs and
     after each settling pass, with its confidence interval; a filled marker is resolved
-    (p < :data:`~bladelab.design.settling_effects.RESOLVED_P`), a hollow one not. ``effects``: response -> the table of
+    (p < :data:`~bladelab.design.settling_effects.RESOLVED_P`), a hollow one not.
+    ``effects``: response -> the table of
     :func:`~bladelab.design.settling_effects.effects_by_stage`."""
     if not effects:
         raise SpecError("no effects to plot", where="plot")

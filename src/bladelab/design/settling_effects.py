@@ -30,6 +30,7 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
+from bladelab.design.settling import objective_drop
 from bladelab.design.surfaces import fit_surface
 
 __all__ = ["RESOLVED_P", "SettlingStage", "effects_by_stage", "effects_summary",
@@ -88,7 +89,7 @@ def settling_stages(table: pd.DataFrame, passes: Sequence[Mapping],
     stages: list[SettlingStage] = []
     for rec in reversed(passes):
         rows = [r for r in rec.get("designs", []) if r.get("after") is not None]
-        drops = [(r["before"] - r["after"]) / abs(r["before"]) for r in rows if r.get("before")]
+        drops = [objective_drop(r) for r in rows if r.get("before")]
         changed = [r for r in rows if r.get("from") is not None and r["run"] in values.index]
         label = f"pass {rec['pass']}"
         if not rec.get("complete"):
